@@ -22,6 +22,8 @@ expressions (:mod:`screwkit.linalg`). Only numpy is imported here.
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from itertools import combinations
 from math import comb
@@ -58,6 +60,14 @@ class MotionSpace:
 
     dof: int
     constant_basis: NDArray[np.float64] | None
+
+    @property
+    def complement(self) -> NDArray[np.float64]:
+        """Orthonormal rows spanning the Euclidean complement of :attr:`constant_basis`."""
+        if self.constant_basis is None:
+            raise ValueError("The motion space is not constant; it has no fixed complement.")
+        _, _, right = np.linalg.svd(self.constant_basis)
+        return np.ascontiguousarray(right[self.dof:])
 
 
 def _chain_projector_complements(twists: NDArray[np.float64], tolerance: float) -> NDArray[np.float64]:
@@ -116,7 +126,7 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     generic = np.flatnonzero(dims == found)
     if generic.size == 0:
         return MotionSpace(found, None)
-    candidate = bases[generic[0]]
+    candidate = np.ascontiguousarray(bases[generic[0]])
     for sample in generic[1:]:
         residual = bases[sample] - bases[sample] @ candidate.T @ candidate
         if np.abs(residual).max() > 1e-8:
@@ -242,7 +252,8 @@ def _cross(first: NDArray, second: NDArray) -> NDArray:
 def _shift(twists: NDArray, point: NDArray) -> NDArray:
     """Twists (..., 6, N) expressed about ``point`` (3, N): (omega, v + omega x p)."""
     omega = twists[..., :3, :]
-    return np.concatenate([omega, twists[..., 3:, :] + _cross(omega, point)], axis=-2)
+    velocity = twists[..., 3:, :] + _cross(omega, point)
+    return np.concatenate([np.broadcast_to(omega, velocity.shape), velocity], axis=-2)
 
 
 def _dot(first: NDArray, second: NDArray) -> NDArray:
@@ -274,6 +285,11 @@ class _Plan:
     complement_members: list[NDArray[np.int64]]
     threshold: float
     rank_tolerance: float
+    group_keys: tuple[tuple[int, tuple[int, ...]], ...]
+    group_members: tuple[tuple[int, ...], ...]
+    group_slots: tuple[NDArray[np.int64], ...]
+    complement: NDArray[np.float64] | None
+    appearances: tuple[tuple[NDArray[np.int64], NDArray[np.int64]], ...]
 
 
 def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
@@ -309,23 +325,42 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
     if not rank_tolerance > 0:
         raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
+    # Chains of equal structure are processed together.
+    keys, members = [], []
+    for index, chain in enumerate(chains):
+        key = (chain.n_joints, chain.actuated)
+        if key not in keys:
+            keys.append(key)
+            members.append([])
+        members[keys.index(key)].append(index)
+    slot_of = {actuator: slot for slot, actuator in enumerate(actuators)}
+    slots = tuple(np.array([slot_of[(c, k)] for c in group for k in key[1]], dtype=np.int64)
+                  for key, group in zip(keys, members))
     return _Plan(tuple(c.n_joints for c in chains), tuple(c.actuated for c in chains), actuators, n, space,
                  np.array(submechanisms, dtype=np.int64), fault_list, fault_members, fault_set_arrays,
-                 complement, float(threshold), float(rank_tolerance))
+                 complement, float(threshold), float(rank_tolerance), tuple(keys),
+                 tuple(tuple(g) for g in members), slots,
+                 space.complement if space.constant_basis is not None else None,
+                 tuple((np.array([s for s, sub in enumerate(submechanisms) if k in sub], dtype=np.int64),
+                        np.array([sub.index(k) for sub in submechanisms if k in sub], dtype=np.int64))
+                       for k in range(a)))
 
 
-def _motion_basis(plan: _Plan, twists: list[NDArray]) -> NDArray:
+def _motion_basis(plan: _Plan, groups: list[tuple]) -> NDArray:
     """Motion-space basis (n, 6, N) for a chunk; constant where the joint twists allow it."""
-    count = twists[0].shape[-1]
+    count = groups[0][1].shape[-1]
     n = plan.dof
     basis = plan.space.constant_basis
     if basis is not None:
+        # Every joint twist must lie in the constant space: its part along the orthogonal
+        # complement (6 - n rows) must vanish relative to its size.
         inside = np.ones(count, dtype=bool)
-        for chain_twists in twists:  # (m, 6, N): every joint twist must lie in the constant space
-            coordinates = np.einsum("qc,mcn->mqn", basis, chain_twists)
-            residual = chain_twists - np.einsum("qc,mqn->mcn", basis, coordinates)
-            size = np.sqrt(_dot(chain_twists, chain_twists))
-            inside &= np.all(np.sqrt(_dot(residual, residual)) <= 1e-9 * np.maximum(size, 1.0), axis=0)
+        if plan.complement.shape[0]:
+            for _, twists, _ in groups:
+                outside_part = np.einsum("rc,kmcn->kmrn", plan.complement, twists)
+                leak = np.einsum("kmrn,kmrn->kmn", outside_part, outside_part)
+                size = np.einsum("kmcn,kmcn->kmn", twists, twists)
+                inside &= np.all(leak <= 1e-18 * np.maximum(size, 1.0), axis=(0, 1))
         result = np.broadcast_to(basis[:, :, None], (n, 6, count))
         if inside.all():
             return result
@@ -334,77 +369,85 @@ def _motion_basis(plan: _Plan, twists: list[NDArray]) -> NDArray:
     else:
         result = np.empty((n, 6, count))
         outside = np.ones(count, dtype=bool)
-    batch_twists = [np.moveaxis(t[..., outside], -1, 0).swapaxes(-1, -2) for t in twists]
+    batch_twists = [np.moveaxis(chain[..., outside], -1, 0).swapaxes(-1, -2)
+                    for _, twists, _ in groups for chain in twists]
     _, bases = _null_spaces(batch_twists, n, 1e-9)
     result[..., outside] = np.moveaxis(bases, 0, -1)
     return result
 
 
-def _actuation_wrenches(plan: _Plan, twists: list[NDArray], points: list[NDArray], basis: NDArray):
-    """Unit actuation wrenches (a, 6, N), their characteristic points and ITIs."""
+def _actuation_wrenches(plan: _Plan, groups: list[tuple], basis: NDArray):
+    """Unit actuation wrenches (a, 6, N), their input twists and characteristic points.
+
+    ``groups`` holds ``(actuated, twists (c, m, 6, N), points (c, m, 3, N))`` for chains of
+    equal structure, so that every operation runs on all chains of a group at once.
+    """
     n = plan.dof
-    wrenches, iti_points, oti_points, inputs = [], [], [], []
-    for chain_twists, chain_points, actuated in zip(twists, points, plan.actuated):
+    count = basis.shape[-1]
+    a = len(plan.actuators)
+    wrenches = np.empty((a, 6, count))
+    inputs = np.empty((a, 6, count))
+    iti_points = np.empty((a, 3, count))
+    oti_points = np.empty((a, 3, count))
+    for (actuated, twists, points), slots in zip(groups, plan.group_slots):
         if not actuated:
             continue
-        m = chain_twists.shape[0]
-        platform_point = chain_points[-1]
-        shifted = _shift(chain_twists, platform_point)
+        m = twists.shape[1]
+        platform_point = points[:, -1]  # (c, 3, N)
+        shifted = _shift(twists, platform_point[:, None])  # (c, m, 6, N)
         if m == n:
             # The chain spans the motion space: its constraint wrenches are the mechanism's,
             # and the representative is SWAP @ M' x with x spanning null(J_passive'^T M').
-            shifted_basis = _shift(basis, platform_point)
-            gram = np.einsum("jcn,qcn->jqn", shifted, shifted_basis)  # (m, n, N)
-            chain_wrenches = []
+            shifted_basis = _shift(basis[None], platform_point[:, None])  # (c, n, 6, N)
+            gram = np.einsum("kjcn,kqcn->kjqn", shifted, shifted_basis)  # (c, m, n, N)
+            group_wrenches = []
             for k in actuated:
-                rows = np.delete(gram, k, axis=0)
-                coefficients = null_vector(rows)  # (n, N)
-                chain_wrenches.append(_swap(np.einsum("qn,qcn->cn", coefficients, shifted_basis)))
-            chain_wrenches = np.stack(chain_wrenches)
+                coefficients = null_vector(np.delete(gram, k, axis=1))  # (c, n, N)
+                group_wrenches.append(np.einsum("kqn,kqcn->kcn", coefficients, shifted_basis))
+            group_wrenches = _swap(np.stack(group_wrenches, axis=1))  # (c, actuated, 6, N)
         else:
             # Minimum-norm solution of the reciprocity conditions J'^T SWAP w = e_k:
             # w = SWAP J' (J'^T J')^-1 e_k, orthogonal to the chain's constraint wrenches.
-            gram = np.einsum("icn,jcn->ijn", shifted, shifted)
-            unit = np.zeros((m, len(actuated), 1))
-            unit[list(actuated), range(len(actuated)), 0] = 1.0
-            solution, _ = solve_spd(gram, np.broadcast_to(unit, (m, len(actuated), gram.shape[-1])))
-            chain_wrenches = _swap(np.einsum("jkn,jcn->kcn", solution, shifted))
+            group_wrenches = []
+            for chain_shifted in shifted:
+                gram = np.einsum("icn,jcn->ijn", chain_shifted, chain_shifted)
+                unit = np.zeros((m, len(actuated), 1))
+                unit[list(actuated), range(len(actuated)), 0] = 1.0
+                solution, _ = solve_spd(gram, np.broadcast_to(unit, (m, len(actuated), count)))
+                group_wrenches.append(np.einsum("jkn,jcn->kcn", solution, chain_shifted))
+            group_wrenches = _swap(np.stack(group_wrenches))
         # Back to moments about the world origin: m_0 = m_d + d x f.
-        force = chain_wrenches[:, :3]
-        chain_wrenches = np.concatenate([force, chain_wrenches[:, 3:] + _cross(platform_point, force)], axis=1)
-        for position, k in enumerate(actuated):
-            wrenches.append(chain_wrenches[position])
-            inputs.append(chain_twists[k])
-            iti_points.append(chain_points[min(k + 1, m - 1)])
-            oti_points.append(platform_point)
-    wrenches = np.stack(wrenches)  # (a, 6, N)
-    inputs = np.stack(inputs)
+        force = group_wrenches[:, :, :3]
+        moment = group_wrenches[:, :, 3:] + _cross(platform_point[:, None], force)
+        after = [min(k + 1, m - 1) for k in actuated]
+        wrenches[slots, :3] = force.reshape((-1, 3, count))
+        wrenches[slots, 3:] = moment.reshape((-1, 3, count))
+        inputs[slots] = twists[:, list(actuated)].reshape((-1, 6, count))
+        iti_points[slots] = points[:, after].reshape((-1, 3, count))
+        oti_points[slots] = np.broadcast_to(platform_point[:, None], (len(twists), len(actuated), 3, count)
+                                            ).reshape((-1, 3, count))
     force_sq = _dot(wrenches[:, :3], wrenches[:, :3])
     moment_sq = _dot(wrenches[:, 3:], wrenches[:, 3:])
-    has_force = force_sq > 1e-20 * np.maximum(moment_sq, 1e-300)
+    has_force = force_sq > 1e-20 * moment_sq
     scale = np.sqrt(np.where(has_force, force_sq, moment_sq))
-    wrenches = np.where(scale[:, None] > 0, wrenches / np.where(scale > 0, scale, 1.0)[:, None], 0.0)
+    has_force &= scale > 0
     sign = np.sign(_dot(wrenches[:, :3], inputs[:, 3:]) + _dot(wrenches[:, 3:], inputs[:, :3]))
-    wrenches = wrenches * np.where(sign < 0, -1.0, 1.0)[:, None]
-    force_sq = np.where(has_force, 1.0, 0.0) * (scale > 0)
-    iti_points = np.stack(iti_points)
-    oti_points = np.stack(oti_points)
-    iti_points = _project_on_axis(wrenches, force_sq, iti_points)
-    oti_points = _project_on_axis(wrenches, force_sq, oti_points)
-    return wrenches, inputs, has_force & (scale > 0), iti_points, oti_points
+    wrenches *= (np.where(sign < 0, -1.0, 1.0) / np.where(scale > 0, scale, np.inf))[:, None]
+    unit_force = has_force.astype(float)
+    iti_points = _project_on_axis(wrenches, unit_force, iti_points)
+    oti_points = _project_on_axis(wrenches, unit_force, oti_points)
+    return wrenches, inputs, has_force, iti_points, oti_points
 
 
 def _arm_operator(wrenches, has_force, points, basis):
-    """Per actuator the 3 x n maps y -> v_p + h omega and y -> omega for twists M^T y."""
+    """Per actuator the 3 x n map y -> v_p + h omega (y -> omega for a couple) for twists M^T y."""
     omega = basis[:, :3]  # (n, 3, N)
     velocity = basis[:, 3:]
     force, moment = wrenches[:, :3], wrenches[:, 3:]
     pitch = _dot(force, moment)  # unit force -> pitch = f . m
     # (a, n, 3, N): v + omega x p + h omega for every basis twist.
     arm = (velocity[None] + _cross(omega[None], points[:, None]) + pitch[:, None, None] * omega[None])
-    arm = np.where(has_force[:, None, None], arm, omega[None])
-    reference = np.where(has_force[:, None, None], omega[None], 0.0)
-    return arm, reference
+    return np.where(has_force[:, None, None], arm, omega[None])
 
 
 def _power_coefficients(numerator, arm, reference, threshold):
@@ -415,10 +458,9 @@ def _power_coefficients(numerator, arm, reference, threshold):
     return np.where(singular, 0.0, np.minimum(value, 1.0))
 
 
-def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists):
-    n = plan.dof
-    basis = _motion_basis(plan, twists)
-    wrenches, inputs, has_force, iti_points, oti_points = _actuation_wrenches(plan, twists, points, basis)
+def _analyze_chunk(plan: _Plan, groups, iti_override, oti_override, detail, keep_twists):
+    basis = _motion_basis(plan, groups)
+    wrenches, inputs, has_force, iti_points, oti_points = _actuation_wrenches(plan, groups, basis)
     if iti_override is not None:
         iti_points = iti_override
     if oti_override is not None:
@@ -436,7 +478,7 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     wrench_matrix = np.einsum("acn,qcn->aqn", wrenches[:, :3], basis[:, 3:]) + np.einsum(
         "acn,qcn->aqn", wrenches[:, 3:], basis[:, :3])
     row_norms = np.sqrt(np.einsum("aqn,aqn->an", wrench_matrix, wrench_matrix))
-    arm, reference = _arm_operator(wrenches, has_force, oti_points, basis)
+    arm = _arm_operator(wrenches, has_force, oti_points, basis)
     # Every non-redundant submechanism once (Eq. 10): W = Q[N], output twists = adj(W) columns.
     subs = plan.submechanisms
     matrices = wrench_matrix[subs]  # (S, n rows, n, N)
@@ -445,10 +487,14 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     volume = np.prod(row_norms[subs], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         independent = np.abs(det) > plan.rank_tolerance * volume
-    arm_vectors = np.einsum("spqcn,sqpn->spcn", arm[subs], adj)
-    omega_vectors = np.einsum("spqcn,sqpn->spcn", reference[subs], adj)
-    arm_length = np.sqrt(np.einsum("spcn,spcn->spn", arm_vectors, arm_vectors))
+    arm_length = np.empty(adj.shape[:1] + adj.shape[2:])  # (S, n, N)
+    for k, (sub_index, position) in enumerate(plan.appearances):
+        vectors = np.einsum("qcn,tqn->tcn", arm[k], adj[sub_index, :, position])
+        arm_length[sub_index, position] = np.sqrt(np.einsum("tcn,tcn->tn", vectors, vectors))
+    # |omega| of every output twist; a pure-couple wrench has no moment arm to compare.
+    omega_vectors = np.einsum("qcn,sqpn->spcn", basis[:, :3], adj)
     omega_length = np.sqrt(np.einsum("spcn,spcn->spn", omega_vectors, omega_vectors))
+    omega_length = np.where(has_force[subs], omega_length, 0.0)
     oti_actuators = _power_coefficients(det[:, None], arm_length, omega_length, plan.threshold)
     oti_actuators = np.where(independent[:, None], oti_actuators, 0.0)
     oti_sub = oti_actuators.min(axis=1)  # Eq. 9
@@ -494,6 +540,7 @@ def analyze(
     detail: bool = True,
     keep_twists: bool = False,
     chunk_size: int = 4096,
+    threads: int | None = None,
 ) -> TransmissionResult:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
 
@@ -554,6 +601,8 @@ def analyze(
         Also keep the output twists (memory: ``S * n * 6`` floats per configuration).
     chunk_size : int
         Configurations per chunk (bounds memory).
+    threads : int, optional
+        Threads working on chunks concurrently (default: the number of CPUs, at most 4).
 
     Returns
     -------
@@ -573,6 +622,10 @@ def analyze(
             )
     if not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+    if threads is None:
+        threads = min(os.cpu_count() or 1, 4)
+    if not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     plan = _make_plan(chains, dof, faults, threshold, rank_tolerance)
     a = len(plan.actuators)
     count = int(np.prod(batch_shape, dtype=np.int64))
@@ -585,16 +638,31 @@ def analyze(
             except ValueError:
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
             overrides[name] = _batch_last(array, count)
-    twists = [_batch_last(chain.twists, count) for chain in chains]
-    points = [_batch_last(chain.points, count) for chain in chains]
-    pieces = []
-    for start in range(0, count, chunk_size):
+    twists = [chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains]
+    points = [chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains]
+
+    def group_chunk(part: slice) -> list[tuple]:
+        # (c, m, 6, N) contiguous stacks of the chains of each group, batch last.
+        return [(key[1],
+                 np.ascontiguousarray(np.stack([twists[c][part] for c in members]).transpose(0, 2, 3, 1)),
+                 np.ascontiguousarray(np.stack([points[c][part] for c in members]).transpose(0, 2, 3, 1)))
+                for key, members in zip(plan.group_keys, plan.group_members)]
+
+    def run(start: int) -> dict:
         part = slice(start, min(start + chunk_size, count))
-        pieces.append(_analyze_chunk(
-            plan, [t[..., part] for t in twists], [p[..., part] for p in points],
+        return _analyze_chunk(
+            plan, group_chunk(part),
             overrides["iti_points"][..., part] if "iti_points" in overrides else None,
             overrides["oti_points"][..., part] if "oti_points" in overrides else None,
-            detail, keep_twists))
+            detail, keep_twists)
+
+    starts = range(0, count, chunk_size)
+    if threads > 1 and len(starts) > 1:
+        # numpy releases the GIL inside its kernels: chunks overlap on several cores.
+        with ThreadPoolExecutor(max_workers=threads) as pool:
+            pieces = list(pool.map(run, starts))
+    else:
+        pieces = [run(start) for start in starts]
     merged = {key: np.concatenate([piece[key] for piece in pieces], axis=-1) for key in pieces[0]}
 
     def batch_first(array: NDArray) -> NDArray:

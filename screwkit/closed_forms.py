@@ -1,0 +1,239 @@
+r"""The paper's closed-form planar results, implemented independently of the generic path.
+
+Everything here works with planar vectors (shape ``(..., 2)``) of a planar n-RRR (or
+n-RPR) mechanism whose actuation wrenches are forces along the distal links:
+
+* ``f_i = (d_i - c_i)/l_i`` (Eq. 18) and ``g_i = (c_i - b_i)/a_i`` (Eq. 19);
+* the ITI of a chain, :math:`|\det[g_i\ f_i]|` (Eq. 23);
+* the instantaneous centre of chain ``k``'s output twist (Eq. 30) and its OTI through it
+  (Eqs. 31-33), or equivalently Eq. (A2) and its IC-free form (A4), with the parallel
+  special cases (A5) and (A6);
+* the OTI of a 3-chain submechanism (Eq. 34) and the ITI, LMTI and output fault tolerance
+  of the whole mechanism (Eqs. 35-38 and, for any number of faults, Eq. 12).
+
+Notation: :math:`|x\ y| = \det[x\ y] = x_1 y_2 - x_2 y_1`. Only numpy is imported here.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "det2",
+    "distal_directions",
+    "iti_rrr",
+    "instantaneous_centre",
+    "oti_chain_ic",
+    "oti_chain_a2",
+    "oti_chain_a4",
+    "oti_chain_a5",
+    "oti_chain_a6",
+    "oti_triple",
+    "planar_indices",
+]
+
+
+def det2(first: ArrayLike, second: ArrayLike) -> NDArray[np.float64]:
+    r""":math:`|x\ y| = x_1 y_2 - x_2 y_1` for planar vectors (..., 2)."""
+    first = np.asarray(first, dtype=float)
+    second = np.asarray(second, dtype=float)
+    return first[..., 0] * second[..., 1] - first[..., 1] * second[..., 0]
+
+
+def distal_directions(elbows: ArrayLike, distal: ArrayLike) -> NDArray[np.float64]:
+    """Unit vectors ``f_i = (d_i - c_i)/|d_i - c_i|`` (Eq. 18), shape (..., 2)."""
+    vector = np.asarray(distal, dtype=float) - np.asarray(elbows, dtype=float)
+    return vector / np.linalg.norm(vector, axis=-1, keepdims=True)
+
+
+def iti_rrr(base: ArrayLike, elbows: ArrayLike, distal: ArrayLike) -> NDArray[np.float64]:
+    r"""ITI of RRR chains, :math:`ITI_i = \sin\beta_i = |\det[g_i\ f_i]|` (Eq. 23)."""
+    upper = np.asarray(elbows, dtype=float) - np.asarray(base, dtype=float)
+    upper = upper / np.linalg.norm(upper, axis=-1, keepdims=True)
+    return np.abs(det2(upper, distal_directions(elbows, distal)))
+
+
+def instantaneous_centre(f_l, d_l, f_m, d_m) -> NDArray[np.float64]:
+    r"""Instantaneous centre of chain ``k``'s output twist (Eq. 30).
+
+    .. math:: r_{IC,k} = \frac{1}{|f_l\ f_m|} [f_m\ \ -f_l]
+              \begin{bmatrix} |f_l\ d_l| \\ |f_m\ d_m| \end{bmatrix}
+
+    ``inf``/``nan`` where the lines of chains ``l`` and ``m`` are parallel.
+    """
+    f_l, d_l, f_m, d_m = (np.asarray(v, dtype=float) for v in (f_l, d_l, f_m, d_m))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (f_m * det2(f_l, d_l)[..., None] - f_l * det2(f_m, d_m)[..., None]) / det2(f_l, f_m)[..., None]
+
+
+def oti_chain_ic(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+    r"""OTI of chain ``k`` through the instantaneous centre (Eqs. 30-33).
+
+    :math:`OTI_k = \sin\alpha_k = |\det[\rho_{k\max}/\rho_{k\max}\ \ f_k]|` with
+    :math:`\rho_{k\max} = d_k - r_{IC,k}`; zero when :math:`\rho_{k\max}` is below
+    ``threshold``. Only valid where ``f_l`` and ``f_m`` are not parallel (use A4 there).
+    """
+    centre = instantaneous_centre(f_l, d_l, f_m, d_m)
+    arm = np.asarray(d_k, dtype=float) - centre
+    length = np.linalg.norm(arm, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.abs(det2(arm, f_k)) / length
+    return np.where(length < threshold, 0.0, value)
+
+
+def _numerator(f_k, d_k, f_l, d_l, f_m, d_m):
+    """|f_k d_k||f_l f_m| + |f_l d_l||f_m f_k| + |f_m d_m||f_k f_l| (A2), the same for every k."""
+    return (det2(f_k, d_k) * det2(f_l, f_m) + det2(f_l, d_l) * det2(f_m, f_k)
+            + det2(f_m, d_m) * det2(f_k, f_l))
+
+
+def oti_chain_a2(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+    r"""OTI of chain ``k`` by Eq. (A2): the A3-shared numerator over :math:`|f_l\ f_m|\,\rho_{k\max}`."""
+    centre = instantaneous_centre(f_l, d_l, f_m, d_m)
+    arm = np.linalg.norm(np.asarray(d_k, dtype=float) - centre, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.abs(_numerator(f_k, d_k, f_l, d_l, f_m, d_m)) / (np.abs(det2(f_l, f_m)) * arm)
+    return np.where(arm < threshold, 0.0, value)
+
+
+def oti_chain_a4(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+    r"""OTI of chain ``k`` by Eq. (A4), free of the IC and valid for parallel ``f_l, f_m``.
+
+    .. math:: OTI_k = \frac{\left| |f_k\,d_k||f_l\,f_m| + |f_l\,d_l||f_m\,f_k| + |f_m\,d_m||f_k\,f_l| \right|}
+              {\left\| |f_l\,f_m|\, d_k - [f_m\ -f_l]\begin{bmatrix}|f_l\,d_l|\\|f_m\,d_m|\end{bmatrix}\right\|}
+
+    The denominator is :math:`|f_l\,f_m|\,\rho_{k\max}`; the value is zero when
+    :math:`\rho_{k\max} < p`, i.e. when the denominator is below ``threshold`` times
+    :math:`|f_l\ f_m|` (which includes the collinear case 0/0).
+
+    The extracted text of (A4) shows :math:`|f_l\ d_k|` in the second numerator term; the
+    cyclic form of (A2), used here, is the correct one (the symbolic tests prove it equals
+    the generic derivation; the literal reading does not).
+    """
+    f_k, d_k, f_l, d_l, f_m, d_m = (np.asarray(v, dtype=float) for v in (f_k, d_k, f_l, d_l, f_m, d_m))
+    cross_lm = det2(f_l, f_m)
+    vector = cross_lm[..., None] * d_k - (f_m * det2(f_l, d_l)[..., None] - f_l * det2(f_m, d_m)[..., None])
+    denominator = np.linalg.norm(vector, axis=-1)
+    singular = denominator <= threshold * np.abs(cross_lm)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.abs(_numerator(f_k, d_k, f_l, d_l, f_m, d_m)) / np.where(singular, 1.0, denominator)
+    return np.where(singular, 0.0, np.minimum(value, 1.0))
+
+
+def oti_chain_a5(f_k, d_k, f_l, d_l, f_m, d_m) -> NDArray[np.float64]:
+    r"""OTI of chain ``k`` when ``f_l`` and ``f_m`` are parallel (Eq. A5).
+
+    .. math:: OTI_k = \frac{\left||f_l\,d_l||f_m\,f_k| + |f_m\,d_m||f_k\,f_l|\right|}
+              {\left\|[f_m\ -f_l]\begin{bmatrix}|f_l\,d_l|\\|f_m\,d_m|\end{bmatrix}\right\|}
+
+    (the extraction garbled the denominator; this is A4 with :math:`|f_l\,f_m| = 0`).
+    Zero (0/0) when the two lines are collinear.
+    """
+    f_k, d_k, f_l, d_l, f_m, d_m = (np.asarray(v, dtype=float) for v in (f_k, d_k, f_l, d_l, f_m, d_m))
+    numerator = det2(f_l, d_l) * det2(f_m, f_k) + det2(f_m, d_m) * det2(f_k, f_l)
+    denominator = np.linalg.norm(f_m * det2(f_l, d_l)[..., None] - f_l * det2(f_m, d_m)[..., None], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(denominator > 0, np.abs(numerator) / np.where(denominator > 0, denominator, 1.0), 0.0)
+
+
+def oti_chain_a6(f_k, f_l) -> NDArray[np.float64]:
+    r"""OTI of chain ``k`` when ``f_m = f_l`` (parallel, not collinear): :math:`|\det[f_l\ f_k]|` (Eq. A6)."""
+    return np.abs(det2(f_l, f_k))
+
+
+def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    r"""OTI of each chain of a 3-chain submechanism and their minimum (Eqs. 25, 34).
+
+    Parameters
+    ----------
+    f, d : array_like, shape (..., 3, 2)
+        Distal-link directions and platform joint points of chains ``k, l, m``.
+
+    Returns
+    -------
+    per_chain : ndarray, shape (..., 3)
+    submechanism : ndarray, shape (...)
+    """
+    f = np.asarray(f, dtype=float)
+    d = np.asarray(d, dtype=float)
+    per_chain = np.stack([
+        oti_chain_a4(f[..., k, :], d[..., k, :], f[..., l, :], d[..., l, :], f[..., m, :], d[..., m, :], threshold)
+        for k, l, m in ((0, 1, 2), (1, 2, 0), (2, 0, 1))
+    ], axis=-1)
+    return per_chain, per_chain.min(axis=-1)
+
+
+def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = 1e-6,
+                   faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None) -> dict:
+    r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
+
+    Every 3-subset of the ``k`` chains is a non-redundant submechanism; its OTI is Eq. (34)
+    with the chain OTIs of Eq. (A4). :math:`ITI = \min_i |\det[g_i\ f_i]|` (Eq. 35),
+    :math:`LMTI = \max OTI_{N_i}` (Eq. 36), :math:`F_{Oj} = \min_{E} LMTI_E` over the
+    ``(k - j)``-subsets (Eqs. 37-38 for ``j = 1``), :math:`F_{IOj} = \min(F_{Oj}, ITI)`.
+
+    Parameters
+    ----------
+    base, elbows, distal : array_like, shape (..., k, 2)
+        Points ``b_i, c_i, d_i``. ``elbows`` may be None for RPR chains: then
+        ``directions`` (the leg directions) must be given and the ITI is 1 (prismatic input
+        along its own force).
+    threshold : float
+        Singularity threshold *p* on :math:`\rho_{k\max}`.
+    faults : tuple of int, optional
+        Which ``j`` (default ``1..k-3``).
+    directions : array_like, shape (..., k, 2), optional
+        The distal-link directions ``f_i`` (computed from ``elbows`` if omitted).
+
+    Returns
+    -------
+    dict
+        ``iti_chains`` (..., k), ``iti``, ``oti_submechanisms`` (..., C(k,3)), ``lmti``,
+        ``f_o`` and ``f_io`` (dicts over j), ``submechanisms`` (tuple of triples).
+    """
+    distal = np.asarray(distal, dtype=float)
+    count = distal.shape[-2]
+    if directions is None:
+        directions = distal_directions(elbows, distal)
+        iti_chains = iti_rrr(np.broadcast_to(base, distal.shape), elbows, distal)
+    else:
+        directions = np.asarray(directions, dtype=float)
+        iti_chains = np.ones(distal.shape[:-1])
+    triples = tuple(combinations(range(count), 3))
+    # Batch-last layout: one element-wise expression per triple over the whole batch.
+    f = np.moveaxis(directions, (-2, -1), (0, 1))
+    d = np.moveaxis(distal, (-2, -1), (0, 1))
+    cross_fd = f[:, 0] * d[:, 1] - f[:, 1] * d[:, 0]
+    oti_subs = []
+    for k, l, m in triples:
+        cross_lm = f[l, 0] * f[m, 1] - f[l, 1] * f[m, 0]
+        cross_mk = f[m, 0] * f[k, 1] - f[m, 1] * f[k, 0]
+        cross_kl = f[k, 0] * f[l, 1] - f[k, 1] * f[l, 0]
+        numerator = np.abs(cross_fd[k] * cross_lm + cross_fd[l] * cross_mk + cross_fd[m] * cross_kl)
+        values = []
+        for own, first, second, cross in ((k, l, m, cross_lm), (l, m, k, cross_mk), (m, k, l, cross_kl)):
+            # |f_l f_m| d_k - (f_m |f_l d_l| - f_l |f_m d_m|)
+            vx = cross * d[own, 0] - (f[second, 0] * cross_fd[first] - f[first, 0] * cross_fd[second])
+            vy = cross * d[own, 1] - (f[second, 1] * cross_fd[first] - f[first, 1] * cross_fd[second])
+            denominator = np.sqrt(vx * vx + vy * vy)
+            singular = denominator <= threshold * np.abs(cross)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                values.append(np.where(singular, 0.0, np.minimum(numerator / denominator, 1.0)))
+        oti_subs.append(np.minimum(np.minimum(values[0], values[1]), values[2]))
+    oti_subs = np.stack(oti_subs, axis=-1)
+    iti = iti_chains.min(axis=-1)
+    index = {triple: s for s, triple in enumerate(triples)}
+    faults = tuple(range(1, count - 2)) if faults is None else tuple(faults)
+    f_o, f_io = {}, {}
+    for j in faults:
+        if not 1 <= j <= count - 3:
+            raise ValueError(f"Expected the number of faults `j` in 1..{count - 3}, got {j}.")
+        members = np.array([[index[t] for t in combinations(remaining, 3)]
+                            for remaining in combinations(range(count), count - j)])
+        f_o[j] = oti_subs[..., members].max(axis=-1).min(axis=-1)
+        f_io[j] = np.minimum(f_o[j], iti)
+    return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti_subs, "lmti": oti_subs.max(axis=-1),
+            "f_o": f_o, "f_io": f_io, "submechanisms": triples}
