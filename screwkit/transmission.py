@@ -89,6 +89,17 @@ def _null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, toler
     return dims, np.swapaxes(vectors[..., :count], -1, -2)
 
 
+def _centred(twists: list[NDArray], points: list[NDArray]):
+    """Express batch-first twists (N, m, 6) and points (N, m, 3) about the centroid of the platform joints.
+
+    Every Euclidean norm and tolerance downstream is then invariant to a rigid motion of
+    the whole mechanism and to the choice of the world frame.
+    """
+    centre = np.mean([chain_points[:, -1] for chain_points in points], axis=0)  # (N, 3)
+    moved = [np.concatenate([t[..., :3], t[..., 3:] + np.cross(t[..., :3], centre[:, None])], axis=-1) for t in twists]
+    return moved, [p - centre[:, None] for p in points], centre
+
+
 def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples: int = 9,
                  tolerance: float = 1e-9) -> MotionSpace:
     r"""Find the platform's DOF and, if it is constant, its motion space.
@@ -115,9 +126,11 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     MotionSpace
     """
     flat = [chain.twists.reshape((-1,) + chain.twists.shape[-2:]) for chain in chains]
+    flat_points = [chain.points.reshape((-1,) + chain.points.shape[-2:]) for chain in chains]
     count = flat[0].shape[0]
     index = np.unique(np.linspace(0, count - 1, min(count, samples)).round().astype(int))
-    dims, bases = _null_spaces([twists[index] for twists in flat], dof, tolerance)
+    centred, _, _ = _centred([twists[index] for twists in flat], [points[index] for points in flat_points])
+    dims, bases = _null_spaces(centred, dof, tolerance)
     found = int(dims.max()) if dof is None else dof
     if found == 0:
         raise ValueError("The platform has no mobility: the chains' twist spaces intersect only in zero.")
@@ -458,7 +471,8 @@ def _power_coefficients(numerator, arm, reference, threshold):
     return np.where(singular, 0.0, np.minimum(value, 1.0))
 
 
-def _analyze_chunk(plan: _Plan, groups, iti_override, oti_override, detail, keep_twists):
+def _analyze_chunk(plan: _Plan, groups, centre, iti_override, oti_override, detail, keep_twists):
+    """All indices for one chunk; screws and points are given about ``centre`` (3, N), world axes."""
     basis = _motion_basis(plan, groups)
     wrenches, inputs, has_force, iti_points, oti_points = _actuation_wrenches(plan, groups, basis)
     if iti_override is not None:
@@ -516,10 +530,15 @@ def _analyze_chunk(plan: _Plan, groups, iti_override, oti_override, detail, keep
         np.put_along_axis(failed, remaining, False, axis=1)
         out[f"worst{j}"] = np.nonzero(failed)[1].reshape(-1, j).T
     if detail:
+        # Back to the world origin: m_0 = m_c + c x f and v_0 = v_c - omega x c.
+        world_wrenches = wrenches.copy()
+        world_wrenches[:, 3:] += _cross(centre, wrenches[:, :3])
         out.update(iti_actuators=iti_actuators, oti_actuators=oti_actuators, oti_submechanisms=oti_sub,
-                   actuation_wrenches=wrenches)
+                   actuation_wrenches=world_wrenches)
         if keep_twists:
-            out["output_twists"] = np.einsum("sqpn,qcn->spcn", adj, basis)
+            twists = np.einsum("sqpn,qcn->spcn", adj, basis)
+            twists[:, :, 3:] -= _cross(twists[:, :, :3], centre)
+            out["output_twists"] = twists
     return out
 
 
@@ -641,19 +660,19 @@ def analyze(
     twists = [chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains]
     points = [chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains]
 
-    def group_chunk(part: slice) -> list[tuple]:
-        # (c, m, 6, N) contiguous stacks of the chains of each group, batch last.
-        return [(key[1],
-                 np.ascontiguousarray(np.stack([twists[c][part] for c in members]).transpose(0, 2, 3, 1)),
-                 np.ascontiguousarray(np.stack([points[c][part] for c in members]).transpose(0, 2, 3, 1)))
-                for key, members in zip(plan.group_keys, plan.group_members)]
-
     def run(start: int) -> dict:
         part = slice(start, min(start + chunk_size, count))
+        chunk_twists, chunk_points, centre = _centred([t[part] for t in twists], [p[part] for p in points])
+        # (c, m, 6, N) contiguous stacks of the chains of each group, batch last.
+        groups = [(key[1],
+                   np.ascontiguousarray(np.stack([chunk_twists[c] for c in members]).transpose(0, 2, 3, 1)),
+                   np.ascontiguousarray(np.stack([chunk_points[c] for c in members]).transpose(0, 2, 3, 1)))
+                  for key, members in zip(plan.group_keys, plan.group_members)]
+        centre = np.ascontiguousarray(centre.T)
         return _analyze_chunk(
-            plan, group_chunk(part),
-            overrides["iti_points"][..., part] if "iti_points" in overrides else None,
-            overrides["oti_points"][..., part] if "oti_points" in overrides else None,
+            plan, groups, centre,
+            overrides["iti_points"][..., part] - centre if "iti_points" in overrides else None,
+            overrides["oti_points"][..., part] - centre if "oti_points" in overrides else None,
             detail, keep_twists)
 
     starts = range(0, count, chunk_size)

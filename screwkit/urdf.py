@@ -1,0 +1,340 @@
+"""A safe XML pass over a URDF file for what Pinocchio and yourdfpy do not read.
+
+Pinocchio builds the kinematic tree; this module reads the rest of screwkit's URDF
+convention (see ``docs/urdf-convention.md``):
+
+* ``<loop>`` elements (URDF+ loop joints) that close each leg onto the platform,
+* ``<transmission>`` elements that mark the actuated joints,
+* the optional ``<reference_configuration>`` element (screwkit extension),
+* the tree ``<joint>`` elements (names, types, links, origins, axes) for checks.
+
+Security: a URDF is data from elsewhere. Any document type declaration (``<!DOCTYPE``)
+or entity declaration (``<!ENTITY``) is refused *before* parsing, so entity bombs
+("billion laughs") and external entities are never expanded or fetched. Without a DTD,
+the parser knows no entities besides the five predefined ones.
+
+Every error is a one-line :class:`ValueError` naming the file, the element and the problem.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import xml.etree.ElementTree as ElementTree
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics import LOOP_JOINT_DOFS, rotation_from_rpy
+
+_DECLARATION = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
+TREE_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+"""Joint types of the URDF specification."""
+PLATFORM_JOINT_TYPES = ("floating", "planar")
+"""Types of the joint that attaches the platform to the base."""
+
+
+@dataclass(frozen=True)
+class Origin:
+    """A URDF ``<origin>``: translation ``xyz`` (m) and fixed-axis ``rpy`` angles (rad)."""
+
+    xyz: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    rpy: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+
+    @property
+    def rotation(self) -> NDArray[np.float64]:
+        """Rotation matrix ``Rz(yaw) Ry(pitch) Rx(roll)``."""
+        return rotation_from_rpy(self.rpy)
+
+    @property
+    def translation(self) -> NDArray[np.float64]:
+        """Translation vector."""
+        return np.asarray(self.xyz, dtype=float)
+
+
+@dataclass(frozen=True)
+class JointElement:
+    """A tree ``<joint>`` as written in the file."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: Origin
+    axis: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class LoopElement:
+    """A URDF+ ``<loop>`` joint closing a chain.
+
+    The loop-joint frame is ``predecessor_origin`` in the predecessor link frame and
+    ``successor_origin`` in the successor link frame; at the reference configuration the two
+    frames coincide up to the loop joint's own motion. ``axes`` are unit vectors in the loop
+    frame (``axis`` and, for a universal joint, ``axis2``).
+    """
+
+    name: str
+    type: str
+    predecessor: str
+    predecessor_origin: Origin
+    successor: str
+    successor_origin: Origin
+    axes: tuple[NDArray[np.float64], ...]
+    chain: str
+
+
+@dataclass(frozen=True)
+class TransmissionElement:
+    """A ``<transmission>`` and the joints it drives."""
+
+    name: str
+    joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class UrdfDescription:
+    """What the safe XML pass read from one URDF document.
+
+    Attributes
+    ----------
+    source : str
+        File path (or ``"<string>"``) used in error messages.
+    text : str
+        The document, checked to contain no DTD, for :func:`pinocchio.buildModelFromXML`.
+    robot_name : str
+    links : tuple of str
+    joints : dict of str to JointElement
+        Tree joints by name.
+    loops : tuple of LoopElement
+        In file order (this is the chain order).
+    transmissions : tuple of TransmissionElement
+    reference_configuration : dict of str to float
+        Joint values of the reference assembly given in ``<reference_configuration>``.
+    """
+
+    source: str
+    text: str
+    robot_name: str
+    links: tuple[str, ...]
+    joints: dict[str, JointElement]
+    loops: tuple[LoopElement, ...]
+    transmissions: tuple[TransmissionElement, ...]
+    reference_configuration: dict[str, float]
+
+    def fail(self, element: str, problem: str) -> ValueError:
+        """A one-line error naming this file, an element and a problem."""
+        return ValueError(f"{self.source}: {element}: {problem}")
+
+
+def read_urdf(path: str | os.PathLike) -> UrdfDescription:
+    """Read and check a URDF file (see :func:`parse_urdf`)."""
+    source = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise ValueError(f"{source}: cannot read the file: {error.strerror or error}.") from None
+    return parse_urdf(data, source)
+
+
+def parse_urdf(document: str | bytes, source: str = "<string>") -> UrdfDescription:
+    """Parse a URDF document, refusing DTDs and entity declarations before parsing.
+
+    Parameters
+    ----------
+    document : str or bytes
+        The XML text.
+    source : str
+        Name used in error messages (the file path).
+
+    Raises
+    ------
+    ValueError
+        On a DTD or entity declaration, malformed XML, or an element that breaks the
+        convention (unknown link, unsupported loop type, missing axis, ...).
+    """
+    data = document.encode("utf-8") if isinstance(document, str) else bytes(document)
+    declaration = _DECLARATION.search(data)
+    if declaration is not None:
+        line = data.count(b"\n", 0, declaration.start()) + 1
+        raise ValueError(
+            f"{source}: <!{declaration.group(1).decode().upper()}> at line {line}: document type and entity "
+            "declarations are refused (entity expansion is unsafe and URDF does not need them)."
+        )
+    try:
+        root = ElementTree.fromstring(data)
+    except ElementTree.ParseError as error:
+        raise ValueError(f"{source}: malformed XML: {error}.") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{source}: the file is not UTF-8 text: {error}.") from None
+    if root.tag != "robot":
+        raise ValueError(f"{source}: <{root.tag}>: expected the root element <robot>.")
+    return _Reader(source).read(root, text)
+
+
+class _Reader:
+    """Element-by-element reading with file-and-element error messages."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, element: str, problem: str) -> ValueError:
+        return ValueError(f"{self.source}: {element}: {problem}")
+
+    def read(self, root: ElementTree.Element, text: str) -> UrdfDescription:
+        robot_name = root.get("name", "")
+        links = []
+        for element in root.findall("link"):
+            name = self.required_attribute(element, "<link>", "name")
+            if name in links:
+                raise self.fail(f"<link name='{name}'>", "the link name is used twice.")
+            links.append(name)
+        link_set = set(links)
+        joints: dict[str, JointElement] = {}
+        for element in root.findall("joint"):
+            joint = self.read_joint(element, link_set)
+            if joint.name in joints:
+                raise self.fail(f"<joint name='{joint.name}'>", "the joint name is used twice.")
+            joints[joint.name] = joint
+        loops = []
+        for element in root.findall("loop"):
+            loop = self.read_loop(element, link_set)
+            if loop.name in joints or any(other.name == loop.name for other in loops):
+                raise self.fail(f"<loop name='{loop.name}'>", "the name is already used by another joint or loop.")
+            loops.append(loop)
+        transmissions = tuple(self.read_transmission(element) for element in root.findall("transmission"))
+        reference = {}
+        for element in root.findall("reference_configuration"):
+            for joint_element in element.findall("joint"):
+                name = self.required_attribute(joint_element, "<reference_configuration><joint>", "name")
+                tag = f"<reference_configuration><joint name='{name}'>"
+                if name not in joints:
+                    raise self.fail(tag, "names no tree joint of the robot.")
+                reference[name] = self.number(joint_element, tag, "value")
+        return UrdfDescription(
+            source=self.source,
+            text=text,
+            robot_name=robot_name,
+            links=tuple(links),
+            joints=joints,
+            loops=tuple(loops),
+            transmissions=transmissions,
+            reference_configuration=reference,
+        )
+
+    def required_attribute(self, element: ElementTree.Element, tag: str, attribute: str) -> str:
+        value = element.get(attribute)
+        if value is None or not value.strip():
+            raise self.fail(tag, f"the attribute '{attribute}' is missing.")
+        return value.strip()
+
+    def vector(self, element: ElementTree.Element | None, tag: str, attribute: str, default) -> NDArray[np.float64]:
+        if element is None or element.get(attribute) is None:
+            return np.array(default, dtype=float)
+        words = element.get(attribute).split()
+        try:
+            values = np.array([float(word) for word in words])
+        except ValueError:
+            values = np.array([])
+        if values.shape != (3,) or not np.all(np.isfinite(values)):
+            raise self.fail(tag, f"expected three finite numbers in '{attribute}', got {element.get(attribute)!r}.")
+        return values
+
+    def number(self, element: ElementTree.Element, tag: str, attribute: str) -> float:
+        raw = self.required_attribute(element, tag, attribute)
+        try:
+            value = float(raw)
+        except ValueError:
+            value = float("nan")
+        if not np.isfinite(value):
+            raise self.fail(tag, f"expected a finite number in '{attribute}', got {raw!r}.")
+        return value
+
+    def origin(self, element: ElementTree.Element | None, tag: str) -> Origin:
+        origin = None if element is None else element.find("origin")
+        return Origin(
+            xyz=self.vector(origin, f"{tag}<origin>", "xyz", (0.0, 0.0, 0.0)),
+            rpy=self.vector(origin, f"{tag}<origin>", "rpy", (0.0, 0.0, 0.0)),
+        )
+
+    def axis(self, element: ElementTree.Element, tag: str, name: str, required: bool) -> NDArray[np.float64] | None:
+        axis_element = element.find(name)
+        if axis_element is None:
+            if required:
+                raise self.fail(tag, f"the element <{name} xyz='...'/> is missing.")
+            return None
+        axis = self.vector(axis_element, f"{tag}<{name}>", "xyz", (1.0, 0.0, 0.0))
+        norm = np.linalg.norm(axis)
+        if norm < 1e-12:
+            raise self.fail(f"{tag}<{name}>", "the axis is the zero vector.")
+        return axis / norm
+
+    def link_reference(self, element: ElementTree.Element, tag: str, child: str, links: set[str]) -> tuple[str, ElementTree.Element]:
+        link_element = element.find(child)
+        if link_element is None:
+            raise self.fail(tag, f"the element <{child} link='...'> is missing.")
+        name = self.required_attribute(link_element, f"{tag}<{child}>", "link")
+        if name not in links:
+            raise self.fail(tag, f"<{child}> names an unknown link {name!r}.")
+        return name, link_element
+
+    def read_joint(self, element: ElementTree.Element, links: set[str]) -> JointElement:
+        name = self.required_attribute(element, "<joint>", "name")
+        tag = f"<joint name='{name}'>"
+        joint_type = self.required_attribute(element, tag, "type")
+        if joint_type not in TREE_JOINT_TYPES:
+            raise self.fail(tag, f"unknown joint type {joint_type!r}; expected one of {', '.join(TREE_JOINT_TYPES)}.")
+        parent, _ = self.link_reference(element, tag, "parent", links)
+        child, _ = self.link_reference(element, tag, "child", links)
+        axis = self.axis(element, tag, "axis", required=False)
+        return JointElement(
+            name=name,
+            type=joint_type,
+            parent=parent,
+            child=child,
+            origin=self.origin(element, tag),
+            axis=np.array([1.0, 0.0, 0.0]) if axis is None else axis,
+        )
+
+    def read_loop(self, element: ElementTree.Element, links: set[str]) -> LoopElement:
+        name = self.required_attribute(element, "<loop>", "name")
+        tag = f"<loop name='{name}'>"
+        loop_type = self.required_attribute(element, tag, "type")
+        if loop_type not in LOOP_JOINT_DOFS:
+            raise self.fail(
+                tag, f"unsupported loop joint type {loop_type!r}; expected one of {', '.join(LOOP_JOINT_DOFS)}."
+            )
+        predecessor, predecessor_element = self.link_reference(element, tag, "predecessor", links)
+        successor, successor_element = self.link_reference(element, tag, "successor", links)
+        if predecessor == successor:
+            raise self.fail(tag, f"the predecessor and successor are the same link {predecessor!r}.")
+        axes: tuple[NDArray[np.float64], ...] = ()
+        if loop_type in ("revolute", "continuous", "prismatic", "universal"):
+            axes = (self.axis(element, tag, "axis", required=True),)
+        if loop_type == "universal":
+            second = self.axis(element, tag, "axis2", required=True)
+            if abs(float(axes[0] @ second)) > 1.0 - 1e-9:
+                raise self.fail(tag, "the universal joint's <axis> and <axis2> are parallel.")
+            axes = axes + (second,)
+        return LoopElement(
+            name=name,
+            type=loop_type,
+            predecessor=predecessor,
+            predecessor_origin=self.origin(predecessor_element, f"{tag}<predecessor>"),
+            successor=successor,
+            successor_origin=self.origin(successor_element, f"{tag}<successor>"),
+            axes=axes,
+            chain=element.get("chain", name).strip() or name,
+        )
+
+    def read_transmission(self, element: ElementTree.Element) -> TransmissionElement:
+        name = element.get("name", "").strip() or "(unnamed)"
+        tag = f"<transmission name='{name}'>"
+        joints = tuple(self.required_attribute(joint, f"{tag}<joint>", "name") for joint in element.findall("joint"))
+        if not joints:
+            raise self.fail(tag, "drives no joint (expected <joint name='...'> inside).")
+        return TransmissionElement(name=name, joints=joints)

@@ -1,0 +1,86 @@
+"""Identities: rigid motions in 3-D, batching, world frame choice."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import random_planar_rrr
+from screwkit.chains import ChainScrews
+from screwkit.planar import rrr_chain_screws
+from screwkit.screws import transform_twist
+from screwkit.transmission import analyze
+
+
+def random_rotation(rng):
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def moved(chains, rotation, translation):
+    return [ChainScrews(transform_twist(rotation, translation, c.twists), c.points @ rotation.T + translation,
+                        c.actuated, c.name) for c in chains]
+
+
+def compare(first, second, tolerance=1e-9):
+    np.testing.assert_allclose(first.iti_actuators, second.iti_actuators, atol=tolerance)
+    np.testing.assert_allclose(first.oti_actuators, second.oti_actuators, atol=tolerance)
+    np.testing.assert_allclose(first.lmti, second.lmti, atol=tolerance)
+    for j in first.f_o:
+        np.testing.assert_allclose(first.f_o[j], second.f_o[j], atol=tolerance)
+        np.testing.assert_allclose(first.f_io[j], second.f_io[j], atol=tolerance)
+    np.testing.assert_array_equal(first.mutual_interference, second.mutual_interference)
+
+
+def test_indices_invariant_under_rigid_motion_in_space(rng):
+    base, elbows, distal = random_planar_rrr(rng, 2_000, 5)
+    chains = rrr_chain_screws(base, elbows, distal)
+    reference = analyze(chains, keep_twists=True)
+    for _ in range(5):
+        rotation = random_rotation(rng)
+        translation = rng.uniform(-50, 50, 3)
+        result = analyze(moved(chains, rotation, translation), keep_twists=True)
+        assert result.dof == 3
+        compare(reference, result)
+        # Wrenches move with the same adjoint (as (f, m)).
+        np.testing.assert_allclose(result.actuation_wrenches,
+                                   transform_twist(rotation, translation, reference.actuation_wrenches), atol=1e-9)
+
+
+def test_batched_equals_loop_over_single_configurations(rng):
+    base, elbows, distal = random_planar_rrr(rng, 40, 5)
+    batched = analyze(rrr_chain_screws(base, elbows, distal), chunk_size=7)
+    for index in range(40):
+        single = analyze(rrr_chain_screws(base[index], elbows[index], distal[index]))
+        assert single.iti.shape == ()
+        assert single.iti == pytest.approx(batched.iti[index], abs=1e-12)
+        assert single.lmti == pytest.approx(batched.lmti[index], abs=1e-12)
+        np.testing.assert_allclose(single.oti_submechanisms, batched.oti_submechanisms[index], atol=1e-12)
+        for j in single.f_o:
+            assert single.f_o[j] == pytest.approx(batched.f_o[j][index], abs=1e-12)
+
+
+def test_batch_shape_is_kept(rng):
+    base, elbows, distal = random_planar_rrr(rng, 24, 4)
+    shaped = [a.reshape(2, 3, 4, 4, 2) for a in (base, elbows, distal)]
+    result = analyze(rrr_chain_screws(*shaped))
+    assert result.iti.shape == (2, 3, 4)
+    assert result.oti_submechanisms.shape == (2, 3, 4, 4)
+    assert result.worst_faults[1].shape == (2, 3, 4, 1)
+    flat = analyze(rrr_chain_screws(base, elbows, distal))
+    np.testing.assert_allclose(result.lmti.reshape(-1), flat.lmti, atol=1e-15)
+
+
+def test_threads_and_chunks_do_not_change_results(rng):
+    base, elbows, distal = random_planar_rrr(rng, 3_000, 5)
+    chains = rrr_chain_screws(base, elbows, distal)
+    one = analyze(chains, threads=1, chunk_size=3_000)
+    many = analyze(chains, threads=2, chunk_size=256)
+    np.testing.assert_array_equal(one.f_o[1], many.f_o[1])
+    np.testing.assert_array_equal(one.iti, many.iti)
