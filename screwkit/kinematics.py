@@ -458,9 +458,9 @@ def twists_from_axes_and_points(
         else:
             px, py, pz = points_components[0, joint], points_components[1, joint], points_components[2, joint]
             twists[0, joint], twists[1, joint], twists[2, joint] = ax, ay, az
-            np.subtract(py * az, pz * ay, out=twists[3, joint])
-            np.subtract(pz * ax, px * az, out=twists[4, joint])
-            np.subtract(px * ay, py * ax, out=twists[5, joint])
+            np.subtract(py * az, pz * ay, out=twists[3, joint, ...])
+            np.subtract(pz * ax, px * az, out=twists[4, joint, ...])
+            np.subtract(px * ay, py * ax, out=twists[5, joint, ...])
     return np.moveaxis(twists, (0, 1), (-1, -2))
 
 

@@ -80,7 +80,7 @@ def _adjugate_lapack(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
         # adj(U S V^T) = adj(V^T) adj(S) adj(U) = det(V) V diag(prod_{j != i} s_j) det(U) U^T
         products = np.stack([np.prod(np.delete(singular, i, axis=-1), axis=-1) for i in range(n)], axis=-1)
         signs = np.linalg.det(left) * np.linalg.det(right_t)
-        result[bad] = signs[:, None, None] * np.einsum("bji,bi,bki->bjk", right_t, products, left)
+        result[bad] = signs[:, None, None] * np.einsum("bij,bi,bki->bjk", right_t, products, left)
     return result.reshape(matrix.shape)
 
 

@@ -480,20 +480,24 @@ class Mechanism:
         )
 
     def _choose_solvers(self) -> None:
-        solvers, branches, chains = [], [], []
+        solvers, branches, chains, signs = [], [], [], []
         for index, (chain, geometry) in enumerate(zip(self.chains, self.geometries)):
             solver = closed_form_for(geometry, self.is_planar)
+            frames = self._reference_frames[index]
+            sign = self._determinant_sign(index, frames.axes, frames.points)
             branch = None
             if solver is not None:
                 branch = self._matching_branch(index, solver)
                 if branch is None:
                     solver = None
             if solver is None:
-                branch = self._determinant_sign(index, self._reference_frames[index].axes, self._reference_frames[index].points)
+                branch = sign
+            signs.append(sign)
             solvers.append(solver)
             branches.append(branch)
             chains.append(Chain(**{**chain.__dict__, "solver": "newton" if solver is None else solver.kind}))
         self._solvers = tuple(solvers)
+        self._reference_signs = tuple(signs)
         self.branches = tuple(branches)
         self.chains = tuple(chains)
 
@@ -645,8 +649,9 @@ class Mechanism:
             else:
                 platform = self._platform_cache(flat, cache)
                 start = None if initial_values is None else initial_values[index].reshape(count, geometry.n_dofs)
+                sign = branches[index] if self._solvers[index] is None else self._reference_signs[index]
                 chain_values, chain_reachable, chain_residual = self._newton_chain(
-                    index, flat, platform, start, branches[index], tolerance, max_iterations
+                    index, flat, platform, start, sign, tolerance, max_iterations
                 )
                 frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
                 chain_axes, chain_points = frames.axes, frames.points

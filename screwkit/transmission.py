@@ -382,11 +382,36 @@ def _motion_basis(plan: _Plan, groups: list[tuple]) -> NDArray:
     else:
         result = np.empty((n, 6, count))
         outside = np.ones(count, dtype=bool)
-    batch_twists = [np.moveaxis(chain[..., outside], -1, 0).swapaxes(-1, -2)
+    batch_twists = [np.moveaxis(chain[..., outside], -1, 0)
                     for _, twists, _ in groups for chain in twists]
     _, bases = _null_spaces(batch_twists, n, 1e-9)
     result[..., outside] = np.moveaxis(bases, 0, -1)
     return result
+
+
+def _minimum_norm_wrenches(shifted: NDArray, actuated: tuple[int, ...]) -> NDArray:
+    """Actuation wrenches (k, 6, N) of one chain with more joints than the platform's DOF.
+
+    ``shifted`` holds the chain's twists about its platform joint point (m, 6, N). Where
+    the joint twists are dependent (an idle DoF such as the spin of an S-S rod) the
+    pseudo-inverse gives the minimum-norm solution; it is kept only if it is reciprocal to
+    every passive joint (otherwise the actuator cannot transmit: the wrench is zero).
+    """
+    m, count = shifted.shape[0], shifted.shape[-1]
+    gram = np.einsum("icn,jcn->ijn", shifted, shifted)
+    unit = np.zeros((m, len(actuated), 1))
+    unit[list(actuated), range(len(actuated)), 0] = 1.0
+    solution, regular = solve_spd(gram, np.broadcast_to(unit, (m, len(actuated), count)))
+    if not regular.all():
+        singular = ~regular
+        pseudo = np.linalg.pinv(np.moveaxis(gram[..., singular], -1, 0), hermitian=True)  # (K, m, m)
+        fallback = np.moveaxis(pseudo[:, :, list(actuated)], 0, -1)  # (m, k, K)
+        twists = shifted[..., singular]
+        conditions = np.einsum("icn,jkn,jcn->ikn", twists, fallback, twists)  # J'^T J' y (= e_k if consistent)
+        consistent = np.all(np.abs(conditions - unit) <= 1e-9 * np.maximum(1.0, np.abs(fallback).max(axis=(0, 1))),
+                            axis=(0, 1))
+        solution[..., singular] = np.where(consistent, fallback, 0.0)
+    return _swap(np.einsum("jkn,jcn->kcn", solution, shifted))
 
 
 def _actuation_wrenches(plan: _Plan, groups: list[tuple], basis: NDArray):
@@ -421,14 +446,8 @@ def _actuation_wrenches(plan: _Plan, groups: list[tuple], basis: NDArray):
         else:
             # Minimum-norm solution of the reciprocity conditions J'^T SWAP w = e_k:
             # w = SWAP J' (J'^T J')^-1 e_k, orthogonal to the chain's constraint wrenches.
-            group_wrenches = []
-            for chain_shifted in shifted:
-                gram = np.einsum("icn,jcn->ijn", chain_shifted, chain_shifted)
-                unit = np.zeros((m, len(actuated), 1))
-                unit[list(actuated), range(len(actuated)), 0] = 1.0
-                solution, _ = solve_spd(gram, np.broadcast_to(unit, (m, len(actuated), count)))
-                group_wrenches.append(np.einsum("jkn,jcn->kcn", solution, chain_shifted))
-            group_wrenches = _swap(np.stack(group_wrenches))
+            group_wrenches = np.stack([_minimum_norm_wrenches(chain_shifted, actuated)
+                                       for chain_shifted in shifted])
         # Back to moments about the world origin: m_0 = m_d + d x f.
         force = group_wrenches[:, :, :3]
         moment = group_wrenches[:, :, 3:] + _cross(platform_point[:, None], force)
