@@ -16,6 +16,8 @@ Notation: :math:`|x\ y| = \det[x\ y] = x_1 y_2 - x_2 y_1`. Only numpy is importe
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from itertools import combinations
 
 import numpy as np
@@ -166,8 +168,43 @@ def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDAr
     return per_chain, per_chain.min(axis=-1)
 
 
+def _unit_rows(vectors):
+    """Normalise batch-last planar vectors (k, 2, n)."""
+    return vectors / np.sqrt(vectors[:, 0] ** 2 + vectors[:, 1] ** 2)[:, None]
+
+
+def _planar_chunk(f, d, upper, threshold, triples, fault_members):
+    """Closed-form indices for batch-last chunks: unit f, points d (k, 2, n), unit upper (k, 2, n) or None."""
+    cross_fd = f[:, 0] * d[:, 1] - f[:, 1] * d[:, 0]
+    if upper is None:
+        iti_chains = np.ones(f.shape[::2])
+    else:  # Eq. 23: |det[g f]| with g the unit upper-arm direction
+        iti_chains = np.abs(upper[:, 0] * f[:, 1] - upper[:, 1] * f[:, 0])
+    oti_subs = np.empty((len(triples), f.shape[-1]))
+    for s, (k, l, m) in enumerate(triples):
+        cross_lm = f[l, 0] * f[m, 1] - f[l, 1] * f[m, 0]
+        cross_mk = f[m, 0] * f[k, 1] - f[m, 1] * f[k, 0]
+        cross_kl = f[k, 0] * f[l, 1] - f[k, 1] * f[l, 0]
+        numerator = np.abs(cross_fd[k] * cross_lm + cross_fd[l] * cross_mk + cross_fd[m] * cross_kl)  # A2/A3
+        best = None
+        for own, first, second, cross in ((k, l, m, cross_lm), (l, m, k, cross_mk), (m, k, l, cross_kl)):
+            # Denominator of A4: || |f_l f_m| d_k - (f_m |f_l d_l| - f_l |f_m d_m|) ||
+            vx = cross * d[own, 0] - (f[second, 0] * cross_fd[first] - f[first, 0] * cross_fd[second])
+            vy = cross * d[own, 1] - (f[second, 1] * cross_fd[first] - f[first, 1] * cross_fd[second])
+            denominator = np.sqrt(vx * vx + vy * vy)
+            singular = denominator <= threshold * np.abs(cross)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                value = np.where(singular, 0.0, np.minimum(numerator / denominator, 1.0))
+            best = value if best is None else np.minimum(best, value)
+        oti_subs[s] = best
+    iti = iti_chains.min(axis=0)
+    f_o = {j: oti_subs[members].max(axis=1).min(axis=0) for j, members in fault_members.items()}
+    return iti_chains, iti, oti_subs, f_o
+
+
 def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = 1e-6,
-                   faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None) -> dict:
+                   faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None,
+                   chunk_size: int = 8192, threads: int | None = None) -> dict:
     r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
 
     Every 3-subset of the ``k`` chains is a non-redundant submechanism; its OTI is Eq. (34)
@@ -187,6 +224,10 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         Which ``j`` (default ``1..k-3``).
     directions : array_like, shape (..., k, 2), optional
         The distal-link directions ``f_i`` (computed from ``elbows`` if omitted).
+    chunk_size : int
+        Configurations per chunk (bounds memory, keeps the work in cache).
+    threads : int, optional
+        Threads working on chunks (default: CPUs, at most 4).
 
     Returns
     -------
@@ -195,45 +236,59 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         ``f_o`` and ``f_io`` (dicts over j), ``submechanisms`` (tuple of triples).
     """
     distal = np.asarray(distal, dtype=float)
-    count = distal.shape[-2]
+    if distal.ndim < 2 or distal.shape[-1] != 2 or distal.shape[-2] < 3:
+        raise ValueError(f"Expected `distal` with shape (..., k, 2), k >= 3, got {distal.shape}.")
+    batch, count = distal.shape[:-2], distal.shape[-2]
     if directions is None:
-        directions = distal_directions(elbows, distal)
-        iti_chains = iti_rrr(np.broadcast_to(base, distal.shape), elbows, distal)
+        if elbows is None:
+            raise ValueError("Expected `elbows` or `directions`, got neither.")
+        elbows = np.broadcast_to(np.asarray(elbows, dtype=float), distal.shape)
+        base = np.broadcast_to(np.asarray(base, dtype=float), distal.shape)
     else:
-        directions = np.asarray(directions, dtype=float)
-        iti_chains = np.ones(distal.shape[:-1])
-    triples = tuple(combinations(range(count), 3))
-    # Batch-last layout: one element-wise expression per triple over the whole batch.
-    f = np.moveaxis(directions, (-2, -1), (0, 1))
-    d = np.moveaxis(distal, (-2, -1), (0, 1))
-    cross_fd = f[:, 0] * d[:, 1] - f[:, 1] * d[:, 0]
-    oti_subs = []
-    for k, l, m in triples:
-        cross_lm = f[l, 0] * f[m, 1] - f[l, 1] * f[m, 0]
-        cross_mk = f[m, 0] * f[k, 1] - f[m, 1] * f[k, 0]
-        cross_kl = f[k, 0] * f[l, 1] - f[k, 1] * f[l, 0]
-        numerator = np.abs(cross_fd[k] * cross_lm + cross_fd[l] * cross_mk + cross_fd[m] * cross_kl)
-        values = []
-        for own, first, second, cross in ((k, l, m, cross_lm), (l, m, k, cross_mk), (m, k, l, cross_kl)):
-            # |f_l f_m| d_k - (f_m |f_l d_l| - f_l |f_m d_m|)
-            vx = cross * d[own, 0] - (f[second, 0] * cross_fd[first] - f[first, 0] * cross_fd[second])
-            vy = cross * d[own, 1] - (f[second, 1] * cross_fd[first] - f[first, 1] * cross_fd[second])
-            denominator = np.sqrt(vx * vx + vy * vy)
-            singular = denominator <= threshold * np.abs(cross)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                values.append(np.where(singular, 0.0, np.minimum(numerator / denominator, 1.0)))
-        oti_subs.append(np.minimum(np.minimum(values[0], values[1]), values[2]))
-    oti_subs = np.stack(oti_subs, axis=-1)
-    iti = iti_chains.min(axis=-1)
-    index = {triple: s for s, triple in enumerate(triples)}
+        directions = np.broadcast_to(np.asarray(directions, dtype=float), distal.shape)
     faults = tuple(range(1, count - 2)) if faults is None else tuple(faults)
-    f_o, f_io = {}, {}
     for j in faults:
         if not 1 <= j <= count - 3:
             raise ValueError(f"Expected the number of faults `j` in 1..{count - 3}, got {j}.")
-        members = np.array([[index[t] for t in combinations(remaining, 3)]
-                            for remaining in combinations(range(count), count - j)])
-        f_o[j] = oti_subs[..., members].max(axis=-1).min(axis=-1)
-        f_io[j] = np.minimum(f_o[j], iti)
+    triples = tuple(combinations(range(count), 3))
+    index = {triple: s for s, triple in enumerate(triples)}
+    fault_members = {j: np.array([[index[t] for t in combinations(remaining, 3)]
+                                  for remaining in combinations(range(count), count - j)]) for j in faults}
+    total = int(np.prod(batch, dtype=np.int64))
+    def flat(array):
+        return array.reshape(total, count, 2)
+
+    def chunk(array, part):
+        return np.ascontiguousarray(array[part].transpose(1, 2, 0))
+
+    if directions is None:
+        sources = (flat(base), flat(elbows), flat(distal))
+    else:
+        sources = (flat(directions), flat(distal))
+
+    def run(start):
+        part = slice(start, min(start + chunk_size, total))
+        if directions is None:
+            b, c, d = (chunk(a, part) for a in sources)
+            return _planar_chunk(_unit_rows(d - c), d, _unit_rows(c - b), threshold, triples, fault_members)
+        f, d = (chunk(a, part) for a in sources)
+        return _planar_chunk(f, d, None, threshold, triples, fault_members)
+
+    starts = range(0, total, chunk_size)
+    threads = min(os.cpu_count() or 1, 4) if threads is None else threads
+    if threads > 1 and len(starts) > 1:
+        with ThreadPoolExecutor(max_workers=threads) as pool:
+            pieces = list(pool.map(run, starts))
+    else:
+        pieces = [run(start) for start in starts]
+
+    def gather(arrays):  # batch-last pieces -> batch-first (..., k)
+        joined = np.concatenate(arrays, axis=-1)
+        return np.moveaxis(joined, -1, 0).reshape(batch + joined.shape[:-1])
+
+    iti_chains = gather([p[0] for p in pieces])
+    iti = gather([p[1] for p in pieces])
+    oti_subs = gather([p[2] for p in pieces])
+    f_o = {j: gather([p[3][j] for p in pieces]) for j in faults}
     return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti_subs, "lmti": oti_subs.max(axis=-1),
-            "f_o": f_o, "f_io": f_io, "submechanisms": triples}
+            "f_o": f_o, "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "submechanisms": triples}

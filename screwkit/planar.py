@@ -168,7 +168,7 @@ def _lift(points: NDArray) -> NDArray:
 
 
 def _revolute_z(points3: NDArray) -> NDArray:
-    """Twists of revolute joints about +z through ``points3`` (..., 3)."""
+    """Twists of revolute joints about +z through ``points3`` (..., 3): (0, 0, 1, p_y, -p_x, 0)."""
     omega = np.broadcast_to(Z_AXIS, points3.shape)
     return np.concatenate([omega, np.cross(points3, omega)], axis=-1)
 
@@ -183,8 +183,11 @@ def rrr_chain_screws(base: ArrayLike, elbows: ArrayLike, distal: ArrayLike,
     actuated : tuple of int
         Actuated joints of every chain (0: base joint, the paper's case).
     """
-    points = np.stack([_lift(np.asarray(p, dtype=float)) for p in (base, elbows, distal)], axis=-2)
-    return [ChainScrews(_revolute_z(points[..., i, :, :]), points[..., i, :, :], actuated, name=f"chain{i + 1}")
+    distal = np.asarray(distal, dtype=float)
+    points = np.stack([_lift(np.broadcast_to(np.asarray(p, dtype=float), distal.shape))
+                       for p in (base, elbows, distal)], axis=-2)  # (..., k, 3 joints, 3)
+    twists = _revolute_z(points)
+    return [ChainScrews(twists[..., i, :, :], points[..., i, :, :], actuated, name=f"chain{i + 1}")
             for i in range(points.shape[-3])]
 
 

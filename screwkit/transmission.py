@@ -15,9 +15,11 @@ derives
   ``F_Oj`` for ``j = 1..a-n`` (Eqs. 12-13) and the **input-output** ones ``F_IOj`` (Eq. 14);
 * which actuators are **mutual-interference actuators**.
 
-Everything is batched: the configurations are processed in chunks with the batch on the
-last (contiguous) axis, and small determinants/adjugates are closed-form element-wise
-expressions (:mod:`screwkit.linalg`). Only numpy is imported here.
+Everything is batched: validation, planning (motion space, submechanisms, fault sets) and
+the reductions over actuator sets are numpy; the per-configuration screw algebra runs in
+one compiled kernel (:mod:`screwkit._kernels`, numba, no allocation per configuration)
+over chunks of configurations, the chunks side by side on several cores. numba is
+imported only when :func:`analyze` first runs.
 """
 
 from __future__ import annotations
@@ -34,7 +36,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
-from screwkit.linalg import adjugate, determinant, null_vector, solve_spd
 
 __all__ = ["TransmissionResult", "MotionSpace", "analyze", "motion_space", "fault_sets"]
 
@@ -245,67 +246,31 @@ class TransmissionResult:
 # ----------------------------------------------------------------------------------------
 # Analysis
 # ----------------------------------------------------------------------------------------
-def _swap(screws: NDArray) -> NDArray:
-    """Swap the two halves of batch-last screws (..., 6, N): twist -> wrench coordinates."""
-    return np.concatenate([screws[..., 3:, :], screws[..., :3, :]], axis=-2)
-
-
-def _cross(first: NDArray, second: NDArray) -> NDArray:
-    """Cross product of batch-last 3-vectors (..., 3, N), broadcasting."""
-    return np.stack(
-        [
-            first[..., 1, :] * second[..., 2, :] - first[..., 2, :] * second[..., 1, :],
-            first[..., 2, :] * second[..., 0, :] - first[..., 0, :] * second[..., 2, :],
-            first[..., 0, :] * second[..., 1, :] - first[..., 1, :] * second[..., 0, :],
-        ],
-        axis=-2,
-    )
-
-
-def _shift(twists: NDArray, point: NDArray) -> NDArray:
-    """Twists (..., 6, N) expressed about ``point`` (3, N): (omega, v + omega x p)."""
-    omega = twists[..., :3, :]
-    velocity = twists[..., 3:, :] + _cross(omega, point)
-    return np.concatenate([np.broadcast_to(omega, velocity.shape), velocity], axis=-2)
-
-
-def _dot(first: NDArray, second: NDArray) -> NDArray:
-    return np.einsum("...in,...in->...n", first, second)
-
-
-def _project_on_axis(wrench: NDArray, force_sq: NDArray, point: NDArray) -> NDArray:
-    """Projection of ``point`` on the axis of ``wrench`` (6, N); the point itself for a couple."""
-    force, moment = wrench[..., :3, :], wrench[..., 3:, :]
-    safe = np.where(force_sq > 0, force_sq, 1.0)[..., None, :]
-    foot = _cross(force, moment) / safe
-    along = _dot(point - foot, force)[..., None, :] / safe
-    return np.where(force_sq[..., None, :] > 0, foot + along * force, point)
-
-
 @dataclass
 class _Plan:
     """Everything about a mechanism that does not depend on the configuration."""
 
-    chain_sizes: tuple[int, ...]
-    actuated: tuple[tuple[int, ...], ...]
     actuators: tuple[tuple[int, int], ...]
     dof: int
     space: MotionSpace
+    complement: NDArray[np.float64]
+    chain_start: NDArray[np.int64]
+    actuator_chain: NDArray[np.int64]
+    actuator_joint: NDArray[np.int64]
     submechanisms: NDArray[np.int64]
     faults: tuple[int, ...]
     fault_members: dict[int, NDArray[np.int64]]
-    fault_sets: dict[int, NDArray[np.int64]]
+    failed_sets: dict[int, NDArray[np.int64]]
     complement_members: list[NDArray[np.int64]]
     threshold: float
     rank_tolerance: float
-    group_keys: tuple[tuple[int, tuple[int, ...]], ...]
-    group_members: tuple[tuple[int, ...], ...]
-    group_slots: tuple[NDArray[np.int64], ...]
-    complement: NDArray[np.float64] | None
-    appearances: tuple[tuple[NDArray[np.int64], NDArray[np.int64]], ...]
 
 
 def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
+    if not threshold >= 0:
+        raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
+    if not rank_tolerance > 0:
+        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
     space = motion_space(chains, dof)
     n = space.dof
     actuators = tuple((c, k) for c, chain in enumerate(chains) for k in chain.actuated)
@@ -327,243 +292,92 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
                 raise ValueError(f"Expected the number of faults `j` in 1..a-n = 1..{a - n}, got {j}.")
     submechanisms = list(combinations(range(a), n))
     position = {sub: s for s, sub in enumerate(submechanisms)}
-    fault_members, fault_set_arrays = {}, {}
+    fault_members, failed_sets = {}, {}
     for j in fault_list:
         sets = fault_sets(a, n, j)
-        fault_set_arrays[j] = np.array(sets, dtype=np.int64)
         fault_members[j] = np.array([[position[sub] for sub in combinations(remaining, n)] for remaining in sets])
-    complement = [np.array([s for s, sub in enumerate(submechanisms) if k not in sub], dtype=np.int64)
-                  for k in range(a)]
-    if not threshold >= 0:
-        raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
-    if not rank_tolerance > 0:
-        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
-    # Chains of equal structure are processed together.
-    keys, members = [], []
-    for index, chain in enumerate(chains):
-        key = (chain.n_joints, chain.actuated)
-        if key not in keys:
-            keys.append(key)
-            members.append([])
-        members[keys.index(key)].append(index)
-    slot_of = {actuator: slot for slot, actuator in enumerate(actuators)}
-    slots = tuple(np.array([slot_of[(c, k)] for c in group for k in key[1]], dtype=np.int64)
-                  for key, group in zip(keys, members))
-    return _Plan(tuple(c.n_joints for c in chains), tuple(c.actuated for c in chains), actuators, n, space,
-                 np.array(submechanisms, dtype=np.int64), fault_list, fault_members, fault_set_arrays,
-                 complement, float(threshold), float(rank_tolerance), tuple(keys),
-                 tuple(tuple(g) for g in members), slots,
-                 space.complement if space.constant_basis is not None else None,
-                 tuple((np.array([s for s, sub in enumerate(submechanisms) if k in sub], dtype=np.int64),
-                        np.array([sub.index(k) for sub in submechanisms if k in sub], dtype=np.int64))
-                       for k in range(a)))
+        failed_sets[j] = np.array([sorted(set(range(a)) - set(e)) for e in sets], dtype=np.int64).reshape(-1, j)
+    complement_members = [np.array([s for s, sub in enumerate(submechanisms) if k not in sub], dtype=np.int64)
+                          for k in range(a)]
+    complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
+    return _Plan(
+        actuators=actuators, dof=n, space=space, complement=complement,
+        chain_start=np.cumsum([0] + [c.n_joints for c in chains]).astype(np.int64),
+        actuator_chain=np.array([c for c, _ in actuators], dtype=np.int64),
+        actuator_joint=np.array([k for _, k in actuators], dtype=np.int64),
+        submechanisms=np.array(submechanisms, dtype=np.int64).reshape(-1, n),
+        faults=fault_list, fault_members=fault_members, failed_sets=failed_sets,
+        complement_members=complement_members, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
 
 
-def _motion_basis(plan: _Plan, groups: list[tuple]) -> NDArray:
-    """Motion-space basis (n, 6, N) for a chunk; constant where the joint twists allow it."""
-    count = groups[0][1].shape[-1]
-    n = plan.dof
-    basis = plan.space.constant_basis
-    if basis is not None:
-        # Every joint twist must lie in the constant space: its part along the orthogonal
-        # complement (6 - n rows) must vanish relative to its size.
-        inside = np.ones(count, dtype=bool)
-        if plan.complement.shape[0]:
-            for _, twists, _ in groups:
-                outside_part = np.einsum("rc,kmcn->kmrn", plan.complement, twists)
-                leak = np.einsum("kmrn,kmrn->kmn", outside_part, outside_part)
-                size = np.einsum("kmcn,kmcn->kmn", twists, twists)
-                inside &= np.all(leak <= 1e-18 * np.maximum(size, 1.0), axis=(0, 1))
-        result = np.broadcast_to(basis[:, :, None], (n, 6, count))
-        if inside.all():
-            return result
-        result = result.copy()
-        outside = ~inside
-    else:
-        result = np.empty((n, 6, count))
-        outside = np.ones(count, dtype=bool)
-    batch_twists = [np.moveaxis(chain[..., outside], -1, 0)
-                    for _, twists, _ in groups for chain in twists]
-    _, bases = _null_spaces(batch_twists, n, 1e-9)
-    result[..., outside] = np.moveaxis(bases, 0, -1)
-    return result
+def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
+    from screwkit._kernels import transmission_kernel
 
-
-def _minimum_norm_wrenches(shifted: NDArray, actuated: tuple[int, ...]) -> NDArray:
-    """Actuation wrenches (k, 6, N) of one chain with more joints than the platform's DOF.
-
-    ``shifted`` holds the chain's twists about its platform joint point (m, 6, N). Where
-    the joint twists are dependent (an idle DoF such as the spin of an S-S rod) the
-    pseudo-inverse gives the minimum-norm solution; it is kept only if it is reciprocal to
-    every passive joint (otherwise the actuator cannot transmit: the wrench is zero).
-    """
-    m, count = shifted.shape[0], shifted.shape[-1]
-    gram = np.einsum("icn,jcn->ijn", shifted, shifted)
-    unit = np.zeros((m, len(actuated), 1))
-    unit[list(actuated), range(len(actuated)), 0] = 1.0
-    solution, regular = solve_spd(gram, np.broadcast_to(unit, (m, len(actuated), count)))
-    if not regular.all():
-        singular = ~regular
-        pseudo = np.linalg.pinv(np.moveaxis(gram[..., singular], -1, 0), hermitian=True)  # (K, m, m)
-        fallback = np.moveaxis(pseudo[:, :, list(actuated)], 0, -1)  # (m, k, K)
-        twists = shifted[..., singular]
-        conditions = np.einsum("icn,jkn,jcn->ikn", twists, fallback, twists)  # J'^T J' y (= e_k if consistent)
-        consistent = np.all(np.abs(conditions - unit) <= 1e-9 * np.maximum(1.0, np.abs(fallback).max(axis=(0, 1))),
-                            axis=(0, 1))
-        solution[..., singular] = np.where(consistent, fallback, 0.0)
-    return _swap(np.einsum("jkn,jcn->kcn", solution, shifted))
-
-
-def _actuation_wrenches(plan: _Plan, groups: list[tuple], basis: NDArray):
-    """Unit actuation wrenches (a, 6, N), their input twists and characteristic points.
-
-    ``groups`` holds ``(actuated, twists (c, m, 6, N), points (c, m, 3, N))`` for chains of
-    equal structure, so that every operation runs on all chains of a group at once.
-    """
-    n = plan.dof
-    count = basis.shape[-1]
-    a = len(plan.actuators)
-    wrenches = np.empty((a, 6, count))
-    inputs = np.empty((a, 6, count))
-    iti_points = np.empty((a, 3, count))
-    oti_points = np.empty((a, 3, count))
-    for (actuated, twists, points), slots in zip(groups, plan.group_slots):
-        if not actuated:
-            continue
-        m = twists.shape[1]
-        platform_point = points[:, -1]  # (c, 3, N)
-        shifted = _shift(twists, platform_point[:, None])  # (c, m, 6, N)
-        if m == n:
-            # The chain spans the motion space: its constraint wrenches are the mechanism's,
-            # and the representative is SWAP @ M' x with x spanning null(J_passive'^T M').
-            shifted_basis = _shift(basis[None], platform_point[:, None])  # (c, n, 6, N)
-            gram = np.einsum("kjcn,kqcn->kjqn", shifted, shifted_basis)  # (c, m, n, N)
-            group_wrenches = []
-            for k in actuated:
-                coefficients = null_vector(np.delete(gram, k, axis=1))  # (c, n, N)
-                group_wrenches.append(np.einsum("kqn,kqcn->kcn", coefficients, shifted_basis))
-            group_wrenches = _swap(np.stack(group_wrenches, axis=1))  # (c, actuated, 6, N)
-        else:
-            # Minimum-norm solution of the reciprocity conditions J'^T SWAP w = e_k:
-            # w = SWAP J' (J'^T J')^-1 e_k, orthogonal to the chain's constraint wrenches.
-            group_wrenches = np.stack([_minimum_norm_wrenches(chain_shifted, actuated)
-                                       for chain_shifted in shifted])
-        # Back to moments about the world origin: m_0 = m_d + d x f.
-        force = group_wrenches[:, :, :3]
-        moment = group_wrenches[:, :, 3:] + _cross(platform_point[:, None], force)
-        after = [min(k + 1, m - 1) for k in actuated]
-        wrenches[slots, :3] = force.reshape((-1, 3, count))
-        wrenches[slots, 3:] = moment.reshape((-1, 3, count))
-        inputs[slots] = twists[:, list(actuated)].reshape((-1, 6, count))
-        iti_points[slots] = points[:, after].reshape((-1, 3, count))
-        oti_points[slots] = np.broadcast_to(platform_point[:, None], (len(twists), len(actuated), 3, count)
-                                            ).reshape((-1, 3, count))
-    force_sq = _dot(wrenches[:, :3], wrenches[:, :3])
-    moment_sq = _dot(wrenches[:, 3:], wrenches[:, 3:])
-    has_force = force_sq > 1e-20 * moment_sq
-    scale = np.sqrt(np.where(has_force, force_sq, moment_sq))
-    has_force &= scale > 0
-    sign = np.sign(_dot(wrenches[:, :3], inputs[:, 3:]) + _dot(wrenches[:, 3:], inputs[:, :3]))
-    wrenches *= (np.where(sign < 0, -1.0, 1.0) / np.where(scale > 0, scale, np.inf))[:, None]
-    unit_force = has_force.astype(float)
-    iti_points = _project_on_axis(wrenches, unit_force, iti_points)
-    oti_points = _project_on_axis(wrenches, unit_force, oti_points)
-    return wrenches, inputs, has_force, iti_points, oti_points
-
-
-def _arm_operator(wrenches, has_force, points, basis):
-    """Per actuator the 3 x n map y -> v_p + h omega (y -> omega for a couple) for twists M^T y."""
-    omega = basis[:, :3]  # (n, 3, N)
-    velocity = basis[:, 3:]
-    force, moment = wrenches[:, :3], wrenches[:, 3:]
-    pitch = _dot(force, moment)  # unit force -> pitch = f . m
-    # (a, n, 3, N): v + omega x p + h omega for every basis twist.
-    arm = (velocity[None] + _cross(omega[None], points[:, None]) + pitch[:, None, None] * omega[None])
-    return np.where(has_force[:, None, None], arm, omega[None])
-
-
-def _power_coefficients(numerator, arm, reference, threshold):
-    """|A o T| / |A o T|_max with the zero cases: arm <= threshold * |omega| (incl. 0/0)."""
-    singular = arm <= threshold * reference
-    with np.errstate(divide="ignore", invalid="ignore"):
-        value = np.abs(numerator) / np.where(singular, 1.0, arm)
-    return np.where(singular, 0.0, np.minimum(value, 1.0))
-
-
-def _analyze_chunk(plan: _Plan, groups, centre, iti_override, oti_override, detail, keep_twists):
-    """All indices for one chunk; screws and points are given about ``centre`` (3, N), world axes."""
-    basis = _motion_basis(plan, groups)
-    wrenches, inputs, has_force, iti_points, oti_points = _actuation_wrenches(plan, groups, basis)
-    if iti_override is not None:
-        iti_points = iti_override
-    if oti_override is not None:
-        oti_points = oti_override
-    # ITI per actuator (Eq. 6) and overall (Eq. 7).
-    input_numerator = _dot(wrenches[:, :3], inputs[:, 3:]) + _dot(wrenches[:, 3:], inputs[:, :3])
-    input_omega = inputs[:, :3]
-    pitch = _dot(wrenches[:, :3], wrenches[:, 3:])
-    input_arm_vector = inputs[:, 3:] + _cross(input_omega, iti_points) + pitch[:, None] * input_omega
-    input_arm = np.where(has_force, np.sqrt(_dot(input_arm_vector, input_arm_vector)),
-                         np.sqrt(_dot(input_omega, input_omega)))
-    input_reference = np.where(has_force, np.sqrt(_dot(input_omega, input_omega)), 0.0)
-    iti_actuators = _power_coefficients(input_numerator, input_arm, input_reference, plan.threshold)
-    # Wrench matrix in motion coordinates: Q[k, q] = A_k o M_q.
-    wrench_matrix = np.einsum("acn,qcn->aqn", wrenches[:, :3], basis[:, 3:]) + np.einsum(
-        "acn,qcn->aqn", wrenches[:, 3:], basis[:, :3])
-    row_norms = np.sqrt(np.einsum("aqn,aqn->an", wrench_matrix, wrench_matrix))
-    arm = _arm_operator(wrenches, has_force, oti_points, basis)
-    # Every non-redundant submechanism once (Eq. 10): W = Q[N], output twists = adj(W) columns.
-    subs = plan.submechanisms
-    matrices = wrench_matrix[subs]  # (S, n rows, n, N)
-    det = determinant(matrices)
-    adj = adjugate(matrices)  # adj[s, q, p]: coordinate q of the output twist of position p
-    volume = np.prod(row_norms[subs], axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        independent = np.abs(det) > plan.rank_tolerance * volume
-    arm_length = np.empty(adj.shape[:1] + adj.shape[2:])  # (S, n, N)
-    for k, (sub_index, position) in enumerate(plan.appearances):
-        vectors = np.einsum("qcn,tqn->tcn", arm[k], adj[sub_index, :, position])
-        arm_length[sub_index, position] = np.sqrt(np.einsum("tcn,tcn->tn", vectors, vectors))
-    # |omega| of every output twist; a pure-couple wrench has no moment arm to compare.
-    omega_vectors = np.einsum("qcn,sqpn->spcn", basis[:, :3], adj)
-    omega_length = np.sqrt(np.einsum("spcn,spcn->spn", omega_vectors, omega_vectors))
-    omega_length = np.where(has_force[subs], omega_length, 0.0)
-    oti_actuators = _power_coefficients(det[:, None], arm_length, omega_length, plan.threshold)
-    oti_actuators = np.where(independent[:, None], oti_actuators, 0.0)
-    oti_sub = oti_actuators.min(axis=1)  # Eq. 9
-    # Mutual-interference actuators: the others alone fully constrain the platform.
-    a = len(plan.actuators)
-    mutual = np.stack([independent[members].any(axis=0) if members.size else np.zeros(det.shape[-1], bool)
-                       for members in plan.complement_members])
+    count = twists.shape[0]
+    a, (subs, n) = len(plan.actuators), plan.submechanisms.shape
     out = {
-        "iti": iti_actuators.min(axis=0),
-        "lmti": oti_sub.max(axis=0),
-        "mutual_interference": mutual,
+        "iti_actuators": np.zeros((count, a)),
+        "oti_actuators": np.zeros((count, subs, n)),
+        "independent": np.zeros((count, subs), dtype=bool),
+        "actuation_wrenches": np.zeros((count if detail else 0, a, 6)),
+        "output_twists": np.zeros((count if keep_twists else 0, subs, n, 6)),
+        "outside": np.zeros(count, dtype=bool),
     }
-    for j in plan.faults:
-        lmti_sets = oti_sub[plan.fault_members[j]].max(axis=1)  # (E, N), Eq. 11 on each E_i
-        worst = lmti_sets.argmin(axis=0)
-        out[f"f_o{j}"] = lmti_sets.min(axis=0)
-        remaining = plan.fault_sets[j][worst]  # (N, a-j)
-        failed = np.ones((remaining.shape[0], a), dtype=bool)
-        np.put_along_axis(failed, remaining, False, axis=1)
-        out[f"worst{j}"] = np.nonzero(failed)[1].reshape(-1, j).T
-    if detail:
-        # Back to the world origin: m_0 = m_c + c x f and v_0 = v_c - omega x c.
-        world_wrenches = wrenches.copy()
-        world_wrenches[:, 3:] += _cross(centre, wrenches[:, :3])
-        out.update(iti_actuators=iti_actuators, oti_actuators=oti_actuators, oti_submechanisms=oti_sub,
-                   actuation_wrenches=world_wrenches)
-        if keep_twists:
-            twists = np.einsum("sqpn,qcn->spcn", adj, basis)
-            twists[:, :, 3:] -= _cross(twists[:, :, :3], centre)
-            out["output_twists"] = twists
+    empty = np.empty((0, a, 3))
+    transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
+                        complement, plan.submechanisms, plan.threshold, plan.rank_tolerance,
+                        empty if iti_override is None else iti_override,
+                        empty if oti_override is None else oti_override,
+                        out["iti_actuators"], out["oti_actuators"], out["independent"],
+                        out["actuation_wrenches"], out["output_twists"], out["outside"])
     return out
 
 
-def _batch_last(array: NDArray, count: int) -> NDArray:
-    """(..., m, k) batch-first -> (m, k, N)."""
-    return np.moveaxis(array.reshape((count,) + array.shape[-2:]), 0, -1)
+def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists) -> dict:
+    """All indices for one chunk of configurations (batch-first arrays over all joints)."""
+    if plan.space.constant_basis is not None:
+        basis = plan.space.constant_basis[None]
+        out = _run_kernel(plan, twists, points, basis, plan.complement, iti_override, oti_override,
+                          detail, keep_twists)
+        redo = np.flatnonzero(out["outside"])
+    else:
+        out, redo = None, np.arange(twists.shape[0])
+    if redo.size:
+        # Configurations whose joint twists leave the constant space: their own motion space.
+        starts = plan.chain_start
+        chain_twists = [twists[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+        chain_points = [points[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+        centred, _, _ = _centred(chain_twists, chain_points)
+        _, bases = _null_spaces(centred, plan.dof, 1e-9)
+        again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
+                            None if iti_override is None else iti_override[redo],
+                            None if oti_override is None else oti_override[redo], detail, keep_twists)
+        if out is None:
+            out = again
+        else:
+            for key, value in again.items():
+                if out[key].shape[0]:
+                    out[key][redo] = value
+    oti_sub = out["oti_actuators"].min(axis=2)  # Eq. 9
+    result = {
+        "iti": out["iti_actuators"].min(axis=1),  # Eq. 7
+        "lmti": oti_sub.max(axis=1),  # Eq. 11 on the whole set
+        # Mutual-interference actuators: the others alone fully constrain the platform.
+        "mutual_interference": np.stack(
+            [out["independent"][:, members].any(axis=1) if members.size else np.zeros(oti_sub.shape[0], bool)
+             for members in plan.complement_members], axis=1),
+    }
+    for j in plan.faults:
+        lmti_sets = oti_sub[:, plan.fault_members[j]].max(axis=2)  # (N, E): Eq. 11 on each E_i
+        worst = lmti_sets.argmin(axis=1)
+        result[f"f_o{j}"] = np.take_along_axis(lmti_sets, worst[:, None], axis=1)[:, 0]  # Eq. 12
+        result[f"worst{j}"] = plan.failed_sets[j][worst]  # (N, j): the complement of the worst E_i
+    if detail:
+        result.update(iti_actuators=out["iti_actuators"], oti_actuators=out["oti_actuators"],
+                      oti_submechanisms=oti_sub, actuation_wrenches=out["actuation_wrenches"])
+        if keep_twists:
+            result["output_twists"] = out["output_twists"]
+    return result
 
 
 def analyze(
@@ -577,7 +391,7 @@ def analyze(
     oti_points: ArrayLike | None = None,
     detail: bool = True,
     keep_twists: bool = False,
-    chunk_size: int = 4096,
+    chunk_size: int = 65536,
     threads: int | None = None,
 ) -> TransmissionResult:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
@@ -640,7 +454,7 @@ def analyze(
     chunk_size : int
         Configurations per chunk (bounds memory).
     threads : int, optional
-        Threads working on chunks concurrently (default: the number of CPUs, at most 4).
+        Threads running chunks side by side (default: the number of CPUs).
 
     Returns
     -------
@@ -661,7 +475,7 @@ def analyze(
     if not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
     if threads is None:
-        threads = min(os.cpu_count() or 1, 4)
+        threads = os.cpu_count() or 1
     if not isinstance(threads, (int, np.integer)) or threads < 1:
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     plan = _make_plan(chains, dof, faults, threshold, rank_tolerance)
@@ -675,36 +489,30 @@ def analyze(
                 array = np.broadcast_to(array, batch_shape + (a, 3))
             except ValueError:
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
-            overrides[name] = _batch_last(array, count)
+            overrides[name] = np.ascontiguousarray(array.reshape(count, a, 3))
     twists = [chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains]
     points = [chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains]
 
     def run(start: int) -> dict:
         part = slice(start, min(start + chunk_size, count))
-        chunk_twists, chunk_points, centre = _centred([t[part] for t in twists], [p[part] for p in points])
-        # (c, m, 6, N) contiguous stacks of the chains of each group, batch last.
-        groups = [(key[1],
-                   np.ascontiguousarray(np.stack([chunk_twists[c] for c in members]).transpose(0, 2, 3, 1)),
-                   np.ascontiguousarray(np.stack([chunk_points[c] for c in members]).transpose(0, 2, 3, 1)))
-                  for key, members in zip(plan.group_keys, plan.group_members)]
-        centre = np.ascontiguousarray(centre.T)
         return _analyze_chunk(
-            plan, groups, centre,
-            overrides["iti_points"][..., part] - centre if "iti_points" in overrides else None,
-            overrides["oti_points"][..., part] - centre if "oti_points" in overrides else None,
+            plan, np.concatenate([t[part] for t in twists], axis=1), np.concatenate([p[part] for p in points], axis=1),
+            overrides["iti_points"][part] if "iti_points" in overrides else None,
+            overrides["oti_points"][part] if "oti_points" in overrides else None,
             detail, keep_twists)
 
+    # The compiled kernel releases the GIL: chunks run side by side on `threads` cores.
+    chunk_size = max(1, min(chunk_size, -(-count // threads)))
     starts = range(0, count, chunk_size)
     if threads > 1 and len(starts) > 1:
-        # numpy releases the GIL inside its kernels: chunks overlap on several cores.
         with ThreadPoolExecutor(max_workers=threads) as pool:
             pieces = list(pool.map(run, starts))
     else:
         pieces = [run(start) for start in starts]
-    merged = {key: np.concatenate([piece[key] for piece in pieces], axis=-1) for key in pieces[0]}
+    merged = {key: np.concatenate([piece[key] for piece in pieces], axis=0) for key in pieces[0]}
 
     def batch_first(array: NDArray) -> NDArray:
-        return np.moveaxis(array, -1, 0).reshape(batch_shape + array.shape[:-1])
+        return array.reshape(batch_shape + array.shape[1:])
 
     names = tuple(f"{chains[c].name or f'chain{c + 1}'}:{k}" for c, k in plan.actuators)
     return TransmissionResult(

@@ -1,0 +1,479 @@
+"""Compiled per-configuration kernel of :func:`screwkit.transmission.analyze`.
+
+One numba function walks a chunk of configurations in parallel and, for each, derives the
+actuation wrenches, the ITIs, and the output twists and OTIs of every non-redundant
+submechanism, exactly as documented in :func:`screwkit.transmission.analyze`. The small
+dense algebra (determinants, adjugates, null vectors, solves of at most 6x6 systems) is
+written out here so that nothing is allocated per configuration in the hot loop.
+
+Screws are ordered (omega, v) for twists and (f, m) for wrenches; all arrays are
+batch-first, expressed about the centroid of the platform joints of each configuration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+BLOCK = 64  # configurations sharing one set of scratch arrays
+
+
+@njit(cache=True, error_model="numpy")
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, error_model="numpy")
+def _determinant(matrix, size, work):
+    """Determinant of matrix[:size, :size] by LU with partial pivoting (``work`` is scratch)."""
+    if size == 1:
+        return matrix[0, 0]
+    if size == 2:
+        return matrix[0, 0] * matrix[1, 1] - matrix[0, 1] * matrix[1, 0]
+    if size == 3:
+        return (matrix[0, 0] * (matrix[1, 1] * matrix[2, 2] - matrix[1, 2] * matrix[2, 1])
+                - matrix[0, 1] * (matrix[1, 0] * matrix[2, 2] - matrix[1, 2] * matrix[2, 0])
+                + matrix[0, 2] * (matrix[1, 0] * matrix[2, 1] - matrix[1, 1] * matrix[2, 0]))
+    for i in range(size):
+        for j in range(size):
+            work[i, j] = matrix[i, j]
+    det = 1.0
+    for col in range(size):
+        pivot = col
+        best = abs(work[col, col])
+        for row in range(col + 1, size):
+            if abs(work[row, col]) > best:
+                best = abs(work[row, col])
+                pivot = row
+        if best == 0.0:
+            return 0.0
+        if pivot != col:
+            for j in range(size):
+                tmp = work[col, j]
+                work[col, j] = work[pivot, j]
+                work[pivot, j] = tmp
+            det = -det
+        det *= work[col, col]
+        for row in range(col + 1, size):
+            factor = work[row, col] / work[col, col]
+            for j in range(col + 1, size):
+                work[row, j] -= factor * work[col, j]
+    return det
+
+
+@njit(cache=True, error_model="numpy")
+def _adjugate(matrix, size, out, minor, work):
+    """out[:size, :size] = adj(matrix[:size, :size]) by cofactors (well defined when singular)."""
+    if size == 1:
+        out[0, 0] = 1.0
+        return
+    if size == 3:
+        # Column j is the cross product of the two rows other than j.
+        for j in range(3):
+            r = (j + 1) % 3
+            t = (j + 2) % 3
+            out[0, j] = matrix[r, 1] * matrix[t, 2] - matrix[r, 2] * matrix[t, 1]
+            out[1, j] = matrix[r, 2] * matrix[t, 0] - matrix[r, 0] * matrix[t, 2]
+            out[2, j] = matrix[r, 0] * matrix[t, 1] - matrix[r, 1] * matrix[t, 0]
+        return
+    for i in range(size):
+        for j in range(size):
+            # Cofactor C_ij: delete row i and column j; adj = C^T.
+            r = 0
+            for row in range(size):
+                if row == i:
+                    continue
+                c = 0
+                for col in range(size):
+                    if col == j:
+                        continue
+                    minor[r, c] = matrix[row, col]
+                    c += 1
+                r += 1
+            sign = 1.0 if (i + j) % 2 == 0 else -1.0
+            out[j, i] = sign * _determinant(minor, size - 1, work)
+
+
+@njit(cache=True, error_model="numpy")
+def _solve(matrix, size, rhs, out, work):
+    """Solve matrix[:size,:size] out = rhs by Gaussian elimination; returns False if singular.
+
+    Singular means a pivot at or below 1e-12 times the largest diagonal entry (the matrix
+    is a Gram matrix, positive semi-definite).
+    """
+    scale = 0.0
+    for i in range(size):
+        scale = max(scale, abs(matrix[i, i]))
+        for j in range(size):
+            work[i, j] = matrix[i, j]
+        out[i] = rhs[i]
+    for col in range(size):
+        pivot = col
+        best = abs(work[col, col])
+        for row in range(col + 1, size):
+            if abs(work[row, col]) > best:
+                best = abs(work[row, col])
+                pivot = row
+        if best <= 1e-12 * scale or best == 0.0:
+            return False
+        if pivot != col:
+            for j in range(size):
+                tmp = work[col, j]
+                work[col, j] = work[pivot, j]
+                work[pivot, j] = tmp
+            tmp = out[col]
+            out[col] = out[pivot]
+            out[pivot] = tmp
+        for row in range(col + 1, size):
+            factor = work[row, col] / work[col, col]
+            for j in range(col, size):
+                work[row, j] -= factor * work[col, j]
+            out[row] -= factor * out[col]
+    for row in range(size - 1, -1, -1):
+        total = out[row]
+        for j in range(row + 1, size):
+            total -= work[row, j] * out[j]
+        out[row] = total / work[row, row]
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _power_coefficient(numerator, arm, reference, threshold):
+    """|A o T| / |A o T|_max, zero when the moment arm is at or below threshold * |omega|."""
+    if arm <= threshold * reference or arm <= 0.0:
+        return 0.0
+    value = abs(numerator) / arm
+    return 1.0 if value > 1.0 else value
+
+
+@njit(nogil=True, cache=True, error_model="numpy")
+def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_joint, basis, complement,
+                        submechanisms, threshold, rank_tolerance, iti_override, oti_override,
+                        iti_out, oti_out, independent_out, wrench_out, twist_out, outside_out):
+    """Indices of a chunk of configurations.
+
+    Parameters (N configurations, J joints in all, C chains, a actuators, n DOF, S submechanisms)
+    ----------
+    twists (N, J, 6), points (N, J, 3) : joint screws and points, world frame.
+    chain_start (C + 1,) : joints of chain c are chain_start[c]:chain_start[c+1].
+    actuator_chain, actuator_joint (a,) : chain and joint (within the chain) of each actuator.
+    basis (1 or N, n, 6) : motion-space basis about the centroid (1: the same for all).
+    complement (6 - n, 6) : orthonormal complement of a constant basis, used to flag configurations
+        whose joint twists leave it (``outside_out``); they are recomputed with their own basis.
+    submechanisms (S, n) : actuator indices of each non-redundant submechanism.
+    iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller.
+    Outputs: iti_out (N, a), oti_out (N, S, n), independent_out (N, S) bool,
+        wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6), outside_out (N,) bool.
+    """
+    count = twists.shape[0]
+    joints = twists.shape[1]
+    chains = chain_start.shape[0] - 1
+    a = actuator_chain.shape[0]
+    n = basis.shape[1]
+    subs = submechanisms.shape[0]
+    constant = basis.shape[0] == 1
+    blocks = (count + BLOCK - 1) // BLOCK
+    for block in range(blocks):
+        local = np.empty((joints, 6))
+        local_points = np.empty((joints, 3))
+        motion = np.empty((n, 6))
+        shifted = np.empty((joints, 6))
+        shifted_basis = np.empty((n, 6))
+        rows = np.empty((6, 6))
+        gram = np.empty((6, 6))
+        work = np.empty((6, 6))
+        minor = np.empty((6, 6))
+        rhs = np.zeros(6)
+        solution = np.empty(6)
+        wrenches = np.empty((a, 6))
+        has_force = np.empty(a, dtype=np.bool_)
+        arms = np.empty((a, n, 3))
+        wrench_matrix = np.empty((a, n))
+        row_norms = np.empty(a)
+        matrix = np.empty((n, n))
+        adjugate = np.empty((n, n))
+        for index in range(block * BLOCK, min(count, (block + 1) * BLOCK)):
+            # --- centroid of the platform joints; everything below is expressed about it.
+            c0 = 0.0
+            c1 = 0.0
+            c2 = 0.0
+            for c in range(chains):
+                last = chain_start[c + 1] - 1
+                c0 += points[index, last, 0]
+                c1 += points[index, last, 1]
+                c2 += points[index, last, 2]
+            c0 /= chains
+            c1 /= chains
+            c2 /= chains
+            for j in range(joints):
+                w0, w1, w2 = twists[index, j, 0], twists[index, j, 1], twists[index, j, 2]
+                x0, x1, x2 = _cross(w0, w1, w2, c0, c1, c2)
+                local[j, 0] = w0
+                local[j, 1] = w1
+                local[j, 2] = w2
+                local[j, 3] = twists[index, j, 3] + x0
+                local[j, 4] = twists[index, j, 4] + x1
+                local[j, 5] = twists[index, j, 5] + x2
+                local_points[j, 0] = points[index, j, 0] - c0
+                local_points[j, 1] = points[index, j, 1] - c1
+                local_points[j, 2] = points[index, j, 2] - c2
+            source = 0 if constant else index
+            for q in range(n):
+                for k in range(6):
+                    motion[q, k] = basis[source, q, k]
+            # --- a constant basis must contain every joint twist.
+            if constant and complement.shape[0] > 0:
+                leaving = False
+                for j in range(joints):
+                    size = 0.0
+                    for k in range(6):
+                        size += local[j, k] * local[j, k]
+                    leak = 0.0
+                    for r in range(complement.shape[0]):
+                        dot = 0.0
+                        for k in range(6):
+                            dot += complement[r, k] * local[j, k]
+                        leak += dot * dot
+                    if leak > 1e-18 * max(size, 1.0):
+                        leaving = True
+                outside_out[index] = leaving
+                if leaving:
+                    continue
+            # --- actuation wrenches (one per actuator), in the representative documented in analyze().
+            for act in range(a):
+                chain = actuator_chain[act]
+                start = chain_start[chain]
+                m = chain_start[chain + 1] - start
+                own = start + actuator_joint[act]
+                last = start + m - 1
+                d0, d1, d2 = local_points[last, 0], local_points[last, 1], local_points[last, 2]
+                for j in range(m):  # chain twists about the platform joint point d
+                    w0, w1, w2 = local[start + j, 0], local[start + j, 1], local[start + j, 2]
+                    x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
+                    shifted[j, 0] = w0
+                    shifted[j, 1] = w1
+                    shifted[j, 2] = w2
+                    shifted[j, 3] = local[start + j, 3] + x0
+                    shifted[j, 4] = local[start + j, 4] + x1
+                    shifted[j, 5] = local[start + j, 5] + x2
+                f0 = f1 = f2 = 0.0
+                m0 = m1 = m2 = 0.0
+                if m == n:
+                    # SWAP M' x with x spanning null(J_passive'^T M').
+                    for q in range(n):
+                        w0, w1, w2 = motion[q, 0], motion[q, 1], motion[q, 2]
+                        x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
+                        shifted_basis[q, 0] = w0
+                        shifted_basis[q, 1] = w1
+                        shifted_basis[q, 2] = w2
+                        shifted_basis[q, 3] = motion[q, 3] + x0
+                        shifted_basis[q, 4] = motion[q, 4] + x1
+                        shifted_basis[q, 5] = motion[q, 5] + x2
+                    r = 0
+                    for j in range(m):
+                        if start + j == own:
+                            continue
+                        for q in range(n):
+                            total = 0.0
+                            for k in range(6):
+                                total += shifted[j, k] * shifted_basis[q, k]
+                            rows[r, q] = total
+                        r += 1
+                    for q in range(n):  # generalised cross product of the n - 1 rows
+                        if n == 3:
+                            r = (q + 1) % 3
+                            t = (q + 2) % 3
+                            coefficient = rows[0, r] * rows[1, t] - rows[0, t] * rows[1, r]
+                            f0 += coefficient * shifted_basis[q, 3]
+                            f1 += coefficient * shifted_basis[q, 4]
+                            f2 += coefficient * shifted_basis[q, 5]
+                            m0 += coefficient * shifted_basis[q, 0]
+                            m1 += coefficient * shifted_basis[q, 1]
+                            m2 += coefficient * shifted_basis[q, 2]
+                            continue
+                        for i in range(n - 1):
+                            col = 0
+                            for k in range(n):
+                                if k == q:
+                                    continue
+                                minor[i, col] = rows[i, k]
+                                col += 1
+                        sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
+                        coefficient = sign * _determinant(minor, n - 1, work) if n > 1 else 1.0
+                        f0 += coefficient * shifted_basis[q, 3]
+                        f1 += coefficient * shifted_basis[q, 4]
+                        f2 += coefficient * shifted_basis[q, 5]
+                        m0 += coefficient * shifted_basis[q, 0]
+                        m1 += coefficient * shifted_basis[q, 1]
+                        m2 += coefficient * shifted_basis[q, 2]
+                else:
+                    # Minimum-norm solution: SWAP J' (J'^T J')^-1 e_k.
+                    for i in range(m):
+                        for j in range(m):
+                            total = 0.0
+                            for k in range(6):
+                                total += shifted[i, k] * shifted[j, k]
+                            gram[i, j] = total
+                        rhs[i] = 0.0
+                    rhs[own - start] = 1.0
+                    regular = _solve(gram, m, rhs, solution, work)
+                    if not regular:
+                        # Dependent joint twists (an idle DoF): pseudo-inverse, kept if consistent.
+                        pseudo = np.linalg.pinv(gram[:m, :m].copy())
+                        worst = 0.0
+                        for i in range(m):
+                            solution[i] = pseudo[i, own - start]
+                        for i in range(m):
+                            total = 0.0
+                            for j in range(m):
+                                total += gram[i, j] * solution[j]
+                            worst = max(worst, abs(total - rhs[i]))
+                        largest = 1.0
+                        for i in range(m):
+                            largest = max(largest, abs(solution[i]))
+                        if worst > 1e-9 * largest:
+                            for i in range(m):
+                                solution[i] = 0.0
+                    for j in range(m):
+                        y = solution[j]
+                        f0 += y * shifted[j, 3]
+                        f1 += y * shifted[j, 4]
+                        f2 += y * shifted[j, 5]
+                        m0 += y * shifted[j, 0]
+                        m1 += y * shifted[j, 1]
+                        m2 += y * shifted[j, 2]
+                # Moment about the centroid: m_c = m_d + d x f.
+                x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)
+                m0 += x0
+                m1 += x1
+                m2 += x2
+                force_sq = f0 * f0 + f1 * f1 + f2 * f2
+                moment_sq = m0 * m0 + m1 * m1 + m2 * m2
+                forceful = force_sq > 1e-20 * moment_sq and force_sq > 0.0
+                scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
+                work_done = (f0 * local[own, 3] + f1 * local[own, 4] + f2 * local[own, 5]
+                             + m0 * local[own, 0] + m1 * local[own, 1] + m2 * local[own, 2])
+                factor = 0.0
+                if scale > 0.0:
+                    factor = (-1.0 if work_done < 0.0 else 1.0) / scale
+                wrenches[act, 0] = f0 * factor
+                wrenches[act, 1] = f1 * factor
+                wrenches[act, 2] = f2 * factor
+                wrenches[act, 3] = m0 * factor
+                wrenches[act, 4] = m1 * factor
+                wrenches[act, 5] = m2 * factor
+                forceful = forceful and scale > 0.0
+                has_force[act] = forceful
+                f0, f1, f2 = wrenches[act, 0], wrenches[act, 1], wrenches[act, 2]
+                m0, m1, m2 = wrenches[act, 3], wrenches[act, 4], wrenches[act, 5]
+                pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
+                # Characteristic points: projections on the wrench axis (unit force).
+                axis0, axis1, axis2 = _cross(f0, f1, f2, m0, m1, m2)
+                after = own + 1 if own < last else own
+                for which in range(2):
+                    if which == 0:
+                        if iti_override.shape[0] > 0:
+                            p0 = iti_override[index, act, 0] - c0
+                            p1 = iti_override[index, act, 1] - c1
+                            p2 = iti_override[index, act, 2] - c2
+                        else:
+                            p0, p1, p2 = local_points[after, 0], local_points[after, 1], local_points[after, 2]
+                    else:
+                        if oti_override.shape[0] > 0:
+                            p0 = oti_override[index, act, 0] - c0
+                            p1 = oti_override[index, act, 1] - c1
+                            p2 = oti_override[index, act, 2] - c2
+                        else:
+                            p0, p1, p2 = d0, d1, d2
+                    if forceful and ((which == 0 and iti_override.shape[0] == 0)
+                                     or (which == 1 and oti_override.shape[0] == 0)):
+                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+                        p0 = axis0 + along * f0
+                        p1 = axis1 + along * f1
+                        p2 = axis2 + along * f2
+                    if which == 0:
+                        # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
+                        w0, w1, w2 = local[own, 0], local[own, 1], local[own, 2]
+                        x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
+                        omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+                        if forceful:
+                            v0 = local[own, 3] + x0 + pitch * w0
+                            v1 = local[own, 4] + x1 + pitch * w1
+                            v2 = local[own, 5] + x2 + pitch * w2
+                            arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+                            reference = omega
+                        else:
+                            arm = omega
+                            reference = 0.0
+                        iti_out[index, act] = _power_coefficient(work_done * factor, arm, reference, threshold)
+                    else:
+                        # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega.
+                        for q in range(n):
+                            w0, w1, w2 = motion[q, 0], motion[q, 1], motion[q, 2]
+                            if forceful:
+                                x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
+                                arms[act, q, 0] = motion[q, 3] + x0 + pitch * w0
+                                arms[act, q, 1] = motion[q, 4] + x1 + pitch * w1
+                                arms[act, q, 2] = motion[q, 5] + x2 + pitch * w2
+                            else:
+                                arms[act, q, 0] = w0
+                                arms[act, q, 1] = w1
+                                arms[act, q, 2] = w2
+                # Row of the wrench matrix in motion coordinates: A_k o M_q.
+                norm = 0.0
+                for q in range(n):
+                    value = (f0 * motion[q, 3] + f1 * motion[q, 4] + f2 * motion[q, 5]
+                             + m0 * motion[q, 0] + m1 * motion[q, 1] + m2 * motion[q, 2])
+                    wrench_matrix[act, q] = value
+                    norm += value * value
+                row_norms[act] = np.sqrt(norm)
+                if wrench_out.shape[0] > 0:  # back to the world origin: m_0 = m_c + c x f
+                    x0, x1, x2 = _cross(c0, c1, c2, f0, f1, f2)
+                    wrench_out[index, act, 0] = f0
+                    wrench_out[index, act, 1] = f1
+                    wrench_out[index, act, 2] = f2
+                    wrench_out[index, act, 3] = m0 + x0
+                    wrench_out[index, act, 4] = m1 + x1
+                    wrench_out[index, act, 5] = m2 + x2
+            # --- every non-redundant submechanism once: output twists = adj(W) columns.
+            for s in range(subs):
+                volume = 1.0
+                for i in range(n):
+                    act = submechanisms[s, i]
+                    volume *= row_norms[act]
+                    for q in range(n):
+                        matrix[i, q] = wrench_matrix[act, q]
+                _adjugate(matrix, n, adjugate, minor, work)
+                det = 0.0  # expansion along the first row: W[0, :] . adj(W)[:, 0]
+                for q in range(n):
+                    det += matrix[0, q] * adjugate[q, 0]
+                dependent = not (abs(det) > rank_tolerance * volume)
+                independent_out[index, s] = not dependent
+                for position in range(n):
+                    act = submechanisms[s, position]
+                    a0 = a1 = a2 = 0.0
+                    o0 = o1 = o2 = 0.0
+                    for q in range(n):
+                        y = adjugate[q, position]
+                        a0 += arms[act, q, 0] * y
+                        a1 += arms[act, q, 1] * y
+                        a2 += arms[act, q, 2] * y
+                        o0 += motion[q, 0] * y
+                        o1 += motion[q, 1] * y
+                        o2 += motion[q, 2] * y
+                    arm = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+                    reference = np.sqrt(o0 * o0 + o1 * o1 + o2 * o2) if has_force[act] else 0.0
+                    oti_out[index, s, position] = 0.0 if dependent else _power_coefficient(
+                        det, arm, reference, threshold)
+                    if twist_out.shape[0] > 0:
+                        for k in range(6):
+                            total = 0.0
+                            for q in range(n):
+                                total += adjugate[q, position] * motion[q, k]
+                            twist_out[index, s, position, k] = total
+                        # v_0 = v_c - omega x c
+                        x0, x1, x2 = _cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
+                                            twist_out[index, s, position, 2], c0, c1, c2)
+                        twist_out[index, s, position, 3] -= x0
+                        twist_out[index, s, position, 4] -= x1
+                        twist_out[index, s, position, 5] -= x2
