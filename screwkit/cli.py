@@ -108,7 +108,7 @@ def pose_report(mechanism, pose, result) -> dict:
     angular = {"phi", "roll", "pitch", "yaw"}
     return {
         "mechanism": mechanism.name,
-        "pose": {name: float(np.rad2deg(value)) if name in angular else float(value)
+        "pose": {name: float(np.rad2deg(value)) + 0.0 if name in angular else float(value) + 0.0
                  for name, value in zip(mechanism.task_coordinates, pose)},
         "dof": result.dof,
         "actuators": names,
