@@ -62,36 +62,30 @@ def _determinant(matrix, size, work):
 
 
 @njit(cache=True, error_model="numpy")
-def _adjugate(matrix, size, out, minor, work):
-    """out[:size, :size] = adj(matrix[:size, :size]) by cofactors (well defined when singular)."""
+def _null_vector(rows, size, out, minor, work):
+    """out[:size] = generalised cross product of the size - 1 rows rows[:size-1, :size].
+
+    ``out[q] = (-1)^(size-1+q) det(rows without column q)``: orthogonal to every row, zero
+    exactly when the rows are dependent; for the rows of ``W`` other than row ``k`` it is
+    (up to sign) column ``k`` of ``adj(W)``.
+    """
     if size == 1:
-        out[0, 0] = 1.0
+        out[0] = 1.0
         return
     if size == 3:
-        # Column j is the cross product of the two rows other than j.
-        for j in range(3):
-            r = (j + 1) % 3
-            t = (j + 2) % 3
-            out[0, j] = matrix[r, 1] * matrix[t, 2] - matrix[r, 2] * matrix[t, 1]
-            out[1, j] = matrix[r, 2] * matrix[t, 0] - matrix[r, 0] * matrix[t, 2]
-            out[2, j] = matrix[r, 0] * matrix[t, 1] - matrix[r, 1] * matrix[t, 0]
+        out[0] = rows[0, 1] * rows[1, 2] - rows[0, 2] * rows[1, 1]
+        out[1] = rows[0, 2] * rows[1, 0] - rows[0, 0] * rows[1, 2]
+        out[2] = rows[0, 0] * rows[1, 1] - rows[0, 1] * rows[1, 0]
         return
-    for i in range(size):
-        for j in range(size):
-            # Cofactor C_ij: delete row i and column j; adj = C^T.
-            r = 0
-            for row in range(size):
-                if row == i:
-                    continue
-                c = 0
-                for col in range(size):
-                    if col == j:
-                        continue
-                    minor[r, c] = matrix[row, col]
-                    c += 1
-                r += 1
-            sign = 1.0 if (i + j) % 2 == 0 else -1.0
-            out[j, i] = sign * _determinant(minor, size - 1, work)
+    for q in range(size):
+        for i in range(size - 1):
+            col = 0
+            for k in range(size):
+                if k != q:
+                    minor[i, col] = rows[i, k]
+                    col += 1
+        sign = 1.0 if (size - 1 + q) % 2 == 0 else -1.0
+        out[q] = sign * _determinant(minor, size - 1, work)
 
 
 @njit(cache=True, error_model="numpy")
@@ -148,7 +142,7 @@ def _power_coefficient(numerator, arm, reference, threshold):
 
 @njit(nogil=True, cache=True, error_model="numpy")
 def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_joint, basis, complement,
-                        submechanisms, threshold, rank_tolerance, iti_override, oti_override,
+                        submechanisms, locked_sets, locked_of, threshold, rank_tolerance, iti_override, oti_override,
                         iti_out, oti_out, independent_out, wrench_out, twist_out, outside_out):
     """Indices of a chunk of configurations.
 
@@ -161,9 +155,13 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
     complement (6 - n, 6) : orthonormal complement of a constant basis, used to flag configurations
         whose joint twists leave it (``outside_out``); they are recomputed with their own basis.
     submechanisms (S, n) : actuator indices of each non-redundant submechanism.
+    locked_sets (L, n - 1) : every set of n - 1 actuators (locked while one other drives).
+    locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
+        the other n - 1 actuators of the submechanism.
     iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller.
     Outputs: iti_out (N, a), oti_out (N, S, n), independent_out (N, S) bool,
-        wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6), outside_out (N,) bool.
+        wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6) (output twists, scaled so that
+        |A_k o T_k| = |det W|), outside_out (N,) bool.
     """
     count = twists.shape[0]
     joints = twists.shape[1]
@@ -190,8 +188,9 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
         arms = np.empty((a, n, 3))
         wrench_matrix = np.empty((a, n))
         row_norms = np.empty(a)
-        matrix = np.empty((n, n))
-        adjugate = np.empty((n, n))
+        coefficients = np.empty(6)
+        output = np.empty((locked_sets.shape[0], n))
+        output_omega = np.empty(locked_sets.shape[0])
         for index in range(block * BLOCK, min(count, (block + 1) * BLOCK)):
             # --- centroid of the platform joints; everything below is expressed about it.
             c0 = 0.0
@@ -279,27 +278,9 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                                 total += shifted[j, k] * shifted_basis[q, k]
                             rows[r, q] = total
                         r += 1
-                    for q in range(n):  # generalised cross product of the n - 1 rows
-                        if n == 3:
-                            r = (q + 1) % 3
-                            t = (q + 2) % 3
-                            coefficient = rows[0, r] * rows[1, t] - rows[0, t] * rows[1, r]
-                            f0 += coefficient * shifted_basis[q, 3]
-                            f1 += coefficient * shifted_basis[q, 4]
-                            f2 += coefficient * shifted_basis[q, 5]
-                            m0 += coefficient * shifted_basis[q, 0]
-                            m1 += coefficient * shifted_basis[q, 1]
-                            m2 += coefficient * shifted_basis[q, 2]
-                            continue
-                        for i in range(n - 1):
-                            col = 0
-                            for k in range(n):
-                                if k == q:
-                                    continue
-                                minor[i, col] = rows[i, k]
-                                col += 1
-                        sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
-                        coefficient = sign * _determinant(minor, n - 1, work) if n > 1 else 1.0
+                    _null_vector(rows, n, coefficients, minor, work)
+                    for q in range(n):
+                        coefficient = coefficients[q]
                         f0 += coefficient * shifted_basis[q, 3]
                         f1 += coefficient * shifted_basis[q, 4]
                         f2 += coefficient * shifted_basis[q, 5]
@@ -435,41 +416,50 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                     wrench_out[index, act, 3] = m0 + x0
                     wrench_out[index, act, 4] = m1 + x1
                     wrench_out[index, act, 5] = m2 + x2
-            # --- every non-redundant submechanism once: output twists = adj(W) columns.
+            # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
+            # their wrenches (a column of adj(W) of every submechanism containing the set).
+            for locked in range(locked_sets.shape[0]):
+                for i in range(n - 1):
+                    for q in range(n):
+                        rows[i, q] = wrench_matrix[locked_sets[locked, i], q]
+                _null_vector(rows, n, coefficients, minor, work)
+                o0 = o1 = o2 = 0.0
+                for q in range(n):
+                    y = coefficients[q]
+                    output[locked, q] = y
+                    o0 += motion[q, 0] * y
+                    o1 += motion[q, 1] * y
+                    o2 += motion[q, 2] * y
+                output_omega[locked] = np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+            # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
             for s in range(subs):
                 volume = 1.0
+                det = 0.0
+                first = locked_of[s, 0]
                 for i in range(n):
-                    act = submechanisms[s, i]
-                    volume *= row_norms[act]
-                    for q in range(n):
-                        matrix[i, q] = wrench_matrix[act, q]
-                _adjugate(matrix, n, adjugate, minor, work)
-                det = 0.0  # expansion along the first row: W[0, :] . adj(W)[:, 0]
+                    volume *= row_norms[submechanisms[s, i]]
                 for q in range(n):
-                    det += matrix[0, q] * adjugate[q, 0]
+                    det += wrench_matrix[submechanisms[s, 0], q] * output[first, q]
                 dependent = not (abs(det) > rank_tolerance * volume)
                 independent_out[index, s] = not dependent
                 for position in range(n):
                     act = submechanisms[s, position]
+                    locked = locked_of[s, position]
                     a0 = a1 = a2 = 0.0
-                    o0 = o1 = o2 = 0.0
                     for q in range(n):
-                        y = adjugate[q, position]
+                        y = output[locked, q]
                         a0 += arms[act, q, 0] * y
                         a1 += arms[act, q, 1] * y
                         a2 += arms[act, q, 2] * y
-                        o0 += motion[q, 0] * y
-                        o1 += motion[q, 1] * y
-                        o2 += motion[q, 2] * y
                     arm = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-                    reference = np.sqrt(o0 * o0 + o1 * o1 + o2 * o2) if has_force[act] else 0.0
+                    reference = output_omega[locked] if has_force[act] else 0.0
                     oti_out[index, s, position] = 0.0 if dependent else _power_coefficient(
                         det, arm, reference, threshold)
                     if twist_out.shape[0] > 0:
                         for k in range(6):
                             total = 0.0
                             for q in range(n):
-                                total += adjugate[q, position] * motion[q, k]
+                                total += output[locked, q] * motion[q, k]
                             twist_out[index, s, position, k] = total
                         # v_0 = v_c - omega x c
                         x0, x1, x2 = _cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],

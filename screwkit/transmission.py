@@ -190,7 +190,7 @@ class TransmissionResult:
         Unit actuation wrenches (f, m), world frame.
     output_twists : ndarray (..., S, n, 6) or None
         Output twists (omega, v) of each actuator of each submechanism, scaled so that
-        ``A_k o T_k = det(W_N)`` (the adjugate columns).
+        ``|A_k o T_k| = |det(W_N)|`` (the adjugate columns, up to sign).
     """
 
     actuators: tuple[tuple[int, int], ...]
@@ -258,6 +258,8 @@ class _Plan:
     actuator_chain: NDArray[np.int64]
     actuator_joint: NDArray[np.int64]
     submechanisms: NDArray[np.int64]
+    locked_sets: NDArray[np.int64]
+    locked_of: NDArray[np.int64]
     faults: tuple[int, ...]
     fault_members: dict[int, NDArray[np.int64]]
     failed_sets: dict[int, NDArray[np.int64]]
@@ -297,6 +299,8 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         sets = fault_sets(a, n, j)
         fault_members[j] = np.array([[position[sub] for sub in combinations(remaining, n)] for remaining in sets])
         failed_sets[j] = np.array([sorted(set(range(a)) - set(e)) for e in sets], dtype=np.int64).reshape(-1, j)
+    locked = list(combinations(range(a), n - 1))
+    locked_index = {subset: index for index, subset in enumerate(locked)}
     complement_members = [np.array([s for s, sub in enumerate(submechanisms) if k not in sub], dtype=np.int64)
                           for k in range(a)]
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
@@ -306,6 +310,9 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         actuator_chain=np.array([c for c, _ in actuators], dtype=np.int64),
         actuator_joint=np.array([k for _, k in actuators], dtype=np.int64),
         submechanisms=np.array(submechanisms, dtype=np.int64).reshape(-1, n),
+        locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
+        locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
+                           dtype=np.int64).reshape(-1, n),
         faults=fault_list, fault_members=fault_members, failed_sets=failed_sets,
         complement_members=complement_members, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
 
@@ -325,7 +332,8 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
     }
     empty = np.empty((0, a, 3))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
-                        complement, plan.submechanisms, plan.threshold, plan.rank_tolerance,
+                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of,
+                        plan.threshold, plan.rank_tolerance,
                         empty if iti_override is None else iti_override,
                         empty if oti_override is None else oti_override,
                         out["iti_actuators"], out["oti_actuators"], out["independent"],
