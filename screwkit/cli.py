@@ -216,3 +216,142 @@ def verify(mechanism: str, samples: int, seed: int) -> None:
 
 def main() -> None:  # pragma: no cover - console entry point
     app()
+
+
+def _write_outputs(dataset, out, figure_path, figure_function) -> None:
+    from screwkit.maps import write_dataset
+    from screwkit.plots import save_figure
+
+    if out:
+        try:
+            write_dataset(dataset, out)
+        except ValueError as error:
+            raise click.ClickException(str(error)) from None
+        click.echo(f"wrote {out}", err=True)
+    if figure_path:
+        save_figure(figure_function(dataset), figure_path)
+        click.echo(f"wrote {figure_path}", err=True)
+
+
+def _range(text: str, name: str, angular: bool) -> np.ndarray:
+    from screwkit.sweep import parse_range
+
+    try:
+        values = parse_range(text, name)
+    except ValueError as error:
+        raise click.ClickException(str(error)) from None
+    return np.deg2rad(values) if angular else values
+
+
+def _fixed_pose(mechanism, at) -> np.ndarray:
+    """``--at``: all task coordinates, or for a planar mechanism just x y (phi from the home pose)."""
+    home = np.asarray(mechanism.home_pose, dtype=float)
+    if at is None:
+        return home
+    values = at.split()
+    if mechanism.is_planar and len(values) == 2:
+        values = values + [str(np.rad2deg(home[2]))]
+    return _pose(mechanism, " ".join(values))
+
+
+@app.command()
+@click.argument("mechanism")
+@click.option("--at", cls=GreedyOption, help="Fixed pose: all task coordinates (m, deg), or x y for a planar mechanism.")
+@click.option("--phi", "phi_range", help="Planar shorthand for --sweep phi:START:STOP:STEP (deg).")
+@click.option("--sweep", "sweep_spec", help="COORDINATE:START:STOP:STEP, e.g. yaw:0:360:1 (m or deg; stop exclusive).")
+@click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
+@click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file (.png, .pdf, .svg).")
+@click.option("--threshold", type=float, default=DEFAULT_THRESHOLD, show_default=True, help="Singularity threshold p (m).")
+@click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
+def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, closed_forms) -> None:
+    """Every series of the paper's Fig. 4 along one swept pose coordinate."""
+    from screwkit.analysis import angular_coordinates
+    from screwkit.plots import sweep_figure
+    from screwkit.sweep import sweep as run_sweep
+
+    loaded = _load(mechanism)
+    if (phi_range is None) == (sweep_spec is None):
+        raise click.ClickException("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
+    if phi_range is not None:
+        coordinate, text = "phi", phi_range
+    else:
+        coordinate, _, text = sweep_spec.partition(":")
+    if coordinate not in loaded.task_coordinates:
+        raise click.ClickException(f"Unknown coordinate {coordinate!r} to sweep; {loaded.name!r} has "
+                                   f"{', '.join(loaded.task_coordinates)}.")
+    angular = bool(angular_coordinates(loaded.task_coordinates)[loaded.task_coordinates.index(coordinate)])
+    values = _range(text, "--phi" if phi_range else "--sweep", angular)
+    try:
+        dataset = run_sweep(loaded, _fixed_pose(loaded, at), coordinate, values, threshold=threshold,
+                            closed_forms=closed_forms)
+    except ValueError as error:
+        raise click.ClickException(str(error)) from None
+    reachable = dataset["reachable"].values
+    click.echo(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} reachable)")
+    for name in ["iti", "lmti"] + [v for v in dataset.data_vars if v.startswith("f_o") or v.startswith("f_io")]:
+        series = dataset[name].values
+        if np.any(np.isfinite(series)):
+            at_min = dataset[coordinate].values[np.nanargmin(series)]
+            click.echo(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
+    _write_outputs(dataset, out, figure_path, sweep_figure)
+
+
+def _grid_spec(loaded, text: str):
+    from screwkit.analysis import angular_coordinates
+
+    name, _, rest = text.partition(":")
+    if name not in loaded.task_coordinates:
+        raise click.ClickException(f"Unknown coordinate {name!r} in {text!r}; {loaded.name!r} has "
+                                   f"{', '.join(loaded.task_coordinates)}.")
+    angular = bool(angular_coordinates(loaded.task_coordinates)[loaded.task_coordinates.index(name)])
+    return name, _range(rest, text, angular)
+
+
+@app.command("map")
+@click.argument("mechanism")
+@click.option("--radius", type=float, help="Planar: radius of the disc about the home position (m).")
+@click.option("--step", type=float, help="Planar: grid step in x and y (m).")
+@click.option("--phi-step", type=float, default=1.0, show_default=True, help="Planar: step of the full turn (deg).")
+@click.option("--grid", "grids", multiple=True, help="Spatial: COORDINATE:START:STOP:STEP, given twice (x axis, y axis).")
+@click.option("--over", "overs", multiple=True, help="Spatial: orientation set COORDINATE:START:STOP:STEP, repeatable.")
+@click.option("--at", cls=GreedyOption, help="Spatial: the other coordinates (all task coordinates; default home).")
+@click.option("--out", type=click.Path(dir_okay=False), help="netCDF file (.nc) or .csv.")
+@click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file.")
+@click.option("--threshold", type=float, default=DEFAULT_THRESHOLD, show_default=True, help="Singularity threshold p (m).")
+@click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
+@click.option("--scheduler", help="Address of a running dask.distributed scheduler (default: local threads).")
+@click.option("--quiet", is_flag=True, help="No progress output.")
+def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure_path, threshold, closed_forms,
+                scheduler, quiet) -> None:
+    """Minimum of every index over an orientation set at each point of a grid (Fig. 5).
+
+    Planar: --radius R --step S --phi-step D maps a disc about the home position with phi
+    over a full turn. Spatial: --grid x:-0.2:0.2:0.02 --grid y:-0.2:0.2:0.02
+    --over yaw:0:360:15 [--over roll:-10:10:5] [--at x y z roll pitch yaw].
+    """
+    from screwkit.maps import index_map, planar_disc_map
+    from screwkit.plots import map_figure
+
+    loaded = _load(mechanism)
+    progress = False if quiet else None
+    start = __import__("time").perf_counter()
+    try:
+        if radius is not None or step is not None:
+            if radius is None or step is None or grids or overs:
+                raise click.ClickException("A planar map takes --radius and --step (and --phi-step), not --grid/--over.")
+            dataset = planar_disc_map(loaded, radius, step, phi_step, threshold=threshold, closed_forms=closed_forms,
+                                      scheduler=scheduler, progress=progress)
+        else:
+            if len(grids) != 2:
+                raise click.ClickException("Expected --radius/--step (planar) or exactly two --grid options.")
+            grid = dict(_grid_spec(loaded, g) for g in grids)
+            over = dict(_grid_spec(loaded, o) for o in overs)
+            dataset = index_map(loaded, grid, over, _fixed_pose(loaded, at), threshold=threshold,
+                                closed_forms=closed_forms, scheduler=scheduler, progress=progress)
+    except ValueError as error:
+        raise click.ClickException(str(error)) from None
+    elapsed = __import__("time").perf_counter() - start
+    if not quiet:
+        click.echo(f"{loaded.name}: {dataset.attrs['configurations']:,} configurations in {elapsed:.2f} s "
+                   f"({dataset.attrs['method']})", err=True)
+    _write_outputs(dataset, out, figure_path, map_figure)

@@ -1,0 +1,288 @@
+"""Workspace maps: at each grid position, the minimum of every index over an orientation set.
+
+:func:`index_map` evaluates a 2-D grid of two task coordinates (the rest fixed) and, at
+each grid point, every pose of an orientation set (the product of ranges of other task
+coordinates); it keeps the minimum of the ITI, LMTI, F_Oj and F_IOj over the set, like the
+paper's Fig. 5. :func:`planar_disc_map` is the paper's case: x, y on a disc, phi over a
+full turn.
+
+The grid is cut into tasks run through Dask: the local threaded scheduler by default (no
+set-up), or a running ``dask.distributed`` cluster given by its scheduler address. Tasks
+are pure functions of their inputs (the URDF text travels with them), so a task lost with a
+worker is recomputed elsewhere; results are assembled only when every task is done, and
+files are written atomically.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import sys
+import time
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.analysis import angular_coordinates, indices_at_poses
+from screwkit.transmission import DEFAULT_THRESHOLD
+
+__all__ = ["index_map", "planar_disc_map", "write_dataset", "run_tasks"]
+
+CONFIGURATIONS_PER_TASK = 131_072
+
+
+@functools.lru_cache(maxsize=8)
+def _mechanism_from_text(digest: str, text: str, source: str):
+    from screwkit.mechanism import Mechanism
+    from screwkit.urdf import parse_urdf
+
+    return Mechanism(parse_urdf(text, source))
+
+
+def _portable(mechanism) -> tuple[str, str, str]:
+    """What a task needs to rebuild the mechanism anywhere: (digest, URDF text, source name)."""
+    text = mechanism.description.text
+    text = text if isinstance(text, str) else text.decode()
+    return hashlib.sha256(text.encode()).hexdigest(), text, str(mechanism.path)
+
+
+def map_task(portable, base_poses, over_axes, over_values, threshold, faults, closed_forms, threads=1) -> dict:
+    """Minimum of each index over the orientation set at each of the given grid poses.
+
+    Parameters
+    ----------
+    portable : tuple
+        From :func:`_portable`.
+    base_poses : ndarray (P, n_task)
+        Grid poses (the orientation coordinates are overwritten).
+    over_axes : tuple of int
+        Task coordinates making up the orientation set.
+    over_values : ndarray (K, len(over_axes))
+        Every orientation of the set.
+
+    Returns
+    -------
+    dict of ndarray (P,)
+        ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is
+        unreachable) and ``reachable_fraction``.
+    """
+    mechanism = _mechanism_from_text(*portable)
+    count, orientations = base_poses.shape[0], over_values.shape[0]
+    poses = np.repeat(base_poses[:, None, :], orientations, axis=1)
+    for column, axis in enumerate(over_axes):
+        poses[:, :, axis] = over_values[None, :, column]
+    result = indices_at_poses(mechanism, poses, threshold=threshold, faults=faults, closed_forms=closed_forms,
+                              threads=threads)
+    everywhere = result.reachable.all(axis=1)
+    out = {"reachable_fraction": result.reachable.mean(axis=1)}
+    named = {"iti": result.iti, "lmti": result.lmti}
+    for j in result.f_o:
+        named[f"f_o{j}"] = result.f_o[j]
+        named[f"f_io{j}"] = result.f_io[j]
+    for name, values in named.items():
+        out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
+    return out
+
+
+def run_tasks(function, arguments: list[tuple], *, scheduler: str | None = None, progress: bool | None = None,
+              label: str = "tasks") -> list:
+    """Run ``function(*args)`` for every tuple of ``arguments`` through Dask and return the results in order.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running ``dask.distributed`` scheduler (``tcp://host:8786``) or an
+        existing ``distributed.Client``; default: Dask's local threaded scheduler.
+    progress : bool, optional
+        A progress bar (tqdm, on stderr); default: only when stderr is a terminal.
+    """
+    if progress is None:
+        progress = sys.stderr.isatty()
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(arguments), desc=label, disable=not progress, file=sys.stderr, leave=False)
+    try:
+        if scheduler is None:
+            import dask
+            from dask.callbacks import Callback
+
+            class Counter(Callback):
+                def _posttask(self, key, result, dsk, state, worker_id):
+                    if isinstance(key, tuple) or str(key).startswith("task-"):
+                        bar.update(1)
+
+            tasks = [dask.delayed(function, pure=True)(*args, dask_key_name=f"task-{i}")
+                     for i, args in enumerate(arguments)]
+            with Counter():
+                return list(dask.compute(*tasks, scheduler="threads", num_workers=os.cpu_count() or 1))
+        from distributed import Client, as_completed
+
+        client = scheduler if isinstance(scheduler, Client) else Client(scheduler, set_as_default=False)
+        try:
+            futures = client.map(function, *zip(*arguments), pure=True, retries=3, key=[
+                f"screwkit-{hashlib.sha256(repr((function.__name__, i)).encode()).hexdigest()[:12]}-{time.time_ns()}"
+                for i in range(len(arguments))])
+            for _ in as_completed(futures):
+                bar.update(1)
+            return client.gather(futures)
+        finally:
+            if client is not scheduler:
+                client.close()
+    finally:
+        bar.close()
+
+
+def index_map(mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike], at: ArrayLike | None = None, *,
+              mask: NDArray[np.bool_] | None = None, threshold: float = DEFAULT_THRESHOLD, faults=None,
+              closed_forms: bool = False, scheduler: str | None = None, progress: bool | None = None,
+              configurations_per_task: int = CONFIGURATIONS_PER_TASK):
+    """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
+
+    Parameters
+    ----------
+    mechanism : screwkit.mechanism.Mechanism
+    grid : dict of str -> array_like
+        Exactly two task coordinates and their values (metres / radians); the first is the
+        map's x axis, the second its y axis.
+    over : dict of str -> array_like
+        The orientation set: task coordinates and their values; the set is their product.
+    at : array_like (n_task,), optional
+        Values of the other coordinates (default: the home pose).
+    mask : ndarray of bool, shape (len(y), len(x)), optional
+        Grid points to evaluate (others are NaN).
+    threshold, faults, closed_forms :
+        As in :func:`screwkit.analysis.indices_at_poses`.
+    scheduler : str, optional
+        ``dask.distributed`` scheduler address (default: local threads).
+    progress : bool, optional
+        Progress bar on stderr (default: when stderr is a terminal).
+
+    Returns
+    -------
+    xarray.Dataset
+        Coordinates named after the two grid coordinates (``x``, ``y`` for planar maps);
+        variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
+        orientation of the set) and ``reachable_fraction``.
+    """
+    import xarray as xr
+
+    names = mechanism.task_coordinates
+    if len(grid) != 2:
+        raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
+    for name in list(grid) + list(over):
+        if name not in names:
+            raise ValueError(f"Unknown task coordinate {name!r}; mechanism {mechanism.name!r} has {names}.")
+    if set(grid) & set(over):
+        raise ValueError(f"A coordinate cannot be both on the grid and in the orientation set: {set(grid) & set(over)}.")
+    (x_name, x_values), (y_name, y_values) = ((k, np.asarray(v, dtype=float)) for k, v in grid.items())
+    at = mechanism.check_poses(mechanism.home_pose if at is None else at)
+    over_axes = tuple(names.index(name) for name in over)
+    over_values = np.stack([g.ravel() for g in np.meshgrid(*[np.asarray(v, float) for v in over.values()],
+                                                           indexing="ij")], axis=-1) if over else np.zeros((1, 0))
+    x_grid, y_grid = np.meshgrid(x_values, y_values)
+    mask = np.ones(x_grid.shape, dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
+    if mask.shape != x_grid.shape:
+        raise ValueError(f"Expected `mask` with shape {x_grid.shape} (y, x), got {mask.shape}.")
+    positions = np.flatnonzero(mask.ravel())
+    base = np.repeat(at[None], positions.size, axis=0)
+    base[:, names.index(x_name)] = x_grid.ravel()[positions]
+    base[:, names.index(y_name)] = y_grid.ravel()[positions]
+    per_task = max(1, configurations_per_task // max(1, over_values.shape[0]))
+    portable = _portable(mechanism)
+    faults = None if faults is None else tuple(np.atleast_1d(faults).tolist())
+    arguments = [(portable, base[start:start + per_task], over_axes, over_values, threshold, faults, closed_forms)
+                 for start in range(0, positions.size, per_task)]
+    results = run_tasks(map_task, arguments, scheduler=scheduler, progress=progress, label="map")
+    variables = {}
+    keys = results[0].keys() if results else ("iti", "lmti", "reachable_fraction")
+    for key in keys:
+        values = np.full(x_grid.size, np.nan)
+        if results:
+            values[positions] = np.concatenate([r[key] for r in results])
+        variables[key] = ((y_name, x_name), values.reshape(x_grid.shape))
+    angular = angular_coordinates(names)
+
+    def shown(name, values):
+        return np.rad2deg(values) if angular[names.index(name)] else values
+
+    def unit(name):
+        return "deg" if angular[names.index(name)] else "m"
+
+    dataset = xr.Dataset(variables, coords={
+        x_name: (x_name, shown(x_name, x_values), {"units": unit(x_name)}),
+        y_name: (y_name, shown(y_name, y_values), {"units": unit(y_name)})})
+    for key in dataset.data_vars:
+        if key != "reachable_fraction":
+            dataset[key].attrs["long_name"] = f"minimum of {key} over the orientation set"
+    dataset.attrs.update(
+        mechanism=mechanism.name, threshold_m=threshold, method="closed forms" if closed_forms else "generic screw path",
+        orientation_set="; ".join(f"{name}: {len(np.unique(over_values[:, i]))} values from "
+                                  f"{shown(name, over_values[:, i].min()):g} to {shown(name, over_values[:, i].max()):g} {unit(name)}"
+                                  for i, name in enumerate(over)) or "the fixed pose only",
+        fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
+        configurations=int(positions.size * over_values.shape[0]))
+    return dataset
+
+
+def planar_disc_map(mechanism, radius: float, step: float, phi_step_degrees: float, *, centre=None, **options):
+    """The paper's Fig. 5 map: x, y on a disc about ``centre`` (default the home pose), phi over a full turn.
+
+    ``step`` is the grid spacing (m) and ``phi_step_degrees`` the angular step of the
+    rotation 0 <= phi < 360 deg. Other options as in :func:`index_map`.
+    """
+    if not mechanism.is_planar:
+        raise ValueError(f"planar_disc_map needs a planar mechanism; {mechanism.name!r} is spatial (use index_map).")
+    for name, value in (("radius", radius), ("step", step), ("phi_step_degrees", phi_step_degrees)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"Expected `{name}` > 0, got {value}.")
+    home = np.asarray(mechanism.home_pose, dtype=float)
+    centre = home[:2] if centre is None else np.asarray(centre, dtype=float)
+    count = int(np.floor(radius / step + 1e-9))
+    offsets = step * np.arange(-count, count + 1)
+    x_values, y_values = centre[0] + offsets, centre[1] + offsets
+    x_grid, y_grid = np.meshgrid(offsets, offsets)
+    mask = x_grid**2 + y_grid**2 <= radius**2 * (1 + 1e-12)
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
+    at = home.copy()
+    dataset = index_map(mechanism, {"x": x_values, "y": y_values}, {"phi": phi}, at, mask=mask, **options)
+    dataset.attrs.update(radius_m=radius, step_m=step, phi_step_deg=phi_step_degrees)
+    return dataset
+
+
+def _wide_table(dataset):
+    """A dataset as one row per point of its first dimension(s), one column per series.
+
+    One-dimensional variables are columns; a variable with one more dimension (e.g. the
+    ITI per actuator) gives one column per label, ``iti_actuator[chain_1:joint]``.
+    """
+    import pandas as pd
+
+    leading = [d for d in dataset.dims if not any(d in dataset[v].dims[1:] for v in dataset.data_vars)]
+    leading = [d for d in leading if all(d in dataset[v].dims for v in dataset.data_vars)] or [list(dataset.dims)[0]]
+    frame = dataset[[v for v in dataset.data_vars if set(dataset[v].dims) <= set(leading)]].to_dataframe().reset_index()
+    columns = {}
+    for name in dataset.data_vars:
+        extra = [d for d in dataset[name].dims if d not in leading]
+        if len(extra) == 1:
+            for label in dataset[extra[0]].values:
+                columns[f"{name}[{label}]"] = dataset[name].sel({extra[0]: label}).values.ravel()
+    return pd.concat([frame, pd.DataFrame(columns)], axis=1)
+
+
+def write_dataset(dataset, path) -> None:
+    """Write a netCDF (``.nc``) or CSV file atomically: a temporary file in the same folder, then rename."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    temporary = os.path.join(folder, f".{os.path.basename(path)}.tmp-{os.getpid()}-{time.time_ns()}")
+    try:
+        if path.endswith(".csv"):
+            _wide_table(dataset).to_csv(temporary, index=False)
+        elif path.endswith(".nc"):
+            dataset.to_netcdf(temporary, engine="scipy")
+        else:
+            raise ValueError(f"Expected an output file ending in .nc or .csv, got {path!r}.")
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
