@@ -1,0 +1,113 @@
+"""Indices of the bundled URDF mechanisms against independent computations.
+
+* spatial output twists against finite differences of the closure: lock all actuators of a
+  submechanism but one, move it slightly, re-solve the forward kinematics, compare the
+  platform's twist direction;
+* OTIs of UPS and RSS legs against the leg lines (null space by SVD, power coefficient);
+* the 4-RPR at its concurrent pose, the cooperative arms.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+import pytest
+
+from screwkit import screws
+from screwkit.analysis import analyze_pose
+from screwkit.kinematics import rotation_from_rpy
+from screwkit.mechanism import load
+from screwkit.robots import NAMED_POSES
+from screwkit.transmission import analyze
+
+
+def platform_twist(mechanism, pose_minus, pose_plus, step):
+    """World-frame twist (omega, v at the world origin) from two platform poses, central difference."""
+    rotation_world_base = mechanism.rotation_world_base
+    translation_world_base = mechanism.translation_world_base
+    frames = []
+    for pose in (pose_minus, pose_plus):
+        rotation, translation = mechanism.transforms_from_poses(pose)
+        frames.append((rotation_world_base @ rotation, rotation_world_base @ translation + translation_world_base))
+    (r0, p0), (r1, p1) = frames
+    delta = r1 @ r0.T
+    omega = np.array([delta[2, 1] - delta[1, 2], delta[0, 2] - delta[2, 0], delta[1, 0] - delta[0, 1]]) / 2 / (2 * step)
+    velocity_point = (p1 - p0) / (2 * step)
+    middle = (p0 + p1) / 2
+    return np.concatenate([omega, velocity_point - np.cross(omega, middle)])
+
+
+@pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
+def test_output_twists_match_finite_differences_of_the_closure(name):
+    mechanism = load(name)
+    pose = np.asarray(mechanism.home_pose, dtype=float) + np.array([0.02, -0.03, 0.05, 0.05, -0.04, 0.1])
+    result = analyze_pose(mechanism, pose)
+    solution = mechanism.solve(pose)
+    actuator_values = mechanism.actuator_values(solution.joint_values)
+    step = 1e-6
+    for s in (0, 7, 27):
+        sub = result.submechanisms[s]
+        for position, driven in enumerate(sub):
+            moved = []
+            for sign in (-1, 1):
+                values = actuator_values[list(sub)].copy()
+                values[position] += sign * step
+                moved.append(mechanism.forward(values, pose, actuators=list(sub)))
+            assert all(bool(m.reachable) for m in moved)
+            twist = platform_twist(mechanism, moved[0].poses, moved[1].poses, step)
+            expected = result.output_twists[s, position]
+            cosine = abs(twist @ expected) / np.linalg.norm(twist) / np.linalg.norm(expected)
+            assert cosine > 1 - 1e-6, (s, position, cosine)
+
+
+@pytest.mark.parametrize("name, rod_start", [("ups_hexapod_8", 0), ("rss_hexapod_8", 1)])
+def test_leg_otis_match_an_independent_formula(name, rod_start):
+    """The actuation wrench of a UPS (RSS) leg is the force along the leg (rod); OTIs from those lines."""
+    mechanism = load(name)
+    rng = np.random.default_rng(3)
+    poses = np.asarray(mechanism.home_pose, dtype=float) + rng.uniform(-0.05, 0.05, (20, 6))
+    solution = mechanism.solve(poses)
+    assert np.all(solution.reachable)
+    chains = mechanism.chain_screws(solution)
+    result = analyze(chains)
+    for index in range(0, 20, 5):
+        lines, tops = [], []
+        for chain in chains:
+            points = chain.points[index]
+            start, top = points[rod_start], points[-1]
+            direction = (top - start) / np.linalg.norm(top - start)
+            lines.append(np.concatenate([direction, np.cross(top, direction)]))
+            tops.append(top)
+        for s, sub in enumerate(result.submechanisms):
+            for position, k in enumerate(sub):
+                others = np.array([lines[i] for i in sub if i != k])
+                (twist,) = screws.reciprocal_complement(others)
+                expected = float(screws.power_coefficient(lines[k], twist[0], tops[k]))
+                assert result.oti_actuators[index, s, position] == pytest.approx(expected, abs=1e-9)
+
+
+def test_4rpr_concurrent_pose_names_the_non_mutual_interference_actuator():
+    mechanism = load("planar_4rpr")
+    result = analyze_pose(mechanism, NAMED_POSES["planar_4rpr"]["three_lines_concurrent"])
+    np.testing.assert_array_equal(result.mutual_interference, [True, True, True, False])
+    assert float(result.f_o[1]) < 1e-9
+    assert list(result.worst_faults[1]) == [3]
+    at_home = analyze_pose(mechanism, mechanism.home_pose)
+    assert np.all(at_home.mutual_interference) and float(at_home.f_o[1]) > 0.1
+
+
+def test_cooperative_arms_are_finite_and_frame_invariant():
+    mechanism = load("coop_arms")
+    rng = np.random.default_rng(5)
+    poses = np.asarray(mechanism.home_pose, dtype=float) + rng.uniform(-0.03, 0.03, (4, 6))
+    solution = mechanism.solve(poses)
+    assert np.all(solution.reachable)
+    world = analyze(mechanism.chain_screws(solution))
+    base = analyze(mechanism.chain_screws(solution, frame="base"))
+    assert world.dof == 6 and world.actuator_count == 12 and set(world.f_o) == set(range(1, 7))
+    assert np.all(np.isfinite(world.iti)) and np.all(np.isfinite(world.f_o[6]))
+    assert np.all(world.lmti > 0)
+    for j in world.f_o:
+        np.testing.assert_allclose(world.f_o[j], base.f_o[j], atol=1e-9)
+    np.testing.assert_allclose(world.iti_actuators, base.iti_actuators, atol=1e-9)
