@@ -355,3 +355,107 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
         click.echo(f"{loaded.name}: {dataset.attrs['configurations']:,} configurations in {elapsed:.2f} s "
                    f"({dataset.attrs['method']})", err=True)
     _write_outputs(dataset, out, figure_path, map_figure)
+
+
+@app.command("design-search")
+@click.argument("mechanism")
+@click.option("--permutations", "search_permutations", is_flag=True,
+              help="Rank every assignment of platform slots to chains in both working modes (the paper's selection).")
+@click.option("--optimise", is_flag=True, help="Maximise the fault-tolerant area over platform radius and arm lengths.")
+@click.option("--phi-step", type=float, default=1.0, show_default=True, help="Step of the full rotation (deg).")
+@click.option("--top", type=click.IntRange(min=1), default=12, show_default=True, help="Designs listed (report only).")
+@click.option("--level", type=float, default=0.4, show_default=True, help="--optimise: F_O1 level of the area.")
+@click.option("--maxiter", type=click.IntRange(min=1), default=15, show_default=True, help="--optimise: generations.")
+@click.option("--popsize", type=click.IntRange(min=2), default=8, show_default=True, help="--optimise: population factor.")
+@click.option("--step", type=float, default=0.05, show_default=True, help="--optimise: grid step of the area (m).")
+@click.option("--urdf", "urdf_path", type=click.Path(dir_okay=False), help="--optimise: write the best design here.")
+@click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="--optimise: maps of both designs.")
+@click.option("--closed-forms", is_flag=True, help="--permutations: score with the planar closed forms.")
+@click.option("--scheduler", help="Address of a running dask.distributed scheduler (default: local threads).")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@click.option("--quiet", is_flag=True, help="No progress output.")
+def design_search(mechanism, search_permutations, optimise, phi_step, top, level, maxiter, popsize, step, urdf_path,
+                  figure_path, closed_forms, scheduler, as_json, quiet) -> None:
+    """Search planar n-RRR designs for fault tolerance (score: min of F_O1 over a full rotation at the centre)."""
+    from screwkit import design as search
+
+    loaded = _load(mechanism)
+    if search_permutations == optimise:
+        raise click.ClickException("Expected exactly one of --permutations or --optimise.")
+    try:
+        template = search.planar_design(loaded)
+    except ValueError as error:
+        raise click.ClickException(str(error)) from None
+    current = tuple(int(s) for s in search.slots_of(template))
+    if search_permutations:
+        ranked = search.permutation_search(template, phi_step_degrees=phi_step, closed_forms=closed_forms,
+                                           scheduler=scheduler, progress=False if quiet else None)
+        best = ranked[0].score
+        rows = [{"permutation": list(d.permutation), "working_mode": d.working_mode, "score": d.score,
+                 "rank": 1 + sum(round(o.score, 9) > round(d.score, 9) for o in ranked if np.isfinite(o.score)),
+                 "rotation_class": list(search.rotation_class(d.permutation))} for d in ranked]
+        if as_json:
+            click.echo(json.dumps({"mechanism": loaded.name, "current": list(current), "phi_step_deg": phi_step,
+                                   "designs": rows}))
+            return
+        click.echo(f"{loaded.name}: {len(ranked)} designs (slot permutations x 2 working modes); score = min F_O1 "
+                   f"over a full rotation at the centre, {phi_step:g} deg steps")
+        click.echo(f"{'rank':>4s}  {'permutation':<18s} {'mode':>4s}  {'score':>7s}")
+        for row in rows[:top]:
+            mark = "  <- this file's design" if tuple(row["permutation"]) == current and row["working_mode"] == int(
+                template.working_mode[0]) else ""
+            click.echo(f"{row['rank']:>4d}  {str(row['permutation']):<18s} {row['working_mode']:>+4d}  "
+                       f"{row['score']:.4f}{mark}")
+        mine = next(r for r in rows if tuple(r["permutation"]) == current and r["working_mode"] == int(template.working_mode[0]))
+        click.echo(f"this file's design {list(current)} ranks {mine['rank']} (best score {best:.4f})")
+        return
+    design, area, result = search.optimise_design(template, current, level=level, step=step, maxiter=maxiter,
+                                                  popsize=popsize, phi_step_degrees=5.0)
+    reference_area, reference_grid = search.fault_tolerant_area(template, level=level, step=step)
+    _, best_grid = search.fault_tolerant_area(design, level=level, step=step)
+    summary = {"mechanism": loaded.name, "level": level, "permutation": list(current),
+               "reference": {"platform_radius": float(np.mean(np.linalg.norm(template.platform, axis=-1))),
+                             "upper": float(template.upper[0]), "lower": float(template.lower[0]), "area_m2": reference_area},
+               "optimised": {"platform_radius": float(result.x[0]), "upper": float(result.x[1]),
+                             "lower": float(result.x[2]), "area_m2": area},
+               "evaluations": int(result.nfev)}
+    if urdf_path:
+        from screwkit.robots.generate import planar_rrr_urdf
+
+        text = planar_rrr_urdf(f"{loaded.name}_optimised", design.base, design.platform, design.upper, design.lower,
+                               design.working_mode, comment=f" Optimised by screwkit design-search --optimise "
+                               f"(F_O1 >= {level} area {area:.4f} m^2) from {loaded.name} ")
+        from screwkit.maps import _atomic_text
+
+        _atomic_text(urdf_path, text)
+        summary["urdf"] = urdf_path
+    if figure_path:
+        _design_figure(reference_grid, best_grid, step, level, loaded.name, figure_path)
+        summary["figure"] = figure_path
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    ref, opt = summary["reference"], summary["optimised"]
+    click.echo(f"area where min F_O1 over a full rotation >= {level} (grid step {step} m):")
+    click.echo(f"  {loaded.name}: g = {ref['platform_radius']:.3f} m, a = {ref['upper']:.3f} m, l = {ref['lower']:.3f} m"
+               f" -> {ref['area_m2']:.4f} m^2")
+    click.echo(f"  optimised: g = {opt['platform_radius']:.3f} m, a = {opt['upper']:.3f} m, l = {opt['lower']:.3f} m"
+               f" -> {opt['area_m2']:.4f} m^2  ({summary['evaluations']} evaluations)")
+
+
+def _design_figure(reference, optimised, step, level, name, path) -> None:
+    from screwkit.plots import _pyplot, save_figure
+
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 2, figsize=(8, 3.6), constrained_layout=True)
+    extent = step * (reference.shape[0] // 2)
+    for ax, grid, title in ((axes[0], reference, name), (axes[1], optimised, "optimised")):
+        image = ax.imshow(np.ma.masked_invalid(grid), origin="lower", extent=(-extent, extent, -extent, extent),
+                          cmap="jet", vmin=0, vmax=1)
+        ax.contour(np.linspace(-extent, extent, grid.shape[1]), np.linspace(-extent, extent, grid.shape[0]),
+                   np.nan_to_num(grid), levels=[level], colors="white", linewidths=1.2)
+        ax.set_title(f"{title}: min F_O1 over rotation", fontsize=9)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    figure.colorbar(image, ax=axes, shrink=0.8)
+    save_figure(figure, path)

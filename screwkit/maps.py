@@ -270,6 +270,15 @@ def _wide_table(dataset):
     return pd.concat([frame, pd.DataFrame(columns)], axis=1)
 
 
+def _atomic_text(path, text: str) -> None:
+    """Write a text file atomically (temporary file in the same folder, then rename)."""
+    path = os.fspath(path)
+    temporary = os.path.join(os.path.dirname(os.path.abspath(path)), f".{os.path.basename(path)}.tmp-{os.getpid()}")
+    with open(temporary, "w", encoding="utf-8") as handle:
+        handle.write(text)
+    os.replace(temporary, path)
+
+
 def write_dataset(dataset, path) -> None:
     """Write a netCDF (``.nc``) or CSV file atomically: a temporary file in the same folder, then rename."""
     path = os.fspath(path)
