@@ -218,7 +218,7 @@ def main() -> None:  # pragma: no cover - console entry point
     app()
 
 
-def _write_outputs(dataset, out, figure_path, figure_function) -> None:
+def _write_outputs(dataset, out, figure_path, figure_function, quiet: bool = False) -> None:
     from screwkit.maps import write_dataset
     from screwkit.plots import save_figure
 
@@ -227,10 +227,12 @@ def _write_outputs(dataset, out, figure_path, figure_function) -> None:
             write_dataset(dataset, out)
         except ValueError as error:
             raise click.ClickException(str(error)) from None
-        click.echo(f"wrote {out}", err=True)
+        if not quiet:
+            click.echo(f"wrote {out}", err=True)
     if figure_path:
         save_figure(figure_function(dataset), figure_path)
-        click.echo(f"wrote {figure_path}", err=True)
+        if not quiet:
+            click.echo(f"wrote {figure_path}", err=True)
 
 
 def _range(text: str, name: str, angular: bool) -> np.ndarray:
@@ -354,7 +356,7 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
     if not quiet:
         click.echo(f"{loaded.name}: {dataset.attrs['configurations']:,} configurations in {elapsed:.2f} s "
                    f"({dataset.attrs['method']})", err=True)
-    _write_outputs(dataset, out, figure_path, map_figure)
+    _write_outputs(dataset, out, figure_path, map_figure, quiet)
 
 
 @app.command("design-search")

@@ -1,0 +1,176 @@
+"""Sweeps, workspace maps, Dask execution and design search."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+from click.testing import CliRunner
+
+from screwkit.cli import app
+from screwkit.closed_forms import planar_indices
+from screwkit.design import permutation_search, planar_design, rotation_class
+from screwkit.maps import index_map, planar_disc_map, write_dataset
+from screwkit.mechanism import load
+from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
+from screwkit.sweep import parse_range, sweep
+from screwkit.transmission import analyze
+
+
+@pytest.fixture(scope="module")
+def five():
+    return load("planar_5rrr")
+
+
+def hand_built_minimum(x, y, phi):
+    """Minimum over phi of each index at (x, y), from hand-built screws (independent of the URDF path)."""
+    poses = np.column_stack([np.full_like(phi, x), np.full_like(phi, y), phi])
+    base, elbows, distal, reachable = planar_joint_points(paper_5rrr(), poses)
+    if not reachable.all():
+        return None
+    result = analyze(rrr_chain_screws(base, elbows, distal), detail=False)
+    return {"iti": result.iti.min(), "lmti": result.lmti.min(), "f_o1": result.f_o[1].min(), "f_io1": result.f_io[1].min()}
+
+
+def test_parse_range():
+    assert parse_range("0:360:0.1").size == 3600
+    np.testing.assert_allclose(parse_range("0:1:0.25"), [0, 0.25, 0.5, 0.75])
+    with pytest.raises(ValueError, match=r"START:STOP:STEP \(three numbers\), got '0:1'"):
+        parse_range("0:1")
+    with pytest.raises(ValueError, match="STEP > 0"):
+        parse_range("0:1:-1")
+
+
+def test_sweep_at_the_centre_matches_fig_4(five):
+    phi = np.deg2rad(parse_range("0:360:0.1"))
+    dataset = sweep(five, [0, 0, 0], "phi", phi)
+    assert 0.600 < float(dataset["f_o1"].min()) < 0.601  # Fig. 4(d), 0.6005 at 0.1 deg
+    minimum = hand_built_minimum(0.0, 0.0, phi)
+    assert float(dataset["f_o1"].min()) == pytest.approx(minimum["f_o1"], abs=1e-12)
+    # F_O1 is the minimum over the 4-actuator sets of their LMTIs (Eq. 12), each the max of its OTIs.
+    np.testing.assert_allclose(dataset["f_o1"], dataset["lmti_remaining1"].min("remaining1"), atol=0)
+    np.testing.assert_allclose(dataset["lmti"], dataset["oti_submechanism"].max("submechanism"), atol=0)
+    assert dataset["lmti_remaining1"].sizes["remaining1"] == 5 and dataset["oti_submechanism"].sizes["submechanism"] == 10
+    closed = sweep(five, [0, 0, 0], "phi", phi, closed_forms=True)
+    np.testing.assert_allclose(dataset["f_o2"], closed["f_o2"], atol=1e-9)
+
+
+def test_disc_map_values_are_minima_over_the_rotation(five, tmp_path):
+    dataset = planar_disc_map(five, 2.0, 0.25, 15.0, progress=False)
+    assert set(dataset.coords) >= {"x", "y"}
+    assert {"iti", "lmti", "f_o1", "f_io1", "f_o2", "f_io2"} <= set(dataset.data_vars)
+    iti = dataset["iti"].values
+    assert np.isnan(iti).any() and np.isfinite(iti).any()  # unreachable far out, values inside
+    phi = np.deg2rad(np.arange(0, 360, 15.0))
+    for x, y in ((0.0, 0.0), (0.25, -0.5), (-0.75, 0.5), (1.75, 0.0)):
+        expected = hand_built_minimum(x, y, phi)
+        point = dataset.sel(x=x, y=y, method="nearest")
+        if expected is None:
+            assert np.isnan(float(point["iti"]))
+            continue
+        for name, value in expected.items():
+            assert float(point[name]) == pytest.approx(value, abs=1e-12)
+    closed = planar_disc_map(five, 2.0, 0.25, 15.0, closed_forms=True, progress=False)
+    for name in ("iti", "lmti", "f_o1", "f_io1"):
+        np.testing.assert_allclose(dataset[name], closed[name], atol=1e-9)
+    path = tmp_path / "map.nc"
+    write_dataset(dataset, path)
+    assert sorted(os.listdir(tmp_path)) == ["map.nc"]  # no temporary left behind
+    with xr.open_dataset(path) as reread:
+        np.testing.assert_array_equal(reread["f_o1"].values, dataset["f_o1"].values)
+
+
+def test_spatial_map_over_an_orientation_set():
+    hexapod = load("ups_hexapod_8")
+    grid = {"x": np.array([-0.1, 0.0, 0.1]), "y": np.array([-0.05, 0.05])}
+    over = {"yaw": np.deg2rad([0.0, 10.0, 20.0]), "roll": np.deg2rad([-5.0, 5.0])}
+    dataset = index_map(hexapod, grid, over, progress=False)
+    assert dataset["f_o1"].shape == (2, 3)
+    home = np.asarray(hexapod.home_pose, dtype=float)
+    poses = np.array([[0.1, -0.05, home[2], roll, 0.0, yaw] for yaw in over["yaw"] for roll in over["roll"]])
+    result = analyze(hexapod.chain_screws(hexapod.solve(poses)), detail=False)
+    assert float(dataset["f_o1"].sel(x=0.1, y=-0.05)) == pytest.approx(float(result.f_o[1].min()), abs=1e-12)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            yield client
+
+
+def test_distributed_map_equals_local(five, cluster):
+    """The same tasks give bit-identical results on a 2-worker cluster and on local threads."""
+    local = planar_disc_map(five, 0.4, 0.1, 10.0, progress=False, configurations_per_task=2000)
+    remote = planar_disc_map(five, 0.4, 0.1, 10.0, scheduler=cluster.scheduler.address, progress=False,
+                             configurations_per_task=2000)
+    for name in local.data_vars:
+        np.testing.assert_array_equal(local[name].values, remote[name].values)
+
+
+def test_a_worker_lost_mid_run_loses_nothing(five, cluster):
+    local = planar_disc_map(five, 0.5, 0.05, 10.0, progress=False, configurations_per_task=400)
+    outcome = {}
+
+    def run():
+        outcome["map"] = planar_disc_map(five, 0.5, 0.05, 10.0, scheduler=cluster, progress=False,
+                                         configurations_per_task=400)
+
+    before = cluster.run(os.getpid)
+    thread = threading.Thread(target=run)
+    thread.start()
+    deadline = time.time() + 60
+    while time.time() < deadline and not cluster.run_on_scheduler(
+            lambda dask_scheduler: sum(ts.state == "memory" for ts in dask_scheduler.tasks.values())):
+        time.sleep(0.05)
+    victim = sorted(before)[0]
+    os.kill(before[victim], signal.SIGKILL)  # a worker dies while tasks are queued and running
+    thread.join(timeout=180)
+    assert not thread.is_alive()
+    cluster.wait_for_workers(2, timeout=60)
+    after = cluster.run(os.getpid)
+    assert before[victim] not in after.values()  # the worker really was replaced
+    for name in local.data_vars:
+        np.testing.assert_array_equal(local[name].values, outcome["map"][name].values)
+
+
+def test_permutation_search_ranks_the_papers_design_first(five):
+    ranked = permutation_search(planar_design(five), phi_step_degrees=5.0, progress=False)
+    assert len(ranked) == 240
+    best = round(ranked[0].score, 9)
+    winners = {(d.permutation, d.working_mode) for d in ranked if round(d.score, 9) == best}
+    assert ((0, 3, 1, 4, 2), 1) in winners
+    # The winners are the paper's design, its slot rotations and its mirror working mode only.
+    assert {rotation_class(p) for p, _ in winners} == {rotation_class((0, 3, 1, 4, 2))}
+    assert ranked[0].permutation == (0, 3, 1, 4, 2) and ranked[0].working_mode == 1
+    # The score is the minimum of F_O1 over the rotation, recomputed with the closed forms.
+    phi = np.deg2rad(np.arange(0, 360, 5.0))
+    base, elbows, distal, _ = planar_joint_points(paper_5rrr(), np.column_stack([0 * phi, 0 * phi, phi]))
+    assert ranked[0].score == pytest.approx(planar_indices(base, elbows, distal)["f_o"][1].min(), abs=1e-12)
+
+
+def test_cli_sweep_map_and_design_search(tmp_path):
+    runner = CliRunner()
+    result = runner.invoke(app, ["sweep", "planar_5rrr", "--at", "0", "0", "--phi", "0:360:5", "--out",
+                                 str(tmp_path / "s.nc"), "--figure", str(tmp_path / "s.png")])
+    assert result.exit_code == 0, result.output
+    assert "min f_o1" in result.output and (tmp_path / "s.png").stat().st_size > 10_000
+    result = runner.invoke(app, ["map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--phi-step", "30",
+                                 "--out", str(tmp_path / "m.nc"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert result.output == ""  # --quiet: nothing on the terminal
+    with xr.open_dataset(tmp_path / "m.nc") as dataset:
+        assert dataset["f_o1"].dims == ("y", "x")
+    result = runner.invoke(app, ["design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json",
+                                 "--quiet"])
+    assert result.exit_code == 0, result.output
+    designs = json.loads(result.output)["designs"]
+    assert len(designs) == 240 and set(designs[0]) >= {"permutation", "working_mode", "score"}
+    assert designs[0]["permutation"] == [0, 3, 1, 4, 2]
