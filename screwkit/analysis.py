@@ -161,7 +161,7 @@ def indices_at_poses(mechanism, poses: ArrayLike, *, detail: bool = False, thres
 
 
 def planar_points(mechanism, solution):
-    """Planar joint points of every chain in the base frame, for the closed forms.
+    """Planar joint points of every chain in the base frame (reachable configurations), for the closed forms.
 
     Returns ``(base, elbows, distal, prismatic)``: arrays (N, k, 2) of the first, second and
     last joint points of each 3-joint planar chain, and whether the chains are RPR (actuated
@@ -169,24 +169,35 @@ def planar_points(mechanism, solution):
     """
     if not mechanism.is_planar:
         raise ValueError(f"The closed forms are planar: mechanism {mechanism.name!r} is spatial.")
-    screws = mechanism.chain_screws(solution, frame="base", unreachable="drop")
     kinds = set()
-    for chain, screw in zip(mechanism.chains, screws):
+    for chain in mechanism.chains:
         prismatic = tuple(chain.prismatic)
-        if screw.n_joints != 3 or screw.actuated not in ((0,), (1,)):
+        if chain.n_joints != 3 or chain.actuated not in ((0,), (1,)):
             raise ValueError(f"The closed forms need RRR or RPR chains with one actuator; chain {chain.name!r} "
-                             f"has {screw.n_joints} joints, actuated {screw.actuated}.")
-        if prismatic == (False, False, False) and screw.actuated == (0,):
+                             f"has {chain.n_joints} joints, actuated {chain.actuated}.")
+        if prismatic == (False, False, False) and chain.actuated == (0,):
             kinds.add("rrr")
-        elif prismatic == (False, True, False) and screw.actuated == (1,):
+        elif prismatic == (False, True, False) and chain.actuated == (1,):
             kinds.add("rpr")
         else:
             raise ValueError(f"The closed forms need RRR (base actuated) or RPR (prismatic actuated) chains; "
                              f"chain {chain.name!r} is not one.")
     if len(kinds) != 1:
         raise ValueError(f"The closed forms need chains of one kind, got {sorted(kinds)}.")
-    points = np.stack([s.points[..., :, :2] for s in screws], axis=-3)  # (N, k, 3, 2)
-    return points[..., 0, :], points[..., 1, :], points[..., 2, :], kinds == {"rpr"}
+    mask = np.asarray(solution.reachable).reshape(-1)
+    everything = bool(mask.all())
+    count = int(mask.size if everything else mask.sum())
+    # Joint points in the base frame, reachable configurations only, gathered into batch-last
+    # memory (joint, chain, component, N) and handed out as batch-first views (N, k, 2).
+    memory = np.empty((3, len(solution.joint_points), 2, count))
+    for chain, points in enumerate(solution.joint_points):
+        flat = points.reshape(-1, 3, 3)
+        for joint in range(3):
+            for component in range(2):
+                column = flat[:, joint, component]
+                memory[joint, chain, component] = column if everything else column[mask]
+    views = [np.moveaxis(memory[joint], -1, 0) for joint in range(3)]
+    return views[0], views[1], views[2], kinds == {"rpr"}
 
 
 def _closed_form_result(mechanism, solution, threshold, faults, threads):

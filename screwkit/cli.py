@@ -461,3 +461,7 @@ def _design_figure(reference, optimised, step, level, name, path) -> None:
         ax.set_ylabel("y (m)")
     figure.colorbar(image, ax=axes, shrink=0.8)
     save_figure(figure, path)
+
+
+if __name__ == "__main__":  # python -m screwkit.cli
+    app()

@@ -101,7 +101,7 @@ def run_tasks(function, arguments: list[tuple], *, scheduler: str | None = None,
         progress = sys.stderr.isatty()
     from tqdm import tqdm
 
-    bar = tqdm(total=len(arguments), desc=label, disable=not progress, file=sys.stderr, leave=False)
+    bar = tqdm(total=len(arguments), desc=label, disable=not progress, file=sys.stderr, leave=False, delay=2.0)
     try:
         if scheduler is None:
             import dask

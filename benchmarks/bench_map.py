@@ -1,0 +1,95 @@
+"""Wall time of the full workspace-map command, against a per-configuration loop.
+
+Usage: python benchmarks/bench_map.py [--large] [--loop-samples 300]
+
+1. ``screwkit map planar_5rrr --radius 0.6 --step 0.02 --phi-step 1`` (about 2,800 positions x
+   360 angles, 10^6 configurations, closure solving included) as a subprocess, timed from
+   start to exit, through the generic URDF path and through the planar closed forms; peak
+   resident memory of the command.
+2. With ``--large``: the same map at 0.1 deg steps (10^7 configurations), to show that memory
+   stays constant (the work is chunked).
+3. A straightforward per-configuration loop, as a user would write it by hand: for each pose
+   ``solve_one`` (closure), Pinocchio ``computeJointJacobians``, ``chain_screws`` and
+   ``analyze`` on that single configuration; its rate is measured on ``--loop-samples``
+   poses and compared with the batched generic path's rate in the same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+
+def run_command(arguments: list[str]) -> tuple[float, float]:
+    """Wall time (s) and peak resident memory (MB) of one screwkit command in a subprocess."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "screwkit.cli", *arguments], check=True)
+    elapsed = time.perf_counter() - start
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return elapsed, max(peak, before) / 1024
+
+
+def per_configuration_rate(samples: int) -> float:
+    import pinocchio
+
+    from screwkit.mechanism import load
+    from screwkit.transmission import analyze
+
+    mechanism = load("planar_5rrr")
+    data = mechanism.model.createData()
+    rng = np.random.default_rng(0)
+    radius = 0.6 * np.sqrt(rng.uniform(0, 1, samples))
+    angle = rng.uniform(0, 2 * np.pi, samples)
+    poses = np.column_stack([radius * np.cos(angle), radius * np.sin(angle), rng.uniform(0, 2 * np.pi, samples)])
+    analyze(mechanism.chain_screws(mechanism.solve_one(poses[0])))  # warm up
+    start = time.perf_counter()
+    done = 0
+    for pose in poses:
+        try:
+            solution = mechanism.solve_one(pose)
+        except ValueError:
+            continue
+        q = mechanism.configuration_vector(solution.joint_values, solution.poses)
+        pinocchio.computeJointJacobians(mechanism.model, data, q)
+        analyze(mechanism.chain_screws(solution), threads=1)
+        done += 1
+    return len(poses) / (time.perf_counter() - start)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--large", action="store_true", help="also run the 10^7-configuration map")
+    parser.add_argument("--loop-samples", type=int, default=300)
+    args = parser.parse_args()
+    folder = tempfile.mkdtemp()
+    out = os.path.join(folder, "map.nc")
+    common = ["map", "planar_5rrr", "--radius", "0.6", "--step", "0.02", "--out", out, "--quiet"]
+    run_command(common + ["--phi-step", "30"])  # warm the compiled-kernel cache
+    configurations = 2821 * 360
+    generic, generic_memory = run_command(common + ["--phi-step", "1"])
+    closed, closed_memory = run_command(common + ["--phi-step", "1", "--closed-forms"])
+    print(f"map 0.6 m / 0.02 m / 1 deg ({configurations:,} configurations), whole command, wall:")
+    print(f"  generic URDF path : {generic:6.2f} s  ({configurations / generic:,.0f} configurations/s), "
+          f"peak memory {generic_memory:,.0f} MB")
+    print(f"  planar closed forms: {closed:6.2f} s  ({configurations / closed:,.0f} configurations/s), "
+          f"peak memory {closed_memory:,.0f} MB")
+    loop = per_configuration_rate(args.loop_samples)
+    print(f"per-configuration loop (solve_one + Pinocchio Jacobians + chain_screws + analyze): "
+          f"{loop:,.0f} configurations/s")
+    print(f"batched generic command / per-configuration loop: {configurations / generic / loop:,.0f}x")
+    if args.large:
+        large, large_memory = run_command(["map", "planar_5rrr", "--radius", "0.6", "--step", "0.02", "--phi-step",
+                                           "0.1", "--out", out, "--quiet"])
+        print(f"  10^7 configurations (0.1 deg): {large:6.1f} s, peak memory {large_memory:,.0f} MB")
+
+
+if __name__ == "__main__":
+    main()
