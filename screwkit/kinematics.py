@@ -39,7 +39,10 @@ spherical  3     rotation ``exp([r])`` with ``r`` the rotation vector (3 values)
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,7 +51,8 @@ LOOP_JOINT_DOFS = {"fixed": 0, "revolute": 1, "continuous": 1, "prismatic": 1, "
 """Number of DoFs a loop joint of each supported type adds to its chain."""
 
 _IDENTITY = np.eye(3)
-_BLOCK = 1 << 16  # configurations per block in the closed-form fast paths
+_BLOCK = 1 << 15  # configurations per block in the closed-form fast paths
+_WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads for blocks (numpy releases the GIL)
 
 
 # ----------------------------------------------------------------------------------------
@@ -59,7 +63,10 @@ _BLOCK = 1 << 16  # configurations per block in the closed-form fast paths
 def wrap_angle(angles: ArrayLike) -> NDArray[np.float64]:
     """Wrap angles to the interval (-pi, pi]."""
     angles = np.asarray(angles, dtype=float)
-    return np.pi - np.mod(np.pi - angles, 2.0 * np.pi)
+    wrapped = angles - (2.0 * np.pi) * np.round(angles * (0.5 / np.pi))
+    if wrapped.size and np.min(wrapped) <= -np.pi:
+        wrapped = np.where(wrapped <= -np.pi, wrapped + 2.0 * np.pi, wrapped)
+    return wrapped
 
 
 def skew_matrix(vectors: ArrayLike) -> NDArray[np.float64]:
@@ -105,7 +112,6 @@ def rotation_vector_from_rotation(rotations: ArrayLike) -> NDArray[np.float64]:
     """
     rotations = np.asarray(rotations, dtype=float)
     cosine = np.clip((np.trace(rotations, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(cosine)
     vee = np.stack(
         [
             rotations[..., 2, 1] - rotations[..., 1, 2],
@@ -114,6 +120,7 @@ def rotation_vector_from_rotation(rotations: ArrayLike) -> NDArray[np.float64]:
         ],
         -1,
     )
+    angle = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), cosine)  # accurate near 0 and near pi
     small = angle < 1e-4
     scale = np.where(small, 0.5 + angle**2 / 12.0, angle / (2.0 * np.where(small, 1.0, np.sin(angle))))
     result = scale[..., None] * vee
@@ -222,7 +229,7 @@ def two_axis_pointing(
     -------
     first_angles, second_angles : ndarray, shape (...,)
     gap : ndarray, shape (...,)
-        Negative where ``goal`` cannot be reached (how far ``gamma^2`` is below zero), else 0.
+        Negative where ``goal`` cannot be reached (how far ``gamma^2`` is below -1e-12), else 0.
     """
     cross_axes = np.cross(first_axis, second_axis)
     axes_cosine = np.sum(first_axis * second_axis, -1)
@@ -232,7 +239,7 @@ def two_axis_pointing(
     gamma_squared = (
         np.sum(start * start, -1) - alpha**2 - beta**2 - 2.0 * alpha * beta * axes_cosine
     ) / np.sum(cross_axes * cross_axes, -1)
-    gap = np.minimum(gamma_squared, 0.0)
+    gap = np.where(gamma_squared < -1e-12, gamma_squared, 0.0)  # round-off at the boundary is reachable
     gamma = branch * np.sqrt(np.maximum(gamma_squared, 0.0))
     intermediate = alpha[..., None] * first_axis + beta[..., None] * second_axis + gamma[..., None] * cross_axes
     second_angles = rotation_angle_to_align(second_axis, start, intermediate)
@@ -308,7 +315,8 @@ class ChainFrames:
     axes : ndarray, shape (..., m, 3)
         Unit direction of each joint DoF (rotation axis or sliding direction).
     points : ndarray, shape (..., m, 3)
-        Origin of each joint DoF's frame (on the axis for revolute DoFs).
+        Origin of each joint DoF's frame after its motion, as Pinocchio's ``oMi`` (on the axis
+        for revolute DoFs; a prismatic joint's origin moves with the slider).
     leg_rotation, leg_translation : ndarray, shapes (..., 3, 3) and (..., 3)
         Leg-side loop frame.
     end_rotation, end_translation : ndarray, shapes (..., 3, 3) and (..., 3)
@@ -324,11 +332,31 @@ class ChainFrames:
     end_translation: NDArray[np.float64]
 
 
+def _times_constant(matrices: NDArray, constant: NDArray) -> NDArray:
+    """``matrices @ constant`` for a batch (..., 3, 3) and one (3,) or (3, k) array, as one BLAS call."""
+    shape = matrices.shape
+    if matrices.size == 0:
+        return np.empty(shape[:-1] + constant.shape[1:])
+    if all(stride == 0 for stride in matrices.strides[:-2]):  # one matrix broadcast over the batch
+        return np.broadcast_to(matrices[(0,) * (matrices.ndim - 2)] @ constant, shape[:-1] + constant.shape[1:])
+    product = np.ascontiguousarray(matrices).reshape(-1, 3) @ constant
+    return product.reshape(shape[:-1] + constant.shape[1:])
+
+
+def _turn(rotation: NDArray, axis: NDArray, angles: NDArray) -> NDArray:
+    """``rotation @ Rot(axis, angles)`` = ``R + sin q (R [a]) + (1 - cos q) (R [a]^2)``, batched."""
+    skew = skew_matrix(axis)
+    sine = np.sin(angles)[..., None, None]
+    versine = (1.0 - np.cos(angles))[..., None, None]
+    return rotation + sine * _times_constant(rotation, skew) + versine * _times_constant(rotation, skew @ skew)
+
+
 def chain_forward_kinematics(geometry: ChainGeometry, joint_values: ArrayLike) -> ChainFrames:
     """Forward kinematics of one chain for a batch of joint values (..., m), base frame.
 
     Product of exponentials over the tree joints (each placement then the joint motion),
-    then the loop-joint motion (see the module docstring for the loop types).
+    then the loop-joint motion (see the module docstring for the loop types). Products with
+    the constant placements are single BLAS calls over the whole batch.
     """
     joint_values = np.asarray(joint_values, dtype=float)
     if joint_values.shape[-1:] != (geometry.n_dofs,):
@@ -342,41 +370,42 @@ def chain_forward_kinematics(geometry: ChainGeometry, joint_values: ArrayLike) -
     rotation = np.broadcast_to(_IDENTITY, batch + (3, 3))
     translation = np.zeros(batch + (3,))
     for index in range(geometry.n_tree_joints):
-        translation = translation + rotation @ geometry.joint_translations[index]
-        rotation = rotation @ geometry.joint_rotations[index]
-        axis = rotation @ geometry.joint_axes[index]
+        translation = translation + _times_constant(rotation, geometry.joint_translations[index])
+        rotation = _times_constant(rotation, geometry.joint_rotations[index])
+        axis = _times_constant(rotation, geometry.joint_axes[index])
         axes[..., index, :] = axis
-        points[..., index, :] = translation
         if geometry.joint_prismatic[index]:
             translation = translation + axis * joint_values[..., index, None]
+            points[..., index, :] = translation  # the joint frame origin moves with the slider
         else:
-            rotation = rotation @ rotation_about_axis(geometry.joint_axes[index], joint_values[..., index])
-    translation = translation + rotation @ geometry.leg_loop_translation
-    rotation = rotation @ geometry.leg_loop_rotation
+            points[..., index, :] = translation
+            rotation = _turn(rotation, geometry.joint_axes[index], joint_values[..., index])
+    translation = translation + _times_constant(rotation, geometry.leg_loop_translation)
+    rotation = _times_constant(rotation, geometry.leg_loop_rotation)
     leg_rotation, leg_translation = rotation, translation
     loop_values = joint_values[..., geometry.n_tree_joints :]
     start = geometry.n_tree_joints
     loop_type = geometry.loop_type
     if loop_type in ("revolute", "continuous"):
-        axes[..., start, :] = rotation @ geometry.loop_axes[0]
+        axes[..., start, :] = _times_constant(rotation, geometry.loop_axes[0])
         points[..., start, :] = translation
-        rotation = rotation @ rotation_about_axis(geometry.loop_axes[0], loop_values[..., 0])
+        rotation = _turn(rotation, geometry.loop_axes[0], loop_values[..., 0])
     elif loop_type == "prismatic":
-        axis = rotation @ geometry.loop_axes[0]
+        axis = _times_constant(rotation, geometry.loop_axes[0])
         axes[..., start, :] = axis
-        points[..., start, :] = translation
         translation = translation + axis * loop_values[..., 0, None]
+        points[..., start, :] = translation
     elif loop_type == "universal":
-        axes[..., start, :] = rotation @ geometry.loop_axes[0]
+        axes[..., start, :] = _times_constant(rotation, geometry.loop_axes[0])
         points[..., start : start + 2, :] = translation[..., None, :]
-        rotation = rotation @ rotation_about_axis(geometry.loop_axes[0], loop_values[..., 0])
-        axes[..., start + 1, :] = rotation @ geometry.loop_axes[1]
-        rotation = rotation @ rotation_about_axis(geometry.loop_axes[1], loop_values[..., 1])
+        rotation = _turn(rotation, geometry.loop_axes[0], loop_values[..., 0])
+        axes[..., start + 1, :] = _times_constant(rotation, geometry.loop_axes[1])
+        rotation = _turn(rotation, geometry.loop_axes[1], loop_values[..., 1])
     elif loop_type == "spherical":
         axes[..., start : start + 3, :] = np.swapaxes(rotation, -1, -2)
         points[..., start : start + 3, :] = translation[..., None, :]
         rotation = rotation @ rotation_from_rotation_vector(loop_values)
-    return ChainFrames(axes, points, leg_rotation, leg_translation, np.asarray(rotation), translation)
+    return ChainFrames(axes, points, leg_rotation, leg_translation, np.asarray(rotation), np.asarray(translation))
 
 
 def loop_values_from_relative_transform(
@@ -431,6 +460,29 @@ def loop_values_from_relative_transform(
     return values, position_residual, rotation_residual
 
 
+def _constant_value(plane: NDArray) -> float | None:
+    """The value of a plane that is one number broadcast (all strides 0), else None."""
+    if plane.ndim == 0 or all(stride == 0 for stride in plane.strides):
+        return float(plane.flat[0]) if plane.size else 0.0
+    return None
+
+
+def _linear_combination(out: NDArray, terms: list) -> None:
+    """``out = sum(coefficient * plane)``; coefficients are arrays or numbers, zero numbers skipped.
+
+    ``out`` must hold zeros on entry (it is left untouched when every term vanishes).
+    """
+    first = True
+    for coefficient, plane in terms:
+        if isinstance(coefficient, float) and coefficient == 0.0:
+            continue
+        if first:
+            np.multiply(plane, coefficient, out=out)
+            first = False
+        else:
+            out += coefficient * plane
+
+
 def twists_from_axes_and_points(
     axes: NDArray, points: NDArray, prismatic: tuple[bool, ...] | NDArray
 ) -> NDArray[np.float64]:
@@ -440,27 +492,38 @@ def twists_from_axes_and_points(
 
         \\hat\\$_{revolute} = (a,\\; p \\times a), \\qquad \\hat\\$_{prismatic} = (0,\\; a)
 
-    The result is computed and stored component by component (component-major memory),
-    which is several times faster than interleaved storage for large batches; it is
-    returned as a (..., m, 6) view.
+    The result is computed and stored component by component (component-major memory,
+    returned as a (..., m, 6) view), which is several times faster than interleaved storage
+    for large batches; axis components that are one broadcast number (as for the planar
+    closed forms) are used as numbers and zero ones are skipped.
     """
     axes_components = np.moveaxis(np.asarray(axes, dtype=float), (-1, -2), (0, 1))
     points_components = np.moveaxis(np.asarray(points, dtype=float), (-1, -2), (0, 1))
     prismatic = np.asarray(prismatic, dtype=bool)
     n_joints = axes_components.shape[1]
     batch = np.broadcast_shapes(axes_components.shape[2:], points_components.shape[2:])
-    twists = np.empty((6, n_joints) + batch)
+    twists = np.zeros((6, n_joints) + batch)
     for joint in range(n_joints):
-        ax, ay, az = axes_components[0, joint], axes_components[1, joint], axes_components[2, joint]
+        axis = []
+        for component in range(3):
+            plane = axes_components[component, joint]
+            constant = _constant_value(plane)
+            axis.append(plane if constant is None else constant)
+        angular_rows = range(3, 6) if prismatic[joint] else range(3)
+        for row, value in zip(angular_rows, axis):
+            if isinstance(value, float):
+                if value != 0.0:
+                    twists[row, joint] = value
+            else:
+                twists[row, joint] = value
         if prismatic[joint]:
-            twists[0:3, joint] = 0.0
-            twists[3, joint], twists[4, joint], twists[5, joint] = ax, ay, az
-        else:
-            px, py, pz = points_components[0, joint], points_components[1, joint], points_components[2, joint]
-            twists[0, joint], twists[1, joint], twists[2, joint] = ax, ay, az
-            np.subtract(py * az, pz * ay, out=twists[3, joint, ...])
-            np.subtract(pz * ax, px * az, out=twists[4, joint, ...])
-            np.subtract(px * ay, py * ax, out=twists[5, joint, ...])
+            continue
+        px, py, pz = (points_components[component, joint] for component in range(3))
+        ax, ay, az = axis
+        negative = [-value if isinstance(value, float) else np.negative(value) for value in axis]
+        _linear_combination(twists[3, joint, ...], [(az, py), (negative[1], pz)])
+        _linear_combination(twists[4, joint, ...], [(ax, pz), (negative[2], px)])
+        _linear_combination(twists[5, joint, ...], [(ay, px), (negative[0], py)])
     return np.moveaxis(twists, (0, 1), (-1, -2))
 
 
@@ -549,9 +612,11 @@ def newton_solve_chain(
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
     """Close one chain onto target platform-side loop frames by damped Newton steps.
 
-    Levenberg-Marquardt with damping ``lambda = |e|`` (locally quadratic also at singular
-    solutions), steps limited to ``max_step`` (rad or m) so the branch does not jump.
-    Batched: every iteration works on all configurations not yet converged.
+    Levenberg-Marquardt: the step solves ``(J^T J + (mu + |e|^2) I) dq = J^T e`` and is
+    kept only if it lowers ``|e|``; ``mu`` shrinks after a kept step and grows after a
+    rejected one (the ``|e|^2`` term keeps convergence quadratic at singular solutions).
+    Steps are limited to ``max_step`` (rad or m) so the assembly branch does not jump.
+    Batched: every iteration works on all configurations not yet converged or stalled.
 
     Parameters
     ----------
@@ -565,35 +630,44 @@ def newton_solve_chain(
     converged : ndarray of bool, shape (N,)
         Whether ``|e| < tolerance`` (rotation vector in rad and translation in m stacked).
     residual : ndarray, shape (N,)
-        Final ``|e|``.
+        Final ``|e|`` (where not converged: how far the chain misses the target).
     """
     values = np.array(initial_values, dtype=float, copy=True)
     count = values.shape[0]
-    converged = np.zeros(count, dtype=bool)
-    residual = np.full(count, np.inf)
-    active = np.arange(count)
     n_dofs = geometry.n_dofs
-    for _ in range(max_iterations + 1):
+
+    def errors(at_values: NDArray, rows: NDArray) -> tuple[ChainFrames, NDArray]:
+        frames = chain_forward_kinematics(geometry, at_values)
+        return frames, pose_error(target_rotation[rows], target_translation[rows], frames.end_rotation, frames.end_translation)
+
+    _, error = errors(values, np.arange(count))
+    residual = np.linalg.norm(error, axis=-1)
+    damping = np.full(count, 1e-9)
+    active = np.flatnonzero((residual >= tolerance) & np.isfinite(residual))
+    if n_dofs == 0:
+        return values, residual < tolerance, residual
+    for _ in range(max_iterations):
         if active.size == 0:
             break
-        frames = chain_forward_kinematics(geometry, values[active])
-        error = pose_error(target_rotation[active], target_translation[active], frames.end_rotation, frames.end_translation)
-        norm = np.linalg.norm(error, axis=-1)
-        residual[active] = norm
-        done = norm < tolerance
-        converged[active[done]] = True
-        keep = ~done & np.isfinite(norm)
-        active, error, norm = active[keep], error[keep], norm[keep]
-        if active.size == 0 or n_dofs == 0:
-            break
-        jacobian = chain_jacobian(geometry, frames)[keep]
+        frames, error = errors(values[active], active)
+        norm = residual[active]
+        jacobian = chain_jacobian(geometry, frames)
         transposed = np.swapaxes(jacobian, -1, -2)
-        normal = transposed @ jacobian + (norm**2 + 1e-12)[:, None, None] * np.eye(n_dofs)
+        normal = transposed @ jacobian + (damping[active] + norm**2)[:, None, None] * np.eye(n_dofs)
         step = np.linalg.solve(normal, (transposed @ error[..., None]))[..., 0]
         largest = np.max(np.abs(step), axis=-1)
         step *= np.minimum(1.0, max_step / np.maximum(largest, 1e-300))[:, None]
-        values[active] = _apply_step(geometry, values[active], step)
-    return values, converged, residual
+        candidate = _apply_step(geometry, values[active], step)
+        _, candidate_error = errors(candidate, active)
+        candidate_norm = np.linalg.norm(candidate_error, axis=-1)
+        better = candidate_norm < norm
+        accepted = active[better]
+        values[accepted] = candidate[better]
+        residual[accepted] = candidate_norm[better]
+        damping[accepted] = np.maximum(damping[accepted] * 0.1, 1e-12)
+        damping[active[~better]] = np.maximum(damping[active[~better]] * 10.0, 1e-6)
+        active = active[(residual[active] >= tolerance) & (damping[active] < 1e4)]
+    return values, residual < tolerance, residual
 
 
 # ----------------------------------------------------------------------------------------
@@ -607,8 +681,10 @@ class ClosedFormResult:
 
     Attributes
     ----------
-    values : ndarray, shape (N, m)
-        Joint values, NaN where unreachable.
+    values : ndarray, shape (N, m), or a function returning it
+        Joint values, NaN where unreachable. The planar closed forms return a function: the
+        joint values follow from the joint points by a few ``arctan2`` and are only computed
+        when asked for (screws need the points only).
     reachable : ndarray of bool, shape (N,)
     gap : ndarray, shape (N,)
         0 where reachable, otherwise by how much the target is out of reach (m).
@@ -616,11 +692,27 @@ class ClosedFormResult:
         Joint axes and points in the base frame (possibly component-major views).
     """
 
-    values: NDArray[np.float64]
+    values: NDArray[np.float64] | Callable[[], NDArray[np.float64]]
     reachable: NDArray[np.bool_]
     gap: NDArray[np.float64]
     axes: NDArray[np.float64]
     points: NDArray[np.float64]
+
+
+def for_each_block(count: int, work: Callable[[slice], None]) -> None:
+    """Call ``work(block)`` for consecutive slices of ``range(count)``, in threads when large.
+
+    numpy releases the GIL inside its loops, so blocks that fit in cache run in parallel on
+    all cores; ``work`` must only write to its own slice of the outputs.
+    """
+    blocks = [slice(start, min(start + _BLOCK, count)) for start in range(0, count, _BLOCK)]
+    if _WORKERS > 1 and len(blocks) > 1:
+        with ThreadPoolExecutor(_WORKERS) as pool:
+            for _ in pool.map(work, blocks):
+                pass
+    else:
+        for block in blocks:
+            work(block)
 
 
 def _angle_of(vector: ArrayLike) -> float:
@@ -652,11 +744,15 @@ def _line_intersection(
 
 
 class PlanarClosedForm:
-    """Common part of the planar closed forms (platform pose given as x, y, angle).
+    """Common part of the planar closed forms: base joint ``b``, middle joint, loop joint ``d``.
 
     All revolute axes are along the base z axis; angles are measured in the base x-y plane.
-    Subclasses fill one block of configurations at a time (to stay in cache) into
-    component-major output arrays.
+    The platform pose is ``(x, y, angle)``; the platform joint is
+    ``d = (x, y) + R(angle) d_M``. Work is done block by block (cache-sized, in threads) into
+    component-major output arrays. Joint values: with ``Delta`` the rotation of the distal
+    link from its zero-value direction, the loop joint value is
+    ``q3 = s3 (angle + psi_M - psi_L - Delta)`` (``s3`` the axis sign, ``psi_M`` and ``psi_L``
+    the platform-side and leg-side loop frame angles at zero).
     """
 
     kind = ""
@@ -670,9 +766,8 @@ class PlanarClosedForm:
         self.middle_point = frames.points[1, :2].copy()
         self.end_point = frames.points[2, :2].copy()
         self.heights = frames.points[:, 2].copy()
-        self.leg_loop_angle = _angle_of(frames.leg_rotation[:, 0])
+        self.loop_offset = _angle_of(geometry.platform_loop_rotation[:, 0]) - _angle_of(frames.leg_rotation[:, 0])
         self.platform_point = geometry.platform_loop_translation[:2].copy()
-        self.platform_angle = _angle_of(geometry.platform_loop_rotation[:, 0])
 
     def solve(self, x: NDArray, y: NDArray, cosine: NDArray, sine: NDArray, angle: NDArray, branch) -> ClosedFormResult:
         """Solve flat batches of planar platform poses (x, y, angle) in the base frame.
@@ -681,26 +776,41 @@ class PlanarClosedForm:
         """
         branch = float(np.atleast_1d(branch)[0])
         count = x.shape[0]
-        values = np.empty((3, count))
-        point_components = np.empty((3, 3, count))
+        point_components = np.zeros((3, 3, count))  # constant zero planes are never written
         axis_components = self._allocate_axes(count)
         gap = np.empty(count)
-        for start in range(0, count, _BLOCK):
-            block = slice(start, min(start + _BLOCK, count))
-            end_x = x[block] + cosine[block] * self.platform_point[0] - sine[block] * self.platform_point[1]
-            end_y = y[block] + sine[block] * self.platform_point[0] + cosine[block] * self.platform_point[1]
-            distal_turn = self._solve_block(
-                end_x, end_y, branch, values[:, block], point_components[:, :, block], axis_components[:, :, block], gap[block]
-            )
-            platform_turn = angle[block] + self.platform_angle
-            values[2, block] = wrap_angle(self.signs[2] * (platform_turn - self.leg_loop_angle - distal_turn))
-            point_components[0, 0, block], point_components[1, 0, block] = self.base_point
-            point_components[2, :, block] = self.heights[:, None]
-            point_components[0, 2, block], point_components[1, 2, block] = end_x, end_y
+        platform_x, platform_y = self.platform_point
+        constants = [(0, 0, self.base_point[0]), (1, 0, self.base_point[1])]
+        constants += [(2, joint, height) for joint, height in enumerate(self.heights)]
+        constants = [(row, joint, value) for row, joint, value in constants if value != 0.0]
+
+        def work(block: slice) -> None:
+            block_cosine, block_sine = cosine[block], sine[block]
+            points = point_components[:, :, block]
+            points[0, 2] = x[block] + block_cosine * platform_x - block_sine * platform_y
+            points[1, 2] = y[block] + block_sine * platform_x + block_cosine * platform_y
+            for row, joint, value in constants:
+                points[row, joint] = value
+            self._points_block(branch, points, axis_components[:, :, block], gap[block])
+
+        for_each_block(count, work)
         reachable = gap == 0.0
-        values[:, ~reachable] = np.nan
+
+        def values() -> NDArray:
+            joint_values = np.empty((3, count))
+
+            def value_work(block: slice) -> None:
+                self._values_block(
+                    point_components[:, :, block], axis_components[:, :, block], angle[block], joint_values[:, block]
+                )
+
+            for_each_block(count, value_work)
+            if not np.all(reachable):
+                joint_values[:, ~reachable] = np.nan
+            return joint_values.T
+
         return ClosedFormResult(
-            values=values.T,
+            values=values,
             reachable=reachable,
             gap=gap,
             axes=np.moveaxis(axis_components, (0, 1), (-1, -2)),
@@ -751,26 +861,39 @@ class PlanarRevoluteChain(PlanarClosedForm):
         self.first_zero_angle = _angle_of(self.middle_point - self.base_point)
         self.second_zero_angle = _angle_of(self.end_point - self.middle_point)
 
-    def _solve_block(self, end_x, end_y, branch, values, points, axes, gap) -> NDArray:
+    def _points_block(self, branch: float, points: NDArray, axes: NDArray, gap: NDArray) -> None:
         base_x, base_y = self.base_point
         first, second = self.first_length, self.second_length
-        delta_x = end_x - base_x
-        delta_y = end_y - base_y
-        distance = np.hypot(delta_x, delta_y)
-        gap[:] = np.maximum(np.maximum(distance - (first + second), abs(first - second) - distance), 0.0)
-        safe = np.where(distance > 0.0, distance, 1.0)
-        along = (first * first - second * second + distance * distance) / (2.0 * safe)
-        height = branch * np.sqrt(np.maximum(first * first - along * along, 0.0))
-        unit_x = delta_x / safe
-        unit_y = delta_y / safe
-        middle_x = base_x + along * unit_x - height * unit_y
-        middle_y = base_y + along * unit_y + height * unit_x
-        first_turn = np.arctan2(middle_y - base_y, middle_x - base_x) - self.first_zero_angle
-        distal_turn = np.arctan2(end_y - middle_y, end_x - middle_x) - self.second_zero_angle
+        delta_x = points[0, 2] - base_x
+        delta_y = points[1, 2] - base_y
+        squared = delta_x * delta_x + delta_y * delta_y
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inverse = 1.0 / squared
+            along = (0.5 * (first * first - second * second)) * inverse + 0.5  # along / distance
+            height_squared = (first * first) * inverse - along * along  # (height / distance)^2
+        reachable = height_squared >= 0.0
+        height = np.sqrt(np.maximum(height_squared, 0.0))
+        if branch > 0:
+            points[0, 1] = base_x + along * delta_x - height * delta_y
+            points[1, 1] = base_y + along * delta_y + height * delta_x
+        else:
+            points[0, 1] = base_x + along * delta_x + height * delta_y
+            points[1, 1] = base_y + along * delta_y - height * delta_x
+        gap[:] = 0.0
+        if not np.all(reachable):
+            unreachable = ~reachable
+            distance = np.sqrt(squared[unreachable])
+            gap[unreachable] = np.maximum(
+                np.maximum(distance - (first + second), abs(first - second) - distance), np.finfo(float).tiny
+            )
+
+    def _values_block(self, points: NDArray, axes: NDArray, angle: NDArray, values: NDArray) -> None:
+        base_x, base_y = self.base_point
+        first_turn = np.arctan2(points[1, 1] - base_y, points[0, 1] - base_x) - self.first_zero_angle
+        distal_turn = np.arctan2(points[1, 2] - points[1, 1], points[0, 2] - points[0, 1]) - self.second_zero_angle
         values[0] = wrap_angle(self.signs[0] * first_turn)
         values[1] = wrap_angle(self.signs[1] * (distal_turn - first_turn))
-        points[0, 1], points[1, 1] = middle_x, middle_y
-        return distal_turn
+        values[2] = wrap_angle(self.signs[2] * (angle + self.loop_offset - distal_turn))
 
 
 class PlanarSliderChain(PlanarClosedForm):
@@ -807,34 +930,38 @@ class PlanarSliderChain(PlanarClosedForm):
         self.leg_offset = float((self.end_point - self.base_point) @ self.slider_direction)
 
     def _allocate_axes(self, count: int) -> NDArray:
-        axis_components = np.empty((3, 3, count))
-        axis_components[0:2, 0] = 0.0
+        axis_components = np.zeros((3, 3, count))
         axis_components[2, 0] = self.signs[0]
-        axis_components[2, 1] = 0.0
-        axis_components[0:2, 2] = 0.0
         axis_components[2, 2] = self.signs[2]
         return axis_components
 
-    def _solve_block(self, end_x, end_y, branch, values, points, axes, gap) -> NDArray:
+    def _points_block(self, branch: float, points: NDArray, axes: NDArray, gap: NDArray) -> None:
         base_x, base_y = self.base_point
-        delta_x = end_x - base_x
-        delta_y = end_y - base_y
-        distance = np.hypot(delta_x, delta_y)
-        gap[:] = np.where(distance > 0.0, 0.0, np.inf)
-        safe = np.where(distance > 0.0, distance, 1.0)
-        unit_x = branch * delta_x / safe
-        unit_y = branch * delta_y / safe
+        delta_x = points[0, 2] - base_x
+        delta_y = points[1, 2] - base_y
+        distance = np.sqrt(delta_x * delta_x + delta_y * delta_y)
+        gap[:] = 0.0
+        gap[distance == 0.0] = np.inf
+        inverse = branch / np.maximum(distance, 1e-300)
+        unit_x = delta_x * inverse
+        unit_y = delta_y * inverse
         slider_x, slider_y = self.slider_direction
         cosine = unit_x * slider_x + unit_y * slider_y
         sine = slider_x * unit_y - slider_y * unit_x
-        distal_turn = np.arctan2(sine, cosine)
-        values[0] = wrap_angle(self.signs[0] * distal_turn)
-        values[1] = branch * distance - self.leg_offset
         offset_x, offset_y = self.middle_point - self.base_point
-        points[0, 1] = base_x + cosine * offset_x - sine * offset_y
-        points[1, 1] = base_y + sine * offset_x + cosine * offset_y
+        slide = branch * distance - self.leg_offset  # the slider's joint frame moves with it
+        points[0, 1] = base_x + cosine * offset_x - sine * offset_y + slide * unit_x
+        points[1, 1] = base_y + sine * offset_x + cosine * offset_y + slide * unit_y
         axes[0, 1], axes[1, 1] = unit_x, unit_y
-        return distal_turn
+
+    def _values_block(self, points: NDArray, axes: NDArray, angle: NDArray, values: NDArray) -> None:
+        base_x, base_y = self.base_point
+        slider_x, slider_y = self.slider_direction
+        unit_x, unit_y = axes[0, 1], axes[1, 1]
+        turn = np.arctan2(slider_x * unit_y - slider_y * unit_x, unit_x * slider_x + unit_y * slider_y)
+        values[0] = self.signs[0] * turn
+        values[1] = (points[0, 2] - base_x) * unit_x + (points[1, 2] - base_y) * unit_y - self.leg_offset
+        values[2] = wrap_angle(self.signs[2] * (angle + self.loop_offset - turn))
 
 
 class SpatialClosedForm:
@@ -849,18 +976,42 @@ class SpatialClosedForm:
     n_branches = 2
 
     def solve(self, target_rotation: NDArray, target_translation: NDArray, branch) -> ClosedFormResult:
-        """Solve flat batches of targets, shapes (N, 3, 3) and (N, 3)."""
+        """Solve flat batches of targets, shapes (N, 3, 3) and (N, 3), block by block in threads."""
         branch = tuple(float(sign) for sign in np.atleast_1d(branch))
-        tree_values, gap = self._tree_values(target_translation, branch)
-        reachable = gap == 0.0
         geometry = self.geometry
-        padded = np.concatenate([tree_values, np.zeros(tree_values.shape[:-1] + (3,))], -1)
-        frames = chain_forward_kinematics(geometry, padded)
-        relative_rotation = np.swapaxes(frames.leg_rotation, -1, -2) @ target_rotation
-        loop_values = rotation_vector_from_rotation(relative_rotation)
-        values = np.concatenate([tree_values, loop_values], -1)
-        values[~reachable] = np.nan
-        return ClosedFormResult(values=values, reachable=reachable, gap=gap, axes=frames.axes, points=frames.points)
+        count, n_tree = target_translation.shape[0], geometry.n_tree_joints
+        values = np.empty((count, geometry.n_dofs))
+        axes = np.empty((count, geometry.n_dofs, 3))
+        points = np.empty((count, geometry.n_dofs, 3))
+        gap = np.empty(count)
+
+        def work(block: slice) -> None:
+            tree_values, gap[block] = self._tree_values(target_translation[block], branch)
+            padded = np.concatenate([tree_values, np.zeros(tree_values.shape[:-1] + (geometry.n_dofs - n_tree,))], -1)
+            frames = chain_forward_kinematics(geometry, padded)  # spherical axes do not depend on its values
+            values[block, :n_tree] = tree_values
+            values[block, n_tree:] = rotation_vector_from_rotation(
+                np.swapaxes(frames.leg_rotation, -1, -2) @ target_rotation[block]
+            )
+            axes[block], points[block] = frames.axes, frames.points
+
+        for_each_block(count, work)
+        reachable = gap == 0.0
+        if not np.all(reachable):
+            values[~reachable] = np.nan
+        return ClosedFormResult(values=values, reachable=reachable, gap=gap, axes=axes, points=points)
+
+    @staticmethod
+    def _zero_frames(
+        geometry: ChainGeometry, prismatic: tuple[bool, ...], universal_joints: tuple[int, int]
+    ) -> tuple[ChainFrames, NDArray] | None:
+        """Zero-value frames and universal-joint centre, if the chain has the joint pattern and a spherical loop."""
+        if geometry.joint_prismatic != prismatic or geometry.loop_type != "spherical":
+            return None
+        frames = chain_forward_kinematics(geometry, np.zeros(geometry.n_dofs))
+        first, second = universal_joints
+        centre = _line_intersection(frames.points[first], frames.axes[first], frames.points[second], frames.axes[second])
+        return None if centre is None else (frames, centre)
 
 
 class LegVectorChain(SpatialClosedForm):
@@ -876,12 +1027,10 @@ class LegVectorChain(SpatialClosedForm):
 
     @classmethod
     def from_geometry(cls, geometry: ChainGeometry) -> LegVectorChain | None:
-        if geometry.joint_prismatic != (False, False, True) or geometry.loop_type != "spherical":
+        found = cls._zero_frames(geometry, (False, False, True), (0, 1))
+        if found is None:
             return None
-        frames = chain_forward_kinematics(geometry, np.zeros(6))
-        centre = _line_intersection(frames.points[0], frames.axes[0], frames.points[1], frames.axes[1])
-        if centre is None:
-            return None
+        frames, centre = found
         leg = frames.leg_translation - centre
         if np.linalg.norm(leg) < 1e-9 or np.linalg.norm(np.cross(leg, frames.axes[2])) > 1e-9:
             return None
@@ -922,12 +1071,10 @@ class CrankRodChain(SpatialClosedForm):
 
     @classmethod
     def from_geometry(cls, geometry: ChainGeometry) -> CrankRodChain | None:
-        if geometry.joint_prismatic != (False, False, False) or geometry.loop_type != "spherical":
+        found = cls._zero_frames(geometry, (False, False, False), (1, 2))
+        if found is None:
             return None
-        frames = chain_forward_kinematics(geometry, np.zeros(6))
-        centre = _line_intersection(frames.points[1], frames.axes[1], frames.points[2], frames.axes[2])
-        if centre is None:
-            return None
+        frames, centre = found
         crank = centre - frames.points[0]
         crank_perpendicular = crank - (crank @ frames.axes[0]) * frames.axes[0]
         rod = frames.leg_translation - centre

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field, replace
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import Literal, Sequence
@@ -34,6 +36,7 @@ from screwkit.kinematics import (
     ChainGeometry,
     chain_forward_kinematics,
     closed_form_for,
+    for_each_block,
     loop_values_from_relative_transform,
     newton_solve_chain,
     rotation_about_axis,
@@ -162,17 +165,27 @@ class Solution:
     """
 
     poses: NDArray[np.float64]
-    joint_values: tuple[NDArray[np.float64], ...]
     reachable: NDArray[np.bool_]
     chain_reachable: NDArray[np.bool_]
     residuals: NDArray[np.float64]
     joint_axes: tuple[NDArray[np.float64], ...]
     joint_points: tuple[NDArray[np.float64], ...]
+    value_sources: tuple = field(repr=False)
+    """Per chain, the joint values (..., m_i) or a function computing them flat (N, m_i)."""
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
         """Shape of the batch of poses."""
         return self.poses.shape[:-1]
+
+    @cached_property
+    def joint_values(self) -> tuple[NDArray[np.float64], ...]:
+        """Per chain, joint values (..., m_i); computed on first access for the planar closed forms."""
+        values = []
+        for source in self.value_sources:
+            array = source() if callable(source) else np.asarray(source)
+            values.append(array.reshape(self.batch_shape + array.shape[-1:]))
+        return tuple(values)
 
 
 class Mechanism:
@@ -417,7 +430,7 @@ class Mechanism:
                 f"<robot name='{self.name}'>", "no actuators: mark the actuated joints with <transmission> elements."
             )
         self.chains = tuple(
-            Chain(**{**chain.__dict__, "actuated": tuple(sorted(actuated[index]))}) for index, chain in enumerate(self.chains)
+            replace(chain, actuated=tuple(sorted(actuated[index]))) for index, chain in enumerate(self.chains)
         )
         self.actuators = [(chain.name, chain.joint_names[index]) for chain in self.chains for index in chain.actuated]
 
@@ -439,8 +452,7 @@ class Mechanism:
             frames = chain_forward_kinematics(
                 geometry, np.concatenate([tree_values, np.zeros(geometry.n_dofs - geometry.n_tree_joints)])
             )
-            target_rotation = self._home_rotation @ geometry.platform_loop_rotation
-            target_translation = self._home_translation + self._home_rotation @ geometry.platform_loop_translation
+            target_rotation, target_translation = self._loop_targets(index, self._home_rotation, self._home_translation)
             loop_values, position_gap, rotation_gap = loop_values_from_relative_transform(
                 geometry,
                 frames.leg_rotation.T @ target_rotation,
@@ -449,8 +461,8 @@ class Mechanism:
             if position_gap > CLOSURE_TOLERANCE or rotation_gap > CLOSURE_TOLERANCE:
                 raise description.fail(
                     f"<loop name='{chain.loop_name}'>",
-                    f"does not close at the reference configuration: the loop frames are {position_gap:.6g} m and "
-                    f"{rotation_gap:.6g} rad apart (tree joints at their <reference_configuration> values or 0, "
+                    f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
+                    f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
                     "platform at its joint origin).",
                 )
             values = wrap_revolute_values(geometry, np.concatenate([tree_values, loop_values]))
@@ -495,7 +507,7 @@ class Mechanism:
             signs.append(sign)
             solvers.append(solver)
             branches.append(branch)
-            chains.append(Chain(**{**chain.__dict__, "solver": "newton" if solver is None else solver.kind}))
+            chains.append(replace(chain, solver="newton" if solver is None else solver.kind))
         self._solvers = tuple(solvers)
         self._reference_signs = tuple(signs)
         self.branches = tuple(branches)
@@ -509,7 +521,8 @@ class Mechanism:
             result = self._closed_form(index, solver, self.home_pose[None], branch)
             if not result.reachable[0]:
                 continue
-            difference = result.values[0] - reference
+            values = result.values() if callable(result.values) else result.values
+            difference = values[0] - reference
             revolute = ~np.asarray(self.geometries[index].dof_prismatic)
             difference[revolute] = wrap_angle(difference[revolute])
             if np.max(np.abs(difference), initial=0.0) < 1e-6:
@@ -611,7 +624,8 @@ class Mechanism:
             Per chain working mode; default :attr:`branches` (the reference assembly). For a
             closed-form chain a tuple of +-1 signs; for a Newton chain the required sign of its
             twist-matrix determinant (None: no check). Newton continuation starts from the
-            reference assembly, so another sign also needs ``initial``.
+            reference assembly, so another sign also needs ``initial``. With
+            ``method="newton"`` closed-form chains keep the reference determinant sign.
         initial : Solution or sequence of array_like, optional
             Start values for Newton chains (per chain, broadcastable to (..., m_i)), e.g. a
             solution at nearby poses. Default: continuation from the reference assembly.
@@ -639,7 +653,9 @@ class Mechanism:
         count = flat.shape[0]
         initial_values = self._check_initial(initial, batch)
         cache: dict = {}
-        values, reachable, residuals, axes, points = [], [], [], [], []
+        values, axes, points = [], [], []
+        reachable = np.empty((len(self.chains), count), dtype=bool)
+        residuals = np.empty((len(self.chains), count))
         for index, geometry in enumerate(self.geometries):
             solver = self._solvers[index] if method == "auto" else None
             if solver is not None:
@@ -655,20 +671,19 @@ class Mechanism:
                 )
                 frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
                 chain_axes, chain_points = frames.axes, frames.points
-            values.append(chain_values.reshape(batch + (geometry.n_dofs,)))
-            reachable.append(chain_reachable)
-            residuals.append(chain_residual)
+            values.append(chain_values if callable(chain_values) else chain_values.reshape(batch + (geometry.n_dofs,)))
+            reachable[index] = chain_reachable
+            residuals[index] = chain_residual
             axes.append(chain_axes.reshape(batch + chain_axes.shape[-2:]))
             points.append(chain_points.reshape(batch + chain_points.shape[-2:]))
-        chain_reachable = np.stack(reachable, -1).reshape(batch + (len(self.chains),))
         return Solution(
             poses=poses,
-            joint_values=tuple(values),
-            reachable=np.all(chain_reachable, axis=-1),
-            chain_reachable=chain_reachable,
-            residuals=np.stack(residuals, -1).reshape(batch + (len(self.chains),)),
+            reachable=np.logical_and.reduce(reachable, axis=0).reshape(batch),
+            chain_reachable=reachable.T.reshape(batch + (len(self.chains),)),
+            residuals=residuals.T.reshape(batch + (len(self.chains),)),
             joint_axes=tuple(axes),
             joint_points=tuple(points),
+            value_sources=tuple(values),
         )
 
     def _platform_cache(self, flat_poses: NDArray, cache: dict):
@@ -682,10 +697,16 @@ class Mechanism:
         if solver.planar:
             if "planar" not in cache:
                 angle = np.ascontiguousarray(flat_poses[:, 2])
+                cosine, sine = np.empty_like(angle), np.empty_like(angle)
+
+                def trigonometry(block: slice) -> None:
+                    np.cos(angle[block], out=cosine[block])
+                    np.sin(angle[block], out=sine[block])
+
+                for_each_block(angle.shape[0], trigonometry)
                 cache["planar"] = (
-                    np.ascontiguousarray(flat_poses[:, 0]), np.ascontiguousarray(flat_poses[:, 1]),
-                    np.cos(angle), np.sin(angle), angle,
-                )  # fmt: skip
+                    np.ascontiguousarray(flat_poses[:, 0]), np.ascontiguousarray(flat_poses[:, 1]), cosine, sine, angle
+                )
             return solver.solve(*cache["planar"], branch)
         return solver.solve(*self._loop_targets(index, *self._platform_cache(flat_poses, cache)), branch)
 
@@ -696,12 +717,14 @@ class Mechanism:
             raise ValueError(f"Expected one pose with shape ({self.n_task},), got {pose.shape}.")
         solution = self.solve(pose, **options)
         if not solution.reachable:
-            index = int(np.argmin(solution.chain_reachable))
+            failed = np.flatnonzero(~solution.chain_reachable)
+            index = int(failed[0])
             spelled = ", ".join(f"{name}={value:.6g}" for name, value in zip(self.task_coordinates, pose))
             unit = "m" if self._solvers[index] is not None else "(Newton error norm, m and rad)"
+            more = f" (and {failed.size - 1} more chain(s))" if failed.size > 1 else ""
             raise ValueError(
                 f"Pose ({spelled}) is unreachable for mechanism {self.name!r}: chain {self.chains[index].name!r} "
-                f"misses closure by {solution.residuals[index]:.6g} {unit}."
+                f"misses closure by {solution.residuals[index]:.6g} {unit}{more}."
             )
         return solution
 
@@ -752,15 +775,26 @@ class Mechanism:
         geometry = self.geometries[index]
         count = flat_poses.shape[0]
         targets = self._loop_targets(index, *platform)
-        if start is not None and np.all(np.isfinite(start)):
-            values, converged, residual = newton_solve_chain(geometry, *targets, start, tolerance, max_iterations)
-        else:
-            reference = np.broadcast_to(self.reference_joint_values[index], (count, geometry.n_dofs))
-            home = (
-                np.broadcast_to(self._home_rotation, (count, 3, 3)),
-                np.broadcast_to(self._home_translation, (count, 3)),
+        values = np.empty((count, geometry.n_dofs))
+        converged = np.zeros(count, dtype=bool)
+        residual = np.full(count, np.inf)
+        given = np.zeros(count, dtype=bool) if start is None else np.all(np.isfinite(start), axis=-1)
+        if np.any(given):  # Newton from the given start values
+            rows = np.flatnonzero(given)
+            values[rows], converged[rows], residual[rows] = newton_solve_chain(
+                geometry, targets[0][rows], targets[1][rows], start[rows], tolerance, max_iterations
             )
-            values, converged, residual = self._track(index, home, reference, platform, tolerance, max_iterations)
+        if not np.all(given):  # continuation from the reference assembly
+            rows = np.flatnonzero(~given)
+            reference = np.broadcast_to(self.reference_joint_values[index], (rows.size, geometry.n_dofs))
+            home = (
+                np.broadcast_to(self._home_rotation, (rows.size, 3, 3)),
+                np.broadcast_to(self._home_translation, (rows.size, 3)),
+            )
+            goal = (platform[0][rows], platform[1][rows])
+            values[rows], converged[rows], residual[rows] = self._track(
+                index, home, reference, goal, tolerance, max_iterations
+            )
         converged &= self._branch_kept(index, values, branch)
         scaled = self._scaled_poses(flat_poses)
         for _ in range(2):  # continuation from solved neighbours
@@ -858,8 +892,8 @@ class Mechanism:
                 f"{int(np.sum(~mask))} of {mask.size} configurations are unreachable (first at index {first}); "
                 "pass unreachable='drop' or 'reference' to chain_screws, or mask the poses."
             )
-        screws = []
-        for index, chain in enumerate(self.chains):
+
+        def screws_of_chain(index: int) -> ChainScrews:
             axes, points = solution.joint_axes[index], solution.joint_points[index]
             if not all_reachable and unreachable == "drop":
                 axes, points = axes[mask], points[mask]
@@ -867,8 +901,12 @@ class Mechanism:
                 frames = self._reference_frames[index]
                 axes = np.where(mask[..., None, None], axes, frames.axes)
                 points = np.where(mask[..., None, None], points, frames.points)
-            screws.append(self._chain_screws_from_frames(index, axes, points, frame))
-        return screws
+            return self._chain_screws_from_frames(index, axes, points, frame)
+
+        if mask.size >= 1 << 16 and len(self.chains) > 1:  # chains in parallel (numpy releases the GIL)
+            with ThreadPoolExecutor(min(len(self.chains), os.cpu_count() or 1)) as pool:
+                return list(pool.map(screws_of_chain, range(len(self.chains))))
+        return [screws_of_chain(index) for index in range(len(self.chains))]
 
     def joint_screws(self, joint_values: Sequence[ArrayLike], *, frame: Literal["world", "base"] = "world") -> list[ChainScrews]:
         """Joint screws at arbitrary joint values (forward kinematics only, no closure).
@@ -996,12 +1034,22 @@ class Mechanism:
         converged = converged.reshape(batch)
         return Solution(
             poses=solution.poses,
-            joint_values=solution.joint_values,
             reachable=solution.reachable & converged,
             chain_reachable=solution.chain_reachable & converged[..., None],
             residuals=solution.residuals,
             joint_axes=solution.joint_axes,
             joint_points=solution.joint_points,
+            value_sources=solution.joint_values,
+        )
+
+    def actuator_values(self, joint_values: Sequence[ArrayLike]) -> NDArray[np.float64]:
+        """Values (..., n_actuators) of all actuators, in :attr:`actuators` order.
+
+        ``joint_values`` holds one array (..., m_i) per chain, e.g. ``solution.joint_values``.
+        """
+        joint_values = tuple(joint_values)
+        return np.stack(
+            [np.asarray(joint_values[chain])[..., joint] for chain, joint in self._actuator_indices(None)], -1
         )
 
     def _actuator_indices(self, actuators) -> list[tuple[int, int]]:
@@ -1023,25 +1071,34 @@ class Mechanism:
 
     # -- Pinocchio configuration -----------------------------------------------------------
 
-    def configuration_vector(self, solution: Solution) -> NDArray[np.float64]:
-        """Pinocchio configuration vectors q (..., nq) of the tree at solved configurations.
+    def configuration_vector(
+        self, joint_values: Sequence[ArrayLike], poses: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
+        """Pinocchio configuration vectors q (..., nq) of the tree.
 
-        Chain tree joints take the solution's values, the platform joint the solved pose;
-        other joints (outside every chain) keep their reference values. Loop-joint values are
-        not part of the tree.
+        Parameters
+        ----------
+        joint_values : sequence of array_like
+            Per chain, values (..., m_i) (e.g. ``solution.joint_values``); the tree joints take
+            them (loop-joint values are not part of the tree).
+        poses : array_like, shape (..., n_task), optional
+            Platform poses for the platform joint (e.g. ``solution.poses``); default the home pose.
+            Joints outside every chain keep their reference values.
         """
         import pinocchio
 
         model = self.model
-        batch = solution.batch_shape
+        joint_values = [np.asarray(values, dtype=float) for values in joint_values]
+        poses = self.home_pose if poses is None else self.check_poses(poses)
+        batch = np.broadcast_shapes(poses.shape[:-1], *(values.shape[:-1] for values in joint_values))
         reference = pinocchio.neutral(model)
         for name, value in self.description.reference_configuration.items():
             self._set_joint(reference, model.joints[model.getJointId(name)], np.asarray(value))
         configuration = np.array(np.broadcast_to(reference, batch + (model.nq,)))
         for index, joint_ids in enumerate(self._tree_joint_ids):
             for position, joint_id in enumerate(joint_ids):
-                self._set_joint(configuration, model.joints[joint_id], solution.joint_values[index][..., position])
-        rotation, translation = self.transforms_from_poses(solution.poses)
+                self._set_joint(configuration, model.joints[joint_id], joint_values[index][..., position])
+        rotation, translation = self.transforms_from_poses(np.broadcast_to(poses, batch + (self.n_task,)))
         world_rotation = self.rotation_world_base @ rotation
         world_translation = self.translation_world_base + translation @ self.rotation_world_base.T
         frame_inverse = self._platform_frame_placement.inverse()
@@ -1087,3 +1144,9 @@ def _quaternion_from_rotation(rotation: NDArray) -> NDArray[np.float64]:
     y = np.copysign(y, rotation[..., 0, 2] - rotation[..., 2, 0])
     z = np.copysign(z, rotation[..., 1, 0] - rotation[..., 0, 1])
     return np.stack([x, y, z, w], -1)
+
+
+def _tidy(value: float) -> str:
+    """A number for messages: 6 significant digits, round-off below 1e-12 shown as 0."""
+    value = float(value)
+    return "0" if abs(value) < 1e-12 else f"{value:.6g}"

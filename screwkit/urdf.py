@@ -126,7 +126,12 @@ class UrdfDescription:
 
     def fail(self, element: str, problem: str) -> ValueError:
         """A one-line error naming this file, an element and a problem."""
-        return ValueError(f"{self.source}: {element}: {problem}")
+        return file_error(self.source, element, problem)
+
+
+def file_error(source: str, element: str, problem: str) -> ValueError:
+    """``ValueError("<file>: <element>: <problem>")``, the form of every URDF error."""
+    return ValueError(f"{source}: {element}: {problem}")
 
 
 def read_urdf(path: str | os.PathLike) -> UrdfDescription:
@@ -172,7 +177,7 @@ def parse_urdf(document: str | bytes, source: str = "<string>") -> UrdfDescripti
     except UnicodeDecodeError as error:
         raise ValueError(f"{source}: the file is not UTF-8 text: {error}.") from None
     if root.tag != "robot":
-        raise ValueError(f"{source}: <{root.tag}>: expected the root element <robot>.")
+        raise file_error(source, f"<{root.tag}>", "expected the root element <robot>.")
     return _Reader(source).read(root, text)
 
 
@@ -183,7 +188,7 @@ class _Reader:
         self.source = source
 
     def fail(self, element: str, problem: str) -> ValueError:
-        return ValueError(f"{self.source}: {element}: {problem}")
+        return file_error(self.source, element, problem)
 
     def read(self, root: ElementTree.Element, text: str) -> UrdfDescription:
         robot_name = root.get("name", "")
