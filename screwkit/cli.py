@@ -425,7 +425,7 @@ def design_search(mechanism, search_permutations, optimise, phi_step, top, level
         from screwkit.robots.generate import planar_rrr_urdf
 
         text = planar_rrr_urdf(f"{loaded.name}_optimised", design.base, design.platform, design.upper, design.lower,
-                               design.working_mode, comment=f" Optimised by screwkit design-search --optimise "
+                               design.working_mode, comment=f" Optimised by screwkit design-search (optimise) "
                                f"(F_O1 >= {level} area {area:.4f} m^2) from {loaded.name} ")
         from screwkit.maps import _atomic_text
 

@@ -174,3 +174,25 @@ def test_cli_sweep_map_and_design_search(tmp_path):
     designs = json.loads(result.output)["designs"]
     assert len(designs) == 240 and set(designs[0]) >= {"permutation", "working_mode", "score"}
     assert designs[0]["permutation"] == [0, 3, 1, 4, 2]
+
+
+def test_optimised_design_is_no_worse_and_its_urdf_loads(five, tmp_path):
+    from screwkit.design import fault_tolerant_area, optimise_design, slots_of
+
+    template = planar_design(five)
+    options = {"level": 0.4, "step": 0.1, "phi_step_degrees": 15.0}
+    design, area, result = optimise_design(template, slots_of(template), maxiter=2, popsize=3, **options)
+    reference, _ = fault_tolerant_area(template, **options)
+    assert area >= reference
+    assert fault_tolerant_area(design, **options)[0] == pytest.approx(area)
+    result = CliRunner().invoke(app, ["design-search", "planar_5rrr", "--optimise", "--maxiter", "1", "--popsize", "2",
+                                      "--step", "0.1", "--urdf", str(tmp_path / "best.urdf"), "--json", "--quiet"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert summary["optimised"]["area_m2"] >= summary["reference"]["area_m2"]
+    optimised = load(tmp_path / "best.urdf")
+    assert optimised.dof == 3 and len(optimised.actuators) == 5
+    expected = planar_design(optimised)
+    np.testing.assert_allclose(expected.upper, summary["optimised"]["upper"], atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(expected.platform, axis=-1), summary["optimised"]["platform_radius"],
+                               atol=1e-9)
