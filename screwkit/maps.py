@@ -68,7 +68,7 @@ def map_task(portable, base_poses, over_axes, over_values, threshold, faults, cl
         unreachable) and ``reachable_fraction``.
     """
     mechanism = _mechanism_from_text(*portable)
-    count, orientations = base_poses.shape[0], over_values.shape[0]
+    orientations = over_values.shape[0]
     poses = np.repeat(base_poses[:, None, :], orientations, axis=1)
     for column, axis in enumerate(over_axes):
         poses[:, :, axis] = over_values[None, :, column]

@@ -28,7 +28,6 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from itertools import combinations
-from math import comb
 from typing import Sequence
 
 import numpy as np

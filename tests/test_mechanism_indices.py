@@ -9,14 +9,12 @@
 
 from __future__ import annotations
 
-from itertools import combinations
 
 import numpy as np
 import pytest
 
 from screwkit import screws
 from screwkit.analysis import analyze_pose
-from screwkit.kinematics import rotation_from_rpy
 from screwkit.mechanism import load
 from screwkit.robots import NAMED_POSES
 from screwkit.transmission import analyze
