@@ -278,15 +278,8 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                                 total += shifted[j, k] * shifted_basis[q, k]
                             rows[r, q] = total
                         r += 1
-                    _null_vector(rows, n, coefficients, minor, work)
-                    for q in range(n):
-                        coefficient = coefficients[q]
-                        f0 += coefficient * shifted_basis[q, 3]
-                        f1 += coefficient * shifted_basis[q, 4]
-                        f2 += coefficient * shifted_basis[q, 5]
-                        m0 += coefficient * shifted_basis[q, 0]
-                        m1 += coefficient * shifted_basis[q, 1]
-                        m2 += coefficient * shifted_basis[q, 2]
+                    _null_vector(rows, n, solution, minor, work)
+                    combined = shifted_basis
                 else:
                     # Minimum-norm solution: SWAP J' (J'^T J')^-1 e_k.
                     for i in range(m):
@@ -315,14 +308,16 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         if worst > 1e-9 * largest:
                             for i in range(m):
                                 solution[i] = 0.0
-                    for j in range(m):
-                        y = solution[j]
-                        f0 += y * shifted[j, 3]
-                        f1 += y * shifted[j, 4]
-                        f2 += y * shifted[j, 5]
-                        m0 += y * shifted[j, 0]
-                        m1 += y * shifted[j, 1]
-                        m2 += y * shifted[j, 2]
+                    combined = shifted
+                # The wrench about d is SWAP (sum of the combined twists about d).
+                for j in range(n if m == n else m):
+                    y = solution[j]
+                    f0 += y * combined[j, 3]
+                    f1 += y * combined[j, 4]
+                    f2 += y * combined[j, 5]
+                    m0 += y * combined[j, 0]
+                    m1 += y * combined[j, 1]
+                    m2 += y * combined[j, 2]
                 # Moment about the centroid: m_c = m_d + d x f.
                 x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)
                 m0 += x0
