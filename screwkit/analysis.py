@@ -187,17 +187,15 @@ def planar_points(mechanism, solution):
     mask = np.asarray(solution.reachable).reshape(-1)
     everything = bool(mask.all())
     count = int(mask.size if everything else mask.sum())
-    # Joint points in the base frame, reachable configurations only, gathered into batch-last
-    # memory (joint, chain, component, N) and handed out as batch-first views (N, k, 2).
-    memory = np.empty((3, len(solution.joint_points), 2, count))
+    # Joint points in the base frame, reachable configurations only: (N, k, 2) per joint.
+    memory = np.empty((3, count, len(solution.joint_points), 2))
     for chain, points in enumerate(solution.joint_points):
         flat = points.reshape(-1, 3, 3)
         for joint in range(3):
             for component in range(2):
                 column = flat[:, joint, component]
-                memory[joint, chain, component] = column if everything else column[mask]
-    views = [np.moveaxis(memory[joint], -1, 0) for joint in range(3)]
-    return views[0], views[1], views[2], kinds == {"rpr"}
+                memory[joint, :, chain, component] = column if everything else column[mask]
+    return memory[0], memory[1], memory[2], kinds == {"rpr"}
 
 
 def _closed_form_result(mechanism, solution, threshold, faults, threads):

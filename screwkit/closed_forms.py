@@ -168,43 +168,25 @@ def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDAr
     return per_chain, per_chain.min(axis=-1)
 
 
-def _unit_rows(vectors):
-    """Normalise batch-last planar vectors (k, 2, n)."""
-    return vectors / np.sqrt(vectors[:, 0] ** 2 + vectors[:, 1] ** 2)[:, None]
+def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_members):
+    """Closed-form indices of one chunk (batch-first (n, k, 2) arrays) through the compiled kernel."""
+    from screwkit._kernels import planar_closed_form_kernel
 
-
-def _planar_chunk(f, d, upper, threshold, triples, fault_members):
-    """Closed-form indices for batch-last chunks: unit f, points d (k, 2, n), unit upper (k, 2, n) or None."""
-    cross_fd = f[:, 0] * d[:, 1] - f[:, 1] * d[:, 0]
-    if upper is None:
-        iti_chains = np.ones(f.shape[::2])
-    else:  # Eq. 23: |det[g f]| with g the unit upper-arm direction
-        iti_chains = np.abs(upper[:, 0] * f[:, 1] - upper[:, 1] * f[:, 0])
-    oti_subs = np.empty((len(triples), f.shape[-1]))
-    for s, (k, l, m) in enumerate(triples):
-        cross_lm = f[l, 0] * f[m, 1] - f[l, 1] * f[m, 0]
-        cross_mk = f[m, 0] * f[k, 1] - f[m, 1] * f[k, 0]
-        cross_kl = f[k, 0] * f[l, 1] - f[k, 1] * f[l, 0]
-        numerator = np.abs(cross_fd[k] * cross_lm + cross_fd[l] * cross_mk + cross_fd[m] * cross_kl)  # A2/A3
-        best = None
-        for own, first, second, cross in ((k, l, m, cross_lm), (l, m, k, cross_mk), (m, k, l, cross_kl)):
-            # Denominator of A4: || |f_l f_m| d_k - (f_m |f_l d_l| - f_l |f_m d_m|) ||
-            vx = cross * d[own, 0] - (f[second, 0] * cross_fd[first] - f[first, 0] * cross_fd[second])
-            vy = cross * d[own, 1] - (f[second, 1] * cross_fd[first] - f[first, 1] * cross_fd[second])
-            denominator = np.sqrt(vx * vx + vy * vy)
-            singular = denominator <= threshold * np.abs(cross)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                value = np.where(singular, 0.0, np.minimum(numerator / denominator, 1.0))
-            best = value if best is None else np.minimum(best, value)
-        oti_subs[s] = best
-    iti = iti_chains.min(axis=0)
-    f_o = {j: oti_subs[members].max(axis=1).min(axis=0) for j, members in fault_members.items()}
+    count, chains = distal.shape[:2]
+    iti_chains = np.empty((count, chains))
+    oti_subs = np.empty((count, len(triples)))
+    empty = np.empty((0, chains, 2))
+    planar_closed_form_kernel(empty if base is None else base, empty if elbows is None else elbows, distal,
+                              empty if directions is None else directions, np.array(triples, dtype=np.int64),
+                              float(threshold), iti_chains, oti_subs)
+    iti = iti_chains.min(axis=1)
+    f_o = {j: oti_subs[:, members].max(axis=2).min(axis=1) for j, members in fault_members.items()}
     return iti_chains, iti, oti_subs, f_o
 
 
 def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = 1e-6,
                    faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None,
-                   chunk_size: int = 8192, threads: int | None = None) -> dict:
+                   chunk_size: int = 65536, threads: int | None = None) -> dict:
     r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
 
     Every 3-subset of the ``k`` chains is a non-redundant submechanism; its OTI is Eq. (34)
@@ -225,9 +207,10 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     directions : array_like, shape (..., k, 2), optional
         The distal-link directions ``f_i`` (computed from ``elbows`` if omitted).
     chunk_size : int
-        Configurations per chunk (bounds memory, keeps the work in cache).
+        Configurations per chunk (bounds memory).
     threads : int, optional
-        Threads working on chunks (default: CPUs, at most 4).
+        Threads working on chunks side by side (default: the number of CPUs); the compiled
+        kernel (:func:`screwkit._kernels.planar_closed_form_kernel`) releases the GIL.
 
     Returns
     -------
@@ -256,35 +239,28 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
                                   for remaining in combinations(range(count), count - j)]) for j in faults}
     total = int(np.prod(batch, dtype=np.int64))
     def flat(array):
-        return array.reshape(total, count, 2)
+        return None if array is None else array.reshape(total, count, 2)
 
-    def chunk(array, part):
-        return np.ascontiguousarray(array[part].transpose(1, 2, 0))
-
-    if directions is None:
-        sources = (flat(base), flat(elbows), flat(distal))
-    else:
-        sources = (flat(directions), flat(distal))
+    sources = [flat(base), flat(elbows), flat(distal), flat(directions)] if directions is None else \
+        [None, None, flat(distal), flat(directions)]
 
     def run(start):
         part = slice(start, min(start + chunk_size, total))
-        if directions is None:
-            b, c, d = (chunk(a, part) for a in sources)
-            return _planar_chunk(_unit_rows(d - c), d, _unit_rows(c - b), threshold, triples, fault_members)
-        f, d = (chunk(a, part) for a in sources)
-        return _planar_chunk(f, d, None, threshold, triples, fault_members)
+        chunk = [None if a is None else np.ascontiguousarray(a[part]) for a in sources]
+        return _planar_chunk(*chunk, threshold, triples, fault_members)
 
+    threads = (os.cpu_count() or 1) if threads is None else threads
+    chunk_size = max(1, min(chunk_size, -(-total // threads)))
     starts = range(0, total, chunk_size)
-    threads = min(os.cpu_count() or 1, 4) if threads is None else threads
     if threads > 1 and len(starts) > 1:
         with ThreadPoolExecutor(max_workers=threads) as pool:
             pieces = list(pool.map(run, starts))
     else:
         pieces = [run(start) for start in starts]
 
-    def gather(arrays):  # batch-last pieces -> batch-first (..., k)
-        joined = np.concatenate(arrays, axis=-1)
-        return np.moveaxis(joined, -1, 0).reshape(batch + joined.shape[:-1])
+    def gather(arrays):  # chunk pieces (n, ...) -> (..., ...)
+        joined = np.concatenate(arrays, axis=0)
+        return joined.reshape(batch + joined.shape[1:])
 
     iti_chains = gather([p[0] for p in pieces])
     iti = gather([p[1] for p in pieces])
