@@ -214,6 +214,11 @@ def verify(mechanism: str, samples: int, seed: int) -> None:
         sys.exit(1)
 
 
+from screwkit.viewer import view  # noqa: E402  (light: meshcat and Pinocchio load when it runs)
+
+app.add_command(view)
+
+
 def main() -> None:  # pragma: no cover - console entry point
     app()
 

@@ -1,0 +1,627 @@
+"""The Meshcat viewer: a loopback-only server, what the scene contains, and the offline HTML
+rendered by headless Chromium.
+
+The scene contents are read back from the exported HTML itself (the msgpack drawing commands
+it inlines), so these tests check what a reader of the file gets.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import html
+import json
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from screwkit.analysis import analyze_pose
+from screwkit.mechanism import load
+from screwkit.viewer import (
+    FAILED_COLOR,
+    ROOT_PATH,
+    animate_sweep,
+    colors_from_values,
+    export_html,
+    resolve_actuators,
+    show,
+    start_viewer,
+    view,
+)
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_FLAGS = (
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    # WebGL on the CPU: SwiftShader through ANGLE (the automatic fallback is deprecated).
+    "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--hide-scrollbars", "--mute-audio",
+    # Proof that the page needs no network: no host name resolves.
+    "--host-resolver-rules=MAP * ~NOTFOUND",
+    "--window-size=1024,768",
+)
+PLANAR_POSE = np.array([0.05, -0.03, np.deg2rad(12.0)])
+SPATIAL_POSE = np.array([0.02, -0.01, 1.0, np.deg2rad(3.0), 0.0, np.deg2rad(5.0)])
+
+
+# ----------------------------------------------------------------------------------------
+# Helpers
+# ----------------------------------------------------------------------------------------
+def scene_commands(html: str) -> list[dict]:
+    """The Meshcat commands inlined in an exported page, decoded."""
+    import umsgpack
+
+    blobs = re.findall(r'data:application/octet-binary;base64,([A-Za-z0-9+/=]*)"', html)
+    return [umsgpack.unpackb(base64.b64decode(blob)) for blob in blobs]
+
+
+def scene_tree(html: str) -> dict[str, dict]:
+    """Per Meshcat path: its object, transform (4x4) and properties, as the page sets them."""
+    tree: dict[str, dict] = {}
+    for command in scene_commands(html):
+        node = tree.setdefault(command.get("path", ""), {"properties": {}})
+        if command["type"] == "set_object":
+            node["object"] = command["object"]
+        elif command["type"] == "set_transform":
+            node["transform"] = np.array(command["matrix"], dtype=float).reshape(4, 4).T
+        elif command["type"] == "set_property":
+            node["properties"][command["property"]] = command["value"]
+        elif command["type"] == "set_animation":
+            node["animation"] = command
+    return tree
+
+
+def full_path(path: str) -> str:
+    return f"/meshcat/{path}"
+
+
+def distance_to_line(points, point_on_line, direction) -> np.ndarray:
+    direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    offset = np.asarray(points, dtype=float) - point_on_line
+    return np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=-1)
+
+
+def listening_sockets(pid: int) -> list[tuple[str, int]]:
+    """(address, port) of every TCP socket of a process in the LISTEN state (Linux /proc)."""
+    inodes = set()
+    for descriptor in os.listdir(f"/proc/{pid}/fd"):
+        try:
+            target = os.readlink(f"/proc/{pid}/fd/{descriptor}")
+        except OSError:
+            continue
+        match = re.fullmatch(r"socket:\[(\d+)\]", target)
+        if match:
+            inodes.add(match.group(1))
+    found = []
+    for table, family in (("tcp", socket.AF_INET), ("tcp6", socket.AF_INET6)):
+        lines = Path(f"/proc/{pid}/net/{table}").read_text().splitlines()[1:]
+        for line in lines:
+            fields = line.split()
+            local, state, inode = fields[1], fields[3], fields[9]
+            if state != "0A" or inode not in inodes:  # 0A: LISTEN
+                continue
+            address_hex, port_hex = local.split(":")
+            raw = bytes.fromhex(address_hex)
+            raw = b"".join(raw[i:i + 4][::-1] for i in range(0, len(raw), 4))  # host-order words
+            found.append((socket.inet_ntop(family, raw), int(port_hex, 16)))
+    return found
+
+
+def stop_viewer(viewer) -> None:
+    viewer.window.zmq_socket.close(linger=0)
+    viewer.window.screwkit_server.stop()
+
+
+@pytest.fixture(scope="module")
+def viewer():
+    """One server (127.0.0.1) shared by the scene tests; show() replaces the scene each time."""
+    started = start_viewer()
+    yield started
+    stop_viewer(started)
+
+
+@pytest.fixture(scope="module")
+def planar():
+    return load("planar_5rrr")
+
+
+@pytest.fixture(scope="module")
+def hexapod():
+    return load("ups_hexapod_8")
+
+
+# ----------------------------------------------------------------------------------------
+# Import, server
+# ----------------------------------------------------------------------------------------
+def test_import_stays_light():
+    code = ("import sys, screwkit.viewer; heavy = [m for m in ('meshcat', 'pinocchio', 'zmq', 'tornado') "
+            "if m in sys.modules]; print(heavy); sys.exit(1 if heavy else 0)")
+    completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                               check=False)
+    assert completed.returncode == 0, f"importing screwkit.viewer imported {completed.stdout.strip()}"
+
+
+def test_scene_server_listens_on_loopback_only_and_stops(planar, viewer):
+    with show(planar, PLANAR_POSE) as scene:  # starts its own server
+        server = scene.server
+        assert server is not None and server.running and scene.viewer.window.server_proc is server.process
+        assert scene.url == server.web_url and server.web_url.startswith("http://127.0.0.1:"), server.web_url
+        assert server.zmq_url.startswith("tcp://127.0.0.1:"), server.zmq_url
+        web_port = int(re.search(r":(\d+)/", server.web_url).group(1))
+        zmq_port = int(server.zmq_url.rsplit(":", 1)[1])
+        sockets = listening_sockets(server.process.pid)
+        assert {port for _, port in sockets} == {web_port, zmq_port}, sockets
+        assert all(address == "127.0.0.1" for address, _ in sockets), f"not loopback only: {sockets}"
+    assert server.process.returncode is not None and not server.running
+    for port in (web_port, zmq_port):  # the ports are free again
+        with socket.socket() as probe:
+            assert probe.connect_ex(("127.0.0.1", port)) != 0
+    server.stop()  # idempotent
+    with pytest.raises(ValueError, match="stopped"):
+        export_html(scene, Path(tempfile.gettempdir()) / "never-written.html")
+    borrowed = show(planar, PLANAR_POSE, viewer=viewer)  # a given viewer: its server is not ours to stop
+    assert borrowed.server is None
+    borrowed.close()
+    assert viewer.window.screwkit_server.running
+
+
+# ----------------------------------------------------------------------------------------
+# Scene contents
+# ----------------------------------------------------------------------------------------
+def test_resolve_actuators_by_index_and_names(planar):
+    assert resolve_actuators(planar, None) == ()
+    for spelling in (1, "1", "chain_2:chain_2_joint_b", "chain_2_joint_b", "chain_2", [1, "chain_2"]):
+        assert resolve_actuators(planar, spelling) == (1,)
+    with pytest.raises(ValueError, match="Unknown actuator 'nope'.*chain_1:chain_1_joint_b"):
+        resolve_actuators(planar, "nope")
+    with pytest.raises(ValueError, match=r"0\.\.4.*got 7"):
+        resolve_actuators(planar, 7)
+
+
+def test_chains_coloured_by_iti_and_failed_chain_distinct(planar, viewer):
+    healthy = scene_tree(show(planar, PLANAR_POSE, viewer=viewer).static_html())
+    scene = show(planar, PLANAR_POSE, failed=["chain_2:chain_2_joint_b"], viewer=viewer)
+    tree = scene_tree(scene.static_html())
+    result = analyze_pose(planar, PLANAR_POSE)
+    visuals = full_path(f"{ROOT_PATH}/mechanism/visuals")
+    for index, chain in enumerate(planar.chains):
+        paths = [path for path in tree if path.startswith(f"{visuals}/{chain.name}_")]
+        assert len(paths) == 2, paths  # two links per RRR chain
+        for path in paths:
+            drawn = np.array(tree[path]["properties"]["color"])
+            before = np.array(healthy[path]["properties"]["color"])
+            np.testing.assert_allclose(before, colors_from_values(result.iti_actuators[index]), atol=1e-12)
+            if index == 1:
+                np.testing.assert_allclose(drawn, FAILED_COLOR)
+                assert drawn[3] < 1 and np.max(np.abs(drawn - before)) > 0.3
+            else:
+                np.testing.assert_allclose(drawn, before, atol=1e-12)
+    cross = full_path(f"{ROOT_PATH}/failed/1-chain_2-chain_2_joint_b")
+    assert cross in tree and f"{cross}/bar_0" in tree and f"{cross}/bar_1" in tree
+    base_joint = planar.chain_screws(planar.solve_one(PLANAR_POSE))[1].points[0]
+    np.testing.assert_allclose(tree[cross]["transform"][:3, 3], base_joint, atol=1e-12)
+    failed_line = tree[full_path(f"{ROOT_PATH}/actuation_wrenches/1-chain_2-chain_2_joint_b/line")]["object"]
+    assert failed_line["materials"][0]["transparent"] and failed_line["materials"][0]["opacity"] < 1
+    assert full_path(f"{ROOT_PATH}/failed/0-chain_1-chain_1_joint_b") not in tree
+    # The best submechanism avoids the failed actuator and is the best of those that do.
+    working = [s for s, sub in enumerate(result.submechanisms) if 1 not in sub]
+    best = max(working, key=lambda s: result.oti_submechanisms[s])
+    assert scene.best_submechanisms[0] == tuple(result.submechanisms[best])
+    assert np.isnan(scene.chain_values[0, 1]) and not np.isnan(scene.chain_values[0, 0])
+
+
+def test_wrench_lines_lie_on_the_actuation_wrench_axes(planar, viewer):
+    scene = show(planar, PLANAR_POSE, viewer=viewer)
+    tree = scene_tree(scene.static_html())
+    result = analyze_pose(planar, PLANAR_POSE)
+    points = [screws.points for screws in planar.chain_screws(planar.solve_one(PLANAR_POSE))]
+    for actuator, (chain, joint) in enumerate(planar.actuators):
+        path = full_path(f"{ROOT_PATH}/actuation_wrenches/{actuator}-{chain}-{joint}")
+        matrix = tree[path]["transform"]
+        direction, centre = matrix[:3, 1], matrix[:3, 3]
+        force, moment = result.actuation_wrenches[actuator, :3], result.actuation_wrenches[actuator, 3:]
+        np.testing.assert_allclose(direction, force / np.linalg.norm(force), atol=1e-12)
+        on_axis = np.cross(force, moment) / (force @ force)
+        assert distance_to_line(centre[None], on_axis, force)[0] < 1e-12
+        # The planar RRR actuation wrench is a force along the distal link: through c and d.
+        assert np.all(distance_to_line(points[actuator][1:], centre, direction) < 1e-9)
+        # Centred on the characteristic point: the platform-joint point d projected on the axis.
+        np.testing.assert_allclose(centre, points[actuator][2], atol=1e-9)
+        line = tree[f"{path}/line"]["object"]["geometries"][0]
+        assert line["type"] == "CylinderGeometry" and line["height"] == pytest.approx(2 * planar.length_scale)
+        assert line["radiusTop"] < 0.02 * planar.length_scale
+
+
+def test_instantaneous_centres_of_the_best_submechanism(planar, viewer):
+    scene = show(planar, PLANAR_POSE, viewer=viewer)
+    tree = scene_tree(scene.static_html())
+    result = analyze_pose(planar, PLANAR_POSE)
+    best = int(np.argmax(result.oti_submechanisms))
+    submechanism = result.submechanisms[best]
+    assert scene.best_submechanisms[0] == tuple(submechanism)
+    wrenches = result.actuation_wrenches
+    for slot, twist in enumerate(result.output_twists[best]):
+        omega, velocity = twist[:3], twist[3:]
+        expected = np.cross(omega, velocity) / (omega @ omega)
+        centre = tree[full_path(f"{ROOT_PATH}/output_twists/{slot}/centre")]["transform"][:3, 3]
+        np.testing.assert_allclose(centre[:2], expected[:2], atol=1e-9)
+        assert centre[2] == pytest.approx(0.0, abs=1e-12)  # the platform plane
+        # Identity: with actuator k driven and the others of the set locked, the platform
+        # turns about the point where the locked actuators' wrench lines meet.
+        for other in submechanism:
+            if other == submechanism[slot]:
+                continue
+            force, moment = wrenches[other, :3], wrenches[other, 3:]
+            assert distance_to_line(centre[None], np.cross(force, moment) / (force @ force), force)[0] < 1e-9
+        axis = tree[full_path(f"{ROOT_PATH}/output_twists/{slot}/axis")]["transform"]
+        np.testing.assert_allclose(np.abs(axis[:3, 1]), [0, 0, 1], atol=1e-12)  # vertical through the centre
+        np.testing.assert_allclose(axis[:2, 3], centre[:2], atol=1e-9)
+    assert len(scene.markers_of_kind("instantaneous_centre")) == 3
+
+
+def test_spatial_twist_axes_and_platform_pose(hexapod, viewer):
+    scene = show(hexapod, SPATIAL_POSE, failed=[3], viewer=viewer)
+    tree = scene_tree(scene.static_html())
+    result = scene.result
+    best = scene.best_submechanisms[0]
+    assert 3 not in best and len(best) == 6
+    s = result.submechanisms.index(best)
+    for slot, twist in enumerate(result.output_twists[s]):
+        omega, velocity = twist[:3], twist[3:]
+        matrix = tree[full_path(f"{ROOT_PATH}/output_twists/{slot}/axis")]["transform"]
+        np.testing.assert_allclose(np.cross(matrix[:3, 1], omega / np.linalg.norm(omega)), 0, atol=1e-9)
+        assert distance_to_line(matrix[None, :3, 3], np.cross(omega, velocity) / (omega @ omega), omega)[0] < 1e-9
+    assert not scene.markers_of_kind("instantaneous_centre")
+    platform = tree[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]["transform"]
+    np.testing.assert_allclose(platform[:3, 3], SPATIAL_POSE[:3], atol=1e-12)
+    legs = [path for path in tree if "/visuals/leg_4_" in path and "properties" in tree[path]
+            and "color" in tree[path]["properties"]]
+    assert legs and all(np.allclose(tree[path]["properties"]["color"], FAILED_COLOR) for path in legs)
+
+
+def test_links_without_visuals_are_drawn_as_rods(planar, viewer, tmp_path):
+    text = Path(planar.path).read_text()
+    bare = re.sub(r'(<link name="chain_[^"]*">)\s*<visual>.*?</visual>', r"\1", text, flags=re.DOTALL)
+    assert bare.count("<visual>") == 2  # base and platform keep theirs
+    path = tmp_path / "bare_5rrr.urdf"
+    path.write_text(bare)
+    mechanism = load(path)
+    scene = show(mechanism, PLANAR_POSE, viewer=viewer)
+    links = scene.markers_of_kind("link")
+    assert len(links) == 2 * len(mechanism.chains)
+    tree = scene_tree(scene.static_html())
+    points = [screws.points for screws in mechanism.chain_screws(mechanism.solve_one(PLANAR_POSE))]
+    for marker in links:
+        position = int(marker.path.rsplit("/", 1)[1])
+        np.testing.assert_allclose(marker.start, points[marker.chain][position], atol=1e-12)
+        np.testing.assert_allclose(marker.end, points[marker.chain][position + 1], atol=1e-12)
+        matrix = tree[full_path(marker.path)]["transform"]
+        np.testing.assert_allclose(matrix[:3, 1], marker.end - marker.start, atol=1e-12)  # y scaled to the length
+        np.testing.assert_allclose(matrix[:3, 3], 0.5 * (marker.start + marker.end), atol=1e-12)
+    assert scene.markers_of_kind("joint")
+
+
+def test_chains_coloured_by_best_submechanism_oti(planar, viewer):
+    scene = show(planar, PLANAR_POSE, failed=[4], color_by="oti", viewer=viewer)
+    result = analyze_pose(planar, PLANAR_POSE)
+    for chain in range(4):
+        expected = max(result.oti_submechanisms[s] for s, sub in enumerate(result.submechanisms)
+                       if chain in sub and 4 not in sub)
+        assert scene.chain_values[0, chain] == pytest.approx(expected, abs=1e-12)
+    assert np.isnan(scene.chain_values[0, 4])
+    np.testing.assert_allclose(scene.chain_colors[:4], colors_from_values(scene.chain_values[0, :4]))
+    np.testing.assert_allclose(scene.chain_colors[4], FAILED_COLOR)
+    with pytest.raises(ValueError, match="color_by"):
+        show(planar, PLANAR_POSE, color_by="lmti", viewer=viewer)
+
+
+def test_twists_at_infinity_are_drawn_as_translation_arrows(planar):
+    from screwkit.viewer import _twist_markers
+
+    centre = np.array([0.1, 0.2, 0.0])
+    for omega in ([0.0, 0.0, 0.0], [0.0, 0.0, 1e-14]):  # a translation, and a centre 1e13 m away
+        twist = np.concatenate([omega, [3.0, 4.0, 0.0]])
+        (marker,) = _twist_markers(planar, 0, 2, twist, centre, planar.length_scale)
+        assert marker.kind == "translation" and marker.actuator == 2
+        np.testing.assert_allclose(marker.start, centre)
+        np.testing.assert_allclose(marker.direction, [0.6, 0.8, 0.0], atol=1e-9)
+    twist = np.concatenate([[0.0, 0.0, 2.0], np.cross([0.3, -0.1, 0.0], [0.0, 0.0, 2.0])])  # about (0.3, -0.1)
+    kinds = {m.kind: m for m in _twist_markers(planar, 0, 2, twist, centre, planar.length_scale)}
+    np.testing.assert_allclose(kinds["instantaneous_centre"].start, [0.3, -0.1, 0.0], atol=1e-12)
+
+
+def test_unreachable_pose_is_reported_before_any_server_starts(planar):
+    with pytest.raises(ValueError, match="unreachable.*chain"):
+        show(planar, [3.0, 0.0, 0.0])
+
+
+def test_animate_sweep_keyframes_follow_the_poses(planar, viewer):
+    angles = np.deg2rad([-20.0, -10.0, 0.0, 10.0, 20.0])
+    poses = np.column_stack([np.full(6, 0.05), np.full(6, -0.03), np.append(angles, 0.0)])
+    poses[-1, 0] = 3.0  # unreachable: skipped
+    scene = animate_sweep(planar, poses, viewer=viewer, frame_rate=5)
+    np.testing.assert_allclose(scene.poses, poses[:-1])
+    commands = [c for c in scene_commands(scene.static_html()) if c["type"] == "set_animation"]
+    assert len(commands) == 1
+    clips = {item["path"]: item["clip"] for item in commands[0]["animations"]}
+    platform = clips[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]
+    assert platform["fps"] == 5
+    positions = {track["name"]: track for track in platform["tracks"]}[".position"]["keys"]
+    assert [key["time"] for key in positions] == [0, 1, 2, 3, 4]
+    np.testing.assert_allclose([key["value"][:2] for key in positions], poses[:-1, :2], atol=1e-12)
+    wrench = f"{ROOT_PATH}/actuation_wrenches/0-chain_1-chain_1_joint_b"
+    tracks = {track["name"]: track["keys"] for track in clips[full_path(wrench)]["tracks"]}
+    for frame in (0, 4):  # each keyframe is the still scene of that pose
+        still = {marker.path: marker for marker in show(planar, poses[frame], viewer=viewer).markers}[wrench]
+        np.testing.assert_allclose(tracks[".position"][frame]["value"], 0.5 * (still.start + still.end), atol=1e-12)
+        assert tracks[".visible"][frame]["value"] is True
+    after = [c for c in scene_commands(show(planar, PLANAR_POSE, viewer=viewer).static_html())
+             if c["type"] == "set_animation"]
+    assert all(not command["animations"] for command in after)  # the still scene cleared it
+
+
+def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):
+    scene = show(planar, PLANAR_POSE, viewer=viewer)
+    target = tmp_path / "scene.html"
+    target.write_text("old")
+    assert export_html(scene, target) == target
+    html = target.read_text()
+    assert "MeshCat.Viewer" in html and "set_object" not in html[:100]
+    assert not re.search(r"<script[^>]*\ssrc=|<link[^>]*\shref=", html), "the page loads external files"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.html"]  # no temporary left
+    assert oct(target.stat().st_mode & 0o777) != oct(0o600)
+    with pytest.raises(ValueError, match="does not exist"):
+        export_html(scene, tmp_path / "missing" / "scene.html")
+    with pytest.raises(ValueError, match="Expected a Scene"):
+        export_html(object(), tmp_path / "x.html")
+
+
+# ----------------------------------------------------------------------------------------
+# Command line
+# ----------------------------------------------------------------------------------------
+def test_cli_view_writes_html_and_animations(tmp_path):
+    from click.testing import CliRunner
+
+    runner = CliRunner()
+    still = tmp_path / "still.html"
+    outcome = runner.invoke(view, ["planar_5rrr", "--pose", "0.05", "-0.03", "12", "--failed", "1",
+                                   "--html", str(still)])
+    assert outcome.exit_code == 0, outcome.output
+    assert "chain_2" in outcome.output and "failed: chain_2:chain_2_joint_b" in outcome.output
+    tree = scene_tree(still.read_text())
+    np.testing.assert_allclose(tree[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]["transform"][:3, 3],
+                               [0.05, -0.03, 0.0], atol=1e-12)
+    sweep = tmp_path / "sweep.html"
+    outcome = runner.invoke(view, ["planar_5rrr", "--sweep-phi", "-10:10:5", "--html", str(sweep)])
+    assert outcome.exit_code == 0, outcome.output
+    animation = [c for c in scene_commands(sweep.read_text()) if c["type"] == "set_animation"]
+    keys = animation[0]["animations"][0]["clip"]["tracks"][0]["keys"]
+    assert len(keys) == 4  # -10, -5, 0, 5 (stop exclusive)
+    for arguments, message in (
+        (["planar_5rrr", "--failed", "chain_9", "--html", str(still)], "Unknown actuator 'chain_9'"),
+        (["ups_hexapod_8", "--sweep-phi", "0:10:5", "--html", str(still)], "planar"),
+        (["planar_5rrr", "--pose", "0", "0", "--html", str(still)], "Expected --pose with 3 values"),
+    ):
+        outcome = runner.invoke(view, arguments)
+        assert outcome.exit_code == 1 and message in outcome.output, outcome.output
+
+
+def test_cli_view_serves_on_loopback_until_interrupted(monkeypatch):
+    from click.testing import CliRunner
+
+    import screwkit.viewer
+
+    seen = {}
+    real_sleep = screwkit.viewer.time.sleep
+
+    def interrupt(seconds):  # the serving loop's first sleep: check the server, then press Ctrl+C
+        if "listening" in seen:  # later sleeps (stopping the server) are real
+            return real_sleep(seconds)
+        with socket.socket() as probe:
+            seen["listening"] = probe.connect_ex(("127.0.0.1", seen["port"])) == 0
+        raise KeyboardInterrupt
+
+    original_echo = screwkit.viewer.click.echo
+
+    def echo(message=None, **kwargs):
+        match = re.search(r"Serving at http://127\.0\.0\.1:(\d+)/static/", str(message))
+        if match:
+            seen["port"] = int(match.group(1))
+        return original_echo(message, **kwargs)
+
+    monkeypatch.setattr(screwkit.viewer.time, "sleep", interrupt)
+    monkeypatch.setattr(screwkit.viewer.click, "echo", echo)
+    outcome = CliRunner().invoke(view, ["planar_5rrr", "--failed", "chain_3"])
+    monkeypatch.undo()
+    assert outcome.exit_code == 0 and "Stopped." in outcome.output, outcome.output
+    assert seen["listening"], "the server was not listening on 127.0.0.1 while serving"
+    with socket.socket() as probe:  # stopped on Ctrl+C
+        assert probe.connect_ex(("127.0.0.1", seen["port"])) != 0
+
+
+# ----------------------------------------------------------------------------------------
+# Headless Chromium renders the offline page
+# ----------------------------------------------------------------------------------------
+def chromium_or_skip() -> Path:
+    """/usr/bin/chromium, installed with apt-get when missing and possible; else a skip saying why."""
+    if CHROMIUM.exists():
+        return CHROMIUM
+    why = "headless Chromium (Debian packages chromium, chromium-driver) renders the exported HTML"
+    if not hasattr(os, "geteuid") or os.geteuid() != 0:
+        pytest.skip(f"{CHROMIUM} is missing and this test is not running as root, so it cannot "
+                    f"apt-get install it; {why}.")
+    if shutil.which("apt-get") is None:
+        pytest.skip(f"{CHROMIUM} is missing and there is no apt-get to install it; {why}.")
+    environment = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    for command in (["apt-get", "update"], ["apt-get", "install", "-y", "chromium", "chromium-driver"]):
+        completed = subprocess.run(command, capture_output=True, text=True, env=environment, timeout=900,
+                                   check=False)
+        if completed.returncode != 0:
+            pytest.skip(f"{CHROMIUM} is missing and `{' '.join(command)}` failed with exit code "
+                        f"{completed.returncode}: {completed.stderr.strip()[-500:]}")
+    if not CHROMIUM.exists():
+        pytest.skip(f"apt-get installed chromium but {CHROMIUM} still does not exist.")
+    return CHROMIUM
+
+
+def render(pages: dict[str, Path], folder: Path, dump_dom: tuple[str, ...] = ()) -> dict[str, tuple]:
+    """Screenshots (768, 1024, 3) of HTML files, rendered side by side by headless Chromium.
+
+    Returns per page ``(image, dom)``: ``dom`` is the page's DOM after its scripts ran for the
+    pages named in ``dump_dom`` (``--dump-dom``), else None.
+    """
+    from PIL import Image
+
+    chromium = chromium_or_skip()
+    rendered = {}
+    with contextlib.ExitStack() as stack:
+        running = {}
+        for name, page in pages.items():
+            profile = stack.enter_context(tempfile.TemporaryDirectory(prefix="chromium-profile-",
+                                                                      ignore_cleanup_errors=True))
+            log = stack.enter_context(open(folder / f"{name}.log", "wb"))
+            dom = stack.enter_context(open(folder / f"{name}.dom.html", "wb"))
+            screenshot = folder / f"{name}.png"
+            command = [str(chromium), *CHROMIUM_FLAGS, f"--user-data-dir={profile}", f"--screenshot={screenshot}",
+                       *(["--dump-dom"] if name in dump_dom else []), page.resolve().as_uri()]
+            process = subprocess.Popen(command, stdout=dom, stderr=log, stdin=subprocess.DEVNULL)
+            stack.callback(end_process, process)  # runs before its files close and its profile goes
+            running[name] = (process, screenshot)
+        for name, (process, screenshot) in running.items():
+            try:
+                process.wait(timeout=120)
+            except subprocess.TimeoutExpired:
+                pytest.fail(f"Chromium did not finish rendering {pages[name]} within 120 s.")
+            assert screenshot.exists(), (f"Chromium wrote no screenshot of {pages[name]} (exit code "
+                                         f"{process.returncode}); see {folder / (name + '.log')}")
+            image = np.asarray(Image.open(screenshot).convert("RGB")).astype(int)
+            rendered[name] = (image, (folder / f"{name}.dom.html").read_text() if name in dump_dom else None)
+    return rendered
+
+
+def end_process(process: subprocess.Popen) -> None:
+    if process.poll() is None:
+        process.kill()
+        process.wait()
+
+
+def middle(image: np.ndarray) -> np.ndarray:
+    height, width, _ = image.shape
+    return image[height // 5: 4 * height // 5, width // 5: 4 * width // 5]
+
+
+def coloured_fraction(image: np.ndarray) -> float:
+    """Share of clearly coloured pixels (channel spread > 60 of 255) in the middle region.
+
+    The background and the ground grid are grey; chains (viridis), wrench lines (orange) and
+    twist axes (magenta) are not.
+    """
+    region = middle(image)
+    return float(np.mean(region.max(axis=-1) - region.min(axis=-1) > 60))
+
+
+def shows_a_mechanism(image: np.ndarray) -> bool:
+    region = middle(image)
+    coarse = region // 32
+    colours = len(np.unique(coarse[..., 0] * 64 + coarse[..., 1] * 8 + coarse[..., 2]))  # distinct coarse colours
+    return coloured_fraction(image) > 0.02 and colours > 60
+
+
+SYNCHRONOUS_FETCH = """<script>
+// Test only: run the page's drawing commands (data: URLs) at once instead of in promises,
+// so that the probe below sees the whole scene.
+window.fetch = function (url) {
+  const bytes = Uint8Array.from(atob(url.split(",")[1]), (c) => c.charCodeAt(0));
+  const now = (value) => ({ then: (next) => now(next(value)) });
+  return now({ arrayBuffer: () => bytes.buffer });
+};
+</script>
+"""
+
+
+def with_animation_probe(html: str, seconds: float, paths: dict[str, list[str]]) -> str:
+    """The page, paused at ``seconds`` of its animation, writing the state of ``paths`` to its title."""
+    start = html.rindex("<script", 0, html.index("var viewer = new MeshCat.Viewer"))
+    html = html[:start] + SYNCHRONOUS_FETCH + html[start:]
+    probe = f"""<script>
+viewer.animator.pause();
+viewer.animator.seek({seconds});
+const probed = {{}};
+for (const [name, path] of Object.entries({json.dumps(paths)})) {{
+  const node = viewer.scene_tree.find(path).object;
+  probed[name] = {{position: node.position.toArray(), quaternion: node.quaternion.toArray(),
+                  visible: node.visible}};
+}}
+document.title = "PROBE" + JSON.stringify(probed) + "PROBE";
+</script>
+"""
+    end = html.rindex("</body>")
+    return html[:end] + probe + html[end:]
+
+
+SWEEP_FRAME = 6  # probed keyframe of the animation (phi = 10 deg)
+
+
+@pytest.fixture(scope="module")
+def screenshots(planar, hexapod, viewer, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("screenshots")
+    export_html(show(planar, PLANAR_POSE, failed=[1], viewer=viewer), folder / "planar_5rrr.html")
+    export_html(show(hexapod, SPATIAL_POSE, failed=[3], viewer=viewer), folder / "ups_hexapod_8.html")
+    poses = np.column_stack([np.full(9, 0.05), np.full(9, -0.03), np.deg2rad(np.arange(-20.0, 21.0, 5.0))])
+    sweep = animate_sweep(planar, poses, failed=[2], viewer=viewer, frame_rate=10)
+    paths = {"platform": ["meshcat", ROOT_PATH, "mechanism", "visuals", "platform_0"],
+             "wrench": ["meshcat", ROOT_PATH, "actuation_wrenches", "0-chain_1-chain_1_joint_b"],
+             "centre": ["meshcat", ROOT_PATH, "output_twists", "0", "centre"]}
+    (folder / "planar_5rrr_sweep.html").write_text(
+        with_animation_probe(sweep.static_html(), SWEEP_FRAME / 10, paths))
+    viewer[ROOT_PATH].delete()  # the same viewer (background, grid, last camera) without the mechanism
+    show(planar, PLANAR_POSE, viewer=viewer)  # also clears the animation
+    viewer[ROOT_PATH].delete()
+    export_html(viewer, folder / "blank.html")
+    pages = {name: folder / f"{name}.html" for name in ("planar_5rrr", "ups_hexapod_8", "blank", "planar_5rrr_sweep")}
+    return render(pages, folder, dump_dom=("planar_5rrr_sweep",)), folder, sweep
+
+
+def test_blank_page_fails_the_check(screenshots):
+    rendered, folder, _ = screenshots
+    blank = rendered["blank"][0]
+    assert blank.shape == (768, 1024, 3)
+    assert not shows_a_mechanism(blank), f"the check passes on an empty scene ({folder / 'blank.png'})"
+    assert coloured_fraction(blank) < 0.01
+    assert np.ptp(middle(blank)) > 20  # the viewer did render: a background gradient and grid, not a white page
+
+
+@pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "planar_5rrr_sweep"])
+def test_offline_page_renders_the_mechanism(screenshots, name):
+    rendered, folder, _ = screenshots
+    image, blank = rendered[name][0], rendered["blank"][0]
+    assert shows_a_mechanism(image), (f"{folder / (name + '.png')}: only {coloured_fraction(image):.2%} "
+                                      "coloured pixels in the middle")
+    changed = np.mean(np.max(np.abs(middle(image) - middle(blank)), axis=-1) > 40)
+    assert changed > 0.05, f"{folder / (name + '.png')} differs from the empty scene in {changed:.2%} of the middle"
+
+
+def test_browser_plays_the_sweep_animation(screenshots):
+    rendered, folder, sweep = screenshots
+    dom = rendered["planar_5rrr_sweep"][1]
+    match = re.search(r"PROBE(.*?)PROBE", dom)
+    assert match, f"the probe did not run in the page; see {folder / 'planar_5rrr_sweep.dom.html'}"
+    probed = json.loads(html.unescape(match.group(1)))
+    pose = sweep.poses[SWEEP_FRAME]
+    np.testing.assert_allclose(probed["platform"]["position"][:2], pose[:2], atol=1e-6)
+    x, y, z, w = probed["platform"]["quaternion"]  # three.js order
+    assert 2 * np.arctan2(z, w) == pytest.approx(pose[2], abs=1e-6) and abs(x) + abs(y) < 1e-6
+    markers = {marker.path: marker for marker in sweep.frame_markers[SWEEP_FRAME]}
+    wrench = markers[f"{ROOT_PATH}/actuation_wrenches/0-chain_1-chain_1_joint_b"]
+    np.testing.assert_allclose(probed["wrench"]["position"], 0.5 * (wrench.start + wrench.end), atol=1e-6)
+    centre = markers[f"{ROOT_PATH}/output_twists/0/centre"]
+    np.testing.assert_allclose(probed["centre"]["position"], centre.start, atol=1e-6)
+    assert probed["wrench"]["visible"] and probed["centre"]["visible"]
