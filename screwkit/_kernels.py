@@ -143,7 +143,8 @@ def _power_coefficient(numerator, arm, reference, threshold):
 @njit(nogil=True, cache=True, error_model="numpy")
 def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_joint, basis, complement,
                         submechanisms, locked_sets, locked_of, threshold, rank_tolerance, iti_override, oti_override,
-                        iti_out, oti_out, independent_out, wrench_out, twist_out, outside_out):
+                        iti_out, oti_out, oti_sub_out, summary_out, independent_out, wrench_out, twist_out,
+                        outside_out):
     """Indices of a chunk of configurations.
 
     Parameters (N configurations, J joints in all, C chains, a actuators, n DOF, S submechanisms)
@@ -159,7 +160,8 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
     locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
         the other n - 1 actuators of the submechanism.
     iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller.
-    Outputs: iti_out (N, a), oti_out (N, S, n), independent_out (N, S) bool,
+    Outputs: iti_out (N, a), oti_out (N, S, n), oti_sub_out (N, S) (Eq. 9), summary_out (N, 2) holding
+        the ITI (Eq. 7) and the LMTI of all actuators (Eq. 11), independent_out (N, S) bool,
         wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6) (output twists, scaled so that
         |A_k o T_k| = |det W|), outside_out (N,) bool.
     """
@@ -279,7 +281,14 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                             rows[r, q] = total
                         r += 1
                     _null_vector(rows, n, solution, minor, work)
-                    combined = shifted_basis
+                    for q in range(n):
+                        y = solution[q]
+                        f0 += y * shifted_basis[q, 3]
+                        f1 += y * shifted_basis[q, 4]
+                        f2 += y * shifted_basis[q, 5]
+                        m0 += y * shifted_basis[q, 0]
+                        m1 += y * shifted_basis[q, 1]
+                        m2 += y * shifted_basis[q, 2]
                 else:
                     # Minimum-norm solution: SWAP J' (J'^T J')^-1 e_k.
                     for i in range(m):
@@ -308,16 +317,15 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         if worst > 1e-9 * largest:
                             for i in range(m):
                                 solution[i] = 0.0
-                    combined = shifted
-                # The wrench about d is SWAP (sum of the combined twists about d).
-                for j in range(n if m == n else m):
-                    y = solution[j]
-                    f0 += y * combined[j, 3]
-                    f1 += y * combined[j, 4]
-                    f2 += y * combined[j, 5]
-                    m0 += y * combined[j, 0]
-                    m1 += y * combined[j, 1]
-                    m2 += y * combined[j, 2]
+                    # The wrench about d is SWAP (the combination of the chain's twists about d).
+                    for j in range(m):
+                        y = solution[j]
+                        f0 += y * shifted[j, 3]
+                        f1 += y * shifted[j, 4]
+                        f2 += y * shifted[j, 5]
+                        m0 += y * shifted[j, 0]
+                        m1 += y * shifted[j, 1]
+                        m2 += y * shifted[j, 2]
                 # Moment about the centroid: m_c = m_d + d x f.
                 x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)
                 m0 += x0
@@ -427,6 +435,7 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                     o2 += motion[q, 2] * y
                 output_omega[locked] = np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
             # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
+            lmti = 0.0
             for s in range(subs):
                 volume = 1.0
                 det = 0.0
@@ -437,6 +446,7 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                     det += wrench_matrix[submechanisms[s, 0], q] * output[first, q]
                 dependent = not (abs(det) > rank_tolerance * volume)
                 independent_out[index, s] = not dependent
+                oti_sub = 1.0
                 for position in range(n):
                     act = submechanisms[s, position]
                     locked = locked_of[s, position]
@@ -448,8 +458,9 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         a2 += arms[act, q, 2] * y
                     arm = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
                     reference = output_omega[locked] if has_force[act] else 0.0
-                    oti_out[index, s, position] = 0.0 if dependent else _power_coefficient(
-                        det, arm, reference, threshold)
+                    value = 0.0 if dependent else _power_coefficient(det, arm, reference, threshold)
+                    oti_out[index, s, position] = value
+                    oti_sub = min(oti_sub, value)
                     if twist_out.shape[0] > 0:
                         for k in range(6):
                             total = 0.0
@@ -462,6 +473,13 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         twist_out[index, s, position, 3] -= x0
                         twist_out[index, s, position, 4] -= x1
                         twist_out[index, s, position, 5] -= x2
+                oti_sub_out[index, s] = oti_sub
+                lmti = max(lmti, oti_sub)
+            iti = 1.0
+            for act in range(a):
+                iti = min(iti, iti_out[index, act])
+            summary_out[index, 0] = iti
+            summary_out[index, 1] = lmti
 
 
 @njit(nogil=True, cache=True, error_model="numpy")

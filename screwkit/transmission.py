@@ -324,6 +324,8 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
     out = {
         "iti_actuators": np.zeros((count, a)),
         "oti_actuators": np.zeros((count, subs, n)),
+        "oti_submechanisms": np.zeros((count, subs)),
+        "summary": np.zeros((count, 2)),
         "independent": np.zeros((count, subs), dtype=bool),
         "actuation_wrenches": np.zeros((count if detail else 0, a, 6)),
         "output_twists": np.zeros((count if keep_twists else 0, subs, n, 6)),
@@ -335,7 +337,8 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
                         plan.threshold, plan.rank_tolerance,
                         empty if iti_override is None else iti_override,
                         empty if oti_override is None else oti_override,
-                        out["iti_actuators"], out["oti_actuators"], out["independent"],
+                        out["iti_actuators"], out["oti_actuators"], out["oti_submechanisms"], out["summary"],
+                        out["independent"],
                         out["actuation_wrenches"], out["output_twists"], out["outside"])
     return out
 
@@ -365,10 +368,10 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
             for key, value in again.items():
                 if out[key].shape[0]:
                     out[key][redo] = value
-    oti_sub = out["oti_actuators"].min(axis=2)  # Eq. 9
+    oti_sub = out["oti_submechanisms"]  # Eq. 9
     result = {
-        "iti": out["iti_actuators"].min(axis=1),  # Eq. 7
-        "lmti": oti_sub.max(axis=1),  # Eq. 11 on the whole set
+        "iti": out["summary"][:, 0],  # Eq. 7
+        "lmti": out["summary"][:, 1],  # Eq. 11 on the whole set
         # Mutual-interference actuators: the others alone fully constrain the platform.
         "mutual_interference": np.stack(
             [out["independent"][:, members].any(axis=1) if members.size else np.zeros(oti_sub.shape[0], bool)
