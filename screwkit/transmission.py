@@ -390,6 +390,31 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     return result
 
 
+def _joints_of_all_chains(arrays: list[NDArray]):
+    """A function giving, for a slice of the batch, the (n, J, k) array of every chain's joints.
+
+    When the chains are consecutive blocks of one C-ordered (N, J, k) array (as the chain
+    builders make them), the slice is a view of that array; otherwise the chains' slices are
+    concatenated.
+    """
+    first = arrays[0]
+    width = sum(a.shape[1] for a in arrays)
+    item = first.itemsize
+    expected = (width * first.shape[2] * item, first.shape[2] * item, item)
+    address = first.__array_interface__["data"][0]
+    tiled = True
+    for array in arrays:
+        tiled &= array.strides == expected and array.dtype == first.dtype
+        tiled &= array.__array_interface__["data"][0] == address
+        address += array.shape[1] * first.shape[2] * item
+    if tiled and first.shape[0] > 0:
+        # Writable exactly when the chains' memory is (the kernel only reads it).
+        whole = np.lib.stride_tricks.as_strided(first, (first.shape[0], width, first.shape[2]), expected)
+        if all(np.shares_memory(whole, array) for array in arrays):
+            return lambda part: whole[part]
+    return lambda part: np.concatenate([a[part] for a in arrays], axis=1)
+
+
 def analyze(
     chains: Sequence[ChainScrews],
     *,
@@ -500,13 +525,13 @@ def analyze(
             except ValueError:
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
             overrides[name] = np.ascontiguousarray(array.reshape(count, a, 3))
-    twists = [chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains]
-    points = [chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains]
+    twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
+    points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
     def run(start: int) -> dict:
         part = slice(start, min(start + chunk_size, count))
         return _analyze_chunk(
-            plan, np.concatenate([t[part] for t in twists], axis=1), np.concatenate([p[part] for p in points], axis=1),
+            plan, twists(part), points(part),
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
             detail, keep_twists)
