@@ -33,7 +33,7 @@ def reachable_points(rng, count, design):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--configurations", type=int, default=1_000_000)
-    parser.add_argument("--batch", type=int, default=200_000)
+    parser.add_argument("--batch", type=int, default=100_000)
     parser.add_argument("--threads", type=int, default=None)
     args = parser.parse_args()
     rng = np.random.default_rng(0)

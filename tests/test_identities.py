@@ -84,3 +84,15 @@ def test_threads_and_chunks_do_not_change_results(rng):
     many = analyze(chains, threads=2, chunk_size=256)
     np.testing.assert_array_equal(one.f_o[1], many.f_o[1])
     np.testing.assert_array_equal(one.iti, many.iti)
+
+
+def test_tiled_and_separate_chain_memory_give_the_same_result(rng):
+    """Chains built as blocks of one array are read in place; separate copies are concatenated."""
+    base, elbows, distal = random_planar_rrr(rng, 500, 5)
+    tiled = rrr_chain_screws(base, elbows, distal)
+    separate = [ChainScrews(c.twists.copy(), c.points.copy(), c.actuated, c.name) for c in tiled]
+    first, second = analyze(tiled), analyze(separate)
+    np.testing.assert_array_equal(first.oti_actuators, second.oti_actuators)
+    np.testing.assert_array_equal(first.iti_actuators, second.iti_actuators)
+    reordered = analyze(tiled[::-1])  # blocks out of order: not tiled, concatenated
+    np.testing.assert_allclose(reordered.f_o[1], first.f_o[1], atol=1e-12)
