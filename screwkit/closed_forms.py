@@ -16,12 +16,12 @@ Notation: :math:`|x\ y| = \det[x\ y] = x_1 y_2 - x_2 y_1`. Only numpy is importe
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from itertools import combinations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from screwkit._chunks import map_chunks
 
 __all__ = [
     "det2",
@@ -244,19 +244,11 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     sources = [flat(base), flat(elbows), flat(distal), flat(directions)] if directions is None else \
         [None, None, flat(distal), flat(directions)]
 
-    def run(start):
-        part = slice(start, min(start + chunk_size, total))
+    def run(part):
         chunk = [None if a is None else np.ascontiguousarray(a[part]) for a in sources]
         return _planar_chunk(*chunk, threshold, triples, fault_members)
 
-    threads = (os.cpu_count() or 1) if threads is None else threads
-    chunk_size = max(1, min(chunk_size, -(-total // threads)))
-    starts = range(0, total, chunk_size)
-    if threads > 1 and len(starts) > 1:
-        with ThreadPoolExecutor(max_workers=threads) as pool:
-            pieces = list(pool.map(run, starts))
-    else:
-        pieces = [run(start) for start in starts]
+    pieces = map_chunks(run, total, chunk_size, threads)
 
     def gather(arrays):  # chunk pieces (n, ...) -> (..., ...)
         joined = np.concatenate(arrays, axis=0)

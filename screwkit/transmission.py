@@ -24,8 +24,6 @@ imported only when :func:`analyze` first runs.
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from itertools import combinations
 from typing import Sequence
@@ -33,6 +31,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit._chunks import map_chunks
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
 
@@ -509,9 +508,7 @@ def analyze(
             )
     if not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
-    if threads is None:
-        threads = os.cpu_count() or 1
-    if not isinstance(threads, (int, np.integer)) or threads < 1:
+    if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     plan = _make_plan(chains, dof, faults, threshold, rank_tolerance)
     a = len(plan.actuators)
@@ -528,22 +525,14 @@ def analyze(
     twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
-    def run(start: int) -> dict:
-        part = slice(start, min(start + chunk_size, count))
+    def run(part: slice) -> dict:
         return _analyze_chunk(
             plan, twists(part), points(part),
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
             detail, keep_twists)
 
-    # The compiled kernel releases the GIL: chunks run side by side on `threads` cores.
-    chunk_size = max(1, min(chunk_size, -(-count // threads)))
-    starts = range(0, count, chunk_size)
-    if threads > 1 and len(starts) > 1:
-        with ThreadPoolExecutor(max_workers=threads) as pool:
-            pieces = list(pool.map(run, starts))
-    else:
-        pieces = [run(start) for start in starts]
+    pieces = map_chunks(run, count, chunk_size, threads)
     merged = {key: np.concatenate([piece[key] for piece in pieces], axis=0) for key in pieces[0]}
 
     def batch_first(array: NDArray) -> NDArray:
