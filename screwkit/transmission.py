@@ -453,15 +453,19 @@ def analyze(
 
     **Output twists** (Eq. 8): for a submechanism ``N`` with wrench matrix
     :math:`W_N = [A_k \circ M_q]` in motion coordinates, the output twists are the
-    columns of :math:`\mathrm{adj}(W_N)` mapped by ``M``; then
-    :math:`A_k \circ T_k = \det W_N` for every ``k`` (general form of Eq. A3), and
+    columns of :math:`\mathrm{adj}(W_N)` mapped by ``M``. Column ``k`` depends only on the
+    other ``n - 1`` (locked) actuators, so it is computed once per locked set and shared by
+    every submechanism containing it; :math:`|A_k \circ T_k| = |\det W_N|` for every ``k``
+    (general form of Eq. A3), and
 
     .. math:: OTI_k = \frac{|\det W_N|}{\| v_k + \omega_k \times p_k + h_k \omega_k \|}
 
     with the zero cases of the paper: ``OTI_k = 0`` when the moment arm is at or below
     ``threshold`` (the paper's *p*), and every ``OTI_k`` of ``N`` is zero when its wrenches
     are dependent (:math:`|\det W_N|` at or below ``rank_tolerance`` times the product of
-    its row norms).
+    its row norms, with screws taken about the centroid of the platform joints so that the
+    test does not depend on the world frame). An actuator is a mutual-interference
+    actuator when some ``n`` of the other actuators have independent wrenches.
 
     Then ``OTI_N = min_k OTI_k`` (Eq. 9), ``LMTI_E = max_{N subset E} OTI_N`` (Eq. 11),
     ``F_Oj = min_{|E| = a - j} LMTI_E`` (Eqs. 12-13; for ``j = a - n`` this is the minimum
