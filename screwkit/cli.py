@@ -271,7 +271,7 @@ def _fixed_pose(mechanism, at) -> np.ndarray:
 @click.option("--threshold", type=float, default=DEFAULT_THRESHOLD, show_default=True, help="Singularity threshold p (m).")
 @click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
 def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, closed_forms) -> None:
-    """Every series of the paper's Fig. 4 along one swept pose coordinate."""
+    """Sweep one pose coordinate: every series of the paper's Figure 4 along it."""
     from screwkit.analysis import angular_coordinates
     from screwkit.plots import sweep_figure
     from screwkit.sweep import sweep as run_sweep
