@@ -1,9 +1,10 @@
 """screwkit: screw-theory fault-tolerance indices for redundantly actuated parallel robots.
 
 The math core (:mod:`screwkit.screws`, :mod:`screwkit.transmission`,
-:mod:`screwkit.closed_forms`, :mod:`screwkit.planar`) imports numpy only; everything
-that touches Pinocchio, files, plots, Meshcat, Dask or the terminal lives at the edges
-and is imported lazily.
+:mod:`screwkit.closed_forms`, :mod:`screwkit.planar`) imports numpy only; its compiled
+per-configuration kernels (:mod:`screwkit._kernels`, numba) load when indices are first
+computed. Everything that touches Pinocchio, files, plots, Meshcat, Dask or the terminal
+lives at the edges and is imported lazily.
 """
 
 __version__ = "0.1.0"
