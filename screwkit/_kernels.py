@@ -281,14 +281,7 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                             rows[r, q] = total
                         r += 1
                     _null_vector(rows, n, solution, minor, work)
-                    for q in range(n):
-                        y = solution[q]
-                        f0 += y * shifted_basis[q, 3]
-                        f1 += y * shifted_basis[q, 4]
-                        f2 += y * shifted_basis[q, 5]
-                        m0 += y * shifted_basis[q, 0]
-                        m1 += y * shifted_basis[q, 1]
-                        m2 += y * shifted_basis[q, 2]
+                    combined = shifted_basis
                 else:
                     # Minimum-norm solution: SWAP J' (J'^T J')^-1 e_k.
                     for i in range(m):
@@ -317,15 +310,17 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         if worst > 1e-9 * largest:
                             for i in range(m):
                                 solution[i] = 0.0
-                    # The wrench about d is SWAP (the combination of the chain's twists about d).
-                    for j in range(m):
-                        y = solution[j]
-                        f0 += y * shifted[j, 3]
-                        f1 += y * shifted[j, 4]
-                        f2 += y * shifted[j, 5]
-                        m0 += y * shifted[j, 0]
-                        m1 += y * shifted[j, 1]
-                        m2 += y * shifted[j, 2]
+                    combined = shifted
+                # The wrench about d is SWAP (the combination of the twists about d); m = n in
+                # the first case, so both combine m rows.
+                for j in range(m):
+                    y = solution[j]
+                    f0 += y * combined[j, 3]
+                    f1 += y * combined[j, 4]
+                    f2 += y * combined[j, 5]
+                    m0 += y * combined[j, 0]
+                    m1 += y * combined[j, 1]
+                    m2 += y * combined[j, 2]
                 # Moment about the centroid: m_c = m_d + d x f.
                 x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)
                 m0 += x0
