@@ -24,6 +24,42 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True, error_model="numpy")
+def _eliminate(work, size, rhs, limit):
+    """Gaussian elimination with partial pivoting of work[:size, :size], in place.
+
+    The same row operations are applied to ``rhs[:size]`` unless ``rhs`` is empty. Returns
+    the sign of the row permutation, or 0 when a pivot is at or below ``limit`` (singular).
+    """
+    sign = 1.0
+    for col in range(size):
+        pivot = col
+        best = abs(work[col, col])
+        for row in range(col + 1, size):
+            if abs(work[row, col]) > best:
+                best = abs(work[row, col])
+                pivot = row
+        if best <= limit or best == 0.0:
+            return 0.0
+        if pivot != col:
+            for j in range(size):
+                tmp = work[col, j]
+                work[col, j] = work[pivot, j]
+                work[pivot, j] = tmp
+            if rhs.shape[0] > 0:
+                tmp = rhs[col]
+                rhs[col] = rhs[pivot]
+                rhs[pivot] = tmp
+            sign = -sign
+        for row in range(col + 1, size):
+            factor = work[row, col] / work[col, col]
+            for j in range(col + 1, size):
+                work[row, j] -= factor * work[col, j]
+            if rhs.shape[0] > 0:
+                rhs[row] -= factor * rhs[col]
+    return sign
+
+
+@njit(cache=True, error_model="numpy")
 def _determinant(matrix, size, work):
     """Determinant of matrix[:size, :size] by LU with partial pivoting (``work`` is scratch)."""
     if size == 1:
@@ -37,27 +73,9 @@ def _determinant(matrix, size, work):
     for i in range(size):
         for j in range(size):
             work[i, j] = matrix[i, j]
-    det = 1.0
-    for col in range(size):
-        pivot = col
-        best = abs(work[col, col])
-        for row in range(col + 1, size):
-            if abs(work[row, col]) > best:
-                best = abs(work[row, col])
-                pivot = row
-        if best == 0.0:
-            return 0.0
-        if pivot != col:
-            for j in range(size):
-                tmp = work[col, j]
-                work[col, j] = work[pivot, j]
-                work[pivot, j] = tmp
-            det = -det
-        det *= work[col, col]
-        for row in range(col + 1, size):
-            factor = work[row, col] / work[col, col]
-            for j in range(col + 1, size):
-                work[row, j] -= factor * work[col, j]
+    det = _eliminate(work, size, work[0, :0], 0.0)
+    for i in range(size):
+        det *= work[i, i]
     return det
 
 
@@ -101,28 +119,8 @@ def _solve(matrix, size, rhs, out, work):
         for j in range(size):
             work[i, j] = matrix[i, j]
         out[i] = rhs[i]
-    for col in range(size):
-        pivot = col
-        best = abs(work[col, col])
-        for row in range(col + 1, size):
-            if abs(work[row, col]) > best:
-                best = abs(work[row, col])
-                pivot = row
-        if best <= 1e-12 * scale or best == 0.0:
-            return False
-        if pivot != col:
-            for j in range(size):
-                tmp = work[col, j]
-                work[col, j] = work[pivot, j]
-                work[pivot, j] = tmp
-            tmp = out[col]
-            out[col] = out[pivot]
-            out[pivot] = tmp
-        for row in range(col + 1, size):
-            factor = work[row, col] / work[col, col]
-            for j in range(col, size):
-                work[row, j] -= factor * work[col, j]
-            out[row] -= factor * out[col]
+    if _eliminate(work, size, out[:size], 1e-12 * scale) == 0.0:
+        return False
     for row in range(size - 1, -1, -1):
         total = out[row]
         for j in range(row + 1, size):
@@ -173,6 +171,12 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
     subs = submechanisms.shape[0]
     constant = basis.shape[0] == 1
     blocks = (count + BLOCK - 1) // BLOCK
+    # Scratch for the solves: a chain may have more joint DoFs than 6 (e.g. an S-S rod with
+    # its idle spin), and numba does not check bounds.
+    capacity = 6
+    for c in range(chains):
+        if chain_start[c + 1] - chain_start[c] > capacity:
+            capacity = chain_start[c + 1] - chain_start[c]
     for block in range(blocks):
         local = np.empty((joints, 6))
         local_points = np.empty((joints, 3))
@@ -180,11 +184,11 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
         shifted = np.empty((joints, 6))
         shifted_basis = np.empty((n, 6))
         rows = np.empty((6, 6))
-        gram = np.empty((6, 6))
-        work = np.empty((6, 6))
+        gram = np.empty((capacity, capacity))
+        work = np.empty((capacity, capacity))
         minor = np.empty((6, 6))
-        rhs = np.zeros(6)
-        solution = np.empty(6)
+        rhs = np.zeros(capacity)
+        solution = np.empty(capacity)
         wrenches = np.empty((a, 6))
         has_force = np.empty(a, dtype=np.bool_)
         arms = np.empty((a, n, 3))
