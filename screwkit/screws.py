@@ -137,22 +137,21 @@ def project_on_axis(screw: ArrayLike, point: ArrayLike) -> NDArray[np.float64]:
     return np.where(norm_sq > 0, foot + along * direction, point)
 
 
+def _shift(screw: NDArray, point: NDArray) -> NDArray[np.float64]:
+    """(s, s_O + s x p): the moment part of a screw taken about ``point``."""
+    direction = screw[..., :3]
+    return np.concatenate([np.broadcast_to(direction, np.broadcast_shapes(direction.shape, point.shape)),
+                           screw[..., 3:] + np.cross(direction, point)], axis=-1)
+
+
 def shift_twist(twist: ArrayLike, point: ArrayLike) -> NDArray[np.float64]:
     r"""Express a twist about ``point``: :math:`(\omega, v + \omega \times p)` (the velocity of ``point``)."""
-    twist = _screws(twist, "twist")
-    point = _points(point, "point")
-    omega = twist[..., :3]
-    return np.concatenate([np.broadcast_to(omega, np.broadcast_shapes(omega.shape, point.shape)),
-                           twist[..., 3:] + np.cross(omega, point)], axis=-1)
+    return _shift(_screws(twist, "twist"), _points(point, "point"))
 
 
 def shift_wrench(wrench: ArrayLike, point: ArrayLike) -> NDArray[np.float64]:
     r"""Express a wrench about ``point``: :math:`(f, m - p \times f)` (the moment about ``point``)."""
-    wrench = _screws(wrench, "wrench")
-    point = _points(point, "point")
-    force = wrench[..., :3]
-    return np.concatenate([np.broadcast_to(force, np.broadcast_shapes(force.shape, point.shape)),
-                           wrench[..., 3:] - np.cross(point, force)], axis=-1)
+    return _shift(_screws(wrench, "wrench"), _points(point, "point"))
 
 
 def adjoint(rotation: ArrayLike, translation: ArrayLike) -> NDArray[np.float64]:
