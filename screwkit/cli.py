@@ -347,14 +347,14 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
             if radius is None or step is None or grids or overs:
                 raise click.ClickException("A planar map takes --radius and --step (and --phi-step), not --grid/--over.")
             dataset = planar_disc_map(loaded, radius, step, phi_step, threshold=threshold, closed_forms=closed_forms,
-                                      scheduler=scheduler, progress=progress)
+                                      scheduler=scheduler, progress=progress, as_dataset=False)
         else:
             if len(grids) != 2:
                 raise click.ClickException("Expected --radius/--step (planar) or exactly two --grid options.")
             grid = dict(_grid_spec(loaded, g) for g in grids)
             over = dict(_grid_spec(loaded, o) for o in overs)
             dataset = index_map(loaded, grid, over, _fixed_pose(loaded, at), threshold=threshold,
-                                closed_forms=closed_forms, scheduler=scheduler, progress=progress)
+                                closed_forms=closed_forms, scheduler=scheduler, progress=progress, as_dataset=False)
     except ValueError as error:
         raise click.ClickException(str(error)) from None
     elapsed = __import__("time").perf_counter() - start

@@ -20,6 +20,7 @@ import hashlib
 import os
 import sys
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,9 +28,71 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.analysis import angular_coordinates, indices_at_poses
 from screwkit.transmission import DEFAULT_THRESHOLD
 
-__all__ = ["index_map", "planar_disc_map", "write_dataset", "run_tasks"]
+__all__ = ["index_map", "planar_disc_map", "GridMap", "write_dataset", "run_tasks"]
 
 CONFIGURATIONS_PER_TASK = 131_072
+
+
+@dataclass
+class GridMap:
+    """A computed map as plain numpy arrays, before (or without) xarray.
+
+    :func:`index_map` returns it with ``as_dataset=False``; the command line writes it to
+    netCDF directly (:meth:`to_netcdf`), which spares the import of xarray, pandas and
+    dask.array (about 1 s of a map command's start-up).
+
+    Attributes
+    ----------
+    coordinates : dict of str -> (ndarray, str)
+        The two grid coordinates, x axis first: values (as shown: degrees for angles) and unit.
+    variables : dict of str -> ndarray (len(y), len(x))
+    long_names : dict of str -> str
+    attrs : dict
+        Global attributes (mechanism, method, orientation set, ...).
+    """
+
+    coordinates: dict[str, tuple[NDArray[np.float64], str]]
+    variables: dict[str, NDArray[np.float64]]
+    long_names: dict[str, str]
+    attrs: dict = field(default_factory=dict)
+
+    def to_dataset(self):
+        """The same map as an ``xarray.Dataset`` (what :func:`index_map` returns by default)."""
+        import xarray as xr
+
+        (x_name, _), (y_name, _) = self.coordinates.items()
+        dataset = xr.Dataset(
+            {key: ((y_name, x_name), values) for key, values in self.variables.items()},
+            coords={name: (name, values, {"units": unit}) for name, (values, unit) in self.coordinates.items()})
+        for key, long_name in self.long_names.items():
+            dataset[key].attrs["long_name"] = long_name
+        dataset.attrs.update(self.attrs)
+        return dataset
+
+    def to_netcdf(self, path) -> None:
+        """Write a netCDF-3 file (``scipy.io.netcdf_file``) atomically; ``xarray.open_dataset`` reads it."""
+        from scipy.io import netcdf_file
+
+        (x_name, _), (y_name, _) = self.coordinates.items()
+
+        def write(temporary):
+            with netcdf_file(temporary, "w", version=2) as handle:
+                for name, (values, unit) in self.coordinates.items():
+                    handle.createDimension(name, values.size)
+                    variable = handle.createVariable(name, "d", (name,))
+                    variable[:] = values
+                    variable.units = unit
+                for key, values in self.variables.items():
+                    variable = handle.createVariable(key, "d", (y_name, x_name))
+                    variable[:] = values
+                    if key in self.long_names:
+                        variable.long_name = self.long_names[key]
+                for key, value in self.attrs.items():
+                    if key in handle.__dict__:
+                        raise ValueError(f"Cannot write a global attribute named {key!r} to netCDF.")
+                    setattr(handle, key, _netcdf_attribute(value))
+
+        _atomic_write(path, write)
 
 
 @functools.lru_cache(maxsize=8)
@@ -104,18 +167,24 @@ def run_tasks(function, arguments: list[tuple], *, scheduler: str | None = None,
     bar = tqdm(total=len(arguments), desc=label, disable=not progress, file=sys.stderr, leave=False, delay=2.0)
     try:
         if scheduler is None:
+            # Dask's local threaded scheduler on a plain task graph: unlike dask.compute it
+            # does not import dask.distributed (0.2-0.3 s of start-up) to look for a client.
             import dask
             from dask.callbacks import Callback
+            from dask.threaded import get
 
             class Counter(Callback):
                 def _posttask(self, key, result, dsk, state, worker_id):
-                    if isinstance(key, tuple) or str(key).startswith("task-"):
+                    if str(key).startswith("task-"):
                         bar.update(1)
 
             tasks = [dask.delayed(function, pure=True)(*args, dask_key_name=f"task-{i}")
                      for i, args in enumerate(arguments)]
+            graph = {}
+            for task in tasks:
+                graph.update(task.__dask_graph__())
             with Counter():
-                return list(dask.compute(*tasks, scheduler="threads", num_workers=os.cpu_count() or 1))
+                return list(get(graph, [task.key for task in tasks], num_workers=os.cpu_count() or 1))
         from distributed import Client, as_completed
 
         client = scheduler if isinstance(scheduler, Client) else Client(scheduler, set_as_default=False)
@@ -136,7 +205,7 @@ def run_tasks(function, arguments: list[tuple], *, scheduler: str | None = None,
 def index_map(mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike], at: ArrayLike | None = None, *,
               mask: NDArray[np.bool_] | None = None, threshold: float = DEFAULT_THRESHOLD, faults=None,
               closed_forms: bool = False, scheduler: str | None = None, progress: bool | None = None,
-              configurations_per_task: int = CONFIGURATIONS_PER_TASK):
+              configurations_per_task: int = CONFIGURATIONS_PER_TASK, as_dataset: bool = True):
     """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
 
     Parameters
@@ -157,16 +226,16 @@ def index_map(mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
         ``dask.distributed`` scheduler address (default: local threads).
     progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
+    as_dataset : bool
+        Return an ``xarray.Dataset`` (default) or the plain :class:`GridMap`.
 
     Returns
     -------
-    xarray.Dataset
+    xarray.Dataset or GridMap
         Coordinates named after the two grid coordinates (``x``, ``y`` for planar maps);
         variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
         orientation of the set) and ``reachable_fraction``.
     """
-    import xarray as xr
-
     names = mechanism.task_coordinates
     if len(grid) != 2:
         raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
@@ -200,7 +269,7 @@ def index_map(mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
         values = np.full(x_grid.size, np.nan)
         if results:
             values[positions] = np.concatenate([r[key] for r in results])
-        variables[key] = ((y_name, x_name), values.reshape(x_grid.shape))
+        variables[key] = values.reshape(x_grid.shape)
     angular = angular_coordinates(names)
 
     def shown(name, values):
@@ -209,20 +278,20 @@ def index_map(mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
     def unit(name):
         return "deg" if angular[names.index(name)] else "m"
 
-    dataset = xr.Dataset(variables, coords={
-        x_name: (x_name, shown(x_name, x_values), {"units": unit(x_name)}),
-        y_name: (y_name, shown(y_name, y_values), {"units": unit(y_name)})})
-    for key in dataset.data_vars:
-        if key != "reachable_fraction":
-            dataset[key].attrs["long_name"] = f"minimum of {key} over the orientation set"
-    dataset.attrs.update(
-        mechanism=mechanism.name, threshold_m=threshold, method="closed forms" if closed_forms else "generic screw path",
-        orientation_set="; ".join(f"{name}: {len(np.unique(over_values[:, i]))} values from "
-                                  f"{shown(name, over_values[:, i].min()):g} to {shown(name, over_values[:, i].max()):g} {unit(name)}"
-                                  for i, name in enumerate(over)) or "the fixed pose only",
-        fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
-        configurations=int(positions.size * over_values.shape[0]))
-    return dataset
+    grid_map = GridMap(
+        coordinates={x_name: (shown(x_name, x_values), unit(x_name)), y_name: (shown(y_name, y_values), unit(y_name))},
+        variables=variables,
+        long_names={key: f"minimum of {key} over the orientation set" for key in variables if key != "reachable_fraction"},
+        attrs=dict(
+            mechanism=mechanism.name, threshold_m=threshold,
+            method="closed forms" if closed_forms else "generic screw path",
+            orientation_set="; ".join(
+                f"{name}: {len(np.unique(over_values[:, i]))} values from {shown(name, over_values[:, i].min()):g} "
+                f"to {shown(name, over_values[:, i].max()):g} {unit(name)}" for i, name in enumerate(over))
+            or "the fixed pose only",
+            fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
+            configurations=int(positions.size * over_values.shape[0])))
+    return grid_map.to_dataset() if as_dataset else grid_map
 
 
 def planar_disc_map(mechanism, radius: float, step: float, phi_step_degrees: float, *, centre=None, **options):
@@ -270,28 +339,54 @@ def _wide_table(dataset):
     return pd.concat([frame, pd.DataFrame(columns)], axis=1)
 
 
+def _netcdf_attribute(value):
+    """A global attribute in the type xarray's own netCDF-3 writer gives it (floats stay double)."""
+    if isinstance(value, (bool, np.bool_)):
+        return np.int8(value)
+    if isinstance(value, (int, np.integer)):
+        return np.int32(value) if abs(int(value)) < 2**31 else np.float64(value)
+    if isinstance(value, (float, np.floating)):
+        return np.float64(value)
+    return value
+
+
 def _atomic_text(path, text: str) -> None:
     """Write a text file atomically (temporary file in the same folder, then rename)."""
-    path = os.fspath(path)
-    temporary = os.path.join(os.path.dirname(os.path.abspath(path)), f".{os.path.basename(path)}.tmp-{os.getpid()}")
-    with open(temporary, "w", encoding="utf-8") as handle:
-        handle.write(text)
-    os.replace(temporary, path)
+
+    def write(temporary):
+        with open(temporary, "w", encoding="utf-8") as handle:
+            handle.write(text)
+
+    _atomic_write(path, write)
 
 
-def write_dataset(dataset, path) -> None:
-    """Write a netCDF (``.nc``) or CSV file atomically: a temporary file in the same folder, then rename."""
+def _atomic_write(path, write) -> None:
+    """Call ``write(temporary)`` on a temporary file in the same folder, then rename it to ``path``."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     temporary = os.path.join(folder, f".{os.path.basename(path)}.tmp-{os.getpid()}-{time.time_ns()}")
     try:
-        if path.endswith(".csv"):
-            _wide_table(dataset).to_csv(temporary, index=False)
-        elif path.endswith(".nc"):
-            dataset.to_netcdf(temporary, engine="scipy")
-        else:
-            raise ValueError(f"Expected an output file ending in .nc or .csv, got {path!r}.")
+        write(temporary)
         os.replace(temporary, path)
     finally:
         if os.path.exists(temporary):
             os.remove(temporary)
+
+
+def write_dataset(dataset, path) -> None:
+    """Write a netCDF (``.nc``) or CSV file atomically: a temporary file in the same folder, then rename.
+
+    ``dataset`` is an ``xarray.Dataset`` or a :class:`GridMap` (written to netCDF without xarray).
+    """
+    path = os.fspath(path)
+    if not path.endswith((".nc", ".csv")):
+        raise ValueError(f"Expected an output file ending in .nc or .csv, got {path!r}.")
+    if isinstance(dataset, GridMap):
+        if path.endswith(".nc"):
+            dataset.to_netcdf(path)
+            return
+        dataset = dataset.to_dataset()
+    if path.endswith(".csv"):
+        _atomic_write(path, lambda temporary: _wide_table(dataset).to_csv(temporary, index=False))
+    else:
+        _atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))

@@ -89,14 +89,15 @@ def map_figure(dataset, variables=None, reference=None):
 
     Parameters
     ----------
-    dataset : xarray.Dataset
+    dataset : xarray.Dataset or screwkit.maps.GridMap
         From :func:`screwkit.maps.index_map`, with two grid coordinates.
     variables : sequence of str, optional
         Default: ``iti``, ``lmti`` and every ``f_o{j}``.
-    reference : xarray.Dataset, optional
+    reference : xarray.Dataset or GridMap, optional
         A second map drawn in a row below (e.g. the paper's design beside an optimised one).
     """
     plt = _pyplot()
+    dataset, reference = (d.to_dataset() if hasattr(d, "to_dataset") else d for d in (dataset, reference))
     if variables is None:
         variables = ["iti", "lmti"] + sorted(v for v in dataset.data_vars if v.startswith("f_o"))
     rows = [dataset] + ([reference] if reference is not None else [])

@@ -16,7 +16,7 @@ from click.testing import CliRunner
 from screwkit.cli import app
 from screwkit.closed_forms import planar_indices
 from screwkit.design import permutation_search, planar_design, rotation_class
-from screwkit.maps import index_map, planar_disc_map, write_dataset
+from screwkit.maps import GridMap, index_map, planar_disc_map, write_dataset
 from screwkit.mechanism import load
 from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
 from screwkit.sweep import parse_range, sweep
@@ -84,6 +84,22 @@ def test_disc_map_values_are_minima_over_the_rotation(five, tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["map.nc"]  # no temporary left behind
     with xr.open_dataset(path) as reread:
         np.testing.assert_array_equal(reread["f_o1"].values, dataset["f_o1"].values)
+
+
+def test_map_written_without_xarray_reads_back_as_the_dataset(five, tmp_path):
+    """The command line writes the plain GridMap with scipy; xarray reads it back as index_map's dataset."""
+    grid = planar_disc_map(five, 0.5, 0.25, 30.0, progress=False, as_dataset=False)
+    assert isinstance(grid, GridMap)
+    dataset = grid.to_dataset()
+    write_dataset(grid, tmp_path / "plain.nc")
+    write_dataset(dataset, tmp_path / "xarray.nc")
+    assert sorted(os.listdir(tmp_path)) == ["plain.nc", "xarray.nc"]
+    with xr.open_dataset(tmp_path / "plain.nc") as plain, xr.open_dataset(tmp_path / "xarray.nc") as written:
+        xr.testing.assert_identical(plain, written)
+        xr.testing.assert_identical(plain, dataset)
+        for key, value in written.attrs.items():  # same attribute types as xarray's own writer
+            assert type(plain.attrs[key]) is type(value), key
+    assert np.isnan(dataset["f_o1"].values).any() and np.isfinite(dataset["f_o1"].values).any()
 
 
 def test_spatial_map_over_an_orientation_set():
