@@ -145,15 +145,17 @@ def _power_coefficient(numerator, arm, reference, threshold):
 
 
 @njit(nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
-def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_joint, basis, complement,
-                        submechanisms, locked_sets, locked_of, threshold, rank_tolerance, iti_override, oti_override,
-                        iti_out, oti_out, oti_sub_out, summary_out, independent_out, wrench_out, twist_out,
-                        outside_out):
+def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
+                        submechanisms, locked_sets, locked_of, fault_start, fault_table, threshold, rank_tolerance,
+                        iti_override, oti_override, iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out,
+                        wrench_out, twist_out, outside_out):
     """Indices of a chunk of configurations.
 
     Parameters (N configurations, J joints in all, C chains, a actuators, n DOF, S submechanisms)
     ----------
-    twists (N, J, 6), points (N, J, 3) : joint screws and points, world frame.
+    all_twists (N, J, 6), all_points (N, J, 3) : joint screws and points of every chain, world
+        frame, in any memory layout (the loader's are component-major): each block of
+        configurations is first gathered into a small batch-first buffer.
     chain_start (C + 1,) : joints of chain c are chain_start[c]:chain_start[c+1].
     actuator_chain, actuator_joint (a,) : chain and joint (within the chain) of each actuator.
     basis (1 or N, n, 6) : motion-space basis about the centroid (1: the same for all).
@@ -163,15 +165,21 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
     locked_sets (L, n - 1) : every set of n - 1 actuators (locked while one other drives).
     locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
         the other n - 1 actuators of the submechanism.
+    fault_start (F + 1,), fault_table (E, M) : the actuator sets E_i left after j faults, for each
+        of F values of j: rows fault_start[f]:fault_start[f+1] of fault_table list the
+        submechanisms contained in each set (padded with -1).
     iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller.
-    Outputs: iti_out (N, a), oti_out (N, S, n), oti_sub_out (N, S) (Eq. 9), summary_out (N, 2) holding
-        the ITI (Eq. 7) and the LMTI of all actuators (Eq. 11), independent_out (N, S) bool,
+    Outputs: iti_out (N or 0, a), oti_out (N or 0, S, n), oti_sub_out (N or 0, S) (Eq. 9);
+        summary_out (N, 2 + F) holding the ITI (Eq. 7), the LMTI of all actuators (Eq. 11) and
+        F_Oj for each of the F values of j (Eqs. 12-13); worst_out (N, F) the worst set (first
+        minimum, as numpy's argmin); mutual_out (N, a) bool, whether each actuator is a
+        mutual-interference actuator (some n others have independent wrenches);
         wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6) (output twists, scaled so that
         |A_k o T_k| = |det W|), outside_out (N,) bool.
     """
-    count = twists.shape[0]
-    joints = twists.shape[1]
+    count = all_twists.shape[0]
     chains = chain_start.shape[0] - 1
+    joints = chain_start[chains]
     a = actuator_chain.shape[0]
     n = basis.shape[1]
     subs = submechanisms.shape[0]
@@ -184,6 +192,17 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
         if chain_start[c + 1] - chain_start[c] > capacity:
             capacity = chain_start[c + 1] - chain_start[c]
     for block in range(blocks):
+        first_index = block * BLOCK
+        last_index = min(count, first_index + BLOCK)
+        twists = np.empty((last_index - first_index, joints, 6))
+        points = np.empty((last_index - first_index, joints, 3))
+        for j in range(joints):  # gather the block batch-first (reading component-major input in runs)
+            for k in range(6):
+                for i in range(first_index, last_index):
+                    twists[i - first_index, j, k] = all_twists[i, j, k]
+            for k in range(3):
+                for i in range(first_index, last_index):
+                    points[i - first_index, j, k] = all_points[i, j, k]
         local = np.empty((joints, 6))
         local_points = np.empty((joints, 3))
         motion = np.empty((n, 6))
@@ -198,36 +217,40 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
         wrenches = np.empty((a, 6))
         has_force = np.empty(a, dtype=np.bool_)
         arms = np.empty((a, n, 3))
+        iti_local = np.empty(a)
+        oti_local = np.empty(subs)
+        independent = np.empty(subs, dtype=np.bool_)
         wrench_matrix = np.empty((a, n))
         row_norms = np.empty(a)
         coefficients = np.empty(6)
         output = np.empty((locked_sets.shape[0], n))
         output_omega = np.empty(locked_sets.shape[0])
-        for index in range(block * BLOCK, min(count, (block + 1) * BLOCK)):
+        for index in range(first_index, last_index):
+            row = index - first_index
             # --- centroid of the platform joints; everything below is expressed about it.
             c0 = 0.0
             c1 = 0.0
             c2 = 0.0
             for c in range(chains):
                 last = chain_start[c + 1] - 1
-                c0 += points[index, last, 0]
-                c1 += points[index, last, 1]
-                c2 += points[index, last, 2]
+                c0 += points[row, last, 0]
+                c1 += points[row, last, 1]
+                c2 += points[row, last, 2]
             c0 /= chains
             c1 /= chains
             c2 /= chains
             for j in range(joints):
-                w0, w1, w2 = twists[index, j, 0], twists[index, j, 1], twists[index, j, 2]
+                w0, w1, w2 = twists[row, j, 0], twists[row, j, 1], twists[row, j, 2]
                 x0, x1, x2 = _cross(w0, w1, w2, c0, c1, c2)
                 local[j, 0] = w0
                 local[j, 1] = w1
                 local[j, 2] = w2
-                local[j, 3] = twists[index, j, 3] + x0
-                local[j, 4] = twists[index, j, 4] + x1
-                local[j, 5] = twists[index, j, 5] + x2
-                local_points[j, 0] = points[index, j, 0] - c0
-                local_points[j, 1] = points[index, j, 1] - c1
-                local_points[j, 2] = points[index, j, 2] - c2
+                local[j, 3] = twists[row, j, 3] + x0
+                local[j, 4] = twists[row, j, 4] + x1
+                local[j, 5] = twists[row, j, 5] + x2
+                local_points[j, 0] = points[row, j, 0] - c0
+                local_points[j, 1] = points[row, j, 1] - c1
+                local_points[j, 2] = points[row, j, 2] - c2
             source = 0 if constant else index
             for q in range(n):
                 for k in range(6):
@@ -398,7 +421,7 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         else:
                             arm = omega
                             reference = 0.0
-                        iti_out[index, act] = _power_coefficient(work_done * factor, arm, reference, threshold)
+                        iti_local[act] = _power_coefficient(work_done * factor, arm, reference, threshold)
                     else:
                         # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega.
                         for q in range(n):
@@ -458,7 +481,7 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                 for q in range(n):
                     det += wrench_matrix[submechanisms[s, 0], q] * output[first, q]
                 dependent = not (abs(det) > rank_tolerance * volume)
-                independent_out[index, s] = not dependent
+                independent[s] = not dependent
                 oti_sub = 1.0
                 for position in range(n):
                     act = submechanisms[s, position]
@@ -472,7 +495,8 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                     arm = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
                     reference = output_omega[locked] if has_force[act] else 0.0
                     value = 0.0 if dependent else _power_coefficient(det, arm, reference, threshold)
-                    oti_out[index, s, position] = value
+                    if oti_out.shape[0] > 0:
+                        oti_out[index, s, position] = value
                     oti_sub = min(oti_sub, value)
                     if twist_out.shape[0] > 0:
                         for k in range(6):
@@ -486,13 +510,45 @@ def transmission_kernel(twists, points, chain_start, actuator_chain, actuator_jo
                         twist_out[index, s, position, 3] -= x0
                         twist_out[index, s, position, 4] -= x1
                         twist_out[index, s, position, 5] -= x2
-                oti_sub_out[index, s] = oti_sub
+                oti_local[s] = oti_sub
+                if oti_sub_out.shape[0] > 0:
+                    oti_sub_out[index, s] = oti_sub
                 lmti = max(lmti, oti_sub)
             iti = 1.0
             for act in range(a):
-                iti = min(iti, iti_out[index, act])
+                iti = min(iti, iti_local[act])
+                if iti_out.shape[0] > 0:
+                    iti_out[index, act] = iti_local[act]
             summary_out[index, 0] = iti
             summary_out[index, 1] = lmti
+            # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
+            for f in range(fault_start.shape[0] - 1):
+                best = np.inf
+                worst = 0
+                for e in range(fault_start[f], fault_start[f + 1]):
+                    value = -np.inf
+                    for t in range(fault_table.shape[1]):
+                        s = fault_table[e, t]
+                        if s < 0:
+                            break
+                        value = max(value, oti_local[s])
+                    if value < best:
+                        best = value
+                        worst = e - fault_start[f]
+                summary_out[index, 2 + f] = best
+                worst_out[index, f] = worst
+            # --- mutual interference: the other actuators alone fully constrain the platform.
+            for act in range(a):
+                mutual = False
+                for s in range(subs):
+                    if independent[s]:
+                        member = False
+                        for i in range(n):
+                            member = member or submechanisms[s, i] == act
+                        if not member:
+                            mutual = True
+                            break
+                mutual_out[index, act] = mutual
 
 
 @njit(nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)

@@ -484,7 +484,7 @@ def _linear_combination(out: NDArray, terms: list) -> None:
 
 
 def twists_from_axes_and_points(
-    axes: NDArray, points: NDArray, prismatic: tuple[bool, ...] | NDArray
+    axes: NDArray, points: NDArray, prismatic: tuple[bool, ...] | NDArray, out: NDArray | None = None
 ) -> NDArray[np.float64]:
     """Unit joint twists ``(omega, v)`` (..., m, 6) from joint axes and points (..., m, 3).
 
@@ -495,14 +495,21 @@ def twists_from_axes_and_points(
     The result is computed and stored component by component (component-major memory,
     returned as a (..., m, 6) view), which is several times faster than interleaved storage
     for large batches; axis components that are one broadcast number (as for the planar
-    closed forms) are used as numbers and zero ones are skipped.
+    closed forms) are used as numbers and zero ones are skipped. ``out``, a zeroed
+    component-major array (6, m, ...), receives the result (several chains can so share one
+    block of memory that the index kernel reads in place).
     """
     axes_components = np.moveaxis(np.asarray(axes, dtype=float), (-1, -2), (0, 1))
     points_components = np.moveaxis(np.asarray(points, dtype=float), (-1, -2), (0, 1))
     prismatic = np.asarray(prismatic, dtype=bool)
     n_joints = axes_components.shape[1]
     batch = np.broadcast_shapes(axes_components.shape[2:], points_components.shape[2:])
-    twists = np.zeros((6, n_joints) + batch)
+    if out is None:
+        twists = np.zeros((6, n_joints) + batch)
+    elif out.shape != (6, n_joints) + batch:
+        raise ValueError(f"Expected `out` with shape {(6, n_joints) + batch}, got {out.shape}.")
+    else:
+        twists = out
     for joint in range(n_joints):
         axis = []
         for component in range(3):

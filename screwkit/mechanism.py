@@ -893,6 +893,13 @@ class Mechanism:
                 "pass unreachable='drop' or 'reference' to chain_screws, or mask the poses."
             )
 
+        # Every chain's twists and points go into one component-major block (6 or 3, J, batch),
+        # chain after chain along the joint axis, which analyze() then reads in place.
+        batch = (int(mask.sum()),) if not all_reachable and unreachable == "drop" else mask.shape
+        starts = np.cumsum([0] + [chain.n_joints for chain in self.chains])
+        twist_block = np.zeros((6, starts[-1]) + batch)
+        point_block = np.empty((3, starts[-1]) + batch)
+
         def screws_of_chain(index: int) -> ChainScrews:
             axes, points = solution.joint_axes[index], solution.joint_points[index]
             if not all_reachable and unreachable == "drop":
@@ -901,7 +908,9 @@ class Mechanism:
                 frames = self._reference_frames[index]
                 axes = np.where(mask[..., None, None], axes, frames.axes)
                 points = np.where(mask[..., None, None], points, frames.points)
-            return self._chain_screws_from_frames(index, axes, points, frame)
+            joints = slice(starts[index], starts[index + 1])
+            return self._chain_screws_from_frames(index, axes, points, frame, twist_block[:, joints],
+                                                  point_block[:, joints])
 
         if mask.size >= 1 << 16 and len(self.chains) > 1:  # chains in parallel (numpy releases the GIL)
             with ThreadPoolExecutor(min(len(self.chains), os.cpu_count() or 1)) as pool:
@@ -922,11 +931,16 @@ class Mechanism:
             screws.append(self._chain_screws_from_frames(index, frames.axes, frames.points, frame))
         return screws
 
-    def _chain_screws_from_frames(self, index: int, axes: NDArray, points: NDArray, frame: str) -> ChainScrews:
+    def _chain_screws_from_frames(self, index: int, axes: NDArray, points: NDArray, frame: str,
+                                  twist_block: NDArray | None = None, point_block: NDArray | None = None) -> ChainScrews:
+        """Screws of one chain; ``twist_block`` (zeroed) and ``point_block``, (6 or 3, m, ...), receive them."""
         chain = self.chains[index]
         if frame == "world" and not self._base_is_world:
             axes, points = transform_axes_and_points(self.rotation_world_base, self.translation_world_base, axes, points)
-        twists = twists_from_axes_and_points(axes, points, chain.prismatic)
+        twists = twists_from_axes_and_points(axes, points, chain.prismatic, out=twist_block)
+        if point_block is not None:
+            point_block[...] = np.moveaxis(points, (-1, -2), (0, 1))
+            points = np.moveaxis(point_block, (0, 1), (-1, -2))
         return ChainScrews(twists, points, chain.actuated, chain.name)
 
     def closure_residuals(self, solution: Solution) -> NDArray[np.float64]:

@@ -261,7 +261,8 @@ class _Plan:
     faults: tuple[int, ...]
     fault_members: dict[int, NDArray[np.int64]]
     failed_sets: dict[int, NDArray[np.int64]]
-    complement_members: list[NDArray[np.int64]]
+    fault_start: NDArray[np.int64]
+    fault_table: NDArray[np.int64]
     threshold: float
     rank_tolerance: float
 
@@ -299,8 +300,12 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         failed_sets[j] = np.array([sorted(set(range(a)) - set(e)) for e in sets], dtype=np.int64).reshape(-1, j)
     locked = list(combinations(range(a), n - 1))
     locked_index = {subset: index for index, subset in enumerate(locked)}
-    complement_members = [np.array([s for s, sub in enumerate(submechanisms) if k not in sub], dtype=np.int64)
-                          for k in range(a)]
+    # Every set left after j faults, for every j, as rows of submechanism indices (padded with -1).
+    rows = [members for j in fault_list for members in fault_members[j]]
+    fault_table = np.full((len(rows), max((len(r) for r in rows), default=0)), -1, dtype=np.int64)
+    for row, members in enumerate(rows):
+        fault_table[row, :len(members)] = members
+    fault_start = np.cumsum([0] + [len(fault_members[j]) for j in fault_list]).astype(np.int64)
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
     return _Plan(
         actuators=actuators, dof=n, space=space, complement=complement,
@@ -311,39 +316,41 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
                            dtype=np.int64).reshape(-1, n),
-        faults=fault_list, fault_members=fault_members, failed_sets=failed_sets,
-        complement_members=complement_members, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
+        faults=fault_list, fault_members=fault_members, failed_sets=failed_sets, fault_start=fault_start,
+        fault_table=fault_table, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
     from screwkit._kernels import transmission_kernel
 
     count = twists.shape[0]
+    kept = count if detail else 0
     a, (subs, n) = len(plan.actuators), plan.submechanisms.shape
     out = {
-        "iti_actuators": np.zeros((count, a)),
-        "oti_actuators": np.zeros((count, subs, n)),
-        "oti_submechanisms": np.zeros((count, subs)),
-        "summary": np.zeros((count, 2)),
-        "independent": np.zeros((count, subs), dtype=bool),
-        "actuation_wrenches": np.zeros((count if detail else 0, a, 6)),
+        "iti_actuators": np.zeros((kept, a)),
+        "oti_actuators": np.zeros((kept, subs, n)),
+        "oti_submechanisms": np.zeros((kept, subs)),
+        "summary": np.zeros((count, 2 + len(plan.faults))),
+        "worst": np.zeros((count, len(plan.faults)), dtype=np.int64),
+        "mutual_interference": np.zeros((count, a), dtype=bool),
+        "actuation_wrenches": np.zeros((kept, a, 6)),
         "output_twists": np.zeros((count if keep_twists else 0, subs, n, 6)),
         "outside": np.zeros(count, dtype=bool),
     }
     empty = np.empty((0, a, 3))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
-                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of,
-                        plan.threshold, plan.rank_tolerance,
+                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
+                        plan.fault_table, plan.threshold, plan.rank_tolerance,
                         empty if iti_override is None else iti_override,
                         empty if oti_override is None else oti_override,
                         out["iti_actuators"], out["oti_actuators"], out["oti_submechanisms"], out["summary"],
-                        out["independent"],
+                        out["worst"], out["mutual_interference"],
                         out["actuation_wrenches"], out["output_twists"], out["outside"])
     return out
 
 
 def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists) -> dict:
-    """All indices for one chunk of configurations (batch-first arrays over all joints)."""
+    """All indices for one chunk of configurations (arrays (N, J, 6) and (N, J, 3) over all joints)."""
     if plan.space.constant_basis is not None:
         basis = plan.space.constant_basis[None]
         out = _run_kernel(plan, twists, points, basis, plan.complement, iti_override, oti_override,
@@ -367,23 +374,18 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
             for key, value in again.items():
                 if out[key].shape[0]:
                     out[key][redo] = value
-    oti_sub = out["oti_submechanisms"]  # Eq. 9
+    summary = out["summary"]
     result = {
-        "iti": out["summary"][:, 0],  # Eq. 7
-        "lmti": out["summary"][:, 1],  # Eq. 11 on the whole set
-        # Mutual-interference actuators: the others alone fully constrain the platform.
-        "mutual_interference": np.stack(
-            [out["independent"][:, members].any(axis=1) if members.size else np.zeros(oti_sub.shape[0], bool)
-             for members in plan.complement_members], axis=1),
+        "iti": summary[:, 0],  # Eq. 7
+        "lmti": summary[:, 1],  # Eq. 11 on the whole set
+        "mutual_interference": out["mutual_interference"],
     }
-    for j in plan.faults:
-        lmti_sets = oti_sub[:, plan.fault_members[j]].max(axis=2)  # (N, E): Eq. 11 on each E_i
-        worst = lmti_sets.argmin(axis=1)
-        result[f"f_o{j}"] = np.take_along_axis(lmti_sets, worst[:, None], axis=1)[:, 0]  # Eq. 12
-        result[f"worst{j}"] = plan.failed_sets[j][worst]  # (N, j): the complement of the worst E_i
+    for column, j in enumerate(plan.faults):
+        result[f"f_o{j}"] = summary[:, 2 + column]  # Eqs. 12-13
+        result[f"worst{j}"] = plan.failed_sets[j][out["worst"][:, column]]  # (N, j): the complement of the worst E_i
     if detail:
         result.update(iti_actuators=out["iti_actuators"], oti_actuators=out["oti_actuators"],
-                      oti_submechanisms=oti_sub, actuation_wrenches=out["actuation_wrenches"])
+                      oti_submechanisms=out["oti_submechanisms"], actuation_wrenches=out["actuation_wrenches"])
         if keep_twists:
             result["output_twists"] = out["output_twists"]
     return result
@@ -392,23 +394,23 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
 def _joints_of_all_chains(arrays: list[NDArray]):
     """A function giving, for a slice of the batch, the (n, J, k) array of every chain's joints.
 
-    When the chains are consecutive blocks of one C-ordered (N, J, k) array (as the chain
-    builders make them), the slice is a view of that array; otherwise the chains' slices are
-    concatenated.
+    When the chains are consecutive blocks along the joint axis of one array, whatever its
+    memory layout (the loader's screws are component-major, hand-built ones batch-first), the
+    slice is a view of that array and the kernel reads it in place; otherwise the chains'
+    slices are concatenated.
     """
     first = arrays[0]
     width = sum(a.shape[1] for a in arrays)
-    item = first.itemsize
-    expected = (width * first.shape[2] * item, first.shape[2] * item, item)
+    strides = first.strides
     address = first.__array_interface__["data"][0]
-    tiled = True
+    tiled = first.shape[0] > 0 and first.dtype == np.float64
     for array in arrays:
-        tiled &= array.strides == expected and array.dtype == first.dtype
+        tiled &= array.strides == strides and array.dtype == first.dtype
         tiled &= array.__array_interface__["data"][0] == address
-        address += array.shape[1] * first.shape[2] * item
-    if tiled and first.shape[0] > 0:
+        address += array.shape[1] * strides[1]
+    if tiled:
         # Writable exactly when the chains' memory is (the kernel only reads it).
-        whole = np.lib.stride_tricks.as_strided(first, (first.shape[0], width, first.shape[2]), expected)
+        whole = np.lib.stride_tricks.as_strided(first, (first.shape[0], width, first.shape[2]), strides)
         if all(np.shares_memory(whole, array) for array in arrays):
             return lambda part: whole[part]
     return lambda part: np.concatenate([a[part] for a in arrays], axis=1)
