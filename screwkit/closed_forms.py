@@ -170,7 +170,7 @@ def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDAr
 
 def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_members):
     """Closed-form indices of one chunk (batch-first (n, k, 2) arrays) through the compiled kernel."""
-    from screwkit._kernels import planar_closed_form_kernel
+    from screwkit._planar_kernel import planar_closed_form_kernel
 
     count, chains = distal.shape[:2]
     iti_chains = np.empty((count, chains))
@@ -210,7 +210,7 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         Configurations per chunk (bounds memory).
     threads : int, optional
         Threads working on chunks side by side (default: the number of CPUs); the compiled
-        kernel (:func:`screwkit._kernels.planar_closed_form_kernel`) releases the GIL.
+        kernel (:func:`screwkit._planar_kernel.planar_closed_form_kernel`) releases the GIL.
 
     Returns
     -------

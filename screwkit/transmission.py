@@ -338,6 +338,9 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
         "outside": np.zeros(count, dtype=bool),
     }
     empty = np.empty((0, a, 3))
+    # The kernel's one signature: screws in any layout but writable float64, the rest C-contiguous.
+    twists, points = (array if array.flags.writeable else array.copy() for array in (twists, points))
+    basis, complement = np.ascontiguousarray(basis), np.ascontiguousarray(complement)
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
                         complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
                         plan.fault_table, plan.threshold, plan.rank_tolerance,
