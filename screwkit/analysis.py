@@ -187,15 +187,18 @@ def planar_points(mechanism, solution):
     mask = np.asarray(solution.reachable).reshape(-1)
     everything = bool(mask.all())
     count = int(mask.size if everything else mask.sum())
-    # Joint points in the base frame, reachable configurations only: (N, k, 2) per joint.
-    memory = np.empty((3, count, len(solution.joint_points), 2))
+    # Joint points in the base frame, reachable configurations only, stored component-major
+    # (joint, component, chain, configuration) so that every copy below is contiguous; the
+    # returned (N, k, 2) arrays are views of it (the closed-form kernel reads any layout).
+    memory = np.empty((3, 2, len(solution.joint_points), count))
     for chain, points in enumerate(solution.joint_points):
         flat = points.reshape(-1, 3, 3)
         for joint in range(3):
             for component in range(2):
                 column = flat[:, joint, component]
-                memory[joint, :, chain, component] = column if everything else column[mask]
-    return memory[0], memory[1], memory[2], kinds == {"rpr"}
+                memory[joint, component, chain] = column if everything else column[mask]
+    base, elbows, distal = (memory[joint].transpose(2, 1, 0) for joint in range(3))
+    return base, elbows, distal, kinds == {"rpr"}
 
 
 def _closed_form_result(mechanism, solution, threshold, faults, threads):

@@ -244,8 +244,9 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     sources = [flat(base), flat(elbows), flat(distal), flat(directions)] if directions is None else \
         [None, None, flat(distal), flat(directions)]
 
-    def run(part):
-        chunk = [None if a is None else np.ascontiguousarray(a[part]) for a in sources]
+    def run(part):  # views where possible: the kernel reads any memory layout (but writable arrays)
+        chunk = [None if a is None else a[part] if a.flags.writeable else np.ascontiguousarray(a[part])
+                 for a in sources]
         return _planar_chunk(*chunk, threshold, triples, fault_members)
 
     pieces = map_chunks(run, total, chunk_size, threads)
