@@ -17,7 +17,7 @@ from numba import njit
 
 from screwkit._fastmath import FASTMATH
 
-BLOCK = 64  # configurations sharing one set of scratch arrays
+BLOCK = 64  # configurations gathered batch-first at a time
 
 # The one signature of transmission_kernel. Joint screws and points come in any memory layout
 # ("A": the loader's component-major blocks, hand-built batch-first arrays, slices of either),
@@ -198,11 +198,34 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     for c in range(chains):
         if chain_start[c + 1] - chain_start[c] > capacity:
             capacity = chain_start[c + 1] - chain_start[c]
+    # Scratch, allocated once per call.
+    twists = np.empty((BLOCK, joints, 6))  # one block, batch-first
+    points = np.empty((BLOCK, joints, 3))
+    local = np.empty((joints, 6))
+    local_points = np.empty((joints, 3))
+    motion = np.empty((n, 6))
+    shifted = np.empty((joints, 6))
+    shifted_basis = np.empty((n, 6))
+    rows = np.empty((6, 6))
+    gram = np.empty((capacity, capacity))
+    work = np.empty((capacity, capacity))
+    minor = np.empty((6, 6))
+    rhs = np.zeros(capacity)
+    solution = np.empty(capacity)
+    wrenches = np.empty((a, 6))
+    has_force = np.empty(a, dtype=np.bool_)
+    arms = np.empty((a, n, 3))
+    iti_local = np.empty(a)
+    oti_local = np.empty(subs)
+    independent = np.empty(subs, dtype=np.bool_)
+    wrench_matrix = np.empty((a, n))
+    row_norms = np.empty(a)
+    coefficients = np.empty(6)
+    output = np.empty((locked_sets.shape[0], n))
+    output_omega = np.empty(locked_sets.shape[0])
     for block in range(blocks):
         first_index = block * BLOCK
         last_index = min(count, first_index + BLOCK)
-        twists = np.empty((last_index - first_index, joints, 6))
-        points = np.empty((last_index - first_index, joints, 3))
         for j in range(joints):  # gather the block batch-first (reading component-major input in runs)
             for k in range(6):
                 for i in range(first_index, last_index):
@@ -210,28 +233,6 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
             for k in range(3):
                 for i in range(first_index, last_index):
                     points[i - first_index, j, k] = all_points[i, j, k]
-        local = np.empty((joints, 6))
-        local_points = np.empty((joints, 3))
-        motion = np.empty((n, 6))
-        shifted = np.empty((joints, 6))
-        shifted_basis = np.empty((n, 6))
-        rows = np.empty((6, 6))
-        gram = np.empty((capacity, capacity))
-        work = np.empty((capacity, capacity))
-        minor = np.empty((6, 6))
-        rhs = np.zeros(capacity)
-        solution = np.empty(capacity)
-        wrenches = np.empty((a, 6))
-        has_force = np.empty(a, dtype=np.bool_)
-        arms = np.empty((a, n, 3))
-        iti_local = np.empty(a)
-        oti_local = np.empty(subs)
-        independent = np.empty(subs, dtype=np.bool_)
-        wrench_matrix = np.empty((a, n))
-        row_norms = np.empty(a)
-        coefficients = np.empty(6)
-        output = np.empty((locked_sets.shape[0], n))
-        output_omega = np.empty(locked_sets.shape[0])
         for index in range(first_index, last_index):
             row = index - first_index
             # --- centroid of the platform joints; everything below is expressed about it.
