@@ -213,16 +213,34 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     rhs = np.zeros(capacity)
     solution = np.empty(capacity)
     wrenches = np.empty((a, 6))
-    has_force = np.empty(a, dtype=np.bool_)
-    arms = np.empty((a, n, 3))
-    iti_local = np.empty(a)
-    oti_local = np.empty(subs)
-    independent = np.empty(subs, dtype=np.bool_)
-    wrench_matrix = np.empty((a, n))
-    row_norms = np.empty(a)
     coefficients = np.empty(6)
-    output = np.empty((locked_sets.shape[0], n))
-    output_omega = np.empty(locked_sets.shape[0])
+    # Per-configuration results of the first stage, one lane per configuration of the block:
+    # the second stage (output twists, OTIs, reductions) runs lane-innermost, so that the
+    # compiler vectorises it across configurations.
+    has_force = np.zeros((a, BLOCK), dtype=np.bool_)
+    arms = np.zeros((a, n, 3, BLOCK))
+    iti_local = np.zeros((a, BLOCK))
+    wrench_matrix = np.zeros((a, n, BLOCK))
+    row_norms = np.zeros((a, BLOCK))
+    motion_lanes = np.zeros((n, 6, BLOCK))
+    centres = np.zeros((3, BLOCK))
+    output = np.empty((locked_sets.shape[0], n, BLOCK))
+    output_omega = np.empty((locked_sets.shape[0], BLOCK))
+    oti_local = np.empty((subs, BLOCK))
+    independent = np.empty((subs, BLOCK), dtype=np.bool_)
+    values = np.empty((n, BLOCK))
+    determinant = np.empty(BLOCK)
+    volume = np.empty(BLOCK)
+    lane0 = np.empty(BLOCK)
+    lane1 = np.empty(BLOCK)
+    lane2 = np.empty(BLOCK)
+    best = np.empty(BLOCK)
+    worst_set = np.empty(BLOCK, dtype=np.int64)
+    mutual = np.empty(BLOCK, dtype=np.bool_)
+    member = np.zeros((subs, a), dtype=np.bool_)
+    for s in range(subs):
+        for i in range(n):
+            member[s, submechanisms[s, i]] = True
     for block in range(blocks):
         first_index = block * BLOCK
         last_index = min(count, first_index + BLOCK)
@@ -263,6 +281,10 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
             for q in range(n):
                 for k in range(6):
                     motion[q, k] = basis[source, q, k]
+                    motion_lanes[q, k, row] = basis[source, q, k]
+            centres[0, row] = c0
+            centres[1, row] = c1
+            centres[2, row] = c2
             # --- a constant basis must contain every joint twist.
             if constant and complement.shape[0] > 0:
                 leaving = False
@@ -387,7 +409,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 wrenches[act, 4] = m1 * factor
                 wrenches[act, 5] = m2 * factor
                 forceful = forceful and scale > 0.0
-                has_force[act] = forceful
+                has_force[act, row] = forceful
                 f0, f1, f2 = wrenches[act, 0], wrenches[act, 1], wrenches[act, 2]
                 m0, m1, m2 = wrenches[act, 3], wrenches[act, 4], wrenches[act, 5]
                 pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
@@ -429,28 +451,28 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         else:
                             arm = omega
                             reference = 0.0
-                        iti_local[act] = _power_coefficient(work_done * factor, arm, reference, threshold)
+                        iti_local[act, row] = _power_coefficient(work_done * factor, arm, reference, threshold)
                     else:
                         # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega.
                         for q in range(n):
                             w0, w1, w2 = motion[q, 0], motion[q, 1], motion[q, 2]
                             if forceful:
                                 x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
-                                arms[act, q, 0] = motion[q, 3] + x0 + pitch * w0
-                                arms[act, q, 1] = motion[q, 4] + x1 + pitch * w1
-                                arms[act, q, 2] = motion[q, 5] + x2 + pitch * w2
+                                arms[act, q, 0, row] = motion[q, 3] + x0 + pitch * w0
+                                arms[act, q, 1, row] = motion[q, 4] + x1 + pitch * w1
+                                arms[act, q, 2, row] = motion[q, 5] + x2 + pitch * w2
                             else:
-                                arms[act, q, 0] = w0
-                                arms[act, q, 1] = w1
-                                arms[act, q, 2] = w2
+                                arms[act, q, 0, row] = w0
+                                arms[act, q, 1, row] = w1
+                                arms[act, q, 2, row] = w2
                 # Row of the wrench matrix in motion coordinates: A_k o M_q.
                 norm = 0.0
                 for q in range(n):
                     value = (f0 * motion[q, 3] + f1 * motion[q, 4] + f2 * motion[q, 5]
                              + m0 * motion[q, 0] + m1 * motion[q, 1] + m2 * motion[q, 2])
-                    wrench_matrix[act, q] = value
+                    wrench_matrix[act, q, row] = value
                     norm += value * value
-                row_norms[act] = np.sqrt(norm)
+                row_norms[act, row] = np.sqrt(norm)
                 if wrench_out.shape[0] > 0:  # back to the world origin: m_0 = m_c + c x f
                     x0, x1, x2 = _cross(c0, c1, c2, f0, f1, f2)
                     wrench_out[index, act, 0] = f0
@@ -459,101 +481,146 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     wrench_out[index, act, 3] = m0 + x0
                     wrench_out[index, act, 4] = m1 + x1
                     wrench_out[index, act, 5] = m2 + x2
-            # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
-            # their wrenches (a column of adj(W) of every submechanism containing the set).
-            for locked in range(locked_sets.shape[0]):
-                for i in range(n - 1):
-                    for q in range(n):
-                        rows[i, q] = wrench_matrix[locked_sets[locked, i], q]
-                if n == 3:
-                    coefficients[0], coefficients[1], coefficients[2] = _cross(
-                        rows[0, 0], rows[0, 1], rows[0, 2], rows[1, 0], rows[1, 1], rows[1, 2])
-                else:
+        # ---------------- second stage, lane-innermost over the block's configurations.
+        width = last_index - first_index
+        # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
+        # their wrenches (a column of adj(W) of every submechanism containing the set).
+        for locked in range(locked_sets.shape[0]):
+            if n == 3:  # the cross product of the two locked rows, written out
+                i0 = locked_sets[locked, 0]
+                i1 = locked_sets[locked, 1]
+                for r in range(width):
+                    output[locked, 0, r] = (wrench_matrix[i0, 1, r] * wrench_matrix[i1, 2, r]
+                                            - wrench_matrix[i0, 2, r] * wrench_matrix[i1, 1, r])
+                    output[locked, 1, r] = (wrench_matrix[i0, 2, r] * wrench_matrix[i1, 0, r]
+                                            - wrench_matrix[i0, 0, r] * wrench_matrix[i1, 2, r])
+                    output[locked, 2, r] = (wrench_matrix[i0, 0, r] * wrench_matrix[i1, 1, r]
+                                            - wrench_matrix[i0, 1, r] * wrench_matrix[i1, 0, r])
+            else:
+                for r in range(width):
+                    for i in range(n - 1):
+                        for q in range(n):
+                            rows[i, q] = wrench_matrix[locked_sets[locked, i], q, r]
                     _null_vector(rows, n, coefficients, minor, work)
-                o0 = o1 = o2 = 0.0
-                for q in range(n):
-                    y = coefficients[q]
-                    output[locked, q] = y
-                    o0 += motion[q, 0] * y
-                    o1 += motion[q, 1] * y
-                    o2 += motion[q, 2] * y
-                output_omega[locked] = np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-            # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
-            lmti = 0.0
-            for s in range(subs):
-                volume = 1.0
-                det = 0.0
-                first = locked_of[s, 0]
-                for i in range(n):
-                    volume *= row_norms[submechanisms[s, i]]
-                for q in range(n):
-                    det += wrench_matrix[submechanisms[s, 0], q] * output[first, q]
-                dependent = not (abs(det) > rank_tolerance * volume)
-                independent[s] = not dependent
-                oti_sub = 1.0
-                for position in range(n):
-                    act = submechanisms[s, position]
-                    locked = locked_of[s, position]
-                    a0 = a1 = a2 = 0.0
                     for q in range(n):
-                        y = output[locked, q]
-                        a0 += arms[act, q, 0] * y
-                        a1 += arms[act, q, 1] * y
-                        a2 += arms[act, q, 2] * y
-                    arm = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-                    reference = output_omega[locked] if has_force[act] else 0.0
-                    value = 0.0 if dependent else _power_coefficient(det, arm, reference, threshold)
-                    if oti_out.shape[0] > 0:
-                        oti_out[index, s, position] = value
-                    oti_sub = min(oti_sub, value)
-                    if twist_out.shape[0] > 0:
+                        output[locked, q, r] = coefficients[q]
+            for r in range(width):
+                lane0[r] = 0.0
+                lane1[r] = 0.0
+                lane2[r] = 0.0
+            for q in range(n):
+                for r in range(width):
+                    y = output[locked, q, r]
+                    lane0[r] += motion_lanes[q, 0, r] * y
+                    lane1[r] += motion_lanes[q, 1, r] * y
+                    lane2[r] += motion_lanes[q, 2, r] * y
+            for r in range(width):
+                output_omega[locked, r] = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
+        # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
+        for s in range(subs):
+            first = locked_of[s, 0]
+            leader = submechanisms[s, 0]
+            for r in range(width):
+                volume[r] = 1.0
+                determinant[r] = 0.0
+                best[r] = 1.0  # the submechanism's OTI (Eq. 9), a minimum
+            for i in range(n):
+                act = submechanisms[s, i]
+                for r in range(width):
+                    volume[r] *= row_norms[act, r]
+            for q in range(n):
+                for r in range(width):
+                    determinant[r] += wrench_matrix[leader, q, r] * output[first, q, r]
+            for r in range(width):
+                independent[s, r] = abs(determinant[r]) > rank_tolerance * volume[r]
+            for position in range(n):
+                act = submechanisms[s, position]
+                locked = locked_of[s, position]
+                for r in range(width):
+                    lane0[r] = 0.0
+                    lane1[r] = 0.0
+                    lane2[r] = 0.0
+                for q in range(n):
+                    for r in range(width):
+                        y = output[locked, q, r]
+                        lane0[r] += arms[act, q, 0, r] * y
+                        lane1[r] += arms[act, q, 1, r] * y
+                        lane2[r] += arms[act, q, 2, r] * y
+                for r in range(width):
+                    arm = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
+                    reference = output_omega[locked, r] if has_force[act, r] else 0.0
+                    value = _power_coefficient(determinant[r], arm, reference, threshold) if independent[s, r] else 0.0
+                    values[position, r] = value
+                    best[r] = min(best[r], value)
+                if oti_out.shape[0] > 0:
+                    for r in range(width):
+                        oti_out[first_index + r, s, position] = values[position, r]
+                if twist_out.shape[0] > 0:
+                    for r in range(width):
+                        index = first_index + r
                         for k in range(6):
                             total = 0.0
                             for q in range(n):
-                                total += output[locked, q] * motion[q, k]
+                                total += output[locked, q, r] * motion_lanes[q, k, r]
                             twist_out[index, s, position, k] = total
                         # v_0 = v_c - omega x c
                         x0, x1, x2 = _cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
-                                            twist_out[index, s, position, 2], c0, c1, c2)
+                                            twist_out[index, s, position, 2], centres[0, r], centres[1, r],
+                                            centres[2, r])
                         twist_out[index, s, position, 3] -= x0
                         twist_out[index, s, position, 4] -= x1
                         twist_out[index, s, position, 5] -= x2
-                oti_local[s] = oti_sub
-                if oti_sub_out.shape[0] > 0:
-                    oti_sub_out[index, s] = oti_sub
-                lmti = max(lmti, oti_sub)
-            iti = 1.0
-            for act in range(a):
-                iti = min(iti, iti_local[act])
-                if iti_out.shape[0] > 0:
-                    iti_out[index, act] = iti_local[act]
-            summary_out[index, 0] = iti
-            summary_out[index, 1] = lmti
-            # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
-            for f in range(fault_start.shape[0] - 1):
-                best = np.inf
-                worst = 0
-                for e in range(fault_start[f], fault_start[f + 1]):
-                    value = -np.inf
-                    for t in range(fault_table.shape[1]):
-                        s = fault_table[e, t]
-                        if s < 0:
-                            break
-                        value = max(value, oti_local[s])
-                    if value < best:
-                        best = value
-                        worst = e - fault_start[f]
-                summary_out[index, 2 + f] = best
-                worst_out[index, f] = worst
-            # --- mutual interference: the other actuators alone fully constrain the platform.
-            for act in range(a):
-                mutual = False
-                for s in range(subs):
-                    if independent[s]:
-                        member = False
-                        for i in range(n):
-                            member = member or submechanisms[s, i] == act
-                        if not member:
-                            mutual = True
-                            break
-                mutual_out[index, act] = mutual
+            for r in range(width):
+                oti_local[s, r] = best[r]
+            if oti_sub_out.shape[0] > 0:
+                for r in range(width):
+                    oti_sub_out[first_index + r, s] = best[r]
+        # --- ITI (Eq. 7) and LMTI of all actuators (Eq. 11).
+        for r in range(width):
+            lane0[r] = 1.0
+            lane1[r] = 0.0
+        for act in range(a):
+            for r in range(width):
+                lane0[r] = min(lane0[r], iti_local[act, r])
+        for s in range(subs):
+            for r in range(width):
+                lane1[r] = max(lane1[r], oti_local[s, r])
+        for r in range(width):
+            summary_out[first_index + r, 0] = lane0[r]
+            summary_out[first_index + r, 1] = lane1[r]
+        if iti_out.shape[0] > 0:
+            for r in range(width):
+                for act in range(a):
+                    iti_out[first_index + r, act] = iti_local[act, r]
+        # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E
+        # (the first worst set, as numpy's argmin).
+        for f in range(fault_start.shape[0] - 1):
+            for r in range(width):
+                best[r] = np.inf
+                worst_set[r] = 0
+            for e in range(fault_start[f], fault_start[f + 1]):
+                for r in range(width):
+                    lane2[r] = -np.inf
+                for t in range(fault_table.shape[1]):
+                    s = fault_table[e, t]
+                    if s < 0:
+                        break
+                    for r in range(width):
+                        lane2[r] = max(lane2[r], oti_local[s, r])
+                for r in range(width):
+                    if lane2[r] < best[r]:
+                        best[r] = lane2[r]
+                        worst_set[r] = e - fault_start[f]
+            for r in range(width):
+                summary_out[first_index + r, 2 + f] = best[r]
+                worst_out[first_index + r, f] = worst_set[r]
+        # --- mutual interference: the other actuators alone fully constrain the platform.
+        for act in range(a):
+            for r in range(width):
+                mutual[r] = False
+            for s in range(subs):
+                if not member[s, act]:
+                    for r in range(width):
+                        mutual[r] = mutual[r] or independent[s, r]
+            for r in range(width):
+                mutual_out[first_index + r, act] = mutual[r]
