@@ -198,32 +198,35 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     for c in range(chains):
         if chain_start[c + 1] - chain_start[c] > capacity:
             capacity = chain_start[c + 1] - chain_start[c]
-    # Scratch, allocated once per call.
-    twists = np.empty((BLOCK, joints, 6))  # one block, batch-first
-    points = np.empty((BLOCK, joints, 3))
-    local = np.empty((joints, 6))
-    local_points = np.empty((joints, 3))
-    motion = np.empty((n, 6))
-    shifted = np.empty((joints, 6))
-    shifted_basis = np.empty((n, 6))
+    # Scratch, allocated once per call. Per-configuration quantities have a last "lane" axis:
+    # each block of BLOCK configurations goes through every step lane-innermost, so that the
+    # compiler vectorises the steps across configurations; the few steps with a data-dependent
+    # algebra (null vectors of n > 3, Gram solves of chains with more joints than n) run per lane.
+    local = np.empty((joints, 6, BLOCK))  # joint twists about the centroid
+    local_points = np.empty((joints, 3, BLOCK))  # joint points relative to the centroid
+    centres = np.empty((3, BLOCK))
+    motion_lanes = np.empty((n, 6, BLOCK))
+    outside = np.zeros(BLOCK, dtype=np.bool_)
+    shifted_basis = np.empty((n, 6, BLOCK))
+    passive_rows = np.empty((6, 6, BLOCK))
+    combination = np.empty((capacity, BLOCK))
+    force = np.empty((6, BLOCK))  # (f, m) of the wrench being built
+    wrench_lanes = np.empty((a, 6, BLOCK))
+    point_lanes = np.empty((3, BLOCK))  # the OTI characteristic point of the actuator
+    pitch_lanes = np.empty(BLOCK)
+    shifted = np.empty((capacity, 6))
     rows = np.empty((6, 6))
     gram = np.empty((capacity, capacity))
     work = np.empty((capacity, capacity))
     minor = np.empty((6, 6))
     rhs = np.zeros(capacity)
     solution = np.empty(capacity)
-    wrenches = np.empty((a, 6))
     coefficients = np.empty(6)
-    # Per-configuration results of the first stage, one lane per configuration of the block:
-    # the second stage (output twists, OTIs, reductions) runs lane-innermost, so that the
-    # compiler vectorises it across configurations.
     has_force = np.zeros((a, BLOCK), dtype=np.bool_)
     arms = np.zeros((a, n, 3, BLOCK))
     iti_local = np.zeros((a, BLOCK))
     wrench_matrix = np.zeros((a, n, BLOCK))
     row_norms = np.zeros((a, BLOCK))
-    motion_lanes = np.zeros((n, 6, BLOCK))
-    centres = np.zeros((3, BLOCK))
     output = np.empty((locked_sets.shape[0], n, BLOCK))
     output_omega = np.empty((locked_sets.shape[0], BLOCK))
     oti_local = np.empty((subs, BLOCK))
@@ -244,113 +247,146 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     for block in range(blocks):
         first_index = block * BLOCK
         last_index = min(count, first_index + BLOCK)
-        for j in range(joints):  # gather the block batch-first (reading component-major input in runs)
+        width = last_index - first_index
+        # ---------------- first stage: centroid frame, actuation wrenches, ITIs, moment arms.
+        for j in range(joints):  # gather the block lane-innermost (component-major input is read in runs)
             for k in range(6):
-                for i in range(first_index, last_index):
-                    twists[i - first_index, j, k] = all_twists[i, j, k]
+                for r in range(width):
+                    local[j, k, r] = all_twists[first_index + r, j, k]
             for k in range(3):
-                for i in range(first_index, last_index):
-                    points[i - first_index, j, k] = all_points[i, j, k]
-        for index in range(first_index, last_index):
-            row = index - first_index
-            # --- centroid of the platform joints; everything below is expressed about it.
-            c0 = 0.0
-            c1 = 0.0
-            c2 = 0.0
-            for c in range(chains):
-                last = chain_start[c + 1] - 1
-                c0 += points[row, last, 0]
-                c1 += points[row, last, 1]
-                c2 += points[row, last, 2]
-            c0 /= chains
-            c1 /= chains
-            c2 /= chains
-            for j in range(joints):
-                w0, w1, w2 = twists[row, j, 0], twists[row, j, 1], twists[row, j, 2]
-                x0, x1, x2 = _cross(w0, w1, w2, c0, c1, c2)
-                local[j, 0] = w0
-                local[j, 1] = w1
-                local[j, 2] = w2
-                local[j, 3] = twists[row, j, 3] + x0
-                local[j, 4] = twists[row, j, 4] + x1
-                local[j, 5] = twists[row, j, 5] + x2
-                local_points[j, 0] = points[row, j, 0] - c0
-                local_points[j, 1] = points[row, j, 1] - c1
-                local_points[j, 2] = points[row, j, 2] - c2
-            source = 0 if constant else index
-            for q in range(n):
-                for k in range(6):
-                    motion[q, k] = basis[source, q, k]
-                    motion_lanes[q, k, row] = basis[source, q, k]
-            centres[0, row] = c0
-            centres[1, row] = c1
-            centres[2, row] = c2
-            # --- a constant basis must contain every joint twist.
-            if constant and complement.shape[0] > 0:
-                leaving = False
-                for j in range(joints):
-                    size = 0.0
-                    for k in range(6):
-                        size += local[j, k] * local[j, k]
-                    leak = 0.0
-                    for r in range(complement.shape[0]):
-                        dot = 0.0
-                        for k in range(6):
-                            dot += complement[r, k] * local[j, k]
-                        leak += dot * dot
-                    if leak > 1e-18 * max(size, 1.0):
-                        leaving = True
-                outside_out[index] = leaving
-                if leaving:
-                    continue
-            # --- actuation wrenches (one per actuator), in the representative documented in analyze().
-            for act in range(a):
-                chain = actuator_chain[act]
-                start = chain_start[chain]
-                m = chain_start[chain + 1] - start
-                own = start + actuator_joint[act]
-                last = start + m - 1
-                d0, d1, d2 = local_points[last, 0], local_points[last, 1], local_points[last, 2]
-                for j in range(m):  # chain twists about the platform joint point d
-                    w0, w1, w2 = local[start + j, 0], local[start + j, 1], local[start + j, 2]
-                    x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
-                    shifted[j, 0] = w0
-                    shifted[j, 1] = w1
-                    shifted[j, 2] = w2
-                    shifted[j, 3] = local[start + j, 3] + x0
-                    shifted[j, 4] = local[start + j, 4] + x1
-                    shifted[j, 5] = local[start + j, 5] + x2
-                f0 = f1 = f2 = 0.0
-                m0 = m1 = m2 = 0.0
-                if m == n:
-                    # SWAP M' x with x spanning null(J_passive'^T M').
-                    for q in range(n):
-                        w0, w1, w2 = motion[q, 0], motion[q, 1], motion[q, 2]
-                        x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
-                        shifted_basis[q, 0] = w0
-                        shifted_basis[q, 1] = w1
-                        shifted_basis[q, 2] = w2
-                        shifted_basis[q, 3] = motion[q, 3] + x0
-                        shifted_basis[q, 4] = motion[q, 4] + x1
-                        shifted_basis[q, 5] = motion[q, 5] + x2
-                    r = 0
-                    for j in range(m):
-                        if start + j == own:
-                            continue
-                        for q in range(n):
-                            total = 0.0
-                            for k in range(6):
-                                total += shifted[j, k] * shifted_basis[q, k]
-                            rows[r, q] = total
-                        r += 1
-                    if n == 3:  # written out: a call passing arrays costs reference counting
-                        solution[0], solution[1], solution[2] = _cross(rows[0, 0], rows[0, 1], rows[0, 2],
-                                                                       rows[1, 0], rows[1, 1], rows[1, 2])
-                    else:
-                        _null_vector(rows, n, solution, minor, work)
-                    combined = shifted_basis
+                for r in range(width):
+                    local_points[j, k, r] = all_points[first_index + r, j, k]
+        # --- centroid of the platform joints; everything below is expressed about it.
+        for k in range(3):
+            for r in range(width):
+                centres[k, r] = 0.0
+        for c in range(chains):
+            last = chain_start[c + 1] - 1
+            for k in range(3):
+                for r in range(width):
+                    centres[k, r] += local_points[last, k, r]
+        for k in range(3):
+            for r in range(width):
+                centres[k, r] /= chains
+        for j in range(joints):
+            for r in range(width):
+                x0, x1, x2 = _cross(local[j, 0, r], local[j, 1, r], local[j, 2, r],
+                                    centres[0, r], centres[1, r], centres[2, r])
+                local[j, 3, r] += x0
+                local[j, 4, r] += x1
+                local[j, 5, r] += x2
+                local_points[j, 0, r] -= centres[0, r]
+                local_points[j, 1, r] -= centres[1, r]
+                local_points[j, 2, r] -= centres[2, r]
+        for q in range(n):
+            for k in range(6):
+                if constant:
+                    for r in range(width):
+                        motion_lanes[q, k, r] = basis[0, q, k]
                 else:
-                    # Minimum-norm solution: SWAP J' (J'^T J')^-1 e_k.
+                    for r in range(width):
+                        motion_lanes[q, k, r] = basis[first_index + r, q, k]
+        # --- a constant basis must contain every joint twist.
+        for r in range(width):
+            outside[r] = False
+        if constant and complement.shape[0] > 0:
+            for j in range(joints):
+                for r in range(width):
+                    lane0[r] = 0.0  # |t|^2
+                    lane1[r] = 0.0  # |projection on the complement|^2
+                for k in range(6):
+                    for r in range(width):
+                        lane0[r] += local[j, k, r] * local[j, k, r]
+                for row in range(complement.shape[0]):
+                    for r in range(width):
+                        lane2[r] = 0.0
+                    for k in range(6):
+                        for r in range(width):
+                            lane2[r] += complement[row, k] * local[j, k, r]
+                    for r in range(width):
+                        lane1[r] += lane2[r] * lane2[r]
+                for r in range(width):
+                    outside[r] = outside[r] or lane1[r] > 1e-18 * max(lane0[r], 1.0)
+            for r in range(width):
+                outside_out[first_index + r] = outside[r]
+        # --- actuation wrenches (one per actuator), in the representative documented in analyze().
+        for act in range(a):
+            chain = actuator_chain[act]
+            start = chain_start[chain]
+            m = chain_start[chain + 1] - start
+            own = start + actuator_joint[act]
+            last = start + m - 1
+            after = own + 1 if own < last else own
+            for k in range(6):
+                for r in range(width):
+                    force[k, r] = 0.0
+            if m == n:
+                # SWAP M' x with x spanning null(J_passive'^T M'), all about the platform joint d.
+                for q in range(n):
+                    for r in range(width):
+                        x0, x1, x2 = _cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
+                                            local_points[last, 0, r], local_points[last, 1, r],
+                                            local_points[last, 2, r])
+                        shifted_basis[q, 0, r] = motion_lanes[q, 0, r]
+                        shifted_basis[q, 1, r] = motion_lanes[q, 1, r]
+                        shifted_basis[q, 2, r] = motion_lanes[q, 2, r]
+                        shifted_basis[q, 3, r] = motion_lanes[q, 3, r] + x0
+                        shifted_basis[q, 4, r] = motion_lanes[q, 4, r] + x1
+                        shifted_basis[q, 5, r] = motion_lanes[q, 5, r] + x2
+                passive = 0
+                for j in range(start, last + 1):
+                    if j == own:
+                        continue
+                    for q in range(n):
+                        for r in range(width):
+                            x0, x1, x2 = _cross(local[j, 0, r], local[j, 1, r], local[j, 2, r],
+                                                local_points[last, 0, r], local_points[last, 1, r],
+                                                local_points[last, 2, r])
+                            passive_rows[passive, q, r] = (
+                                local[j, 0, r] * shifted_basis[q, 0, r] + local[j, 1, r] * shifted_basis[q, 1, r]
+                                + local[j, 2, r] * shifted_basis[q, 2, r]
+                                + (local[j, 3, r] + x0) * shifted_basis[q, 3, r]
+                                + (local[j, 4, r] + x1) * shifted_basis[q, 4, r]
+                                + (local[j, 5, r] + x2) * shifted_basis[q, 5, r])
+                    passive += 1
+                if n == 3:  # the null vector of two rows is their cross product
+                    for r in range(width):
+                        combination[0, r], combination[1, r], combination[2, r] = _cross(
+                            passive_rows[0, 0, r], passive_rows[0, 1, r], passive_rows[0, 2, r],
+                            passive_rows[1, 0, r], passive_rows[1, 1, r], passive_rows[1, 2, r])
+                else:
+                    for r in range(width):
+                        for i in range(n - 1):
+                            for q in range(n):
+                                rows[i, q] = passive_rows[i, q, r]
+                        _null_vector(rows, n, solution, minor, work)
+                        for q in range(n):
+                            combination[q, r] = solution[q]
+                # The wrench about d: SWAP of the combination of the shifted basis.
+                for q in range(n):
+                    for r in range(width):
+                        y = combination[q, r]
+                        force[0, r] += y * shifted_basis[q, 3, r]
+                        force[1, r] += y * shifted_basis[q, 4, r]
+                        force[2, r] += y * shifted_basis[q, 5, r]
+                        force[3, r] += y * shifted_basis[q, 0, r]
+                        force[4, r] += y * shifted_basis[q, 1, r]
+                        force[5, r] += y * shifted_basis[q, 2, r]
+            else:
+                # Minimum-norm solution SWAP J' (J'^T J')^-1 e_k, configuration by configuration.
+                for r in range(width):
+                    if outside[r]:
+                        continue  # recomputed with its own motion space
+                    d0, d1, d2 = local_points[last, 0, r], local_points[last, 1, r], local_points[last, 2, r]
+                    for j in range(m):  # chain twists about the platform joint point d
+                        w0, w1, w2 = local[start + j, 0, r], local[start + j, 1, r], local[start + j, 2, r]
+                        x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
+                        shifted[j, 0] = w0
+                        shifted[j, 1] = w1
+                        shifted[j, 2] = w2
+                        shifted[j, 3] = local[start + j, 3, r] + x0
+                        shifted[j, 4] = local[start + j, 4, r] + x1
+                        shifted[j, 5] = local[start + j, 5, r] + x2
                     for i in range(m):
                         for j in range(m):
                             total = 0.0
@@ -377,112 +413,115 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         if worst > 1e-9 * largest:
                             for i in range(m):
                                 solution[i] = 0.0
-                    combined = shifted
-                # The wrench about d is SWAP (the combination of the twists about d); m = n in
-                # the first case, so both combine m rows.
-                for j in range(m):
-                    y = solution[j]
-                    f0 += y * combined[j, 3]
-                    f1 += y * combined[j, 4]
-                    f2 += y * combined[j, 5]
-                    m0 += y * combined[j, 0]
-                    m1 += y * combined[j, 1]
-                    m2 += y * combined[j, 2]
-                # Moment about the centroid: m_c = m_d + d x f.
-                x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)
-                m0 += x0
-                m1 += x1
-                m2 += x2
+                    for j in range(m):  # the wrench about d: SWAP of the combination
+                        y = solution[j]
+                        force[0, r] += y * shifted[j, 3]
+                        force[1, r] += y * shifted[j, 4]
+                        force[2, r] += y * shifted[j, 5]
+                        force[3, r] += y * shifted[j, 0]
+                        force[4, r] += y * shifted[j, 1]
+                        force[5, r] += y * shifted[j, 2]
+            # --- unit wrench about the centroid, its ITI (Eq. 6) and its OTI characteristic point.
+            for r in range(width):
+                d0, d1, d2 = local_points[last, 0, r], local_points[last, 1, r], local_points[last, 2, r]
+                f0, f1, f2 = force[0, r], force[1, r], force[2, r]
+                x0, x1, x2 = _cross(d0, d1, d2, f0, f1, f2)  # m_c = m_d + d x f
+                m0 = force[3, r] + x0
+                m1 = force[4, r] + x1
+                m2 = force[5, r] + x2
                 force_sq = f0 * f0 + f1 * f1 + f2 * f2
                 moment_sq = m0 * m0 + m1 * m1 + m2 * m2
                 forceful = force_sq > 1e-20 * moment_sq and force_sq > 0.0
                 scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
-                work_done = (f0 * local[own, 3] + f1 * local[own, 4] + f2 * local[own, 5]
-                             + m0 * local[own, 0] + m1 * local[own, 1] + m2 * local[own, 2])
-                factor = 0.0
-                if scale > 0.0:
-                    factor = (-1.0 if work_done < 0.0 else 1.0) / scale
-                wrenches[act, 0] = f0 * factor
-                wrenches[act, 1] = f1 * factor
-                wrenches[act, 2] = f2 * factor
-                wrenches[act, 3] = m0 * factor
-                wrenches[act, 4] = m1 * factor
-                wrenches[act, 5] = m2 * factor
+                work_done = (f0 * local[own, 3, r] + f1 * local[own, 4, r] + f2 * local[own, 5, r]
+                             + m0 * local[own, 0, r] + m1 * local[own, 1, r] + m2 * local[own, 2, r])
+                factor = ((-1.0 if work_done < 0.0 else 1.0) / scale) if scale > 0.0 else 0.0
+                f0 *= factor
+                f1 *= factor
+                f2 *= factor
+                m0 *= factor
+                m1 *= factor
+                m2 *= factor
+                wrench_lanes[act, 0, r] = f0
+                wrench_lanes[act, 1, r] = f1
+                wrench_lanes[act, 2, r] = f2
+                wrench_lanes[act, 3, r] = m0
+                wrench_lanes[act, 4, r] = m1
+                wrench_lanes[act, 5, r] = m2
                 forceful = forceful and scale > 0.0
-                has_force[act, row] = forceful
-                f0, f1, f2 = wrenches[act, 0], wrenches[act, 1], wrenches[act, 2]
-                m0, m1, m2 = wrenches[act, 3], wrenches[act, 4], wrenches[act, 5]
+                has_force[act, r] = forceful
                 pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
+                pitch_lanes[r] = pitch
                 # Characteristic points: projections on the wrench axis (unit force).
                 axis0, axis1, axis2 = _cross(f0, f1, f2, m0, m1, m2)
-                after = own + 1 if own < last else own
-                for which in range(2):
-                    if which == 0:
-                        if iti_override.shape[0] > 0:
-                            p0 = iti_override[index, act, 0] - c0
-                            p1 = iti_override[index, act, 1] - c1
-                            p2 = iti_override[index, act, 2] - c2
-                        else:
-                            p0, p1, p2 = local_points[after, 0], local_points[after, 1], local_points[after, 2]
-                    else:
-                        if oti_override.shape[0] > 0:
-                            p0 = oti_override[index, act, 0] - c0
-                            p1 = oti_override[index, act, 1] - c1
-                            p2 = oti_override[index, act, 2] - c2
-                        else:
-                            p0, p1, p2 = d0, d1, d2
-                    if forceful and ((which == 0 and iti_override.shape[0] == 0)
-                                     or (which == 1 and oti_override.shape[0] == 0)):
+                if iti_override.shape[0] > 0:
+                    p0 = iti_override[first_index + r, act, 0] - centres[0, r]
+                    p1 = iti_override[first_index + r, act, 1] - centres[1, r]
+                    p2 = iti_override[first_index + r, act, 2] - centres[2, r]
+                else:
+                    p0, p1, p2 = local_points[after, 0, r], local_points[after, 1, r], local_points[after, 2, r]
+                    if forceful:
                         along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
                         p0 = axis0 + along * f0
                         p1 = axis1 + along * f1
                         p2 = axis2 + along * f2
-                    if which == 0:
-                        # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
-                        w0, w1, w2 = local[own, 0], local[own, 1], local[own, 2]
-                        x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
-                        omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-                        if forceful:
-                            v0 = local[own, 3] + x0 + pitch * w0
-                            v1 = local[own, 4] + x1 + pitch * w1
-                            v2 = local[own, 5] + x2 + pitch * w2
-                            arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-                            reference = omega
-                        else:
-                            arm = omega
-                            reference = 0.0
-                        iti_local[act, row] = _power_coefficient(work_done * factor, arm, reference, threshold)
-                    else:
-                        # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega.
-                        for q in range(n):
-                            w0, w1, w2 = motion[q, 0], motion[q, 1], motion[q, 2]
-                            if forceful:
-                                x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
-                                arms[act, q, 0, row] = motion[q, 3] + x0 + pitch * w0
-                                arms[act, q, 1, row] = motion[q, 4] + x1 + pitch * w1
-                                arms[act, q, 2, row] = motion[q, 5] + x2 + pitch * w2
-                            else:
-                                arms[act, q, 0, row] = w0
-                                arms[act, q, 1, row] = w1
-                                arms[act, q, 2, row] = w2
-                # Row of the wrench matrix in motion coordinates: A_k o M_q.
-                norm = 0.0
-                for q in range(n):
-                    value = (f0 * motion[q, 3] + f1 * motion[q, 4] + f2 * motion[q, 5]
-                             + m0 * motion[q, 0] + m1 * motion[q, 1] + m2 * motion[q, 2])
-                    wrench_matrix[act, q, row] = value
-                    norm += value * value
-                row_norms[act, row] = np.sqrt(norm)
-                if wrench_out.shape[0] > 0:  # back to the world origin: m_0 = m_c + c x f
-                    x0, x1, x2 = _cross(c0, c1, c2, f0, f1, f2)
-                    wrench_out[index, act, 0] = f0
-                    wrench_out[index, act, 1] = f1
-                    wrench_out[index, act, 2] = f2
-                    wrench_out[index, act, 3] = m0 + x0
-                    wrench_out[index, act, 4] = m1 + x1
-                    wrench_out[index, act, 5] = m2 + x2
-        # ---------------- second stage, lane-innermost over the block's configurations.
-        width = last_index - first_index
+                # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
+                w0, w1, w2 = local[own, 0, r], local[own, 1, r], local[own, 2, r]
+                x0, x1, x2 = _cross(w0, w1, w2, p0, p1, p2)
+                omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+                v0 = local[own, 3, r] + x0 + pitch * w0
+                v1 = local[own, 4, r] + x1 + pitch * w1
+                v2 = local[own, 5, r] + x2 + pitch * w2
+                arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if forceful else omega
+                reference = omega if forceful else 0.0
+                iti_local[act, r] = _power_coefficient(work_done * factor, arm, reference, threshold)
+                if oti_override.shape[0] > 0:
+                    p0 = oti_override[first_index + r, act, 0] - centres[0, r]
+                    p1 = oti_override[first_index + r, act, 1] - centres[1, r]
+                    p2 = oti_override[first_index + r, act, 2] - centres[2, r]
+                else:
+                    p0, p1, p2 = d0, d1, d2
+                    if forceful:
+                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+                        p0 = axis0 + along * f0
+                        p1 = axis1 + along * f1
+                        p2 = axis2 + along * f2
+                point_lanes[0, r] = p0
+                point_lanes[1, r] = p1
+                point_lanes[2, r] = p2
+            # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega (omega for a couple),
+            # and the row of the wrench matrix in motion coordinates, A_k o M_q.
+            for r in range(width):
+                row_norms[act, r] = 0.0
+            for q in range(n):
+                for r in range(width):
+                    w0, w1, w2 = motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r]
+                    x0, x1, x2 = _cross(w0, w1, w2, point_lanes[0, r], point_lanes[1, r], point_lanes[2, r])
+                    pitch = pitch_lanes[r]
+                    forceful = has_force[act, r]
+                    arms[act, q, 0, r] = motion_lanes[q, 3, r] + x0 + pitch * w0 if forceful else w0
+                    arms[act, q, 1, r] = motion_lanes[q, 4, r] + x1 + pitch * w1 if forceful else w1
+                    arms[act, q, 2, r] = motion_lanes[q, 5, r] + x2 + pitch * w2 if forceful else w2
+                    value = (wrench_lanes[act, 0, r] * motion_lanes[q, 3, r]
+                             + wrench_lanes[act, 1, r] * motion_lanes[q, 4, r]
+                             + wrench_lanes[act, 2, r] * motion_lanes[q, 5, r]
+                             + wrench_lanes[act, 3, r] * w0 + wrench_lanes[act, 4, r] * w1
+                             + wrench_lanes[act, 5, r] * w2)
+                    wrench_matrix[act, q, r] = value
+                    row_norms[act, r] += value * value
+            for r in range(width):
+                row_norms[act, r] = np.sqrt(row_norms[act, r])
+            if wrench_out.shape[0] > 0:  # back to the world origin: m_0 = m_c + c x f
+                for r in range(width):
+                    f0, f1, f2 = wrench_lanes[act, 0, r], wrench_lanes[act, 1, r], wrench_lanes[act, 2, r]
+                    x0, x1, x2 = _cross(centres[0, r], centres[1, r], centres[2, r], f0, f1, f2)
+                    wrench_out[first_index + r, act, 0] = f0
+                    wrench_out[first_index + r, act, 1] = f1
+                    wrench_out[first_index + r, act, 2] = f2
+                    wrench_out[first_index + r, act, 3] = wrench_lanes[act, 3, r] + x0
+                    wrench_out[first_index + r, act, 4] = wrench_lanes[act, 4, r] + x1
+                    wrench_out[first_index + r, act, 5] = wrench_lanes[act, 5, r] + x2
+        # ---------------- second stage: output twists, OTIs and the reductions over actuator sets.
         # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
         # their wrenches (a column of adj(W) of every submechanism containing the set).
         for locked in range(locked_sets.shape[0]):
