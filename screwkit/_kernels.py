@@ -36,7 +36,7 @@ def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _eliminate(work, size, rhs, limit):
     """Gaussian elimination with partial pivoting of work[:size, :size], in place.
 
@@ -72,33 +72,17 @@ def _eliminate(work, size, rhs, limit):
     return sign
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def _determinant(matrix, size, work):
-    """Determinant of matrix[:size, :size] by LU with partial pivoting (``work`` is scratch)."""
-    if size == 1:
-        return matrix[0, 0]
-    if size == 2:
-        return matrix[0, 0] * matrix[1, 1] - matrix[0, 1] * matrix[1, 0]
-    if size == 3:
-        return (matrix[0, 0] * (matrix[1, 1] * matrix[2, 2] - matrix[1, 2] * matrix[2, 1])
-                - matrix[0, 1] * (matrix[1, 0] * matrix[2, 2] - matrix[1, 2] * matrix[2, 0])
-                + matrix[0, 2] * (matrix[1, 0] * matrix[2, 1] - matrix[1, 1] * matrix[2, 0]))
-    for i in range(size):
-        for j in range(size):
-            work[i, j] = matrix[i, j]
-    det = _eliminate(work, size, work[0, :0], 0.0)
-    for i in range(size):
-        det *= work[i, i]
-    return det
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def _null_vector(rows, size, out, minor, work):
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _null_vector(rows, size, out, work, columns):
     """out[:size] = generalised cross product of the size - 1 rows rows[:size-1, :size].
 
     ``out[q] = (-1)^(size-1+q) det(rows without column q)``: orthogonal to every row, zero
     exactly when the rows are dependent; for the rows of ``W`` other than row ``k`` it is
-    (up to sign) column ``k`` of ``adj(W)``.
+    (up to sign) column ``k`` of ``adj(W)``. Computed with one Gaussian elimination with full
+    pivoting, ``rows Q = P L U``: the cofactor vector of the upper-trapezoidal ``U`` is
+    ``prod(diag U)`` times its null vector with last entry 1, and permutations only change its
+    sign and order. ``work`` (float, at least (size - 1, size)) and ``columns`` (int, size) are
+    scratch.
     """
     if size == 1:
         out[0] = 1.0
@@ -108,18 +92,60 @@ def _null_vector(rows, size, out, minor, work):
         out[1] = rows[0, 2] * rows[1, 0] - rows[0, 0] * rows[1, 2]
         out[2] = rows[0, 0] * rows[1, 1] - rows[0, 1] * rows[1, 0]
         return
-    for q in range(size):
-        for i in range(size - 1):
-            col = 0
-            for k in range(size):
-                if k != q:
-                    minor[i, col] = rows[i, k]
-                    col += 1
-        sign = 1.0 if (size - 1 + q) % 2 == 0 else -1.0
-        out[q] = sign * _determinant(minor, size - 1, work)
+    m = size - 1
+    for i in range(m):
+        for j in range(size):
+            work[i, j] = rows[i, j]
+    for j in range(size):
+        columns[j] = j
+    sign = 1.0
+    for col in range(m):
+        best = 0.0
+        pivot_row = col
+        pivot_column = col
+        for i in range(col, m):
+            for j in range(col, size):
+                if abs(work[i, j]) > best:
+                    best = abs(work[i, j])
+                    pivot_row = i
+                    pivot_column = j
+        if best == 0.0:  # rank below size - 1: every cofactor vanishes
+            for j in range(size):
+                out[j] = 0.0
+            return
+        if pivot_row != col:
+            for j in range(size):
+                tmp = work[col, j]
+                work[col, j] = work[pivot_row, j]
+                work[pivot_row, j] = tmp
+            sign = -sign
+        if pivot_column != col:
+            for i in range(m):
+                tmp = work[i, col]
+                work[i, col] = work[i, pivot_column]
+                work[i, pivot_column] = tmp
+            swap = columns[col]
+            columns[col] = columns[pivot_column]
+            columns[pivot_column] = swap
+            sign = -sign
+        for i in range(col + 1, m):
+            factor = work[i, col] / work[col, col]
+            for j in range(col + 1, size):
+                work[i, j] -= factor * work[col, j]
+    # Null vector of U with last entry 1 (back substitution), scaled by prod(diag U) and the sign.
+    scale = sign
+    for i in range(m):
+        scale *= work[i, i]
+    out[columns[m]] = scale
+    for i in range(m - 1, -1, -1):
+        total = work[i, m] * out[columns[m]]
+        for j in range(i + 1, m):
+            total += work[i, j] * out[columns[j]]
+        out[columns[i]] = -total / work[i, i]
+    return
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _solve(matrix, size, rhs, out, work):
     """Solve matrix[:size,:size] out = rhs by Gaussian elimination; returns False if singular.
 
@@ -218,7 +244,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     rows = np.empty((6, 6))
     gram = np.empty((capacity, capacity))
     work = np.empty((capacity, capacity))
-    minor = np.empty((6, 6))
+    columns = np.empty(6, dtype=np.int64)
     rhs = np.zeros(capacity)
     solution = np.empty(capacity)
     coefficients = np.empty(6)
@@ -359,7 +385,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         for i in range(n - 1):
                             for q in range(n):
                                 rows[i, q] = passive_rows[i, q, r]
-                        _null_vector(rows, n, solution, minor, work)
+                        _null_vector(rows, n, solution, work, columns)
                         for q in range(n):
                             combination[q, r] = solution[q]
                 # The wrench about d: SWAP of the combination of the shifted basis.
@@ -540,7 +566,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     for i in range(n - 1):
                         for q in range(n):
                             rows[i, q] = wrench_matrix[locked_sets[locked, i], q, r]
-                    _null_vector(rows, n, coefficients, minor, work)
+                    _null_vector(rows, n, coefficients, work, columns)
                     for q in range(n):
                         output[locked, q, r] = coefficients[q]
             for r in range(width):
