@@ -2,7 +2,7 @@
 
 The math core (:mod:`screwkit.screws`, :mod:`screwkit.transmission`,
 :mod:`screwkit.closed_forms`, :mod:`screwkit.planar`) imports numpy only; its compiled
-per-configuration kernels (:mod:`screwkit._kernels`, numba) load when indices are first
+per-configuration kernels (:mod:`screwkit._kernels`, :mod:`screwkit._planar_kernel`, numba) load when indices are first
 computed. Everything that touches Pinocchio, files, plots, Meshcat, Dask or the terminal
 lives at the edges and is imported lazily.
 """
