@@ -163,6 +163,7 @@ class ViewerServer:
         self.zmq_url = zmq_url
         self.web_url = web_url
         self._finalizer = weakref.finalize(self, _stop_process, process)
+        _SERVERS.add(self)
 
     @classmethod
     def start(cls, host: str = LOOPBACK_HOST, timeout: float = 30.0) -> ViewerServer:
@@ -225,6 +226,14 @@ class ViewerServer:
     def __repr__(self) -> str:
         state = "running" if self.running else f"stopped ({self.process.returncode})"
         return f"ViewerServer(web_url={self.web_url!r}, pid={self.process.pid}, {state})"
+
+
+_SERVERS: weakref.WeakSet = weakref.WeakSet()
+
+
+def servers_to_stop() -> bool:
+    """Whether some server process started here is still to be stopped (at the latest at exit)."""
+    return any(server._finalizer.alive for server in _SERVERS)
 
 
 def _stop_process(process: subprocess.Popen) -> None:

@@ -110,3 +110,29 @@ def test_verify_compares_with_the_closed_forms():
 def test_list_names_the_bundled_robots():
     result = run("list")
     assert result.output.split() == ["coop_arms", "planar_4rpr", "planar_5rrr", "rss_hexapod_8", "ups_hexapod_8"]
+
+
+def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):
+    """main() ends the process without the interpreter's teardown: nothing may be lost."""
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    def command(*arguments):
+        return subprocess.run([sys.executable, "-m", "screwkit.cli", *arguments], capture_output=True, text=True,
+                              timeout=300)
+
+    listed = command("list")
+    assert listed.returncode == 0 and "planar_5rrr" in listed.stdout and "ups_hexapod_8" in listed.stdout
+    analysed = command("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45", "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    assert json.loads(analysed.stdout)["f_o"]["1"] == pytest.approx(0.6793, abs=5e-5)  # the whole JSON arrived
+    wrong = command("analyze", "no_such_robot")
+    assert wrong.returncode == 1 and "Unknown bundled mechanism 'no_such_robot'" in wrong.stderr
+    path = tmp_path / "map.nc"
+    mapped = command("map", "planar_5rrr", "--radius", "0.1", "--step", "0.05", "--phi-step", "60", "--out", str(path))
+    assert mapped.returncode == 0, mapped.stderr
+    assert f"wrote {path}" in mapped.stderr
+    with xr.open_dataset(path) as dataset:
+        assert np.isfinite(dataset["f_o1"].values).sum() == 13  # the disc of radius 0.1 m at 0.05 m steps
