@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.kinematics import thread_limit
 from screwkit.transmission import DEFAULT_THRESHOLD, TransmissionResult, analyze
 
 __all__ = ["PoseIndices", "indices_at_poses", "analyze_pose", "poses_from_degrees", "angular_coordinates"]
@@ -97,7 +98,8 @@ def indices_at_poses(mechanism, poses: ArrayLike, *, detail: bool = False, thres
     progress : callable, optional
         Called with the number of poses done after each chunk.
     threads : int, optional
-        Threads for the index kernel.
+        Threads for the index kernel, and at most as many for closure solving and screws
+        (default: all cores).
     closed_forms : bool
         Use the paper's planar closed forms instead of the generic screw path (planar RRR/RPR
         mechanisms only; see :func:`planar_points`).
@@ -119,15 +121,18 @@ def indices_at_poses(mechanism, poses: ArrayLike, *, detail: bool = False, thres
     meta = None
     for start in range(0, count, chunk_size):
         part = slice(start, min(start + chunk_size, count))
-        solution = mechanism.solve(flat[part])
+        with thread_limit(threads):
+            solution = mechanism.solve(flat[part])
         ok = np.asarray(solution.reachable)
         index = np.flatnonzero(ok) + start
         reachable[index] = True
         if index.size:
             if closed_forms:
-                result = _closed_form_result(mechanism, solution, threshold, faults, threads)
+                with thread_limit(threads):
+                    result = _closed_form_result(mechanism, solution, threshold, faults, threads)
             else:
-                chains = mechanism.chain_screws(solution, unreachable="drop")
+                with thread_limit(threads):
+                    chains = mechanism.chain_screws(solution, unreachable="drop")
                 result = analyze(chains, detail=detail, threshold=threshold, faults=faults, threads=threads)
             if meta is None:
                 meta = result

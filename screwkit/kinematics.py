@@ -41,8 +41,10 @@ from __future__ import annotations
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,6 +55,30 @@ LOOP_JOINT_DOFS = {"fixed": 0, "revolute": 1, "continuous": 1, "prismatic": 1, "
 _IDENTITY = np.eye(3)
 _BLOCK = 1 << 15  # configurations per block in the closed-form fast paths
 _WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads for blocks (numpy releases the GIL)
+_THREAD_LIMIT: ContextVar[int] = ContextVar("screwkit_thread_limit", default=_WORKERS)
+
+
+@contextmanager
+def thread_limit(threads: int | None) -> Iterator[None]:
+    """Within the block, closure solving and screw building use at most ``threads`` threads.
+
+    For callers that already run one task per core (a map's Dask tasks): nested thread
+    pools would only compete for the same cores. ``None`` leaves the default (all cores, up
+    to 4). The limit is per thread (a context variable).
+    """
+    if threads is None:
+        yield
+        return
+    token = _THREAD_LIMIT.set(max(1, int(threads)))
+    try:
+        yield
+    finally:
+        _THREAD_LIMIT.reset(token)
+
+
+def block_threads() -> int:
+    """Threads the closure and screw computations may use here (see :func:`thread_limit`)."""
+    return min(_WORKERS, _THREAD_LIMIT.get())
 
 
 # ----------------------------------------------------------------------------------------
@@ -713,8 +739,9 @@ def for_each_block(count: int, work: Callable[[slice], None]) -> None:
     all cores; ``work`` must only write to its own slice of the outputs.
     """
     blocks = [slice(start, min(start + _BLOCK, count)) for start in range(0, count, _BLOCK)]
-    if _WORKERS > 1 and len(blocks) > 1:
-        with ThreadPoolExecutor(_WORKERS) as pool:
+    workers = block_threads()
+    if workers > 1 and len(blocks) > 1:
+        with ThreadPoolExecutor(workers) as pool:
             for _ in pool.map(work, blocks):
                 pass
     else:

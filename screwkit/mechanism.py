@@ -34,6 +34,7 @@ from screwkit.chains import ChainScrews
 from screwkit.kinematics import (
     LOOP_JOINT_DOFS,
     ChainGeometry,
+    block_threads,
     chain_forward_kinematics,
     closed_form_for,
     for_each_block,
@@ -912,8 +913,9 @@ class Mechanism:
             return self._chain_screws_from_frames(index, axes, points, frame, twist_block[:, joints],
                                                   point_block[:, joints])
 
-        if mask.size >= 1 << 16 and len(self.chains) > 1:  # chains in parallel (numpy releases the GIL)
-            with ThreadPoolExecutor(min(len(self.chains), os.cpu_count() or 1)) as pool:
+        threads = min(len(self.chains), block_threads())
+        if mask.size >= 1 << 16 and threads > 1:  # chains in parallel (numpy releases the GIL)
+            with ThreadPoolExecutor(threads) as pool:
                 return list(pool.map(screws_of_chain, range(len(self.chains))))
         return [screws_of_chain(index) for index in range(len(self.chains))]
 

@@ -470,3 +470,21 @@ def test_an_empty_batch_of_poses_gives_empty_results(name):
         assert solution.reachable.shape == (0,) and solution.chain_reachable.shape == (0, len(mechanism_.chains))
         for chain, values, screws in zip(mechanism_.chains, solution.joint_values, mechanism_.chain_screws(solution)):
             assert values.shape == (0, chain.n_joints) and screws.twists.shape == (0, chain.n_joints, 6)
+
+
+def test_thread_limit_bounds_the_nested_pools_and_keeps_results():
+    from screwkit.kinematics import block_threads, thread_limit
+    from screwkit.mechanism import load
+
+    default = block_threads()
+    mechanism = load("planar_5rrr")
+    rng = np.random.default_rng(3)
+    poses = np.column_stack([rng.uniform(-0.3, 0.3, (70_000, 2)), rng.uniform(0, 2 * np.pi, 70_000)])
+    free = mechanism.chain_screws(mechanism.solve(poses), unreachable="drop")
+    with thread_limit(1):
+        assert block_threads() == 1
+        limited = mechanism.chain_screws(mechanism.solve(poses), unreachable="drop")
+    assert block_threads() == default
+    for a, b in zip(free, limited):
+        np.testing.assert_array_equal(a.twists, b.twists)
+        np.testing.assert_array_equal(a.points, b.points)
