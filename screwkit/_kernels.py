@@ -1,13 +1,17 @@
-"""Compiled per-configuration kernel of :func:`screwkit.transmission.analyze`.
+"""Compiled kernel of :func:`screwkit.transmission.analyze`.
 
-One numba function walks a chunk of configurations in parallel and, for each, derives the
+One numba function takes a chunk of configurations, 64 at a time, and for each derives the
 actuation wrenches, the ITIs, and the output twists and OTIs of every non-redundant
-submechanism, exactly as documented in :func:`screwkit.transmission.analyze`. The small
-dense algebra (determinants, adjugates, null vectors, solves of at most 6x6 systems) is
-written out here so that nothing is allocated per configuration in the hot loop.
+submechanism, then the LMTI, F_Oj and the mutual-interference actuators, exactly as
+documented in :func:`screwkit.transmission.analyze`. Every per-configuration quantity has a
+last "lane" axis over the 64 configurations and every step loops over the lanes innermost,
+so that the compiler vectorises the algebra across configurations; only the null vectors of
+n > 3 rows and the Gram solves of chains with more joint DoFs than n run lane by lane. The
+small dense algebra (null vectors, Gram solves over one chain's joints) is written out here, and
+scratch is allocated once per call (the pseudo-inverse fallback for idle DoFs excepted).
 
-Screws are ordered (omega, v) for twists and (f, m) for wrenches; all arrays are
-batch-first, expressed about the centroid of the platform joints of each configuration.
+Screws are ordered (omega, v) for twists and (f, m) for wrenches, expressed about the
+centroid of the platform joints of each configuration.
 """
 
 from __future__ import annotations

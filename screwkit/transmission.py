@@ -15,11 +15,11 @@ derives
   ``F_Oj`` for ``j = 1..a-n`` (Eqs. 12-13) and the **input-output** ones ``F_IOj`` (Eq. 14);
 * which actuators are **mutual-interference actuators**.
 
-Everything is batched: validation, planning (motion space, submechanisms, fault sets) and
-the reductions over actuator sets are numpy; the per-configuration screw algebra runs in
-one compiled kernel (:mod:`screwkit._kernels`, numba, no allocation per configuration)
-over chunks of configurations, the chunks side by side on several cores. numba is
-imported only when :func:`analyze` first runs.
+Everything is batched: validation and planning (motion space, submechanisms, fault sets)
+are numpy; the per-configuration screw algebra and the reductions over actuator sets run
+in one compiled kernel (:mod:`screwkit._kernels`, numba, vectorised across configurations,
+no allocation per configuration) over chunks of configurations, the chunks side by side on
+several cores. numba is imported only when :func:`analyze` first runs.
 """
 
 from __future__ import annotations
