@@ -338,9 +338,10 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
         "outside": np.zeros(count, dtype=bool),
     }
     empty = np.empty((0, a, 3))
-    # The kernel's one signature: screws in any layout but writable float64, the rest C-contiguous.
+    # The kernel's one signature: screws in any layout, the rest C-contiguous; all writable float64.
     twists, points = (array if array.flags.writeable else array.copy() for array in (twists, points))
-    basis, complement = np.ascontiguousarray(basis), np.ascontiguousarray(complement)
+    basis, complement = (array if array.flags.writeable and array.flags.c_contiguous else np.array(array, order="C")
+                         for array in (basis, complement))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
                         complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
                         plan.fault_table, plan.threshold, plan.rank_tolerance,
@@ -530,7 +531,7 @@ def analyze(
                 array = np.broadcast_to(array, batch_shape + (a, 3))
             except ValueError:
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
-            overrides[name] = np.ascontiguousarray(array.reshape(count, a, 3))
+            overrides[name] = np.array(array.reshape(count, a, 3), dtype=np.float64, order="C")  # writable for the kernel
     twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 

@@ -96,3 +96,20 @@ def test_tiled_and_separate_chain_memory_give_the_same_result(rng):
     np.testing.assert_array_equal(first.iti_actuators, second.iti_actuators)
     reordered = analyze(tiled[::-1])  # blocks out of order: not tiled, concatenated
     np.testing.assert_allclose(reordered.f_o[1], first.f_o[1], atol=1e-12)
+
+
+def test_characteristic_points_given_on_the_wrench_axis_change_nothing():
+    """For an RRR chain the elbow c and the platform joint d lie on the actuation wrench's axis (the
+    distal link), so passing them as the ITI and OTI points must reproduce the default projections;
+    points off the axis must change the indices."""
+    rng = np.random.default_rng(11)
+    base, elbows, distal = random_planar_rrr(rng, 3000)
+    chains = rrr_chain_screws(base, elbows, distal)
+    on_axis = analyze(chains, iti_points=np.pad(elbows, ((0, 0), (0, 0), (0, 1))),
+                      oti_points=np.pad(distal, ((0, 0), (0, 0), (0, 1))))
+    compare(analyze(chains), on_axis)
+    for detail in (False, True):  # the override path with and without per-actuator outputs
+        plain = analyze(chains, detail=detail, oti_points=np.pad(distal, ((0, 0), (0, 0), (0, 1))))
+        np.testing.assert_allclose(plain.f_o[1], on_axis.f_o[1], atol=1e-9)
+    off_axis = analyze(chains, oti_points=np.pad(distal + 0.3, ((0, 0), (0, 0), (0, 1))))
+    assert np.abs(off_axis.oti_actuators - on_axis.oti_actuators).max() > 1e-3
