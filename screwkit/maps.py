@@ -320,22 +320,25 @@ def planar_disc_map(mechanism, radius: float, step: float, phi_step_degrees: flo
 
 
 def _wide_table(dataset):
-    """A dataset as one row per point of its first dimension(s), one column per series.
+    """A dataset as one row per point of the dimensions every variable shares, one column per series.
 
-    One-dimensional variables are columns; a variable with one more dimension (e.g. the
-    ITI per actuator) gives one column per label, ``iti_actuator[chain_1:joint]``.
+    Variables over exactly those dimensions are columns (a sweep's ``phi``; a map's ``y`` and
+    ``x``); a variable with one more dimension (e.g. the ITI per actuator) gives one column per
+    label, ``iti_actuator[chain_1:joint]``.
     """
     import pandas as pd
 
-    leading = [d for d in dataset.dims if not any(d in dataset[v].dims[1:] for v in dataset.data_vars)]
-    leading = [d for d in leading if all(d in dataset[v].dims for v in dataset.data_vars)] or [list(dataset.dims)[0]]
-    frame = dataset[[v for v in dataset.data_vars if set(dataset[v].dims) <= set(leading)]].to_dataframe().reset_index()
+    shared = [d for d in dataset.dims if all(d in dataset[v].dims for v in dataset.data_vars)]
+    if not shared:
+        raise ValueError(f"Cannot write a table: the variables share no dimension ({dict(dataset.sizes)}).")
+    frame = dataset[[v for v in dataset.data_vars if set(dataset[v].dims) == set(shared)]].to_dataframe()
+    frame = frame.reset_index()
     columns = {}
     for name in dataset.data_vars:
-        extra = [d for d in dataset[name].dims if d not in leading]
+        extra = [d for d in dataset[name].dims if d not in shared]
         if len(extra) == 1:
             for label in dataset[extra[0]].values:
-                columns[f"{name}[{label}]"] = dataset[name].sel({extra[0]: label}).values.ravel()
+                columns[f"{name}[{label}]"] = dataset[name].sel({extra[0]: label}).transpose(*shared).values.ravel()
     return pd.concat([frame, pd.DataFrame(columns)], axis=1)
 
 

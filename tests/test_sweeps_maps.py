@@ -102,6 +102,20 @@ def test_map_written_without_xarray_reads_back_as_the_dataset(five, tmp_path):
     assert np.isnan(dataset["f_o1"].values).any() and np.isfinite(dataset["f_o1"].values).any()
 
 
+def test_map_as_csv_has_one_row_per_grid_point(five, tmp_path):
+    import pandas as pd
+
+    grid = planar_disc_map(five, 0.2, 0.1, 30.0, progress=False, as_dataset=False)
+    dataset = grid.to_dataset()
+    write_dataset(grid, tmp_path / "map.csv")
+    table = pd.read_csv(tmp_path / "map.csv")
+    assert len(table) == dataset.sizes["x"] * dataset.sizes["y"] == 25
+    for _, row in table.iterrows():
+        expected = float(dataset["f_o1"].sel(x=row["x"], y=row["y"]))
+        assert (np.isnan(row["f_o1"]) and np.isnan(expected)) or row["f_o1"] == pytest.approx(expected, abs=1e-12)
+    assert table["f_o1"].isna().sum() == 12 and table["f_o1"].notna().sum() == 13  # 13 grid points on the disc
+
+
 def test_spatial_map_over_an_orientation_set():
     hexapod = load("ups_hexapod_8")
     grid = {"x": np.array([-0.1, 0.0, 0.1]), "y": np.array([-0.05, 0.05])}
