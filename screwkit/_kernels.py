@@ -41,42 +41,6 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _eliminate(work, size, rhs, limit):
-    """Gaussian elimination with partial pivoting of work[:size, :size], in place.
-
-    The same row operations are applied to ``rhs[:size]`` unless ``rhs`` is empty. Returns
-    the sign of the row permutation, or 0 when a pivot is at or below ``limit`` (singular).
-    """
-    sign = 1.0
-    for col in range(size):
-        pivot = col
-        best = abs(work[col, col])
-        for row in range(col + 1, size):
-            if abs(work[row, col]) > best:
-                best = abs(work[row, col])
-                pivot = row
-        if best <= limit or best == 0.0:
-            return 0.0
-        if pivot != col:
-            for j in range(size):
-                tmp = work[col, j]
-                work[col, j] = work[pivot, j]
-                work[pivot, j] = tmp
-            if rhs.shape[0] > 0:
-                tmp = rhs[col]
-                rhs[col] = rhs[pivot]
-                rhs[pivot] = tmp
-            sign = -sign
-        for row in range(col + 1, size):
-            factor = work[row, col] / work[col, col]
-            for j in range(col + 1, size):
-                work[row, j] -= factor * work[col, j]
-            if rhs.shape[0] > 0:
-                rhs[row] -= factor * rhs[col]
-    return sign
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _null_vector(rows, size, out, work, columns):
     """out[:size] = generalised cross product of the size - 1 rows rows[:size-1, :size].
 
@@ -92,9 +56,7 @@ def _null_vector(rows, size, out, work, columns):
         out[0] = 1.0
         return
     if size == 3:
-        out[0] = rows[0, 1] * rows[1, 2] - rows[0, 2] * rows[1, 1]
-        out[1] = rows[0, 2] * rows[1, 0] - rows[0, 0] * rows[1, 2]
-        out[2] = rows[0, 0] * rows[1, 1] - rows[0, 1] * rows[1, 0]
+        out[0], out[1], out[2] = _cross(rows[0, 0], rows[0, 1], rows[0, 2], rows[1, 0], rows[1, 1], rows[1, 2])
         return
     m = size - 1
     for i in range(m):
@@ -151,10 +113,10 @@ def _null_vector(rows, size, out, work, columns):
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _solve(matrix, size, rhs, out, work):
-    """Solve matrix[:size,:size] out = rhs by Gaussian elimination; returns False if singular.
+    """Solve matrix[:size,:size] out = rhs by Gaussian elimination with partial pivoting.
 
-    Singular means a pivot at or below 1e-12 times the largest diagonal entry (the matrix
-    is a Gram matrix, positive semi-definite).
+    Returns False if singular: a pivot at or below 1e-12 times the largest diagonal entry
+    (the matrix is a Gram matrix, positive semi-definite). ``work`` is scratch.
     """
     scale = 0.0
     for i in range(size):
@@ -162,8 +124,29 @@ def _solve(matrix, size, rhs, out, work):
         for j in range(size):
             work[i, j] = matrix[i, j]
         out[i] = rhs[i]
-    if _eliminate(work, size, out[:size], 1e-12 * scale) == 0.0:
-        return False
+    limit = 1e-12 * scale
+    for col in range(size):
+        pivot = col
+        best = abs(work[col, col])
+        for row in range(col + 1, size):
+            if abs(work[row, col]) > best:
+                best = abs(work[row, col])
+                pivot = row
+        if best <= limit or best == 0.0:
+            return False
+        if pivot != col:
+            for j in range(size):
+                tmp = work[col, j]
+                work[col, j] = work[pivot, j]
+                work[pivot, j] = tmp
+            tmp = out[col]
+            out[col] = out[pivot]
+            out[pivot] = tmp
+        for row in range(col + 1, size):
+            factor = work[row, col] / work[col, col]
+            for j in range(col + 1, size):
+                work[row, j] -= factor * work[col, j]
+            out[row] -= factor * out[col]
     for row in range(size - 1, -1, -1):
         total = out[row]
         for j in range(row + 1, size):
@@ -559,12 +542,9 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 i0 = locked_sets[locked, 0]
                 i1 = locked_sets[locked, 1]
                 for r in range(width):
-                    output[locked, 0, r] = (wrench_matrix[i0, 1, r] * wrench_matrix[i1, 2, r]
-                                            - wrench_matrix[i0, 2, r] * wrench_matrix[i1, 1, r])
-                    output[locked, 1, r] = (wrench_matrix[i0, 2, r] * wrench_matrix[i1, 0, r]
-                                            - wrench_matrix[i0, 0, r] * wrench_matrix[i1, 2, r])
-                    output[locked, 2, r] = (wrench_matrix[i0, 0, r] * wrench_matrix[i1, 1, r]
-                                            - wrench_matrix[i0, 1, r] * wrench_matrix[i1, 0, r])
+                    output[locked, 0, r], output[locked, 1, r], output[locked, 2, r] = _cross(
+                        wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
+                        wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
             else:
                 for r in range(width):
                     for i in range(n - 1):

@@ -119,38 +119,36 @@ def indices_at_poses(mechanism, poses: ArrayLike, *, detail: bool = False, thres
     f_io: dict[int, NDArray] = {}
     iti_actuators = oti_subs = None
     meta = None
-    for start in range(0, count, chunk_size):
-        part = slice(start, min(start + chunk_size, count))
-        with thread_limit(threads):
+    with thread_limit(threads):  # closures and screws on no more threads than the kernel
+        for start in range(0, count, chunk_size):
+            part = slice(start, min(start + chunk_size, count))
             solution = mechanism.solve(flat[part])
-        ok = np.asarray(solution.reachable)
-        index = np.flatnonzero(ok) + start
-        reachable[index] = True
-        if index.size:
-            if closed_forms:
-                with thread_limit(threads):
+            ok = np.asarray(solution.reachable)
+            index = np.flatnonzero(ok) + start
+            reachable[index] = True
+            if index.size:
+                if closed_forms:
                     result = _closed_form_result(mechanism, solution, threshold, faults, threads)
-            else:
-                with thread_limit(threads):
+                else:
                     chains = mechanism.chain_screws(solution, unreachable="drop")
-                result = analyze(chains, detail=detail, threshold=threshold, faults=faults, threads=threads)
-            if meta is None:
-                meta = result
-                f_o = {j: np.full(count, np.nan) for j in result.f_o}
-                f_io = {j: np.full(count, np.nan) for j in result.f_o}
-                if detail and result.iti_actuators is not None:
-                    iti_actuators = np.full((count, result.iti_actuators.shape[-1]), np.nan)
-                    oti_subs = np.full((count, result.oti_submechanisms.shape[-1]), np.nan)
-            iti[index] = result.iti
-            lmti[index] = result.lmti
-            for j in f_o:
-                f_o[j][index] = result.f_o[j]
-                f_io[j][index] = result.f_io[j]
-            if iti_actuators is not None:
-                iti_actuators[index] = result.iti_actuators
-                oti_subs[index] = result.oti_submechanisms
-        if progress is not None:
-            progress(part.stop - part.start)
+                    result = analyze(chains, detail=detail, threshold=threshold, faults=faults, threads=threads)
+                if meta is None:
+                    meta = result
+                    f_o = {j: np.full(count, np.nan) for j in result.f_o}
+                    f_io = {j: np.full(count, np.nan) for j in result.f_o}
+                    if detail and result.iti_actuators is not None:
+                        iti_actuators = np.full((count, result.iti_actuators.shape[-1]), np.nan)
+                        oti_subs = np.full((count, result.oti_submechanisms.shape[-1]), np.nan)
+                iti[index] = result.iti
+                lmti[index] = result.lmti
+                for j in f_o:
+                    f_o[j][index] = result.f_o[j]
+                    f_io[j][index] = result.f_io[j]
+                if iti_actuators is not None:
+                    iti_actuators[index] = result.iti_actuators
+                    oti_subs[index] = result.oti_submechanisms
+            if progress is not None:
+                progress(part.stop - part.start)
 
     def shaped(array):
         return None if array is None else array.reshape(batch + array.shape[1:])

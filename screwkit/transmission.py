@@ -259,7 +259,6 @@ class _Plan:
     locked_sets: NDArray[np.int64]
     locked_of: NDArray[np.int64]
     faults: tuple[int, ...]
-    fault_members: dict[int, NDArray[np.int64]]
     failed_sets: dict[int, NDArray[np.int64]]
     fault_start: NDArray[np.int64]
     fault_table: NDArray[np.int64]
@@ -316,7 +315,7 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
                            dtype=np.int64).reshape(-1, n),
-        faults=fault_list, fault_members=fault_members, failed_sets=failed_sets, fault_start=fault_start,
+        faults=fault_list, failed_sets=failed_sets, fault_start=fault_start,
         fault_table=fault_table, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
 
 
