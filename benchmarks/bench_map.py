@@ -50,26 +50,28 @@ def run_process(command: list[str]) -> tuple[float, float]:
 def per_configuration_rate(samples: int) -> float:
     import pinocchio
 
-    from screwkit.mechanism import load
+    from screwkit.closure import chain_screws, solve_one
+    from screwkit.loader import load
+    from screwkit.model.pinocchio_bridge import configuration_vector
     from screwkit.transmission import analyze
 
     mechanism = load("planar_5rrr")
-    data = mechanism.model.createData()
+    data = mechanism.pinocchio_model.createData()
     rng = np.random.default_rng(0)
     radius = 0.6 * np.sqrt(rng.uniform(0, 1, samples))
     angle = rng.uniform(0, 2 * np.pi, samples)
     poses = np.column_stack([radius * np.cos(angle), radius * np.sin(angle), rng.uniform(0, 2 * np.pi, samples)])
-    analyze(mechanism.chain_screws(mechanism.solve_one(poses[0])))  # warm up
+    analyze(chain_screws(mechanism, solve_one(mechanism, poses[0])))  # warm up
     start = time.perf_counter()
     done = 0
     for pose in poses:
         try:
-            solution = mechanism.solve_one(pose)
+            solution = solve_one(mechanism, pose)
         except ValueError:
             continue
-        q = mechanism.configuration_vector(solution.joint_values, solution.poses)
-        pinocchio.computeJointJacobians(mechanism.model, data, q)
-        analyze(mechanism.chain_screws(solution), threads=1)
+        q = configuration_vector(mechanism, solution.joint_values, solution.poses)
+        pinocchio.computeJointJacobians(mechanism.pinocchio_model, data, q)
+        analyze(chain_screws(mechanism, solution), threads=1)
         done += 1
     return len(poses) / (time.perf_counter() - start)
 
@@ -82,7 +84,7 @@ def main() -> None:
     args = parser.parse_args()
     folder = tempfile.mkdtemp()
     out = os.path.join(folder, "map.nc")
-    common = ["map", "planar_5rrr", "--out", out, "--quiet"]
+    common = ["map", "planar_5rrr", "--out", out, "--overwrite", "--quiet"]
     full = ["--radius", "0.6", "--step", "0.02", "--phi-step", "1"]
     tiny = ["--radius", "0.02", "--step", "0.02", "--phi-step", "120"]  # 5 positions x 3 angles
     run_command(common + full[:4] + ["--phi-step", "30"])  # warm the compiled-kernel caches

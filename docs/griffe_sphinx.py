@@ -4,7 +4,7 @@ screwkit's docstrings follow numpydoc and write the Sphinx way: formulas as ``:m
 inline and ``.. math:: ...`` displays, references as ``:func:`name```, ``:class:`~a.b.C```.
 mkdocstrings renders docstrings as Markdown, where those would come out as literal text. This
 extension rewrites every docstring before it is parsed: formulas into the delimiters of
-``pymdownx.arithmatex`` (``\\( ... \\)`` and ``\\[ ... \\]``, typeset by MathJax), references into
+``pymdownx.arithmatex`` (``\\( ... \\)`` and ``\\[ ... \\]``, typeset as MathML by docs/mathml_hook.py), references into
 inline code (``~a.b.C`` shows as ``C``). Loaded from mkdocs.yml
 (``extensions: [docs/griffe_sphinx.py:SphinxMarkup]``); not part of the site.
 """

@@ -1,4 +1,4 @@
-"""Generate the bundled URDF files from their parameters.
+"""Generate the bundled URDF files from their parameters (a script over :mod:`screwkit.model.urdf_writer`).
 
 Run ``python -m screwkit.robots.generate`` (optionally with an output folder) to rewrite the
 ``*.urdf`` files next to this module. The files are committed; this script documents and
@@ -21,103 +21,20 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics import rotation_from_rpy, rpy_from_rotation
+from screwkit.model.urdf_writer import UrdfWriter, planar_rrr_urdf
+from screwkit.rotations import rotation_from_rpy, rpy_from_rotation
 
 FOLDER = Path(__file__).resolve().parent
 Z_AXIS = np.array([0.0, 0.0, 1.0])
 
 
 # ---------------------------------------------------------------------------------------------
-# Writing helpers
+# Geometry helpers
 # ---------------------------------------------------------------------------------------------
 
 
-def _number(value: float) -> str:
-    """Shortest text that reads back as the same float (integers without '.0', tiny values as 0)."""
-    value = float(value)
-    if abs(value) < 1e-15:
-        return "0"
-    if value.is_integer():
-        return str(int(value))
-    return repr(value)
-
-
-def _triple(values) -> str:
-    return " ".join(_number(value) for value in values)
-
-
-class UrdfWriter:
-    """Builds one URDF document with ElementTree."""
-
-    def __init__(self, name: str, comment: str):
-        self.robot = ElementTree.Element("robot", name=name)
-        # "--" may not appear inside an XML comment.
-        self.robot.append(ElementTree.Comment(comment.replace("--", "- -")))
-
-    def link(self, name: str, shape: tuple | None = None, xyz=(0, 0, 0), rpy=(0, 0, 0)) -> None:
-        """A link; ``shape`` is ("box", size3), ("cylinder", radius, length) or ("sphere", radius)."""
-        link = ElementTree.SubElement(self.robot, "link", name=name)
-        if shape is None:
-            return
-        visual = ElementTree.SubElement(link, "visual")
-        ElementTree.SubElement(visual, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        geometry = ElementTree.SubElement(visual, "geometry")
-        if shape[0] == "box":
-            ElementTree.SubElement(geometry, "box", size=_triple(shape[1]))
-        elif shape[0] == "cylinder":
-            ElementTree.SubElement(geometry, "cylinder", radius=_number(shape[1]), length=_number(shape[2]))
-        else:
-            ElementTree.SubElement(geometry, "sphere", radius=_number(shape[1]))
-
-    def rod(self, name: str, length: float, radius: float = 0.015) -> None:
-        """A link drawn as a cylinder from its origin along its x axis."""
-        self.link(name, ("cylinder", radius, length), xyz=(length / 2, 0, 0), rpy=(0, math.pi / 2, 0))
-
-    def joint(self, name, joint_type, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=None, limit=None) -> None:
-        joint = ElementTree.SubElement(self.robot, "joint", name=name, type=joint_type)
-        ElementTree.SubElement(joint, "parent", link=parent)
-        ElementTree.SubElement(joint, "child", link=child)
-        ElementTree.SubElement(joint, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        if axis is not None:
-            ElementTree.SubElement(joint, "axis", xyz=_triple(axis))
-        if limit is not None:
-            lower, upper, effort, velocity = limit
-            ElementTree.SubElement(
-                joint, "limit", lower=_number(lower), upper=_number(upper), effort=_number(effort), velocity=_number(velocity)
-            )
-
-    def loop(
-        self, name, loop_type, chain, predecessor, predecessor_pose, successor, successor_pose, axis=None, second_axis=None
-    ) -> None:
-        """A URDF+ loop joint; poses are (xyz, rpy) of the loop frame in each link frame."""
-        loop = ElementTree.SubElement(self.robot, "loop", name=name, type=loop_type, chain=chain)
-        for tag, link, (xyz, rpy) in (
-            ("predecessor", predecessor, predecessor_pose),
-            ("successor", successor, successor_pose),
-        ):
-            side = ElementTree.SubElement(loop, tag, link=link)
-            ElementTree.SubElement(side, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        if axis is not None:
-            ElementTree.SubElement(loop, "axis", xyz=_triple(axis))
-        if second_axis is not None:
-            ElementTree.SubElement(loop, "axis2", xyz=_triple(second_axis))
-
-    def transmission(self, joint: str) -> None:
-        transmission = ElementTree.SubElement(self.robot, "transmission", name=f"{joint}_transmission")
-        ElementTree.SubElement(transmission, "type").text = "transmission_interface/SimpleTransmission"
-        joint_element = ElementTree.SubElement(transmission, "joint", name=joint)
-        ElementTree.SubElement(joint_element, "hardwareInterface").text = "hardware_interface/EffortJointInterface"
-        actuator = ElementTree.SubElement(transmission, "actuator", name=f"{joint}_motor")
-        ElementTree.SubElement(actuator, "mechanicalReduction").text = "1"
-
-    def reference_configuration(self, values: dict[str, float]) -> None:
-        element = ElementTree.SubElement(self.robot, "reference_configuration")
-        for name, value in values.items():
-            ElementTree.SubElement(element, "joint", name=name, value=_number(value))
-
-    def text(self) -> str:
-        ElementTree.indent(self.robot, space="  ")
-        return '<?xml version="1.0"?>\n' + ElementTree.tostring(self.robot, encoding="unicode") + "\n"
+def _angle(vector: NDArray) -> float:
+    return math.atan2(vector[1], vector[0])
 
 
 def _frame_rpy(x_axis: NDArray, y_axis: NDArray) -> NDArray:
@@ -128,10 +45,6 @@ def _frame_rpy(x_axis: NDArray, y_axis: NDArray) -> NDArray:
 
 def _unit(vector: NDArray) -> NDArray:
     return vector / np.linalg.norm(vector)
-
-
-def _angle(vector: NDArray) -> float:
-    return math.atan2(vector[1], vector[0])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -150,49 +63,6 @@ def five_rrr_points(parameters: dict = FIVE_RRR) -> tuple[NDArray, NDArray]:
     return base, platform
 
 
-def elbow(base: NDArray, end: NDArray, proximal: float, distal: float, side: float = 1.0) -> NDArray:
-    """Elbow c of an R-R-R leg, on the ``side`` (+1: left, the +u_perp side) of the line base -> end."""
-    delta = end - base
-    distance = np.linalg.norm(delta)
-    along = (proximal**2 - distal**2 + distance**2) / (2 * distance)
-    height = side * math.sqrt(proximal**2 - along**2)
-    unit = delta / distance
-    return base + along * unit + height * np.array([-unit[1], unit[0]])
-
-
-def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, distal, working_mode=1.0,
-                    comment: str = "") -> str:
-    """URDF of a planar n-RRR: base joints ``base`` (n, 2), platform joints ``platform`` (n, 2) in the
-    platform frame, arm lengths (scalars or (n,)), elbows on the ``working_mode`` side (+1: +u_perp)
-    in the reference assembly (platform at x = y = phi = 0). Base joints are actuated."""
-    base, platform = np.asarray(base, dtype=float), np.asarray(platform, dtype=float)
-    count = base.shape[0]
-    proximal = np.broadcast_to(np.asarray(proximal, dtype=float), (count,))
-    distal = np.broadcast_to(np.asarray(distal, dtype=float), (count,))
-    sides = np.broadcast_to(np.asarray(working_mode, dtype=float), (count,))
-    reach = float(np.max(np.linalg.norm(base, axis=-1)))
-    writer = UrdfWriter(name, comment)
-    writer.link("base_link", ("cylinder", round(reach + 0.05, 6), 0.01), xyz=(0, 0, -0.02))
-    writer.link("platform", ("cylinder", round(float(np.max(np.linalg.norm(platform, axis=-1))) + 0.02, 6), 0.02))
-    writer.joint("platform_joint", "planar", "base_link", "platform", axis=(0, 0, 1))
-    for i in range(count):
-        chain = f"chain_{i + 1}"
-        b, d, a, l = base[i], platform[i], float(proximal[i]), float(distal[i])
-        c = elbow(b, d, a, l, side=float(sides[i]))
-        first_angle, second_angle = _angle(c - b), _angle(d - c)
-        writer.rod(f"{chain}_link_a", a)
-        writer.rod(f"{chain}_link_l", l)
-        writer.joint(f"{chain}_joint_b", "continuous", "base_link", f"{chain}_link_a",
-                     xyz=(b[0], b[1], 0), rpy=(0, 0, first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.joint(f"{chain}_joint_c", "continuous", f"{chain}_link_a", f"{chain}_link_l",
-                     xyz=(a, 0, 0), rpy=(0, 0, second_angle - first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.loop(f"{chain}_joint_d", "revolute", chain,
-                    f"{chain}_link_l", ((l, 0, 0), (0, 0, -second_angle)),
-                    "platform", ((d[0], d[1], 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
-        writer.transmission(f"{chain}_joint_b")
-    return writer.text()
-
-
 def planar_5rrr() -> str:
     parameters = FIVE_RRR
     base, platform = five_rrr_points(parameters)
@@ -201,6 +71,7 @@ def planar_5rrr() -> str:
         " Planar 5-RRR of the paper (Table 2): e = 1.0 m, g = 0.1 m, a_i = l_i = 1.0 m, gamma = 2 pi / 5. "
         "Reference assembly: platform at x = y = 0, phi = 0, every elbow c_i on the +u_perp side of b_i -> d_i. "
         "Generated by python -m screwkit.robots.generate ",
+        named_poses={"paper_fig_2a": (-0.2, 0.0, math.pi / 4)},  # the configuration of the paper's Fig. 2(a)
     )
 
 
@@ -281,6 +152,8 @@ def planar_4rpr() -> str:
                     f"{chain}_piston", ((length, 0, 0), (0, 0, -yaw)),
                     "platform", ((d[0], d[1], 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
         writer.transmission(f"{chain}_joint_slider")
+    pose, _ = four_rpr_concurrent_pose(parameters)  # leg lines 1, 2, 3 meet: actuator 4 is not mutual-interference
+    writer.named_pose("three_lines_concurrent", {"x": pose[0], "y": pose[1], "phi": pose[2]})
     return writer.text()
 
 
@@ -465,7 +338,7 @@ def example_robot_data_ur5() -> Path:
 
 def _ur5_joints() -> list[dict]:
     """Kinematics of the UR5 arm joints and of its tool0 frame, read from example-robot-data."""
-    from screwkit.urdf import read_urdf
+    from screwkit.model.urdf_reader import read_urdf
 
     description = read_urdf(example_robot_data_ur5())  # the safe pass: no DTD, no entities
     names = UR5_JOINTS + ("wrist_3_link-tool0_fixed_joint",)
@@ -496,7 +369,7 @@ def _ur5_joints() -> list[dict]:
 
 def _ur5_tool_pose(joints: list[dict], values) -> tuple[NDArray, NDArray]:
     """tool0 frame in the arm base frame at joint ``values`` (product of URDF transforms)."""
-    from screwkit.kinematics import rotation_about_axis
+    from screwkit.rotations import rotation_about_axis
 
     rotation, translation = np.eye(3), np.zeros(3)
     for index, joint in enumerate(joints):

@@ -10,8 +10,17 @@ n > 3 rows and the Gram solves of chains with more joint DoFs than n run lane by
 small dense algebra (null vectors, Gram solves over one chain's joints) is written out here, and
 scratch is allocated once per call (the pseudo-inverse fallback for idle DoFs excepted).
 
-Screws are ordered (omega, v) for twists and (f, m) for wrenches, expressed about the
-centroid of the platform joints of each configuration.
+Screws are ordered (omega, v) for twists and (f, m) for wrenches. Inside the kernel every
+configuration is in its own *working coordinates*: about the centroid ``c`` of the platform
+joints, with lengths in units of ``L``, the RMS distance of all the configuration's joint points
+from ``c`` (a twist (omega, v) becomes (omega, v_c / L), a point p becomes (p - c) / L, a wrench
+(f, m) becomes (f, m_c / L)). Every tolerance is then compared with dimensionless numbers, so
+that no decision depends on the length unit, the scale of the mechanism or the world frame; the
+singularity threshold *p*, a length, is compared as p / L. ``c`` and ``L`` are computed per
+configuration, exactly as :func:`screwkit.transmission._working_coordinates` does for the
+motion-space bases it passes in; outputs go back to world units and frame. The tolerances come
+in as arguments (named in :mod:`screwkit.tolerances`): numba's disk cache would not notice a
+changed constant of another module.
 """
 
 from __future__ import annotations
@@ -30,6 +39,7 @@ BLOCK = 64  # configurations gathered batch-first at a time
 _SIGNATURE = (
     "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
     "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], float64, float64, "
+    "float64, float64, float64, float64, float64, "
     "float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], "
     "int64[:, ::1], boolean[:, ::1], float64[:, :, ::1], float64[:, :, :, ::1], boolean[::1])"
 )
@@ -112,11 +122,11 @@ def _null_vector(rows, size, out, work, columns):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _solve(matrix, size, rhs, out, work):
+def _solve(matrix, size, rhs, out, work, pivot_tolerance):
     """Solve matrix[:size,:size] out = rhs by Gaussian elimination with partial pivoting.
 
-    Returns False if singular: a pivot at or below 1e-12 times the largest diagonal entry
-    (the matrix is a Gram matrix, positive semi-definite). ``work`` is scratch.
+    Returns False if singular: a pivot at or below ``pivot_tolerance`` times the largest diagonal
+    entry (the matrix is a Gram matrix, positive semi-definite). ``work`` is scratch.
     """
     scale = 0.0
     for i in range(size):
@@ -124,7 +134,7 @@ def _solve(matrix, size, rhs, out, work):
         for j in range(size):
             work[i, j] = matrix[i, j]
         out[i] = rhs[i]
-    limit = 1e-12 * scale
+    limit = pivot_tolerance * scale
     for col in range(size):
         pivot = col
         best = abs(work[col, col])
@@ -157,7 +167,11 @@ def _solve(matrix, size, rhs, out, work):
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def _power_coefficient(numerator, arm, reference, threshold):
-    """|A o T| / |A o T|_max, zero when the moment arm is at or below threshold * |omega|."""
+    """|A o T| / |A o T|_max, zero when the moment arm is at or below threshold * |omega|.
+
+    Homogeneous: ``arm``, ``numerator`` and ``threshold`` are in working coordinates (lengths in
+    units of L), ``threshold`` being p / L.
+    """
     if arm <= threshold * reference or arm <= 0.0:
         return 0.0
     value = abs(numerator) / arm
@@ -167,6 +181,7 @@ def _power_coefficient(numerator, arm, reference, threshold):
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
                         submechanisms, locked_sets, locked_of, fault_start, fault_table, threshold, rank_tolerance,
+                        pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency, worst_fault_tie,
                         iti_override, oti_override, iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out,
                         wrench_out, twist_out, outside_out):
     """Indices of a chunk of configurations.
@@ -178,7 +193,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
         configurations is first gathered into a small batch-first buffer.
     chain_start (C + 1,) : joints of chain c are chain_start[c]:chain_start[c+1].
     actuator_chain, actuator_joint (a,) : chain and joint (within the chain) of each actuator.
-    basis (1 or N, n, 6) : motion-space basis about the centroid (1: the same for all).
+    basis (1 or N, n, 6) : orthonormal motion-space basis in working coordinates (1: the same
+        for all).
     complement (6 - n, 6) : orthonormal complement of a constant basis, used to flag configurations
         whose joint twists leave it (``outside_out``); they are recomputed with their own basis.
     submechanisms (S, n) : actuator indices of each non-redundant submechanism.
@@ -188,14 +204,22 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     fault_start (F + 1,), fault_table (E, M) : the actuator sets E_i left after j faults, for each
         of F values of j: rows fault_start[f]:fault_start[f+1] of fault_table list the
         submechanisms contained in each set (padded with -1).
-    iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller.
+    threshold : the singularity threshold p, in the length unit of the screws (compared as p / L).
+    rank_tolerance, pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency,
+        worst_fault_tie : the dimensionless tolerances RANK_TOLERANCE, PURE_COUPLE,
+        OUTSIDE_CONSTANT_SPACE, GRAM_PIVOT, PSEUDO_INVERSE_CONSISTENCY and WORST_FAULT_TIE of
+        :mod:`screwkit.tolerances`, applied in working coordinates.
+    iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller (world).
     Outputs: iti_out (N or 0, a), oti_out (N or 0, S, n), oti_sub_out (N or 0, S) (Eq. 9);
         summary_out (N, 2 + F) holding the ITI (Eq. 7), the LMTI of all actuators (Eq. 11) and
-        F_Oj for each of the F values of j (Eqs. 12-13); worst_out (N, F) the worst set (first
-        minimum, as numpy's argmin); mutual_out (N, a) bool, whether each actuator is a
-        mutual-interference actuator (some n others have independent wrenches);
-        wrench_out (N or 0, a, 6), twist_out (N or 0, S, n, 6) (output twists, scaled so that
-        |A_k o T_k| = |det W|), outside_out (N,) bool.
+        F_Oj for each of the F values of j (Eqs. 12-13); worst_out (N, F) the worst set: the
+        first set, in combination order, whose LMTI is at most F_Oj + worst_fault_tie (numpy's
+        argmin, made robust to rounding between sets of mathematically equal LMTI);
+        mutual_out (N, a) bool, whether each actuator is a mutual-interference actuator (some n
+        others have independent wrenches); wrench_out (N or 0, a, 6) (world frame and unit:
+        unit force, or unit moment for a pure couple), twist_out (N or 0, S, n, 6) (output
+        twists, world frame and unit, scaled as the adjugate columns in working coordinates,
+        so that |A'_k o T'_k| = |det W|), outside_out (N,) bool.
     """
     count = all_twists.shape[0]
     chains = chain_start.shape[0] - 1
@@ -218,6 +242,9 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     local = np.empty((joints, 6, BLOCK))  # joint twists about the centroid
     local_points = np.empty((joints, 3, BLOCK))  # joint points relative to the centroid
     centres = np.empty((3, BLOCK))
+    lengths = np.empty(BLOCK)  # the characteristic length L of each configuration
+    inverse_lengths = np.empty(BLOCK)
+    thresholds = np.empty(BLOCK)  # p / L
     motion_lanes = np.empty((n, 6, BLOCK))
     outside = np.zeros(BLOCK, dtype=np.bool_)
     shifted_basis = np.empty((n, 6, BLOCK))
@@ -227,7 +254,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     wrench_lanes = np.empty((a, 6, BLOCK))
     point_lanes = np.empty((3, BLOCK))  # the OTI characteristic point of the actuator
     pitch_lanes = np.empty(BLOCK)
-    shifted = np.empty((capacity, 6))
+    shifted_lanes = np.empty((capacity, 6, BLOCK))  # a chain's unit twists about d
+    gram_lanes = np.empty((capacity, capacity, BLOCK))
     rows = np.empty((6, 6))
     gram = np.empty((capacity, capacity))
     work = np.empty((capacity, capacity))
@@ -251,8 +279,14 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     lane1 = np.empty(BLOCK)
     lane2 = np.empty(BLOCK)
     best = np.empty(BLOCK)
-    worst_set = np.empty(BLOCK, dtype=np.int64)
     mutual = np.empty(BLOCK, dtype=np.bool_)
+    set_count = 1
+    for f in range(fault_start.shape[0] - 1):
+        set_count = max(set_count, fault_start[f + 1] - fault_start[f])
+    set_values = np.empty((set_count, BLOCK))  # LMTI of every set left after j faults
+    first_set = np.empty(BLOCK, dtype=np.int64)
+    pure_couple_sq = pure_couple * pure_couple
+    outside_sq = outside_tolerance * outside_tolerance
     member = np.zeros((subs, a), dtype=np.bool_)
     for s in range(subs):
         for i in range(n):
@@ -281,16 +315,37 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
         for k in range(3):
             for r in range(width):
                 centres[k, r] /= chains
+        # --- the characteristic length L: RMS distance of every joint point from the centroid.
+        for r in range(width):
+            lane0[r] = 0.0
+        for j in range(joints):
+            for r in range(width):
+                p0 = local_points[j, 0, r] - centres[0, r]
+                p1 = local_points[j, 1, r] - centres[1, r]
+                p2 = local_points[j, 2, r] - centres[2, r]
+                local_points[j, 0, r] = p0
+                local_points[j, 1, r] = p1
+                local_points[j, 2, r] = p2
+                lane0[r] += p0 * p0 + p1 * p1 + p2 * p2
+        for r in range(width):
+            length = np.sqrt(lane0[r] / joints)
+            if not length > 0.0:  # every joint point at the centroid: no length to scale by
+                length = 1.0
+            lengths[r] = length
+            inverse_lengths[r] = 1.0 / length
+            thresholds[r] = threshold / length
+        # --- working coordinates: twists about the centroid, lengths in units of L.
         for j in range(joints):
             for r in range(width):
                 x0, x1, x2 = _cross(local[j, 0, r], local[j, 1, r], local[j, 2, r],
                                     centres[0, r], centres[1, r], centres[2, r])
-                local[j, 3, r] += x0
-                local[j, 4, r] += x1
-                local[j, 5, r] += x2
-                local_points[j, 0, r] -= centres[0, r]
-                local_points[j, 1, r] -= centres[1, r]
-                local_points[j, 2, r] -= centres[2, r]
+                inverse = inverse_lengths[r]
+                local[j, 3, r] = (local[j, 3, r] + x0) * inverse
+                local[j, 4, r] = (local[j, 4, r] + x1) * inverse
+                local[j, 5, r] = (local[j, 5, r] + x2) * inverse
+                local_points[j, 0, r] *= inverse
+                local_points[j, 1, r] *= inverse
+                local_points[j, 2, r] *= inverse
         for q in range(n):
             for k in range(6):
                 if constant:
@@ -319,7 +374,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     for r in range(width):
                         lane1[r] += lane2[r] * lane2[r]
                 for r in range(width):
-                    outside[r] = outside[r] or lane1[r] > 1e-18 * max(lane0[r], 1.0)
+                    outside[r] = outside[r] or lane1[r] > outside_sq * lane0[r]
             for r in range(width):
                 outside_out[first_index + r] = outside[r]
         # --- actuation wrenches (one per actuator), in the representative documented in analyze().
@@ -334,7 +389,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 for r in range(width):
                     force[k, r] = 0.0
             if m == n:
-                # SWAP M' x with x spanning null(J_passive'^T M'), all about the platform joint d.
+                # SWAP M' x with x spanning null(J_passive'^T M'), all about the platform joint d
+                # (working coordinates).
                 for q in range(n):
                     for r in range(width):
                         x0, x1, x2 = _cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
@@ -386,29 +442,45 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         force[4, r] += y * shifted_basis[q, 1, r]
                         force[5, r] += y * shifted_basis[q, 2, r]
             else:
-                # Minimum-norm solution SWAP J' (J'^T J')^-1 e_k, configuration by configuration.
+                # Minimum-norm solution SWAP J' (J'^T J')^-1 e_k, J' the chain's twists about d in
+                # working coordinates, each scaled to unit norm (a column scaling: the same wrench,
+                # and the Gram pivot test compares dimensionless numbers). J' and its Gram matrix
+                # across the lanes, then the solve configuration by configuration.
+                for j in range(m):
+                    for r in range(width):
+                        w0, w1, w2 = local[start + j, 0, r], local[start + j, 1, r], local[start + j, 2, r]
+                        x0, x1, x2 = _cross(w0, w1, w2, local_points[last, 0, r], local_points[last, 1, r],
+                                            local_points[last, 2, r])
+                        u0 = local[start + j, 3, r] + x0
+                        u1 = local[start + j, 4, r] + x1
+                        u2 = local[start + j, 5, r] + x2
+                        norm = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2 + u0 * u0 + u1 * u1 + u2 * u2)
+                        inverse = 1.0 / norm if norm > 0.0 else 0.0
+                        shifted_lanes[j, 0, r] = w0 * inverse
+                        shifted_lanes[j, 1, r] = w1 * inverse
+                        shifted_lanes[j, 2, r] = w2 * inverse
+                        shifted_lanes[j, 3, r] = u0 * inverse
+                        shifted_lanes[j, 4, r] = u1 * inverse
+                        shifted_lanes[j, 5, r] = u2 * inverse
+                for i in range(m):
+                    for j in range(i + 1):
+                        for r in range(width):
+                            lane0[r] = 0.0
+                        for k in range(6):
+                            for r in range(width):
+                                lane0[r] += shifted_lanes[i, k, r] * shifted_lanes[j, k, r]
+                        for r in range(width):
+                            gram_lanes[i, j, r] = lane0[r]
+                            gram_lanes[j, i, r] = lane0[r]
                 for r in range(width):
                     if outside[r]:
                         continue  # recomputed with its own motion space
-                    d0, d1, d2 = local_points[last, 0, r], local_points[last, 1, r], local_points[last, 2, r]
-                    for j in range(m):  # chain twists about the platform joint point d
-                        w0, w1, w2 = local[start + j, 0, r], local[start + j, 1, r], local[start + j, 2, r]
-                        x0, x1, x2 = _cross(w0, w1, w2, d0, d1, d2)
-                        shifted[j, 0] = w0
-                        shifted[j, 1] = w1
-                        shifted[j, 2] = w2
-                        shifted[j, 3] = local[start + j, 3, r] + x0
-                        shifted[j, 4] = local[start + j, 4, r] + x1
-                        shifted[j, 5] = local[start + j, 5, r] + x2
                     for i in range(m):
                         for j in range(m):
-                            total = 0.0
-                            for k in range(6):
-                                total += shifted[i, k] * shifted[j, k]
-                            gram[i, j] = total
+                            gram[i, j] = gram_lanes[i, j, r]
                         rhs[i] = 0.0
                     rhs[own - start] = 1.0
-                    regular = _solve(gram, m, rhs, solution, work)
+                    regular = _solve(gram, m, rhs, solution, work, gram_pivot)
                     if not regular:
                         # Dependent joint twists (an idle DoF): pseudo-inverse, kept if consistent.
                         pseudo = np.linalg.pinv(gram[:m, :m].copy())
@@ -423,17 +495,17 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         largest = 1.0
                         for i in range(m):
                             largest = max(largest, abs(solution[i]))
-                        if worst > 1e-9 * largest:
+                        if worst > pseudo_inverse_consistency * largest:
                             for i in range(m):
                                 solution[i] = 0.0
                     for j in range(m):  # the wrench about d: SWAP of the combination
                         y = solution[j]
-                        force[0, r] += y * shifted[j, 3]
-                        force[1, r] += y * shifted[j, 4]
-                        force[2, r] += y * shifted[j, 5]
-                        force[3, r] += y * shifted[j, 0]
-                        force[4, r] += y * shifted[j, 1]
-                        force[5, r] += y * shifted[j, 2]
+                        force[0, r] += y * shifted_lanes[j, 3, r]
+                        force[1, r] += y * shifted_lanes[j, 4, r]
+                        force[2, r] += y * shifted_lanes[j, 5, r]
+                        force[3, r] += y * shifted_lanes[j, 0, r]
+                        force[4, r] += y * shifted_lanes[j, 1, r]
+                        force[5, r] += y * shifted_lanes[j, 2, r]
             # --- unit wrench about the centroid, its ITI (Eq. 6) and its OTI characteristic point.
             for r in range(width):
                 d0, d1, d2 = local_points[last, 0, r], local_points[last, 1, r], local_points[last, 2, r]
@@ -444,7 +516,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 m2 = force[5, r] + x2
                 force_sq = f0 * f0 + f1 * f1 + f2 * f2
                 moment_sq = m0 * m0 + m1 * m1 + m2 * m2
-                forceful = force_sq > 1e-20 * moment_sq and force_sq > 0.0
+                # A pure couple: |f| <= PURE_COUPLE |m_c| / L (working coordinates, moment about c).
+                forceful = force_sq > pure_couple_sq * moment_sq and force_sq > 0.0
                 scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
                 work_done = (f0 * local[own, 3, r] + f1 * local[own, 4, r] + f2 * local[own, 5, r]
                              + m0 * local[own, 0, r] + m1 * local[own, 1, r] + m2 * local[own, 2, r])
@@ -468,9 +541,9 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 # Characteristic points: projections on the wrench axis (unit force).
                 axis0, axis1, axis2 = _cross(f0, f1, f2, m0, m1, m2)
                 if iti_override.shape[0] > 0:
-                    p0 = iti_override[first_index + r, act, 0] - centres[0, r]
-                    p1 = iti_override[first_index + r, act, 1] - centres[1, r]
-                    p2 = iti_override[first_index + r, act, 2] - centres[2, r]
+                    p0 = (iti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
+                    p1 = (iti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
+                    p2 = (iti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
                 else:
                     p0, p1, p2 = local_points[after, 0, r], local_points[after, 1, r], local_points[after, 2, r]
                     if forceful:
@@ -487,11 +560,11 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 v2 = local[own, 5, r] + x2 + pitch * w2
                 arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if forceful else omega
                 reference = omega if forceful else 0.0
-                iti_local[act, r] = _power_coefficient(work_done * factor, arm, reference, threshold)
+                iti_local[act, r] = _power_coefficient(work_done * factor, arm, reference, thresholds[r])
                 if oti_override.shape[0] > 0:
-                    p0 = oti_override[first_index + r, act, 0] - centres[0, r]
-                    p1 = oti_override[first_index + r, act, 1] - centres[1, r]
-                    p2 = oti_override[first_index + r, act, 2] - centres[2, r]
+                    p0 = (oti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
+                    p1 = (oti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
+                    p2 = (oti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
                 else:
                     p0, p1, p2 = d0, d1, d2
                     if forceful:
@@ -524,16 +597,18 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     row_norms[act, r] += value * value
             for r in range(width):
                 row_norms[act, r] = np.sqrt(row_norms[act, r])
-            if wrench_out.shape[0] > 0:  # back to the world origin: m_0 = m_c + c x f
+            if wrench_out.shape[0] > 0:  # back to world units and origin: m_0 = L m' + c x f
                 for r in range(width):
                     f0, f1, f2 = wrench_lanes[act, 0, r], wrench_lanes[act, 1, r], wrench_lanes[act, 2, r]
                     x0, x1, x2 = _cross(centres[0, r], centres[1, r], centres[2, r], f0, f1, f2)
-                    wrench_out[first_index + r, act, 0] = f0
-                    wrench_out[first_index + r, act, 1] = f1
-                    wrench_out[first_index + r, act, 2] = f2
-                    wrench_out[first_index + r, act, 3] = wrench_lanes[act, 3, r] + x0
-                    wrench_out[first_index + r, act, 4] = wrench_lanes[act, 4, r] + x1
-                    wrench_out[first_index + r, act, 5] = wrench_lanes[act, 5, r] + x2
+                    length = lengths[r]
+                    unit = 1.0 if has_force[act, r] else inverse_lengths[r]  # a couple: unit moment in world units
+                    wrench_out[first_index + r, act, 0] = f0 * unit
+                    wrench_out[first_index + r, act, 1] = f1 * unit
+                    wrench_out[first_index + r, act, 2] = f2 * unit
+                    wrench_out[first_index + r, act, 3] = (wrench_lanes[act, 3, r] * length + x0) * unit
+                    wrench_out[first_index + r, act, 4] = (wrench_lanes[act, 4, r] * length + x1) * unit
+                    wrench_out[first_index + r, act, 5] = (wrench_lanes[act, 5, r] * length + x2) * unit
         # ---------------- second stage: output twists, OTIs and the reductions over actuator sets.
         # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
         # their wrenches (a column of adj(W) of every submechanism containing the set).
@@ -598,7 +673,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                 for r in range(width):
                     arm = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
                     reference = output_omega[locked, r] if has_force[act, r] else 0.0
-                    value = _power_coefficient(determinant[r], arm, reference, threshold) if independent[s, r] else 0.0
+                    value = (_power_coefficient(determinant[r], arm, reference, thresholds[r])
+                             if independent[s, r] else 0.0)
                     values[position, r] = value
                     best[r] = min(best[r], value)
                 if oti_out.shape[0] > 0:
@@ -611,8 +687,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                             total = 0.0
                             for q in range(n):
                                 total += output[locked, q, r] * motion_lanes[q, k, r]
-                            twist_out[index, s, position, k] = total
-                        # v_0 = v_c - omega x c
+                            twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
+                        # back to world units and origin: v_0 = L v' - omega x c
                         x0, x1, x2 = _cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
                                             twist_out[index, s, position, 2], centres[0, r], centres[1, r],
                                             centres[2, r])
@@ -641,12 +717,12 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
             for r in range(width):
                 for act in range(a):
                     iti_out[first_index + r, act] = iti_local[act, r]
-        # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E
-        # (the first worst set, as numpy's argmin).
+        # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
+        # The worst set reported is the first, in combination order, whose LMTI is within
+        # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
         for f in range(fault_start.shape[0] - 1):
             for r in range(width):
                 best[r] = np.inf
-                worst_set[r] = 0
             for e in range(fault_start[f], fault_start[f + 1]):
                 for r in range(width):
                     lane2[r] = -np.inf
@@ -657,12 +733,18 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     for r in range(width):
                         lane2[r] = max(lane2[r], oti_local[s, r])
                 for r in range(width):
-                    if lane2[r] < best[r]:
-                        best[r] = lane2[r]
-                        worst_set[r] = e - fault_start[f]
+                    set_values[e - fault_start[f], r] = lane2[r]
+                    best[r] = min(best[r], lane2[r])
+            for r in range(width):
+                lane2[r] = best[r] + worst_fault_tie
+                first_set[r] = -1
+            for e in range(fault_start[f + 1] - fault_start[f]):
+                for r in range(width):
+                    if first_set[r] < 0 and set_values[e, r] <= lane2[r]:
+                        first_set[r] = e
             for r in range(width):
                 summary_out[first_index + r, 2 + f] = best[r]
-                worst_out[first_index + r, f] = worst_set[r]
+                worst_out[first_index + r, f] = max(first_set[r], 0)
         # --- mutual interference: the other actuators alone fully constrain the platform.
         for act in range(a):
             for r in range(width):

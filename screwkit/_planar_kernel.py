@@ -13,19 +13,39 @@ from screwkit._fastmath import FASTMATH
 
 
 @njit(nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
-def planar_closed_form_kernel(base, elbows, distal, directions, triples, threshold, iti_out, oti_out):
+def planar_closed_form_kernel(base, elbows, distal, directions, triples, threshold, rank_tolerance, iti_out, oti_out,
+                              independent_out):
     """The paper's planar closed forms for a chunk of configurations (Eqs. 18-19, 23, 34, A2-A4).
 
     base, elbows, distal : (N, k, 2) points b_i, c_i, d_i; ``elbows`` may be empty (0, k, 2)
         when ``directions`` (N, k, 2) give the leg directions of RPR chains (ITI = 1).
     triples : (S, 3) chains of each 3-chain submechanism.
-    Outputs: iti_out (N, k), oti_out (N, S) = min over the three chains of OTI_k (A4).
+    rank_tolerance : the wrenches of a submechanism are dependent when the numerator of A2 (its
+        wrench determinant), in units of the characteristic length L of the configuration (the RMS
+        distance of the platform joints from their centroid c), is at or below this times the
+        product of the norms of its rows ``(f_i, (d_i - c) x f_i / L)``.
+    Outputs: iti_out (N, k), oti_out (N, S) = min over the three chains of OTI_k (A4),
+        independent_out (N, S): whether each submechanism's wrenches are independent.
     """
     count, chains = distal.shape[0], distal.shape[1]
     rrr = elbows.shape[0] > 0
     f = np.empty((chains, 2))
     fd = np.empty(chains)
+    row_norm = np.empty(chains)
     for index in range(count):
+        cx = 0.0
+        cy = 0.0
+        for i in range(chains):
+            cx += distal[index, i, 0]
+            cy += distal[index, i, 1]
+        cx /= chains
+        cy /= chains
+        spread = 0.0
+        for i in range(chains):
+            spread += (distal[index, i, 0] - cx) ** 2 + (distal[index, i, 1] - cy) ** 2
+        length = np.sqrt(spread / chains)
+        if length <= 0.0:
+            length = 1.0
         for i in range(chains):
             if rrr:
                 fx = distal[index, i, 0] - elbows[index, i, 0]
@@ -44,12 +64,15 @@ def planar_closed_form_kernel(base, elbows, distal, directions, triples, thresho
             f[i, 0] = fx
             f[i, 1] = fy
             fd[i] = fx * distal[index, i, 1] - fy * distal[index, i, 0]  # |f_i d_i|
+            moment = (fx * (distal[index, i, 1] - cy) - fy * (distal[index, i, 0] - cx)) / length
+            row_norm[i] = np.sqrt(fx * fx + fy * fy + moment * moment)
         for s in range(triples.shape[0]):
             k, l, m = triples[s, 0], triples[s, 1], triples[s, 2]
             cross_lm = f[l, 0] * f[m, 1] - f[l, 1] * f[m, 0]
             cross_mk = f[m, 0] * f[k, 1] - f[m, 1] * f[k, 0]
             cross_kl = f[k, 0] * f[l, 1] - f[k, 1] * f[l, 0]
             numerator = abs(fd[k] * cross_lm + fd[l] * cross_mk + fd[m] * cross_kl)  # A2 / A3
+            independent_out[index, s] = numerator > rank_tolerance * length * row_norm[k] * row_norm[l] * row_norm[m]
             best = 1.0
             for which in range(3):
                 if which == 0:

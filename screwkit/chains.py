@@ -32,16 +32,20 @@ class ChainScrews:
     actuated : tuple of int
         Indices (0-based, into the m joints) of the actuated joints of this chain.
     name : str
-        A label for reports.
+        The chain's name (actuators are reported as ``name:joint``).
+    joint_names : sequence of str, optional
+        One name per joint DoF (default ``joint_0``, ``joint_1``, ...).
     """
 
     twists: NDArray[np.float64]
     points: NDArray[np.float64]
     actuated: tuple[int, ...]
     name: str = ""
+    joint_names: tuple[str, ...] = ()
     batch_shape: tuple[int, ...] = field(init=False)
 
-    def __init__(self, twists: ArrayLike, points: ArrayLike, actuated, name: str = ""):
+    def __init__(self, twists: ArrayLike, points: ArrayLike, actuated, name: str = "",
+                 joint_names: tuple[str, ...] | None = None):
         twists = check_finite(check_shape(np.asarray(twists, dtype=float), (None, 6), "twists", batch=True), "twists")
         points = check_finite(check_shape(np.asarray(points, dtype=float), (None, 3), "points", batch=True), "points")
         m = twists.shape[-2]
@@ -66,7 +70,13 @@ class ChainScrews:
         object.__setattr__(self, "twists", twists)
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "actuated", actuated_tuple)
+        if joint_names is None:
+            joint_names = tuple(f"joint_{k}" for k in range(m))
+        joint_names = tuple(str(joint) for joint in joint_names)
+        if len(joint_names) != m:
+            raise ValueError(f"Expected one joint name per joint ({m}) of chain {name!r}, got {len(joint_names)}.")
         object.__setattr__(self, "name", name)
+        object.__setattr__(self, "joint_names", joint_names)
         object.__setattr__(self, "batch_shape", twists.shape[:-2])
 
     @property

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit._chunks import map_chunks
+from screwkit.tolerances import RANK_TOLERANCE, SINGULARITY_THRESHOLD, WORST_FAULT_TIE
 
 __all__ = [
     "det2",
@@ -71,7 +72,7 @@ def instantaneous_centre(f_l, d_l, f_m, d_m) -> NDArray[np.float64]:
         return (f_m * det2(f_l, d_l)[..., None] - f_l * det2(f_m, d_m)[..., None]) / det2(f_l, f_m)[..., None]
 
 
-def oti_chain_ic(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+def oti_chain_ic(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = SINGULARITY_THRESHOLD) -> NDArray[np.float64]:
     r"""OTI of chain ``k`` through the instantaneous centre (Eqs. 30-33).
 
     :math:`OTI_k = \sin\alpha_k = |\det[\rho_{k\max}/\rho_{k\max}\ \ f_k]|` with
@@ -92,7 +93,7 @@ def _numerator(f_k, d_k, f_l, d_l, f_m, d_m):
             + det2(f_m, d_m) * det2(f_k, f_l))
 
 
-def oti_chain_a2(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+def oti_chain_a2(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = SINGULARITY_THRESHOLD) -> NDArray[np.float64]:
     r"""OTI of chain ``k`` by Eq. (A2): the A3-shared numerator over :math:`|f_l\ f_m|\,\rho_{k\max}`."""
     centre = instantaneous_centre(f_l, d_l, f_m, d_m)
     arm = np.linalg.norm(np.asarray(d_k, dtype=float) - centre, axis=-1)
@@ -101,7 +102,7 @@ def oti_chain_a2(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArr
     return np.where(arm < threshold, 0.0, value)
 
 
-def oti_chain_a4(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = 1e-6) -> NDArray[np.float64]:
+def oti_chain_a4(f_k, d_k, f_l, d_l, f_m, d_m, threshold: float = SINGULARITY_THRESHOLD) -> NDArray[np.float64]:
     r"""OTI of chain ``k`` by Eq. (A4), free of the IC and valid for parallel ``f_l, f_m``.
 
     .. math:: OTI_k = \frac{\left| |f_k\,d_k||f_l\,f_m| + |f_l\,d_l||f_m\,f_k| + |f_m\,d_m||f_k\,f_l| \right|}
@@ -146,7 +147,7 @@ def oti_chain_a6(f_k, f_l) -> NDArray[np.float64]:
     return np.abs(det2(f_l, f_k))
 
 
-def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def oti_triple(f, d, threshold: float = SINGULARITY_THRESHOLD) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     r"""OTI of each chain of a 3-chain submechanism and their minimum (Eqs. 25, 34).
 
     Parameters
@@ -168,25 +169,31 @@ def oti_triple(f, d, threshold: float = 1e-6) -> tuple[NDArray[np.float64], NDAr
     return per_chain, per_chain.min(axis=-1)
 
 
-def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_members):
+def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_members, rank_tolerance, without):
     """Closed-form indices of one chunk (batch-first (n, k, 2) arrays) through the compiled kernel."""
-    from screwkit._planar_kernel import planar_closed_form_kernel
+    from screwkit._planar_kernel import planar_closed_form_kernel  # numba: loaded when the closed forms first run
 
     count, chains = distal.shape[:2]
     iti_chains = np.empty((count, chains))
     oti_subs = np.empty((count, len(triples)))
+    independent = np.empty((count, len(triples)), dtype=bool)
     empty = np.empty((0, chains, 2))
     planar_closed_form_kernel(empty if base is None else base, empty if elbows is None else elbows, distal,
                               empty if directions is None else directions, np.array(triples, dtype=np.int64),
-                              float(threshold), iti_chains, oti_subs)
+                              float(threshold), float(rank_tolerance), iti_chains, oti_subs, independent)
     iti = iti_chains.min(axis=1)
-    f_o = {j: oti_subs[:, members].max(axis=2).min(axis=1) for j, members in fault_members.items()}
-    return iti_chains, iti, oti_subs, f_o
+    f_o, worst = {}, {}
+    for j, members in fault_members.items():
+        lmti_sets = oti_subs[:, members].max(axis=2)  # Eq. 38 for every set left after j faults
+        f_o[j] = lmti_sets.min(axis=1)  # Eq. 37
+        worst[j] = np.argmax(lmti_sets <= f_o[j][:, None] + WORST_FAULT_TIE, axis=1)  # the first worst set
+    mutual = np.stack([independent[:, subs].any(axis=1) for subs in without], axis=1)
+    return iti_chains, iti, oti_subs, f_o, worst, mutual
 
 
-def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = 1e-6,
+def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = SINGULARITY_THRESHOLD,
                    faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None,
-                   chunk_size: int = 65536, threads: int | None = None) -> dict:
+                   chunk_size: int = 65536, threads: int | None = None, rank_tolerance: float = RANK_TOLERANCE) -> dict:
     r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
 
     Every 3-subset of the ``k`` chains is a non-redundant submechanism; its OTI is Eq. (34)
@@ -212,11 +219,17 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         Threads working on chunks side by side (default: the number of CPUs); the compiled
         kernel (:func:`screwkit._planar_kernel.planar_closed_form_kernel`) releases the GIL.
 
+    rank_tolerance : float
+        Relative tolerance of dependent wrenches (see the kernel).
+
     Returns
     -------
     dict
         ``iti_chains`` (..., k), ``iti``, ``oti_submechanisms`` (..., C(k,3)), ``lmti``,
-        ``f_o`` and ``f_io`` (dicts over j), ``submechanisms`` (tuple of triples).
+        ``f_o`` and ``f_io`` (dicts over j), ``worst_faults`` (dict over j of (..., j) failed
+        chains of the first worst set, within :data:`screwkit.tolerances.WORST_FAULT_TIE`), ``mutual_interference``
+        (..., k) (some 3 of the other chains have independent wrenches), ``submechanisms``
+        (tuple of triples).
     """
     distal = np.asarray(distal, dtype=float)
     if distal.ndim < 2 or distal.shape[-1] != 2 or distal.shape[-2] < 3:
@@ -237,6 +250,11 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     index = {triple: s for s, triple in enumerate(triples)}
     fault_members = {j: np.array([[index[t] for t in combinations(remaining, 3)]
                                   for remaining in combinations(range(count), count - j)]) for j in faults}
+    failed_sets = {j: np.array([sorted(set(range(count)) - set(remaining))
+                                for remaining in combinations(range(count), count - j)], dtype=np.int64).reshape(-1, j)
+                   for j in faults}
+    without = [np.array([s for s, triple in enumerate(triples) if k not in triple], dtype=np.int64)
+               for k in range(count)]
     total = int(np.prod(batch, dtype=np.int64))
     def flat(array):
         return None if array is None else array.reshape(total, count, 2)
@@ -247,7 +265,7 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     def run(part):  # views where possible: the kernel reads any memory layout (but writable arrays)
         chunk = [None if a is None else a[part] if a.flags.writeable else np.ascontiguousarray(a[part])
                  for a in sources]
-        return _planar_chunk(*chunk, threshold, triples, fault_members)
+        return _planar_chunk(*chunk, threshold, triples, fault_members, rank_tolerance, without)
 
     pieces = map_chunks(run, total, chunk_size, threads)
 
@@ -259,5 +277,7 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     iti = gather([p[1] for p in pieces])
     oti_subs = gather([p[2] for p in pieces])
     f_o = {j: gather([p[3][j] for p in pieces]) for j in faults}
+    worst = {j: failed_sets[j][gather([p[4][j] for p in pieces])] for j in faults}
     return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti_subs, "lmti": oti_subs.max(axis=-1),
-            "f_o": f_o, "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "submechanisms": triples}
+            "f_o": f_o, "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "worst_faults": worst,
+            "mutual_interference": gather([p[5] for p in pieces]), "submechanisms": triples}

@@ -187,7 +187,8 @@ def rrr_chain_screws(base: ArrayLike, elbows: ArrayLike, distal: ArrayLike,
     points = np.stack([_lift(np.broadcast_to(np.asarray(p, dtype=float), distal.shape))
                        for p in (base, elbows, distal)], axis=-2)  # (..., k, 3 joints, 3)
     twists = _revolute_z(points)
-    return [ChainScrews(twists[..., i, :, :], points[..., i, :, :], actuated, name=f"chain{i + 1}")
+    return [ChainScrews(twists[..., i, :, :], points[..., i, :, :], actuated, name=f"chain_{i + 1}",
+                        joint_names=("b", "c", "d"))
             for i in range(points.shape[-3])]
 
 
@@ -207,5 +208,6 @@ def rpr_chain_screws(base: ArrayLike, distal: ArrayLike, actuated: tuple[int, ..
     slide = np.concatenate([np.zeros_like(direction), direction / length], axis=-1)
     twists = np.stack([_revolute_z(base3), slide, _revolute_z(distal3)], axis=-2)
     points = np.stack([base3, distal3, distal3], axis=-2)
-    return [ChainScrews(twists[..., i, :, :], points[..., i, :, :], actuated, name=f"chain{i + 1}")
+    return [ChainScrews(twists[..., i, :, :], points[..., i, :, :], actuated, name=f"leg_{i + 1}",
+                        joint_names=("base", "slider", "platform"))
             for i in range(twists.shape[-3])]

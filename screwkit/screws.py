@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit._validation import as_float_array, check_finite, check_shape
+from screwkit.tolerances import PURE_COUPLE, SINGULARITY_THRESHOLD
 
 __all__ = [
     "SWAP",
@@ -65,8 +66,10 @@ def reciprocal_product(screw_1: ArrayLike, screw_2: ArrayLike) -> NDArray[np.flo
 
     Examples
     --------
-    >>> reciprocal_product([1, 0, 0, 0, 0, 0], [0, 0, 1, 0, 2, 0])  # force along x at origin, rotation about z at (-2, 0, 0)... v_x
-    array(0.)
+    A force along the x axis and a rotation about z through (-2, 0, 0), whose axes meet: no work.
+
+    >>> float(reciprocal_product([1, 0, 0, 0, 0, 0], [0, 0, 1, 0, 2, 0]))
+    0.0
     >>> float(reciprocal_product([1, 0, 0, 0, 0, 0], [0, 0, 1, 2, 0, 0]))
     2.0
     """
@@ -233,7 +236,14 @@ def reciprocal_complement(screws: ArrayLike, tolerance: float = 1e-9) -> list[ND
     return result
 
 
-def max_reciprocal_product(wrench: ArrayLike, twist: ArrayLike, point: ArrayLike) -> NDArray[np.float64]:
+def _length(length) -> float:
+    if not (isinstance(length, (int, float, np.floating, np.integer)) and np.isfinite(length) and length > 0):
+        raise ValueError(f"Expected `length` > 0 (a length in the unit of the screws), got {length!r}.")
+    return float(length)
+
+
+def max_reciprocal_product(wrench: ArrayLike, twist: ArrayLike, point: ArrayLike, *,
+                           length: float = 1.0) -> NDArray[np.float64]:
     r"""Local maximum of :math:`|A \circ T|` over all rotations of the wrench about ``point`` (Eq. 5).
 
     For a wrench of force :math:`f`, pitch :math:`h` applied at its characteristic point
@@ -243,12 +253,15 @@ def max_reciprocal_product(wrench: ArrayLike, twist: ArrayLike, point: ArrayLike
 
     which for unit screws equals :math:`\sqrt{(h_1 + h_2)^2 + \rho_{\max}^2}`. A twist
     at infinity (:math:`\omega = 0`) needs no special case. A pure moment (infinite
-    pitch wrench) gives :math:`|m|\,|\omega|`.
+    pitch wrench) gives :math:`|m|\,|\omega|`; the wrench counts as one when
+    :math:`|f|\,\ell \le` ``PURE_COUPLE`` :math:`|m_p|` (see :func:`power_coefficient`).
 
     Parameters
     ----------
     wrench, twist : array_like, shape (..., 6)
     point : array_like, shape (..., 3)
+    length : float
+        Characteristic length :math:`\ell` of the pure-couple test, in the unit of the screws.
 
     Returns
     -------
@@ -257,29 +270,36 @@ def max_reciprocal_product(wrench: ArrayLike, twist: ArrayLike, point: ArrayLike
     wrench = _screws(wrench, "wrench")
     twist = _screws(twist, "twist")
     point = _points(point, "point")
-    arm, _, scale = _moment_arm(wrench, twist, point)
+    arm, _, scale = _moment_arm(wrench, twist, point, _length(length))
     return arm * scale
 
 
-def _moment_arm(wrench, twist, point):
-    """Return ``(|v_p + h omega|, |omega|, |f|)``; for a pure moment ``(|omega|, 0, |m|)``."""
+def _moment_arm(wrench, twist, point, length):
+    """Return ``(|v_p + h omega|, |omega|, |f|)``; for a pure couple ``(|omega|, 0, |m|)``.
+
+    The wrench is a pure couple when ``|f| * length <= PURE_COUPLE * |m_p|``, ``m_p`` its moment
+    about ``point``: the test of the compiled kernel (which takes the moment about the centroid
+    of the platform joints and ``length = L``), dimensionless and frame free.
+    """
     force, moment = wrench[..., :3], wrench[..., 3:]
     omega, velocity = twist[..., :3], twist[..., 3:]
     force_sq = np.einsum("...i,...i->...", force, force)
-    moment_norm = np.linalg.norm(moment, axis=-1)
-    has_force = force_sq > (1e-24 * moment_norm**2)
+    moment_about_point = moment - np.cross(point, force)
+    moment_sq = np.einsum("...i,...i->...", moment_about_point, moment_about_point)
+    has_force = (force_sq * length**2 > PURE_COUPLE**2 * moment_sq) & (force_sq > 0)
     safe = np.where(has_force, force_sq, 1.0)
     wrench_pitch = np.where(has_force, np.einsum("...i,...i->...", force, moment) / safe, 0.0)
     arm_vector = velocity + np.cross(omega, point) + wrench_pitch[..., None] * omega
     omega_norm = np.linalg.norm(omega, axis=-1)
     arm = np.where(has_force, np.linalg.norm(arm_vector, axis=-1), omega_norm)
     reference = np.where(has_force, omega_norm, 0.0)
-    scale = np.where(has_force, np.sqrt(force_sq), moment_norm)
+    scale = np.where(has_force, np.sqrt(force_sq), np.linalg.norm(moment, axis=-1))
     return arm, reference, scale
 
 
 def power_coefficient(
-    wrench: ArrayLike, twist: ArrayLike, point: ArrayLike, threshold: float = 1e-6
+    wrench: ArrayLike, twist: ArrayLike, point: ArrayLike, threshold: float = SINGULARITY_THRESHOLD, *,
+    length: float = 1.0,
 ) -> NDArray[np.float64]:
     r"""Power coefficient of a wrench on a twist with the local maximum of the moment arm (Eqs. 4-5).
 
@@ -291,6 +311,18 @@ def power_coefficient(
     below ``threshold`` (the singularity threshold *p*, default 1 um), which also
     covers a zero twist or a zero wrench.
 
+    The wrench is a **pure couple** (infinite pitch) when
+
+    .. math:: |f|\,\ell \le \varepsilon\,|m_p|
+
+    with :math:`m_p` its moment about ``point``, :math:`\ell` = ``length`` and
+    :math:`\varepsilon` = :data:`screwkit.tolerances.PURE_COUPLE`: the test
+    :func:`screwkit.transmission.analyze` applies with the characteristic length ``L`` of the
+    configuration (moment about the centroid of the platform joints, which differs from
+    :math:`m_p` by :math:`|f|` times a distance of order ``L``, immaterial at this tolerance).
+    ``threshold`` and ``length`` are the only lengths: with both scaled with the screws, the
+    result does not depend on the length unit or the scale, and it never depends on the frame.
+
     Parameters
     ----------
     wrench : array_like, shape (..., 6)
@@ -301,6 +333,9 @@ def power_coefficient(
         Characteristic point of the wrench (where it is rotated).
     threshold : float
         Singularity threshold on the moment arm, in length units (>= 0).
+    length : float
+        Characteristic length of the mechanism (> 0, same unit), for the pure-couple test;
+        default 1, e.g. 1 m for screws in metres.
 
     Returns
     -------
@@ -311,7 +346,7 @@ def power_coefficient(
     point = _points(point, "point")
     if not threshold >= 0:
         raise ValueError(f"Expected `threshold` >= 0, got {threshold}.")
-    arm, omega_norm, scale = _moment_arm(wrench, twist, point)
+    arm, omega_norm, scale = _moment_arm(wrench, twist, point, _length(length))
     numerator = np.abs(
         np.einsum("...i,...i->...", wrench[..., :3], twist[..., 3:])
         + np.einsum("...i,...i->...", wrench[..., 3:], twist[..., :3])

@@ -20,24 +20,33 @@ are numpy; the per-configuration screw algebra and the reductions over actuator 
 in one compiled kernel (:mod:`screwkit._kernels`, numba, vectorised across configurations,
 no allocation per configuration) over chunks of configurations, the chunks side by side on
 several cores. numba is imported only when :func:`analyze` first runs.
+
+**Working coordinates.** The indices are dimensionless and frame invariant, and so is every
+decision taken on the way: each configuration is expressed about the centroid ``c`` of its
+platform joints with lengths in units of its characteristic length ``L`` (the RMS distance of
+all its joint points from ``c``), and every tolerance (:mod:`screwkit.tolerances`) compares
+numbers of those coordinates. The one length is the singularity threshold *p*, compared as
+``p / L``. Results come back in world units and frame.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from itertools import combinations
 from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit import tolerances
 from screwkit._chunks import map_chunks
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
+from screwkit.results import Indices
 
-__all__ = ["TransmissionResult", "MotionSpace", "analyze", "motion_space", "fault_sets"]
+__all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets"]
 
-DEFAULT_THRESHOLD = 1e-6
+DEFAULT_THRESHOLD = tolerances.SINGULARITY_THRESHOLD
 """The paper's singularity threshold *p* on the moment arm: 1 um (in metres)."""
 
 
@@ -53,8 +62,11 @@ class MotionSpace:
     dof : int
         Degrees of freedom ``n`` of the platform.
     constant_basis : ndarray, shape (n, 6) or None
-        Orthonormal basis (rows, world coordinates) of the motion space when it was the
-        same at every sample (planar mechanisms, 6-DoF legs); ``None`` otherwise.
+        Orthonormal basis (rows) of the motion space when it was the same at every sample
+        (planar mechanisms, 6-DoF legs); ``None`` otherwise. In the working coordinates of each
+        configuration (twists about the centroid of the platform joints, ``(omega, v / L)``,
+        see :func:`analyze`): a constant space is the same space in those coordinates at
+        every configuration.
     """
 
     dof: int
@@ -69,38 +81,61 @@ class MotionSpace:
         return np.ascontiguousarray(right[self.dof:])
 
 
-def _chain_projector_complements(twists: NDArray[np.float64], tolerance: float) -> NDArray[np.float64]:
-    """Sum over chains of ``I - P_chain`` for twists given as a list of (K, m, 6) arrays."""
+def _chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: float) -> NDArray[np.float64]:
+    """Sum over chains of ``I - P_chain`` for twists given as a list of (K, m, 6) arrays.
+
+    Each joint twist is scaled to unit norm first (a column scaling: the same span), so that
+    the relative rank ``tolerance`` compares dimensionless singular values whatever the joint
+    types; twists are expected in working coordinates.
+    """
     total = np.zeros((twists[0].shape[0], 6, 6))
     for chain_twists in twists:
-        left, singular, _ = np.linalg.svd(np.swapaxes(chain_twists, -1, -2), full_matrices=False)
-        rank_mask = singular > tolerance * np.maximum(singular[..., :1], 1.0)
+        norms = np.linalg.norm(chain_twists, axis=-1, keepdims=True)
+        columns = chain_twists / np.where(norms > 0.0, norms, 1.0)
+        left, singular, _ = np.linalg.svd(np.swapaxes(columns, -1, -2), full_matrices=False)
+        rank_mask = singular > tolerance * singular[..., :1]
         basis = left * rank_mask[..., None, :]
         total += np.eye(6) - basis @ np.swapaxes(basis, -1, -2)
     return total
 
 
 def _null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float):
-    """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i)."""
+    """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i) (working coordinates)."""
     values, vectors = np.linalg.eigh(_chain_projector_complements(chain_twists, tolerance))
-    dims = np.sum(values <= 1e-8, axis=-1)
+    dims = np.sum(values <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)
     count = int(dims.max()) if dof is None else dof
     return dims, np.swapaxes(vectors[..., :count], -1, -2)
 
 
-def _centred(twists: list[NDArray], points: list[NDArray]):
-    """Express batch-first twists (N, m, 6) and points (N, m, 3) about the centroid of the platform joints.
+def _working_coordinates(twists: list[NDArray], points: list[NDArray]):
+    """Batch-first twists (N, m, 6) and points (N, m, 3) of every chain in working coordinates.
 
-    Every Euclidean norm and tolerance downstream is then invariant to a rigid motion of
-    the whole mechanism and to the choice of the world frame.
+    About the centroid ``c`` of the platform joints (the last joint of every chain) with lengths
+    in units of ``L``, the RMS distance of every joint point from ``c``: a twist becomes
+    ``(omega, (v + omega x c) / L)`` and a point ``(p - c) / L``. Every Euclidean norm and
+    tolerance downstream is then invariant to the length unit, the scale of the mechanism and
+    the world frame. The compiled kernel computes ``c`` and ``L`` by the same formulas
+    (a configuration whose joint points all coincide gets ``L = 1``).
+
+    Returns
+    -------
+    twists, points : lists of arrays as given, in working coordinates
+    centre : ndarray (N, 3)
+    length : ndarray (N,)
     """
     centre = np.mean([chain_points[:, -1] for chain_points in points], axis=0)  # (N, 3)
-    moved = [np.concatenate([t[..., :3], t[..., 3:] + np.cross(t[..., :3], centre[:, None])], axis=-1) for t in twists]
-    return moved, [p - centre[:, None] for p in points], centre
+    relative = [chain_points - centre[:, None] for chain_points in points]
+    joints = sum(chain_points.shape[1] for chain_points in points)
+    length = np.sqrt(sum(np.einsum("nmk,nmk->n", r, r) for r in relative) / joints)
+    length = np.where(length > 0.0, length, 1.0)
+    scale = 1.0 / length[:, None, None]
+    moved = [np.concatenate([t[..., :3], (t[..., 3:] + np.cross(t[..., :3], centre[:, None])) * scale], axis=-1)
+             for t in twists]
+    return moved, [r * scale for r in relative], centre, length
 
 
 def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples: int = 9,
-                 tolerance: float = 1e-9) -> MotionSpace:
+                 tolerance: float = tolerances.MOTION_SPACE_TOLERANCE) -> MotionSpace:
     r"""Find the platform's DOF and, if it is constant, its motion space.
 
     The motion space is the intersection of the chains' twist spaces,
@@ -108,7 +143,10 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     :math:`\sum_i (I - P_i)` with :math:`P_i` the orthogonal projector on the span of chain
     ``i``'s joint twists. It is evaluated on ``samples`` configurations spread over the
     batch; the DOF is the largest dimension found (a singular sample can only lose
-    mobility). Not a hot path: a few SVDs.
+    mobility). Every sample is in its working coordinates (about the centroid of its platform
+    joints, lengths in units of its characteristic length, as in :func:`analyze`), so that the
+    rank decisions do not depend on the length unit, the scale or the world frame. Not a hot
+    path: a few SVDs.
 
     Parameters
     ----------
@@ -118,7 +156,7 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     samples : int
         Number of configurations to sample.
     tolerance : float
-        Relative rank tolerance of the chains' twist systems.
+        Relative rank tolerance of the chains' twist systems (each twist scaled to unit norm).
 
     Returns
     -------
@@ -128,8 +166,9 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     flat_points = [chain.points.reshape((-1,) + chain.points.shape[-2:]) for chain in chains]
     count = flat[0].shape[0]
     index = np.unique(np.linspace(0, count - 1, min(count, samples)).round().astype(int))
-    centred, _, _ = _centred([twists[index] for twists in flat], [points[index] for points in flat_points])
-    dims, bases = _null_spaces(centred, dof, tolerance)
+    working, _, _, _ = _working_coordinates([twists[index] for twists in flat],
+                                            [points[index] for points in flat_points])
+    dims, bases = _null_spaces(working, dof, tolerance)
     found = int(dims.max()) if dof is None else dof
     if found == 0:
         raise ValueError("The platform has no mobility: the chains' twist spaces intersect only in zero.")
@@ -141,7 +180,7 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     candidate = np.ascontiguousarray(bases[generic[0]])
     for sample in generic[1:]:
         residual = bases[sample] - bases[sample] @ candidate.T @ candidate
-        if np.abs(residual).max() > 1e-8:
+        if np.abs(residual).max() > tolerances.CONSTANT_BASIS_TOLERANCE:
             return MotionSpace(found, None)
     return MotionSpace(found, candidate)
 
@@ -152,93 +191,6 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
 def fault_sets(actuator_count: int, dof: int, faults: int) -> tuple[tuple[int, ...], ...]:
     """The remaining-actuator sets ``E_i`` (Eq. 13) for ``faults`` failed actuators, in combination order."""
     return tuple(combinations(range(actuator_count), actuator_count - faults))
-
-
-@dataclass
-class TransmissionResult:
-    """Indices of a mechanism over a batch of configurations (leading shape ``batch_shape``).
-
-    Attributes
-    ----------
-    actuators : tuple of (int, int)
-        ``(chain index, joint index)`` of every actuator, in order; the set A.
-    actuator_names : tuple of str
-    dof : int
-        Degrees of freedom ``n``.
-    submechanisms : tuple of tuple of int
-        The non-redundant ``n``-subsets ``N_i`` of actuators (Eq. 10).
-    iti : ndarray (...)
-        Overall ITI (Eq. 7).
-    lmti : ndarray (...)
-        LMTI of the whole actuator set (Eq. 11).
-    f_o, f_io : dict of int -> ndarray (...)
-        ``F_Oj`` (Eq. 12) and ``F_IOj`` (Eq. 14) for every computed ``j``.
-    worst_faults : dict of int -> ndarray (..., j)
-        For each ``j``, the failed actuators of the worst case (the minimising ``E_i``'s complement).
-    mutual_interference : ndarray (..., a) of bool
-        Whether each actuator is a mutual-interference actuator (with all the others
-        locked, the platform is fully constrained). If one is not, every ``F_Oj`` is zero.
-    iti_actuators : ndarray (..., a) or None
-        ITI of every actuator (Eq. 6).
-    oti_actuators : ndarray (..., S, n) or None
-        ``OTI_k`` of each actuator of each submechanism (Eq. 8).
-    oti_submechanisms : ndarray (..., S) or None
-        OTI of every submechanism (Eq. 9).
-    actuation_wrenches : ndarray (..., a, 6) or None
-        Unit actuation wrenches (f, m), world frame.
-    output_twists : ndarray (..., S, n, 6) or None
-        Output twists (omega, v) of each actuator of each submechanism, scaled so that
-        ``|A_k o T_k| = |det(W_N)|`` (the adjugate columns, up to sign).
-    """
-
-    actuators: tuple[tuple[int, int], ...]
-    actuator_names: tuple[str, ...]
-    dof: int
-    submechanisms: tuple[tuple[int, ...], ...]
-    iti: NDArray[np.float64]
-    lmti: NDArray[np.float64]
-    f_o: dict[int, NDArray[np.float64]]
-    f_io: dict[int, NDArray[np.float64]]
-    worst_faults: dict[int, NDArray[np.int64]]
-    mutual_interference: NDArray[np.bool_]
-    iti_actuators: NDArray[np.float64] | None = None
-    oti_actuators: NDArray[np.float64] | None = None
-    oti_submechanisms: NDArray[np.float64] | None = None
-    actuation_wrenches: NDArray[np.float64] | None = None
-    output_twists: NDArray[np.float64] | None = None
-    threshold: float = DEFAULT_THRESHOLD
-    batch_shape: tuple[int, ...] = field(default=())
-
-    @property
-    def actuator_count(self) -> int:
-        """Number of actuators ``a``."""
-        return len(self.actuators)
-
-    def lmti_of(self, actuator_set: Sequence[int]) -> NDArray[np.float64]:
-        """LMTI of a set of actuators (Eq. 11): the best OTI of its ``n``-subsets.
-
-        Parameters
-        ----------
-        actuator_set : sequence of int
-            Indices into :attr:`actuators`, at least ``n`` of them.
-
-        Returns
-        -------
-        ndarray (...)
-        """
-        if self.oti_submechanisms is None:
-            raise ValueError("This result was computed with detail=False; recompute with detail=True.")
-        chosen = sorted(set(int(i) for i in actuator_set))
-        if any(not 0 <= i < self.actuator_count for i in chosen):
-            raise ValueError(f"Expected actuator indices in 0..{self.actuator_count - 1}, got {list(actuator_set)}.")
-        if len(chosen) < self.dof:
-            raise ValueError(f"Expected at least n = {self.dof} actuators in `actuator_set`, got {len(chosen)}.")
-        members = [s for s, sub in enumerate(self.submechanisms) if set(sub) <= set(chosen)]
-        return self.oti_submechanisms[..., members].max(axis=-1)
-
-    def not_mutual_interference(self) -> NDArray[np.bool_]:
-        """Mask (..., a) of actuators that are *not* mutual-interference actuators."""
-        return ~self.mutual_interference
 
 
 # ----------------------------------------------------------------------------------------
@@ -320,7 +272,8 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
-    from screwkit._kernels import transmission_kernel
+    """The compiled kernel on one chunk; ``basis`` in working coordinates (see :func:`_working_coordinates`)."""
+    from screwkit._kernels import transmission_kernel  # numba: loaded when indices first run
 
     count = twists.shape[0]
     kept = count if detail else 0
@@ -343,7 +296,9 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
                          for array in (basis, complement))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
                         complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
-                        plan.fault_table, plan.threshold, plan.rank_tolerance,
+                        plan.fault_table, plan.threshold, plan.rank_tolerance, tolerances.PURE_COUPLE,
+                        tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT,
+                        tolerances.PSEUDO_INVERSE_CONSISTENCY, tolerances.WORST_FAULT_TIE,
                         empty if iti_override is None else iti_override,
                         empty if oti_override is None else oti_override,
                         out["iti_actuators"], out["oti_actuators"], out["oti_submechanisms"], out["summary"],
@@ -362,12 +317,13 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     else:
         out, redo = None, np.arange(twists.shape[0])
     if redo.size:
-        # Configurations whose joint twists leave the constant space: their own motion space.
+        # Configurations whose joint twists leave the constant space: their own motion space, in
+        # the working coordinates the kernel uses (same centroid and characteristic length).
         starts = plan.chain_start
         chain_twists = [twists[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
         chain_points = [points[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        centred, _, _ = _centred(chain_twists, chain_points)
-        _, bases = _null_spaces(centred, plan.dof, 1e-9)
+        working, _, _, _ = _working_coordinates(chain_twists, chain_points)
+        _, bases = _null_spaces(working, plan.dof, tolerances.MOTION_SPACE_TOLERANCE)
         again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
                             None if iti_override is None else iti_override[redo],
                             None if oti_override is None else oti_override[redo], detail, keep_twists)
@@ -425,42 +381,60 @@ def analyze(
     dof: int | None = None,
     faults: int | Sequence[int] | None = None,
     threshold: float = DEFAULT_THRESHOLD,
-    rank_tolerance: float = 1e-9,
+    rank_tolerance: float = tolerances.RANK_TOLERANCE,
     iti_points: ArrayLike | None = None,
     oti_points: ArrayLike | None = None,
     detail: bool = True,
     keep_twists: bool = False,
     chunk_size: int = 65536,
     threads: int | None = None,
-) -> TransmissionResult:
+) -> Indices:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
+
+    **Working coordinates.** Each configuration is expressed about the centroid ``c`` of its
+    platform joints (the last joint of every chain) with lengths in units of its characteristic
+    length
+
+    .. math:: L = \sqrt{\tfrac{1}{J} \textstyle\sum_j \lVert p_j - c \rVert^2}
+
+    over all its ``J`` joint points: a twist :math:`(\omega, v)` becomes
+    :math:`(\omega, v_c / L)`, a wrench :math:`(f, m)` becomes :math:`(f, m_c / L)`, a point
+    :math:`(p - c) / L`. These coordinates are the same for a mechanism and for any scaled or
+    rigidly moved copy of it, so every tolerance below compares dimensionless numbers and no
+    decision depends on the length unit, the scale or the world frame; the singularity
+    threshold *p*, a length, is compared as :math:`p / L`. ``c`` and ``L`` belong to each
+    configuration: a batch gives what a loop over single configurations gives.
 
     **Actuation wrench** (Sec. 2): the wrench of chain ``i`` reciprocal to every other
     joint of the chain; it is defined modulo the chain's constraint wrenches. screwkit's
-    representative is the one *orthogonal to the constraint wrenches with moments taken
-    about the chain's platform-joint point* ``d`` — the minimum-norm solution of the
-    reciprocity conditions
+    representative is the one *orthogonal to the constraint wrenches in working coordinates,
+    with moments taken about the chain's platform-joint point* ``d`` — the minimum-norm
+    solution of the reciprocity conditions
 
     .. math:: w = \Delta J'_i (J_i'^T J'_i)^{-1} e_k
 
-    (:math:`J'_i` the chain's twists about ``d``, :math:`\Delta` the swap of the halves).
-    For a planar RRR/RPR chain it is the paper's force along the distal link through
-    :math:`d_i` (Eq. 21); it is invariant to a rigid motion of the whole mechanism and to
-    the world frame. For a chain with exactly ``n`` joints (which then spans the motion
-    space ``M``) the same wrench is computed as :math:`\Delta M' x`,
-    :math:`x \in \mathrm{null}(J'^T_{\text{passive}} M')`, which stays defined where the
-    chain itself is singular (ITI = 0). Wrenches are scaled to a unit force (a unit
-    moment for a pure couple) and signed so that they do positive work on their own joint.
+    (:math:`J'_i` the chain's twists about ``d`` in working coordinates, :math:`\Delta` the
+    swap of the halves), i.e. orthogonal in the metric :math:`|f|^2 + |m_d|^2 / L^2`. It is
+    covariant with the scale and invariant to a rigid motion of the whole mechanism and to the
+    world frame. Where a constraint wrench passes through ``d`` (planar RRR/RPR, RPS, PRS
+    chains) the metric does not matter; for a planar RRR/RPR chain it is the paper's force
+    along the distal link through :math:`d_i` (Eq. 21). For a chain with exactly ``n`` joints
+    (which then spans the motion space ``M``) the same wrench is computed as
+    :math:`\Delta M' x`, :math:`x \in \mathrm{null}(J'^T_{\text{passive}} M')`, which stays
+    defined where the chain itself is singular (ITI = 0). Wrenches are scaled to a unit force
+    (a unit moment for a pure couple: :math:`|f| \le` ``PURE_COUPLE`` :math:`|m_c| / L`) and
+    signed so that they do positive work on their own joint.
 
     **Characteristic points**: for the ITI the point of the first joint after the actuator,
     for the OTI the chain's platform-joint point, each projected on the wrench axis
     (overridable with ``iti_points`` / ``oti_points``, used as given).
 
     **Output twists** (Eq. 8): for a submechanism ``N`` with wrench matrix
-    :math:`W_N = [A_k \circ M_q]` in motion coordinates, the output twists are the
-    columns of :math:`\mathrm{adj}(W_N)` mapped by ``M``. Column ``k`` depends only on the
-    other ``n - 1`` (locked) actuators, so it is computed once per locked set and shared by
-    every submechanism containing it; :math:`|A_k \circ T_k| = |\det W_N|` for every ``k``
+    :math:`W_N = [A_k \circ M_q]` in motion coordinates (``M`` an orthonormal basis of the
+    motion space in working coordinates), the output twists are the columns of
+    :math:`\mathrm{adj}(W_N)` mapped by ``M``. Column ``k`` depends only on the other
+    ``n - 1`` (locked) actuators, so it is computed once per locked set and shared by every
+    submechanism containing it; :math:`|A_k \circ T_k| = |\det W_N|` for every ``k``
     (general form of Eq. A3), and
 
     .. math:: OTI_k = \frac{|\det W_N|}{\| v_k + \omega_k \times p_k + h_k \omega_k \|}
@@ -468,13 +442,21 @@ def analyze(
     with the zero cases of the paper: ``OTI_k = 0`` when the moment arm is at or below
     ``threshold`` (the paper's *p*), and every ``OTI_k`` of ``N`` is zero when its wrenches
     are dependent (:math:`|\det W_N|` at or below ``rank_tolerance`` times the product of
-    its row norms, with screws taken about the centroid of the platform joints so that the
-    test does not depend on the world frame). An actuator is a mutual-interference
-    actuator when some ``n`` of the other actuators have independent wrenches.
+    its row norms, in working coordinates). An actuator is a mutual-interference actuator
+    when some ``n`` of the other actuators have independent wrenches.
 
     Then ``OTI_N = min_k OTI_k`` (Eq. 9), ``LMTI_E = max_{N subset E} OTI_N`` (Eq. 11),
     ``F_Oj = min_{|E| = a - j} LMTI_E`` (Eqs. 12-13; for ``j = a - n`` this is the minimum
-    OTI), ``F_IOj = min(F_Oj, ITI)`` (Eq. 14).
+    OTI), ``F_IOj = min(F_Oj, ITI)`` (Eq. 14). The **worst fault** reported with ``F_Oj`` is
+    the complement of the first set ``E``, in combination order, whose LMTI is at most
+    ``F_Oj + WORST_FAULT_TIE`` (``1e-12``): numpy's argmin, except that sets whose LMTIs are
+    mathematically equal and differ by rounding count as equal, so the choice does not change
+    with the unit or the frame.
+
+    The dimensionless tolerances are named in :mod:`screwkit.tolerances` (``RANK_TOLERANCE``,
+    ``PURE_COUPLE``, ``MOTION_SPACE_TOLERANCE``, ``MOTION_SPACE_EIGENVALUE``,
+    ``CONSTANT_BASIS_TOLERANCE``, ``OUTSIDE_CONSTANT_SPACE``, ``GRAM_PIVOT``,
+    ``PSEUDO_INVERSE_CONSISTENCY``, ``WORST_FAULT_TIE``).
 
     Parameters
     ----------
@@ -485,13 +467,15 @@ def analyze(
     faults : int or sequence of int, optional
         Which ``j`` to compute ``F_Oj``/``F_IOj`` for; default ``1..a-n``.
     threshold : float
-        Singularity threshold on the moment arm, in the length unit of the screws (1e-6).
+        Singularity threshold *p* on the moment arm, in the length unit of the screws
+        (default 1e-6: 1 um in metres). The only input with a unit: scale it with the
+        mechanism.
     rank_tolerance : float
-        Relative tolerance for dependent actuation wrenches.
+        Relative tolerance for dependent actuation wrenches (dimensionless).
     iti_points, oti_points : array_like, shape (..., a, 3), optional
-        Characteristic points overriding the defaults.
+        Characteristic points overriding the defaults (world frame).
     detail : bool
-        Keep per-actuator and per-submechanism arrays (needed by :meth:`TransmissionResult.lmti_of`).
+        Keep per-actuator and per-submechanism arrays (needed by :meth:`Indices.lmti_of`).
     keep_twists : bool
         Also keep the output twists (memory: ``S * n * 6`` floats per configuration).
     chunk_size : int
@@ -501,7 +485,9 @@ def analyze(
 
     Returns
     -------
-    TransmissionResult
+    Indices
+        Actuators named ``chain:joint`` from the chains' names and joint names. Actuation
+        wrenches and output twists are in the world frame and the unit of the screws.
     """
     chains = list(chains)
     if not chains:
@@ -547,23 +533,21 @@ def analyze(
     def batch_first(array: NDArray) -> NDArray:
         return array.reshape(batch_shape + array.shape[1:])
 
-    names = tuple(f"{chains[c].name or f'chain{c + 1}'}:{k}" for c, k in plan.actuators)
-    return TransmissionResult(
-        actuators=plan.actuators,
-        actuator_names=names,
+    names = tuple(f"{chains[c].name or f'chain_{c + 1}'}:{chains[c].joint_names[k]}" for c, k in plan.actuators)
+    return Indices(
+        actuators=names,
         dof=plan.dof,
         submechanisms=tuple(tuple(int(i) for i in sub) for sub in plan.submechanisms),
         iti=batch_first(merged["iti"]),
         lmti=batch_first(merged["lmti"]),
         f_o={j: batch_first(merged[f"f_o{j}"]) for j in plan.faults},
         f_io={j: np.minimum(batch_first(merged[f"f_o{j}"]), batch_first(merged["iti"])) for j in plan.faults},
-        worst_faults={j: batch_first(merged[f"worst{j}"]) for j in plan.faults},
+        worst_fault_indices={j: batch_first(merged[f"worst{j}"]) for j in plan.faults},
         mutual_interference=batch_first(merged["mutual_interference"]),
+        threshold=plan.threshold,
         iti_actuators=batch_first(merged["iti_actuators"]) if detail else None,
         oti_actuators=batch_first(merged["oti_actuators"]) if detail else None,
         oti_submechanisms=batch_first(merged["oti_submechanisms"]) if detail else None,
         actuation_wrenches=batch_first(merged["actuation_wrenches"]) if detail else None,
         output_twists=batch_first(merged["output_twists"]) if detail and keep_twists else None,
-        threshold=plan.threshold,
-        batch_shape=batch_shape,
     )

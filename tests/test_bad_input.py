@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import random_planar_rrr
+from helpers import random_planar_rrr
 from screwkit.chains import ChainScrews
 from screwkit.planar import PlanarDesign, platform_points, rrr_chain_screws
 from screwkit.transmission import analyze
@@ -55,7 +55,7 @@ def test_faults_outside_range(chains, faults):
 
 def test_mismatched_batches(rng, chains):
     other = rrr_chain_screws(*random_planar_rrr(rng, 3, 1))
-    with pytest.raises(ValueError, match=r"share the batch shape \(4,\), chain 'chain1' has \(3,\)"):
+    with pytest.raises(ValueError, match=r"share the batch shape \(4,\), chain 'chain_1' has \(3,\)"):
         analyze(chains[:4] + other)
 
 
@@ -83,7 +83,7 @@ def test_lmti_of_checks_its_set(chains):
     result = analyze(chains)
     with pytest.raises(ValueError, match=r"at least n = 3 actuators in `actuator_set`, got 2"):
         result.lmti_of([0, 1])
-    with pytest.raises(ValueError, match=r"actuator indices in 0\.\.4, got \[0, 1, 9\]"):
+    with pytest.raises(ValueError, match=r"Expected an actuator index in 0\.\.4, got 9"):
         result.lmti_of([0, 1, 9])
 
 

@@ -1,4 +1,4 @@
-"""The command line and the URDF path end to end: the paper's numbers, frames, bad input."""
+"""The command line as users run it (a subprocess each): the paper's numbers, outputs, errors, conventions."""
 
 from __future__ import annotations
 
@@ -6,45 +6,59 @@ import json
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
-from screwkit.cli import app
-from screwkit.mechanism import load
+from helpers import screwkit
+from screwkit.closure import chain_screws, solve
+from screwkit.loader import load
 from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
 from screwkit.transmission import analyze
 
 
-def run(*arguments):
-    result = CliRunner().invoke(app, list(arguments), catch_exceptions=False)
-    return result
-
-
 def test_analyze_reproduces_the_paper_through_the_urdf():
-    result = run("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45")
-    assert result.exit_code == 0, result.output
-    assert "ITI  (Eq. 7)                        0.6973" in result.output
-    assert "LMTI (Eq. 11, all actuators)        0.9814" in result.output
-    assert "F_O1 (Eq. 12) 0.6793   F_IO1 (Eq. 14) 0.6793" in result.output
+    result = screwkit("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45")
+    assert result.returncode == 0, result.stderr
+    assert "ITI  (Eq. 7)                        0.6973" in result.stdout
+    assert "LMTI (Eq. 11, all actuators)        0.9814" in result.stdout
+    assert "F_O1 (Eq. 12) 0.6793   F_IO1 (Eq. 14) 0.6793" in result.stdout
+    assert result.stderr == ""
 
 
-def test_analyze_json():
-    result = run("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45", "--json")
-    assert result.exit_code == 0, result.output
-    report = json.loads(result.output)
-    assert round(report["iti"], 4) == 0.6973
-    assert round(report["lmti"], 4) == 0.9814
+def test_analyze_json_and_named_poses():
+    by_name = screwkit("analyze", "planar_5rrr", "--pose", "paper_fig_2a", "--json")
+    by_values = screwkit("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45", "--json")
+    assert by_name.returncode == by_values.returncode == 0, by_name.stderr + by_values.stderr
+    report = json.loads(by_name.stdout)
+    assert report == json.loads(by_values.stdout)
+    assert report["pose"] == {"x": -0.2, "y": 0.0, "phi": 45.0}
+    assert round(report["iti"], 4) == 0.6973 and round(report["lmti"], 4) == 0.9814
     assert set(report["f_o"]) == set(report["f_io"]) == {"1", "2"}
     assert round(report["f_o"]["1"], 4) == round(report["f_io"]["1"], 4) == 0.6793
-    assert report["not_mutual_interference"] == []
+    assert report["worst_faults"]["1"] == ["chain_2:chain_2_joint_b"]
+    assert report["actuators"][0] == "chain_1:chain_1_joint_b" and report["not_mutual_interference"] == []
+    four = json.loads(screwkit("analyze", "planar_4rpr", "--pose", "three_lines_concurrent", "--json").stdout)
+    assert four["not_mutual_interference"] == ["leg_4:leg_4_joint_slider"] and four["f_o"]["1"] < 1e-9
+
+
+def test_info_lists_task_coordinates_solvers_and_named_poses():
+    result = screwkit("info", "planar_4rpr", "--json")
+    assert result.returncode == 0, result.stderr
+    info = json.loads(result.stdout)
+    assert info["dof"] == 3
+    assert info["task_coordinates"] == [{"name": "x", "unit": "m"}, {"name": "y", "unit": "m"},
+                                        {"name": "phi", "unit": "deg"}]
+    assert {chain["solver"] for chain in info["chains"]} == {"planar_rpr"}
+    assert info["named_poses"]["three_lines_concurrent"]["phi"] == pytest.approx(np.rad2deg(0.4))
+    text = screwkit("info", "coop_arms")
+    assert text.returncode == 0 and "solver newton: damped Newton: not ups (" in text.stdout
 
 
 def test_urdf_path_equals_hand_built_screws(rng):
     mechanism = load("planar_5rrr")
     poses = np.column_stack([rng.uniform(-0.4, 0.4, 3000), rng.uniform(-0.4, 0.4, 3000), rng.uniform(-np.pi, np.pi, 3000)])
-    solution = mechanism.solve(poses)
+    solution = solve(mechanism, poses)
     ok = np.asarray(solution.reachable)
     assert ok.mean() > 0.5
-    from_urdf = analyze(mechanism.chain_screws(solution, unreachable="drop"))
+    from_urdf = analyze(chain_screws(mechanism, solution, unreachable="drop"))
     base, elbows, distal, reachable = planar_joint_points(paper_5rrr(), poses[ok])
     assert reachable.all()
     by_hand = analyze(rrr_chain_screws(base, elbows, distal))
@@ -52,12 +66,12 @@ def test_urdf_path_equals_hand_built_screws(rng):
     np.testing.assert_allclose(from_urdf.oti_submechanisms, by_hand.oti_submechanisms, atol=1e-9)
     for j in by_hand.f_o:
         np.testing.assert_allclose(from_urdf.f_o[j], by_hand.f_o[j], atol=1e-9)
+        np.testing.assert_array_equal(from_urdf.worst_fault_indices[j], by_hand.worst_fault_indices[j])
 
 
 def placed_copy(tmp_path, rpy, xyz):
     """The bundled 5-RRR hung below a new world link by a fixed joint with the given origin."""
     text = load("planar_5rrr").description.text
-    text = text if isinstance(text, str) else text.decode()
     head, tail = text.split("<link name=\"base_link\">", 1)
     extra = (f'<link name="world" />\n  <joint name="world_to_base" type="fixed">\n    <parent link="world" />\n'
              f'    <child link="base_link" />\n    <origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}" />\n'
@@ -71,68 +85,85 @@ def test_mechanism_placed_and_tilted_in_space_gives_the_same_indices(tmp_path, r
     reference = load("planar_5rrr")
     moved = load(placed_copy(tmp_path, (0.4, -0.7, 1.1), (3.0, -2.0, 5.0)))
     poses = np.column_stack([rng.uniform(-0.3, 0.3, 500), rng.uniform(-0.3, 0.3, 500), rng.uniform(-np.pi, np.pi, 500)])
-    first = analyze(reference.chain_screws(reference.solve(poses), unreachable="drop"))
-    second_screws = moved.chain_screws(moved.solve(poses), unreachable="drop")
+    first = analyze(chain_screws(reference, solve(reference, poses), unreachable="drop"))
+    second_screws = chain_screws(moved, solve(moved, poses), unreachable="drop")
     assert np.abs(second_screws[0].twists[..., 2]).max() < 0.99  # the joint axes really are tilted
     second = analyze(second_screws)
     np.testing.assert_allclose(first.iti_actuators, second.iti_actuators, atol=1e-9)
     np.testing.assert_allclose(first.oti_submechanisms, second.oti_submechanisms, atol=1e-9)
     np.testing.assert_allclose(first.f_o[1], second.f_o[1], atol=1e-9)
-    result = run("analyze", str(tmp_path / "tilted_5rrr.urdf"), "--pose", "-0.2", "0", "45", "--json")
-    assert round(json.loads(result.output)["f_o"]["1"], 4) == 0.6793
+    result = screwkit("analyze", tmp_path / "tilted_5rrr.urdf", "--pose", "-0.2", "0", "45", "--json")
+    assert round(json.loads(result.stdout)["f_o"]["1"], 4) == 0.6793
 
 
 @pytest.mark.parametrize("arguments, message", [
     (("analyze", "planar_9rrr"), "Unknown bundled mechanism 'planar_9rrr'; bundled are: coop_arms, planar_4rpr"),
-    (("analyze", "planar_5rrr", "--pose", "0", "0"), "Expected --pose with 3 values (x, y, phi) for mechanism 'planar_5rrr', got 2"),
+    (("analyze", "planar_5rrr", "--pose", "0", "0"),
+     "Expected --pose with 3 values (x (m), y (m), phi (deg)) or a named pose (home, paper_fig_2a)"),
     (("analyze", "planar_5rrr", "--pose", "0", "nan", "0"), "Expected finite values in `poses`, got nan"),
-    (("analyze", "planar_5rrr", "--pose", "0", "x", "0"), "Expected numbers after --pose, got 0 x 0"),
-    (("analyze", "planar_5rrr", "--pose", "5", "0", "0"), "is unreachable for mechanism 'planar_5rrr': chain 'chain_1' misses closure by"),
-    (("sweep", "planar_5rrr", "--phi", "0:360"), "Expected `--phi` as START:STOP:STEP"),
+    (("analyze", "planar_5rrr", "--pose", "0", "x", "0"), "Expected numbers or a named pose after --pose, got '0 x 0'"),
+    (("analyze", "planar_5rrr", "--pose", "paper_fig_9"), "Unknown pose 'paper_fig_9' of mechanism 'planar_5rrr'"),
+    (("analyze", "planar_5rrr", "--pose", "5", "0", "0"),  # the chain that misses the most first
+     "is unreachable for mechanism 'planar_5rrr': chain 'chain_3' misses closure by 3.86066 m; chain 'chain_4'"),
+    (("sweep", "planar_5rrr", "--phi", "0:360"), "Expected --phi as START:STOP:STEP"),
     (("map", "planar_5rrr", "--radius", "0.3"), "A planar map takes --radius and --step"),
+    (("map", "planar_5rrr", "--radius", "0.3", "--step", "0.1", "--phi-step", "400"), "Expected 0 < --phi-step <= 360"),
 ])
 def test_bad_input_is_one_line(arguments, message):
-    result = run(*arguments)
-    assert result.exit_code == 1
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
+    result = screwkit(*arguments)
+    assert result.returncode == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
     assert message in lines[0], lines[0]
+    assert result.stdout == ""
+
+
+def test_with_json_errors_are_json_on_stdout():
+    result = screwkit("analyze", "planar_5rrr", "--pose", "5", "0", "0", "--json")
+    assert result.returncode == 1 and result.stderr == ""
+    assert "is unreachable" in json.loads(result.stdout)["error"]
+    missing = screwkit("info", "no/such/file.urdf", "--json")
+    assert missing.returncode == 1 and json.loads(missing.stdout) == {
+        "error": "no/such/file.urdf: no such URDF file (bundled mechanisms are: coop_arms, planar_4rpr, planar_5rrr, "
+                 "rss_hexapod_8, ups_hexapod_8)."}
 
 
 def test_verify_compares_with_the_closed_forms():
-    result = run("verify", "planar_5rrr", "--samples", "500")
-    assert result.exit_code == 0, result.output
-    deviation = float(result.output.strip().splitlines()[-1].split()[-1])
-    assert deviation < 1e-9
-    assert run("verify", "planar_4rpr", "--samples", "300").exit_code == 0
+    result = screwkit("verify", "planar_5rrr", "--samples", "500", "--json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["poses"] == 500 and report["largest_deviation"] < 1e-9
+    assert set(report["differing_poses"].values()) == {0}  # worst faults and mutual interference agree too
+    assert screwkit("verify", "planar_4rpr", "--samples", "300").returncode == 0
 
 
 def test_list_names_the_bundled_robots():
-    result = run("list")
-    assert result.output.split() == ["coop_arms", "planar_4rpr", "planar_5rrr", "rss_hexapod_8", "ups_hexapod_8"]
+    result = screwkit("list")
+    assert result.stdout.split() == ["coop_arms", "planar_4rpr", "planar_5rrr", "rss_hexapod_8", "ups_hexapod_8"]
 
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):
     """main() ends the process without the interpreter's teardown: nothing may be lost."""
-    import subprocess
-    import sys
-
     import xarray as xr
 
-    def command(*arguments):
-        return subprocess.run([sys.executable, "-m", "screwkit.cli", *arguments], capture_output=True, text=True,
-                              timeout=300)
-
-    listed = command("list")
-    assert listed.returncode == 0 and "planar_5rrr" in listed.stdout and "ups_hexapod_8" in listed.stdout
-    analysed = command("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45", "--json")
+    analysed = screwkit("analyze", "planar_5rrr", "--pose", "-0.2", "0", "45", "--json")
     assert analysed.returncode == 0, analysed.stderr
     assert json.loads(analysed.stdout)["f_o"]["1"] == pytest.approx(0.6793, abs=5e-5)  # the whole JSON arrived
-    wrong = command("analyze", "no_such_robot")
+    wrong = screwkit("analyze", "no_such_robot")
     assert wrong.returncode == 1 and "Unknown bundled mechanism 'no_such_robot'" in wrong.stderr
     path = tmp_path / "map.nc"
-    mapped = command("map", "planar_5rrr", "--radius", "0.1", "--step", "0.05", "--phi-step", "60", "--out", str(path))
+    mapped = screwkit("map", "planar_5rrr", "--radius", "0.1", "--step", "0.05", "--phi-step", "60", "--out", path)
     assert mapped.returncode == 0, mapped.stderr
-    assert f"wrote {path}" in mapped.stderr
+    assert f"wrote {path}" in mapped.stderr and mapped.stdout == ""
     with xr.open_dataset(path) as dataset:
         assert np.isfinite(dataset["f_o1"].values).sum() == 13  # the disc of radius 0.1 m at 0.05 m steps
+
+
+def test_data_go_to_stdout_and_summaries_to_stderr():
+    swept = screwkit("sweep", "planar_5rrr", "--phi", "0:360:30")
+    assert swept.returncode == 0, swept.stderr
+    header, *rows = swept.stdout.strip().splitlines()
+    assert header.startswith("phi,") and len(rows) == 12  # the data, as CSV
+    assert "min f_o1" in swept.stderr
+    quiet = screwkit("sweep", "planar_5rrr", "--phi", "0:360:30", "--quiet")
+    assert quiet.stdout == swept.stdout and quiet.stderr == ""

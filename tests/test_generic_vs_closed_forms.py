@@ -7,7 +7,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from conftest import random_planar_rrr, special_planar_rrr
+from helpers import random_planar_rrr, special_planar_rrr
 from screwkit import closed_forms as cf
 from screwkit.planar import rpr_chain_screws, rrr_chain_screws
 from screwkit.transmission import analyze
@@ -169,7 +169,7 @@ def test_fault_sets_follow_eq_12(rng):
     for j in range(1, a - n + 1):
         lmtis = [result.lmti_of(remaining) for remaining in combinations(range(a), a - j)]
         np.testing.assert_array_equal(result.f_o[j], np.min(lmtis, axis=0))
-        worst = result.worst_faults[j]
+        worst = result.worst_fault_indices[j]
         for index in range(0, 500, 97):
             remaining = sorted(set(range(a)) - set(worst[index]))
             assert result.lmti_of(remaining)[index] == result.f_o[j][index]

@@ -5,27 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import random_planar_rrr
+from helpers import moved, random_planar_rrr, random_rotation
 from screwkit.chains import ChainScrews
 from screwkit.planar import rrr_chain_screws
 from screwkit.screws import transform_twist
 from screwkit.transmission import analyze
-
-
-def random_rotation(rng):
-    q = rng.normal(size=4)
-    q /= np.linalg.norm(q)
-    w, x, y, z = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def moved(chains, rotation, translation):
-    return [ChainScrews(transform_twist(rotation, translation, c.twists), c.points @ rotation.T + translation,
-                        c.actuated, c.name) for c in chains]
 
 
 def compare(first, second, tolerance=1e-9):
@@ -58,7 +42,7 @@ def test_batched_equals_loop_over_single_configurations(rng):
     batched = analyze(rrr_chain_screws(base, elbows, distal), chunk_size=7)
     for index in range(40):
         single = analyze(rrr_chain_screws(base[index], elbows[index], distal[index]))
-        assert single.iti.shape == ()
+        assert isinstance(single.iti, float) and single.batch_shape == ()  # one configuration: plain floats
         assert single.iti == pytest.approx(batched.iti[index], abs=1e-12)
         assert single.lmti == pytest.approx(batched.lmti[index], abs=1e-12)
         np.testing.assert_allclose(single.oti_submechanisms, batched.oti_submechanisms[index], atol=1e-12)

@@ -33,3 +33,30 @@ def test_null_vector_is_the_cofactor_vector():
             np.testing.assert_allclose(rows @ out, 0.0, atol=1e-12 * scale * np.abs(rows).max())
             if case % 4 == 2 and size > 2:
                 assert np.all(out == 0.0) or np.abs(out).max() <= 1e-12 * scale
+
+
+def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
+    """_solve on Gram matrices of unit columns (as the kernel builds them): numpy's solution when
+    regular, False when a pivot is at or below the tolerance it is given (GRAM_PIVOT)."""
+    from screwkit._kernels import _solve
+    from screwkit.tolerances import GRAM_PIVOT
+
+    rng = np.random.default_rng(8)
+    out, work = np.empty(8), np.empty((8, 8))
+    for size in range(1, 8):
+        columns = rng.standard_normal((6, size))  # seven columns in six dimensions: singular
+        columns /= np.linalg.norm(columns, axis=0)
+        gram = np.ascontiguousarray(columns.T @ columns)
+        rhs = rng.standard_normal(size)
+        regular = _solve(gram, size, rhs, out, work, GRAM_PIVOT)
+        assert regular == (size <= 6)
+        if regular:
+            np.testing.assert_allclose(out[:size], np.linalg.solve(gram, rhs), rtol=1e-9, atol=1e-9)
+    # Two columns 1e-5 apart: the last pivot is about 1e-10 of the diagonal.
+    first = rng.standard_normal(6)
+    first /= np.linalg.norm(first)
+    second = first + 1e-5 * rng.standard_normal(6)
+    second /= np.linalg.norm(second)
+    gram = np.ascontiguousarray(np.array([first, second]) @ np.array([first, second]).T)
+    assert _solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-12)
+    assert not _solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-8)

@@ -8,17 +8,29 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from screwkit.kinematics import (
+from screwkit.closure import (
+    actuator_values,
+    chain_screws,
+    closure_residuals,
+    forward,
+    joint_screws,
+    solve,
+    solve_one,
+    thread_limit,
+)
+from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian, twists_from_axes_and_points
+from screwkit.loader import bundled_names, load, load_text
+from screwkit.model.pinocchio_bridge import configuration_vector, twist_from_pinocchio_motion
+from screwkit.model.urdf_writer import UrdfWriter
+from screwkit.rotations import (
     rotation_about_axis,
     rotation_from_rotation_vector,
     rotation_from_rpy,
     rotation_vector_from_rotation,
     rpy_from_rotation,
-    twists_from_axes_and_points,
     two_axis_pointing,
     wrap_angle,
 )
-from screwkit.mechanism import bundled_names, load, twist_from_pinocchio_motion
 
 CLOSED_FORM_CASES = {
     # mechanism: (scale of the random pose offsets around home, expected solver kind)
@@ -40,13 +52,11 @@ LOOP_KINDS = (("universal", 4), ("prismatic", 5), ("spherical", 3), ("revolute",
 
 def random_loops_mechanism():
     """The first seeded :func:`random_legs_mechanism` whose legs are all well conditioned at home."""
-    from screwkit.kinematics import chain_forward_kinematics, chain_jacobian
-
     for seed in range(30, 200):
         candidate = random_legs_mechanism(seed)
         smallest = min(
             np.linalg.svd(chain_jacobian(geometry, chain_forward_kinematics(geometry, values)), compute_uv=False)[-1]
-            for geometry, values in zip(candidate.geometries, candidate.reference_joint_values)
+            for geometry, values in zip(candidate.geometries, (c.reference_values for c in candidate.chains))
         )
         if smallest > 0.04:
             return candidate
@@ -61,11 +71,6 @@ def random_legs_mechanism(seed: int):
     joint values zero and the platform at its joint origin, so every loop closes there.
     """
     import pinocchio
-
-    from screwkit.kinematics import rpy_from_rotation
-    from screwkit.mechanism import Mechanism
-    from screwkit.robots.generate import UrdfWriter
-    from screwkit.urdf import parse_urdf
 
     def build(successor_origins=None) -> str:
         rng = np.random.default_rng(seed)
@@ -85,6 +90,8 @@ def random_legs_mechanism(seed: int):
                              axis=axis / np.linalg.norm(axis), limit=(-3.0, 3.0, 1.0, 1.0))  # fmt: skip
                 parent = child
             writer.transmission(f"leg_{leg}_joint_1")
+            if leg == 0:  # six actuators for the six DOF (the loader refuses fewer)
+                writer.transmission(f"leg_{leg}_joint_2")
             frame = (rng.uniform(-0.2, 0.2, 3), rng.uniform(-1, 1, 3))
             axis, second = rng.normal(size=3), rng.normal(size=3)
             if successor_origins is None:  # the tree only: mark the loop frame to place it
@@ -106,7 +113,7 @@ def random_legs_mechanism(seed: int):
     for leg in range(len(LOOP_KINDS)):
         relative = platform.inverse() * data.oMf[tree.getFrameId(f"leg_{leg}_loop_frame")]
         origins.append((relative.translation, rpy_from_rotation(relative.rotation)))
-    return Mechanism(parse_urdf(build(origins), "random_loops.urdf"))
+    return load_text(build(origins), "random_loops.urdf")
 
 
 def random_poses(mechanism_, scale, count, seed):
@@ -198,7 +205,7 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
     import pinocchio
 
     mechanism_ = mechanism(name)
-    model = mechanism_.model
+    model = mechanism_.pinocchio_model
     data = model.createData()
     rng = np.random.default_rng(5)
     count = 6
@@ -206,21 +213,21 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
         np.where(chain.prismatic, rng.uniform(-0.3, 0.3, (count, chain.n_joints)), rng.uniform(-np.pi, np.pi, (count, chain.n_joints)))
         for chain in mechanism_.chains
     ]
-    screws = mechanism_.joint_screws(joint_values)
-    configuration = mechanism_.configuration_vector(joint_values)
+    screws = joint_screws(mechanism_, joint_values)
+    configuration = configuration_vector(mechanism_, joint_values)
     description = mechanism_.description
     loops = {loop.name: loop for loop in description.loops}
     for sample in range(count):
         pinocchio.computeJointJacobians(model, data, configuration[sample])
         pinocchio.updateFramePlacements(model, data)
-        for chain, chain_screws in zip(mechanism_.chains, screws):
+        for chain, screws_of_chain in zip(mechanism_.chains, screws):
             for index, joint_name in enumerate(chain.joint_names):
                 if not model.existJointName(joint_name):
                     continue
                 joint_id = model.getJointId(joint_name)
                 column = pinocchio.getJointJacobian(model, data, joint_id, pinocchio.WORLD)[:, model.joints[joint_id].idx_v]
-                np.testing.assert_allclose(chain_screws.twists[sample, index], twist_from_pinocchio_motion(column), atol=1e-12)
-                np.testing.assert_allclose(chain_screws.points[sample, index], data.oMi[joint_id].translation, atol=1e-12)
+                np.testing.assert_allclose(screws_of_chain.twists[sample, index], twist_from_pinocchio_motion(column), atol=1e-12)
+                np.testing.assert_allclose(screws_of_chain.points[sample, index], data.oMi[joint_id].translation, atol=1e-12)
             loop = loops[chain.loop_name]
             leg_frame = data.oMf[model.getFrameId(loop.predecessor, pinocchio.BODY)]
             leg_rotation = leg_frame.rotation @ loop.predecessor_origin.rotation
@@ -228,12 +235,12 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
             loop_values = joint_values[mechanism_.chains.index(chain)][sample, len(chain.joint_names) - len(_loop_names(chain)) :]
             for offset, (axis, point) in enumerate(_expected_loop_screws(loop, leg_rotation, leg_point, loop_values)):
                 index = len(chain.joint_names) - len(_loop_names(chain)) + offset
-                twist = chain_screws.twists[sample, index]
+                twist = screws_of_chain.twists[sample, index]
                 if loop.type == "prismatic":
                     np.testing.assert_allclose(twist, np.concatenate([np.zeros(3), axis]), atol=1e-12)
                 else:
                     np.testing.assert_allclose(twist, np.concatenate([axis, np.cross(point, axis)]), atol=1e-12)
-                np.testing.assert_allclose(chain_screws.points[sample, index], point, atol=1e-12)
+                np.testing.assert_allclose(screws_of_chain.points[sample, index], point, atol=1e-12)
 
 
 def _expected_loop_screws(loop, leg_rotation, leg_point, values):
@@ -272,12 +279,12 @@ def test_solved_loops_close_in_pinocchio_forward_kinematics(name):
     mechanism_ = mechanism(name)
     scales = {"coop_arms": (0.03,) * 3 + (0.1,) * 3, "random_loops": (0.003,) * 3 + (0.01,) * 3}
     scale = scales[name] if name in scales else CLOSED_FORM_CASES[name][0]
-    solution = mechanism_.solve(random_poses(mechanism_, scale, 8, seed=6))
+    solution = solve(mechanism_, random_poses(mechanism_, scale, 8, seed=6))
     assert solution.reachable.sum() >= 4
     if name == "random_loops":
         assert mechanism_.dof == 6 and {chain.loop_type for chain in mechanism_.chains} == {kind for kind, _ in LOOP_KINDS}
-    configuration = mechanism_.configuration_vector(solution.joint_values, solution.poses)
-    model, data = mechanism_.model, mechanism_.model.createData()
+    configuration = configuration_vector(mechanism_, solution.joint_values, solution.poses)
+    model, data = mechanism_.pinocchio_model, mechanism_.pinocchio_model.createData()
     loops = {loop.name: loop for loop in mechanism_.description.loops}
     for sample in np.flatnonzero(solution.reachable):
         pinocchio.forwardKinematics(model, data, configuration[sample])
@@ -311,37 +318,37 @@ def test_closed_forms_equal_the_newton_solver(name):
     mechanism_ = mechanism(name)
     assert {chain.solver for chain in mechanism_.chains} == {kind}
     poses = random_poses(mechanism_, scale, 150, seed=7)
-    closed = mechanism_.solve(poses)
-    newton = mechanism_.solve(poses, method="newton")
+    closed = solve(mechanism_, poses)
+    newton = solve(mechanism_, poses, method="newton")
     assert closed.reachable.sum() >= 60
     np.testing.assert_array_equal(closed.chain_reachable, newton.chain_reachable)
     for chain, first, second in zip(mechanism_.chains, closed.joint_values, newton.joint_values):
         reachable = np.all(np.isfinite(first), axis=-1)
         assert np.all(np.isnan(first[~reachable])) and np.all(np.isnan(second[~reachable]))
         np.testing.assert_allclose(angular_difference(first[reachable], second[reachable], chain.prismatic), 0.0, atol=1e-9)
-    residuals = mechanism_.closure_residuals(closed)
+    residuals = closure_residuals(mechanism_, closed)
     assert np.nanmax(residuals) < 1e-12
-    assert np.nanmax(mechanism_.closure_residuals(newton)) < 1e-10
-    for first, second in zip(mechanism_.chain_screws(closed, unreachable="drop"), mechanism_.chain_screws(newton, unreachable="drop")):
+    assert np.nanmax(closure_residuals(mechanism_, newton)) < 1e-10
+    for first, second in zip(chain_screws(mechanism_, closed, unreachable="drop"), chain_screws(mechanism_, newton, unreachable="drop")):
         np.testing.assert_allclose(first.twists, second.twists, atol=1e-9)
 
 
 def test_newton_closes_the_cooperative_arms():
     mechanism_ = mechanism("coop_arms")
     poses = random_poses(mechanism_, (0.05, 0.05, 0.05, 0.3, 0.3, 0.3), 40, seed=8)
-    solution = mechanism_.solve(poses)
+    solution = solve(mechanism_, poses)
     assert solution.reachable.all()
-    assert np.max(mechanism_.closure_residuals(solution)) < 1e-10
+    assert np.max(closure_residuals(mechanism_, solution)) < 1e-10
     assert all(chain.solver == "newton" for chain in mechanism_.chains)
 
 
 @pytest.mark.parametrize("name", sorted(CLOSED_FORM_CASES))
 def test_screws_of_a_solution_equal_forward_kinematics_of_its_joint_values(name):
     mechanism_ = mechanism(name)
-    solution = mechanism_.solve(random_poses(mechanism_, CLOSED_FORM_CASES[name][0], 50, seed=9))
+    solution = solve(mechanism_, random_poses(mechanism_, CLOSED_FORM_CASES[name][0], 50, seed=9))
     mask = solution.reachable
-    from_solution = mechanism_.chain_screws(solution, unreachable="drop")
-    from_values = mechanism_.joint_screws([values[mask] for values in solution.joint_values])
+    from_solution = chain_screws(mechanism_, solution, unreachable="drop")
+    from_values = joint_screws(mechanism_, [values[mask] for values in solution.joint_values])
     for first, second in zip(from_solution, from_values):
         np.testing.assert_allclose(first.twists, second.twists, atol=1e-12)
         np.testing.assert_allclose(first.points, second.points, atol=1e-12)
@@ -351,13 +358,13 @@ def test_screws_of_a_solution_equal_forward_kinematics_of_its_joint_values(name)
 def test_batched_solve_equals_a_loop_over_single_poses():
     mechanism_ = mechanism("planar_5rrr")
     poses = random_poses(mechanism_, (0.3, 0.3, 1.0), 12, seed=10).reshape(3, 4, 3)
-    batched = mechanism_.solve(poses)
+    batched = solve(mechanism_, poses)
     assert batched.reachable.shape == (3, 4) and batched.chain_reachable.shape == (3, 4, 5)
     for index in np.ndindex(3, 4):
-        single = mechanism_.solve_one(poses[index])
+        single = solve_one(mechanism_, poses[index])
         for first, second in zip(batched.joint_values, single.joint_values):
             np.testing.assert_allclose(first[index], second, atol=1e-14)
-    screws = mechanism_.chain_screws(batched)
+    screws = chain_screws(mechanism_, batched)
     assert screws[0].twists.shape == (3, 4, 3, 6) and screws[0].points.shape == (3, 4, 3, 3)
 
 
@@ -375,34 +382,34 @@ def _elbow_sides(solution):
 def test_five_rrr_working_mode_is_kept_and_explicit_branches_switch_it():
     mechanism_ = mechanism("planar_5rrr")
     poses = random_poses(mechanism_, (0.5, 0.5, np.pi), 400, seed=11)
-    solution = mechanism_.solve(poses)
+    solution = solve(mechanism_, poses)
     reachable = solution.reachable
     assert reachable.sum() > 100
     assert np.all(_elbow_sides(solution)[reachable] > 0)
-    newton = mechanism_.solve(poses[reachable][:60], method="newton")
+    newton = solve(mechanism_, poses[reachable][:60], method="newton")
     assert np.all(_elbow_sides(newton)[newton.reachable] > 0) and newton.reachable.sum() >= 50
-    mirrored = mechanism_.solve(poses, branches=[(-1,)] * 5)
+    mirrored = solve(mechanism_, poses, branches=[(-1,)] * 5)
     np.testing.assert_array_equal(mirrored.reachable, reachable)
     assert np.all(_elbow_sides(mirrored)[reachable] < 0)
-    assert mechanism_.branches == ((1,),) * 5
+    assert tuple(chain.branch for chain in mechanism_.chains) == ((1,),) * 5
 
 
 def test_unreachable_poses_are_nan_and_strict_solving_names_the_chain():
     mechanism_ = mechanism("planar_5rrr")
-    solution = mechanism_.solve([[0.0, 0.0, 0.0], [1.9, 0.0, 0.0]])
+    solution = solve(mechanism_, [[0.0, 0.0, 0.0], [1.9, 0.0, 0.0]])
     np.testing.assert_array_equal(solution.reachable, [True, False])
     assert np.all(np.isnan(solution.joint_values[2][1])) and np.all(np.isfinite(solution.joint_values[0][1]))
-    with pytest.raises(ValueError, match=r"Pose \(x=1\.9, y=0, phi=0\) is unreachable .* chain 'chain_3' misses closure by 0\.78"):
-        mechanism_.solve_one([1.9, 0.0, 0.0])
+    with pytest.raises(ValueError, match=r"Pose \(x=1\.9, y=0, phi=0 deg\) is unreachable .* chain 'chain_3' misses closure by 0\.78"):
+        solve_one(mechanism_, [1.9, 0.0, 0.0])
     with pytest.raises(ValueError, match="1 of 2 configurations are unreachable"):
-        mechanism_.chain_screws(solution)
-    dropped = mechanism_.chain_screws(solution, unreachable="drop")
+        chain_screws(mechanism_, solution)
+    dropped = chain_screws(mechanism_, solution, unreachable="drop")
     assert dropped[0].twists.shape == (1, 3, 6)
-    filled = mechanism_.chain_screws(solution, unreachable="reference")
+    filled = chain_screws(mechanism_, solution, unreachable="reference")
     np.testing.assert_allclose(filled[2].twists[1], filled[2].twists[0], atol=1e-12)  # reference = home here
     newton = mechanism("coop_arms")
     with pytest.raises(ValueError, match="chain 'left_arm' misses closure"):
-        newton.solve_one(newton.home_pose + [2.0, 0, 0, 0, 0, 0])
+        solve_one(newton, newton.home_pose + [2.0, 0, 0, 0, 0, 0])
 
 
 @pytest.mark.parametrize(
@@ -415,18 +422,18 @@ def test_unreachable_poses_are_nan_and_strict_solving_names_the_chain():
 )
 def test_bad_poses_raise(poses, message):
     with pytest.raises(ValueError, match=message):
-        mechanism("planar_5rrr").solve(poses)
+        solve(mechanism("planar_5rrr"), poses)
 
 
 def test_forward_kinematics_recovers_the_pose_from_three_locked_actuators():
     mechanism_ = mechanism("planar_5rrr")
     poses = np.array([[-0.2, 0.0, np.pi / 4], [0.1, 0.15, -0.4], [0.05, -0.2, 1.0]])
-    solution = mechanism_.solve(poses)
+    solution = solve(mechanism_, poses)
     actuators = [0, 2, 3]
-    all_values = mechanism_.actuator_values(solution.joint_values)
+    all_values = actuator_values(mechanism_, solution.joint_values)
     np.testing.assert_array_equal(all_values[:, 2], solution.joint_values[2][:, 0])  # chain_3_joint_b
     values = all_values[:, actuators]
-    recovered = mechanism_.forward(values, poses + [0.02, -0.02, 0.05], actuators=actuators)
+    recovered = forward(mechanism_, values, poses + [0.02, -0.02, 0.05], actuators=actuators)
     assert recovered.reachable.all()
     np.testing.assert_allclose(recovered.poses, poses, atol=1e-10)
 
@@ -434,10 +441,10 @@ def test_forward_kinematics_recovers_the_pose_from_three_locked_actuators():
 def test_forward_kinematics_of_the_hexapod_with_named_actuators():
     mechanism_ = mechanism("ups_hexapod_8")
     pose = mechanism_.home_pose + [0.05, -0.03, 0.04, 0.1, -0.05, 0.2]
-    solution = mechanism_.solve(pose)
+    solution = solve(mechanism_, pose)
     names = mechanism_.actuators[:6]
-    values = mechanism_.actuator_values(solution.joint_values)[:6]
-    recovered = mechanism_.forward(values, mechanism_.home_pose, actuators=names)
+    values = actuator_values(mechanism_, solution.joint_values)[:6]
+    recovered = forward(mechanism_, values, mechanism_.home_pose, actuators=names)
     assert recovered.reachable
     np.testing.assert_allclose(recovered.poses, pose, atol=1e-9)
 
@@ -445,8 +452,8 @@ def test_forward_kinematics_of_the_hexapod_with_named_actuators():
 def test_newton_initial_values_are_used():
     mechanism_ = mechanism("coop_arms")
     poses = random_poses(mechanism_, (0.02,) * 3 + (0.05,) * 3, 5, seed=12)
-    first = mechanism_.solve(poses)
-    again = mechanism_.solve(poses + 1e-4, initial=first)
+    first = solve(mechanism_, poses)
+    again = solve(mechanism_, poses + 1e-4, initial=first)
     assert again.reachable.all()
     for first_values, second_values in zip(first.joint_values, again.joint_values):
         assert np.max(np.abs(first_values - second_values)) < 0.01
@@ -456,8 +463,8 @@ def test_closure_and_screws_of_a_large_batch_keep_their_shapes():
     """Speed is measured by benchmarks/; here only that a large batch goes through whole."""
     mechanism_ = mechanism("planar_5rrr")
     poses = random_poses(mechanism_, (0.5, 0.5, np.pi), 200_000, seed=13)
-    solution = mechanism_.solve(poses)
-    screws = mechanism_.chain_screws(solution, unreachable="reference")
+    solution = solve(mechanism_, poses)
+    screws = chain_screws(mechanism_, solution, unreachable="reference")
     assert len(screws) == 5 and screws[0].twists.shape == (200_000, 3, 6)
     assert np.all(np.isfinite(screws[0].twists))
 
@@ -466,24 +473,23 @@ def test_closure_and_screws_of_a_large_batch_keep_their_shapes():
 def test_an_empty_batch_of_poses_gives_empty_results(name):
     mechanism_ = mechanism(name)
     for method in ("auto", "newton"):
-        solution = mechanism_.solve(np.zeros((0, mechanism_.n_task)), method=method)
+        solution = solve(mechanism_, np.zeros((0, mechanism_.n_task)), method=method)
         assert solution.reachable.shape == (0,) and solution.chain_reachable.shape == (0, len(mechanism_.chains))
-        for chain, values, screws in zip(mechanism_.chains, solution.joint_values, mechanism_.chain_screws(solution)):
+        for chain, values, screws in zip(mechanism_.chains, solution.joint_values, chain_screws(mechanism_, solution)):
             assert values.shape == (0, chain.n_joints) and screws.twists.shape == (0, chain.n_joints, 6)
 
 
 def test_thread_limit_bounds_the_nested_pools_and_keeps_results():
-    from screwkit.kinematics import block_threads, thread_limit
-    from screwkit.mechanism import load
+    from screwkit.closure.threads import block_threads
 
     default = block_threads()
     mechanism = load("planar_5rrr")
     rng = np.random.default_rng(3)
     poses = np.column_stack([rng.uniform(-0.3, 0.3, (70_000, 2)), rng.uniform(0, 2 * np.pi, 70_000)])
-    free = mechanism.chain_screws(mechanism.solve(poses), unreachable="drop")
+    free = chain_screws(mechanism, solve(mechanism, poses), unreachable="drop")
     with thread_limit(1):
         assert block_threads() == 1
-        limited = mechanism.chain_screws(mechanism.solve(poses), unreachable="drop")
+        limited = chain_screws(mechanism, solve(mechanism, poses), unreachable="drop")
     assert block_threads() == default
     for a, b in zip(free, limited):
         np.testing.assert_array_equal(a.twists, b.twists)

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from screwkit import screws
-from screwkit.analysis import analyze_pose
-from screwkit.mechanism import load
-from screwkit.robots import NAMED_POSES
+from screwkit.closure import actuator_values, chain_screws, forward, solve
+from screwkit.loader import load
+from screwkit.studies import indices_at_pose
 from screwkit.transmission import analyze
 
 
@@ -40,18 +40,18 @@ def platform_twist(mechanism, pose_minus, pose_plus, step):
 def test_output_twists_match_finite_differences_of_the_closure(name):
     mechanism = load(name)
     pose = np.asarray(mechanism.home_pose, dtype=float) + np.array([0.02, -0.03, 0.05, 0.05, -0.04, 0.1])
-    result = analyze_pose(mechanism, pose)
-    solution = mechanism.solve(pose)
-    actuator_values = mechanism.actuator_values(solution.joint_values)
+    result = indices_at_pose(mechanism, pose)
+    solution = solve(mechanism, pose)
+    at_pose = actuator_values(mechanism, solution.joint_values)
     step = 1e-6
     for s in (0, 7, 27):
         sub = list(result.submechanisms[s])
         # One batched forward-kinematics call: each actuator of the submechanism moved by -step and +step.
-        values = np.repeat(actuator_values[sub][None], 2 * len(sub), axis=0)
+        values = np.repeat(at_pose[sub][None], 2 * len(sub), axis=0)
         for position in range(len(sub)):
             values[2 * position, position] -= step
             values[2 * position + 1, position] += step
-        moved = mechanism.forward(values, pose, actuators=sub)
+        moved = forward(mechanism, values, pose, actuators=sub)
         assert np.all(moved.reachable)
         for position in range(len(sub)):
             twist = platform_twist(mechanism, moved.poses[2 * position], moved.poses[2 * position + 1], step)
@@ -66,9 +66,9 @@ def test_leg_otis_match_an_independent_formula(name, rod_start):
     mechanism = load(name)
     rng = np.random.default_rng(3)
     poses = np.asarray(mechanism.home_pose, dtype=float) + rng.uniform(-0.05, 0.05, (20, 6))
-    solution = mechanism.solve(poses)
+    solution = solve(mechanism, poses)
     assert np.all(solution.reachable)
-    chains = mechanism.chain_screws(solution)
+    chains = chain_screws(mechanism, solution)
     result = analyze(chains)
     for index in range(0, 20, 5):
         lines, tops = [], []
@@ -88,11 +88,12 @@ def test_leg_otis_match_an_independent_formula(name, rod_start):
 
 def test_4rpr_concurrent_pose_names_the_non_mutual_interference_actuator():
     mechanism = load("planar_4rpr")
-    result = analyze_pose(mechanism, NAMED_POSES["planar_4rpr"]["three_lines_concurrent"])
+    result = indices_at_pose(mechanism, mechanism.named_pose("three_lines_concurrent"))
     np.testing.assert_array_equal(result.mutual_interference, [True, True, True, False])
-    assert float(result.f_o[1]) < 1e-9
-    assert list(result.worst_faults[1]) == [3]
-    at_home = analyze_pose(mechanism, mechanism.home_pose)
+    assert result.f_o[1] < 1e-9
+    assert result.worst_faults[1] == ("leg_4:leg_4_joint_slider",)
+    assert result.not_mutual_interference == ("leg_4:leg_4_joint_slider",)
+    at_home = indices_at_pose(mechanism, mechanism.home_pose)
     assert np.all(at_home.mutual_interference) and float(at_home.f_o[1]) > 0.1
 
 
@@ -100,10 +101,10 @@ def test_cooperative_arms_are_finite_and_frame_invariant():
     mechanism = load("coop_arms")
     rng = np.random.default_rng(5)
     poses = np.asarray(mechanism.home_pose, dtype=float) + rng.uniform(-0.03, 0.03, (4, 6))
-    solution = mechanism.solve(poses)
+    solution = solve(mechanism, poses)
     assert np.all(solution.reachable)
-    world = analyze(mechanism.chain_screws(solution))
-    base = analyze(mechanism.chain_screws(solution, frame="base"))
+    world = analyze(chain_screws(mechanism, solution))
+    base = analyze(chain_screws(mechanism, solution, frame="base"))
     assert world.dof == 6 and world.actuator_count == 12 and set(world.f_o) == set(range(1, 7))
     assert np.all(np.isfinite(world.iti)) and np.all(np.isfinite(world.f_o[6]))
     assert np.all(world.lmti > 0)

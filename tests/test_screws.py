@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_identities import random_rotation
+from helpers import random_rotation
 from screwkit import screws
 
 

@@ -9,7 +9,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from test_identities import moved, random_rotation
+from helpers import moved, random_rotation
 from screwkit import screws
 from screwkit.chains import ChainScrews
 from screwkit.planar import rpr_chain_screws
@@ -175,7 +175,9 @@ def test_two_arms_holding_one_object(rng):
     result = analyze(chains)
     assert result.dof == 6 and result.actuator_count == 12
     assert set(result.f_o) == set(range(1, 7))
-    for k, (c, joint) in enumerate(result.actuators):
+    actuators = [(c, k) for c, chain in enumerate(chains) for k in chain.actuated]
+    assert result.actuators == tuple(f"chain_{c + 1}:joint_{k}" for c, k in actuators)  # unnamed chains and joints
+    for k, (c, joint) in enumerate(actuators):
         others = np.delete(chains[c].twists, joint, axis=0)
         np.testing.assert_allclose(screws.reciprocal_product(result.actuation_wrenches[k], others), 0, atol=1e-9)
     assert np.all(np.diff([float(result.f_o[j]) for j in range(1, 7)]) <= 1e-15)  # more faults, no better
@@ -198,7 +200,8 @@ def test_4rpr_with_three_concurrent_legs_names_the_non_mutual_interference_actua
     assert float(result.f_o[1]) < 1e-12
     assert float(result.oti_submechanisms[result.submechanisms.index((0, 1, 2))]) < 1e-12
     assert float(result.lmti) > 0.1
-    np.testing.assert_array_equal(result.worst_faults[1], [3])
+    np.testing.assert_array_equal(result.worst_fault_indices[1], [3])
+    assert result.worst_faults[1] == ("leg_4:slider",) and result.not_mutual_interference == ("leg_4:slider",)
     # Move leg 3 off the common point: every actuator is then a mutual-interference actuator.
     base[2] += np.array([0.2, 0.0])
     assert np.all(analyze(rpr_chain_screws(base, distal)).mutual_interference)

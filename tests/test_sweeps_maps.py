@@ -11,15 +11,16 @@ import time
 import numpy as np
 import pytest
 import xarray as xr
-from click.testing import CliRunner
-
-from screwkit.cli import app
+from helpers import screwkit
+from screwkit.cli.options import parse_range
 from screwkit.closed_forms import planar_indices
-from screwkit.design import permutation_search, planar_design, rotation_class
-from screwkit.maps import GridMap, index_map, planar_disc_map, write_dataset
-from screwkit.mechanism import load
+from screwkit.closure import chain_screws, solve
+from screwkit.loader import load
 from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
-from screwkit.sweep import parse_range, sweep
+from screwkit.studies.design import permutation_search, planar_design, rotation_class
+from screwkit.studies.files import write_dataset
+from screwkit.studies.maps import GridMap, index_map, planar_disc_map
+from screwkit.studies.sweep import sweep
 from screwkit.transmission import analyze
 
 
@@ -39,16 +40,20 @@ def hand_built_minimum(x, y, phi):
 
 
 def test_parse_range():
-    assert parse_range("0:360:0.1").size == 3600
-    np.testing.assert_allclose(parse_range("0:1:0.25"), [0, 0.25, 0.5, 0.75])
-    with pytest.raises(ValueError, match=r"START:STOP:STEP \(three numbers\), got '0:1'"):
-        parse_range("0:1")
-    with pytest.raises(ValueError, match="STEP > 0"):
-        parse_range("0:1:-1")
+    import click
+
+    assert parse_range("0:360:0.1", "--phi").size == 3600
+    np.testing.assert_allclose(parse_range("0:1:0.25", "--over"), [0, 0.25, 0.5, 0.75])
+    np.testing.assert_allclose(parse_range("-0.2:0.2:0.1", "--grid", include_stop=True), [-0.2, -0.1, 0, 0.1, 0.2])
+    np.testing.assert_allclose(parse_range("0:90:45", "--over", angular=True), np.deg2rad([0, 45]))
+    with pytest.raises(click.ClickException, match=r"START:STOP:STEP \(three numbers\), got '0:1'"):
+        parse_range("0:1", "--phi")
+    with pytest.raises(click.ClickException, match="STEP > 0"):
+        parse_range("0:1:-1", "--phi")
 
 
 def test_sweep_at_the_centre_matches_fig_4(five):
-    phi = np.deg2rad(parse_range("0:360:0.1"))
+    phi = parse_range("0:360:0.1", "--phi", angular=True)
     dataset = sweep(five, [0, 0, 0], "phi", phi)
     assert 0.600 < float(dataset["f_o1"].min()) < 0.601  # Fig. 4(d), 0.6005 at 0.1 deg
     minimum = hand_built_minimum(0.0, 0.0, phi)
@@ -124,7 +129,7 @@ def test_spatial_map_over_an_orientation_set():
     assert dataset["f_o1"].shape == (2, 3)
     home = np.asarray(hexapod.home_pose, dtype=float)
     poses = np.array([[0.1, -0.05, home[2], roll, 0.0, yaw] for yaw in over["yaw"] for roll in over["roll"]])
-    result = analyze(hexapod.chain_screws(hexapod.solve(poses)), detail=False)
+    result = analyze(chain_screws(hexapod, solve(hexapod, poses)), detail=False)
     assert float(dataset["f_o1"].sel(x=0.1, y=-0.05)) == pytest.approx(float(result.f_o[1].min()), abs=1e-12)
 
 
@@ -132,7 +137,7 @@ def test_spatial_map_over_an_orientation_set():
 def cluster():
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        with distributed.Client(cluster) as client:
+        with distributed.Client(cluster, set_as_default=False) as client:  # no default client: run_tasks needs none
             yield client
 
 
@@ -187,27 +192,27 @@ def test_permutation_search_ranks_the_papers_design_first(five):
 
 
 def test_cli_sweep_map_and_design_search(tmp_path):
-    runner = CliRunner()
-    result = runner.invoke(app, ["sweep", "planar_5rrr", "--at", "0", "0", "--phi", "0:360:5", "--out",
-                                 str(tmp_path / "s.nc"), "--figure", str(tmp_path / "s.png")])
-    assert result.exit_code == 0, result.output
-    assert "min f_o1" in result.output and (tmp_path / "s.png").stat().st_size > 10_000
-    result = runner.invoke(app, ["map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--phi-step", "30",
-                                 "--out", str(tmp_path / "m.nc"), "--quiet"])
-    assert result.exit_code == 0, result.output
-    assert result.output == ""  # --quiet: nothing on the terminal
+    result = screwkit("sweep", "planar_5rrr", "--at", "0", "0", "--phi", "0:360:5", "--out", tmp_path / "s.nc",
+                      "--figure", tmp_path / "s.png")
+    assert result.returncode == 0, result.stderr
+    assert "min f_o1" in result.stderr and (tmp_path / "s.png").stat().st_size > 10_000 and result.stdout == ""
+    result = screwkit("map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--phi-step", "30",
+                      "--out", tmp_path / "m.nc", "--quiet")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == result.stderr == ""  # --quiet: nothing on the terminal
     with xr.open_dataset(tmp_path / "m.nc") as dataset:
         assert dataset["f_o1"].dims == ("y", "x")
-    result = runner.invoke(app, ["design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json",
-                                 "--quiet"])
-    assert result.exit_code == 0, result.output
-    designs = json.loads(result.output)["designs"]
+    again = screwkit("map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--out", tmp_path / "m.nc")
+    assert again.returncode == 1 and "m.nc: the file exists; pass --overwrite to replace it." in again.stderr
+    result = screwkit("design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json", "--quiet")
+    assert result.returncode == 0, result.stderr
+    designs = json.loads(result.stdout)["designs"]
     assert len(designs) == 240 and set(designs[0]) >= {"permutation", "working_mode", "score"}
     assert designs[0]["permutation"] == [0, 3, 1, 4, 2]
 
 
 def test_optimised_design_is_no_worse_and_its_urdf_loads(five, tmp_path):
-    from screwkit.design import fault_tolerant_area, optimise_design, slots_of
+    from screwkit.studies.design import fault_tolerant_area, optimise_design, slots_of
 
     template = planar_design(five)
     options = {"level": 0.4, "step": 0.1, "phi_step_degrees": 15.0}
@@ -215,10 +220,12 @@ def test_optimised_design_is_no_worse_and_its_urdf_loads(five, tmp_path):
     reference, _ = fault_tolerant_area(template, **options)
     assert area >= reference
     assert fault_tolerant_area(design, **options)[0] == pytest.approx(area)
-    result = CliRunner().invoke(app, ["design-search", "planar_5rrr", "--optimise", "--maxiter", "1", "--popsize", "2",
-                                      "--step", "0.1", "--urdf", str(tmp_path / "best.urdf"), "--json", "--quiet"])
-    assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    result = screwkit("design-search", "planar_5rrr", "--optimise", "--maxiter", "1", "--popsize", "2",
+                      "--step", "0.1", "--urdf", tmp_path / "best.urdf", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["files"] == [str(tmp_path / "best.urdf")] and f"wrote {tmp_path / 'best.urdf'}" in result.stderr
+    assert set(summary["parameters"]) == {"platform_radius", "upper", "lower"}
     assert summary["optimised"]["area_m2"] >= summary["reference"]["area_m2"]
     optimised = load(tmp_path / "best.urdf")
     assert optimised.dof == 3 and len(optimised.actuators) == 5

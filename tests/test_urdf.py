@@ -1,4 +1,4 @@
-"""The safe XML pass and the URDF convention (screwkit.urdf)."""
+"""The safe XML pass and the URDF convention (screwkit.model.urdf_reader)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import time
 import numpy as np
 import pytest
 
-from screwkit.mechanism import bundled_names, bundled_path
-from screwkit.urdf import parse_urdf, read_urdf
+from screwkit.loader import bundled_names, bundled_path
+from screwkit.model.urdf_reader import parse_urdf, read_urdf
 
 MINIMAL = """<?xml version="1.0"?>
 <robot name="toy">
@@ -136,7 +136,7 @@ def test_entity_declarations_are_refused_fast_without_expansion(document):
 def test_entity_bomb_file_is_refused_before_pinocchio_sees_it(tmp_path):
     path = tmp_path / "bomb.urdf"
     path.write_text(BILLION_LAUGHS)
-    from screwkit.mechanism import load
+    from screwkit.loader import load
 
     start = time.perf_counter()
     with pytest.raises(ValueError, match="document type and entity declarations are refused"):

@@ -13,29 +13,30 @@ import html
 import json
 import os
 import re
-import shutil
 import socket
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from screwkit.analysis import analyze_pose
-from screwkit.mechanism import load
+from helpers import screwkit
+from screwkit.closure import chain_screws, solve_one
+from screwkit.loader import load
+from screwkit.studies import indices_at_pose
 from screwkit.viewer import (
     FAILED_COLOR,
-    ROOT_PATH,
     animate_sweep,
     colors_from_values,
     export_html,
     resolve_actuators,
     show,
     start_viewer,
-    view,
 )
+from screwkit.viewer.markers import ROOT_PATH
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_FLAGS = (
@@ -87,6 +88,14 @@ def distance_to_line(points, point_on_line, direction) -> np.ndarray:
     direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
     offset = np.asarray(points, dtype=float) - point_on_line
     return np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=-1)
+
+
+def _parent_pid(pid: int) -> int | None:
+    try:
+        with open(f"/proc/{pid}/stat") as handle:
+            return int(handle.read().rsplit(")", 1)[1].split()[1])
+    except (OSError, ValueError, IndexError):
+        return None
 
 
 def listening_sockets(pid: int) -> list[tuple[str, int]]:
@@ -190,7 +199,7 @@ def test_chains_coloured_by_iti_and_failed_chain_distinct(planar, viewer):
     healthy = scene_tree(show(planar, PLANAR_POSE, viewer=viewer).static_html())
     scene = show(planar, PLANAR_POSE, failed=["chain_2:chain_2_joint_b"], viewer=viewer)
     tree = scene_tree(scene.static_html())
-    result = analyze_pose(planar, PLANAR_POSE)
+    result = indices_at_pose(planar, PLANAR_POSE)
     visuals = full_path(f"{ROOT_PATH}/mechanism/visuals")
     for index, chain in enumerate(planar.chains):
         paths = [path for path in tree if path.startswith(f"{visuals}/{chain.name}_")]
@@ -206,7 +215,7 @@ def test_chains_coloured_by_iti_and_failed_chain_distinct(planar, viewer):
                 np.testing.assert_allclose(drawn, before, atol=1e-12)
     cross = full_path(f"{ROOT_PATH}/failed/1-chain_2-chain_2_joint_b")
     assert cross in tree and f"{cross}/bar_0" in tree and f"{cross}/bar_1" in tree
-    base_joint = planar.chain_screws(planar.solve_one(PLANAR_POSE))[1].points[0]
+    base_joint = chain_screws(planar, solve_one(planar, PLANAR_POSE))[1].points[0]
     np.testing.assert_allclose(tree[cross]["transform"][:3, 3], base_joint, atol=1e-12)
     failed_line = tree[full_path(f"{ROOT_PATH}/actuation_wrenches/1-chain_2-chain_2_joint_b/line")]["object"]
     assert failed_line["materials"][0]["transparent"] and failed_line["materials"][0]["opacity"] < 1
@@ -221,8 +230,8 @@ def test_chains_coloured_by_iti_and_failed_chain_distinct(planar, viewer):
 def test_wrench_lines_lie_on_the_actuation_wrench_axes(planar, viewer):
     scene = show(planar, PLANAR_POSE, viewer=viewer)
     tree = scene_tree(scene.static_html())
-    result = analyze_pose(planar, PLANAR_POSE)
-    points = [screws.points for screws in planar.chain_screws(planar.solve_one(PLANAR_POSE))]
+    result = indices_at_pose(planar, PLANAR_POSE)
+    points = [screws.points for screws in chain_screws(planar, solve_one(planar, PLANAR_POSE))]
     for actuator, (chain, joint) in enumerate(planar.actuators):
         path = full_path(f"{ROOT_PATH}/actuation_wrenches/{actuator}-{chain}-{joint}")
         matrix = tree[path]["transform"]
@@ -243,7 +252,7 @@ def test_wrench_lines_lie_on_the_actuation_wrench_axes(planar, viewer):
 def test_instantaneous_centres_of_the_best_submechanism(planar, viewer):
     scene = show(planar, PLANAR_POSE, viewer=viewer)
     tree = scene_tree(scene.static_html())
-    result = analyze_pose(planar, PLANAR_POSE)
+    result = indices_at_pose(planar, PLANAR_POSE)
     best = int(np.argmax(result.oti_submechanisms))
     submechanism = result.submechanisms[best]
     assert scene.best_submechanisms[0] == tuple(submechanism)
@@ -298,7 +307,7 @@ def test_links_without_visuals_are_drawn_as_rods(planar, viewer, tmp_path):
     links = scene.markers_of_kind("link")
     assert len(links) == 2 * len(mechanism.chains)
     tree = scene_tree(scene.static_html())
-    points = [screws.points for screws in mechanism.chain_screws(mechanism.solve_one(PLANAR_POSE))]
+    points = [screws.points for screws in chain_screws(mechanism, solve_one(mechanism, PLANAR_POSE))]
     for marker in links:
         position = int(marker.path.rsplit("/", 1)[1])
         np.testing.assert_allclose(marker.start, points[marker.chain][position], atol=1e-12)
@@ -311,7 +320,7 @@ def test_links_without_visuals_are_drawn_as_rods(planar, viewer, tmp_path):
 
 def test_chains_coloured_by_best_submechanism_oti(planar, viewer):
     scene = show(planar, PLANAR_POSE, failed=[4], color_by="oti", viewer=viewer)
-    result = analyze_pose(planar, PLANAR_POSE)
+    result = indices_at_pose(planar, PLANAR_POSE)
     for chain in range(4):
         expected = max(result.oti_submechanisms[s] for s, sub in enumerate(result.submechanisms)
                        if chain in sub and 4 not in sub)
@@ -324,17 +333,17 @@ def test_chains_coloured_by_best_submechanism_oti(planar, viewer):
 
 
 def test_twists_at_infinity_are_drawn_as_translation_arrows(planar):
-    from screwkit.viewer import _twist_markers
+    from screwkit.viewer.markers import twist_markers
 
     centre = np.array([0.1, 0.2, 0.0])
     for omega in ([0.0, 0.0, 0.0], [0.0, 0.0, 1e-14]):  # a translation, and a centre 1e13 m away
         twist = np.concatenate([omega, [3.0, 4.0, 0.0]])
-        (marker,) = _twist_markers(planar, 0, 2, twist, centre, planar.length_scale)
+        (marker,) = twist_markers(planar, 0, 2, twist, centre, planar.length_scale)
         assert marker.kind == "translation" and marker.actuator == 2
         np.testing.assert_allclose(marker.start, centre)
         np.testing.assert_allclose(marker.direction, [0.6, 0.8, 0.0], atol=1e-9)
     twist = np.concatenate([[0.0, 0.0, 2.0], np.cross([0.3, -0.1, 0.0], [0.0, 0.0, 2.0])])  # about (0.3, -0.1)
-    kinds = {m.kind: m for m in _twist_markers(planar, 0, 2, twist, centre, planar.length_scale)}
+    kinds = {m.kind: m for m in twist_markers(planar, 0, 2, twist, centre, planar.length_scale)}
     np.testing.assert_allclose(kinds["instantaneous_centre"].start, [0.3, -0.1, 0.0], atol=1e-12)
 
 
@@ -388,88 +397,74 @@ def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):
 # Command line
 # ----------------------------------------------------------------------------------------
 def test_cli_view_writes_html_and_animations(tmp_path):
-    from click.testing import CliRunner
-
-    runner = CliRunner()
     still = tmp_path / "still.html"
-    outcome = runner.invoke(view, ["planar_5rrr", "--pose", "0.05", "-0.03", "12", "--failed", "1",
-                                   "--html", str(still)])
-    assert outcome.exit_code == 0, outcome.output
-    assert "chain_2" in outcome.output and "failed: chain_2:chain_2_joint_b" in outcome.output
+    outcome = screwkit("view", "planar_5rrr", "--pose", "0.05", "-0.03", "12", "--failed", "1", "--html", still)
+    assert outcome.returncode == 0, outcome.stderr
+    assert "chain_2" in outcome.stdout and "failed: chain_2:chain_2_joint_b" in outcome.stdout
+    assert f"wrote {still}" in outcome.stderr
     tree = scene_tree(still.read_text())
     np.testing.assert_allclose(tree[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]["transform"][:3, 3],
                                [0.05, -0.03, 0.0], atol=1e-12)
     sweep = tmp_path / "sweep.html"
-    outcome = runner.invoke(view, ["planar_5rrr", "--sweep-phi", "-10:10:5", "--html", str(sweep)])
-    assert outcome.exit_code == 0, outcome.output
+    outcome = screwkit("view", "planar_5rrr", "--sweep-phi", "-10:10:5", "--html", sweep)
+    assert outcome.returncode == 0, outcome.stderr
     animation = [c for c in scene_commands(sweep.read_text()) if c["type"] == "set_animation"]
     keys = animation[0]["animations"][0]["clip"]["tracks"][0]["keys"]
     assert len(keys) == 4  # -10, -5, 0, 5 (stop exclusive)
+    other = tmp_path / "other.html"
     for arguments, message in (
-        (["planar_5rrr", "--failed", "chain_9", "--html", str(still)], "Unknown actuator 'chain_9'"),
-        (["ups_hexapod_8", "--sweep-phi", "0:10:5", "--html", str(still)], "planar"),
-        (["planar_5rrr", "--pose", "0", "0", "--html", str(still)], "Expected --pose with 3 values"),
+        (["planar_5rrr", "--failed", "chain_9", "--html", other], "Unknown actuator 'chain_9'"),
+        (["ups_hexapod_8", "--sweep-phi", "0:10:5", "--html", other], "planar"),
+        (["planar_5rrr", "--pose", "0", "0", "--html", other], "Expected --pose with 3 values"),
+        (["planar_5rrr", "--html", still], "still.html: the file exists; pass --overwrite to replace it."),
     ):
-        outcome = runner.invoke(view, arguments)
-        assert outcome.exit_code == 1 and message in outcome.output, outcome.output
+        outcome = screwkit("view", *arguments)
+        assert outcome.returncode == 1 and message in outcome.stderr, outcome.stderr
+        assert len(outcome.stderr.strip().splitlines()) == 1
 
 
-def test_cli_view_serves_on_loopback_until_interrupted(monkeypatch):
-    from click.testing import CliRunner
+def test_cli_view_serves_on_loopback_until_interrupted():
+    """``screwkit view`` serves on 127.0.0.1 until Ctrl+C (SIGINT), then stops the server and exits 0."""
+    import signal
 
-    import screwkit.viewer
-
-    seen = {}
-    real_sleep = screwkit.viewer.time.sleep
-
-    def interrupt(seconds):  # the serving loop's first sleep: check the server, then press Ctrl+C
-        if "listening" in seen:  # later sleeps (stopping the server) are real
-            return real_sleep(seconds)
+    process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", "view", "planar_5rrr", "--failed", "chain_3"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = None
+        deadline = time.monotonic() + 120
+        while port is None and time.monotonic() < deadline:
+            line = process.stderr.readline()
+            if not line:
+                break
+            match = re.search(r"Serving at http://127\.0\.0\.1:(\d+)/static/", line)
+            port = int(match.group(1)) if match else None
+        assert port is not None, "no 'Serving at' line on stderr"
         with socket.socket() as probe:
-            seen["listening"] = probe.connect_ex(("127.0.0.1", seen["port"])) == 0
-        raise KeyboardInterrupt
-
-    original_echo = screwkit.viewer.click.echo
-
-    def echo(message=None, **kwargs):
-        match = re.search(r"Serving at http://127\.0\.0\.1:(\d+)/static/", str(message))
-        if match:
-            seen["port"] = int(match.group(1))
-        return original_echo(message, **kwargs)
-
-    monkeypatch.setattr(screwkit.viewer.time, "sleep", interrupt)
-    monkeypatch.setattr(screwkit.viewer.click, "echo", echo)
-    outcome = CliRunner().invoke(view, ["planar_5rrr", "--failed", "chain_3"])
-    monkeypatch.undo()
-    assert outcome.exit_code == 0 and "Stopped." in outcome.output, outcome.output
-    assert seen["listening"], "the server was not listening on 127.0.0.1 while serving"
+            assert probe.connect_ex(("127.0.0.1", port)) == 0, "the server is not listening on 127.0.0.1"
+        servers = [int(entry) for entry in os.listdir("/proc") if entry.isdigit()
+                   and _parent_pid(int(entry)) == process.pid]  # the Meshcat server is a child process
+        sockets = [item for child in servers for item in listening_sockets(child)]
+        assert ("127.0.0.1", port) in sockets and all(address == "127.0.0.1" for address, _ in sockets), sockets
+        process.send_signal(signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0 and "Stopped." in stderr, stderr
+    assert "chain_3" in stdout and "failed: chain_3:chain_3_joint_b" in stdout
     with socket.socket() as probe:  # stopped on Ctrl+C
-        assert probe.connect_ex(("127.0.0.1", seen["port"])) != 0
+        assert probe.connect_ex(("127.0.0.1", port)) != 0
 
 
 # ----------------------------------------------------------------------------------------
 # Headless Chromium renders the offline page
 # ----------------------------------------------------------------------------------------
 def chromium_or_skip() -> Path:
-    """/usr/bin/chromium, installed with apt-get when missing and possible; else a skip saying why."""
+    """/usr/bin/chromium, or a skip that says why (the tests never change the host: .ci/run installs it)."""
     if CHROMIUM.exists():
         return CHROMIUM
-    why = "headless Chromium (Debian packages chromium, chromium-driver) renders the exported HTML"
-    if not hasattr(os, "geteuid") or os.geteuid() != 0:
-        pytest.skip(f"{CHROMIUM} is missing and this test is not running as root, so it cannot "
-                    f"apt-get install it; {why}.")
-    if shutil.which("apt-get") is None:
-        pytest.skip(f"{CHROMIUM} is missing and there is no apt-get to install it; {why}.")
-    environment = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-    for command in (["apt-get", "update"], ["apt-get", "install", "-y", "chromium", "chromium-driver"]):
-        completed = subprocess.run(command, capture_output=True, text=True, env=environment, timeout=900,
-                                   check=False)
-        if completed.returncode != 0:
-            pytest.skip(f"{CHROMIUM} is missing and `{' '.join(command)}` failed with exit code "
-                        f"{completed.returncode}: {completed.stderr.strip()[-500:]}")
-    if not CHROMIUM.exists():
-        pytest.skip(f"apt-get installed chromium but {CHROMIUM} still does not exist.")
-    return CHROMIUM
+    pytest.skip(f"{CHROMIUM} is missing: headless Chromium renders the exported HTML; install the Debian packages "
+                "chromium and chromium-driver (.ci/run does) to run this test.")
 
 
 def render(pages: dict[str, Path], folder: Path, dump_dom: tuple[str, ...] = ()) -> dict[str, tuple]:

@@ -20,10 +20,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from screwkit.maps import planar_disc_map  # noqa: E402
-from screwkit.mechanism import load  # noqa: E402
-from screwkit.plots import map_figure, save_figure, sweep_figure  # noqa: E402
-from screwkit.sweep import sweep  # noqa: E402
+from screwkit.loader import load  # noqa: E402
+from screwkit.plots import COLORMAP, map_figure, save_figure, sweep_figure  # noqa: E402
+from screwkit.studies.maps import planar_disc_map  # noqa: E402
+from screwkit.studies.sweep import sweep  # noqa: E402
 
 FOLDER = Path(__file__).resolve().parent
 
@@ -64,7 +64,7 @@ def main() -> None:
     coarse = fig4.isel(phi=slice(0, None, 10))
     print(f"Fig. 4: min F_O1 {float(coarse['f_o1'].min()):.4f} (1 deg)")
     figure = sweep_figure(fig4)
-    figure.savefig(FOLDER / "fig4_sweep.png", dpi=90)
+    save_figure(figure, FOLDER / "fig4_sweep.png", dpi=90)
     plt.close(figure)
 
     fig5 = planar_disc_map(mechanism, 0.6, 0.02, 1.0, progress=False)
@@ -79,7 +79,7 @@ def main() -> None:
         print(f"Fig. 5: min {label} >= {level}: every grid position within r = {inner:.3f} m "
               f"(nearest failing point at {failing:.3f} m); the region reaches {outer:.3f} m along some rays; "
               f"the paper's text: {text_radius} m")
-        image = ax.pcolormesh(fig5["x"], fig5["y"], np.ma.masked_invalid(fig5[name].values), cmap="jet",
+        image = ax.pcolormesh(fig5["x"], fig5["y"], np.ma.masked_invalid(fig5[name].values), cmap=COLORMAP,
                               vmin=0, vmax=1, shading="nearest")
         ax.contour(fig5["x"], fig5["y"], np.nan_to_num(fig5[name].values), levels=[level], colors="white",
                    linewidths=1.4)

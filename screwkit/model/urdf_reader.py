@@ -6,7 +6,16 @@ convention (see ``docs/urdf-convention.md``):
 * ``<loop>`` elements (URDF+ loop joints) that close each leg onto the platform,
 * ``<transmission>`` elements that mark the actuated joints,
 * the optional ``<reference_configuration>`` element (screwkit extension),
-* the tree ``<joint>`` elements (names, types, links, origins, axes) for checks.
+* the optional ``<named_pose>`` elements and ``<units length="mm"/>`` (screwkit extensions),
+* the tree ``<joint>`` elements (names, types, links, origins, axes, limits) and the tree's
+  shape: one root link, one parent per link, no cycle.
+
+Lengths: a file written in another unit (``<units length="mm"/>`` or the ``length_unit``
+argument) is converted to metres here, in the description *and* in the text handed to
+Pinocchio, so everything downstream is in metres.
+
+Size: files above :data:`MAX_FILE_BYTES` are refused before parsing; reading is linear in the
+file size.
 
 Security: a URDF is data from elsewhere. Any document type declaration (``<!DOCTYPE``)
 or entity declaration (``<!ENTITY``) is refused *before* parsing, so entity bombs
@@ -27,13 +36,19 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics import LOOP_JOINT_DOFS, rotation_from_rpy
+from screwkit.model.chain import LOOP_JOINT_DOFS
+from screwkit.rotations import rotation_from_rpy
+from screwkit.units import LENGTH_UNITS, metres_per
 
 _DECLARATION = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
 TREE_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 """Joint types of the URDF specification."""
 PLATFORM_JOINT_TYPES = ("floating", "planar")
 """Types of the joint that attaches the platform to the base."""
+AXIS_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar")
+"""Joint types whose ``<axis>`` means something (a zero axis is refused on them only)."""
+MAX_FILE_BYTES = 16 * 2**20
+"""Largest mechanism file read (16 MiB); larger files are refused before parsing."""
 
 
 @dataclass(frozen=True)
@@ -64,6 +79,8 @@ class JointElement:
     child: str
     origin: Origin
     axis: NDArray[np.float64]
+    limits: tuple[float, float] = (-np.inf, np.inf)
+    """Position limits (rad or m): ``<limit lower upper>`` of revolute and prismatic joints, else unlimited."""
 
 
 @dataclass(frozen=True)
@@ -113,6 +130,10 @@ class UrdfDescription:
     transmissions : tuple of TransmissionElement
     reference_configuration : dict of str to float
         Joint values of the reference assembly given in ``<reference_configuration>``.
+    named_poses : dict of str to dict of str to float
+        ``<named_pose name="..." x="..." ...>``: task coordinate values (m, rad) by pose name.
+    length_unit : str
+        The unit the file was written in (its lengths are converted to metres here).
     """
 
     source: str
@@ -123,6 +144,8 @@ class UrdfDescription:
     loops: tuple[LoopElement, ...]
     transmissions: tuple[TransmissionElement, ...]
     reference_configuration: dict[str, float]
+    named_poses: dict[str, dict[str, float]] = field(default_factory=dict)
+    length_unit: str = "m"
 
     def fail(self, element: str, problem: str) -> ValueError:
         """A one-line error naming this file, an element and a problem."""
@@ -134,17 +157,23 @@ def file_error(source: str, element: str, problem: str) -> ValueError:
     return ValueError(f"{source}: {element}: {problem}")
 
 
-def read_urdf(path: str | os.PathLike) -> UrdfDescription:
-    """Read and check a URDF file (see :func:`parse_urdf`)."""
+def read_urdf(path: str | os.PathLike, *, length_unit: str | None = None,
+              max_bytes: int = MAX_FILE_BYTES) -> UrdfDescription:
+    """Read and check a URDF file (see :func:`parse_urdf`); files above ``max_bytes`` are refused unread."""
     source = str(path)
     try:
+        size = os.path.getsize(path)
+        if size > max_bytes:
+            raise ValueError(f"{source}: the file has {size:,} bytes, more than the {max_bytes:,} bytes screwkit reads "
+                             "(screwkit.model.urdf_reader.MAX_FILE_BYTES).")
         data = Path(path).read_bytes()
     except OSError as error:
         raise ValueError(f"{source}: cannot read the file: {error.strerror or error}.") from None
-    return parse_urdf(data, source)
+    return parse_urdf(data, source, length_unit=length_unit, max_bytes=max_bytes)
 
 
-def parse_urdf(document: str | bytes, source: str = "<string>") -> UrdfDescription:
+def parse_urdf(document: str | bytes, source: str = "<string>", *, length_unit: str | None = None,
+               max_bytes: int = MAX_FILE_BYTES) -> UrdfDescription:
     """Parse a URDF document, refusing DTDs and entity declarations before parsing.
 
     Parameters
@@ -153,14 +182,23 @@ def parse_urdf(document: str | bytes, source: str = "<string>") -> UrdfDescripti
         The XML text.
     source : str
         Name used in error messages (the file path).
+    length_unit : str, optional
+        The unit the document's lengths are written in (one of
+        :data:`screwkit.units.LENGTH_UNITS`); overrides the file's ``<units length=...>``;
+        default metres.
+    max_bytes : int
+        Largest document accepted.
 
     Raises
     ------
     ValueError
         On a DTD or entity declaration, malformed XML, or an element that breaks the
-        convention (unknown link, unsupported loop type, missing axis, ...).
+        convention (unknown link, unsupported loop type, missing axis, a cycle in the tree, ...).
     """
     data = document.encode("utf-8") if isinstance(document, str) else bytes(document)
+    if len(data) > max_bytes:
+        raise ValueError(f"{source}: the document has {len(data):,} bytes, more than the {max_bytes:,} bytes "
+                         "screwkit reads (screwkit.model.urdf_reader.MAX_FILE_BYTES).")
     declaration = _DECLARATION.search(data)
     if declaration is not None:
         line = data.count(b"\n", 0, declaration.start()) + 1
@@ -178,7 +216,74 @@ def parse_urdf(document: str | bytes, source: str = "<string>") -> UrdfDescripti
         raise ValueError(f"{source}: the file is not UTF-8 text: {error}.") from None
     if root.tag != "robot":
         raise file_error(source, f"<{root.tag}>", "expected the root element <robot>.")
-    return _Reader(source).read(root, text)
+    unit = _length_unit(root, source, length_unit)
+    if unit != "m":
+        scale_lengths(root, metres_per(unit))
+        for element in root.findall("units"):
+            element.set("length", "m")  # the text handed on is in metres
+        text = '<?xml version="1.0"?>\n' + ElementTree.tostring(root, encoding="unicode") + "\n"
+    return _Reader(source).read(root, text, unit)
+
+
+def _length_unit(root: ElementTree.Element, source: str, given: str | None) -> str:
+    """The document's length unit: ``given``, else ``<units length=...>``, else metres."""
+    declared = None
+    for element in root.findall("units"):
+        declared = (element.get("length") or "").strip()
+        if declared not in LENGTH_UNITS:
+            raise file_error(source, f"<units length='{declared}'>",
+                             f"unknown length unit; expected one of {', '.join(LENGTH_UNITS)}.")
+    unit = given if given is not None else (declared or "m")
+    if unit not in LENGTH_UNITS:
+        raise ValueError(f"Unknown length unit {unit!r}; expected one of {', '.join(LENGTH_UNITS)}.")
+    return unit
+
+
+def _scale_attribute(element: ElementTree.Element | None, attribute: str, factor: float) -> None:
+    if element is None or element.get(attribute) is None:
+        return
+    words = element.get(attribute).split()
+    try:
+        element.set(attribute, " ".join(repr(float(word) * factor) for word in words))
+    except ValueError:
+        pass  # left as written: the reader reports it with the element's name
+
+
+def scale_lengths(root: ElementTree.Element, factor: float) -> None:
+    """Multiply every length of a URDF tree by ``factor``, in place.
+
+    Lengths are: ``xyz`` of every ``<origin>``; the limits of prismatic joints; primitive
+    sizes (box size, cylinder radius and length, sphere radius) and mesh scales of visual and
+    collision geometry; the position values of prismatic joints in ``<reference_configuration>``
+    and the x, y, z values of ``<named_pose>``. Angles, masses and inertias are left alone
+    (inertias are not used by screwkit).
+    """
+    for origin in root.iter("origin"):
+        _scale_attribute(origin, "xyz", factor)
+    prismatic = {joint.get("name") for joint in root.findall("joint") if joint.get("type") == "prismatic"}
+    prismatic |= {loop.get("name") for loop in root.findall("loop") if loop.get("type") == "prismatic"}
+    for joint in root.findall("joint"):
+        if joint.get("name") in prismatic:
+            for limit in joint.findall("limit"):
+                _scale_attribute(limit, "lower", factor)
+                _scale_attribute(limit, "upper", factor)
+    for geometry in root.iter("geometry"):
+        _scale_attribute(geometry.find("box"), "size", factor)
+        _scale_attribute(geometry.find("cylinder"), "radius", factor)
+        _scale_attribute(geometry.find("cylinder"), "length", factor)
+        _scale_attribute(geometry.find("sphere"), "radius", factor)
+        mesh = geometry.find("mesh")
+        if mesh is not None:
+            if mesh.get("scale") is None:
+                mesh.set("scale", "1 1 1")
+            _scale_attribute(mesh, "scale", factor)
+    for configuration in root.findall("reference_configuration"):
+        for joint in configuration.findall("joint"):
+            if joint.get("name") in prismatic:
+                _scale_attribute(joint, "value", factor)
+    for pose in root.findall("named_pose"):
+        for coordinate in ("x", "y", "z"):
+            _scale_attribute(pose, coordinate, factor)
 
 
 class _Reader:
@@ -190,21 +295,22 @@ class _Reader:
     def fail(self, element: str, problem: str) -> ValueError:
         return file_error(self.source, element, problem)
 
-    def read(self, root: ElementTree.Element, text: str) -> UrdfDescription:
+    def read(self, root: ElementTree.Element, text: str, length_unit: str = "m") -> UrdfDescription:
         robot_name = root.get("name", "")
-        links = []
+        links: dict[str, None] = {}  # ordered, with constant-time lookups
         for element in root.findall("link"):
             name = self.required_attribute(element, "<link>", "name")
             if name in links:
                 raise self.fail(f"<link name='{name}'>", "the link name is used twice.")
-            links.append(name)
-        link_set = set(links)
+            links[name] = None
+        link_set = links.keys()
         joints: dict[str, JointElement] = {}
         for element in root.findall("joint"):
             joint = self.read_joint(element, link_set)
             if joint.name in joints:
                 raise self.fail(f"<joint name='{joint.name}'>", "the joint name is used twice.")
             joints[joint.name] = joint
+        self.check_tree(robot_name, tuple(links), joints)
         loops = []
         for element in root.findall("loop"):
             loop = self.read_loop(element, link_set)
@@ -220,6 +326,13 @@ class _Reader:
                 if name not in joints:
                     raise self.fail(tag, "names no tree joint of the robot.")
                 reference[name] = self.number(joint_element, tag, "value")
+        named_poses = {}
+        for element in root.findall("named_pose"):
+            name = self.required_attribute(element, "<named_pose>", "name")
+            tag = f"<named_pose name='{name}'>"
+            if name in named_poses:
+                raise self.fail(tag, "the pose name is used twice.")
+            named_poses[name] = {key: self.number(element, tag, key) for key in element.keys() if key != "name"}
         return UrdfDescription(
             source=self.source,
             text=text,
@@ -229,7 +342,42 @@ class _Reader:
             loops=tuple(loops),
             transmissions=transmissions,
             reference_configuration=reference,
+            named_poses=named_poses,
+            length_unit=length_unit,
         )
+
+    def check_tree(self, robot_name: str, links: tuple[str, ...], joints: dict[str, JointElement]) -> None:
+        """One root link, one parent joint per link, no cycle: else name the links and joints."""
+        parent_joint: dict[str, str] = {}
+        for joint in joints.values():
+            if joint.child in parent_joint:
+                raise self.fail(f"<link name='{joint.child}'>",
+                                f"the link has two parents: joints {parent_joint[joint.child]!r} and {joint.name!r} "
+                                "(a tree gives every link one parent; close loops with <loop>).")
+            if joint.child == joint.parent:
+                raise self.fail(f"<joint name='{joint.name}'>", f"the joint connects the link {joint.child!r} to itself.")
+            parent_joint[joint.child] = joint.name
+        roots = [link for link in links if link not in parent_joint]
+        state: dict[str, int] = {}  # 1: on the current path, 2: leads to a root
+        for start in links:
+            path = []
+            link = start
+            while link in parent_joint and state.get(link) != 2:
+                if state.get(link) == 1:
+                    cycle = path[path.index(link):] + [link]
+                    spelled = " -> ".join(f"{a} ({parent_joint[a]})" for a in cycle[:-1]) + f" -> {link}"
+                    raise self.fail(f"<joint name='{parent_joint[link]}'>",
+                                    f"the tree has a cycle of links (joints): {spelled}; close loops with <loop>.")
+                state[link] = 1
+                path.append(link)
+                link = joints[parent_joint[link]].parent
+            for visited in path:
+                state[visited] = 2
+        if len(roots) != 1:
+            spelled = ", ".join(repr(link) for link in roots[:5]) + (" ..." if len(roots) > 5 else "")
+            raise self.fail(f"<robot name='{robot_name}'>",
+                            f"expected one root link (a link that is no joint's child), found {len(roots)}: "
+                            f"{spelled or 'none'}.")
 
     def required_attribute(self, element: ElementTree.Element, tag: str, attribute: str) -> str:
         value = element.get(attribute)
@@ -266,7 +414,9 @@ class _Reader:
             rpy=self.vector(origin, f"{tag}<origin>", "rpy", (0.0, 0.0, 0.0)),
         )
 
-    def axis(self, element: ElementTree.Element, tag: str, name: str, required: bool) -> NDArray[np.float64] | None:
+    def axis(self, element: ElementTree.Element, tag: str, name: str, required: bool,
+             meaningful: bool = True) -> NDArray[np.float64] | None:
+        """A unit axis; a zero axis is refused where the axis means something (``meaningful``)."""
         axis_element = element.find(name)
         if axis_element is None:
             if required:
@@ -275,10 +425,12 @@ class _Reader:
         axis = self.vector(axis_element, f"{tag}<{name}>", "xyz", (1.0, 0.0, 0.0))
         norm = np.linalg.norm(axis)
         if norm < 1e-12:
+            if not meaningful:
+                return None
             raise self.fail(f"{tag}<{name}>", "the axis is the zero vector.")
         return axis / norm
 
-    def link_reference(self, element: ElementTree.Element, tag: str, child: str, links: set[str]) -> tuple[str, ElementTree.Element]:
+    def link_reference(self, element: ElementTree.Element, tag: str, child: str, links) -> tuple[str, ElementTree.Element]:
         link_element = element.find(child)
         if link_element is None:
             raise self.fail(tag, f"the element <{child} link='...'> is missing.")
@@ -295,7 +447,15 @@ class _Reader:
             raise self.fail(tag, f"unknown joint type {joint_type!r}; expected one of {', '.join(TREE_JOINT_TYPES)}.")
         parent, _ = self.link_reference(element, tag, "parent", links)
         child, _ = self.link_reference(element, tag, "child", links)
-        axis = self.axis(element, tag, "axis", required=False)
+        axis = self.axis(element, tag, "axis", required=False, meaningful=joint_type in AXIS_JOINT_TYPES)
+        limits = (-np.inf, np.inf)
+        limit = element.find("limit")
+        if joint_type in ("revolute", "prismatic") and limit is not None:
+            lower = self.number(limit, f"{tag}<limit>", "lower") if limit.get("lower") is not None else -np.inf
+            upper = self.number(limit, f"{tag}<limit>", "upper") if limit.get("upper") is not None else np.inf
+            if lower > upper:
+                raise self.fail(f"{tag}<limit>", f"the lower limit {lower:g} is above the upper limit {upper:g}.")
+            limits = (lower, upper)
         return JointElement(
             name=name,
             type=joint_type,
@@ -303,6 +463,7 @@ class _Reader:
             child=child,
             origin=self.origin(element, tag),
             axis=np.array([1.0, 0.0, 0.0]) if axis is None else axis,
+            limits=limits,
         )
 
     def read_loop(self, element: ElementTree.Element, links: set[str]) -> LoopElement:

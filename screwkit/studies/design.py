@@ -8,7 +8,7 @@
   minimum-over-rotation F_O1 reaches a threshold, over continuous design parameters, with
   ``scipy.optimize.differential_evolution``.
 
-Evaluations run through Dask (:func:`screwkit.maps.run_tasks`).
+Evaluations run through Dask (:func:`screwkit.studies.tasks.run_tasks`).
 """
 
 from __future__ import annotations
@@ -19,14 +19,20 @@ from itertools import permutations
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closed_forms import planar_indices
+from screwkit.closure import solve
+from screwkit.model import Mechanism
 from screwkit.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
-from screwkit.transmission import DEFAULT_THRESHOLD
+from screwkit.studies.poses import planar_points
+from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.transmission import analyze
 
 __all__ = ["planar_design", "slot_design", "slots_of", "rotation_score", "permutation_search", "rotation_class",
            "DesignScore", "fault_tolerant_area", "optimise_design"]
 
 
-def planar_design(mechanism) -> PlanarDesign:
+def planar_design(mechanism: Mechanism) -> PlanarDesign:
     """The :class:`~screwkit.planar.PlanarDesign` of a planar n-RRR mechanism at its home pose.
 
     Base and platform joint points, arm lengths and working mode are read from the solved
@@ -34,10 +40,8 @@ def planar_design(mechanism) -> PlanarDesign:
     """
     if not mechanism.is_planar:
         raise ValueError(f"Design search needs a planar n-RRR; {mechanism.name!r} is spatial.")
-    from screwkit.analysis import planar_points
-
-    home = np.asarray(mechanism.home_pose, dtype=float)
-    solution = mechanism.solve(home[None])
+    home = mechanism.home_pose
+    solution = solve(mechanism, home[None])
     base, elbows, distal, prismatic = planar_points(mechanism, solution)
     if prismatic:
         raise ValueError(f"Design search needs RRR chains; {mechanism.name!r} has RPR chains.")
@@ -76,11 +80,8 @@ def slot_design(design: PlanarDesign, permutation, working_mode: int | None = No
 
 
 def rotation_score(design: PlanarDesign, centre=(0.0, 0.0), phi_step_degrees: float = 1.0, *,
-                   faults: int = 1, threshold: float = DEFAULT_THRESHOLD, closed_forms: bool = False) -> float:
+                   faults: int = 1, threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False) -> float:
     """Minimum of F_Oj over a full platform rotation at ``centre`` (NaN if some angle is unreachable)."""
-    from screwkit.closed_forms import planar_indices
-    from screwkit.transmission import analyze
-
     phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
     poses = np.column_stack([np.full_like(phi, centre[0]), np.full_like(phi, centre[1]), phi])
     base, elbows, distal, reachable = planar_joint_points(design, poses)
@@ -109,8 +110,8 @@ def _score_task(design, permutation, mode, phi_step, faults, threshold, closed_f
 
 
 def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, faults: int = 1,
-                       threshold: float = DEFAULT_THRESHOLD, closed_forms: bool = False,
-                       scheduler=None, progress=None) -> list[DesignScore]:
+                       threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False,
+                       scheduler=None, progress=None, connect_timeout: float = CONNECT_TIMEOUT) -> list[DesignScore]:
     """Every slot permutation in both working modes, ranked by the minimum of F_O1 over a full rotation.
 
     As the paper's Sec. 4: base and platform joints on regular polygons, identical arms,
@@ -123,12 +124,11 @@ def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, f
     list of DesignScore
         Best first (NaN scores, i.e. not fully rotatable, last).
     """
-    from screwkit.maps import run_tasks
-
     n = design.chain_count
     candidates = [(p, mode) for mode in (1, -1) for p in permutations(range(n))]
     arguments = [(design, p, mode, phi_step_degrees, faults, threshold, closed_forms) for p, mode in candidates]
-    scores = run_tasks(_score_task, arguments, scheduler=scheduler, progress=progress, label="designs")
+    scores = run_tasks(_score_task, arguments, scheduler=scheduler, progress=progress, label="designs",
+                       connect_timeout=connect_timeout)
     ranked = [DesignScore(tuple(int(i) for i in p), mode, float(s)) for (p, mode), s in zip(candidates, scores)]
     # Scores equal to 1e-9 are ties (rotated or mirrored copies differ only by rounding);
     # ties are listed working mode +1 first, then by permutation.
@@ -143,7 +143,7 @@ def rotation_class(permutation) -> tuple[int, ...]:
 
 
 def fault_tolerant_area(design: PlanarDesign, *, level: float = 0.4, radius: float = 0.6, step: float = 0.05,
-                        phi_step_degrees: float = 5.0, faults: int = 1, threshold: float = DEFAULT_THRESHOLD):
+                        phi_step_degrees: float = 5.0, faults: int = 1, threshold: float = SINGULARITY_THRESHOLD):
     """Area (m^2) of the positions of a disc where the minimum of F_Oj over a full rotation is >= ``level``.
 
     Evaluated with the planar closed forms on a grid of spacing ``step`` (each point counts
@@ -155,8 +155,6 @@ def fault_tolerant_area(design: PlanarDesign, *, level: float = 0.4, radius: flo
     grid : ndarray (k, k)
         Minimum over the rotation at every grid point (NaN outside the disc or unreachable).
     """
-    from screwkit.closed_forms import planar_indices
-
     count = int(np.floor(radius / step + 1e-9))
     offsets = step * np.arange(-count, count + 1)
     x, y = np.meshgrid(offsets, offsets)

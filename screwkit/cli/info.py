@@ -1,0 +1,71 @@
+"""``screwkit info``: what a mechanism is, as screwkit read it."""
+
+from __future__ import annotations
+
+import json
+
+import click
+import numpy as np
+
+from screwkit.cli.options import (
+    json_option,
+    length_unit_option,
+    load_mechanism,
+    mechanism_argument,
+)
+from screwkit.units import is_angular, unit_of
+
+__all__ = ["info", "mechanism_info"]
+
+
+def mechanism_info(mechanism) -> dict:
+    """A JSON-ready description of a mechanism: DOF, task coordinates, chains, solvers, actuators, named poses."""
+
+    def shown(pose):
+        return {name: float(np.rad2deg(value) if is_angular(name) else value) + 0.0
+                for name, value in zip(mechanism.task_coordinates, pose)}
+
+    return {
+        "mechanism": mechanism.name,
+        "file": mechanism.path,
+        "length_unit": mechanism.length_unit,
+        "dof": mechanism.dof,
+        "task_coordinates": [{"name": name, "unit": unit_of(name)} for name in mechanism.task_coordinates],
+        "platform": {"link": mechanism.platform_link, "joint": mechanism.platform_joint, "base_link": mechanism.base_link,
+                     "planar": mechanism.is_planar},
+        "actuators": list(mechanism.actuator_names),
+        "chains": [{"name": chain.name, "joints": list(chain.joint_names),
+                    "actuated": [chain.joint_names[k] for k in chain.actuated], "loop": chain.loop_name,
+                    "loop_type": chain.loop_type, "solver": chain.solver, "why": chain.solver_reason}
+                   for chain in mechanism.chains],
+        "named_poses": {name: shown(pose) for name, pose in mechanism.named_poses.items()},
+        "length_scale_m": mechanism.length_scale,
+    }
+
+
+@click.command()
+@mechanism_argument
+@length_unit_option
+@json_option
+def info(mechanism: str, length_unit, as_json: bool) -> None:
+    """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
+    actuators, named poses (m, deg)."""
+    loaded = load_mechanism(mechanism, length_unit)
+    report = mechanism_info(loaded)
+    if as_json:
+        click.echo(json.dumps(report))
+        return
+    click.echo(f"{report['mechanism']} ({report['file']}, lengths in {report['length_unit']} in the file)")
+    coordinates = ", ".join(f"{c['name']} ({c['unit']})" for c in report["task_coordinates"])
+    click.echo(f"  DOF {report['dof']}; task coordinates: {coordinates}")
+    click.echo(f"  platform {report['platform']['link']!r} on {report['platform']['joint']!r} "
+               f"({'planar' if loaded.is_planar else 'floating'}) from {report['platform']['base_link']!r}")
+    click.echo(f"  {len(report['actuators'])} actuators: {', '.join(report['actuators'])}")
+    click.echo("  chains:")
+    for chain in report["chains"]:
+        click.echo(f"    {chain['name']}: {' - '.join(chain['joints'])} (actuated: {', '.join(chain['actuated'])}); "
+                   f"loop {chain['loop']} ({chain['loop_type']})")
+        click.echo(f"      solver {chain['solver']}: {chain['why']}")
+    click.echo("  named poses (m, deg):")
+    for name, pose in report["named_poses"].items():
+        click.echo(f"    {name}: " + ", ".join(f"{k} = {v:.6g}" for k, v in pose.items()))

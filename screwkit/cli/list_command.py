@@ -1,0 +1,26 @@
+"""``screwkit list``: the bundled mechanisms."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from screwkit.cli.options import json_option
+from screwkit.loader import bundled_names
+
+__all__ = ["list_command"]
+
+
+@click.command("list")
+@json_option
+def list_command(as_json: bool) -> None:
+    """List the bundled mechanisms (names MECHANISM accepts besides a file path)."""
+
+
+    names = bundled_names()
+    if as_json:
+        click.echo(json.dumps({"mechanisms": list(names)}))
+        return
+    for name in names:
+        click.echo(name)

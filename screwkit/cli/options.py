@@ -1,0 +1,223 @@
+"""What every command shares: options, parsing of poses and ranges, loading, errors, outputs.
+
+Conventions of the command line: lengths in metres and angles in degrees; data on stdout,
+progress and summaries on stderr; every error one line (``Error: ...``, or ``{"error": ...}``
+on stdout with ``--json``) and exit status 1; outputs checked before any computation.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from typing import Callable
+
+import click
+import numpy as np
+
+from screwkit.loader import load
+from screwkit.studies.files import check_output
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.units import LENGTH_UNITS, is_angular
+
+__all__ = [
+    "GreedyOption",
+    "ScrewkitGroup",
+    "mechanism_argument",
+    "length_unit_option",
+    "threshold_option",
+    "ignore_limits_option",
+    "json_option",
+    "quiet_option",
+    "overwrite_option",
+    "load_mechanism",
+    "parse_pose",
+    "parse_range",
+    "check_outputs",
+    "fail",
+    "echo_error",
+]
+
+
+class ScrewkitGroup(click.Group):
+    """The command group: errors become one line (JSON on stdout when the command got ``--json``)."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        arguments = list(sys.argv[1:] if args is None else args)
+        try:
+            result = super().main(arguments, prog_name, complete_var, standalone_mode=False, **extra)
+        except click.exceptions.Exit as stop:
+            if standalone_mode:
+                sys.exit(stop.exit_code)
+            raise
+        except click.ClickException as error:
+            if "--json" in arguments:
+                click.echo(json.dumps({"error": error.format_message()}))
+            else:
+                error.show()
+            if standalone_mode:
+                sys.exit(error.exit_code)
+            raise
+        except click.Abort:
+            click.echo("Aborted.", err=True)
+            if standalone_mode:
+                sys.exit(1)
+            raise
+        if standalone_mode:
+            sys.exit(result if isinstance(result, int) else 0)
+        return result
+
+
+class GreedyOption(click.Option):
+    """An option taking every value up to the next option: ``--pose -0.2 0 45``.
+
+    Negative numbers are values, not options. The values arrive joined by spaces.
+    """
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("multiple", False)
+        super().__init__(*args, **kwargs)
+        self._previous_process = None
+
+    def add_to_parser(self, parser, ctx):
+        def process(value, state):
+            values = [value]
+            while state.rargs:
+                token = state.rargs[0]
+                if token.startswith("--") or (token.startswith("-") and not _is_number(token)):
+                    break
+                values.append(state.rargs.pop(0))
+            self._previous_process(" ".join(values), state)
+
+        result = super().add_to_parser(parser, ctx)
+        for name in self.opts:
+            our_parser = parser._long_opt.get(name) or parser._short_opt.get(name)
+            if our_parser:
+                self._previous_process = our_parser.process
+                our_parser.process = process
+        return result
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def fail(message: str) -> click.ClickException:
+    """The one-line error of a command."""
+    return click.ClickException(message)
+
+
+def echo_error(message: str) -> None:
+    """A warning or note on stderr."""
+    click.echo(message, err=True)
+
+
+# -- options shared by several commands ----------------------------------------------------------
+
+def mechanism_argument(function: Callable) -> Callable:
+    return click.argument("mechanism", metavar="MECHANISM")(function)
+
+
+def length_unit_option(function: Callable) -> Callable:
+    return click.option("--length-unit", type=click.Choice(list(LENGTH_UNITS)), default=None,
+                        help="Length unit the MECHANISM file is written in (default: its <units length=...>, else m); "
+                             "everything shown is in m.")(function)
+
+
+def threshold_option(function: Callable) -> Callable:
+    return click.option("--threshold", type=float, default=SINGULARITY_THRESHOLD, show_default=True,
+                        help="Singularity threshold p on the moment arm (m).")(function)
+
+
+def ignore_limits_option(function: Callable) -> Callable:
+    return click.option("--ignore-limits", is_flag=True,
+                        help="Ignore the joints' position limits of the file (the purely geometric workspace).")(function)
+
+
+def json_option(function: Callable) -> Callable:
+    return click.option("--json", "as_json", is_flag=True,
+                        help="Print one JSON object on stdout (errors too: {\"error\": ...}).")(function)
+
+
+def quiet_option(function: Callable) -> Callable:
+    return click.option("--quiet", is_flag=True, help="No progress or summary on stderr.")(function)
+
+
+def overwrite_option(function: Callable) -> Callable:
+    return click.option("--overwrite", is_flag=True, help="Replace output files that exist.")(function)
+
+
+# -- parsing ---------------------------------------------------------------------------------------
+
+def load_mechanism(name: str, length_unit: str | None = None):
+    """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded."""
+
+    try:
+        return load(name, length_unit=length_unit)
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
+def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarray:
+    """A pose from the command line: a named pose of the mechanism, or every task coordinate (m, deg).
+
+    ``None`` gives the home pose (the reference assembly of the file).
+    """
+    if text is None:
+        return mechanism.home_pose
+    words = text.split()
+    if len(words) == 1 and not _is_number(words[0]):
+        try:
+            return mechanism.named_pose(words[0])
+        except ValueError as error:
+            raise fail(str(error)) from None
+    try:
+        numbers = [float(word) for word in words]
+    except ValueError:
+        raise fail(f"Expected numbers or a named pose after {option}, got {text!r}.") from None
+    if len(numbers) != mechanism.n_task:
+        units = ", ".join(f"{name} ({'deg' if is_angular(name) else 'm'})" for name in mechanism.task_coordinates)
+        raise fail(f"Expected {option} with {mechanism.n_task} values ({units}) or a named pose "
+                   f"({', '.join(mechanism.named_poses)}) for mechanism {mechanism.name!r}, got {len(numbers)}: {text}.")
+    try:
+        return mechanism.poses_from_degrees(numbers)
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
+def parse_range(text: str, option: str, *, include_stop: bool = False, angular: bool = False) -> np.ndarray:
+    """``START:STOP:STEP`` -> START, START+STEP, ... up to STOP (included only if ``include_stop``).
+
+    The stop is compared with a tolerance of a millionth of a step. Angles are given in degrees
+    and returned in radians when ``angular``.
+    """
+    parts = str(text).split(":")
+    try:
+        start, stop, step = (float(p) for p in parts)
+    except ValueError:
+        raise fail(f"Expected {option} as START:STOP:STEP (three numbers), got {text!r}.") from None
+    if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or not step > 0 or not stop > start:
+        raise fail(f"Expected {option} with finite numbers, STEP > 0 and STOP > START, got {text!r}.")
+    span = (stop - start) / step
+    count = int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
+    if count > 10**8:
+        raise fail(f"{option} {text} has {count:,} values; use a larger step.")
+    values = start + step * np.arange(count)
+    return np.deg2rad(values) if angular else values
+
+
+def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwrite: bool, quiet: bool) -> None:
+    """Check every output path before any computation (suffix, folder, existing file)."""
+
+    for option, (path, suffixes) in outputs.items():
+        if path is None:
+            continue
+        try:
+            removed = check_output(path, suffixes, overwrite=overwrite, what=option)
+        except ValueError as error:
+            raise fail(f"{option} {error}") from None
+        if removed and not quiet:
+            echo_error(f"removed {len(removed)} temporary file(s) left by an earlier run killed while writing {path}")

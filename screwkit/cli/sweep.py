@@ -1,0 +1,111 @@
+"""``screwkit sweep``: every series of the paper's Fig. 4 along one pose coordinate."""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from screwkit.cli.options import (
+    GreedyOption,
+    check_outputs,
+    echo_error,
+    fail,
+    ignore_limits_option,
+    length_unit_option,
+    load_mechanism,
+    mechanism_argument,
+    overwrite_option,
+    parse_pose,
+    parse_range,
+    quiet_option,
+    threshold_option,
+)
+from screwkit.plots import save_figure, sweep_figure
+from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.sweep import sweep as run_sweep
+from screwkit.units import is_angular
+
+__all__ = ["sweep", "fixed_pose", "write_outputs"]
+
+
+def fixed_pose(mechanism, at: str | None) -> np.ndarray:
+    """``--at``: every task coordinate (m, deg), a named pose, or for a planar mechanism just x y."""
+    if at is not None and mechanism.is_planar and len(at.split()) == 2:
+        at = f"{at} {float(np.rad2deg(mechanism.home_pose[2]))!r}"
+    return parse_pose(mechanism, at, "--at")
+
+
+def write_outputs(dataset, out, figure_path, figure_function, quiet: bool, **figure_options) -> None:
+    """Write the data file and the figure (both checked before the computation), saying so on stderr.
+
+    With neither, the data go to stdout as a CSV table.
+    """
+
+    if not out and not figure_path:
+        if hasattr(dataset, "to_dataset"):
+            dataset = dataset.to_dataset()
+        click.echo(wide_table(dataset).to_csv(index=False), nl=False)
+        return
+    if out:
+        write_dataset(dataset, out)
+        if not quiet:
+            echo_error(f"wrote {out}")
+    if figure_path:
+        data = dataset.to_dataset() if hasattr(dataset, "to_dataset") else dataset  # a map's GridMap
+        save_figure(figure_function(data, **figure_options), figure_path)
+        if not quiet:
+            echo_error(f"wrote {figure_path}")
+
+
+@click.command()
+@mechanism_argument
+@click.option("--at", cls=GreedyOption, metavar="VALUES|NAME",
+              help="Fixed pose: every task coordinate (m, deg), a named pose, or x y for a planar mechanism "
+                   "(phi from the home pose). Default: the home pose.")
+@click.option("--phi", "phi_range", metavar="START:STOP:STEP",
+              help="Planar shorthand for --sweep phi:START:STOP:STEP (deg; the stop is excluded: 0:360:1 is 360 angles).")
+@click.option("--sweep", "sweep_spec", metavar="COORDINATE:START:STOP:STEP",
+              help="The swept coordinate and its range, m or deg; the stop is excluded (yaw:0:360:1 is 360 angles).")
+@click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
+@click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file: .png, .pdf or .svg.")
+@threshold_option
+@click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
+@ignore_limits_option
+@length_unit_option
+@overwrite_option
+@quiet_option
+def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, closed_forms, ignore_limits, length_unit,
+          overwrite, quiet) -> None:
+    """Sweep one pose coordinate: every series of the paper's Figure 4 along it.
+
+    The data go to --out (or, with neither --out nor --figure, to stdout as CSV); the minima
+    found are summarised on stderr.
+    """
+
+    check_outputs({"--out": (out, (".nc", ".csv")), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
+                  overwrite, quiet)
+    loaded = load_mechanism(mechanism, length_unit)
+    if (phi_range is None) == (sweep_spec is None):
+        raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
+    if phi_range is not None:
+        coordinate, text = "phi", phi_range
+    else:
+        coordinate, _, text = sweep_spec.partition(":")
+    if coordinate not in loaded.task_coordinates:
+        raise fail(f"Unknown coordinate {coordinate!r} to sweep; {loaded.name!r} has "
+                   f"{', '.join(loaded.task_coordinates)}.")
+    values = parse_range(text, "--phi" if phi_range else "--sweep", angular=is_angular(coordinate))
+    try:
+        dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, threshold=threshold,
+                            closed_forms=closed_forms, limits=not ignore_limits)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    if not quiet:
+        reachable = dataset["reachable"].values
+        echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} reachable)")
+        for name in ["iti", "lmti"] + [v for v in dataset.data_vars if v.startswith(("f_o", "f_io"))]:
+            series = dataset[name].values
+            if np.any(np.isfinite(series)):
+                at_min = dataset[coordinate].values[np.nanargmin(series)]
+                echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
+    write_outputs(dataset, out, figure_path, sweep_figure, quiet)

@@ -1,0 +1,184 @@
+"""The reference assembly of a mechanism: closed loops, working modes, solvers and mobility.
+
+:func:`assemble` takes a mechanism model whose chains were read from a file (geometry,
+joints, actuators) and derives, once, what closure solving needs: each chain's joint values
+at the reference assembly (checking that its loop closes there), the closed-form solver that
+fits it (or why none does) and the working mode (branch) that reproduces the reference
+assembly, and the platform's DOF. Every problem is a one-line ValueError naming the file, the
+element and what was found.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.closure.analytic import closed_form_for
+from screwkit.closure.chain_kinematics import (
+    chain_forward_kinematics,
+    loop_values_from_relative_transform,
+    twists_from_axes_and_points,
+    wrap_revolute_values,
+)
+from screwkit.closure.newton import determinant_sign, task_rows
+from screwkit.closure.solve import outside_limits, run_closed_form
+from screwkit.model.chain import Chain
+from screwkit.model.mechanism import Mechanism
+from screwkit.rotations import wrap_angle
+from screwkit.tolerances import (
+    BRANCH_MATCH_TOLERANCE,
+    CLOSURE_TOLERANCE,
+    MOTION_SPACE_TOLERANCE,
+)
+
+__all__ = ["assemble", "mobility"]
+
+
+def _tidy(value: float) -> str:
+    """A number for messages: 6 significant digits, round-off below 1e-12 shown as 0."""
+    value = float(value)
+    return "0" if abs(value) < 1e-12 else f"{value:.6g}"
+
+
+def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
+    """The largest distance of a joint of the reference assembly, or the platform, from the base origin."""
+    points = [mechanism.home_translation[None]]
+    for chain in chains:
+        geometry = chain.geometry
+        tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
+                         for name in chain.joint_names[: geometry.n_tree_joints]])
+        frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
+        points.append(frames.points)
+        points.append(frames.leg_translation[None])
+    return max(float(np.max(np.linalg.norm(np.concatenate(points), axis=-1))), 1e-12)
+
+
+def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_scale: float) -> NDArray[np.float64]:
+    """Joint values of the reference assembly; a ValueError if the loop does not close there."""
+    description, geometry = mechanism.description, chain.geometry
+    tree_values = np.array([description.reference_configuration.get(name, 0.0)
+                            for name in chain.joint_names[: geometry.n_tree_joints]])
+    frames = chain_forward_kinematics(geometry, np.concatenate([tree_values, np.zeros(geometry.n_dofs - tree_values.size)]))
+    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation, mechanism.home_translation)
+    loop_values, position_gap, rotation_gap = loop_values_from_relative_transform(
+        geometry,
+        frames.leg_rotation.T @ target_rotation,
+        frames.leg_rotation.T @ (target_translation - frames.leg_translation),
+    )
+    if position_gap > CLOSURE_TOLERANCE * length_scale or rotation_gap > CLOSURE_TOLERANCE:
+        raise description.fail(
+            f"<loop name='{chain.loop_name}'>",
+            f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
+            f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
+            "platform at its joint origin).",
+        )
+    values = wrap_revolute_values(geometry, np.concatenate([tree_values, loop_values]))
+    outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None])[0])
+    if outside >= 0:
+        lower, upper = chain.joint_limits[outside]
+        raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
+                               f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "
+                               f"limits [{_tidy(lower)}, {_tidy(upper)}].")
+    return values
+
+
+def _check_planar(mechanism: Mechanism, chain: Chain, values: NDArray) -> None:
+    frames = chain_forward_kinematics(chain.geometry, values)
+    for name, axis, prismatic in zip(chain.joint_names, frames.axes, chain.prismatic):
+        along_normal = abs(axis[2])
+        if (prismatic and along_normal > CLOSURE_TOLERANCE) or (not prismatic and abs(along_normal - 1.0) > CLOSURE_TOLERANCE):
+            raise mechanism.description.fail(
+                f"<loop name='{chain.loop_name}'>",
+                f"the platform moves in the base x-y plane (planar joint {mechanism.platform_joint!r}) but joint "
+                f"{name!r} of this chain is not a planar joint (revolute about z or prismatic in x-y).",
+            )
+
+
+def _matching_branch(mechanism: Mechanism, index: int, solver) -> tuple[int, ...] | None:
+    """The closed-form branch closest to the reference assembly, if it reproduces it (else None)."""
+    chain = mechanism.chains[index]
+    probe = replace(mechanism, chains=mechanism.chains[:index] + (replace(chain, closed_form=solver),)
+                    + mechanism.chains[index + 1:])
+    prismatic = np.asarray(chain.geometry.dof_prismatic)
+    best, closest = None, np.inf
+    for code in range(2**solver.n_branches):
+        branch = tuple(1 if (code >> bit) & 1 == 0 else -1 for bit in range(solver.n_branches))
+        result = run_closed_form(probe, index, mechanism.home_pose[None], branch)
+        if not result.reachable[0]:
+            continue
+        values = result.values() if callable(result.values) else result.values
+        difference = values[0] - chain.reference_values
+        difference[~prismatic] = wrap_angle(difference[~prismatic])
+        difference[prismatic] /= mechanism.length_scale
+        distance = float(np.max(np.abs(difference), initial=0.0))
+        if distance < closest:
+            best, closest = branch, distance
+    return best if closest < BRANCH_MATCH_TOLERANCE else None
+
+
+def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
+    """DOF of the platform at the reference assembly: the dimension of the intersection of the chains' twist spaces.
+
+    Twists are taken about the centroid of the platform joints with lengths in units of the
+    mechanism's length scale, so the count does not depend on the unit or the frame.
+    """
+    rows = task_rows(mechanism.is_planar)
+    frames = [chain_forward_kinematics(chain.geometry, chain.reference_values) for chain in chains]
+    centre = np.mean([f.points[-1] for f in frames], axis=0)
+    complements = []
+    for chain, chain_frames in zip(chains, frames):
+        twists = twists_from_axes_and_points(chain_frames.axes, chain_frames.points - centre, chain.prismatic)
+        twists = np.concatenate([twists[:, :3], twists[:, 3:] / mechanism.length_scale], axis=-1)[:, rows].T
+        left, singular, _ = np.linalg.svd(twists)
+        rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * max(1.0, singular[0] if singular.size else 1.0)))
+        complements.append(left[:, rank:].T)
+    stacked = np.concatenate(complements, axis=0)
+    if stacked.size == 0:
+        return len(rows)
+    singular = np.linalg.svd(stacked, compute_uv=False)
+    return len(rows) - int(np.sum(singular > MOTION_SPACE_TOLERANCE))
+
+
+def assemble(mechanism: Mechanism) -> Mechanism:
+    """The mechanism with its reference assembly, solvers, working modes, length scale and DOF.
+
+    ``mechanism`` holds chains as read from the file (geometry, joints, limits, actuators);
+    the result is the complete, immutable model.
+    """
+    length_scale = _length_scale(mechanism, mechanism.chains)
+    mechanism = replace(mechanism, length_scale=length_scale)
+    chains = []
+    for index, chain in enumerate(mechanism.chains):
+        values = _reference_values(mechanism, index, chain, length_scale)
+        if mechanism.is_planar:
+            _check_planar(mechanism, chain, values)
+        frames = chain_forward_kinematics(chain.geometry, values)
+        chains.append(replace(chain, reference_values=values,
+                              reference_sign=determinant_sign(chain.geometry, mechanism.is_planar, frames.axes,
+                                                              frames.points)))
+    mechanism = replace(mechanism, chains=tuple(chains))
+    solved = []
+    for index, chain in enumerate(mechanism.chains):
+        solver, reason = closed_form_for(chain.geometry, mechanism.is_planar, length_scale)
+        branch = None
+        if solver is not None:
+            branch = _matching_branch(mechanism, index, solver)
+            if branch is None:
+                reason = (f"damped Newton: {solver.kind} fits the chain's joints but none of its working modes "
+                          "reproduces the reference assembly")
+                solver = None
+        if solver is None:
+            branch = chain.reference_sign
+        solved.append(replace(chain, closed_form=solver, branch=branch, solver=solver.kind if solver else "newton",
+                              solver_reason=reason))
+    mechanism = replace(mechanism, chains=tuple(solved))
+    dof = mobility(mechanism, mechanism.chains)
+    actuators = mechanism.actuator_names
+    if len(actuators) < dof:
+        raise mechanism.description.fail(
+            f"<robot name='{mechanism.name}'>",
+            f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for a platform with {dof} DOF: at least {dof} "
+            "are needed (mark actuated joints with <transmission>).")
+    return replace(mechanism, dof=dof)

@@ -1,0 +1,467 @@
+"""Closing every chain of a mechanism for a batch of platform poses, and the reverse.
+
+:func:`solve` closes all chains for platform poses (a closed form where the chain type has
+one, batched damped Newton with continuation otherwise), keeping the working mode and, by
+default, the joints' position limits; :func:`solve_one` does one pose and says why it is
+unreachable; :func:`forward` finds platform poses from actuator values (forward kinematics of
+the closed mechanism) by Newton steps on the pose with the analytic chain Jacobians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Literal, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian
+from screwkit.closure.newton import pose_error, solve_newton_chain
+from screwkit.closure.threads import for_each_block
+from screwkit.model.mechanism import Mechanism
+from screwkit.rotations import wrap_angle
+from screwkit.tolerances import NEWTON_TOLERANCE
+
+__all__ = [
+    "Solution",
+    "UnreachablePose",
+    "solve",
+    "solve_one",
+    "forward",
+    "actuator_values",
+    "closure_residuals",
+    "unreachable_reason",
+    "run_closed_form",
+    "outside_limits",
+]
+
+REACHABLE, MISSES_CLOSURE, OUTSIDE_LIMITS = 0, 1, 2
+"""Codes of :attr:`Solution.status`: closed, no closure in the working mode, a joint outside its limits."""
+
+
+class UnreachablePose(ValueError):
+    """A pose that cannot be reached, with the chain that misses the most named first."""
+
+
+@dataclass(frozen=True)
+class Solution:
+    """Closed-chain configurations of a mechanism for a batch of platform poses.
+
+    Attributes
+    ----------
+    poses : ndarray, shape (..., n_task)
+    reachable : ndarray of bool, shape (...)
+        Every chain closed in the requested working mode with its joints within their limits.
+    chain_reachable : ndarray of bool, shape (..., n_chains)
+    status : ndarray of int8, shape (..., n_chains)
+        Per chain: 0 closed, 1 misses its closure (no assembly in the working mode), 2 closed
+        but a joint is outside its position limits.
+    residuals : ndarray, shape (..., n_chains)
+        Where the closure failed, by how far the chain misses (m for closed forms, the final
+        Newton error norm in m and rad otherwise); else the remaining closure error (0 for
+        closed forms).
+    limit_joints : ndarray of int, shape (..., n_chains)
+        Where ``status`` is 2, the index (into the chain's joints) of the first joint outside
+        its limits; else -1.
+    joint_axes, joint_points : tuple of ndarray, each shape (..., m_i, 3)
+        Per chain, joint axes and points in the **base** frame (component-major views for the
+        closed forms); meaningful only where the chain closed.
+    """
+
+    poses: NDArray[np.float64]
+    reachable: NDArray[np.bool_]
+    chain_reachable: NDArray[np.bool_]
+    status: NDArray[np.int8]
+    residuals: NDArray[np.float64]
+    limit_joints: NDArray[np.int64]
+    joint_axes: tuple[NDArray[np.float64], ...]
+    joint_points: tuple[NDArray[np.float64], ...]
+    value_sources: tuple = field(repr=False)
+    """Per chain, the joint values (..., m_i) or a function computing them flat (N, m_i)."""
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        """Shape of the batch of poses."""
+        return self.poses.shape[:-1]
+
+    @cached_property
+    def joint_values(self) -> tuple[NDArray[np.float64], ...]:
+        """Per chain, joint values (..., m_i) (rad or m; revolute values wrapped to (-pi, pi],
+        spherical loop values as rotation vectors); NaN where the chain misses its closure."""
+        values = []
+        for source in self.value_sources:
+            array = source() if callable(source) else np.asarray(source)
+            values.append(array.reshape(self.batch_shape + array.shape[-1:]))
+        return tuple(values)
+
+
+def _check_branches(mechanism: Mechanism, branches) -> tuple:
+    if branches is None:
+        return tuple(chain.branch for chain in mechanism.chains)
+    branches = tuple(branches)
+    if len(branches) != len(mechanism.chains):
+        raise ValueError(f"Expected one branch per chain ({len(mechanism.chains)}), got {len(branches)}.")
+    checked = []
+    for chain, branch in zip(mechanism.chains, branches):
+        if chain.closed_form is not None:
+            signs = tuple(int(sign) for sign in np.atleast_1d(branch))
+            if len(signs) != chain.closed_form.n_branches or any(sign not in (1, -1) for sign in signs):
+                raise ValueError(f"Expected {chain.closed_form.n_branches} sign(s) of +-1 as branch of chain "
+                                 f"{chain.name!r} ({chain.solver}), got {branch!r}.")
+            checked.append(signs)
+        else:
+            if branch is not None and branch not in (1, -1):
+                raise ValueError(f"Expected +1, -1 or None as branch of Newton chain {chain.name!r}, got {branch!r}.")
+            checked.append(branch)
+    return tuple(checked)
+
+
+def _check_initial(mechanism: Mechanism, initial, batch: tuple[int, ...]):
+    if initial is None:
+        return None
+    if isinstance(initial, Solution):
+        initial = initial.joint_values
+    initial = tuple(initial)
+    if len(initial) != len(mechanism.chains):
+        raise ValueError(f"Expected initial joint values for {len(mechanism.chains)} chains, got {len(initial)}.")
+    arrays = []
+    for chain, values in zip(mechanism.chains, initial):
+        values = np.asarray(values, dtype=float)
+        try:
+            arrays.append(np.broadcast_to(values, batch + (chain.n_joints,)))
+        except ValueError:
+            raise ValueError(f"Expected initial values of chain {chain.name!r} broadcastable to "
+                             f"{batch + (chain.n_joints,)}, got {values.shape}.") from None
+    return arrays
+
+
+class _PoseCache:
+    """Quantities of a flat batch of poses shared by every chain (computed once, on demand)."""
+
+    def __init__(self, mechanism: Mechanism, flat_poses: NDArray):
+        self.mechanism = mechanism
+        self.flat_poses = flat_poses
+
+    @cached_property
+    def platform(self):
+        return self.mechanism.transforms_from_poses(self.flat_poses)
+
+    @cached_property
+    def planar(self):
+        flat = self.flat_poses
+        angle = np.ascontiguousarray(flat[:, 2])
+        cosine, sine = np.empty_like(angle), np.empty_like(angle)
+
+        def trigonometry(block: slice) -> None:
+            np.cos(angle[block], out=cosine[block])
+            np.sin(angle[block], out=sine[block])
+
+        for_each_block(angle.shape[0], trigonometry)
+        return np.ascontiguousarray(flat[:, 0]), np.ascontiguousarray(flat[:, 1]), cosine, sine, angle
+
+
+def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branch, cache: _PoseCache | None = None):
+    """The closed-form solver of chain ``index`` on flat poses (N, n_task) in working mode ``branch``."""
+    solver = mechanism.chains[index].closed_form
+    cache = _PoseCache(mechanism, flat_poses) if cache is None else cache
+    if solver.planar:
+        return solver.solve(*cache.planar, branch)
+    return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
+
+
+def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray) -> NDArray[np.int64]:
+    """Index of the first joint outside its limits for each row of ``values`` (N, m); -1 if none.
+
+    A revolute value counts as within its limits if it, or it plus or minus a full turn, is.
+    """
+    lower, upper = limits[:, 0], limits[:, 1]
+    slack = 1e-12 * (1.0 + np.maximum(np.abs(np.where(np.isfinite(lower), lower, 0.0)),
+                                      np.abs(np.where(np.isfinite(upper), upper, 0.0))))
+    inside = (values >= lower - slack) & (values <= upper + slack)
+    revolute = ~np.asarray(prismatic, dtype=bool)
+    for turn in (2.0 * np.pi, -2.0 * np.pi):
+        shifted = values + turn
+        inside |= revolute & (shifted >= lower - slack) & (shifted <= upper + slack)
+    inside |= np.isnan(values)  # a chain that did not close is reported as such, not as a limit
+    outside = ~inside
+    return np.where(outside.any(axis=-1), np.argmax(outside, axis=-1), -1)
+
+
+def solve(
+    mechanism: Mechanism,
+    poses: ArrayLike,
+    *,
+    branches: Sequence | None = None,
+    initial: Solution | Sequence[ArrayLike] | None = None,
+    method: Literal["auto", "newton"] = "auto",
+    tolerance: float = NEWTON_TOLERANCE,
+    max_iterations: int = 40,
+    limits: bool = True,
+) -> Solution:
+    """Close every chain for a batch of platform poses, keeping the working mode.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    poses : array_like, shape (..., n_task)
+        Platform poses in the task coordinates (m, rad).
+    branches : sequence, optional
+        Per chain working mode; default each chain's :attr:`~screwkit.model.chain.Chain.branch`
+        (the reference assembly). For a closed-form chain a tuple of +-1 signs; for a Newton
+        chain the required sign of its twist-matrix determinant (None: no check). Newton
+        continuation starts from the reference assembly, so another sign also needs
+        ``initial``. With ``method="newton"`` closed-form chains keep the reference
+        determinant sign.
+    initial : Solution or sequence of array_like, optional
+        Start values for Newton chains (per chain, broadcastable to (..., m_i)), e.g. a
+        solution at nearby poses. Default: continuation from the reference assembly.
+    method : {"auto", "newton"}
+        ``"auto"`` uses a closed form for chains that have one; ``"newton"`` forces the
+        generic solver everywhere (for checks).
+    tolerance : float
+        Newton convergence on the closure error norm (rad and m).
+    max_iterations : int
+        Newton iterations per continuation step.
+    limits : bool
+        Whether a configuration with a joint outside the position limits of the file counts
+        as unreachable (default; ``False``: the purely geometric workspace).
+
+    Returns
+    -------
+    Solution
+        Never raises for an unreachable pose: ``reachable`` is False there and ``status``,
+        ``residuals`` and ``limit_joints`` say why (see :func:`solve_one`).
+    """
+    poses = mechanism.check_poses(poses)
+    if method not in ("auto", "newton"):
+        raise ValueError(f"Expected `method` 'auto' or 'newton', got {method!r}.")
+    branches = _check_branches(mechanism, branches)
+    batch = poses.shape[:-1]
+    flat = poses.reshape(-1, mechanism.n_task)
+    count = flat.shape[0]
+    initial_values = _check_initial(mechanism, initial, batch)
+    cache = _PoseCache(mechanism, flat)
+    values, axes, points = [], [], []
+    chains = len(mechanism.chains)
+    status = np.zeros((chains, count), dtype=np.int8)
+    residuals = np.empty((chains, count))
+    limit_joints = np.full((chains, count), -1, dtype=np.int64)
+    for index, chain in enumerate(mechanism.chains):
+        geometry = chain.geometry
+        if chain.closed_form is not None and method == "auto":
+            result = run_closed_form(mechanism, index, flat, branches[index], cache)
+            chain_values, chain_reachable, chain_residual = result.values, result.reachable, result.gap
+            chain_axes, chain_points = result.axes, result.points
+        else:
+            start = None if initial_values is None else initial_values[index].reshape(count, geometry.n_dofs)
+            sign = branches[index] if chain.closed_form is None else chain.reference_sign
+            chain_values, chain_reachable, chain_residual = solve_newton_chain(
+                mechanism, index, flat, cache.platform, start, sign, tolerance, max_iterations)
+            frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
+            chain_axes, chain_points = frames.axes, frames.points
+        status[index] = np.where(chain_reachable, REACHABLE, MISSES_CLOSURE)
+        if limits and np.any(np.isfinite(chain.joint_limits)):
+            flat_values = chain_values() if callable(chain_values) else chain_values
+            chain_values = flat_values
+            outside = outside_limits(chain.joint_limits, chain.prismatic, flat_values.reshape(count, geometry.n_dofs))
+            limit_joints[index] = np.where(chain_reachable, outside, -1)
+            status[index] = np.where(chain_reachable & (outside >= 0), OUTSIDE_LIMITS, status[index])
+        values.append(chain_values if callable(chain_values) else chain_values.reshape(batch + (geometry.n_dofs,)))
+        residuals[index] = chain_residual
+        axes.append(chain_axes.reshape(batch + chain_axes.shape[-2:]))
+        points.append(chain_points.reshape(batch + chain_points.shape[-2:]))
+    chain_reachable = status == REACHABLE
+    return Solution(
+        poses=poses,
+        reachable=np.logical_and.reduce(chain_reachable, axis=0).reshape(batch),
+        chain_reachable=chain_reachable.T.reshape(batch + (chains,)),
+        status=status.T.reshape(batch + (chains,)),
+        residuals=residuals.T.reshape(batch + (chains,)),
+        limit_joints=limit_joints.T.reshape(batch + (chains,)),
+        joint_axes=tuple(axes),
+        joint_points=tuple(points),
+        value_sources=tuple(values),
+    )
+
+
+def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = ()) -> str:
+    """Why the pose at ``index`` of a solution is unreachable, worst chain first (one line)."""
+    status = solution.status[index]
+    residuals = solution.residuals[index]
+    missing = [c for c in np.flatnonzero(status == MISSES_CLOSURE)]
+    missing.sort(key=lambda c: -float(residuals[c]) if np.isfinite(residuals[c]) else -np.inf)
+    parts = []
+    for c in missing:
+        chain = mechanism.chains[c]
+        unit = "m" if chain.closed_form is not None else "(Newton error norm, m and rad)"
+        parts.append(f"chain {chain.name!r} misses closure by {residuals[c]:.6g} {unit}")
+    for c in np.flatnonzero(status == OUTSIDE_LIMITS):
+        chain = mechanism.chains[c]
+        joint = int(solution.limit_joints[index][c])
+        value = float(solution.joint_values[c][index][joint])
+        lower, upper = chain.joint_limits[joint]
+        unit = "m" if chain.prismatic[joint] else "rad"
+        parts.append(f"chain {chain.name!r}: joint {chain.joint_names[joint]!r} at {value:.6g} {unit} is outside "
+                     f"its limits [{lower:.6g}, {upper:.6g}]")
+    return "; ".join(parts)
+
+
+def solve_one(mechanism: Mechanism, pose: ArrayLike, **options) -> Solution:
+    """Solve a single pose (n_task,); raise :class:`UnreachablePose` naming the worst chain if unreachable.
+
+    The message names every chain that fails, the one that misses its closure by the most
+    first, and joints outside their limits with their values (``limits=False`` ignores them).
+    """
+    pose = mechanism.check_poses(pose)
+    if pose.ndim != 1:
+        raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}.")
+    solution = solve(mechanism, pose, **options)
+    if not solution.reachable:
+        shown = np.where(mechanism.angular, np.rad2deg(pose), pose)
+        spelled = ", ".join(f"{name}={value:.6g}{' deg' if angular else ''}"
+                            for name, value, angular in zip(mechanism.task_coordinates, shown, mechanism.angular))
+        raise UnreachablePose(f"Pose ({spelled}) is unreachable for mechanism {mechanism.name!r}: "
+                              f"{unreachable_reason(mechanism, solution)}.")
+    return solution
+
+
+def actuator_values(mechanism: Mechanism, joint_values: Sequence[ArrayLike]) -> NDArray[np.float64]:
+    """Values (..., a) of all actuators, in :attr:`~Mechanism.actuators` order.
+
+    ``joint_values`` holds one array (..., m_i) per chain, e.g. ``solution.joint_values``.
+    """
+    joint_values = tuple(joint_values)
+    return np.stack([np.asarray(joint_values[chain])[..., joint]
+                     for chain, joint in mechanism.actuator_positions(None)], -1)
+
+
+def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.float64]:
+    """Loop-closure error norm (rad and m) of every chain, recomputed by forward kinematics.
+
+    Returns an array (..., n_chains); NaN where the chain did not close.
+    """
+    rotation, translation = mechanism.transforms_from_poses(solution.poses)
+    residuals = []
+    for index, chain in enumerate(mechanism.chains):
+        frames = chain_forward_kinematics(chain.geometry, solution.joint_values[index])
+        target_rotation, target_translation = mechanism.loop_targets(index, rotation, translation)
+        error = pose_error(target_rotation, target_translation, frames.end_rotation, frames.end_translation)
+        residuals.append(np.linalg.norm(error, axis=-1))
+    return np.stack(residuals, -1)
+
+
+def _pose_rates(mechanism: Mechanism, poses: NDArray) -> NDArray[np.float64]:
+    """d(platform frame)/d(task coordinates): (N, 6, n_task), rows (angular velocity, origin velocity), base frame."""
+    count = poses.shape[0]
+    rates = np.zeros((count, 6, mechanism.n_task))
+    if mechanism.is_planar:
+        rates[:, 2, 2] = 1.0
+        rates[:, 3, 0] = rates[:, 4, 1] = 1.0
+        return rates
+    pitch, yaw = poses[:, 4], poses[:, 5]
+    zero, one = np.zeros(count), np.ones(count)
+    # R = Rz(yaw) Ry(pitch) Rx(roll): omega = z * yaw' + Rz(yaw) y * pitch' + Rz(yaw) Ry(pitch) x * roll'
+    rates[:, :3, 3] = np.stack([np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)], -1)
+    rates[:, :3, 4] = np.stack([-np.sin(yaw), np.cos(yaw), zero], -1)
+    rates[:, :3, 5] = np.stack([zero, zero, one], -1)
+    rates[:, 3:, :3] = np.eye(3)
+    return rates
+
+
+def forward(
+    mechanism: Mechanism,
+    actuator_values: ArrayLike,
+    initial_pose: ArrayLike,
+    *,
+    actuators: Sequence[int | str | tuple[str, str]] | None = None,
+    tolerance: float = 1e-12,
+    max_iterations: int = 30,
+    limits: bool = False,
+) -> Solution:
+    """Platform poses for given actuator values (forward kinematics of the closed mechanism).
+
+    Only the listed ``actuators`` are held at ``actuator_values``; all others move freely
+    (they act as passive joints). With as many listed actuators as DOF this is the forward
+    kinematics of a non-redundant submechanism. Newton steps on the pose: the rates of the
+    listed actuators per task-coordinate rate come from each chain's analytic Jacobian
+    (:func:`~screwkit.closure.chain_kinematics.chain_jacobian`), ``dq = J^+ dT``, at the
+    current closed configuration; the working mode is the one reachable from ``initial_pose``.
+
+    Parameters
+    ----------
+    actuator_values : array_like, shape (..., k)
+        Values of the listed actuators (rad or m).
+    initial_pose : array_like, shape (..., n_task)
+        Start pose.
+    actuators : sequence, optional
+        Indices into :attr:`~Mechanism.actuators`, ``chain:joint`` names or ``(chain, joint)``
+        pairs; default all.
+    tolerance : float
+        Convergence on the largest actuator mismatch.
+    limits : bool
+        Whether joint limits make a pose unreachable (default: no, as in the pure geometry).
+
+    Returns
+    -------
+    Solution
+        At the poses found; ``reachable`` is False where Newton did not converge.
+    """
+    selected = mechanism.actuator_positions(actuators)
+    targets = np.asarray(actuator_values, dtype=float)
+    if targets.shape[-1:] != (len(selected),):
+        raise ValueError(f"Expected `actuator_values` with shape (..., {len(selected)}), got {targets.shape}.")
+    poses = mechanism.check_poses(initial_pose)
+    batch = np.broadcast_shapes(targets.shape[:-1], poses.shape[:-1])
+    targets = np.broadcast_to(targets, batch + (len(selected),)).reshape(-1, len(selected))
+    poses = np.array(np.broadcast_to(poses, batch + (mechanism.n_task,)).reshape(-1, mechanism.n_task))
+    angular = np.array([not mechanism.chains[chain].prismatic[joint] for chain, joint in selected])
+    converged = np.zeros(poses.shape[0], dtype=bool)
+    active = np.arange(poses.shape[0])
+    previous = None
+    for _ in range(max_iterations):
+        if active.size == 0:
+            break
+        solution = solve(mechanism, poses[active], initial=previous, tolerance=1e-13, limits=False)
+        values = np.stack([solution.joint_values[chain][..., joint] for chain, joint in selected], -1)
+        error = values - targets[active]
+        error[:, angular] = wrap_angle(error[:, angular])
+        done = np.all(np.abs(error) < tolerance, axis=-1)
+        converged[active[done]] = True
+        keep = ~done & np.all(np.isfinite(error), axis=-1)
+        previous = [chain_values[keep] for chain_values in solution.joint_values]
+        active, error = active[keep], error[keep]
+        if active.size == 0:
+            break
+        rates = _pose_rates(mechanism, poses[active])  # (N, 6, n_task) of the platform frame's origin
+        rotation, translation = mechanism.transforms_from_poses(poses[active])
+        jacobian = np.empty((active.size, len(selected), mechanism.n_task))
+        for row, (chain_index, joint) in enumerate(selected):
+            chain = mechanism.chains[chain_index]
+            frames = chain_forward_kinematics(chain.geometry, previous[chain_index])
+            _, end = mechanism.loop_targets(chain_index, rotation, translation)
+            # velocity of the loop frame's origin: v_end = v_origin + omega x (end - origin)
+            arm = end - translation
+            loop_rates = rates.copy()
+            loop_rates[:, 3:] += np.swapaxes(np.cross(np.swapaxes(rates[:, :3], 1, 2), arm[:, None, :]), 1, 2)
+            joint_rates = np.linalg.pinv(chain_jacobian(chain.geometry, frames)) @ loop_rates
+            jacobian[:, row] = joint_rates[:, joint]
+        update = -(np.linalg.pinv(jacobian) @ error[..., None])[..., 0]
+        largest = np.max(np.abs(update), axis=-1)
+        update *= np.minimum(1.0, 0.2 * mechanism.length_scale / np.maximum(largest, 1e-300))[:, None]
+        usable = np.all(np.isfinite(update), axis=-1)
+        poses[active[usable]] += update[usable]
+    solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), tolerance=1e-13, limits=limits)
+    converged = converged.reshape(batch)
+    return Solution(
+        poses=solution.poses,
+        reachable=solution.reachable & converged,
+        chain_reachable=solution.chain_reachable & converged[..., None],
+        status=np.where(converged[..., None], solution.status, np.maximum(solution.status, 1)).astype(np.int8),
+        residuals=solution.residuals,
+        limit_joints=solution.limit_joints,
+        joint_axes=solution.joint_axes,
+        joint_points=solution.joint_points,
+        value_sources=solution.joint_values,
+    )
+

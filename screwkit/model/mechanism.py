@@ -1,0 +1,224 @@
+"""The mechanism model: an immutable record of a closed-loop mechanism and its platform poses.
+
+A :class:`Mechanism` holds what a file describes (the chains, their joints and actuators, the
+platform joint, the reference assembly, named poses) and what was derived from it once when it
+was loaded (each chain's closure solver and working mode, the platform's DOF). It never
+changes: closure solving (:mod:`screwkit.closure`), screws and indices are functions of a
+mechanism and of configurations, as Pinocchio's algorithms are of its ``Model``.
+Build one with :func:`screwkit.loader.load`.
+
+Frames: poses are the platform frame relative to the **base link** frame (the parent link of
+the platform's floating/planar joint), in task coordinates (:data:`PLANAR_TASK_COORDINATES`,
+:data:`SPATIAL_TASK_COORDINATES`); metres and radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.model.chain import Chain, ChainGeometry
+from screwkit.model.urdf_reader import UrdfDescription
+from screwkit.rotations import rotation_about_axis, rotation_from_rpy, rpy_from_rotation
+from screwkit.units import is_angular
+
+__all__ = ["Mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
+
+PLANAR_TASK_COORDINATES = ("x", "y", "phi")
+"""Task coordinates of a planar mechanism: platform position in the base x-y plane (m) and
+its rotation about the base z axis (rad)."""
+SPATIAL_TASK_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
+"""Task coordinates of a spatial mechanism: platform position (m) and orientation
+``R = Rz(yaw) Ry(pitch) Rx(roll)`` (rad, fixed axes, the URDF ``rpy`` convention)."""
+
+
+@dataclass(frozen=True, repr=False, eq=False)
+class Mechanism:
+    """A redundantly actuated closed-loop mechanism (immutable).
+
+    Attributes
+    ----------
+    name : str
+        The robot's name (the file name when the file names none).
+    path : str
+        The file it was read from.
+    description : UrdfDescription
+        What the file says (the safe XML pass), lengths in metres.
+    pinocchio_model : pinocchio.Model
+        The kinematic tree (loops are not part of it).
+    is_planar : bool
+        The platform hangs from a ``planar`` joint (else ``floating``).
+    task_coordinates : tuple of str
+        :data:`PLANAR_TASK_COORDINATES` or :data:`SPATIAL_TASK_COORDINATES`.
+    base_link, platform_link, platform_joint : str
+        The links the platform joint connects, and its name.
+    platform_joint_id : int
+        Pinocchio id of the platform joint.
+    platform_frame_placement : pinocchio.SE3
+        Placement of the platform link's frame in the platform joint's frame.
+    rotation_world_base, translation_world_base : ndarray, shapes (3, 3) and (3,)
+        Placement of the base link frame in the world frame (the URDF root).
+    home_rotation, home_translation : ndarray, shapes (3, 3) and (3,)
+        The platform frame in the base frame at the reference assembly.
+    chains : tuple of Chain
+        In ``<loop>`` file order.
+    dof : int
+        Mobility of the platform at the reference assembly (dimension of the intersection of
+        the chains' twist spaces).
+    length_scale : float
+        A characteristic length of the mechanism (m): the largest distance of a joint of the
+        reference assembly from the base frame origin (at least 1 mm). Used for step sizes of
+        continuation and for judging point coincidences relative to the mechanism's size.
+    named_poses : dict of str to ndarray
+        Documented poses (task coordinates, m and rad): ``home`` (the reference assembly) and
+        those of the file's ``<named_pose>`` elements.
+    length_unit : str
+        The unit the file was written in (converted to metres when read).
+    """
+
+    name: str
+    path: str
+    description: UrdfDescription = field(repr=False)
+    pinocchio_model: Any = field(repr=False)
+    is_planar: bool
+    task_coordinates: tuple[str, ...]
+    base_link: str
+    platform_link: str
+    platform_joint: str
+    platform_joint_id: int
+    platform_frame_placement: Any = field(repr=False)
+    rotation_world_base: NDArray[np.float64] = field(repr=False)
+    translation_world_base: NDArray[np.float64] = field(repr=False)
+    home_rotation: NDArray[np.float64] = field(repr=False)
+    home_translation: NDArray[np.float64] = field(repr=False)
+    chains: tuple[Chain, ...]
+    dof: int
+    length_scale: float
+    named_poses: dict[str, NDArray[np.float64]] = field(repr=False)
+    length_unit: str = "m"
+
+    # -- derived -------------------------------------------------------------------------
+
+    @property
+    def n_task(self) -> int:
+        """Number of task coordinates (3 planar, 6 spatial)."""
+        return len(self.task_coordinates)
+
+    @property
+    def home_pose(self) -> NDArray[np.float64]:
+        """Task coordinates of the reference assembly (a copy)."""
+        return np.array(self.named_poses["home"], dtype=float)
+
+    @property
+    def actuators(self) -> tuple[tuple[str, str], ...]:
+        """``(chain name, joint name)`` of every actuated joint, in chain order: the set A."""
+        return tuple((chain.name, chain.joint_names[index]) for chain in self.chains for index in chain.actuated)
+
+    @property
+    def actuator_names(self) -> tuple[str, ...]:
+        """Every actuator as ``chain:joint``, in :attr:`actuators` order."""
+        return tuple(f"{chain}:{joint}" for chain, joint in self.actuators)
+
+    @property
+    def geometries(self) -> tuple[ChainGeometry, ...]:
+        """Each chain's constant geometry (base frame)."""
+        return tuple(chain.geometry for chain in self.chains)
+
+    @property
+    def base_is_world(self) -> bool:
+        """Whether the base link frame is the world frame."""
+        return bool(np.array_equal(self.rotation_world_base, np.eye(3)) and not np.any(self.translation_world_base))
+
+    @property
+    def angular(self) -> NDArray[np.bool_]:
+        """Which task coordinates are angles (phi, roll, pitch, yaw)."""
+        return np.array([is_angular(name) for name in self.task_coordinates])
+
+    def __repr__(self) -> str:
+        return (f"Mechanism(name={self.name!r}, dof={self.dof}, chains={len(self.chains)}, "
+                f"actuators={len(self.actuators)}, task_coordinates={self.task_coordinates})")
+
+    # -- poses ---------------------------------------------------------------------------
+
+    def check_poses(self, poses: ArrayLike) -> NDArray[np.float64]:
+        """Poses as a float array (..., n_task) with finite values, or a ValueError saying what arrived."""
+        try:
+            poses = np.asarray(poses, dtype=float)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"Expected numeric `poses` for mechanism {self.name!r}: {error}") from None
+        if poses.ndim == 0 or poses.shape[-1] != self.n_task:
+            raise ValueError(
+                f"Expected `poses` with shape (..., {self.n_task}) for mechanism {self.name!r} "
+                f"({', '.join(self.task_coordinates)}), got {poses.shape}."
+            )
+        if not np.all(np.isfinite(poses)):
+            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(poses))[0])
+            raise ValueError(f"Expected finite values in `poses`, got {poses[bad]} at index {bad}.")
+        return poses
+
+    def named_pose(self, name: str) -> NDArray[np.float64]:
+        """A documented pose by name (m, rad); a ValueError lists the names."""
+        if name not in self.named_poses:
+            raise ValueError(f"Unknown pose {name!r} of mechanism {self.name!r}; named poses are "
+                             f"{', '.join(self.named_poses)}.")
+        return np.array(self.named_poses[name], dtype=float)
+
+    def poses_from_degrees(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Task coordinates with angles in degrees -> radians (checked)."""
+        poses = self.check_poses(values).copy()
+        poses[..., self.angular] = np.deg2rad(poses[..., self.angular])
+        return poses
+
+    def transforms_from_poses(self, poses: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Platform frames (rotation (..., 3, 3), translation (..., 3)) in the base frame."""
+        poses = np.asarray(poses, dtype=float)
+        if self.is_planar:
+            rotation = rotation_about_axis(np.array([0.0, 0.0, 1.0]), poses[..., 2])
+            translation = np.stack(
+                [poses[..., 0], poses[..., 1], np.full(poses.shape[:-1], self.home_translation[2])], -1
+            )
+            return rotation, translation
+        return rotation_from_rpy(poses[..., 3:]), poses[..., :3].copy()
+
+    def poses_from_transforms(self, rotation: ArrayLike, translation: ArrayLike) -> NDArray[np.float64]:
+        """Task coordinates of platform frames given in the base frame."""
+        rotation = np.asarray(rotation, dtype=float)
+        translation = np.asarray(translation, dtype=float)
+        if self.is_planar:
+            return np.stack(
+                [translation[..., 0], translation[..., 1], np.arctan2(rotation[..., 1, 0], rotation[..., 0, 0])], -1
+            )
+        return np.concatenate([translation, rpy_from_rotation(rotation)], -1)
+
+    def loop_targets(self, index: int, platform_rotation: NDArray, platform_translation: NDArray):
+        """The platform-side loop frame of chain ``index`` (base frame) for platform frames (..., 3, 3), (..., 3)."""
+        geometry = self.chains[index].geometry
+        return (
+            platform_rotation @ geometry.platform_loop_rotation,
+            platform_translation + platform_rotation @ geometry.platform_loop_translation,
+        )
+
+    # -- actuators -----------------------------------------------------------------------
+
+    def actuator_positions(self, actuators=None) -> list[tuple[int, int]]:
+        """``(chain index, joint index)`` of actuators given by index into :attr:`actuators`,
+        ``(chain, joint)`` names or ``chain:joint`` names (default: all)."""
+        if actuators is None:
+            actuators = range(len(self.actuators))
+        chain_names = [chain.name for chain in self.chains]
+        selected = []
+        for actuator in actuators:
+            if isinstance(actuator, (int, np.integer)):
+                if not 0 <= actuator < len(self.actuators):
+                    raise ValueError(f"Expected actuator indices in 0..{len(self.actuators) - 1}, got {actuator}.")
+                chain_name, joint_name = self.actuators[actuator]
+            else:
+                chain_name, joint_name = actuator.split(":", 1) if isinstance(actuator, str) else actuator
+                if (chain_name, joint_name) not in self.actuators:
+                    raise ValueError(f"Unknown actuator {actuator!r}; actuators are {', '.join(self.actuator_names)}.")
+            chain_index = chain_names.index(chain_name)
+            selected.append((chain_index, self.chains[chain_index].joint_names.index(joint_name)))
+        return selected

@@ -1,0 +1,13 @@
+"""Studies: indices at poses, sweeps, workspace maps and design searches of a mechanism.
+
+* :func:`indices_at_poses`, :func:`indices_at_pose` (:mod:`~screwkit.studies.poses`): closure ->
+  screws -> :class:`~screwkit.results.Indices`;
+* :func:`~screwkit.studies.sweep.sweep`: the paper's Fig. 4 series along one coordinate;
+* :mod:`~screwkit.studies.maps`: the Fig. 5 maps (minimum over an orientation set on a grid);
+* :mod:`~screwkit.studies.design`: the paper's permutation selection and design optimisation;
+* :mod:`~screwkit.studies.tasks` (Dask) and :mod:`~screwkit.studies.files` (atomic netCDF/CSV).
+"""
+
+from screwkit.studies.poses import indices_at_pose, indices_at_poses
+
+__all__ = ["indices_at_poses", "indices_at_pose"]

@@ -1,0 +1,428 @@
+"""Workspace maps: at each grid position, the minimum of every index over an orientation set.
+
+:func:`index_map` evaluates a 2-D grid of two task coordinates (the rest fixed) and, at
+each grid point, every pose of an orientation set (the product of ranges of other task
+coordinates); it keeps the minimum of the ITI, LMTI, F_Oj and F_IOj over the set, like the
+paper's Fig. 5. :func:`planar_disc_map` is the paper's case: x, y on a disc, phi over a
+full turn.
+
+The grid is cut into rectangular blocks of about :data:`CONFIGURATIONS_PER_TASK`
+configurations, run as tasks through Dask (:func:`screwkit.studies.tasks.run_tasks`): the local
+threaded scheduler by default, or a running ``dask.distributed`` cluster. A task receives only
+its block's coordinates and mask and returns only the block's minima, so memory beyond the
+output grid does not grow with the number of configurations; :func:`map_size` states the size
+of a map before anything is allocated. Tasks are pure functions of their inputs (the URDF text
+travels with them), so a task lost with a worker is recomputed elsewhere.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.loader import cached_mechanism
+from screwkit.model import Mechanism
+from screwkit.studies.files import atomic_write
+from screwkit.studies.poses import indices_at_poses
+from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.units import is_angular, unit_of
+
+__all__ = ["index_map", "planar_disc_map", "disc_grid", "GridMap", "MapSize", "map_size", "map_task"]
+
+CONFIGURATIONS_PER_TASK = 131_072
+"""Configurations (grid points times orientations) per task."""
+MAX_CONFIGURATIONS = 2_000_000_000
+"""Maps with more configurations are refused unless the caller says to proceed (``--yes``)."""
+
+
+@dataclass(frozen=True)
+class MapSize:
+    """The size of a map, known before it is computed.
+
+    Attributes
+    ----------
+    grid_points : int
+        Grid points evaluated (inside the mask).
+    orientations : int
+        Poses of the orientation set at every grid point.
+    variables : int
+        Variables of the output grid.
+    grid_shape : tuple of int
+        (len(y), len(x)).
+    """
+
+    grid_points: int
+    orientations: int
+    variables: int
+    grid_shape: tuple[int, int]
+
+    @property
+    def configurations(self) -> int:
+        """Poses evaluated: grid points times orientations."""
+        return self.grid_points * self.orientations
+
+    @property
+    def memory_bytes(self) -> int:
+        """Memory of the result: every variable on the whole grid, plus the mask and coordinates."""
+        cells = self.grid_shape[0] * self.grid_shape[1]
+        return int(cells * (8 * self.variables + 1) + 8 * sum(self.grid_shape))
+
+    def check(self, *, max_configurations: int = MAX_CONFIGURATIONS, proceed: bool = False,
+              available_bytes: int | None = None) -> None:
+        """Refuse, with one line, a map that would not fit in memory or is larger than stated without ``proceed``."""
+        available = _available_memory() if available_bytes is None else available_bytes
+        summary = (f"{self.configurations:,} configurations ({self.grid_points:,} grid points x "
+                   f"{self.orientations:,} orientations)")
+        if available is not None and self.memory_bytes > 0.8 * available:
+            raise ValueError(f"The map has {summary}; its result alone needs {_bytes(self.memory_bytes)}, more than "
+                             f"this machine can give ({_bytes(available)} available): use a coarser grid.")
+        if self.configurations > max_configurations and not proceed:
+            raise ValueError(f"The map has {summary}, more than {max_configurations:,}; it would run for a long time "
+                             f"and its result needs {_bytes(self.memory_bytes)}: use a coarser grid, or pass --yes "
+                             "to proceed.")
+
+
+def _bytes(count: int) -> str:
+    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if count >= size:
+            return f"{count / size:.1f} {unit}"
+    return f"{count} B"
+
+
+def _available_memory() -> int | None:
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+@dataclass
+class GridMap:
+    """A computed map as plain numpy arrays, before (or without) xarray.
+
+    :func:`index_map` returns it with ``as_dataset=False``; the command line writes it to
+    netCDF directly (:meth:`write_netcdf`), which spares the import of xarray, pandas and
+    dask.array (about 1 s of a map command's start-up).
+
+    Attributes
+    ----------
+    coordinates : dict of str to (ndarray, str)
+        The two grid coordinates, x axis first: values (as shown: degrees for angles) and unit.
+    variables : dict of str to ndarray (len(y), len(x))
+        The minimum of each index over the orientation set (NaN outside the mask or where some
+        orientation is unreachable), and ``reachable_fraction``.
+    long_names : dict of str to str
+        A description of each variable.
+    attrs : dict
+        Global attributes (mechanism, method, orientation set, ...).
+    """
+
+    coordinates: dict[str, tuple[NDArray[np.float64], str]]
+    variables: dict[str, NDArray[np.float64]]
+    long_names: dict[str, str]
+    attrs: dict = field(default_factory=dict)
+
+    def to_dataset(self):
+        """The same map as an ``xarray.Dataset`` (what :func:`index_map` returns by default)."""
+        import xarray as xr
+
+        (x_name, _), (y_name, _) = self.coordinates.items()
+        dataset = xr.Dataset(
+            {key: ((y_name, x_name), values) for key, values in self.variables.items()},
+            coords={name: (name, values, {"units": unit}) for name, (values, unit) in self.coordinates.items()})
+        for key, long_name in self.long_names.items():
+            dataset[key].attrs["long_name"] = long_name
+        dataset.attrs.update(self.attrs)
+        return dataset
+
+    def write_netcdf(self, path) -> None:
+        """Write a netCDF-3 file (``scipy.io.netcdf_file``) atomically; ``xarray.open_dataset`` reads it."""
+        from scipy.io import netcdf_file
+
+        (x_name, _), (y_name, _) = self.coordinates.items()
+
+        def write(temporary):
+            with netcdf_file(temporary, "w", version=2) as handle:
+                for name, (values, unit) in self.coordinates.items():
+                    handle.createDimension(name, values.size)
+                    variable = handle.createVariable(name, "d", (name,))
+                    variable[:] = values
+                    variable.units = unit
+                for key, values in self.variables.items():
+                    variable = handle.createVariable(key, "d", (y_name, x_name))
+                    variable[:] = values
+                    if key in self.long_names:
+                        variable.long_name = self.long_names[key]
+                for key, value in self.attrs.items():
+                    if key in handle.__dict__:
+                        raise ValueError(f"Cannot write a global attribute named {key!r} to netCDF.")
+                    setattr(handle, key, _netcdf_attribute(value))
+
+        atomic_write(path, write)
+
+
+def _netcdf_attribute(value):
+    """A global attribute in the type xarray's own netCDF-3 writer gives it (floats stay double)."""
+    if isinstance(value, (bool, np.bool_)):
+        return np.int8(value)
+    if isinstance(value, (int, np.integer)):
+        return np.int32(value) if abs(int(value)) < 2**31 else np.float64(value)
+    if isinstance(value, (float, np.floating)):
+        return np.float64(value)
+    return value
+
+
+def portable(mechanism: Mechanism) -> tuple[str, str, str]:
+    """What a task needs to rebuild the mechanism anywhere: (digest, URDF text in metres, source name)."""
+    text = mechanism.description.text
+    text = text if isinstance(text, str) else text.decode()
+    return hashlib.sha256(text.encode()).hexdigest(), text, str(mechanism.path)
+
+
+def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_axes, over_values, threshold,
+             faults, closed_forms, limits=True, threads=1) -> dict:
+    """Minimum of each index over the orientation set at the grid points of one block.
+
+    Parameters
+    ----------
+    mechanism_text : tuple
+        From :func:`portable`.
+    at : ndarray (n_task,)
+        The fixed coordinates.
+    x_axis, y_axis : int
+        Task coordinates of the grid's x and y.
+    x_values, y_values : ndarray
+        The block's grid values (m, rad).
+    mask : ndarray of bool, shape (len(y_values), len(x_values))
+        Grid points of the block to evaluate.
+    over_axes : tuple of int
+        Task coordinates making up the orientation set.
+    over_values : ndarray (K, len(over_axes))
+        Every orientation of the set.
+
+    Returns
+    -------
+    dict of ndarray (P,)
+        For the P masked points of the block in row-major order: ``iti``, ``lmti``,
+        ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is unreachable) and
+        ``reachable_fraction``.
+    """
+    mechanism = cached_mechanism(*mechanism_text)
+    rows, columns = np.nonzero(mask)
+    base = np.repeat(np.asarray(at, dtype=float)[None], rows.size, axis=0)
+    base[:, x_axis] = x_values[columns]
+    base[:, y_axis] = y_values[rows]
+    orientations = over_values.shape[0]
+    poses = np.repeat(base[:, None, :], orientations, axis=1)
+    for column, axis in enumerate(over_axes):
+        poses[:, :, axis] = over_values[None, :, column]
+    result = indices_at_poses(mechanism, poses, threshold=threshold, faults=faults, closed_forms=closed_forms,
+                              threads=threads, limits=limits)
+    everywhere = result.reachable.all(axis=1)
+    out = {"reachable_fraction": result.reachable.mean(axis=1)}
+    named = {"iti": result.iti, "lmti": result.lmti}
+    for j in result.faults:
+        named[f"f_o{j}"] = result.f_o[j]
+        named[f"f_io{j}"] = result.f_io[j]
+    for name, values in named.items():
+        out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
+    return out
+
+
+def _blocks(mask: NDArray[np.bool_], per_task: int) -> list[tuple[slice, slice]]:
+    """Rectangular blocks of the grid (row slice, column slice) with about ``per_task`` masked points each."""
+    counts = mask.sum(axis=1)
+    blocks, start, total = [], 0, 0
+    for row, count in enumerate(counts):
+        if count > per_task:  # one long row: split its columns
+            if row > start:
+                blocks.append((slice(start, row), slice(None)))
+            columns = np.flatnonzero(mask[row])
+            for first in range(0, columns.size, per_task):
+                chosen = columns[first:first + per_task]
+                blocks.append((slice(row, row + 1), slice(int(chosen[0]), int(chosen[-1]) + 1)))
+            start, total = row + 1, 0
+            continue
+        if total + count > per_task and row > start:
+            blocks.append((slice(start, row), slice(None)))
+            start, total = row, 0
+        total += count
+    if start < mask.shape[0]:
+        blocks.append((slice(start, mask.shape[0]), slice(None)))
+    return [block for block in blocks if mask[block].any()]
+
+
+def _orientation_set(over: dict[str, ArrayLike]) -> NDArray[np.float64]:
+    if not over:
+        return np.zeros((1, 0))
+    return np.stack([g.ravel() for g in np.meshgrid(*[np.asarray(v, float) for v in over.values()], indexing="ij")],
+                    axis=-1)
+
+
+def map_size(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
+             mask: NDArray[np.bool_] | None = None, faults=None) -> MapSize:
+    """How many grid points, orientations and configurations a map has, and the memory of its result."""
+    (_, x_values), (_, y_values) = ((k, np.asarray(v)) for k, v in grid.items())
+    shape = (y_values.size, x_values.size)
+    points = int(np.count_nonzero(mask)) if mask is not None else shape[0] * shape[1]
+    orientations = int(np.prod([np.asarray(v).size for v in over.values()], dtype=np.int64)) if over else 1
+    a = len(mechanism.actuators)
+    j_count = (a - mechanism.dof) if faults is None else len(np.atleast_1d(faults))
+    return MapSize(points, orientations, 3 + 2 * max(j_count, 0), shape)
+
+
+def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
+              at: ArrayLike | None = None, *, mask: NDArray[np.bool_] | None = None,
+              threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False,
+              limits: bool = True, scheduler=None, progress: bool | None = None,
+              connect_timeout: float = CONNECT_TIMEOUT, configurations_per_task: int = CONFIGURATIONS_PER_TASK,
+              as_dataset: bool = True, proceed: bool = False, max_configurations: int = MAX_CONFIGURATIONS):
+    """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    grid : dict of str to array_like
+        Exactly two task coordinates and their values (metres / radians); the first is the
+        map's x axis, the second its y axis.
+    over : dict of str to array_like
+        The orientation set: task coordinates and their values; the set is their product.
+    at : array_like (n_task,), optional
+        Values of the other coordinates (default: the home pose).
+    mask : ndarray of bool, shape (len(y), len(x)), optional
+        Grid points to evaluate (others are NaN).
+    threshold, faults, closed_forms, limits :
+        As in :func:`screwkit.studies.indices_at_poses`.
+    scheduler : str or distributed.Client, optional
+        ``dask.distributed`` scheduler address (default: local threads).
+    progress : bool, optional
+        Progress bar on stderr (default: when stderr is a terminal).
+    connect_timeout : float
+        Seconds to wait for the scheduler.
+    configurations_per_task : int
+        Grid points times orientations per task.
+    as_dataset : bool
+        Return an ``xarray.Dataset`` (default) or the plain :class:`GridMap`.
+    proceed, max_configurations :
+        Maps with more configurations are refused unless ``proceed`` (see :meth:`MapSize.check`).
+
+    Returns
+    -------
+    xarray.Dataset or GridMap
+        Coordinates named after the two grid coordinates (``x``, ``y`` for planar maps);
+        variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
+        orientation of the set) and ``reachable_fraction``.
+    """
+    names = mechanism.task_coordinates
+    if len(grid) != 2:
+        raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
+    for name in list(grid) + list(over):
+        if name not in names:
+            raise ValueError(f"Unknown task coordinate {name!r}; mechanism {mechanism.name!r} has {names}.")
+    if set(grid) & set(over):
+        raise ValueError(f"A coordinate cannot be both on the grid and in the orientation set: {set(grid) & set(over)}.")
+    (x_name, x_values), (y_name, y_values) = ((k, np.asarray(v, dtype=float)) for k, v in grid.items())
+    shape = (y_values.size, x_values.size)
+    if mask is not None:
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != shape:
+            raise ValueError(f"Expected `mask` with shape {shape} (y, x), got {mask.shape}.")
+    size = map_size(mechanism, grid, over, mask, faults)
+    size.check(max_configurations=max_configurations, proceed=proceed)
+    mask = np.ones(shape, dtype=bool) if mask is None else mask
+    at = mechanism.check_poses(mechanism.home_pose if at is None else at)
+    over_axes = tuple(names.index(name) for name in over)
+    over_values = _orientation_set(over)
+    per_task = max(1, configurations_per_task // max(1, over_values.shape[0]))
+    faults = None if faults is None else tuple(np.atleast_1d(faults).tolist())
+    text = portable(mechanism)
+    blocks = _blocks(mask, per_task)
+    arguments = [(text, at, names.index(x_name), x_values[columns], names.index(y_name), y_values[rows],
+                  mask[rows, columns], over_axes, over_values, threshold, faults, closed_forms, limits)
+                 for rows, columns in blocks]
+    results = run_tasks(map_task, arguments, scheduler=scheduler, progress=progress, label="map",
+                        connect_timeout=connect_timeout)
+    keys = results[0].keys() if results else ("iti", "lmti", "reachable_fraction")
+    variables = {key: np.full(shape, np.nan) for key in keys}
+    for (rows, columns), result in zip(blocks, results):
+        block_mask = mask[rows, columns]
+        for key in keys:
+            view = variables[key][rows, columns]
+            view[block_mask] = result[key]
+    angular = {name: is_angular(name) for name in names}
+
+    def shown(name, values):
+        return np.rad2deg(values) if angular[name] else values
+
+    grid_map = GridMap(
+        coordinates={x_name: (shown(x_name, x_values), unit_of(x_name)), y_name: (shown(y_name, y_values), unit_of(y_name))},
+        variables=variables,
+        long_names={key: f"minimum of {key} over the orientation set" for key in variables if key != "reachable_fraction"},
+        attrs=dict(
+            mechanism=mechanism.name, threshold_m=threshold,
+            method="closed forms" if closed_forms else "generic screw path",
+            orientation_set="; ".join(
+                f"{name}: {len(np.unique(over_values[:, i]))} values from {shown(name, over_values[:, i].min()):g} "
+                f"to {shown(name, over_values[:, i].max()):g} {unit_of(name)}" for i, name in enumerate(over))
+            or "the fixed pose only",
+            fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
+            joint_limits="respected" if limits else "ignored",
+            configurations=int(size.configurations)))
+    return grid_map.to_dataset() if as_dataset else grid_map
+
+
+def disc_grid(radius: float, step: float, centre=(0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray[np.bool_]]:
+    """x and y values of a square grid of spacing ``step`` about ``centre``, and the mask of the disc of ``radius``."""
+    for name, value in (("radius", radius), ("step", step)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"Expected `{name}` > 0, got {value}.")
+    count = int(math.floor(radius / step + 1e-9))
+    offsets = step * np.arange(-count, count + 1)
+    mask = offsets[None, :] ** 2 + offsets[:, None] ** 2 <= radius**2 * (1 + 1e-12)
+    return centre[0] + offsets, centre[1] + offsets, mask
+
+
+def disc_size(mechanism: Mechanism, radius: float, step: float, phi_step_degrees: float) -> MapSize:
+    """The size of :func:`planar_disc_map`'s map, computed without allocating its grid."""
+    for name, value in (("radius", radius), ("step", step), ("phi_step_degrees", phi_step_degrees)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"Expected `{name}` > 0, got {value}.")
+    count = int(math.floor(radius / step + 1e-9))
+    offsets = step * np.arange(-count, count + 1, dtype=float) if count < 10**7 else None
+    if offsets is None:  # too many rows to list: the disc's area is close enough for a refusal
+        points = int(math.pi * (radius / step) ** 2)
+    else:
+        half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
+        points = int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
+    orientations = len(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees)) if phi_step_degrees >= 1e-6 else 10**12
+    a = len(mechanism.actuators)
+    return MapSize(points, orientations, 3 + 2 * max(a - mechanism.dof, 0), (2 * count + 1, 2 * count + 1))
+
+
+def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_degrees: float, *, centre=None,
+                    proceed: bool = False, **options):
+    """The paper's Fig. 5 map: x, y on a disc about ``centre`` (default the home pose), phi over a full turn.
+
+    ``step`` is the grid spacing (m) and ``phi_step_degrees`` the angular step of the
+    rotation 0 <= phi < 360 deg. Other options as in :func:`index_map`.
+    """
+    if not mechanism.is_planar:
+        raise ValueError(f"planar_disc_map needs a planar mechanism; {mechanism.name!r} is spatial (use index_map).")
+    if phi_step_degrees > 360:
+        raise ValueError(f"Expected a phi step of at most 360 deg, got {phi_step_degrees:g}.")
+    disc_size(mechanism, radius, step, phi_step_degrees).check(
+        proceed=proceed, max_configurations=options.get("max_configurations", MAX_CONFIGURATIONS))
+    home = mechanism.home_pose
+    centre = home[:2] if centre is None else np.asarray(centre, dtype=float)
+    x_values, y_values, mask = disc_grid(radius, step, centre)
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
+    result = index_map(mechanism, {"x": x_values, "y": y_values}, {"phi": phi}, home, mask=mask, proceed=proceed,
+                       **options)
+    result.attrs.update(radius_m=radius, step_m=step, phi_step_deg=phi_step_degrees)
+    return result

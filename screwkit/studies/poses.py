@@ -1,0 +1,222 @@
+"""Indices of a mechanism at platform poses: closure -> screws -> indices, in chunks.
+
+This is the layer sweeps, maps, design searches, the command line and the viewer stand on:
+:func:`indices_at_poses` solves the closures of a batch of poses, hands the screws of the
+reachable ones to :func:`screwkit.transmission.analyze` (or to the paper's planar closed forms)
+and returns one :class:`~screwkit.results.Indices` with NaN where a pose is unreachable;
+:func:`indices_at_pose` does one pose and says why it is unreachable.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from itertools import combinations
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.closed_forms import planar_indices
+from screwkit.closure import chain_screws, solve, solve_one, thread_limit
+from screwkit.model import Mechanism
+from screwkit.results import Indices
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.transmission import analyze
+
+__all__ = ["indices_at_poses", "indices_at_pose", "planar_points", "closed_form_indices"]
+
+
+def planar_points(mechanism: Mechanism, solution):
+    """Planar joint points of every chain in the base frame (reachable configurations), for the closed forms.
+
+    Returns ``(base, elbows, distal, prismatic)``: arrays (N, k, 2) of the first, second and
+    last joint points of each 3-joint planar chain, and whether the chains are RPR (actuated
+    prismatic middle joint) rather than RRR (actuated base joint).
+    """
+    if not mechanism.is_planar:
+        raise ValueError(f"The closed forms are planar: mechanism {mechanism.name!r} is spatial.")
+    kinds = set()
+    for chain in mechanism.chains:
+        prismatic = tuple(chain.prismatic)
+        if chain.n_joints != 3 or chain.actuated not in ((0,), (1,)):
+            raise ValueError(f"The closed forms need RRR or RPR chains with one actuator; chain {chain.name!r} "
+                             f"has {chain.n_joints} joints, actuated {chain.actuated}.")
+        if prismatic == (False, False, False) and chain.actuated == (0,):
+            kinds.add("rrr")
+        elif prismatic == (False, True, False) and chain.actuated == (1,):
+            kinds.add("rpr")
+        else:
+            raise ValueError(f"The closed forms need RRR (base actuated) or RPR (prismatic actuated) chains; "
+                             f"chain {chain.name!r} is not one.")
+    if len(kinds) != 1:
+        raise ValueError(f"The closed forms need chains of one kind, got {sorted(kinds)}.")
+    mask = np.asarray(solution.reachable).reshape(-1)
+    everything = bool(mask.all())
+    count = int(mask.size if everything else mask.sum())
+    # Joint points in the base frame, reachable configurations only, stored component-major
+    # (joint, component, chain, configuration) so that every copy below is contiguous; the
+    # returned (N, k, 2) arrays are views of it (the closed-form kernel reads any layout).
+    memory = np.empty((3, 2, len(solution.joint_points), count))
+    for chain, points in enumerate(solution.joint_points):
+        flat = points.reshape(-1, 3, 3)
+        for joint in range(3):
+            for component in range(2):
+                column = flat[:, joint, component]
+                memory[joint, component, chain] = column if everything else column[mask]
+    base, elbows, distal = (memory[joint].transpose(2, 1, 0) for joint in range(3))
+    return base, elbows, distal, kinds == {"rpr"}
+
+
+def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGULARITY_THRESHOLD, faults=None,
+                        threads: int | None = None) -> Indices:
+    """The paper's planar closed forms at the reachable configurations of a solution (a 1-D batch).
+
+    ITI per chain (Eq. 23; 1 for RPR chains, whose input is along the force), the OTI of every
+    3-chain submechanism (Eqs. 34, A4), LMTI, F_Oj, F_IOj, the worst faults and the
+    mutual-interference actuators, all from :func:`screwkit.closed_forms.planar_indices`.
+    """
+    base, elbows, distal, prismatic = planar_points(mechanism, solution)
+    if prismatic:
+        direction = distal - base
+        closed = planar_indices(base, None, distal, threshold=threshold, faults=faults, threads=threads,
+                                directions=direction / np.linalg.norm(direction, axis=-1, keepdims=True))
+    else:
+        closed = planar_indices(base, elbows, distal, threshold=threshold, faults=faults, threads=threads)
+    return Indices(
+        actuators=mechanism.actuator_names, dof=3, submechanisms=closed["submechanisms"], iti=closed["iti"],
+        lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
+        mutual_interference=closed["mutual_interference"], threshold=threshold,
+        iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
+        task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name)
+
+
+def _allocate(count: int, result: Indices, detail: bool) -> dict[str, NDArray]:
+    """Output arrays for a whole batch, NaN (unreachable) until filled."""
+    a = result.actuator_count
+    arrays = {"iti": np.full(count, np.nan), "lmti": np.full(count, np.nan),
+              "mutual_interference": np.zeros((count, a), dtype=bool)}
+    for j in result.faults:
+        arrays[f"f_o{j}"] = np.full(count, np.nan)
+        arrays[f"f_io{j}"] = np.full(count, np.nan)
+        arrays[f"worst{j}"] = np.full((count, j), -1, dtype=np.int64)
+    if detail:
+        arrays["iti_actuators"] = np.full((count, a), np.nan)
+        if result.oti_submechanisms is not None:
+            arrays["oti_submechanisms"] = np.full((count, result.oti_submechanisms.shape[-1]), np.nan)
+    return arrays
+
+
+def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = False,
+                     threshold: float = SINGULARITY_THRESHOLD, faults=None, chunk_size: int = 262_144,
+                     progress: Callable[[int], None] | None = None, threads: int | None = None,
+                     closed_forms: bool = False, limits: bool = True) -> Indices:
+    """Solve the closures of ``poses`` and compute every index at the reachable ones.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    poses : array_like, shape (..., n_task)
+        Task coordinates in metres and radians.
+    detail : bool
+        Also keep the ITI per actuator and the OTI per submechanism (for :meth:`Indices.lmti_of`).
+    threshold : float
+        Singularity threshold *p* (m).
+    faults : int or sequence of int, optional
+        ``j`` values (default all).
+    chunk_size : int
+        Poses solved and analysed at a time (memory stays bounded).
+    progress : callable, optional
+        Called with the number of poses done after each chunk.
+    threads : int, optional
+        Threads for the index kernel, and at most as many for closure solving and screws
+        (default: all cores).
+    closed_forms : bool
+        Use the paper's planar closed forms instead of the generic screw path (planar RRR/RPR
+        mechanisms only; see :func:`planar_points`).
+    limits : bool
+        Whether poses that put a joint outside its position limits are unreachable (default).
+
+    Returns
+    -------
+    Indices
+        Batch shape of ``poses``; NaN (and no worst fault) where unreachable.
+    """
+    poses = mechanism.check_poses(poses)
+    batch = poses.shape[:-1]
+    flat = poses.reshape(-1, mechanism.n_task)
+    count = flat.shape[0]
+    reachable = np.zeros(count, dtype=bool)
+    arrays: dict[str, NDArray] | None = None
+    meta: Indices | None = None
+    with thread_limit(threads):  # closures and screws on no more threads than the kernel
+        for start in range(0, count, chunk_size):
+            part = slice(start, min(start + chunk_size, count))
+            solution = solve(mechanism, flat[part], limits=limits)
+            index = np.flatnonzero(np.asarray(solution.reachable)) + start
+            reachable[index] = True
+            if index.size:
+                if closed_forms:
+                    result = closed_form_indices(mechanism, solution, threshold, faults, threads)
+                else:
+                    chains = chain_screws(mechanism, solution, unreachable="drop")
+                    result = analyze(chains, detail=detail, threshold=threshold, faults=faults, threads=threads)
+                if arrays is None:
+                    meta, arrays = result, _allocate(count, result, detail)
+                arrays["iti"][index] = result.iti
+                arrays["lmti"][index] = result.lmti
+                arrays["mutual_interference"][index] = result.mutual_interference
+                for j in result.faults:
+                    arrays[f"f_o{j}"][index] = result.f_o[j]
+                    arrays[f"f_io{j}"][index] = result.f_io[j]
+                    arrays[f"worst{j}"][index] = result.worst_fault_indices[j]
+                if detail:
+                    arrays["iti_actuators"][index] = result.iti_actuators
+                    if "oti_submechanisms" in arrays:
+                        arrays["oti_submechanisms"][index] = result.oti_submechanisms
+            if progress is not None:
+                progress(part.stop - part.start)
+
+    def shaped(name):
+        if arrays is None or name not in arrays:
+            return None
+        return arrays[name].reshape(batch + arrays[name].shape[1:])
+
+    a = len(mechanism.actuators)
+    if meta is None:  # nothing reachable: the structure of the indices from the mechanism alone
+        dof = mechanism.dof
+        faults_list = tuple(range(1, a - dof + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
+        nothing = np.full(batch, np.nan)
+        return Indices(actuators=mechanism.actuator_names, dof=dof,
+                       submechanisms=tuple(combinations(range(a), dof)), iti=nothing, lmti=nothing.copy(),
+                       f_o={j: nothing.copy() for j in faults_list}, f_io={j: nothing.copy() for j in faults_list},
+                       worst_fault_indices={j: np.full(batch + (j,), -1, dtype=np.int64) for j in faults_list},
+                       mutual_interference=np.zeros(batch + (a,), dtype=bool), threshold=threshold,
+                       iti_actuators=np.full(batch + (a,), np.nan) if detail else None,
+                       poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
+                       mechanism=mechanism.name)
+    return Indices(
+        actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms,
+        iti=shaped("iti"), lmti=shaped("lmti"),
+        f_o={j: shaped(f"f_o{j}") for j in meta.faults}, f_io={j: shaped(f"f_io{j}") for j in meta.faults},
+        worst_fault_indices={j: shaped(f"worst{j}") for j in meta.faults},
+        mutual_interference=shaped("mutual_interference"), threshold=threshold,
+        iti_actuators=shaped("iti_actuators"), oti_submechanisms=shaped("oti_submechanisms"),
+        poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
+        mechanism=mechanism.name)
+
+
+def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float = SINGULARITY_THRESHOLD,
+                    faults=None, limits: bool = True, keep_twists: bool = True) -> Indices:
+    """Every index at one pose (metres, radians), with every detail (wrenches, output twists).
+
+    Raises
+    ------
+    screwkit.closure.UnreachablePose
+        If the pose is unreachable: the message names the chains, the one that misses its
+        closure by the most first, and joints outside their limits.
+    """
+    pose = mechanism.check_poses(pose)
+    solution = solve_one(mechanism, pose, limits=limits)
+    result = analyze(chain_screws(mechanism, solution), threshold=threshold, faults=faults, keep_twists=keep_twists)
+    return replace(result, poses=pose, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
+                   reachable=True)

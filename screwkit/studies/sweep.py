@@ -1,0 +1,86 @@
+"""Sweeps of one pose coordinate: every series of the paper's Fig. 4, as an xarray Dataset.
+
+:func:`sweep` varies one task coordinate (the platform angle ``phi`` of a planar mechanism,
+or any coordinate of a spatial one) with the others fixed and returns, along the swept
+coordinate: the ITI of each actuator and overall; the OTI of every non-redundant
+submechanism and the LMTI; for every number of faults j the LMTI of each actuator set left
+after j faults, F_Oj and F_IOj.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from screwkit.model import Mechanism
+from screwkit.results import set_label
+from screwkit.studies.poses import indices_at_poses
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.units import is_angular
+
+__all__ = ["sweep"]
+
+
+def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLike, *,
+          threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False, limits: bool = True):
+    """Every index along one swept task coordinate.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    at : array_like, shape (n_task,)
+        The fixed pose (metres, radians); its ``coordinate`` entry is replaced by ``values``.
+    coordinate : str
+        One of ``mechanism.task_coordinates``.
+    values : array_like, shape (k,)
+        Values of the swept coordinate (metres or radians).
+    threshold : float
+        Singularity threshold *p* (m).
+    faults : int or sequence of int, optional
+        Numbers of faults j (default all).
+    closed_forms : bool
+        Use the planar closed forms instead of the generic screw path.
+    limits : bool
+        Whether joint limits make a pose unreachable (default).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``coordinate`` (degrees for angles), ``actuator``, ``submechanism`` and for
+        each j ``remaining{j}`` (the actuator sets left after j faults). Variables:
+        ``iti``, ``iti_actuator``, ``oti_submechanism``, ``lmti``, ``lmti_remaining{j}``,
+        ``f_o{j}``, ``f_io{j}``, ``worst_fault{j}``, ``mutual_interference``, ``reachable``
+        (those of :meth:`screwkit.results.Indices.to_dataset` along the swept coordinate,
+        and the LMTI of every set left after j faults).
+    """
+
+    if coordinate not in mechanism.task_coordinates:
+        raise ValueError(f"Expected `coordinate` in {mechanism.task_coordinates}, got {coordinate!r}.")
+    at = mechanism.check_poses(at)
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size == 0:
+        raise ValueError(f"Expected `values` with shape (k,), k >= 1, got {values.shape}.")
+    axis = mechanism.task_coordinates.index(coordinate)
+    poses = np.repeat(at[None], values.size, axis=0)
+    poses[:, axis] = values
+    result = indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
+                              closed_forms=closed_forms, limits=limits)
+    angular = is_angular(coordinate)
+    shown = np.rad2deg(values) if angular else values
+    dataset = result.to_dataset(dims=(coordinate,),
+                                coords={coordinate: (coordinate, shown, {"units": "deg" if angular else "m"})})
+    a = result.actuator_count
+    for j in result.faults:
+        remaining = list(combinations(range(a), a - j))
+        dimension = f"remaining{j}"
+        dataset.coords[dimension] = (dimension, [set_label(e) for e in remaining])
+        if result.oti_submechanisms is not None:
+            stacked = np.stack([np.asarray(result.lmti_of(e)) for e in remaining], axis=-1)
+            dataset[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
+                                             {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
+    dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
+                         fixed_pose=", ".join(f"{n}={v:g}" for n, v in zip(mechanism.task_coordinates, at)),
+                         method="closed forms" if closed_forms else "generic screw path")
+    return dataset

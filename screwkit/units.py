@@ -1,0 +1,43 @@
+"""Units of task coordinates and lengths, written down once.
+
+In Python every length is in metres and every angle in radians; the command line and the
+reports show angles in degrees. A mechanism file may be written in another length unit and
+is converted to metres when it is read (:data:`LENGTH_UNITS`).
+Only the standard library is imported here.
+"""
+
+from __future__ import annotations
+
+ANGULAR_COORDINATES = frozenset({"phi", "roll", "pitch", "yaw"})
+"""Task coordinates that are angles (rad in Python, deg at the command line)."""
+
+LENGTH_UNITS = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001, "um": 1e-6, "km": 1000.0, "in": 0.0254, "ft": 0.3048}
+"""Length units a mechanism file may be written in, as their length in metres."""
+
+
+def is_angular(coordinate: str) -> bool:
+    """Whether the task coordinate ``coordinate`` is an angle."""
+    return coordinate in ANGULAR_COORDINATES
+
+
+def unit_of(coordinate: str, *, degrees: bool = True) -> str:
+    """The unit a task coordinate is shown in: ``"deg"`` (or ``"rad"``) for angles, ``"m"`` otherwise.
+
+    >>> unit_of("yaw"), unit_of("yaw", degrees=False), unit_of("z")
+    ('deg', 'rad', 'm')
+    """
+    if is_angular(coordinate):
+        return "deg" if degrees else "rad"
+    return "m"
+
+
+def metres_per(unit: str) -> float:
+    """The length of one ``unit`` in metres; a ValueError lists the known units.
+
+    >>> metres_per("mm")
+    0.001
+    """
+    try:
+        return LENGTH_UNITS[unit]
+    except KeyError:
+        raise ValueError(f"Unknown length unit {unit!r}; expected one of {', '.join(LENGTH_UNITS)}.") from None

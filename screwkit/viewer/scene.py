@@ -1,0 +1,375 @@
+"""Scenes: a mechanism drawn in Meshcat at one pose (:func:`show`) or along a sweep
+(:func:`animate_sweep`), and exported as one offline HTML page (:func:`export_html`)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, Self
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.loader import load
+from screwkit.tolerances import SINGULARITY_THRESHOLD
+from screwkit.viewer.drawing import (
+    BASE_COLOR,
+    PLATFORM_COLOR,
+    animate,
+    clear_animation,
+    create_marker,
+    failed_joint_ids,
+    frame_view,
+    geometry_owners,
+    load_visual_model,
+    marker_matrix,
+)
+from screwkit.viewer.markers import (
+    FAILED_COLOR,
+    MARKER_KINDS,
+    ROOT_PATH,
+    Marker,
+    best_submechanism,
+    chain_index_values,
+    colors_from_values,
+    markers_of_frame,
+    resolve_actuators,
+    solve_frames,
+)
+from screwkit.viewer.server import ViewerServer, import_meshcat, start_viewer
+
+__all__ = ["Scene", "show", "animate_sweep", "export_html"]
+
+
+@dataclass(eq=False)
+class Scene:
+    """A mechanism drawn in a Meshcat viewer, with the indices it shows.
+
+    Made by :func:`show` and :func:`animate_sweep`. Use it as a context manager, or call
+    :meth:`close`, to stop a server it started.
+
+    Attributes
+    ----------
+    mechanism : screwkit.model.Mechanism
+    poses : ndarray, shape (frames, n_task)
+        The drawn poses (metres, radians): one for :func:`show`, the reachable poses of the
+        sweep for :func:`animate_sweep`.
+    result : screwkit.transmission.TransmissionResult
+        Indices at the poses (batch shape ``()`` for :func:`show`, ``(frames,)`` for a sweep).
+    failed : tuple of int
+        Failed actuators (indices into ``mechanism.actuators``).
+    color_by : {"iti", "oti"}
+    chain_values : ndarray, shape (frames, n_chains)
+        The index each chain is coloured by (NaN: none); the drawn colours are those of the
+        first frame.
+    chain_colors : ndarray, shape (n_chains, 4)
+        RGBA drawn for each chain (failed chains: :data:`FAILED_COLOR`).
+    best_submechanisms : tuple
+        Per frame, the best working submechanism (actuator indices) or None.
+    frame_markers : tuple of tuple of Marker
+        Per frame, the overlays drawn.
+    visualizer : pinocchio.visualize.MeshcatVisualizer
+    viewer : meshcat.Visualizer
+    server : ViewerServer or None
+        The server this scene started (None when drawn into a given viewer).
+    frame_rate : float or None
+        Frames per second of the animation (None for a still scene).
+    display_offset : ndarray, shape (3,)
+        Translation of the drawing (``/meshcat``, grid and axes) in the viewer, which puts the
+        mechanism's centre on Meshcat's fixed orbit target; markers are in the mechanism's
+        world frame.
+    """
+
+    mechanism: Any
+    poses: NDArray[np.float64]
+    result: Any
+    failed: tuple[int, ...]
+    color_by: str
+    chain_values: NDArray[np.float64]
+    chain_colors: NDArray[np.float64]
+    best_submechanisms: tuple
+    frame_markers: tuple
+    visualizer: Any = field(repr=False)
+    viewer: Any = field(repr=False)
+    server: ViewerServer | None = None
+    frame_rate: float | None = None
+    display_offset: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+
+    @property
+    def pose(self) -> NDArray[np.float64]:
+        """The (first) drawn pose."""
+        return self.poses[0]
+
+    @property
+    def markers(self) -> tuple[Marker, ...]:
+        """The overlays of the (first) frame."""
+        return self.frame_markers[0]
+
+    @property
+    def url(self) -> str:
+        """The viewer page, ``http://127.0.0.1:PORT/static/``."""
+        return self.viewer.url()
+
+    def markers_of_kind(self, kind: str, frame: int = 0) -> list[Marker]:
+        """The markers of one kind (see :data:`MARKER_KINDS`) in a frame."""
+        if kind not in MARKER_KINDS:
+            raise ValueError(f"Expected a marker kind among {', '.join(MARKER_KINDS)}, got {kind!r}.")
+        return [marker for marker in self.frame_markers[frame] if marker.kind == kind]
+
+    def static_html(self) -> str:
+        """The scene as one self-contained HTML page (see :func:`export_html`)."""
+        return self.viewer.static_html()
+
+    def close(self) -> None:
+        """Disconnect and stop the server this scene started (nothing else); idempotent."""
+        if self.server is not None:
+            with contextlib.suppress(Exception):
+                self.viewer.window.zmq_socket.close(linger=0)
+            self.server.stop()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exception) -> None:
+        self.close()
+
+
+def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
+         color_by: Literal["iti", "oti"] = "iti", viewer=None, open_browser: bool = False) -> Scene:
+    """Draw a mechanism at one pose, coloured by its indices, with its screws.
+
+    See the module docstring for what is drawn and in which colours.
+
+    Parameters
+    ----------
+    mechanism : Mechanism, str or path
+        A loaded mechanism, a bundled name or a URDF path (see :func:`screwkit.loader.load`).
+    pose : array_like, shape (n_task,), optional
+        Platform pose in metres and radians; default the home pose.
+    failed : int, str or sequence of them, optional
+        Failed actuators (see :func:`resolve_actuators`).
+    threshold : float
+        Singularity threshold *p* (m) of the indices.
+    color_by : {"iti", "oti"}
+        Colour each chain by the lowest ITI of its working actuators, or by the OTI of the
+        best working submechanism that uses one of them.
+    viewer : meshcat.Visualizer, Scene or pinocchio MeshcatVisualizer, optional
+        Draw into this viewer (everything under ``/meshcat/screwkit`` is replaced); default:
+        start a server on 127.0.0.1 (:func:`start_viewer`), stopped by :meth:`Scene.close`.
+    open_browser : bool
+        Open the viewer page in the default browser.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        An unreachable pose (naming the chain), an unknown actuator, or a bad ``color_by``.
+    """
+    mechanism = mechanism_of(mechanism)
+    pose = np.asarray(mechanism.home_pose if pose is None else pose, dtype=float)
+    pose = mechanism.check_poses(pose)
+    if pose.ndim != 1:
+        raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}; "
+                         "use animate_sweep for several poses.")
+    return _draw(mechanism, pose[None], failed, threshold, color_by, viewer, open_browser, frame_rate=None,
+                 strict=True, squeeze=True)
+
+
+def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
+                  color_by: Literal["iti", "oti"] = "iti", viewer=None, frame_rate: float = 10.0,
+                  loop: bool = True, open_browser: bool = False) -> Scene:
+    """Animate the mechanism along a sweep of poses, with its screws following.
+
+    The first reachable pose is drawn as by :func:`show` (chain colours from its indices);
+    a Meshcat animation then moves the links, the wrench lines, the twist axes and the
+    instantaneous centres through the reachable poses (unreachable ones are skipped), one
+    keyframe per pose. Markers that do not exist in a frame (a centre at infinity, a twist
+    of a frame without a working submechanism) are hidden in it.
+
+    Parameters
+    ----------
+    mechanism : Mechanism, str or path
+    poses : array_like, shape (frames, n_task)
+        Platform poses in metres and radians, in the order to play them.
+    failed, threshold, color_by, viewer, open_browser
+        As for :func:`show`.
+    frame_rate : float
+        Keyframes per second.
+    loop : bool
+        Repeat the animation (else play it once).
+
+    Returns
+    -------
+    Scene
+        ``scene.poses`` are the animated (reachable) poses.
+
+    Raises
+    ------
+    ValueError
+        No reachable pose, or bad arguments.
+    """
+    mechanism = mechanism_of(mechanism)
+    poses = mechanism.check_poses(poses).reshape(-1, mechanism.n_task)
+    if not frame_rate > 0:
+        raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
+    return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, frame_rate=float(frame_rate),
+                 strict=False, squeeze=False, loop=loop)
+
+
+def export_html(target, path: str | os.PathLike) -> Path:
+    """Write a scene as one self-contained HTML page that works offline.
+
+    The page is Meshcat's ``static_html()``: the viewer's JavaScript and every drawing
+    command inlined, no network access. It is written to a temporary file in the same
+    folder and moved into place (``os.replace``), so a reader never sees a partial file.
+
+    Parameters
+    ----------
+    target : Scene, meshcat.Visualizer or pinocchio MeshcatVisualizer
+    path : str or path-like
+        The HTML file (its folder must exist).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    viewer = meshcat_viewer_of(target)
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"Cannot write {path}: the folder {folder} does not exist.")
+    html = viewer.static_html()
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(descriptor, "w", encoding="utf-8") as handle:
+            handle.write(html)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.chmod(temporary, 0o666 & ~_umask())
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+    return path
+
+
+def _umask() -> int:
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    return 0o022
+
+
+def mechanism_of(mechanism):
+    if isinstance(mechanism, (str, os.PathLike)):
+
+        return load(mechanism)
+    return mechanism
+
+
+def meshcat_viewer_of(target):
+    if isinstance(target, Scene):
+        if target.server is not None and not target.server.running:
+            raise ValueError("The scene's server is stopped (Scene.close was called): export or draw before closing.")
+        return target.viewer
+    if hasattr(target, "static_html") and hasattr(target, "window"):
+        return target
+    if hasattr(target, "viewer") and hasattr(target.viewer, "static_html"):
+        return target.viewer  # pinocchio's MeshcatVisualizer
+    raise ValueError("Expected a Scene, a meshcat.Visualizer or a pinocchio MeshcatVisualizer, "
+                     f"got {type(target).__name__}.")
+
+
+def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, *, frame_rate, strict, squeeze,
+          loop=True) -> Scene:
+    import pinocchio
+
+    import_meshcat()
+    from pinocchio.visualize import MeshcatVisualizer
+
+    if color_by not in ("iti", "oti"):
+        raise ValueError(f"Expected `color_by` 'iti' or 'oti', got {color_by!r}.")
+    failed = resolve_actuators(mechanism, failed)
+    frames = solve_frames(mechanism, poses, threshold, strict)
+    count = frames.poses.shape[0]
+    result = frames.result
+    best = tuple(best_submechanism(result, frame, failed) for frame in range(count))
+    chain_values = np.stack([chain_index_values(mechanism, result, frame, failed, color_by) for frame in range(count)])
+    visual_model = load_visual_model(mechanism)
+    owners, bare = geometry_owners(mechanism, visual_model)
+    failed_joints, failed_chains = failed_joint_ids(mechanism, failed)
+    model = mechanism.pinocchio_model
+    bare_links = []
+    for chain, position in bare:
+        tree_joints = [name for name in mechanism.chains[chain].joint_names if model.existJointName(name)]
+        joint_id = model.getJointId(tree_joints[position])
+        bare_links.append((chain, position, chain in failed_chains or joint_id in failed_joints))
+    markers = tuple(tuple(markers_of_frame(mechanism, frames, frame, failed, best[frame], bare_links))
+                    for frame in range(count))
+    chain_colors = colors_from_values(chain_values[0])
+    for chain in failed_chains:
+        chain_colors[chain] = FAILED_COLOR
+
+    server = None
+    if viewer is None:
+        meshcat_viewer = start_viewer()
+        server = meshcat_viewer.window.screwkit_server
+    else:
+        meshcat_viewer = meshcat_viewer_of(viewer)
+    try:
+        meshcat_viewer[ROOT_PATH].delete()
+        if getattr(meshcat_viewer.window, "screwkit_animated", False):
+            clear_animation(meshcat_viewer)
+        visualizer = MeshcatVisualizer(model, None, visual_model)
+        visualizer.initViewer(viewer=meshcat_viewer)
+        visualizer.loadViewerModel(rootNodeName=f"{ROOT_PATH}/mechanism")
+        for geometry, owner in zip(visual_model.geometryObjects, owners):
+            if owner == "base":
+                color = BASE_COLOR
+            elif owner == "platform":
+                color = PLATFORM_COLOR
+            elif owner in failed_chains or geometry.parentJoint in failed_joints:
+                color = FAILED_COLOR
+            else:
+                color = tuple(chain_colors[owner])
+            node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
+            meshcat_viewer[node].set_property("color", [float(c) for c in color])
+        visualizer.display(frames.configurations[0])
+        all_markers = {}
+        for frame_markers in markers:
+            for marker in frame_markers:
+                all_markers.setdefault(marker.path, marker)
+        for marker in all_markers.values():
+            create_marker(meshcat_viewer, marker, mechanism, chain_colors)
+        for marker in markers[0]:
+            meshcat_viewer[marker.path].set_transform(marker_matrix(marker))
+        for path in set(all_markers) - {marker.path for marker in markers[0]}:
+            meshcat_viewer[path].set_property("visible", False)
+        display_offset = frame_view(meshcat_viewer, mechanism, frames)
+        if frame_rate is not None:
+            animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, frame_rate, loop)
+    except BaseException:
+        if server is not None:
+            with contextlib.suppress(Exception):
+                meshcat_viewer.window.zmq_socket.close(linger=0)
+            server.stop()
+        raise
+    if squeeze:
+        result = result.at(0)
+    scene = Scene(mechanism=mechanism, poses=frames.poses, result=result, failed=failed, color_by=color_by,
+                  chain_values=chain_values, chain_colors=chain_colors, best_submechanisms=tuple(
+                      None if b is None else tuple(result.submechanisms[b]) for b in best),
+                  frame_markers=markers, visualizer=visualizer, viewer=meshcat_viewer, server=server,
+                  frame_rate=frame_rate, display_offset=display_offset)
+    if open_browser:
+        meshcat_viewer.open()
+    return scene
+

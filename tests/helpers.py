@@ -1,0 +1,125 @@
+"""Helpers shared by several test modules (imported as ``from helpers import ...``)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+
+
+def screwkit(*arguments, timeout=300, **options) -> subprocess.CompletedProcess:
+    """Run the ``screwkit`` command as users do, in a subprocess, with Python warnings turned into errors."""
+    return subprocess.run([sys.executable, "-W", "error", "-m", "screwkit.cli", *map(str, arguments)],
+                          capture_output=True, text=True, timeout=timeout, **options)
+
+
+def rotation_2d(angle):
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], -2)
+
+
+def unit(angle):
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def random_planar_rrr(rng: np.random.Generator, count: int, chains: int = 5):
+    """Random RRR configurations: points b, c, d of `chains` chains, shape (count, chains, 2).
+
+    Arm lengths vary in [0.3, 1.5] and directions are uniform, so every geometry occurs.
+    """
+    distal = rng.uniform(-0.5, 0.5, (count, chains, 2))
+    f_angle = rng.uniform(0, 2 * np.pi, (count, chains))
+    g_angle = rng.uniform(0, 2 * np.pi, (count, chains))
+    lower = rng.uniform(0.3, 1.5, (count, chains, 1))
+    upper = rng.uniform(0.3, 1.5, (count, chains, 1))
+    elbows = distal - lower * unit(f_angle)
+    base = elbows - upper * unit(g_angle)
+    return base, elbows, distal
+
+
+def special_planar_rrr(rng: np.random.Generator, count: int, chains: int = 5):
+    """Configurations with exactly/nearly parallel distal links, collinear and concurrent lines,
+    and type-one singular chains (f parallel to g). Returns (base, elbows, distal, kind)."""
+    base, elbows, distal = random_planar_rrr(rng, count, chains)
+    f = distal - elbows
+    lengths = np.linalg.norm(f, axis=-1, keepdims=True)
+    kind = rng.integers(0, 6, count)
+    # 0: chains 0 and 1 exactly parallel distal links (equal f), 1: nearly parallel (1e-7 rad),
+    # 2: chains 0 and 1 collinear lines, 3: lines of chains 0, 1, 2 concurrent,
+    # 4: chain 0 stretched (f parallel to g: type-one singular), 5: three chains with equal f.
+    direction = f[:, 0] / lengths[:, 0]
+    for index in range(count):
+        k = kind[index]
+        if k in (0, 1, 5):
+            angle = 0.0 if k != 1 else 1e-7
+            rotated = rotation_2d(angle) @ direction[index]
+            targets = (1, 2) if k == 5 else (1,)
+            for target in targets:
+                elbows[index, target] = distal[index, target] - lengths[index, target] * rotated
+        elif k == 2:
+            offset = rng.uniform(0.2, 0.6)
+            distal[index, 1] = distal[index, 0] + offset * direction[index]
+            elbows[index, 1] = distal[index, 1] - lengths[index, 1] * direction[index]
+        elif k == 3:
+            centre = rng.uniform(-0.3, 0.3, 2)
+            for target in (0, 1, 2):
+                u = distal[index, target] - centre
+                u = u / np.linalg.norm(u)
+                elbows[index, target] = distal[index, target] - lengths[index, target] * u
+        elif k == 4:
+            upper = np.linalg.norm(elbows[index, 0] - base[index, 0])
+            base[index, 0] = elbows[index, 0] - upper * direction[index]
+    base = base.copy()
+    # Keep the base joints where the arms put them (upper arm from b to c).
+    return base, elbows, distal, kind
+
+
+def moved(chains, rotation, translation):
+    """Chain screws moved by one rigid motion (rotation, translation) of the whole mechanism."""
+    from screwkit.chains import ChainScrews
+    from screwkit.screws import transform_twist
+
+    return [ChainScrews(transform_twist(rotation, translation, c.twists), c.points @ rotation.T + translation,
+                        c.actuated, c.name, joint_names=c.joint_names) for c in chains]
+
+
+def random_rotation(rng: np.random.Generator) -> np.ndarray:
+    """A uniformly random rotation matrix (QR of a Gaussian matrix, sign-fixed)."""
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q @ np.diag(np.sign(np.diag(r)))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+def random_reachable_poses(mechanism, rng: np.random.Generator, count: int, spread: float = 1.0) -> np.ndarray:
+    """``count`` reachable platform poses (m, rad) scattered about the mechanism's home pose."""
+    from screwkit.closure import solve
+
+    home = np.asarray(mechanism.home_pose, dtype=float)
+    if mechanism.is_planar:
+        span = spread * np.array([0.3, 0.3, 1.0]) * [mechanism.length_scale, mechanism.length_scale, 1.0]
+    else:
+        scale = mechanism.length_scale
+        span = spread * np.array([0.05 * scale, 0.05 * scale, 0.05 * scale, 0.08, 0.08, 0.3])
+    found = []
+    while sum(len(f) for f in found) < count:
+        poses = home + rng.uniform(-1.0, 1.0, (4 * count, home.size)) * span
+        found.append(poses[solve(mechanism, poses).reachable])
+    return np.concatenate(found)[:count]
+
+
+def bundled_chain_screws(name: str, count: int = 200, seed: int = 0):
+    """Chain screws (world frame) of a bundled mechanism at ``count`` random reachable poses.
+
+    Returns ``(chains, poses)``: a list of :class:`screwkit.chains.ChainScrews` with batch
+    shape (count,), and the poses.
+    """
+    from screwkit.closure import chain_screws, solve
+    from screwkit.loader import load
+
+    mechanism = load(name)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(seed), count)
+    return chain_screws(mechanism, solve(mechanism, poses)), poses

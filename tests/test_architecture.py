@@ -1,0 +1,159 @@
+"""The shape of the package: one-way layers, no import cycle, no private name across modules, small modules.
+
+The import graph is read from the source (every ``import`` and ``from ... import``, at module
+level and inside functions), so a cycle hidden by a function-local import is found too.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "screwkit"
+
+LAYERS = {
+    # the math core and what it shares: numpy only
+    "screwkit._chunks": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0, "screwkit._planar_kernel": 0,
+    "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
+    "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
+    "screwkit.transmission": 0, "screwkit.units": 0, "screwkit": 0,
+    "screwkit.model": 1, "screwkit.closure": 2, "screwkit.loader": 3, "screwkit.studies": 4,
+    "screwkit.plots": 5, "screwkit.viewer": 5, "screwkit.cli": 6,
+}
+"""Layer of each module or package, bottom up: a module may import its own layer and those below."""
+
+
+def module_name(path: Path) -> str:
+    relative = path.relative_to(PACKAGE.parent).with_suffix("")
+    parts = list(relative.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def layer(module: str) -> int:
+    while module not in LAYERS:
+        module = module.rsplit(".", 1)[0]
+    return LAYERS[module]
+
+
+def imports(path: Path):
+    """(line, imported module, imported names) of every import of a screwkit module in a file."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == "screwkit":
+                    yield node.lineno, alias.name, ()
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "screwkit":
+            yield node.lineno, node.module, tuple(alias.name for alias in node.names)
+
+
+MODULES = {module_name(path): path for path in sorted(PACKAGE.rglob("*.py"))}
+
+
+def graph() -> dict[str, set[str]]:
+    edges: dict[str, set[str]] = {module: set() for module in MODULES}
+    for module, path in MODULES.items():
+        for _, target, names in imports(path):
+            for name in names or ("",):
+                candidate = f"{target}.{name}" if name else target
+                resolved = candidate if candidate in MODULES else target
+                if resolved in MODULES and resolved != module:
+                    edges[module].add(resolved)
+    return edges
+
+
+def test_the_import_graph_has_no_cycle():
+    edges = graph()
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(module: str) -> None:
+        state[module] = 1
+        path.append(module)
+        for target in sorted(edges[module]):
+            if state.get(target) == 1:
+                cycle = path[path.index(target):] + [target]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if target not in state:
+                visit(target)
+        path.pop()
+        state[module] = 2
+
+    for module in sorted(edges):
+        if module not in state:
+            visit(module)
+
+
+def test_layers_import_only_downwards():
+    wrong = []
+    for module, path in MODULES.items():
+        for line, target, _ in imports(path):
+            if target in MODULES or target.rsplit(".", 1)[0] in MODULES:
+                if layer(target) > layer(module) and not target.startswith(module + "."):
+                    wrong.append(f"{path.relative_to(PACKAGE.parent)}:{line}: {module} (layer {layer(module)}) "
+                                 f"imports {target} (layer {layer(target)})")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_private_name_is_imported_from_another_module():
+    wrong = []
+    for module, path in MODULES.items():
+        for line, target, names in imports(path):
+            private = [name for name in names if name.startswith("_") and not name.startswith("__")]
+            if private and target != module:
+                wrong.append(f"{path.relative_to(PACKAGE.parent)}:{line}: {', '.join(private)} from {target}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_function_local_imports_of_the_package_say_why():
+    """Inside functions, screwkit modules are imported only to keep a heavy dependency off the import path."""
+    wrong = []
+    for module, path in MODULES.items():
+        source = path.read_text(encoding="utf-8")
+        lines = source.splitlines()
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for inner in ast.walk(node):
+                    if isinstance(inner, ast.ImportFrom) and (inner.module or "").startswith("screwkit"):
+                        if "#" not in lines[inner.lineno - 1]:
+                            wrong.append(f"{path.relative_to(PACKAGE.parent)}:{inner.lineno}: {lines[inner.lineno - 1].strip()}")
+    assert not wrong, "function-local imports without a reason:\n" + "\n".join(wrong)
+
+
+def test_modules_and_classes_stay_small():
+    """No module above ~600 lines but the compiled kernel, no class above ~300 lines."""
+    too_long = []
+    for module, path in MODULES.items():
+        source = path.read_text(encoding="utf-8")
+        if module != "screwkit._kernels" and source.count("\n") > 660:
+            too_long.append(f"{module}: {source.count(chr(10))} lines")
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno > 300:
+                too_long.append(f"{module}.{node.name}: {node.end_lineno - node.lineno} lines")
+    assert not too_long, "\n".join(too_long)
+
+
+def test_the_core_imports_numpy_only():
+    """The math core loads no Pinocchio, numba, Dask, matplotlib, Meshcat, xarray or scipy when imported."""
+    heavy = ("pinocchio", "numba", "dask", "distributed", "matplotlib", "meshcat", "xarray", "scipy", "pandas")
+    code = ("import sys; import screwkit.screws, screwkit.transmission, screwkit.results, screwkit.closed_forms, "
+            "screwkit.planar, screwkit.chains, screwkit.tolerances, screwkit.units, screwkit.rotations; "
+            f"print(sorted(m for m in {heavy!r} if m in sys.modules))")
+    completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert completed.returncode == 0, completed.stderr
+    assert completed.stdout.strip() == "[]", completed.stdout
+
+
+def test_the_command_line_starts_without_heavy_dependencies():
+    """``screwkit --help`` and ``screwkit list`` import no numba, Pinocchio, Dask, matplotlib or Meshcat."""
+    heavy = ("pinocchio", "numba", "dask", "distributed", "matplotlib", "meshcat", "xarray")
+    code = f"import sys; import screwkit.cli; print(sorted(m for m in {heavy!r} if m in sys.modules))"
+    completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert completed.returncode == 0, completed.stderr
+    assert completed.stdout.strip() == "[]", completed.stdout
