@@ -69,7 +69,7 @@ def per_configuration_rate(samples: int) -> float:
             solution = solve_one(mechanism, pose)
         except ValueError:
             continue
-        q = configuration_vector(mechanism, solution.joint_values, solution.poses)
+        q = configuration_vector(mechanism, solution.joint_values, solution.full_poses)
         pinocchio.computeJointJacobians(mechanism.pinocchio_model, data, q)
         analyze(chain_screws(mechanism, solution), threads=1)
         done += 1

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from screwkit.closure.assembly import assemble
+from screwkit.closure.assembly import assemble, task_space
 from screwkit.model.builder import read_chains, read_platform
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.pinocchio_bridge import build_model
@@ -44,11 +44,12 @@ def bundled_path(name: str) -> Path:
 
 
 def _named_poses(description: UrdfDescription, mechanism: Mechanism) -> dict[str, np.ndarray]:
-    poses = {"home": mechanism.poses_from_transforms(mechanism.home_rotation, mechanism.home_translation)}
+    """The reference assembly as ``home``, and the file's named poses, in task coordinates."""
+    poses = {"home": mechanism.task_poses(mechanism.home_full_pose)}
     for name, values in description.named_poses.items():
         tag = f"<named_pose name='{name}'>"
         missing = [c for c in mechanism.task_coordinates if c not in values]
-        unknown = [c for c in values if c not in mechanism.task_coordinates]
+        unknown = [c for c in values if c not in mechanism.pose_coordinates]
         if missing or unknown:
             raise description.fail(tag, f"expected the task coordinates {', '.join(mechanism.task_coordinates)} "
                                         f"(m, rad), got {', '.join(values) or 'none'}.")
@@ -66,14 +67,16 @@ def mechanism_from_description(description: UrdfDescription) -> Mechanism:
     chains = read_chains(description, model, platform)
     draft = Mechanism(
         name=name, path=description.source, description=description, pinocchio_model=model,
-        is_planar=platform.is_planar, task_coordinates=platform.task_coordinates, base_link=platform.base_link,
+        is_planar=platform.is_planar, pose_coordinates=platform.pose_coordinates, base_link=platform.base_link,
         platform_link=platform.platform_link, platform_joint=platform.platform_joint,
         platform_joint_id=platform.platform_joint_id, platform_frame_placement=platform.platform_frame_placement,
         rotation_world_base=platform.rotation_world_base, translation_world_base=platform.translation_world_base,
         home_rotation=platform.home_rotation, home_translation=platform.home_translation,
-        chains=chains, dof=0, length_scale=1.0, named_poses={}, length_unit=description.length_unit)
-    draft = replace(draft, named_poses=_named_poses(description, draft))
-    return assemble(draft)
+        chains=chains, dof=0, length_scale=1.0, named_poses={}, length_unit=description.length_unit,
+        output_point=np.zeros(3) if description.output == "point" else None)
+    draft = replace(draft, named_poses={"home": draft.home_full_pose})  # the reference assembly, for assembling
+    mechanism = task_space(assemble(draft), getattr(description, "task_coordinates", None))
+    return replace(mechanism, named_poses=_named_poses(description, mechanism))
 
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,

@@ -88,6 +88,13 @@ class Indices:
         Names of the pose coordinates (empty when computed from screws).
     mechanism : str
         The mechanism's name (empty when computed from screws).
+    chain_status : ndarray (..., n_chains) of int8 or None
+        Why a pose is unreachable, chain by chain: 0 closed, 1 misses its closure, 2 a joint
+        outside its position limits (``screwkit.closure.Solution.status``); None from screws.
+    full_poses : ndarray (..., n_pose) or None
+        The poses in every pose coordinate, dependent (parasitic) ones included.
+    pose_coordinates : tuple of str
+        Names of the full poses' coordinates.
     """
 
     actuators: tuple[str, ...]
@@ -109,6 +116,9 @@ class Indices:
     reachable: Any = None
     task_coordinates: tuple[str, ...] = ()
     mechanism: str = ""
+    chain_status: NDArray[np.int8] | None = None
+    full_poses: NDArray[np.float64] | None = None
+    pose_coordinates: tuple[str, ...] = ()
     batch_shape: tuple[int, ...] = field(init=False)
 
     def __post_init__(self):
@@ -195,7 +205,8 @@ class Indices:
             iti_actuators=pick(self.iti_actuators), oti_actuators=pick(self.oti_actuators),
             oti_submechanisms=pick(self.oti_submechanisms), actuation_wrenches=pick(self.actuation_wrenches),
             output_twists=pick(self.output_twists), poses=pick(self.poses), reachable=pick(self.reachable),
-            task_coordinates=self.task_coordinates, mechanism=self.mechanism)
+            task_coordinates=self.task_coordinates, mechanism=self.mechanism, chain_status=pick(self.chain_status),
+            full_poses=pick(self.full_poses), pose_coordinates=self.pose_coordinates)
 
     def lmti_of(self, actuator_set: Sequence[int | str]) -> Any:
         """LMTI of a set of actuators (Eq. 11): the best OTI of its ``n``-subsets.
@@ -250,6 +261,14 @@ class Indices:
                 if is_angular(name):
                     shown[..., axis] = np.rad2deg(shown[..., axis])
             report["pose"] = ({name: number(shown[..., axis]) for axis, name in enumerate(self.task_coordinates)})
+        if self.full_poses is not None and self.pose_coordinates:
+            dependent = [name for name in self.pose_coordinates if name not in self.task_coordinates]
+            if dependent:  # the parasitic coordinates the closure gave
+                full = np.array(self.full_poses, dtype=float, copy=True)
+                for axis, name in enumerate(self.pose_coordinates):
+                    if is_angular(name):
+                        full[..., axis] = np.rad2deg(full[..., axis])
+                report["dependent"] = {name: number(full[..., self.pose_coordinates.index(name)]) for name in dependent}
         report["reachable"] = self.reachable if not self.batch_shape else np.asarray(self.reachable).tolist()
         report["dof"] = self.dof
         report["actuators"] = list(self.actuators)

@@ -42,6 +42,7 @@ from screwkit import tolerances
 from screwkit._chunks import map_chunks
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
+from screwkit.outputs import idle_rotations, quotient_bases, with_idle_joints
 from screwkit.results import Indices
 
 __all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets"]
@@ -216,15 +217,20 @@ class _Plan:
     fault_table: NDArray[np.int64]
     threshold: float
     rank_tolerance: float
+    idle_count: int = 0
 
 
-def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
+def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int = 0) -> _Plan:
     if not threshold >= 0:
         raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
     if not rank_tolerance > 0:
         raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
-    space = motion_space(chains, dof)
-    n = space.dof
+    space = motion_space(chains, None if dof is None else dof + idle_count)
+    n = space.dof - idle_count
+    if idle_count:  # a point output: the motion space modulo the idle rotations, configuration by configuration
+        if n < 1:
+            raise ValueError("The output point has no mobility: every platform motion is an idle rotation about it.")
+        space = MotionSpace(space.dof, None)
     actuators = tuple((c, k) for c, chain in enumerate(chains) for k in chain.actuated)
     a = len(actuators)
     if a < n:
@@ -268,7 +274,8 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance) -> _Plan:
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
                            dtype=np.int64).reshape(-1, n),
         faults=fault_list, failed_sets=failed_sets, fault_start=fault_start,
-        fault_table=fault_table, threshold=float(threshold), rank_tolerance=float(rank_tolerance))
+        fault_table=fault_table, threshold=float(threshold), rank_tolerance=float(rank_tolerance),
+        idle_count=idle_count)
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
@@ -307,7 +314,7 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
     return out
 
 
-def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists) -> dict:
+def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None) -> dict:
     """All indices for one chunk of configurations (arrays (N, J, 6) and (N, J, 3) over all joints)."""
     if plan.space.constant_basis is not None:
         basis = plan.space.constant_basis[None]
@@ -322,8 +329,10 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
         starts = plan.chain_start
         chain_twists = [twists[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
         chain_points = [points[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        working, _, _, _ = _working_coordinates(chain_twists, chain_points)
-        _, bases = _null_spaces(working, plan.dof, tolerances.MOTION_SPACE_TOLERANCE)
+        working, _, centre, length = _working_coordinates(chain_twists, chain_points)
+        _, bases = _null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE)
+        if plan.idle_count:
+            bases = quotient_bases(bases, idle[redo], centre, length, plan.dof)
         again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
                             None if iti_override is None else iti_override[redo],
                             None if oti_override is None else oti_override[redo], detail, keep_twists)
@@ -388,6 +397,8 @@ def analyze(
     keep_twists: bool = False,
     chunk_size: int = 65536,
     threads: int | None = None,
+    output_point: ArrayLike | None = None,
+    planar: bool = False,
 ) -> Indices:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
 
@@ -482,6 +493,12 @@ def analyze(
         Configurations per chunk (bounds memory).
     threads : int, optional
         Threads running chunks side by side (default: the number of CPUs).
+    output_point : array_like, shape (..., 3), optional
+        A point output (world frame): the rotations of the platform about it are idle
+        (:mod:`screwkit.outputs`) and the indices are those of the point's motion: ``n`` is the
+        DOF of the point, actuation wrenches are forces through it.
+    planar : bool
+        With ``output_point``: the mechanism is planar, its only idle rotation is about z.
 
     Returns
     -------
@@ -505,9 +522,22 @@ def analyze(
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
     if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
-    plan = _make_plan(chains, dof, faults, threshold, rank_tolerance)
-    a = len(plan.actuators)
     count = int(np.prod(batch_shape, dtype=np.int64))
+    idle = None
+    if output_point is not None:
+        point = check_finite(as_float_array(output_point, "output_point"), "output_point")
+        try:
+            point = np.broadcast_to(point, batch_shape + (3,)).reshape(count, 3)
+        except ValueError:
+            raise ValueError(f"Expected `output_point` with shape (..., 3), got {point.shape}.") from None
+        idle, idle_points = idle_rotations(point, planar)
+        index = np.unique(np.linspace(0, count - 1, min(count, 9)).round().astype(int)) if count else np.arange(0)
+        flat_points = [c.points.reshape((count,) + c.points.shape[-2:])[index] for c in chains]
+        flat_twists = [c.twists.reshape((count,) + c.twists.shape[-2:])[index] for c in chains]
+        _, _, centre, length = _working_coordinates(flat_twists, flat_points)
+        chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
+    plan = _make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
+    a = len(plan.actuators)
     overrides = {}
     for name, value in (("iti_points", iti_points), ("oti_points", oti_points)):
         if value is not None:
@@ -525,7 +555,7 @@ def analyze(
             plan, twists(part), points(part),
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
-            detail, keep_twists)
+            detail, keep_twists, None if idle is None else idle[part])
 
     pieces = map_chunks(run, count, chunk_size, threads)
     merged = {key: np.concatenate([piece[key] for piece in pieces], axis=0) for key in pieces[0]}

@@ -283,7 +283,7 @@ def test_solved_loops_close_in_pinocchio_forward_kinematics(name):
     assert solution.reachable.sum() >= 4
     if name == "random_loops":
         assert mechanism_.dof == 6 and {chain.loop_type for chain in mechanism_.chains} == {kind for kind, _ in LOOP_KINDS}
-    configuration = configuration_vector(mechanism_, solution.joint_values, solution.poses)
+    configuration = configuration_vector(mechanism_, solution.joint_values, solution.full_poses)
     model, data = mechanism_.pinocchio_model, mechanism_.pinocchio_model.createData()
     loops = {loop.name: loop for loop in mechanism_.description.loops}
     for sample in np.flatnonzero(solution.reachable):

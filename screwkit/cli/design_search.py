@@ -22,7 +22,7 @@ from screwkit.model.urdf_writer import planar_rrr_urdf
 from screwkit.plots import design_comparison_figure, save_figure
 from screwkit.studies import design as search
 from screwkit.studies.files import atomic_text
-from screwkit.studies.tasks import ClusterError
+from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 
 __all__ = ["design_search"]
 
@@ -117,7 +117,8 @@ def _optimise(loaded, template, current, level, step, maxiter, popsize, urdf_pat
 @click.option("--closed-forms", is_flag=True, help="--permutations: score with the planar closed forms.")
 @click.option("--scheduler", metavar="ADDRESS",
               help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 (default: local threads).")
-@click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=5.0, show_default=True,
+@click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
+              show_default=True,
               help="Seconds to wait for the --scheduler to answer.")
 @length_unit_option
 @json_option

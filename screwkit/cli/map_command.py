@@ -23,7 +23,7 @@ from screwkit.cli.options import (
 from screwkit.cli.sweep import fixed_pose, write_outputs
 from screwkit.plots import map_figure
 from screwkit.studies.maps import index_map, planar_disc_map
-from screwkit.studies.tasks import ClusterError
+from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 from screwkit.units import is_angular
 
 __all__ = ["map_command", "grid_spec"]
@@ -61,8 +61,8 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
 @ignore_limits_option
 @click.option("--scheduler", metavar="ADDRESS",
               help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 (default: local threads).")
-@click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=5.0, show_default=True,
-              help="Seconds to wait for the --scheduler to answer.")
+@click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
+              show_default=True, help="Seconds to wait for the --scheduler to answer.")
 @click.option("--task-size", type=click.IntRange(min=1), default=131_072, show_default=True,
               help="Configurations (grid points x orientations) per task.")
 @click.option("--yes", is_flag=True, help="Proceed with a map of more than 2e9 configurations.")

@@ -49,13 +49,21 @@ class ScrewkitGroup(click.Group):
             if standalone_mode:
                 sys.exit(stop.exit_code)
             raise
-        except click.ClickException as error:
-            if "--json" in arguments:
-                click.echo(json.dumps({"error": error.format_message()}))
-            else:
-                error.show()
+        except click.exceptions.NoArgsIsHelpError as error:  # a command given no arguments: its help
+            error.show()
             if standalone_mode:
                 sys.exit(error.exit_code)
+            raise
+        except click.ClickException as error:
+            message = error.format_message()
+            if isinstance(error, click.UsageError) and error.ctx is not None:  # one line, not click's usage block
+                message = f"{message} See '{error.ctx.command_path} --help'."
+            if "--json" in arguments:
+                click.echo(json.dumps({"error": message}))
+            else:
+                click.echo(f"Error: {message}", err=True)
+            if standalone_mode:
+                sys.exit(1)
             raise
         except click.Abort:
             click.echo("Aborted.", err=True)
@@ -220,4 +228,5 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
         except ValueError as error:
             raise fail(f"{option} {error}") from None
         if removed and not quiet:
-            echo_error(f"removed {len(removed)} temporary file(s) left by an earlier run killed while writing {path}")
+            echo_error(f"removed {', '.join(removed)}: temporary file(s) left by an earlier run killed while writing "
+                       f"{path}")

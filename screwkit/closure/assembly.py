@@ -24,6 +24,7 @@ from screwkit.closure.chain_kinematics import (
 )
 from screwkit.closure.newton import determinant_sign, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form
+from screwkit.closure.task_space import close_constraining_chains, constraining_chains, infer_task_axes, motion_space_at
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 from screwkit.rotations import wrap_angle
@@ -105,7 +106,7 @@ def _matching_branch(mechanism: Mechanism, index: int, solver) -> tuple[int, ...
     best, closest = None, np.inf
     for code in range(2**solver.n_branches):
         branch = tuple(1 if (code >> bit) & 1 == 0 else -1 for bit in range(solver.n_branches))
-        result = run_closed_form(probe, index, mechanism.home_pose[None], branch)
+        result = run_closed_form(probe, index, mechanism.home_full_pose[None], branch)
         if not result.reachable[0]:
             continue
         values = result.values() if callable(result.values) else result.values
@@ -182,3 +183,74 @@ def assemble(mechanism: Mechanism) -> Mechanism:
             f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for a platform with {dof} DOF: at least {dof} "
             "are needed (mark actuated joints with <transmission>).")
     return replace(mechanism, dof=dof)
+
+
+def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0):
+    """Closed configurations near the reference assembly, off any special pose: random small full-pose
+    offsets, each brought back onto the closure by the least change of every pose coordinate."""
+    chains = constraining_chains(mechanism)
+    rng = np.random.default_rng(seed)
+    offsets = rng.uniform(-1.0, 1.0, (count, mechanism.n_pose)) * np.where(
+        mechanism.pose_angular, 0.05, 0.05 * mechanism.length_scale)
+    poses = mechanism.home_full_pose + offsets
+    values = [np.broadcast_to(mechanism.chains[i].reference_values, (count, mechanism.chains[i].n_joints))
+              for i in chains]
+    poses, values, converged, _ = close_constraining_chains(mechanism, chains, poses, values,
+                                                      tuple(range(mechanism.n_pose)), 1e-11, 60, 0.5)
+    return chains, poses[converged], [v[converged] for v in values]
+
+
+def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) -> Mechanism:
+    """The mechanism with its mobility, its instantaneous DOF at the reference assembly and its task coordinates.
+
+    The DOF at the reference assembly (:attr:`~Mechanism.dof` as :func:`assemble` found it) is the
+    *instantaneous* DOF there; the mechanism's *mobility* is the DOF at generic closed
+    configurations near it (the least found at a few). When the reference assembly has more, it
+    is a constraint singularity. Task coordinates are the file's ``<task_coordinates>`` when it
+    declares them (checked to be independent), else inferred from the motion space at a generic
+    configuration (:func:`~screwkit.closure.task_space.infer_task_axes`).
+    """
+    names = mechanism.pose_coordinates
+    idle = 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)  # rotations about the point
+    instantaneous = mechanism.dof
+    mobility, at_pose, at_values = instantaneous, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains]
+    chains = constraining_chains(mechanism)
+    if chains:
+        chain_indices, poses, values = _generic_samples(mechanism)
+        if poses.shape[0]:
+            subset = replace(mechanism, chains=tuple(mechanism.chains[i] for i in chain_indices))
+            dofs, _ = motion_space_at(subset, poses, values)
+            sample = int(np.argmin(dofs))
+            if dofs[sample] < instantaneous:
+                mobility = int(dofs[sample])
+                at_pose = poses[sample]
+                at_values = [c.reference_values for c in mechanism.chains]
+                for index, chain_values in zip(chain_indices, values):
+                    at_values[index] = chain_values[sample]
+    mobility, instantaneous = mobility - idle, instantaneous - idle
+    if mobility < 1:
+        raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
+                                                                  "motion is a rotation about it.")
+    mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
+    candidates = [i for i, name in enumerate(names) if not (idle and name in ("phi", "roll", "pitch", "yaw"))]
+    if declared is not None:
+        unknown = [name for name in declared if name not in names]
+        if unknown or len(set(declared)) != len(declared):
+            raise mechanism.description.fail("<task_coordinates>", f"expected distinct names among {', '.join(names)}, "
+                                                                   f"got {' '.join(declared)}.")
+        axes = tuple(sorted(names.index(name) for name in declared))
+        if any(axis not in candidates for axis in axes):
+            raise mechanism.description.fail("<task_coordinates>", "a point output has no orientation coordinate: "
+                                                                   "its rotations about the point are idle.")
+        subset = replace(mechanism, chains=tuple(c for c in mechanism.chains))
+        _, basis = motion_space_at(subset, at_pose[None], [np.asarray(v)[None] for v in at_values])
+        singular = np.linalg.svd(basis[0][list(axes)][:, :mobility + idle], compute_uv=False)
+        if len(axes) != mobility or (singular.size and singular[-1] <= 1e-6):
+            raise mechanism.description.fail(
+                "<task_coordinates>", f"{' '.join(declared)} cannot drive a platform of mobility {mobility}: "
+                f"they are not {mobility} independent coordinates of its motion.")
+        return replace(mechanism, task_axes=axes, task_source="declared")
+    if mobility == mechanism.n_pose:
+        return mechanism
+    axes = infer_task_axes(mechanism, at_pose, at_values, mobility, candidates)
+    return replace(mechanism, task_axes=axes, task_source="inferred")

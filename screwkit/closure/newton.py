@@ -26,7 +26,7 @@ from screwkit.rotations import (
     rotation_vector_from_rotation,
 )
 
-__all__ = ["pose_error", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "task_rows"]
+__all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "task_rows"]
 
 
 def pose_error(
@@ -41,7 +41,7 @@ def pose_error(
     return np.concatenate([rotation_error, target_translation - translation], -1)
 
 
-def _apply_step(geometry: ChainGeometry, values: NDArray, step: NDArray) -> NDArray:
+def apply_step(geometry: ChainGeometry, values: NDArray, step: NDArray) -> NDArray:
     """Add a Newton step; spherical loop DoFs compose on the left (leg-side frame axes)."""
     updated = values + step
     if geometry.loop_type == "spherical":
@@ -108,7 +108,7 @@ def newton_solve_chain(
         step = np.linalg.solve(normal, (transposed @ error[..., None]))[..., 0]
         largest = np.max(np.abs(step), axis=-1)
         step *= np.minimum(1.0, max_step / np.maximum(largest, 1e-300))[:, None]
-        candidate = _apply_step(geometry, values[active], step)
+        candidate = apply_step(geometry, values[active], step)
         _, candidate_error = errors(candidate, active)
         candidate_norm = np.linalg.norm(candidate_error, axis=-1)
         better = candidate_norm < norm
@@ -177,7 +177,7 @@ def _track(mechanism, index, source, values, goal, tolerance, max_iterations):
 def _scaled_poses(mechanism, flat_poses: NDArray) -> NDArray:
     """Poses with angles multiplied by the length scale, for nearest-neighbour lookups."""
     scaled = flat_poses.copy()
-    scaled[:, mechanism.angular] *= mechanism.length_scale
+    scaled[:, mechanism.pose_angular] *= mechanism.length_scale
     return scaled
 
 

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian
 from screwkit.closure.newton import pose_error, solve_newton_chain
+from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
 from screwkit.closure.threads import for_each_block
 from screwkit.model.mechanism import Mechanism
 from screwkit.rotations import wrap_angle
@@ -51,6 +52,9 @@ class Solution:
     Attributes
     ----------
     poses : ndarray, shape (..., n_task)
+        The poses solved, in task coordinates.
+    full_poses : ndarray, shape (..., n_pose)
+        The same poses in every pose coordinate, dependent (parasitic) ones included.
     reachable : ndarray of bool, shape (...)
         Every chain closed in the requested working mode with its joints within their limits.
     chain_reachable : ndarray of bool, shape (..., n_chains)
@@ -70,6 +74,7 @@ class Solution:
     """
 
     poses: NDArray[np.float64]
+    full_poses: NDArray[np.float64]
     reachable: NDArray[np.bool_]
     chain_reachable: NDArray[np.bool_]
     status: NDArray[np.int8]
@@ -238,9 +243,19 @@ def solve(
         raise ValueError(f"Expected `method` 'auto' or 'newton', got {method!r}.")
     branches = _check_branches(mechanism, branches)
     batch = poses.shape[:-1]
-    flat = poses.reshape(-1, mechanism.n_task)
-    count = flat.shape[0]
+    task_flat = poses.reshape(-1, mechanism.n_task)
+    count = task_flat.shape[0]
     initial_values = _check_initial(mechanism, initial, batch)
+    completed, complete_residual = np.ones(count, dtype=bool), np.zeros(count)
+    if mechanism.dependent_indices:  # lower mobility: the dependent coordinates close the constraining chains
+        flat, dependent_values, completed, complete_residual = complete_poses(mechanism, task_flat)
+        initial_values = list(initial_values) if initial_values is not None else [None] * len(mechanism.chains)
+        for index, chain_values in zip(constraining_chains(mechanism), dependent_values):
+            if initial_values[index] is None:
+                initial_values[index] = np.where(completed[:, None], chain_values, np.nan).reshape(
+                    batch + (mechanism.chains[index].n_joints,))
+    else:
+        flat = task_flat
     cache = _PoseCache(mechanism, flat)
     values, axes, points = [], [], []
     chains = len(mechanism.chains)
@@ -254,12 +269,16 @@ def solve(
             chain_values, chain_reachable, chain_residual = result.values, result.reachable, result.gap
             chain_axes, chain_points = result.axes, result.points
         else:
-            start = None if initial_values is None else initial_values[index].reshape(count, geometry.n_dofs)
+            start = None if initial_values is None or initial_values[index] is None else \
+                np.asarray(initial_values[index]).reshape(count, geometry.n_dofs)
             sign = branches[index] if chain.closed_form is None else chain.reference_sign
             chain_values, chain_reachable, chain_residual = solve_newton_chain(
                 mechanism, index, flat, cache.platform, start, sign, tolerance, max_iterations)
             frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
             chain_axes, chain_points = frames.axes, frames.points
+        if not np.all(completed):  # no dependent coordinates close the constraining chains
+            chain_reachable = chain_reachable & completed
+            chain_residual = np.where(completed, chain_residual, np.maximum(chain_residual, complete_residual))
         status[index] = np.where(chain_reachable, REACHABLE, MISSES_CLOSURE)
         if limits and np.any(np.isfinite(chain.joint_limits)):
             flat_values = chain_values() if callable(chain_values) else chain_values
@@ -274,6 +293,7 @@ def solve(
     chain_reachable = status == REACHABLE
     return Solution(
         poses=poses,
+        full_poses=flat.reshape(batch + (mechanism.n_pose,)),
         reachable=np.logical_and.reduce(chain_reachable, axis=0).reshape(batch),
         chain_reachable=chain_reachable.T.reshape(batch + (chains,)),
         status=status.T.reshape(batch + (chains,)),
@@ -341,7 +361,7 @@ def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.fl
 
     Returns an array (..., n_chains); NaN where the chain did not close.
     """
-    rotation, translation = mechanism.transforms_from_poses(solution.poses)
+    rotation, translation = mechanism.transforms_from_poses(solution.full_poses)
     residuals = []
     for index, chain in enumerate(mechanism.chains):
         frames = chain_forward_kinematics(chain.geometry, solution.joint_values[index])
@@ -351,22 +371,18 @@ def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.fl
     return np.stack(residuals, -1)
 
 
-def _pose_rates(mechanism: Mechanism, poses: NDArray) -> NDArray[np.float64]:
-    """d(platform frame)/d(task coordinates): (N, 6, n_task), rows (angular velocity, origin velocity), base frame."""
-    count = poses.shape[0]
-    rates = np.zeros((count, 6, mechanism.n_task))
-    if mechanism.is_planar:
-        rates[:, 2, 2] = 1.0
-        rates[:, 3, 0] = rates[:, 4, 1] = 1.0
-        return rates
-    pitch, yaw = poses[:, 4], poses[:, 5]
-    zero, one = np.zeros(count), np.ones(count)
-    # R = Rz(yaw) Ry(pitch) Rx(roll): omega = z * yaw' + Rz(yaw) y * pitch' + Rz(yaw) Ry(pitch) x * roll'
-    rates[:, :3, 3] = np.stack([np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), -np.sin(pitch)], -1)
-    rates[:, :3, 4] = np.stack([-np.sin(yaw), np.cos(yaw), zero], -1)
-    rates[:, :3, 5] = np.stack([zero, zero, one], -1)
-    rates[:, 3:, :3] = np.eye(3)
-    return rates
+def _task_to_pose_rates(mechanism: Mechanism, full_poses: NDArray, joint_values) -> NDArray[np.float64]:
+    """d(pose coordinates)/d(task coordinates) (N, n_pose, n_task) on the closure: the identity at full
+    mobility, else the dependent rates that keep the platform in its motion space."""
+    count = full_poses.shape[0]
+    if not mechanism.dependent_indices:
+        return np.broadcast_to(np.eye(mechanism.n_pose), (count, mechanism.n_pose, mechanism.n_pose))
+    _, basis = motion_space_at(mechanism, full_poses, joint_values)
+    space = basis[..., :mechanism.dof]  # pose-coordinate rates, lengths in units of the length scale
+    scale = np.where(mechanism.pose_angular, 1.0, mechanism.length_scale)
+    space = space * scale[:, None]  # back to metres
+    task = space[:, list(mechanism.task_indices)]  # (N, n_task, dof)
+    return space @ np.linalg.pinv(task)
 
 
 def forward(
@@ -433,8 +449,9 @@ def forward(
         active, error = active[keep], error[keep]
         if active.size == 0:
             break
-        rates = _pose_rates(mechanism, poses[active])  # (N, 6, n_task) of the platform frame's origin
-        rotation, translation = mechanism.transforms_from_poses(poses[active])
+        full = solution.full_poses[keep]
+        rates = pose_rates(mechanism, full) @ _task_to_pose_rates(mechanism, full, previous)  # (N, 6, n_task)
+        rotation, translation = mechanism.transforms_from_poses(full)
         jacobian = np.empty((active.size, len(selected), mechanism.n_task))
         for row, (chain_index, joint) in enumerate(selected):
             chain = mechanism.chains[chain_index]
@@ -455,6 +472,7 @@ def forward(
     converged = converged.reshape(batch)
     return Solution(
         poses=solution.poses,
+        full_poses=solution.full_poses,
         reachable=solution.reachable & converged,
         chain_reachable=solution.chain_reachable & converged[..., None],
         status=np.where(converged[..., None], solution.status, np.maximum(solution.status, 1)).astype(np.int8),

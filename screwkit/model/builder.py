@@ -36,7 +36,7 @@ class Platform:
 
     name: str
     is_planar: bool
-    task_coordinates: tuple[str, ...]
+    pose_coordinates: tuple[str, ...]
     base_link: str
     platform_link: str
     platform_joint: str
@@ -80,7 +80,7 @@ def read_platform(description: UrdfDescription, model, name: str) -> Platform:
     world_rotation, world_translation = placement_arrays(model.jointPlacements[joint_id] * platform_frame.placement)
     return Platform(
         name=name, is_planar=is_planar,
-        task_coordinates=PLANAR_TASK_COORDINATES if is_planar else SPATIAL_TASK_COORDINATES,
+        pose_coordinates=PLANAR_TASK_COORDINATES if is_planar else SPATIAL_TASK_COORDINATES,
         base_link=joint.parent, platform_link=joint.child, platform_joint=joint.name, platform_joint_id=joint_id,
         platform_frame_placement=platform_frame.placement,
         rotation_world_base=rotation_world_base, translation_world_base=translation_world_base,

@@ -7,9 +7,12 @@ changes: closure solving (:mod:`screwkit.closure`), screws and indices are funct
 mechanism and of configurations, as Pinocchio's algorithms are of its ``Model``.
 Build one with :func:`screwkit.loader.load`.
 
-Frames: poses are the platform frame relative to the **base link** frame (the parent link of
-the platform's floating/planar joint), in task coordinates (:data:`PLANAR_TASK_COORDINATES`,
-:data:`SPATIAL_TASK_COORDINATES`); metres and radians.
+Frames and coordinates: a **full pose** is the platform frame relative to the **base link** frame
+(the parent link of the platform's floating/planar joint) in the pose coordinates
+(:data:`PLANAR_TASK_COORDINATES`, :data:`SPATIAL_TASK_COORDINATES`). A mechanism of lower mobility
+is driven through its **task coordinates**, the independent subset of them (z, roll, pitch for a
+3-PRS; x, y, z for a Delta); the others are *dependent* (parasitic) and follow from the closure.
+Every pose a user gives is in task coordinates; metres and radians.
 """
 
 from __future__ import annotations
@@ -51,8 +54,9 @@ class Mechanism:
         The kinematic tree (loops are not part of it).
     is_planar : bool
         The platform hangs from a ``planar`` joint (else ``floating``).
-    task_coordinates : tuple of str
-        :data:`PLANAR_TASK_COORDINATES` or :data:`SPATIAL_TASK_COORDINATES`.
+    pose_coordinates : tuple of str
+        :data:`PLANAR_TASK_COORDINATES` or :data:`SPATIAL_TASK_COORDINATES`: every coordinate of a
+        full pose.
     base_link, platform_link, platform_joint : str
         The links the platform joint connects, and its name.
     platform_joint_id : int
@@ -77,6 +81,18 @@ class Mechanism:
         those of the file's ``<named_pose>`` elements.
     length_unit : str
         The unit the file was written in (converted to metres when read).
+    task_axes : tuple of int
+        Indices into :attr:`pose_coordinates` of the task coordinates (empty: all of them).
+    task_source : str
+        Where the task coordinates come from: ``"all"`` (full mobility), ``"declared"`` (the
+        file's ``<task_coordinates>``) or ``"inferred"`` (from the motion space at the
+        reference assembly).
+    output_point : ndarray, shape (3,) or None
+        A point output: the point of the platform link (platform frame, m) whose motion is the
+        mechanism's output (``<output type="point">``); None for the platform frame.
+    instantaneous_dof : int
+        Dimension of the platform's motion space at the reference assembly; larger than
+        :attr:`dof` when the reference assembly is a constraint singularity.
     """
 
     name: str
@@ -84,7 +100,7 @@ class Mechanism:
     description: UrdfDescription = field(repr=False)
     pinocchio_model: Any = field(repr=False)
     is_planar: bool
-    task_coordinates: tuple[str, ...]
+    pose_coordinates: tuple[str, ...]
     base_link: str
     platform_link: str
     platform_joint: str
@@ -99,13 +115,55 @@ class Mechanism:
     length_scale: float
     named_poses: dict[str, NDArray[np.float64]] = field(repr=False)
     length_unit: str = "m"
+    task_axes: tuple[int, ...] = ()
+    task_source: str = "all"
+    output_point: NDArray[np.float64] | None = field(default=None, repr=False)
+    instantaneous_dof: int = 0
 
     # -- derived -------------------------------------------------------------------------
 
     @property
+    def task_coordinates(self) -> tuple[str, ...]:
+        """The independent coordinates a pose is given in (every pose coordinate at full mobility)."""
+        return tuple(self.pose_coordinates[i] for i in self.task_indices)
+
+    @property
+    def task_indices(self) -> tuple[int, ...]:
+        """Indices into :attr:`pose_coordinates` of the task coordinates."""
+        return self.task_axes if self.task_axes else tuple(range(len(self.pose_coordinates)))
+
+    @property
+    def dependent_indices(self) -> tuple[int, ...]:
+        """Indices into :attr:`pose_coordinates` of the dependent (parasitic) coordinates."""
+        return tuple(i for i in range(len(self.pose_coordinates)) if i not in self.task_indices)
+
+    @property
     def n_task(self) -> int:
-        """Number of task coordinates (3 planar, 6 spatial)."""
-        return len(self.task_coordinates)
+        """Number of task coordinates."""
+        return len(self.task_indices)
+
+    @property
+    def n_pose(self) -> int:
+        """Number of pose coordinates (3 planar, 6 spatial)."""
+        return len(self.pose_coordinates)
+
+    @property
+    def home_full_pose(self) -> NDArray[np.float64]:
+        """Every pose coordinate of the reference assembly."""
+        return self.poses_from_transforms(self.home_rotation, self.home_translation)
+
+    def full_poses(self, task_poses: ArrayLike, dependent: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Full poses (..., n_pose) from task poses (..., n_task) and dependent values (default: home's)."""
+        task_poses = np.asarray(task_poses, dtype=float)
+        full = np.array(np.broadcast_to(self.home_full_pose, task_poses.shape[:-1] + (self.n_pose,)))
+        full[..., list(self.task_indices)] = task_poses
+        if dependent is not None and self.dependent_indices:
+            full[..., list(self.dependent_indices)] = dependent
+        return full
+
+    def task_poses(self, full_poses: ArrayLike) -> NDArray[np.float64]:
+        """The task coordinates (..., n_task) of full poses (..., n_pose)."""
+        return np.asarray(full_poses, dtype=float)[..., list(self.task_indices)]
 
     @property
     def home_pose(self) -> NDArray[np.float64]:
@@ -136,6 +194,11 @@ class Mechanism:
     def angular(self) -> NDArray[np.bool_]:
         """Which task coordinates are angles (phi, roll, pitch, yaw)."""
         return np.array([is_angular(name) for name in self.task_coordinates])
+
+    @property
+    def pose_angular(self) -> NDArray[np.bool_]:
+        """Which pose coordinates are angles."""
+        return np.array([is_angular(name) for name in self.pose_coordinates])
 
     def __repr__(self) -> str:
         return (f"Mechanism(name={self.name!r}, dof={self.dof}, chains={len(self.chains)}, "
@@ -173,7 +236,7 @@ class Mechanism:
         return poses
 
     def transforms_from_poses(self, poses: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Platform frames (rotation (..., 3, 3), translation (..., 3)) in the base frame."""
+        """Platform frames (rotation (..., 3, 3), translation (..., 3)) in the base frame, of full poses (..., n_pose)."""
         poses = np.asarray(poses, dtype=float)
         if self.is_planar:
             rotation = rotation_about_axis(np.array([0.0, 0.0, 1.0]), poses[..., 2])
@@ -184,7 +247,7 @@ class Mechanism:
         return rotation_from_rpy(poses[..., 3:]), poses[..., :3].copy()
 
     def poses_from_transforms(self, rotation: ArrayLike, translation: ArrayLike) -> NDArray[np.float64]:
-        """Task coordinates of platform frames given in the base frame."""
+        """Full poses (pose coordinates) of platform frames given in the base frame."""
         rotation = np.asarray(rotation, dtype=float)
         translation = np.asarray(translation, dtype=float)
         if self.is_planar:

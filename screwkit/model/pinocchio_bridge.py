@@ -101,15 +101,18 @@ def configuration_vector(mechanism, joint_values: Sequence[ArrayLike], poses: Ar
     joint_values : sequence of array_like
         Per chain, values (..., m_i) (e.g. ``solution.joint_values``); the tree joints take
         them (loop-joint values are not part of the tree).
-    poses : array_like, shape (..., n_task), optional
-        Platform poses for the platform joint (e.g. ``solution.poses``); default the home pose.
+    poses : array_like, shape (..., n_pose), optional
+        Full platform poses for the platform joint (e.g. ``solution.full_poses``); default the
+        reference assembly.
         Joints outside every chain keep their reference values.
     """
     import pinocchio
 
     model = mechanism.pinocchio_model
     joint_values = [np.asarray(values, dtype=float) for values in joint_values]
-    poses = mechanism.home_pose if poses is None else mechanism.check_poses(poses)
+    poses = mechanism.home_full_pose if poses is None else np.asarray(poses, dtype=float)
+    if poses.shape[-1:] != (mechanism.n_pose,):
+        raise ValueError(f"Expected full poses with shape (..., {mechanism.n_pose}), got {poses.shape}.")
     batch = np.broadcast_shapes(poses.shape[:-1], *(values.shape[:-1] for values in joint_values))
     reference = pinocchio.neutral(model)
     for name, value in mechanism.description.reference_configuration.items():
@@ -118,7 +121,7 @@ def configuration_vector(mechanism, joint_values: Sequence[ArrayLike], poses: Ar
     for index, chain in enumerate(mechanism.chains):
         for position, joint_id in enumerate(chain.tree_joint_ids):
             _set_joint(configuration, model.joints[joint_id], joint_values[index][..., position])
-    rotation, translation = mechanism.transforms_from_poses(np.broadcast_to(poses, batch + (mechanism.n_task,)))
+    rotation, translation = mechanism.transforms_from_poses(np.broadcast_to(poses, batch + (mechanism.n_pose,)))
     world_rotation = mechanism.rotation_world_base @ rotation
     world_translation = mechanism.translation_world_base + translation @ mechanism.rotation_world_base.T
     frame_inverse = mechanism.platform_frame_placement.inverse()

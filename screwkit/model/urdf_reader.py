@@ -14,8 +14,11 @@ Lengths: a file written in another unit (``<units length="mm"/>`` or the ``lengt
 argument) is converted to metres here, in the description *and* in the text handed to
 Pinocchio, so everything downstream is in metres.
 
-Size: files above :data:`MAX_FILE_BYTES` are refused before parsing; reading is linear in the
-file size.
+Size: files above :data:`MAX_FILE_BYTES` are refused before parsing, and trees of more than
+:data:`MAX_LINKS` links or deeper than :data:`MAX_TREE_DEPTH` joints before Pinocchio sees them
+(its URDF parser takes time growing with the square of the number of links, and recurses once
+per level of the tree, so that a very deep tree overflows the stack and crashes the process);
+reading is linear in the file size.
 
 Security: a URDF is data from elsewhere. Any document type declaration (``<!DOCTYPE``)
 or entity declaration (``<!ENTITY``) is refused *before* parsing, so entity bombs
@@ -49,6 +52,13 @@ AXIS_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar")
 """Joint types whose ``<axis>`` means something (a zero axis is refused on them only)."""
 MAX_FILE_BYTES = 16 * 2**20
 """Largest mechanism file read (16 MiB); larger files are refused before parsing."""
+MAX_LINKS = 10_000
+"""Most links a mechanism file may have; Pinocchio's model building grows with the square of
+their number (10,000 links: about 1 s; 148,000 links: 8.5 min), so more are refused after parsing."""
+MAX_TREE_DEPTH = 200
+"""Most joints between the root link and any link; Pinocchio's URDF parser recurses once per
+level and crashes the process on a stack overflow at a few hundred levels in a thread with a
+small stack (about 230 with 512 KiB, 3,800 with 8 MiB), so deeper trees are refused."""
 
 
 @dataclass(frozen=True)
@@ -134,6 +144,12 @@ class UrdfDescription:
         ``<named_pose name="..." x="..." ...>``: task coordinate values (m, rad) by pose name.
     length_unit : str
         The unit the file was written in (its lengths are converted to metres here).
+    task_coordinates : tuple of str or None
+        ``<task_coordinates names="z roll pitch"/>``: the independent coordinates a pose is
+        given in, for a mechanism of lower mobility (None: inferred).
+    output : str
+        ``"frame"`` (the platform frame, the default) or ``"point"`` (``<output type="point"/>``:
+        the platform frame's origin is a point output, rotations about it are idle).
     """
 
     source: str
@@ -146,6 +162,8 @@ class UrdfDescription:
     reference_configuration: dict[str, float]
     named_poses: dict[str, dict[str, float]] = field(default_factory=dict)
     length_unit: str = "m"
+    task_coordinates: tuple[str, ...] | None = None
+    output: str = "frame"
 
     def fail(self, element: str, problem: str) -> ValueError:
         """A one-line error naming this file, an element and a problem."""
@@ -298,7 +316,12 @@ class _Reader:
     def read(self, root: ElementTree.Element, text: str, length_unit: str = "m") -> UrdfDescription:
         robot_name = root.get("name", "")
         links: dict[str, None] = {}  # ordered, with constant-time lookups
-        for element in root.findall("link"):
+        link_elements = root.findall("link")
+        if len(link_elements) > MAX_LINKS:
+            raise self.fail(f"<robot name='{robot_name}'>",
+                            f"the file has {len(link_elements):,} links, more than the {MAX_LINKS:,} screwkit reads "
+                            "(screwkit.model.urdf_reader.MAX_LINKS).")
+        for element in link_elements:
             name = self.required_attribute(element, "<link>", "name")
             if name in links:
                 raise self.fail(f"<link name='{name}'>", "the link name is used twice.")
@@ -333,6 +356,14 @@ class _Reader:
             if name in named_poses:
                 raise self.fail(tag, "the pose name is used twice.")
             named_poses[name] = {key: self.number(element, tag, key) for key in element.keys() if key != "name"}
+        task_coordinates = None
+        for element in root.findall("task_coordinates"):
+            task_coordinates = tuple(self.required_attribute(element, "<task_coordinates>", "names").split())
+        output = "frame"
+        for element in root.findall("output"):
+            output = self.required_attribute(element, "<output>", "type")
+            if output not in ("frame", "point"):
+                raise self.fail(f"<output type='{output}'>", "expected type 'frame' or 'point'.")
         return UrdfDescription(
             source=self.source,
             text=text,
@@ -344,6 +375,8 @@ class _Reader:
             reference_configuration=reference,
             named_poses=named_poses,
             length_unit=length_unit,
+            task_coordinates=task_coordinates,
+            output=output,
         )
 
     def check_tree(self, robot_name: str, links: tuple[str, ...], joints: dict[str, JointElement]) -> None:
@@ -358,21 +391,27 @@ class _Reader:
                 raise self.fail(f"<joint name='{joint.name}'>", f"the joint connects the link {joint.child!r} to itself.")
             parent_joint[joint.child] = joint.name
         roots = [link for link in links if link not in parent_joint]
-        state: dict[str, int] = {}  # 1: on the current path, 2: leads to a root
+        depth: dict[str, int] = {}  # links known to lead to a root: the number of joints above them
         for start in links:
-            path = []
+            path, on_path = [], set()
             link = start
-            while link in parent_joint and state.get(link) != 2:
-                if state.get(link) == 1:
+            while link in parent_joint and link not in depth:
+                if link in on_path:
                     cycle = path[path.index(link):] + [link]
                     spelled = " -> ".join(f"{a} ({parent_joint[a]})" for a in cycle[:-1]) + f" -> {link}"
                     raise self.fail(f"<joint name='{parent_joint[link]}'>",
                                     f"the tree has a cycle of links (joints): {spelled}; close loops with <loop>.")
-                state[link] = 1
+                on_path.add(link)
                 path.append(link)
                 link = joints[parent_joint[link]].parent
-            for visited in path:
-                state[visited] = 2
+            above = depth.get(link, 0)  # 0 at a root
+            for visited in reversed(path):
+                above += 1
+                depth[visited] = above
+                if above > MAX_TREE_DEPTH:
+                    raise self.fail(f"<link name='{visited}'>",
+                                    f"the link is {above} joints below the root link, more than the {MAX_TREE_DEPTH} "
+                                    "levels screwkit reads (screwkit.model.urdf_reader.MAX_TREE_DEPTH).")
         if len(roots) != 1:
             spelled = ", ".join(repr(link) for link in roots[:5]) + (" ..." if len(roots) > 5 else "")
             raise self.fail(f"<robot name='{robot_name}'>",

@@ -97,6 +97,14 @@ class UrdfWriter:
         actuator = ElementTree.SubElement(transmission, "actuator", name=f"{joint}_motor")
         ElementTree.SubElement(actuator, "mechanicalReduction").text = "1"
 
+    def task_coordinates(self, names) -> None:
+        """``<task_coordinates names="z roll pitch"/>``: the independent coordinates of a lower-mobility mechanism."""
+        ElementTree.SubElement(self.robot, "task_coordinates", names=" ".join(names))
+
+    def output(self, output_type: str) -> None:
+        """``<output type="point"/>``: the platform frame's origin is a point output (``"frame"``: the default)."""
+        ElementTree.SubElement(self.robot, "output", type=output_type)
+
     def named_pose(self, name: str, values: dict[str, float]) -> None:
         """A ``<named_pose>``: task coordinate values (m, rad) by coordinate name."""
         ElementTree.SubElement(self.robot, "named_pose", name=name, **{k: _number(v) for k, v in values.items()})
@@ -126,7 +134,8 @@ def elbow(base: NDArray, end: NDArray, proximal: float, distal: float, side: flo
 
 
 def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, distal, working_mode=1.0,
-                    comment: str = "", named_poses: dict[str, tuple[float, float, float]] | None = None) -> str:
+                    comment: str = "", named_poses: dict[str, tuple[float, ...]] | None = None,
+                    output: str = "frame", home: tuple[float, float] = (0.0, 0.0)) -> str:
     """URDF of a planar n-RRR: base joints ``base`` (n, 2), platform joints ``platform`` (n, 2) in the
     platform frame, arm lengths (scalars or (n,)), elbows on the ``working_mode`` side (+1: +u_perp)
     in the reference assembly (platform at x = y = phi = 0). Base joints are actuated."""
@@ -155,7 +164,9 @@ def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, dista
                     f"{chain}_link_l", ((l, 0, 0), (0, 0, -second_angle)),
                     "platform", ((d[0], d[1], 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
         writer.transmission(f"{chain}_joint_b")
-    for pose_name, (x, y, phi) in (named_poses or {}).items():
-        writer.named_pose(pose_name, {"x": x, "y": y, "phi": phi})
+    if output != "frame":
+        writer.output(output)
+    for pose_name, values in (named_poses or {}).items():
+        writer.named_pose(pose_name, dict(zip(("x", "y", "phi") if output == "frame" else ("x", "y"), values)))
     return writer.text()
 

@@ -63,15 +63,15 @@ def check_output(path: str | os.PathLike, suffixes: tuple[str, ...], *, overwrit
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise ValueError(f"{path}: the folder {folder} does not exist.")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise ValueError(f"{path}: the folder {folder} is not writable.")
     if os.path.isdir(path):
         raise ValueError(f"{path}: is a folder, not a file.")
     if os.path.exists(path):
         if not overwrite:
             raise ValueError(f"{path}: the file exists; pass --overwrite to replace it.")
-        if not os.access(path, os.W_OK):
+        # No write bit for anyone also counts for root, whom os.access lets write anything.
+        if not os.stat(path).st_mode & 0o222 or not os.access(path, os.W_OK):
             raise ValueError(f"{path}: the file exists and is read-only.")
+    _check_folder_writable(path, folder)
     removed = []
     for stale in stale_temporaries(path):
         try:
@@ -82,11 +82,27 @@ def check_output(path: str | os.PathLike, suffixes: tuple[str, ...], *, overwrit
     return removed
 
 
+def _temporary_name(path: str) -> str:
+    """A temporary file beside ``path``: ``.NAME.tmp-PID-NANOSECONDS`` (see :func:`stale_temporaries`)."""
+    return os.path.join(os.path.dirname(os.path.abspath(path)),
+                        f".{os.path.basename(path)}.tmp-{os.getpid()}-{time.time_ns()}")
+
+
+def _check_folder_writable(path: str, folder: str) -> None:
+    """Create and remove a temporary file as a write would: the one sure test (os.access also says yes for
+    an immutable folder or one like /proc, which holds no new files)."""
+    probe = _temporary_name(path)
+    try:
+        os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    except OSError as error:
+        raise ValueError(f"{path}: cannot write in the folder {folder} ({error.strerror or error}).") from None
+    os.remove(probe)
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     """Call ``write(temporary)`` on a temporary file in the same folder, then rename it to ``path``."""
     path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    temporary = os.path.join(folder, f".{os.path.basename(path)}.tmp-{os.getpid()}-{time.time_ns()}")
+    temporary = _temporary_name(path)
     try:
         write(temporary)
         os.replace(temporary, path)

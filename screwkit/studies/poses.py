@@ -23,7 +23,32 @@ from screwkit.results import Indices
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.transmission import analyze
 
-__all__ = ["indices_at_poses", "indices_at_pose", "planar_points", "closed_form_indices"]
+__all__ = ["indices_at_poses", "indices_at_pose", "analyze_solution", "output_points", "planar_points",
+           "closed_form_indices"]
+
+
+def output_points(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float64] | None:
+    """The world position (..., 3) of a mechanism's point output at full poses; None for a frame output."""
+    if mechanism.output_point is None:
+        return None
+    rotation, translation = mechanism.transforms_from_poses(full_poses)
+    in_base = translation + rotation @ mechanism.output_point
+    return in_base @ mechanism.rotation_world_base.T + mechanism.translation_world_base
+
+
+def analyze_solution(mechanism: Mechanism, solution, *, unreachable: str = "raise", **options) -> Indices:
+    """:func:`screwkit.transmission.analyze` on the screws of a solution, with the mechanism's output.
+
+    ``unreachable`` as in :func:`screwkit.closure.chain_screws`; other options go to ``analyze``.
+    A point output (``<output type="point">``) makes the rotations about the point idle.
+    """
+    chains = chain_screws(mechanism, solution, unreachable=unreachable)
+    points = output_points(mechanism, solution.full_poses)
+    if points is not None:
+        if unreachable == "drop":
+            points = points[np.asarray(solution.reachable)]
+        options.update(output_point=points, planar=mechanism.is_planar)
+    return analyze(chains, **options)
 
 
 def planar_points(mechanism: Mechanism, solution):
@@ -146,6 +171,8 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     flat = poses.reshape(-1, mechanism.n_task)
     count = flat.shape[0]
     reachable = np.zeros(count, dtype=bool)
+    chain_status = np.zeros((count, len(mechanism.chains)), dtype=np.int8)
+    full_poses = np.empty((count, mechanism.n_pose))
     arrays: dict[str, NDArray] | None = None
     meta: Indices | None = None
     with thread_limit(threads):  # closures and screws on no more threads than the kernel
@@ -154,12 +181,14 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
             solution = solve(mechanism, flat[part], limits=limits)
             index = np.flatnonzero(np.asarray(solution.reachable)) + start
             reachable[index] = True
+            chain_status[part] = solution.status
+            full_poses[part] = solution.full_poses
             if index.size:
                 if closed_forms:
                     result = closed_form_indices(mechanism, solution, threshold, faults, threads)
                 else:
-                    chains = chain_screws(mechanism, solution, unreachable="drop")
-                    result = analyze(chains, detail=detail, threshold=threshold, faults=faults, threads=threads)
+                    result = analyze_solution(mechanism, solution, unreachable="drop", detail=detail,
+                                              threshold=threshold, faults=faults, threads=threads)
                 if arrays is None:
                     meta, arrays = result, _allocate(count, result, detail)
                 arrays["iti"][index] = result.iti
@@ -193,7 +222,9 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
                        mutual_interference=np.zeros(batch + (a,), dtype=bool), threshold=threshold,
                        iti_actuators=np.full(batch + (a,), np.nan) if detail else None,
                        poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
-                       mechanism=mechanism.name)
+                       mechanism=mechanism.name, chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
+                       full_poses=full_poses.reshape(batch + (mechanism.n_pose,)),
+                       pose_coordinates=mechanism.pose_coordinates)
     return Indices(
         actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms,
         iti=shaped("iti"), lmti=shaped("lmti"),
@@ -202,7 +233,8 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
         mutual_interference=shaped("mutual_interference"), threshold=threshold,
         iti_actuators=shaped("iti_actuators"), oti_submechanisms=shaped("oti_submechanisms"),
         poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
-        mechanism=mechanism.name)
+        mechanism=mechanism.name, chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
+        full_poses=full_poses.reshape(batch + (mechanism.n_pose,)), pose_coordinates=mechanism.pose_coordinates)
 
 
 def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float = SINGULARITY_THRESHOLD,
@@ -217,6 +249,7 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
     """
     pose = mechanism.check_poses(pose)
     solution = solve_one(mechanism, pose, limits=limits)
-    result = analyze(chain_screws(mechanism, solution), threshold=threshold, faults=faults, keep_twists=keep_twists)
+    result = analyze_solution(mechanism, solution, threshold=threshold, faults=faults, keep_twists=keep_twists)
     return replace(result, poses=pose, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
-                   reachable=True)
+                   reachable=True, chain_status=solution.status, full_poses=solution.full_poses,
+                   pose_coordinates=mechanism.pose_coordinates)

@@ -5,12 +5,15 @@ results in order. Tasks are pure functions of their inputs, so a task lost with 
 recomputed on another (three retries); results come back only when every task is done, so a
 caller writes nothing until then. Failures of the cluster itself are one-line
 :class:`ClusterError` messages: an address that does not answer within ``connect_timeout``, a
-scheduler lost mid-run.
+scheduler lost mid-run, a task given up by the scheduler because the workers running it died
+(more often than its ``distributed.scheduler.allowed-failures``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import logging
 import os
 import sys
 import time
@@ -18,8 +21,8 @@ from typing import Any, Callable
 
 __all__ = ["run_tasks", "ClusterError", "CONNECT_TIMEOUT"]
 
-CONNECT_TIMEOUT = 5.0
-"""Seconds to wait for a Dask scheduler to answer before giving up."""
+CONNECT_TIMEOUT = 3.0
+"""Seconds to wait for a Dask scheduler to answer before giving up (a command then fails within 5 s)."""
 
 
 class ClusterError(RuntimeError):
@@ -46,6 +49,26 @@ def _run_local(function: Callable, arguments: list[tuple], bar) -> list:
         return list(get(graph, [task.key for task in tasks], num_workers=os.cpu_count() or 1))
 
 
+@contextlib.contextmanager
+def _distributed_logs_muted():
+    """Drop the records of distributed's loggers meanwhile, such as the traceback it logs when a client
+    whose scheduler is gone is closed: the failure is reported once, as a ClusterError."""
+
+    def keep(record: logging.LogRecord) -> bool:
+        return not record.name.startswith("distributed")
+
+    loggers = [logging.root] + [logging.getLogger(name) for name in list(logging.root.manager.loggerDict)
+                                if name == "distributed" or name.startswith("distributed.")]
+    handlers = {handler for logger in loggers for handler in logger.handlers}
+    for handler in handlers:
+        handler.addFilter(keep)
+    try:
+        yield
+    finally:
+        for handler in handlers:
+            handler.removeFilter(keep)
+
+
 def _connect(scheduler: str, connect_timeout: float):
     from distributed import Client
 
@@ -62,7 +85,7 @@ def _connect(scheduler: str, connect_timeout: float):
 def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any, connect_timeout: float, bar) -> list:
     from concurrent.futures import CancelledError
 
-    from distributed import Client, as_completed
+    from distributed import Client, KilledWorker, as_completed
 
     client = scheduler if isinstance(scheduler, Client) else _connect(scheduler, connect_timeout)
     address = getattr(client.scheduler, "address", scheduler)
@@ -78,12 +101,16 @@ def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any,
         except (CancelledError, OSError, TimeoutError) as error:
             raise ClusterError(f"Lost the Dask scheduler at {address} mid-run ({type(error).__name__}); "
                                "nothing was written.") from None
+        except KilledWorker as error:  # the scheduler gave a task up: every worker that ran it died
+            raise ClusterError(f"Dask workers of the scheduler at {address} died while running a task "
+                               f"(KilledWorker: {str(error).split('. ')[0]}); nothing was written.") from None
     finally:
         if client is not scheduler:
-            try:
-                client.close(timeout=connect_timeout)
-            except Exception:  # closing a client whose scheduler is gone can only time out
-                pass
+            with _distributed_logs_muted():
+                try:
+                    client.close(timeout=connect_timeout)
+                except Exception:  # closing a client whose scheduler is gone can only time out
+                    pass
 
 
 def run_tasks(function: Callable, arguments: list[tuple], *, scheduler: Any = None, progress: bool | None = None,

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure import chain_screws, solve, solve_one
 from screwkit.model.pinocchio_bridge import configuration_vector
-from screwkit.transmission import analyze
+from screwkit.studies.poses import analyze_solution
 
 __all__ = [
     "ROOT_PATH",
@@ -216,9 +216,9 @@ def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> F
         poses = poses[reachable]
         solution = solve(mechanism, poses)
     screws = chain_screws(mechanism, solution)
-    result = analyze(screws, threshold=threshold, keep_twists=True)
-    configurations = configuration_vector(mechanism, solution.joint_values, solution.poses)
-    _, translation = mechanism.transforms_from_poses(solution.poses)
+    result = analyze_solution(mechanism, solution, threshold=threshold, keep_twists=True)
+    configurations = configuration_vector(mechanism, solution.joint_values, solution.full_poses)
+    _, translation = mechanism.transforms_from_poses(solution.full_poses)
     centres = translation @ np.asarray(mechanism.rotation_world_base).T + np.asarray(mechanism.translation_world_base)
     return Frames(poses=np.asarray(solution.poses),
                    configurations=np.asarray(configurations).reshape(poses.shape[0], -1),

@@ -175,8 +175,18 @@ def start_viewer(server: ViewerServer | None = None, *, timeout: float = 30.0):
 
     meshcat = import_meshcat()
     server = ViewerServer.start(timeout=timeout) if server is None else server
+    class Window(meshcat.visualizer.ViewerWindow):
+        """meshcat's window, closing its ZeroMQ socket before it opens another (it reconnects once)."""
+
+        def connect_zmq(self):
+            previous = getattr(self, "zmq_socket", None)
+            if previous is not None:
+                previous.close(linger=0)
+            super().connect_zmq()
+
     with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints the URL
-        viewer = meshcat.Visualizer(zmq_url=server.zmq_url)
+        window = Window(zmq_url=server.zmq_url, start_server=False, server_args=[])
+        viewer = meshcat.Visualizer(window=window)
     viewer.window.zmq_socket.setsockopt(zmq.RCVTIMEO, int(max(timeout, 60.0) * 1000))
     viewer.window.server_proc = server.process
     viewer.window.screwkit_server = server

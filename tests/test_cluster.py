@@ -1,0 +1,266 @@
+"""The cluster path as users run it: a real ``dask scheduler`` and ``dask worker`` processes on loopback.
+
+The scheduler and the workers are started with the ``dask`` command line, each in its own
+process group (so that one can be killed with SIGKILL, nanny and worker together, as when a
+machine is lost), and always ended when the tests are done. The ``screwkit`` command runs in a
+subprocess against them; a separate client only watches the scheduler's task states to kill
+things mid-run. Nothing here uses a default distributed client.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from helpers import screwkit
+
+distributed = pytest.importorskip("distributed")
+
+DASK = str(Path(sys.executable).with_name("dask"))
+MAP = ("map", "planar_5rrr", "--radius", "0.5", "--step", "0.01", "--phi-step", "2", "--task-size", "4000")
+"""1.4 million configurations in over 300 tasks: a few seconds on two single-threaded workers."""
+SEARCH = ("design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json", "--quiet")
+
+
+def free_port() -> int:
+    """A loopback port nothing listens on (bound, then released)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+class Cluster:
+    """``dask scheduler`` and ``dask worker`` processes on 127.0.0.1, each in its own process group."""
+
+    def __init__(self, folder: Path, workers: int, scheduler_environment: dict | None = None):
+        self.folder = folder
+        self.port = free_port()
+        self.address = f"tcp://127.0.0.1:{self.port}"
+        self.logs = []
+        self.scheduler = self.start("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", str(self.port),
+                                                  "--no-dashboard"], scheduler_environment)
+        self.workers = [self.start(f"worker-{i}", ["worker", self.address, "--nworkers", "1", "--nthreads", "1",
+                                                   "--no-dashboard"]) for i in range(workers)]
+        self.client = None
+        try:
+            self.client = distributed.Client(self.address, timeout=30, set_as_default=False)
+            self.client.wait_for_workers(workers, timeout=60)
+        except BaseException:
+            self.stop()
+            raise
+
+    def start(self, name: str, arguments: list[str], environment: dict | None = None) -> subprocess.Popen:
+        log = open(self.folder / f"{name}.log", "w")
+        self.logs.append(log)
+        return subprocess.Popen([DASK, *arguments], cwd=self.folder, stdin=subprocess.DEVNULL,
+                                stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
+                                env=None if environment is None else {**os.environ, **environment})
+
+    def kill(self, process: subprocess.Popen) -> None:
+        """SIGKILL to the process's whole group (a worker's nanny and the worker it spawned)."""
+        try:
+            os.killpg(process.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        process.wait(timeout=30)
+
+    def finished_tasks(self, prefix: str = "screwkit-map_task-") -> tuple[int, int]:
+        """(tasks in memory, all tasks) of screwkit's tasks on the scheduler."""
+
+        def count(dask_scheduler, prefix=prefix):
+            states = [task.state for key, task in dask_scheduler.tasks.items() if str(key).startswith(prefix)]
+            return sum(state == "memory" for state in states), len(states)
+
+        return tuple(self.client.run_on_scheduler(count))
+
+    def wait_until_some_finished(self, command: subprocess.Popen, count: int = 5, timeout: float = 60) -> tuple:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            assert command.poll() is None, "the command ended before anything could be killed"
+            done, total = self.finished_tasks()
+            if done >= count:
+                return done, total
+            time.sleep(0.02)
+        raise AssertionError(f"no {count} tasks finished within {timeout} s")
+
+    def close_client(self) -> None:
+        if self.client is not None:
+            self.client.close(timeout=10)
+            self.client = None
+
+    def stop(self) -> None:
+        try:
+            self.close_client()
+        finally:
+            for process in [*self.workers, self.scheduler]:
+                self.kill(process)
+            for log in self.logs:
+                log.close()
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    running = Cluster(tmp_path_factory.mktemp("cluster"), workers=2)
+    try:
+        yield running
+    finally:
+        running.stop()
+
+
+@pytest.fixture(scope="module")
+def local_map(tmp_path_factory) -> Path:
+    """The map computed on local threads, the reference."""
+    out = tmp_path_factory.mktemp("local") / "local.nc"
+    result = screwkit(*MAP, "--out", out)
+    assert result.returncode == 0, result.stderr
+    return out
+
+
+def assert_same_file(expected: Path, actual: Path) -> None:
+    """Every variable, coordinate and attribute equal, and the files equal byte for byte."""
+    with xr.open_dataset(expected) as one, xr.open_dataset(actual) as other:
+        assert set(one.variables) == set(other.variables) and one.attrs == other.attrs
+        for name in one.variables:
+            np.testing.assert_array_equal(one[name].values, other[name].values, err_msg=name)
+            assert one[name].attrs == other[name].attrs, name
+    assert expected.read_bytes() == actual.read_bytes()
+
+
+def one_line(result: subprocess.CompletedProcess | tuple, *needles: str) -> str:
+    code, stdout, stderr = (result.returncode, result.stdout, result.stderr) if hasattr(result, "stderr") else result
+    assert code == 1, (code, stderr)
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), stderr
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    assert stdout == ""
+    return lines[0]
+
+
+def test_map_on_the_cluster_equals_the_local_map(cluster, local_map, tmp_path):
+    out = tmp_path / "remote.nc"
+    result = screwkit(*MAP, "--scheduler", cluster.address, "--out", out)
+    assert result.returncode == 0, result.stderr
+    assert "Warning" not in result.stderr and "Traceback" not in result.stderr, result.stderr
+    assert_same_file(local_map, out)
+    assert sorted(os.listdir(tmp_path)) == ["remote.nc"]
+
+
+def test_design_search_on_the_cluster_equals_the_local_search(cluster):
+    local = screwkit(*SEARCH)
+    remote = screwkit(*SEARCH, "--scheduler", cluster.address)
+    assert local.returncode == 0 and remote.returncode == 0, remote.stderr
+    assert json.loads(remote.stdout) == json.loads(local.stdout)
+    assert len(json.loads(remote.stdout)["designs"]) == 240
+
+
+def test_a_worker_killed_mid_run_loses_nothing(cluster, local_map, tmp_path):
+    out = tmp_path / "remote.nc"
+    with open(tmp_path / "stderr.txt", "w+") as errors:
+        command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", *MAP,
+                                    "--scheduler", cluster.address, "--out", str(out)],
+                                   stdout=subprocess.DEVNULL, stderr=errors)
+        try:
+            done, total = cluster.wait_until_some_finished(command, count=100)
+            victim = cluster.workers[0]
+            cluster.kill(victim)  # the nanny and its worker: a lost machine, not a restarted worker
+            assert command.poll() is None, "the kill came after the run"
+            assert 100 <= done < total and total > 300, (done, total)
+            assert command.wait(timeout=120) == 0
+        finally:
+            if command.poll() is None:
+                command.kill()
+        errors.seek(0)
+        stderr = errors.read()
+    assert "Warning" not in stderr and "Traceback" not in stderr, stderr
+    assert len(cluster.client.scheduler_info()["workers"]) == len(cluster.workers) - 1  # really gone
+    assert_same_file(local_map, out)
+
+
+def test_an_unreachable_scheduler_fails_in_seconds_with_one_line(tmp_path):
+    address = f"tcp://127.0.0.1:{free_port()}"
+    out = tmp_path / "remote.nc"
+    start = time.perf_counter()
+    result = screwkit(*MAP, "--scheduler", address, "--out", out)
+    default = time.perf_counter() - start
+    one_line(result, f"Cannot reach the Dask scheduler at {address} within 3 s")
+    assert default < 5.0, default
+    # --connect-timeout is honoured, both ways.
+    start = time.perf_counter()
+    result = screwkit(*MAP, "--scheduler", address, "--out", out, "--connect-timeout", "0.5")
+    short = time.perf_counter() - start
+    one_line(result, "within 0.5 s")
+    assert short < default - 1.0, (short, default)
+    start = time.perf_counter()
+    result = screwkit(*SEARCH[:-2], "--scheduler", address, "--connect-timeout", "4")
+    longer = time.perf_counter() - start
+    one_line(result, f"Cannot reach the Dask scheduler at {address} within 4 s")
+    assert longer >= 4.0, longer
+    # An address that is no address, and the same with --json.
+    result = screwkit(*MAP, "--scheduler", "nowhere", "--out", out)
+    one_line(result, "Dask scheduler address 'nowhere'")
+    result = screwkit(*SEARCH[:-1], "--scheduler", address, "--connect-timeout", "0.5")
+    assert result.returncode == 1 and result.stderr == ""
+    assert "Cannot reach the Dask scheduler" in json.loads(result.stdout)["error"]
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_scheduler_lost_mid_run_gives_one_line_and_no_file(tmp_path_factory, tmp_path):
+    lost = Cluster(tmp_path_factory.mktemp("lost"), workers=1)
+    out = tmp_path / "remote.nc"
+    try:
+        command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", *MAP,
+                                    "--scheduler", lost.address, "--out", str(out)],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            done, total = lost.wait_until_some_finished(command)
+            lost.close_client()
+            lost.kill(lost.scheduler)
+            killed = time.perf_counter()
+            assert command.poll() is None, "the kill came after the run"
+            stdout, stderr = command.communicate(timeout=60)
+            ended = time.perf_counter() - killed
+        finally:
+            if command.poll() is None:
+                command.kill()
+    finally:
+        lost.stop()
+    assert 5 <= done < total, (done, total)
+    one_line((command.returncode, stdout, stderr), f"Lost the Dask scheduler at {lost.address} mid-run",
+             "nothing was written")
+    assert ended < 15, ended
+    assert os.listdir(tmp_path) == []  # no output, no temporary file
+
+
+def test_a_task_given_up_by_the_scheduler_gives_one_line_and_no_file(tmp_path_factory, tmp_path):
+    """With allowed-failures 0 the scheduler gives a task up as soon as a worker dies running it (KilledWorker)."""
+    fragile = Cluster(tmp_path_factory.mktemp("fragile"), workers=2,
+                      scheduler_environment={"DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"})
+    out = tmp_path / "remote.nc"
+    try:
+        command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", *MAP,
+                                    "--scheduler", fragile.address, "--out", str(out)],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            done, total = fragile.wait_until_some_finished(command)
+            fragile.kill(fragile.workers[0])  # busy with a task: there are hundreds queued
+            assert command.poll() is None, "the kill came after the run"
+            stdout, stderr = command.communicate(timeout=60)
+        finally:
+            if command.poll() is None:
+                command.kill()
+    finally:
+        fragile.stop()
+    one_line((command.returncode, stdout, stderr), f"Dask workers of the scheduler at {fragile.address} died while "
+             "running a task (KilledWorker:", "nothing was written")
+    assert os.listdir(tmp_path) == []
