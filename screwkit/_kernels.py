@@ -17,7 +17,7 @@ from ``c`` (a twist (omega, v) becomes (omega, v_c / L), a point p becomes (p - 
 (f, m) becomes (f, m_c / L)). Every tolerance is then compared with dimensionless numbers, so
 that no decision depends on the length unit, the scale of the mechanism or the world frame; the
 singularity threshold *p*, a length, is compared as p / L. ``c`` and ``L`` are computed per
-configuration, exactly as :func:`screwkit.transmission._working_coordinates` does for the
+configuration, exactly as :func:`screwkit.motion.working_coordinates` does for the
 motion-space bases it passes in; outputs go back to world units and frame. The tolerances come
 in as arguments (named in :mod:`screwkit.tolerances`): numba's disk cache would not notice a
 changed constant of another module.

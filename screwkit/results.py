@@ -11,28 +11,28 @@ Only numpy is imported here (xarray when :meth:`Indices.to_dataset` is called).
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.units import is_angular
+from screwkit.reports import indices_to_dataset, indices_to_dict, set_label
 
-__all__ = ["Indices", "set_label"]
+__all__ = ["Indices", "set_label", "PER_CONFIGURATION", "PER_CONFIGURATION_DICTS"]
+
+PER_CONFIGURATION = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_actuators", "oti_submechanisms",
+                     "actuation_wrenches", "output_twists", "poses", "reachable", "chain_status", "full_poses",
+                     "cti", "cti_submechanisms", "instantaneous_dof", "constraint_singular")
+"""Fields of :class:`Indices` with one entry per configuration (leading batch axes)."""
+PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c")
+"""Fields of :class:`Indices` that map ``j`` to one entry per configuration."""
 
 
 def _scalar_or_array(value):
     """A 0-d array (or numpy scalar) as a Python float; arrays unchanged."""
     array = np.asarray(value)
     return float(array) if array.ndim == 0 else array
-
-
-def _json_number(value: float) -> float | None:
-    """A float for JSON: NaN (an unreachable pose) becomes None (null); -0.0 becomes 0.0."""
-    value = float(value)
-    return None if math.isnan(value) else value + 0.0
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -95,6 +95,22 @@ class Indices:
         The poses in every pose coordinate, dependent (parasitic) ones included.
     pose_coordinates : tuple of str
         Names of the full poses' coordinates.
+    cti : float or ndarray (...) or None
+        Constraint transmission index (:mod:`screwkit.constraints`): the best non-redundant
+        actuator set's; NaN where no constraint wrench applies, None when not computed.
+    f_c : dict of int to float or ndarray (...)
+        Its fault-tolerant counterpart over ``j`` faults (screwkit's extension).
+    cti_submechanisms : ndarray (..., S) or None
+        CTI of every non-redundant actuator set.
+    constraint_count : int
+        Constraint wrenches the CTI releases (0: the CTI does not apply).
+    instantaneous_dof : ndarray (...) of int or None
+        The platform's DOF at each configuration; above :attr:`dof` at a constraint singularity.
+    constraint_singular : ndarray (...) of bool or None
+        Whether each configuration is a constraint singularity.
+    fault_type : str
+        ``"free-swinging"`` (failed actuators become passive joints, the paper's FSJF) or
+        ``"link"`` (their chains disappear with their constraint wrenches, the paper's LF).
     """
 
     actuators: tuple[str, ...]
@@ -119,6 +135,13 @@ class Indices:
     chain_status: NDArray[np.int8] | None = None
     full_poses: NDArray[np.float64] | None = None
     pose_coordinates: tuple[str, ...] = ()
+    cti: Any = None
+    f_c: dict[int, Any] = field(default_factory=dict)
+    cti_submechanisms: NDArray[np.float64] | None = None
+    constraint_count: int = 0
+    instantaneous_dof: Any = None
+    constraint_singular: Any = None
+    fault_type: str = "free-swinging"
     batch_shape: tuple[int, ...] = field(init=False)
 
     def __post_init__(self):
@@ -129,6 +152,15 @@ class Indices:
         object.__setattr__(self, "lmti", _scalar_or_array(self.lmti))
         object.__setattr__(self, "f_o", {int(j): _scalar_or_array(v) for j, v in self.f_o.items()})
         object.__setattr__(self, "f_io", {int(j): _scalar_or_array(v) for j, v in self.f_io.items()})
+        object.__setattr__(self, "f_c", {int(j): _scalar_or_array(v) for j, v in self.f_c.items()})
+        if self.cti is not None:
+            object.__setattr__(self, "cti", _scalar_or_array(self.cti))
+        if self.instantaneous_dof is not None:
+            dofs = np.asarray(self.instantaneous_dof)
+            object.__setattr__(self, "instantaneous_dof", int(dofs) if dofs.ndim == 0 else dofs)
+        if self.constraint_singular is not None:
+            flags = np.asarray(self.constraint_singular, dtype=bool)
+            object.__setattr__(self, "constraint_singular", bool(flags) if flags.ndim == 0 else flags)
         reachable = np.ones(shape, dtype=bool) if self.reachable is None else np.asarray(self.reachable, dtype=bool)
         object.__setattr__(self, "reachable", bool(reachable) if reachable.ndim == 0 else reachable)
         object.__setattr__(self, "threshold", float(self.threshold))
@@ -196,17 +228,9 @@ class Indices:
         def pick(value):
             return None if value is None else np.asarray(value)[index]
 
-        return Indices(
-            actuators=self.actuators, dof=self.dof, submechanisms=self.submechanisms, iti=pick(self.iti),
-            lmti=pick(self.lmti), f_o={j: pick(v) for j, v in self.f_o.items()},
-            f_io={j: pick(v) for j, v in self.f_io.items()},
-            worst_fault_indices={j: pick(v) for j, v in self.worst_fault_indices.items()},
-            mutual_interference=pick(self.mutual_interference), threshold=self.threshold,
-            iti_actuators=pick(self.iti_actuators), oti_actuators=pick(self.oti_actuators),
-            oti_submechanisms=pick(self.oti_submechanisms), actuation_wrenches=pick(self.actuation_wrenches),
-            output_twists=pick(self.output_twists), poses=pick(self.poses), reachable=pick(self.reachable),
-            task_coordinates=self.task_coordinates, mechanism=self.mechanism, chain_status=pick(self.chain_status),
-            full_poses=pick(self.full_poses), pose_coordinates=self.pose_coordinates)
+        changes = {name: pick(getattr(self, name)) for name in PER_CONFIGURATION}
+        changes.update({name: {j: pick(v) for j, v in getattr(self, name).items()} for name in PER_CONFIGURATION_DICTS})
+        return replace(self, **changes)
 
     def lmti_of(self, actuator_set: Sequence[int | str]) -> Any:
         """LMTI of a set of actuators (Eq. 11): the best OTI of its ``n``-subsets.
@@ -245,48 +269,7 @@ class Indices:
         Angles of the pose are in degrees; NaN (unreachable) becomes None. For a batch, every
         per-configuration entry is a nested list in the batch's order.
         """
-
-        def number(values):
-            array = np.asarray(values, dtype=float)
-            if array.ndim == 0:
-                return _json_number(array)
-            return [number(v) for v in array]
-
-        report: dict[str, Any] = {}
-        if self.mechanism:
-            report["mechanism"] = self.mechanism
-        if self.poses is not None and self.task_coordinates:
-            shown = np.array(self.poses, dtype=float, copy=True)
-            for axis, name in enumerate(self.task_coordinates):
-                if is_angular(name):
-                    shown[..., axis] = np.rad2deg(shown[..., axis])
-            report["pose"] = ({name: number(shown[..., axis]) for axis, name in enumerate(self.task_coordinates)})
-        if self.full_poses is not None and self.pose_coordinates:
-            dependent = [name for name in self.pose_coordinates if name not in self.task_coordinates]
-            if dependent:  # the parasitic coordinates the closure gave
-                full = np.array(self.full_poses, dtype=float, copy=True)
-                for axis, name in enumerate(self.pose_coordinates):
-                    if is_angular(name):
-                        full[..., axis] = np.rad2deg(full[..., axis])
-                report["dependent"] = {name: number(full[..., self.pose_coordinates.index(name)]) for name in dependent}
-        report["reachable"] = self.reachable if not self.batch_shape else np.asarray(self.reachable).tolist()
-        report["dof"] = self.dof
-        report["actuators"] = list(self.actuators)
-        report["iti"] = number(self.iti)
-        if self.iti_actuators is not None:
-            report["iti_actuators"] = {name: number(self.iti_actuators[..., i]) for i, name in enumerate(self.actuators)}
-        report["lmti"] = number(self.lmti)
-        report["f_o"] = {str(j): number(v) for j, v in self.f_o.items()}
-        report["f_io"] = {str(j): number(v) for j, v in self.f_io.items()}
-        worst = self.worst_faults
-        report["worst_faults"] = {str(j): (list(v) if not self.batch_shape else np.asarray(v).tolist())
-                                  for j, v in worst.items()}
-        if self.batch_shape:
-            report["not_mutual_interference"] = np.asarray(self.not_mutual_interference).tolist()
-        else:
-            report["not_mutual_interference"] = list(self.not_mutual_interference)
-        report["threshold_m"] = self.threshold
-        return report
+        return indices_to_dict(self)
 
     def to_dataset(self, dims: Sequence[str] | None = None, coords: dict | None = None):
         """The indices as an ``xarray.Dataset``.
@@ -307,53 +290,4 @@ class Indices:
             ``iti_actuator`` and ``oti_submechanism``; the pose coordinates, when known, as
             coordinates along the batch dimensions (m, deg).
         """
-        import xarray as xr
-
-        batch = self.batch_shape
-        if dims is None:
-            dims = ("pose",) if len(batch) == 1 else tuple(f"pose_{i}" for i in range(len(batch)))
-        dims = tuple(dims)
-        if len(dims) != len(batch):
-            raise ValueError(f"Expected {len(batch)} names in `dims` for the batch shape {batch}, got {dims}.")
-        variables = {
-            "reachable": (dims, np.asarray(self.reachable)),
-            "iti": (dims, np.asarray(self.iti), {"long_name": "ITI (Eq. 7)"}),
-            "lmti": (dims, np.asarray(self.lmti), {"long_name": "LMTI of all actuators (Eq. 11)"}),
-            "mutual_interference": (dims + ("actuator",), self.mutual_interference,
-                                    {"long_name": "mutual-interference actuator"}),
-        }
-        if self.iti_actuators is not None:
-            variables["iti_actuator"] = (dims + ("actuator",), self.iti_actuators,
-                                         {"long_name": "ITI per actuator (Eq. 6)"})
-        if self.oti_submechanisms is not None:
-            variables["oti_submechanism"] = (dims + ("submechanism",), self.oti_submechanisms,
-                                             {"long_name": "OTI of each non-redundant submechanism (Eq. 9)"})
-        worst = self.worst_faults
-        for j in self.faults:
-            variables[f"f_o{j}"] = (dims, np.asarray(self.f_o[j]), {"long_name": f"F_O{j} (Eq. 12)"})
-            variables[f"f_io{j}"] = (dims, np.asarray(self.f_io[j]), {"long_name": f"F_IO{j} (Eq. 14)"})
-            variables[f"worst_fault{j}"] = (dims + (f"fault{j}",), np.asarray(worst[j], dtype=str),
-                                            {"long_name": f"failed actuators of the worst case of {j} fault(s)"})
-        all_coords = {"actuator": ("actuator", list(self.actuators)),
-                      "submechanism": ("submechanism", [set_label(s) for s in self.submechanisms])}
-        if self.poses is not None and self.task_coordinates:
-            for axis, name in enumerate(self.task_coordinates):
-                values = np.asarray(self.poses)[..., axis]
-                values = np.rad2deg(values) if is_angular(name) else values
-                if name not in dims:
-                    all_coords[name] = (dims, values, {"units": "deg" if is_angular(name) else "m"})
-        all_coords.update(coords or {})
-        dataset = xr.Dataset({k: xr.Variable(*v) for k, v in variables.items()}, coords=all_coords)
-        dataset.attrs.update(threshold_m=self.threshold, dof=self.dof)
-        if self.mechanism:
-            dataset.attrs["mechanism"] = self.mechanism
-        return dataset
-
-
-def set_label(actuators: Sequence[int]) -> str:
-    """A set of 0-based actuator indices as the paper writes it, counting from 1.
-
-    >>> set_label((0, 1, 2))
-    '1-2-3'
-    """
-    return "-".join(str(i + 1) for i in actuators)
+        return indices_to_dataset(self, dims, coords)

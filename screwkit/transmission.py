@@ -42,6 +42,9 @@ from screwkit import tolerances
 from screwkit._chunks import map_chunks
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
+from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
+from screwkit.link_faults import FAULT_TYPES, link_fault_indices
+from screwkit.motion import MotionSpace, motion_space, null_spaces, working_coordinates
 from screwkit.outputs import idle_rotations, quotient_bases, with_idle_joints
 from screwkit.results import Indices
 
@@ -49,141 +52,6 @@ __all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets"]
 
 DEFAULT_THRESHOLD = tolerances.SINGULARITY_THRESHOLD
 """The paper's singularity threshold *p* on the moment arm: 1 um (in metres)."""
-
-
-# ----------------------------------------------------------------------------------------
-# Motion space
-# ----------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class MotionSpace:
-    """The platform's motion space found on sample configurations.
-
-    Attributes
-    ----------
-    dof : int
-        Degrees of freedom ``n`` of the platform.
-    constant_basis : ndarray, shape (n, 6) or None
-        Orthonormal basis (rows) of the motion space when it was the same at every sample
-        (planar mechanisms, 6-DoF legs); ``None`` otherwise. In the working coordinates of each
-        configuration (twists about the centroid of the platform joints, ``(omega, v / L)``,
-        see :func:`analyze`): a constant space is the same space in those coordinates at
-        every configuration.
-    """
-
-    dof: int
-    constant_basis: NDArray[np.float64] | None
-
-    @property
-    def complement(self) -> NDArray[np.float64]:
-        """Orthonormal rows spanning the Euclidean complement of :attr:`constant_basis`."""
-        if self.constant_basis is None:
-            raise ValueError("The motion space is not constant; it has no fixed complement.")
-        _, _, right = np.linalg.svd(self.constant_basis)
-        return np.ascontiguousarray(right[self.dof:])
-
-
-def _chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: float) -> NDArray[np.float64]:
-    """Sum over chains of ``I - P_chain`` for twists given as a list of (K, m, 6) arrays.
-
-    Each joint twist is scaled to unit norm first (a column scaling: the same span), so that
-    the relative rank ``tolerance`` compares dimensionless singular values whatever the joint
-    types; twists are expected in working coordinates.
-    """
-    total = np.zeros((twists[0].shape[0], 6, 6))
-    for chain_twists in twists:
-        norms = np.linalg.norm(chain_twists, axis=-1, keepdims=True)
-        columns = chain_twists / np.where(norms > 0.0, norms, 1.0)
-        left, singular, _ = np.linalg.svd(np.swapaxes(columns, -1, -2), full_matrices=False)
-        rank_mask = singular > tolerance * singular[..., :1]
-        basis = left * rank_mask[..., None, :]
-        total += np.eye(6) - basis @ np.swapaxes(basis, -1, -2)
-    return total
-
-
-def _null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float):
-    """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i) (working coordinates)."""
-    values, vectors = np.linalg.eigh(_chain_projector_complements(chain_twists, tolerance))
-    dims = np.sum(values <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)
-    count = int(dims.max()) if dof is None else dof
-    return dims, np.swapaxes(vectors[..., :count], -1, -2)
-
-
-def _working_coordinates(twists: list[NDArray], points: list[NDArray]):
-    """Batch-first twists (N, m, 6) and points (N, m, 3) of every chain in working coordinates.
-
-    About the centroid ``c`` of the platform joints (the last joint of every chain) with lengths
-    in units of ``L``, the RMS distance of every joint point from ``c``: a twist becomes
-    ``(omega, (v + omega x c) / L)`` and a point ``(p - c) / L``. Every Euclidean norm and
-    tolerance downstream is then invariant to the length unit, the scale of the mechanism and
-    the world frame. The compiled kernel computes ``c`` and ``L`` by the same formulas
-    (a configuration whose joint points all coincide gets ``L = 1``).
-
-    Returns
-    -------
-    twists, points : lists of arrays as given, in working coordinates
-    centre : ndarray (N, 3)
-    length : ndarray (N,)
-    """
-    centre = np.mean([chain_points[:, -1] for chain_points in points], axis=0)  # (N, 3)
-    relative = [chain_points - centre[:, None] for chain_points in points]
-    joints = sum(chain_points.shape[1] for chain_points in points)
-    length = np.sqrt(sum(np.einsum("nmk,nmk->n", r, r) for r in relative) / joints)
-    length = np.where(length > 0.0, length, 1.0)
-    scale = 1.0 / length[:, None, None]
-    moved = [np.concatenate([t[..., :3], (t[..., 3:] + np.cross(t[..., :3], centre[:, None])) * scale], axis=-1)
-             for t in twists]
-    return moved, [r * scale for r in relative], centre, length
-
-
-def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples: int = 9,
-                 tolerance: float = tolerances.MOTION_SPACE_TOLERANCE) -> MotionSpace:
-    r"""Find the platform's DOF and, if it is constant, its motion space.
-
-    The motion space is the intersection of the chains' twist spaces,
-    :math:`\mathcal{M} = \bigcap_i \mathrm{span}(J_i)`, i.e. the null space of
-    :math:`\sum_i (I - P_i)` with :math:`P_i` the orthogonal projector on the span of chain
-    ``i``'s joint twists. It is evaluated on ``samples`` configurations spread over the
-    batch; the DOF is the largest dimension found (a singular sample can only lose
-    mobility). Every sample is in its working coordinates (about the centroid of its platform
-    joints, lengths in units of its characteristic length, as in :func:`analyze`), so that the
-    rank decisions do not depend on the length unit, the scale or the world frame. Not a hot
-    path: a few SVDs.
-
-    Parameters
-    ----------
-    chains : sequence of ChainScrews
-    dof : int, optional
-        Impose the DOF instead of deriving it.
-    samples : int
-        Number of configurations to sample.
-    tolerance : float
-        Relative rank tolerance of the chains' twist systems (each twist scaled to unit norm).
-
-    Returns
-    -------
-    MotionSpace
-    """
-    flat = [chain.twists.reshape((-1,) + chain.twists.shape[-2:]) for chain in chains]
-    flat_points = [chain.points.reshape((-1,) + chain.points.shape[-2:]) for chain in chains]
-    count = flat[0].shape[0]
-    index = np.unique(np.linspace(0, count - 1, min(count, samples)).round().astype(int))
-    working, _, _, _ = _working_coordinates([twists[index] for twists in flat],
-                                            [points[index] for points in flat_points])
-    dims, bases = _null_spaces(working, dof, tolerance)
-    found = int(dims.max()) if dof is None else dof
-    if found == 0:
-        raise ValueError("The platform has no mobility: the chains' twist spaces intersect only in zero.")
-    if dof is not None and (not isinstance(dof, (int, np.integer)) or not 1 <= dof <= 6):
-        raise ValueError(f"Expected `dof` in 1..6, got {dof!r}.")
-    generic = np.flatnonzero(dims == found)
-    if generic.size == 0:
-        return MotionSpace(found, None)
-    candidate = np.ascontiguousarray(bases[generic[0]])
-    for sample in generic[1:]:
-        residual = bases[sample] - bases[sample] @ candidate.T @ candidate
-        if np.abs(residual).max() > tolerances.CONSTANT_BASIS_TOLERANCE:
-            return MotionSpace(found, None)
-    return MotionSpace(found, candidate)
 
 
 # ----------------------------------------------------------------------------------------
@@ -279,7 +147,7 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
-    """The compiled kernel on one chunk; ``basis`` in working coordinates (see :func:`_working_coordinates`)."""
+    """The compiled kernel on one chunk; ``basis`` in working coordinates (see :func:`working_coordinates`)."""
     from screwkit._kernels import transmission_kernel  # numba: loaded when indices first run
 
     count = twists.shape[0]
@@ -329,8 +197,8 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
         starts = plan.chain_start
         chain_twists = [twists[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
         chain_points = [points[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        working, _, centre, length = _working_coordinates(chain_twists, chain_points)
-        _, bases = _null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE)
+        working, _, centre, length = working_coordinates(chain_twists, chain_points)
+        _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE)
         if plan.idle_count:
             bases = quotient_bases(bases, idle[redo], centre, length, plan.dof)
         again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
@@ -384,6 +252,44 @@ def _joints_of_all_chains(arrays: list[NDArray]):
     return lambda part: np.concatenate([a[part] for a in arrays], axis=1)
 
 
+def _constraint_plan(chains: list[ChainScrews], count: int) -> ConstraintPlan:
+    """The constraint structure of the chains, found on up to 9 configurations spread over the batch."""
+    index = np.unique(np.linspace(0, count - 1, min(count, 9)).round().astype(int)) if count else np.arange(0)
+    flat_twists = [c.twists.reshape((count,) + c.twists.shape[-2:])[index] for c in chains]
+    flat_points = [c.points.reshape((count,) + c.points.shape[-2:])[index] for c in chains]
+    working, _, _, _ = working_coordinates(flat_twists, flat_points)
+    return plan_constraints(working) if count else ConstraintPlan(tuple(0 for _ in chains), 0, (), ())
+
+
+def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, twists, points, wrenches, fault_members) -> dict:
+    """The CTI of a chunk (see :mod:`screwkit.constraints`), in the kernel's working coordinates."""
+    starts = plan.chain_start
+    chain_twists = [twists[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+    chain_points = [points[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+    working, working_points, centre, length = working_coordinates(chain_twists, chain_points)
+    moments = wrenches[..., 3:] + np.cross(wrenches[..., :3], centre[:, None, :])  # about the centroid
+    working_wrenches = np.concatenate([wrenches[..., :3], moments / length[:, None, None]], axis=-1)
+    norms = np.linalg.norm(working_wrenches, axis=-1, keepdims=True)
+    working_wrenches = working_wrenches / np.where(norms > 0.0, norms, 1.0)
+    return constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
+                              plan.dof, fault_members, plan.threshold / length)
+
+
+def _at_constraint_singularities(plan: _Plan, result: dict, held: NDArray) -> None:
+    """Where the platform has more instantaneous DOF than its mobility ``n``, no ``n`` actuators hold it:
+    every OTI, LMTI and F_Oj is zero (the worst fault the first set, as for ties), and an actuator is a
+    mutual-interference one when the others with every constraint wrench still hold the platform."""
+    rows = np.flatnonzero(result["constraint_singular"])
+    result["lmti"][rows] = 0.0
+    for j in plan.faults:
+        result[f"f_o{j}"][rows] = 0.0
+        result[f"worst{j}"][rows] = plan.failed_sets[j][0]
+    for key in ("oti_actuators", "oti_submechanisms"):
+        if key in result:
+            result[key][rows] = 0.0
+    result["mutual_interference"][rows] = held
+
+
 def analyze(
     chains: Sequence[ChainScrews],
     *,
@@ -399,6 +305,7 @@ def analyze(
     threads: int | None = None,
     output_point: ArrayLike | None = None,
     planar: bool = False,
+    fault_type: str = "free-swinging",
 ) -> Indices:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
 
@@ -499,6 +406,10 @@ def analyze(
         DOF of the point, actuation wrenches are forces through it.
     planar : bool
         With ``output_point``: the mechanism is planar, its only idle rotation is about z.
+    fault_type : {"free-swinging", "link"}
+        What a fault is: a failed actuator becomes a passive joint (the paper's FSJF, default),
+        or its chain disappears with its constraint wrenches (LF, :mod:`screwkit.link_faults`).
+        Changes ``F_Oj``, ``F_IOj``, the worst faults and ``F_Cj``.
 
     Returns
     -------
@@ -509,6 +420,11 @@ def analyze(
     chains = list(chains)
     if not chains:
         raise ValueError("Expected at least one chain in `chains`, got none.")
+    if fault_type not in FAULT_TYPES:
+        raise ValueError(f"Expected `fault_type` in {', '.join(FAULT_TYPES)}, got {fault_type!r}.")
+    if fault_type == "link" and (iti_points is not None or oti_points is not None):
+        raise ValueError("`iti_points` and `oti_points` apply to free-swinging faults only, not fault_type='link'.")
+    given_chains = chains
     for chain in chains:
         if not isinstance(chain, ChainScrews):
             raise ValueError(f"Expected `chains` to hold ChainScrews, got {type(chain).__name__}.")
@@ -534,7 +450,7 @@ def analyze(
         index = np.unique(np.linspace(0, count - 1, min(count, 9)).round().astype(int)) if count else np.arange(0)
         flat_points = [c.points.reshape((count,) + c.points.shape[-2:])[index] for c in chains]
         flat_twists = [c.twists.reshape((count,) + c.twists.shape[-2:])[index] for c in chains]
-        _, _, centre, length = _working_coordinates(flat_twists, flat_points)
+        _, _, centre, length = working_coordinates(flat_twists, flat_points)
         chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
     plan = _make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
     a = len(plan.actuators)
@@ -550,12 +466,26 @@ def analyze(
     twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
+    constraint_plan = _constraint_plan(chains, count)
+    fault_members = actuator_sets(a, plan.dof, plan.faults) if constraint_plan.count else {}
+
     def run(part: slice) -> dict:
-        return _analyze_chunk(
-            plan, twists(part), points(part),
+        chunk_twists, chunk_points = twists(part), points(part)
+        result = _analyze_chunk(
+            plan, chunk_twists, chunk_points,
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
-            detail, keep_twists, None if idle is None else idle[part])
+            detail or constraint_plan.count > 0, keep_twists, None if idle is None else idle[part])
+        if constraint_plan.count:
+            result.update(_constraint_chunk(plan, constraint_plan, chunk_twists, chunk_points,
+                                            result["actuation_wrenches"], fault_members))
+            if "held_without" in result:
+                _at_constraint_singularities(plan, result, result.pop("held_without"))
+            if not detail:
+                for key in ("iti_actuators", "oti_actuators", "oti_submechanisms", "actuation_wrenches",
+                            "cti_submechanisms"):
+                    result.pop(key, None)
+        return result
 
     pieces = map_chunks(run, count, chunk_size, threads)
     merged = {key: np.concatenate([piece[key] for piece in pieces], axis=0) for key in pieces[0]}
@@ -564,15 +494,25 @@ def analyze(
         return array.reshape(batch_shape + array.shape[1:])
 
     names = tuple(f"{chains[c].name or f'chain_{c + 1}'}:{chains[c].joint_names[k]}" for c, k in plan.actuators)
+    f_o = {j: batch_first(merged[f"f_o{j}"]) for j in plan.faults}
+    worst = {j: batch_first(merged[f"worst{j}"]) for j in plan.faults}
+    f_c = {j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count else {}
+    if fault_type == "link" and plan.faults:
+        options = {"analyze": dict(threshold=threshold, rank_tolerance=rank_tolerance, chunk_size=chunk_size,
+                                   threads=threads, output_point=output_point, planar=planar),
+                   "idle_count": 0 if idle is None else idle.shape[-2]}
+        link = link_fault_indices(given_chains, plan.actuators, plan.faults, batch_shape, analyze, options)
+        f_o, worst = link["f_o"], link["worst"]
+        f_c = link["f_c"] if constraint_plan.count else {}
     return Indices(
         actuators=names,
         dof=plan.dof,
         submechanisms=tuple(tuple(int(i) for i in sub) for sub in plan.submechanisms),
         iti=batch_first(merged["iti"]),
         lmti=batch_first(merged["lmti"]),
-        f_o={j: batch_first(merged[f"f_o{j}"]) for j in plan.faults},
-        f_io={j: np.minimum(batch_first(merged[f"f_o{j}"]), batch_first(merged["iti"])) for j in plan.faults},
-        worst_fault_indices={j: batch_first(merged[f"worst{j}"]) for j in plan.faults},
+        f_o=f_o,
+        f_io={j: np.minimum(f_o[j], batch_first(merged["iti"])) for j in plan.faults},
+        worst_fault_indices=worst,
         mutual_interference=batch_first(merged["mutual_interference"]),
         threshold=plan.threshold,
         iti_actuators=batch_first(merged["iti_actuators"]) if detail else None,
@@ -580,4 +520,11 @@ def analyze(
         oti_submechanisms=batch_first(merged["oti_submechanisms"]) if detail else None,
         actuation_wrenches=batch_first(merged["actuation_wrenches"]) if detail else None,
         output_twists=batch_first(merged["output_twists"]) if detail and keep_twists else None,
+        cti=batch_first(merged["cti"]) if constraint_plan.count else None,
+        f_c=f_c,
+        cti_submechanisms=batch_first(merged["cti_submechanisms"]) if constraint_plan.count and detail else None,
+        constraint_count=constraint_plan.count,
+        instantaneous_dof=batch_first(merged["instantaneous_dof"]) if constraint_plan.count else None,
+        constraint_singular=batch_first(merged["constraint_singular"]) if constraint_plan.count else None,
+        fault_type=fault_type,
     )

@@ -20,7 +20,8 @@ LAYERS = {
     "screwkit._chunks": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0, "screwkit._planar_kernel": 0,
     "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
     "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
-    "screwkit.transmission": 0, "screwkit.units": 0, "screwkit": 0,
+    "screwkit.transmission": 0, "screwkit.units": 0, "screwkit.motion": 0, "screwkit.outputs": 0,
+    "screwkit.constraints": 0, "screwkit.reports": 0, "screwkit.link_faults": 0, "screwkit": 0,
     "screwkit.model": 1, "screwkit.closure": 2, "screwkit.loader": 3, "screwkit.studies": 4,
     "screwkit.plots": 5, "screwkit.viewer": 5, "screwkit.cli": 6,
 }
@@ -36,6 +37,7 @@ def module_name(path: Path) -> str:
 
 
 def layer(module: str) -> int:
+    assert module.count(".") != 1 or module in LAYERS, f"{module} has no layer: add it to LAYERS"
     while module not in LAYERS:
         module = module.rsplit(".", 1)[0]
     return LAYERS[module]

@@ -11,6 +11,7 @@ from screwkit.cli.options import (
     check_outputs,
     echo_error,
     fail,
+    fault_option,
     ignore_limits_option,
     length_unit_option,
     load_mechanism,
@@ -57,6 +58,7 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
 @click.option("--vmin", type=float, default=None, help="Lower end of the figure's colour scale (index value; default 0).")
 @click.option("--vmax", type=float, default=None, help="Upper end of the figure's colour scale (index value; default 1).")
 @threshold_option
+@fault_option
 @click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
 @ignore_limits_option
 @click.option("--scheduler", metavar="ADDRESS",
@@ -70,7 +72,7 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
 @overwrite_option
 @quiet_option
 def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure_path, vmin, vmax, threshold,
-                closed_forms, ignore_limits, scheduler, connect_timeout, task_size, yes, length_unit, overwrite,
+                fault_type, closed_forms, ignore_limits, scheduler, connect_timeout, task_size, yes, length_unit, overwrite,
                 quiet) -> None:
     """Minimum of every index over an orientation set at each point of a grid (Fig. 5).
 
@@ -83,7 +85,7 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
     check_outputs({"--out": (out, (".nc", ".csv")), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
                   overwrite, quiet)
     loaded = load_mechanism(mechanism, length_unit)
-    options = dict(threshold=threshold, closed_forms=closed_forms, limits=not ignore_limits, scheduler=scheduler,
+    options = dict(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms, limits=not ignore_limits, scheduler=scheduler,
                    progress=False if quiet else None, connect_timeout=connect_timeout,
                    configurations_per_task=task_size, as_dataset=False, proceed=yes)
     start = time.perf_counter()

@@ -25,6 +25,7 @@ __all__ = [
     "mechanism_argument",
     "length_unit_option",
     "threshold_option",
+    "fault_option",
     "ignore_limits_option",
     "json_option",
     "quiet_option",
@@ -138,6 +139,13 @@ def length_unit_option(function: Callable) -> Callable:
 def threshold_option(function: Callable) -> Callable:
     return click.option("--threshold", type=float, default=SINGULARITY_THRESHOLD, show_default=True,
                         help="Singularity threshold p on the moment arm (m).")(function)
+
+
+def fault_option(function: Callable) -> Callable:
+    return click.option("--fault", "fault_type", type=click.Choice(["free-swinging", "link"]), default="free-swinging",
+                        show_default=True,
+                        help="What a failed actuator does: becomes a passive joint (free-swinging, the paper's FSJF) "
+                             "or takes its chain away with its constraint wrenches (link, LF).")(function)
 
 
 def ignore_limits_option(function: Callable) -> Callable:

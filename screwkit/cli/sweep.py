@@ -10,6 +10,7 @@ from screwkit.cli.options import (
     check_outputs,
     echo_error,
     fail,
+    fault_option,
     ignore_limits_option,
     length_unit_option,
     load_mechanism,
@@ -69,13 +70,14 @@ def write_outputs(dataset, out, figure_path, figure_function, quiet: bool, **fig
 @click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
 @click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file: .png, .pdf or .svg.")
 @threshold_option
+@fault_option
 @click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
 @ignore_limits_option
 @length_unit_option
 @overwrite_option
 @quiet_option
-def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, closed_forms, ignore_limits, length_unit,
-          overwrite, quiet) -> None:
+def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fault_type, closed_forms, ignore_limits,
+          length_unit, overwrite, quiet) -> None:
     """Sweep one pose coordinate: every series of the paper's Figure 4 along it.
 
     The data go to --out (or, with neither --out nor --figure, to stdout as CSV); the minima
@@ -97,13 +99,15 @@ def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, clo
     values = parse_range(text, "--phi" if phi_range else "--sweep", angular=is_angular(coordinate))
     try:
         dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, threshold=threshold,
-                            closed_forms=closed_forms, limits=not ignore_limits)
+                            closed_forms=closed_forms, limits=not ignore_limits, fault_type=fault_type)
     except ValueError as error:
         raise fail(str(error)) from None
     if not quiet:
         reachable = dataset["reachable"].values
         echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} reachable)")
-        for name in ["iti", "lmti"] + [v for v in dataset.data_vars if v.startswith(("f_o", "f_io"))]:
+        for name in ["iti", "lmti", "cti"] + [v for v in dataset.data_vars if v.startswith(("f_o", "f_io", "f_c"))]:
+            if name not in dataset.data_vars:
+                continue
             series = dataset[name].values
             if np.any(np.isfinite(series)):
                 at_min = dataset[coordinate].values[np.nanargmin(series)]

@@ -186,7 +186,7 @@ def portable(mechanism: Mechanism) -> tuple[str, str, str]:
 
 
 def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_axes, over_values, threshold,
-             faults, closed_forms, limits=True, threads=1) -> dict:
+             faults, closed_forms, limits=True, fault_type="free-swinging", threads=1) -> dict:
     """Minimum of each index over the orientation set at the grid points of one block.
 
     Parameters
@@ -223,13 +223,16 @@ def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_
     for column, axis in enumerate(over_axes):
         poses[:, :, axis] = over_values[None, :, column]
     result = indices_at_poses(mechanism, poses, threshold=threshold, faults=faults, closed_forms=closed_forms,
-                              threads=threads, limits=limits)
+                              threads=threads, limits=limits, fault_type=fault_type)
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
     named = {"iti": result.iti, "lmti": result.lmti}
     for j in result.faults:
         named[f"f_o{j}"] = result.f_o[j]
         named[f"f_io{j}"] = result.f_io[j]
+    if result.cti is not None and result.constraint_count:
+        named["cti"] = result.cti
+        named.update({f"f_c{j}": value for j, value in result.f_c.items()})
     for name, values in named.items():
         out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
     return out
@@ -280,7 +283,7 @@ def map_size(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, A
 def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
               at: ArrayLike | None = None, *, mask: NDArray[np.bool_] | None = None,
               threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False,
-              limits: bool = True, scheduler=None, progress: bool | None = None,
+              limits: bool = True, fault_type: str = "free-swinging", scheduler=None, progress: bool | None = None,
               connect_timeout: float = CONNECT_TIMEOUT, configurations_per_task: int = CONFIGURATIONS_PER_TASK,
               as_dataset: bool = True, proceed: bool = False, max_configurations: int = MAX_CONFIGURATIONS):
     """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
@@ -297,7 +300,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         Values of the other coordinates (default: the home pose).
     mask : ndarray of bool, shape (len(y), len(x)), optional
         Grid points to evaluate (others are NaN).
-    threshold, faults, closed_forms, limits :
+    threshold, faults, closed_forms, limits, fault_type :
         As in :func:`screwkit.studies.indices_at_poses`.
     scheduler : str or distributed.Client, optional
         ``dask.distributed`` scheduler address (default: local threads).
@@ -344,7 +347,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
     text = portable(mechanism)
     blocks = _blocks(mask, per_task)
     arguments = [(text, at, names.index(x_name), x_values[columns], names.index(y_name), y_values[rows],
-                  mask[rows, columns], over_axes, over_values, threshold, faults, closed_forms, limits)
+                  mask[rows, columns], over_axes, over_values, threshold, faults, closed_forms, limits, fault_type)
                  for rows, columns in blocks]
     results = run_tasks(map_task, arguments, scheduler=scheduler, progress=progress, label="map",
                         connect_timeout=connect_timeout)
@@ -372,7 +375,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
                 f"to {shown(name, over_values[:, i].max()):g} {unit_of(name)}" for i, name in enumerate(over))
             or "the fixed pose only",
             fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
-            joint_limits="respected" if limits else "ignored",
+            joint_limits="respected" if limits else "ignored", fault_type=fault_type,
             configurations=int(size.configurations)))
     return grid_map.to_dataset() if as_dataset else grid_map
 

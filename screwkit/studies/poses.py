@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closed_forms import planar_indices
 from screwkit.closure import chain_screws, solve, solve_one, thread_limit
+from screwkit.link_faults import FAULT_TYPES
 from screwkit.model import Mechanism
 from screwkit.results import Indices
 from screwkit.tolerances import SINGULARITY_THRESHOLD
@@ -48,6 +49,7 @@ def analyze_solution(mechanism: Mechanism, solution, *, unreachable: str = "rais
         if unreachable == "drop":
             points = points[np.asarray(solution.reachable)]
         options.update(output_point=points, planar=mechanism.is_planar)
+    options.setdefault("dof", mechanism.dof)  # the mobility: a constraint singularity is not another mechanism
     return analyze(chains, **options)
 
 
@@ -115,26 +117,34 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
         task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name)
 
 
-def _allocate(count: int, result: Indices, detail: bool) -> dict[str, NDArray]:
-    """Output arrays for a whole batch, NaN (unreachable) until filled."""
-    a = result.actuator_count
-    arrays = {"iti": np.full(count, np.nan), "lmti": np.full(count, np.nan),
-              "mutual_interference": np.zeros((count, a), dtype=bool)}
-    for j in result.faults:
-        arrays[f"f_o{j}"] = np.full(count, np.nan)
-        arrays[f"f_io{j}"] = np.full(count, np.nan)
-        arrays[f"worst{j}"] = np.full((count, j), -1, dtype=np.int64)
-    if detail:
-        arrays["iti_actuators"] = np.full((count, a), np.nan)
-        if result.oti_submechanisms is not None:
-            arrays["oti_submechanisms"] = np.full((count, result.oti_submechanisms.shape[-1]), np.nan)
-    return arrays
+_ARRAYS = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms",
+           "instantaneous_dof", "constraint_singular")
+_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c")
+
+
+def _blank(count: int, value) -> NDArray:
+    """An array for a whole batch like one chunk's ``value``: NaN, -1 or False until filled (unreachable)."""
+    value = np.asarray(value)
+    fill = False if value.dtype == bool else -1 if np.issubdtype(value.dtype, np.integer) else np.nan
+    return np.full((count,) + value.shape[1:], fill, dtype=value.dtype)
+
+
+def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
+    """Copy one chunk's per-configuration results (batch-first) into the batch arrays at ``index``."""
+    pieces = {name: getattr(result, name) for name in _ARRAYS}
+    pieces.update({(name, j): value for name in _DICTS for j, value in getattr(result, name).items()})
+    for key, value in pieces.items():
+        if value is None:
+            continue
+        if key not in arrays:
+            arrays[key] = _blank(count, value)
+        arrays[key][index] = value
 
 
 def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = False,
                      threshold: float = SINGULARITY_THRESHOLD, faults=None, chunk_size: int = 262_144,
                      progress: Callable[[int], None] | None = None, threads: int | None = None,
-                     closed_forms: bool = False, limits: bool = True) -> Indices:
+                     closed_forms: bool = False, limits: bool = True, fault_type: str = "free-swinging") -> Indices:
     """Solve the closures of ``poses`` and compute every index at the reachable ones.
 
     Parameters
@@ -160,12 +170,17 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
         mechanisms only; see :func:`planar_points`).
     limits : bool
         Whether poses that put a joint outside its position limits are unreachable (default).
+    fault_type : {"free-swinging", "link"}
+        What a fault is (see :func:`screwkit.transmission.analyze`). The planar closed forms are for
+        free-swinging faults, which give the same numbers as link faults on planar RRR/RPR chains.
 
     Returns
     -------
     Indices
         Batch shape of ``poses``; NaN (and no worst fault) where unreachable.
     """
+    if fault_type not in FAULT_TYPES:
+        raise ValueError(f"Expected `fault_type` in {', '.join(FAULT_TYPES)}, got {fault_type!r}.")
     poses = mechanism.check_poses(poses)
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, mechanism.n_task)
@@ -173,7 +188,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     reachable = np.zeros(count, dtype=bool)
     chain_status = np.zeros((count, len(mechanism.chains)), dtype=np.int8)
     full_poses = np.empty((count, mechanism.n_pose))
-    arrays: dict[str, NDArray] | None = None
+    arrays: dict = {}
     meta: Indices | None = None
     with thread_limit(threads):  # closures and screws on no more threads than the kernel
         for start in range(0, count, chunk_size):
@@ -185,30 +200,19 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
             full_poses[part] = solution.full_poses
             if index.size:
                 if closed_forms:
-                    result = closed_form_indices(mechanism, solution, threshold, faults, threads)
+                    result = replace(closed_form_indices(mechanism, solution, threshold, faults, threads),
+                                     fault_type=fault_type)  # the same numbers for both types on these chains
                 else:
                     result = analyze_solution(mechanism, solution, unreachable="drop", detail=detail,
-                                              threshold=threshold, faults=faults, threads=threads)
-                if arrays is None:
-                    meta, arrays = result, _allocate(count, result, detail)
-                arrays["iti"][index] = result.iti
-                arrays["lmti"][index] = result.lmti
-                arrays["mutual_interference"][index] = result.mutual_interference
-                for j in result.faults:
-                    arrays[f"f_o{j}"][index] = result.f_o[j]
-                    arrays[f"f_io{j}"][index] = result.f_io[j]
-                    arrays[f"worst{j}"][index] = result.worst_fault_indices[j]
-                if detail:
-                    arrays["iti_actuators"][index] = result.iti_actuators
-                    if "oti_submechanisms" in arrays:
-                        arrays["oti_submechanisms"][index] = result.oti_submechanisms
+                                              threshold=threshold, faults=faults, threads=threads,
+                                              fault_type=fault_type)
+                meta = result
+                _scatter(arrays, count, index, result)
             if progress is not None:
                 progress(part.stop - part.start)
 
-    def shaped(name):
-        if arrays is None or name not in arrays:
-            return None
-        return arrays[name].reshape(batch + arrays[name].shape[1:])
+    def shaped(key):
+        return arrays[key].reshape(batch + arrays[key].shape[1:]) if key in arrays else None
 
     a = len(mechanism.actuators)
     if meta is None:  # nothing reachable: the structure of the indices from the mechanism alone
@@ -227,18 +231,18 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
                        pose_coordinates=mechanism.pose_coordinates)
     return Indices(
         actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms,
-        iti=shaped("iti"), lmti=shaped("lmti"),
-        f_o={j: shaped(f"f_o{j}") for j in meta.faults}, f_io={j: shaped(f"f_io{j}") for j in meta.faults},
-        worst_fault_indices={j: shaped(f"worst{j}") for j in meta.faults},
-        mutual_interference=shaped("mutual_interference"), threshold=threshold,
-        iti_actuators=shaped("iti_actuators"), oti_submechanisms=shaped("oti_submechanisms"),
-        poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
-        mechanism=mechanism.name, chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
-        full_poses=full_poses.reshape(batch + (mechanism.n_pose,)), pose_coordinates=mechanism.pose_coordinates)
+        **{name: shaped(name) for name in _ARRAYS},
+        **{name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS},
+        threshold=threshold, poses=poses, reachable=reachable.reshape(batch),
+        task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
+        chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
+        full_poses=full_poses.reshape(batch + (mechanism.n_pose,)), pose_coordinates=mechanism.pose_coordinates,
+        constraint_count=meta.constraint_count, fault_type=meta.fault_type)
 
 
 def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float = SINGULARITY_THRESHOLD,
-                    faults=None, limits: bool = True, keep_twists: bool = True) -> Indices:
+                    faults=None, limits: bool = True, keep_twists: bool = True,
+                    fault_type: str = "free-swinging") -> Indices:
     """Every index at one pose (metres, radians), with every detail (wrenches, output twists).
 
     Raises
@@ -249,7 +253,8 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
     """
     pose = mechanism.check_poses(pose)
     solution = solve_one(mechanism, pose, limits=limits)
-    result = analyze_solution(mechanism, solution, threshold=threshold, faults=faults, keep_twists=keep_twists)
+    result = analyze_solution(mechanism, solution, threshold=threshold, faults=faults, keep_twists=keep_twists,
+                              fault_type=fault_type)
     return replace(result, poses=pose, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
                    reachable=True, chain_status=solution.status, full_poses=solution.full_poses,
                    pose_coordinates=mechanism.pose_coordinates)

@@ -24,7 +24,8 @@ __all__ = ["sweep"]
 
 
 def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLike, *,
-          threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False, limits: bool = True):
+          threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False, limits: bool = True,
+          fault_type: str = "free-swinging"):
     """Every index along one swept task coordinate.
 
     Parameters
@@ -66,7 +67,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
     poses = np.repeat(at[None], values.size, axis=0)
     poses[:, axis] = values
     result = indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
-                              closed_forms=closed_forms, limits=limits)
+                              closed_forms=closed_forms, limits=limits, fault_type=fault_type)
     angular = is_angular(coordinate)
     shown = np.rad2deg(values) if angular else values
     dataset = result.to_dataset(dims=(coordinate,),
@@ -76,11 +77,11 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         remaining = list(combinations(range(a), a - j))
         dimension = f"remaining{j}"
         dataset.coords[dimension] = (dimension, [set_label(e) for e in remaining])
-        if result.oti_submechanisms is not None:
+        if result.oti_submechanisms is not None and fault_type == "free-swinging":
             stacked = np.stack([np.asarray(result.lmti_of(e)) for e in remaining], axis=-1)
             dataset[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
                                              {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
     dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
                          fixed_pose=", ".join(f"{n}={v:g}" for n, v in zip(mechanism.task_coordinates, at)),
-                         method="closed forms" if closed_forms else "generic screw path")
+                         method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
     return dataset

@@ -1,0 +1,179 @@
+"""Constraint wrenches, the CTI, constraint singularities and link failures.
+
+The CTI is checked against an independent computation from the explicit geometry of PRS legs
+(constraint force through the S centre along the R axis, actuation force along the link through
+the S centre, the freed twist as the null space of the other wrenches by an SVD, the power
+coefficient as the cosine between the released force and the velocity of its S centre), on a
+symmetric 4-PRS at tilted poses. Its home pose, where four constraint forces span only three
+wrenches, is a constraint singularity. Link failures agree with free-swinging ones where the
+paper says they must (chains without constraint wrenches of their own) and differ where a chain
+holds one. Invariance to the length unit and the world frame is checked on the CTI too.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+import pytest
+
+from helpers import moved, random_rotation, screwkit
+from screwkit.chains import ChainScrews
+from screwkit.closure import chain_screws, solve
+from screwkit.loader import load_text
+from screwkit.robots.generate import PRS_UPS, prs_mechanism
+from screwkit.studies.poses import analyze_solution, indices_at_poses
+from screwkit.transmission import analyze
+
+TOLERANCE = 1e-9
+
+
+@pytest.fixture(scope="module")
+def prs_4(tmp_path_factory):
+    """A symmetric 4-PRS (rails at 0, 90, 180, 270 deg): mobility 2 (z and a tilt), 4 actuators."""
+    parameters = dict(PRS_UPS, prs_angles_deg=(0.0, 90.0, 180.0, 270.0))
+    text = prs_mechanism("prs_4_symmetric", parameters, with_ups=False)
+    path = tmp_path_factory.mktemp("prs") / "prs_4_symmetric.urdf"
+    path.write_text(text)
+    return load_text(text, str(path)), path
+
+
+@pytest.fixture(scope="module")
+def prs_3_ups():
+    return load_text(prs_mechanism("prs_3_ups_test", PRS_UPS, with_ups=True), "prs_3_ups_test")
+
+
+def _coefficient(force, point, twist):
+    """|f . v_P| / (|f| |v_P|) for a pure force through ``point`` and a twist (omega, v about the origin)."""
+    velocity = twist[3:] + np.cross(twist[:3], point)
+    return abs(force @ velocity) / (np.linalg.norm(force) * np.linalg.norm(velocity))
+
+
+def prs_cti(twists, points, dof):
+    """The CTI of PRS legs from their explicit geometry (joint twists (m, 6) and points (m, 3) of each leg,
+    P, R, then the S joint's three): max over n-subsets of min over the released constraint forces."""
+    centres = [p[-1] for p in points]  # S centre
+    r_axes = [t[1, :3] for t in twists]
+    links = [centre - p[1] for p, centre in zip(points, centres)]  # R point -> S centre
+
+    def line(direction, point):  # a unit force (f, m) through a point
+        direction = direction / np.linalg.norm(direction)
+        return np.concatenate([direction, np.cross(point, direction)])
+
+    constraints = np.array([line(r, c) for r, c in zip(r_axes, centres)])
+    actuation = np.array([line(u, c) for u, c in zip(links, centres)])
+    best = 0.0
+    for subset in combinations(range(len(twists)), dof):
+        system = np.vstack([actuation[list(subset)], constraints])
+        if np.linalg.matrix_rank(system, tol=1e-9) < 6:
+            continue
+        kappas = []
+        for j in range(len(twists)):
+            others = np.delete(system, dof + j, axis=0)
+            _, _, right = np.linalg.svd(others)
+            null = right[-1]  # Euclidean null vector x: others @ x = 0, x = (v, omega) of a twist
+            twist = np.concatenate([null[3:], null[:3]])
+            kappas.append(_coefficient(constraints[j, :3], centres[j], twist))
+        best = max(best, min(kappas))
+    return best
+
+
+def test_4_prs_home_is_a_constraint_singularity(prs_4):
+    mechanism, path = prs_4
+    assert mechanism.dof == 2
+    result = indices_at_poses(mechanism, mechanism.home_pose[None])
+    assert result.instantaneous_dof[0] == 3 and result.constraint_singular[0]
+    assert result.dof == 2
+    assert result.cti[0] == 0.0 and result.lmti[0] == 0.0 and all(v[0] == 0.0 for v in result.f_o.values())
+    assert result.iti[0] > 0.9  # the input transmission is not what failed
+    completed = screwkit("analyze", path)
+    assert completed.returncode == 0, completed.stderr
+    assert "CONSTRAINT SINGULARITY: 3 instantaneous DOF at this pose, mobility 2" in completed.stdout
+
+
+@pytest.mark.parametrize("tilt_degrees", [3.0, 8.0, -12.0])
+def test_4_prs_cti_matches_the_explicit_geometry(prs_4, tilt_degrees):
+    mechanism, _ = prs_4
+    pose = mechanism.home_pose + np.array([0.01, np.deg2rad(tilt_degrees)])
+    solution = solve(mechanism, pose[None])
+    assert solution.reachable.all()
+    result = analyze_solution(mechanism, solution, detail=True)
+    assert not result.constraint_singular[0] and result.instantaneous_dof[0] == 2
+    chains = chain_screws(mechanism, solution)
+    expected = prs_cti([c.twists[0] for c in chains], [c.points[0] for c in chains], 2)
+    assert 0.0 < expected < 1.0
+    assert abs(result.cti[0] - expected) < TOLERANCE
+
+
+def test_cti_is_not_applicable_without_own_constraint_wrenches():
+    from screwkit.loader import load
+
+    for name in ("planar_5rrr", "ups_hexapod_8"):
+        mechanism = load(name)
+        result = indices_at_poses(mechanism, mechanism.home_pose[None])
+        assert result.cti is None and result.constraint_count == 0
+        assert result.at(0).to_dict()["cti"] == "not applicable"
+
+
+def test_cti_is_invariant_to_unit_and_frame(prs_3_ups):
+    rng = np.random.default_rng(3)
+    mechanism = prs_3_ups
+    poses = mechanism.home_pose + rng.uniform(-1, 1, (40, 3)) * np.array([0.01, 0.2, 0.2])
+    solution = solve(mechanism, poses)
+    chains = chain_screws(mechanism, solution, unreachable="drop")
+    reference = analyze(chains, dof=3)
+    assert reference.constraint_count == 3 and np.all(reference.cti > 0.9)
+    for scale in (1e-3, 1e3):
+        rotation = random_rotation(rng)
+        changed = moved(chains, rotation, rng.normal(size=3))
+        scaled = [ChainScrews(c.twists * np.r_[np.ones(3), np.full(3, scale)], c.points * scale, c.actuated,
+                              c.name, joint_names=c.joint_names) for c in changed]
+        other = analyze(scaled, dof=3, threshold=1e-6 * scale)
+        np.testing.assert_allclose(other.cti, reference.cti, atol=TOLERANCE, rtol=0)
+        for j in reference.faults:
+            np.testing.assert_allclose(other.f_c[j], reference.f_c[j], atol=TOLERANCE, rtol=0)
+
+
+@pytest.mark.parametrize("name", ["planar_5rrr", "planar_4rpr", "ups_hexapod_8"])
+def test_link_and_free_swinging_faults_agree_without_own_constraints(name):
+    from screwkit.loader import load
+
+    mechanism = load(name)
+    rng = np.random.default_rng(7)
+    poses = mechanism.home_pose + rng.uniform(-1, 1, (30, mechanism.n_task)) * 0.02
+    free = indices_at_poses(mechanism, poses)
+    link = indices_at_poses(mechanism, poses, fault_type="link")
+    assert link.fault_type == "link" and free.fault_type == "free-swinging"
+    both = free.reachable & link.reachable
+    assert both.sum() > 20
+    for j in free.faults:
+        np.testing.assert_allclose(link.f_o[j][both], free.f_o[j][both], atol=1e-12, rtol=0)
+        np.testing.assert_allclose(link.f_io[j][both], free.f_io[j][both], atol=1e-12, rtol=0)
+
+
+def test_link_failure_of_a_constraining_leg_frees_the_platform(prs_3_ups):
+    """3-PRS + UPS: losing a PRS leg takes its constraint force away; the platform gains a DOF that the
+    three actuators left cannot hold (F_O1 = 0), while a free-swinging PRS joint keeps the force."""
+    mechanism = prs_3_ups
+    poses = mechanism.home_pose + np.array([[0.0, 0.05, 0.02], [0.01, -0.1, 0.08]])
+    free = indices_at_poses(mechanism, poses, detail=True)
+    link = indices_at_poses(mechanism, poses, fault_type="link")
+    assert np.all(free.f_o[1] > 0.5)
+    np.testing.assert_array_equal(link.f_o[1], 0.0)
+    prs = [name for name in mechanism.actuator_names if name.startswith("prs")]
+    assert len(prs) == 3 and all(name in prs for row in link.worst_faults[1] for name in row)
+    # the UPS leg holds no constraint: the 3-PRS without it transmits as the free-swinging set of its actuators
+    chains = chain_screws(mechanism, solve(mechanism, poses))
+    alone = analyze([c for c in chains if c.name.startswith("prs")], dof=3)
+    np.testing.assert_allclose(alone.lmti, free.lmti_of(prs), atol=TOLERANCE, rtol=0)
+
+
+def test_cli_fault_option_reports_the_type():
+    import json
+
+    completed = screwkit("analyze", "planar_5rrr", "--pose", "paper_fig_2a", "--fault", "link", "--json")
+    assert completed.returncode == 0, completed.stderr
+    report = json.loads(completed.stdout)
+    assert report["fault_type"] == "link" and report["cti"] == "not applicable"
+    wrong = screwkit("analyze", "planar_5rrr", "--fault", "gearbox")
+    assert wrong.returncode != 0 and "--fault" in wrong.stderr
