@@ -191,8 +191,9 @@ def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_me
     return iti_chains, iti, oti_subs, f_o, worst, mutual
 
 
-def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike, threshold: float = SINGULARITY_THRESHOLD,
-                   faults: tuple[int, ...] | None = None, directions: ArrayLike | None = None,
+def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
+                   threshold: float = SINGULARITY_THRESHOLD, faults: tuple[int, ...] | None = None,
+                   directions: ArrayLike | None = None,
                    chunk_size: int = 65536, threads: int | None = None, rank_tolerance: float = RANK_TOLERANCE) -> dict:
     r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
 

@@ -126,7 +126,8 @@ def _orthonormal(rows: NDArray, count: int) -> NDArray:
 
 
 def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
-    """The constraint structure of a mechanism from its chains' twists at sample configurations (working coordinates)."""
+    """The constraint structure of a mechanism from its chains' twists at sample configurations
+    (working coordinates)."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
     counts = tuple(int(6 - np.max(_rank(twists, tolerance))) for twists in chain_twists)
     wrenches = [chain_constraint_wrenches(twists, c) for twists, c in zip(chain_twists, counts)]

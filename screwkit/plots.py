@@ -126,7 +126,7 @@ def _wrap(text: str, width_inches: float, fontsize: float) -> str:
     lines = "\n".join(textwrap.fill(line, characters, break_long_words=False, break_on_hyphens=False)
                       for line in text.split("\n"))
     for i, segment in enumerate(segments):
-        lines = re.sub(chr(0xE000 + i) + "+", lambda _: segment, lines, count=1)
+        lines = re.sub(chr(0xE000 + i) + "+", lambda _, segment=segment: segment, lines, count=1)
     return lines
 
 

@@ -432,7 +432,8 @@ def analyze(
     for chain in chains[1:]:
         if chain.batch_shape != batch_shape:
             raise ValueError(
-                f"Expected every chain to share the batch shape {batch_shape}, chain {chain.name!r} has {chain.batch_shape}."
+                f"Expected every chain to share the batch shape {batch_shape}, "
+                f"chain {chain.name!r} has {chain.batch_shape}."
             )
     if not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
@@ -462,7 +463,8 @@ def analyze(
                 array = np.broadcast_to(array, batch_shape + (a, 3))
             except ValueError:
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
-            overrides[name] = np.array(array.reshape(count, a, 3), dtype=np.float64, order="C")  # writable for the kernel
+            # writable for the kernel
+            overrides[name] = np.array(array.reshape(count, a, 3), dtype=np.float64, order="C")
     twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 

@@ -116,7 +116,7 @@ def test_no_private_name_is_imported_from_another_module():
 def test_function_local_imports_of_the_package_say_why():
     """Inside functions, screwkit modules are imported only to keep a heavy dependency off the import path."""
     wrong = []
-    for module, path in MODULES.items():
+    for path in MODULES.values():
         source = path.read_text(encoding="utf-8")
         lines = source.splitlines()
         for node in ast.walk(ast.parse(source)):
@@ -124,7 +124,8 @@ def test_function_local_imports_of_the_package_say_why():
                 for inner in ast.walk(node):
                     if isinstance(inner, ast.ImportFrom) and (inner.module or "").startswith("screwkit"):
                         if "#" not in lines[inner.lineno - 1]:
-                            wrong.append(f"{path.relative_to(PACKAGE.parent)}:{inner.lineno}: {lines[inner.lineno - 1].strip()}")
+                            wrong.append(f"{path.relative_to(PACKAGE.parent)}:{inner.lineno}: "
+                                         f"{lines[inner.lineno - 1].strip()}")
     assert not wrong, "function-local imports without a reason:\n" + "\n".join(wrong)
 
 

@@ -90,7 +90,7 @@ def test_lmti_of_checks_its_set(chains):
 def test_core_imports_numpy_only():
     """The math core pulls in none of the edge dependencies."""
     code = ("import sys; import screwkit.transmission, screwkit.closed_forms, screwkit.planar, screwkit.screws; "
-            "bad = [m for m in ('pinocchio', 'matplotlib', 'dask', 'meshcat', 'xarray', 'numba', 'yourdfpy', 'sympy', 'scipy') "
-            "if m in sys.modules]; print(bad); sys.exit(1 if bad else 0)")
+            "bad = [m for m in ('pinocchio', 'matplotlib', 'dask', 'meshcat', 'xarray', 'numba', 'yourdfpy', 'sympy', "
+            "'scipy') if m in sys.modules]; print(bad); sys.exit(1 if bad else 0)")
     completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert completed.returncode == 0, completed.stdout + completed.stderr

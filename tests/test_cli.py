@@ -54,7 +54,8 @@ def test_info_lists_task_coordinates_solvers_and_named_poses():
 
 def test_urdf_path_equals_hand_built_screws(rng):
     mechanism = load("planar_5rrr")
-    poses = np.column_stack([rng.uniform(-0.4, 0.4, 3000), rng.uniform(-0.4, 0.4, 3000), rng.uniform(-np.pi, np.pi, 3000)])
+    poses = np.column_stack([rng.uniform(-0.4, 0.4, 3000), rng.uniform(-0.4, 0.4, 3000),
+                             rng.uniform(-np.pi, np.pi, 3000)])
     solution = solve(mechanism, poses)
     ok = np.asarray(solution.reachable)
     assert ok.mean() > 0.5
@@ -74,7 +75,8 @@ def placed_copy(tmp_path, rpy, xyz):
     text = load("planar_5rrr").description.text
     head, tail = text.split("<link name=\"base_link\">", 1)
     extra = (f'<link name="world" />\n  <joint name="world_to_base" type="fixed">\n    <parent link="world" />\n'
-             f'    <child link="base_link" />\n    <origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}" />\n'
+             f'    <child link="base_link" />\n'
+             f'    <origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}" />\n'
              f'  </joint>\n  ')
     path = tmp_path / "tilted_5rrr.urdf"
     path.write_text(head + extra + "<link name=\"base_link\">" + tail)

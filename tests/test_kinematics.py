@@ -101,7 +101,8 @@ def random_legs_mechanism(seed: int):
             writer.loop(
                 f"leg_{leg}_loop", loop_type, f"leg_{leg}", parent, frame, "platform", successor_origins[leg],
                 axis=None if loop_type in ("spherical", "fixed") else axis / np.linalg.norm(axis),
-                second_axis=np.cross(axis, second) / np.linalg.norm(np.cross(axis, second)) if loop_type == "universal" else None,
+                second_axis=(np.cross(axis, second) / np.linalg.norm(np.cross(axis, second))
+                             if loop_type == "universal" else None),
             )  # fmt: skip
         return writer.text()
 
@@ -135,7 +136,8 @@ def test_rotation_vector_round_trip_including_small_and_near_pi_angles():
     rng = np.random.default_rng(0)
     axes = rng.normal(size=(4000, 3))
     axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
-    angles = np.concatenate([rng.uniform(0, np.pi, 1000), rng.uniform(0, 1e-7, 1000), np.pi - rng.uniform(0, 1e-6, 1000), rng.uniform(3.0, np.pi, 1000)])
+    angles = np.concatenate([rng.uniform(0, np.pi, 1000), rng.uniform(0, 1e-7, 1000),
+                             np.pi - rng.uniform(0, 1e-6, 1000), rng.uniform(3.0, np.pi, 1000)])
     vectors = axes * angles[:, None]
     rotations = rotation_from_rotation_vector(vectors)
     np.testing.assert_allclose(rotations, Rotation.from_rotvec(vectors).as_matrix(), atol=1e-14)
@@ -158,7 +160,8 @@ def test_rotation_about_axis_and_wrap_angle():
     axis = rng.normal(size=3)
     axis /= np.linalg.norm(axis)
     angles = rng.uniform(-10, 10, 500)
-    np.testing.assert_allclose(rotation_about_axis(axis, angles), Rotation.from_rotvec(np.outer(angles, axis)).as_matrix(), atol=1e-13)
+    np.testing.assert_allclose(rotation_about_axis(axis, angles),
+                               Rotation.from_rotvec(np.outer(angles, axis)).as_matrix(), atol=1e-13)
     wrapped = wrap_angle(angles)
     assert np.all((wrapped > -np.pi) & (wrapped <= np.pi))
     np.testing.assert_allclose(np.cos(wrapped), np.cos(angles), atol=1e-12)
@@ -171,7 +174,8 @@ def test_two_axis_pointing_reaches_the_goal_on_one_branch():
     first = rng.normal(size=(500, 3))
     second = rng.normal(size=(500, 3))
     start = rng.normal(size=(500, 3))
-    first, second, start = (vector / np.linalg.norm(vector, axis=-1, keepdims=True) for vector in (first, second, start))
+    first, second, start = (vector / np.linalg.norm(vector, axis=-1, keepdims=True)
+                            for vector in (first, second, start))
     true_first, true_second = rng.uniform(-np.pi, np.pi, (2, 500))
     rotate = lambda axis, angle: Rotation.from_rotvec(axis * angle[:, None])  # noqa: E731
     goal = (rotate(first, true_first) * rotate(second, true_second)).apply(start)
@@ -193,7 +197,8 @@ def test_twists_from_axes_and_points_equal_a_loop_over_configurations():
     for index in np.ndindex(7, 3):
         for joint in range(4):
             axis, point = axes[index][joint], points[index][joint]
-            expected = np.concatenate([np.zeros(3), axis]) if prismatic[joint] else np.concatenate([axis, np.cross(point, axis)])
+            expected = (np.concatenate([np.zeros(3), axis]) if prismatic[joint]
+                        else np.concatenate([axis, np.cross(point, axis)]))
             np.testing.assert_allclose(twists[index][joint], expected, atol=1e-15)
 
 
@@ -210,7 +215,8 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
     rng = np.random.default_rng(5)
     count = 6
     joint_values = [
-        np.where(chain.prismatic, rng.uniform(-0.3, 0.3, (count, chain.n_joints)), rng.uniform(-np.pi, np.pi, (count, chain.n_joints)))
+        np.where(chain.prismatic, rng.uniform(-0.3, 0.3, (count, chain.n_joints)),
+                 rng.uniform(-np.pi, np.pi, (count, chain.n_joints)))
         for chain in mechanism_.chains
     ]
     screws = joint_screws(mechanism_, joint_values)
@@ -225,14 +231,19 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
                 if not model.existJointName(joint_name):
                     continue
                 joint_id = model.getJointId(joint_name)
-                column = pinocchio.getJointJacobian(model, data, joint_id, pinocchio.WORLD)[:, model.joints[joint_id].idx_v]
-                np.testing.assert_allclose(screws_of_chain.twists[sample, index], twist_from_pinocchio_motion(column), atol=1e-12)
-                np.testing.assert_allclose(screws_of_chain.points[sample, index], data.oMi[joint_id].translation, atol=1e-12)
+                column = (pinocchio.getJointJacobian(model, data, joint_id, pinocchio.WORLD)
+                          [:, model.joints[joint_id].idx_v])
+                np.testing.assert_allclose(screws_of_chain.twists[sample, index], twist_from_pinocchio_motion(column),
+                                           atol=1e-12)
+                np.testing.assert_allclose(screws_of_chain.points[sample, index], data.oMi[joint_id].translation,
+                                           atol=1e-12)
             loop = loops[chain.loop_name]
             leg_frame = data.oMf[model.getFrameId(loop.predecessor, pinocchio.BODY)]
             leg_rotation = leg_frame.rotation @ loop.predecessor_origin.rotation
             leg_point = leg_frame.translation + leg_frame.rotation @ loop.predecessor_origin.translation
-            loop_values = joint_values[mechanism_.chains.index(chain)][sample, len(chain.joint_names) - len(_loop_names(chain)) :]
+            loop_values = joint_values[mechanism_.chains.index(chain)][
+                sample, len(chain.joint_names) - len(_loop_names(chain)) :
+            ]
             for offset, (axis, point) in enumerate(_expected_loop_screws(loop, leg_rotation, leg_point, loop_values)):
                 index = len(chain.joint_names) - len(_loop_names(chain)) + offset
                 twist = screws_of_chain.twists[sample, index]
@@ -282,7 +293,8 @@ def test_solved_loops_close_in_pinocchio_forward_kinematics(name):
     solution = solve(mechanism_, random_poses(mechanism_, scale, 8, seed=6))
     assert solution.reachable.sum() >= 4
     if name == "random_loops":
-        assert mechanism_.dof == 6 and {chain.loop_type for chain in mechanism_.chains} == {kind for kind, _ in LOOP_KINDS}
+        assert mechanism_.dof == 6 and ({chain.loop_type for chain in mechanism_.chains}
+                                        == {kind for kind, _ in LOOP_KINDS})
     configuration = configuration_vector(mechanism_, solution.joint_values, solution.full_poses)
     model, data = mechanism_.pinocchio_model, mechanism_.pinocchio_model.createData()
     loops = {loop.name: loop for loop in mechanism_.description.loops}
@@ -301,7 +313,8 @@ def test_solved_loops_close_in_pinocchio_forward_kinematics(name):
             end_translation = leg_translation + leg_rotation @ motion_translation
             np.testing.assert_allclose(end_rotation, successor.rotation @ loop.successor_origin.rotation, atol=1e-9)
             np.testing.assert_allclose(
-                end_translation, successor.translation + successor.rotation @ loop.successor_origin.translation, atol=1e-9
+                end_translation, successor.translation + successor.rotation @ loop.successor_origin.translation,
+                atol=1e-9,
             )
 
 
@@ -325,11 +338,13 @@ def test_closed_forms_equal_the_newton_solver(name):
     for chain, first, second in zip(mechanism_.chains, closed.joint_values, newton.joint_values):
         reachable = np.all(np.isfinite(first), axis=-1)
         assert np.all(np.isnan(first[~reachable])) and np.all(np.isnan(second[~reachable]))
-        np.testing.assert_allclose(angular_difference(first[reachable], second[reachable], chain.prismatic), 0.0, atol=1e-9)
+        np.testing.assert_allclose(angular_difference(first[reachable], second[reachable], chain.prismatic), 0.0,
+                                   atol=1e-9)
     residuals = closure_residuals(mechanism_, closed)
     assert np.nanmax(residuals) < 1e-12
     assert np.nanmax(closure_residuals(mechanism_, newton)) < 1e-10
-    for first, second in zip(chain_screws(mechanism_, closed, unreachable="drop"), chain_screws(mechanism_, newton, unreachable="drop")):
+    for first, second in zip(chain_screws(mechanism_, closed, unreachable="drop"),
+                             chain_screws(mechanism_, newton, unreachable="drop")):
         np.testing.assert_allclose(first.twists, second.twists, atol=1e-9)
 
 
@@ -399,7 +414,8 @@ def test_unreachable_poses_are_nan_and_strict_solving_names_the_chain():
     solution = solve(mechanism_, [[0.0, 0.0, 0.0], [1.9, 0.0, 0.0]])
     np.testing.assert_array_equal(solution.reachable, [True, False])
     assert np.all(np.isnan(solution.joint_values[2][1])) and np.all(np.isfinite(solution.joint_values[0][1]))
-    with pytest.raises(ValueError, match=r"Pose \(x=1\.9, y=0, phi=0 deg\) is unreachable .* chain 'chain_3' misses closure by 0\.78"):
+    with pytest.raises(ValueError, match=r"Pose \(x=1\.9, y=0, phi=0 deg\) is unreachable .* "
+                                         r"chain 'chain_3' misses closure by 0\.78"):
         solve_one(mechanism_, [1.9, 0.0, 0.0])
     with pytest.raises(ValueError, match="1 of 2 configurations are unreachable"):
         chain_screws(mechanism_, solution)
@@ -415,7 +431,8 @@ def test_unreachable_poses_are_nan_and_strict_solving_names_the_chain():
 @pytest.mark.parametrize(
     ("poses", "message"),
     [
-        ([0.0, 0.0], r"Expected `poses` with shape \(\.\.\., 3\) for mechanism 'planar_5rrr' \(x, y, phi\), got \(2,\)"),
+        ([0.0, 0.0],
+         r"Expected `poses` with shape \(\.\.\., 3\) for mechanism 'planar_5rrr' \(x, y, phi\), got \(2,\)"),
         ([[0.0, np.nan, 0.0]], r"Expected finite values in `poses`, got nan at index \(0, 1\)"),
         ("abc", "Expected numeric `poses`"),
     ],

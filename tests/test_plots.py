@@ -21,8 +21,15 @@ from matplotlib.colors import same_color  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 
 from screwkit import plots  # noqa: E402
-from screwkit.plots import (COLORMAP, INDEX_RANGE, MAX_LABELLED_CURVES, design_comparison_figure,  # noqa: E402
-                            map_figure, save_figure, sweep_figure)
+from screwkit.plots import (  # noqa: E402
+    COLORMAP,
+    INDEX_RANGE,
+    MAX_LABELLED_CURVES,
+    design_comparison_figure,
+    map_figure,
+    save_figure,
+    sweep_figure,
+)
 
 
 @pytest.fixture(autouse=True)

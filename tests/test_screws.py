@@ -134,7 +134,8 @@ def test_power_coefficient_is_frame_invariant_and_scale_free(rng):
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda: screws.reciprocal_product(np.zeros((3, 5)), np.zeros(6)), r"`screw_1` with shape \(\.\.\., 6\), got \(3, 5\)"),
+    (lambda: screws.reciprocal_product(np.zeros((3, 5)), np.zeros(6)),
+     r"`screw_1` with shape \(\.\.\., 6\), got \(3, 5\)"),
     (lambda: screws.reciprocal_product(np.zeros(6), [0, 0, np.nan, 0, 0, 0]), r"finite values in `screw_2`, got nan"),
     (lambda: screws.power_coefficient(np.zeros(6), np.zeros(6), np.zeros(2)), r"`point` with shape \(\.\.\., 3\)"),
     (lambda: screws.power_coefficient(np.zeros(6), np.zeros(6), np.zeros(3), threshold=-1), r"`threshold` >= 0"),

@@ -130,7 +130,8 @@ def hybrid_chains(rng):
 
 def test_hybrid_with_constraint_wrenches(rng):
     configurations = [hybrid_chains(rng) for _ in range(30)]
-    stacked = [ChainScrews(np.stack([c[i].twists for c in configurations]), np.stack([c[i].points for c in configurations]),
+    stacked = [ChainScrews(np.stack([c[i].twists for c in configurations]),
+                           np.stack([c[i].points for c in configurations]),
                            configurations[0][i].actuated, configurations[0][i].name) for i in range(4)]
     result = analyze(stacked, keep_twists=True)
     assert result.dof == 3 and result.actuator_count == 4

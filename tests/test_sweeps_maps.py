@@ -11,6 +11,7 @@ import time
 import numpy as np
 import pytest
 import xarray as xr
+
 from helpers import screwkit
 from screwkit.cli.options import parse_range
 from screwkit.closed_forms import planar_indices
@@ -36,7 +37,8 @@ def hand_built_minimum(x, y, phi):
     if not reachable.all():
         return None
     result = analyze(rrr_chain_screws(base, elbows, distal), detail=False)
-    return {"iti": result.iti.min(), "lmti": result.lmti.min(), "f_o1": result.f_o[1].min(), "f_io1": result.f_io[1].min()}
+    return {"iti": result.iti.min(), "lmti": result.lmti.min(), "f_o1": result.f_o[1].min(),
+            "f_io1": result.f_io[1].min()}
 
 
 def test_parse_range():
@@ -61,7 +63,8 @@ def test_sweep_at_the_centre_matches_fig_4(five):
     # F_O1 is the minimum over the 4-actuator sets of their LMTIs (Eq. 12), each the max of its OTIs.
     np.testing.assert_allclose(dataset["f_o1"], dataset["lmti_remaining1"].min("remaining1"), atol=0)
     np.testing.assert_allclose(dataset["lmti"], dataset["oti_submechanism"].max("submechanism"), atol=0)
-    assert dataset["lmti_remaining1"].sizes["remaining1"] == 5 and dataset["oti_submechanism"].sizes["submechanism"] == 10
+    assert (dataset["lmti_remaining1"].sizes["remaining1"] == 5
+            and dataset["oti_submechanism"].sizes["submechanism"] == 10)
     closed = sweep(five, [0, 0, 0], "phi", phi, closed_forms=True)
     np.testing.assert_allclose(dataset["f_o2"], closed["f_o2"], atol=1e-9)
 

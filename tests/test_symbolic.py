@@ -130,6 +130,8 @@ def test_literal_a4_extraction_differs():
     """The extracted (A4) shows |f_l d_k| in its second term: that reading is not the OTI."""
     f = [sp.Matrix([1, 0]), sp.Matrix([0, 1]), sp.Matrix([1, 1]) / sp.sqrt(2)]
     d = [sp.Matrix([0, 0]), sp.Matrix([1, 0]), sp.Matrix([0, 1])]
-    cyclic = det2(f[0], d[0]) * det2(f[1], f[2]) + det2(f[1], d[1]) * det2(f[2], f[0]) + det2(f[2], d[2]) * det2(f[0], f[1])
-    literal = det2(f[0], d[0]) * det2(f[1], f[2]) + det2(f[1], d[0]) * det2(f[2], f[0]) + det2(f[2], d[2]) * det2(f[0], f[1])
+    cyclic = (det2(f[0], d[0]) * det2(f[1], f[2]) + det2(f[1], d[1]) * det2(f[2], f[0])
+              + det2(f[2], d[2]) * det2(f[0], f[1]))
+    literal = (det2(f[0], d[0]) * det2(f[1], f[2]) + det2(f[1], d[0]) * det2(f[2], f[0])
+               + det2(f[2], d[2]) * det2(f[0], f[1]))
     assert sp.simplify(cyclic - literal) != 0

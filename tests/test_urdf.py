@@ -110,7 +110,10 @@ def test_supported_loop_types(loop_type, axes, n_axes):
             MINIMAL.format(loops="").replace('<joint name="arm_joint"><hardware', "<joint><hardware"),
             "<transmission name='arm_transmission'><joint>: the attribute 'name' is missing",
         ),
-        (MINIMAL.format(loops="").replace('<joint name="arm_joint" type', "<joint type"), "<joint>: the attribute 'name'"),
+        (
+            MINIMAL.format(loops="").replace('<joint name="arm_joint" type', "<joint type"),
+            "<joint>: the attribute 'name'",
+        ),
         (MINIMAL.format(loops="").replace('type="continuous"', 'type="ball"'), "unknown joint type 'ball'"),
         (MINIMAL.format(loops="").replace("<link name=\"arm\"/>", "<link name=\"platform\"/>"), "used twice"),
         ("<robot name='x'><link name='a'/><transmission name='t'/></robot>", "drives no joint"),

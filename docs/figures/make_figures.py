@@ -60,7 +60,8 @@ def main() -> None:
 
     fig4 = sweep(mechanism, [0.0, 0.0, 0.0], "phi", np.deg2rad(np.arange(0.0, 360.0, 0.1)), faults=1)
     minimum = int(np.argmin(fig4["f_o1"].values))
-    print(f"Fig. 4: min F_O1 {float(fig4['f_o1'][minimum]):.4f} at phi = {float(fig4['phi'][minimum]):.1f} deg (0.1 deg)")
+    print(f"Fig. 4: min F_O1 {float(fig4['f_o1'][minimum]):.4f} at phi = {float(fig4['phi'][minimum]):.1f} deg "
+          "(0.1 deg)")
     coarse = fig4.isel(phi=slice(0, None, 10))
     print(f"Fig. 4: min F_O1 {float(coarse['f_o1'].min()):.4f} (1 deg)")
     figure = sweep_figure(fig4)

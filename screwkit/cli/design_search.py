@@ -109,7 +109,8 @@ def _optimise(loaded, template, current, level, step, maxiter, popsize, urdf_pat
 @click.option("--popsize", type=click.IntRange(min=2), default=8, show_default=True,
               help="--optimise: population size per parameter (count).")
 @click.option("--step", type=float, default=0.05, show_default=True, help="--optimise: grid step of the area (m).")
-@click.option("--urdf", "urdf_path", type=click.Path(dir_okay=False), help="--optimise: write the best design here (.urdf).")
+@click.option("--urdf", "urdf_path", type=click.Path(dir_okay=False),
+              help="--optimise: write the best design here (.urdf).")
 @click.option("--figure", "figure_path", type=click.Path(dir_okay=False),
               help="--optimise: maps of both designs (.png, .pdf or .svg).")
 @click.option("--vmin", type=float, default=None, help="--figure: lower end of the colour scale (index value).")

@@ -31,8 +31,14 @@ def mechanism_info(mechanism) -> dict:
         "length_unit": mechanism.length_unit,
         "dof": mechanism.dof,
         "task_coordinates": [{"name": name, "unit": unit_of(name)} for name in mechanism.task_coordinates],
-        "platform": {"link": mechanism.platform_link, "joint": mechanism.platform_joint, "base_link": mechanism.base_link,
-                     "planar": mechanism.is_planar},
+        "task_coordinates_source": mechanism.task_source,
+        "dependent_coordinates": [{"name": mechanism.pose_coordinates[i],
+                                   "unit": unit_of(mechanism.pose_coordinates[i])}
+                                  for i in mechanism.dependent_indices],
+        "instantaneous_dof_at_home": mechanism.instantaneous_dof,
+        "output": "frame" if mechanism.output_point is None else "point",
+        "platform": {"link": mechanism.platform_link, "joint": mechanism.platform_joint,
+                     "base_link": mechanism.base_link, "planar": mechanism.is_planar},
         "actuators": list(mechanism.actuator_names),
         "chains": [{"name": chain.name, "joints": list(chain.joint_names),
                     "actuated": [chain.joint_names[k] for k in chain.actuated], "loop": chain.loop_name,
@@ -57,7 +63,17 @@ def info(mechanism: str, length_unit, as_json: bool) -> None:
         return
     click.echo(f"{report['mechanism']} ({report['file']}, lengths in {report['length_unit']} in the file)")
     coordinates = ", ".join(f"{c['name']} ({c['unit']})" for c in report["task_coordinates"])
-    click.echo(f"  DOF {report['dof']}; task coordinates: {coordinates}")
+    source = {"all": "full mobility", "declared": "declared in the file", "inferred": "inferred from the motion space"}
+    click.echo(f"  DOF {report['dof']}; task coordinates: {coordinates} "
+               f"({source.get(report['task_coordinates_source'], report['task_coordinates_source'])})")
+    if report["dependent_coordinates"]:
+        click.echo("  dependent (parasitic) coordinates, solved with the closure: "
+                   + ", ".join(c["name"] for c in report["dependent_coordinates"]))
+    if report["instantaneous_dof_at_home"] > report["dof"]:
+        click.echo(f"  the home pose is a constraint singularity: {report['instantaneous_dof_at_home']} "
+                   "instantaneous DOF")
+    if report["output"] == "point":
+        click.echo("  output: the platform frame's origin, a point (rotations about it are idle)")
     click.echo(f"  platform {report['platform']['link']!r} on {report['platform']['joint']!r} "
                f"({'planar' if loaded.is_planar else 'floating'}) from {report['platform']['base_link']!r}")
     click.echo(f"  {len(report['actuators'])} actuators: {', '.join(report['actuators'])}")

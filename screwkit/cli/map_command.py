@@ -55,8 +55,10 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
               help="Spatial: the other coordinates, all task coordinates (m, deg) or a named pose; default home.")
 @click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
 @click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file: .png, .pdf or .svg.")
-@click.option("--vmin", type=float, default=None, help="Lower end of the figure's colour scale (index value; default 0).")
-@click.option("--vmax", type=float, default=None, help="Upper end of the figure's colour scale (index value; default 1).")
+@click.option("--vmin", type=float, default=None,
+              help="Lower end of the figure's colour scale (index value; default 0).")
+@click.option("--vmax", type=float, default=None,
+              help="Upper end of the figure's colour scale (index value; default 1).")
 @threshold_option
 @fault_option
 @click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
@@ -72,8 +74,8 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
 @overwrite_option
 @quiet_option
 def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure_path, vmin, vmax, threshold,
-                fault_type, closed_forms, ignore_limits, scheduler, connect_timeout, task_size, yes, length_unit, overwrite,
-                quiet) -> None:
+                fault_type, closed_forms, ignore_limits, scheduler, connect_timeout, task_size, yes, length_unit,
+                overwrite, quiet) -> None:
     """Minimum of every index over an orientation set at each point of a grid (Fig. 5).
 
     Planar: --radius R --step S --phi-step D maps a disc about the home position with phi
@@ -85,8 +87,8 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
     check_outputs({"--out": (out, (".nc", ".csv")), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
                   overwrite, quiet)
     loaded = load_mechanism(mechanism, length_unit)
-    options = dict(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms, limits=not ignore_limits, scheduler=scheduler,
-                   progress=False if quiet else None, connect_timeout=connect_timeout,
+    options = dict(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms, limits=not ignore_limits,
+                   scheduler=scheduler, progress=False if quiet else None, connect_timeout=connect_timeout,
                    configurations_per_task=task_size, as_dataset=False, proceed=yes)
     start = time.perf_counter()
     try:

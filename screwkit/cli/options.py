@@ -150,7 +150,8 @@ def fault_option(function: Callable) -> Callable:
 
 def ignore_limits_option(function: Callable) -> Callable:
     return click.option("--ignore-limits", is_flag=True,
-                        help="Ignore the joints' position limits of the file (the purely geometric workspace).")(function)
+                        help="Ignore the joints' position limits of the file "
+                             "(the purely geometric workspace).")(function)
 
 
 def json_option(function: Callable) -> Callable:
@@ -197,7 +198,8 @@ def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarra
     if len(numbers) != mechanism.n_task:
         units = ", ".join(f"{name} ({'deg' if is_angular(name) else 'm'})" for name in mechanism.task_coordinates)
         raise fail(f"Expected {option} with {mechanism.n_task} values ({units}) or a named pose "
-                   f"({', '.join(mechanism.named_poses)}) for mechanism {mechanism.name!r}, got {len(numbers)}: {text}.")
+                   f"({', '.join(mechanism.named_poses)}) for mechanism {mechanism.name!r}, "
+                   f"got {len(numbers)}: {text}.")
     try:
         return mechanism.poses_from_degrees(numbers)
     except ValueError as error:

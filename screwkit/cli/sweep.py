@@ -64,7 +64,8 @@ def write_outputs(dataset, out, figure_path, figure_function, quiet: bool, **fig
               help="Fixed pose: every task coordinate (m, deg), a named pose, or x y for a planar mechanism "
                    "(phi from the home pose). Default: the home pose.")
 @click.option("--phi", "phi_range", metavar="START:STOP:STEP",
-              help="Planar shorthand for --sweep phi:START:STOP:STEP (deg; the stop is excluded: 0:360:1 is 360 angles).")
+              help="Planar shorthand for --sweep phi:START:STOP:STEP "
+                   "(deg; the stop is excluded: 0:360:1 is 360 angles).")
 @click.option("--sweep", "sweep_spec", metavar="COORDINATE:START:STOP:STEP",
               help="The swept coordinate and its range, m or deg; the stop is excluded (yaw:0:360:1 is 360 angles).")
 @click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")

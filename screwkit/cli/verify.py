@@ -61,8 +61,9 @@ def verify(mechanism: str, samples: int, seed: int, length_unit, as_json: bool) 
     rows += [(f"F_O{j}", generic.f_o[j], closed.f_o[j]) for j in generic.faults]
     rows += [(f"F_IO{j}", generic.f_io[j], closed.f_io[j]) for j in generic.faults]
     deviations = {label: float(np.max(np.abs(first - second))) for label, first, second in rows}
-    differing = {f"worst faults j={j}": int(np.sum(np.any(generic.worst_fault_indices[j] != closed.worst_fault_indices[j],
-                                                           axis=-1))) for j in generic.faults}
+    differing = {f"worst faults j={j}":
+                 int(np.sum(np.any(generic.worst_fault_indices[j] != closed.worst_fault_indices[j], axis=-1)))
+                 for j in generic.faults}
     differing["mutual interference"] = int(np.sum(np.any(generic.mutual_interference != closed.mutual_interference,
                                                          axis=-1)))
     worst = max(deviations.values())

@@ -283,7 +283,8 @@ class PlanarSliderChain(PlanarClosedForm):
         signs = np.array([_sign_along_z(frames.axes[0]), 1.0, _sign_along_z(frames.axes[2])])
         if signs[0] == 0.0 or signs[2] == 0.0 or abs(frames.axes[1, 2]) > CLOSURE_TOLERANCE:
             return Rejection(cls.kind, "a revolute axis is not along z or the slider leaves the x-y plane")
-        if _sign_along_z(frames.leg_rotation[:, 2]) == 0.0 or _sign_along_z(geometry.platform_loop_rotation[:, 2]) == 0.0:
+        if (_sign_along_z(frames.leg_rotation[:, 2]) == 0.0
+                or _sign_along_z(geometry.platform_loop_rotation[:, 2]) == 0.0):
             return Rejection(cls.kind, "a loop frame's z axis is not along the base z axis")
         leg = frames.points[2, :2] - frames.points[0, :2]
         slider = frames.axes[1, :2] / np.linalg.norm(frames.axes[1, :2])
@@ -291,7 +292,8 @@ class PlanarSliderChain(PlanarClosedForm):
         if leg_length <= CLOSURE_TOLERANCE * length:
             return Rejection(cls.kind, "its base and platform joints coincide")
         if abs(leg[0] * slider[1] - leg[1] * slider[0]) > CLOSURE_TOLERANCE * leg_length:
-            return Rejection(cls.kind, "the slider does not run along the line from the base joint to the platform joint")
+            return Rejection(cls.kind,
+                             "the slider does not run along the line from the base joint to the platform joint")
         return cls(geometry, frames, signs)
 
     def __init__(self, geometry: ChainGeometry, frames: ChainFrames, signs: NDArray):
@@ -381,10 +383,11 @@ class SpatialClosedForm:
             return Rejection(cls.kind, f"its joints are not {pattern} closed by a spherical loop joint")
         frames = chain_forward_kinematics(geometry, np.zeros(geometry.n_dofs))
         first, second = universal_joints
-        centre = _line_intersection(frames.points[first], frames.axes[first], frames.points[second], frames.axes[second],
-                                    CLOSURE_TOLERANCE * length)
+        centre = _line_intersection(frames.points[first], frames.axes[first],
+                                    frames.points[second], frames.axes[second], CLOSURE_TOLERANCE * length)
         if centre is None:
-            return Rejection(cls.kind, f"the axes of joints {first + 1} and {second + 1} do not meet (no universal joint)")
+            return Rejection(cls.kind,
+                             f"the axes of joints {first + 1} and {second + 1} do not meet (no universal joint)")
         return frames, centre
 
 
@@ -411,7 +414,8 @@ class LegVectorChain(SpatialClosedForm):
         if leg_length <= CLOSURE_TOLERANCE * length:
             return Rejection(cls.kind, "its universal and spherical joint centres coincide")
         if np.linalg.norm(np.cross(leg, frames.axes[2])) > CLOSURE_TOLERANCE * leg_length:
-            return Rejection(cls.kind, "the slider does not run along the leg from the universal to the spherical joint")
+            return Rejection(cls.kind,
+                             "the slider does not run along the leg from the universal to the spherical joint")
         return cls(geometry, frames, centre)
 
     def __init__(self, geometry: ChainGeometry, frames: ChainFrames, centre: NDArray):

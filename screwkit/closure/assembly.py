@@ -61,8 +61,10 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
     description, geometry = mechanism.description, chain.geometry
     tree_values = np.array([description.reference_configuration.get(name, 0.0)
                             for name in chain.joint_names[: geometry.n_tree_joints]])
-    frames = chain_forward_kinematics(geometry, np.concatenate([tree_values, np.zeros(geometry.n_dofs - tree_values.size)]))
-    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation, mechanism.home_translation)
+    frames = chain_forward_kinematics(geometry,
+                                      np.concatenate([tree_values, np.zeros(geometry.n_dofs - tree_values.size)]))
+    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
+                                                                 mechanism.home_translation)
     loop_values, position_gap, rotation_gap = loop_values_from_relative_transform(
         geometry,
         frames.leg_rotation.T @ target_rotation,
@@ -89,7 +91,8 @@ def _check_planar(mechanism: Mechanism, chain: Chain, values: NDArray) -> None:
     frames = chain_forward_kinematics(chain.geometry, values)
     for name, axis, prismatic in zip(chain.joint_names, frames.axes, chain.prismatic):
         along_normal = abs(axis[2])
-        if (prismatic and along_normal > CLOSURE_TOLERANCE) or (not prismatic and abs(along_normal - 1.0) > CLOSURE_TOLERANCE):
+        if ((prismatic and along_normal > CLOSURE_TOLERANCE)
+                or (not prismatic and abs(along_normal - 1.0) > CLOSURE_TOLERANCE)):
             raise mechanism.description.fail(
                 f"<loop name='{chain.loop_name}'>",
                 f"the platform moves in the base x-y plane (planar joint {mechanism.platform_joint!r}) but joint "
@@ -213,7 +216,8 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     names = mechanism.pose_coordinates
     idle = 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)  # rotations about the point
     instantaneous = mechanism.dof
-    mobility, at_pose, at_values = instantaneous, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains]
+    mobility, at_pose, at_values = (instantaneous, mechanism.home_full_pose,
+                                    [c.reference_values for c in mechanism.chains])
     chains = constraining_chains(mechanism)
     if chains:
         chain_indices, poses, values = _generic_samples(mechanism)

@@ -308,7 +308,9 @@ def transform_axes_and_points(
     new_points = np.empty_like(new_axes)
     for row in range(3):
         new_axes[row] = (
-            rotation[row, 0] * axes_components[0] + rotation[row, 1] * axes_components[1] + rotation[row, 2] * axes_components[2]
+            rotation[row, 0] * axes_components[0]
+            + rotation[row, 1] * axes_components[1]
+            + rotation[row, 2] * axes_components[2]
         )
         new_points[row] = (
             rotation[row, 0] * points_components[0]

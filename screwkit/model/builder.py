@@ -74,7 +74,8 @@ def read_platform(description: UrdfDescription, model, name: str) -> Platform:
     joint_id = model.getJointId(joint.name)
     base_frame = body_frame(model, joint.parent)
     if base_frame.parentJoint != 0 or model.parents[joint_id] != 0:
-        raise description.fail(tag, f"the base link {joint.parent!r} must be fixed to the world (no moving joint above it).")
+        raise description.fail(tag, f"the base link {joint.parent!r} must be fixed to the world "
+                                    "(no moving joint above it).")
     rotation_world_base, translation_world_base = placement_arrays(base_frame.placement)
     platform_frame = body_frame(model, joint.child)
     world_rotation, world_translation = placement_arrays(model.jointPlacements[joint_id] * platform_frame.placement)

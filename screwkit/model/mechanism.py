@@ -236,7 +236,8 @@ class Mechanism:
         return poses
 
     def transforms_from_poses(self, poses: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Platform frames (rotation (..., 3, 3), translation (..., 3)) in the base frame, of full poses (..., n_pose)."""
+        """Platform frames (rotation (..., 3, 3), translation (..., 3)) in the base frame, of full poses
+        (..., n_pose)."""
         poses = np.asarray(poses, dtype=float)
         if self.is_planar:
             rotation = rotation_about_axis(np.array([0.0, 0.0, 1.0]), poses[..., 2])

@@ -92,7 +92,8 @@ def _set_joint(configuration: NDArray, joint, value: NDArray) -> None:
         configuration[..., joint.idx_q] = value
 
 
-def configuration_vector(mechanism, joint_values: Sequence[ArrayLike], poses: ArrayLike | None = None) -> NDArray[np.float64]:
+def configuration_vector(mechanism, joint_values: Sequence[ArrayLike],
+                         poses: ArrayLike | None = None) -> NDArray[np.float64]:
     """Pinocchio configuration vectors q (..., nq) of a mechanism's tree.
 
     Parameters

@@ -388,7 +388,8 @@ class _Reader:
                                 f"the link has two parents: joints {parent_joint[joint.child]!r} and {joint.name!r} "
                                 "(a tree gives every link one parent; close loops with <loop>).")
             if joint.child == joint.parent:
-                raise self.fail(f"<joint name='{joint.name}'>", f"the joint connects the link {joint.child!r} to itself.")
+                raise self.fail(f"<joint name='{joint.name}'>",
+                                f"the joint connects the link {joint.child!r} to itself.")
             parent_joint[joint.child] = joint.name
         roots = [link for link in links if link not in parent_joint]
         depth: dict[str, int] = {}  # links known to lead to a root: the number of joints above them
@@ -469,7 +470,8 @@ class _Reader:
             raise self.fail(f"{tag}<{name}>", "the axis is the zero vector.")
         return axis / norm
 
-    def link_reference(self, element: ElementTree.Element, tag: str, child: str, links) -> tuple[str, ElementTree.Element]:
+    def link_reference(self, element: ElementTree.Element, tag: str, child: str,
+                       links) -> tuple[str, ElementTree.Element]:
         link_element = element.find(child)
         if link_element is None:
             raise self.fail(tag, f"the element <{child} link='...'> is missing.")

@@ -70,11 +70,13 @@ class UrdfWriter:
         if limit is not None:
             lower, upper, effort, velocity = limit
             ElementTree.SubElement(
-                joint, "limit", lower=_number(lower), upper=_number(upper), effort=_number(effort), velocity=_number(velocity)
+                joint, "limit", lower=_number(lower), upper=_number(upper), effort=_number(effort),
+                velocity=_number(velocity)
             )
 
     def loop(
-        self, name, loop_type, chain, predecessor, predecessor_pose, successor, successor_pose, axis=None, second_axis=None
+        self, name, loop_type, chain, predecessor, predecessor_pose, successor, successor_pose, axis=None,
+        second_axis=None
     ) -> None:
         """A URDF+ loop joint; poses are (xyz, rpy) of the loop frame in each link frame."""
         loop = ElementTree.SubElement(self.robot, "loop", name=name, type=loop_type, chain=chain)

@@ -208,8 +208,8 @@ def optimise_design(template: PlanarDesign, permutation, *, bounds=((0.05, 0.4),
     # The template itself seeds the population, so the result is never worse than it.
     start = np.clip([np.mean(np.linalg.norm(template.platform, axis=-1)), np.mean(template.upper),
                      np.mean(template.lower)], [b[0] for b in bounds], [b[1] for b in bounds])
-    result = differential_evolution(_negative_area, bounds=bounds, args=(template, tuple(permutation), options), x0=start,
-                                    maxiter=maxiter, popsize=popsize, seed=seed, polish=False, tol=1e-6,
+    result = differential_evolution(_negative_area, bounds=bounds, args=(template, tuple(permutation), options),
+                                    x0=start, maxiter=maxiter, popsize=popsize, seed=seed, polish=False, tol=1e-6,
                                     workers=workers, updating="deferred" if workers != 1 else "immediate")
     design = _design_from_vector(template, result.x, permutation)
     return design, -float(result.fun), result

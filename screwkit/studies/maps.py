@@ -329,7 +329,8 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         if name not in names:
             raise ValueError(f"Unknown task coordinate {name!r}; mechanism {mechanism.name!r} has {names}.")
     if set(grid) & set(over):
-        raise ValueError(f"A coordinate cannot be both on the grid and in the orientation set: {set(grid) & set(over)}.")
+        raise ValueError("A coordinate cannot be both on the grid and in the orientation set: "
+                         f"{set(grid) & set(over)}.")
     (x_name, x_values), (y_name, y_values) = ((k, np.asarray(v, dtype=float)) for k, v in grid.items())
     shape = (y_values.size, x_values.size)
     if mask is not None:
@@ -364,9 +365,11 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         return np.rad2deg(values) if angular[name] else values
 
     grid_map = GridMap(
-        coordinates={x_name: (shown(x_name, x_values), unit_of(x_name)), y_name: (shown(y_name, y_values), unit_of(y_name))},
+        coordinates={x_name: (shown(x_name, x_values), unit_of(x_name)),
+                     y_name: (shown(y_name, y_values), unit_of(y_name))},
         variables=variables,
-        long_names={key: f"minimum of {key} over the orientation set" for key in variables if key != "reachable_fraction"},
+        long_names={key: f"minimum of {key} over the orientation set"
+                    for key in variables if key != "reachable_fraction"},
         attrs=dict(
             mechanism=mechanism.name, threshold_m=threshold,
             method="closed forms" if closed_forms else "generic screw path",
