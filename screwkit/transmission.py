@@ -498,14 +498,16 @@ def analyze(
     names = tuple(f"{chains[c].name or f'chain_{c + 1}'}:{chains[c].joint_names[k]}" for c, k in plan.actuators)
     f_o = {j: batch_first(merged[f"f_o{j}"]) for j in plan.faults}
     worst = {j: batch_first(merged[f"worst{j}"]) for j in plan.faults}
-    f_c = {j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count else {}
+    not_applicable = np.full(batch_shape, np.nan)  # no constraint wrench held by one chain alone: no CTI
+    f_c = ({j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count
+           else {j: not_applicable.copy() for j in plan.faults})
     if fault_type == "link" and plan.faults:
         options = {"analyze": dict(threshold=threshold, rank_tolerance=rank_tolerance, chunk_size=chunk_size,
                                    threads=threads, output_point=output_point, planar=planar),
                    "idle_count": 0 if idle is None else idle.shape[-2]}
         link = link_fault_indices(given_chains, plan.actuators, plan.faults, batch_shape, analyze, options)
         f_o, worst = link["f_o"], link["worst"]
-        f_c = link["f_c"] if constraint_plan.count else {}
+        f_c = link["f_c"] if constraint_plan.count else f_c
     return Indices(
         actuators=names,
         dof=plan.dof,
@@ -522,7 +524,7 @@ def analyze(
         oti_submechanisms=batch_first(merged["oti_submechanisms"]) if detail else None,
         actuation_wrenches=batch_first(merged["actuation_wrenches"]) if detail else None,
         output_twists=batch_first(merged["output_twists"]) if detail and keep_twists else None,
-        cti=batch_first(merged["cti"]) if constraint_plan.count else None,
+        cti=batch_first(merged["cti"]) if constraint_plan.count else not_applicable,
         f_c=f_c,
         cti_submechanisms=batch_first(merged["cti_submechanisms"]) if constraint_plan.count and detail else None,
         constraint_count=constraint_plan.count,

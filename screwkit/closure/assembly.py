@@ -180,12 +180,18 @@ def assemble(mechanism: Mechanism) -> Mechanism:
     mechanism = replace(mechanism, chains=tuple(solved))
     dof = mobility(mechanism, mechanism.chains)
     actuators = mechanism.actuator_names
-    if len(actuators) < dof:
+    needed = dof - idle_rotation_count(mechanism)  # a point output: the rotations about it need no actuator
+    if len(actuators) < needed:
         raise mechanism.description.fail(
             f"<robot name='{mechanism.name}'>",
-            f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for a platform with {dof} DOF: at least {dof} "
-            "are needed (mark actuated joints with <transmission>).")
+            f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
+            f"{needed} are needed (mark actuated joints with <transmission>).")
     return replace(mechanism, dof=dof)
+
+
+def idle_rotation_count(mechanism: Mechanism) -> int:
+    """Rotations of the platform about a point output (none for a frame output): 1 planar, 3 spatial."""
+    return 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)
 
 
 def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0):
@@ -214,7 +220,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     configuration (:func:`~screwkit.closure.task_space.infer_task_axes`).
     """
     names = mechanism.pose_coordinates
-    idle = 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)  # rotations about the point
+    idle = idle_rotation_count(mechanism)
     instantaneous = mechanism.dof
     mobility, at_pose, at_values = (instantaneous, mechanism.home_full_pose,
                                     [c.reference_values for c in mechanism.chains])

@@ -407,6 +407,8 @@ def disc_size(mechanism: Mechanism, radius: float, step: float, phi_step_degrees
         half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
         points = int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
     orientations = len(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees)) if phi_step_degrees >= 1e-6 else 10**12
+    if "phi" not in mechanism.task_coordinates:  # a planar point output: no rotation to map over
+        orientations = 1
     a = len(mechanism.actuators)
     return MapSize(points, orientations, 3 + 2 * max(a - mechanism.dof, 0), (2 * count + 1, 2 * count + 1))
 
@@ -416,7 +418,9 @@ def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_d
     """The paper's Fig. 5 map: x, y on a disc about ``centre`` (default the home pose), phi over a full turn.
 
     ``step`` is the grid spacing (m) and ``phi_step_degrees`` the angular step of the
-    rotation 0 <= phi < 360 deg. Other options as in :func:`index_map`.
+    rotation 0 <= phi < 360 deg. A planar point output (task coordinates x, y: its rotation is idle)
+    is mapped at its positions alone and ``phi_step_degrees`` is not used. Other options as in
+    :func:`index_map`.
     """
     if not mechanism.is_planar:
         raise ValueError(f"planar_disc_map needs a planar mechanism; {mechanism.name!r} is spatial (use index_map).")
@@ -427,8 +431,11 @@ def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_d
     home = mechanism.home_pose
     centre = home[:2] if centre is None else np.asarray(centre, dtype=float)
     x_values, y_values, mask = disc_grid(radius, step, centre)
-    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
-    result = index_map(mechanism, {"x": x_values, "y": y_values}, {"phi": phi}, home, mask=mask, proceed=proceed,
+    rotating = "phi" in mechanism.task_coordinates
+    over = {"phi": np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))} if rotating else {}
+    result = index_map(mechanism, {"x": x_values, "y": y_values}, over, home, mask=mask, proceed=proceed,
                        **options)
-    result.attrs.update(radius_m=radius, step_m=step, phi_step_deg=phi_step_degrees)
+    result.attrs.update(radius_m=radius, step_m=step)
+    if rotating:
+        result.attrs.update(phi_step_deg=phi_step_degrees)
     return result
