@@ -99,11 +99,12 @@ def random_reachable_poses(mechanism, rng: np.random.Generator, count: int, spre
     from screwkit.closure import solve
 
     home = np.asarray(mechanism.home_pose, dtype=float)
+    scale = mechanism.length_scale
     if mechanism.is_planar:
-        span = spread * np.array([0.3, 0.3, 1.0]) * [mechanism.length_scale, mechanism.length_scale, 1.0]
+        spans = {"x": 0.3 * scale, "y": 0.3 * scale, "phi": 1.0}
     else:
-        scale = mechanism.length_scale
-        span = spread * np.array([0.05 * scale, 0.05 * scale, 0.05 * scale, 0.08, 0.08, 0.3])
+        spans = {"x": 0.05 * scale, "y": 0.05 * scale, "z": 0.05 * scale, "roll": 0.08, "pitch": 0.08, "yaw": 0.3}
+    span = spread * np.array([spans[name] for name in mechanism.task_coordinates])  # any mobility
     found = []
     while sum(len(f) for f in found) < count:
         poses = home + rng.uniform(-1.0, 1.0, (4 * count, home.size)) * span

@@ -99,7 +99,7 @@ def test_mechanism_placed_and_tilted_in_space_gives_the_same_indices(tmp_path, r
 
 
 @pytest.mark.parametrize("arguments, message", [
-    (("analyze", "planar_9rrr"), "Unknown bundled mechanism 'planar_9rrr'; bundled are: coop_arms, planar_4rpr"),
+    (("analyze", "planar_9rrr"), "Unknown bundled mechanism 'planar_9rrr'; bundled are: coop_arms, delta_4"),
     (("analyze", "planar_5rrr", "--pose", "0", "0"),
      "Expected --pose with 3 values (x (m), y (m), phi (deg)) or a named pose (home, paper_fig_2a)"),
     (("analyze", "planar_5rrr", "--pose", "0", "nan", "0"), "Expected finite values in `poses`, got nan"),
@@ -126,8 +126,8 @@ def test_with_json_errors_are_json_on_stdout():
     assert "is unreachable" in json.loads(result.stdout)["error"]
     missing = screwkit("info", "no/such/file.urdf", "--json")
     assert missing.returncode == 1 and json.loads(missing.stdout) == {
-        "error": "no/such/file.urdf: no such URDF file (bundled mechanisms are: coop_arms, planar_4rpr, planar_5rrr, "
-                 "rss_hexapod_8, ups_hexapod_8)."}
+        "error": "no/such/file.urdf: no such URDF file (bundled mechanisms are: coop_arms, delta_4, five_bar_3, "
+                 "planar_4rpr, planar_5rrr, prs_3_ups, rss_hexapod_8, schoenflies_5, ups_hexapod_8)."}
 
 
 def test_verify_compares_with_the_closed_forms():
@@ -141,7 +141,8 @@ def test_verify_compares_with_the_closed_forms():
 
 def test_list_names_the_bundled_robots():
     result = screwkit("list")
-    assert result.stdout.split() == ["coop_arms", "planar_4rpr", "planar_5rrr", "rss_hexapod_8", "ups_hexapod_8"]
+    assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups",
+                                     "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8"]
 
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):

@@ -178,3 +178,44 @@ def test_cli_fault_option_reports_the_type():
     assert report["fault_type"] == "link" and report["cti"] == "not applicable"
     wrong = screwkit("analyze", "planar_5rrr", "--fault", "gearbox")
     assert wrong.returncode != 0 and "--fault" in wrong.stderr
+
+
+def delta_cti(twists, points, dof=3):
+    """The CTI of R-U-U Delta legs from their explicit geometry: each leg's constraint couple a x w
+    (a the arm axis, w the universal joints' middle axis), its actuation force along the rod through the
+    platform joint; the couples of the first legs that span the couple space are released (screwkit's
+    convention for over-constrained mechanisms), in chain order."""
+    couples = [np.cross(t[0, :3], t[2, :3]) for t in twists]
+    couples = [c / np.linalg.norm(c) for c in couples]
+    released = []
+    for c in couples:
+        if np.linalg.matrix_rank(np.array(released + [c]), tol=1e-9) == len(released) + 1:
+            released.append(c)
+    constraint_rows = np.array([np.concatenate([np.zeros(3), c]) for c in released])
+    rods = [(p[-1] - p[1]) / np.linalg.norm(p[-1] - p[1]) for p in points]
+    forces = np.array([np.concatenate([u, np.cross(p[-1], u)]) for u, p in zip(rods, points)])
+    best = 0.0
+    for subset in combinations(range(len(twists)), dof):
+        system = np.vstack([forces[list(subset)], constraint_rows])
+        if np.linalg.matrix_rank(system, tol=1e-9) < 6:
+            continue
+        kappas = []
+        for j, couple in enumerate(released):
+            _, _, right = np.linalg.svd(np.delete(system, dof + j, axis=0))
+            omega = right[-1][3:]  # the freed twist's rotation: (v, omega) order of the Euclidean null vector
+            kappas.append(abs(couple @ omega) / np.linalg.norm(omega))
+        best = max(best, min(kappas))
+    return best
+
+
+@pytest.mark.parametrize("pose_name", ["home", "raised", "off_centre"])
+def test_delta_cti_matches_the_explicit_geometry(pose_name):
+    from screwkit.loader import load
+
+    mechanism = load("delta_4")
+    solution = solve(mechanism, mechanism.named_pose(pose_name)[None])
+    result = analyze_solution(mechanism, solution)
+    chains = chain_screws(mechanism, solution)
+    expected = delta_cti([c.twists[0] for c in chains], [c.points[0] for c in chains])
+    assert result.constraint_count == 3 and 0.0 < expected <= 1.0
+    assert abs(result.cti[0] - expected) < TOLERANCE

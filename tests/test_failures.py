@@ -269,6 +269,9 @@ def test_continuous_joints_have_no_limits():
     ("ups_hexapod_8", "0.05 -0.03 1.1 4 -3 10"),
     ("planar_5rrr", "paper_fig_2a"),
     ("coop_arms", "home"),
+    ("delta_4", "off_centre"),  # lower mobility: poses in task coordinates (x y z; z roll pitch; x y z yaw)
+    ("prs_3_ups", "0.2 10 -5"),
+    ("schoenflies_5", "shifted_turned"),
 ])
 def test_indices_at_reachable_poses_do_not_depend_on_limits(mechanism, pose):
     within = screwkit("analyze", mechanism, "--pose", *pose.split(), "--json")
@@ -550,6 +553,7 @@ def in_millimetres(text: str) -> str:
 @pytest.mark.parametrize("mechanism, poses", [
     ("planar_5rrr", ["paper_fig_2a", "0.1 -0.05 20"]),
     ("ups_hexapod_8", ["home", "0.05 -0.03 1.1 4 -3 10"]),
+    ("schoenflies_5", ["shifted_turned"]),  # lower mobility (x y z yaw), a prismatic limit scaled
 ])
 def test_a_file_in_millimetres_gives_the_indices_of_the_file_in_metres(tmp_path, mechanism, poses):
     path = write(tmp_path / f"{mechanism}_mm.urdf", in_millimetres(bundled_text(mechanism)))

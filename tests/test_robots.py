@@ -15,7 +15,8 @@ from screwkit.closure import chain_screws, solve, solve_one
 from screwkit.loader import bundled_names, bundled_path, load
 from screwkit.model.pinocchio_bridge import configuration_vector
 
-BUNDLED = ("coop_arms", "planar_4rpr", "planar_5rrr", "rss_hexapod_8", "ups_hexapod_8")
+BUNDLED = ("coop_arms", "delta_4", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups", "rss_hexapod_8",
+           "schoenflies_5", "ups_hexapod_8")
 
 
 @lru_cache(maxsize=None)
@@ -35,7 +36,7 @@ def write(tmp_path: Path, text: str, name: str = "changed.urdf") -> Path:
 
 def test_bundled_names_and_unknown_names():
     assert bundled_names() == BUNDLED
-    with pytest.raises(ValueError, match=r"Unknown bundled mechanism 'planar_6rrr'; bundled are: coop_arms, planar_4rpr"):
+    with pytest.raises(ValueError, match=r"Unknown bundled mechanism 'planar_6rrr'; bundled are: coop_arms, delta_4"):
         load("planar_6rrr")
     with pytest.raises(ValueError, match=r"missing\.urdf: no such URDF file \(bundled mechanisms are: coop_arms"):
         load("somewhere/missing.urdf")
@@ -126,7 +127,8 @@ def test_four_rpr_has_a_pose_where_three_leg_lines_meet():
     at_home = solve_one(four, four.home_pose)
     home_legs = [(points[0, :2], points[2, :2]) for points in at_home.joint_points]
     matrix = np.column_stack([home_legs[0][1] - home_legs[0][0], home_legs[1][0] - home_legs[1][1]])
-    home_point = home_legs[0][0] + np.linalg.solve(matrix, home_legs[1][0] - home_legs[0][0])[0] * (home_legs[0][1] - home_legs[0][0])
+    along = np.linalg.solve(matrix, home_legs[1][0] - home_legs[0][0])[0]
+    home_point = home_legs[0][0] + along * (home_legs[0][1] - home_legs[0][0])
     assert _line_distance(home_point, *home_legs[2]) > 0.05
 
 
@@ -157,7 +159,8 @@ def test_hexapods_have_eight_legs_and_no_singular_six_leg_submechanism_at_home(n
     lines = np.concatenate([directions, np.cross(ends, directions) / 0.5], -1)
     import itertools
 
-    smallest = min(np.linalg.svd(lines[list(subset)], compute_uv=False)[-1] for subset in itertools.combinations(range(8), 6))
+    smallest = min(np.linalg.svd(lines[list(subset)], compute_uv=False)[-1]
+                   for subset in itertools.combinations(range(8), 6))
     assert abs(smallest - worst) < 1e-3
 
 
@@ -200,8 +203,10 @@ def test_tilted_planar_mechanism_gives_the_same_relative_geometry(tmp_path):
     xyz, rpy = np.array([0.3, -0.2, 0.5]), np.array([0.4, -0.3, 0.7])
     text = bundled_text("planar_5rrr").replace(
         '<link name="base_link">',
-        '<link name="world"/>\n  <joint name="world_to_base" type="fixed"><parent link="world"/><child link="base_link"/>'
-        f'<origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}"/></joint>\n  <link name="base_link">',
+        '<link name="world"/>\n  <joint name="world_to_base" type="fixed">'
+        '<parent link="world"/><child link="base_link"/>'
+        f'<origin xyz="{xyz[0]} {xyz[1]} {xyz[2]}" rpy="{rpy[0]} {rpy[1]} {rpy[2]}"/></joint>\n'
+        '  <link name="base_link">',
         1,
     )
     tilted = load(write(tmp_path, text))
@@ -263,7 +268,8 @@ def _replace(text: str, pattern: str, replacement: str, count: int = 1) -> str:
             r"<loop name='chain_1_joint_d'>: <predecessor> names an unknown link 'chain_1_elbow'",
         ),
         ("planar_5rrr", lambda text: text.replace("</robot>", "</robo>"), "malformed XML: mismatched tag"),
-        ("planar_5rrr", lambda text: _replace(text, 'type="planar"', 'type="fixed"'), "exactly one floating or planar joint"),
+        ("planar_5rrr", lambda text: _replace(text, 'type="planar"', 'type="fixed"'),
+         "exactly one floating or planar joint"),
         (
             "planar_5rrr",
             lambda text: _replace(text, '<joint name="chain_1_joint_b">', '<joint name="chain_9_joint_b">'),
