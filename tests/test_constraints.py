@@ -219,3 +219,20 @@ def test_delta_cti_matches_the_explicit_geometry(pose_name):
     expected = delta_cti([c.twists[0] for c in chains], [c.points[0] for c in chains])
     assert result.constraint_count == 3 and 0.0 < expected <= 1.0
     assert abs(result.cti[0] - expected) < TOLERANCE
+
+
+def test_a_3_prs_reports_3_dof_and_its_parasitic_motion():
+    """The non-redundant 3-PRS: z, roll, pitch drive it; at a pitch theta about the axis through leg 1 the
+    platform centre shifts by R2 (1 - cos theta) / 2 along that axis (closed form), with no torsion."""
+    mechanism = load_text(prs_mechanism("prs_3", PRS_UPS, with_ups=False), "prs_3")
+    assert mechanism.dof == 3 and mechanism.task_coordinates == ("z", "roll", "pitch")
+    theta = np.deg2rad(np.array([5.0, 15.0, 25.0]))
+    poses = np.column_stack([np.full(3, mechanism.home_pose[0]), np.zeros(3), theta])
+    result = indices_at_poses(mechanism, poses)
+    assert result.reachable.all() and result.dof == 3 and not result.constraint_singular.any()
+    full = dict(zip(mechanism.pose_coordinates, np.moveaxis(result.full_poses, -1, 0)))
+    shift = PRS_UPS["platform_radius"] * (1 - np.cos(theta)) / 2
+    np.testing.assert_allclose(np.abs(full["y"]), shift, atol=1e-10, rtol=0)
+    np.testing.assert_allclose(full["x"], 0.0, atol=1e-10)
+    np.testing.assert_allclose(full["yaw"], 0.0, atol=1e-10)
+    assert not result.faults  # 3 actuators for 3 DOF: no fault index
