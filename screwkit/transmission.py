@@ -498,9 +498,9 @@ def analyze(
     names = tuple(f"{chains[c].name or f'chain_{c + 1}'}:{chains[c].joint_names[k]}" for c, k in plan.actuators)
     f_o = {j: batch_first(merged[f"f_o{j}"]) for j in plan.faults}
     worst = {j: batch_first(merged[f"worst{j}"]) for j in plan.faults}
-    not_applicable = np.full(batch_shape, np.nan)  # no constraint wrench held by one chain alone: no CTI
+    not_applicable = np.broadcast_to(np.nan, batch_shape)  # no constraint wrench held by one chain alone: no CTI
     f_c = ({j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count
-           else {j: not_applicable.copy() for j in plan.faults})
+           else dict.fromkeys(plan.faults, not_applicable))
     if fault_type == "link" and plan.faults:
         options = {"analyze": dict(threshold=threshold, rank_tolerance=rank_tolerance, chunk_size=chunk_size,
                                    threads=threads, output_point=output_point, planar=planar),

@@ -8,33 +8,47 @@ go to stdout (or the files named), progress and summaries to stderr. Errors are 
 
 from __future__ import annotations
 
+import importlib
 import os
 import sys
 
 import click
 
-from screwkit.cli.analyze import analyze
-from screwkit.cli.design_search import design_search
-from screwkit.cli.info import info
-from screwkit.cli.list_command import list_command
-from screwkit.cli.map_command import map_command
 from screwkit.cli.options import ScrewkitGroup
-from screwkit.cli.sweep import sweep
-from screwkit.cli.verify import verify
-from screwkit.cli.view import view
-from screwkit.viewer.server import servers_to_stop
 
-__all__ = ["app", "main"]
+__all__ = ["app", "main", "COMMANDS"]
+
+COMMANDS = {
+    "list": "screwkit.cli.list_command:list_command",
+    "info": "screwkit.cli.info:info",
+    "analyze": "screwkit.cli.analyze:analyze",
+    "verify": "screwkit.cli.verify:verify",
+    "sweep": "screwkit.cli.sweep:sweep",
+    "map": "screwkit.cli.map_command:map_command",
+    "design-search": "screwkit.cli.design_search:design_search",
+    "view": "screwkit.cli.view:view",
+}
+"""Every command and where it lives: a command's module is imported only when that command runs
+(or ``--help`` lists them), so ``screwkit map`` does not load the viewer, the plots or the design search."""
 
 
-@click.group(cls=ScrewkitGroup, context_settings={"help_option_names": ["-h", "--help"]})
+class LazyGroup(ScrewkitGroup):
+    """The command group, importing each command's module on first use."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(COMMANDS)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in COMMANDS:
+            return None
+        module, attribute = COMMANDS[name].split(":")
+        return getattr(importlib.import_module(module), attribute)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="screwkit")
 def app() -> None:
     """Screw-theory transmission and fault-tolerance indices of redundantly actuated parallel robots."""
-
-
-for command in (list_command, info, analyze, verify, sweep, map_command, design_search, view):
-    app.add_command(command)
 
 
 def main() -> None:
@@ -51,7 +65,8 @@ def main() -> None:
     except SystemExit as stop:
         code = stop.code
 
-    if servers_to_stop():
+    server = sys.modules.get("screwkit.viewer.server")  # loaded only if a command used the viewer
+    if server is not None and server.servers_to_stop():
         sys.exit(code)
     if code is not None and not isinstance(code, int):
         print(code, file=sys.stderr)

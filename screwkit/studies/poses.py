@@ -131,8 +131,10 @@ def _blank(count: int, value) -> NDArray:
 
 def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
     """Copy one chunk's per-configuration results (batch-first) into the batch arrays at ``index``."""
-    pieces = {name: getattr(result, name) for name in _ARRAYS}
-    pieces.update({(name, j): value for name in _DICTS for j, value in getattr(result, name).items()})
+    applicable = _ARRAYS if result.constraint_count else tuple(n for n in _ARRAYS if not n.startswith("cti"))
+    pieces = {name: getattr(result, name) for name in applicable}
+    pieces.update({(name, j): value for name in _DICTS for j, value in getattr(result, name).items()
+                   if result.constraint_count or name != "f_c"})
     for key, value in pieces.items():
         if value is None:
             continue
@@ -211,6 +213,10 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
             if progress is not None:
                 progress(part.stop - part.start)
 
+    # no CTI (no constraint wrench held by one chain alone): NaN everywhere, as a view of one NaN
+    not_applicable = {} if meta is None else {"cti": np.broadcast_to(np.nan, batch),
+                                              "f_c": dict.fromkeys(meta.faults, np.broadcast_to(np.nan, batch))}
+
     def shaped(key):
         return arrays[key].reshape(batch + arrays[key].shape[1:]) if key in arrays else None
 
@@ -229,10 +235,12 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
                        mechanism=mechanism.name, chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
                        full_poses=full_poses.reshape(batch + (mechanism.n_pose,)),
                        pose_coordinates=mechanism.pose_coordinates)
+    fields = {name: shaped(name) for name in _ARRAYS}
+    fields.update({name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS})
+    if not meta.constraint_count:
+        fields.update(not_applicable)
     return Indices(
-        actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms,
-        **{name: shaped(name) for name in _ARRAYS},
-        **{name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS},
+        actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms, **fields,
         threshold=threshold, poses=poses, reachable=reachable.reshape(batch),
         task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
         chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
