@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 
@@ -124,3 +125,32 @@ def bundled_chain_screws(name: str, count: int = 200, seed: int = 0):
     mechanism = load(name)
     poses = random_reachable_poses(mechanism, np.random.default_rng(seed), count)
     return chain_screws(mechanism, solve(mechanism, poses)), poses
+
+
+def in_millimetres(text: str, *, declare: bool = False) -> str:
+    """A URDF's lengths times 1000: origins, prismatic limits, primitive sizes and the x, y, z of named poses
+    (written here, independently of screwkit's reader); with ``declare``, also ``<units length="mm"/>``."""
+    root = ElementTree.fromstring(text)
+
+    def scale(element, attribute):
+        if element is not None and element.get(attribute) is not None:
+            element.set(attribute, " ".join(repr(1000 * float(v)) for v in element.get(attribute).split()))
+
+    for origin in root.iter("origin"):
+        scale(origin, "xyz")
+    for joint in root.iter("joint"):
+        if joint.get("type") == "prismatic":
+            scale(joint.find("limit"), "lower")
+            scale(joint.find("limit"), "upper")
+    for box in root.iter("box"):
+        scale(box, "size")
+    for tag in ("cylinder", "sphere"):
+        for shape in root.iter(tag):
+            scale(shape, "radius")
+            scale(shape, "length")
+    for pose in root.iter("named_pose"):
+        for coordinate in ("x", "y", "z"):
+            scale(pose, coordinate)
+    if declare:
+        ElementTree.SubElement(root, "units", length="mm")
+    return ElementTree.tostring(root, encoding="unicode")

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import in_millimetres, screwkit
 from screwkit.closure import UnreachablePose, solve, solve_one
 from screwkit.closure.solve import MISSES_CLOSURE, OUTSIDE_LIMITS
 from screwkit.loader import bundled_path, load
@@ -522,32 +522,6 @@ def test_a_phi_step_beyond_a_turn_is_refused(arguments):
 
 
 # -- units ---------------------------------------------------------------------------------------
-
-
-def in_millimetres(text: str) -> str:
-    """A URDF's lengths times 1000: origins, prismatic limits, primitive sizes (written independently of screwkit)."""
-    root = ElementTree.fromstring(text)
-
-    def scale(element, attribute):
-        if element is not None and element.get(attribute) is not None:
-            element.set(attribute, " ".join(repr(1000 * float(v)) for v in element.get(attribute).split()))
-
-    for origin in root.iter("origin"):
-        scale(origin, "xyz")
-    for joint in root.iter("joint"):
-        if joint.get("type") == "prismatic":
-            scale(joint.find("limit"), "lower")
-            scale(joint.find("limit"), "upper")
-    for box in root.iter("box"):
-        scale(box, "size")
-    for tag in ("cylinder", "sphere"):
-        for shape in root.iter(tag):
-            scale(shape, "radius")
-            scale(shape, "length")
-    for pose in root.iter("named_pose"):
-        for coordinate in ("x", "y", "z"):
-            scale(pose, coordinate)
-    return ElementTree.tostring(root, encoding="unicode")
 
 
 @pytest.mark.parametrize("mechanism, poses", [

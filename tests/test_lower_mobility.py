@@ -24,14 +24,13 @@ from __future__ import annotations
 import json
 import math
 import re
-import xml.etree.ElementTree as ElementTree
 from functools import lru_cache
 from itertools import combinations
 
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import in_millimetres, screwkit
 from screwkit.closure import solve_one
 from screwkit.loader import bundled_path, load, load_text
 from screwkit.studies.poses import indices_at_poses
@@ -535,34 +534,6 @@ def test_planar_disc_map_of_a_point_output(tmp_path):
 # ---------------------------------------------------------------------------------------------
 
 
-def in_millimetres(text: str) -> str:
-    """Every length of a URDF times 1000 (origins, prismatic limits, primitive sizes, named poses) and
-    ``<units length="mm"/>`` (written here, independently of screwkit's reader)."""
-    root = ElementTree.fromstring(text)
-
-    def scale(element, attribute):
-        if element is not None and element.get(attribute) is not None:
-            element.set(attribute, " ".join(repr(1000 * float(v)) for v in element.get(attribute).split()))
-
-    for origin in root.iter("origin"):
-        scale(origin, "xyz")
-    for joint in root.iter("joint"):
-        if joint.get("type") == "prismatic":
-            scale(joint.find("limit"), "lower")
-            scale(joint.find("limit"), "upper")
-    for box in root.iter("box"):
-        scale(box, "size")
-    for tag in ("cylinder", "sphere"):
-        for shape in root.iter(tag):
-            scale(shape, "radius")
-            scale(shape, "length")
-    for pose in root.iter("named_pose"):
-        for coordinate in ("x", "y", "z"):
-            scale(pose, coordinate)
-    ElementTree.SubElement(root, "units", length="mm")
-    return ElementTree.tostring(root, encoding="unicode")
-
-
 def moved_in_the_world(text: str, xyz, rpy) -> str:
     """The whole mechanism placed in a new world frame: ``base_link`` hangs from ``world`` by a fixed joint."""
     return text.replace(
@@ -601,13 +572,13 @@ def test_indices_do_not_depend_on_the_unit_or_the_world_frame(tmp_path, name):
     assert reference.reachable.all()
     text = bundled_path(name).read_text()
     millimetres = tmp_path / f"{name}_mm.urdf"
-    millimetres.write_text(in_millimetres(text))
+    millimetres.write_text(in_millimetres(text, declare=True))
     in_mm = load(millimetres)
     assert in_mm.length_unit == "mm" and in_mm.task_coordinates == reference_mechanism.task_coordinates
     np.testing.assert_allclose(np.array(list(in_mm.named_poses.values())), named, rtol=0, atol=1e-12)
     assert_same_indices(reference, indices_at_poses(in_mm, poses, detail=True))
     xyz, rpy = rng.uniform(-2, 2, 3), rng.uniform(-np.pi, np.pi, 3)
-    for source, length in ((text, 1.0), (in_millimetres(text), 1000.0)):
+    for source, length in ((text, 1.0), (in_millimetres(text, declare=True), 1000.0)):
         moved = tmp_path / f"{name}_moved.urdf"
         moved.write_text(moved_in_the_world(source, xyz * length, rpy))
         placed = load(moved)
