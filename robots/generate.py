@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.model.urdf_writer import UrdfWriter, elbow, planar_rrr_urdf
+from screwkit.model.urdf_writer import UrdfWriter, planar_rrr_urdf, rrr_leg
 from screwkit.rotations import rotation_from_rpy, rpy_from_rotation
 
 FOLDER = Path(__file__).resolve().parent
@@ -404,21 +404,9 @@ def five_bar_3() -> str:
     writer.link("base_link", ("box", (0.5, 0.9, 0.01)), xyz=(0, 0.35, -0.02))
     writer.link("platform", ("sphere", 0.02))
     writer.joint("platform_joint", "planar", "base_link", "platform", xyz=(home[0], home[1], 0), axis=(0, 0, 1))
-    for i in range(len(base)):
-        chain = f"chain_{i + 1}"
-        a = base[i]
-        b = elbow(a, home, proximal, distal, side=parameters["sides"][i])
-        first_angle, second_angle = _angle(b - a), _angle(home - b)
-        writer.rod(f"{chain}_link_a", proximal)
-        writer.rod(f"{chain}_link_l", distal)
-        writer.joint(f"{chain}_joint_b", "continuous", "base_link", f"{chain}_link_a",
-                     xyz=(a[0], a[1], 0), rpy=(0, 0, first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.joint(f"{chain}_joint_c", "continuous", f"{chain}_link_a", f"{chain}_link_l",
-                     xyz=(proximal, 0, 0), rpy=(0, 0, second_angle - first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.loop(f"{chain}_joint_d", "revolute", chain,
-                    f"{chain}_link_l", ((distal, 0, 0), (0, 0, -second_angle)),
-                    "platform", ((0, 0, 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
-        writer.transmission(f"{chain}_joint_b")
+    for i in range(len(base)):  # every leg ends at the output point P, the platform frame's origin
+        rrr_leg(writer, f"chain_{i + 1}", np.asarray(base[i], dtype=float), home, np.zeros(2), proximal, distal,
+                parameters["sides"][i])
     writer.output("point")
     writer.task_coordinates(("x", "y"))
     for name, (x, y) in parameters["named_poses"].items():

@@ -18,7 +18,8 @@ from numpy.typing import NDArray
 from screwkit import tolerances
 from screwkit.chains import ChainScrews
 
-__all__ = ["MotionSpace", "motion_space", "null_spaces", "chain_projector_complements", "working_coordinates"]
+__all__ = ["MotionSpace", "motion_space", "null_spaces", "chain_projector_complements", "working_coordinates",
+           "sampled_working_coordinates"]
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,23 @@ def working_coordinates(twists: list[NDArray], points: list[NDArray]):
     return moved, [r * scale for r in relative], centre, length
 
 
+def sampled_working_coordinates(chains: Sequence[ChainScrews], samples: int = 9):
+    """:func:`working_coordinates` of up to ``samples`` configurations spread evenly over the chains' batch.
+
+    Returns
+    -------
+    index : ndarray of int
+        The sampled configurations (flat indices into the batch).
+    twists, points, centre, length :
+        As :func:`working_coordinates` returns them, for those configurations.
+    """
+    flat = [chain.twists.reshape((-1,) + chain.twists.shape[-2:]) for chain in chains]
+    flat_points = [chain.points.reshape((-1,) + chain.points.shape[-2:]) for chain in chains]
+    count = flat[0].shape[0]
+    index = np.unique(np.linspace(0, count - 1, min(count, samples)).round().astype(int)) if count else np.arange(0)
+    return (index,) + working_coordinates([twists[index] for twists in flat], [points[index] for points in flat_points])
+
+
 def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples: int = 9,
                  tolerance: float = tolerances.MOTION_SPACE_TOLERANCE) -> MotionSpace:
     r"""Find the platform's DOF and, if it is constant, its motion space.
@@ -130,12 +148,7 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     -------
     MotionSpace
     """
-    flat = [chain.twists.reshape((-1,) + chain.twists.shape[-2:]) for chain in chains]
-    flat_points = [chain.points.reshape((-1,) + chain.points.shape[-2:]) for chain in chains]
-    count = flat[0].shape[0]
-    index = np.unique(np.linspace(0, count - 1, min(count, samples)).round().astype(int))
-    working, _, _, _ = working_coordinates([twists[index] for twists in flat],
-                                            [points[index] for points in flat_points])
+    _, working, _, _, _ = sampled_working_coordinates(chains, samples)
     dims, bases = null_spaces(working, dof, tolerance)
     found = int(dims.max()) if dof is None else dof
     if found == 0:

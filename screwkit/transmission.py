@@ -44,7 +44,7 @@ from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
 from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
 from screwkit.link_faults import FAULT_TYPES, link_fault_indices
-from screwkit.motion import MotionSpace, motion_space, null_spaces, working_coordinates
+from screwkit.motion import MotionSpace, motion_space, null_spaces, sampled_working_coordinates, working_coordinates
 from screwkit.outputs import idle_rotations, quotient_bases, with_idle_joints
 from screwkit.results import Indices
 
@@ -254,11 +254,10 @@ def _joints_of_all_chains(arrays: list[NDArray]):
 
 def _constraint_plan(chains: list[ChainScrews], count: int) -> ConstraintPlan:
     """The constraint structure of the chains, found on up to 9 configurations spread over the batch."""
-    index = np.unique(np.linspace(0, count - 1, min(count, 9)).round().astype(int)) if count else np.arange(0)
-    flat_twists = [c.twists.reshape((count,) + c.twists.shape[-2:])[index] for c in chains]
-    flat_points = [c.points.reshape((count,) + c.points.shape[-2:])[index] for c in chains]
-    working, _, _, _ = working_coordinates(flat_twists, flat_points)
-    return plan_constraints(working) if count else ConstraintPlan(tuple(0 for _ in chains), 0, (), ())
+    if not count:
+        return ConstraintPlan(tuple(0 for _ in chains), 0, (), ())
+    _, working, _, _, _ = sampled_working_coordinates(chains)
+    return plan_constraints(working)
 
 
 def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, twists, points, wrenches, fault_members) -> dict:
@@ -448,10 +447,7 @@ def analyze(
         except ValueError:
             raise ValueError(f"Expected `output_point` with shape (..., 3), got {point.shape}.") from None
         idle, idle_points = idle_rotations(point, planar)
-        index = np.unique(np.linspace(0, count - 1, min(count, 9)).round().astype(int)) if count else np.arange(0)
-        flat_points = [c.points.reshape((count,) + c.points.shape[-2:])[index] for c in chains]
-        flat_twists = [c.twists.reshape((count,) + c.twists.shape[-2:])[index] for c in chains]
-        _, _, centre, length = working_coordinates(flat_twists, flat_points)
+        index, _, _, centre, length = sampled_working_coordinates(chains)
         chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
     plan = _make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
     a = len(plan.actuators)

@@ -135,9 +135,28 @@ def elbow(base: NDArray, end: NDArray, proximal: float, distal: float, side: flo
     return base + along * unit + height * np.array([-unit[1], unit[0]])
 
 
+def rrr_leg(writer: UrdfWriter, chain: str, base: NDArray, end: NDArray, platform_point: NDArray, proximal: float,
+            distal: float, side: float) -> None:
+    """One actuated planar R-R-R leg ``chain``: base joint at ``base`` (base frame), elbow on the ``side`` of
+    the line to ``end`` (the leg's end in the base frame, reference assembly), loop onto the platform at
+    ``platform_point`` (platform frame); links, joints, the loop and the transmission."""
+    c = elbow(base, end, proximal, distal, side=side)
+    first_angle, second_angle = _angle(c - base), _angle(end - c)
+    writer.rod(f"{chain}_link_a", proximal)
+    writer.rod(f"{chain}_link_l", distal)
+    writer.joint(f"{chain}_joint_b", "continuous", "base_link", f"{chain}_link_a",
+                 xyz=(base[0], base[1], 0), rpy=(0, 0, first_angle), axis=(0, 0, 1))  # fmt: skip
+    writer.joint(f"{chain}_joint_c", "continuous", f"{chain}_link_a", f"{chain}_link_l",
+                 xyz=(proximal, 0, 0), rpy=(0, 0, second_angle - first_angle), axis=(0, 0, 1))  # fmt: skip
+    writer.loop(f"{chain}_joint_d", "revolute", chain,
+                f"{chain}_link_l", ((distal, 0, 0), (0, 0, -second_angle)),
+                "platform", ((platform_point[0], platform_point[1], 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
+    writer.transmission(f"{chain}_joint_b")
+
+
 def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, distal, working_mode=1.0,
                     comment: str = "", named_poses: dict[str, tuple[float, ...]] | None = None,
-                    output: str = "frame", home: tuple[float, float] = (0.0, 0.0)) -> str:
+                    output: str = "frame") -> str:
     """URDF of a planar n-RRR: base joints ``base`` (n, 2), platform joints ``platform`` (n, 2) in the
     platform frame, arm lengths (scalars or (n,)), elbows on the ``working_mode`` side (+1: +u_perp)
     in the reference assembly (platform at x = y = phi = 0). Base joints are actuated."""
@@ -152,20 +171,8 @@ def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, dista
     writer.link("platform", ("cylinder", round(float(np.max(np.linalg.norm(platform, axis=-1))) + 0.02, 6), 0.02))
     writer.joint("platform_joint", "planar", "base_link", "platform", axis=(0, 0, 1))
     for i in range(count):
-        chain = f"chain_{i + 1}"
-        b, d, a, l = base[i], platform[i], float(proximal[i]), float(distal[i])
-        c = elbow(b, d, a, l, side=float(sides[i]))
-        first_angle, second_angle = _angle(c - b), _angle(d - c)
-        writer.rod(f"{chain}_link_a", a)
-        writer.rod(f"{chain}_link_l", l)
-        writer.joint(f"{chain}_joint_b", "continuous", "base_link", f"{chain}_link_a",
-                     xyz=(b[0], b[1], 0), rpy=(0, 0, first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.joint(f"{chain}_joint_c", "continuous", f"{chain}_link_a", f"{chain}_link_l",
-                     xyz=(a, 0, 0), rpy=(0, 0, second_angle - first_angle), axis=(0, 0, 1))  # fmt: skip
-        writer.loop(f"{chain}_joint_d", "revolute", chain,
-                    f"{chain}_link_l", ((l, 0, 0), (0, 0, -second_angle)),
-                    "platform", ((d[0], d[1], 0), (0, 0, 0)), axis=(0, 0, 1))  # fmt: skip
-        writer.transmission(f"{chain}_joint_b")
+        rrr_leg(writer, f"chain_{i + 1}", base[i], platform[i], platform[i], float(proximal[i]), float(distal[i]),
+                float(sides[i]))
     if output != "frame":
         writer.output(output)
     for pose_name, values in (named_poses or {}).items():
