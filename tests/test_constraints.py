@@ -236,3 +236,63 @@ def test_a_3_prs_reports_3_dof_and_its_parasitic_motion():
     np.testing.assert_allclose(full["x"], 0.0, atol=1e-10)
     np.testing.assert_allclose(full["yaw"], 0.0, atol=1e-10)
     assert not result.faults  # 3 actuators for 3 DOF: no fault index
+
+
+def test_link_faults_are_invariant_to_unit_and_frame(prs_4):
+    """Link failures of the 4-PRS: a lost leg leaves a 3-PRS of mobility 3 held by its three actuators, a
+    reduced mechanism of its own; its F_O1 and worst faults do not depend on the unit or the world frame."""
+    mechanism, _ = prs_4
+    rng = np.random.default_rng(5)
+    poses = mechanism.home_pose + np.column_stack([rng.uniform(-0.01, 0.01, 20),
+                                                   np.deg2rad(rng.choice([-1, 1], 20) * rng.uniform(3, 15, 20))])
+    chains = chain_screws(mechanism, solve(mechanism, poses), unreachable="drop")
+    reference = analyze(chains, dof=2, fault_type="link")
+    assert np.all(reference.f_o[1] > 0.5)
+    for scale in (1e-3, 1e3):
+        changed = moved(chains, random_rotation(rng), rng.normal(size=3))
+        scaled = [ChainScrews(c.twists * np.r_[np.ones(3), np.full(3, scale)], c.points * scale, c.actuated,
+                              c.name, joint_names=c.joint_names) for c in changed]
+        other = analyze(scaled, dof=2, fault_type="link", threshold=1e-6 * scale)
+        for j in reference.faults:
+            np.testing.assert_allclose(other.f_o[j], reference.f_o[j], atol=TOLERANCE, rtol=0)
+            np.testing.assert_array_equal(other.worst_fault_indices[j], reference.worst_fault_indices[j])
+
+
+def test_cli_pose_from_actuator_values(tmp_path):
+    """`analyze --actuators` finds the pose whose actuator values are given (closure solved here by screwkit's
+    inverse kinematics, read back through the command) and refuses values redundant actuators cannot share."""
+    import json
+
+    from screwkit.closure import actuator_values, solve_one
+    from screwkit.loader import load
+
+    mechanism = load("prs_3_ups")
+    pose = mechanism.named_pose("pitch_10") + np.array([0.005, np.deg2rad(3.0), 0.0])
+    values = actuator_values(mechanism, solve_one(mechanism, pose).joint_values).reshape(-1)
+    completed = screwkit("analyze", "prs_3_ups", "--actuators", *[repr(float(v)) for v in values], "--json")
+    assert completed.returncode == 0, completed.stderr
+    report = json.loads(completed.stdout)
+    shown = [report["pose"]["z"], np.deg2rad(report["pose"]["roll"]), np.deg2rad(report["pose"]["pitch"])]
+    np.testing.assert_allclose(shown, pose, atol=1e-9)
+    inconsistent = values + np.array([0.0, 0.0, 0.0, 0.02])  # the UPS leg 2 cm longer than the PRS legs allow
+    refused = screwkit("analyze", "prs_3_ups", "--actuators", *[repr(float(v)) for v in inconsistent])
+    assert refused.returncode == 1 and refused.stderr.strip().splitlines() == [
+        "Error: No closed pose of 'prs_3_ups' has these actuator values near the start pose (redundant actuators "
+        "must agree with one another; give another start with --pose)."]
+
+
+def test_cli_sweep_and_map_say_their_fault_type(tmp_path):
+    import xarray as xr
+
+    sweep_file, map_file = tmp_path / "sweep.nc", tmp_path / "map.nc"
+    completed = screwkit("sweep", "prs_3_ups", "--sweep", "pitch:-10:11:10", "--fault", "link", "--out", sweep_file,
+                         "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    completed = screwkit("map", "prs_3_ups", "--grid", "roll:-5:5:5", "--grid", "pitch:-5:5:5", "--fault", "link",
+                         "--out", map_file, "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    with xr.open_dataset(sweep_file) as sweep, xr.open_dataset(map_file) as grid:
+        assert sweep.attrs["fault_type"] == "link" and grid.attrs["fault_type"] == "link"
+        np.testing.assert_array_equal(sweep["f_o1"].values, 0.0)  # a lost PRS leg frees the platform
+        np.testing.assert_array_equal(grid["f_o1"].values, 0.0)
+        assert np.all(sweep["cti"].values > 0.9)
