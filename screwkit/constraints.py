@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit import tolerances
+from screwkit.motion import chain_decompositions
 
 __all__ = ["ConstraintPlan", "plan_constraints", "constraint_indices", "chain_constraint_wrenches"]
 
@@ -82,14 +83,13 @@ def _unit_rows(rows: NDArray) -> NDArray:
     return rows / np.where(norms > 0.0, norms, 1.0)
 
 
-def chain_constraint_wrenches(twists: NDArray, count: int) -> NDArray[np.float64]:
+def chain_constraint_wrenches(twists: NDArray, count: int, decomposition: tuple | None = None) -> NDArray[np.float64]:
     """The ``count`` constraint wrenches (N, count, 6) of a chain's joint twists (N, m, 6): an orthonormal
-    basis of the wrenches reciprocal to all of them (working coordinates)."""
+    basis of the wrenches reciprocal to all of them (working coordinates). ``decomposition``: the chain's
+    :func:`screwkit.motion.chain_decompositions` when already computed."""
     if count == 0:
         return np.zeros(twists.shape[:-2] + (0, 6))
-    columns = _unit_rows(twists)
-    padded = np.concatenate([columns, np.zeros(columns.shape[:-2] + (max(0, 6 - columns.shape[-2]), 6))], axis=-2)
-    _, _, right = np.linalg.svd(padded)
+    _, right = decomposition if decomposition is not None else chain_decompositions([twists])[0]
     return right[..., 6 - count:, :] @ _SWAP  # twists reciprocal to ... -> wrenches: swap the halves
 
 
@@ -186,7 +186,7 @@ def _project_on_axis(wrench: NDArray, point: NDArray) -> NDArray:
 
 def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_points: list[NDArray],
                        wrenches: NDArray, submechanisms: NDArray, dof: int, fault_members: dict,
-                       threshold: NDArray) -> dict[str, NDArray]:
+                       threshold: NDArray, decompositions: list | None = None) -> dict[str, NDArray]:
     """CTI of every non-redundant actuator set, the mechanism's CTI, F_Cj, and the instantaneous DOF.
 
     Parameters
@@ -203,6 +203,8 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         For each ``j``, the submechanisms (rows of ``submechanisms``) in each set left after j faults.
     threshold : ndarray (N,)
         The singularity threshold in working coordinates (*p* / *L*).
+    decompositions : list, optional
+        :func:`screwkit.motion.chain_decompositions` of ``chain_twists`` when already computed.
 
     Returns
     -------
@@ -213,7 +215,10 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         with each actuator free and every other one locked.
     """
     count = wrenches.shape[0]
-    constraints = [chain_constraint_wrenches(t, c) for t, c in zip(chain_twists, plan.chain_counts)]
+    if decompositions is None:
+        decompositions = [None] * len(chain_twists)
+    constraints = [chain_constraint_wrenches(t, c, d)
+                   for t, c, d in zip(chain_twists, plan.chain_counts, decompositions)]
     stacked = np.concatenate(constraints, axis=-2) if constraints else np.zeros((count, 0, 6))
     instantaneous = 6 - _rank(stacked, tolerances.MOTION_SPACE_TOLERANCE)
     singular = instantaneous > dof

@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 from screwkit import tolerances
 from screwkit.chains import ChainScrews
 
-__all__ = ["MotionSpace", "motion_space", "null_spaces", "chain_projector_complements", "working_coordinates",
-           "sampled_working_coordinates"]
+__all__ = ["MotionSpace", "motion_space", "null_spaces", "chain_decompositions", "chain_projector_complements",
+           "working_coordinates", "sampled_working_coordinates"]
 
 
 @dataclass(frozen=True)
@@ -50,27 +50,50 @@ class MotionSpace:
         return np.ascontiguousarray(right[self.dof:])
 
 
-def chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: float) -> NDArray[np.float64]:
-    """Sum over chains of ``I - P_chain`` for twists given as a list of (K, m, 6) arrays.
+def chain_decompositions(twists: list[NDArray[np.float64]]) -> list[tuple[NDArray, NDArray]]:
+    """Per chain, the singular values (K, 6) and right singular vectors (K, 6, 6) of its joint twists.
 
-    Each joint twist is scaled to unit norm first (a column scaling: the same span), so that
-    the relative rank ``tolerance`` compares dimensionless singular values whatever the joint
-    types; twists are expected in working coordinates.
+    The twists (K, m, 6) of each chain, in working coordinates, are scaled to unit norm (a
+    scaling of the rows: the same span, so that relative rank decisions compare dimensionless
+    singular values whatever the joint types) and padded with zero rows to six: the last rows of
+    the right singular vectors then span the twists' Euclidean complement whatever ``m``. One
+    decomposition serves the motion space (:func:`chain_projector_complements`) and the chain's
+    constraint wrenches (:func:`screwkit.constraints.chain_constraint_wrenches`).
     """
-    total = np.zeros((twists[0].shape[0], 6, 6))
+    decompositions = []
     for chain_twists in twists:
         norms = np.linalg.norm(chain_twists, axis=-1, keepdims=True)
-        columns = chain_twists / np.where(norms > 0.0, norms, 1.0)
-        left, singular, _ = np.linalg.svd(np.swapaxes(columns, -1, -2), full_matrices=False)
-        rank_mask = singular > tolerance * singular[..., :1]
-        basis = left * rank_mask[..., None, :]
-        total += np.eye(6) - basis @ np.swapaxes(basis, -1, -2)
+        rows = chain_twists / np.where(norms > 0.0, norms, 1.0)
+        padding = max(0, 6 - rows.shape[-2])
+        if padding:
+            rows = np.concatenate([rows, np.zeros(rows.shape[:-2] + (padding, 6))], axis=-2)
+        _, singular, right = np.linalg.svd(rows)
+        decompositions.append((singular[..., :6], right))
+    return decompositions
+
+
+def chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: float,
+                                decompositions: list | None = None) -> NDArray[np.float64]:
+    """Sum over chains of ``I - P_chain`` for twists given as a list of (K, m, 6) arrays.
+
+    ``I - P_chain`` projects on the Euclidean complement of the span of the chain's twists: the
+    right singular vectors of :func:`chain_decompositions` whose singular values are at most
+    ``tolerance`` times the largest (passed in as ``decompositions`` when already computed).
+    """
+    if decompositions is None:
+        decompositions = chain_decompositions(twists)
+    total = np.zeros((decompositions[0][0].shape[0], 6, 6))
+    for singular, right in decompositions:
+        outside = singular <= tolerance * singular[..., :1]
+        rows = right * outside[..., :, None]
+        total += np.swapaxes(rows, -1, -2) @ rows
     return total
 
 
-def null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float):
+def null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float,
+                decompositions: list | None = None):
     """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i) (working coordinates)."""
-    values, vectors = np.linalg.eigh(chain_projector_complements(chain_twists, tolerance))
+    values, vectors = np.linalg.eigh(chain_projector_complements(chain_twists, tolerance, decompositions))
     dims = np.sum(values <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)
     count = int(dims.max()) if dof is None else dof
     return dims, np.swapaxes(vectors[..., :count], -1, -2)

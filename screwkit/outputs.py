@@ -21,8 +21,12 @@ from screwkit.tolerances import MOTION_SPACE_TOLERANCE
 __all__ = ["idle_rotations", "with_idle_joints", "quotient_bases"]
 
 
-def idle_rotations(points: ArrayLike, planar: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit rotations about a point (..., 3): about z only for a planar mechanism, else about x, y, z.
+def idle_rotations(points: ArrayLike, planar) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit rotations about a point (..., 3): about the plane's normal only for a planar mechanism, else
+    about x, y, z.
+
+    ``planar`` is False (spatial), True (the plane's normal is z) or the plane's normal (3,), in the
+    frame of the points: a planar mechanism placed in a tilted world frame turns about its own normal.
 
     Returns
     -------
@@ -30,7 +34,15 @@ def idle_rotations(points: ArrayLike, planar: bool) -> tuple[NDArray[np.float64]
     points : ndarray (..., r, 3)
     """
     points = np.asarray(points, dtype=float)
-    axes = np.array([[0.0, 0.0, 1.0]]) if planar else np.eye(3)
+    if isinstance(planar, (bool, np.bool_)):
+        axes = np.array([[0.0, 0.0, 1.0]]) if planar else np.eye(3)
+    else:
+        normal = np.asarray(planar, dtype=float).reshape(-1)
+        length = float(np.linalg.norm(normal)) if normal.shape == (3,) and np.all(np.isfinite(normal)) else 0.0
+        if length == 0.0:
+            raise ValueError(f"Expected `planar` True, False or a plane normal of 3 finite numbers, not all 0; "
+                             f"got {planar!r}.")
+        axes = (normal / length)[None]
     axes = np.broadcast_to(axes, points.shape[:-1] + axes.shape)
     where = np.broadcast_to(points[..., None, :], axes.shape)
     return np.concatenate([axes, np.cross(where, axes)], axis=-1), np.array(where)

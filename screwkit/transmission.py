@@ -32,6 +32,7 @@ numbers of those coordinates. The one length is the singularity threshold *p*, c
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from itertools import combinations
 from typing import Sequence
 
@@ -44,7 +45,14 @@ from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
 from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
 from screwkit.link_faults import FAULT_TYPES, link_fault_indices
-from screwkit.motion import MotionSpace, motion_space, null_spaces, sampled_working_coordinates, working_coordinates
+from screwkit.motion import (
+    MotionSpace,
+    chain_decompositions,
+    motion_space,
+    null_spaces,
+    sampled_working_coordinates,
+    working_coordinates,
+)
 from screwkit.outputs import idle_rotations, quotient_bases, with_idle_joints
 from screwkit.results import Indices
 
@@ -182,8 +190,29 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
     return out
 
 
-def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None) -> dict:
-    """All indices for one chunk of configurations (arrays (N, J, 6) and (N, J, 3) over all joints)."""
+class _ChunkSpaces:
+    """A chunk's chains in working coordinates and their decompositions, computed once when first asked
+    (shared by the motion spaces and the constraint indices)."""
+
+    def __init__(self, plan: _Plan, twists, points):
+        self.plan, self.twists, self.points = plan, twists, points
+
+    @cached_property
+    def working(self):
+        starts = self.plan.chain_start
+        chain_twists = [self.twists[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+        chain_points = [self.points[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
+        return working_coordinates(chain_twists, chain_points)
+
+    @cached_property
+    def decompositions(self):
+        return chain_decompositions(self.working[0])
+
+
+def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None,
+                   spaces: _ChunkSpaces | None = None) -> dict:
+    """All indices for one chunk of configurations (arrays (N, J, 6) and (N, J, 3) over all joints);
+    ``spaces`` the chunk's working coordinates when they are needed for every configuration anyway."""
     if plan.space.constant_basis is not None:
         basis = plan.space.constant_basis[None]
         out = _run_kernel(plan, twists, points, basis, plan.complement, iti_override, oti_override,
@@ -194,11 +223,17 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     if redo.size:
         # Configurations whose joint twists leave the constant space: their own motion space, in
         # the working coordinates the kernel uses (same centroid and characteristic length).
-        starts = plan.chain_start
-        chain_twists = [twists[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        chain_points = [points[redo, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        working, _, centre, length = working_coordinates(chain_twists, chain_points)
-        _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE)
+        if spaces is not None or redo.size == twists.shape[0]:
+            spaces = spaces or _ChunkSpaces(plan, twists, points)
+            working, _, centre, length = spaces.working
+            working = [chain[redo] for chain in working]
+            centre, length = centre[redo], length[redo]
+            decompositions = [(singular[redo], right[redo]) for singular, right in spaces.decompositions]
+        else:
+            working, _, centre, length = _ChunkSpaces(plan, twists[redo], points[redo]).working
+            decompositions = None
+        _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE,
+                               decompositions)
         if plan.idle_count:
             bases = quotient_bases(bases, idle[redo], centre, length, plan.dof)
         again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
@@ -260,18 +295,16 @@ def _constraint_plan(chains: list[ChainScrews], count: int) -> ConstraintPlan:
     return plan_constraints(working)
 
 
-def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, twists, points, wrenches, fault_members) -> dict:
+def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, spaces: _ChunkSpaces, wrenches,
+                      fault_members) -> dict:
     """The CTI of a chunk (see :mod:`screwkit.constraints`), in the kernel's working coordinates."""
-    starts = plan.chain_start
-    chain_twists = [twists[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-    chain_points = [points[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-    working, working_points, centre, length = working_coordinates(chain_twists, chain_points)
+    working, working_points, centre, length = spaces.working
     moments = wrenches[..., 3:] + np.cross(wrenches[..., :3], centre[:, None, :])  # about the centroid
     working_wrenches = np.concatenate([wrenches[..., :3], moments / length[:, None, None]], axis=-1)
     norms = np.linalg.norm(working_wrenches, axis=-1, keepdims=True)
     working_wrenches = working_wrenches / np.where(norms > 0.0, norms, 1.0)
     return constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
-                              plan.dof, fault_members, plan.threshold / length)
+                              plan.dof, fault_members, plan.threshold / length, spaces.decompositions)
 
 
 def _at_constraint_singularities(plan: _Plan, result: dict, held: NDArray) -> None:
@@ -303,7 +336,7 @@ def analyze(
     chunk_size: int = 65536,
     threads: int | None = None,
     output_point: ArrayLike | None = None,
-    planar: bool = False,
+    planar: bool | ArrayLike = False,
     fault_type: str = "free-swinging",
 ) -> Indices:
     r"""Every index of the paper for a batch of configurations, derived from chain screws.
@@ -403,8 +436,9 @@ def analyze(
         A point output (world frame): the rotations of the platform about it are idle
         (:mod:`screwkit.outputs`) and the indices are those of the point's motion: ``n`` is the
         DOF of the point, actuation wrenches are forces through it.
-    planar : bool
-        With ``output_point``: the mechanism is planar, its only idle rotation is about z.
+    planar : bool or array_like (3,)
+        With ``output_point``: the mechanism is planar, its only idle rotation is about the plane's
+        normal: z when True, else the normal given (world frame).
     fault_type : {"free-swinging", "link"}
         What a fault is: a failed actuator becomes a passive joint (the paper's FSJF, default),
         or its chain disappears with its constraint wrenches (LF, :mod:`screwkit.link_faults`).
@@ -469,14 +503,15 @@ def analyze(
 
     def run(part: slice) -> dict:
         chunk_twists, chunk_points = twists(part), points(part)
+        spaces = _ChunkSpaces(plan, chunk_twists, chunk_points) if constraint_plan.count else None
         result = _analyze_chunk(
             plan, chunk_twists, chunk_points,
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
-            detail or constraint_plan.count > 0, keep_twists, None if idle is None else idle[part])
+            detail or constraint_plan.count > 0, keep_twists, None if idle is None else idle[part], spaces)
         if constraint_plan.count:
-            result.update(_constraint_chunk(plan, constraint_plan, chunk_twists, chunk_points,
-                                            result["actuation_wrenches"], fault_members))
+            result.update(_constraint_chunk(plan, constraint_plan, spaces, result["actuation_wrenches"],
+                                            fault_members))
             if "held_without" in result:
                 _at_constraint_singularities(plan, result, result.pop("held_without"))
             if not detail:

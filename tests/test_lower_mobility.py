@@ -584,3 +584,40 @@ def test_indices_do_not_depend_on_the_unit_or_the_world_frame(tmp_path, name):
         placed = load(moved)
         assert not placed.base_is_world
         assert_same_indices(reference, indices_at_poses(placed, poses, detail=True))
+
+
+def test_a_planar_point_output_turns_about_its_own_plane_normal_in_any_world_frame(tmp_path, monkeypatch):
+    """The idle rotation of a planar point output is about the plane's normal, not the world z axis: with
+    world z it would be one more shared twist, and which motion-space basis is kept would be arbitrary."""
+    from screwkit import transmission
+
+    reference_mechanism = mechanism("five_bar_3")
+    poses = np.array(list(reference_mechanism.named_poses.values()))
+    reference = indices_at_poses(reference_mechanism, poses, detail=True)
+    rng = np.random.default_rng(11)
+    text = bundled_path("five_bar_3").read_text()
+    appended = []
+
+    def recording(chains, *arguments):
+        result = original(chains, *arguments)
+        appended.append([b.twists.shape[-2] - a.twists.shape[-2] for a, b in zip(chains, result)])
+        return result
+
+    original = transmission.with_idle_joints
+    monkeypatch.setattr(transmission, "with_idle_joints", recording)
+    for trial in range(4):
+        moved = tmp_path / f"moved_{trial}.urdf"
+        moved.write_text(moved_in_the_world(text, rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3)))
+        assert_same_indices(reference, indices_at_poses(load(moved), poses, detail=True))
+    # each chain ends in a revolute joint about the point's normal: no idle joint is appended
+    assert appended and all(count == 0 for counts in appended for count in counts), appended
+
+
+def test_idle_rotations_about_a_given_normal():
+    from screwkit.outputs import idle_rotations
+
+    twists, points = idle_rotations(np.array([[1.0, 2.0, 3.0]]), np.array([0.0, 0.0, 2.0]))
+    np.testing.assert_allclose(twists, [[[0, 0, 1, 2, -1, 0]]])
+    np.testing.assert_allclose(points, [[[1, 2, 3]]])
+    with pytest.raises(ValueError, match="plane normal"):
+        idle_rotations(np.zeros((1, 3)), np.zeros(3))

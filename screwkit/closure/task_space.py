@@ -11,18 +11,15 @@ constraining chains together, with continuation from the reference assembly.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure.chain_kinematics import (
     chain_forward_kinematics,
-    chain_jacobian,
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.closure.newton import apply_step, pose_error
+from screwkit.closure.threads import for_each_block
 from screwkit.model.mechanism import Mechanism
 from screwkit.tolerances import MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 
@@ -31,6 +28,7 @@ __all__ = [
     "constraining_chains",
     "complete_poses",
     "close_constraining_chains",
+    "packed_geometry",
     "motion_space_at",
     "infer_task_axes",
 ]
@@ -75,38 +73,76 @@ def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:
     return tuple(index for index in range(len(mechanism.chains)) if _chain_rank(mechanism, index) < mechanism.n_pose)
 
 
-def _residuals(mechanism, chains, full_poses, values):
-    """Closure errors (N, 6 c) of the constraining chains and their frames."""
-    rotation, translation = mechanism.transforms_from_poses(full_poses)
-    errors, frames = [], []
-    for index, chain_values in zip(chains, values):
-        chain_frames = chain_forward_kinematics(mechanism.chains[index].geometry, chain_values)
-        target_rotation, target_translation = mechanism.loop_targets(index, rotation, translation)
-        errors.append(pose_error(target_rotation, target_translation, chain_frames.end_rotation,
-                                 chain_frames.end_translation))
-        frames.append(chain_frames)
-    return np.concatenate(errors, axis=-1), frames
+def packed_geometry(mechanism: Mechanism, chains: tuple[int, ...]) -> dict:
+    """The geometry of ``chains`` packed for the compiled closure (tree joints stacked with offsets)."""
+    from screwkit.closure._task_kernel import LOOP_CODES  # numba: loaded when a closure first runs
+
+    geometries = [mechanism.chains[index].geometry for index in chains]
+    tree = np.cumsum([0] + [g.n_tree_joints for g in geometries])
+    dofs = np.cumsum([0] + [g.n_dofs for g in geometries])
+    joints = int(tree[-1])
+
+    def stacked(name, shape):
+        parts = [np.asarray(getattr(g, name), dtype=float).reshape((-1,) + shape) for g in geometries]
+        return np.ascontiguousarray(np.concatenate(parts) if joints else np.zeros((0,) + shape))
+
+    loop_axes = np.zeros((len(geometries), 2, 3))
+    for row, geometry in enumerate(geometries):
+        axes = np.asarray(geometry.loop_axes, dtype=float).reshape(-1, 3)
+        loop_axes[row, :axes.shape[0]] = axes[:2]
+    return dict(
+        planar=mechanism.is_planar, planar_z=float(mechanism.home_translation[2]),
+        tree_start=tree.astype(np.int64), dof_start=dofs.astype(np.int64),
+        joint_rot=stacked("joint_rotations", (3, 3)), joint_trans=stacked("joint_translations", (3,)),
+        joint_axis=stacked("joint_axes", (3,)),
+        joint_prism=np.array([p for g in geometries for p in g.joint_prismatic], dtype=np.bool_),
+        dof_prism=np.array([p for g in geometries for p in g.dof_prismatic], dtype=np.bool_),
+        leg_rot=np.array([g.leg_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
+        leg_trans=np.array([g.leg_loop_translation for g in geometries], dtype=float).reshape(-1, 3),
+        loop_code=np.array([LOOP_CODES[g.loop_type] for g in geometries], dtype=np.int64),
+        loop_axes=loop_axes,
+        plat_rot=np.array([g.platform_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
+        plat_trans=np.array([g.platform_loop_translation for g in geometries], dtype=float).reshape(-1, 3),
+    )
 
 
-def _jacobian(mechanism, chains, full_poses, frames, free_axes):
-    """d(closure errors)/d(free pose coordinates, joint values): (N, 6 c, len(free) + sum m)."""
-    count = full_poses.shape[0]
-    rates = pose_rates(mechanism, full_poses)[:, :, list(free_axes)]  # (N, 6, f)
-    _, translation = mechanism.transforms_from_poses(full_poses)
-    rotation, _ = mechanism.transforms_from_poses(full_poses)
+BLOCK = 2048
+"""Configurations per thread block of the compiled closure."""
+
+
+def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, tolerance, iterations,
+                 step_tolerance, step_iterations, max_step):
+    """The compiled closure (:mod:`screwkit.closure._task_kernel`) over a batch, in thread blocks."""
+    from screwkit.closure._task_kernel import close_chains_kernel  # numba: loaded when a closure first runs
+
+    poses = np.array(full_poses, dtype=float, order="C", copy=True)
+    count = poses.shape[0]
     sizes = [mechanism.chains[index].n_joints for index in chains]
-    jacobian = np.zeros((count, 6 * len(chains), len(free_axes) + sum(sizes)))
-    column = len(free_axes)
-    for row, (index, chain_frames, size) in enumerate(zip(chains, frames, sizes)):
-        _, target = mechanism.loop_targets(index, rotation, translation)
-        arm = target - translation  # the loop frame's origin relative to the platform frame's
-        moved = rates.copy()
-        moved[:, 3:] += np.swapaxes(np.cross(np.swapaxes(rates[:, :3], 1, 2), arm[:, None, :]), 1, 2)
-        jacobian[:, 6 * row:6 * row + 6, :len(free_axes)] = moved
-        jacobian[:, 6 * row:6 * row + 6, column:column + size] = -chain_jacobian(mechanism.chains[index].geometry,
-                                                                                  chain_frames)
+    flat = np.zeros((count, sum(sizes)))
+    column = 0
+    for chain_values, size in zip(values, sizes):
+        flat[:, column:column + size] = chain_values
         column += size
-    return jacobian
+    free = np.asarray(free_axes, dtype=np.int64)
+    task = np.array([axis for axis in range(mechanism.n_pose) if axis not in free_axes], dtype=np.int64)
+    targets = np.ascontiguousarray(np.broadcast_to(targets, (count, task.size)), dtype=float)
+    steps = np.ascontiguousarray(np.broadcast_to(steps, (count,)), dtype=np.int64)
+    scale = np.concatenate([np.where(mechanism.pose_angular[free], 1.0, mechanism.length_scale),
+                            np.ones(flat.shape[1])])
+    geometry = packed_geometry(mechanism, chains)
+    residual = np.empty(count)
+
+    def work(block: slice) -> None:
+        close_chains_kernel(poses[block], flat[block], targets[block], steps[block], task, free, scale,
+                            geometry["planar"], geometry["planar_z"], geometry["tree_start"], geometry["dof_start"],
+                            geometry["joint_rot"], geometry["joint_trans"], geometry["joint_axis"],
+                            geometry["joint_prism"], geometry["dof_prism"], geometry["leg_rot"], geometry["leg_trans"],
+                            geometry["loop_code"], geometry["loop_axes"], geometry["plat_rot"], geometry["plat_trans"],
+                            tolerance, iterations, step_tolerance, step_iterations, max_step, residual[block])
+
+    for_each_block(count, work, block=BLOCK)
+    split = np.cumsum([0] + sizes)
+    return poses, [flat[:, split[i]:split[i + 1]] for i in range(len(sizes))], residual < tolerance, residual
 
 
 def close_constraining_chains(mechanism, chains, full_poses, values, free_axes, tolerance, iterations, max_step):
@@ -114,60 +150,32 @@ def close_constraining_chains(mechanism, chains, full_poses, values, free_axes, 
 
     Levenberg-Marquardt as :func:`screwkit.closure.newton.newton_solve_chain`, on the unknowns
     (free pose coordinates, joint values of every constraining chain) with lengths in units of
-    the length scale; batched over configurations.
+    the length scale: the step solves ``(J^T J + (mu + |e|^2) I) dx = -J^T e`` for the closure
+    errors ``e`` of every constraining chain, is limited to ``max_step`` and kept only if it
+    lowers ``|e|``. Compiled (:mod:`screwkit.closure._task_kernel`), one configuration at a time.
+
+    Returns
+    -------
+    full_poses : ndarray (N, n_pose)
+    values : list of ndarray (N, m_i)
+    converged : ndarray (N,) of bool
+    residual : ndarray (N,)
     """
-    full_poses = np.array(full_poses, dtype=float, copy=True)
-    values = [np.array(v, dtype=float, copy=True) for v in values]
-    count = full_poses.shape[0]
-    error, _ = _residuals(mechanism, chains, full_poses, values)
-    residual = np.linalg.norm(error, axis=-1)
-    damping = np.full(count, 1e-9)
-    active = np.flatnonzero((residual >= tolerance) & np.isfinite(residual))
-    sizes = [mechanism.chains[index].n_joints for index in chains]
-    scale = np.concatenate([np.where(mechanism.pose_angular[list(free_axes)], 1.0, mechanism.length_scale),
-                            np.ones(sum(sizes))])
-    for _ in range(iterations):
-        if active.size == 0:
-            break
-        current_poses = full_poses[active]
-        current_values = [v[active] for v in values]
-        current_error, frames = _residuals(mechanism, chains, current_poses, current_values)
-        jacobian = _jacobian(mechanism, chains, current_poses, frames, free_axes) * scale
-        transposed = np.swapaxes(jacobian, -1, -2)
-        norm = residual[active]
-        normal = transposed @ jacobian + (damping[active] + norm**2)[:, None, None] * np.eye(jacobian.shape[-1])
-        step = -np.linalg.solve(normal, transposed @ current_error[..., None])[..., 0]
-        largest = np.max(np.abs(step), axis=-1)
-        step *= np.minimum(1.0, max_step / np.maximum(largest, 1e-300))[:, None]
-        step *= scale
-        candidate_poses = current_poses.copy()
-        candidate_poses[:, list(free_axes)] += step[:, :len(free_axes)]
-        candidate_values, column = [], len(free_axes)
-        for index, chain_values, size in zip(chains, current_values, sizes):
-            candidate_values.append(apply_step(mechanism.chains[index].geometry, chain_values,
-                                               step[:, column:column + size]))
-            column += size
-        candidate_error, _ = _residuals(mechanism, chains, candidate_poses, candidate_values)
-        candidate_norm = np.linalg.norm(candidate_error, axis=-1)
-        better = candidate_norm < norm
-        accepted = active[better]
-        full_poses[accepted] = candidate_poses[better]
-        for chain_values, candidate in zip(values, candidate_values):
-            chain_values[accepted] = candidate[better]
-        residual[accepted] = candidate_norm[better]
-        damping[accepted] = np.maximum(damping[accepted] * 0.1, 1e-12)
-        damping[active[~better]] = np.maximum(damping[active[~better]] * 10.0, 1e-6)
-        active = active[(residual[active] >= tolerance) & (damping[active] < 1e4)]
-    return full_poses, values, residual < tolerance, residual
+    full_poses = np.asarray(full_poses, dtype=float)
+    task = [axis for axis in range(mechanism.n_pose) if axis not in free_axes]
+    return _run_closure(mechanism, chains, full_poses, values, tuple(free_axes), full_poses[:, task], 1, tolerance,
+                        iterations, tolerance, iterations, max_step)
 
 
 def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: NDArray | None = None,
                    start_values=None, tolerance: float = NEWTON_TOLERANCE, iterations: int = 40):
     """Full poses (N, n_pose) of task poses (N, n_task): the dependent coordinates that close the chains.
 
-    Continuation from the reference assembly along straight paths in task coordinates (steps of
-    at most 0.1 rad and 0.1 length scales), each step closed by Levenberg-Marquardt on the
-    dependent coordinates and the joint values of the :func:`constraining_chains` together.
+    Continuation from the reference assembly along straight paths in task coordinates (for each
+    pose, steps of at most 0.1 rad and 0.1 length scales), each step closed by
+    Levenberg-Marquardt on the dependent coordinates and the joint values of the
+    :func:`constraining_chains` together (:func:`close_constraining_chains`; intermediate steps to
+    1e-8 in at most 12 iterations).
 
     Returns
     -------
@@ -191,17 +199,10 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
             np.ones(count, dtype=bool), np.zeros(count)
     start_task = mechanism.task_poses(start_poses)
     distance = np.abs(task_poses - start_task) / np.where(mechanism.angular, 1.0, mechanism.length_scale)
-    steps = int(min(64, max(1, math.ceil(float(np.max(distance, initial=0.0)) / 0.1))))
-    poses = np.array(start_poses, dtype=float, copy=True)
-    values = [np.array(v, dtype=float, copy=True) for v in start_values]
-    converged, residual = np.zeros(count, dtype=bool), np.full(count, np.inf)
-    for step in range(1, steps + 1):
-        fraction = step / steps
-        poses[:, list(mechanism.task_indices)] = start_task + fraction * (task_poses - start_task)
-        last = step == steps
-        poses, values, converged, residual = close_constraining_chains(
-            mechanism, chains, poses, values, free, tolerance if last else 1e-8, iterations if last else 12,
-            max_step=0.5)
+    largest = np.nan_to_num(np.max(distance, axis=-1, initial=0.0), nan=0.0, posinf=6.4)
+    steps = np.clip(np.ceil(largest / 0.1), 1, 64).astype(np.int64)
+    poses, values, converged, residual = _run_closure(mechanism, chains, start_poses, start_values, free, task_poses,
+                                                      steps, tolerance, iterations, 1e-8, 12, 0.5)
     values = [wrap_revolute_values(mechanism.chains[i].geometry, v) for i, v in zip(chains, values)]
     return poses, values, converged, residual
 

@@ -45,13 +45,14 @@ def block_threads() -> int:
     return min(_WORKERS, _THREAD_LIMIT.get())
 
 
-def for_each_block(count: int, work: Callable[[slice], None]) -> None:
-    """Call ``work(block)`` for consecutive slices of ``range(count)``, in threads when large.
+def for_each_block(count: int, work: Callable[[slice], None], block: int = BLOCK) -> None:
+    """Call ``work(block)`` for consecutive slices of ``range(count)`` (``block`` long), in threads when large.
 
-    numpy releases the GIL inside its loops, so blocks that fit in cache run in parallel on
-    all cores; ``work`` must only write to its own slice of the outputs.
+    numpy (and a numba function compiled ``nogil``) releases the GIL inside its loops, so blocks
+    that fit in cache run in parallel on all cores; ``work`` must only write to its own slice of
+    the outputs.
     """
-    blocks = [slice(start, min(start + BLOCK, count)) for start in range(0, count, BLOCK)]
+    blocks = [slice(start, min(start + block, count)) for start in range(0, count, block)]
     workers = block_threads()
     if workers > 1 and len(blocks) > 1:
         with ThreadPoolExecutor(workers) as pool:

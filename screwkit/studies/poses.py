@@ -48,7 +48,9 @@ def analyze_solution(mechanism: Mechanism, solution, *, unreachable: str = "rais
     if points is not None:
         if unreachable == "drop":
             points = points[np.asarray(solution.reachable)]
-        options.update(output_point=points, planar=mechanism.is_planar)
+        # a planar mechanism's idle rotation is about its plane's normal, the base z axis in the world frame
+        normal = mechanism.rotation_world_base[:, 2] if mechanism.is_planar else False
+        options.update(output_point=points, planar=normal)
     options.setdefault("dof", mechanism.dof)  # the mobility: a constraint singularity is not another mechanism
     return analyze(chains, **options)
 

@@ -1,0 +1,92 @@
+"""The compiled closure of the constraining chains (lower mobility), against independent numpy computations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from screwkit.closure import _task_kernel as kernel
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
+from screwkit.closure.newton import pose_error
+from screwkit.closure.task_space import complete_poses, constraining_chains, pose_rates
+from screwkit.closure.threads import thread_limit
+from screwkit.loader import load
+from screwkit.rotations import rotation_from_rotation_vector, rotation_vector_from_rotation
+
+LOWER_MOBILITY = ("prs_3_ups", "delta_4", "schoenflies_5")
+
+
+def random_rotation_vectors(rng, count):
+    axes = rng.normal(size=(count, 3))
+    axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+    angles = np.concatenate([rng.uniform(0.0, np.pi, count - 6), [0.0, 1e-9, 1e-5, np.pi - 1e-4, np.pi - 1e-7, np.pi]])
+    return axes * angles[:, None]
+
+
+def test_compiled_exp_and_log_equal_the_numpy_maps_small_angles_and_near_pi_included():
+    rng = np.random.default_rng(3)
+    for vector in random_rotation_vectors(rng, 60):
+        rotation = np.array(kernel._exp(*vector)).reshape(3, 3)
+        np.testing.assert_allclose(rotation, rotation_from_rotation_vector(vector), atol=1e-14)
+        logged = np.array(kernel._log(tuple(rotation.ravel())))
+        expected = rotation_vector_from_rotation(rotation)
+        # at exactly pi the vector and its opposite are the same rotation
+        assert np.allclose(logged, expected, atol=1e-9) or np.allclose(logged, -expected, atol=1e-9)
+        np.testing.assert_allclose(np.array(kernel._exp(*logged)).reshape(3, 3), rotation, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["prs_3_ups", "planar_5rrr"])
+def test_compiled_platform_frame_and_pose_rates_equal_the_mechanism_model(name):
+    mechanism = load(name)
+    rng = np.random.default_rng(4)
+    poses = mechanism.home_full_pose + rng.uniform(-0.4, 0.4, (20, mechanism.n_pose))
+    rotation, translation = mechanism.transforms_from_poses(poses)
+    free = np.arange(mechanism.n_pose, dtype=np.int64)
+    for pose, expected_rotation, expected_translation, expected_rates in zip(
+            poses, rotation, translation, pose_rates(mechanism, poses)):
+        got_rotation, got_translation = kernel._platform(pose, mechanism.is_planar, mechanism.home_translation[2])
+        np.testing.assert_allclose(np.array(got_rotation).reshape(3, 3), expected_rotation, atol=1e-15)
+        np.testing.assert_allclose(got_translation, expected_translation, atol=1e-15)
+        rates = np.empty((6, mechanism.n_pose))
+        kernel._pose_rates(pose, mechanism.is_planar, free, rates)
+        np.testing.assert_allclose(rates, expected_rates, atol=1e-15)
+
+
+def task_samples(mechanism, count, seed):
+    """Task poses around the reference assembly (0.3 rad, 0.15 length scales)."""
+    rng = np.random.default_rng(seed)
+    home = mechanism.task_poses(mechanism.home_full_pose)
+    spread = np.where(mechanism.angular, 0.3, 0.15 * mechanism.length_scale)
+    return home + rng.uniform(-1.0, 1.0, (count, mechanism.n_task)) * spread
+
+
+@pytest.mark.parametrize("name", LOWER_MOBILITY)
+def test_completed_poses_close_every_constraining_chain_in_numpy_forward_kinematics(name):
+    mechanism = load(name)
+    tasks = task_samples(mechanism, 200, 5)
+    full, values, converged, residual = complete_poses(mechanism, tasks)
+    assert converged.mean() > 0.5, f"{name}: {converged.mean():.2f} of the samples closed"
+    np.testing.assert_allclose(mechanism.task_poses(full[converged]), tasks[converged], atol=1e-12)
+    rotation, translation = mechanism.transforms_from_poses(full[converged])
+    for index, chain_values in zip(constraining_chains(mechanism), values):
+        frames = chain_forward_kinematics(mechanism.chains[index].geometry, chain_values[converged])
+        target_rotation, target_translation = mechanism.loop_targets(index, rotation, translation)
+        error = pose_error(target_rotation, target_translation, frames.end_rotation, frames.end_translation)
+        assert np.linalg.norm(error, axis=-1).max() < 1e-10
+    assert np.all(residual[converged] < 1e-11) and np.all(residual[~converged] >= 1e-11)
+
+
+@pytest.mark.parametrize("name", LOWER_MOBILITY)
+def test_each_pose_is_completed_as_if_alone_whatever_the_batch_and_the_threads(name):
+    mechanism = load(name)
+    tasks = task_samples(mechanism, 40, 6)
+    full, values, converged, _ = complete_poses(mechanism, tasks)
+    with thread_limit(1):
+        one_thread = complete_poses(mechanism, tasks[::-1])
+    np.testing.assert_array_equal(one_thread[0][::-1], full)
+    for pose_index in (0, 17, 39):
+        alone = complete_poses(mechanism, tasks[pose_index:pose_index + 1])
+        assert alone[2][0] == converged[pose_index]
+        np.testing.assert_array_equal(alone[0][0], full[pose_index])
+        for chain_values, alone_values in zip(values, alone[1]):
+            np.testing.assert_array_equal(alone_values[0], chain_values[pose_index])
