@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.closure.assembly import assemble, task_space
+from screwkit.io import is_foreign, read_mechanism_file
 from screwkit.model.builder import read_chains, read_platform
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.pinocchio_bridge import build_model
@@ -86,7 +87,9 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     Parameters
     ----------
     name_or_path : str or path
-        A bundled name, or the path of a URDF following ``docs/urdf-convention.md``.
+        A bundled name, the path of a URDF following ``docs/urdf-convention.md``, of an MJCF file
+        (``.xml``, ``.mjcf``) or of a URDF tree with a Gepetto ``robot.yaml`` beside it (both
+        converted by :mod:`screwkit.io`; ``screwkit convert`` writes the conversion).
     length_unit : str, optional
         The unit the file's lengths are written in (``"mm"``, ...; see
         :data:`screwkit.units.LENGTH_UNITS`); overrides the file's ``<units length=...>``.
@@ -101,13 +104,19 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         the file, the element and the problem).
     """
     text = os.fspath(name_or_path)
-    looks_like_path = isinstance(name_or_path, os.PathLike) or text.endswith(".urdf") or os.sep in text or "/" in text
+    looks_like_path = (isinstance(name_or_path, os.PathLike) or text.endswith((".urdf", ".xml", ".mjcf"))
+                       or os.sep in text or "/" in text)
     if not looks_like_path:
         path = bundled_path(text)
     else:
         path = Path(text)
         if not path.is_file():
-            raise ValueError(f"{text}: no such URDF file (bundled mechanisms are: {', '.join(bundled_names())}).")
+            raise ValueError(f"{text}: no such file (bundled mechanisms are: {', '.join(bundled_names())}).")
+        if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it
+            if path.stat().st_size > max_bytes:
+                raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
+            converted, _ = read_mechanism_file(path)
+            return load_text(converted, str(path), length_unit=length_unit)
     return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes))
 
 

@@ -303,8 +303,17 @@ def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, spaces: _Chu
     working_wrenches = np.concatenate([wrenches[..., :3], moments / length[:, None, None]], axis=-1)
     norms = np.linalg.norm(working_wrenches, axis=-1, keepdims=True)
     working_wrenches = working_wrenches / np.where(norms > 0.0, norms, 1.0)
-    return constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
-                              plan.dof, fault_members, plan.threshold / length, spaces.decompositions)
+    # With a point output the idle rotations are joints of the chains: the platform's instantaneous DOF
+    # counts them, and the CTI (defined for a frame output, every wrench acting on the platform) does not apply.
+    result = constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
+                                plan.dof + plan.idle_count, fault_members, plan.threshold / length,
+                                spaces.decompositions)
+    if plan.idle_count:
+        result["instantaneous_dof"] = result["instantaneous_dof"] - plan.idle_count
+        for key in result:
+            if key == "cti" or key == "cti_submechanisms" or key.startswith("f_c"):
+                result[key] = np.full(result[key].shape, np.nan)
+    return result
 
 
 def _at_constraint_singularities(plan: _Plan, result: dict, held: NDArray) -> None:
@@ -532,6 +541,11 @@ def analyze(
     not_applicable = np.broadcast_to(np.nan, batch_shape)  # no constraint wrench held by one chain alone: no CTI
     f_c = ({j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count
            else dict.fromkeys(plan.faults, not_applicable))
+    if not plan.faults and faults is None:  # no redundancy (a = n): one failed actuator leaves the platform
+        # uncontrolled, so no set of n working actuators remains: F_O1 = F_IO1 = 0 (the worst fault the first)
+        f_o = {1: np.zeros(batch_shape)}
+        worst = {1: np.zeros(batch_shape + (1,), dtype=np.int64)}
+        f_c = {1: np.zeros(batch_shape) if constraint_plan.count else not_applicable}
     if fault_type == "link" and plan.faults:
         options = {"analyze": dict(threshold=threshold, rank_tolerance=rank_tolerance, chunk_size=chunk_size,
                                    threads=threads, output_point=output_point, planar=planar),
@@ -546,7 +560,7 @@ def analyze(
         iti=batch_first(merged["iti"]),
         lmti=batch_first(merged["lmti"]),
         f_o=f_o,
-        f_io={j: np.minimum(f_o[j], batch_first(merged["iti"])) for j in plan.faults},
+        f_io={j: np.minimum(f_o[j], batch_first(merged["iti"])) for j in f_o},
         worst_fault_indices=worst,
         mutual_interference=batch_first(merged["mutual_interference"]),
         threshold=plan.threshold,

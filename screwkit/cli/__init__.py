@@ -21,6 +21,7 @@ __all__ = ["app", "main", "COMMANDS"]
 COMMANDS = {
     "list": "screwkit.cli.list_command:list_command",
     "info": "screwkit.cli.info:info",
+    "convert": "screwkit.cli.convert:convert",
     "analyze": "screwkit.cli.analyze:analyze",
     "verify": "screwkit.cli.verify:verify",
     "sweep": "screwkit.cli.sweep:sweep",

@@ -42,8 +42,8 @@ def print_report(report: dict) -> None:
         click.echo(f"  {name:<32s} {value:.4f}{'  <- lowest' if name == lowest else ''}")
     click.echo(f"ITI  (Eq. 7)                        {report['iti']:.4f}")
     click.echo(f"LMTI (Eq. 11, all actuators)        {report['lmti']:.4f}")
-    if not report["f_o"]:
-        click.echo("No redundancy (a = n): no fault-tolerance index is defined.")
+    if len(report["actuators"]) == report["dof"]:
+        click.echo("No redundancy (a = n): one failed actuator leaves the platform uncontrolled, so F_O1 = F_IO1 = 0.")
     elif report["fault_type"] != "free-swinging":
         click.echo(f"Faults: {report['fault_type']} failures")
     for j in report["f_o"]:

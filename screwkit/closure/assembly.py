@@ -24,7 +24,13 @@ from screwkit.closure.chain_kinematics import (
 )
 from screwkit.closure.newton import determinant_sign, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form
-from screwkit.closure.task_space import close_constraining_chains, constraining_chains, infer_task_axes, motion_space_at
+from screwkit.closure.task_space import (
+    TASK_RANK_TOLERANCE,
+    close_constraining_chains,
+    constraining_chains,
+    infer_task_axes,
+    motion_space_at,
+)
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 from screwkit.rotations import wrap_angle
@@ -180,13 +186,26 @@ def assemble(mechanism: Mechanism) -> Mechanism:
     mechanism = replace(mechanism, chains=tuple(solved))
     dof = mobility(mechanism, mechanism.chains)
     actuators = mechanism.actuator_names
-    needed = dof - idle_rotation_count(mechanism)  # a point output: the rotations about it need no actuator
+    needed = dof  # a point output: its DOF, the rotations about it need no actuator
+    if mechanism.output_point is not None:
+        needed = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains], dof)
     if len(actuators) < needed:
         raise mechanism.description.fail(
             f"<robot name='{mechanism.name}'>",
             f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
             f"{needed} are needed (mark actuated joints with <transmission>).")
     return replace(mechanism, dof=dof)
+
+
+def point_dof(mechanism: Mechanism, full_pose, joint_values, dof: int) -> int:
+    """DOF of a point output (the platform frame's origin): the dimension of the velocities the point has
+    over the platform's ``dof``-dimensional motion space at a closed configuration. The rotations about
+    the point that the platform can perform add nothing; a platform that cannot rotate about it (a
+    five-bar's distal link) loses nothing."""
+    _, basis = motion_space_at(mechanism, np.asarray(full_pose)[None], [np.asarray(v)[None] for v in joint_values])
+    translations = basis[0][~mechanism.pose_angular][:, :dof]
+    singular = np.linalg.svd(translations, compute_uv=False)
+    return int(np.sum(singular > TASK_RANK_TOLERANCE))
 
 
 def idle_rotation_count(mechanism: Mechanism) -> int:
@@ -237,7 +256,10 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                 at_values = [c.reference_values for c in mechanism.chains]
                 for index, chain_values in zip(chain_indices, values):
                     at_values[index] = chain_values[sample]
-    mobility, instantaneous = mobility - idle, instantaneous - idle
+    if idle:
+        instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
+                                  instantaneous)
+        mobility = point_dof(mechanism, at_pose, at_values, mobility)
     if mobility < 1:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")

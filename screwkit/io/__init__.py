@@ -1,0 +1,54 @@
+"""Closed-loop mechanisms written by other tools, read into screwkit's model.
+
+* :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser) or a URDF
+  tree with a Gepetto ``robot.yaml`` beside it, as the text of a URDF in screwkit's convention
+  and an :class:`~screwkit.io.closed_tree.ImportReport`;
+* :func:`is_foreign`: whether a path is such a file (the loader then imports it).
+
+The conversion itself (assembly, platform, legs, loop joints, idle joints, output) is
+:func:`screwkit.io.closed_tree.convert_tree`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, convert_tree
+from screwkit.io.gepetto import read_gepetto, yaml_beside
+from screwkit.io.mjcf import read_mjcf
+
+__all__ = ["read_mechanism_file", "is_foreign", "convert_tree", "ClosedTree", "Closure", "ImportReport",
+           "ImportError_", "read_gepetto", "read_mjcf"]
+
+MJCF_SUFFIXES = (".xml", ".mjcf")
+
+
+def is_foreign(path: Path) -> bool:
+    """An MJCF file, or a URDF with a Gepetto ``robot.yaml`` beside it and no ``<loop>`` of its own."""
+    path = Path(path)
+    if path.suffix.lower() in MJCF_SUFFIXES:
+        return True
+    if path.suffix.lower() == ".urdf" and yaml_beside(path) is not None:
+        head = path.read_bytes()[:4_000_000]
+        return b"<loop" not in head
+    return False
+
+
+def read_mechanism_file(path: Path, *, output: str | None = None,
+                        output_type: str | None = None) -> tuple[str, ImportReport]:
+    """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
+
+    ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
+    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.closed_tree` says).
+    """
+    path = Path(path)
+    if output_type not in (None, "point", "frame"):
+        raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
+    if path.suffix.lower() in MJCF_SUFFIXES:
+        tree = read_mjcf(path, output=output, output_type=output_type)
+    else:
+        yaml_path = yaml_beside(path)
+        if yaml_path is None:
+            raise ImportError_(f"{path}: no robot.yaml beside it: not a Gepetto closed-loop robot.")
+        tree = read_gepetto(path, yaml_path, output=output, output_type=output_type)
+    return convert_tree(tree)

@@ -1,0 +1,567 @@
+"""A kinematic tree closed by frame pairs (MJCF equalities, Gepetto robot.yaml), written in screwkit's convention.
+
+Other tools describe a closed-loop mechanism as a **tree** (a Pinocchio model built from a URDF
+or an MJCF file) plus **closures**: pairs of frames that must coincide in position (``3d``: a ball
+joint) or entirely (``6d``: a weld). screwkit's convention (``docs/urdf-convention.md``) is a
+*star*: a platform hanging from the base by a floating (or planar) joint, and legs, each a
+serial chain from the base closed onto the platform by one loop joint. :func:`convert_tree`
+maps one onto the other:
+
+1. **Assembly.** The closures are solved near the file's reference joint values (the least
+   change, Levenberg-Marquardt on every joint); the gaps closed are reported, and a closure that
+   cannot close is named with its gap.
+2. **Platform.** The body carrying the output frame (named, or a frame called effector, eff, ee,
+   tool, tcp, foot or platform). Its own tree path from the root is one leg, welded to the platform.
+3. **Legs and loop joints.** Every closure joins a leg (a tree path from the root that shares no
+   joint with another leg) to the platform; the joints between the platform body and the
+   closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
+   ``spherical``), one revolute or prismatic joint (``revolute``/``prismatic``), or three
+   revolute joints through one point or a ball joint (``spherical``). Anything else (a closure
+   between two legs, nested loops) is refused with the closure named.
+4. **Idle joints.** A leg whose joint twists are dependent at the assembly (a second pin coaxial
+   with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
+   assembled values, from its end backwards, until they are independent: the span of the leg's
+   twists, so the platform's motion and every index, is unchanged; the report names them.
+5. **Output.** When every closure onto the platform meets it at one point and the mechanism
+   moves in a plane or is of lower mobility, the output is that point (a five-bar's distal
+   joint, where pressure angles are measured); otherwise the output frame. A mechanism whose
+   revolute axes are all parallel (and slides perpendicular to them) is written planar.
+
+The result is the text of a URDF in screwkit's convention and an :class:`ImportReport`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.model.urdf_writer import UrdfWriter
+from screwkit.rotations import rotation_vector_from_rotation, rpy_from_rotation
+
+__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "convert_tree", "OUTPUT_NAMES"]
+
+OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
+"""Frame names taken as the output when none is given, in this order (case-insensitive)."""
+
+ASSEMBLY_TOLERANCE = 1e-10
+"""Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
+
+UNLIMITED_SLIDE = 1e6
+"""Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
+
+INDEPENDENCE_TOLERANCE = 1e-9
+"""Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
+largest, for them to count as independent (as :data:`screwkit.tolerances.MOTION_SPACE_TOLERANCE`)."""
+
+
+class ImportError_(ValueError):
+    """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
+
+
+@dataclass(frozen=True)
+class Closure:
+    """Two frames of the tree that must coincide: ``kind`` "3d" (origins) or "6d" (frames)."""
+
+    name: str
+    joint_a: int
+    placement_a: NDArray[np.float64]  # 4x4, in joint_a's frame
+    joint_b: int
+    placement_b: NDArray[np.float64]
+    kind: str
+
+
+@dataclass
+class ClosedTree:
+    """A Pinocchio model, its closures, its motors and the reference joint values of the file."""
+
+    source: str
+    model: object
+    closures: list[Closure]
+    motors: list[str]
+    q_reference: NDArray[np.float64]
+    output: str | None = None
+    output_type: str | None = None  # "point", "frame" or None (decided as the module says)
+    file_format: str = ""
+
+
+@dataclass
+class ImportReport:
+    """What an import did: for ``screwkit convert`` and ``screwkit info``."""
+
+    source: str
+    file_format: str
+    platform_body: str = ""
+    output: str = ""
+    planar: bool = False
+    chains: list[str] = field(default_factory=list)
+    locked: list[str] = field(default_factory=list)
+    dropped: list[str] = field(default_factory=list)
+    gaps_before: dict = field(default_factory=dict)
+    gaps_after: dict = field(default_factory=dict)
+    motors: list[str] = field(default_factory=list)
+
+    def lines(self) -> list[str]:
+        """The report as lines of text."""
+        out = [f"{self.source}: {self.file_format}, platform body {self.platform_body!r}, output {self.output}"
+               + (", planar" if self.planar else "")]
+        for name in self.gaps_before:
+            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} m at the file's joint values, "
+                       f"{self.gaps_after[name]:.1e} after assembly")
+        out += [f"  chain {line}" for line in self.chains]
+        out.append(f"  actuators: {', '.join(self.motors)}")
+        if self.locked:
+            out.append(f"  idle joints locked at their assembled values: {', '.join(self.locked)}")
+        if self.dropped:
+            out.append(f"  joints outside every chain, left out: {', '.join(self.dropped)}")
+        return out
+
+
+# -- the tree ------------------------------------------------------------------------------------
+
+
+def _homogeneous(placement) -> NDArray[np.float64]:
+    matrix = np.eye(4)
+    matrix[:3, :3] = np.asarray(placement.rotation)
+    matrix[:3, 3] = np.asarray(placement.translation)
+    return matrix
+
+
+def _inverse(matrix: NDArray) -> NDArray:
+    out = np.eye(4)
+    out[:3, :3] = matrix[:3, :3].T
+    out[:3, 3] = -matrix[:3, :3].T @ matrix[:3, 3]
+    return out
+
+
+def joint_kind(model, joint: int) -> tuple[str, NDArray | None]:
+    """("revolute" | "prismatic" | "spherical" | other shortname, unit axis in the joint frame or None)."""
+    joint_model = model.joints[joint]
+    name = joint_model.shortname()
+    for prefix, kind in (("JointModelRevoluteUnbounded", "revolute"), ("JointModelRevolute", "revolute"),
+                         ("JointModelPrismatic", "prismatic")):
+        if name.startswith(prefix):
+            axis = np.asarray(joint_model.extract().axis, dtype=float)
+            return kind, axis / np.linalg.norm(axis)
+    for prefix, kind in (("JointModelRUB", "revolute"), ("JointModelR", "revolute"), ("JointModelP", "prismatic")):
+        if name.startswith(prefix) and name[-1] in "XYZ" and len(name) == len(prefix) + 1:
+            return kind, np.eye(3)["XYZ".index(name[-1])]
+    if name == "JointModelSpherical":
+        return "spherical", None
+    return name, None
+
+
+def joint_value(model, joint: int, q: NDArray) -> float:
+    """The value (rad or m) of a 1-DoF joint in configuration q (an unbounded revolute's angle from cos, sin)."""
+    joint_model = model.joints[joint]
+    values = q[joint_model.idx_q:joint_model.idx_q + joint_model.nq]
+    return float(np.arctan2(values[1], values[0])) if joint_model.nq == 2 else float(values[0])
+
+
+def path_to(model, joint: int) -> list[int]:
+    """Joints from the root to ``joint`` (included), root side first."""
+    path = []
+    while joint != 0:
+        path.append(joint)
+        joint = model.parents[joint]
+    return path[::-1]
+
+
+def _length_scale(model, data) -> float:
+    points = np.array([np.asarray(data.oMi[j].translation) for j in range(model.njoints)])
+    spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
+    return float(spread) if spread > 0.0 else 1.0
+
+
+def _frames(model, data, closure: Closure) -> tuple[NDArray, NDArray]:
+    return (_homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a,
+            _homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b)
+
+
+def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
+    """Distance (m) between the two frame origins of every closure at q."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    data = tree.model.createData()
+    pin.forwardKinematics(tree.model, data, q)
+    return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c in tree.closures for a, b in [_frames(
+        tree.model, data, c)]}
+
+
+def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
+    """A configuration closing every closure, near the file's reference one; and the length scale.
+
+    Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
+    joint type; a damped step is the least change when the closures leave joints free),
+    residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
+    their rotation vectors; the Jacobian by central differences.
+    """
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, tree.q_reference)
+    scale = _length_scale(model, data)
+    prismatic = np.zeros(model.nv, dtype=bool)
+    for joint in range(1, model.njoints):
+        if joint_kind(model, joint)[0] == "prismatic":
+            prismatic[model.joints[joint].idx_v] = True
+    unit = np.where(prismatic, scale, 1.0)
+
+    def configuration(v):
+        return pin.integrate(model, tree.q_reference, v * unit)
+
+    def residuals(v):
+        pin.forwardKinematics(model, data, configuration(v))
+        rows = []
+        for closure in tree.closures:
+            a, b = _frames(model, data, closure)
+            rows.append((b[:3, 3] - a[:3, 3]) / scale)
+            if closure.kind == "6d":
+                rows.append(rotation_vector_from_rotation(a[:3, :3].T @ b[:3, :3]))
+        return np.concatenate(rows)
+
+    if not tree.closures:
+        raise ImportError_(f"{tree.source}: no closure: nothing closes the tree into a parallel mechanism.")
+    v = np.zeros(model.nv)
+    error = residuals(v)
+    damping = 1e-6
+    for _ in range(500):
+        norm = float(np.linalg.norm(error))
+        if norm < ASSEMBLY_TOLERANCE or damping > 1e8:
+            break
+        step = 1e-7
+        jacobian = np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step)
+                                    for e in np.eye(model.nv)])
+        normal = jacobian.T @ jacobian + (damping + norm**2) * np.eye(model.nv)
+        change = -np.linalg.solve(normal, jacobian.T @ error)
+        change *= min(1.0, 0.5 / max(float(np.max(np.abs(change))), 1e-300))
+        candidate = residuals(v + change)
+        if np.linalg.norm(candidate) < norm:
+            v, error, damping = v + change, candidate, max(damping * 0.1, 1e-12)
+        else:
+            damping *= 10.0
+    result = type("Result", (), {"x": v})
+    q = configuration(result.x)
+    final = error
+    if np.max(np.abs(final)) >= ASSEMBLY_TOLERANCE:
+        gaps = closure_gaps(tree, q)
+        worst = max(gaps, key=gaps.get)
+        raise ImportError_(f"{tree.source}: the loops cannot be closed near the file's joint values: closure "
+                           f"{worst!r} still misses by {gaps[worst]:.3g} m after assembly (gaps: "
+                           + ", ".join(f"{k} {v:.3g} m" for k, v in gaps.items()) + ").")
+    return q, scale
+
+
+# -- the star --------------------------------------------------------------------------------------
+
+
+def _output_frame(tree: ClosedTree) -> int:
+    model = tree.model
+    names = [frame.name for frame in model.frames]
+    if tree.output is not None:
+        if tree.output not in names:
+            raise ImportError_(f"{tree.source}: no frame named {tree.output!r} for the output; frames are "
+                               + ", ".join(names[1:]) + ".")
+        return names.index(tree.output)
+    lowered = [name.lower() for name in names]
+    for candidate in OUTPUT_NAMES:
+        if candidate in lowered:
+            return lowered.index(candidate)
+    raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
+                       f"no frame is called {', '.join(OUTPUT_NAMES)}.")
+
+
+def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
+    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples."""
+    rows = []
+    for kind, axis, point in axis_kinds:
+        row = np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else \
+            np.concatenate([axis, np.cross(point - centre, axis) / scale])
+        rows.append(row / np.linalg.norm(row))
+    return np.array(rows).reshape(-1, 6)
+
+
+def _independent(rows: NDArray) -> bool:
+    if rows.shape[0] == 0:
+        return True
+    singular = np.linalg.svd(rows, compute_uv=False)
+    return rows.shape[0] <= 6 and singular[-1] > INDEPENDENCE_TOLERANCE * singular[0]
+
+
+@dataclass
+class _Leg:
+    joints: list[int]
+    loop: str  # fixed, revolute, prismatic, spherical
+    predecessor: NDArray  # 4x4 in the leg end's joint frame
+    successor_world: NDArray  # 4x4 world pose of the platform-side loop frame at the assembly
+    axis: NDArray | None
+    loop_dofs: list[tuple[str, NDArray, NDArray]]  # world (kind, axis, point) of the loop DoFs at the assembly
+    closure: str
+    locked: list[int] = field(default_factory=list)
+
+
+def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
+    """The leg and loop joint of a closure (side b made the platform side)."""
+    model = tree.model
+    a_path, b_path = path_to(model, closure.joint_a), path_to(model, closure.joint_b)
+    on_platform_a, on_platform_b = platform in a_path, platform in b_path
+    if on_platform_a and not on_platform_b:
+        closure = Closure(closure.name, closure.joint_b, closure.placement_b, closure.joint_a, closure.placement_a,
+                          closure.kind)
+        a_path, b_path = b_path, a_path
+    elif not on_platform_b:
+        raise ImportError_(f"{tree.source}: closure {closure.name!r} joins two legs ({model.names[closure.joint_a]}, "
+                           f"{model.names[closure.joint_b]}), not a leg and the platform {model.names[platform]!r}: "
+                           "nested loops are not supported in screwkit's convention.")
+    elif on_platform_a:
+        raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side.")
+    after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
+    frame_a = _homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
+    kinds = [joint_kind(model, joint) for joint in after]
+    if closure.kind == "3d":
+        if after:
+            raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
+                               f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
+                               "screwkit supports.")
+        centre = frame_a[:3, 3]
+        axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
+        return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name)
+    if not after:
+        return _Leg(a_path, "fixed", closure.placement_a, frame_a, None, [], closure.name)
+    # the platform-side loop frame: the first joint beyond the platform at zero motion
+    first = after[0]
+    zero = _homogeneous(data.oMi[model.parents[first]]) @ _homogeneous(model.jointPlacements[first])
+    predecessor = closure.placement_a @ _inverse(closure.placement_b)  # frame b's joint frame, on leg a
+    if len(after) == 1 and kinds[0][0] in ("revolute", "prismatic"):
+        kind, axis = kinds[0]
+        world_axis = zero[:3, :3] @ axis
+        return _Leg(a_path, kind, predecessor, zero, axis, [(kind, world_axis, zero[:3, 3])], closure.name)
+    concurrent = all(np.linalg.norm(np.asarray(model.jointPlacements[j].translation)) < 1e-9 * scale
+                     for j in after[1:])
+    if (len(after) == 3 and concurrent and all(k[0] == "revolute" for k in kinds)) or \
+            (len(after) == 1 and kinds[0][0] == "spherical"):
+        centre = zero[:3, 3]
+        axes = [("revolute", zero[:3, k], centre) for k in range(3)]
+        return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name)
+    raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
+                       f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
+                       "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
+                       "one point (a spherical joint).")
+
+
+def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
+    """Lock passive joints, from the leg end backwards, while the leg's joint twists are dependent."""
+    model = tree.model
+
+    def rows(kept):
+        triples = []
+        for joint in kept:
+            kind, axis = joint_kind(model, joint)
+            placement = data.oMi[joint]
+            triples.append((kind, np.asarray(placement.rotation) @ axis, np.asarray(placement.translation)))
+        return _twists(triples + leg.loop_dofs, leg.successor_world[:3, 3], scale)
+
+    kept = list(leg.joints)
+    for joint in reversed(leg.joints):
+        if _independent(rows(kept)):
+            break
+        if joint in motors:
+            continue
+        trial = [j for j in kept if j != joint]
+        if np.linalg.matrix_rank(rows(trial), tol=INDEPENDENCE_TOLERANCE) == \
+                np.linalg.matrix_rank(rows(kept), tol=INDEPENDENCE_TOLERANCE):
+            kept = trial
+            leg.locked.append(joint)
+    if not _independent(rows(kept)):
+        raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
+                           "its idle passive joints (its actuated joints are dependent at the assembly).")
+
+
+def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
+    """The common direction of every revolute axis when slides are perpendicular to it, else None."""
+    model = tree.model
+    axes = []
+    for leg in legs:
+        for joint in leg.joints:
+            kind, axis = joint_kind(model, joint)
+            axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
+        if leg.loop == "spherical":
+            return None
+        axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
+    revolute = [axis for kind, axis in axes if kind == "revolute"]
+    if not revolute:
+        return None
+    normal = revolute[0]
+    for kind, axis in axes:
+        if kind == "revolute" and np.linalg.norm(np.cross(axis, normal)) > 1e-9:
+            return None
+        if kind == "prismatic" and abs(axis @ normal) > 1e-9:
+            return None
+    return normal
+
+
+def _origin(matrix: NDArray) -> dict:
+    return dict(zip(("xyz", "rpy"), _pose(matrix)))
+
+
+def _pose(matrix: NDArray) -> tuple:
+    return tuple(matrix[:3, 3]), tuple(rpy_from_rotation(matrix[:3, :3]))
+
+
+def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
+    kind, axis = joint_kind(model, joint)
+    motion = np.eye(4)
+    value = joint_value(model, joint, q)
+    if kind == "revolute":
+        skew = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        motion[:3, :3] = np.eye(3) + np.sin(value) * skew + (1 - np.cos(value)) * skew @ skew
+    else:
+        motion[:3, 3] = axis * value
+    return motion
+
+
+def _base_rotation(normal: NDArray | None) -> NDArray:
+    """World rotation of the written base frame: its z axis along a planar mechanism's normal."""
+    if normal is None:
+        return np.eye(3)
+    z = normal / np.linalg.norm(normal)
+    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
+    if np.linalg.norm(x) < 1e-6:
+        x = np.array([0.0, 1.0, 0.0]) - z[1] * z
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
+    """The URDF text of a closed tree in screwkit's convention, and what was done (see the module docstring)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    report = ImportReport(source=tree.source, file_format=tree.file_format)
+    report.gaps_before = closure_gaps(tree, tree.q_reference)
+    q, scale = assemble(tree)
+    report.gaps_after = closure_gaps(tree, q)
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    frame_index = _output_frame(tree)
+    output_frame = model.frames[frame_index]
+    platform = int(output_frame.parentJoint)
+    if platform == 0:
+        raise ImportError_(f"{tree.source}: the output frame {output_frame.name!r} is on the fixed base.")
+    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    body = bodies.get(platform, model.names[platform])
+    report.platform_body = body
+    spine = _Leg(path_to(model, platform), "fixed", np.eye(4), _homogeneous(data.oMi[platform]), None, [], "")
+    legs = [spine] + [_loop_of(tree, data, closure, platform, scale) for closure in tree.closures]
+    owner: dict[int, str] = {}
+    for leg in legs:
+        for joint in leg.joints:
+            if joint in owner:
+                raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} belongs to two legs "
+                                   f"({owner[joint] or 'the platform body'}, {leg.closure or 'the platform body'}): "
+                                   "legs sharing joints (nested loops) are not supported in screwkit's convention.")
+            owner[joint] = leg.closure
+    motor_ids = {}
+    for name in tree.motors:
+        if not model.existJointName(name):
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} is not a joint of the tree.")
+        joint = model.getJointId(name)
+        if joint not in owner:
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} is on no leg (a leg is a tree path from the "
+                               "base to the platform or to a closure).")
+        motor_ids[joint] = name
+    for leg in legs:
+        _lock_idle(tree, data, leg, scale, set(motor_ids))
+    absorbed = set()
+    for closure in tree.closures:
+        for joint in (closure.joint_a, closure.joint_b):
+            absorbed.update(path_to(model, joint))
+    report.dropped = [model.names[j] for j in range(1, model.njoints) if j not in owner and j not in absorbed]
+    normal = _planar_normal(tree, data, legs)
+    report.planar = normal is not None
+    centres = [leg.successor_world[:3, 3] for leg in legs[1:]]
+    meet = all(np.linalg.norm(c - centres[0]) < 1e-9 * scale for c in centres)
+    output_world = _homogeneous(data.oMf[frame_index])
+    point = tree.output_type == "point" or (tree.output_type is None and meet)
+    if point and not meet:
+        raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
+                           "point; they do not.")
+    if point:
+        offset = output_world[:3, 3] - centres[0]
+        if normal is not None:  # the distance in the plane of motion
+            offset = offset - (offset @ normal) * normal
+        report.output = (f"the point where the chains meet on body {body!r} (closure {tree.closures[0].name!r}), "
+                         f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
+                         f"frame {output_frame.name!r}")
+    else:
+        report.output = f"frame {output_frame.name!r} on body {body!r}"
+    base_rotation = _base_rotation(normal)
+    world_base = np.eye(4)
+    world_base[:3, :3] = base_rotation
+    platform_world = np.eye(4)
+    platform_world[:3, :3] = base_rotation if (point or normal is not None) else output_world[:3, :3]
+    platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
+    writer = UrdfWriter(tree.source.rsplit("/", 1)[-1].split(".")[0] or "mechanism",
+                        f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
+    base = "base"
+    if normal is not None:
+        writer.link("world")
+        writer.joint("world_to_base", "fixed", "world", base, **_origin(world_base))
+    writer.link(base)
+    platform_base = _inverse(world_base) @ platform_world
+    if normal is not None:
+        writer.link("platform")
+        writer.joint("platform_joint", "planar", base, "platform", xyz=tuple(platform_base[:3, 3]), axis=(0, 0, 1))
+    else:
+        writer.link("platform")
+        writer.joint("platform_joint", "floating", base, "platform", **_origin(platform_base))
+    reference = {}
+    legs.sort(key=lambda leg: leg.joints[0])
+    for leg in legs:
+        parent, end = base, base
+        for position, joint in enumerate(leg.joints):
+            placement = _homogeneous(model.jointPlacements[joint])
+            if position == 0:
+                placement = _inverse(world_base) @ placement
+            link = f"{model.names[joint]}_link"
+            if joint in leg.locked:
+                writer.link(link)
+                writer.joint(model.names[joint], "fixed", parent, link, **_origin(placement @ _joint_motion(
+                    model, joint, q)))
+                report.locked.append(model.names[joint])
+            else:
+                kind, axis = joint_kind(model, joint)
+                if kind not in ("revolute", "prismatic"):
+                    raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: write "
+                                       "it as 1-DoF joints (a ball joint as three hinges).")
+                lower = model.lowerPositionLimit[model.joints[joint].idx_q]
+                upper = model.upperPositionLimit[model.joints[joint].idx_q]
+                limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
+                    and model.joints[joint].nq == 1 else None
+                joint_type = kind
+                if limit is None:  # no limits in the file: a continuous joint, a slide limited only far away
+                    joint_type = "continuous" if kind == "revolute" else kind
+                    limit = None if kind == "revolute" else (-UNLIMITED_SLIDE, UNLIMITED_SLIDE, 0, 0)
+                writer.link(link)
+                writer.joint(model.names[joint], joint_type, parent, link, axis=tuple(axis), limit=limit,
+                             **_origin(placement))
+                reference[model.names[joint]] = joint_value(model, joint, q)
+            parent, end = link, link
+        name = model.names[leg.joints[0]]
+        successor = _inverse(platform_world) @ leg.successor_world
+        writer.loop(f"{name}_loop", leg.loop, name, end, _pose(leg.predecessor), "platform", _pose(successor),
+                    axis=None if leg.axis is None else tuple(leg.axis))
+        actuated = [model.names[j] for j in leg.joints if j in motor_ids]
+        report.chains.append(f"{name}: joints {', '.join(model.names[j] for j in leg.joints)}, loop {leg.loop}"
+                             + (f" (closure {leg.closure})" if leg.closure else " (the platform body's own path)")
+                             + (f", actuated {', '.join(actuated)}" if actuated else ""))
+    for name in motor_ids.values():
+        writer.transmission(name)
+    report.motors = list(motor_ids.values())
+    if point:
+        writer.output("point")
+    writer.reference_configuration(reference)
+    return writer.text(), report

@@ -1,0 +1,210 @@
+"""Closed-loop robots written by other tools (MJCF, URDF + Gepetto robot.yaml), against independent values.
+
+The files are written here: the five-bar with a third leg of ``robots/five_bar_3.urdf`` (bases
+A_i, proximal 0.2 m, distal 0.3 m, the three distal links meeting at the output point), in MJCF
+(``<connect>`` closures) and as a Gepetto-style URDF tree (a ``6d`` weld between two coaxial
+closure pins, a ``3d`` closure, fixed joints with zero axes, and joint origins that leave the loops
+open at q = 0). Their indices are compared with the textbook pressure angles of the five-bar
+(``five_bar_expected`` of the lower-mobility tests), computed from the geometry alone.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
+
+from helpers import random_rotation, screwkit
+from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.loader import load
+from screwkit.studies.poses import indices_at_pose, indices_at_poses
+
+HOME = np.array([0.0, 0.35])
+TOLERANCE = 1e-9
+
+
+def text(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def five_bar_mjcf(rotation=None, scale=1.0, legs=3, name_equalities=True, actuators=True) -> str:
+    """The five-bar in MJCF, its points moved by ``rotation`` and scaled; closed at q = 0."""
+    rotation = np.eye(3) if rotation is None else rotation
+    elbows = five_bar_elbows(HOME)
+
+    def at(point2):
+        return rotation @ (scale * np.array([point2[0], point2[1], 0.0]))
+
+    axis = text(rotation @ np.array([0.0, 0.0, 1.0]))
+    bodies, equalities, motors = [], [], []
+    for i in range(legs):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        site = f'<site name="effector" pos="{text(at(HOME - elbow))}"/>' if i == 0 else ""
+        bodies.append(
+            f'<body name="proximal_{i + 1}" pos="{text(at(base))}">'
+            f'<joint name="a_{i + 1}" type="hinge" axis="{axis}"/><geom type="sphere" size="0.01"/>'
+            f'<body name="distal_{i + 1}" pos="{text(at(elbow - base))}">'
+            f'<joint name="b_{i + 1}" type="hinge" axis="{axis}"/><geom type="sphere" size="0.01"/>{site}'
+            '</body></body>')
+        if i:
+            label = f' name="loop_{i + 1}"' if name_equalities else ""
+            equalities.append(f'<connect{label} body1="distal_{i + 1}" body2="distal_1" '
+                              f'anchor="{text(at(HOME - elbow))}"/>')
+        motors.append(f'<motor name="m_{i + 1}" joint="a_{i + 1}"/>')
+    return ('<mujoco model="five_bar_mjcf"><compiler angle="radian"/><worldbody><body name="base">'
+            + "".join(bodies) + "</body></worldbody><equality>" + "".join(equalities) + "</equality>"
+            + ("<actuator>" + "".join(motors) + "</actuator>" if actuators else "") + "</mujoco>")
+
+
+def five_bar_gepetto(legs=3, opening=0.3) -> tuple[str, str]:
+    """The five-bar as a Gepetto-style URDF tree and robot.yaml.
+
+    Leg 1 carries the output (frame ``effector``); leg 2 ends in an extra pin ``closure_2b`` on
+    leg 1's distal link, welded (6d) to the pin ``closure_2a`` at the end of leg 2 (two coaxial
+    pins: one idle DoF); leg 3 meets leg 1 by a 3d closure. Every proximal joint origin is turned
+    by ``opening`` (rad), so q = 0 leaves the loops open. Fixed joints carry zero axes.
+    """
+    elbows = five_bar_elbows(HOME)
+    links, joints = ['<link name="built"/>'], []
+
+    def joint(name, kind, parent, child, xyz=(0, 0, 0), yaw=0.0):
+        axis = "0 0 0" if kind == "fixed" else "0 0 1"
+        limit = '<limit effort="1" velocity="1"/>' if kind == "revolute" else ""  # no lower/upper: as exported
+        links.append(f'<link name="{child}"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" '
+                     'iyz="0" izz="0"/></inertial></link>')
+        joints.append(f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+                      f'<origin xyz="{text(xyz)}" rpy="0 0 {float(yaw)!r}"/><axis xyz="{axis}"/>{limit}'
+                      '<joint_properties friction="0.0"/></joint>')
+
+    for i in range(legs):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        first = np.arctan2(*(elbow - base)[::-1])
+        second = np.arctan2(*(HOME - elbow)[::-1])
+        joint(f"mot{i + 1}", "revolute", "built", f"proximal_{i + 1}", (*base, 0.0), first + opening)
+        joint(f"free{i + 1}", "revolute", f"proximal_{i + 1}", f"distal_{i + 1}", (PROXIMAL, 0.0, 0.0),
+              second - first)
+    joint("effector_frame", "fixed", "distal_1", "effector", (DISTAL, 0.0, 0.0))
+    joint("closure_2b", "revolute", "distal_1", "pin_2b", (DISTAL, 0.0, 0.0))
+    joint("closure_2a", "revolute", "distal_2", "pin_2a", (DISTAL, 0.0, 0.0))
+    pairs, kinds = [["closure_2a", "closure_2b"]], ["6d"]
+    if legs > 2:
+        joint("closedloop3_A_frame", "fixed", "distal_3", "closedloop3_A", (DISTAL, 0.0, 0.0))
+        joint("closedloop3_B_frame", "fixed", "distal_1", "closedloop3_B", (DISTAL, 0.0, 0.0))
+        pairs.append(["closedloop3_B", "closedloop3_A"])
+        kinds.append("3D")
+    urdf = '<?xml version="1.0"?>\n<robot name="five_bar_gepetto">' + "".join(links) + "".join(joints) + "</robot>"
+    yaml = (f"closed_loop: {json.dumps(pairs)}\ntype: {json.dumps(kinds)}\n"
+            f"name_mot: {json.dumps([f'mot{i + 1}' for i in range(legs)])}\n")
+    return urdf, yaml
+
+
+def poses_near_home(count=8, seed=3):
+    return HOME + np.random.default_rng(seed).uniform(-0.05, 0.05, (count, 2))
+
+
+def assert_textbook(result, points):
+    for k, point in enumerate(points):
+        expected = five_bar_expected(point)
+        np.testing.assert_allclose(result.iti_actuators[k], expected["iti_actuators"], atol=TOLERANCE)
+        np.testing.assert_allclose(result.lmti[k], expected["lmti"], atol=TOLERANCE)
+        np.testing.assert_allclose(result.f_o[1][k], expected["f_o1"], atol=TOLERANCE)
+
+
+def test_an_mjcf_five_bar_has_the_textbook_pressure_angles(tmp_path):
+    path = tmp_path / "five_bar.xml"
+    path.write_text(five_bar_mjcf())
+    mechanism = load(path)
+    assert mechanism.dof == 2 and mechanism.output_point is not None
+    assert mechanism.actuator_names == ("a_1:a_1", "a_2:a_2", "a_3:a_3")  # chains named after their first joint
+    np.testing.assert_allclose(mechanism.home_pose, HOME, atol=1e-12)  # the world x, y of the meeting point
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_an_mjcf_file_gives_the_same_indices_in_any_unit_and_world_frame(tmp_path, scale):
+    rotation = random_rotation(np.random.default_rng(int(scale * 1000) % 97))
+    path = tmp_path / "moved.xml"
+    path.write_text(five_bar_mjcf(rotation, scale))
+    mechanism = load(path)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    expected = five_bar_expected(HOME)
+    np.testing.assert_allclose(result.iti_actuators, expected["iti_actuators"], atol=TOLERANCE)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+
+
+def test_a_gepetto_style_urdf_and_yaml_with_open_loops_is_assembled(tmp_path):
+    urdf, yaml = five_bar_gepetto()
+    (tmp_path / "robot.urdf").write_text(urdf)
+    (tmp_path / "robot.yaml").write_text(yaml)
+    converted, report = read_mechanism_file(tmp_path / "robot.urdf")
+    assert all(gap > 0.01 for gap in report.gaps_before.values()), report.gaps_before  # q = 0 is open
+    assert all(gap < 1e-9 for gap in report.gaps_after.values()), report.gaps_after
+    assert report.locked == ["closure_2a"]  # coaxial with the welded pin closure_2b: the idle DoF
+    assert report.planar is False  # a 3d closure: spherical loop joint
+    assert report.output.startswith("the point where the chains meet on body 'distal_1'")
+    assert report.output.endswith("0 m from frame 'effector'")
+    mechanism = load(tmp_path / "robot.urdf")
+    assert mechanism.dof == 2 and mechanism.actuator_names[0].endswith("mot1")
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+def test_a_planar_gepetto_five_bar_is_written_planar_and_non_redundant_gives_zero_fault_tolerance(tmp_path):
+    urdf, yaml = five_bar_gepetto(legs=2)
+    (tmp_path / "robot.urdf").write_text(urdf)
+    (tmp_path / "robot.yaml").write_text(yaml)
+    mechanism = load(tmp_path / "robot.urdf")
+    assert mechanism.is_planar and mechanism.dof == 2 and len(mechanism.actuators) == 2
+    points = poses_near_home()
+    result = indices_at_poses(mechanism, points, detail=True)
+    for k, point in enumerate(points):
+        expected = five_bar_expected(point, legs=(0, 1))
+        np.testing.assert_allclose(result.iti_actuators[k], expected["iti_actuators"], atol=TOLERANCE)
+        np.testing.assert_allclose(result.lmti[k], expected["lmti"], atol=TOLERANCE)
+    assert result.f_o.keys() == {1} and np.all(result.f_o[1] == 0.0) and np.all(result.f_io[1] == 0.0)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda t: t.replace(' name="loop_2"', ""), "must have a name"),
+    (lambda t: t.replace("<actuator>", "<actuator>").replace('<motor name="m_1" joint="a_1"/>', "")
+     .replace('<motor name="m_2" joint="a_2"/>', "").replace('<motor name="m_3" joint="a_3"/>', ""),
+     "drives a joint"),
+    (lambda t: t.replace("</body></worldbody>", '</body><body name="other"/></worldbody>'), "holds 2 bodies"),
+    (lambda t: t.replace('name="effector"', 'name="marker"'), "which body is the platform"),
+])
+def test_an_mjcf_file_that_cannot_be_read_says_why(tmp_path, change, message):
+    path = tmp_path / "bad.xml"
+    path.write_text(change(five_bar_mjcf()))
+    with pytest.raises(ValueError, match=message):
+        load(path)
+
+
+def test_a_closure_between_two_legs_is_refused_by_name(tmp_path):
+    urdf, yaml = five_bar_gepetto()
+    yaml = yaml.replace('["closedloop3_B", "closedloop3_A"]', '["closedloop3_A", "closure_2a"]')
+    (tmp_path / "robot.urdf").write_text(urdf)
+    (tmp_path / "robot.yaml").write_text(yaml)
+    with pytest.raises(ImportError_, match="closure 'closedloop3_A-closure_2a' joins two legs"):
+        read_mechanism_file(tmp_path / "robot.urdf")
+
+
+def test_convert_on_the_command_line_round_trips(tmp_path):
+    source = tmp_path / "five_bar.xml"
+    source.write_text(five_bar_mjcf())
+    out = tmp_path / "converted.urdf"
+    result = screwkit("convert", source, out, "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["dof"] == 2 and summary["task_coordinates"] == ["x", "y"] and out.is_file()
+    original = json.loads(screwkit("analyze", source, "--json").stdout)
+    converted = json.loads(screwkit("analyze", out, "--json").stdout)
+    for key in ("iti", "lmti", "f_o", "iti_actuators"):
+        assert original[key] == converted[key], key
+    assert converted["iti"] == pytest.approx(five_bar_expected(HOME)["iti"], abs=TOLERANCE)
+    again = screwkit("convert", source, out)
+    assert again.returncode == 1 and "exists" in again.stderr and again.stderr.count("\n") == 1
+    missing = screwkit("convert", tmp_path / "none.xml", tmp_path / "x.urdf")
+    assert missing.returncode == 1 and "no such file" in missing.stderr and missing.stderr.count("\n") == 1
