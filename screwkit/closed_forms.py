@@ -279,6 +279,8 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     oti_subs = gather([p[2] for p in pieces])
     f_o = {j: gather([p[3][j] for p in pieces]) for j in faults}
     worst = {j: failed_sets[j][gather([p[4][j] for p in pieces])] for j in faults}
+    if count == 3 and not faults:  # no redundancy: one failed actuator leaves the platform uncontrolled
+        f_o, worst, faults = {1: np.zeros(batch)}, {1: np.zeros(batch + (1,), dtype=np.int64)}, (1,)
     return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti_subs, "lmti": oti_subs.max(axis=-1),
             "f_o": f_o, "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "worst_faults": worst,
             "mutual_interference": gather([p[5] for p in pieces]), "submechanisms": triples}

@@ -126,7 +126,7 @@ def test_with_json_errors_are_json_on_stdout():
     assert "is unreachable" in json.loads(result.stdout)["error"]
     missing = screwkit("info", "no/such/file.urdf", "--json")
     assert missing.returncode == 1 and json.loads(missing.stdout) == {
-        "error": "no/such/file.urdf: no such URDF file (bundled mechanisms are: coop_arms, delta_4, five_bar_3, "
+        "error": "no/such/file.urdf: no such file (bundled mechanisms are: coop_arms, delta_4, five_bar_3, "
                  "planar_4rpr, planar_5rrr, prs_3_ups, rss_hexapod_8, schoenflies_5, ups_hexapod_8)."}
 
 

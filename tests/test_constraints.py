@@ -235,7 +235,7 @@ def test_a_3_prs_reports_3_dof_and_its_parasitic_motion():
     np.testing.assert_allclose(np.abs(full["y"]), shift, atol=1e-10, rtol=0)
     np.testing.assert_allclose(full["x"], 0.0, atol=1e-10)
     np.testing.assert_allclose(full["yaw"], 0.0, atol=1e-10)
-    assert not result.faults  # 3 actuators for 3 DOF: no fault index
+    assert result.faults == (1,) and np.all(result.f_o[1] == 0.0)  # 3 actuators for 3 DOF: one fault, no control
 
 
 def test_link_faults_are_invariant_to_unit_and_frame(prs_4):

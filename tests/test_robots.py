@@ -38,7 +38,7 @@ def test_bundled_names_and_unknown_names():
     assert bundled_names() == BUNDLED
     with pytest.raises(ValueError, match=r"Unknown bundled mechanism 'planar_6rrr'; bundled are: coop_arms, delta_4"):
         load("planar_6rrr")
-    with pytest.raises(ValueError, match=r"missing\.urdf: no such URDF file \(bundled mechanisms are: coop_arms"):
+    with pytest.raises(ValueError, match=r"missing\.urdf: no such file \(bundled mechanisms are: coop_arms"):
         load("somewhere/missing.urdf")
 
 
