@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit._chunks import map_chunks
+from screwkit._compile_notice import announce_compilation
 from screwkit.tolerances import RANK_TOLERANCE, SINGULARITY_THRESHOLD, WORST_FAULT_TIE
 
 __all__ = [
@@ -171,6 +172,7 @@ def oti_triple(f, d, threshold: float = SINGULARITY_THRESHOLD) -> tuple[NDArray[
 
 def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_members, rank_tolerance, without):
     """Closed-form indices of one chunk (batch-first (n, k, 2) arrays) through the compiled kernel."""
+    announce_compilation("screwkit._planar_kernel")
     from screwkit._planar_kernel import planar_closed_form_kernel  # numba: loaded when the closed forms first run
 
     count, chains = distal.shape[:2]

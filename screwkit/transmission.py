@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit import tolerances
 from screwkit._chunks import map_chunks
+from screwkit._compile_notice import announce_compilation
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
 from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
@@ -156,6 +157,7 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
     """The compiled kernel on one chunk; ``basis`` in working coordinates (see :func:`working_coordinates`)."""
+    announce_compilation("screwkit._kernels")
     from screwkit._kernels import transmission_kernel  # numba: loaded when indices first run
 
     count = twists.shape[0]

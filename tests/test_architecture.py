@@ -17,7 +17,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "screwkit"
 
 LAYERS = {
     # the math core and what it shares: numpy only
-    "screwkit._chunks": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0, "screwkit._planar_kernel": 0,
+    "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0,
+    "screwkit._planar_kernel": 0,
     "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
     "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
     "screwkit.transmission": 0, "screwkit.units": 0, "screwkit.motion": 0, "screwkit.outputs": 0,

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -170,3 +172,30 @@ def test_data_go_to_stdout_and_summaries_to_stderr():
     assert "min f_o1" in swept.stderr
     quiet = screwkit("sweep", "planar_5rrr", "--phi", "0:360:30", "--quiet")
     assert quiet.stdout == swept.stdout and quiet.stderr == ""
+
+
+def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the_kernels(tmp_path):
+    """With an empty numba cache the first line on stderr says a kernel is being compiled (the process is
+    stopped there: compiling takes tens of seconds); with the cache, warmup finds every kernel cached."""
+    import os
+    import time
+
+    environment = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty_cache"))
+    start = time.monotonic()
+    process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", "analyze", "planar_5rrr"], env=environment,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first = process.stderr.readline()
+        waited = time.monotonic() - start
+    finally:
+        process.kill()
+        process.communicate()
+    assert first.startswith("screwkit: compiling transmission_kernel (first run only, about"), first
+    assert waited < 5.0  # before the file is loaded (the interpreter and the command line start first)
+    warm = screwkit("warmup")
+    assert warm.returncode == 0, warm.stderr
+    lines = warm.stderr.splitlines()
+    assert lines[-1] == "screwkit kernels ready"
+    assert [line.split()[0] for line in lines[:-1]] == ["transmission_kernel", "planar_closed_form_kernel",
+                                                        "close_chains_kernel"]
+    assert all(" cached in " in line for line in lines[:-1]), lines  # the suite compiled them already

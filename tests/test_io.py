@@ -17,7 +17,8 @@ import pytest
 from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 
 from helpers import random_rotation, screwkit
-from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
+from screwkit.io.closed_tree import assemble, joint_kind
 from screwkit.loader import load
 from screwkit.studies.poses import indices_at_pose, indices_at_poses
 
@@ -208,3 +209,79 @@ def test_convert_on_the_command_line_round_trips(tmp_path):
     assert again.returncode == 1 and "exists" in again.stderr and again.stderr.count("\n") == 1
     missing = screwkit("convert", tmp_path / "none.xml", tmp_path / "x.urdf")
     assert missing.returncode == 1 and "no such file" in missing.stderr and missing.stderr.count("\n") == 1
+
+
+def mjcf_of_tree(tree, q, output: str) -> str:
+    """The same closed tree written in MJCF, its bodies placed at the configuration q (closed there, so that
+    MJCF's closures, taken at q0, are the tree's); a site at the output frame."""
+    import pinocchio as pin
+
+    model = tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    frames = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    output_frame = model.frames[model.getFrameId(output)]
+
+    def placement(matrix):
+        quaternion = pin.Quaternion(matrix[:3, :3]).coeffs()  # x, y, z, w
+        return (f'pos="{text(matrix[:3, 3])}" '
+                f'quat="{text([quaternion[3], quaternion[0], quaternion[1], quaternion[2]])}"')
+
+    def body(joint):
+        kind, axis = joint_kind(model, joint)
+        local = np.eye(4)
+        local[:3, :3] = model.jointPlacements[joint].rotation
+        local[:3, 3] = model.jointPlacements[joint].translation
+        children = "".join(body(child) for child in range(1, model.njoints) if model.parents[child] == joint)
+        site = ""
+        if int(output_frame.parentJoint) == joint:
+            site_placement = np.eye(4)
+            site_placement[:3, :3] = output_frame.placement.rotation
+            site_placement[:3, 3] = output_frame.placement.translation
+            site = f'<site name="{output}" {placement(site_placement)}/>'
+        # the body frame is the joint frame at q: MJCF's q0 is the assembly, the joint keeps its axis
+        motion = np.eye(4)
+        value = q[model.joints[joint].idx_q]
+        if kind == "revolute":
+            motion[:3, :3] = pin.exp3(axis * value)
+        else:
+            motion[:3, 3] = axis * value
+        return (f'<body name="{frames[joint]}" {placement(local @ motion)}>'
+                f'<joint name="{model.names[joint]}" type="{"hinge" if kind == "revolute" else "slide"}" '
+                f'axis="{text(axis)}"/><geom type="sphere" size="0.005"/>{site}{children}</body>')
+
+    roots = "".join(body(joint) for joint in range(1, model.njoints) if model.parents[joint] == 0)
+    equalities = []
+    for index, closure in enumerate(tree.closures):
+        # in the joint frames after the motion: the tree's closure frames, here at the assembly q
+        anchor = closure.placement_a[:3, 3]
+        name = f"closure_{index}"
+        if closure.kind == "3d":
+            equalities.append(f'<connect name="{name}" body1="{frames[closure.joint_a]}" '
+                              f'body2="{frames[closure.joint_b]}" anchor="{text(anchor)}"/>')
+        else:
+            equalities.append(f'<weld name="{name}" body1="{frames[closure.joint_a]}" '
+                              f'body2="{frames[closure.joint_b]}"/>')
+    motors = "".join(f'<motor name="motor_{name}" joint="{name}"/>' for name in tree.motors)
+    return ('<mujoco model="from_tree"><compiler angle="radian"/><worldbody><body name="base">' + roots
+            + "</body></worldbody><equality>" + "".join(equalities) + f"</equality><actuator>{motors}</actuator>"
+            "</mujoco>")
+
+
+def test_the_same_mechanism_in_mjcf_and_in_urdf_and_yaml_gives_identical_indices(tmp_path):
+    """Both formats of one five-bar (a 6d weld of two coaxial pins, a 3d closure) convert to the same indices."""
+    urdf, yaml = five_bar_gepetto(opening=0.0)
+    (tmp_path / "robot.urdf").write_text(urdf)
+    (tmp_path / "robot.yaml").write_text(yaml)
+    tree = read_gepetto(tmp_path / "robot.urdf", tmp_path / "robot.yaml")
+    q, _ = assemble(tree)
+    (tmp_path / "same.xml").write_text(mjcf_of_tree(tree, q, "effector"))
+    from_yaml, from_mjcf = load(tmp_path / "robot.urdf"), load(tmp_path / "same.xml")
+    _, report = read_mechanism_file(tmp_path / "same.xml")
+    assert report.locked == ["closure_2a"] and from_mjcf.dof == from_yaml.dof == 2
+    points = poses_near_home()
+    first, second = (indices_at_poses(m, points, detail=True) for m in (from_yaml, from_mjcf))
+    for key in ("iti_actuators", "oti_submechanisms", "lmti"):
+        np.testing.assert_allclose(getattr(second, key), getattr(first, key), rtol=0, atol=TOLERANCE, err_msg=key)
+    np.testing.assert_allclose(second.f_o[1], first.f_o[1], rtol=0, atol=TOLERANCE)
+    assert_textbook(second, points)

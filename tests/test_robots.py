@@ -10,8 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from helpers import screwkit
 from screwkit.chains import ChainScrews
 from screwkit.closure import chain_screws, solve, solve_one
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.loader import bundled_names, bundled_path, load
 from screwkit.model.pinocchio_bridge import configuration_vector
 
@@ -251,9 +253,9 @@ def _replace(text: str, pattern: str, replacement: str, count: int = 1) -> str:
     [
         (
             "planar_5rrr",
-            lambda text: _replace(text, r'(<successor link="platform">\s*<origin xyz=")0\.1 ', r"\g<1>0.2 "),
-            r"<loop name='chain_1_joint_d'>: does not close at the reference configuration: the loop frames are 0\.1 m "
-            r"and 0 rad apart",
+            lambda text: _replace(text, r'(<successor link="platform">\s*<origin xyz=")0\.1 ', r"\g<1>5.1 "),
+            r"<loop name='chain_1_joint_d'>: does not close at the reference configuration: the loop frames are 5 m "
+            r"and 0 rad apart .*, and moving the chain's joints leaves them 2\.1 \(m and rad\) apart",
         ),
         ("planar_5rrr", lambda text: re.sub(r"<transmission.*?</transmission>", "", text, flags=re.S), "no actuators"),
         (
@@ -305,6 +307,28 @@ def test_bad_files_raise_one_line_errors_naming_file_element_and_problem(tmp_pat
     assert text.startswith(f"{path}: "), text
     assert re.search(message, text), text
     assert "\n" not in text
+
+
+def test_a_loop_left_open_by_the_file_is_closed_at_loading_and_said(tmp_path):
+    """A loop the file's joint values leave open (0.1 m here) is closed by moving its chain's joints, the platform
+    where the file puts it; the indices are those of the closed file, and convert writes the closure back."""
+    text = _replace(bundled_text("planar_5rrr"), r'(<successor link="platform">\s*<origin xyz=")0\.1 ', r"\g<1>0.2 ")
+    opened = load(write(tmp_path, text, "open.urdf"))
+    assert len(opened.assembly_notes) == 1 and opened.assembly_notes[0].startswith(
+        "loop 'chain_1_joint_d' was 0.1 m and 0 rad open at the file's joint values: closed by moving chain 'chain_1'")
+    frames = chain_forward_kinematics(opened.chains[0].geometry, opened.chains[0].reference_values)
+    target_rotation, target_translation = opened.loop_targets(0, opened.home_rotation, opened.home_translation)
+    np.testing.assert_allclose(frames.end_translation, target_translation, atol=1e-10)
+    np.testing.assert_allclose(frames.end_rotation, target_rotation, atol=1e-10)
+    assert mechanism("planar_5rrr").assembly_notes == ()
+    out = tmp_path / "closed.urdf"
+    result = screwkit("convert", tmp_path / "open.urdf", out)
+    assert result.returncode == 0, result.stderr
+    assert "closed by moving chain 'chain_1'" in result.stderr
+    closed = load(out)
+    assert closed.assembly_notes == ()  # the reference configuration written back closes the loop
+    for first, second in zip(opened.chains, closed.chains):
+        np.testing.assert_allclose(second.reference_values, first.reference_values, atol=1e-12)
 
 
 def test_the_chain_attribute_names_the_chain_and_defaults_to_the_loop_name(tmp_path):

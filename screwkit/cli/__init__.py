@@ -28,6 +28,7 @@ COMMANDS = {
     "map": "screwkit.cli.map_command:map_command",
     "design-search": "screwkit.cli.design_search:design_search",
     "view": "screwkit.cli.view:view",
+    "warmup": "screwkit.cli.warmup:warmup",
 }
 """Every command and where it lives: a command's module is imported only when that command runs
 (or ``--help`` lists them), so ``screwkit map`` does not load the viewer, the plots or the design search."""

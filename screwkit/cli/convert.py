@@ -8,8 +8,8 @@ from pathlib import Path
 import click
 
 from screwkit.cli.options import fail, json_option, overwrite_option, quiet_option
-from screwkit.io import ImportError_, read_mechanism_file
-from screwkit.loader import load_text
+from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
+from screwkit.loader import load, load_text
 from screwkit.studies.files import check_output
 
 __all__ = ["convert"]
@@ -29,7 +29,8 @@ __all__ = ["convert"]
 @json_option
 def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool, quiet: bool, as_json: bool) -> None:
     """Write SOURCE (an MJCF file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
-    URDF convention: loops, transmissions and the assembled reference configuration (lengths in m)."""
+    URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
+    already in the convention whose joint values leave loops open is written back with them closed."""
     if not source.is_file():
         raise fail(f"{source}: no such file.")
     if source.suffix.lower() not in (".xml", ".mjcf", ".urdf"):
@@ -39,16 +40,25 @@ def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool,
     except ValueError as error:
         raise fail(str(error)) from None
     try:
-        text, report = read_mechanism_file(source, output=output_frame, output_type=output_type)
+        if is_foreign(source):
+            text, report = read_mechanism_file(source, output=output_frame, output_type=output_type)
+        else:  # screwkit's own convention: the loops the file leaves open, closed and written back
+            own = load(source)
+            text = with_reference_configuration(own.description.text, own)
+            report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
+                                  planar=own.is_planar, motors=list(own.actuator_names))
+            report.notes = [f"assembled: {note}" for note in own.assembly_notes] or ["every loop closes as written"]
         mechanism = load_text(text, str(out))  # what is written must load
     except (ImportError_, ValueError) as error:
         raise fail(str(error)) from None
+    if mechanism.assembly_notes:
+        raise fail(f"{out}: the converted file still leaves loops open: {'; '.join(mechanism.assembly_notes)}")
     out.write_text(text, encoding="utf-8")
     summary = {"source": str(source), "written": str(out), "format": report.file_format,
                "platform_body": report.platform_body, "output": report.output, "planar": report.planar,
                "dof": mechanism.dof, "task_coordinates": list(mechanism.task_coordinates),
                "actuators": list(mechanism.actuator_names), "chains": report.chains, "locked_joints": report.locked,
-               "left_out_joints": report.dropped,
+               "left_out_joints": report.dropped, "notes": report.notes,
                "closure_gaps_m": {name: {"file": report.gaps_before[name], "assembled": report.gaps_after[name]}
                                   for name in report.gaps_before}}
     if as_json:

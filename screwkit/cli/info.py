@@ -46,6 +46,7 @@ def mechanism_info(mechanism) -> dict:
                    for chain in mechanism.chains],
         "named_poses": {name: shown(pose) for name, pose in mechanism.named_poses.items()},
         "length_scale_m": mechanism.length_scale,
+        "assembly_notes": list(mechanism.assembly_notes),
     }
 
 
@@ -56,7 +57,7 @@ def mechanism_info(mechanism) -> dict:
 def info(mechanism: str, length_unit, as_json: bool) -> None:
     """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
     actuators, named poses (m, deg)."""
-    loaded = load_mechanism(mechanism, length_unit)
+    loaded = load_mechanism(mechanism, length_unit, indices=False)
     report = mechanism_info(loaded)
     if as_json:
         click.echo(json.dumps(report))
@@ -82,6 +83,8 @@ def info(mechanism: str, length_unit, as_json: bool) -> None:
         click.echo(f"    {chain['name']}: {' - '.join(chain['joints'])} (actuated: {', '.join(chain['actuated'])}); "
                    f"loop {chain['loop']} ({chain['loop_type']})")
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
+    for note in report["assembly_notes"]:
+        click.echo(f"  assembled: {note}")
     click.echo("  named poses (m, deg):")
     for name, pose in report["named_poses"].items():
         click.echo(f"    {name}: " + ", ".join(f"{k} = {v:.6g}" for k, v in pose.items()))

@@ -14,6 +14,7 @@ from typing import Callable
 import click
 import numpy as np
 
+from screwkit._compile_notice import announce_compilation
 from screwkit.loader import load
 from screwkit.studies.files import check_output
 from screwkit.tolerances import SINGULARITY_THRESHOLD
@@ -169,8 +170,13 @@ def overwrite_option(function: Callable) -> Callable:
 
 # -- parsing ---------------------------------------------------------------------------------------
 
-def load_mechanism(name: str, length_unit: str | None = None):
-    """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded."""
+def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True):
+    """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded.
+
+    ``indices``: the command computes indices, so a first run says at once that the index kernel
+    is about to be compiled (before Pinocchio is even imported)."""
+    if indices:
+        announce_compilation("screwkit._kernels")
 
     try:
         return load(name, length_unit=length_unit)

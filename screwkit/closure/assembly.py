@@ -22,7 +22,7 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.closure.newton import determinant_sign, task_rows
+from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form
 from screwkit.closure.task_space import (
     TASK_RANK_TOLERANCE,
@@ -38,6 +38,7 @@ from screwkit.tolerances import (
     BRANCH_MATCH_TOLERANCE,
     CLOSURE_TOLERANCE,
     MOTION_SPACE_TOLERANCE,
+    NEWTON_TOLERANCE,
 )
 
 __all__ = ["assemble", "mobility"]
@@ -62,8 +63,16 @@ def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
     return max(float(np.max(np.linalg.norm(np.concatenate(points), axis=-1))), 1e-12)
 
 
-def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_scale: float) -> NDArray[np.float64]:
-    """Joint values of the reference assembly; a ValueError if the loop does not close there."""
+def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
+                      length_scale: float) -> tuple[NDArray[np.float64], str | None]:
+    """Joint values of the reference assembly, and a note when the file's values left the loop open.
+
+    The file's tree joint values (``<reference_configuration>`` or 0) with the loop joint's best
+    fit; when the loop frames stay apart (a CAD export, a hand-edited file), the leg's joints are
+    moved to close it with the platform where the file puts it (damped Newton from those values,
+    so the working mode is the nearest one) and the gap closed is returned as a note. A ValueError
+    names the loop when it cannot be closed.
+    """
     description, geometry = mechanism.description, chain.geometry
     tree_values = np.array([description.reference_configuration.get(name, 0.0)
                             for name in chain.joint_names[: geometry.n_tree_joints]])
@@ -76,21 +85,33 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
         frames.leg_rotation.T @ target_rotation,
         frames.leg_rotation.T @ (target_translation - frames.leg_translation),
     )
+    values, note = np.concatenate([tree_values, loop_values]), None
     if position_gap > CLOSURE_TOLERANCE * length_scale or rotation_gap > CLOSURE_TOLERANCE:
-        raise description.fail(
-            f"<loop name='{chain.loop_name}'>",
-            f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
-            f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
-            "platform at its joint origin).",
-        )
-    values = wrap_revolute_values(geometry, np.concatenate([tree_values, loop_values]))
+        scale = np.where(np.asarray(geometry.dof_prismatic), length_scale, 1.0)
+        tolerance = NEWTON_TOLERANCE * max(1.0, length_scale)
+        solved, converged, residual = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
+                                                         values[None], tolerance=tolerance, max_iterations=200)
+        if not converged[0]:
+            raise description.fail(
+                f"<loop name='{chain.loop_name}'>",
+                f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
+                f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
+                f"platform at its joint origin), and moving the chain's joints leaves them {_tidy(residual[0])} "
+                "(m and rad) apart.",
+            )
+        moved = np.max(np.abs(solved[0] - values) / scale)
+        values = solved[0]
+        note = (f"loop {chain.loop_name!r} was {_tidy(position_gap)} m and {_tidy(rotation_gap)} rad open at the "
+                f"file's joint values: closed by moving chain {chain.name!r}'s joints (by at most {_tidy(moved)} rad "
+                "or length scales)")
+    values = wrap_revolute_values(geometry, values)
     outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None])[0])
     if outside >= 0:
         lower, upper = chain.joint_limits[outside]
         raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
                                f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "
                                f"limits [{_tidy(lower)}, {_tidy(upper)}].")
-    return values
+    return values, note
 
 
 def _check_planar(mechanism: Mechanism, chain: Chain, values: NDArray) -> None:
@@ -159,16 +180,18 @@ def assemble(mechanism: Mechanism) -> Mechanism:
     """
     length_scale = _length_scale(mechanism, mechanism.chains)
     mechanism = replace(mechanism, length_scale=length_scale)
-    chains = []
+    chains, notes = [], []
     for index, chain in enumerate(mechanism.chains):
-        values = _reference_values(mechanism, index, chain, length_scale)
+        values, note = _reference_values(mechanism, index, chain, length_scale)
+        if note:
+            notes.append(note)
         if mechanism.is_planar:
             _check_planar(mechanism, chain, values)
         frames = chain_forward_kinematics(chain.geometry, values)
         chains.append(replace(chain, reference_values=values,
                               reference_sign=determinant_sign(chain.geometry, mechanism.is_planar, frames.axes,
                                                               frames.points)))
-    mechanism = replace(mechanism, chains=tuple(chains))
+    mechanism = replace(mechanism, chains=tuple(chains), assembly_notes=tuple(notes))
     solved = []
     for index, chain in enumerate(mechanism.chains):
         solver, reason = closed_form_for(chain.geometry, mechanism.is_planar, length_scale)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit._compile_notice import announce_compilation
 from screwkit.closure.chain_kinematics import (
     chain_forward_kinematics,
     twists_from_axes_and_points,
@@ -75,6 +76,7 @@ def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:
 
 def packed_geometry(mechanism: Mechanism, chains: tuple[int, ...]) -> dict:
     """The geometry of ``chains`` packed for the compiled closure (tree joints stacked with offsets)."""
+    announce_compilation("screwkit.closure._task_kernel")
     from screwkit.closure._task_kernel import LOOP_CODES  # numba: loaded when a closure first runs
 
     geometries = [mechanism.chains[index].geometry for index in chains]
@@ -113,6 +115,7 @@ BLOCK = 2048
 def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, tolerance, iterations,
                  step_tolerance, step_iterations, max_step):
     """The compiled closure (:mod:`screwkit.closure._task_kernel`) over a batch, in thread blocks."""
+    announce_compilation("screwkit.closure._task_kernel")
     from screwkit.closure._task_kernel import close_chains_kernel  # numba: loaded when a closure first runs
 
     poses = np.array(full_poses, dtype=float, order="C", copy=True)

@@ -16,9 +16,10 @@ from pathlib import Path
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, convert_tree
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.mjcf import read_mjcf
+from screwkit.units import metres_per
 
 __all__ = ["read_mechanism_file", "is_foreign", "convert_tree", "ClosedTree", "Closure", "ImportReport",
-           "ImportError_", "read_gepetto", "read_mjcf"]
+           "ImportError_", "read_gepetto", "read_mjcf", "with_reference_configuration"]
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
@@ -52,3 +53,25 @@ def read_mechanism_file(path: Path, *, output: str | None = None,
             raise ImportError_(f"{path}: no robot.yaml beside it: not a Gepetto closed-loop robot.")
         tree = read_gepetto(path, yaml_path, output=output, output_type=output_type)
     return convert_tree(tree)
+
+
+def with_reference_configuration(text: str, mechanism) -> str:
+    """A URDF text of screwkit's convention with its ``<reference_configuration>`` replaced by the
+    mechanism's reference assembly (every tree joint, prismatic values in the file's length unit):
+    a file whose loops were closed at loading (:attr:`~screwkit.model.mechanism.Mechanism.assembly_notes`)
+    then closes as written. Comments are kept."""
+    import xml.etree.ElementTree as ElementTree
+
+    root = ElementTree.fromstring(text, parser=ElementTree.XMLParser(
+        target=ElementTree.TreeBuilder(insert_comments=True)))
+    for old in root.findall("reference_configuration"):
+        root.remove(old)
+    element = ElementTree.SubElement(root, "reference_configuration")
+    factor = metres_per(mechanism.length_unit)
+    for chain in mechanism.chains:
+        for name, value, prismatic in zip(chain.joint_names, chain.reference_values, chain.prismatic):
+            if name in chain.joint_names[:chain.geometry.n_tree_joints]:
+                ElementTree.SubElement(element, "joint", name=name,
+                                       value=repr(float(value / factor if prismatic else value)))
+    ElementTree.indent(root, space="  ")
+    return '<?xml version="1.0"?>\n' + ElementTree.tostring(root, encoding="unicode") + "\n"

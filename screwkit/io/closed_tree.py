@@ -101,11 +101,13 @@ class ImportReport:
     gaps_before: dict = field(default_factory=dict)
     gaps_after: dict = field(default_factory=dict)
     motors: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     def lines(self) -> list[str]:
         """The report as lines of text."""
-        out = [f"{self.source}: {self.file_format}, platform body {self.platform_body!r}, output {self.output}"
-               + (", planar" if self.planar else "")]
+        platform = f", platform body {self.platform_body!r}" if self.platform_body else ""
+        planar = ", planar" if self.planar else ""
+        out = [f"{self.source}: {self.file_format}{platform}, output {self.output}{planar}"]
         for name in self.gaps_before:
             out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} m at the file's joint values, "
                        f"{self.gaps_after[name]:.1e} after assembly")
@@ -115,6 +117,7 @@ class ImportReport:
             out.append(f"  idle joints locked at their assembled values: {', '.join(self.locked)}")
         if self.dropped:
             out.append(f"  joints outside every chain, left out: {', '.join(self.dropped)}")
+        out += [f"  {note}" for note in self.notes]
         return out
 
 

@@ -93,6 +93,8 @@ class Mechanism:
     instantaneous_dof : int
         Dimension of the platform's motion space at the reference assembly; larger than
         :attr:`dof` when the reference assembly is a constraint singularity.
+    assembly_notes : tuple of str
+        The loops the file's joint values left open and how far each was (closed at loading).
     """
 
     name: str
@@ -119,6 +121,7 @@ class Mechanism:
     task_source: str = "all"
     output_point: NDArray[np.float64] | None = field(default=None, repr=False)
     instantaneous_dof: int = 0
+    assembly_notes: tuple[str, ...] = ()
 
     # -- derived -------------------------------------------------------------------------
 

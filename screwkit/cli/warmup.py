@@ -1,0 +1,33 @@
+"""``screwkit warmup``: compile every kernel ahead (for a CI image, a cluster's workers, a first session)."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+from screwkit._compile_notice import KERNELS, kernel_is_cached
+
+__all__ = ["warmup"]
+
+
+@click.command()
+def warmup() -> None:
+    """Compile the index kernel, the planar closed forms and the lower-mobility closure into numba's cache,
+    saying for each whether it was cached and how long it took (later runs load them in under a second)."""
+    from screwkit.loader import load  # Pinocchio: loaded when the command runs, not for --help
+    from screwkit.studies.poses import indices_at_pose, indices_at_poses  # idem
+
+    five = load("planar_5rrr")
+    steps = {
+        "screwkit._kernels": lambda: indices_at_pose(five, five.home_pose),
+        "screwkit._planar_kernel": lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
+        "screwkit.closure._task_kernel": lambda: load("prs_3_ups"),
+    }
+    for module, step in steps.items():
+        cached = kernel_is_cached(module)
+        start = time.perf_counter()
+        step()
+        click.echo(f"{KERNELS[module][0]:28s} {'cached' if cached else 'compiled'} in "
+                   f"{time.perf_counter() - start:.1f} s", err=True)
+    click.echo("screwkit kernels ready", err=True)
