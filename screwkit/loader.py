@@ -115,8 +115,9 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
-            converted, _ = read_mechanism_file(path)
-            return load_text(converted, str(path), length_unit=length_unit)
+            converted, report = read_mechanism_file(path)
+            mechanism = load_text(converted, str(path), length_unit=length_unit)
+            return replace(mechanism, import_report=tuple(report.lines()))
     return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes))
 
 

@@ -204,6 +204,10 @@ def test_convert_on_the_command_line_round_trips(tmp_path):
     converted = json.loads(screwkit("analyze", out, "--json").stdout)
     for key in ("iti", "lmti", "f_o", "iti_actuators"):
         assert original[key] == converted[key], key
+    assert original["converted"][0].startswith(f"{source}: MJCF, platform body 'distal_1', output the point where "
+                                                "the chains meet") and "converted" not in converted
+    info = json.loads(screwkit("info", source, "--json").stdout)
+    assert info["import_report"] == original["converted"] and info["dof"] == 2
     assert converted["iti"] == pytest.approx(five_bar_expected(HOME)["iti"], abs=TOLERANCE)
     again = screwkit("convert", source, out)
     assert again.returncode == 1 and "exists" in again.stderr and again.stderr.count("\n") == 1

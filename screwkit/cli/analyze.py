@@ -110,7 +110,11 @@ def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type:
     except ValueError as error:
         raise fail(str(error)) from None
     report = result.to_dict()
+    if loaded.import_report:  # a file of another tool: which body and which point the indices are for
+        report["converted"] = list(loaded.import_report)
     if as_json:
         click.echo(json.dumps(report))
     else:
         print_report(report)
+        for line in loaded.import_report[:1]:
+            click.echo(f"(converted from {line})", err=True)

@@ -47,6 +47,7 @@ def mechanism_info(mechanism) -> dict:
         "named_poses": {name: shown(pose) for name, pose in mechanism.named_poses.items()},
         "length_scale_m": mechanism.length_scale,
         "assembly_notes": list(mechanism.assembly_notes),
+        "import_report": list(mechanism.import_report),
     }
 
 
@@ -85,6 +86,10 @@ def info(mechanism: str, length_unit, as_json: bool) -> None:
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
     for note in report["assembly_notes"]:
         click.echo(f"  assembled: {note}")
+    if report["import_report"]:
+        click.echo("  converted from " + report["import_report"][0])
+        for line in report["import_report"][1:]:
+            click.echo(f"  {line}")
     click.echo("  named poses (m, deg):")
     for name, pose in report["named_poses"].items():
         click.echo(f"    {name}: " + ", ".join(f"{k} = {v:.6g}" for k, v in pose.items()))

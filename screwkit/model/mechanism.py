@@ -95,6 +95,9 @@ class Mechanism:
         :attr:`dof` when the reference assembly is a constraint singularity.
     assembly_notes : tuple of str
         The loops the file's joint values left open and how far each was (closed at loading).
+    import_report : tuple of str
+        For a file of another tool (MJCF, URDF + robot.yaml): what the conversion did, line by line
+        (platform body, output point or frame and why, loops assembled, joints locked).
     """
 
     name: str
@@ -122,6 +125,7 @@ class Mechanism:
     output_point: NDArray[np.float64] | None = field(default=None, repr=False)
     instantaneous_dof: int = 0
     assembly_notes: tuple[str, ...] = ()
+    import_report: tuple[str, ...] = ()
 
     # -- derived -------------------------------------------------------------------------
 
