@@ -90,3 +90,12 @@ def test_each_pose_is_completed_as_if_alone_whatever_the_batch_and_the_threads(n
         np.testing.assert_array_equal(alone[0][0], full[pose_index])
         for chain_values, alone_values in zip(values, alone[1]):
             np.testing.assert_array_equal(alone_values[0], chain_values[pose_index])
+
+
+def test_every_caller_uses_one_compiled_signature_of_the_kernel():
+    """Each new argument type (a read-only array, another dtype) would compile the kernel again (about 15 s)."""
+    for name in LOWER_MOBILITY:
+        mechanism = load(name)
+        complete_poses(mechanism, task_samples(mechanism, 1, 7))
+        complete_poses(mechanism, task_samples(mechanism, 5, 8))
+    assert len(kernel.close_chains_kernel.signatures) == 1

@@ -128,8 +128,9 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
         column += size
     free = np.asarray(free_axes, dtype=np.int64)
     task = np.array([axis for axis in range(mechanism.n_pose) if axis not in free_axes], dtype=np.int64)
-    targets = np.ascontiguousarray(np.broadcast_to(targets, (count, task.size)), dtype=float)
-    steps = np.ascontiguousarray(np.broadcast_to(steps, (count,)), dtype=np.int64)
+    # writable copies: one compiled signature of the kernel whatever the caller passed
+    targets = np.array(np.broadcast_to(targets, (count, task.size)), dtype=float, order="C")
+    steps = np.array(np.broadcast_to(steps, (count,)), dtype=np.int64, order="C")
     scale = np.concatenate([np.where(mechanism.pose_angular[free], 1.0, mechanism.length_scale),
                             np.ones(flat.shape[1])])
     geometry = packed_geometry(mechanism, chains)
