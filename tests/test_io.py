@@ -289,3 +289,11 @@ def test_the_same_mechanism_in_mjcf_and_in_urdf_and_yaml_gives_identical_indices
         np.testing.assert_allclose(getattr(second, key), getattr(first, key), rtol=0, atol=TOLERANCE, err_msg=key)
     np.testing.assert_allclose(second.f_o[1], first.f_o[1], rtol=0, atol=TOLERANCE)
     assert_textbook(second, points)
+
+
+def test_a_tree_without_loops_or_yaml_says_what_is_missing(tmp_path):
+    urdf, _ = five_bar_gepetto()
+    (tmp_path / "robot.urdf").write_text(urdf)  # no robot.yaml beside it
+    with pytest.raises(ValueError, match="a tree with no <loop>: a closed-loop robot of another tool needs its "
+                                         "robot.yaml beside it, or an MJCF file"):
+        load(tmp_path / "robot.urdf")

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rotation_vector_from_rotation, rpy_from_rotation
+from screwkit.rotations import rpy_from_rotation
 
 __all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "convert_tree", "OUTPUT_NAMES"]
 
@@ -198,7 +198,8 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
     Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
     joint type; a damped step is the least change when the closures leave joints free),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
-    their rotation vectors; the Jacobian by central differences.
+    the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
+    turn); the Jacobian by central differences.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -221,8 +222,8 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
         for closure in tree.closures:
             a, b = _frames(model, data, closure)
             rows.append((b[:3, 3] - a[:3, 3]) / scale)
-            if closure.kind == "6d":
-                rows.append(rotation_vector_from_rotation(a[:3, :3].T @ b[:3, :3]))
+            if closure.kind == "6d":  # smooth everywhere (a rotation vector jumps at half a turn)
+                rows.append((b[:3, :3] - a[:3, :3]).ravel())
         return np.concatenate(rows)
 
     if not tree.closures:

@@ -59,9 +59,11 @@ def read_platform(description: UrdfDescription, model, name: str) -> Platform:
     candidates = [joint for joint in description.joints.values() if joint.type in PLATFORM_JOINT_TYPES]
     if len(candidates) != 1:
         found = ", ".join(repr(joint.name) for joint in candidates) or "none"
+        hint = ("" if candidates or description.loops else " (a tree with no <loop>: a closed-loop robot of another "
+                "tool needs its robot.yaml beside it, or an MJCF file; see docs/other-formats.md)")
         raise description.fail(
             f"<robot name='{name}'>",
-            f"expected exactly one floating or planar joint attaching the platform to the base, found {found}.",
+            f"expected exactly one floating or planar joint attaching the platform to the base, found {found}{hint}.",
         )
     joint = candidates[0]
     tag = f"<joint name='{joint.name}'>"
