@@ -297,3 +297,13 @@ def test_a_tree_without_loops_or_yaml_says_what_is_missing(tmp_path):
     with pytest.raises(ValueError, match="a tree with no <loop>: a closed-loop robot of another tool needs its "
                                          "robot.yaml beside it, or an MJCF file"):
         load(tmp_path / "robot.urdf")
+
+
+def test_a_ball_joint_inside_a_leg_is_refused_by_name(tmp_path):
+    text = five_bar_mjcf().replace('<joint name="b_2" type="hinge" axis="0.0 0.0 1.0"/>',
+                                   '<joint name="b_2" type="ball"/>')
+    assert 'name="b_2" type="ball"' in text
+    path = tmp_path / "ball.xml"
+    path.write_text(text)
+    with pytest.raises(ImportError_, match=r"joint 'b_2' \(spherical\) inside a leg: write it as 1-DoF joints"):
+        read_mechanism_file(path)

@@ -462,6 +462,14 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     legs = [spine] + [_loop_of(tree, data, closure, platform, scale) for closure in tree.closures]
     owner: dict[int, str] = {}
     for leg in legs:
+        if not leg.joints:
+            raise ImportError_(f"{tree.source}: closure {leg.closure!r} ties the platform to the fixed base: no leg.")
+        for joint in leg.joints:
+            kind, _ = joint_kind(model, joint)
+            if kind not in ("revolute", "prismatic"):
+                raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: write it as "
+                                   "1-DoF joints (a ball joint as three hinges).")
+    for leg in legs:
         for joint in leg.joints:
             if joint in owner:
                 raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} belongs to two legs "
@@ -538,9 +546,6 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 report.locked.append(model.names[joint])
             else:
                 kind, axis = joint_kind(model, joint)
-                if kind not in ("revolute", "prismatic"):
-                    raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: write "
-                                       "it as 1-DoF joints (a ball joint as three hinges).")
                 lower = model.lowerPositionLimit[model.joints[joint].idx_q]
                 upper = model.upperPositionLimit[model.joints[joint].idx_q]
                 limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
