@@ -19,7 +19,7 @@ from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows
 from helpers import random_rotation, screwkit
 from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble, joint_kind
-from screwkit.loader import load
+from screwkit.loader import bundled_path, load
 from screwkit.studies.poses import indices_at_pose, indices_at_poses
 
 HOME = np.array([0.0, 0.35])
@@ -307,3 +307,15 @@ def test_a_ball_joint_inside_a_leg_is_refused_by_name(tmp_path):
     path.write_text(text)
     with pytest.raises(ImportError_, match=r"joint 'b_2' \(spherical\) inside a leg: write it as 1-DoF joints"):
         read_mechanism_file(path)
+
+
+def test_a_urdf_named_xml_and_output_options_on_a_screwkit_file_are_refused_in_one_line(tmp_path):
+    urdf, _ = five_bar_gepetto()
+    (tmp_path / "tree.xml").write_text(urdf)
+    with pytest.raises(ValueError, match=r"the root element is <robot>, not <mujoco> \(a URDF: give it the suffix"):
+        load(tmp_path / "tree.xml")
+    own = tmp_path / "five.urdf"
+    own.write_text(bundled_path("five_bar_3").read_text())
+    result = screwkit("convert", own, tmp_path / "out.urdf", "--output", "effector")
+    assert result.returncode == 1 and "apply to MJCF files and URDF + robot.yaml" in result.stderr
+    assert result.stderr.count("\n") == 1

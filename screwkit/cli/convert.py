@@ -43,6 +43,9 @@ def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool,
         if is_foreign(source):
             text, report = read_mechanism_file(source, output=output_frame, output_type=output_type)
         else:  # screwkit's own convention: the loops the file leaves open, closed and written back
+            if output_frame is not None or output_type is not None:
+                raise fail(f"{source}: --output and --output-type apply to MJCF files and URDF + robot.yaml; this "
+                           "file is in screwkit's convention (its output is its platform).")
             own = load(source)
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",

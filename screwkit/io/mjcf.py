@@ -38,7 +38,8 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
     except ElementTree.ParseError as error:
         raise ImportError_(f"{source}: not well-formed XML ({error}).") from None
     if root.tag != "mujoco":
-        raise ImportError_(f"{source}: the root element is <{root.tag}>, not <mujoco>.")
+        hint = " (a URDF: give it the suffix .urdf)" if root.tag == "robot" else ""
+        raise ImportError_(f"{source}: the root element is <{root.tag}>, not <mujoco>{hint}.")
     world = root.find("worldbody")
     bodies = [] if world is None else world.findall("body")
     if len(bodies) != 1:
