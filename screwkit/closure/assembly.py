@@ -70,7 +70,7 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
     The file's tree joint values (``<reference_configuration>`` or 0) with the loop joint's best
     fit; when the loop frames stay apart (a CAD export, a hand-edited file), the leg's joints are
     moved to close it with the platform where the file puts it (damped Newton from those values,
-    so the working mode is the nearest one) and the gap closed is returned as a note. A ValueError
+    so the working mode is usually the nearest one) and the gap closed is returned as a note. A ValueError
     names the loop when it cannot be closed.
     """
     description, geometry = mechanism.description, chain.geometry

@@ -7,9 +7,10 @@ joint) or entirely (``6d``: a weld). screwkit's convention (``docs/urdf-conventi
 serial chain from the base closed onto the platform by one loop joint. :func:`convert_tree`
 maps one onto the other:
 
-1. **Assembly.** The closures are solved near the file's reference joint values (the least
-   change, Levenberg-Marquardt on every joint); the gaps closed are reported, and a closure that
-   cannot close is named with its gap.
+1. **Assembly.** The closures are solved from the file's reference joint values
+   (Levenberg-Marquardt on every joint: damped steps, so the configuration reached is usually the
+   nearest closed one); the gaps closed and the largest joint change are reported, and a closure
+   that cannot close is named with its gap.
 2. **Platform.** The body carrying the output frame (named, or a frame called effector, eff, ee,
    tool, tcp, foot or platform). Its own tree path from the root is one leg, welded to the platform.
 3. **Legs and loop joints.** Every closure joins a leg (a tree path from the root that shares no
@@ -447,6 +448,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.gaps_before = closure_gaps(tree, tree.q_reference)
     q, scale = assemble(tree)
     report.gaps_after = closure_gaps(tree, q)
+    change = pin.difference(model, tree.q_reference, q)
+    report.notes.append(f"working mode: the closed configuration damped least squares reach from the file's joint "
+                        f"values (the largest joint change {float(np.max(np.abs(change), initial=0.0)):.3g} rad or m)")
     data = model.createData()
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
