@@ -5,8 +5,10 @@ actuation wrenches, the ITIs, and the output twists and OTIs of every non-redund
 submechanism, then the LMTI, F_Oj and the mutual-interference actuators, exactly as
 documented in :func:`screwkit.transmission.analyze`. Every per-configuration quantity has a
 last "lane" axis over the 64 configurations and every step loops over the lanes innermost,
-so that the compiler vectorises the algebra across configurations; only the null vectors of
-n > 3 rows and the Gram solves of chains with more joint DoFs than n run lane by lane. The
+so that the compiler vectorises the algebra across configurations. The null vectors of n - 1 > 2
+rows (output twists, actuation wrenches) are eliminated lane-innermost too, pivot choices and row
+swaps as per-lane blends (:func:`_null_vectors_lanes`); only the lanes whose leading block is
+poorly conditioned, and the Gram solves of chains with more joint DoFs than n, run lane by lane. The
 small dense algebra (null vectors, Gram solves over one chain's joints) is written out here, and
 scratch is allocated once per call (the pseudo-inverse fallback for idle DoFs excepted).
 
@@ -119,6 +121,95 @@ def _null_vector(rows, size, out, work, columns):
             total += work[i, j] * out[columns[j]]
         out[columns[i]] = -total / work[i, i]
     return
+
+
+LEADING_PIVOT_RATIO = 1e-2
+"""Lanes whose leading block's smallest pivot is below this fraction of its largest (a poorly
+conditioned block) get their null vector from :func:`_null_vector`'s full pivoting instead."""
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def _null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch, smallest, largest,
+                        scalar_rows, scalar_work, scalar_columns, scalar_out):
+    """out[:size, r] = generalised cross product of the rows rows[:size-1, :size, r], every lane r at once.
+
+    The vector of :func:`_null_vector` (``out[q] = (-1)^(size-1+q) det(rows without column q)``),
+    computed lane-innermost so that the compiler vectorises it across configurations: Gaussian
+    elimination with partial pivoting of the leading (size-1) x (size-1) block, the last column
+    carried along (pivot choices and row swaps as per-lane blends); then ``out`` is
+    ``det(leading block)`` times the null vector whose last entry is 1, by back substitution.
+    Lanes whose leading block is poorly conditioned (smallest pivot below
+    :data:`LEADING_PIVOT_RATIO` of the largest) are redone one by one with :func:`_null_vector`.
+    ``work`` (size-1, size, BLOCK), ``pivot``, ``determinant``, ``scratch``, ``smallest``,
+    ``largest`` (BLOCK) and the ``scalar_*`` arrays are scratch.
+    """
+    m = size - 1
+    for i in range(m):
+        for j in range(size):
+            for r in range(width):
+                work[i, j, r] = rows[i, j, r]
+    for r in range(width):
+        determinant[r] = 1.0
+        smallest[r] = np.inf
+        largest[r] = 0.0
+    for k in range(m):
+        for r in range(width):
+            pivot[r] = float(k)
+            scratch[r] = abs(work[k, k, r])
+        for i in range(k + 1, m):
+            row = float(i)
+            for r in range(width):
+                value = abs(work[i, k, r])
+                better = value > scratch[r]
+                scratch[r] = value if better else scratch[r]
+                pivot[r] = row if better else pivot[r]
+        for i in range(k + 1, m):
+            row = float(i)
+            for r in range(width):
+                scratch[r] = 1.0 if pivot[r] == row else 0.0
+                determinant[r] *= 1.0 - 2.0 * scratch[r]
+            for j in range(k, size):
+                for r in range(width):  # exact blends (a weight of 0 or 1), which vectorise unlike branches
+                    upper = work[k, j, r]
+                    lower = work[i, j, r]
+                    work[k, j, r] = lower * scratch[r] + upper * (1.0 - scratch[r])
+                    work[i, j, r] = upper * scratch[r] + lower * (1.0 - scratch[r])
+        for r in range(width):
+            value = work[k, k, r]
+            determinant[r] *= value
+            magnitude = abs(value)
+            smallest[r] = min(smallest[r], magnitude)
+            largest[r] = max(largest[r], magnitude)
+            scratch[r] = 1.0 / value if value != 0.0 else 0.0
+        for i in range(k + 1, m):
+            for r in range(width):
+                pivot[r] = work[i, k, r] * scratch[r]  # reused: the row's multiplier
+            for j in range(k + 1, size):
+                for r in range(width):
+                    work[i, j, r] -= pivot[r] * work[k, j, r]
+    # back substitution: U y = -u (u the last column), out = det * (y, 1)
+    for r in range(width):
+        out[m, r] = 1.0
+    for i in range(m - 1, -1, -1):
+        for r in range(width):
+            scratch[r] = -work[i, m, r]
+        for j in range(i + 1, m):
+            for r in range(width):
+                scratch[r] -= work[i, j, r] * out[j, r]
+        for r in range(width):
+            value = work[i, i, r]
+            out[i, r] = scratch[r] / value if value != 0.0 else 0.0
+    for q in range(size):
+        for r in range(width):
+            out[q, r] *= determinant[r]
+    for r in range(width):
+        if not smallest[r] > LEADING_PIVOT_RATIO * largest[r]:  # poorly conditioned (or zero) block
+            for i in range(m):
+                for j in range(size):
+                    scalar_rows[i, j] = rows[i, j, r]
+            _null_vector(scalar_rows, size, scalar_out, scalar_work, scalar_columns)
+            for q in range(size):
+                out[q, r] = scalar_out[q]
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -262,13 +353,20 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     columns = np.empty(6, dtype=np.int64)
     rhs = np.zeros(capacity)
     solution = np.empty(capacity)
-    coefficients = np.empty(6)
     has_force = np.zeros((a, BLOCK), dtype=np.bool_)
     arms = np.zeros((a, n, 3, BLOCK))
     iti_local = np.zeros((a, BLOCK))
     wrench_matrix = np.zeros((a, n, BLOCK))
     row_norms = np.zeros((a, BLOCK))
     output = np.empty((locked_sets.shape[0], n, BLOCK))
+    locked_rows = np.empty((max(n - 1, 1), n, BLOCK))
+    elimination = np.empty((max(n - 1, 1), n, BLOCK))
+    lane_a = np.empty(BLOCK)
+    lane_b = np.empty(BLOCK)
+    lane_c = np.empty(BLOCK)
+    lane_d = np.empty(BLOCK)
+    lane_e = np.empty(BLOCK)
+    scalar_out = np.empty(6)
     output_omega = np.empty((locked_sets.shape[0], BLOCK))
     oti_local = np.empty((subs, BLOCK))
     independent = np.empty((subs, BLOCK), dtype=np.bool_)
@@ -424,13 +522,12 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                             passive_rows[0, 0, r], passive_rows[0, 1, r], passive_rows[0, 2, r],
                             passive_rows[1, 0, r], passive_rows[1, 1, r], passive_rows[1, 2, r])
                 else:
-                    for r in range(width):
-                        for i in range(n - 1):
-                            for q in range(n):
-                                rows[i, q] = passive_rows[i, q, r]
-                        _null_vector(rows, n, solution, work, columns)
+                    for i in range(n - 1):
                         for q in range(n):
-                            combination[q, r] = solution[q]
+                            for r in range(width):
+                                locked_rows[i, q, r] = passive_rows[i, q, r]
+                    _null_vectors_lanes(locked_rows, n, width, combination, elimination, lane_a, lane_b, lane_c,
+                                        lane_d, lane_e, rows, work, columns, scalar_out)
                 # The wrench about d: SWAP of the combination of the shifted basis.
                 for q in range(n):
                     for r in range(width):
@@ -621,13 +718,12 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                         wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
                         wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
             else:
-                for r in range(width):
-                    for i in range(n - 1):
-                        for q in range(n):
-                            rows[i, q] = wrench_matrix[locked_sets[locked, i], q, r]
-                    _null_vector(rows, n, coefficients, work, columns)
+                for i in range(n - 1):
                     for q in range(n):
-                        output[locked, q, r] = coefficients[q]
+                        for r in range(width):
+                            locked_rows[i, q, r] = wrench_matrix[locked_sets[locked, i], q, r]
+                _null_vectors_lanes(locked_rows, n, width, output[locked], elimination, lane_a, lane_b, lane_c,
+                                    lane_d, lane_e, rows, work, columns, scalar_out)
             for r in range(width):
                 lane0[r] = 0.0
                 lane1[r] = 0.0

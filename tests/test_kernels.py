@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit._kernels import _null_vector
+from screwkit._kernels import BLOCK, LEADING_PIVOT_RATIO, _null_vector, _null_vectors_lanes
 
 
 def cofactors(rows):
@@ -33,6 +33,31 @@ def test_null_vector_is_the_cofactor_vector():
             np.testing.assert_allclose(rows @ out, 0.0, atol=1e-12 * scale * np.abs(rows).max())
             if case % 4 == 2 and size > 2:
                 assert np.all(out == 0.0) or np.abs(out).max() <= 1e-12 * scale
+
+
+def test_null_vectors_of_every_lane_are_the_cofactor_vectors():
+    """The lane-innermost version: the same cofactor vectors for a block of configurations mixing generic
+    rows, a singular leading block (redone by full pivoting), dependent rows, poor scaling and lanes
+    left unused (width below the block)."""
+    rng = np.random.default_rng(8)
+    for size in (4, 5, 6):
+        m = size - 1
+        rows = rng.standard_normal((m, size, BLOCK))
+        rows[:, 0, 1::5] = 0.0  # singular leading blocks
+        rows[-1, :, 2::5] = 2.0 * rows[0, :, 2::5]  # dependent rows
+        rows[:, :, 3::5] *= 1e5
+        rows[:, m - 1, 4::5] = 1e-9 * rows[:, 0, 4::5]  # a nearly singular leading block
+        width = BLOCK - 3
+        out = np.full((size, BLOCK), np.nan)
+        scratch = [np.empty(BLOCK) for _ in range(5)]
+        _null_vectors_lanes(rows, size, width, out, np.empty((m, size, BLOCK)), *scratch, np.empty((6, 6)),
+                            np.empty((6, 6)), np.empty(6, dtype=np.int64), np.empty(6))
+        assert np.isnan(out[:, width:]).all()  # lanes beyond the width are left alone
+        for r in range(width):
+            expected = cofactors(rows[:, :, r])
+            scale = np.prod(np.linalg.norm(rows[:, :, r], axis=1))
+            np.testing.assert_allclose(out[:, r], expected, rtol=0, atol=1e-12 * scale, err_msg=f"lane {r}")
+    assert 0.0 < LEADING_PIVOT_RATIO < 1.0
 
 
 def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
