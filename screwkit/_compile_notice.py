@@ -13,7 +13,7 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["announce_compilation", "kernel_is_cached", "KERNELS"]
+__all__ = ["announce_compilation", "kernel_is_cached", "silence", "KERNELS"]
 
 KERNELS = {
     "screwkit._kernels": ("transmission_kernel", 35),
@@ -23,6 +23,13 @@ KERNELS = {
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
 _checked: set[str] = set()
+_silent = False
+
+
+def silence() -> None:
+    """No notice from now on in this process (a command run with ``--quiet`` or ``--json``)."""
+    global _silent
+    _silent = True
 
 
 def _first_line(source: Path, function: str) -> int | None:
@@ -62,7 +69,7 @@ def kernel_is_cached(module: str) -> bool:
 
 def announce_compilation(module: str) -> None:
     """Once per process and module: a line on stderr when the module's kernel is about to be compiled."""
-    if module in _checked or module in sys.modules:
+    if _silent or module in _checked or module in sys.modules:
         return
     _checked.add(module)
     if not kernel_is_cached(module):

@@ -192,6 +192,19 @@ def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the
         process.communicate()
     assert first.startswith("screwkit: compiling transmission_kernel (first run only, about"), first
     assert waited < 5.0  # before the file is loaded (the interpreter and the command line start first)
+    quiet_commands = (["analyze", "planar_5rrr", "--json"],
+                      ["map", "planar_5rrr", "--radius", "0.05", "--step", "0.05", "--phi-step", "90", "--out",
+                       str(tmp_path / "m.nc"), "--quiet"])
+    for command in quiet_commands:  # stderr stays empty: no notice either
+        option = command[-1]
+        process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", *command],
+                                   env=environment, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            _, stderr = process.communicate(timeout=waited + 3.0)
+        except subprocess.TimeoutExpired:  # still compiling: what it wrote so far
+            process.kill()
+            _, stderr = process.communicate()
+        assert stderr == "", (option, stderr)
     kernels = ["transmission_kernel", "planar_closed_form_kernel", "close_chains_kernel"]
     for _ in range(2):  # the first run compiles what no earlier test has; the second finds everything cached
         warm = screwkit("warmup", timeout=600)

@@ -14,7 +14,7 @@ from typing import Callable
 import click
 import numpy as np
 
-from screwkit._compile_notice import announce_compilation
+from screwkit._compile_notice import announce_compilation, silence
 from screwkit.loader import load
 from screwkit.studies.files import check_output
 from screwkit.tolerances import SINGULARITY_THRESHOLD
@@ -45,6 +45,8 @@ class ScrewkitGroup(click.Group):
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         arguments = list(sys.argv[1:] if args is None else args)
+        if "--quiet" in arguments or "--json" in arguments:  # stderr stays empty: no compile notice either
+            silence()
         try:
             result = super().main(arguments, prog_name, complete_var, standalone_mode=False, **extra)
         except click.exceptions.Exit as stop:
