@@ -10,7 +10,7 @@ import click
 from screwkit.cli.options import fail, json_option, overwrite_option, quiet_option
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
 from screwkit.loader import load, load_text
-from screwkit.studies.files import check_output
+from screwkit.studies.files import atomic_text, check_output
 
 __all__ = ["convert"]
 
@@ -56,7 +56,7 @@ def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool,
         raise fail(str(error)) from None
     if mechanism.assembly_notes:
         raise fail(f"{out}: the converted file still leaves loops open: {'; '.join(mechanism.assembly_notes)}")
-    out.write_text(text, encoding="utf-8")
+    atomic_text(out, text)
     summary = {"source": str(source), "written": str(out), "format": report.file_format,
                "platform_body": report.platform_body, "output": report.output, "planar": report.planar,
                "dof": mechanism.dof, "task_coordinates": list(mechanism.task_coordinates),
