@@ -154,3 +154,20 @@ def in_millimetres(text: str, *, declare: bool = False) -> str:
     if declare:
         ElementTree.SubElement(root, "units", length="mm")
     return ElementTree.tostring(root, encoding="unicode")
+
+
+def platform_twist(mechanism, pose_minus, pose_plus, step):
+    """World-frame twist (omega, v at the world origin) of the platform between two full poses a step
+    either side of a configuration: a central difference."""
+    rotation_world_base = mechanism.rotation_world_base
+    translation_world_base = mechanism.translation_world_base
+    frames = []
+    for pose in (pose_minus, pose_plus):
+        rotation, translation = mechanism.transforms_from_poses(pose)
+        frames.append((rotation_world_base @ rotation, rotation_world_base @ translation + translation_world_base))
+    (r0, p0), (r1, p1) = frames
+    delta = r1 @ r0.T
+    omega = np.array([delta[2, 1] - delta[1, 2], delta[0, 2] - delta[2, 0], delta[1, 0] - delta[0, 1]]) / 2 / (2 * step)
+    velocity_point = (p1 - p0) / (2 * step)
+    middle = (p0 + p1) / 2
+    return np.concatenate([omega, velocity_point - np.cross(omega, middle)])

@@ -27,7 +27,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import platform_twist, screwkit
 from screwkit.closure import actuator_values, chain_screws, forward, solve
 from screwkit.loader import load
 from screwkit.studies import indices_at_pose, indices_at_poses
@@ -302,15 +302,6 @@ def test_schoenflies_5_indices_from_the_leg_plane_forces():
     # well conditioned: at home ITI = sin 55 deg on every leg, and every 4-leg set has OTI > 0.2 about home
     np.testing.assert_allclose(result.iti_actuators[0], math.sin(math.radians(55.0)), atol=1e-12)
     assert result.f_o[1][0] > 0.69 and np.min(result.f_o[1]) > 0.2
-
-
-def platform_twist(mechanism_, pose_minus, pose_plus, step):
-    """Base-frame twist (omega, v at the origin) between two full poses, central difference."""
-    (r0, p0), (r1, p1) = (mechanism_.transforms_from_poses(pose) for pose in (pose_minus, pose_plus))
-    delta = r1 @ r0.T
-    omega = np.array([delta[2, 1] - delta[1, 2], delta[0, 2] - delta[2, 0], delta[1, 0] - delta[0, 1]]) / 2
-    omega, velocity = omega / (2 * step), (p1 - p0) / (2 * step)
-    return np.concatenate([omega, velocity - np.cross(omega, (p0 + p1) / 2)])
 
 
 @pytest.mark.parametrize("pose_name", ["home", "shifted_turned"])

@@ -12,27 +12,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from helpers import platform_twist
 from screwkit import screws
 from screwkit.closure import actuator_values, chain_screws, forward, solve
 from screwkit.loader import load
 from screwkit.studies import indices_at_pose
 from screwkit.transmission import analyze
-
-
-def platform_twist(mechanism, pose_minus, pose_plus, step):
-    """World-frame twist (omega, v at the world origin) from two platform poses, central difference."""
-    rotation_world_base = mechanism.rotation_world_base
-    translation_world_base = mechanism.translation_world_base
-    frames = []
-    for pose in (pose_minus, pose_plus):
-        rotation, translation = mechanism.transforms_from_poses(pose)
-        frames.append((rotation_world_base @ rotation, rotation_world_base @ translation + translation_world_base))
-    (r0, p0), (r1, p1) = frames
-    delta = r1 @ r0.T
-    omega = np.array([delta[2, 1] - delta[1, 2], delta[0, 2] - delta[2, 0], delta[1, 0] - delta[0, 1]]) / 2 / (2 * step)
-    velocity_point = (p1 - p0) / (2 * step)
-    middle = (p0 + p1) / 2
-    return np.concatenate([omega, velocity_point - np.cross(omega, middle)])
 
 
 @pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
