@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rpy_from_rotation
+from screwkit.rotations import rotation_about_axis, rpy_from_rotation
 
 __all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "convert_tree", "OUTPUT_NAMES"]
 
@@ -420,8 +420,7 @@ def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
     motion = np.eye(4)
     value = joint_value(model, joint, q)
     if kind == "revolute":
-        skew = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        motion[:3, :3] = np.eye(3) + np.sin(value) * skew + (1 - np.cos(value)) * skew @ skew
+        motion[:3, :3] = rotation_about_axis(axis, value)
     else:
         motion[:3, 3] = axis * value
     return motion
