@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 from screwkit.model.urdf_writer import UrdfWriter
 from screwkit.rotations import rotation_about_axis, rpy_from_rotation
 
-__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "convert_tree", "OUTPUT_NAMES"]
+__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "convert_tree", "OUTPUT_NAMES", "homogeneous"]
 
 OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
 """Frame names taken as the output when none is given, in this order (case-insensitive)."""
@@ -125,7 +125,8 @@ class ImportReport:
 # -- the tree ------------------------------------------------------------------------------------
 
 
-def _homogeneous(placement) -> NDArray[np.float64]:
+def homogeneous(placement) -> NDArray[np.float64]:
+    """A Pinocchio placement (SE3) as a 4x4 matrix."""
     matrix = np.eye(4)
     matrix[:3, :3] = np.asarray(placement.rotation)
     matrix[:3, 3] = np.asarray(placement.translation)
@@ -179,8 +180,8 @@ def _length_scale(model, data) -> float:
 
 
 def _frames(model, data, closure: Closure) -> tuple[NDArray, NDArray]:
-    return (_homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a,
-            _homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b)
+    return (homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a,
+            homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b)
 
 
 def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
@@ -323,7 +324,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     elif on_platform_a:
         raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side.")
     after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
-    frame_a = _homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
+    frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
     kinds = [joint_kind(model, joint) for joint in after]
     if closure.kind == "3d":
         if after:
@@ -337,7 +338,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         return _Leg(a_path, "fixed", closure.placement_a, frame_a, None, [], closure.name)
     # the platform-side loop frame: the first joint beyond the platform at zero motion
     first = after[0]
-    zero = _homogeneous(data.oMi[model.parents[first]]) @ _homogeneous(model.jointPlacements[first])
+    zero = homogeneous(data.oMi[model.parents[first]]) @ homogeneous(model.jointPlacements[first])
     predecessor = closure.placement_a @ _inverse(closure.placement_b)  # frame b's joint frame, on leg a
     if len(after) == 1 and kinds[0][0] in ("revolute", "prismatic"):
         kind, axis = kinds[0]
@@ -461,7 +462,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
     body = bodies.get(platform, model.names[platform])
     report.platform_body = body
-    spine = _Leg(path_to(model, platform), "fixed", np.eye(4), _homogeneous(data.oMi[platform]), None, [], "")
+    spine = _Leg(path_to(model, platform), "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
     legs = [spine] + [_loop_of(tree, data, closure, platform, scale) for closure in tree.closures]
     owner: dict[int, str] = {}
     for leg in legs:
@@ -499,7 +500,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.planar = normal is not None
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]
     meet = all(np.linalg.norm(c - centres[0]) < 1e-9 * scale for c in centres)
-    output_world = _homogeneous(data.oMf[frame_index])
+    output_world = homogeneous(data.oMf[frame_index])
     point = tree.output_type == "point" or (tree.output_type is None and meet)
     if point and not meet:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
@@ -538,7 +539,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     for leg in legs:
         parent, end = base, base
         for position, joint in enumerate(leg.joints):
-            placement = _homogeneous(model.jointPlacements[joint])
+            placement = homogeneous(model.jointPlacements[joint])
             if position == 0:
                 placement = _inverse(world_base) @ placement
             link = f"{model.names[joint]}_link"

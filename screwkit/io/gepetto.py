@@ -13,9 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
 
 __all__ = ["read_gepetto", "yaml_beside"]
 
@@ -68,9 +66,7 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
             if name not in names:
                 raise ImportError_(f"{yaml_path}: closed_loop[{index}] names frame {name!r}, not in {urdf.name}.")
             frame = model.frames[names.index(name)]
-            placement = np.eye(4)
-            placement[:3, :3], placement[:3, 3] = frame.placement.rotation, frame.placement.translation
-            sides.append((int(frame.parentJoint), placement))
+            sides.append((int(frame.parentJoint), homogeneous(frame.placement)))
         closures.append(Closure(f"{pair[0]}-{pair[1]}", sides[0][0], sides[0][1], sides[1][0], sides[1][1],
                                 str(kind).lower()))
     return ClosedTree(source, model, closures, [str(m) for m in motors], pin.neutral(model), output, output_type,

@@ -17,15 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
 
 __all__ = ["read_mjcf"]
-
-
-def _matrix(placement) -> np.ndarray:
-    matrix = np.eye(4)
-    matrix[:3, :3], matrix[:3, 3] = placement.rotation, placement.translation
-    return matrix
 
 
 def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -72,10 +66,10 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
     constraints = sorted(equalities, key=lambda e: e.get("name"))  # Pinocchio returns them sorted by name
     connects = [e.get("name") for e in constraints if e.tag == "connect"]
     welds = [e.get("name") for e in constraints if e.tag == "weld"]
-    closures = [Closure(name, int(c.joint1_id), _matrix(c.joint1_placement), int(c.joint2_id),
-                        _matrix(c.joint2_placement), "3d") for name, c in zip(connects, points)]
-    closures += [Closure(name, int(c.joint1_id), _matrix(c.joint1_placement), int(c.joint2_id),
-                         _matrix(c.joint2_placement), "6d") for name, c in zip(welds, frames)]
+    closures = [Closure(name, int(c.joint1_id), homogeneous(c.joint1_placement), int(c.joint2_id),
+                        homogeneous(c.joint2_placement), "3d") for name, c in zip(connects, points)]
+    closures += [Closure(name, int(c.joint1_id), homogeneous(c.joint1_placement), int(c.joint2_id),
+                         homogeneous(c.joint2_placement), "6d") for name, c in zip(welds, frames)]
     references = {item.key(): np.array(item.data()) for item in model.referenceConfigurations}
     q = references.get("home", references.get("qpos0", pin.neutral(model)))
     return ClosedTree(source, model, closures, motors, np.asarray(q, dtype=float), output, output_type, "MJCF")
