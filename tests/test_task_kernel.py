@@ -1,10 +1,13 @@
-"""The compiled closure of the constraining chains (lower mobility), against independent numpy computations."""
+"""The compiled forward kinematics and closure of the constraining chains, against independent numpy computations."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from screwkit.closure import _frames_kernel as frames
 from screwkit.closure import _task_kernel as kernel
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.closure.newton import pose_error
@@ -26,13 +29,58 @@ def random_rotation_vectors(rng, count):
 def test_compiled_exp_and_log_equal_the_numpy_maps_small_angles_and_near_pi_included():
     rng = np.random.default_rng(3)
     for vector in random_rotation_vectors(rng, 60):
-        rotation = np.array(kernel._exp(*vector)).reshape(3, 3)
+        rotation = np.array(frames.exp_map(*vector)).reshape(3, 3)
         np.testing.assert_allclose(rotation, rotation_from_rotation_vector(vector), atol=1e-14)
-        logged = np.array(kernel._log(tuple(rotation.ravel())))
+        logged = np.array(frames.log_map(tuple(rotation.ravel())))
         expected = rotation_vector_from_rotation(rotation)
         # at exactly pi the vector and its opposite are the same rotation
         assert np.allclose(logged, expected, atol=1e-9) or np.allclose(logged, -expected, atol=1e-9)
-        np.testing.assert_allclose(np.array(kernel._exp(*logged)).reshape(3, 3), rotation, atol=1e-12)
+        np.testing.assert_allclose(np.array(frames.exp_map(*logged)).reshape(3, 3), rotation, atol=1e-12)
+
+
+FRAMES = ("axes", "points", "leg_rotation", "leg_translation", "end_rotation", "end_translation")
+BUNDLED = ("planar_5rrr", "planar_4rpr", "five_bar_3", "ups_hexapod_8", "rss_hexapod_8", "prs_3_ups", "delta_4",
+           "schoenflies_5", "coop_arms")
+
+
+def loop_variants(geometry):
+    """The chain closed by every loop joint type in turn (axes: the platform frame's, unit)."""
+    axes = {"fixed": np.zeros((0, 3)), "revolute": np.array([[0.0, 0.6, 0.8]]),
+            "prismatic": np.array([[0.0, 0.6, 0.8]]), "universal": np.array([[1.0, 0.0, 0.0], [0.0, 0.6, 0.8]]),
+            "spherical": np.eye(3)}
+    return [replace(geometry, loop_type=kind, loop_axes=value) for kind, value in axes.items()]
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_compiled_forward_kinematics_equals_numpy_for_every_chain_and_loop_type(name):
+    """Random joint values, batch of any shape, read-only input: the kernel gives numpy's frames."""
+    rng = np.random.default_rng(11)
+    for chain in load(name).chains:
+        for geometry in loop_variants(chain.geometry):
+            values = rng.uniform(-3.0, 3.0, (4, 150, geometry.n_dofs))
+            values.flags.writeable = False
+            numpy_frames = chain_forward_kinematics(geometry, values, compiled=False)
+            compiled = chain_forward_kinematics(geometry, values, compiled=True)
+            for field in FRAMES:
+                expected = getattr(numpy_frames, field)
+                assert getattr(compiled, field).shape == expected.shape, (chain.name, geometry.loop_type, field)
+                np.testing.assert_allclose(getattr(compiled, field), expected, rtol=0, atol=1e-13,
+                                           err_msg=f"{chain.name} {geometry.loop_type} {field}")
+    assert len(frames.chain_frames_kernel.signatures) == 1
+
+
+def test_large_batches_go_through_the_compiled_forward_kinematics(monkeypatch):
+    """The default path by batch size: numpy below COMPILED_FROM, the kernel from it on."""
+    from screwkit.closure import chain_kinematics
+
+    geometry = load("ups_hexapod_8").chains[0].geometry
+    calls = []
+    original = chain_kinematics._compiled_frames
+    monkeypatch.setattr(chain_kinematics, "_compiled_frames", lambda *a: calls.append(a) or original(*a))
+    chain_forward_kinematics(geometry, np.zeros((chain_kinematics.COMPILED_FROM - 1, geometry.n_dofs)))
+    assert not calls
+    chain_forward_kinematics(geometry, np.zeros((chain_kinematics.COMPILED_FROM, geometry.n_dofs)))
+    assert len(calls) == 1
 
 
 @pytest.mark.parametrize("name", ["prs_3_ups", "planar_5rrr"])

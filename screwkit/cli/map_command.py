@@ -67,8 +67,9 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
               help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 (default: local threads).")
 @click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
               show_default=True, help="Seconds to wait for the --scheduler to answer.")
-@click.option("--task-size", type=click.IntRange(min=1), default=131_072, show_default=True,
-              help="Configurations (grid points x orientations) per task.")
+@click.option("--task-size", type=click.IntRange(min=1),
+              help="Configurations (grid points x orientations) per task (default: at most 131,072 and at least "
+                   "16,384, and 4 tasks per core of this machine where the map is large enough).")
 @click.option("--yes", is_flag=True, help="Proceed with a map of more than 2e9 configurations.")
 @length_unit_option
 @overwrite_option

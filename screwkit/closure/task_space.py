@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from screwkit._compile_notice import announce_compilation
 from screwkit.closure.chain_kinematics import (
     chain_forward_kinematics,
+    packed_chains,
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
@@ -75,37 +76,14 @@ def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:
 
 
 def packed_geometry(mechanism: Mechanism, chains: tuple[int, ...]) -> dict:
-    """The geometry of ``chains`` packed for the compiled closure (tree joints stacked with offsets)."""
+    """The geometry of ``chains`` packed for the compiled closure (:func:`packed_chains`, and the planar plane)."""
     announce_compilation("screwkit.closure._task_kernel")
-    from screwkit.closure._task_kernel import LOOP_CODES  # numba: loaded when a closure first runs
-
     geometries = [mechanism.chains[index].geometry for index in chains]
-    tree = np.cumsum([0] + [g.n_tree_joints for g in geometries])
-    dofs = np.cumsum([0] + [g.n_dofs for g in geometries])
-    joints = int(tree[-1])
-
-    def stacked(name, shape):
-        parts = [np.asarray(getattr(g, name), dtype=float).reshape((-1,) + shape) for g in geometries]
-        return np.ascontiguousarray(np.concatenate(parts) if joints else np.zeros((0,) + shape))
-
-    loop_axes = np.zeros((len(geometries), 2, 3))
-    for row, geometry in enumerate(geometries):
-        axes = np.asarray(geometry.loop_axes, dtype=float).reshape(-1, 3)
-        loop_axes[row, :axes.shape[0]] = axes[:2]
-    return dict(
-        planar=mechanism.is_planar, planar_z=float(mechanism.home_translation[2]),
-        tree_start=tree.astype(np.int64), dof_start=dofs.astype(np.int64),
-        joint_rot=stacked("joint_rotations", (3, 3)), joint_trans=stacked("joint_translations", (3,)),
-        joint_axis=stacked("joint_axes", (3,)),
-        joint_prism=np.array([p for g in geometries for p in g.joint_prismatic], dtype=np.bool_),
-        dof_prism=np.array([p for g in geometries for p in g.dof_prismatic], dtype=np.bool_),
-        leg_rot=np.array([g.leg_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
-        leg_trans=np.array([g.leg_loop_translation for g in geometries], dtype=float).reshape(-1, 3),
-        loop_code=np.array([LOOP_CODES[g.loop_type] for g in geometries], dtype=np.int64),
-        loop_axes=loop_axes,
-        plat_rot=np.array([g.platform_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
-        plat_trans=np.array([g.platform_loop_translation for g in geometries], dtype=float).reshape(-1, 3),
-    )
+    return dict(packed_chains(geometries), planar=mechanism.is_planar,
+                planar_z=float(mechanism.home_translation[2]),
+                dof_prism=np.array([p for g in geometries for p in g.dof_prismatic], dtype=np.bool_),
+                plat_rot=np.array([g.platform_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
+                plat_trans=np.array([g.platform_loop_translation for g in geometries], dtype=float).reshape(-1, 3))
 
 
 BLOCK = 2048

@@ -36,7 +36,12 @@ from screwkit.units import is_angular, unit_of
 __all__ = ["index_map", "planar_disc_map", "disc_grid", "GridMap", "MapSize", "map_size", "map_task"]
 
 CONFIGURATIONS_PER_TASK = 131_072
-"""Configurations (grid points times orientations) per task."""
+"""Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
+TASKS_PER_CORE = 4
+"""A map of local threads is cut into at least this many tasks per core when it is large enough
+(two tasks of 131,072 and 27,000 configurations kept one of two cores idle most of the time)."""
+MIN_CONFIGURATIONS_PER_TASK = 16_384
+"""Smaller tasks than this cost more scheduling than they balance."""
 MAX_CONFIGURATIONS = 2_000_000_000
 """Maps with more configurations are refused unless the caller says to proceed (``--yes``)."""
 
@@ -268,6 +273,15 @@ def _orientation_set(over: dict[str, ArrayLike]) -> NDArray[np.float64]:
                     axis=-1)
 
 
+def task_size(configurations: int, cores: int | None = None) -> int:
+    """Default configurations per task of a map of ``configurations``: at most
+    :data:`CONFIGURATIONS_PER_TASK`, at least :data:`MIN_CONFIGURATIONS_PER_TASK`, and small
+    enough for :data:`TASKS_PER_CORE` tasks per core of this machine (``cores``, default all)."""
+    cores = max(1, cores or os.cpu_count() or 1)
+    balanced = -(-int(configurations) // (TASKS_PER_CORE * cores))
+    return int(min(CONFIGURATIONS_PER_TASK, max(MIN_CONFIGURATIONS_PER_TASK, balanced)))
+
+
 def map_size(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
              mask: NDArray[np.bool_] | None = None, faults=None) -> MapSize:
     """How many grid points, orientations and configurations a map has, and the memory of its result."""
@@ -284,7 +298,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
               at: ArrayLike | None = None, *, mask: NDArray[np.bool_] | None = None,
               threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False,
               limits: bool = True, fault_type: str = "free-swinging", scheduler=None, progress: bool | None = None,
-              connect_timeout: float = CONNECT_TIMEOUT, configurations_per_task: int = CONFIGURATIONS_PER_TASK,
+              connect_timeout: float = CONNECT_TIMEOUT, configurations_per_task: int | None = None,
               as_dataset: bool = True, proceed: bool = False, max_configurations: int = MAX_CONFIGURATIONS):
     """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
 
@@ -308,8 +322,8 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         Progress bar on stderr (default: when stderr is a terminal).
     connect_timeout : float
         Seconds to wait for the scheduler.
-    configurations_per_task : int
-        Grid points times orientations per task.
+    configurations_per_task : int, optional
+        Grid points times orientations per task (default: :func:`task_size` of the map).
     as_dataset : bool
         Return an ``xarray.Dataset`` (default) or the plain :class:`GridMap`.
     proceed, max_configurations :
@@ -343,6 +357,8 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
     at = mechanism.check_poses(mechanism.home_pose if at is None else at)
     over_axes = tuple(names.index(name) for name in over)
     over_values = _orientation_set(over)
+    if configurations_per_task is None:
+        configurations_per_task = task_size(size.configurations)
     per_task = max(1, configurations_per_task // max(1, over_values.shape[0]))
     faults = None if faults is None else tuple(np.atleast_1d(faults).tolist())
     text = portable(mechanism)
