@@ -40,7 +40,8 @@ BLOCK = 64  # configurations gathered batch-first at a time
 # when this module is imported; every other argument is C-contiguous (analyze() sees to it).
 _SIGNATURE = (
     "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
-    "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], float64, float64, "
+    "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], int64[:, ::1], "
+    "int64[:, ::1], float64, float64, "
     "float64, float64, float64, float64, float64, "
     "float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], "
     "int64[:, ::1], boolean[:, ::1], float64[:, :, ::1], float64[:, :, :, ::1], boolean[::1])"
@@ -271,7 +272,8 @@ def _power_coefficient(numerator, arm, reference, threshold):
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
-                        submechanisms, locked_sets, locked_of, fault_start, fault_table, threshold, rank_tolerance,
+                        submechanisms, locked_sets, locked_of, fault_start, fault_table, lattice_children, fault_rows,
+                        threshold, rank_tolerance,
                         pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency, worst_fault_tie,
                         iti_override, oti_override, iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out,
                         wrench_out, twist_out, outside_out):
@@ -295,6 +297,11 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     fault_start (F + 1,), fault_table (E, M) : the actuator sets E_i left after j faults, for each
         of F values of j: rows fault_start[f]:fault_start[f+1] of fault_table list the
         submechanisms contained in each set (padded with -1).
+    lattice_children (R, K), fault_rows (F, 2) : when ``fault_rows`` has rows, the reductions go
+        through the lattice of actuator sets instead of the table (see
+        :func:`screwkit.transmission._reductions`): row t of ``lattice_children`` lists the sets
+        one smaller (rows of the OTIs, then of the lattice, padded with -1) whose LMTIs give set
+        S + t its LMTI; ``fault_rows[f]`` is the range of rows of the sets left after the f-th j.
     threshold : the singularity threshold p, in the length unit of the screws (compared as p / L).
     rank_tolerance, pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency,
         worst_fault_tie : the dimensionless tolerances RANK_TOLERANCE, PURE_COUPLE,
@@ -368,7 +375,8 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     lane_e = np.empty(BLOCK)
     scalar_out = np.empty(6)
     output_omega = np.empty((locked_sets.shape[0], BLOCK))
-    oti_local = np.empty((subs, BLOCK))
+    lattice = fault_rows.shape[0] > 0
+    oti_local = np.empty((subs + lattice_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the lattice
     independent = np.empty((subs, BLOCK), dtype=np.bool_)
     values = np.empty((n, BLOCK))
     determinant = np.empty(BLOCK)
@@ -816,6 +824,35 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
         # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
         # The worst set reported is the first, in combination order, whose LMTI is within
         # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
+        if lattice:  # the LMTI of every larger set, level by level, from its subsets one smaller
+            for row in range(lattice_children.shape[0]):
+                for r in range(width):
+                    lane2[r] = -np.inf
+                for t in range(lattice_children.shape[1]):
+                    child = lattice_children[row, t]
+                    if child < 0:
+                        break
+                    for r in range(width):
+                        lane2[r] = max(lane2[r], oti_local[child, r])
+                for r in range(width):
+                    oti_local[subs + row, r] = lane2[r]
+            for f in range(fault_rows.shape[0]):
+                first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
+                for r in range(width):
+                    best[r] = np.inf
+                for e in range(first_row, last_row):
+                    for r in range(width):
+                        best[r] = min(best[r], oti_local[e, r])
+                for r in range(width):
+                    lane2[r] = best[r] + worst_fault_tie
+                    first_set[r] = -1
+                for e in range(first_row, last_row):
+                    for r in range(width):
+                        if first_set[r] < 0 and oti_local[e, r] <= lane2[r]:
+                            first_set[r] = e - first_row
+                for r in range(width):
+                    summary_out[first_index + r, 2 + f] = best[r]
+                    worst_out[first_index + r, f] = max(first_set[r], 0)
         for f in range(fault_start.shape[0] - 1):
             for r in range(width):
                 best[r] = np.inf

@@ -34,6 +34,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from itertools import combinations
+from math import comb
 from typing import Sequence
 
 import numpy as np
@@ -92,6 +93,8 @@ class _Plan:
     failed_sets: dict[int, NDArray[np.int64]]
     fault_start: NDArray[np.int64]
     fault_table: NDArray[np.int64]
+    lattice_children: NDArray[np.int64]
+    fault_rows: NDArray[np.int64]
     threshold: float
     rank_tolerance: float
     idle_count: int = 0
@@ -126,20 +129,11 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
             if not 1 <= j <= a - n:
                 raise ValueError(f"Expected the number of faults `j` in 1..a-n = 1..{a - n}, got {j}.")
     submechanisms = list(combinations(range(a), n))
-    position = {sub: s for s, sub in enumerate(submechanisms)}
-    fault_members, failed_sets = {}, {}
-    for j in fault_list:
-        sets = fault_sets(a, n, j)
-        fault_members[j] = np.array([[position[sub] for sub in combinations(remaining, n)] for remaining in sets])
-        failed_sets[j] = np.array([sorted(set(range(a)) - set(e)) for e in sets], dtype=np.int64).reshape(-1, j)
+    failed_sets = {j: np.array([sorted(set(range(a)) - set(e)) for e in fault_sets(a, n, j)],
+                               dtype=np.int64).reshape(-1, j) for j in fault_list}
     locked = list(combinations(range(a), n - 1))
     locked_index = {subset: index for index, subset in enumerate(locked)}
-    # Every set left after j faults, for every j, as rows of submechanism indices (padded with -1).
-    rows = [members for j in fault_list for members in fault_members[j]]
-    fault_table = np.full((len(rows), max((len(r) for r in rows), default=0)), -1, dtype=np.int64)
-    for row, members in enumerate(rows):
-        fault_table[row, :len(members)] = members
-    fault_start = np.cumsum([0] + [len(fault_members[j]) for j in fault_list]).astype(np.int64)
+    fault_start, fault_table, lattice_children, fault_rows = _reductions(a, n, submechanisms, fault_list)
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
     return _Plan(
         actuators=actuators, dof=n, space=space, complement=complement,
@@ -151,8 +145,51 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
                            dtype=np.int64).reshape(-1, n),
         faults=fault_list, failed_sets=failed_sets, fault_start=fault_start,
-        fault_table=fault_table, threshold=float(threshold), rank_tolerance=float(rank_tolerance),
+        fault_table=fault_table, lattice_children=lattice_children, fault_rows=fault_rows,
+        threshold=float(threshold), rank_tolerance=float(rank_tolerance),
         idle_count=idle_count)
+
+
+def _reductions(a: int, n: int, submechanisms: list[tuple[int, ...]], fault_list: tuple[int, ...]):
+    """How the kernel reduces the submechanisms' OTIs to F_Oj, whichever costs fewer operations.
+
+    *Table*: for each set ``E`` left after ``j`` faults, the max over the C(a - j, n)
+    submechanisms it contains (``fault_start``, ``fault_table``), Sum_j C(a, j) C(a - j, n) reads.
+    *Lattice*: ``LMTI_E = max_{e in E} LMTI_{E - e}`` for ``|E| > n`` (every submechanism of ``E``
+    misses some ``e``), so the LMTIs of every set of size n + 1, n + 2, ... follow level by level
+    from the OTIs, each from its ``|E|`` subsets one smaller: Sum_k k C(a, k) reads, far fewer
+    when ``a - n`` is large (``coop_arms``, every j: 14,785 against 58,212). Both are exact
+    (maxima and minima of the same numbers). Lattice rows (``lattice_children``, padded with -1)
+    index the kernel's array of OTIs followed by the lattice's own rows; ``fault_rows[f]`` is the
+    range of rows holding the sets ``E`` of the f-th ``j``, in combination order.
+    """
+    empty = np.zeros((0, 0), dtype=np.int64)
+    if not fault_list:
+        return np.zeros(1, dtype=np.int64), empty, empty, np.zeros((0, 2), dtype=np.int64)
+    largest = a - min(fault_list)
+    table_cost = sum(comb(a, j) * comb(a - j, n) for j in fault_list)
+    lattice_cost = sum(k * comb(a, k) for k in range(n + 1, largest + 1)) + sum(comb(a, j) for j in fault_list)
+    if lattice_cost < table_cost:
+        index = {sub: row for row, sub in enumerate(submechanisms)}
+        children, start = [], {n: 0}
+        for size in range(n + 1, largest + 1):
+            start[size] = len(index)
+            for members in combinations(range(a), size):
+                children.append([index[members[:k] + members[k + 1:]] for k in range(size)])
+                index[members] = len(index)
+        lattice = np.full((len(children), largest), -1, dtype=np.int64)
+        for row, kids in enumerate(children):
+            lattice[row, :len(kids)] = kids
+        rows = np.array([[start[a - j], start[a - j] + comb(a, a - j)] for j in fault_list], dtype=np.int64)
+        return np.zeros(1, dtype=np.int64), empty, lattice.reshape(-1, max(largest, 1)), rows
+    position = {sub: s for s, sub in enumerate(submechanisms)}
+    members = [[position[sub] for sub in combinations(remaining, n)]
+               for j in fault_list for remaining in fault_sets(a, n, j)]
+    table = np.full((len(members), max(len(m) for m in members)), -1, dtype=np.int64)
+    for row, subs in enumerate(members):
+        table[row, :len(subs)] = subs
+    fault_start = np.cumsum([0] + [comb(a, j) for j in fault_list]).astype(np.int64)
+    return fault_start, table, empty, np.zeros((0, 2), dtype=np.int64)
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
@@ -181,7 +218,8 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
                          for array in (basis, complement))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
                         complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
-                        plan.fault_table, plan.threshold, plan.rank_tolerance, tolerances.PURE_COUPLE,
+                        plan.fault_table, plan.lattice_children, plan.fault_rows, plan.threshold, plan.rank_tolerance,
+                        tolerances.PURE_COUPLE,
                         tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT,
                         tolerances.PSEUDO_INVERSE_CONSISTENCY, tolerances.WORST_FAULT_TIE,
                         empty if iti_override is None else iti_override,
