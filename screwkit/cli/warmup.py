@@ -13,8 +13,12 @@ __all__ = ["warmup"]
 
 @click.command()
 def warmup() -> None:
-    """Compile the index kernel, the planar closed forms and the lower-mobility closure into numba's cache,
-    saying for each whether it was cached and how long it took (later runs load them in under a second)."""
+    """Compile the index kernel, the planar closed forms, the lower-mobility closure and the batched forward
+    kinematics into numba's cache, saying for each whether it was cached and how long it took (later runs load
+    them in under a second)."""
+    import numpy as np
+
+    from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics  # idem
     from screwkit.loader import load  # Pinocchio: loaded when the command runs, not for --help
     from screwkit.studies.poses import indices_at_pose, indices_at_poses  # idem
 
@@ -23,6 +27,8 @@ def warmup() -> None:
         "screwkit._kernels": lambda: indices_at_pose(five, five.home_pose),
         "screwkit._planar_kernel": lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
         "screwkit.closure._task_kernel": lambda: load("prs_3_ups"),
+        "screwkit.closure._frames_kernel": lambda: chain_forward_kinematics(
+            five.chains[0].geometry, np.zeros((COMPILED_FROM, five.chains[0].geometry.n_dofs))),
     }
     for module, step in steps.items():
         cached = kernel_is_cached(module)
