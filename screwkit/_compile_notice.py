@@ -19,7 +19,7 @@ KERNELS = {
     "screwkit._kernels": ("transmission_kernel", 35),
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 5),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 15),
-    "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
+    "screwkit.closure._frames_kernel": ("chain_frames_kernel", 4),
 }
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 

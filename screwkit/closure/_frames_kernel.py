@@ -154,15 +154,10 @@ def leg_frames(c, values, tree_start, dof_start, joint_rot, joint_trans, joint_a
     return leg_rotation, leg_translation, rotation, (t0, t1, t2)
 
 
-# One signature: every caller passes C-contiguous arrays of these types, so one compiled version
-# serves every chain and loads from numba's disk cache.
-_SIGNATURE = ("void(float64[:, ::1], int64[::1], int64[::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], "
-              "boolean[::1], float64[:, :, ::1], float64[:, ::1], int64[::1], float64[:, :, ::1], "
-              "float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, :, ::1], "
-              "float64[:, ::1])")
-
-
-@njit(_SIGNATURE, cache=True, nogil=True, error_model="numpy")
+# Compiled on its first call (not when the module is imported for its helpers by the closure
+# kernel); every caller passes C-contiguous writeable arrays of one set of types, so one compiled
+# version serves every chain and loads from numba's disk cache.
+@njit(cache=True, nogil=True, error_model="numpy")
 def chain_frames_kernel(values, tree_start, dof_start, joint_rot, joint_trans, joint_axis, joint_prism, leg_rot,
                         leg_trans, loop_code, loop_axes, axes, points, leg_rotation, leg_translation, end_rotation,
                         end_translation):
