@@ -5,10 +5,12 @@ actuation wrenches, the ITIs, and the output twists and OTIs of every non-redund
 submechanism, then the LMTI, F_Oj and the mutual-interference actuators, exactly as
 documented in :func:`screwkit.transmission.analyze`. Every per-configuration quantity has a
 last "lane" axis over the 64 configurations and every step loops over the lanes innermost,
-so that the compiler vectorises the algebra across configurations. The null vectors of n - 1 > 2
-rows (output twists, actuation wrenches) are eliminated lane-innermost too, pivot choices and row
-swaps as per-lane blends (:func:`_null_vectors_lanes`); only the lanes whose leading block is
-poorly conditioned, and the Gram solves of chains with more joint DoFs than n, run lane by lane. The
+so that the compiler vectorises the algebra across configurations. The output twists (cofactor
+vectors of n - 1 locked wrenches) are exterior products of the locked rows, level by level, each
+locked set starting from the minors it shares with the set before it (no pivoting, no division);
+the actuation wrenches' null vectors are eliminated lane-innermost, pivot choices and row swaps as
+per-lane blends (:func:`_null_vectors_lanes`); only the lanes whose leading block is poorly
+conditioned, and the Gram solves of chains with more joint DoFs than n, run lane by lane. The
 small dense algebra (null vectors, Gram solves over one chain's joints) is written out here, and
 scratch is allocated once per call (the pseudo-inverse fallback for idle DoFs excepted).
 
@@ -41,7 +43,7 @@ BLOCK = 64  # configurations gathered batch-first at a time
 _SIGNATURE = (
     "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
     "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], int64[:, ::1], "
-    "int64[:, ::1], float64, float64, "
+    "int64[:, ::1], int64[::1], int64[:, ::1], int64[::1], float64, float64, "
     "float64, float64, float64, float64, float64, "
     "float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], "
     "int64[:, ::1], boolean[:, ::1], float64[:, :, ::1], float64[:, :, :, ::1], boolean[::1])"
@@ -273,7 +275,7 @@ def _power_coefficient(numerator, arm, reference, threshold):
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
                         submechanisms, locked_sets, locked_of, fault_start, fault_table, lattice_children, fault_rows,
-                        threshold, rank_tolerance,
+                        locked_depth, wedge_table, wedge_start, threshold, rank_tolerance,
                         pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency, worst_fault_tie,
                         iti_override, oti_override, iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out,
                         wrench_out, twist_out, outside_out):
@@ -294,6 +296,11 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     locked_sets (L, n - 1) : every set of n - 1 actuators (locked while one other drives).
     locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
         the other n - 1 actuators of the submechanism.
+    locked_depth (L,), wedge_table (T, 5), wedge_start (n + 1,) : for n >= 4, the output twists'
+        exterior products (see :func:`screwkit.transmission._wedge_tables`): the first position at
+        which each locked set differs from the one before, and the expansion terms (target minor,
+        source minor, column, sign, first term of its target) of level K in rows
+        wedge_start[K]:wedge_start[K+1].
     fault_start (F + 1,), fault_table (E, M) : the actuator sets E_i left after j faults, for each
         of F values of j: rows fault_start[f]:fault_start[f+1] of fault_table list the
         submechanisms contained in each set (padded with -1).
@@ -366,6 +373,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     wrench_matrix = np.zeros((a, n, BLOCK))
     row_norms = np.zeros((a, BLOCK))
     output = np.empty((locked_sets.shape[0], n, BLOCK))
+    wedge = np.zeros((max(n, 1), 20, BLOCK))  # minors of the first K locked rows, at most C(6, 3) = 20 per level
     locked_rows = np.empty((max(n - 1, 1), n, BLOCK))
     elimination = np.empty((max(n - 1, 1), n, BLOCK))
     lane_a = np.empty(BLOCK)
@@ -725,13 +733,43 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
                     output[locked, 0, r], output[locked, 1, r], output[locked, 2, r] = _cross(
                         wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
                         wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
+            elif n == 1:  # no locked row: the one motion
+                for r in range(width):
+                    output[locked, 0, r] = 1.0
+            elif n == 2:  # one locked row (x, y): (-y, x)
+                i0 = locked_sets[locked, 0]
+                for r in range(width):
+                    output[locked, 0, r] = -wrench_matrix[i0, 1, r]
+                    output[locked, 1, r] = wrench_matrix[i0, 0, r]
             else:
-                for i in range(n - 1):
-                    for q in range(n):
-                        for r in range(width):
-                            locked_rows[i, q, r] = wrench_matrix[locked_sets[locked, i], q, r]
-                _null_vectors_lanes(locked_rows, n, width, output[locked], elimination, lane_a, lane_b, lane_c,
-                                    lane_d, lane_e, rows, work, columns, scalar_out)
+                # The cofactor vector as the exterior product of the locked rows: level K holds the
+                # K x K minors of the first K rows (one per K-column set, combination order), each
+                # from level K - 1 by expansion along row K; lexicographic neighbours share their
+                # first rows, so only the levels past the first changed row are recomputed.
+                for level in range(max(locked_depth[locked], 1) + 1, n):
+                    row = locked_sets[locked, level - 1]
+                    first_row = locked_sets[locked, 0]
+                    for term in range(wedge_start[level], wedge_start[level + 1]):
+                        target = wedge_table[term, 0]
+                        source = wedge_table[term, 1]
+                        column = wedge_table[term, 2]
+                        sign = float(wedge_table[term, 3])
+                        if wedge_table[term, 4] == 1:
+                            for r in range(width):
+                                wedge[level, target, r] = 0.0
+                        if level == 2:
+                            for r in range(width):
+                                wedge[2, target, r] += sign * wrench_matrix[first_row, source, r] * wrench_matrix[
+                                    row, column, r]
+                        else:
+                            for r in range(width):
+                                wedge[level, target, r] += sign * wedge[level - 1, source, r] * wrench_matrix[
+                                    row, column, r]
+                # out[q] = (-1)^(n-1+q) det(rows without column q): minor n - 1 - q of the last level
+                for q in range(n):
+                    sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
+                    for r in range(width):
+                        output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
             for r in range(width):
                 lane0[r] = 0.0
                 lane1[r] = 0.0

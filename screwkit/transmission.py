@@ -95,6 +95,9 @@ class _Plan:
     fault_table: NDArray[np.int64]
     lattice_children: NDArray[np.int64]
     fault_rows: NDArray[np.int64]
+    locked_depth: NDArray[np.int64]
+    wedge_table: NDArray[np.int64]
+    wedge_start: NDArray[np.int64]
     threshold: float
     rank_tolerance: float
     idle_count: int = 0
@@ -146,8 +149,35 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
                            dtype=np.int64).reshape(-1, n),
         faults=fault_list, failed_sets=failed_sets, fault_start=fault_start,
         fault_table=fault_table, lattice_children=lattice_children, fault_rows=fault_rows,
+        locked_depth=np.array([0] + [next(k for k in range(n - 1) if before[k] != after[k])
+                                     for before, after in zip(locked, locked[1:])], dtype=np.int64),
+        **_wedge_tables(n),
         threshold=float(threshold), rank_tolerance=float(rank_tolerance),
         idle_count=idle_count)
+
+
+def _wedge_tables(n: int) -> dict:
+    """Expansion terms of the exterior products that give the output twists for n >= 4.
+
+    The minor of rows ``r_1..r_K`` on columns ``S = {s_0 < ... < s_(K-1)}`` expands along its last
+    row: ``sum_t (-1)^(K-1-t) m_(S - s_t) r_K[s_t]``, ``m`` the minors of the first ``K - 1`` rows.
+    Row ``i`` of ``wedge_table`` is one term: (index of ``S`` among the K-column sets, index of
+    ``S - s_t`` among the (K-1)-column sets, ``s_t``, the sign, 1 for the first term of its ``S``);
+    level K's terms are rows ``wedge_start[K]:wedge_start[K+1]`` (none below K = 2). At level n - 1
+    the minors are the cofactor vector's entries: no pivoting and no division, each locked set's
+    vector from its predecessor's minors (Sum_K C(n, K) K multiply-adds per new row).
+    """
+    table, start = [], [0, 0, 0]
+    for size in range(2, max(n, 2)):
+        previous = {columns: index for index, columns in enumerate(combinations(range(n), size - 1))}
+        for target, columns in enumerate(combinations(range(n), size)):
+            for t, column in enumerate(columns):
+                table.append((target, previous[columns[:t] + columns[t + 1:]], column, (-1) ** (size - 1 - t),
+                              int(t == 0)))
+        start.append(len(table))
+    start += [len(table)] * (n + 1 - len(start))
+    return dict(wedge_table=np.array(table, dtype=np.int64).reshape(-1, 5),
+                wedge_start=np.array(start[:n + 1], dtype=np.int64))
 
 
 def _reductions(a: int, n: int, submechanisms: list[tuple[int, ...]], fault_list: tuple[int, ...]):
@@ -218,7 +248,8 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
                          for array in (basis, complement))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
                         complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
-                        plan.fault_table, plan.lattice_children, plan.fault_rows, plan.threshold, plan.rank_tolerance,
+                        plan.fault_table, plan.lattice_children, plan.fault_rows, plan.locked_depth, plan.wedge_table,
+                        plan.wedge_start, plan.threshold, plan.rank_tolerance,
                         tolerances.PURE_COUPLE,
                         tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT,
                         tolerances.PSEUDO_INVERSE_CONSISTENCY, tolerances.WORST_FAULT_TIE,
@@ -433,7 +464,8 @@ def analyze(
     motion space in working coordinates), the output twists are the columns of
     :math:`\mathrm{adj}(W_N)` mapped by ``M``. Column ``k`` depends only on the other
     ``n - 1`` (locked) actuators, so it is computed once per locked set and shared by every
-    submechanism containing it; :math:`|A_k \circ T_k| = |\det W_N|` for every ``k``
+    submechanism containing it (for ``n >= 4`` as the exterior product of the locked wrenches,
+    whose minors lexicographically neighbouring locked sets share); :math:`|A_k \circ T_k| = |\det W_N|` for every ``k``
     (general form of Eq. A3), and
 
     .. math:: OTI_k = \frac{|\det W_N|}{\| v_k + \omega_k \times p_k + h_k \omega_k \|}

@@ -127,3 +127,30 @@ def test_fault_reductions_equal_the_brute_force_over_every_set_both_table_and_la
         value, failed = brute_force_fault_tolerance(result.oti_submechanisms, a, n, j)
         np.testing.assert_array_equal(result.f_o[j], value)
         np.testing.assert_array_equal(result.worst_fault_indices[j], failed)
+
+
+@pytest.mark.parametrize("n", [4, 5, 6])
+def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
+    """The output twists' expansion terms (level by level, as the kernel runs them) against numpy's determinants."""
+    from itertools import combinations
+
+    from screwkit.transmission import _wedge_tables
+
+    tables = _wedge_tables(n)
+    table, start = tables["wedge_table"], tables["wedge_start"]
+    rows = np.random.default_rng(n).normal(size=(n - 1, n))
+    minors = {1: rows[0].copy()}
+    for level in range(2, n):
+        values = np.zeros(len(list(combinations(range(n), level))))
+        for target, source, column, sign, first in table[start[level]:start[level + 1]]:
+            if first:
+                values[target] = 0.0
+            values[target] += sign * minors[level - 1][source] * rows[level - 1, column]
+        minors[level] = values
+        for index, columns in enumerate(combinations(range(n), level)):
+            assert np.isclose(values[index], np.linalg.det(rows[:level][:, columns]), rtol=1e-12, atol=1e-12)
+    cofactor = np.array([(-1) ** (n - 1 + q) * minors[n - 1][n - 1 - q] for q in range(n)])
+    expected = np.empty(n)
+    _null_vector(rows, n, expected, np.empty((n, n)), np.empty(n, dtype=np.int64))
+    np.testing.assert_allclose(cofactor, expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(rows @ cofactor, 0.0, atol=1e-12)
