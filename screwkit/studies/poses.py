@@ -145,11 +145,13 @@ def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
         arrays[key][index] = value
 
 
-JOINT_SLOTS_PER_CHUNK = 1 << 18
-"""Configurations times joint DoFs closed, screwed and analysed at a time by :func:`indices_at_poses`:
-about 19 MB of joint screws and points, so that a chunk's arrays stay in cache-sized, reused memory
-(measured: the 8-leg hexapod 1.6x and the planar 5-RRR 1.5x faster per configuration than with
-chunks of 262,144 configurations, and far less memory)."""
+JOINT_SLOTS_PER_CHUNK = 1 << 20
+"""Configurations times joint DoFs closed, screwed and analysed at a time by :func:`indices_at_poses`
+(about 75 MB of joint screws and points): 21,845 configurations of the 8-leg hexapod, 69,905 of
+the 5-RRR. Chunks of 262,144 configurations made the hexapod 1.6x and the 5-RRR 1.5x slower per
+configuration in one process (arrays out of cache, fresh pages for every chunk); much smaller ones
+spend more on each chunk's fixed cost (about 5 ms) than they save: at 2^18 a hexapod map took 322
+instead of 438 MiB at the same speed, but the 5-RRR's 10^6-configuration map 1.09x longer."""
 MIN_CHUNK, MAX_CHUNK = 4096, 262_144
 
 
