@@ -16,10 +16,10 @@ from pathlib import Path
 __all__ = ["announce_compilation", "kernel_is_cached", "silence", "KERNELS"]
 
 KERNELS = {
-    "screwkit._kernels": ("transmission_kernel", 35),
-    "screwkit._planar_kernel": ("planar_closed_form_kernel", 5),
-    "screwkit.closure._task_kernel": ("close_chains_kernel", 15),
-    "screwkit.closure._frames_kernel": ("chain_frames_kernel", 4),
+    "screwkit._kernels": ("transmission_kernel", 40),
+    "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
+    "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
+    "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
 }
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
