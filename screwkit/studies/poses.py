@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from itertools import combinations
+from math import comb
 from typing import Callable
 
 import numpy as np
@@ -145,20 +146,34 @@ def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
         arrays[key][index] = value
 
 
-JOINT_SLOTS_PER_CHUNK = 1 << 20
-"""Configurations times joint DoFs closed, screwed and analysed at a time by :func:`indices_at_poses`
-(about 75 MB of joint screws and points): 21,845 configurations of the 8-leg hexapod, 69,905 of
-the 5-RRR. Chunks of 262,144 configurations made the hexapod 1.6x and the 5-RRR 1.5x slower per
-configuration in one process (arrays out of cache, fresh pages for every chunk); much smaller ones
-spend more on each chunk's fixed cost (about 5 ms) than they save: at 2^18 a hexapod map took 322
-instead of 438 MiB at the same speed, but the 5-RRR's 10^6-configuration map 1.09x longer."""
+CHUNK_WORK = 1 << 21
+"""Configurations times work units closed, screwed and analysed at a time by :func:`indices_at_poses`
+(see :func:`poses_per_chunk`). Each chunk costs about 5 ms of Python around the compiled kernels;
+its work should dwarf that, and its arrays stay small. Measured: chunks of 262,144 configurations
+made the 8-leg hexapod 1.6x and the 5-RRR 1.5x slower per configuration in one process (arrays out
+of cache, fresh pages for every chunk); sized by joint count alone, chunks small enough for the
+hexapod's memory (5,461 configurations, 322 MiB for its 21 x 21 x 360 map) made the 5-RRR's
+10^6-configuration map 1.09x slower, and large enough for the 5-RRR (69,905) took the hexapod's
+41 x 41 x 360 map to 642 MiB."""
+CHUNK_BYTES = 96 << 20
+"""At most this much memory per chunk, at about 130 bytes per configuration and joint DoF (closure
+results and screws: 34 MB for 5,461 hexapod configurations, traced)."""
+BYTES_PER_JOINT = 130
 MIN_CHUNK, MAX_CHUNK = 4096, 262_144
 
 
 def poses_per_chunk(mechanism: Mechanism) -> int:
-    """How many poses :func:`indices_at_poses` takes at a time for ``mechanism`` (see :data:`JOINT_SLOTS_PER_CHUNK`)."""
+    """How many poses :func:`indices_at_poses` takes at a time for ``mechanism``.
+
+    :data:`CHUNK_WORK` divided by the work of one configuration, counted as its joint DoFs (closure
+    and screws) plus n times its C(a, n) submechanisms (the index kernel), within
+    :data:`CHUNK_BYTES` of memory: 46,603 poses of the 5-RRR, 9,709 of the 8-leg hexapod, 36,873 of
+    the 3-PRS-UPS; at least 4,096 and at most 262,144.
+    """
     joints = sum(len(chain.joint_names) for chain in mechanism.chains)
-    return int(np.clip(JOINT_SLOTS_PER_CHUNK // max(joints, 1), MIN_CHUNK, MAX_CHUNK))
+    work = joints + mechanism.dof * comb(len(mechanism.actuators), mechanism.dof)
+    memory = CHUNK_BYTES // (BYTES_PER_JOINT * max(joints, 1))
+    return int(np.clip(min(CHUNK_WORK // max(work, 1), memory), MIN_CHUNK, MAX_CHUNK))
 
 
 def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = False,
