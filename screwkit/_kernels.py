@@ -42,8 +42,8 @@ BLOCK = 64  # configurations gathered batch-first at a time
 # when this module is imported; every other argument is C-contiguous (analyze() sees to it).
 _SIGNATURE = (
     "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
-    "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], int64[:, ::1], "
-    "int64[:, ::1], int64[::1], int64[:, ::1], int64[::1], float64, float64, "
+    "float64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], "
+    "int64[::1], int64[:, ::1], int64[::1], float64, float64, "
     "float64, float64, float64, float64, float64, "
     "float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], "
     "int64[:, ::1], boolean[:, ::1], float64[:, :, ::1], float64[:, :, :, ::1], boolean[::1])"
@@ -274,8 +274,8 @@ def _power_coefficient(numerator, arm, reference, threshold):
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
-                        submechanisms, locked_sets, locked_of, fault_start, fault_table, lattice_children, fault_rows,
-                        locked_depth, wedge_table, wedge_start, threshold, rank_tolerance,
+                        submechanisms, locked_sets, locked_of, set_children, fault_rows, locked_depth,
+                        wedge_table, wedge_start, threshold, rank_tolerance,
                         pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency, worst_fault_tie,
                         iti_override, oti_override, iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out,
                         wrench_out, twist_out, outside_out):
@@ -301,14 +301,11 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
         which each locked set differs from the one before, and the expansion terms (target minor,
         source minor, column, sign, first term of its target) of level K in rows
         wedge_start[K]:wedge_start[K+1].
-    fault_start (F + 1,), fault_table (E, M) : the actuator sets E_i left after j faults, for each
-        of F values of j: rows fault_start[f]:fault_start[f+1] of fault_table list the
-        submechanisms contained in each set (padded with -1).
-    lattice_children (R, K), fault_rows (F, 2) : when ``fault_rows`` has rows, the reductions go
-        through the lattice of actuator sets instead of the table (see
-        :func:`screwkit.transmission._reductions`): row t of ``lattice_children`` lists the sets
-        one smaller (rows of the OTIs, then of the lattice, padded with -1) whose LMTIs give set
-        S + t its LMTI; ``fault_rows[f]`` is the range of rows of the sets left after the f-th j.
+    set_children (R, K), fault_rows (F, 2) : the actuator sets whose LMTI the reductions need
+        (see :func:`screwkit.transmission._reductions`): row t of ``set_children`` lists rows of
+        the OTIs and sets before it (OTIs of submechanisms first, then the sets in order, padded
+        with -1) whose maximum is the LMTI of set t; ``fault_rows[f]`` is the range of those rows
+        (OTIs included) holding the sets left after the f-th value of j, in combination order.
     threshold : the singularity threshold p, in the length unit of the screws (compared as p / L).
     rank_tolerance, pure_couple, outside_tolerance, gram_pivot, pseudo_inverse_consistency,
         worst_fault_tie : the dimensionless tolerances RANK_TOLERANCE, PURE_COUPLE,
@@ -383,8 +380,7 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     lane_e = np.empty(BLOCK)
     scalar_out = np.empty(6)
     output_omega = np.empty((locked_sets.shape[0], BLOCK))
-    lattice = fault_rows.shape[0] > 0
-    oti_local = np.empty((subs + lattice_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the lattice
+    oti_local = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the sets
     independent = np.empty((subs, BLOCK), dtype=np.bool_)
     values = np.empty((n, BLOCK))
     determinant = np.empty(BLOCK)
@@ -394,10 +390,6 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
     lane2 = np.empty(BLOCK)
     best = np.empty(BLOCK)
     mutual = np.empty(BLOCK, dtype=np.bool_)
-    set_count = 1
-    for f in range(fault_start.shape[0] - 1):
-        set_count = max(set_count, fault_start[f + 1] - fault_start[f])
-    set_values = np.empty((set_count, BLOCK))  # LMTI of every set left after j faults
     first_set = np.empty(BLOCK, dtype=np.int64)
     pure_couple_sq = pure_couple * pure_couple
     outside_sq = outside_tolerance * outside_tolerance
@@ -862,57 +854,33 @@ def transmission_kernel(all_twists, all_points, chain_start, actuator_chain, act
         # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
         # The worst set reported is the first, in combination order, whose LMTI is within
         # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
-        if lattice:  # the LMTI of every larger set, level by level, from its subsets one smaller
-            for row in range(lattice_children.shape[0]):
+        # Each row of set_children is a set whose LMTI is the max over earlier rows (submechanisms'
+        # OTIs, or sets one smaller); its value goes after the OTIs.
+        for row in range(set_children.shape[0]):
+            for r in range(width):
+                lane2[r] = -np.inf
+            for t in range(set_children.shape[1]):
+                child = set_children[row, t]
+                if child < 0:
+                    break
                 for r in range(width):
-                    lane2[r] = -np.inf
-                for t in range(lattice_children.shape[1]):
-                    child = lattice_children[row, t]
-                    if child < 0:
-                        break
-                    for r in range(width):
-                        lane2[r] = max(lane2[r], oti_local[child, r])
-                for r in range(width):
-                    oti_local[subs + row, r] = lane2[r]
-            for f in range(fault_rows.shape[0]):
-                first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
-                for r in range(width):
-                    best[r] = np.inf
-                for e in range(first_row, last_row):
-                    for r in range(width):
-                        best[r] = min(best[r], oti_local[e, r])
-                for r in range(width):
-                    lane2[r] = best[r] + worst_fault_tie
-                    first_set[r] = -1
-                for e in range(first_row, last_row):
-                    for r in range(width):
-                        if first_set[r] < 0 and oti_local[e, r] <= lane2[r]:
-                            first_set[r] = e - first_row
-                for r in range(width):
-                    summary_out[first_index + r, 2 + f] = best[r]
-                    worst_out[first_index + r, f] = max(first_set[r], 0)
-        for f in range(fault_start.shape[0] - 1):
+                    lane2[r] = max(lane2[r], oti_local[child, r])
+            for r in range(width):
+                oti_local[subs + row, r] = lane2[r]
+        for f in range(fault_rows.shape[0]):
+            first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
             for r in range(width):
                 best[r] = np.inf
-            for e in range(fault_start[f], fault_start[f + 1]):
+            for e in range(first_row, last_row):
                 for r in range(width):
-                    lane2[r] = -np.inf
-                for t in range(fault_table.shape[1]):
-                    s = fault_table[e, t]
-                    if s < 0:
-                        break
-                    for r in range(width):
-                        lane2[r] = max(lane2[r], oti_local[s, r])
-                for r in range(width):
-                    set_values[e - fault_start[f], r] = lane2[r]
-                    best[r] = min(best[r], lane2[r])
+                    best[r] = min(best[r], oti_local[e, r])
             for r in range(width):
                 lane2[r] = best[r] + worst_fault_tie
                 first_set[r] = -1
-            for e in range(fault_start[f + 1] - fault_start[f]):
+            for e in range(first_row, last_row):
                 for r in range(width):
-                    if first_set[r] < 0 and set_values[e, r] <= lane2[r]:
-                        first_set[r] = e
+                    if first_set[r] < 0 and oti_local[e, r] <= lane2[r]:
+                        first_set[r] = e - first_row
             for r in range(width):
                 summary_out[first_index + r, 2 + f] = best[r]
                 worst_out[first_index + r, f] = max(first_set[r], 0)

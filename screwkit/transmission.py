@@ -91,9 +91,7 @@ class _Plan:
     locked_of: NDArray[np.int64]
     faults: tuple[int, ...]
     failed_sets: dict[int, NDArray[np.int64]]
-    fault_start: NDArray[np.int64]
-    fault_table: NDArray[np.int64]
-    lattice_children: NDArray[np.int64]
+    set_children: NDArray[np.int64]
     fault_rows: NDArray[np.int64]
     locked_depth: NDArray[np.int64]
     wedge_table: NDArray[np.int64]
@@ -136,7 +134,7 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
                                dtype=np.int64).reshape(-1, j) for j in fault_list}
     locked = list(combinations(range(a), n - 1))
     locked_index = {subset: index for index, subset in enumerate(locked)}
-    fault_start, fault_table, lattice_children, fault_rows = _reductions(a, n, submechanisms, fault_list)
+    set_children, fault_rows = _reductions(a, n, submechanisms, fault_list)
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
     return _Plan(
         actuators=actuators, dof=n, space=space, complement=complement,
@@ -147,8 +145,7 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
         locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
                            dtype=np.int64).reshape(-1, n),
-        faults=fault_list, failed_sets=failed_sets, fault_start=fault_start,
-        fault_table=fault_table, lattice_children=lattice_children, fault_rows=fault_rows,
+        faults=fault_list, failed_sets=failed_sets, set_children=set_children, fault_rows=fault_rows,
         locked_depth=np.array([0] + [next(k for k in range(n - 1) if before[k] != after[k])
                                      for before, after in zip(locked, locked[1:])], dtype=np.int64),
         **_wedge_tables(n),
@@ -181,45 +178,50 @@ def _wedge_tables(n: int) -> dict:
 
 
 def _reductions(a: int, n: int, submechanisms: list[tuple[int, ...]], fault_list: tuple[int, ...]):
-    """How the kernel reduces the submechanisms' OTIs to F_Oj, whichever costs fewer operations.
+    """The sets whose LMTIs give F_Oj, each as the maximum of earlier rows, whichever way costs fewer reads.
 
-    *Table*: for each set ``E`` left after ``j`` faults, the max over the C(a - j, n)
-    submechanisms it contains (``fault_start``, ``fault_table``), Sum_j C(a, j) C(a - j, n) reads.
+    The kernel's rows are the submechanisms' OTIs (``S = C(a, n)`` of them), then one row per set
+    ``E`` of ``set_children``, the maximum over the rows it lists. *Table*: each set left after
+    ``j`` faults lists the C(a - j, n) submechanisms it contains (Sum_j C(a, j) C(a - j, n) reads).
     *Lattice*: ``LMTI_E = max_{e in E} LMTI_{E - e}`` for ``|E| > n`` (every submechanism of ``E``
-    misses some ``e``), so the LMTIs of every set of size n + 1, n + 2, ... follow level by level
-    from the OTIs, each from its ``|E|`` subsets one smaller: Sum_k k C(a, k) reads, far fewer
-    when ``a - n`` is large (``coop_arms``, every j: 14,785 against 58,212). Both are exact
-    (maxima and minima of the same numbers). Lattice rows (``lattice_children``, padded with -1)
-    index the kernel's array of OTIs followed by the lattice's own rows; ``fault_rows[f]`` is the
-    range of rows holding the sets ``E`` of the f-th ``j``, in combination order.
+    misses some ``e``), so every set of size n + 1, n + 2, ... lists its ``|E|`` subsets one
+    smaller (Sum_k k C(a, k) reads), far fewer when ``a - n`` is large (``coop_arms``, every j:
+    14,785 against 58,212). Both are exact (maxima and minima of the same numbers).
+
+    Returns
+    -------
+    set_children : ndarray (R, K) of int
+        Rows listed by each set, padded with -1.
+    fault_rows : ndarray (F, 2) of int
+        For the f-th ``j``, the range of rows (OTIs included) holding the sets left after ``j``
+        faults, in combination order.
     """
-    empty = np.zeros((0, 0), dtype=np.int64)
     if not fault_list:
-        return np.zeros(1, dtype=np.int64), empty, empty, np.zeros((0, 2), dtype=np.int64)
+        return np.zeros((0, 0), dtype=np.int64), np.zeros((0, 2), dtype=np.int64)
     largest = a - min(fault_list)
     table_cost = sum(comb(a, j) * comb(a - j, n) for j in fault_list)
     lattice_cost = sum(k * comb(a, k) for k in range(n + 1, largest + 1)) + sum(comb(a, j) for j in fault_list)
+    index = {sub: row for row, sub in enumerate(submechanisms)}
+    children, start = [], {}
     if lattice_cost < table_cost:
-        index = {sub: row for row, sub in enumerate(submechanisms)}
-        children, start = [], {n: 0}
+        start[n] = 0
         for size in range(n + 1, largest + 1):
             start[size] = len(index)
             for members in combinations(range(a), size):
                 children.append([index[members[:k] + members[k + 1:]] for k in range(size)])
                 index[members] = len(index)
-        lattice = np.full((len(children), largest), -1, dtype=np.int64)
-        for row, kids in enumerate(children):
-            lattice[row, :len(kids)] = kids
-        rows = np.array([[start[a - j], start[a - j] + comb(a, a - j)] for j in fault_list], dtype=np.int64)
-        return np.zeros(1, dtype=np.int64), empty, lattice.reshape(-1, max(largest, 1)), rows
-    position = {sub: s for s, sub in enumerate(submechanisms)}
-    members = [[position[sub] for sub in combinations(remaining, n)]
-               for j in fault_list for remaining in fault_sets(a, n, j)]
-    table = np.full((len(members), max(len(m) for m in members)), -1, dtype=np.int64)
-    for row, subs in enumerate(members):
-        table[row, :len(subs)] = subs
-    fault_start = np.cumsum([0] + [comb(a, j) for j in fault_list]).astype(np.int64)
-    return fault_start, table, empty, np.zeros((0, 2), dtype=np.int64)
+        rows = [(start[a - j], start[a - j] + comb(a, a - j)) for j in fault_list]
+    else:
+        rows = []
+        for j in fault_list:
+            first = len(submechanisms) + len(children)
+            children += [[index[sub] for sub in combinations(remaining, n)] for remaining in fault_sets(a, n, j)]
+            rows.append((first, len(submechanisms) + len(children)))
+    width = max((len(kids) for kids in children), default=0)
+    set_children = np.full((len(children), width), -1, dtype=np.int64)
+    for row, kids in enumerate(children):
+        set_children[row, :len(kids)] = kids
+    return set_children, np.array(rows, dtype=np.int64).reshape(-1, 2)
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
@@ -247,9 +249,9 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
     basis, complement = (array if array.flags.writeable and array.flags.c_contiguous else np.array(array, order="C")
                          for array in (basis, complement))
     transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
-                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.fault_start,
-                        plan.fault_table, plan.lattice_children, plan.fault_rows, plan.locked_depth, plan.wedge_table,
-                        plan.wedge_start, plan.threshold, plan.rank_tolerance,
+                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children,
+                        plan.fault_rows, plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.threshold,
+                        plan.rank_tolerance,
                         tolerances.PURE_COUPLE,
                         tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT,
                         tolerances.PSEUDO_INVERSE_CONSISTENCY, tolerances.WORST_FAULT_TIE,
