@@ -39,7 +39,7 @@ CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
 TASKS_PER_CORE = 4
 """A map of local threads is cut into at least this many tasks per core when it is large enough
-(two tasks of 131,072 and 27,000 configurations kept one of two cores idle most of the time)."""
+(two tasks of 131,072 and 27,688 configurations kept one of two cores idle most of the time)."""
 MIN_CONFIGURATIONS_PER_TASK = 16_384
 """Smaller tasks than this cost more scheduling than they balance."""
 MAX_CONFIGURATIONS = 2_000_000_000

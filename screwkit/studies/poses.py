@@ -195,7 +195,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
         ``j`` values (default all).
     chunk_size : int, optional
         Poses solved and analysed at a time, so that memory stays bounded (default:
-        :func:`poses_per_chunk`, from the mechanism's joint count).
+        :func:`poses_per_chunk`, from the work and memory of one configuration).
     progress : callable, optional
         Called with the number of poses done after each chunk.
     threads : int, optional

@@ -1,0 +1,94 @@
+"""The hexapod map command against the straightforward numpy script, side by side, as whole processes.
+
+Usage: python benchmarks/bench_hexapod_map.py [--step 0.005] [--half 0.1] [--yaw-step 1] [--repeat 3]
+
+Runs, in turn, ``screwkit map ups_hexapod_8 --grid x:-H:H:S --grid y:-H:H:S --over yaw:0:360:D
+--ignore-limits`` and ``python benchmarks/reference_hexapod_map.py --step S --half H --yaw-step D``
+(``--repeat`` pairs, after one unmeasured run of each), each as a new process: wall time, CPU time
+and peak resident memory from the operating system (``os.wait4``). Prints the medians, the ratio
+command / script pair by pair (median, min, max), the fixed cost of each (the same commands on a
+3 x 3 grid with 3 yaws) and the largest difference between the two maps (LMTI, F_O1, F_O2).
+The defaults are the 41 x 41 grid and full turn at 1 deg: 605,160 configurations.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+
+
+def commands(step: float, half: float, yaw_step: float, folder: Path) -> tuple[list[str], list[str]]:
+    grid = [f"x:{-half}:{half}:{step}", f"y:{-half}:{half}:{step}"]
+    command = [sys.executable, "-m", "screwkit.cli", "map", "ups_hexapod_8", "--grid", grid[0], "--grid", grid[1],
+               "--over", f"yaw:0:360:{yaw_step}", "--ignore-limits", "--quiet", "--overwrite",
+               "--out", str(folder / "map.nc")]
+    script = [sys.executable, str(HERE / "reference_hexapod_map.py"), "--step", str(step), "--half", str(half),
+              "--yaw-step", str(yaw_step), "--out", str(folder / "reference.npz")]
+    return command, script
+
+
+def measured(arguments: list[str]) -> tuple[float, float, float]:
+    """Wall (s), CPU (s) and peak resident memory (MiB) of one run of a new process."""
+    start = time.perf_counter()
+    process = subprocess.Popen(arguments, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(process.pid, 0)
+    wall = time.perf_counter() - start
+    errors = process.stderr.read().decode()
+    process.stderr.close()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"{' '.join(arguments)} failed:\n{errors}")
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--step", type=float, default=0.005)
+    parser.add_argument("--half", type=float, default=0.1)
+    parser.add_argument("--yaw-step", type=float, default=1.0)
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as folder:
+        folder = Path(folder)
+        command, script = commands(args.step, args.half, args.yaw_step, folder)
+        small_command, small_script = commands(args.half, args.half, 120.0, folder / "small")
+        (folder / "small").mkdir()
+        for arguments in (command, script):  # compiled kernels, warm file cache
+            measured(arguments)
+        runs = {"command": [], "script": []}
+        for _ in range(args.repeat):
+            runs["command"].append(measured(command))
+            runs["script"].append(measured(script))
+        fixed = {"command": measured(small_command), "script": measured(small_script)}
+        import xarray  # the map's file: read once both have run
+
+        reference = np.load(folder / "reference.npz")
+        with xarray.open_dataset(folder / "map.nc") as mapped:
+            difference = max(float(np.nanmax(np.abs(reference[key] - mapped[key].values)))
+                             for key in ("lmti", "f_o1", "f_o2"))
+    points = int(round(2 * args.half / args.step)) + 1
+    yaws = int(round(360 / args.yaw_step))
+    print(f"ups_hexapod_8 map, {points} x {points} grid, {yaws} yaws: {points * points * yaws:,} configurations; "
+          f"{args.repeat} pairs, medians")
+    print(f"{'':10s} {'wall s':>8s} {'CPU s':>8s} {'peak MiB':>9s}   fixed cost (3 x 3 grid, 3 yaws): wall, peak")
+    for name in ("command", "script"):
+        wall, cpu, peak = (statistics.median(values) for values in zip(*runs[name]))
+        print(f"{name:10s} {wall:8.2f} {cpu:8.2f} {peak:9.0f}   {fixed[name][0]:.2f} s, {fixed[name][2]:.0f} MiB")
+    for index, label in enumerate(("wall", "CPU")):
+        ratios = [a[index] / b[index] for a, b in zip(runs["command"], runs["script"])]
+        print(f"command / script, {label} (pair by pair): median {statistics.median(ratios):.3f}, "
+              f"min {min(ratios):.3f}, max {max(ratios):.3f}  ({1 / statistics.median(ratios):.1f}x faster)")
+    print(f"largest difference between the two maps (LMTI, F_O1, F_O2): {difference:.1e}")
+
+
+if __name__ == "__main__":
+    main()
