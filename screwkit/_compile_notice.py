@@ -70,7 +70,7 @@ def kernel_is_cached(module: str) -> bool:
 
 def announce_compilation(module: str) -> None:
     """Once per process and module: a line on stderr when the module's kernel is about to be compiled."""
-    if _silent or module in _checked or module in sys.modules:
+    if _silent or module in _checked:  # (an imported module may still compile on first call)
         return
     _checked.add(module)
     if not kernel_is_cached(module):
