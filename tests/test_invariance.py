@@ -444,18 +444,25 @@ def test_power_coefficient_is_free_of_unit_and_frame_with_its_lengths(rng):
         np.testing.assert_allclose(value, reference, rtol=0, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", ["prs_3_six_actuators", "coop_arms"])
-def test_worst_fault_is_the_first_set_within_the_tie_margin(name):
+@pytest.mark.parametrize("name, faults", [("prs_3_six_actuators", None), ("coop_arms", None), ("coop_arms", 1),
+                                          ("coop_arms", (2, 5))])
+def test_worst_fault_is_the_first_set_within_the_tie_margin(name, faults):
     """F_Oj is the minimum LMTI over the sets left after j faults; the worst fault reported is the
     complement of the first set (combination order) whose LMTI is within WORST_FAULT_TIE of it,
     recomputed here from the OTIs of the submechanisms. Two actuators of one PRS chain give sets
-    of mathematically equal LMTI, so ties occur and are resolved by the rule, not by rounding."""
+    of mathematically equal LMTI, so ties occur and are resolved by the rule, not by rounding.
+    coop_arms (a = 12, n = 6) reduces every j, and j = 2 and 5, through the lattice of sets, j = 1
+    alone through the table of submechanisms: both are checked."""
     from itertools import combinations
 
     from screwkit.tolerances import WORST_FAULT_TIE
+    from screwkit.transmission import _reductions
 
-    result = analyze(build(name), threshold=THRESHOLD)
+    result = analyze(build(name), threshold=THRESHOLD, faults=faults)
     a = result.actuator_count
+    if name == "coop_arms":
+        children, _ = _reductions(a, result.dof, list(combinations(range(a), result.dof)), tuple(result.f_o))
+        assert (children.shape[1] <= a) == (faults != 1)  # lattice rows list at most a sets
     ties = 0
     for j in result.f_o:
         sets = list(combinations(range(a), a - j))

@@ -88,47 +88,6 @@ def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
     assert not _solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-8)
 
 
-def brute_force_fault_tolerance(oti, a, n, j):
-    """F_Oj (Eqs. 11-13) and the first worst set straight from the OTIs of every submechanism (N, C(a, n))."""
-    from itertools import combinations
-
-    from screwkit.tolerances import WORST_FAULT_TIE
-
-    position = {sub: s for s, sub in enumerate(combinations(range(a), n))}
-    sets = list(combinations(range(a), a - j))
-    lmti = np.stack([oti[:, [position[sub] for sub in combinations(e, n)]].max(axis=1) for e in sets], axis=1)
-    value = lmti.min(axis=1)
-    first = np.argmax(lmti <= value[:, None] + WORST_FAULT_TIE, axis=1)
-    failed = np.array([sorted(set(range(a)) - set(sets[k])) for k in first])
-    return value, failed
-
-
-@pytest.mark.parametrize("faults", [None, 1, (2, 5)])
-def test_fault_reductions_equal_the_brute_force_over_every_set_both_table_and_lattice(faults):
-    """coop_arms (a = 12, n = 6): every j goes through the lattice of sets, j = 1 alone through the table."""
-    from itertools import combinations
-
-    from screwkit.closure import chain_screws, solve
-    from screwkit.loader import load
-    from screwkit.transmission import _reductions, analyze
-
-    mechanism = load("coop_arms")
-    a, n = len(mechanism.actuators), mechanism.dof
-    requested = tuple(range(1, a - n + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
-    lattice = _reductions(a, n, list(combinations(range(a), n)), requested)[0].shape[1] <= a  # rows list <= a sets
-    assert lattice == (faults != 1)
-    rng = np.random.default_rng(5)
-    home = mechanism.task_poses(mechanism.home_full_pose)
-    poses = home + rng.uniform(-1, 1, (150, mechanism.n_task)) * np.where(mechanism.angular, 0.1, 0.03)
-    solution = solve(mechanism, poses)
-    result = analyze(chain_screws(mechanism, solution, unreachable="drop"), faults=faults, detail=True)
-    assert result.f_o[requested[0]].shape[0] > 100
-    for j in requested:
-        value, failed = brute_force_fault_tolerance(result.oti_submechanisms, a, n, j)
-        np.testing.assert_array_equal(result.f_o[j], value)
-        np.testing.assert_array_equal(result.worst_fault_indices[j], failed)
-
-
 @pytest.mark.parametrize("n", [4, 5, 6])
 def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
     """The output twists' expansion terms (level by level, as the kernel runs them) against numpy's determinants."""
