@@ -28,7 +28,11 @@ import textwrap
 
 import numpy as np
 
-__all__ = ["COLORMAP", "INDEX_RANGE", "sweep_figure", "map_figure", "design_comparison_figure", "save_figure"]
+from screwkit.studies.files import FORMATS, save_figure  # re-exported: figures are saved from here
+from screwkit.studies.objectives import UNITS
+
+__all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure",
+           "pareto_figure", "save_figure"]
 
 COLORMAP = "viridis"
 """The colour map of every figure (perceptually uniform and colour-blind safe; never ``jet``)."""
@@ -36,8 +40,6 @@ COLORMAP = "viridis"
 INDEX_RANGE = (0.0, 1.0)
 """Default colour scale and y range: the range every transmission and fault-tolerance index lives in."""
 
-FORMATS = ("png", "pdf", "svg")
-"""File types :func:`save_figure` writes."""
 
 MAX_LABELLED_CURVES = 12
 """Most thin curves a sweep panel names in its legend; beyond that colours cannot be matched to entries."""
@@ -528,8 +530,9 @@ def map_figure(dataset, variables=None, reference=None, *, vmin=None, vmax=None,
     return figure
 
 
-def design_comparison_figure(reference_grid, optimised_grid, step, level, name, *, vmin=None, vmax=None):
-    """Side-by-side maps of the minimum F_O1 over a rotation for a reference and an optimised design.
+def design_comparison_figure(reference_grid, optimised_grid, step, level, name, *, vmin=None, vmax=None,
+                             index="f_o1", over="a full rotation"):
+    """Side-by-side maps of the minimum of ``index`` (F_O1) over ``over`` for a reference and an optimised design.
 
     Each panel shows one grid (centred on the origin) in :data:`COLORMAP` on a shared colour
     scale, with the contour F_O1 = ``level`` (white with a black edge, readable on any colour)
@@ -552,6 +555,8 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     vmin, vmax : float, optional
         Ends of the shared colour scale. ``None`` means the end of :data:`INDEX_RANGE`
         ([0, 1], not the data range), so both designs and other figures compare.
+    index, over : str
+        The index mapped (``f_o1``, ``f_io2``, ...) and the orientation set, for the labels.
 
     Returns
     -------
@@ -575,6 +580,7 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     for g in grids:
         if g.ndim != 2:
             raise ValueError(f"Expected two-dimensional grids, got shape {g.shape}.")
+    label = _index_name(index)
     figure, axes = plt.subplots(1, 2, figsize=(8.6, 4.3), layout="compressed")
     halo = [effects.Stroke(linewidth=2.8, foreground="black"), effects.Normal()]
     image = None
@@ -593,60 +599,41 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
         if finite.size and finite.max() >= level and (below < level).any():
             ax.contour(x, y, below, levels=[level], colors="white", linewidths=1.4).set(path_effects=halo)
         area = float(np.sum(finite >= level) * step**2)
-        ax.set_title(_wrap(f"{letter} {title}\narea where min F$_{{\\mathrm{{O}}1}}$ \u2265 {level:g}: "
+        ax.set_title(_wrap(f"{letter} {title}\narea where min {label} \u2265 {level:g}: "
                            f"{area:.4f} m\u00b2", 3.8, TITLE_SIZE), fontsize=TITLE_SIZE)
         ax.set_aspect("equal")
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
-        handles = [Line2D([], [], color="white", linewidth=1.4, path_effects=halo,
-                          label=f"F$_{{\\mathrm{{O}}1}}$ = {level:g}")]
+        handles = [Line2D([], [], color="white", linewidth=1.4, path_effects=halo, label=f"{label} = {level:g}")]
         if grey.any():
             from matplotlib.patches import Patch
 
             handles.append(Patch(color=UNREACHABLE_COLOR, label="unreachable"))
         ax.legend(handles=handles, loc="lower left", fontsize=LEGEND_SIZE, framealpha=0.9)
     bar = figure.colorbar(image, ax=list(axes), shrink=0.85, extend=_extend(grids, low, high))
-    bar.set_label("min F$_{\\mathrm{O}1}$ over the rotation", fontsize=TITLE_SIZE)
-    figure.suptitle("Minimum of F$_{\\mathrm{O}1}$ over a full rotation at each position", fontsize=TITLE_SIZE + 1)
+    bar.set_label(f"min {label} over {over}", fontsize=TITLE_SIZE)
+    figure.suptitle(f"Minimum of {label} over {over} at each position", fontsize=TITLE_SIZE + 1)
     return figure
 
 
-# --------------------------------------------------------------------------------------------
-# Files
-# --------------------------------------------------------------------------------------------
+def pareto_figure(result):
+    """The objectives of every evaluation of a design search, the Pareto front and the start.
 
-def save_figure(figure, path, *, dpi: float = 130) -> None:
-    """Save a figure as PNG, PDF or SVG, atomically (a temporary file in the same folder, then rename).
-
-    The bounding box is tight (``bbox_inches="tight"``), so nothing drawn outside the
-    figure's nominal area (a long title, a legend, a colour-bar label) is cut off.
-
-    Parameters
-    ----------
-    figure : matplotlib.figure.Figure
-        The figure to save.
-    path : str or os.PathLike
-        Output file; its suffix (``.png``, ``.pdf`` or ``.svg``, any case) picks the format.
-    dpi : float
-        Resolution of PNG files and of rasterised map panels in PDF and SVG files.
-
-    Raises
-    ------
-    ValueError
-        If the suffix is not one of :data:`FORMATS` (the message names the path).
-    """
-    path = os.fspath(path)
-    root, extension = os.path.splitext(path)
-    kind = extension[1:].lower()
-    if kind not in FORMATS:
-        found = repr(extension) if extension else "no suffix"
-        raise ValueError(f"Cannot save a figure to {path!r}: expected a file ending in "
-                         f"{', '.join('.' + f for f in FORMATS[:-1])} or .{FORMATS[-1]}, got {found}.")
-    folder = os.path.dirname(os.path.abspath(path))
-    temporary = os.path.join(folder, f".{os.path.basename(root)}.tmp-{os.getpid()}.{kind}")
-    try:
-        figure.savefig(temporary, format=kind, dpi=dpi, bbox_inches="tight", pad_inches=0.05)
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
+    ``result`` is a :class:`screwkit.studies.optimise.StudyResult` with two or more objectives;
+    the first two are plotted (grey: every evaluation, red: infeasible, blue line: the front)."""
+    plt = _pyplot()
+    first, second = result.study.objectives[:2]
+    figure, ax = plt.subplots(figsize=(5.2, 4.2), layout="constrained")
+    for records, style in ((result.evaluations, dict(color="0.7", s=10, label="evaluated")),
+                           ([r for r in result.evaluations if not r["feasible"]], dict(color="tab:red", s=10,
+                                                                                         label="infeasible"))):
+        if records:
+            ax.scatter([r["metrics"][first] for r in records], [r["metrics"][second] for r in records], **style)
+    ax.plot([r["metrics"][first] for r in result.best], [r["metrics"][second] for r in result.best], "o-",
+            color="tab:blue", markersize=4, label=f"Pareto front ({len(result.best)})")
+    ax.plot(result.start["metrics"][first], result.start["metrics"][second], "*", color="black", markersize=11,
+            label="start")
+    ax.set(xlabel=f"{first} ({UNITS.get(first, 'index')})", ylabel=f"{second} ({UNITS.get(second, 'index')})",
+           title=f"{result.study.family.name}: {len(result.evaluations)} evaluations")
+    ax.legend(fontsize=LEGEND_SIZE)
+    return figure

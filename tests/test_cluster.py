@@ -264,3 +264,45 @@ def test_a_task_given_up_by_the_scheduler_gives_one_line_and_no_file(tmp_path_fa
     one_line((command.returncode, stdout, stderr), f"Dask workers of the scheduler at {fragile.address} died while "
              "running a task (KilledWorker:", "nothing was written")
     assert os.listdir(tmp_path) == []
+
+
+FAMILY_SEARCH = ("design-search", "ups_hexapod", "--grid", "x:-0.1:0.1:0.05", "--grid", "y:-0.1:0.1:0.05",
+                 "--over", "yaw:-20:40:20", "--free", "platform_radius", "--free", "height", "--objective", "mean",
+                 "--budget", "64", "--popsize", "4", "--json", "--quiet")
+"""A family search of up to 65 hexapod designs in 9 batches (the start, then 8 populations of 8; the mean index
+varies continuously, so the search does not stop early on a converged population)."""
+
+
+def test_a_family_search_on_two_workers_equals_the_local_search_and_survives_a_killed_worker(tmp_path_factory,
+                                                                                             tmp_path):
+    local = screwkit(*FAMILY_SEARCH, "--urdf", tmp_path / "local.urdf")
+    assert local.returncode == 0, local.stderr
+    own = Cluster(tmp_path_factory.mktemp("search"), workers=2)
+    try:
+        command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", *FAMILY_SEARCH,
+                                    "--urdf", str(tmp_path / "remote.urdf"), "--scheduler", own.address],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            deadline, seen = time.monotonic() + 120, set()
+            while len(seen) < 17:  # the start and more than a population: each batch's tasks are forgotten after it
+                assert command.poll() is None, "the search ended before a worker could be killed"
+                assert time.monotonic() < deadline, "no 17 designs sent within 120 s"
+                seen.update(own.client.run_on_scheduler(
+                    lambda dask_scheduler: [str(k) for k in dask_scheduler.tasks
+                                            if str(k).startswith("screwkit-evaluate_candidate-")]))
+                time.sleep(0.01)
+            own.kill(own.workers[0])  # the nanny and its worker: a lost machine
+            assert command.poll() is None, "the kill came after the run"
+            stdout, stderr = command.communicate(timeout=300)
+        finally:
+            if command.poll() is None:
+                command.kill()
+        assert len(own.client.scheduler_info()["workers"]) == 1  # really gone
+    finally:
+        own.stop()
+    assert command.returncode == 0, stderr
+    assert "Warning" not in stderr and "Traceback" not in stderr, stderr
+    remote, expected = json.loads(stdout), json.loads(local.stdout)
+    assert remote["evaluations"] == expected["evaluations"] > 48  # designs asked twice (at a bound) count once
+    assert remote["best"] == expected["best"] and remote["start"] == expected["start"]
+    assert (tmp_path / "remote.urdf").read_text() == (tmp_path / "local.urdf").read_text()

@@ -1,4 +1,4 @@
-"""``screwkit design-search``: the paper's permutation selection, and optimising a planar n-RRR."""
+"""``screwkit design-search``: the paper's permutation selection, and searching a parametric family."""
 
 from __future__ import annotations
 
@@ -7,21 +7,19 @@ import json
 import click
 import numpy as np
 
+from screwkit.cli.family_search import parse_assignments, parse_bounds, region_of, search_family
 from screwkit.cli.options import (
     check_outputs,
-    echo_error,
     fail,
     json_option,
     length_unit_option,
     load_mechanism,
-    mechanism_argument,
     overwrite_option,
     quiet_option,
 )
-from screwkit.model.urdf_writer import planar_rrr_urdf
-from screwkit.plots import design_comparison_figure, save_figure
 from screwkit.studies import design as search
-from screwkit.studies.files import atomic_text
+from screwkit.studies.families import FAMILIES, family
+from screwkit.studies.objectives import METRICS
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 
 __all__ = ["design_search"]
@@ -52,67 +50,58 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
     click.echo(f"this file's design {list(current)} ranks {mine['rank']} (best score {best:.4f})")
 
 
-def _optimise(loaded, template, current, level, step, maxiter, popsize, urdf_path, figure_path, vmin, vmax, as_json,
-              quiet):
-
-    design, area, result = search.optimise_design(template, current, level=level, step=step, maxiter=maxiter,
-                                                  popsize=popsize, phi_step_degrees=5.0)
-    reference_area, reference_grid = search.fault_tolerant_area(template, level=level, step=step)
-    _, best_grid = search.fault_tolerant_area(design, level=level, step=step)
-    summary = {"mechanism": loaded.name, "level": level, "permutation": list(current),
-               "parameters": {"platform_radius": "radius g of the circle of platform joints (m)",
-                              "upper": "length a of every proximal (upper) arm (m)",
-                              "lower": "length l of every distal (lower) arm (m)"},
-               "reference": {"platform_radius": float(np.mean(np.linalg.norm(template.platform, axis=-1))),
-                             "upper": float(template.upper[0]), "lower": float(template.lower[0]),
-                             "area_m2": reference_area},
-               "optimised": {"platform_radius": float(result.x[0]), "upper": float(result.x[1]),
-                             "lower": float(result.x[2]), "area_m2": area},
-               "evaluations": int(result.nfev), "files": []}
-    if urdf_path:
-        text = planar_rrr_urdf(f"{loaded.name}_optimised", design.base, design.platform, design.upper, design.lower,
-                               design.working_mode, comment=f" Optimised by screwkit design-search (optimise) "
-                               f"(F_O1 >= {level} area {area:.4f} m^2) from {loaded.name} ")
-        atomic_text(urdf_path, text)
-        summary["files"].append(urdf_path)
-    if figure_path:
-        save_figure(design_comparison_figure(reference_grid, best_grid, step, level, loaded.name, vmin=vmin, vmax=vmax),
-                    figure_path)
-        summary["files"].append(figure_path)
-    if as_json:
-        click.echo(json.dumps(summary))
-    else:
-        ref, opt = summary["reference"], summary["optimised"]
-        click.echo(f"area where the minimum of F_O1 over a full rotation is >= {level} (grid step {step} m), over the "
-                   "platform radius g, the proximal arm length a and the distal arm length l:")
-        click.echo(f"  {loaded.name}: g = {ref['platform_radius']:.3f} m, a = {ref['upper']:.3f} m, "
-                   f"l = {ref['lower']:.3f} m -> {ref['area_m2']:.4f} m^2")
-        click.echo(f"  optimised: g = {opt['platform_radius']:.3f} m, a = {opt['upper']:.3f} m, "
-                   f"l = {opt['lower']:.3f} m -> {opt['area_m2']:.4f} m^2  ({summary['evaluations']} evaluations)")
-    if not quiet:
-        for path in summary["files"]:
-            echo_error(f"wrote {path}")
-
-
 @click.command("design-search")
-@mechanism_argument
+@click.argument("mechanism", metavar="FAMILY|MECHANISM")
 @click.option("--permutations", "search_permutations", is_flag=True,
-              help="Rank every assignment of platform slots to chains in both working modes (the paper's selection).")
+              help="MECHANISM: rank every assignment of platform slots to chains in both working modes "
+                   "(the paper's selection).")
 @click.option("--optimise", is_flag=True,
-              help="Maximise the fault-tolerant area over the platform radius and the proximal and distal arm lengths.")
-@click.option("--phi-step", type=float, default=1.0, show_default=True, help="Step of the full rotation (deg).")
-@click.option("--top", type=click.IntRange(min=1), default=12, show_default=True, help="Designs listed (count).")
-@click.option("--level", type=float, default=0.4, show_default=True,
-              help="--optimise: the F_O1 level that makes a position fault tolerant (index value).")
-@click.option("--maxiter", type=click.IntRange(min=1), default=15, show_default=True,
-              help="--optimise: generations of differential evolution (count).")
+              help="MECHANISM: search the planar_rrr family from this planar n-RRR (its platform radius and arm "
+                   "lengths; base, slots and working mode kept).")
+@click.option("--legs", type=click.IntRange(min=1), help="FAMILY: number of legs (default: 5 planar, 8 hexapods).")
+@click.option("--objective", "objectives", multiple=True, type=click.Choice(list(METRICS)),
+              help="Metric to optimise (repeat for a Pareto front; default: area). See docs/design.md.")
+@click.option("--constraint", "constraints", multiple=True, metavar="METRIC>=VALUE|METRIC<=VALUE",
+              help="A bound every design kept must meet, e.g. footprint<=1.2 (repeatable).")
+@click.option("--free", multiple=True, metavar="NAME", help="A parameter to vary (repeatable; default: the family's).")
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Fix a parameter (repeatable).")
+@click.option("--start", "starts", multiple=True, metavar="NAME=VALUE",
+              help="Starting value of a varied parameter (repeatable; default: the family's default).")
+@click.option("--bounds", "bound_texts", multiple=True, metavar="NAME=LOWER:UPPER",
+              help="Narrow a varied parameter's bounds (repeatable).")
+@click.option("--budget", type=click.IntRange(min=0), help="Designs evaluated (count; default: 384).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search (same seed, same run).")
+@click.option("--state", type=click.Path(dir_okay=False),
+              help="Evaluation log: written as the search goes; run again with it to resume an interrupted search.")
+@click.option("--radius", type=float, help="Planar region: radius of the disc (m; default 0.6).")
+@click.option("--grid", "grids", multiple=True, metavar="COORDINATE:START:STOP:STEP",
+              help="Spatial region: a map coordinate, stop included (twice), as screwkit map --grid.")
+@click.option("--over", "overs", multiple=True, metavar="COORDINATE:START:STOP:STEP",
+              help="Spatial region: the orientation set, stop excluded, as screwkit map --over (repeatable).")
+@click.option("--layers", metavar="COORDINATE:START:STOP:STEP",
+              help="Spatial region: stack maps along a third coordinate (stop excluded) for a volume.")
+@click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|...",
+              help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1).")
+@click.option("--phi-step", type=float, default=None,
+              help="Step of the full rotation (deg; --permutations: 1, planar region: 5).")
+@click.option("--top", type=click.IntRange(min=1), default=12, show_default=True,
+              help="--permutations: designs listed (count).")
+@click.option("--level", type=float, default=None,
+              help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar).")
+@click.option("--maxiter", type=click.IntRange(min=1),
+              help="One objective: generations of differential evolution (sets the budget to popsize x parameters x "
+                   "(maxiter + 1)).")
 @click.option("--popsize", type=click.IntRange(min=2), default=8, show_default=True,
-              help="--optimise: population size per parameter (count).")
-@click.option("--step", type=float, default=0.05, show_default=True, help="--optimise: grid step of the area (m).")
+              help="Population size per varied parameter (count).")
+@click.option("--step", type=float, default=None, help="Planar region: grid step of the disc (m; default 0.05).")
 @click.option("--urdf", "urdf_path", type=click.Path(dir_okay=False),
-              help="--optimise: write the best design here (.urdf).")
+              help="Write the best design here (.urdf; several objectives: the front's best in the first).")
+@click.option("--table", "table_path", type=click.Path(dir_okay=False),
+              help="Every evaluation, its parameters and metrics, the best flagged (.nc or .csv).")
 @click.option("--figure", "figure_path", type=click.Path(dir_okay=False),
-              help="--optimise: maps of both designs (.png, .pdf or .svg).")
+              help="Maps of the start and the best design side by side (.png, .pdf or .svg).")
+@click.option("--front-figure", "front_figure_path", type=click.Path(dir_okay=False),
+              help="Several objectives: the Pareto front over every evaluation (.png, .pdf or .svg).")
 @click.option("--vmin", type=float, default=None, help="--figure: lower end of the colour scale (index value).")
 @click.option("--vmax", type=float, default=None, help="--figure: upper end of the colour scale (index value).")
 @click.option("--closed-forms", is_flag=True, help="--permutations: score with the planar closed forms.")
@@ -125,32 +114,73 @@ def _optimise(loaded, template, current, level, step, maxiter, popsize, urdf_pat
 @json_option
 @overwrite_option
 @quiet_option
-def design_search(mechanism, search_permutations, optimise, phi_step, top, level, maxiter, popsize, step, urdf_path,
-                  figure_path, vmin, vmax, closed_forms, scheduler, connect_timeout, length_unit, as_json, overwrite,
-                  quiet) -> None:
-    """Search planar n-RRR designs for fault tolerance (score: min of F_O1 over a full rotation at the centre)."""
+def design_search(mechanism, search_permutations, optimise, legs, objectives, constraints, free, assignments, starts,
+                  bound_texts, budget, seed, state, radius, grids, overs, layers, region_index, phi_step, top, level,
+                  maxiter, popsize, step, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax,
+                  closed_forms, scheduler, connect_timeout, length_unit, as_json, overwrite, quiet) -> None:
+    """Search designs for fault tolerance.
 
-    if search_permutations == optimise:
-        raise fail("Expected exactly one of --permutations or --optimise.")
-    if not 0 < phi_step <= 360:
+    FAMILY (planar_rrr, ups_hexapod, rss_hexapod): vary the family's parameters to optimise one
+    or more metrics of the fault-tolerant region of a map (differential evolution, or NSGA-II for
+    a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200.
+    MECHANISM (a planar n-RRR): --permutations ranks every slot assignment (the paper's
+    selection); --optimise searches the planar_rrr family from it.
+    """
+    family_mode = mechanism in FAMILIES
+    if family_mode and (search_permutations or optimise):
+        raise fail(f"{mechanism} is a family: --permutations and --optimise take a mechanism (planar_5rrr, a file).")
+    if not family_mode and search_permutations == optimise:
+        raise fail(f"Expected a family ({', '.join(FAMILIES)}), or a mechanism with exactly one of --permutations "
+                   "or --optimise.")
+    if phi_step is not None and not 0 < phi_step <= 360:
         raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
-    if search_permutations and (urdf_path or figure_path):
-        raise fail("--urdf and --figure go with --optimise.")
-    check_outputs({"--urdf": (urdf_path, (".urdf",)), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
-                  overwrite, quiet)
-    loaded = load_mechanism(mechanism, length_unit)
-    try:
-        template = search.planar_design(loaded)
-    except ValueError as error:
-        raise fail(str(error)) from None
-    current = tuple(int(s) for s in search.slots_of(template))
-    if search_permutations:
-
+    if search_permutations and (urdf_path or figure_path or table_path or front_figure_path):
+        raise fail("--urdf, --table, --figure and --front-figure go with a family search or --optimise.")
+    if maxiter is not None and budget is not None:
+        raise fail("Give --budget or --maxiter, not both.")
+    check_outputs({"--urdf": (urdf_path, (".urdf",)), "--table": (table_path, (".nc", ".csv")),
+                   "--figure": (figure_path, (".png", ".pdf", ".svg")),
+                   "--front-figure": (front_figure_path, (".png", ".pdf", ".svg"))}, overwrite, quiet)
+    if family_mode:
         try:
-            _permutations(loaded, template, current, phi_step, closed_forms, scheduler, connect_timeout, top, as_json,
-                          quiet)
-        except ClusterError as error:
+            chosen = family(mechanism, legs)
+        except ValueError as error:
             raise fail(str(error)) from None
+        fixed, initial = parse_assignments(chosen, assignments, "--set"), parse_assignments(chosen, starts, "--start")
     else:
-        _optimise(loaded, template, current, level, step, maxiter, popsize, urdf_path, figure_path, vmin, vmax,
-                  as_json, quiet)
+        if legs is not None:
+            raise fail("--legs goes with a family.")
+        loaded = load_mechanism(mechanism, length_unit)
+        try:
+            template = search.planar_design(loaded)
+        except ValueError as error:
+            raise fail(str(error)) from None
+        if search_permutations:
+            current = tuple(int(s) for s in search.slots_of(template))
+            try:
+                _permutations(loaded, template, current, 1.0 if phi_step is None else phi_step, closed_forms,
+                              scheduler, connect_timeout, top, as_json, quiet)
+            except ClusterError as error:
+                raise fail(str(error)) from None
+            return
+        try:
+            count, values = search.family_values(template)
+        except ValueError as error:
+            raise fail(f"--optimise: {error}") from None
+        chosen = family("planar_rrr", count)
+        varied = free or chosen.free
+        fixed = {name: value for name, value in values.items() if name not in varied}
+        fixed.update(parse_assignments(chosen, assignments, "--set"))
+        initial = {name: values[name] for name in varied if name not in fixed}
+        initial.update(parse_assignments(chosen, starts, "--start"))
+    start_mechanism = chosen.mechanism({**fixed, **initial}) if (grids or overs or layers) else None
+    region = region_of(chosen, start_mechanism, radius, step, phi_step, grids, overs, layers, region_index, level)
+    varied_count = len(free or [n for n in chosen.free if n not in fixed])
+    if maxiter is not None:
+        budget = popsize * varied_count * (maxiter + 1)
+    search_family(chosen, region, objectives=objectives, constraints=constraints,
+                  free=free or [n for n in chosen.free if n not in fixed], fixed=fixed, initial=initial,
+                  bounds=parse_bounds(chosen, bound_texts), budget=384 if budget is None else budget, seed=seed,
+                  popsize=popsize, state=state, scheduler=scheduler, connect_timeout=connect_timeout,
+                  urdf_path=urdf_path, table_path=table_path, figure_path=figure_path,
+                  front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet)

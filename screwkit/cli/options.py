@@ -17,6 +17,7 @@ import numpy as np
 from screwkit._compile_notice import announce_compilation, silence
 from screwkit.loader import load
 from screwkit.studies.files import check_output
+from screwkit.studies.maps import range_values
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import LENGTH_UNITS, is_angular
 
@@ -225,13 +226,10 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
         start, stop, step = (float(p) for p in parts)
     except ValueError:
         raise fail(f"Expected {option} as START:STOP:STEP (three numbers), got {text!r}.") from None
-    if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or not step > 0 or not stop > start:
-        raise fail(f"Expected {option} with finite numbers, STEP > 0 and STOP > START, got {text!r}.")
-    span = (stop - start) / step
-    count = int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
-    if count > 10**8:
-        raise fail(f"{option} {text} has {count:,} values; use a larger step.")
-    values = start + step * np.arange(count)
+    try:
+        values = range_values(start, stop, step, include_stop=include_stop)
+    except ValueError as error:
+        raise fail(f"Expected {option} with {error}, got {text!r}.") from None
     return np.deg2rad(values) if angular else values
 
 

@@ -4,9 +4,8 @@
 * :func:`permutation_search` redoes the paper's selection (Sec. 4): every assignment of
   the platform joint slots to the chains (n! of them) in both working modes, scored by the
   minimum of F_O1 over a full rotation at the workspace centre, ranked;
-* :func:`optimise_design` is the paper's future work: maximise the area where the
-  minimum-over-rotation F_O1 reaches a threshold, over continuous design parameters, with
-  ``scipy.optimize.differential_evolution``.
+* :func:`family_values` places a planar n-RRR in the family ``planar_rrr``, whose design search
+  (the paper's future work) is :mod:`screwkit.studies.optimise`.
 
 Evaluations run through Dask (:func:`screwkit.studies.tasks.run_tasks`).
 """
@@ -23,13 +22,14 @@ from screwkit.closed_forms import planar_indices
 from screwkit.closure import solve
 from screwkit.model import Mechanism
 from screwkit.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
+from screwkit.studies.families import permutation_rank
 from screwkit.studies.poses import planar_points
 from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.transmission import analyze
 
 __all__ = ["planar_design", "slot_design", "slots_of", "rotation_score", "permutation_search", "rotation_class",
-           "DesignScore", "fault_tolerant_area", "optimise_design"]
+           "DesignScore", "fault_tolerant_area", "family_values"]
 
 
 def planar_design(mechanism: Mechanism) -> PlanarDesign:
@@ -174,42 +174,32 @@ def fault_tolerant_area(design: PlanarDesign, *, level: float = 0.4, radius: flo
     return float(np.sum(minimum >= level) * step**2), grid
 
 
-def _design_from_vector(template: PlanarDesign, vector, permutation) -> PlanarDesign:
-    platform_radius, upper, lower = vector
-    design = slot_design(template, permutation, platform_radius=platform_radius)
+def family_values(design: PlanarDesign) -> tuple[int, dict[str, float]]:
+    """(legs, values) of ``design`` in the family ``planar_rrr`` (:mod:`screwkit.studies.families`).
+
+    Raises ValueError naming the first chain that does not fit the family (base joints on a circle
+    at the angles 2 pi i / n, platform joints on a circle at slot angles, identical arms, one
+    working mode)."""
     n = design.chain_count
-    return replace(design, upper=np.full(n, upper), lower=np.full(n, lower))
-
-
-def _negative_area(vector, template, permutation, options):
-    area, _ = fault_tolerant_area(_design_from_vector(template, vector, permutation), **options)
-    return -area
-
-
-def optimise_design(template: PlanarDesign, permutation, *, bounds=((0.05, 0.4), (0.5, 1.5), (0.5, 1.5)),
-                    level: float = 0.4, radius: float = 0.6, step: float = 0.05, phi_step_degrees: float = 5.0,
-                    maxiter: int = 30, popsize: int = 10, seed: int = 0, workers: int = 1):
-    """Maximise the fault-tolerant area over (platform radius g, upper arm a, lower arm l).
-
-    The base stays as in ``template`` (the scale of the problem: without it every length
-    would grow); chains keep the slot ``permutation``; the objective is
-    :func:`fault_tolerant_area` (area where min over rotation of F_O1 >= ``level``).
-    Uses ``scipy.optimize.differential_evolution`` (seeded, deterministic).
-
-    Returns
-    -------
-    design : PlanarDesign
-    area : float
-    result : scipy.optimize.OptimizeResult
-    """
-    from scipy.optimize import differential_evolution
-
-    options = {"level": level, "radius": radius, "step": step, "phi_step_degrees": phi_step_degrees}
-    # The template itself seeds the population, so the result is never worse than it.
-    start = np.clip([np.mean(np.linalg.norm(template.platform, axis=-1)), np.mean(template.upper),
-                     np.mean(template.lower)], [b[0] for b in bounds], [b[1] for b in bounds])
-    result = differential_evolution(_negative_area, bounds=bounds, args=(template, tuple(permutation), options),
-                                    x0=start, maxiter=maxiter, popsize=popsize, seed=seed, polish=False, tol=1e-6,
-                                    workers=workers, updating="deferred" if workers != 1 else "immediate")
-    design = _design_from_vector(template, result.x, permutation)
-    return design, -float(result.fun), result
+    radius = float(np.mean(np.linalg.norm(design.base, axis=-1)))
+    angles = 2 * np.pi * np.arange(n) / n
+    expected = radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    platform_radius = float(np.mean(np.linalg.norm(design.platform, axis=-1)))
+    slots = slots_of(design)
+    slot_points = platform_radius * np.column_stack([np.cos(slots * 2 * np.pi / n), np.sin(slots * 2 * np.pi / n)])
+    for i in range(n):
+        for what, actual, wanted in (("base joint", design.base[i], expected[i]),
+                                     ("platform joint", design.platform[i], slot_points[i]),
+                                     ("proximal arm", design.upper[i], design.upper[0]),
+                                     ("distal arm", design.lower[i], design.lower[0]),
+                                     ("working mode", design.working_mode[i], design.working_mode[0])):
+            if not np.allclose(actual, wanted, rtol=0, atol=1e-9 * max(1.0, radius)):
+                raise ValueError(f"The design is not a member of the family planar_rrr: chain {i + 1}'s {what} "
+                                 f"is {np.round(actual, 6).tolist()}, the family's would be "
+                                 f"{np.round(wanted, 6).tolist()}.")
+    if sorted(slots.tolist()) != list(range(n)):
+        raise ValueError(f"The design is not a member of the family planar_rrr: platform slots {slots.tolist()} "
+                         "are not a permutation.")
+    return n, {"base_radius": radius, "platform_radius": platform_radius, "upper": float(design.upper[0]),
+               "lower": float(design.lower[0]), "slots": float(permutation_rank(slots.tolist())),
+               "mirrored": float(design.working_mode[0] < 0)}

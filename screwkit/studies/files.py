@@ -15,12 +15,15 @@ import re
 import time
 from typing import Callable
 
-__all__ = ["check_output", "write_dataset", "atomic_write", "atomic_text", "DATA_SUFFIXES", "FIGURE_SUFFIXES"]
+__all__ = ["check_output", "write_dataset", "atomic_write", "atomic_text", "save_figure", "DATA_SUFFIXES",
+           "FIGURE_SUFFIXES", "FORMATS"]
 
 DATA_SUFFIXES = (".nc", ".csv")
 """Data files screwkit writes: netCDF (``.nc``) or CSV."""
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 """Figure files screwkit writes."""
+FORMATS = ("png", "pdf", "svg")
+"""File types :func:`save_figure` writes."""
 _TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp-(?P<pid>\d+)-\d+$")
 
 
@@ -163,3 +166,39 @@ def write_dataset(dataset, path) -> None:
     else:
         atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))
 
+
+def save_figure(figure, path, *, dpi: float = 130) -> None:
+    """Save a figure as PNG, PDF or SVG, atomically (a temporary file in the same folder, then rename).
+
+    The bounding box is tight (``bbox_inches="tight"``), so nothing drawn outside the
+    figure's nominal area (a long title, a legend, a colour-bar label) is cut off.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to save.
+    path : str or os.PathLike
+        Output file; its suffix (``.png``, ``.pdf`` or ``.svg``, any case) picks the format.
+    dpi : float
+        Resolution of PNG files and of rasterised map panels in PDF and SVG files.
+
+    Raises
+    ------
+    ValueError
+        If the suffix is not one of :data:`FORMATS` (the message names the path).
+    """
+    path = os.fspath(path)
+    root, extension = os.path.splitext(path)
+    kind = extension[1:].lower()
+    if kind not in FORMATS:
+        found = repr(extension) if extension else "no suffix"
+        raise ValueError(f"Cannot save a figure to {path!r}: expected a file ending in "
+                         f"{', '.join('.' + f for f in FORMATS[:-1])} or .{FORMATS[-1]}, got {found}.")
+    folder = os.path.dirname(os.path.abspath(path))
+    temporary = os.path.join(folder, f".{os.path.basename(root)}.tmp-{os.getpid()}.{kind}")
+    try:
+        figure.savefig(temporary, format=kind, dpi=dpi, bbox_inches="tight", pad_inches=0.05)
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)

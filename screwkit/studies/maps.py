@@ -33,7 +33,7 @@ from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular, unit_of
 
-__all__ = ["index_map", "planar_disc_map", "disc_grid", "GridMap", "MapSize", "map_size", "map_task"]
+__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "map_task"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -397,6 +397,19 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
             joint_limits="respected" if limits else "ignored", fault_type=fault_type,
             configurations=int(size.configurations)))
     return grid_map.to_dataset() if as_dataset else grid_map
+
+
+def range_values(start: float, stop: float, step: float, *, include_stop: bool = False) -> NDArray[np.float64]:
+    """START, START + STEP, ... up to STOP (included only if ``include_stop``; compared with a
+    tolerance of a millionth of a step): the ranges of ``screwkit map --grid`` (stop included) and
+    ``--over`` (stop excluded)."""
+    if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or not step > 0 or not stop > start:
+        raise ValueError("finite numbers, STEP > 0 and STOP > START")
+    span = (stop - start) / step
+    count = int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
+    if count > 10**8:
+        raise ValueError(f"at most 10^8 values ({count:,} asked; use a larger step)")
+    return start + step * np.arange(count)
 
 
 def disc_grid(radius: float, step: float, centre=(0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray[np.bool_]]:

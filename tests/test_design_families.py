@@ -1,0 +1,334 @@
+"""Parametric families, region metrics and design searches (``screwkit design-search FAMILY``).
+
+Each family's writer is checked against an independent construction (the bundled files, the
+planar closed forms, leg lines written from the geometry); each metric against a brute force;
+each search path as users run it: the command in a subprocess, its best design re-mapped by a
+fresh ``screwkit map`` of the URDF it wrote, an interrupted run resumed from its state file.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from itertools import combinations, permutations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from helpers import screwkit
+from screwkit.loader import bundled_path, load
+from screwkit.planar import PlanarDesign
+from screwkit.studies import indices_at_poses
+from screwkit.studies.design import family_values, fault_tolerant_area, planar_design
+from screwkit.studies.families import FAMILIES, family, permutation_of_rank, permutation_rank
+from screwkit.studies.objectives import default_region, disc_region, grid_region, inscribed_radius, region_metrics
+from screwkit.studies.optimise import Constraint, StateError, Study, pareto_front, run_study
+
+SMALL_DISC = ("--radius", "0.3", "--step", "0.1", "--phi-step", "30")
+"""A planar region of 29 points x 12 angles: a search of 24 designs in a few seconds."""
+SMALL_GRID = ("--grid", "x:-0.1:0.1:0.1", "--grid", "y:-0.1:0.1:0.1", "--over", "yaw:-20:40:20")
+
+
+def without_comments(text: str) -> str:
+    return re.sub(r"<!--.*?-->", "", text, flags=re.S)
+
+
+def test_permutation_ranks_follow_the_lexicographic_order():
+    for count in (4, 5):
+        for rank, permutation in enumerate(permutations(range(count))):
+            assert permutation_of_rank(count, rank) == permutation
+            assert permutation_rank(permutation) == rank
+
+
+@pytest.mark.parametrize("name, bundled", [("ups_hexapod", "ups_hexapod_8"), ("rss_hexapod", "rss_hexapod_8")])
+def test_hexapod_families_at_their_defaults_are_the_bundled_hexapods(name, bundled):
+    text = family(name, 8).urdf(name=bundled)
+    assert without_comments(text) == without_comments(bundled_path(bundled).read_text())
+
+
+def test_the_planar_family_at_its_defaults_is_table_2():
+    """Same indices as the bundled planar_5rrr (written by generate.py's own code) at random poses."""
+    candidate, bundled = family("planar_rrr", 5).mechanism(), load("planar_5rrr")
+    rng = np.random.default_rng(3)
+    poses = np.column_stack([rng.uniform(-0.3, 0.3, (50, 2)), rng.uniform(-np.pi, np.pi, 50)])
+    one, other = indices_at_poses(candidate, poses), indices_at_poses(bundled, poses)
+    np.testing.assert_array_equal(one.reachable, other.reachable)
+    for j in (1, 2):
+        np.testing.assert_allclose(one.f_o[j], other.f_o[j], atol=1e-12, equal_nan=True)
+    legs, values = family_values(planar_design(bundled))
+    assert legs == 5 and values == pytest.approx(family("planar_rrr").defaults(), abs=1e-12)
+
+
+def ups_f_o1(base, platform, poses):
+    """F_O1 of a UPS hexapod at (x, y, z, yaw) poses, from the leg lines alone: every 6-leg
+    submechanism's output twists are the columns of its inverse wrench matrix."""
+    c, s = np.cos(poses[:, 3]), np.sin(poses[:, 3])
+    rotation = np.zeros((len(poses), 3, 3))
+    rotation[:, 0, 0], rotation[:, 0, 1], rotation[:, 1, 0], rotation[:, 1, 1], rotation[:, 2, 2] = c, -s, s, c, 1
+    points = np.einsum("nij,lj->nli", rotation, platform) + poses[:, None, :3]
+    direction = (points - base) / np.linalg.norm(points - base, axis=-1, keepdims=True)
+    wrenches = np.concatenate([direction, np.cross(points, direction)], -1)
+    legs = len(base)
+    lmti = {}
+    for subset in combinations(range(legs), 6):
+        twists = np.linalg.inv(wrenches[:, subset])
+        oti = []
+        for k, leg in enumerate(subset):
+            v, w = twists[:, :3, k], twists[:, 3:, k]
+            power = np.abs(np.einsum("ni,ni->n", wrenches[:, leg, :3], v)
+                           + np.einsum("ni,ni->n", wrenches[:, leg, 3:], w))
+            speed = np.linalg.norm(v + np.cross(w, points[:, leg]), axis=-1)
+            oti.append(power / speed)
+        lmti[subset] = np.min(oti, axis=0)
+    return np.min([np.max([lmti[s] for s in lmti if set(s) <= set(range(legs)) - {e}], axis=0)
+                   for e in range(legs)], axis=0)
+
+
+def test_a_spread_and_permuted_ups_hexapod_has_the_indices_of_its_leg_lines():
+    chosen = family("ups_hexapod", 7)
+    values = {"platform_radius": 0.42, "height": 0.9, "base_spread": 20.0, "platform_spread": 11.0, "slots": 1234}
+    mechanism = chosen.mechanism(values)
+    slots = permutation_of_rank(7, 1234)
+
+    def angles(k, spread):
+        return 2 * math.pi * np.asarray(k) / 7 + np.where(np.asarray(k) % 2 == 0, 0.5, -0.5) * math.radians(spread)
+
+    base = np.column_stack([np.cos(angles(range(7), 20)), np.sin(angles(range(7), 20)), np.zeros(7)])
+    platform = 0.42 * np.column_stack([np.cos(angles(slots, 11)), np.sin(angles(slots, 11)), np.zeros(7)])
+    rng = np.random.default_rng(5)
+    poses = np.column_stack([rng.uniform(-0.1, 0.1, (20, 2)), 0.9 + rng.uniform(-0.05, 0.05, 20),
+                             rng.uniform(-0.3, 0.3, 20)])
+    full = np.zeros((20, 6))
+    full[:, [0, 1, 2, 5]] = poses
+    result = indices_at_poses(mechanism, full, faults=1, limits=False)
+    assert result.reachable.all()
+    np.testing.assert_allclose(result.f_o[1], ups_f_o1(base, platform, poses), atol=1e-10)
+    assert chosen.size(values)["footprint"] == 1.0
+
+
+def test_the_planar_family_area_equals_the_closed_form_area_of_its_design():
+    """The family writes a URDF that is loaded and mapped; fault_tolerant_area computes from the
+    design's points with the closed forms: the same area for random candidates."""
+    chosen = family("planar_rrr", 5)
+    region = disc_region(0.4, 0.1, 30.0)
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        values = {"platform_radius": rng.uniform(0.05, 0.3), "upper": rng.uniform(0.7, 1.2),
+                  "lower": rng.uniform(0.7, 1.2), "slots": int(rng.integers(0, 120)), "mirrored": 1}
+        metrics = region_metrics(chosen.mechanism(values), region, chosen.size(values))
+        slots = np.array(permutation_of_rank(5, values["slots"]))
+        angles = 2 * np.pi * np.arange(5) / 5
+        design = PlanarDesign(np.column_stack([np.cos(angles), np.sin(angles)]),
+                              values["platform_radius"] * np.column_stack([np.cos(slots * 2 * np.pi / 5),
+                                                                           np.sin(slots * 2 * np.pi / 5)]),
+                              np.full(5, values["upper"]), np.full(5, values["lower"]), np.full(5, -1.0))
+        area, _ = fault_tolerant_area(design, radius=0.4, step=0.1, phi_step_degrees=30.0)
+        assert metrics["area"] == pytest.approx(area, abs=1e-12)
+
+
+def test_region_metrics_equal_a_brute_force_over_the_poses():
+    chosen = family("ups_hexapod", 8)
+    region = grid_region({"x": (-0.2, 0.2, 0.1), "y": (-0.1, 0.1, 0.1)}, {"yaw": (-30, 30, 15)},
+                         layers=("z", (0.9, 1.1, 0.1)), level=0.42)
+    mechanism = chosen.mechanism()
+    metrics = region_metrics(mechanism, region, chosen.size())
+    x, y, yaw, z = np.arange(-0.2, 0.21, 0.1), np.arange(-0.1, 0.11, 0.1), np.radians([-30, -15, 0, 15]), [0.9, 1.0]
+    inside, values, iti = 0, [], []
+    for zz in z:
+        for yy in y:
+            for xx in x:
+                poses = np.array([[xx, yy, zz, 0, 0, angle] for angle in yaw])
+                result = indices_at_poses(mechanism, poses)
+                worst = result.f_o[1].min() if result.reachable.all() else 0.0
+                values.append(worst)
+                iti.append(result.iti.min() if result.reachable.all() else 0.0)
+                inside += worst >= 0.42
+    assert metrics["area"] == pytest.approx(inside * 0.01, abs=1e-12)
+    assert metrics["volume"] == pytest.approx(inside * 0.001, abs=1e-12)
+    assert metrics["worst"] == pytest.approx(min(values), abs=1e-12)
+    assert metrics["mean"] == pytest.approx(np.mean(values), abs=1e-12)
+    assert metrics["iti_floor"] == pytest.approx(min(iti), abs=1e-12)
+    assert 0 < inside < len(values)  # the level cuts the region: the test can fail both ways
+
+
+def test_the_inscribed_radius_is_the_largest_clearance_to_an_outside_point():
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        inside = rng.random((7, 9)) < 0.8
+        padded = np.pad(inside, 1)
+        points = np.argwhere(padded) * [0.2, 0.1]
+        outside = np.argwhere(~padded) * [0.2, 0.1]
+        expected = max((np.min(np.linalg.norm(outside - p, axis=-1)) for p in points), default=0.0)
+        assert inscribed_radius(inside, [0.2, 0.1]) == pytest.approx(expected, abs=1e-12)
+
+
+def test_the_pareto_front_is_every_non_dominated_score_once():
+    rng = np.random.default_rng(6)
+    scores = np.round(rng.random((60, 2)), 1)
+    front = pareto_front(scores)
+    for i, row in enumerate(scores):
+        dominated = any(np.all(other <= row) and np.any(other < row) for other in scores)
+        first = not any(np.array_equal(scores[j], row) for j in range(i))
+        assert (i in front) == (not dominated and first)
+    assert list(scores[front, 0]) == sorted(scores[front, 0])
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(objectives=("volume",)), "needs a region with layers"),
+    (dict(objectives=("speed",)), "Unknown objective 'speed'"),
+    (dict(free=("radius",)), "Unknown parameter 'radius' of family 'planar_rrr'"),
+    (dict(fixed={"base_radius": 3.0}), "Expected base_radius in [0.5, 2] m, got 3"),
+    (dict(fixed={"upper": 1.0}), "both varied and fixed: upper"),
+    (dict(bounds={"upper": (1.2, 0.9)}), "lower bound below the upper bound of upper"),
+])
+def test_a_bad_study_is_named_before_anything_is_computed(change, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), **change)
+    with pytest.raises(ValueError, match="METRIC>=VALUE"):
+        Constraint.parse("area=3")
+
+
+def comparable(records):
+    """Records with NaN metrics (volume without layers) as None, so that equal records compare equal."""
+    return json.loads(json.dumps(records).replace("NaN", "null"))
+
+
+def test_a_resumed_search_equals_an_uninterrupted_one(tmp_path):
+    study = Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), budget=24, popsize=4)
+    state = tmp_path / "state.jsonl"
+    short = run_study(replace(study, budget=12), state=state, progress=False)
+    assert short.computed == 12 and short.replayed == 0
+    resumed = run_study(study, state=state, progress=False)
+    fresh = run_study(study, progress=False)
+    assert resumed.replayed == 12 and resumed.computed == 12
+    assert comparable(resumed.best) == comparable(fresh.best)
+    assert comparable(resumed.evaluations) == comparable(fresh.evaluations)
+    other = replace(study, region=disc_region(0.3, 0.1, 15.0))
+    with pytest.raises(StateError, match="belongs to another study"):
+        run_study(other, state=state, progress=False)
+
+
+def test_every_family_evaluates_its_default_region():
+    for name in FAMILIES:
+        chosen = family(name)
+        metrics = region_metrics(chosen.mechanism(), default_region(chosen), chosen.size())
+        assert metrics["area"] > 0, name  # the default region holds fault-tolerant points of the default design
+
+
+# -- the command --------------------------------------------------------------------------------
+
+
+def remapped_area(tmp_path, urdf, map_command: str, index: str, level: float, cell: float) -> float:
+    options = map_command.split(" ", 3)[3].split()
+    out = tmp_path / "remap.nc"
+    result = screwkit("map", urdf, *options, "--out", out, "--quiet", "--overwrite")
+    assert result.returncode == 0, result.stderr
+    with xr.open_dataset(out) as dataset:
+        return float(np.sum(np.nan_to_num(dataset[index].values) >= level) * cell)
+
+
+@pytest.mark.parametrize("arguments, cell", [
+    (("planar_rrr", *SMALL_DISC), 0.01),
+    (("ups_hexapod", *SMALL_GRID, "--level", "0.33", "--free", "platform_radius", "--free", "height"), 0.01),
+])
+def test_the_best_design_remapped_by_a_fresh_map_has_the_reported_area(tmp_path, arguments, cell):
+    urdf = tmp_path / "best.urdf"
+    result = screwkit("design-search", *arguments, "--budget", "16", "--popsize", "4", "--urdf", urdf,
+                      "--table", tmp_path / "all.csv", "--figure", tmp_path / "maps.png", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    best = summary["best"][0]
+    level = 0.33 if "--level" in arguments else 0.4
+    assert best["metrics"]["area"] >= summary["start"]["metrics"]["area"]
+    area = remapped_area(tmp_path, urdf, summary["map_commands"][0], "f_o1", level, cell)
+    assert abs(area - best["metrics"]["area"]) <= 1e-9
+    table = np.genfromtxt(tmp_path / "all.csv", delimiter=",", names=True)
+    assert len(table) == summary["evaluations"] and table["best"].sum() == 1
+    assert np.max(table["area"]) == pytest.approx(best["metrics"]["area"], abs=1e-12)
+    assert (tmp_path / "maps.png").stat().st_size > 10_000
+
+
+def test_a_pareto_search_writes_its_front(tmp_path):
+    result = screwkit("design-search", "ups_hexapod", *SMALL_GRID, "--level", "0.33", "--objective", "worst",
+                      "--objective", "footprint", "--free", "base_radius", "--free", "platform_radius",
+                      "--constraint", "lmti_floor>=0.5", "--budget", "16", "--popsize", "4",
+                      "--front-figure", tmp_path / "front.png", "--table", tmp_path / "front.nc", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    front = summary["best"]
+    assert len(front) >= 2 and all(r["metrics"]["lmti_floor"] >= 0.5 for r in front)
+    worst = [r["metrics"]["worst"] for r in front]
+    footprints = [r["metrics"]["footprint"] for r in front]
+    assert worst == sorted(worst, reverse=True) and footprints == sorted(footprints, reverse=True)
+    with xr.open_dataset(tmp_path / "front.nc") as table:
+        assert int(table["best"].sum()) == len(front) and table.attrs["objectives"] == "worst, footprint"
+        feasible = table.where(table["feasible"] == 1, drop=True)
+        for w, f in zip(feasible["worst"].values, feasible["footprint"].values):  # no feasible design beats the front
+            for r in front:
+                better = (w >= r["metrics"]["worst"] and f <= r["metrics"]["footprint"]
+                          and (w > r["metrics"]["worst"] or f < r["metrics"]["footprint"]))
+                assert not better, (w, f, r["metrics"])
+    assert (tmp_path / "front.png").stat().st_size > 10_000
+
+
+def test_optimise_searches_the_planar_family_from_the_file(tmp_path):
+    base = ("--budget", "12", "--popsize", "4", *SMALL_DISC, "--json", "--quiet")
+    from_file = screwkit("design-search", "planar_5rrr", "--optimise", *base)
+    from_family = screwkit("design-search", "planar_rrr", *base)
+    assert from_file.returncode == 0 and from_family.returncode == 0, from_file.stderr + from_family.stderr
+    assert json.loads(from_file.stdout)["best"] == json.loads(from_family.stdout)["best"]
+
+
+def test_an_interrupted_search_resumes_from_its_state(tmp_path):
+    arguments = ("design-search", "planar_rrr", *SMALL_DISC, "--budget", "48", "--popsize", "4", "--json", "--quiet")
+    state = tmp_path / "state.jsonl"
+    command = subprocess.Popen([sys.executable, "-m", "screwkit.cli", *arguments, "--state", str(state)],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and (not state.exists() or len(state.read_text().splitlines()) < 13):
+            assert command.poll() is None, "the search ended before it could be interrupted"
+            time.sleep(0.02)
+        os.killpg(command.pid, signal.SIGKILL)
+        command.wait(timeout=30)
+    finally:
+        if command.poll() is None:
+            command.kill()
+    written = len(state.read_text().splitlines()) - 1
+    assert 12 <= written < 48
+    resumed = screwkit(*arguments, "--state", state)
+    fresh = screwkit(*arguments)
+    assert resumed.returncode == 0 and fresh.returncode == 0, resumed.stderr
+    resumed, fresh = json.loads(resumed.stdout), json.loads(fresh.stdout)
+    assert resumed["replayed"] == written and resumed["computed"] == 48 - written
+    assert resumed["best"] == fresh["best"]
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (("planar_rrr", "--set", "upper=3"), "--set upper=3: Expected upper in [0.5, 1.5] m, got 3"),
+    (("planar_rrr", "--objective", "volume"), "The objective volume needs a region with layers."),
+    (("ups_hexapod", "--grid", "x:-0.1:0.1:0.1", "--grid", "q:0:1:1"), "Unknown coordinate 'q' in --grid"),
+    (("ups_hexapod", "--radius", "0.2"), "--radius, --step and --phi-step map a planar family's disc"),
+    (("planar_rrr", "--front-figure", "{tmp}/f.png"), "--front-figure needs two or more --objective."),
+    (("planar_rrr", "--legs", "3"), "Family planar_rrr needs at least 4 legs"),
+    (("five_bar", "--budget", "2"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod), or a mechanism"),
+    (("ups_hexapod_8", "--optimise"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
+    (("planar_rrr", "--state", "{tmp}/other.jsonl"), "belongs to another study"),
+])
+def test_bad_search_options_give_one_line(tmp_path, arguments, message):
+    other = tmp_path / "other.jsonl"
+    other.write_text(json.dumps({"screwkit_design_state": 1, "study": "0" * 16, "family": "ups_hexapod",
+                                 "free": ["height"]}) + "\n")
+    result = screwkit("design-search", *(str(a).format(tmp=tmp_path) for a in arguments), "--budget", "4")
+    assert result.returncode == 1, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert lines[-1].startswith("Error: ") and message in lines[-1], result.stderr
+    assert "Traceback" not in result.stderr
