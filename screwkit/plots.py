@@ -633,7 +633,10 @@ def pareto_figure(result):
             color="tab:blue", markersize=4, label=f"Pareto front ({len(result.best)})")
     ax.plot(result.start["metrics"][first], result.start["metrics"][second], "*", color="black", markersize=11,
             label="start")
-    ax.set(xlabel=f"{first} ({UNITS.get(first, 'index')})", ylabel=f"{second} ({UNITS.get(second, 'index')})",
+    def label(name):
+        return f"{name} ({UNITS.get(name, 'index')})".replace("^2", "\u00b2").replace("^3", "\u00b3")
+
+    ax.set(xlabel=label(first), ylabel=label(second),
            title=f"{result.study.family.name}: {len(result.evaluations)} evaluations")
     ax.legend(fontsize=LEGEND_SIZE)
     return figure

@@ -156,6 +156,9 @@ def test_region_metrics_equal_a_brute_force_over_the_poses():
     assert metrics["worst"] == pytest.approx(min(values), abs=1e-12)
     assert metrics["mean"] == pytest.approx(np.mean(values), abs=1e-12)
     assert metrics["iti_floor"] == pytest.approx(min(iti), abs=1e-12)
+    tolerant = (np.array(values) >= 0.42).reshape(2, 3, 5)  # (z, y, x)
+    assert metrics["inscribed"] == pytest.approx(inscribed_radius(tolerant, [0.1, 0.1, 0.1]), abs=1e-12)
+    assert metrics["cylinder"] == pytest.approx(inscribed_radius(tolerant.all(axis=0), [0.1, 0.1]), abs=1e-12)
     assert 0 < inside < len(values)  # the level cuts the region: the test can fail both ways
 
 
@@ -332,3 +335,34 @@ def test_bad_search_options_give_one_line(tmp_path, arguments, message):
     lines = result.stderr.strip().splitlines()
     assert lines[-1].startswith("Error: ") and message in lines[-1], result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_the_design_page_names_every_family_parameter_and_metric():
+    from pathlib import Path
+
+    from screwkit.studies.objectives import METRICS
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "design.md").read_text()
+    for name in FAMILIES:
+        assert f"`{name}`" in page, name
+        for parameter in family(name).parameters:
+            assert f"`{parameter.name}`" in page, (name, parameter.name)
+    for metric in METRICS:
+        assert f"| `{metric}` |" in page, metric
+
+
+def test_a_study_file_is_the_same_search_as_its_options(tmp_path):
+    study = tmp_path / "study.yaml"
+    study.write_text("family: planar_rrr\nobjectives: [area]\nset: {mirrored: 1}\nstart: {upper: 0.9}\n"
+                     "bounds: {lower: [0.8, 1.2]}\nradius: 0.3\nstep: 0.1\nphi_step: 30\nbudget: 12\npopsize: 4\n")
+    from_file = screwkit("design-search", "--study", study, "--json", "--quiet")
+    from_options = screwkit("design-search", "planar_rrr", "--objective", "area", "--set", "mirrored=1", "--start",
+                            "upper=0.9", "--bounds", "lower=0.8:1.2", *SMALL_DISC, "--budget", "12", "--popsize", "4",
+                            "--json", "--quiet")
+    assert from_file.returncode == 0 and from_options.returncode == 0, from_file.stderr + from_options.stderr
+    assert json.loads(from_file.stdout) == json.loads(from_options.stdout)
+    overridden = json.loads(screwkit("design-search", "--study", study, "--budget", "0", "--json").stdout)
+    assert overridden["evaluations"] == 1 and overridden["start"]["values"]["upper"] == 0.9
+    study.write_text("family: planar_rrr\ncolour: blue\n")
+    bad = screwkit("design-search", "--study", study)
+    assert bad.returncode == 1 and "Error: Unknown key 'colour' in the study file" in bad.stderr

@@ -36,7 +36,7 @@ def kernel_folder(tmp_path_factory) -> Path:
 def test_notebooks_exist():
     assert [path.name for path in NOTEBOOKS] == [
         "01_reproduce_the_paper.ipynb", "02_plug_in_a_mechanism.ipynb", "03_meshcat_inspection.ipynb",
-        "04_any_mobility.ipynb"]
+        "04_any_mobility.ipynb", "05_design_search.ipynb"]
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)

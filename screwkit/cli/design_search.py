@@ -6,8 +6,9 @@ import json
 
 import click
 import numpy as np
+from click.core import ParameterSource
 
-from screwkit.cli.family_search import parse_assignments, parse_bounds, region_of, search_family
+from screwkit.cli.family_search import parse_assignments, parse_bounds, read_study, region_of, search_family
 from screwkit.cli.options import (
     check_outputs,
     fail,
@@ -51,7 +52,11 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
 
 
 @click.command("design-search")
-@click.argument("mechanism", metavar="FAMILY|MECHANISM")
+@click.argument("mechanism", metavar="FAMILY|MECHANISM", required=False)
+@click.option("--study", "study_path", type=click.Path(dir_okay=False),
+              help="A study file (.yaml or .json) whose keys stand for this command's options (family, objectives, "
+                   "constraints, free, set, start, bounds, budget, seed, popsize, radius, step, phi_step, grid, over, "
+                   "layers, index, level); options given on the command line win.")
 @click.option("--permutations", "search_permutations", is_flag=True,
               help="MECHANISM: rank every assignment of platform slots to chains in both working modes "
                    "(the paper's selection).")
@@ -84,8 +89,8 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
               help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1).")
 @click.option("--phi-step", type=float, default=None,
               help="Step of the full rotation (deg; --permutations: 1, planar region: 5).")
-@click.option("--top", type=click.IntRange(min=1), default=12, show_default=True,
-              help="--permutations: designs listed (count).")
+@click.option("--top", type=click.IntRange(min=2), default=12, show_default=True,
+              help="Designs listed: --permutations ranks, the Pareto front (evenly spread along it) (count).")
 @click.option("--level", type=float, default=None,
               help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar).")
 @click.option("--maxiter", type=click.IntRange(min=1),
@@ -114,18 +119,30 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
 @json_option
 @overwrite_option
 @quiet_option
-def design_search(mechanism, search_permutations, optimise, legs, objectives, constraints, free, assignments, starts,
-                  bound_texts, budget, seed, state, radius, grids, overs, layers, region_index, phi_step, top, level,
-                  maxiter, popsize, step, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax,
-                  closed_forms, scheduler, connect_timeout, length_unit, as_json, overwrite, quiet) -> None:
+@click.pass_context
+def design_search(context, study_path, **options) -> None:
     """Search designs for fault tolerance.
 
     FAMILY (planar_rrr, ups_hexapod, rss_hexapod): vary the family's parameters to optimise one
     or more metrics of the fault-tolerant region of a map (differential evolution, or NSGA-II for
-    a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200.
-    MECHANISM (a planar n-RRR): --permutations ranks every slot assignment (the paper's
-    selection); --optimise searches the planar_rrr family from it.
+    a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200, or
+    design-search --study study.yaml. MECHANISM (a planar n-RRR): --permutations ranks every slot
+    assignment (the paper's selection); --optimise searches the planar_rrr family from it.
     """
+    if study_path:
+        for name, value in read_study(study_path).items():
+            given = context.get_parameter_source(name) not in (ParameterSource.DEFAULT, None)
+            if not given:
+                options[name] = value
+    if options["mechanism"] is None:
+        raise fail("Expected a FAMILY or MECHANISM argument (or a study file with a family).")
+    _design_search(**options)
+
+
+def _design_search(mechanism, search_permutations, optimise, legs, objectives, constraints, free, assignments, starts,
+                   bound_texts, budget, seed, state, radius, grids, overs, layers, region_index, phi_step, top, level,
+                   maxiter, popsize, step, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax,
+                   closed_forms, scheduler, connect_timeout, length_unit, as_json, overwrite, quiet) -> None:
     family_mode = mechanism in FAMILIES
     if family_mode and (search_permutations or optimise):
         raise fail(f"{mechanism} is a family: --permutations and --optimise take a mechanism (planar_5rrr, a file).")
@@ -183,4 +200,5 @@ def design_search(mechanism, search_permutations, optimise, legs, objectives, co
                   bounds=parse_bounds(chosen, bound_texts), budget=384 if budget is None else budget, seed=seed,
                   popsize=popsize, state=state, scheduler=scheduler, connect_timeout=connect_timeout,
                   urdf_path=urdf_path, table_path=table_path, figure_path=figure_path,
-                  front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet)
+                  front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet,
+                  start_name=None if family_mode else loaded.name, top=top)

@@ -16,7 +16,42 @@ from screwkit.studies.objectives import METRICS, default_region, region_maps
 from screwkit.studies.optimise import Constraint, StateError, Study, run_study
 from screwkit.studies.tasks import ClusterError
 
-__all__ = ["parse_assignments", "parse_bounds", "region_of", "search_family"]
+__all__ = ["parse_assignments", "parse_bounds", "region_of", "search_family", "STUDY_KEYS", "read_study"]
+
+STUDY_KEYS = {"family": "mechanism", "legs": "legs", "objectives": "objectives", "constraints": "constraints",
+              "free": "free", "set": "assignments", "start": "starts", "bounds": "bound_texts", "budget": "budget",
+              "seed": "seed", "popsize": "popsize", "radius": "radius", "step": "step", "phi_step": "phi_step",
+              "grid": "grids", "over": "overs", "layers": "layers", "index": "region_index", "level": "level"}
+"""Keys of a study file and the option each stands for (``set``, ``start``: name -> value; ``bounds``:
+name -> [lower, upper]; ``objectives``, ``constraints``, ``free``, ``grid``, ``over``: lists)."""
+
+
+def read_study(path: str) -> dict:
+    """A study file (YAML or JSON) as option values: {option destination: value as the option gives it}."""
+    import yaml
+
+    try:
+        with open(path, encoding="utf-8") as file:
+            content = yaml.safe_load(file)
+    except OSError as error:
+        raise fail(f"Cannot read the study file {path}: {error.strerror}.") from None
+    except yaml.YAMLError as error:
+        raise fail(f"Cannot read the study file {path}: {str(error).splitlines()[0]}.") from None
+    if not isinstance(content, dict):
+        raise fail(f"Expected the study file {path} to hold a mapping of keys ({', '.join(STUDY_KEYS)}).")
+    out = {}
+    for key, value in content.items():
+        if key not in STUDY_KEYS:
+            raise fail(f"Unknown key {key!r} in the study file {path}; keys: {', '.join(STUDY_KEYS)}.")
+        if key in ("set", "start", "bounds"):
+            if not isinstance(value, dict):
+                raise fail(f"Expected {key!r} in the study file {path} to map parameter names to values.")
+            value = tuple(f"{name}={':'.join(map(str, v)) if isinstance(v, (list, tuple)) else v}"
+                          for name, v in value.items())
+        elif key in ("objectives", "constraints", "free", "grid", "over"):
+            value = tuple(str(v) for v in (value if isinstance(value, (list, tuple)) else [value]))
+        out[STUDY_KEYS[key]] = value
+    return out
 
 
 def parse_assignments(family: Family, texts, option: str) -> dict[str, float]:
@@ -116,7 +151,7 @@ def _table(result):
     return dataset
 
 
-def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax, summary):
+def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax, summary, start_name):
     from screwkit.plots import design_comparison_figure, pareto_figure, save_figure  # matplotlib: on use only
     from screwkit.studies.files import atomic_text, write_dataset  # netCDF writers: on use only
 
@@ -133,7 +168,7 @@ def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path
         grids = [region_maps(study.family.mechanism(r["values"]), region)[region.index][layer]
                  for r in (result.start, best)]
         step = float(region.grid[0][1][1] - region.grid[0][1][0])
-        figure = design_comparison_figure(*grids, step, region.level, f"{study.family.name} start", vmin=vmin,
+        figure = design_comparison_figure(*grids, step, region.level, start_name, vmin=vmin,
                                           vmax=vmax, index=region.index, over=region.orientations)
         save_figure(figure, figure_path)
         summary["files"].append(figure_path)
@@ -144,7 +179,7 @@ def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path
 
 def search_family(family: Family, region, *, objectives, constraints, free, fixed, initial, bounds, budget, seed,
                   popsize, state, scheduler, connect_timeout, urdf_path, table_path, figure_path, front_figure_path,
-                  vmin, vmax, as_json, quiet) -> None:
+                  vmin, vmax, as_json, quiet, start_name=None, top=12) -> None:
     """Run the search and report it (the body of ``design-search FAMILY``)."""
     try:
         study = Study(family, region, tuple(objectives) or ("area",), free=tuple(free) or None, fixed=fixed,
@@ -173,17 +208,18 @@ def search_family(family: Family, region, *, objectives, constraints, free, fixe
                "map_commands": [f"screwkit map BEST.urdf {shlex.join(options)}" for options in map_options],
                "evaluations": len(result.evaluations), "computed": result.computed, "replayed": result.replayed,
                "start": _record(result.start), "best": [_record(r) for r in result.best], "files": []}
-    _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax, summary)
+    _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax, summary,
+                   start_name or f"{family.name} start")
     if as_json:
         click.echo(json.dumps(summary))
     else:
-        _print(summary, study)
+        _print(summary, study, top)
     if not quiet:
         for path in summary["files"]:
             echo_error(f"wrote {path}")
 
 
-def _print(summary: dict, study: Study) -> None:
+def _print(summary: dict, study: Study, top: int) -> None:
     def line(record):
         values = ", ".join(f"{name} = {record['values'][name]:.4g}" for name in study.free)
         scores = ", ".join(f"{name} = {_shown(record['metrics'][name])}" for name in study.objectives)
@@ -195,8 +231,11 @@ def _print(summary: dict, study: Study) -> None:
     if len(study.objectives) == 1:
         click.echo(f"  best:  {line(summary['best'][0])}")
     else:
-        click.echo(f"  Pareto front ({len(summary['best'])} designs):")
-        for record in summary["best"]:
+        front = summary["best"]
+        shown = front if len(front) <= top else [front[round(i * (len(front) - 1) / (top - 1))] for i in range(top)]
+        more = f", {len(shown)} of them shown: all in --json and --table" if len(shown) < len(front) else ""
+        click.echo(f"  Pareto front ({len(front)} designs{more}):")
+        for record in shown:
             click.echo(f"    {line(record)}")
     click.echo("  the best design's map: " + summary["map_commands"][0])
 

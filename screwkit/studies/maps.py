@@ -33,7 +33,8 @@ from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular, unit_of
 
-__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "map_task"]
+__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "map_task",
+           "map_block"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -218,7 +219,13 @@ def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_
         ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is unreachable) and
         ``reachable_fraction``.
     """
-    mechanism = cached_mechanism(*mechanism_text)
+    return map_block(cached_mechanism(*mechanism_text), at, x_axis, x_values, y_axis, y_values, mask, over_axes,
+                     over_values, threshold, faults, closed_forms, limits, fault_type, threads)
+
+
+def map_block(mechanism: Mechanism, at, x_axis, x_values, y_axis, y_values, mask, over_axes, over_values, threshold,
+              faults, closed_forms, limits=True, fault_type="free-swinging", threads=1) -> dict:
+    """:func:`map_task` on a loaded mechanism (in the calling process)."""
     rows, columns = np.nonzero(mask)
     base = np.repeat(np.asarray(at, dtype=float)[None], rows.size, axis=0)
     base[:, x_axis] = x_values[columns]

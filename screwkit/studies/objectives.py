@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.model import Mechanism
-from screwkit.studies.maps import disc_grid, map_task, portable, range_values
+from screwkit.studies.maps import disc_grid, map_block, range_values
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular
 
@@ -31,6 +31,8 @@ METRICS = {
     "volume": "volume of the fault-tolerant region: area of each layer times the layer step (m^3; needs layers)",
     "inscribed": "radius of the largest disc (ball with layers) about a grid point that holds no grid point "
                  "outside the fault-tolerant region nor beyond the map (m)",
+    "cylinder": "radius of the largest disc about a grid point whose points are fault tolerant in every layer: "
+                "the largest vertical cylinder through the layers (m; without layers the inscribed disc)",
     "worst": "minimum of the index over the whole map (an unreachable point counts 0)",
     "mean": "mean of the index over the whole map (an unreachable point counts 0)",
     "iti_floor": "minimum of the ITI over the whole map (an unreachable point counts 0)",
@@ -40,11 +42,11 @@ METRICS = {
 }
 """Every metric of a candidate, with its meaning and unit."""
 
-UNITS = {"area": "m^2", "volume": "m^3", "inscribed": "m", "footprint": "m", "link_length": "m"}
+UNITS = {"area": "m^2", "volume": "m^3", "inscribed": "m", "cylinder": "m", "footprint": "m", "link_length": "m"}
 """Units of the metrics that have one (the others are index values)."""
 
-MAXIMISED = {"area": True, "volume": True, "inscribed": True, "worst": True, "mean": True, "iti_floor": True,
-             "lmti_floor": True, "footprint": False, "link_length": False}
+MAXIMISED = {"area": True, "volume": True, "inscribed": True, "cylinder": True, "worst": True, "mean": True,
+             "iti_floor": True, "lmti_floor": True, "footprint": False, "link_length": False}
 """The sense in which each metric is better: larger (True) or smaller (False)."""
 
 
@@ -100,7 +102,12 @@ class Region:
     @property
     def orientations(self) -> str:
         """The orientation set in words."""
-        return "; ".join(_span(name, values) for name, values in self.over) or "the home orientation"
+        words = []
+        for name, values in self.over:
+            step = math.degrees(_step(values))
+            full = is_angular(name) and values.size > 1 and abs(values.size * step - 360) < 1e-6
+            words.append(f"a full turn of {name} ({step:g} deg steps)" if full else _span(name, values))
+        return "; ".join(words) or "the home orientation"
 
     def describe(self) -> str:
         layers = f", layers {_span(*self.layers)}" if self.layers else ""
@@ -221,13 +228,12 @@ def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
     over_values = np.stack(np.meshgrid(*[v for _, v in region.over], indexing="ij"), -1).reshape(
         -1, len(region.over)) if region.over else np.zeros((1, 0))
     layer_values = region.layers[1] if region.layers else [None]
-    text = portable(mechanism)
     out: dict[str, NDArray] = {}
     for k, value in enumerate(layer_values):
         at = mechanism.home_pose.copy()
         if value is not None:
             at[names.index(region.layers[0])] = value
-        values = map_task(text, at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes,
+        values = map_block(mechanism, at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes,
                           over_values, region.threshold, (region.faults,), region.closed_forms)
         for key, column in values.items():
             grid = out.setdefault(key, np.full((len(layer_values),) + shape, np.nan))
@@ -249,6 +255,7 @@ def region_metrics(mechanism: Mechanism, region: Region, size: dict[str, float] 
     spacing = [_step(v) for _, v in region.grid][::-1]
     radius = inscribed_radius(inside, [layer_step, *spacing]) if layer_step else inscribed_radius(inside[0], spacing)
     metrics = {"area": area, "volume": area * layer_step if layer_step else math.nan, "inscribed": radius,
+               "cylinder": inscribed_radius(inside.all(axis=0), spacing),
                "worst": float(np.nanmin(index)), "mean": float(np.nanmean(index)),
                "iti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["iti"], nan=0.0), np.nan))),
                "lmti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["lmti"], nan=0.0), np.nan)))}

@@ -9,12 +9,12 @@ evaluation budget and a seed. :func:`run_study` searches it:
   one batch of independent evaluations);
 * several: pymoo's NSGA-II, the Pareto front taken over every evaluation of the run.
 
-Every generation is evaluated as one batch through :func:`screwkit.studies.tasks.run_tasks` (local
-threads or a Dask cluster); a candidate's metrics depend on its parameters alone, so the run is
-the same wherever it is evaluated. With a ``state`` file, each batch's metrics are appended to it
-as they come; a run started again with the same study and state replays the evaluations it finds
-there instead of recomputing them (the optimisers are seeded, so they ask for the same
-candidates), which resumes an interrupted run where it stopped.
+Every generation is evaluated as one batch, in local worker processes (one per core) or as tasks
+of a Dask cluster (:func:`screwkit.studies.tasks.run_tasks`); a candidate's metrics depend on its
+parameters alone, so the run is the same wherever it is evaluated. With a ``state`` file, each
+batch's metrics are appended to it as they come; a run started again with the same study and
+state replays the evaluations it finds there instead of recomputing them (the optimisers are
+seeded, so they ask for the same candidates), which resumes an interrupted run where it stopped.
 """
 
 from __future__ import annotations
@@ -210,7 +210,7 @@ class _Evaluations:
             with open(state, "w", encoding="utf-8") as file:
                 file.write(json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
                                        "family": study.family.name, "free": list(study.free)}) + "\n")
-        self.bar = None
+        self.bar, self.pool = None, None
         if progress:
             from tqdm import tqdm
 
@@ -242,8 +242,7 @@ class _Evaluations:
         if missing:
             arguments = [(self.study.family, self.study.values(vectors[first[key]]), self.study.region)
                          for key in missing]
-            results = run_tasks(evaluate_candidate, arguments, scheduler=self.scheduler, progress=False,
-                                connect_timeout=self.connect_timeout)
+            results = self._run(arguments)
             self.known.update(zip(missing, results))
             if self.state is not None:
                 with open(self.state, "a", encoding="utf-8") as file:
@@ -258,9 +257,30 @@ class _Evaluations:
             self.bar.update(len(new))
         return [self.known[key] for key in keys]
 
+    def _run(self, arguments: list[tuple]) -> list[dict]:
+        """Evaluate on the cluster, or locally in worker processes: a candidate's evaluation is mostly
+        Python (writing, parsing and assembling its file), which threads would run one at a time.
+        A family whose functions a new process cannot import (written in a notebook or a script
+        run as ``__main__``) is evaluated on local threads."""
+        family = self.study.family
+        importable = all(f.__module__ != "__main__" and "<locals>" not in f.__qualname__
+                         for f in (family.writer, family.measures))  # what a spawned process can import
+        if self.scheduler is not None or len(arguments) < 2 or (os.cpu_count() or 1) < 2 or not importable:
+            return run_tasks(evaluate_candidate, arguments, scheduler=self.scheduler, progress=False,
+                             connect_timeout=self.connect_timeout)
+        if self.pool is None:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            # spawn: a forked copy of a process that already runs threads (numba, Dask) can deadlock
+            self.pool = ProcessPoolExecutor(os.cpu_count(), mp_context=multiprocessing.get_context("spawn"))
+        return list(self.pool.map(evaluate_candidate, *zip(*arguments)))
+
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+        if self.pool is not None:
+            self.pool.shutdown(cancel_futures=True)
 
 
 @dataclass
