@@ -17,7 +17,7 @@ import subprocess
 import sys
 import time
 
-FAMILIES = ("planar_rrr", "ups_hexapod", "rss_hexapod")
+FAMILIES = ("planar_rrr", "ups_hexapod", "rss_hexapod", "delta")
 
 
 def run(family: str, budget: int) -> tuple[float, int]:

@@ -48,10 +48,13 @@ def test_permutation_ranks_follow_the_lexicographic_order():
             assert permutation_rank(permutation) == rank
 
 
-@pytest.mark.parametrize("name, bundled", [("ups_hexapod", "ups_hexapod_8"), ("rss_hexapod", "rss_hexapod_8")])
-def test_hexapod_families_at_their_defaults_are_the_bundled_hexapods(name, bundled):
-    text = family(name, 8).urdf(name=bundled)
-    assert without_comments(text) == without_comments(bundled_path(bundled).read_text())
+@pytest.mark.parametrize("name, bundled", [("ups_hexapod", "ups_hexapod_8"), ("rss_hexapod", "rss_hexapod_8"),
+                                           ("delta", "delta_4")])
+def test_spatial_families_at_their_defaults_are_the_bundled_mechanisms(name, bundled):
+    """The same file but for comments and the bundled file's named poses."""
+    text = family(name).urdf(name=bundled)
+    expected = re.sub(r"\n *<named_pose [^>]*/>", "", without_comments(bundled_path(bundled).read_text()))
+    assert without_comments(text) == expected
 
 
 def test_the_planar_family_at_its_defaults_is_table_2():
@@ -322,9 +325,11 @@ def test_an_interrupted_search_resumes_from_its_state(tmp_path):
     (("ups_hexapod", "--radius", "0.2"), "--radius, --step and --phi-step map a planar family's disc"),
     (("planar_rrr", "--front-figure", "{tmp}/f.png"), "--front-figure needs two or more --objective."),
     (("planar_rrr", "--legs", "3"), "Family planar_rrr needs at least 4 legs"),
-    (("five_bar", "--budget", "2"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod), or a mechanism"),
+    (("five_bar", "--budget", "2"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta), or a mechanism"),
     (("ups_hexapod_8", "--optimise"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
     (("planar_rrr", "--state", "{tmp}/other.jsonl"), "belongs to another study"),
+    (("planar_rrr", "--state", "{tmp}/missing/state.jsonl"), "Cannot write the design-search state"),
+    (("ups_hexapod", "--grid", "x:-1:1:0.0001", "--grid", "y:-1:1:0.001"), "configurations per design"),
 ])
 def test_bad_search_options_give_one_line(tmp_path, arguments, message):
     other = tmp_path / "other.jsonl"
@@ -366,3 +371,42 @@ def test_a_study_file_is_the_same_search_as_its_options(tmp_path):
     study.write_text("family: planar_rrr\ncolour: blue\n")
     bad = screwkit("design-search", "--study", study)
     assert bad.returncode == 1 and "Error: Unknown key 'colour' in the study file" in bad.stderr
+
+
+def delta_rods(angles, base_radius, platform_radius, arm, rod, position):
+    """Unit rod directions of Delta legs, elbow out, from the legs' inverse kinematics (a quadratic in
+    tan(t / 2) per leg, the root with the elbow farther out)."""
+    rods = []
+    for angle in angles:
+        e = np.array([math.cos(angle), math.sin(angle), 0.0])
+        delta = np.asarray(position) + platform_radius * e - base_radius * e
+        k = delta @ delta + arm**2 - rod**2
+        p, q = 2 * arm * (delta @ e), -2 * arm * delta[2]
+        roots = np.roots([k + p, -2 * q, k - p])
+        theta = max(2 * np.arctan(roots[np.abs(roots.imag) < 1e-12].real), key=math.cos)
+        elbow = base_radius * e + arm * (math.cos(theta) * e - math.sin(theta) * np.array([0.0, 0.0, 1.0]))
+        rods.append((np.asarray(position) + platform_radius * e - elbow) / rod)
+    return np.array(rods)
+
+
+def test_a_five_legged_delta_of_the_family_has_the_pressure_angle_f_o1():
+    """F_O1 of a translating platform driven by rod forces: OTI_k of a 3-leg set is
+    |u_k . (u_j x u_l)| / |u_j x u_l|; a set of four legs keeps its best 3-leg set; the worst fault."""
+    values = {"base_radius": 0.25, "platform_radius": 0.07, "arm": 0.4, "rod": 0.9, "depth": 0.8, "spread": 20.0}
+    mechanism = family("delta", 5).mechanism(values)
+    angles = 2 * np.pi * np.arange(5) / 5 + np.where(np.arange(5) % 2 == 0, 0.5, -0.5) * math.radians(20)
+    rng = np.random.default_rng(8)
+    poses = np.column_stack([rng.uniform(-0.2, 0.2, (15, 2)), rng.uniform(-0.9, -0.7, 15)])
+    result = indices_at_poses(mechanism, poses, faults=1)
+    assert result.reachable.all()
+    for index, pose in enumerate(poses):
+        u = delta_rods(angles, 0.25, 0.07, 0.4, 0.9, pose)
+
+        def oti(members, u=u):
+            return min(abs(np.linalg.det(u[list(members)])) / np.linalg.norm(np.cross(*u[[j for j in members
+                                                                                         if j != k]]))
+                       for k in members)
+
+        expected = min(max(oti(s) for s in combinations([i for i in range(5) if i != e], 3)) for e in range(5))
+        assert result.f_o[1][index] == pytest.approx(expected, abs=1e-10)
+    assert family("delta").size(values) == {"footprint": 0.65, "link_length": 0.9}

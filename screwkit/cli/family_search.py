@@ -101,17 +101,20 @@ def region_of(family: Family, start_mechanism, radius, step, phi_step, grids, ov
     if radius is not None or step is not None or phi_step is not None:
         if not family.planar:
             raise fail("--radius, --step and --phi-step map a planar family's disc; give --grid and --over.")
-        if grids or overs or layers:
-            raise fail("A planar family's region is a disc (--radius, --step, --phi-step), not --grid/--over.")
         disc = family.region["disc"]
         changes["disc"] = (disc[0] if radius is None else radius, disc[1] if step is None else step,
                            disc[2] if phi_step is None else phi_step)
-    if grids or overs or layers:
-        if len(grids) != 2:
-            raise fail("Expected exactly two --grid options (the region's map).")
-        changes["grid"] = dict(_spec(start_mechanism, g, "--grid") for g in grids)
-        changes["over"] = dict(_spec(start_mechanism, o, "--over") for o in overs)
-        changes["layers"] = _spec(start_mechanism, layers, "--layers") if layers else None
+    if grids or overs or layers:  # each given part replaces the family's default, the others stay
+        if family.planar:
+            raise fail("A planar family's region is a disc (--radius, --step, --phi-step), not --grid/--over.")
+        if grids:
+            if len(grids) != 2:
+                raise fail("Expected exactly two --grid options (the region's map).")
+            changes["grid"] = dict(_spec(start_mechanism, g, "--grid") for g in grids)
+        if overs:
+            changes["over"] = dict(_spec(start_mechanism, o, "--over") for o in overs)
+        if layers:
+            changes["layers"] = _spec(start_mechanism, layers, "--layers")
     try:
         return default_region(family, **changes)
     except ValueError as error:

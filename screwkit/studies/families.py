@@ -10,7 +10,8 @@ Bundled families (:data:`FAMILIES`, built for a leg count by :func:`family`):
 
 * ``planar_rrr``: planar n-RRR, n >= 4 (the paper's Sec. 4; n = 5 at its defaults is Table 2);
 * ``ups_hexapod``: a-UPS hexapod, a >= 7 (a = 8 at its defaults is the bundled ``ups_hexapod_8``);
-* ``rss_hexapod``: a-RSS hexapod, a >= 7 (a = 8 at its defaults is the bundled ``rss_hexapod_8``).
+* ``rss_hexapod``: a-RSS hexapod, a >= 7 (a = 8 at its defaults is the bundled ``rss_hexapod_8``);
+* ``delta``: Delta robot, a >= 4 legs (3 DOF; a = 4 at its defaults is the bundled ``delta_4``).
 
 A new family is a :class:`Family` built from its parameters and a writer ``values -> URDF text``;
 see ``docs/design.md``.
@@ -24,7 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from screwkit.model.hexapod_writer import hexapod_points, rss_hexapod_urdf, ups_hexapod_urdf
+from screwkit.model.delta_writer import delta_urdf
+from screwkit.model.hexapod_writer import hexapod_points, rss_hexapod_urdf, slot_angles, ups_hexapod_urdf
 from screwkit.model.urdf_writer import planar_rrr_urdf
 
 __all__ = ["Parameter", "Family", "FAMILIES", "family", "permutation_rank", "permutation_of_rank"]
@@ -293,11 +295,53 @@ def rss_hexapod(legs: int = 8) -> Family:
                               "U and S joints to the platform circle")
 
 
+# ---------------------------------------------------------------------------------------------
+# Delta robots with a legs (3 DOF, translational)
+# ---------------------------------------------------------------------------------------------
+
+
+def _delta_parameters(legs: int, values: Mapping[str, float]) -> dict:
+    return {"leg_angles_deg": tuple(np.degrees(slot_angles(legs, math.radians(values["spread"])))),
+            "base_radius": values["base_radius"], "platform_radius": values["platform_radius"],
+            "arm": values["arm"], "rod": values["rod"], "home": (0.0, 0.0, -values["depth"])}
+
+
+def _delta_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+    summary = ", ".join(f"{k} = {v:g}" for k, v in values.items())
+    return delta_urdf(name, _delta_parameters(legs, values),
+                      f" Delta robot with {legs} legs of the family delta (R-U-U forearms): {summary} "
+                      "(lengths m, spread deg) ")
+
+
+def _delta_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]:
+    return {"footprint": float(values["base_radius"] + values["arm"]),
+            "link_length": float(max(values["arm"], values["rod"]))}
+
+
+def delta(legs: int = 4) -> Family:
+    if legs < 4:
+        raise ValueError(f"Family delta needs at least 4 legs (3 DOF, redundantly actuated), got {legs}.")
+    widest = round(0.8 * 360 / legs, 6)
+    return Family(
+        "delta", legs,
+        (Parameter("base_radius", 0.1, 0.4, 0.2, "m", "distance of the actuated axes from the centre"),
+         Parameter("platform_radius", 0.02, 0.15, 0.05, "m", "distance of the rod ends from the platform centre"),
+         Parameter("arm", 0.2, 0.6, 0.35, "m", "upper arm length"),
+         Parameter("rod", 0.5, 1.2, 0.8, "m", "forearm (rod) length"),
+         Parameter("depth", 0.4, 1.1, 0.75, "m", "depth of the platform below the base at the home pose"),
+         Parameter("spread", 0.0, widest, 0.0, "deg", "legs gathered in pairs: even legs turned by +spread/2, "
+                   "odd ones by -spread/2")),
+        ("arm", "rod", "depth"), _delta_writer, _delta_measures,
+        region={"grid": {"x": (-0.4, 0.4, 0.05), "y": (-0.4, 0.4, 0.05)}, "over": {}, "level": 0.5},
+        description="Delta robot with a legs at uniform angles (optionally in pairs): actuated arms about axes "
+                    "tangent to the base circle, parallelogram forearms modelled as R-U-U legs")
+
+
 FAMILIES: dict[str, Callable[[int], Family]] = {"planar_rrr": planar_rrr, "ups_hexapod": ups_hexapod,
-                                                 "rss_hexapod": rss_hexapod}
+                                                 "rss_hexapod": rss_hexapod, "delta": delta}
 """Bundled families by name: each builds the :class:`Family` for a leg count."""
 
-DEFAULT_LEGS = {"planar_rrr": 5, "ups_hexapod": 8, "rss_hexapod": 8}
+DEFAULT_LEGS = {"planar_rrr": 5, "ups_hexapod": 8, "rss_hexapod": 8, "delta": 4}
 
 
 def family(name: str, legs: int | None = None) -> Family:

@@ -96,6 +96,14 @@ class Region:
         return float(np.prod([_step(values) for _, values in self.grid]))
 
     @property
+    def configurations(self) -> int:
+        """Poses a design is evaluated at: grid points (in the mask) x orientations x layers."""
+        points = int(np.count_nonzero(self.mask)) if self.mask is not None else int(np.prod(
+            [values.size for _, values in self.grid]))
+        orientations = int(np.prod([values.size for _, values in self.over])) if self.over else 1
+        return points * orientations * (self.layers[1].size if self.layers else 1)
+
+    @property
     def faults(self) -> int:
         return int(self.index.rpartition("o")[2])
 
@@ -189,7 +197,7 @@ def default_region(family, **changes) -> Region:
     """The family's default region (:attr:`~screwkit.studies.families.Family.region`) with ``changes``
     (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``)."""
     spec = {**family.region, **{k: v for k, v in changes.items() if v is not None}}
-    if "grid" in changes and changes["grid"] is not None:
+    if changes.get("grid") is not None:
         spec.pop("disc", None)
     index, level = spec.get("index", "f_o1"), spec.get("level", 0.4)
     if "disc" in spec:

@@ -40,6 +40,10 @@ INFEASIBLE = 1e6
 feasible score is minus a metric, far smaller)."""
 
 
+MAX_CONFIGURATIONS_PER_DESIGN = 10**8
+"""Largest region a design is mapped on (about an hour of one core per design on the spatial path)."""
+
+
 class StateError(ValueError):
     """A state file that belongs to another study, or cannot be read."""
 
@@ -148,6 +152,10 @@ class Study:
             raise ValueError(f"No parameter of family {family.name!r} varies.")
         if self.budget < 0:
             raise ValueError(f"Expected a budget >= 0 evaluations, got {self.budget}.")
+        configurations = self.region.configurations
+        if configurations > MAX_CONFIGURATIONS_PER_DESIGN:
+            raise ValueError(f"The region has {configurations:,} configurations per design (grid points x "
+                             f"orientations x layers), more than {MAX_CONFIGURATIONS_PER_DESIGN:,}: use larger steps.")
 
     @property
     def limits(self) -> NDArray[np.float64]:
@@ -207,9 +215,12 @@ class _Evaluations:
         if state is not None and os.path.exists(state):
             self._read(state)
         elif state is not None:
-            with open(state, "w", encoding="utf-8") as file:
-                file.write(json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
-                                       "family": study.family.name, "free": list(study.free)}) + "\n")
+            try:
+                with open(state, "w", encoding="utf-8") as file:
+                    file.write(json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
+                                           "family": study.family.name, "free": list(study.free)}) + "\n")
+            except OSError as error:
+                raise StateError(f"Cannot write the design-search state {state}: {error.strerror}.") from None
         self.bar, self.pool = None, None
         if progress:
             from tqdm import tqdm
@@ -221,7 +232,13 @@ class _Evaluations:
             with open(state, encoding="utf-8") as file:
                 lines = file.read().splitlines()
             header = json.loads(lines[0])
-            records = [json.loads(line) for line in lines[1:] if line.strip()]
+            records = []
+            for number, line in enumerate(lines[1:], start=2):
+                try:
+                    records.append(json.loads(line))
+                except ValueError:
+                    if number < len(lines):  # only the last line may be cut short (a run killed while writing)
+                        raise
         except (OSError, ValueError, IndexError) as error:
             raise StateError(f"Cannot read the design-search state {state}: {error}") from None
         if header.get("study") != self.study.fingerprint():
