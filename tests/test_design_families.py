@@ -327,6 +327,7 @@ def test_an_interrupted_search_resumes_from_its_state(tmp_path):
     (("planar_rrr", "--legs", "3"), "Family planar_rrr needs at least 4 legs"),
     (("five_bar", "--budget", "2"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta), or a mechanism"),
     (("ups_hexapod_8", "--optimise"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
+    (("five_bar_3", "--permutations"), "'five_bar_3' has the task coordinates x, y."),
     (("planar_rrr", "--state", "{tmp}/other.jsonl"), "belongs to another study"),
     (("planar_rrr", "--state", "{tmp}/missing/state.jsonl"), "Cannot write the design-search state"),
     (("ups_hexapod", "--grid", "x:-1:1:0.0001", "--grid", "y:-1:1:0.001"), "configurations per design"),

@@ -40,6 +40,9 @@ def planar_design(mechanism: Mechanism) -> PlanarDesign:
     """
     if not mechanism.is_planar:
         raise ValueError(f"Design search needs a planar n-RRR; {mechanism.name!r} is spatial.")
+    if mechanism.task_coordinates != ("x", "y", "phi"):
+        raise ValueError(f"Design search needs a planar n-RRR whose platform turns (x, y, phi); {mechanism.name!r} "
+                         f"has the task coordinates {', '.join(mechanism.task_coordinates)}.")
     home = mechanism.home_pose
     solution = solve(mechanism, home[None])
     base, elbows, distal, prismatic = planar_points(mechanism, solution)
