@@ -233,6 +233,7 @@ def test_every_family_evaluates_its_default_region():
 
 
 def remapped_area(tmp_path, urdf, map_command: str, index: str, level: float, cell: float) -> float:
+    assert map_command.startswith(f"screwkit map {urdf} ")  # the command names the file written
     options = map_command.split(" ", 3)[3].split()
     out = tmp_path / "remap.nc"
     result = screwkit("map", urdf, *options, "--out", out, "--quiet", "--overwrite")

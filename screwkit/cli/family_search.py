@@ -208,7 +208,8 @@ def search_family(family: Family, region, *, objectives, constraints, free, fixe
     summary = {"family": family.name, "legs": family.legs, "objectives": list(study.objectives),
                "constraints": [str(c) for c in study.constraints], "free": list(study.free), "seed": seed,
                "budget": budget, "region": region.describe(),
-               "map_commands": [f"screwkit map BEST.urdf {shlex.join(options)}" for options in map_options],
+               "map_commands": [f"screwkit map {shlex.quote(str(urdf_path or 'BEST.urdf'))} {shlex.join(options)}"
+                                for options in map_options],
                "evaluations": len(result.evaluations), "computed": result.computed, "replayed": result.replayed,
                "start": _record(result.start), "best": [_record(r) for r in result.best], "files": []}
     _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax, summary,
