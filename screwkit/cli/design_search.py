@@ -123,7 +123,7 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
 def design_search(context, study_path, **options) -> None:
     """Search designs for fault tolerance.
 
-    FAMILY (planar_rrr, ups_hexapod, rss_hexapod): vary the family's parameters to optimise one
+    FAMILY (planar_rrr, ups_hexapod, rss_hexapod, delta): vary the family's parameters to optimise one
     or more metrics of the fault-tolerant region of a map (differential evolution, or NSGA-II for
     a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200, or
     design-search --study study.yaml. MECHANISM (a planar n-RRR): --permutations ranks every slot
@@ -153,6 +153,13 @@ def _design_search(mechanism, search_permutations, optimise, legs, objectives, c
         raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
     if search_permutations and (urdf_path or figure_path or table_path or front_figure_path):
         raise fail("--urdf, --table, --figure and --front-figure go with a family search or --optimise.")
+    searched = {"--objective": objectives, "--constraint": constraints, "--free": free, "--set": assignments,
+                "--start": starts, "--bounds": bound_texts, "--budget": budget, "--state": state, "--grid": grids,
+                "--over": overs, "--layers": layers, "--index": region_index, "--level": level, "--radius": radius,
+                "--step": step, "--maxiter": maxiter}
+    if search_permutations and any(value not in (None, ()) for value in searched.values()):
+        raise fail(f"{', '.join(k for k, v in searched.items() if v not in (None, ()))} go with a family search or "
+                   "--optimise, not --permutations.")
     if maxiter is not None and budget is not None:
         raise fail("Give --budget or --maxiter, not both.")
     check_outputs({"--urdf": (urdf_path, (".urdf",)), "--table": (table_path, (".nc", ".csv")),
@@ -190,7 +197,10 @@ def _design_search(mechanism, search_permutations, optimise, legs, objectives, c
         fixed.update(parse_assignments(chosen, assignments, "--set"))
         initial = {name: values[name] for name in varied if name not in fixed}
         initial.update(parse_assignments(chosen, starts, "--start"))
-    start_mechanism = chosen.mechanism({**fixed, **initial}) if (grids or overs or layers) else None
+    try:
+        start_mechanism = chosen.mechanism({**fixed, **initial}) if (grids or overs or layers) else None
+    except ValueError as error:
+        raise fail(f"The start design: {error}") from None
     region = region_of(chosen, start_mechanism, radius, step, phi_step, grids, overs, layers, region_index, level)
     varied_count = len(free or [n for n in chosen.free if n not in fixed])
     if maxiter is not None:
