@@ -17,7 +17,7 @@ import subprocess
 import sys
 import time
 
-FAMILIES = ("planar_rrr", "ups_hexapod", "rss_hexapod", "delta")
+FAMILIES = ("planar_rrr", "ups_hexapod", "rss_hexapod", "delta", "prs_ups")
 
 
 def run(family: str, budget: int) -> tuple[float, int]:
@@ -31,9 +31,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--budget", type=int, default=192)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--families", nargs="+", default=FAMILIES, choices=FAMILIES)
     arguments = parser.parse_args()
     print(f"{'family':12s} {'budget 0 (s)':>13s} {'budget N (s)':>13s} {'designs':>8s} {'designs/s':>10s}")
-    for family in FAMILIES:
+    for family in arguments.families:
         run(family, 0)  # warm the compile cache and the file cache
         empty, full, count = [], [], 0
         for _ in range(arguments.runs):

@@ -29,7 +29,6 @@ import textwrap
 import numpy as np
 
 from screwkit.studies.files import FORMATS, save_figure  # re-exported: figures are saved from here
-from screwkit.studies.objectives import UNITS
 
 __all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure",
            "pareto_figure", "save_figure"]
@@ -634,7 +633,7 @@ def pareto_figure(result):
     ax.plot(result.start["metrics"][first], result.start["metrics"][second], "*", color="black", markersize=11,
             label="start")
     def label(name):
-        return f"{name} ({UNITS.get(name, 'index')})".replace("^2", "\u00b2").replace("^3", "\u00b3")
+        return f"{name} ({result.study.region.unit(name)})".replace("^2", "\u00b2").replace("^3", "\u00b3")
 
     ax.set(xlabel=label(first), ylabel=label(second),
            title=f"{result.study.family.name}: {len(result.evaluations)} evaluations")

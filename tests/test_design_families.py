@@ -49,7 +49,7 @@ def test_permutation_ranks_follow_the_lexicographic_order():
 
 
 @pytest.mark.parametrize("name, bundled", [("ups_hexapod", "ups_hexapod_8"), ("rss_hexapod", "rss_hexapod_8"),
-                                           ("delta", "delta_4")])
+                                           ("delta", "delta_4"), ("prs_ups", "prs_3_ups")])
 def test_spatial_families_at_their_defaults_are_the_bundled_mechanisms(name, bundled):
     """The same file but for comments and the bundled file's named poses."""
     text = family(name).urdf(name=bundled)
@@ -245,6 +245,7 @@ def remapped_area(tmp_path, urdf, map_command: str, index: str, level: float, ce
 @pytest.mark.parametrize("arguments, cell", [
     (("planar_rrr", *SMALL_DISC), 0.01),
     (("ups_hexapod", *SMALL_GRID, "--level", "0.33", "--free", "platform_radius", "--free", "height"), 0.01),
+    (("prs_ups", "--grid", "roll:-20:20:10", "--grid", "pitch:-20:20:10", "--level", "0.7"), math.radians(10) ** 2),
 ])
 def test_the_best_design_remapped_by_a_fresh_map_has_the_reported_area(tmp_path, arguments, cell):
     urdf = tmp_path / "best.urdf"
@@ -253,7 +254,7 @@ def test_the_best_design_remapped_by_a_fresh_map_has_the_reported_area(tmp_path,
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
     best = summary["best"][0]
-    level = 0.33 if "--level" in arguments else 0.4
+    level = float(arguments[arguments.index("--level") + 1]) if "--level" in arguments else 0.4
     assert best["metrics"]["area"] >= summary["start"]["metrics"]["area"]
     area = remapped_area(tmp_path, urdf, summary["map_commands"][0], "f_o1", level, cell)
     assert abs(area - best["metrics"]["area"]) <= 1e-9
@@ -326,7 +327,8 @@ def test_an_interrupted_search_resumes_from_its_state(tmp_path):
     (("ups_hexapod", "--radius", "0.2"), "--radius, --step and --phi-step map a planar family's disc"),
     (("planar_rrr", "--front-figure", "{tmp}/f.png"), "--front-figure needs two or more --objective."),
     (("planar_rrr", "--legs", "3"), "Family planar_rrr needs at least 4 legs"),
-    (("five_bar", "--budget", "2"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta), or a mechanism"),
+    (("five_bar", "--budget", "2"),
+     "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta, prs_ups), or a mechanism"),
     (("ups_hexapod_8", "--optimise"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
     (("five_bar_3", "--optimise"), "'five_bar_3' has the task coordinates x, y."),
     (("planar_5rrr", "--permutations", "--objective", "area"), "--objective, --budget go with a family search"),

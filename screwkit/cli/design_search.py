@@ -123,7 +123,7 @@ def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, 
 def design_search(context, study_path, **options) -> None:
     """Search designs for fault tolerance.
 
-    FAMILY (planar_rrr, ups_hexapod, rss_hexapod, delta): vary the family's parameters to optimise one
+    FAMILY (planar_rrr, ups_hexapod, rss_hexapod, delta, prs_ups): vary the family's parameters to optimise one
     or more metrics of the fault-tolerant region of a map (differential evolution, or NSGA-II for
     a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200, or
     design-search --study study.yaml. MECHANISM (a planar n-RRR): --permutations ranks every slot

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from screwkit.model.urdf_writer import UrdfWriter
 from screwkit.rotations import rotation_from_rpy, rpy_from_rotation
 
-__all__ = ["slot_angles", "hexapod_points", "ups_hexapod_urdf", "rss_hexapod_urdf"]
+__all__ = ["slot_angles", "hexapod_points", "ups_hexapod_urdf", "rss_hexapod_urdf", "unit", "universal_axes"]
 
 Z_AXIS = np.array([0.0, 0.0, 1.0])
 
@@ -43,13 +43,14 @@ def hexapod_points(legs: int, base_radius: float, platform_radius: float, platfo
     return base, platform
 
 
-def _unit(vector: NDArray) -> NDArray:
+def unit(vector: NDArray) -> NDArray:
+    """``vector`` divided by its norm."""
     return vector / np.linalg.norm(vector)
 
 
-def _universal_axes(direction: NDArray) -> tuple[NDArray, NDArray]:
-    """Two unit axes perpendicular to ``direction`` (the first horizontal)."""
-    first = _unit(np.cross(Z_AXIS, direction))
+def universal_axes(direction: NDArray) -> tuple[NDArray, NDArray]:
+    """Two unit axes perpendicular to ``direction`` (the first horizontal): a universal joint's."""
+    first = unit(np.cross(Z_AXIS, direction))
     return first, np.cross(direction, first)
 
 
@@ -67,9 +68,9 @@ def ups_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float,
     for i in range(base.shape[0]):
         chain = f"leg_{i + 1}"
         top = platform[i] + np.array([0, 0, height])
-        direction = _unit(top - base[i])
+        direction = unit(top - base[i])
         length = float(np.linalg.norm(top - base[i]))
-        first_axis, second_axis = _universal_axes(direction)
+        first_axis, second_axis = universal_axes(direction)
         leg_rotation = np.column_stack([direction, first_axis, second_axis])
         writer.link(f"{chain}_cross", ("sphere", 0.03))
         writer.rod(f"{chain}_cylinder", 0.6 * length, radius=0.03)
@@ -102,9 +103,9 @@ def rss_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float,
         crank_rotation = rotation_from_rpy(np.array([0.0, 0.0, angle]))
         crank_end = base[i] + crank * radial
         top = platform[i] + np.array([0, 0, height])
-        direction = _unit(top - crank_end)
+        direction = unit(top - crank_end)
         rod_length = float(np.linalg.norm(top - crank_end))
-        first_axis, second_axis = _universal_axes(direction)
+        first_axis, second_axis = universal_axes(direction)
         rod_rotation = np.column_stack([direction, first_axis, second_axis])
         writer.rod(f"{chain}_crank", crank, radius=0.03)
         writer.link(f"{chain}_cross", ("sphere", 0.03))

@@ -11,7 +11,8 @@ Bundled families (:data:`FAMILIES`, built for a leg count by :func:`family`):
 * ``planar_rrr``: planar n-RRR, n >= 4 (the paper's Sec. 4; n = 5 at its defaults is Table 2);
 * ``ups_hexapod``: a-UPS hexapod, a >= 7 (a = 8 at its defaults is the bundled ``ups_hexapod_8``);
 * ``rss_hexapod``: a-RSS hexapod, a >= 7 (a = 8 at its defaults is the bundled ``rss_hexapod_8``);
-* ``delta``: Delta robot, a >= 4 legs (3 DOF; a = 4 at its defaults is the bundled ``delta_4``).
+* ``delta``: Delta robot, a >= 4 legs (3 DOF; a = 4 at its defaults is the bundled ``delta_4``);
+* ``prs_ups``: 3-PRS made redundant by a UPS leg (3 DOF: z, roll, pitch; the bundled ``prs_3_ups``).
 
 A new family is a :class:`Family` built from its parameters and a writer ``values -> URDF text``;
 see ``docs/design.md``.
@@ -27,6 +28,7 @@ import numpy as np
 
 from screwkit.model.delta_writer import delta_urdf
 from screwkit.model.hexapod_writer import hexapod_points, rss_hexapod_urdf, slot_angles, ups_hexapod_urdf
+from screwkit.model.prs_writer import prs_urdf
 from screwkit.model.urdf_writer import planar_rrr_urdf
 
 __all__ = ["Parameter", "Family", "FAMILIES", "family", "permutation_rank", "permutation_of_rank"]
@@ -337,11 +339,51 @@ def delta(legs: int = 4) -> Family:
                     "tangent to the base circle, parallelogram forearms modelled as R-U-U legs")
 
 
+# ---------------------------------------------------------------------------------------------
+# 3-PRS + UPS (3 DOF: z, roll, pitch)
+# ---------------------------------------------------------------------------------------------
+
+
+def _prs_parameters(values: Mapping[str, float]) -> dict:
+    return {"base_radius": values["base_radius"], "platform_radius": values["platform_radius"],
+            "link": values["link"], "prs_angles_deg": (90.0, 210.0, 330.0), "ups_angle_deg": values["ups_angle"],
+            "ups_base_radius": values["ups_base_radius"], "stroke": (-0.15, 0.15)}
+
+
+def _prs_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+    summary = ", ".join(f"{k} = {v:g}" for k, v in values.items())
+    return prs_urdf(name, _prs_parameters(values), True,
+                    f" 3-PRS + UPS of the family prs_ups (chains at 90, 210, 330 deg): {summary} (lengths m, angle "
+                    "deg) ", task_coordinates=("z", "roll", "pitch"))
+
+
+def _prs_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]:
+    return {"footprint": float(max(values["base_radius"], values["ups_base_radius"])),
+            "link_length": float(values["link"])}
+
+
+def prs_ups(legs: int = 4) -> Family:
+    if legs != 4:
+        raise ValueError(f"Family prs_ups has 4 legs (three P-R-S and one U-P-S), got {legs}.")
+    return Family(
+        "prs_ups", 4,
+        (Parameter("base_radius", 0.1, 0.35, 0.2, "m", "distance of the vertical actuated sliders from the axis"),
+         Parameter("platform_radius", 0.05, 0.25, 0.13, "m", "distance of the S centres from the platform centre"),
+         Parameter("link", 0.12, 0.4, 0.22, "m", "length of the P-R-S links (R to S)"),
+         Parameter("ups_base_radius", 0.1, 0.4, 0.26, "m", "distance of the UPS leg's U joint from the axis"),
+         Parameter("ups_angle", 0.0, 359.0, 270.0, "deg", "angle of the UPS leg about the axis (the PRS chains sit "
+                   "at 90, 210 and 330 deg)")),
+        ("platform_radius", "link", "ups_base_radius", "ups_angle"), _prs_writer, _prs_measures,
+        region={"grid": {"roll": (-30, 30, 5), "pitch": (-30, 30, 5)}, "over": {}, "level": 0.5},
+        description="3-PRS (vertical actuated sliders, tangential R axes, S joints on the platform circle) made "
+                    "redundant by a fourth, actuated U-P-S leg; its workspace is a region of orientations")
+
+
 FAMILIES: dict[str, Callable[[int], Family]] = {"planar_rrr": planar_rrr, "ups_hexapod": ups_hexapod,
-                                                 "rss_hexapod": rss_hexapod, "delta": delta}
+                                                 "rss_hexapod": rss_hexapod, "delta": delta, "prs_ups": prs_ups}
 """Bundled families by name: each builds the :class:`Family` for a leg count."""
 
-DEFAULT_LEGS = {"planar_rrr": 5, "ups_hexapod": 8, "rss_hexapod": 8, "delta": 4}
+DEFAULT_LEGS = {"planar_rrr": 5, "ups_hexapod": 8, "rss_hexapod": 8, "delta": 4, "prs_ups": 4}
 
 
 def family(name: str, legs: int | None = None) -> Family:

@@ -26,13 +26,15 @@ __all__ = ["METRICS", "MAXIMISED", "UNITS", "Region", "disc_region", "grid_regio
            "region_metrics", "inscribed_radius"]
 
 METRICS = {
-    "area": "area of the fault-tolerant region of the map (m^2; the sum over layers times the layer step "
-            "is the volume)",
+    "area": "area of the fault-tolerant region of the map (m^2 on a grid of two lengths, rad^2 on a grid of two "
+            "angles, m rad on a mixed one; summed over layers)",
     "volume": "volume of the fault-tolerant region: area of each layer times the layer step (m^3; needs layers)",
     "inscribed": "radius of the largest disc (ball with layers) about a grid point that holds no grid point "
-                 "outside the fault-tolerant region nor beyond the map (m)",
+                 "outside the fault-tolerant region nor beyond the map (m, or rad on a grid of angles; NaN on a "
+                 "grid that mixes lengths and angles)",
     "cylinder": "radius of the largest disc about a grid point whose points are fault tolerant in every layer: "
-                "the largest vertical cylinder through the layers (m; without layers the inscribed disc)",
+                "the largest vertical cylinder through the layers (unit and NaN as inscribed; without layers the "
+                "inscribed disc)",
     "worst": "minimum of the index over the whole map (an unreachable point counts 0)",
     "mean": "mean of the index over the whole map (an unreachable point counts 0)",
     "iti_floor": "minimum of the ITI over the whole map (an unreachable point counts 0)",
@@ -94,6 +96,22 @@ class Region:
     def cell(self) -> float:
         """Area of one grid cell (m^2)."""
         return float(np.prod([_step(values) for _, values in self.grid]))
+
+    @property
+    def length_unit(self) -> str:
+        """Unit of the grid's distances: ``m``, ``rad``, or ``""`` when the grid mixes lengths and angles."""
+        kinds = {is_angular(name) for name, _ in self.grid}
+        return "" if len(kinds) > 1 else ("rad" if kinds.pop() else "m")
+
+    def unit(self, metric: str) -> str:
+        """Unit of ``metric`` on this region (``index`` for index values)."""
+        if metric in ("area", "volume"):
+            units = [("rad" if is_angular(name) else "m") for name, _ in self.grid]
+            area = f"{units[0]}^2" if units[0] == units[1] else "m rad"
+            return area if metric == "area" else f"{area} m"
+        if metric in ("inscribed", "cylinder"):
+            return self.length_unit or "mixed"
+        return UNITS.get(metric, "index")
 
     @property
     def configurations(self) -> int:
@@ -261,9 +279,14 @@ def region_metrics(mechanism: Mechanism, region: Region, size: dict[str, float] 
     layer_step = _step(region.layers[1]) if region.layers else None
     area = float(np.sum(inside) * region.cell)
     spacing = [_step(v) for _, v in region.grid][::-1]
-    radius = inscribed_radius(inside, [layer_step, *spacing]) if layer_step else inscribed_radius(inside[0], spacing)
+    if not region.length_unit or (layer_step and region.length_unit != "m"):  # distances across units: none
+        radius = cylinder = math.nan
+    else:
+        radius = inscribed_radius(inside, [layer_step, *spacing]) if layer_step else inscribed_radius(inside[0],
+                                                                                                      spacing)
+        cylinder = inscribed_radius(inside.all(axis=0), spacing)
     metrics = {"area": area, "volume": area * layer_step if layer_step else math.nan, "inscribed": radius,
-               "cylinder": inscribed_radius(inside.all(axis=0), spacing),
+               "cylinder": cylinder,
                "worst": float(np.nanmin(index)), "mean": float(np.nanmean(index)),
                "iti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["iti"], nan=0.0), np.nan))),
                "lmti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["lmti"], nan=0.0), np.nan)))}
