@@ -415,3 +415,16 @@ def test_a_five_legged_delta_of_the_family_has_the_pressure_angle_f_o1():
         expected = min(max(oti(s) for s in combinations([i for i in range(5) if i != e], 3)) for e in range(5))
         assert result.f_o[1][index] == pytest.approx(expected, abs=1e-10)
     assert family("delta").size(values) == {"footprint": 0.65, "link_length": 0.9}
+
+
+def test_a_grid_of_a_length_and_an_angle_has_no_distances():
+    chosen = family("ups_hexapod")
+    region = grid_region({"x": (-0.1, 0.1, 0.1), "roll": (-10, 10, 10)}, {}, level=0.3)
+    metrics = region_metrics(chosen.mechanism(), region, chosen.size())
+    assert region.unit("area") == "m rad" and region.unit("inscribed") == "mixed"
+    assert math.isnan(metrics["inscribed"]) and math.isnan(metrics["cylinder"])
+    poses = np.array([[x, 0, 1, roll, 0, 0] for roll in np.radians([-10, 0, 10]) for x in (-0.1, 0, 0.1)])
+    tolerant = np.nan_to_num(indices_at_poses(chosen.mechanism(), poses).f_o[1]) >= 0.3
+    assert metrics["area"] == pytest.approx(tolerant.sum() * 0.1 * math.radians(10), abs=1e-12)
+    angular = grid_region({"roll": (-10, 10, 10), "pitch": (-10, 10, 10)}, {})
+    assert angular.unit("area") == "rad^2" and angular.unit("inscribed") == "rad"
