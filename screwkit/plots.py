@@ -530,7 +530,8 @@ def map_figure(dataset, variables=None, reference=None, *, vmin=None, vmax=None,
 
 
 def design_comparison_figure(reference_grid, optimised_grid, step, level, name, *, vmin=None, vmax=None,
-                             index="f_o1", over="a full rotation"):
+                             index="f_o1", over="a full rotation", axes_labels=("x (m)", "y (m)"), area_unit="m\u00b2",
+                             coordinates=None):
     """Side-by-side maps of the minimum of ``index`` (F_O1) over ``over`` for a reference and an optimised design.
 
     Each panel shows one grid (centred on the origin) in :data:`COLORMAP` on a shared colour
@@ -556,6 +557,11 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
         ([0, 1], not the data range), so both designs and other figures compare.
     index, over : str
         The index mapped (``f_o1``, ``f_io2``, ...) and the orientation set, for the labels.
+    axes_labels, area_unit : str
+        Labels of the grid's axes and the unit of its areas (a grid of angles: rad, rad²).
+    coordinates : (array_like, array_like), optional
+        The grid's x and y values (a rectangular map, evenly spaced; ``step`` is then unused and
+        every NaN point is unreachable). Default: a grid of ``step`` centred on the origin.
 
     Returns
     -------
@@ -585,10 +591,16 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     image = None
     for ax, grid, title, letter in ((axes[0], grids[0], f"{name} (reference)", "(a)"),
                                     (axes[1], grids[1], "optimised", "(b)")):
-        x = step * (np.arange(grid.shape[1]) - grid.shape[1] // 2)
-        y = step * (np.arange(grid.shape[0]) - grid.shape[0] // 2)
-        inscribed = step * min(grid.shape[0] // 2, grid.shape[1] // 2)
-        grey = ~np.isfinite(grid) & (np.hypot(*np.meshgrid(x, y)) <= inscribed * (1 + 1e-9))
+        if coordinates is None:
+            x = step * (np.arange(grid.shape[1]) - grid.shape[1] // 2)
+            y = step * (np.arange(grid.shape[0]) - grid.shape[0] // 2)
+            inscribed = step * min(grid.shape[0] // 2, grid.shape[1] // 2)
+            grey = ~np.isfinite(grid) & (np.hypot(*np.meshgrid(x, y)) <= inscribed * (1 + 1e-9))
+            cell = step**2
+        else:
+            x, y = (np.asarray(values, dtype=float) for values in coordinates)
+            grey = ~np.isfinite(grid)
+            cell = abs((x[1] - x[0]) * (y[1] - y[0])) if x.size > 1 and y.size > 1 else 0.0
         if grey.any():
             _grey_layer(ax, x, y, grey)
         image = ax.pcolormesh(x, y, np.ma.masked_invalid(grid), cmap=COLORMAP, vmin=low, vmax=high,
@@ -597,12 +609,12 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
         finite = grid[np.isfinite(grid)]
         if finite.size and finite.max() >= level and (below < level).any():
             ax.contour(x, y, below, levels=[level], colors="white", linewidths=1.4).set(path_effects=halo)
-        area = float(np.sum(finite >= level) * step**2)
+        area = float(np.sum(finite >= level) * cell)
         ax.set_title(_wrap(f"{letter} {title}\narea where min {label} \u2265 {level:g}: "
-                           f"{area:.4f} m\u00b2", 3.8, TITLE_SIZE), fontsize=TITLE_SIZE)
+                           f"{area:.4f} {area_unit}", 3.8, TITLE_SIZE), fontsize=TITLE_SIZE)
         ax.set_aspect("equal")
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
+        ax.set_xlabel(axes_labels[0])
+        ax.set_ylabel(axes_labels[1])
         handles = [Line2D([], [], color="white", linewidth=1.4, path_effects=halo, label=f"{label} = {level:g}")]
         if grey.any():
             from matplotlib.patches import Patch

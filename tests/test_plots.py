@@ -411,3 +411,22 @@ def test_save_figure_refuses_other_suffixes(tmp_path, name):
         save_figure(small_figure(), path)
     assert repr(str(path)) in str(error.value)
     assert not list(tmp_path.iterdir())
+
+
+def test_design_comparison_on_a_rectangular_grid_of_angles():
+    """Given coordinates (unequal steps, off the origin), the axes follow them and each area is the
+    count at the level times dx dy, in the unit given."""
+    roll, pitch = np.linspace(0.0, 0.4, 5), np.linspace(-0.3, 0.3, 4)
+    rng = np.random.default_rng(1)
+    grids = [rng.uniform(0, 1, (4, 5)) for _ in range(2)]
+    grids[1][0, 0] = np.nan
+    figure = design_comparison_figure(*grids, 1.0, 0.5, "start", index="f_io1", over="yaw",
+                                      axes_labels=("roll (rad)", "pitch (rad)"), area_unit="rad\u00b2",
+                                      coordinates=(roll, pitch))
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    for ax, grid in zip(panels, grids):
+        area = np.sum(grid[np.isfinite(grid)] >= 0.5) * 0.1 * 0.2
+        assert f"{area:.4f} rad\u00b2" in ax.get_title() and "mathrm{IO}1" in ax.get_title()
+        assert ax.get_xlabel() == "roll (rad)" and ax.get_ylabel() == "pitch (rad)"
+        assert ax.get_xlim()[0] < 0.0 < 0.4 < ax.get_xlim()[1] and ax.get_ylim()[0] < -0.3
+    assert any(t.get_text() == "unreachable" for t in panels[1].get_legend().get_texts())

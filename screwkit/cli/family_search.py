@@ -15,6 +15,7 @@ from screwkit.studies.families import Family
 from screwkit.studies.objectives import METRICS, default_region, region_maps
 from screwkit.studies.optimise import Constraint, StateError, Study, run_study
 from screwkit.studies.tasks import ClusterError
+from screwkit.units import is_angular
 
 __all__ = ["parse_assignments", "parse_bounds", "region_of", "search_family", "STUDY_KEYS", "read_study"]
 
@@ -171,8 +172,13 @@ def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path
         grids = [region_maps(study.family.mechanism(r["values"]), region)[region.index][layer]
                  for r in (result.start, best)]
         step = float(region.grid[0][1][1] - region.grid[0][1][0])
+        units = {name: "rad" if is_angular(name) else "m" for name, _ in region.grid}
         figure = design_comparison_figure(*grids, step, region.level, start_name, vmin=vmin,
-                                          vmax=vmax, index=region.index, over=region.orientations)
+                                          vmax=vmax, index=region.index, over=region.orientations,
+                                          axes_labels=[f"{name} ({unit})" for name, unit in units.items()],
+                                          area_unit=region.unit("area").replace("^2", "\u00b2"),
+                                          coordinates=None if region.mask is not None else
+                                          [values for _, values in region.grid])
         save_figure(figure, figure_path)
         summary["files"].append(figure_path)
     if front_figure_path:

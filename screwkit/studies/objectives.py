@@ -94,7 +94,7 @@ class Region:
 
     @property
     def cell(self) -> float:
-        """Area of one grid cell (m^2)."""
+        """Area of one grid cell, in :meth:`unit` ``("area")`` (m^2, rad^2 or m rad)."""
         return float(np.prod([_step(values) for _, values in self.grid]))
 
     @property
