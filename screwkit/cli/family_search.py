@@ -168,7 +168,7 @@ def _write_outputs(result, urdf_path, table_path, figure_path, front_figure_path
         summary["files"].append(table_path)
     if figure_path:
         region = study.region
-        layer = 0 if not region.layers else int(np.argmin(np.abs(region.layers[1])))
+        layer = 0 if not region.layers else region.layers[1].size // 2  # with layers: the middle one
         grids = [region_maps(study.family.mechanism(r["values"]), region)[region.index][layer]
                  for r in (result.start, best)]
         step = float(region.grid[0][1][1] - region.grid[0][1][0])
