@@ -86,13 +86,8 @@ def parse_bounds(family: Family, texts) -> dict[str, tuple[float, float]]:
 
 
 def _spec(mechanism, text: str, option: str) -> tuple[str, tuple[float, float, float]]:
-    name, _, rest = text.partition(":")
-    parts = rest.split(":")
-    try:
-        start, stop, step = (float(p) for p in parts)
-    except ValueError:
-        raise fail(f"Expected {option} as COORDINATE:START:STOP:STEP, got {text!r}.") from None
-    grid_spec(mechanism, text, option, True)  # the same checks and messages as screwkit map
+    name, _ = grid_spec(mechanism, text, option, True)  # the checks and messages of screwkit map
+    start, stop, step = (float(part) for part in text.split(":")[1:])
     return name, (start, stop, step)
 
 

@@ -34,7 +34,7 @@ from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular, unit_of
 
 __all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "map_task",
-           "map_block"]
+           "map_block", "orientation_set"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -273,7 +273,9 @@ def _blocks(mask: NDArray[np.bool_], per_task: int) -> list[tuple[slice, slice]]
     return [block for block in blocks if mask[block].any()]
 
 
-def _orientation_set(over: dict[str, ArrayLike]) -> NDArray[np.float64]:
+def orientation_set(over: dict[str, ArrayLike]) -> NDArray[np.float64]:
+    """Every orientation of the product set ``over`` (coordinate -> values) as rows (K, len(over));
+    one empty row when ``over`` is empty."""
     if not over:
         return np.zeros((1, 0))
     return np.stack([g.ravel() for g in np.meshgrid(*[np.asarray(v, float) for v in over.values()], indexing="ij")],
@@ -363,7 +365,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
     mask = np.ones(shape, dtype=bool) if mask is None else mask
     at = mechanism.check_poses(mechanism.home_pose if at is None else at)
     over_axes = tuple(names.index(name) for name in over)
-    over_values = _orientation_set(over)
+    over_values = orientation_set(over)
     if configurations_per_task is None:
         configurations_per_task = task_size(size.configurations)
     per_task = max(1, configurations_per_task // max(1, over_values.shape[0]))

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.model import Mechanism
-from screwkit.studies.maps import disc_grid, map_block, range_values
+from screwkit.studies.maps import disc_grid, map_block, orientation_set, range_values
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular
 
@@ -251,8 +251,7 @@ def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
     shape = (y_values.size, x_values.size)
     mask = np.ones(shape, dtype=bool) if region.mask is None else region.mask
     over_axes = tuple(names.index(name) for name, _ in region.over)
-    over_values = np.stack(np.meshgrid(*[v for _, v in region.over], indexing="ij"), -1).reshape(
-        -1, len(region.over)) if region.over else np.zeros((1, 0))
+    over_values = orientation_set(dict(region.over))
     layer_values = region.layers[1] if region.layers else [None]
     out: dict[str, NDArray] = {}
     for k, value in enumerate(layer_values):
