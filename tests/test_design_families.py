@@ -428,3 +428,31 @@ def test_a_grid_of_a_length_and_an_angle_has_no_distances():
     assert metrics["area"] == pytest.approx(tolerant.sum() * 0.1 * math.radians(10), abs=1e-12)
     angular = grid_region({"roll": (-10, 10, 10), "pitch": (-10, 10, 10)}, {})
     assert angular.unit("area") == "rad^2" and angular.unit("inscribed") == "rad"
+
+
+def scaled_hexapod_metrics(scale: float, quarter_turns: int) -> dict:
+    """Metrics of an 8-UPS with spread slots, every length times ``scale`` and the mechanism turned by
+    ``quarter_turns`` x 90 deg about the vertical (the square map turns onto itself), on the region
+    scaled with it: x, y in +-0.2, three layers of z about the home height, yaw in +-30 deg."""
+    from screwkit.loader import load_text
+    from screwkit.model.hexapod_writer import hexapod_points, ups_hexapod_urdf
+
+    base, platform = hexapod_points(8, 1.0, 0.45, (0, 4, 2, 7, 5, 3, 1, 6), base_spread=0.3, platform_spread=0.2)
+    turn = np.linalg.matrix_power(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), quarter_turns)
+    mechanism = load_text(ups_hexapod_urdf("scaled", scale * base @ turn.T, scale * platform @ turn.T, scale * 1.0))
+    region = grid_region({"x": (-0.2 * scale, 0.2 * scale, 0.1 * scale), "y": (-0.2 * scale, 0.2 * scale, 0.1 * scale)},
+                         {"yaw": (-30, 40, 10)}, layers=("z", (0.9 * scale, 1.2 * scale, 0.1 * scale)), level=0.34)
+    return region_metrics(mechanism, region)
+
+
+@pytest.mark.parametrize("scale, quarter_turns", [(1e-3, 0), (1e3, 0), (1.0, 1), (1e-3, 3)])
+def test_region_metrics_follow_the_scale_and_not_the_frame(scale, quarter_turns):
+    """Lengths x s: areas x s^2, the volume x s^3, radii x s, index values unchanged; a turn of the
+    mechanism about the vertical (a change of world frame that maps the square map onto itself)
+    changes nothing."""
+    reference, scaled = scaled_hexapod_metrics(1.0, 0), scaled_hexapod_metrics(scale, quarter_turns)
+    assert 0 < reference["area"] < 75 * 0.01  # the level cuts the region: the test can fail both ways
+    assert reference["inscribed"] > 0 and reference["cylinder"] > 0
+    for name, power in (("area", 2), ("volume", 3), ("inscribed", 1), ("cylinder", 1), ("worst", 0), ("mean", 0),
+                        ("iti_floor", 0), ("lmti_floor", 0)):
+        assert scaled[name] == pytest.approx(reference[name] * scale**power, rel=1e-9, abs=0), name
