@@ -456,3 +456,16 @@ def test_region_metrics_follow_the_scale_and_not_the_frame(scale, quarter_turns)
     for name, power in (("area", 2), ("volume", 3), ("inscribed", 1), ("cylinder", 1), ("worst", 0), ("mean", 0),
                         ("iti_floor", 0), ("lmti_floor", 0)):
         assert scaled[name] == pytest.approx(reference[name] * scale**power, rel=1e-9, abs=0), name
+
+
+def test_a_volume_search_gives_one_map_command_per_layer(tmp_path):
+    urdf = tmp_path / "best.urdf"
+    result = screwkit("design-search", "delta", "--grid", "x:-0.2:0.2:0.1", "--grid", "y:-0.2:0.2:0.1", "--layers",
+                      "z:-0.9:-0.6:0.1", "--objective", "volume", "--budget", "6", "--popsize", "2", "--urdf", urdf,
+                      "--figure", tmp_path / "maps.png", "--json", "--quiet")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert len(summary["map_commands"]) == 3 and all("--at" in command for command in summary["map_commands"])
+    areas = [remapped_area(tmp_path, urdf, command, "f_o1", 0.5, 0.01) for command in summary["map_commands"]]
+    assert sum(areas) * 0.1 == pytest.approx(summary["best"][0]["metrics"]["volume"], abs=1e-9)
+    assert summary["best"][0]["metrics"]["volume"] >= summary["start"]["metrics"]["volume"] > 0
