@@ -1,4 +1,5 @@
-"""A line on stderr before a compiled kernel is built for the first time (numba, tens of seconds).
+"""A line on stderr before a compiled kernel is built for the first time (numba, tens of seconds),
+and the index kernels compiled in parallel child processes on a first run.
 
 numba keeps compiled kernels in a cache (an index file ``<module>.<function>-<line>.pyXY.nbi`` in
 ``__pycache__`` beside the source, in ``NUMBA_CACHE_DIR`` when that is set, else in the user's
@@ -10,21 +11,31 @@ that a first run does not look hung. ``screwkit warmup`` compiles every kernel a
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
+import threading
 from pathlib import Path
 
-__all__ = ["announce_compilation", "kernel_is_cached", "silence", "KERNELS"]
+__all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "KERNELS",
+           "INDEX_KERNELS"]
 
 KERNELS = {
-    "screwkit._kernels": ("transmission_kernel", 40),
+    "screwkit._wrench_kernel": ("wrench_kernel", 14),
+    "screwkit._output_kernel": ("output_kernel", 10),
+    "screwkit._gram_kernel": ("gram_kernel", 6),
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
     "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
 }
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
+INDEX_KERNELS = ("screwkit._wrench_kernel", "screwkit._output_kernel")
+"""The two stages of :func:`screwkit.transmission.analyze`, compiled apart (in parallel on a first run)."""
+
 _checked: set[str] = set()
 _silent = False
+_children: dict[str, subprocess.Popen] = {}
+_lock = threading.Lock()
 
 
 def silence() -> None:
@@ -77,3 +88,43 @@ def announce_compilation(module: str) -> None:
         function, seconds = KERNELS[module]
         print(f"screwkit: compiling {function} (first run only, about {seconds} s; `screwkit warmup` compiles "
               "every kernel ahead)", file=sys.stderr, flush=True)
+
+
+def compile_ahead(*modules: str) -> None:
+    """Once per process and module: for the kernels numba's cache lacks, one line on stderr and, on a
+    machine with more than one core, one child process per kernel that compiles it into the cache
+    while this process goes on (:func:`prepare_kernels` waits for them). On one core they compile
+    in this process, when first imported."""
+    with _lock:
+        missing = [module for module in modules if module not in _checked and not kernel_is_cached(module)]
+        _checked.update(modules)
+        if not missing:
+            return
+        parallel = (os.cpu_count() or 1) > 1
+        if not _silent:
+            names = " and ".join(KERNELS[module][0] for module in missing)
+            seconds = (max if parallel else sum)(KERNELS[module][1] for module in missing)
+            where = f" in {len(missing)} processes" if parallel and len(missing) > 1 else ""
+            print(f"screwkit: compiling {names}{where} (first run only, about {seconds} s; `screwkit warmup` "
+                  "compiles every kernel ahead)", file=sys.stderr, flush=True)
+        if not parallel:
+            return  # compiled here, when first imported
+        package_parent = str(Path(__file__).resolve().parents[1])
+        path = os.pathsep.join(filter(None, [package_parent, os.environ.get("PYTHONPATH")]))
+        for module in missing:
+            _children[module] = subprocess.Popen(
+                [sys.executable, "-c", f"import {module}"], env=dict(os.environ, PYTHONPATH=path),
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
+    """Before the index kernels' modules are imported: start compiling those not cached
+    (:func:`compile_ahead`) and wait for the child processes compiling them."""
+    compile_ahead(*modules)
+    for module in modules:
+        with _lock:
+            child = _children.get(module)
+        if child is not None:
+            child.wait()  # (thread-safe: every thread needing the kernel waits here)
+            with _lock:
+                _children.pop(module, None)

@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit import tolerances
 from screwkit._chunks import map_chunks
-from screwkit._compile_notice import announce_compilation
+from screwkit._compile_notice import prepare_kernels
 from screwkit._validation import as_float_array, check_finite
 from screwkit.chains import ChainScrews
 from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
@@ -230,9 +230,9 @@ def _reductions(a: int, n: int, submechanisms: list[tuple[int, ...]], fault_list
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
-    """The compiled kernel on one chunk; ``basis`` in working coordinates (see :func:`working_coordinates`)."""
-    announce_compilation("screwkit._kernels")
-    from screwkit._kernels import transmission_kernel  # numba: loaded when indices first run
+    """The compiled kernels on one chunk; ``basis`` in working coordinates (see :func:`working_coordinates`)."""
+    prepare_kernels()
+    from screwkit._index_kernels import run_kernels  # numba: loaded when indices first run
 
     count = twists.shape[0]
     kept = count if detail else 0
@@ -248,23 +248,11 @@ def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, ot
         "output_twists": np.zeros((count if keep_twists else 0, subs, n, 6)),
         "outside": np.zeros(count, dtype=bool),
     }
-    empty = np.empty((0, a, 3))
-    # The kernel's one signature: screws in any layout, the rest C-contiguous; all writable float64.
+    # The kernels' one signature: screws in any layout, the rest C-contiguous; all writable float64.
     twists, points = (array if array.flags.writeable else array.copy() for array in (twists, points))
     basis, complement = (array if array.flags.writeable and array.flags.c_contiguous else np.array(array, order="C")
                          for array in (basis, complement))
-    transmission_kernel(twists, points, plan.chain_start, plan.actuator_chain, plan.actuator_joint, basis,
-                        complement, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children,
-                        plan.fault_rows, plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.threshold,
-                        plan.rank_tolerance,
-                        tolerances.PURE_COUPLE,
-                        tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT,
-                        tolerances.PSEUDO_INVERSE_CONSISTENCY, tolerances.WORST_FAULT_TIE,
-                        empty if iti_override is None else iti_override,
-                        empty if oti_override is None else oti_override,
-                        out["iti_actuators"], out["oti_actuators"], out["oti_submechanisms"], out["summary"],
-                        out["worst"], out["mutual_interference"],
-                        out["actuation_wrenches"], out["output_twists"], out["outside"])
+    run_kernels(plan, twists, points, basis, complement, iti_override, oti_override, out)
     return out
 
 

@@ -18,6 +18,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "screwkit"
 LAYERS = {
     # the math core and what it shares: numpy only
     "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0,
+    "screwkit._wrench_kernel": 0, "screwkit._output_kernel": 0, "screwkit._index_kernels": 0,
+    "screwkit._gram_kernel": 0,
     "screwkit._planar_kernel": 0,
     "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
     "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
@@ -131,11 +133,11 @@ def test_function_local_imports_of_the_package_say_why():
 
 
 def test_modules_and_classes_stay_small():
-    """No module above ~600 lines but the compiled kernel, no class above ~300 lines."""
+    """No module above ~600 lines (the compiled kernels included), no class above ~300 lines."""
     too_long = []
     for module, path in MODULES.items():
         source = path.read_text(encoding="utf-8")
-        if module != "screwkit._kernels" and source.count("\n") > 660:
+        if source.count("\n") > 660:
             too_long.append(f"{module}: {source.count(chr(10))} lines")
         for node in ast.walk(ast.parse(source)):
             if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno > 300:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit._kernels import BLOCK, LEADING_PIVOT_RATIO, _null_vector, _null_vectors_lanes
+from screwkit._kernels import BLOCK, LEADING_PIVOT_RATIO, null_vector, null_vectors_lanes
 
 
 def cofactors(rows):
@@ -27,7 +27,7 @@ def test_null_vector_is_the_cofactor_vector():
             elif case % 4 == 3:
                 rows *= 10.0 ** rng.integers(-6, 6)  # scale
             out = np.full(size, np.nan)
-            _null_vector(np.ascontiguousarray(rows), size, out, work, columns)
+            null_vector(np.ascontiguousarray(rows), size, out, work, columns)
             expected = cofactors(rows)
             scale = np.prod(np.linalg.norm(rows, axis=1))
             np.testing.assert_allclose(out, expected, rtol=0, atol=1e-12 * scale)
@@ -51,7 +51,7 @@ def test_null_vectors_of_every_lane_are_the_cofactor_vectors():
         width = BLOCK - 3
         out = np.full((size, BLOCK), np.nan)
         scratch = [np.empty(BLOCK) for _ in range(5)]
-        _null_vectors_lanes(rows, size, width, out, np.empty((m, size, BLOCK)), *scratch, np.empty((6, 6)),
+        null_vectors_lanes(rows, size, width, out, np.empty((m, size, BLOCK)), *scratch, np.empty((6, 6)),
                             np.empty((6, 6)), np.empty(6, dtype=np.int64), np.empty(6))
         assert np.isnan(out[:, width:]).all()  # lanes beyond the width are left alone
         for r in range(width):
@@ -62,9 +62,9 @@ def test_null_vectors_of_every_lane_are_the_cofactor_vectors():
 
 
 def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
-    """_solve on Gram matrices of unit columns (as the kernel builds them): numpy's solution when
+    """solve on Gram matrices of unit columns (as the kernel builds them): numpy's solution when
     regular, False when a pivot is at or below the tolerance it is given (GRAM_PIVOT)."""
-    from screwkit._kernels import _solve
+    from screwkit._kernels import solve
     from screwkit.tolerances import GRAM_PIVOT
 
     rng = np.random.default_rng(8)
@@ -74,7 +74,7 @@ def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
         columns /= np.linalg.norm(columns, axis=0)
         gram = np.ascontiguousarray(columns.T @ columns)
         rhs = rng.standard_normal(size)
-        regular = _solve(gram, size, rhs, out, work, GRAM_PIVOT)
+        regular = solve(gram, size, rhs, out, work, GRAM_PIVOT)
         assert regular == (size <= 6)
         if regular:
             np.testing.assert_allclose(out[:size], np.linalg.solve(gram, rhs), rtol=1e-9, atol=1e-9)
@@ -84,8 +84,8 @@ def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
     second = first + 1e-5 * rng.standard_normal(6)
     second /= np.linalg.norm(second)
     gram = np.ascontiguousarray(np.array([first, second]) @ np.array([first, second]).T)
-    assert _solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-12)
-    assert not _solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-8)
+    assert solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-12)
+    assert not solve(gram, 2, np.array([1.0, 0.0]), out, work, 1e-8)
 
 
 @pytest.mark.parametrize("n", [4, 5, 6])
@@ -110,6 +110,27 @@ def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
             assert np.isclose(values[index], np.linalg.det(rows[:level][:, columns]), rtol=1e-12, atol=1e-12)
     cofactor = np.array([(-1) ** (n - 1 + q) * minors[n - 1][n - 1 - q] for q in range(n)])
     expected = np.empty(n)
-    _null_vector(rows, n, expected, np.empty((n, n)), np.empty(n, dtype=np.int64))
+    null_vector(rows, n, expected, np.empty((n, n)), np.empty(n, dtype=np.int64))
     np.testing.assert_allclose(cofactor, expected, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(rows @ cofactor, 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("size, rank", [(1, 0), (1, 1), (3, 2), (6, 6), (7, 6), (9, 5)])
+def test_pseudo_inverse_matches_numpy_on_symmetric_matrices_of_any_rank(size, rank):
+    """The written-out Jacobi pseudo-inverse of the wrench kernel's idle-DoF fallback equals
+    numpy's SVD-based pinv on Gram matrices of unit twists (positive semi-definite, rank deficient)."""
+    from screwkit._kernels import pseudo_inverse
+
+    rng = np.random.default_rng(size * 10 + rank)
+    for _ in range(20):
+        factors = rng.standard_normal((size, rank))
+        factors /= np.maximum(np.linalg.norm(factors, axis=1, keepdims=True), 1e-300)
+        gram = factors @ factors.T if rank else np.zeros((size, size))
+        capacity = size + 2  # scratch larger than the matrix, as in the kernel
+        matrix = np.full((capacity, capacity), np.nan)
+        matrix[:size, :size] = gram
+        out = np.full((capacity, capacity), np.nan)
+        result = pseudo_inverse(matrix, size, out, np.empty((capacity, capacity)), np.empty(capacity))
+        expected = np.linalg.pinv(gram)
+        assert result is out
+        np.testing.assert_allclose(out[:size, :size], expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))

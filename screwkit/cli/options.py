@@ -14,7 +14,7 @@ from typing import Callable
 import click
 import numpy as np
 
-from screwkit._compile_notice import announce_compilation, silence
+from screwkit._compile_notice import INDEX_KERNELS, compile_ahead, silence
 from screwkit.loader import load
 from screwkit.studies.files import check_output
 from screwkit.studies.maps import range_values
@@ -177,14 +177,17 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
     """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded.
 
     ``indices``: the command computes indices, so a first run says at once that the index kernel
-    is about to be compiled (before Pinocchio is even imported)."""
+    is about to be compiled, and starts compiling it (before Pinocchio is even imported)."""
     if indices:
-        announce_compilation("screwkit._kernels")
+        compile_ahead(*INDEX_KERNELS)
 
     try:
-        return load(name, length_unit=length_unit)
+        mechanism = load(name, length_unit=length_unit)
     except ValueError as error:
         raise fail(str(error)) from None
+    if indices and any(chain.geometry.n_dofs != mechanism.dof for chain in mechanism.chains if chain.actuated):
+        compile_ahead("screwkit._gram_kernel")  # a chain whose wrench is a Gram solve (see _index_kernels)
+    return mechanism
 
 
 def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarray:

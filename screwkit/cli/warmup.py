@@ -6,7 +6,7 @@ import time
 
 import click
 
-from screwkit._compile_notice import KERNELS, kernel_is_cached
+from screwkit._compile_notice import INDEX_KERNELS, KERNELS, kernel_is_cached
 
 __all__ = ["warmup"]
 
@@ -23,17 +23,19 @@ def warmup() -> None:
     from screwkit.studies.poses import indices_at_pose, indices_at_poses  # idem
 
     five = load("planar_5rrr")
-    steps = {
-        "screwkit._kernels": lambda: indices_at_pose(five, five.home_pose),
-        "screwkit._planar_kernel": lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
-        "screwkit.closure._task_kernel": lambda: load("prs_3_ups"),
-        "screwkit.closure._frames_kernel": lambda: chain_forward_kinematics(
+    steps = {  # the two index kernels compile together, in two processes
+        INDEX_KERNELS: lambda: indices_at_pose(five, five.home_pose),
+        ("screwkit._gram_kernel",): lambda: indices_at_pose(three := load("five_bar_3"), three.home_pose),
+        ("screwkit._planar_kernel",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
+        ("screwkit.closure._task_kernel",): lambda: load("prs_3_ups"),
+        ("screwkit.closure._frames_kernel",): lambda: chain_forward_kinematics(
             five.chains[0].geometry, np.zeros((COMPILED_FROM, five.chains[0].geometry.n_dofs))),
     }
-    for module, step in steps.items():
-        cached = kernel_is_cached(module)
+    for modules, step in steps.items():
+        cached = [kernel_is_cached(module) for module in modules]
         start = time.perf_counter()
         step()
-        click.echo(f"{KERNELS[module][0]:28s} {'cached' if cached else 'compiled'} in "
-                   f"{time.perf_counter() - start:.1f} s", err=True)
+        for module, was_cached in zip(modules, cached):
+            click.echo(f"{KERNELS[module][0]:28s} {'cached' if was_cached else 'compiled'} in "
+                       f"{time.perf_counter() - start:.1f} s", err=True)
     click.echo("screwkit kernels ready", err=True)

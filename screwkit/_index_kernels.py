@@ -1,0 +1,74 @@
+"""Both compiled stages of :func:`screwkit.transmission.analyze` on a chunk of configurations.
+
+Importing this module loads :mod:`screwkit._wrench_kernel` and :mod:`screwkit._output_kernel`
+(numba: from its cache, or compiled; :func:`screwkit._compile_notice.prepare_kernels` compiles
+them in parallel first).
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from screwkit import tolerances
+from screwkit._compile_notice import prepare_kernels
+from screwkit._kernels import BLOCK, KERNEL_BATCH, carry_arrays
+from screwkit._output_kernel import output_kernel
+from screwkit._wrench_kernel import wrench_kernel
+
+__all__ = ["run_kernels", "needs_gram_kernel"]
+
+
+def needs_gram_kernel(chain_start: np.ndarray, actuator_chain: np.ndarray, n: int) -> bool:
+    """Whether an actuator's chain has more or fewer joint DoFs than n: its wrench is then
+    :func:`screwkit._gram_kernel.gram_kernel`'s (a Gram solve), compiled only for such mechanisms."""
+    return bool(np.any(np.diff(chain_start)[actuator_chain] != n))
+
+_carry = threading.local()  # each thread's carry arrays, kept between calls (no fresh pages per chunk)
+
+
+def _carry_arrays(blocks: int, a: int, n: int) -> tuple[np.ndarray, ...]:
+    """This thread's :func:`~screwkit._kernels.carry_arrays` for ``blocks`` blocks of a and n, reused."""
+    kept = getattr(_carry, "arrays", None)
+    if kept is None or kept[0].shape[:2] != (blocks, a) or kept[2].shape[1] != n:
+        kept = _carry.arrays = carry_arrays(blocks, a, n)
+    return kept
+
+
+def run_kernels(plan, twists, points, basis, complement, iti_override, oti_override, out: dict) -> None:
+    """Both kernels on a chunk, ``KERNEL_BATCH`` configurations at a time, into the arrays of ``out``.
+
+    ``plan`` is the chunk's :class:`screwkit.transmission._Plan` (actuators, submechanisms, locked
+    sets, reductions, threshold); arrays as :func:`screwkit.transmission._run_kernel` prepares them,
+    ``iti_override`` and ``oti_override`` (N, a, 3) or None. The first stage hands the second its
+    per-block results (:func:`~screwkit._kernels.carry_arrays`) for one batch at a time, a few MiB kept in cache,
+    rather than for the whole chunk.
+    """
+    count = twists.shape[0]
+    a, n = len(plan.actuators), plan.submechanisms.shape[1]
+    empty = np.empty((0, a, 3))
+    iti_override, oti_override = (empty if point is None else point for point in (iti_override, oti_override))
+    carry = _carry_arrays(KERNEL_BATCH // BLOCK, a, n)
+    gram_kernel = None
+    if needs_gram_kernel(plan.chain_start, plan.actuator_chain, n):
+        prepare_kernels(("screwkit._gram_kernel",))
+        from screwkit._gram_kernel import gram_kernel  # numba: compiled only for mechanisms that need it
+    for start in range(0, count, KERNEL_BATCH):
+        part = slice(start, min(count, start + KERNEL_BATCH))
+        own = {key: value[part] if len(value) else value for key, value in out.items()}
+        wrench_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint,
+                      basis if len(basis) == 1 else basis[part], complement, plan.threshold,
+                      tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT, tolerances.PSEUDO_INVERSE_CONSISTENCY,
+                      own["outside"], *carry)
+        if gram_kernel is not None:
+            gram_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint, n,
+                        tolerances.GRAM_PIVOT, tolerances.PSEUDO_INVERSE_CONSISTENCY, own["outside"], carry[0],
+                        carry[4], carry[5])
+        output_kernel(plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children, plan.fault_rows,
+                      plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.rank_tolerance,
+                      tolerances.PURE_COUPLE, tolerances.WORST_FAULT_TIE,
+                      iti_override[part] if len(iti_override) else empty,
+                      oti_override[part] if len(oti_override) else empty, own["iti_actuators"],
+                      own["oti_actuators"], own["oti_submechanisms"], own["summary"], own["worst"],
+                      own["mutual_interference"], own["actuation_wrenches"], own["output_twists"], *carry)

@@ -1,0 +1,404 @@
+"""Compiled second stage of :func:`screwkit.transmission.analyze`: ITIs, output twists, OTIs, LMTI, F_Oj.
+
+For the blocks of configurations :func:`screwkit._wrench_kernel.wrench_kernel` has prepared
+(:func:`screwkit._kernels.carry_arrays`, working coordinates), :func:`output_kernel` normalises
+each actuation wrench, computes its ITI (Eq. 6; the mechanism's, Eq. 7) and the moment-arm
+operator of its OTI, then builds the output twist of every set of n - 1 locked actuators (the
+cofactor vector of their wrench rows: an exterior product of the locked rows, level by level,
+each locked set starting from the minors it shares with the set before it; no pivoting, no
+division), the OTIs of every non-redundant
+submechanism (Eqs. 8-9, with the identity |A_k o T_k| = |det W| of Eq. A3), the LMTI of all
+actuators (Eq. 11), F_Oj for each j (Eqs. 12-13) with the worst fault set, and the
+mutual-interference actuators. Its own module, so that it compiles apart from
+:mod:`screwkit._wrench_kernel` (in parallel on a first run, :mod:`screwkit._compile_notice`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from screwkit._fastmath import FASTMATH
+from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, power_coefficient
+
+__all__ = ["output_kernel"]
+
+# The one signature: every array C-contiguous (analyze() sees to it).
+_SIGNATURE = (
+    "void(int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], "
+    "int64[::1], float64, float64, float64, float64[:, :, ::1], float64[:, :, ::1], "
+    "float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], int64[:, ::1], boolean[:, ::1], "
+    "float64[:, :, ::1], float64[:, :, :, ::1], "
+    + CARRY_SIGNATURE + ")"
+)
+
+
+@njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
+def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_rows, locked_depth, wedge_table,
+                  wedge_start, rank_tolerance, pure_couple, worst_fault_tie, iti_override, oti_override,
+                  iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out, wrench_out, twist_out,
+                  force_rows, actuated_rows, motion_rows, threshold_rows, length_rows, centre_rows):
+    """ITIs, output twists, OTIs and the reductions over actuator sets of a chunk of configurations.
+
+    Parameters (N configurations, a actuators, n DOF, S submechanisms)
+    ----------
+    submechanisms (S, n) : actuator indices of each non-redundant submechanism.
+    locked_sets (L, n - 1) : every set of n - 1 actuators (locked while one other drives).
+    locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
+        the other n - 1 actuators of the submechanism.
+    set_children (R, K), fault_rows (F, 2) : the actuator sets whose LMTI the reductions need
+        (see :func:`screwkit.transmission._reductions`): row t of ``set_children`` lists rows of
+        the OTIs and sets before it (OTIs of submechanisms first, then the sets in order, padded
+        with -1) whose maximum is the LMTI of set t; ``fault_rows[f]`` is the range of those rows
+        (OTIs included) holding the sets left after the f-th value of j, in combination order.
+    locked_depth (L,), wedge_table (T, 5), wedge_start (n + 1,) : for n >= 4, the output twists'
+        exterior products (see :func:`screwkit.transmission._wedge_tables`): the first position at
+        which each locked set differs from the one before, and the expansion terms (target minor,
+        source minor, column, sign, first term of its target) of level K in rows
+        wedge_start[K]:wedge_start[K+1].
+    rank_tolerance, pure_couple, worst_fault_tie : the dimensionless tolerances RANK_TOLERANCE,
+        PURE_COUPLE and WORST_FAULT_TIE of :mod:`screwkit.tolerances`, in working coordinates.
+    iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller (world).
+    Outputs: iti_out (N or 0, a) (Eq. 6), oti_out (N or 0, S, n), oti_sub_out (N or 0, S) (Eq. 9);
+        summary_out (N, 2 + F) holding the ITI (Eq. 7), the LMTI of all actuators (Eq. 11) and
+        F_Oj for each of the F values of j (Eqs. 12-13); worst_out (N, F) the worst set: the
+        first set, in combination order, whose LMTI is at most F_Oj + worst_fault_tie (numpy's
+        argmin, made robust to rounding between sets of mathematically equal LMTI);
+        mutual_out (N, a) bool, whether each actuator is a mutual-interference actuator (some n
+        others have independent wrenches); wrench_out (N or 0, a, 6) (world frame and unit: unit
+        force, or unit moment for a pure couple), twist_out (N or 0, S, n, 6) (output twists, world frame
+        and unit, scaled as the adjugate columns in working coordinates, so that
+        |A'_k o T'_k| = |det W|). The per-block inputs are the first stage's
+        (:func:`screwkit._kernels.carry_arrays`).
+    """
+    count = summary_out.shape[0]
+    a = force_rows.shape[1]
+    n = motion_rows.shape[1]
+    subs = submechanisms.shape[0]
+    blocks = (count + BLOCK - 1) // BLOCK
+    wrench_lanes = np.empty((a, 6, BLOCK))
+    point_lanes = np.empty((3, BLOCK))  # the OTI characteristic point of the actuator
+    pitch_lanes = np.empty(BLOCK)
+    inverse_lengths = np.empty(BLOCK)
+    iti_local = np.zeros((a, BLOCK))
+    has_force = np.zeros((a, BLOCK), dtype=np.bool_)
+    arms = np.zeros((a, n, 3, BLOCK))
+    wrench_matrix = np.zeros((a, n, BLOCK))
+    row_norms = np.zeros((a, BLOCK))
+    pure_couple_sq = pure_couple * pure_couple
+    output = np.empty((locked_sets.shape[0], n, BLOCK))
+    wedge = np.zeros((max(n, 1), 20, BLOCK))  # minors of the first K locked rows, at most C(6, 3) = 20 per level
+    output_omega = np.empty((locked_sets.shape[0], BLOCK))
+    oti_local = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the sets
+    independent = np.empty((subs, BLOCK), dtype=np.bool_)
+    values = np.empty((n, BLOCK))
+    determinant = np.empty(BLOCK)
+    volume = np.empty(BLOCK)
+    lane0 = np.empty(BLOCK)
+    lane1 = np.empty(BLOCK)
+    lane2 = np.empty(BLOCK)
+    best = np.empty(BLOCK)
+    mutual = np.empty(BLOCK, dtype=np.bool_)
+    first_set = np.empty(BLOCK, dtype=np.int64)
+    member = np.zeros((subs, a), dtype=np.bool_)
+    for s in range(subs):
+        for i in range(n):
+            member[s, submechanisms[s, i]] = True
+    for block in range(blocks):
+        first_index = block * BLOCK
+        last_index = min(count, first_index + BLOCK)
+        width = last_index - first_index
+        forces = force_rows[block]
+        actuated = actuated_rows[block]
+        motion_lanes = motion_rows[block]
+        thresholds = threshold_rows[block]
+        lengths = length_rows[block]
+        centres = centre_rows[block]
+        for r in range(width):
+            inverse_lengths[r] = 1.0 / lengths[r]
+        for act in range(a):
+            # --- unit wrench about the centroid, its ITI (Eq. 6) and its OTI characteristic point.
+            for r in range(width):
+                d0, d1, d2 = actuated[act, 9, r], actuated[act, 10, r], actuated[act, 11, r]
+                f0, f1, f2 = forces[act, 0, r], forces[act, 1, r], forces[act, 2, r]
+                x0, x1, x2 = cross(d0, d1, d2, f0, f1, f2)  # m_c = m_d + d x f
+                m0 = forces[act, 3, r] + x0
+                m1 = forces[act, 4, r] + x1
+                m2 = forces[act, 5, r] + x2
+                force_sq = f0 * f0 + f1 * f1 + f2 * f2
+                moment_sq = m0 * m0 + m1 * m1 + m2 * m2
+                # A pure couple: |f| <= PURE_COUPLE |m_c| / L (working coordinates, moment about c).
+                forceful = force_sq > pure_couple_sq * moment_sq and force_sq > 0.0
+                scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
+                work_done = (f0 * actuated[act, 3, r] + f1 * actuated[act, 4, r] + f2 * actuated[act, 5, r]
+                             + m0 * actuated[act, 0, r] + m1 * actuated[act, 1, r] + m2 * actuated[act, 2, r])
+                factor = ((-1.0 if work_done < 0.0 else 1.0) / scale) if scale > 0.0 else 0.0
+                f0 *= factor
+                f1 *= factor
+                f2 *= factor
+                m0 *= factor
+                m1 *= factor
+                m2 *= factor
+                wrench_lanes[act, 0, r] = f0
+                wrench_lanes[act, 1, r] = f1
+                wrench_lanes[act, 2, r] = f2
+                wrench_lanes[act, 3, r] = m0
+                wrench_lanes[act, 4, r] = m1
+                wrench_lanes[act, 5, r] = m2
+                forceful = forceful and scale > 0.0
+                has_force[act, r] = forceful
+                pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
+                pitch_lanes[r] = pitch
+                # Characteristic points: projections on the wrench axis (unit force).
+                axis0, axis1, axis2 = cross(f0, f1, f2, m0, m1, m2)
+                if iti_override.shape[0] > 0:
+                    p0 = (iti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
+                    p1 = (iti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
+                    p2 = (iti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
+                else:
+                    p0, p1, p2 = actuated[act, 6, r], actuated[act, 7, r], actuated[act, 8, r]
+                    if forceful:
+                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+                        p0 = axis0 + along * f0
+                        p1 = axis1 + along * f1
+                        p2 = axis2 + along * f2
+                # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
+                w0, w1, w2 = actuated[act, 0, r], actuated[act, 1, r], actuated[act, 2, r]
+                x0, x1, x2 = cross(w0, w1, w2, p0, p1, p2)
+                omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+                v0 = actuated[act, 3, r] + x0 + pitch * w0
+                v1 = actuated[act, 4, r] + x1 + pitch * w1
+                v2 = actuated[act, 5, r] + x2 + pitch * w2
+                arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if forceful else omega
+                reference = omega if forceful else 0.0
+                iti_local[act, r] = power_coefficient(work_done * factor, arm, reference, thresholds[r])
+                if oti_override.shape[0] > 0:
+                    p0 = (oti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
+                    p1 = (oti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
+                    p2 = (oti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
+                else:
+                    p0, p1, p2 = d0, d1, d2
+                    if forceful:
+                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+                        p0 = axis0 + along * f0
+                        p1 = axis1 + along * f1
+                        p2 = axis2 + along * f2
+                point_lanes[0, r] = p0
+                point_lanes[1, r] = p1
+                point_lanes[2, r] = p2
+            # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega (omega for a couple),
+            # and the row of the wrench matrix in motion coordinates, A_k o M_q.
+            for r in range(width):
+                row_norms[act, r] = 0.0
+            for q in range(n):
+                for r in range(width):
+                    w0, w1, w2 = motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r]
+                    x0, x1, x2 = cross(w0, w1, w2, point_lanes[0, r], point_lanes[1, r], point_lanes[2, r])
+                    pitch = pitch_lanes[r]
+                    forceful = has_force[act, r]
+                    arms[act, q, 0, r] = motion_lanes[q, 3, r] + x0 + pitch * w0 if forceful else w0
+                    arms[act, q, 1, r] = motion_lanes[q, 4, r] + x1 + pitch * w1 if forceful else w1
+                    arms[act, q, 2, r] = motion_lanes[q, 5, r] + x2 + pitch * w2 if forceful else w2
+                    value = (wrench_lanes[act, 0, r] * motion_lanes[q, 3, r]
+                             + wrench_lanes[act, 1, r] * motion_lanes[q, 4, r]
+                             + wrench_lanes[act, 2, r] * motion_lanes[q, 5, r]
+                             + wrench_lanes[act, 3, r] * w0 + wrench_lanes[act, 4, r] * w1
+                             + wrench_lanes[act, 5, r] * w2)
+                    wrench_matrix[act, q, r] = value
+                    row_norms[act, r] += value * value
+            for r in range(width):
+                row_norms[act, r] = np.sqrt(row_norms[act, r])
+            if wrench_out.shape[0] > 0:  # back to world units and origin: m_0 = L m' + c x f
+                for r in range(width):
+                    f0, f1, f2 = wrench_lanes[act, 0, r], wrench_lanes[act, 1, r], wrench_lanes[act, 2, r]
+                    x0, x1, x2 = cross(centres[0, r], centres[1, r], centres[2, r], f0, f1, f2)
+                    length = lengths[r]
+                    unit = 1.0 if has_force[act, r] else inverse_lengths[r]  # a couple: unit moment in world units
+                    wrench_out[first_index + r, act, 0] = f0 * unit
+                    wrench_out[first_index + r, act, 1] = f1 * unit
+                    wrench_out[first_index + r, act, 2] = f2 * unit
+                    wrench_out[first_index + r, act, 3] = (wrench_lanes[act, 3, r] * length + x0) * unit
+                    wrench_out[first_index + r, act, 4] = (wrench_lanes[act, 4, r] * length + x1) * unit
+                    wrench_out[first_index + r, act, 5] = (wrench_lanes[act, 5, r] * length + x2) * unit
+        # --- ITI (Eq. 7).
+        for r in range(width):
+            lane0[r] = 1.0
+        for act in range(a):
+            for r in range(width):
+                lane0[r] = min(lane0[r], iti_local[act, r])
+        for r in range(width):
+            summary_out[first_index + r, 0] = lane0[r]
+        if iti_out.shape[0] > 0:
+            for r in range(width):
+                for act in range(a):
+                    iti_out[first_index + r, act] = iti_local[act, r]
+                # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
+        # their wrenches (a column of adj(W) of every submechanism containing the set).
+        for locked in range(locked_sets.shape[0]):
+            if n == 3:  # the cross product of the two locked rows, written out
+                i0 = locked_sets[locked, 0]
+                i1 = locked_sets[locked, 1]
+                for r in range(width):
+                    output[locked, 0, r], output[locked, 1, r], output[locked, 2, r] = cross(
+                        wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
+                        wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
+            elif n == 1:  # no locked row: the one motion
+                for r in range(width):
+                    output[locked, 0, r] = 1.0
+            elif n == 2:  # one locked row (x, y): (-y, x)
+                i0 = locked_sets[locked, 0]
+                for r in range(width):
+                    output[locked, 0, r] = -wrench_matrix[i0, 1, r]
+                    output[locked, 1, r] = wrench_matrix[i0, 0, r]
+            else:
+                # The cofactor vector as the exterior product of the locked rows: level K holds the
+                # K x K minors of the first K rows (one per K-column set, combination order), each
+                # from level K - 1 by expansion along row K; lexicographic neighbours share their
+                # first rows, so only the levels past the first changed row are recomputed.
+                for level in range(max(locked_depth[locked], 1) + 1, n):
+                    row = locked_sets[locked, level - 1]
+                    first_row = locked_sets[locked, 0]
+                    for term in range(wedge_start[level], wedge_start[level + 1]):
+                        target = wedge_table[term, 0]
+                        source = wedge_table[term, 1]
+                        column = wedge_table[term, 2]
+                        sign = float(wedge_table[term, 3])
+                        if wedge_table[term, 4] == 1:
+                            for r in range(width):
+                                wedge[level, target, r] = 0.0
+                        if level == 2:
+                            for r in range(width):
+                                wedge[2, target, r] += sign * wrench_matrix[first_row, source, r] * wrench_matrix[
+                                    row, column, r]
+                        else:
+                            for r in range(width):
+                                wedge[level, target, r] += sign * wedge[level - 1, source, r] * wrench_matrix[
+                                    row, column, r]
+                # out[q] = (-1)^(n-1+q) det(rows without column q): minor n - 1 - q of the last level
+                for q in range(n):
+                    sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
+                    for r in range(width):
+                        output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
+            for r in range(width):
+                lane0[r] = 0.0
+                lane1[r] = 0.0
+                lane2[r] = 0.0
+            for q in range(n):
+                for r in range(width):
+                    y = output[locked, q, r]
+                    lane0[r] += motion_lanes[q, 0, r] * y
+                    lane1[r] += motion_lanes[q, 1, r] * y
+                    lane2[r] += motion_lanes[q, 2, r] * y
+            for r in range(width):
+                output_omega[locked, r] = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
+        # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
+        for s in range(subs):
+            first = locked_of[s, 0]
+            leader = submechanisms[s, 0]
+            for r in range(width):
+                volume[r] = 1.0
+                determinant[r] = 0.0
+                best[r] = 1.0  # the submechanism's OTI (Eq. 9), a minimum
+            for i in range(n):
+                act = submechanisms[s, i]
+                for r in range(width):
+                    volume[r] *= row_norms[act, r]
+            for q in range(n):
+                for r in range(width):
+                    determinant[r] += wrench_matrix[leader, q, r] * output[first, q, r]
+            for r in range(width):
+                independent[s, r] = abs(determinant[r]) > rank_tolerance * volume[r]
+            for position in range(n):
+                act = submechanisms[s, position]
+                locked = locked_of[s, position]
+                for r in range(width):
+                    lane0[r] = 0.0
+                    lane1[r] = 0.0
+                    lane2[r] = 0.0
+                for q in range(n):
+                    for r in range(width):
+                        y = output[locked, q, r]
+                        lane0[r] += arms[act, q, 0, r] * y
+                        lane1[r] += arms[act, q, 1, r] * y
+                        lane2[r] += arms[act, q, 2, r] * y
+                for r in range(width):
+                    arm = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
+                    reference = output_omega[locked, r] if has_force[act, r] else 0.0
+                    value = (power_coefficient(determinant[r], arm, reference, thresholds[r])
+                             if independent[s, r] else 0.0)
+                    values[position, r] = value
+                    best[r] = min(best[r], value)
+                if oti_out.shape[0] > 0:
+                    for r in range(width):
+                        oti_out[first_index + r, s, position] = values[position, r]
+                if twist_out.shape[0] > 0:
+                    for r in range(width):
+                        index = first_index + r
+                        for k in range(6):
+                            total = 0.0
+                            for q in range(n):
+                                total += output[locked, q, r] * motion_lanes[q, k, r]
+                            twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
+                        # back to world units and origin: v_0 = L v' - omega x c
+                        x0, x1, x2 = cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
+                                            twist_out[index, s, position, 2], centres[0, r], centres[1, r],
+                                            centres[2, r])
+                        twist_out[index, s, position, 3] -= x0
+                        twist_out[index, s, position, 4] -= x1
+                        twist_out[index, s, position, 5] -= x2
+            for r in range(width):
+                oti_local[s, r] = best[r]
+            if oti_sub_out.shape[0] > 0:
+                for r in range(width):
+                    oti_sub_out[first_index + r, s] = best[r]
+        # --- LMTI of all actuators (Eq. 11).
+        for r in range(width):
+            lane1[r] = 0.0
+        for s in range(subs):
+            for r in range(width):
+                lane1[r] = max(lane1[r], oti_local[s, r])
+        for r in range(width):
+            summary_out[first_index + r, 1] = lane1[r]
+        # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
+        # The worst set reported is the first, in combination order, whose LMTI is within
+        # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
+        # Each row of set_children is a set whose LMTI is the max over earlier rows (submechanisms'
+        # OTIs, or sets one smaller); its value goes after the OTIs.
+        for row in range(set_children.shape[0]):
+            for r in range(width):
+                lane2[r] = -np.inf
+            for t in range(set_children.shape[1]):
+                child = set_children[row, t]
+                if child < 0:
+                    break
+                for r in range(width):
+                    lane2[r] = max(lane2[r], oti_local[child, r])
+            for r in range(width):
+                oti_local[subs + row, r] = lane2[r]
+        for f in range(fault_rows.shape[0]):
+            first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
+            for r in range(width):
+                best[r] = np.inf
+            for e in range(first_row, last_row):
+                for r in range(width):
+                    best[r] = min(best[r], oti_local[e, r])
+            for r in range(width):
+                lane2[r] = best[r] + worst_fault_tie
+                first_set[r] = -1
+            for e in range(first_row, last_row):
+                for r in range(width):
+                    if first_set[r] < 0 and oti_local[e, r] <= lane2[r]:
+                        first_set[r] = e - first_row
+            for r in range(width):
+                summary_out[first_index + r, 2 + f] = best[r]
+                worst_out[first_index + r, f] = max(first_set[r], 0)
+        # --- mutual interference: the other actuators alone fully constrain the platform.
+        for act in range(a):
+            for r in range(width):
+                mutual[r] = False
+            for s in range(subs):
+                if not member[s, act]:
+                    for r in range(width):
+                        mutual[r] = mutual[r] or independent[s, r]
+            for r in range(width):
+                mutual_out[first_index + r, act] = mutual[r]

@@ -1,0 +1,273 @@
+"""Compiled first stage of :func:`screwkit.transmission.analyze`: working coordinates, actuation wrenches.
+
+For a chunk of configurations, 64 at a time (:data:`screwkit._kernels.BLOCK`, lane-innermost),
+:func:`wrench_kernel` moves every configuration into its working coordinates (see
+:mod:`screwkit._kernels`), flags those whose joint twists leave a constant motion space, and
+derives the actuation wrench of every actuator in the representative documented in
+:func:`screwkit.transmission.analyze` (the null vector of the passive joint twists in the motion
+space; a Gram solve over the chain's joints when the chain has more joint DoFs than n, with a
+pseudo-inverse for idle DoFs), leaving per block what the second stage needs
+(:func:`screwkit._kernels.carry_arrays`).
+Its own module, so that it compiles apart from :mod:`screwkit._output_kernel` (in parallel on a
+first run, :mod:`screwkit._compile_notice`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from screwkit._fastmath import FASTMATH
+from screwkit._kernels import (
+    BLOCK,
+    CARRY_SIGNATURE,
+    cross,
+    null_vectors_lanes,
+)
+
+__all__ = ["wrench_kernel"]
+
+# The one signature. Joint screws and points come in any memory layout ("A": the loader's
+# component-major blocks, hand-built batch-first arrays, slices of either), so a single compiled
+# version serves every mechanism and is loaded from numba's disk cache when this module is
+# imported; every other argument is C-contiguous (analyze() sees to it).
+_SIGNATURE = (
+    "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
+    "float64[:, ::1], float64, float64, float64, float64, boolean[::1], "
+    + CARRY_SIGNATURE + ")"
+)
+
+
+@njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
+def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
+                  threshold, outside_tolerance, gram_pivot, pseudo_inverse_consistency, outside_out,
+                  force_rows, actuated_rows, motion_rows, threshold_rows, length_rows, centre_rows):
+    """Working coordinates and actuation wrenches (before normalisation) of a chunk of configurations.
+
+    Parameters (N configurations, J joints in all, C chains, a actuators, n DOF)
+    ----------
+    all_twists (N, J, 6), all_points (N, J, 3) : joint screws and points of every chain, world
+        frame, in any memory layout (the loader's are component-major): each block of
+        configurations is first gathered into a small batch-first buffer.
+    chain_start (C + 1,) : joints of chain c are chain_start[c]:chain_start[c+1].
+    actuator_chain, actuator_joint (a,) : chain and joint (within the chain) of each actuator.
+    basis (1 or N, n, 6) : orthonormal motion-space basis in working coordinates (1: the same
+        for all).
+    complement (6 - n, 6) : orthonormal complement of a constant basis, used to flag configurations
+        whose joint twists leave it (``outside_out``); they are recomputed with their own basis.
+    threshold : the singularity threshold p, in the length unit of the screws (compared as p / L).
+    outside_tolerance, gram_pivot, pseudo_inverse_consistency : the dimensionless tolerances
+        OUTSIDE_CONSTANT_SPACE, GRAM_PIVOT and PSEUDO_INVERSE_CONSISTENCY of
+        :mod:`screwkit.tolerances`, applied in working coordinates.
+    Outputs: outside_out (N,) bool; and, per block, the arrays of
+        :func:`screwkit._kernels.carry_arrays` (at least (N + BLOCK - 1) // BLOCK blocks) for
+        :func:`screwkit._output_kernel.output_kernel`.
+    """
+    count = all_twists.shape[0]
+    chains = chain_start.shape[0] - 1
+    joints = chain_start[chains]
+    a = actuator_chain.shape[0]
+    n = basis.shape[1]
+    constant = basis.shape[0] == 1
+    blocks = (count + BLOCK - 1) // BLOCK
+    # Scratch for the solves: a chain may have more joint DoFs than 6 (e.g. an S-S rod with
+    # its idle spin), and numba does not check bounds.
+    capacity = 6
+    for c in range(chains):
+        if chain_start[c + 1] - chain_start[c] > capacity:
+            capacity = chain_start[c + 1] - chain_start[c]
+    # Scratch, allocated once per call. Per-configuration quantities have a last "lane" axis:
+    # each block of BLOCK configurations goes through every step lane-innermost, so that the
+    # compiler vectorises the steps across configurations; the few steps with a data-dependent
+    # algebra (null vectors of n > 3, Gram solves of chains with more joints than n) run per lane.
+    local = np.empty((joints, 6, BLOCK))  # joint twists about the centroid
+    local_points = np.empty((joints, 3, BLOCK))  # joint points relative to the centroid
+    inverse_lengths = np.empty(BLOCK)
+    outside = np.zeros(BLOCK, dtype=np.bool_)
+    force = np.empty((6, BLOCK))  # (f, m) of the wrench being built
+    shifted_basis = np.empty((n, 6, BLOCK))
+    passive_rows = np.empty((6, 6, BLOCK))
+    combination = np.empty((capacity, BLOCK))
+    rows = np.empty((6, 6))
+    work = np.empty((capacity, capacity))
+    columns = np.empty(6, dtype=np.int64)
+    locked_rows = np.empty((max(n - 1, 1), n, BLOCK))
+    elimination = np.empty((max(n - 1, 1), n, BLOCK))
+    lane_a = np.empty(BLOCK)
+    lane_b = np.empty(BLOCK)
+    lane_c = np.empty(BLOCK)
+    lane_d = np.empty(BLOCK)
+    lane_e = np.empty(BLOCK)
+    scalar_out = np.empty(6)
+    lane0 = np.empty(BLOCK)
+    lane1 = np.empty(BLOCK)
+    lane2 = np.empty(BLOCK)
+    outside_sq = outside_tolerance * outside_tolerance
+    for block in range(blocks):
+        first_index = block * BLOCK
+        last_index = min(count, first_index + BLOCK)
+        width = last_index - first_index
+        forces = force_rows[block]
+        actuated = actuated_rows[block]
+        motion_lanes = motion_rows[block]
+        thresholds = threshold_rows[block]
+        lengths = length_rows[block]
+        centres = centre_rows[block]
+        # --- centroid frame, actuation wrenches, ITIs, moment arms.
+        for j in range(joints):  # gather the block lane-innermost (component-major input is read in runs)
+            for k in range(6):
+                for r in range(width):
+                    local[j, k, r] = all_twists[first_index + r, j, k]
+            for k in range(3):
+                for r in range(width):
+                    local_points[j, k, r] = all_points[first_index + r, j, k]
+        # --- centroid of the platform joints; everything below is expressed about it.
+        for k in range(3):
+            for r in range(width):
+                centres[k, r] = 0.0
+        for c in range(chains):
+            last = chain_start[c + 1] - 1
+            for k in range(3):
+                for r in range(width):
+                    centres[k, r] += local_points[last, k, r]
+        for k in range(3):
+            for r in range(width):
+                centres[k, r] /= chains
+        # --- the characteristic length L: RMS distance of every joint point from the centroid.
+        for r in range(width):
+            lane0[r] = 0.0
+        for j in range(joints):
+            for r in range(width):
+                p0 = local_points[j, 0, r] - centres[0, r]
+                p1 = local_points[j, 1, r] - centres[1, r]
+                p2 = local_points[j, 2, r] - centres[2, r]
+                local_points[j, 0, r] = p0
+                local_points[j, 1, r] = p1
+                local_points[j, 2, r] = p2
+                lane0[r] += p0 * p0 + p1 * p1 + p2 * p2
+        for r in range(width):
+            length = np.sqrt(lane0[r] / joints)
+            if not length > 0.0:  # every joint point at the centroid: no length to scale by
+                length = 1.0
+            lengths[r] = length
+            inverse_lengths[r] = 1.0 / length
+            thresholds[r] = threshold / length
+        # --- working coordinates: twists about the centroid, lengths in units of L.
+        for j in range(joints):
+            for r in range(width):
+                x0, x1, x2 = cross(local[j, 0, r], local[j, 1, r], local[j, 2, r],
+                                    centres[0, r], centres[1, r], centres[2, r])
+                inverse = inverse_lengths[r]
+                local[j, 3, r] = (local[j, 3, r] + x0) * inverse
+                local[j, 4, r] = (local[j, 4, r] + x1) * inverse
+                local[j, 5, r] = (local[j, 5, r] + x2) * inverse
+                local_points[j, 0, r] *= inverse
+                local_points[j, 1, r] *= inverse
+                local_points[j, 2, r] *= inverse
+        for q in range(n):
+            for k in range(6):
+                if constant:
+                    for r in range(width):
+                        motion_lanes[q, k, r] = basis[0, q, k]
+                else:
+                    for r in range(width):
+                        motion_lanes[q, k, r] = basis[first_index + r, q, k]
+        # --- a constant basis must contain every joint twist.
+        for r in range(width):
+            outside[r] = False
+        if constant and complement.shape[0] > 0:
+            for j in range(joints):
+                for r in range(width):
+                    lane0[r] = 0.0  # |t|^2
+                    lane1[r] = 0.0  # |projection on the complement|^2
+                for k in range(6):
+                    for r in range(width):
+                        lane0[r] += local[j, k, r] * local[j, k, r]
+                for row in range(complement.shape[0]):
+                    for r in range(width):
+                        lane2[r] = 0.0
+                    for k in range(6):
+                        for r in range(width):
+                            lane2[r] += complement[row, k] * local[j, k, r]
+                    for r in range(width):
+                        lane1[r] += lane2[r] * lane2[r]
+                for r in range(width):
+                    outside[r] = outside[r] or lane1[r] > outside_sq * lane0[r]
+            for r in range(width):
+                outside_out[first_index + r] = outside[r]
+        # --- actuation wrenches (one per actuator), in the representative documented in analyze().
+        for act in range(a):
+            chain = actuator_chain[act]
+            start = chain_start[chain]
+            m = chain_start[chain + 1] - start
+            own = start + actuator_joint[act]
+            last = start + m - 1
+            after = own + 1 if own < last else own
+            for k in range(6):
+                for r in range(width):
+                    force[k, r] = 0.0
+            if m == n:
+                # SWAP M' x with x spanning null(J_passive'^T M'), all about the platform joint d
+                # (working coordinates).
+                for q in range(n):
+                    for r in range(width):
+                        x0, x1, x2 = cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
+                                            local_points[last, 0, r], local_points[last, 1, r],
+                                            local_points[last, 2, r])
+                        shifted_basis[q, 0, r] = motion_lanes[q, 0, r]
+                        shifted_basis[q, 1, r] = motion_lanes[q, 1, r]
+                        shifted_basis[q, 2, r] = motion_lanes[q, 2, r]
+                        shifted_basis[q, 3, r] = motion_lanes[q, 3, r] + x0
+                        shifted_basis[q, 4, r] = motion_lanes[q, 4, r] + x1
+                        shifted_basis[q, 5, r] = motion_lanes[q, 5, r] + x2
+                passive = 0
+                for j in range(start, last + 1):
+                    if j == own:
+                        continue
+                    for q in range(n):
+                        for r in range(width):
+                            x0, x1, x2 = cross(local[j, 0, r], local[j, 1, r], local[j, 2, r],
+                                                local_points[last, 0, r], local_points[last, 1, r],
+                                                local_points[last, 2, r])
+                            passive_rows[passive, q, r] = (
+                                local[j, 0, r] * shifted_basis[q, 0, r] + local[j, 1, r] * shifted_basis[q, 1, r]
+                                + local[j, 2, r] * shifted_basis[q, 2, r]
+                                + (local[j, 3, r] + x0) * shifted_basis[q, 3, r]
+                                + (local[j, 4, r] + x1) * shifted_basis[q, 4, r]
+                                + (local[j, 5, r] + x2) * shifted_basis[q, 5, r])
+                    passive += 1
+                if n == 3:  # the null vector of two rows is their cross product
+                    for r in range(width):
+                        combination[0, r], combination[1, r], combination[2, r] = cross(
+                            passive_rows[0, 0, r], passive_rows[0, 1, r], passive_rows[0, 2, r],
+                            passive_rows[1, 0, r], passive_rows[1, 1, r], passive_rows[1, 2, r])
+                else:
+                    for i in range(n - 1):
+                        for q in range(n):
+                            for r in range(width):
+                                locked_rows[i, q, r] = passive_rows[i, q, r]
+                    null_vectors_lanes(locked_rows, n, width, combination, elimination, lane_a, lane_b, lane_c,
+                                        lane_d, lane_e, rows, work, columns, scalar_out)
+                # The wrench about d: SWAP of the combination of the shifted basis.
+                for q in range(n):
+                    for r in range(width):
+                        y = combination[q, r]
+                        force[0, r] += y * shifted_basis[q, 3, r]
+                        force[1, r] += y * shifted_basis[q, 4, r]
+                        force[2, r] += y * shifted_basis[q, 5, r]
+                        force[3, r] += y * shifted_basis[q, 0, r]
+                        force[4, r] += y * shifted_basis[q, 1, r]
+                        force[5, r] += y * shifted_basis[q, 2, r]
+            # Other chains (more or fewer joint DoFs than n): screwkit._gram_kernel, after this one.
+            # --- what the second stage needs of the actuator: its wrench, its joint twist, the point
+            # after it and the platform joint d (working coordinates).
+            for k in range(6):
+                for r in range(width):
+                    forces[act, k, r] = force[k, r]
+            for k in range(6):
+                for r in range(width):
+                    actuated[act, k, r] = local[own, k, r]
+            for k in range(3):
+                for r in range(width):
+                    actuated[act, 6 + k, r] = local_points[after, k, r]
+                    actuated[act, 9 + k, r] = local_points[last, k, r]
