@@ -1,8 +1,9 @@
-"""Both compiled stages of :func:`screwkit.transmission.analyze` on a chunk of configurations.
+"""The compiled stages of :func:`screwkit.transmission.analyze` on a chunk of configurations.
 
 Importing this module loads :mod:`screwkit._wrench_kernel` and :mod:`screwkit._output_kernel`
 (numba: from its cache, or compiled; :func:`screwkit._compile_notice.prepare_kernels` compiles
-them in parallel first).
+them in parallel first); :mod:`screwkit._gram_kernel` is loaded (and compiled) only for a
+mechanism that needs it (:func:`needs_gram_kernel`).
 """
 
 from __future__ import annotations

@@ -1,14 +1,17 @@
 """Compiled kernels of :func:`screwkit.transmission.analyze`: shared helpers and the block layout.
 
-The indices of a chunk of configurations come from two numba functions, each in its own module
-so that a first run compiles them at once in two processes (:mod:`screwkit._compile_notice`):
-:func:`screwkit._wrench_kernel.wrench_kernel` derives the actuation wrenches, the ITIs and the
-moment-arm operators of the OTIs; :func:`screwkit._output_kernel.output_kernel` the output twists
-and OTIs of every non-redundant submechanism, then the LMTI, F_Oj and the mutual-interference
-actuators, exactly as documented in :func:`screwkit.transmission.analyze`. Both take the
-configurations 64 at a time (:data:`BLOCK`): every per-configuration quantity has a last "lane"
-axis over the 64 configurations and every step loops over the lanes innermost, so that the
-compiler vectorises the algebra across configurations. What the first hands to the second is
+The indices of a chunk of configurations come from numba functions in their own modules, so that
+a first run compiles them at once in several processes (:mod:`screwkit._compile_notice`) and a
+mechanism compiles only those it needs: :func:`screwkit._wrench_kernel.wrench_kernel` moves the
+configurations into working coordinates and derives the actuation wrenches of chains with n joint
+DoFs; :func:`screwkit._gram_kernel.gram_kernel` those of the other chains (a Gram solve), for
+mechanisms that have such chains; :func:`screwkit._output_kernel.output_kernel` the ITIs, the
+output twists and OTIs of every non-redundant submechanism, then the LMTI, F_Oj and the
+mutual-interference actuators, exactly as documented in :func:`screwkit.transmission.analyze`
+(:func:`screwkit._index_kernels.run_kernels` runs them in turn). They take the configurations 64
+at a time (:data:`BLOCK`): every per-configuration quantity has a last "lane" axis over the 64
+configurations and every step loops over the lanes innermost, so that the compiler vectorises
+the algebra across configurations. What the first hands to the others is
 kept per block (arrays ``(blocks, ..., BLOCK)``, see :func:`carry_arrays`).
 
 Screws are ordered (omega, v) for twists and (f, m) for wrenches. Inside the kernels every

@@ -113,7 +113,7 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
         thresholds = threshold_rows[block]
         lengths = length_rows[block]
         centres = centre_rows[block]
-        # --- centroid frame, actuation wrenches, ITIs, moment arms.
+        # --- centroid frame and actuation wrenches.
         for j in range(joints):  # gather the block lane-innermost (component-major input is read in runs)
             for k in range(6):
                 for r in range(width):
