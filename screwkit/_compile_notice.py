@@ -22,6 +22,7 @@ __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_i
 KERNELS = {
     "screwkit._wrench_kernel": ("wrench_kernel", 14),
     "screwkit._output_kernel": ("output_kernel", 10),
+    "screwkit._null_kernel": ("null_kernel", 5),
     "screwkit._gram_kernel": ("gram_kernel", 6),
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),

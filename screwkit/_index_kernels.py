@@ -2,8 +2,9 @@
 
 Importing this module loads :mod:`screwkit._wrench_kernel` and :mod:`screwkit._output_kernel`
 (numba: from its cache, or compiled; :func:`screwkit._compile_notice.prepare_kernels` compiles
-them in parallel first); :mod:`screwkit._gram_kernel` is loaded (and compiled) only for a
-mechanism that needs it (:func:`needs_gram_kernel`).
+them in parallel first); :mod:`screwkit._null_kernel` and :mod:`screwkit._gram_kernel` are
+loaded (and compiled) only for a mechanism that needs them (:func:`needs_null_kernel`,
+:func:`needs_gram_kernel`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,14 @@ from screwkit._kernels import BLOCK, KERNEL_BATCH, carry_arrays
 from screwkit._output_kernel import output_kernel
 from screwkit._wrench_kernel import wrench_kernel
 
-__all__ = ["run_kernels", "needs_gram_kernel"]
+__all__ = ["run_kernels", "needs_null_kernel", "needs_gram_kernel"]
+
+
+def needs_null_kernel(chain_start: np.ndarray, actuator_chain: np.ndarray, n: int) -> bool:
+    """Whether an actuator's chain has n joint DoFs with n other than 3: its wrench is then
+    :func:`screwkit._null_kernel.null_kernel`'s (a null vector of n - 1 rows), compiled only for
+    such mechanisms."""
+    return n != 3 and bool(np.any(np.diff(chain_start)[actuator_chain] == n))
 
 
 def needs_gram_kernel(chain_start: np.ndarray, actuator_chain: np.ndarray, n: int) -> bool:
@@ -32,42 +40,49 @@ _carry = threading.local()  # each thread's carry arrays, kept between calls (no
 def _carry_arrays(blocks: int, a: int, n: int) -> tuple[np.ndarray, ...]:
     """This thread's :func:`~screwkit._kernels.carry_arrays` for ``blocks`` blocks of a and n, reused."""
     kept = getattr(_carry, "arrays", None)
-    if kept is None or kept[0].shape[:2] != (blocks, a) or kept[2].shape[1] != n:
+    if kept is None or kept[0].shape[:2] != (blocks, a) or kept[1].shape[3] != n:
         kept = _carry.arrays = carry_arrays(blocks, a, n)
     return kept
 
 
 def run_kernels(plan, twists, points, basis, complement, iti_override, oti_override, out: dict) -> None:
-    """Both kernels on a chunk, ``KERNEL_BATCH`` configurations at a time, into the arrays of ``out``.
+    """The kernels on a chunk, ``KERNEL_BATCH`` configurations at a time, into the arrays of ``out``.
 
     ``plan`` is the chunk's :class:`screwkit.transmission._Plan` (actuators, submechanisms, locked
     sets, reductions, threshold); arrays as :func:`screwkit.transmission._run_kernel` prepares them,
-    ``iti_override`` and ``oti_override`` (N, a, 3) or None. The first stage hands the second its
-    per-block results (:func:`~screwkit._kernels.carry_arrays`) for one batch at a time, a few MiB kept in cache,
-    rather than for the whole chunk.
+    ``iti_override`` and ``oti_override`` (N, a, 3) or None. The first stage hands the later ones
+    its per-block results (:func:`~screwkit._kernels.carry_arrays`) for one batch at a time (kept
+    in cache), rather than for the whole chunk.
     """
     count = twists.shape[0]
     a, n = len(plan.actuators), plan.submechanisms.shape[1]
     empty = np.empty((0, a, 3))
     iti_override, oti_override = (empty if point is None else point for point in (iti_override, oti_override))
     carry = _carry_arrays(KERNEL_BATCH // BLOCK, a, n)
-    gram_kernel = None
+    null_kernel = gram_kernel = None
+    if needs_null_kernel(plan.chain_start, plan.actuator_chain, n):
+        prepare_kernels(("screwkit._null_kernel",))
+        from screwkit._null_kernel import null_kernel  # numba: compiled only for mechanisms that need it
     if needs_gram_kernel(plan.chain_start, plan.actuator_chain, n):
         prepare_kernels(("screwkit._gram_kernel",))
-        from screwkit._gram_kernel import gram_kernel  # numba: compiled only for mechanisms that need it
+        from screwkit._gram_kernel import gram_kernel  # idem
     for start in range(0, count, KERNEL_BATCH):
         part = slice(start, min(count, start + KERNEL_BATCH))
         own = {key: value[part] if len(value) else value for key, value in out.items()}
+        basis_part = basis if len(basis) == 1 else basis[part]
         wrench_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint,
-                      basis if len(basis) == 1 else basis[part], complement, plan.threshold,
+                      basis_part, complement, plan.threshold,
                       tolerances.OUTSIDE_CONSTANT_SPACE, tolerances.GRAM_PIVOT, tolerances.PSEUDO_INVERSE_CONSISTENCY,
                       own["outside"], *carry)
+        if null_kernel is not None:
+            null_kernel(points[part], plan.chain_start, plan.actuator_chain, basis_part, part.stop - part.start, *carry)
         if gram_kernel is not None:
             gram_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint, n,
                         tolerances.GRAM_PIVOT, tolerances.PSEUDO_INVERSE_CONSISTENCY, own["outside"], carry[0],
-                        carry[4], carry[5])
-        output_kernel(plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children, plan.fault_rows,
-                      plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.rank_tolerance,
+                        carry[3], carry[4])
+        output_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint,
+                      basis_part, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children,
+                      plan.fault_rows, plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.rank_tolerance,
                       tolerances.PURE_COUPLE, tolerances.WORST_FAULT_TIE,
                       iti_override[part] if len(iti_override) else empty,
                       oti_override[part] if len(oti_override) else empty, own["iti_actuators"],

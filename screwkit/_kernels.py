@@ -35,7 +35,8 @@ from numba import njit
 from screwkit._fastmath import FASTMATH
 
 __all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND", "carry_arrays",
-           "cross", "null_vector", "null_vectors_lanes", "pseudo_inverse", "power_coefficient", "solve"]
+           "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes", "pseudo_inverse", "power_coefficient",
+           "solve", "working_point", "working_twist"]
 
 BLOCK = 64  # configurations gathered batch-first at a time
 KERNEL_BATCH = 32 * BLOCK
@@ -324,6 +325,35 @@ def pseudo_inverse(matrix, size, out, vectors, values):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def working_twist(all_twists, index, joint, c0, c1, c2, inverse):
+    """Joint ``joint``'s twist of configuration ``index`` in working coordinates: (omega, (v + omega x c) / L)."""
+    w0, w1, w2 = all_twists[index, joint, 0], all_twists[index, joint, 1], all_twists[index, joint, 2]
+    x0, x1, x2 = cross(w0, w1, w2, c0, c1, c2)
+    return (w0, w1, w2, (all_twists[index, joint, 3] + x0) * inverse, (all_twists[index, joint, 4] + x1) * inverse,
+            (all_twists[index, joint, 5] + x2) * inverse)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def working_point(all_points, index, joint, c0, c1, c2, inverse):
+    """Joint ``joint``'s point of configuration ``index`` in working coordinates: (p - c) / L."""
+    return ((all_points[index, joint, 0] - c0) * inverse, (all_points[index, joint, 1] - c1) * inverse,
+            (all_points[index, joint, 2] - c2) * inverse)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def motion_lanes_of(basis, first_index, width, out):
+    """out[q, k, r] = the motion basis of configuration first_index + r (one basis for all when ``basis`` has one)."""
+    for q in range(basis.shape[1]):
+        for k in range(6):
+            if basis.shape[0] == 1:
+                for r in range(width):
+                    out[q, k, r] = basis[0, q, k]
+            else:
+                for r in range(width):
+                    out[q, k, r] = basis[first_index + r, q, k]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def power_coefficient(numerator, arm, reference, threshold):
     """|A o T| / |A o T|_max, zero when the moment arm is at or below threshold * |omega|.
 
@@ -337,17 +367,18 @@ def power_coefficient(numerator, arm, reference, threshold):
 
 
 def carry_arrays(blocks: int, a: int, n: int) -> tuple[np.ndarray, ...]:
-    """What :func:`~screwkit._wrench_kernel.wrench_kernel` hands to
-    :func:`~screwkit._output_kernel.output_kernel`, per block of :data:`BLOCK` configurations, in
-    working coordinates: each actuator's wrench before normalisation, about its platform joint d
-    (blocks, a, 6, BLOCK); its joint twist, the point of the joint after it and d (blocks, a, 12,
-    BLOCK); the motion basis (blocks, n, 6, BLOCK); the thresholds p / L and lengths L (blocks,
-    BLOCK) and the centroids (blocks, 3, BLOCK)."""
-    return (np.empty((blocks, a, 6, BLOCK)), np.empty((blocks, a, 12, BLOCK)), np.empty((blocks, n, 6, BLOCK)),
+    """What :func:`~screwkit._wrench_kernel.wrench_kernel` hands to the later stages, per block of
+    :data:`BLOCK` configurations, in working coordinates: each actuator's wrench before
+    normalisation, about its platform joint d (blocks, a, 6, BLOCK); its chain's n - 1 passive rows
+    against the motion basis about d (blocks, a, n - 1, n, BLOCK; for :mod:`screwkit._null_kernel`,
+    written only when n is not 3); the thresholds p / L, the lengths L (blocks, BLOCK) and the
+    centroids c (blocks, 3, BLOCK). The later stages recompute what else they need of the joints
+    (:func:`working_twist`, :func:`working_point`) rather than read it back."""
+    return (np.empty((blocks, a, 6, BLOCK)), np.empty((blocks, a, max(n - 1, 1), n, BLOCK)),
             np.empty((blocks, BLOCK)), np.empty((blocks, BLOCK)), np.empty((blocks, 3, BLOCK)))
 
 
-CARRY_SIGNATURE = ("float64[:, :, :, ::1], float64[:, :, :, ::1], float64[:, :, :, ::1], float64[:, ::1], "
-                   "float64[:, ::1], float64[:, :, ::1]")
-"""numba types of :func:`carry_arrays`, in its order (part of both kernels' one signature)."""
+CARRY_SIGNATURE = ("float64[:, :, :, ::1], float64[:, :, :, :, ::1], float64[:, ::1], float64[:, ::1], "
+                   "float64[:, :, ::1]")
+"""numba types of :func:`carry_arrays`, in its order (part of every stage's one signature)."""
 

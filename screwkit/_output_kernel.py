@@ -19,13 +19,22 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, power_coefficient
+from screwkit._kernels import (
+    BLOCK,
+    CARRY_SIGNATURE,
+    cross,
+    motion_lanes_of,
+    power_coefficient,
+    working_point,
+    working_twist,
+)
 
 __all__ = ["output_kernel"]
 
-# The one signature: every array C-contiguous (analyze() sees to it).
+# The one signature: joint screws and points in any layout (as the first stage's), the rest C-contiguous.
 _SIGNATURE = (
-    "void(int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], "
+    "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], float64[:, :, ::1], "
+    "int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[:, ::1], "
     "int64[::1], float64, float64, float64, float64[:, :, ::1], float64[:, :, ::1], "
     "float64[:, ::1], float64[:, :, ::1], float64[:, ::1], float64[:, ::1], int64[:, ::1], boolean[:, ::1], "
     "float64[:, :, ::1], float64[:, :, :, ::1], "
@@ -34,14 +43,17 @@ _SIGNATURE = (
 
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
-def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_rows, locked_depth, wedge_table,
-                  wedge_start, rank_tolerance, pure_couple, worst_fault_tie, iti_override, oti_override,
+def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, submechanisms,
+                  locked_sets, locked_of, set_children, fault_rows, locked_depth, wedge_table, wedge_start,
+                  rank_tolerance, pure_couple, worst_fault_tie, iti_override, oti_override,
                   iti_out, oti_out, oti_sub_out, summary_out, worst_out, mutual_out, wrench_out, twist_out,
-                  force_rows, actuated_rows, motion_rows, threshold_rows, length_rows, centre_rows):
+                  force_rows, passive_row_rows, threshold_rows, length_rows, centre_rows):
     """ITIs, output twists, OTIs and the reductions over actuator sets of a chunk of configurations.
 
     Parameters (N configurations, a actuators, n DOF, S submechanisms)
     ----------
+    all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis : as for
+        :func:`screwkit._wrench_kernel.wrench_kernel`.
     submechanisms (S, n) : actuator indices of each non-redundant submechanism.
     locked_sets (L, n - 1) : every set of n - 1 actuators (locked while one other drives).
     locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
@@ -68,15 +80,17 @@ def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_row
         others have independent wrenches); wrench_out (N or 0, a, 6) (world frame and unit: unit
         force, or unit moment for a pure couple), twist_out (N or 0, S, n, 6) (output twists, world frame
         and unit, scaled as the adjugate columns in working coordinates, so that
-        |A'_k o T'_k| = |det W|). The per-block inputs are the first stage's
-        (:func:`screwkit._kernels.carry_arrays`).
+        |A'_k o T'_k| = |det W|). The per-block inputs are the earlier stages'
+        (:func:`screwkit._kernels.carry_arrays`; the passive rows are not used here).
     """
     count = summary_out.shape[0]
     a = force_rows.shape[1]
-    n = motion_rows.shape[1]
+    n = basis.shape[1]
     subs = submechanisms.shape[0]
     blocks = (count + BLOCK - 1) // BLOCK
     wrench_lanes = np.empty((a, 6, BLOCK))
+    motion_lanes = np.empty((n, 6, BLOCK))
+    joint_lanes = np.empty((12, BLOCK))  # an actuator's joint twist, the point after it and d
     point_lanes = np.empty((3, BLOCK))  # the OTI characteristic point of the actuator
     pitch_lanes = np.empty(BLOCK)
     inverse_lengths = np.empty(BLOCK)
@@ -109,17 +123,30 @@ def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_row
         last_index = min(count, first_index + BLOCK)
         width = last_index - first_index
         forces = force_rows[block]
-        actuated = actuated_rows[block]
-        motion_lanes = motion_rows[block]
         thresholds = threshold_rows[block]
         lengths = length_rows[block]
         centres = centre_rows[block]
         for r in range(width):
             inverse_lengths[r] = 1.0 / lengths[r]
+        motion_lanes_of(basis, first_index, width, motion_lanes)
         for act in range(a):
+            # The actuated joint's twist, the point of the joint after it and the platform joint d,
+            # in working coordinates (as the first stage computed them).
+            start = chain_start[actuator_chain[act]]
+            own = start + actuator_joint[act]
+            last = chain_start[actuator_chain[act] + 1] - 1
+            after = own + 1 if own < last else own
+            for r in range(width):
+                c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
+                (joint_lanes[0, r], joint_lanes[1, r], joint_lanes[2, r], joint_lanes[3, r], joint_lanes[4, r],
+                 joint_lanes[5, r]) = working_twist(all_twists, first_index + r, own, c0, c1, c2, inverse)
+                joint_lanes[6, r], joint_lanes[7, r], joint_lanes[8, r] = working_point(
+                    all_points, first_index + r, after, c0, c1, c2, inverse)
+                joint_lanes[9, r], joint_lanes[10, r], joint_lanes[11, r] = working_point(
+                    all_points, first_index + r, last, c0, c1, c2, inverse)
             # --- unit wrench about the centroid, its ITI (Eq. 6) and its OTI characteristic point.
             for r in range(width):
-                d0, d1, d2 = actuated[act, 9, r], actuated[act, 10, r], actuated[act, 11, r]
+                d0, d1, d2 = joint_lanes[9, r], joint_lanes[10, r], joint_lanes[11, r]
                 f0, f1, f2 = forces[act, 0, r], forces[act, 1, r], forces[act, 2, r]
                 x0, x1, x2 = cross(d0, d1, d2, f0, f1, f2)  # m_c = m_d + d x f
                 m0 = forces[act, 3, r] + x0
@@ -130,8 +157,8 @@ def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_row
                 # A pure couple: |f| <= PURE_COUPLE |m_c| / L (working coordinates, moment about c).
                 forceful = force_sq > pure_couple_sq * moment_sq and force_sq > 0.0
                 scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
-                work_done = (f0 * actuated[act, 3, r] + f1 * actuated[act, 4, r] + f2 * actuated[act, 5, r]
-                             + m0 * actuated[act, 0, r] + m1 * actuated[act, 1, r] + m2 * actuated[act, 2, r])
+                work_done = (f0 * joint_lanes[3, r] + f1 * joint_lanes[4, r] + f2 * joint_lanes[5, r]
+                             + m0 * joint_lanes[0, r] + m1 * joint_lanes[1, r] + m2 * joint_lanes[2, r])
                 factor = ((-1.0 if work_done < 0.0 else 1.0) / scale) if scale > 0.0 else 0.0
                 f0 *= factor
                 f1 *= factor
@@ -156,19 +183,19 @@ def output_kernel(submechanisms, locked_sets, locked_of, set_children, fault_row
                     p1 = (iti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
                     p2 = (iti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
                 else:
-                    p0, p1, p2 = actuated[act, 6, r], actuated[act, 7, r], actuated[act, 8, r]
+                    p0, p1, p2 = joint_lanes[6, r], joint_lanes[7, r], joint_lanes[8, r]
                     if forceful:
                         along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
                         p0 = axis0 + along * f0
                         p1 = axis1 + along * f1
                         p2 = axis2 + along * f2
                 # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
-                w0, w1, w2 = actuated[act, 0, r], actuated[act, 1, r], actuated[act, 2, r]
+                w0, w1, w2 = joint_lanes[0, r], joint_lanes[1, r], joint_lanes[2, r]
                 x0, x1, x2 = cross(w0, w1, w2, p0, p1, p2)
                 omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-                v0 = actuated[act, 3, r] + x0 + pitch * w0
-                v1 = actuated[act, 4, r] + x1 + pitch * w1
-                v2 = actuated[act, 5, r] + x2 + pitch * w2
+                v0 = joint_lanes[3, r] + x0 + pitch * w0
+                v1 = joint_lanes[4, r] + x1 + pitch * w1
+                v2 = joint_lanes[5, r] + x2 + pitch * w2
                 arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if forceful else omega
                 reference = omega if forceful else 0.0
                 iti_local[act, r] = power_coefficient(work_done * factor, arm, reference, thresholds[r])

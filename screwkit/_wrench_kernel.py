@@ -3,13 +3,13 @@
 For a chunk of configurations, 64 at a time (:data:`screwkit._kernels.BLOCK`, lane-innermost),
 :func:`wrench_kernel` moves every configuration into its working coordinates (see
 :mod:`screwkit._kernels`), flags those whose joint twists leave a constant motion space, and
-derives the actuation wrench of every actuator in the representative documented in
-:func:`screwkit.transmission.analyze` (the null vector of the passive joint twists in the motion
-space; a Gram solve over the chain's joints when the chain has more joint DoFs than n, with a
-pseudo-inverse for idle DoFs), leaving per block what the second stage needs
-(:func:`screwkit._kernels.carry_arrays`).
-Its own module, so that it compiles apart from :mod:`screwkit._output_kernel` (in parallel on a
-first run, :mod:`screwkit._compile_notice`).
+derives the actuation wrench, in the representative documented in
+:func:`screwkit.transmission.analyze`, of every actuator whose chain has n = 3 joint DoFs (the
+cross product of its two passive rows in the motion space). For chains of n joint DoFs with
+n other than 3 it leaves the passive rows to :mod:`screwkit._null_kernel`, for the other chains
+everything to :mod:`screwkit._gram_kernel`; per block, what the later stages need
+(:func:`screwkit._kernels.carry_arrays`). Its own module, so that it compiles apart from the
+others (in parallel on a first run, :mod:`screwkit._compile_notice`).
 """
 
 from __future__ import annotations
@@ -18,12 +18,7 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import (
-    BLOCK,
-    CARRY_SIGNATURE,
-    cross,
-    null_vectors_lanes,
-)
+from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, motion_lanes_of
 
 __all__ = ["wrench_kernel"]
 
@@ -41,7 +36,7 @@ _SIGNATURE = (
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, basis, complement,
                   threshold, outside_tolerance, gram_pivot, pseudo_inverse_consistency, outside_out,
-                  force_rows, actuated_rows, motion_rows, threshold_rows, length_rows, centre_rows):
+                  force_rows, passive_row_rows, threshold_rows, length_rows, centre_rows):
     """Working coordinates and actuation wrenches (before normalisation) of a chunk of configurations.
 
     Parameters (N configurations, J joints in all, C chains, a actuators, n DOF)
@@ -70,35 +65,18 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     n = basis.shape[1]
     constant = basis.shape[0] == 1
     blocks = (count + BLOCK - 1) // BLOCK
-    # Scratch for the solves: a chain may have more joint DoFs than 6 (e.g. an S-S rod with
-    # its idle spin), and numba does not check bounds.
-    capacity = 6
-    for c in range(chains):
-        if chain_start[c + 1] - chain_start[c] > capacity:
-            capacity = chain_start[c + 1] - chain_start[c]
     # Scratch, allocated once per call. Per-configuration quantities have a last "lane" axis:
     # each block of BLOCK configurations goes through every step lane-innermost, so that the
-    # compiler vectorises the steps across configurations; the few steps with a data-dependent
-    # algebra (null vectors of n > 3, Gram solves of chains with more joints than n) run per lane.
+    # compiler vectorises the steps across configurations.
     local = np.empty((joints, 6, BLOCK))  # joint twists about the centroid
     local_points = np.empty((joints, 3, BLOCK))  # joint points relative to the centroid
     inverse_lengths = np.empty(BLOCK)
     outside = np.zeros(BLOCK, dtype=np.bool_)
     force = np.empty((6, BLOCK))  # (f, m) of the wrench being built
+    motion_lanes = np.empty((n, 6, BLOCK))
     shifted_basis = np.empty((n, 6, BLOCK))
     passive_rows = np.empty((6, 6, BLOCK))
-    combination = np.empty((capacity, BLOCK))
-    rows = np.empty((6, 6))
-    work = np.empty((capacity, capacity))
-    columns = np.empty(6, dtype=np.int64)
-    locked_rows = np.empty((max(n - 1, 1), n, BLOCK))
-    elimination = np.empty((max(n - 1, 1), n, BLOCK))
-    lane_a = np.empty(BLOCK)
-    lane_b = np.empty(BLOCK)
-    lane_c = np.empty(BLOCK)
-    lane_d = np.empty(BLOCK)
-    lane_e = np.empty(BLOCK)
-    scalar_out = np.empty(6)
+    combination = np.empty((3, BLOCK))
     lane0 = np.empty(BLOCK)
     lane1 = np.empty(BLOCK)
     lane2 = np.empty(BLOCK)
@@ -108,8 +86,7 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
         last_index = min(count, first_index + BLOCK)
         width = last_index - first_index
         forces = force_rows[block]
-        actuated = actuated_rows[block]
-        motion_lanes = motion_rows[block]
+        null_rows = passive_row_rows[block]
         thresholds = threshold_rows[block]
         lengths = length_rows[block]
         centres = centre_rows[block]
@@ -164,14 +141,7 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                 local_points[j, 0, r] *= inverse
                 local_points[j, 1, r] *= inverse
                 local_points[j, 2, r] *= inverse
-        for q in range(n):
-            for k in range(6):
-                if constant:
-                    for r in range(width):
-                        motion_lanes[q, k, r] = basis[0, q, k]
-                else:
-                    for r in range(width):
-                        motion_lanes[q, k, r] = basis[first_index + r, q, k]
+        motion_lanes_of(basis, first_index, width, motion_lanes)
         # --- a constant basis must contain every joint twist.
         for r in range(width):
             outside[r] = False
@@ -202,7 +172,6 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
             m = chain_start[chain + 1] - start
             own = start + actuator_joint[act]
             last = start + m - 1
-            after = own + 1 if own < last else own
             for k in range(6):
                 for r in range(width):
                     force[k, r] = 0.0
@@ -241,33 +210,22 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                         combination[0, r], combination[1, r], combination[2, r] = cross(
                             passive_rows[0, 0, r], passive_rows[0, 1, r], passive_rows[0, 2, r],
                             passive_rows[1, 0, r], passive_rows[1, 1, r], passive_rows[1, 2, r])
-                else:
+                    # The wrench about d: SWAP of the combination of the shifted basis.
+                    for q in range(n):
+                        for r in range(width):
+                            y = combination[q, r]
+                            force[0, r] += y * shifted_basis[q, 3, r]
+                            force[1, r] += y * shifted_basis[q, 4, r]
+                            force[2, r] += y * shifted_basis[q, 5, r]
+                            force[3, r] += y * shifted_basis[q, 0, r]
+                            force[4, r] += y * shifted_basis[q, 1, r]
+                            force[5, r] += y * shifted_basis[q, 2, r]
+                else:  # their null vector and the wrench: screwkit._null_kernel, after this one
                     for i in range(n - 1):
                         for q in range(n):
                             for r in range(width):
-                                locked_rows[i, q, r] = passive_rows[i, q, r]
-                    null_vectors_lanes(locked_rows, n, width, combination, elimination, lane_a, lane_b, lane_c,
-                                        lane_d, lane_e, rows, work, columns, scalar_out)
-                # The wrench about d: SWAP of the combination of the shifted basis.
-                for q in range(n):
-                    for r in range(width):
-                        y = combination[q, r]
-                        force[0, r] += y * shifted_basis[q, 3, r]
-                        force[1, r] += y * shifted_basis[q, 4, r]
-                        force[2, r] += y * shifted_basis[q, 5, r]
-                        force[3, r] += y * shifted_basis[q, 0, r]
-                        force[4, r] += y * shifted_basis[q, 1, r]
-                        force[5, r] += y * shifted_basis[q, 2, r]
+                                null_rows[act, i, q, r] = passive_rows[i, q, r]
             # Other chains (more or fewer joint DoFs than n): screwkit._gram_kernel, after this one.
-            # --- what the second stage needs of the actuator: its wrench, its joint twist, the point
-            # after it and the platform joint d (working coordinates).
-            for k in range(6):
+            for k in range(6):  # for the later stages
                 for r in range(width):
                     forces[act, k, r] = force[k, r]
-            for k in range(6):
-                for r in range(width):
-                    actuated[act, k, r] = local[own, k, r]
-            for k in range(3):
-                for r in range(width):
-                    actuated[act, 6 + k, r] = local_points[after, k, r]
-                    actuated[act, 9 + k, r] = local_points[last, k, r]

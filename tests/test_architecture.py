@@ -19,7 +19,7 @@ LAYERS = {
     # the math core and what it shares: numpy only
     "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0,
     "screwkit._wrench_kernel": 0, "screwkit._output_kernel": 0, "screwkit._index_kernels": 0,
-    "screwkit._gram_kernel": 0,
+    "screwkit._gram_kernel": 0, "screwkit._null_kernel": 0,
     "screwkit._planar_kernel": 0,
     "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
     "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,

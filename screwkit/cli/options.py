@@ -185,8 +185,10 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
         mechanism = load(name, length_unit=length_unit)
     except ValueError as error:
         raise fail(str(error)) from None
-    if indices and any(chain.geometry.n_dofs != mechanism.dof for chain in mechanism.chains if chain.actuated):
-        compile_ahead("screwkit._gram_kernel")  # a chain whose wrench is a Gram solve (see _index_kernels)
+    if indices:  # the kernels of this mechanism's chains (see screwkit._index_kernels), compiled while it goes on
+        joints = {chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated}
+        compile_ahead(*(["screwkit._null_kernel"] if mechanism.dof != 3 and mechanism.dof in joints else []),
+                      *(["screwkit._gram_kernel"] if joints - {mechanism.dof} else []))
     return mechanism
 
 

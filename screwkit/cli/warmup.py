@@ -25,6 +25,7 @@ def warmup() -> None:
     five = load("planar_5rrr")
     steps = {  # the two index kernels compile together, in two processes
         INDEX_KERNELS: lambda: indices_at_pose(five, five.home_pose),
+        ("screwkit._null_kernel",): lambda: indices_at_pose(hexapod := load("ups_hexapod_8"), hexapod.home_pose),
         ("screwkit._gram_kernel",): lambda: indices_at_pose(three := load("five_bar_3"), three.home_pose),
         ("screwkit._planar_kernel",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
         ("screwkit.closure._task_kernel",): lambda: load("prs_3_ups"),
