@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import BLOCK, cross, pseudo_inverse, solve
+from screwkit._kernels import BLOCK, cross, pseudo_inverse, solve, working_point, working_twist
 
 __all__ = ["gram_kernel"]
 
@@ -83,20 +83,12 @@ def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_jo
             # L (as the first kernel computes them).
             for j in range(m):
                 for r in range(width):
-                    w0 = all_twists[first_index + r, start + j, 0]
-                    w1 = all_twists[first_index + r, start + j, 1]
-                    w2 = all_twists[first_index + r, start + j, 2]
-                    x0, x1, x2 = cross(w0, w1, w2, centres[0, r], centres[1, r], centres[2, r])
-                    inverse = inverse_lengths[r]
-                    local[j, 0, r] = w0
-                    local[j, 1, r] = w1
-                    local[j, 2, r] = w2
-                    local[j, 3, r] = (all_twists[first_index + r, start + j, 3] + x0) * inverse
-                    local[j, 4, r] = (all_twists[first_index + r, start + j, 4] + x1) * inverse
-                    local[j, 5, r] = (all_twists[first_index + r, start + j, 5] + x2) * inverse
-            for k in range(3):
-                for r in range(width):
-                    platform[k, r] = (all_points[first_index + r, last, k] - centres[k, r]) * inverse_lengths[r]
+                    c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
+                    (local[j, 0, r], local[j, 1, r], local[j, 2, r], local[j, 3, r], local[j, 4, r],
+                     local[j, 5, r]) = working_twist(all_twists, first_index + r, start + j, c0, c1, c2, inverse)
+            for r in range(width):
+                platform[0, r], platform[1, r], platform[2, r] = working_point(
+                    all_points, first_index + r, last, centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r])
             # Minimum-norm solution SWAP J' (J'^T J')^-1 e_k, J' the chain's twists about d in
             # working coordinates, each scaled to unit norm (a column scaling: the same wrench,
             # and the Gram pivot test compares dimensionless numbers). J' and its Gram matrix

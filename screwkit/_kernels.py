@@ -36,7 +36,7 @@ from screwkit._fastmath import FASTMATH
 
 __all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND", "carry_arrays",
            "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes", "pseudo_inverse", "power_coefficient",
-           "solve", "working_point", "working_twist"]
+           "shifted_basis_lanes", "solve", "working_point", "working_twist"]
 
 BLOCK = 64  # configurations gathered batch-first at a time
 KERNEL_BATCH = 32 * BLOCK
@@ -351,6 +351,21 @@ def motion_lanes_of(basis, first_index, width, out):
             else:
                 for r in range(width):
                     out[q, k, r] = basis[first_index + r, q, k]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def shifted_basis_lanes(motion_lanes, point, width, out):
+    """out[q, :, r] = the motion basis twist q of lane r taken about point[:, r]: (omega, v + omega x point)."""
+    for q in range(motion_lanes.shape[0]):
+        for r in range(width):
+            x0, x1, x2 = cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
+                               point[0, r], point[1, r], point[2, r])
+            out[q, 0, r] = motion_lanes[q, 0, r]
+            out[q, 1, r] = motion_lanes[q, 1, r]
+            out[q, 2, r] = motion_lanes[q, 2, r]
+            out[q, 3, r] = motion_lanes[q, 3, r] + x0
+            out[q, 4, r] = motion_lanes[q, 4, r] + x1
+            out[q, 5, r] = motion_lanes[q, 5, r] + x2
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)

@@ -16,7 +16,14 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, motion_lanes_of, null_vectors_lanes, working_point
+from screwkit._kernels import (
+    BLOCK,
+    CARRY_SIGNATURE,
+    motion_lanes_of,
+    null_vectors_lanes,
+    shifted_basis_lanes,
+    working_point,
+)
 
 __all__ = ["null_kernel"]
 
@@ -72,16 +79,7 @@ def null_kernel(all_points, chain_start, actuator_chain, basis, count, force_row
                     all_points, first_index + r, chain_start[chain + 1] - 1, centres[0, r], centres[1, r],
                     centres[2, r], 1.0 / lengths[r])
             # The motion basis about d (as the first kernel shifted it).
-            for q in range(n):
-                for r in range(width):
-                    x0, x1, x2 = cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
-                                       platform[0, r], platform[1, r], platform[2, r])
-                    shifted_basis[q, 0, r] = motion_lanes[q, 0, r]
-                    shifted_basis[q, 1, r] = motion_lanes[q, 1, r]
-                    shifted_basis[q, 2, r] = motion_lanes[q, 2, r]
-                    shifted_basis[q, 3, r] = motion_lanes[q, 3, r] + x0
-                    shifted_basis[q, 4, r] = motion_lanes[q, 4, r] + x1
-                    shifted_basis[q, 5, r] = motion_lanes[q, 5, r] + x2
+            shifted_basis_lanes(motion_lanes, platform, width, shifted_basis)
             for i in range(n - 1):
                 for q in range(n):
                     for r in range(width):

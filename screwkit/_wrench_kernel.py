@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, motion_lanes_of
+from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, motion_lanes_of, shifted_basis_lanes
 
 __all__ = ["wrench_kernel"]
 
@@ -178,17 +178,7 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
             if m == n:
                 # SWAP M' x with x spanning null(J_passive'^T M'), all about the platform joint d
                 # (working coordinates).
-                for q in range(n):
-                    for r in range(width):
-                        x0, x1, x2 = cross(motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r],
-                                            local_points[last, 0, r], local_points[last, 1, r],
-                                            local_points[last, 2, r])
-                        shifted_basis[q, 0, r] = motion_lanes[q, 0, r]
-                        shifted_basis[q, 1, r] = motion_lanes[q, 1, r]
-                        shifted_basis[q, 2, r] = motion_lanes[q, 2, r]
-                        shifted_basis[q, 3, r] = motion_lanes[q, 3, r] + x0
-                        shifted_basis[q, 4, r] = motion_lanes[q, 4, r] + x1
-                        shifted_basis[q, 5, r] = motion_lanes[q, 5, r] + x2
+                shifted_basis_lanes(motion_lanes, local_points[last], width, shifted_basis)
                 passive = 0
                 for j in range(start, last + 1):
                     if j == own:
