@@ -621,3 +621,29 @@ def test_idle_rotations_about_a_given_normal():
     np.testing.assert_allclose(points, [[[1, 2, 3]]])
     with pytest.raises(ValueError, match="plane normal"):
         idle_rotations(np.zeros((1, 3)), np.zeros(3))
+
+
+def test_poses_whose_dependent_coordinates_do_not_close_are_unreachable_without_solving_the_chains():
+    """A Delta batch mixing reachable poses with poses far outside the workspace: the second are
+    unreachable with the closure error of the dependent coordinates for every chain (the chains
+    are not tracked there: the pose is unreachable whatever they do), the first have the values
+    and reachability they have alone."""
+    from screwkit.closure import solve
+    from screwkit.closure.task_space import complete_poses
+
+    delta = mechanism("delta_4")
+    home = delta.home_pose
+    poses = np.array([home, home + [0.05, -0.03, 0.02], [0.9, 0.9, -0.1], home + [-0.04, 0.02, -0.03],
+                      [-1.5, 0.2, 0.4]])
+    _, _, completed, completion_residual = complete_poses(delta, poses)
+    assert completed.tolist() == [True, True, False, True, False]
+    batch = solve(delta, poses)
+    assert batch.reachable.tolist() == [True, True, False, True, False]
+    for row in np.flatnonzero(~completed):
+        np.testing.assert_array_equal(batch.residuals[row], np.full(len(delta.chains), completion_residual[row]))
+        assert all(np.all(np.isnan(values[row])) for values in batch.joint_values)
+    for row in np.flatnonzero(completed):
+        alone = solve(delta, poses[row:row + 1])
+        assert alone.reachable[0]
+        for values, single in zip(batch.joint_values, alone.joint_values):
+            np.testing.assert_allclose(values[row], single[0], rtol=0, atol=1e-12)

@@ -272,8 +272,17 @@ def solve(
             start = None if initial_values is None or initial_values[index] is None else \
                 np.asarray(initial_values[index]).reshape(count, geometry.n_dofs)
             sign = branches[index] if chain.closed_form is None else chain.reference_sign
-            chain_values, chain_reachable, chain_residual = solve_newton_chain(
-                mechanism, index, flat, cache.platform, start, sign, tolerance, max_iterations)
+            if np.all(completed):
+                chain_values, chain_reachable, chain_residual = solve_newton_chain(
+                    mechanism, index, flat, cache.platform, start, sign, tolerance, max_iterations)
+            else:  # where the dependent coordinates do not close, the pose is unreachable whatever this chain does
+                todo = np.flatnonzero(completed)
+                chain_values = np.full((count, geometry.n_dofs), np.nan)
+                chain_reachable, chain_residual = np.zeros(count, dtype=bool), np.zeros(count)
+                if todo.size:
+                    chain_values[todo], chain_reachable[todo], chain_residual[todo] = solve_newton_chain(
+                        mechanism, index, flat[todo], tuple(part[todo] for part in cache.platform),
+                        None if start is None else start[todo], sign, tolerance, max_iterations)
             frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
             chain_axes, chain_points = frames.axes, frames.points
         if not np.all(completed):  # no dependent coordinates close the constraining chains
