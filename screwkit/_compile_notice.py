@@ -6,6 +6,13 @@ numba keeps compiled kernels in a cache (an index file ``<module>.<function>-<li
 cache folder). :func:`announce_compilation` looks for that index before the kernel's module is
 imported or first called, without importing numba, and when it is missing says so on stderr, so
 that a first run does not look hung. ``screwkit warmup`` compiles every kernel ahead.
+
+The index kernels (:mod:`screwkit._index_kernels`) are the longest to compile. As soon as a
+command knows it will compute indices (before Pinocchio is even imported), :func:`compile_ahead`
+starts one child process per kernel missing from the cache, each importing the kernel's module
+and so compiling it into the cache, and :func:`prepare_kernels` waits for them before the modules
+are imported here (they then load from the cache; if a child failed, the import compiles the
+kernel in this process). Two cores compile two kernels in about the time of the longer one.
 """
 
 from __future__ import annotations
@@ -20,9 +27,9 @@ __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_i
            "INDEX_KERNELS"]
 
 KERNELS = {
-    "screwkit._wrench_kernel": ("wrench_kernel", 14),
-    "screwkit._output_kernel": ("output_kernel", 10),
-    "screwkit._null_kernel": ("null_kernel", 5),
+    "screwkit._wrench_kernel": ("wrench_kernel", 7),
+    "screwkit._output_kernel": ("output_kernel", 14),
+    "screwkit._null_kernel": ("null_kernel", 8),
     "screwkit._gram_kernel": ("gram_kernel", 6),
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
@@ -31,7 +38,8 @@ KERNELS = {
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
 INDEX_KERNELS = ("screwkit._wrench_kernel", "screwkit._output_kernel")
-"""The two stages of :func:`screwkit.transmission.analyze`, compiled apart (in parallel on a first run)."""
+"""The stages of :func:`screwkit.transmission.analyze` every mechanism needs, compiled apart (in parallel on a
+first run); the null-vector and Gram stages are compiled only for mechanisms that need them."""
 
 _checked: set[str] = set()
 _silent = False
