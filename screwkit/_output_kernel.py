@@ -247,19 +247,7 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                     wrench_out[first_index + r, act, 3] = (wrench_lanes[act, 3, r] * length + x0) * unit
                     wrench_out[first_index + r, act, 4] = (wrench_lanes[act, 4, r] * length + x1) * unit
                     wrench_out[first_index + r, act, 5] = (wrench_lanes[act, 5, r] * length + x2) * unit
-        # --- ITI (Eq. 7).
-        for r in range(width):
-            lane0[r] = 1.0
-        for act in range(a):
-            for r in range(width):
-                lane0[r] = min(lane0[r], iti_local[act, r])
-        for r in range(width):
-            summary_out[first_index + r, 0] = lane0[r]
-        if iti_out.shape[0] > 0:
-            for r in range(width):
-                for act in range(a):
-                    iti_out[first_index + r, act] = iti_local[act, r]
-                # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
+        # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
         # their wrenches (a column of adj(W) of every submechanism containing the set).
         for locked in range(locked_sets.shape[0]):
             if n == 3:  # the cross product of the two locked rows, written out
@@ -378,14 +366,23 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
             if oti_sub_out.shape[0] > 0:
                 for r in range(width):
                     oti_sub_out[first_index + r, s] = best[r]
-        # --- LMTI of all actuators (Eq. 11).
+        # --- ITI (Eq. 7) and LMTI of all actuators (Eq. 11).
         for r in range(width):
+            lane0[r] = 1.0
             lane1[r] = 0.0
+        for act in range(a):
+            for r in range(width):
+                lane0[r] = min(lane0[r], iti_local[act, r])
         for s in range(subs):
             for r in range(width):
                 lane1[r] = max(lane1[r], oti_local[s, r])
         for r in range(width):
+            summary_out[first_index + r, 0] = lane0[r]
             summary_out[first_index + r, 1] = lane1[r]
+        if iti_out.shape[0] > 0:
+            for r in range(width):
+                for act in range(a):
+                    iti_out[first_index + r, act] = iti_local[act, r]
         # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
         # The worst set reported is the first, in combination order, whose LMTI is within
         # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
