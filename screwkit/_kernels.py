@@ -34,9 +34,9 @@ from numba import njit
 
 from screwkit._fastmath import FASTMATH
 
-__all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND", "carry_arrays",
-           "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes", "pseudo_inverse", "power_coefficient",
-           "shifted_basis_lanes", "solve", "working_point", "working_twist"]
+__all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND",
+           "add_swapped_combination", "carry_arrays", "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes",
+           "pseudo_inverse", "power_coefficient", "shifted_basis_lanes", "solve", "working_point", "working_twist"]
 
 BLOCK = 64  # configurations gathered batch-first at a time
 KERNEL_BATCH = 32 * BLOCK
@@ -366,6 +366,21 @@ def shifted_basis_lanes(motion_lanes, point, width, out):
             out[q, 3, r] = motion_lanes[q, 3, r] + x0
             out[q, 4, r] = motion_lanes[q, 4, r] + x1
             out[q, 5, r] = motion_lanes[q, 5, r] + x2
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def add_swapped_combination(combination, shifted_basis, width, force):
+    """force[:, r] += SWAP of sum_q combination[q, r] shifted_basis[q, :, r]: the wrench (f, m) reciprocal
+    to the combined twists (omega, v), about the point the basis was shifted to."""
+    for q in range(shifted_basis.shape[0]):
+        for r in range(width):
+            y = combination[q, r]
+            force[0, r] += y * shifted_basis[q, 3, r]
+            force[1, r] += y * shifted_basis[q, 4, r]
+            force[2, r] += y * shifted_basis[q, 5, r]
+            force[3, r] += y * shifted_basis[q, 0, r]
+            force[4, r] += y * shifted_basis[q, 1, r]
+            force[5, r] += y * shifted_basis[q, 2, r]
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)

@@ -19,6 +19,7 @@ from screwkit._fastmath import FASTMATH
 from screwkit._kernels import (
     BLOCK,
     CARRY_SIGNATURE,
+    add_swapped_combination,
     motion_lanes_of,
     null_vectors_lanes,
     shifted_basis_lanes,
@@ -86,13 +87,4 @@ def null_kernel(all_points, chain_start, actuator_chain, basis, count, force_row
                         locked_rows[i, q, r] = null_rows[act, i, q, r]
             null_vectors_lanes(locked_rows, n, width, combination, elimination, lane_a, lane_b, lane_c, lane_d,
                                lane_e, rows, work, columns, scalar_out)
-            # The wrench about d: SWAP of the combination of the shifted basis.
-            for q in range(n):
-                for r in range(width):
-                    y = combination[q, r]
-                    forces[act, 0, r] += y * shifted_basis[q, 3, r]
-                    forces[act, 1, r] += y * shifted_basis[q, 4, r]
-                    forces[act, 2, r] += y * shifted_basis[q, 5, r]
-                    forces[act, 3, r] += y * shifted_basis[q, 0, r]
-                    forces[act, 4, r] += y * shifted_basis[q, 1, r]
-                    forces[act, 5, r] += y * shifted_basis[q, 2, r]
+            add_swapped_combination(combination, shifted_basis, width, forces[act])  # the wrench about d

@@ -18,7 +18,14 @@ import numpy as np
 from numba import njit
 
 from screwkit._fastmath import FASTMATH
-from screwkit._kernels import BLOCK, CARRY_SIGNATURE, cross, motion_lanes_of, shifted_basis_lanes
+from screwkit._kernels import (
+    BLOCK,
+    CARRY_SIGNATURE,
+    add_swapped_combination,
+    cross,
+    motion_lanes_of,
+    shifted_basis_lanes,
+)
 
 __all__ = ["wrench_kernel"]
 
@@ -200,16 +207,7 @@ def wrench_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                         combination[0, r], combination[1, r], combination[2, r] = cross(
                             passive_rows[0, 0, r], passive_rows[0, 1, r], passive_rows[0, 2, r],
                             passive_rows[1, 0, r], passive_rows[1, 1, r], passive_rows[1, 2, r])
-                    # The wrench about d: SWAP of the combination of the shifted basis.
-                    for q in range(n):
-                        for r in range(width):
-                            y = combination[q, r]
-                            force[0, r] += y * shifted_basis[q, 3, r]
-                            force[1, r] += y * shifted_basis[q, 4, r]
-                            force[2, r] += y * shifted_basis[q, 5, r]
-                            force[3, r] += y * shifted_basis[q, 0, r]
-                            force[4, r] += y * shifted_basis[q, 1, r]
-                            force[5, r] += y * shifted_basis[q, 2, r]
+                    add_swapped_combination(combination, shifted_basis, width, force)  # the wrench about d
                 else:  # their null vector and the wrench: screwkit._null_kernel, after this one
                     for i in range(n - 1):
                         for q in range(n):
