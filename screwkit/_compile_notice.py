@@ -23,8 +23,8 @@ import sys
 import threading
 from pathlib import Path
 
-__all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "KERNELS",
-           "INDEX_KERNELS"]
+__all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
+           "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL"]
 
 KERNELS = {
     "screwkit._wrench_kernel": ("wrench_kernel", 7),
@@ -40,6 +40,18 @@ KERNELS = {
 INDEX_KERNELS = ("screwkit._wrench_kernel", "screwkit._output_kernel")
 """The stages of :func:`screwkit.transmission.analyze` every mechanism needs, compiled apart (in parallel on a
 first run); the null-vector and Gram stages are compiled only for mechanisms that need them."""
+
+NULL_KERNEL, GRAM_KERNEL = "screwkit._null_kernel", "screwkit._gram_kernel"
+
+
+def stage_kernels(joint_counts, n: int) -> tuple[str, ...]:
+    """The kernels beyond :data:`INDEX_KERNELS` that actuated chains of these joint DoF counts need
+    in a motion space of dimension n: the null-vector kernel for a chain of n joint DoFs when n is
+    not 3 (for n = 3 the wrench kernel takes a cross product), the Gram kernel for a chain of more
+    or fewer joint DoFs than n."""
+    counts = {int(count) for count in joint_counts}
+    return (NULL_KERNEL,) * (n != 3 and n in counts) + (GRAM_KERNEL,) * bool(counts - {n})
+
 
 _checked: set[str] = set()
 _silent = False

@@ -3,8 +3,8 @@
 Importing this module loads :mod:`screwkit._wrench_kernel` and :mod:`screwkit._output_kernel`
 (numba: from its cache, or compiled; :func:`screwkit._compile_notice.prepare_kernels` compiles
 them in parallel first); :mod:`screwkit._null_kernel` and :mod:`screwkit._gram_kernel` are
-loaded (and compiled) only for a mechanism that needs them (:func:`needs_null_kernel`,
-:func:`needs_gram_kernel`).
+loaded (and compiled) only for a mechanism that needs them
+(:func:`screwkit._compile_notice.stage_kernels`).
 """
 
 from __future__ import annotations
@@ -14,25 +14,12 @@ import threading
 import numpy as np
 
 from screwkit import tolerances
-from screwkit._compile_notice import prepare_kernels
+from screwkit._compile_notice import GRAM_KERNEL, NULL_KERNEL, prepare_kernels, stage_kernels
 from screwkit._kernels import BLOCK, KERNEL_BATCH, carry_arrays
 from screwkit._output_kernel import output_kernel
 from screwkit._wrench_kernel import wrench_kernel
 
-__all__ = ["run_kernels", "needs_null_kernel", "needs_gram_kernel"]
-
-
-def needs_null_kernel(chain_start: np.ndarray, actuator_chain: np.ndarray, n: int) -> bool:
-    """Whether an actuator's chain has n joint DoFs with n other than 3: its wrench is then
-    :func:`screwkit._null_kernel.null_kernel`'s (a null vector of n - 1 rows), compiled only for
-    such mechanisms."""
-    return n != 3 and bool(np.any(np.diff(chain_start)[actuator_chain] == n))
-
-
-def needs_gram_kernel(chain_start: np.ndarray, actuator_chain: np.ndarray, n: int) -> bool:
-    """Whether an actuator's chain has more or fewer joint DoFs than n: its wrench is then
-    :func:`screwkit._gram_kernel.gram_kernel`'s (a Gram solve), compiled only for such mechanisms."""
-    return bool(np.any(np.diff(chain_start)[actuator_chain] != n))
+__all__ = ["run_kernels"]
 
 _carry = threading.local()  # each thread's carry arrays, kept between calls (no fresh pages per chunk)
 
@@ -59,12 +46,12 @@ def run_kernels(plan, twists, points, basis, complement, iti_override, oti_overr
     empty = np.empty((0, a, 3))
     iti_override, oti_override = (empty if point is None else point for point in (iti_override, oti_override))
     carry = _carry_arrays(KERNEL_BATCH // BLOCK, a, n)
+    stages = stage_kernels(np.diff(plan.chain_start)[plan.actuator_chain], n)
+    prepare_kernels(stages)
     null_kernel = gram_kernel = None
-    if needs_null_kernel(plan.chain_start, plan.actuator_chain, n):
-        prepare_kernels(("screwkit._null_kernel",))
+    if NULL_KERNEL in stages:
         from screwkit._null_kernel import null_kernel  # numba: compiled only for mechanisms that need it
-    if needs_gram_kernel(plan.chain_start, plan.actuator_chain, n):
-        prepare_kernels(("screwkit._gram_kernel",))
+    if GRAM_KERNEL in stages:
         from screwkit._gram_kernel import gram_kernel  # idem
     for start in range(0, count, KERNEL_BATCH):
         part = slice(start, min(count, start + KERNEL_BATCH))

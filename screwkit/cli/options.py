@@ -14,7 +14,7 @@ from typing import Callable
 import click
 import numpy as np
 
-from screwkit._compile_notice import INDEX_KERNELS, compile_ahead, silence
+from screwkit._compile_notice import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.loader import load
 from screwkit.studies.files import check_output
 from screwkit.studies.maps import range_values
@@ -185,10 +185,9 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
         mechanism = load(name, length_unit=length_unit)
     except ValueError as error:
         raise fail(str(error)) from None
-    if indices:  # the kernels of this mechanism's chains (see screwkit._index_kernels), compiled while it goes on
-        joints = {chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated}
-        compile_ahead(*(["screwkit._null_kernel"] if mechanism.dof != 3 and mechanism.dof in joints else []),
-                      *(["screwkit._gram_kernel"] if joints - {mechanism.dof} else []))
+    if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
+        compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
+                                     mechanism.dof))
     return mechanism
 
 
