@@ -12,7 +12,11 @@ command knows it will compute indices (before Pinocchio is even imported), :func
 starts one child process per kernel missing from the cache, each importing the kernel's module
 and so compiling it into the cache, and :func:`prepare_kernels` waits for them before the modules
 are imported here (they then load from the cache; if a child failed, the import compiles the
-kernel in this process). Two cores compile two kernels in about the time of the longer one.
+kernel in this process). Two cores compile two kernels in about the time of the longer one. No
+more children run at once than there are cores: a kernel asked for while every core compiles one
+(the hexapod's null-vector kernel, known once the file is loaded) starts when the first of them
+ends, so that three kernels of 5, 6 and 10 s take about 11 s on two cores, not the 17 s of three
+processes sharing them.
 """
 
 from __future__ import annotations
@@ -21,16 +25,17 @@ import os
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
            "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL"]
 
 KERNELS = {
-    "screwkit._wrench_kernel": ("wrench_kernel", 7),
-    "screwkit._output_kernel": ("output_kernel", 14),
-    "screwkit._null_kernel": ("null_kernel", 8),
-    "screwkit._gram_kernel": ("gram_kernel", 6),
+    "screwkit._wrench_kernel": ("wrench_kernel", 6),
+    "screwkit._output_kernel": ("output_kernel", 12),
+    "screwkit._null_kernel": ("null_kernel", 7),
+    "screwkit._gram_kernel": ("gram_kernel", 5),
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
     "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
@@ -56,6 +61,7 @@ def stage_kernels(joint_counts, n: int) -> tuple[str, ...]:
 _checked: set[str] = set()
 _silent = False
 _children: dict[str, subprocess.Popen] = {}
+_queued: list[str] = []  # kernels waiting for a core (started by _start_queued)
 _lock = threading.Lock()
 
 
@@ -111,31 +117,76 @@ def announce_compilation(module: str) -> None:
               "every kernel ahead)", file=sys.stderr, flush=True)
 
 
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # (not on every platform)
+        return os.cpu_count() or 1
+
+
+def _start(module: str) -> None:
+    """One child process that imports ``module`` (compiling its kernel into numba's cache); with _lock held."""
+    package_parent = str(Path(__file__).resolve().parents[1])
+    path = os.pathsep.join(filter(None, [package_parent, os.environ.get("PYTHONPATH")]))
+    _children[module] = subprocess.Popen(
+        [sys.executable, "-c", f"import {module}"], env=dict(os.environ, PYTHONPATH=path),
+        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def _start_what_fits() -> None:
+    """Start queued kernels' children while fewer than the cores are compiling; with _lock held."""
+    running = sum(child.poll() is None for child in _children.values())
+    while _queued and running < _cores():
+        _start(_queued.pop(0))
+        running += 1
+
+
+def _start_queued() -> None:
+    """Start each queued kernel's child as soon as a core is free (a daemon thread)."""
+    while True:
+        time.sleep(0.05)
+        with _lock:
+            _start_what_fits()
+            if not _queued:
+                return
+
+
 def compile_ahead(*modules: str) -> None:
     """Once per process and module: for the kernels numba's cache lacks, one line on stderr and, on a
     machine with more than one core, one child process per kernel that compiles it into the cache
-    while this process goes on (:func:`prepare_kernels` waits for them). On one core they compile
-    in this process, when first imported."""
+    while this process goes on (:func:`prepare_kernels` waits for them), the longest first and no
+    more at once than the cores. On one core they compile in this process, when first imported."""
     with _lock:
         missing = [module for module in modules if module not in _checked and not kernel_is_cached(module)]
         _checked.update(modules)
         if not missing:
             return
-        parallel = (os.cpu_count() or 1) > 1
+        cores = _cores()
+        parallel = cores > 1
+        busy = sum(child.poll() is None for child in _children.values()) + len(_queued)
         if not _silent:
-            names = " and ".join(KERNELS[module][0] for module in missing)
-            seconds = (max if parallel else sum)(KERNELS[module][1] for module in missing)
-            where = f" in {len(missing)} processes" if parallel and len(missing) > 1 else ""
-            print(f"screwkit: compiling {names}{where} (first run only, about {seconds} s; `screwkit warmup` "
+            names = ", ".join(KERNELS[module][0] for module in missing[:-1])
+            names = f"{names} and {KERNELS[missing[-1]][0]}" if names else KERNELS[missing[-1]][0]
+            seconds = _expected_seconds(missing, cores) if parallel else sum(KERNELS[m][1] for m in missing)
+            where = f" in {min(len(missing), cores)} processes" if parallel and len(missing) > 1 else ""
+            when = " as cores free up" if parallel and busy else ""
+            print(f"screwkit: compiling {names}{where}{when} (first run only, about {seconds} s; `screwkit warmup` "
                   "compiles every kernel ahead)", file=sys.stderr, flush=True)
         if not parallel:
             return  # compiled here, when first imported
-        package_parent = str(Path(__file__).resolve().parents[1])
-        path = os.pathsep.join(filter(None, [package_parent, os.environ.get("PYTHONPATH")]))
-        for module in missing:
-            _children[module] = subprocess.Popen(
-                [sys.executable, "-c", f"import {module}"], env=dict(os.environ, PYTHONPATH=path),
-                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        _queued.extend(sorted(missing, key=lambda module: -KERNELS[module][1]))  # the longest first
+        _start_what_fits()
+        if _queued:
+            threading.Thread(target=_start_queued, daemon=True).start()
+
+
+def _expected_seconds(modules: list[str], cores: int) -> int:
+    """About how long ``modules`` take to compile on ``cores`` processes, the longest first, each to
+    the process free first."""
+    ends = [0] * cores
+    for module in sorted(modules, key=lambda module: -KERNELS[module][1]):
+        ends[ends.index(min(ends))] += KERNELS[module][1]
+    return max(ends)
 
 
 def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
@@ -143,8 +194,12 @@ def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
     (:func:`compile_ahead`) and wait for the child processes compiling them."""
     compile_ahead(*modules)
     for module in modules:
-        with _lock:
-            child = _children.get(module)
+        while True:
+            with _lock:
+                if module not in _queued:
+                    child = _children.get(module)
+                    break
+            time.sleep(0.05)  # waiting for a core (_start_queued)
         if child is not None:
             child.wait()  # (thread-safe: every thread needing the kernel waits here)
             with _lock:

@@ -1,0 +1,69 @@
+"""The first-run compilation of the index kernels in child processes: at most as many at once as cores."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import pytest
+
+import screwkit._compile_notice as notice
+
+WRENCH, OUTPUT = notice.INDEX_KERNELS
+
+
+@pytest.fixture
+def stand_in_children(monkeypatch):
+    """Children that sleep instead of compiling (seconds per module), on two cores, nothing cached;
+    returns the (module, start, end) of each child, ends filled in once waited for."""
+    seconds = {WRENCH: 0.6, OUTPUT: 2.0, notice.NULL_KERNEL: 0.6, notice.GRAM_KERNEL: 0.3}
+    started: dict[str, float] = {}
+
+    def start(module):
+        started[module] = time.monotonic()
+        sleep = f"import time; time.sleep({seconds[module]})"
+        notice._children[module] = subprocess.Popen([sys.executable, "-c", sleep])
+
+    monkeypatch.setattr(notice, "_start", start)
+    monkeypatch.setattr(notice, "_cores", lambda: 2)
+    monkeypatch.setattr(notice, "kernel_is_cached", lambda module: False)
+    monkeypatch.setattr(notice, "_checked", set())
+    monkeypatch.setattr(notice, "_children", {})
+    monkeypatch.setattr(notice, "_queued", [])
+    monkeypatch.setattr(notice, "_silent", False)
+    return started
+
+
+def test_a_kernel_asked_for_while_the_cores_compile_starts_when_one_is_free(stand_in_children, capsys):
+    begin = time.monotonic()
+    notice.compile_ahead(WRENCH, OUTPUT)
+    first = capsys.readouterr().err
+    assert first.startswith("screwkit: compiling wrench_kernel and output_kernel in 2 processes (first run only")
+    assert set(stand_in_children) == {WRENCH, OUTPUT}  # both at once, on the two cores
+
+    notice.compile_ahead(notice.NULL_KERNEL)  # both cores busy: queued
+    second = capsys.readouterr().err
+    assert second.startswith("screwkit: compiling null_kernel as cores free up"), second
+    assert notice.NULL_KERNEL not in stand_in_children
+
+    notice.prepare_kernels((notice.NULL_KERNEL,))  # waits for the queued kernel to start, then to end
+    done = time.monotonic() - begin
+    null_start = stand_in_children[notice.NULL_KERNEL] - begin
+    assert 0.6 <= null_start < 2.0  # after the wrench kernel's child ended, before the output kernel's
+    assert done < 2.0
+    notice.prepare_kernels(notice.INDEX_KERNELS)
+    assert not notice._children and not notice._queued
+
+
+def test_several_kernels_start_longest_first_and_the_notice_states_the_makespan(stand_in_children, capsys):
+    notice.compile_ahead(WRENCH, OUTPUT, notice.NULL_KERNEL, notice.GRAM_KERNEL)
+    line = capsys.readouterr().err
+    # output 12 s on one core; null 7 + wrench 6 on the other, then gram 5 after the output kernel: 17 s
+    assert notice._expected_seconds([WRENCH, OUTPUT, notice.NULL_KERNEL, notice.GRAM_KERNEL], 2) == 17
+    assert line.startswith("screwkit: compiling wrench_kernel, output_kernel, null_kernel and gram_kernel in 2 "
+                           "processes (first run only, about 17 s"), line
+    assert list(stand_in_children) == [OUTPUT, notice.NULL_KERNEL]  # the two longest first
+    notice.prepare_kernels((WRENCH, OUTPUT, notice.NULL_KERNEL, notice.GRAM_KERNEL))
+    assert list(stand_in_children) == [OUTPUT, notice.NULL_KERNEL, WRENCH, notice.GRAM_KERNEL]
+    assert not notice._children and not notice._queued
