@@ -128,9 +128,12 @@ def _start(module: str) -> None:
     """One child process that imports ``module`` (compiling its kernel into numba's cache); with _lock held."""
     package_parent = str(Path(__file__).resolve().parents[1])
     path = os.pathsep.join(filter(None, [package_parent, os.environ.get("PYTHONPATH")]))
-    _children[module] = subprocess.Popen(
-        [sys.executable, "-c", f"import {module}"], env=dict(os.environ, PYTHONPATH=path),
-        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        _children[module] = subprocess.Popen(
+            [sys.executable, "-c", f"import {module}"], env=dict(os.environ, PYTHONPATH=path),
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    except OSError:  # no child (e.g. no process left): the import compiles the kernel in this process
+        pass
 
 
 def _start_what_fits() -> None:
@@ -196,10 +199,11 @@ def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
     for module in modules:
         while True:
             with _lock:
+                _start_what_fits()
                 if module not in _queued:
                     child = _children.get(module)
                     break
-            time.sleep(0.05)  # waiting for a core (_start_queued)
+            time.sleep(0.05)  # waiting for a core
         if child is not None:
             child.wait()  # (thread-safe: every thread needing the kernel waits here)
             with _lock:
