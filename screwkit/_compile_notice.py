@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
-           "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL"]
+           "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "CLOSED_FORM_KERNEL"]
 
 KERNELS = {
     "screwkit._wrench_kernel": ("wrench_kernel", 6),
@@ -39,6 +39,7 @@ KERNELS = {
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
     "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
+    "screwkit.closure._closed_form_kernel": ("spatial_closed_form_kernel", 4),
 }
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
@@ -47,6 +48,9 @@ INDEX_KERNELS = ("screwkit._wrench_kernel", "screwkit._output_kernel")
 first run); the null-vector and Gram stages are compiled only for mechanisms that need them."""
 
 NULL_KERNEL, GRAM_KERNEL = "screwkit._null_kernel", "screwkit._gram_kernel"
+
+CLOSED_FORM_KERNEL = "screwkit.closure._closed_form_kernel"
+"""The spatial closed forms (U-P-S, R-U-S chains) of large batches."""
 
 
 def stage_kernels(joint_counts, n: int) -> tuple[str, ...]:

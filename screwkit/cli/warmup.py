@@ -6,34 +6,44 @@ import time
 
 import click
 
-from screwkit._compile_notice import GRAM_KERNEL, INDEX_KERNELS, KERNELS, NULL_KERNEL, compile_ahead, kernel_is_cached
+from screwkit._compile_notice import (
+    CLOSED_FORM_KERNEL,
+    GRAM_KERNEL,
+    INDEX_KERNELS,
+    KERNELS,
+    NULL_KERNEL,
+    compile_ahead,
+    kernel_is_cached,
+)
 
 __all__ = ["warmup"]
 
 
 @click.command()
 def warmup() -> None:
-    """Compile the index kernels, the planar closed forms, the lower-mobility closure and the batched forward
-    kinematics into numba's cache, saying for each whether it was cached and when it was ready (later runs load
-    them in under a second). The index kernels compile in child processes, two at a time on two cores, while
-    the others compile in this one."""
+    """Compile the index kernels, the planar and spatial closed forms, the lower-mobility closure and the batched
+    forward kinematics into numba's cache, saying for each whether it was cached and when it was ready (later runs
+    load them in under a second). The index kernels and the spatial closed forms compile in child processes, two
+    at a time on two cores, while the others compile in this one."""
     import numpy as np
 
-    from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics  # numba: when run, not --help
+    from screwkit.closure import solve  # numba: when run, not for --help
+    from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics  # idem
     from screwkit.loader import load  # Pinocchio: loaded when the command runs, not for --help
     from screwkit.studies.poses import indices_at_pose, indices_at_poses  # idem
 
     start = time.perf_counter()
     cached = {module: kernel_is_cached(module) for module in KERNELS}
-    compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL)
-    five = load("planar_5rrr")
+    compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL, CLOSED_FORM_KERNEL)
+    five, hexapod = load("planar_5rrr"), load("ups_hexapod_8")
     steps = {  # the kernels compiled here first, while the child processes compile the index kernels
         ("screwkit._planar_kernel",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
         ("screwkit.closure._task_kernel",): lambda: load("prs_3_ups"),
         ("screwkit.closure._frames_kernel",): lambda: chain_forward_kinematics(
             five.chains[0].geometry, np.zeros((COMPILED_FROM, five.chains[0].geometry.n_dofs))),
         INDEX_KERNELS: lambda: indices_at_pose(five, five.home_pose),
-        (NULL_KERNEL,): lambda: indices_at_pose(hexapod := load("ups_hexapod_8"), hexapod.home_pose),
+        (NULL_KERNEL,): lambda: indices_at_pose(hexapod, hexapod.home_pose),
+        (CLOSED_FORM_KERNEL,): lambda: solve(hexapod, np.repeat(hexapod.home_pose[None], COMPILED_FROM, axis=0)),
         (GRAM_KERNEL,): lambda: indices_at_pose(three := load("five_bar_3"), three.home_pose),
     }
     for modules, step in steps.items():

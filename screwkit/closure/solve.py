@@ -16,7 +16,7 @@ from typing import Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian
+from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics, chain_jacobian
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
 from screwkit.closure.threads import for_each_block
@@ -172,6 +172,8 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
     cache = _PoseCache(mechanism, flat_poses) if cache is None else cache
     if solver.planar:
         return solver.solve(*cache.planar, branch)
+    if flat_poses.shape[0] >= COMPILED_FROM:
+        return solver.solve_compiled(*cache.platform, branch)
     return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
 
 

@@ -1,0 +1,62 @@
+"""The compiled spatial closed forms (U-P-S, R-U-S chains) against the numpy ones they replace on large batches."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from screwkit.closure import solve
+from screwkit.closure.chain_kinematics import COMPILED_FROM
+from screwkit.closure.solve import _PoseCache
+from screwkit.loader import load
+from screwkit.rotations import rotation_from_rotation_vector
+
+BRANCHES = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+
+
+def spread_poses(mechanism, count, seed):
+    """Poses about home, far enough that some are out of reach and some spherical joints turn near pi."""
+    rng = np.random.default_rng(seed)
+    return mechanism.home_pose[None] + rng.normal(scale=[0.08, 0.08, 0.08, 0.3, 0.3, 1.5], size=(count, 6))
+
+
+@pytest.mark.parametrize("name, kind", [("ups_hexapod_8", "ups"), ("rss_hexapod_8", "rus")])
+def test_compiled_closed_forms_equal_the_numpy_ones_in_every_working_mode(name, kind):
+    mechanism = load(name)
+    poses = spread_poses(mechanism, 3000, 1)
+    cache = _PoseCache(mechanism, poses)
+    for index, chain in enumerate(mechanism.chains):
+        solver = chain.closed_form
+        assert solver.kind == kind
+        for branch in BRANCHES:
+            numpy_result = solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
+            compiled = solver.solve_compiled(*cache.platform, branch)
+            reachable = numpy_result.reachable
+            np.testing.assert_array_equal(compiled.reachable, reachable)
+            np.testing.assert_allclose(compiled.gap, numpy_result.gap, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(compiled.axes, numpy_result.axes, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(compiled.points, numpy_result.points, rtol=0, atol=1e-12)
+            assert np.all(np.isnan(compiled.values[~reachable]))
+            np.testing.assert_allclose(compiled.values[reachable, :3], numpy_result.values[reachable, :3], rtol=0,
+                                       atol=1e-12)
+            # the spherical joint's rotation vector, read from the skew part over sin(angle): rounding grows
+            # like 1 / sin(angle) towards pi (1e-12 at angle pi - 1e-3, where the symmetric part takes over)
+            np.testing.assert_allclose(rotation_from_rotation_vector(compiled.values[reachable, 3:]),
+                                       rotation_from_rotation_vector(numpy_result.values[reachable, 3:]),
+                                       rtol=0, atol=1e-11)
+    assert 0.0 < np.mean(reachable) < 1.0 or name == "ups_hexapod_8"  # the RSS poses leave its workspace
+
+
+@pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
+def test_solve_gives_the_same_solution_on_a_large_batch_as_pose_by_small_batch(name):
+    """solve() takes the compiled closed forms from COMPILED_FROM poses on, numpy below."""
+    mechanism = load(name)
+    poses = spread_poses(mechanism, COMPILED_FROM + 40, 2)
+    large = solve(mechanism, poses)
+    small = [solve(mechanism, part) for part in np.array_split(poses, 8)]
+    np.testing.assert_array_equal(large.status, np.concatenate([part.status for part in small]))
+    for index in range(len(mechanism.chains)):
+        np.testing.assert_allclose(large.joint_axes[index],
+                                   np.concatenate([part.joint_axes[index] for part in small]), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(large.joint_points[index],
+                                   np.concatenate([part.joint_points[index] for part in small]), rtol=0, atol=1e-12)
