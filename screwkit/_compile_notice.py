@@ -39,7 +39,7 @@ KERNELS = {
     "screwkit._planar_kernel": ("planar_closed_form_kernel", 2),
     "screwkit.closure._task_kernel": ("close_chains_kernel", 18),
     "screwkit.closure._frames_kernel": ("chain_frames_kernel", 3),
-    "screwkit.closure._closed_form_kernel": ("spatial_closed_form_kernel", 4),
+    "screwkit.closure._closed_form_kernel": ("spatial_closed_form_kernel", 6),
 }
 """Each compiled module: its entry function and about how long (s) it takes to compile on a 2-core machine."""
 
