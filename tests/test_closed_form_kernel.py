@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit.closure import solve
-from screwkit.closure.chain_kinematics import COMPILED_FROM
+from screwkit.closure import chain_screws, solve
+from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.solve import _PoseCache
 from screwkit.loader import load
 from screwkit.rotations import rotation_from_rotation_vector
@@ -60,3 +60,28 @@ def test_solve_gives_the_same_solution_on_a_large_batch_as_pose_by_small_batch(n
                                    np.concatenate([part.joint_axes[index] for part in small]), rtol=0, atol=1e-12)
         np.testing.assert_allclose(large.joint_points[index],
                                    np.concatenate([part.joint_points[index] for part in small]), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
+@pytest.mark.parametrize("unreachable", ["drop", "reference"])
+def test_compiled_joint_screws_are_the_unit_twists_of_the_joint_axes_and_points(name, unreachable):
+    """(a, p x a) for revolute joints and (0, a) for sliders, as numpy gives them on small batches."""
+    mechanism = load(name)
+    poses = mechanism.home_pose + 0.1 * (spread_poses(mechanism, 2 * COMPILED_FROM, 3) - mechanism.home_pose)
+    poses[::8, 2] += 2.0  # out of reach (its joints' limits, or the RSS legs' length)
+    solution = solve(mechanism, poses)
+    reachable = np.asarray(solution.reachable)
+    assert COMPILED_FROM <= reachable.sum() < reachable.size  # the compiled path, with unreachable poses to handle
+    screws = chain_screws(mechanism, solution, unreachable=unreachable)
+    for index, (chain, screw) in enumerate(zip(mechanism.chains, screws)):
+        axes, points = solution.joint_axes[index].copy(), solution.joint_points[index].copy()
+        if unreachable == "drop":
+            axes, points = axes[reachable], points[reachable]
+        else:  # the reference assembly's screws where the chains do not close
+            frames = chain_forward_kinematics(chain.geometry, chain.reference_values)
+            axes[~reachable], points[~reachable] = frames.axes, frames.points
+        prismatic = np.asarray(chain.prismatic)[:, None]
+        expected = np.concatenate([np.where(prismatic, 0.0, axes),
+                                   np.where(prismatic, axes, np.cross(points, axes))], axis=-1)
+        np.testing.assert_allclose(screw.twists, expected, rtol=0, atol=1e-15)
+        np.testing.assert_array_equal(screw.points, points)

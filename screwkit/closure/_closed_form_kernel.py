@@ -8,6 +8,8 @@ the forward kinematics of :func:`screwkit.closure._frames_kernel.leg_frames` and
 joint's rotation vector. The numpy version stays the reference (small batches, tests); this one
 serves batches of :data:`screwkit.closure.chain_kinematics.COMPILED_FROM` configurations or more,
 where the numpy version's array operations per chain cost several times more than the arithmetic.
+:func:`joint_screws_kernel` then writes the joint screws of such batches into the component-major
+block that the index kernels read (:func:`screwkit.closure.screws.chain_screws`).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from numba import njit
 
 from screwkit.closure._frames_kernel import apply, leg_frames, log_map, matrix_at, mul, rotation_about
 
-__all__ = ["spatial_closed_form_kernel"]
+__all__ = ["spatial_closed_form_kernel", "joint_screws_kernel"]
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -169,3 +171,29 @@ def spatial_closed_form_kernel(kind, parameters, branch, platform_rotation, plat
         if missed != 0.0:
             for k in range(row.shape[0]):
                 row[k] = np.nan
+
+
+_SCREWS_SIGNATURE = "void(float64[:, :, ::1], float64[:, :, ::1], boolean[::1], float64[:, :, :], float64[:, :, :])"
+
+
+@njit(_SCREWS_SIGNATURE, cache=True, nogil=True, error_model="numpy")
+def joint_screws_kernel(axes, points, prismatic, twists, twist_points):
+    """Unit joint twists of one chain, as :func:`screwkit.closure.chain_kinematics.twists_from_axes_and_points`.
+
+    axes, points (N, m, 3); prismatic (m,). Outputs, component-major: twists (6, m, N), ``(a, p x a)`` for a
+    revolute joint and ``(0, a)`` for a prismatic one; twist_points (3, m, N), the points.
+    """
+    for joint in range(axes.shape[1]):
+        slider = prismatic[joint]
+        for index in range(axes.shape[0]):
+            a0, a1, a2 = axes[index, joint, 0], axes[index, joint, 1], axes[index, joint, 2]
+            p0, p1, p2 = points[index, joint, 0], points[index, joint, 1], points[index, joint, 2]
+            twist_points[0, joint, index], twist_points[1, joint, index], twist_points[2, joint, index] = p0, p1, p2
+            if slider:
+                twists[0, joint, index] = twists[1, joint, index] = twists[2, joint, index] = 0.0
+                twists[3, joint, index], twists[4, joint, index], twists[5, joint, index] = a0, a1, a2
+            else:
+                twists[0, joint, index], twists[1, joint, index], twists[2, joint, index] = a0, a1, a2
+                twists[3, joint, index] = a2 * p1 - a1 * p2
+                twists[4, joint, index] = a0 * p2 - a2 * p0
+                twists[5, joint, index] = a1 * p0 - a0 * p1

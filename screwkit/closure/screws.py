@@ -14,8 +14,10 @@ from typing import Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit._compile_notice import CLOSED_FORM_KERNEL, prepare_kernels
 from screwkit.chains import ChainScrews
 from screwkit.closure.chain_kinematics import (
+    COMPILED_FROM,
     chain_forward_kinematics,
     transform_axes_and_points,
     twists_from_axes_and_points,
@@ -27,13 +29,29 @@ from screwkit.model.mechanism import Mechanism
 __all__ = ["chain_screws", "joint_screws"]
 
 
+def _compiled(mechanism: Mechanism, batch: tuple[int, ...]) -> bool:
+    """Whether chain_screws builds a batch's screws with the compiled kernel: spatial, flat and large
+    (the planar closed forms broadcast constant components, which numpy skips)."""
+    return not mechanism.is_planar and len(batch) == 1 and batch[0] >= COMPILED_FROM
+
+
 def _chain_screws_from_frames(mechanism: Mechanism, index: int, axes: NDArray, points: NDArray, frame: str,
-                              twist_block: NDArray | None = None, point_block: NDArray | None = None) -> ChainScrews:
-    """Screws of one chain; ``twist_block`` (zeroed) and ``point_block``, (6 or 3, m, ...), receive them."""
+                              twist_block: NDArray | None = None, point_block: NDArray | None = None,
+                              compiled: bool = False) -> ChainScrews:
+    """Screws of one chain; ``twist_block`` (zeroed unless ``compiled``) and ``point_block``, (6 or 3, m, ...),
+    receive them; ``compiled``: by the compiled kernel (see :func:`_compiled`)."""
     chain = mechanism.chains[index]
     if frame == "world" and not mechanism.base_is_world:
         axes, points = transform_axes_and_points(mechanism.rotation_world_base, mechanism.translation_world_base,
                                                  axes, points)
+    if compiled:
+        prepare_kernels((CLOSED_FORM_KERNEL,))
+        from screwkit.closure._closed_form_kernel import joint_screws_kernel  # numba: large batches only
+
+        joint_screws_kernel(np.ascontiguousarray(axes, dtype=float), np.ascontiguousarray(points, dtype=float),
+                            np.asarray(chain.prismatic, dtype=bool), twist_block, point_block)
+        return ChainScrews(np.moveaxis(twist_block, (0, 1), (-1, -2)), np.moveaxis(point_block, (0, 1), (-1, -2)),
+                           chain.actuated, chain.name, joint_names=chain.joint_names)
     twists = twists_from_axes_and_points(axes, points, chain.prismatic, out=twist_block)
     if point_block is not None:
         point_block[...] = np.moveaxis(points, (-1, -2), (0, 1))
@@ -79,7 +97,8 @@ def chain_screws(
     # chain after chain along the joint axis, which analyze() then reads in place.
     batch = (int(mask.sum()),) if not all_reachable and unreachable == "drop" else mask.shape
     starts = np.cumsum([0] + [chain.n_joints for chain in mechanism.chains])
-    twist_block = np.zeros((6, starts[-1]) + batch)
+    compiled = _compiled(mechanism, batch)
+    twist_block = (np.empty if compiled else np.zeros)((6, starts[-1]) + batch)
     point_block = np.empty((3, starts[-1]) + batch)
 
     def screws_of_chain(index: int) -> ChainScrews:
@@ -93,7 +112,7 @@ def chain_screws(
             points = np.where(mask[..., None, None], points, frames.points)
         joints = slice(starts[index], starts[index + 1])
         return _chain_screws_from_frames(mechanism, index, axes, points, frame, twist_block[:, joints],
-                                         point_block[:, joints])
+                                         point_block[:, joints], compiled)
 
     threads = min(len(mechanism.chains), block_threads())
     if mask.size >= 1 << 16 and threads > 1:  # chains in parallel (numpy releases the GIL)
