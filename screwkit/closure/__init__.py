@@ -11,7 +11,8 @@ Functions of an immutable :class:`~screwkit.model.Mechanism` and of configuratio
 
 Modules: :mod:`~screwkit.closure.chain_kinematics` (one chain's forward kinematics and
 twists), :mod:`~screwkit.closure.newton`, :mod:`~screwkit.closure.analytic` (closed-form
-chain solvers), :mod:`~screwkit.closure.assembly` (the reference assembly and working modes),
+chain solvers; the spatial ones, and the joint screws, of large batches compiled in
+``_closed_form_kernel``), :mod:`~screwkit.closure.assembly` (the reference assembly and working modes),
 :mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.screws`, :mod:`~screwkit.closure.threads`.
 """
 

@@ -348,7 +348,7 @@ class SpatialClosedForm:
     kind = ""
     planar = False
     n_branches = 2
-    kernel_kind = -1  # the chain type of the compiled kernel, and the attributes it takes (in order)
+    kernel_kind = -1  # the chain type in the compiled kernel (-1: none, numpy only), and the attributes it takes
     kernel_parameters: tuple[str, ...] = ()
 
     def solve_compiled(self, platform_rotation: NDArray, platform_translation: NDArray, branch) -> ClosedFormResult:

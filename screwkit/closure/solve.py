@@ -172,7 +172,7 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
     cache = _PoseCache(mechanism, flat_poses) if cache is None else cache
     if solver.planar:
         return solver.solve(*cache.planar, branch)
-    if flat_poses.shape[0] >= COMPILED_FROM:
+    if flat_poses.shape[0] >= COMPILED_FROM and solver.kernel_kind >= 0:  # a chain type the kernel knows
         return solver.solve_compiled(*cache.platform, branch)
     return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
 
