@@ -171,13 +171,15 @@ def motion_space(chains: Sequence[ChainScrews], dof: int | None = None, samples:
     -------
     MotionSpace
     """
+    if dof is not None and (not isinstance(dof, (int, np.integer)) or not 1 <= dof <= 6):
+        raise ValueError(f"Expected `dof` in 1..6, got {dof!r}.")
+    if dof == 6:  # every twist: the same space in any coordinates, nothing to sample
+        return MotionSpace(6, np.eye(6))
     _, working, _, _, _ = sampled_working_coordinates(chains, samples)
     dims, bases = null_spaces(working, dof, tolerance)
     found = int(dims.max()) if dof is None else dof
     if found == 0:
         raise ValueError("The platform has no mobility: the chains' twist spaces intersect only in zero.")
-    if dof is not None and (not isinstance(dof, (int, np.integer)) or not 1 <= dof <= 6):
-        raise ValueError(f"Expected `dof` in 1..6, got {dof!r}.")
     generic = np.flatnonzero(dims == found)
     if generic.size == 0:
         return MotionSpace(found, None)

@@ -574,7 +574,9 @@ def analyze(
     twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
-    constraint_plan = _constraint_plan(chains, count)
+    # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
+    constraint_plan = (_constraint_plan(chains, count) if plan.space.dof < 6
+                       else ConstraintPlan(tuple(0 for _ in chains), 0, (), ()))
     fault_members = actuator_sets(a, plan.dof, plan.faults) if constraint_plan.count else {}
 
     def run(part: slice) -> dict:

@@ -234,16 +234,17 @@ def test_optimised_design_is_no_worse_and_its_urdf_loads(five, tmp_path):
 
 
 def test_default_task_and_chunk_sizes_balance_the_cores_and_bound_the_memory(five):
-    """Tasks: at least 4 per core when the map is large, never under 16,384 nor over 131,072
+    """Tasks: at least 16 per core when the map is large, never under 16,384 nor over 131,072
     configurations. Chunks: the same indices whatever the chunk size, and a bad size named."""
     from screwkit.studies.maps import task_size
     from screwkit.studies.poses import indices_at_poses, poses_per_chunk
 
-    assert task_size(158_760, cores=2) == 19_845  # 8 tasks instead of 2
+    assert task_size(158_760, cores=2) == 16_384  # 10 tasks instead of 2
+    assert task_size(605_160, cores=2) == 18_912  # 32 tasks
     assert task_size(10**7, cores=2) == 131_072
     assert task_size(1000, cores=2) == 16_384
     hexapod = load("ups_hexapod_8")
-    assert 4096 <= poses_per_chunk(hexapod) < poses_per_chunk(five) <= 262_144
+    assert 2048 <= poses_per_chunk(hexapod) < poses_per_chunk(five) <= 262_144
     poses = np.column_stack([np.zeros(50), np.linspace(-0.2, 0.2, 50), np.linspace(0, 3, 50)])
     whole = indices_at_poses(five, poses)
     pieces = indices_at_poses(five, poses, chunk_size=7)

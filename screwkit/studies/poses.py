@@ -155,25 +155,33 @@ of cache, fresh pages for every chunk); sized by joint count alone, chunks small
 hexapod's memory (5,461 configurations, 322 MiB for its 21 x 21 x 360 map) made the 5-RRR's
 10^6-configuration map 1.09x slower, and large enough for the 5-RRR (69,905) took the hexapod's
 41 x 41 x 360 map to 642 MiB."""
+FULL_MOBILITY_CHUNK_WORK = 1 << 19
+""":data:`CHUNK_WORK` of a mechanism free in all six DoF. Its chunks take no samples of the motion
+space or the constraint structure (all twists, no constraint wrench: see
+:func:`screwkit.motion.motion_space`), which are most of the Python around the kernels of a chunk
+(about 7 ms per hexapod chunk). Its chunks can so be four times smaller at the same speed, for a
+quarter of the memory: the 8-leg hexapod's 41 x 41 x 360 map peaked at 280-286 MiB in chunks of
+2,048 configurations against 379-419 MiB in chunks of 9,709, in 6.0-7.0 s against 6.4-6.5 s."""
 CHUNK_BYTES = 96 << 20
 """At most this much memory per chunk, at about 130 bytes per configuration and joint DoF (closure
 results and screws: 34 MB for 5,461 hexapod configurations, traced)."""
 BYTES_PER_JOINT = 130
-MIN_CHUNK, MAX_CHUNK = 4096, 262_144
+MIN_CHUNK, MAX_CHUNK = 2048, 262_144
 
 
 def poses_per_chunk(mechanism: Mechanism) -> int:
     """How many poses :func:`indices_at_poses` takes at a time for ``mechanism``.
 
-    :data:`CHUNK_WORK` divided by the work of one configuration, counted as its joint DoFs (closure
-    and screws) plus n times its C(a, n) submechanisms (the index kernel), within
-    :data:`CHUNK_BYTES` of memory: 46,603 poses of the 5-RRR, 9,709 of the 8-leg hexapod, 36,873 of
-    the 3-PRS-UPS; at least 4,096 and at most 262,144.
+    :data:`CHUNK_WORK` (:data:`FULL_MOBILITY_CHUNK_WORK` for six DoF) divided by the work of one
+    configuration, counted as its joint DoFs (closure and screws) plus n times its C(a, n)
+    submechanisms (the index kernel), within :data:`CHUNK_BYTES` of memory: 46,603 poses of the
+    5-RRR, 2,427 of the 8-leg hexapods, 36,873 of the 3-PRS-UPS; at least 2,048 and at most 262,144.
     """
     joints = sum(len(chain.joint_names) for chain in mechanism.chains)
     work = joints + mechanism.dof * comb(len(mechanism.actuators), mechanism.dof)
     memory = CHUNK_BYTES // (BYTES_PER_JOINT * max(joints, 1))
-    return int(np.clip(min(CHUNK_WORK // max(work, 1), memory), MIN_CHUNK, MAX_CHUNK))
+    budget = FULL_MOBILITY_CHUNK_WORK if mechanism.dof == 6 else CHUNK_WORK
+    return int(np.clip(min(budget // max(work, 1), memory), MIN_CHUNK, MAX_CHUNK))
 
 
 def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = False,
