@@ -244,7 +244,7 @@ def test_default_task_and_chunk_sizes_balance_the_cores_and_bound_the_memory(fiv
     assert task_size(10**7, cores=2) == 131_072
     assert task_size(1000, cores=2) == 16_384
     hexapod = load("ups_hexapod_8")
-    assert 2048 <= poses_per_chunk(hexapod) < poses_per_chunk(five) <= 262_144
+    assert 1024 <= poses_per_chunk(hexapod) < poses_per_chunk(five) <= 262_144
     poses = np.column_stack([np.zeros(50), np.linspace(-0.2, 0.2, 50), np.linspace(0, 3, 50)])
     whole = indices_at_poses(five, poses)
     pieces = indices_at_poses(five, poses, chunk_size=7)

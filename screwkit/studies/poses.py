@@ -155,18 +155,19 @@ of cache, fresh pages for every chunk); sized by joint count alone, chunks small
 hexapod's memory (5,461 configurations, 322 MiB for its 21 x 21 x 360 map) made the 5-RRR's
 10^6-configuration map 1.09x slower, and large enough for the 5-RRR (69,905) took the hexapod's
 41 x 41 x 360 map to 642 MiB."""
-FULL_MOBILITY_CHUNK_WORK = 1 << 19
+FULL_MOBILITY_CHUNK_WORK = 1 << 18
 """:data:`CHUNK_WORK` of a mechanism free in all six DoF. Its chunks take no samples of the motion
 space or the constraint structure (all twists, no constraint wrench: see
 :func:`screwkit.motion.motion_space`), which are most of the Python around the kernels of a chunk
-(about 7 ms per hexapod chunk). Its chunks can so be four times smaller at the same speed, for a
-quarter of the memory: the 8-leg hexapod's 41 x 41 x 360 map peaked at 280-286 MiB in chunks of
-2,048 configurations against 379-419 MiB in chunks of 9,709, in 6.0-7.0 s against 6.4-6.5 s."""
+(about 7 ms per hexapod chunk). Its chunks can so be eight times smaller at the same speed, for an
+eighth of the memory: the 8-leg hexapod's 41 x 41 x 360 map peaked at 262 MiB in chunks of 1,024
+configurations, 280-288 MiB in chunks of 2,048 and 379-419 MiB in chunks of 9,709, in 6.5, 6.7-7.0
+and 6.2-6.5 s."""
 CHUNK_BYTES = 96 << 20
 """At most this much memory per chunk, at about 130 bytes per configuration and joint DoF (closure
 results and screws: 34 MB for 5,461 hexapod configurations, traced)."""
 BYTES_PER_JOINT = 130
-MIN_CHUNK, MAX_CHUNK = 2048, 262_144
+MIN_CHUNK, MAX_CHUNK = 1024, 262_144
 
 
 def poses_per_chunk(mechanism: Mechanism) -> int:
@@ -175,7 +176,7 @@ def poses_per_chunk(mechanism: Mechanism) -> int:
     :data:`CHUNK_WORK` (:data:`FULL_MOBILITY_CHUNK_WORK` for six DoF) divided by the work of one
     configuration, counted as its joint DoFs (closure and screws) plus n times its C(a, n)
     submechanisms (the index kernel), within :data:`CHUNK_BYTES` of memory: 46,603 poses of the
-    5-RRR, 2,427 of the 8-leg hexapods, 36,873 of the 3-PRS-UPS; at least 2,048 and at most 262,144.
+    5-RRR, 1,213 of the 8-leg hexapods, 36,873 of the 3-PRS-UPS; at least 1,024 and at most 262,144.
     """
     joints = sum(len(chain.joint_names) for chain in mechanism.chains)
     work = joints + mechanism.dof * comb(len(mechanism.actuators), mechanism.dof)
