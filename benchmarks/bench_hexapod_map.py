@@ -7,7 +7,8 @@ Runs, in turn, ``screwkit map ups_hexapod_8 --grid x:-H:H:S --grid y:-H:H:S --ov
 (``--repeat`` pairs, after one unmeasured run of each), each as a new process: wall time, CPU time
 and peak resident memory from the operating system (``os.wait4``). Prints the medians, the ratio
 command / script pair by pair (median, min, max), the fixed cost of each (the same commands on a
-3 x 3 grid with 3 yaws) and the largest difference between the two maps (LMTI, F_O1, F_O2).
+3 x 3 grid with 3 yaws), the command's peak memory against the script's plus the difference in
+fixed cost, and the largest difference between the two maps (LMTI, F_O1, F_O2).
 The defaults are the 41 x 41 grid and full turn at 1 deg: 605,160 configurations.
 """
 
@@ -87,6 +88,11 @@ def main() -> None:
         ratios = [a[index] / b[index] for a, b in zip(runs["command"], runs["script"])]
         print(f"command / script, {label} (pair by pair): median {statistics.median(ratios):.3f}, "
               f"min {min(ratios):.3f}, max {max(ratios):.3f}  ({1 / statistics.median(ratios):.1f}x faster)")
+    peak = {name: statistics.median(run[2] for run in runs[name]) for name in runs}
+    allowed = peak["script"] + fixed["command"][2] - fixed["script"][2]
+    print(f"peak memory: command {peak['command']:.0f} MiB; the script's {peak['script']:.0f} MiB plus the difference "
+          f"in fixed cost ({fixed['command'][2]:.0f} - {fixed['script'][2]:.0f} MiB) allows {allowed:.0f} MiB: "
+          f"{'within' if peak['command'] <= allowed else 'over'}")
     print(f"largest difference between the two maps (LMTI, F_O1, F_O2): {difference:.1e}")
 
 
