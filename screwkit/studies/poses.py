@@ -161,8 +161,8 @@ space or the constraint structure (all twists, no constraint wrench: see
 :func:`screwkit.motion.motion_space`), which are most of the Python around the kernels of a chunk
 (about 7 ms per hexapod chunk). Its chunks can so be eight times smaller at the same speed, for an
 eighth of the memory: the 8-leg hexapod's 41 x 41 x 360 map peaked at 262 MiB in chunks of 1,024
-configurations, 280-288 MiB in chunks of 2,048 and 379-419 MiB in chunks of 9,709, in 6.5, 6.7-7.0
-and 6.2-6.5 s."""
+configurations, 280-288 MiB in chunks of 2,048 and 379-419 MiB in chunks of 9,709, in 6.5, 6.0-7.0
+and 6.2-6.7 s."""
 CHUNK_BYTES = 96 << 20
 """At most this much memory per chunk, at about 130 bytes per configuration and joint DoF (closure
 results and screws: 34 MB for 5,461 hexapod configurations, traced)."""
