@@ -156,6 +156,17 @@ def in_millimetres(text: str, *, declare: bool = False) -> str:
     return ElementTree.tostring(root, encoding="unicode")
 
 
+def moved_in_the_world(text: str, xyz, rpy) -> str:
+    """The whole mechanism placed in a new world frame: ``base_link`` hangs from ``world`` by a fixed joint."""
+    return text.replace(
+        '<link name="base_link">',
+        '<link name="world"/>\n  <joint name="world_to_base" type="fixed">'
+        '<parent link="world"/><child link="base_link"/>'
+        f'<origin xyz="{" ".join(repr(float(v)) for v in xyz)}" rpy="{" ".join(repr(float(v)) for v in rpy)}"/>'
+        '</joint>\n'
+        '  <link name="base_link">', 1)
+
+
 def platform_twist(mechanism, pose_minus, pose_plus, step):
     """World-frame twist (omega, v at the world origin) of the platform between two full poses a step
     either side of a configuration: a central difference."""

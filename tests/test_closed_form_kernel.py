@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from helpers import in_millimetres, moved_in_the_world
 from screwkit.closure import chain_screws, solve
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.solve import _PoseCache
@@ -85,3 +86,31 @@ def test_compiled_joint_screws_are_the_unit_twists_of_the_joint_axes_and_points(
                                    np.where(prismatic, axes, np.cross(points, axes))], axis=-1)
         np.testing.assert_allclose(screw.twists, expected, rtol=0, atol=1e-15)
         np.testing.assert_array_equal(screw.points, points)
+
+
+@pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
+def test_compiled_closure_keeps_the_indices_in_millimetres_and_in_another_world_frame(tmp_path, name):
+    """The same indices from the file in metres, in millimetres and moved in the world, on a batch that
+    takes the compiled closed forms and screws."""
+    from screwkit.loader import bundled_path
+    from screwkit.studies.poses import indices_at_poses
+
+    mechanism = load(name)
+    rng = np.random.default_rng(7)
+    poses = mechanism.home_pose + rng.uniform(-1, 1, (COMPILED_FROM + 88, 6)) * [0.01, 0.01, 0.01, 0.05, 0.05, 0.2]
+    reference = indices_at_poses(mechanism, poses, detail=True)
+    assert reference.reachable.sum() >= COMPILED_FROM
+    text = bundled_path(name).read_text()
+    xyz, rpy = rng.uniform(-2, 2, 3), rng.uniform(-np.pi, np.pi, 3)
+    files = {"mm": in_millimetres(text, declare=True), "moved": moved_in_the_world(text, xyz, rpy),
+             "moved_mm": moved_in_the_world(in_millimetres(text, declare=True), 1000 * xyz, rpy)}
+    for label, source in files.items():
+        path = tmp_path / f"{name}_{label}.urdf"
+        path.write_text(source)
+        other = indices_at_poses(load(path), poses, detail=True)
+        np.testing.assert_array_equal(other.reachable, reference.reachable)
+        for key in ("iti", "iti_actuators", "oti_submechanisms", "lmti"):
+            np.testing.assert_allclose(getattr(other, key), getattr(reference, key), rtol=0, atol=1e-9,
+                                       err_msg=f"{label} {key}")
+        for j, value in reference.f_o.items():
+            np.testing.assert_allclose(other.f_o[j], value, rtol=0, atol=1e-9, err_msg=f"{label} f_o{j}")

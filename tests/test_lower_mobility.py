@@ -30,7 +30,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import in_millimetres, screwkit
+from helpers import in_millimetres, moved_in_the_world, screwkit
 from screwkit.closure import solve_one
 from screwkit.loader import bundled_path, load, load_text
 from screwkit.studies.poses import indices_at_poses
@@ -532,17 +532,6 @@ def test_planar_disc_map_of_a_point_output(tmp_path):
 # ---------------------------------------------------------------------------------------------
 # The same indices in millimetres and with the whole mechanism moved in the world
 # ---------------------------------------------------------------------------------------------
-
-
-def moved_in_the_world(text: str, xyz, rpy) -> str:
-    """The whole mechanism placed in a new world frame: ``base_link`` hangs from ``world`` by a fixed joint."""
-    return text.replace(
-        '<link name="base_link">',
-        '<link name="world"/>\n  <joint name="world_to_base" type="fixed">'
-        '<parent link="world"/><child link="base_link"/>'
-        f'<origin xyz="{" ".join(repr(float(v)) for v in xyz)}" rpy="{" ".join(repr(float(v)) for v in rpy)}"/>'
-        '</joint>\n'
-        '  <link name="base_link">', 1)
 
 
 def assert_same_indices(reference, other):
