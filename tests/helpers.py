@@ -130,11 +130,17 @@ def bundled_chain_screws(name: str, count: int = 200, seed: int = 0):
 def in_millimetres(text: str, *, declare: bool = False) -> str:
     """A URDF's lengths times 1000: origins, prismatic limits, primitive sizes and the x, y, z of named poses
     (written here, independently of screwkit's reader); with ``declare``, also ``<units length="mm"/>``."""
+    return in_unit(text, "mm", 1000.0, declare=declare)
+
+
+def in_unit(text: str, unit: str, factor: float, *, declare: bool = False) -> str:
+    """A URDF's lengths times ``factor`` (:func:`in_millimetres` for any unit); with ``declare``, also
+    ``<units length="UNIT"/>``."""
     root = ElementTree.fromstring(text)
 
     def scale(element, attribute):
         if element is not None and element.get(attribute) is not None:
-            element.set(attribute, " ".join(repr(1000 * float(v)) for v in element.get(attribute).split()))
+            element.set(attribute, " ".join(repr(factor * float(v)) for v in element.get(attribute).split()))
 
     for origin in root.iter("origin"):
         scale(origin, "xyz")
@@ -152,7 +158,7 @@ def in_millimetres(text: str, *, declare: bool = False) -> str:
         for coordinate in ("x", "y", "z"):
             scale(pose, coordinate)
     if declare:
-        ElementTree.SubElement(root, "units", length="mm")
+        ElementTree.SubElement(root, "units", length=unit)
     return ElementTree.tostring(root, encoding="unicode")
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers import in_millimetres, moved_in_the_world
+from helpers import in_millimetres, in_unit, moved_in_the_world
 from screwkit.closure import chain_screws, solve
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.solve import _PoseCache
@@ -89,9 +89,10 @@ def test_compiled_joint_screws_are_the_unit_twists_of_the_joint_axes_and_points(
 
 
 @pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])
-def test_compiled_closure_keeps_the_indices_in_millimetres_and_in_another_world_frame(tmp_path, name):
-    """The same indices from the file in metres, in millimetres and moved in the world, on a batch that
-    takes the compiled closed forms and screws."""
+def test_compiled_closure_keeps_the_indices_in_other_units_scales_and_world_frames(tmp_path, name):
+    """The same indices, on batches that take the compiled closed forms and screws, from the file in metres,
+    in millimetres, moved in the world, and with the mechanism itself scaled by 1e-3 and 1e3 (its poses'
+    translations and the singularity threshold scaled alike)."""
     from screwkit.loader import bundled_path
     from screwkit.studies.poses import indices_at_poses
 
@@ -102,13 +103,15 @@ def test_compiled_closure_keeps_the_indices_in_millimetres_and_in_another_world_
     assert reference.reachable.sum() >= COMPILED_FROM
     text = bundled_path(name).read_text()
     xyz, rpy = rng.uniform(-2, 2, 3), rng.uniform(-np.pi, np.pi, 3)
-    files = {"mm": in_millimetres(text, declare=True), "moved": moved_in_the_world(text, xyz, rpy),
-             "moved_mm": moved_in_the_world(in_millimetres(text, declare=True), 1000 * xyz, rpy)}
-    for label, source in files.items():
+    files = {"mm": (in_millimetres(text, declare=True), 1.0), "moved": (moved_in_the_world(text, xyz, rpy), 1.0),
+             "moved_mm": (moved_in_the_world(in_millimetres(text, declare=True), 1000 * xyz, rpy), 1.0),
+             "x1e-3": (in_unit(text, "m", 1e-3), 1e-3), "x1e3": (in_unit(text, "m", 1e3), 1e3)}
+    for label, (source, scale) in files.items():
         path = tmp_path / f"{name}_{label}.urdf"
         path.write_text(source)
-        other = indices_at_poses(load(path), poses, detail=True)
-        np.testing.assert_array_equal(other.reachable, reference.reachable)
+        scaled_poses = poses * np.where(np.arange(6) < 3, scale, 1.0)
+        other = indices_at_poses(load(path), scaled_poses, detail=True, threshold=reference.threshold * scale)
+        np.testing.assert_array_equal(other.reachable, reference.reachable, err_msg=label)
         for key in ("iti", "iti_actuators", "oti_submechanisms", "lmti"):
             np.testing.assert_allclose(getattr(other, key), getattr(reference, key), rtol=0, atol=1e-9,
                                        err_msg=f"{label} {key}")
