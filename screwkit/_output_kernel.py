@@ -63,11 +63,11 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
         the OTIs and sets before it (OTIs of submechanisms first, then the sets in order, padded
         with -1) whose maximum is the LMTI of set t; ``fault_rows[f]`` is the range of those rows
         (OTIs included) holding the sets left after the f-th value of j, in combination order.
-    locked_depth (L,), wedge_table (T, 5), wedge_start (n + 1,) : for n >= 4, the output twists'
+    locked_depth (L,), wedge_table (T, 1 + 3 WEDGE_TERMS), wedge_start (n + 1,) : for n >= 4, the output twists'
         exterior products (see :func:`screwkit.transmission._wedge_tables`): the first position at
-        which each locked set differs from the one before, and the expansion terms (target minor,
-        source minor, column, sign, first term of its target) of level K in rows
-        wedge_start[K]:wedge_start[K+1].
+        which each locked set differs from the one before, and one row per minor of level K in rows
+        wedge_start[K]:wedge_start[K+1] (the minor, then source minor, column and sign of each of its
+        WEDGE_TERMS expansion terms, padded with zero signs).
     rank_tolerance, pure_couple, worst_fault_tie : the dimensionless tolerances RANK_TOLERANCE,
         PURE_COUPLE and WORST_FAULT_TIE of :mod:`screwkit.tolerances`, in working coordinates.
     iti_override, oti_override (N or 0, a, 3) : characteristic points given by the caller (world).
@@ -91,21 +91,20 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     wrench_lanes = np.empty((a, 6, BLOCK))
     motion_lanes = np.empty((n, 6, BLOCK))
     joint_lanes = np.empty((12, BLOCK))  # an actuator's joint twist, the point after it and d
-    point_lanes = np.empty((3, BLOCK))  # the OTI characteristic point of the actuator
-    pitch_lanes = np.empty(BLOCK)
+    point_lanes = np.empty((a, 3, BLOCK))  # each actuator's OTI characteristic point
+    pitch_lanes = np.empty((a, BLOCK))  # and its wrench's pitch (0 for a couple)
     inverse_lengths = np.empty(BLOCK)
     iti_local = np.zeros((a, BLOCK))
     has_force = np.zeros((a, BLOCK), dtype=np.bool_)
-    arms = np.zeros((a, n, 3, BLOCK))
     wrench_matrix = np.zeros((a, n, BLOCK))
     row_norms = np.zeros((a, BLOCK))
     pure_couple_sq = pure_couple * pure_couple
     output = np.empty((locked_sets.shape[0], n, BLOCK))
     wedge = np.zeros((max(n, 1), 20, BLOCK))  # minors of the first K locked rows, at most C(6, 3) = 20 per level
-    output_omega = np.empty((locked_sets.shape[0], BLOCK))
+    output_twist = np.empty((locked_sets.shape[0], 6, BLOCK))  # M^T y of each locked set (working coordinates)
+    omega_squares = np.empty((locked_sets.shape[0], BLOCK))  # |omega|^2 of each output twist
     oti_local = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the sets
     independent = np.empty((subs, BLOCK), dtype=np.bool_)
-    values = np.empty((n, BLOCK))
     determinant = np.empty(BLOCK)
     volume = np.empty(BLOCK)
     lane0 = np.empty(BLOCK)
@@ -114,6 +113,10 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     best = np.empty(BLOCK)
     mutual = np.empty(BLOCK, dtype=np.bool_)
     first_set = np.empty(BLOCK, dtype=np.int64)
+    identity = basis.shape[0] == 1 and n == 6  # a platform free in all six DoF: M^T y = y
+    for q in range(n):
+        for k in range(6):
+            identity = identity and basis[0, q, k] == (1.0 if q == k else 0.0)
     member = np.zeros((subs, a), dtype=np.bool_)
     for s in range(subs):
         for i in range(n):
@@ -175,7 +178,7 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                 forceful = forceful and scale > 0.0
                 has_force[act, r] = forceful
                 pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
-                pitch_lanes[r] = pitch
+                pitch_lanes[act, r] = pitch
                 # Characteristic points: projections on the wrench axis (unit force).
                 axis0, axis1, axis2 = cross(f0, f1, f2, m0, m1, m2)
                 if iti_override.shape[0] > 0:
@@ -210,27 +213,20 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                         p0 = axis0 + along * f0
                         p1 = axis1 + along * f1
                         p2 = axis2 + along * f2
-                point_lanes[0, r] = p0
-                point_lanes[1, r] = p1
-                point_lanes[2, r] = p2
-            # Moment-arm operator of the OTI for twists M^T y: v + omega x p + h omega (omega for a couple),
-            # and the row of the wrench matrix in motion coordinates, A_k o M_q.
+                point_lanes[act, 0, r] = p0
+                point_lanes[act, 1, r] = p1
+                point_lanes[act, 2, r] = p2
+            # The row of the wrench matrix in motion coordinates, A_k o M_q.
             for r in range(width):
                 row_norms[act, r] = 0.0
             for q in range(n):
                 for r in range(width):
-                    w0, w1, w2 = motion_lanes[q, 0, r], motion_lanes[q, 1, r], motion_lanes[q, 2, r]
-                    x0, x1, x2 = cross(w0, w1, w2, point_lanes[0, r], point_lanes[1, r], point_lanes[2, r])
-                    pitch = pitch_lanes[r]
-                    forceful = has_force[act, r]
-                    arms[act, q, 0, r] = motion_lanes[q, 3, r] + x0 + pitch * w0 if forceful else w0
-                    arms[act, q, 1, r] = motion_lanes[q, 4, r] + x1 + pitch * w1 if forceful else w1
-                    arms[act, q, 2, r] = motion_lanes[q, 5, r] + x2 + pitch * w2 if forceful else w2
                     value = (wrench_lanes[act, 0, r] * motion_lanes[q, 3, r]
                              + wrench_lanes[act, 1, r] * motion_lanes[q, 4, r]
                              + wrench_lanes[act, 2, r] * motion_lanes[q, 5, r]
-                             + wrench_lanes[act, 3, r] * w0 + wrench_lanes[act, 4, r] * w1
-                             + wrench_lanes[act, 5, r] * w2)
+                             + wrench_lanes[act, 3, r] * motion_lanes[q, 0, r]
+                             + wrench_lanes[act, 4, r] * motion_lanes[q, 1, r]
+                             + wrench_lanes[act, 5, r] * motion_lanes[q, 2, r])
                     wrench_matrix[act, q, r] = value
                     row_norms[act, r] += value * value
             for r in range(width):
@@ -272,40 +268,46 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                 # first rows, so only the levels past the first changed row are recomputed.
                 for level in range(max(locked_depth[locked], 1) + 1, n):
                     row = locked_sets[locked, level - 1]
-                    first_row = locked_sets[locked, 0]
-                    for term in range(wedge_start[level], wedge_start[level + 1]):
-                        target = wedge_table[term, 0]
-                        source = wedge_table[term, 1]
-                        column = wedge_table[term, 2]
-                        sign = float(wedge_table[term, 3])
-                        if wedge_table[term, 4] == 1:
+                    if level == 2:  # level 1's minors: the first row's entries
+                        for q in range(n):
                             for r in range(width):
-                                wedge[level, target, r] = 0.0
-                        if level == 2:
-                            for r in range(width):
-                                wedge[2, target, r] += sign * wrench_matrix[first_row, source, r] * wrench_matrix[
-                                    row, column, r]
-                        else:
-                            for r in range(width):
-                                wedge[level, target, r] += sign * wedge[level - 1, source, r] * wrench_matrix[
-                                    row, column, r]
+                                wedge[1, q, r] = wrench_matrix[locked_sets[locked, 0], q, r]
+                    # Each minor's WEDGE_TERMS terms (padded with zero signs) summed in one pass over
+                    # the lanes: one store per minor, a loop the compiler vectorises.
+                    for target in range(wedge_start[level], wedge_start[level + 1]):
+                        u0, c0, s0 = wedge_table[target, 1], wedge_table[target, 2], float(wedge_table[target, 3])
+                        u1, c1, s1 = wedge_table[target, 4], wedge_table[target, 5], float(wedge_table[target, 6])
+                        u2, c2, s2 = wedge_table[target, 7], wedge_table[target, 8], float(wedge_table[target, 9])
+                        u3, c3, s3 = wedge_table[target, 10], wedge_table[target, 11], float(wedge_table[target, 12])
+                        u4, c4, s4 = wedge_table[target, 13], wedge_table[target, 14], float(wedge_table[target, 15])
+                        minor = wedge_table[target, 0]
+                        for r in range(width):
+                            wedge[level, minor, r] = (s0 * wedge[level - 1, u0, r] * wrench_matrix[row, c0, r]
+                                                      + s1 * wedge[level - 1, u1, r] * wrench_matrix[row, c1, r]
+                                                      + s2 * wedge[level - 1, u2, r] * wrench_matrix[row, c2, r]
+                                                      + s3 * wedge[level - 1, u3, r] * wrench_matrix[row, c3, r]
+                                                      + s4 * wedge[level - 1, u4, r] * wrench_matrix[row, c4, r])
                 # out[q] = (-1)^(n-1+q) det(rows without column q): minor n - 1 - q of the last level
                 for q in range(n):
                     sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
                     for r in range(width):
                         output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
+            # The output twist M^T y, once per locked set: every submechanism holding the set uses it.
+            if identity:
+                for k in range(6):
+                    for r in range(width):
+                        output_twist[locked, k, r] = output[locked, k, r]
+            else:
+                for k in range(6):
+                    for r in range(width):
+                        output_twist[locked, k, r] = 0.0
+                for q in range(n):
+                    for k in range(6):
+                        for r in range(width):
+                            output_twist[locked, k, r] += motion_lanes[q, k, r] * output[locked, q, r]
             for r in range(width):
-                lane0[r] = 0.0
-                lane1[r] = 0.0
-                lane2[r] = 0.0
-            for q in range(n):
-                for r in range(width):
-                    y = output[locked, q, r]
-                    lane0[r] += motion_lanes[q, 0, r] * y
-                    lane1[r] += motion_lanes[q, 1, r] * y
-                    lane2[r] += motion_lanes[q, 2, r] * y
-            for r in range(width):
-                output_omega[locked, r] = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
+                w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
+                omega_squares[locked, r] = w0 * w0 + w1 * w1 + w2 * w2
         # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
         for s in range(subs):
             first = locked_of[s, 0]
@@ -313,7 +315,7 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
             for r in range(width):
                 volume[r] = 1.0
                 determinant[r] = 0.0
-                best[r] = 1.0  # the submechanism's OTI (Eq. 9), a minimum
+                best[r] = 0.0  # the longest moment arm, squared
             for i in range(n):
                 act = submechanisms[s, i]
                 for r in range(width):
@@ -327,32 +329,44 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                 act = submechanisms[s, position]
                 locked = locked_of[s, position]
                 for r in range(width):
-                    lane0[r] = 0.0
-                    lane1[r] = 0.0
-                    lane2[r] = 0.0
-                for q in range(n):
-                    for r in range(width):
-                        y = output[locked, q, r]
-                        lane0[r] += arms[act, q, 0, r] * y
-                        lane1[r] += arms[act, q, 1, r] * y
-                        lane2[r] += arms[act, q, 2, r] * y
-                for r in range(width):
-                    arm = np.sqrt(lane0[r] * lane0[r] + lane1[r] * lane1[r] + lane2[r] * lane2[r])
-                    reference = output_omega[locked, r] if has_force[act, r] else 0.0
-                    value = (power_coefficient(determinant[r], arm, reference, thresholds[r])
-                             if independent[s, r] else 0.0)
-                    values[position, r] = value
-                    best[r] = min(best[r], value)
+                    # The OTI's moment arm: the output twist's velocity at the characteristic point
+                    # plus h omega (v + omega x p + h omega), or |omega| for a couple (both computed,
+                    # one kept, so that the lanes stay branch-free).
+                    w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
+                    x0, x1, x2 = cross(w0, w1, w2, point_lanes[act, 0, r], point_lanes[act, 1, r],
+                                       point_lanes[act, 2, r])
+                    pitch = pitch_lanes[act, r]
+                    v0 = output_twist[locked, 3, r] + x0 + pitch * w0
+                    v1 = output_twist[locked, 4, r] + x1 + pitch * w1
+                    v2 = output_twist[locked, 5, r] + x2 + pitch * w2
+                    forceful = has_force[act, r]
+                    omega_sq = omega_squares[locked, r]
+                    arm_sq = v0 * v0 + v1 * v1 + v2 * v2 if forceful else omega_sq
+                    reference_sq = omega_sq if forceful else 0.0
+                    # power_coefficient's zero (the arm at or below p |omega|, or zero) as an infinite
+                    # arm; one store per lane, so that the compiler vectorises the loop
+                    zero = arm_sq <= thresholds[r] * thresholds[r] * reference_sq or arm_sq <= 0.0
+                    best[r] = max(best[r], np.inf if zero else arm_sq)
                 if oti_out.shape[0] > 0:
                     for r in range(width):
-                        oti_out[first_index + r, s, position] = values[position, r]
+                        w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
+                        x0, x1, x2 = cross(w0, w1, w2, point_lanes[act, 0, r], point_lanes[act, 1, r],
+                                           point_lanes[act, 2, r])
+                        pitch = pitch_lanes[act, r]
+                        v0 = output_twist[locked, 3, r] + x0 + pitch * w0
+                        v1 = output_twist[locked, 4, r] + x1 + pitch * w1
+                        v2 = output_twist[locked, 5, r] + x2 + pitch * w2
+                        omega = np.sqrt(omega_squares[locked, r])
+                        arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if has_force[act, r] else omega
+                        reference = omega if has_force[act, r] else 0.0
+                        oti_out[first_index + r, s, position] = (
+                            power_coefficient(determinant[r], arm, reference, thresholds[r])
+                            if independent[s, r] else 0.0)
                 if twist_out.shape[0] > 0:
                     for r in range(width):
                         index = first_index + r
                         for k in range(6):
-                            total = 0.0
-                            for q in range(n):
-                                total += output[locked, q, r] * motion_lanes[q, k, r]
+                            total = output_twist[locked, k, r]
                             twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
                         # back to world units and origin: v_0 = L v' - omega x c
                         x0, x1, x2 = cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
@@ -361,7 +375,11 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                         twist_out[index, s, position, 3] -= x0
                         twist_out[index, s, position, 4] -= x1
                         twist_out[index, s, position, 5] -= x2
+            # The OTI (Eq. 9), min_k |det W| / arm_k (each at most 1) = |det W| / max_k arm_k: one
+            # root and one division per submechanism; zero if any arm is at or below its threshold.
             for r in range(width):
+                value = abs(determinant[r]) / np.sqrt(best[r]) if independent[s, r] and best[r] < np.inf else 0.0
+                best[r] = 1.0 if value > 1.0 else value
                 oti_local[s, r] = best[r]
             if oti_sub_out.shape[0] > 0:
                 for r in range(width):

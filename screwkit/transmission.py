@@ -162,27 +162,34 @@ def _actuator_sets(a: int, n: int, fault_list: tuple[int, ...]) -> dict:
         **_wedge_tables(n))
 
 
+WEDGE_TERMS = 5
+"""Expansion terms per minor in :func:`_wedge_tables`: at most n - 1 = 5 (twists have six coordinates)."""
+
+
 def _wedge_tables(n: int) -> dict:
     """Expansion terms of the exterior products that give the output twists for n >= 4.
 
     The minor of rows ``r_1..r_K`` on columns ``S = {s_0 < ... < s_(K-1)}`` expands along its last
-    row: ``sum_t (-1)^(K-1-t) m_(S - s_t) r_K[s_t]``, ``m`` the minors of the first ``K - 1`` rows.
-    Row ``i`` of ``wedge_table`` is one term: (index of ``S`` among the K-column sets, index of
-    ``S - s_t`` among the (K-1)-column sets, ``s_t``, the sign, 1 for the first term of its ``S``);
-    level K's terms are rows ``wedge_start[K]:wedge_start[K+1]`` (none below K = 2). At level n - 1
-    the minors are the cofactor vector's entries: no pivoting and no division, each locked set's
-    vector from its predecessor's minors (Sum_K C(n, K) K multiply-adds per new row).
+    row: ``sum_t (-1)^(K-1-t) m_(S - s_t) r_K[s_t]``, ``m`` the minors of the first ``K - 1`` rows
+    (level 1: the first row). Row ``i`` of ``wedge_table`` is one minor: the index of ``S`` among the
+    K-column sets, then for each term the index of ``S - s_t`` among the (K-1)-column sets, ``s_t``
+    and the sign, padded to ``WEDGE_TERMS`` terms with zero signs, so that the kernel sums every
+    minor in one fixed pass; level K's minors are rows ``wedge_start[K]:wedge_start[K+1]`` (none
+    below K = 2). At level n - 1 the minors are the cofactor vector's entries: no pivoting and no
+    division, each locked set's vector from its predecessor's minors (Sum_K C(n, K) K
+    multiply-adds per new row).
     """
     table, start = [], [0, 0, 0]
     for size in range(2, max(n, 2)):
         previous = {columns: index for index, columns in enumerate(combinations(range(n), size - 1))}
         for target, columns in enumerate(combinations(range(n), size)):
-            for t, column in enumerate(columns):
-                table.append((target, previous[columns[:t] + columns[t + 1:]], column, (-1) ** (size - 1 - t),
-                              int(t == 0)))
+            terms = [(previous[columns[:t] + columns[t + 1:]], column, (-1) ** (size - 1 - t))
+                     for t, column in enumerate(columns)]
+            terms += [(0, 0, 0)] * (WEDGE_TERMS - len(terms))
+            table.append((target,) + tuple(value for term in terms for value in term))
         start.append(len(table))
     start += [len(table)] * (n + 1 - len(start))
-    return dict(wedge_table=np.array(table, dtype=np.int64).reshape(-1, 5),
+    return dict(wedge_table=np.array(table, dtype=np.int64).reshape(-1, 1 + 3 * WEDGE_TERMS),
                 wedge_start=np.array(start[:n + 1], dtype=np.int64))
 
 

@@ -93,18 +93,21 @@ def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
     """The output twists' expansion terms (level by level, as the kernel runs them) against numpy's determinants."""
     from itertools import combinations
 
-    from screwkit.transmission import _wedge_tables
+    from screwkit.transmission import WEDGE_TERMS, _wedge_tables
 
     tables = _wedge_tables(n)
     table, start = tables["wedge_table"], tables["wedge_start"]
     rows = np.random.default_rng(n).normal(size=(n - 1, n))
     minors = {1: rows[0].copy()}
     for level in range(2, n):
-        values = np.zeros(len(list(combinations(range(n), level))))
-        for target, source, column, sign, first in table[start[level]:start[level + 1]]:
-            if first:
-                values[target] = 0.0
-            values[target] += sign * minors[level - 1][source] * rows[level - 1, column]
+        sets = list(combinations(range(n), level))
+        entries = table[start[level]:start[level + 1]]
+        assert entries.shape == (len(sets), 1 + 3 * WEDGE_TERMS)
+        values = np.zeros(len(sets))
+        for target, *terms in entries:  # as the kernel sums them: every minor's padded terms in one pass
+            for source, column, sign in np.reshape(terms, (WEDGE_TERMS, 3)):
+                values[target] += sign * minors[level - 1][source] * rows[level - 1, column]
+        assert np.count_nonzero(entries[:, 3::3]) == len(sets) * level  # `level` real terms per minor
         minors[level] = values
         for index, columns in enumerate(combinations(range(n), level)):
             assert np.isclose(values[index], np.linalg.det(rows[:level][:, columns]), rtol=1e-12, atol=1e-12)
