@@ -44,16 +44,23 @@ def test_output_twists_match_finite_differences_of_the_closure(name):
             assert cosine > 1 - 1e-6, (s, position, cosine)
 
 
+@pytest.mark.parametrize("threshold", [None, 0.5])
 @pytest.mark.parametrize("name, rod_start", [("ups_hexapod_8", 0), ("rss_hexapod_8", 1)])
-def test_leg_otis_match_an_independent_formula(name, rod_start):
-    """The actuation wrench of a UPS (RSS) leg is the force along the leg (rod); OTIs from those lines."""
+def test_leg_otis_match_an_independent_formula(name, rod_start, threshold):
+    """The actuation wrench of a UPS (RSS) leg is the force along the leg (rod); OTIs from those lines.
+
+    Each actuator's OTI (Eq. 8), each submechanism's (Eq. 9: the kernel takes |det W| over the
+    longest moment arm, a path apart from the per-actuator values) and the LMTI (Eq. 11), at the
+    paper's threshold and at one large enough (0.5 m) to zero about half the OTIs."""
     mechanism = load(name)
     rng = np.random.default_rng(3)
     poses = np.asarray(mechanism.home_pose, dtype=float) + rng.uniform(-0.05, 0.05, (20, 6))
     solution = solve(mechanism, poses)
     assert np.all(solution.reachable)
     chains = chain_screws(mechanism, solution)
-    result = analyze(chains)
+    options = {} if threshold is None else {"threshold": threshold}
+    result = analyze(chains, **options)
+    zeroed = 0
     for index in range(0, 20, 5):
         lines, tops = [], []
         for chain in chains:
@@ -62,12 +69,20 @@ def test_leg_otis_match_an_independent_formula(name, rod_start):
             direction = (top - start) / np.linalg.norm(top - start)
             lines.append(np.concatenate([direction, np.cross(top, direction)]))
             tops.append(top)
+        submechanism_otis = []
         for s, sub in enumerate(result.submechanisms):
+            values = []
             for position, k in enumerate(sub):
                 others = np.array([lines[i] for i in sub if i != k])
                 (twist,) = screws.reciprocal_complement(others)
-                expected = float(screws.power_coefficient(lines[k], twist[0], tops[k]))
-                assert result.oti_actuators[index, s, position] == pytest.approx(expected, abs=1e-9)
+                values.append(float(screws.power_coefficient(lines[k], twist[0], tops[k], **options)))
+                assert result.oti_actuators[index, s, position] == pytest.approx(values[-1], abs=1e-9)
+            submechanism_otis.append(min(values))
+            assert result.oti_submechanisms[index, s] == pytest.approx(min(values), abs=1e-9)
+            zeroed += min(values) == 0.0
+        assert result.lmti[index] == pytest.approx(max(submechanism_otis), abs=1e-9)
+    assert (zeroed > 0) == (threshold is not None)  # the large threshold zeroes some submechanisms, not all
+    assert zeroed < 4 * len(result.submechanisms)
 
 
 def test_4rpr_concurrent_pose_names_the_non_mutual_interference_actuator():
