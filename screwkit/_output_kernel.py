@@ -2,15 +2,19 @@
 
 For the blocks of configurations :func:`screwkit._wrench_kernel.wrench_kernel` has prepared
 (:func:`screwkit._kernels.carry_arrays`, working coordinates), :func:`output_kernel` normalises
-each actuation wrench, computes its ITI (Eq. 6; the mechanism's, Eq. 7) and the moment-arm
-operator of its OTI, then builds the output twist of every set of n - 1 locked actuators (the
-cofactor vector of their wrench rows: an exterior product of the locked rows, level by level,
-each locked set starting from the minors it shares with the set before it; no pivoting, no
-division), the OTIs of every non-redundant
-submechanism (Eqs. 8-9, with the identity |A_k o T_k| = |det W| of Eq. A3), the LMTI of all
-actuators (Eq. 11), F_Oj for each j (Eqs. 12-13) with the worst fault set, and the
-mutual-interference actuators. Its own module, so that it compiles apart from
+each actuation wrench, computes its ITI (Eq. 6; the mechanism's, Eq. 7) and the characteristic
+point and pitch of its OTI, then builds the output twist of every set of n - 1 locked actuators
+(the cofactor vector of their wrench rows: an exterior product of the locked rows, level by
+level, each locked set starting from the minors it shares with the set before it; no pivoting,
+no division), the OTIs of every non-redundant submechanism (Eqs. 8-9, with the identity
+|A_k o T_k| = |det W| of Eq. A3, so that a submechanism's OTI is |det W| over its longest moment
+arm), the LMTI of all actuators (Eq. 11), F_Oj for each j (Eqs. 12-13) with the worst fault set,
+and the mutual-interference actuators. Its own module, so that it compiles apart from
 :mod:`screwkit._wrench_kernel` (in parallel on a first run, :mod:`screwkit._compile_notice`).
+
+Loops over the configurations of a block (lanes) write one array each where they are hot: the
+compiler vectorises a loop only when it can rule out, with few runtime checks, that what it
+writes overlaps what it reads.
 """
 
 from __future__ import annotations
