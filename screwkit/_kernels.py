@@ -49,6 +49,17 @@ def cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def arm_square(w0, w1, w2, v0, v1, v2, p0, p1, p2, pitch):
+    """|v + omega x p + h omega|^2: the squared moment arm of a wrench of pitch h through p on the
+    twist (omega, v) (|A o T|_max of Eq. 5 for a unit force)."""
+    x0, x1, x2 = cross(w0, w1, w2, p0, p1, p2)
+    a0 = v0 + x0 + pitch * w0
+    a1 = v1 + x1 + pitch * w1
+    a2 = v2 + x2 + pitch * w2
+    return a0 * a0 + a1 * a1 + a2 * a2
+
+
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def null_vector(rows, size, out, work, columns):
     """out[:size] = generalised cross product of the size - 1 rows rows[:size-1, :size].

@@ -26,6 +26,7 @@ from screwkit._fastmath import FASTMATH
 from screwkit._kernels import (
     BLOCK,
     CARRY_SIGNATURE,
+    arm_square,
     cross,
     motion_lanes_of,
     power_coefficient,
@@ -44,6 +45,14 @@ _SIGNATURE = (
     "float64[:, :, ::1], float64[:, :, :, ::1], "
     + CARRY_SIGNATURE + ")"
 )
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r):
+    """The squared moment arm of actuator ``act``'s wrench on locked set ``locked``'s output twist, lane r."""
+    return arm_square(output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r],
+                      output_twist[locked, 3, r], output_twist[locked, 4, r], output_twist[locked, 5, r],
+                      point_lanes[act, 0, r], point_lanes[act, 1, r], point_lanes[act, 2, r], pitch_lanes[act, r])
 
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
@@ -198,12 +207,9 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                         p2 = axis2 + along * f2
                 # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
                 w0, w1, w2 = joint_lanes[0, r], joint_lanes[1, r], joint_lanes[2, r]
-                x0, x1, x2 = cross(w0, w1, w2, p0, p1, p2)
                 omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-                v0 = joint_lanes[3, r] + x0 + pitch * w0
-                v1 = joint_lanes[4, r] + x1 + pitch * w1
-                v2 = joint_lanes[5, r] + x2 + pitch * w2
-                arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if forceful else omega
+                arm = np.sqrt(arm_square(w0, w1, w2, joint_lanes[3, r], joint_lanes[4, r], joint_lanes[5, r],
+                                         p0, p1, p2, pitch)) if forceful else omega
                 reference = omega if forceful else 0.0
                 iti_local[act, r] = power_coefficient(work_done * factor, arm, reference, thresholds[r])
                 if oti_override.shape[0] > 0:
@@ -336,16 +342,10 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                     # The OTI's moment arm: the output twist's velocity at the characteristic point
                     # plus h omega (v + omega x p + h omega), or |omega| for a couple (both computed,
                     # one kept, so that the lanes stay branch-free).
-                    w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
-                    x0, x1, x2 = cross(w0, w1, w2, point_lanes[act, 0, r], point_lanes[act, 1, r],
-                                       point_lanes[act, 2, r])
-                    pitch = pitch_lanes[act, r]
-                    v0 = output_twist[locked, 3, r] + x0 + pitch * w0
-                    v1 = output_twist[locked, 4, r] + x1 + pitch * w1
-                    v2 = output_twist[locked, 5, r] + x2 + pitch * w2
                     forceful = has_force[act, r]
                     omega_sq = omega_squares[locked, r]
-                    arm_sq = v0 * v0 + v1 * v1 + v2 * v2 if forceful else omega_sq
+                    arm_sq = (output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r) if forceful
+                              else omega_sq)
                     reference_sq = omega_sq if forceful else 0.0
                     # power_coefficient's zero (the arm at or below p |omega|, or zero) as an infinite
                     # arm; one store per lane, so that the compiler vectorises the loop
@@ -353,15 +353,9 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                     best[r] = max(best[r], np.inf if zero else arm_sq)
                 if oti_out.shape[0] > 0:
                     for r in range(width):
-                        w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
-                        x0, x1, x2 = cross(w0, w1, w2, point_lanes[act, 0, r], point_lanes[act, 1, r],
-                                           point_lanes[act, 2, r])
-                        pitch = pitch_lanes[act, r]
-                        v0 = output_twist[locked, 3, r] + x0 + pitch * w0
-                        v1 = output_twist[locked, 4, r] + x1 + pitch * w1
-                        v2 = output_twist[locked, 5, r] + x2 + pitch * w2
                         omega = np.sqrt(omega_squares[locked, r])
-                        arm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2) if has_force[act, r] else omega
+                        arm = (np.sqrt(output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r))
+                               if has_force[act, r] else omega)
                         reference = omega if has_force[act, r] else 0.0
                         oti_out[first_index + r, s, position] = (
                             power_coefficient(determinant[r], arm, reference, thresholds[r])
