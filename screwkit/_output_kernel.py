@@ -114,7 +114,6 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     pure_couple_sq = pure_couple * pure_couple
     output = np.empty((locked_sets.shape[0], n, BLOCK))
     wedge = np.zeros((max(n, 1), 20, BLOCK))  # minors of the first K locked rows, at most C(6, 3) = 20 per level
-    output_twist = np.empty((locked_sets.shape[0], 6, BLOCK))  # M^T y of each locked set (working coordinates)
     omega_squares = np.empty((locked_sets.shape[0], BLOCK))  # |omega|^2 of each output twist
     oti_local = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the sets
     independent = np.empty((subs, BLOCK), dtype=np.bool_)
@@ -130,6 +129,8 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     for q in range(n):
         for k in range(6):
             identity = identity and basis[0, q, k] == (1.0 if q == k else 0.0)
+    # M^T y of each locked set (working coordinates): y itself when the basis is the identity
+    output_twist = output if identity else np.empty((locked_sets.shape[0], 6, BLOCK))
     member = np.zeros((subs, a), dtype=np.bool_)
     for s in range(subs):
         for i in range(n):
@@ -303,11 +304,7 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
                     for r in range(width):
                         output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
             # The output twist M^T y, once per locked set: every submechanism holding the set uses it.
-            if identity:
-                for k in range(6):
-                    for r in range(width):
-                        output_twist[locked, k, r] = output[locked, k, r]
-            else:
+            if not identity:
                 for k in range(6):
                     for r in range(width):
                         output_twist[locked, k, r] = 0.0
