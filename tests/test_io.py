@@ -183,12 +183,14 @@ def test_an_mjcf_file_that_cannot_be_read_says_why(tmp_path, change, message):
         load(path)
 
 
-def test_a_closure_between_two_legs_is_refused_by_name(tmp_path):
+def test_an_actuator_on_a_leg_closed_onto_another_leg_is_refused_by_name(tmp_path):
+    """Leg 3 closed onto leg 2's pin instead of the platform: its motor drives through a closed-loop transmission."""
     urdf, yaml = five_bar_gepetto()
     yaml = yaml.replace('["closedloop3_B", "closedloop3_A"]', '["closedloop3_A", "closure_2a"]')
     (tmp_path / "robot.urdf").write_text(urdf)
     (tmp_path / "robot.yaml").write_text(yaml)
-    with pytest.raises(ImportError_, match="closure 'closedloop3_A-closure_2a' joins two legs"):
+    with pytest.raises(ImportError_, match="actuated joint 'mot3' drives through closure 'closedloop3_A-closure_2a', "
+                                           "which ends on another leg's link, not on the platform"):
         read_mechanism_file(tmp_path / "robot.urdf")
 
 

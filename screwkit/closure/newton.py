@@ -168,7 +168,8 @@ def _track(mechanism, index, source, values, goal, tolerance, max_iterations):
         targets = mechanism.loop_targets(index, rotation, translation)
         last = step == steps
         values, converged, residual = newton_solve_chain(
-            geometry, *targets, values, tolerance if last else 1e-8, max_iterations if last else 12
+            geometry, *targets, values, tolerance if last else 1e-8 * max(1.0, mechanism.length_scale),
+            max_iterations if last else 12
         )
         values = np.where(np.isfinite(values), values, 0.0)
     return values, converged, residual
@@ -198,6 +199,7 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
     """
     geometry = mechanism.chains[index].geometry
     count = flat_poses.shape[0]
+    tolerance = tolerance * max(1.0, mechanism.length_scale)  # as the assembly: rounding grows with the size
     targets = mechanism.loop_targets(index, *platform)
     values = np.empty((count, geometry.n_dofs))
     converged = np.zeros(count, dtype=bool)

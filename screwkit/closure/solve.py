@@ -227,7 +227,8 @@ def solve(
         ``"auto"`` uses a closed form for chains that have one; ``"newton"`` forces the
         generic solver everywhere (for checks).
     tolerance : float
-        Newton convergence on the closure error norm (rad and m).
+        Newton convergence on the closure error norm (rad and m; times the length scale when that
+        exceeds 1 m).
     max_iterations : int
         Newton iterations per continuation step.
     limits : bool

@@ -109,9 +109,10 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
     # writable copies: one compiled signature of the kernel whatever the caller passed
     targets = np.array(np.broadcast_to(targets, (count, task.size)), dtype=float, order="C")
     steps = np.array(np.broadcast_to(steps, (count,)), dtype=np.int64, order="C")
-    scale = np.concatenate([np.where(mechanism.pose_angular[free], 1.0, mechanism.length_scale),
-                            np.ones(flat.shape[1])])
     geometry = packed_geometry(mechanism, chains)
+    # unknowns in radians and length scales: a slide's step is limited like a pose coordinate's
+    scale = np.concatenate([np.where(mechanism.pose_angular[free], 1.0, mechanism.length_scale),
+                            np.where(geometry["dof_prism"], mechanism.length_scale, 1.0)])
     residual = np.empty(count)
 
     def work(block: slice) -> None:

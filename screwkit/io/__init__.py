@@ -6,16 +6,18 @@
 * :func:`is_foreign`: whether a path is such a file (the loader then imports it).
 
 The conversion itself (assembly, platform, legs, loop joints, idle joints, output) is
-:func:`screwkit.io.closed_tree.convert_tree`.
+:func:`screwkit.io.star.convert_tree`; legs joined to each other (compound legs) are
+:mod:`screwkit.io.compound`'s.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, convert_tree
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.mjcf import read_mjcf
+from screwkit.io.star import convert_tree
 from screwkit.units import metres_per
 
 __all__ = ["read_mechanism_file", "is_foreign", "convert_tree", "ClosedTree", "Closure", "ImportReport",
@@ -40,7 +42,7 @@ def read_mechanism_file(path: Path, *, output: str | None = None,
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
-    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.closed_tree` says).
+    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says).
     """
     path = Path(path)
     if output_type not in (None, "point", "frame"):

@@ -6,7 +6,7 @@ says how for each pair (``3d``: the origins, a ball joint; ``6d``: the whole fra
 case of the letter does not matter), and ``name_mot`` lists the actuated joints. ``joint_name`` /
 ``joint_type`` (joint types changed when loading) are refused with a message: write the joints
 in the URDF instead. The tree is read by Pinocchio; everything else by
-:func:`screwkit.io.closed_tree.convert_tree`.
+:func:`screwkit.io.star.convert_tree`.
 """
 
 from __future__ import annotations

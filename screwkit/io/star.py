@@ -1,0 +1,426 @@
+"""A closed tree (MJCF equalities, Gepetto robot.yaml) written in screwkit's convention.
+
+screwkit's convention (``docs/urdf-convention.md``) is a *star*: a platform hanging from the base
+by a floating (or planar) joint, and legs, each a serial chain from the base closed onto the
+platform by one loop joint. :func:`convert_tree` maps a closed tree
+(:class:`~screwkit.io.closed_tree.ClosedTree`) onto it:
+
+1. **Assembly** (:func:`~screwkit.io.closed_tree.assemble`): the closures closed near the file's
+   joint values, gaps and working mode reported.
+2. **Platform.** The body carrying the output frame (named, or a frame called effector, eff, ee,
+   tool, tcp, foot or platform). Its own tree path from the root is one leg, welded to the platform.
+3. **Legs and loop joints.** Every closure onto the platform joins a leg (a tree path from the
+   root that shares no joint with another leg) to it; the joints between the platform body and
+   the closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
+   ``spherical``), one revolute or prismatic joint (``revolute``/``prismatic``), or three
+   revolute joints through one point or a ball joint (``spherical``). Closures between two legs
+   make **compound legs** (:mod:`screwkit.io.compound`): each keeps its actuated leg and writes
+   its passive legs as one equivalent constraint chain, or is refused with the reason. Loops that
+   leave a leg's own path, and actuators on branches closed onto other legs (closed-loop
+   transmissions), are refused with the closure named.
+4. **Idle joints.** A leg whose joint twists are dependent at the assembly (a second pin coaxial
+   with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
+   assembled values, from its end backwards, until they are independent: the span of the leg's
+   twists, so the platform's motion and every index, is unchanged; the report names them.
+5. **Output.** When every closure onto the platform meets it at one point and the mechanism
+   moves in a plane or is of lower mobility, the output is that point (a five-bar's distal
+   joint, where pressure angles are measured); otherwise the output frame. A mechanism whose
+   revolute axes are all parallel (and slides perpendicular to them) is written planar.
+
+The result is the text of a URDF in screwkit's convention and an
+:class:`~screwkit.io.closed_tree.ImportReport`.
+"""
+
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.io.closed_tree import (
+    ClosedTree,
+    Closure,
+    ImportError_,
+    ImportReport,
+    assemble,
+    closure_gaps,
+    homogeneous,
+    inverse,
+    joint_kind,
+    joint_value,
+    path_to,
+)
+from screwkit.io.compound import Reduction, compound_legs
+from screwkit.model.urdf_writer import UrdfWriter
+from screwkit.rotations import rotation_about_axis, rpy_from_rotation
+
+__all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
+
+OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
+"""Frame names taken as the output when none is given, in this order (case-insensitive)."""
+
+UNLIMITED_SLIDE = 1e6
+"""Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
+
+INDEPENDENCE_TOLERANCE = 1e-9
+"""Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
+largest, for them to count as independent (as :data:`screwkit.tolerances.MOTION_SPACE_TOLERANCE`)."""
+
+
+# -- the star --------------------------------------------------------------------------------------
+
+
+def _output_frame(tree: ClosedTree) -> int:
+    model = tree.model
+    names = [frame.name for frame in model.frames]
+    if tree.output is not None:
+        if tree.output not in names:
+            raise ImportError_(f"{tree.source}: no frame named {tree.output!r} for the output; frames are "
+                               + ", ".join(names[1:]) + ".")
+        return names.index(tree.output)
+    lowered = [name.lower() for name in names]
+    for candidate in OUTPUT_NAMES:
+        if candidate in lowered:
+            return lowered.index(candidate)
+    raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
+                       f"no frame is called {', '.join(OUTPUT_NAMES)}.")
+
+
+def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
+    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples."""
+    rows = []
+    for kind, axis, point in axis_kinds:
+        row = np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else \
+            np.concatenate([axis, np.cross(point - centre, axis) / scale])
+        rows.append(row / np.linalg.norm(row))
+    return np.array(rows).reshape(-1, 6)
+
+
+def _independent(rows: NDArray) -> bool:
+    if rows.shape[0] == 0:
+        return True
+    singular = np.linalg.svd(rows, compute_uv=False)
+    return rows.shape[0] <= 6 and singular[-1] > INDEPENDENCE_TOLERANCE * singular[0]
+
+
+@dataclass
+class _Leg:
+    joints: list[int]
+    loop: str  # fixed, revolute, prismatic, spherical
+    predecessor: NDArray  # 4x4 in the leg end's joint frame
+    successor_world: NDArray  # 4x4 world pose of the platform-side loop frame at the assembly
+    axis: NDArray | None
+    loop_dofs: list[tuple[str, NDArray, NDArray]]  # world (kind, axis, point) of the loop DoFs at the assembly
+    closure: str
+    locked: list[int] = field(default_factory=list)
+    source: Closure | None = None  # the closure onto the platform (None: the platform body's own path)
+
+
+def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
+    """The leg and loop joint of a closure (side b made the platform side)."""
+    model = tree.model
+    a_path, b_path = path_to(model, closure.joint_a), path_to(model, closure.joint_b)
+    on_platform_a, on_platform_b = platform in a_path, platform in b_path
+    if on_platform_a and not on_platform_b:
+        closure = Closure(closure.name, closure.joint_b, closure.placement_b, closure.joint_a, closure.placement_a,
+                          closure.kind)
+        a_path, b_path = b_path, a_path
+    elif on_platform_a:
+        raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side.")
+    after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
+    frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
+    kinds = [joint_kind(model, joint) for joint in after]
+    if closure.kind == "3d":
+        if after:
+            raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
+                               f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
+                               "screwkit supports.")
+        centre = frame_a[:3, 3]
+        axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
+        return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, source=closure)
+    if not after:
+        return _Leg(a_path, "fixed", closure.placement_a, frame_a, None, [], closure.name, source=closure)
+    # the platform-side loop frame: the first joint beyond the platform at zero motion
+    first = after[0]
+    zero = homogeneous(data.oMi[model.parents[first]]) @ homogeneous(model.jointPlacements[first])
+    predecessor = closure.placement_a @ inverse(closure.placement_b)  # frame b's joint frame, on leg a
+    if len(after) == 1 and kinds[0][0] in ("revolute", "prismatic"):
+        kind, axis = kinds[0]
+        world_axis = zero[:3, :3] @ axis
+        return _Leg(a_path, kind, predecessor, zero, axis, [(kind, world_axis, zero[:3, 3])], closure.name,
+                    source=closure)
+    concurrent = all(np.linalg.norm(np.asarray(model.jointPlacements[j].translation)) < 1e-9 * scale
+                     for j in after[1:])
+    if (len(after) == 3 and concurrent and all(k[0] == "revolute" for k in kinds)) or \
+            (len(after) == 1 and kinds[0][0] == "spherical"):
+        centre = zero[:3, 3]
+        axes = [("revolute", zero[:3, k], centre) for k in range(3)]
+        return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name, source=closure)
+    raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
+                       f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
+                       "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
+                       "one point (a spherical joint).")
+
+
+def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
+    """Lock passive joints, from the leg end backwards, while the leg's joint twists are dependent."""
+    model = tree.model
+
+    def rows(kept):
+        triples = []
+        for joint in kept:
+            kind, axis = joint_kind(model, joint)
+            placement = data.oMi[joint]
+            triples.append((kind, np.asarray(placement.rotation) @ axis, np.asarray(placement.translation)))
+        return _twists(triples + leg.loop_dofs, leg.successor_world[:3, 3], scale)
+
+    kept = list(leg.joints)
+    for joint in reversed(leg.joints):
+        if _independent(rows(kept)):
+            break
+        if joint in motors:
+            continue
+        trial = [j for j in kept if j != joint]
+        if np.linalg.matrix_rank(rows(trial), tol=INDEPENDENCE_TOLERANCE) == \
+                np.linalg.matrix_rank(rows(kept), tol=INDEPENDENCE_TOLERANCE):
+            kept = trial
+            leg.locked.append(joint)
+    if not _independent(rows(kept)):
+        raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
+                           "its idle passive joints (its actuated joints are dependent at the assembly).")
+
+
+def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
+    """The common direction of every revolute axis when slides are perpendicular to it, else None."""
+    model = tree.model
+    axes = []
+    for leg in legs:
+        for joint in leg.joints:
+            kind, axis = joint_kind(model, joint)
+            axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
+        if leg.loop == "spherical":
+            return None
+        axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
+    revolute = [axis for kind, axis in axes if kind == "revolute"]
+    if not revolute:
+        return None
+    normal = revolute[0]
+    for kind, axis in axes:
+        if kind == "revolute" and np.linalg.norm(np.cross(axis, normal)) > 1e-9:
+            return None
+        if kind == "prismatic" and abs(axis @ normal) > 1e-9:
+            return None
+    return normal
+
+
+def _origin(matrix: NDArray) -> dict:
+    return dict(zip(("xyz", "rpy"), _pose(matrix)))
+
+
+def _pose(matrix: NDArray) -> tuple:
+    return tuple(matrix[:3, 3]), tuple(rpy_from_rotation(matrix[:3, :3]))
+
+
+def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
+    kind, axis = joint_kind(model, joint)
+    motion = np.eye(4)
+    value = joint_value(model, joint, q)
+    if kind == "revolute":
+        motion[:3, :3] = rotation_about_axis(axis, value)
+    else:
+        motion[:3, 3] = axis * value
+    return motion
+
+
+def _base_rotation(normal: NDArray | None) -> NDArray:
+    """World rotation of the written base frame: its z axis along a planar mechanism's normal."""
+    if normal is None:
+        return np.eye(3)
+    z = normal / np.linalg.norm(normal)
+    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
+    if np.linalg.norm(x) < 1e-6:
+        x = np.array([0.0, 1.0, 0.0]) - z[1] * z
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def _write_equivalent(writer: UrdfWriter, name: str, reduction: Reduction, attachment: NDArray, world_base: NDArray,
+                      platform_world: NDArray) -> list[str]:
+    """An equivalent constraint chain: slides along the reduction's translations, then revolutes along its rotations,
+    from the attachment point, welded there to the platform. Returns its joint names."""
+    to_base = inverse(world_base)
+    point = tuple((to_base @ np.append(attachment, 1.0))[:3])
+    parent, joints = "base", []
+    directions = [("prismatic", d) for d in reduction.translations] + [("continuous", d) for d in reduction.rotations]
+    for position, (kind, direction) in enumerate(directions):
+        joint = f"{name}_{'slide' if kind == 'prismatic' else 'turn'}_{position + 1}"
+        writer.link(f"{joint}_link")
+        writer.joint(joint, kind, parent, f"{joint}_link", xyz=point if position == 0 else (0, 0, 0),
+                     axis=tuple(to_base[:3, :3] @ direction),
+                     limit=(-UNLIMITED_SLIDE, UNLIMITED_SLIDE, 0, 0) if kind == "prismatic" else None)
+        parent = f"{joint}_link"
+        joints.append(joint)
+    end = world_base.copy()
+    end[:3, 3] = attachment
+    writer.loop(f"{name}_loop", "fixed", name, parent, _pose(np.eye(4)), "platform",
+                _pose(inverse(platform_world) @ end))
+    return joints
+
+
+def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
+    """The URDF text of a closed tree in screwkit's convention, and what was done (see the module docstring)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    report = ImportReport(source=tree.source, file_format=tree.file_format)
+    report.gaps_before = closure_gaps(tree, tree.q_reference)
+    q, scale = assemble(tree)
+    report.gaps_after = closure_gaps(tree, q)
+    change = pin.difference(model, tree.q_reference, q)
+    report.notes.append(f"working mode: the closed configuration damped least squares reach from the file's joint "
+                        f"values (the largest joint change {float(np.max(np.abs(change), initial=0.0)):.3g} rad or m)")
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    frame_index = _output_frame(tree)
+    output_frame = model.frames[frame_index]
+    platform = int(output_frame.parentJoint)
+    if platform == 0:
+        raise ImportError_(f"{tree.source}: the output frame {output_frame.name!r} is on the fixed base.")
+    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    body = bodies.get(platform, model.names[platform])
+    report.platform_body = body
+    spine = _Leg(path_to(model, platform), "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
+    onto_platform = [platform in path_to(model, c.joint_a) or platform in path_to(model, c.joint_b)
+                     for c in tree.closures]
+    couplings = [c for c, onto in zip(tree.closures, onto_platform) if not onto]
+    legs = [spine] + [_loop_of(tree, data, c, platform, scale) for c, onto in zip(tree.closures, onto_platform) if onto]
+    owner: dict[int, str] = {}
+    for leg in legs:
+        if not leg.joints:
+            raise ImportError_(f"{tree.source}: closure {leg.closure!r} ties the platform to the fixed base: no leg.")
+        for joint in leg.joints:
+            kind, _ = joint_kind(model, joint)
+            if kind not in ("revolute", "prismatic"):
+                raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: write it as "
+                                   "1-DoF joints (a ball joint as three hinges).")
+    for leg in legs:
+        for joint in leg.joints:
+            if joint in owner:
+                first = f"closure {owner[joint]!r}" if owner[joint] else "the platform body's own path"
+                raise ImportError_(f"{tree.source}: closure {leg.closure!r} and {first} share joint "
+                                   f"{model.names[joint]!r}: a loop that leaves another leg's path (a closed-loop "
+                                   "transmission inside a leg), which screwkit cannot write as legs from the base.")
+            owner[joint] = leg.closure
+    motor_ids = {}
+    for name in tree.motors:
+        if not model.existJointName(name):
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} is not a joint of the tree.")
+        joint = model.getJointId(name)
+        if joint not in owner:
+            through = [c.name for c in couplings if joint in path_to(model, c.joint_a) + path_to(model, c.joint_b)]
+            if through:
+                raise ImportError_(f"{tree.source}: actuated joint {name!r} drives through closure {through[0]!r}, "
+                                   "which ends on another leg's link, not on the platform (a closed-loop "
+                                   "transmission): screwkit writes compound legs whose actuators lie on a path from "
+                                   "the base to the platform.")
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} is on no leg (a leg is a tree path from the "
+                               "base to the platform or to a closure).")
+        motor_ids[joint] = name
+    normal = _planar_normal(tree, data, legs)
+    centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
+    meet = all(np.linalg.norm(c - centres[0]) < 1e-9 * scale for c in centres)
+    equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
+    for leg in legs:
+        _lock_idle(tree, data, leg, scale, set(motor_ids))
+    absorbed = set()
+    for closure in tree.closures:
+        for joint in (closure.joint_a, closure.joint_b):
+            absorbed.update(path_to(model, joint))
+    report.dropped = [model.names[j] for j in range(1, model.njoints) if j not in owner and j not in absorbed]
+    report.planar = normal is not None
+    output_world = homogeneous(data.oMf[frame_index])
+    point = tree.output_type == "point" or (tree.output_type is None and meet)
+    if point and not meet:
+        raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
+                           "point; they do not.")
+    if point:
+        offset = output_world[:3, 3] - centres[0]
+        if normal is not None:  # the distance in the plane of motion
+            offset = offset - (offset @ normal) * normal
+        report.output = (f"the point where the chains meet on body {body!r} (closure {tree.closures[0].name!r}), "
+                         f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
+                         f"frame {output_frame.name!r}")
+    else:
+        report.output = f"frame {output_frame.name!r} on body {body!r}"
+    base_rotation = _base_rotation(normal)
+    world_base = np.eye(4)
+    world_base[:3, :3] = base_rotation
+    platform_world = np.eye(4)
+    platform_world[:3, :3] = base_rotation if (point or normal is not None) else output_world[:3, :3]
+    platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
+    writer = UrdfWriter(tree.source.rsplit("/", 1)[-1].split(".")[0] or "mechanism",
+                        f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
+    base = "base"
+    if normal is not None:
+        writer.link("world")
+        writer.joint("world_to_base", "fixed", "world", base, **_origin(world_base))
+    writer.link(base)
+    platform_base = inverse(world_base) @ platform_world
+    if normal is not None:
+        writer.link("platform")
+        writer.joint("platform_joint", "planar", base, "platform", xyz=tuple(platform_base[:3, 3]), axis=(0, 0, 1))
+    else:
+        writer.link("platform")
+        writer.joint("platform_joint", "floating", base, "platform", **_origin(platform_base))
+    reference = {}
+    legs.sort(key=lambda leg: leg.joints[0])
+    for leg in legs:
+        parent, end = base, base
+        for position, joint in enumerate(leg.joints):
+            placement = homogeneous(model.jointPlacements[joint])
+            if position == 0:
+                placement = inverse(world_base) @ placement
+            link = f"{model.names[joint]}_link"
+            if joint in leg.locked:
+                writer.link(link)
+                writer.joint(model.names[joint], "fixed", parent, link, **_origin(placement @ _joint_motion(
+                    model, joint, q)))
+                report.locked.append(model.names[joint])
+            else:
+                kind, axis = joint_kind(model, joint)
+                lower = model.lowerPositionLimit[model.joints[joint].idx_q]
+                upper = model.upperPositionLimit[model.joints[joint].idx_q]
+                limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
+                    and model.joints[joint].nq == 1 else None
+                joint_type = kind
+                if limit is None:  # no limits in the file: a continuous joint, a slide limited only far away
+                    joint_type = "continuous" if kind == "revolute" else kind
+                    limit = None if kind == "revolute" else (-UNLIMITED_SLIDE, UNLIMITED_SLIDE, 0, 0)
+                writer.link(link)
+                writer.joint(model.names[joint], joint_type, parent, link, axis=tuple(axis), limit=limit,
+                             **_origin(placement))
+                reference[model.names[joint]] = joint_value(model, joint, q)
+            parent, end = link, link
+        name = model.names[leg.joints[0]]
+        successor = inverse(platform_world) @ leg.successor_world
+        writer.loop(f"{name}_loop", leg.loop, name, end, _pose(leg.predecessor), "platform", _pose(successor),
+                    axis=None if leg.axis is None else tuple(leg.axis))
+        actuated = [model.names[j] for j in leg.joints if j in motor_ids]
+        report.chains.append(f"{name}: joints {', '.join(model.names[j] for j in leg.joints)}, loop {leg.loop}"
+                             + (f" (closure {leg.closure})" if leg.closure else " (the platform body's own path)")
+                             + (f", actuated {', '.join(actuated)}" if actuated else ""))
+    for name, reduction, attachment in equivalents:
+        joints = _write_equivalent(writer, name, reduction, attachment, world_base, platform_world)
+        reference.update(dict.fromkeys(joints, 0.0))
+        report.chains.append(f"{name}: joints {', '.join(joints)}, loop fixed (the equivalent constraint chain of a "
+                             "compound leg)")
+    for name in motor_ids.values():
+        writer.transmission(name)
+    report.motors = list(motor_ids.values())
+    if point:
+        writer.output("point")
+    writer.reference_configuration(reference)
+    return writer.text(), report
