@@ -243,3 +243,32 @@ def test_convert_writes_a_compound_leg_that_opens_with_the_same_indices(tmp_path
     again = tmp_path / "again.urdf"  # converting the converted file: screwkit's convention, written back as it is
     assert screwkit("convert", out, again).returncode == 0
     assert json.loads(screwkit("analyze", again, "--json").stdout)["iti_actuators"] == converted["iti_actuators"]
+
+
+def test_platform_twists_of_a_serial_leg_span_its_joint_twists(tmp_path):
+    """The closure-Jacobian null space of rod 2 alone (its closure onto the effector) spans rod 2's three revolute
+    twists (axes z through B0, B1, E0, written from the points), in any world frame."""
+    import pinocchio as pin
+
+    from screwkit.io.closed_tree import path_to
+    from screwkit.io.compound import platform_twists
+
+    rotation = random_rotation(np.random.default_rng(2))
+    path = write(tmp_path, *delta_gepetto(rotation, 2.0))
+    tree = read_gepetto(path, tmp_path / "robot.yaml")
+    q, scale = assemble(tree)
+    model = tree.model
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    platform = model.getJointId("free2_rod1")
+    closure = next(c for c in tree.closures if c.name == "closedloop2_B-closedloop2_A")
+    spine = set(path_to(model, platform))
+    joints = sorted({j for side in (closure.joint_a, closure.joint_b) for j in path_to(model, side)} - spine)
+    centre = np.asarray(data.oMi[platform].translation)
+    got = platform_twists(model, data, joints, [closure], platform, False, centre, scale)
+    axis = rotation @ np.array([0.0, 0.0, 1.0])
+    expected = np.array([np.concatenate([axis, np.cross(data.oMi[model.getJointId(name)].translation - centre, axis)
+                                         / scale]) for name in ("mot1_rod2", "free1_rod2", "closedloop2_A")])
+    expected = np.linalg.svd(expected, full_matrices=False)[2]
+    assert got.shape == (3, 6)
+    np.testing.assert_allclose(got.T @ got, expected.T @ expected, atol=1e-9)
