@@ -45,12 +45,14 @@ def delta_points(distort: float = 0.0) -> dict[str, np.ndarray]:
 
 
 def delta_gepetto(rotation=None, scale: float = 1.0, opening: float = 0.0, distort: float = 0.0,
-                  couple_only: bool = False, motors=("mot1_rod1", "mot1_rod2")) -> tuple[str, str]:
+                  couple_only: bool = False, motors=("mot1_rod1", "mot1_rod2"), idle_loop: bool = False
+                  ) -> tuple[str, str]:
     """The parallelogram Delta as a Gepetto-style URDF tree and robot.yaml (every joint frame world-aligned).
 
     ``rotation``/``scale`` move the whole mechanism; ``opening`` (rad) turns both motors' origins, so q = 0
     leaves the loops open; ``couple_only`` drops rod 3's second half (P, E1): rod 3 is then a dyad pinned
-    to rod 2 at B1, which constrains nothing.
+    to rod 2 at B1, which constrains nothing; ``idle_loop`` adds two rods from the base pinned to each other
+    (a loop that reaches no leg).
     """
     rotation = np.eye(3) if rotation is None else rotation
     points = delta_points(distort)
@@ -68,6 +70,11 @@ def delta_gepetto(rotation=None, scale: float = 1.0, opening: float = 0.0, disto
         joints += [("closedloop3_B", "free2_rod1", "E1", "revolute"), ("free3_rod3", "free2_rod3", "P", "revolute"),
                    ("closedloop3_A", "free3_rod3", "E1", "revolute")]
         closures.append(("closedloop3_A", "closedloop3_B"))
+    if idle_loop:
+        points = dict(points, X0=np.array([-0.3, 0.0]), Y0=np.array([-0.5, 0.0]), Q=np.array([-0.4, -0.1]))
+        joints += [("idle_a", None, "X0", "revolute"), ("idle_a_pin", "idle_a", "Q", "revolute"),
+                   ("idle_b", None, "Y0", "revolute"), ("idle_b_pin", "idle_b", "Q", "revolute")]
+        closures.append(("idle_a_pin", "idle_b_pin"))
     where = {name: point for name, _, point, _ in joints}
     links, elements = ['<link name="built"/>'], []
     for name, parent, point, kind in joints:
@@ -201,7 +208,8 @@ def test_a_dyad_pinned_inside_a_leg_constrains_nothing_and_leaves_the_five_bar(t
     leg is rod 2 and the indices are the five-bar's, computed from the tree."""
     path = write(tmp_path, *delta_gepetto(couple_only=True))
     _, report = read_mechanism_file(path)
-    assert any("passive legs none left out (they constrain nothing the actuated path does not)" in note
+    assert any("actuated path mot1_rod2 kept, nothing written for its passive branches: they constrain nothing the "
+               "actuated path does not" in note
                for note in report.notes), report.notes
     mechanism = load(path)
     assert [chain.name for chain in mechanism.chains] == ["mot1_rod1", "mot1_rod2"] and mechanism.dof == 2
@@ -272,3 +280,19 @@ def test_platform_twists_of_a_serial_leg_span_its_joint_twists(tmp_path):
     expected = np.linalg.svd(expected, full_matrices=False)[2]
     assert got.shape == (3, 6)
     np.testing.assert_allclose(got.T @ got, expected.T @ expected, atol=1e-9)
+
+
+def test_a_loop_that_reaches_no_leg_is_left_out_and_changes_nothing(tmp_path):
+    plain = load(write(tmp_path, *delta_gepetto()))
+    other = tmp_path / "with_loop"
+    other.mkdir()
+    path = write(other, *delta_gepetto(idle_loop=True))
+    _, report = read_mechanism_file(path)
+    assert "closure 'idle_a_pin-idle_b_pin' closes branches that reach no leg: left out (it does not move the " \
+           "platform)" in report.notes
+    mechanism = load(path)
+    assert [chain.name for chain in mechanism.chains] == [chain.name for chain in plain.chains]
+    poses = poses_near_home(plain)
+    first, second = (indices_at_poses(m, poses, detail=True) for m in (plain, mechanism))
+    np.testing.assert_allclose(second.iti_actuators, first.iti_actuators, atol=TOLERANCE)
+    np.testing.assert_allclose(second.lmti, first.lmti, atol=TOLERANCE)

@@ -257,6 +257,10 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
     equivalents, removed = [], set()
     for members, group_couplings in compound_groups(model, [leg.joints for leg in legs], couplings):
         label = f"the compound leg joined by closure {', '.join(repr(c.name) for c in group_couplings)}"
+        if not members:  # loops among branches that reach no leg: they cannot move the platform
+            report.notes.append(f"closure {', '.join(repr(c.name) for c in group_couplings)} closes branches that "
+                                "reach no leg: left out (it does not move the platform)")
+            continue
         actuated = [index for index in members if motors & set(legs[index].joints)]
         if len(actuated) > 1:
             raise ImportError_(f"{tree.source}: {label} has {len(actuated)} actuated legs "
@@ -283,15 +287,17 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
         removed.update(passive)
         first = legs[passive[0]] if passive else legs[members[0]]
         name = f"{model.names[first.joints[0]]}_equivalent"
-        replaced = ", ".join(model.names[legs[i].joints[0]] for i in passive) or "none"
+        replaced = ", ".join(model.names[legs[i].joints[0]] for i in passive)
         allowed = ("no rotation" if not len(reduction.rotations) else
                    "rotations about " + ", ".join(str(np.round(r, 6).tolist()) for r in reduction.rotations))
         report.notes.append(
             f"{label}: twist system of dimension {reduction.dimension} ({allowed} beyond translations), the same at "
             f"{reduction.samples} closed configurations; actuated path "
-            f"{model.names[legs[actuated[0]].joints[0]] if actuated else 'none'} kept, passive legs {replaced} "
-            + (f"written as the equivalent constraint chain {name}" if reduction.needed else
-               "left out (they constrain nothing the actuated path does not)"))
+            f"{model.names[legs[actuated[0]].joints[0]] if actuated else 'none'} kept, "
+            + (f"passive {'legs ' + replaced if passive else 'branches'} written as the equivalent constraint chain "
+               f"{name}" if reduction.needed else
+               f"nothing written for its passive {'legs ' + replaced + ' and ' if passive else ''}branches: they "
+               "constrain nothing the actuated path does not"))
         if reduction.needed:
             equivalents.append((name, reduction, first.successor_world[:3, 3].copy()))
     legs[:] = [leg for index, leg in enumerate(legs) if index not in removed]
