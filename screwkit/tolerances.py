@@ -79,8 +79,8 @@ file, and the tolerance of recognising a chain's closed-form type (axes parallel
 coincident, axes along z), so that a file written to 6 decimals keeps its closed forms."""
 
 NEWTON_TOLERANCE = 1e-11
-"""Metres and radians: a chain solved by damped Newton is closed when its loop error norm is
-below this."""
+"""Radians and length scales: a chain solved by damped Newton is closed when its loop error norm
+(rotation in rad, translation divided by the mechanism's length scale) is below this."""
 
 BRANCH_MATCH_TOLERANCE = 1e-4
 """Radians, and metres relative to the mechanism's length scale: the closed-form branch closest

@@ -476,3 +476,39 @@ def test_worst_fault_is_the_first_set_within_the_tie_margin(name, faults):
         ties += int(np.sum(np.sum(within & (lmti != lmti.min(axis=1, keepdims=True)), axis=1) > 0))
     if name == "prs_3_six_actuators":
         assert ties > 0  # sets equal up to rounding occur, and the rule decides
+
+
+@pytest.mark.parametrize("name", ["prs_3_ups", "delta_4"])
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_closure_and_forward_kinematics_of_a_scaled_copy(tmp_path, name, scale):
+    """The same mechanism written with every length times ``scale``: its closure (Newton chains, dependent
+    coordinates) reaches the same configurations away from home, forward kinematics finds the same poses
+    from the same actuator values, and the indices are the same (closures in rad and length scales)."""
+    from xml.etree import ElementTree
+
+    from helpers import random_reachable_poses
+    from screwkit.closure import actuator_values, forward, solve
+    from screwkit.loader import bundled_path, load
+    from screwkit.model.urdf_reader import scale_lengths
+    from screwkit.studies.poses import indices_at_poses
+
+    root = ElementTree.parse(bundled_path(name)).getroot()
+    scale_lengths(root, scale)
+    path = tmp_path / f"{name}.urdf"
+    path.write_text(ElementTree.tostring(root, encoding="unicode"))
+    metres, copy = load(bundled_path(name)), load(path)
+    poses = random_reachable_poses(metres, np.random.default_rng(4), 6)
+    factor = np.where(np.array([axis in ("x", "y", "z") for axis in metres.task_coordinates]), scale, 1.0)
+    first, second = solve(metres, poses), solve(copy, poses * factor)
+    assert second.reachable.all()
+    a, b = indices_at_poses(metres, poses, detail=True), indices_at_poses(copy, poses * factor, detail=True)
+    for key in ("iti_actuators", "oti_submechanisms", "lmti"):
+        np.testing.assert_allclose(getattr(b, key), getattr(a, key), atol=1e-9, err_msg=key)
+    prismatic = np.array([copy.chains[c].prismatic[j] for c, j in copy.actuator_positions(None)])
+    targets = actuator_values(metres, first.joint_values) * np.where(prismatic, scale, 1.0)
+    found = forward(copy, targets, np.broadcast_to(copy.home_pose, poses.shape))
+    in_metres = forward(metres, targets / np.where(prismatic, scale, 1.0), np.broadcast_to(metres.home_pose,
+                                                                                          poses.shape))
+    np.testing.assert_array_equal(found.reachable, in_metres.reachable)  # what forward reaches from home
+    assert found.reachable.sum() >= 4
+    np.testing.assert_allclose(found.poses[found.reachable] / factor, poses[found.reachable], atol=1e-9)

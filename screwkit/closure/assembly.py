@@ -88,9 +88,9 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
     values, note = np.concatenate([tree_values, loop_values]), None
     if position_gap > CLOSURE_TOLERANCE * length_scale or rotation_gap > CLOSURE_TOLERANCE:
         scale = np.where(np.asarray(geometry.dof_prismatic), length_scale, 1.0)
-        tolerance = NEWTON_TOLERANCE * max(1.0, length_scale)
         solved, converged, residual = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
-                                                         values[None], tolerance=tolerance, max_iterations=200)
+                                                         values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
+                                                         length=length_scale)
         if not converged[0]:
             raise description.fail(
                 f"<loop name='{chain.loop_name}'>",

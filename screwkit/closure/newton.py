@@ -59,14 +59,17 @@ def newton_solve_chain(
     tolerance: float = 1e-11,
     max_iterations: int = 40,
     max_step: float = 0.5,
+    length: float = 1.0,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
     """Close one chain onto target platform-side loop frames by damped Newton steps.
 
-    Levenberg-Marquardt: the step solves ``(J^T J + (mu + |e|^2) I) dq = J^T e`` and is
-    kept only if it lowers ``|e|``; ``mu`` shrinks after a kept step and grows after a
-    rejected one (the ``|e|^2`` term keeps convergence quadratic at singular solutions).
-    Steps are limited to ``max_step`` (rad or m) so the assembly branch does not jump.
-    Batched: every iteration works on all configurations not yet converged or stalled.
+    Levenberg-Marquardt in working units (lengths divided by ``length``, the mechanism's length
+    scale, so that the damping, the step limit and the tolerance mean the same for a mechanism
+    and any scaled copy): the step solves ``(J^T J + (mu + |e|^2) I) dq = J^T e`` and is kept
+    only if it lowers ``|e|``; ``mu`` shrinks after a kept step and grows after a rejected one
+    (the ``|e|^2`` term keeps convergence quadratic at singular solutions). Steps are limited
+    to ``max_step`` (rad or length scales) so the assembly branch does not jump. Batched: every
+    iteration works on all configurations not yet converged or stalled.
 
     Parameters
     ----------
@@ -78,37 +81,40 @@ def newton_solve_chain(
     -------
     values : ndarray, shape (N, m)
     converged : ndarray of bool, shape (N,)
-        Whether ``|e| < tolerance`` (rotation vector in rad and translation in m stacked).
+        Whether ``|e| < tolerance``, the rotation vector (rad) and translation (length scales)
+        stacked.
     residual : ndarray, shape (N,)
-        Final ``|e|`` (where not converged: how far the chain misses the target).
+        Final ``|e|`` in rad and m (where not converged: how far the chain misses the target).
     """
     values = np.array(initial_values, dtype=float, copy=True)
     count = values.shape[0]
     n_dofs = geometry.n_dofs
+    rows_scale = np.array([1.0, 1.0, 1.0, 1.0 / length, 1.0 / length, 1.0 / length])
+    columns_scale = np.where(np.asarray(geometry.dof_prismatic, dtype=bool), length, 1.0)
 
     def errors(at_values: NDArray, rows: NDArray) -> tuple[ChainFrames, NDArray]:
         frames = chain_forward_kinematics(geometry, at_values)
-        return frames, pose_error(target_rotation[rows], target_translation[rows], frames.end_rotation,
-                                  frames.end_translation)
+        return frames, rows_scale * pose_error(target_rotation[rows], target_translation[rows], frames.end_rotation,
+                                               frames.end_translation)
 
     _, error = errors(values, np.arange(count))
     residual = np.linalg.norm(error, axis=-1)
     damping = np.full(count, 1e-9)
     active = np.flatnonzero((residual >= tolerance) & np.isfinite(residual))
     if n_dofs == 0:
-        return values, residual < tolerance, residual
+        return values, residual < tolerance, np.linalg.norm(error / rows_scale, axis=-1)
     for _ in range(max_iterations):
         if active.size == 0:
             break
         frames, error = errors(values[active], active)
         norm = residual[active]
-        jacobian = chain_jacobian(geometry, frames)
+        jacobian = rows_scale[:, None] * chain_jacobian(geometry, frames) * columns_scale
         transposed = np.swapaxes(jacobian, -1, -2)
         normal = transposed @ jacobian + (damping[active] + norm**2)[:, None, None] * np.eye(n_dofs)
         step = np.linalg.solve(normal, (transposed @ error[..., None]))[..., 0]
         largest = np.max(np.abs(step), axis=-1)
         step *= np.minimum(1.0, max_step / np.maximum(largest, 1e-300))[:, None]
-        candidate = apply_step(geometry, values[active], step)
+        candidate = apply_step(geometry, values[active], step * columns_scale)
         _, candidate_error = errors(candidate, active)
         candidate_norm = np.linalg.norm(candidate_error, axis=-1)
         better = candidate_norm < norm
@@ -118,7 +124,8 @@ def newton_solve_chain(
         damping[accepted] = np.maximum(damping[accepted] * 0.1, 1e-12)
         damping[active[~better]] = np.maximum(damping[active[~better]] * 10.0, 1e-6)
         active = active[(residual[active] >= tolerance) & (damping[active] < 1e4)]
-    return values, residual < tolerance, residual
+    _, error = errors(values, np.arange(count))
+    return values, residual < tolerance, np.linalg.norm(error / rows_scale, axis=-1)
 
 
 def task_rows(is_planar: bool) -> list[int]:
@@ -168,8 +175,8 @@ def _track(mechanism, index, source, values, goal, tolerance, max_iterations):
         targets = mechanism.loop_targets(index, rotation, translation)
         last = step == steps
         values, converged, residual = newton_solve_chain(
-            geometry, *targets, values, tolerance if last else 1e-8 * max(1.0, mechanism.length_scale),
-            max_iterations if last else 12
+            geometry, *targets, values, tolerance if last else 1e-8, max_iterations if last else 12,
+            length=mechanism.length_scale
         )
         values = np.where(np.isfinite(values), values, 0.0)
     return values, converged, residual
@@ -188,7 +195,8 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
     Start values are ``start`` (N, m) where given (finite), else continuation along straight
     platform paths from the reference assembly; configurations that still fail are retried
     from their nearest solved neighbour (twice). ``branch`` (+1/-1/None) is the required sign
-    of the chain's twist-matrix determinant.
+    of the chain's twist-matrix determinant. ``tolerance`` is in rad and length scales
+    (:func:`newton_solve_chain`), so a scaled copy of a mechanism closes alike.
 
     Returns
     -------
@@ -199,7 +207,6 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
     """
     geometry = mechanism.chains[index].geometry
     count = flat_poses.shape[0]
-    tolerance = tolerance * max(1.0, mechanism.length_scale)  # as the assembly: rounding grows with the size
     targets = mechanism.loop_targets(index, *platform)
     values = np.empty((count, geometry.n_dofs))
     converged = np.zeros(count, dtype=bool)
@@ -208,7 +215,8 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
     if np.any(given):  # Newton from the given start values
         rows = np.flatnonzero(given)
         values[rows], converged[rows], residual[rows] = newton_solve_chain(
-            geometry, targets[0][rows], targets[1][rows], start[rows], tolerance, max_iterations
+            geometry, targets[0][rows], targets[1][rows], start[rows], tolerance, max_iterations,
+            length=mechanism.length_scale
         )
     if not np.all(given):  # continuation from the reference assembly
         rows = np.flatnonzero(~given)

@@ -227,8 +227,8 @@ def solve(
         ``"auto"`` uses a closed form for chains that have one; ``"newton"`` forces the
         generic solver everywhere (for checks).
     tolerance : float
-        Newton convergence on the closure error norm (rad and m; times the length scale when that
-        exceeds 1 m).
+        Newton convergence on the closure error norm (rad, and lengths in units of the mechanism's
+        length scale: the same for any scaled copy).
     max_iterations : int
         Newton iterations per continuation step.
     limits : bool
@@ -403,7 +403,7 @@ def forward(
     initial_pose: ArrayLike,
     *,
     actuators: Sequence[int | str | tuple[str, str]] | None = None,
-    tolerance: float = 1e-12,
+    tolerance: float = 1e-11,
     max_iterations: int = 30,
     limits: bool = False,
 ) -> Solution:
@@ -426,7 +426,7 @@ def forward(
         Indices into :attr:`~Mechanism.actuators`, ``chain:joint`` names or ``(chain, joint)``
         pairs; default all.
     tolerance : float
-        Convergence on the largest actuator mismatch.
+        Convergence on the largest actuator mismatch (rad, or length scales for a slide).
     limits : bool
         Whether joint limits make a pose unreachable (default: no, as in the pure geometry).
 
@@ -454,7 +454,7 @@ def forward(
         values = np.stack([solution.joint_values[chain][..., joint] for chain, joint in selected], -1)
         error = values - targets[active]
         error[:, angular] = wrap_angle(error[:, angular])
-        done = np.all(np.abs(error) < tolerance, axis=-1)
+        done = np.all(np.abs(error) / np.where(angular, 1.0, mechanism.length_scale) < tolerance, axis=-1)
         converged[active[done]] = True
         keep = ~done & np.all(np.isfinite(error), axis=-1)
         previous = [chain_values[keep] for chain_values in solution.joint_values]
@@ -476,8 +476,9 @@ def forward(
             joint_rates = np.linalg.pinv(chain_jacobian(chain.geometry, frames)) @ loop_rates
             jacobian[:, row] = joint_rates[:, joint]
         update = -(np.linalg.pinv(jacobian) @ error[..., None])[..., 0]
-        largest = np.max(np.abs(update), axis=-1)
-        update *= np.minimum(1.0, 0.2 * mechanism.length_scale / np.maximum(largest, 1e-300))[:, None]
+        # steps of at most 0.2 rad and 0.2 length scales (task coordinates mix angles and lengths)
+        largest = np.max(np.abs(update) / np.where(mechanism.angular, 1.0, mechanism.length_scale), axis=-1)
+        update *= np.minimum(1.0, 0.2 / np.maximum(largest, 1e-300))[:, None]
         usable = np.all(np.isfinite(update), axis=-1)
         poses[active[usable]] += update[usable]
     solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), tolerance=1e-13, limits=limits)

@@ -92,7 +92,13 @@ BLOCK = 2048
 
 def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, tolerance, iterations,
                  step_tolerance, step_iterations, max_step):
-    """The compiled closure (:mod:`screwkit.closure._task_kernel`) over a batch, in thread blocks."""
+    """The compiled closure (:mod:`screwkit.closure._task_kernel`) over a batch, in thread blocks.
+
+    The kernel runs on the mechanism scaled to a unit length scale (every length, pose
+    coordinate, target and slide value divided by it), so that its damping, step limit and
+    tolerances mean the same for a mechanism and any scaled copy; the residual is in rad and
+    length scales.
+    """
     announce_compilation("screwkit.closure._task_kernel")
     from screwkit.closure._task_kernel import close_chains_kernel  # numba: loaded when a closure first runs
 
@@ -110,9 +116,15 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
     targets = np.array(np.broadcast_to(targets, (count, task.size)), dtype=float, order="C")
     steps = np.array(np.broadcast_to(steps, (count,)), dtype=np.int64, order="C")
     geometry = packed_geometry(mechanism, chains)
-    # unknowns in radians and length scales: a slide's step is limited like a pose coordinate's
-    scale = np.concatenate([np.where(mechanism.pose_angular[free], 1.0, mechanism.length_scale),
-                            np.where(geometry["dof_prism"], mechanism.length_scale, 1.0)])
+    length = mechanism.length_scale
+    for key in ("joint_trans", "leg_trans", "plat_trans"):
+        geometry[key] = geometry[key] / length
+    geometry["planar_z"] = geometry["planar_z"] / length
+    lengths = ~np.asarray(mechanism.pose_angular)
+    poses[:, lengths] /= length
+    targets[:, lengths[task]] /= length
+    flat[:, geometry["dof_prism"]] /= length
+    scale = np.ones(free.size + flat.shape[1])  # unknowns already in rad and length scales
     residual = np.empty(count)
 
     def work(block: slice) -> None:
@@ -124,6 +136,8 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
                             tolerance, iterations, step_tolerance, step_iterations, max_step, residual[block])
 
     for_each_block(count, work, block=BLOCK)
+    poses[:, lengths] *= length
+    flat[:, geometry["dof_prism"]] *= length
     split = np.cumsum([0] + sizes)
     return poses, [flat[:, split[i]:split[i + 1]] for i in range(len(sizes))], residual < tolerance, residual
 
@@ -167,7 +181,8 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
         Joint values of the constraining chains (in :func:`constraining_chains` order).
     converged : ndarray (N,) of bool
     residual : ndarray (N,)
-        The closure error norm left (m and rad).
+        The closure error norm left (rad and length scales), times the length scale: metres for
+        a position error.
     """
     task_poses = np.asarray(task_poses, dtype=float)
     count = task_poses.shape[0]
@@ -187,7 +202,7 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
     poses, values, converged, residual = _run_closure(mechanism, chains, start_poses, start_values, free, task_poses,
                                                       steps, tolerance, iterations, 1e-8, 12, 0.5)
     values = [wrap_revolute_values(mechanism.chains[i].geometry, v) for i, v in zip(chains, values)]
-    return poses, values, converged, residual
+    return poses, values, converged, residual * mechanism.length_scale
 
 
 def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values) -> tuple[NDArray, NDArray]:
