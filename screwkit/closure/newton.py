@@ -99,10 +99,11 @@ def newton_solve_chain(
 
     _, error = errors(values, np.arange(count))
     residual = np.linalg.norm(error, axis=-1)
+    unscaled = np.linalg.norm(error / rows_scale, axis=-1)  # the same error in rad and m, for reports
     damping = np.full(count, 1e-9)
     active = np.flatnonzero((residual >= tolerance) & np.isfinite(residual))
     if n_dofs == 0:
-        return values, residual < tolerance, np.linalg.norm(error / rows_scale, axis=-1)
+        return values, residual < tolerance, unscaled
     for _ in range(max_iterations):
         if active.size == 0:
             break
@@ -121,11 +122,11 @@ def newton_solve_chain(
         accepted = active[better]
         values[accepted] = candidate[better]
         residual[accepted] = candidate_norm[better]
+        unscaled[accepted] = np.linalg.norm(candidate_error[better] / rows_scale, axis=-1)
         damping[accepted] = np.maximum(damping[accepted] * 0.1, 1e-12)
         damping[active[~better]] = np.maximum(damping[active[~better]] * 10.0, 1e-6)
         active = active[(residual[active] >= tolerance) & (damping[active] < 1e4)]
-    _, error = errors(values, np.arange(count))
-    return values, residual < tolerance, np.linalg.norm(error / rows_scale, axis=-1)
+    return values, residual < tolerance, unscaled
 
 
 def task_rows(is_planar: bool) -> list[int]:
