@@ -26,10 +26,12 @@ allows with that actuator locked. For a compound leg with one actuator:
   = S_g (the leg constrains only rotations beyond what its actuated path does) and R_g is the
   same at every closed configuration: then the platform's orientation stays in one family, and
   the platform's motion space and every chain's constraint wrenches are those of the leg. This
-  holds for parallelogram legs (no rotation: R_g = 0; a spatial Delta forearm: R_g = the motor
-  axis). :func:`equivalent_constraint` checks both conditions at several closed configurations
-  and raises :class:`NotReducible` with the reason when they fail, or when R_g has two
-  dimensions (rotations about two fixed axes do not make one family of orientations).
+  holds for planar parallelogram legs (R_g = 0: the effector translates); a spatial Delta forearm
+  with ball joints does not meet it (the rotations it allows turn with the forearm), nor does a
+  four-bar that is not a parallelogram. :func:`equivalent_constraint` checks both conditions at
+  several closed configurations and raises :class:`NotReducible` with the reason when they
+  fail, or when R_g has two dimensions (rotations about two fixed axes do not make one family
+  of orientations).
 
 The passive legs' own reach (link lengths limiting the workspace) is not carried over; a link
 fault (``fault_type="link"``) of the actuated path leaves the equivalent chain in place.
