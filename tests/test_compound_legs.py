@@ -100,7 +100,8 @@ def write(tmp_path, urdf: str, yaml: str):
 
 
 def closed_tree_at(tree, q, motors: dict[str, float]) -> np.ndarray:
-    """The tree closed (Gauss-Newton on every joint but the motors, held at ``motors``), starting from q."""
+    """The tree closed (Gauss-Newton on every joint but the motors, held at ``motors``), starting from q; the gaps
+    are measured relative to the tree's size."""
     import pinocchio as pin
 
     model = tree.model
@@ -112,14 +113,16 @@ def closed_tree_at(tree, q, motors: dict[str, float]) -> np.ndarray:
         q[joint.idx_q] = value
         held.append(joint.idx_v)
     free = [i for i in range(model.nv) if i not in held]
+    size = max(np.linalg.norm(placement.translation) for placement in model.jointPlacements)
 
     def residual(at):
+        """Gaps in units of the tree's longest joint offset (the file may be in any unit), rotations."""
         pin.forwardKinematics(model, data, at)
         rows = []
         for closure in tree.closures:
             a = data.oMi[closure.joint_a].homogeneous @ closure.placement_a
             b = data.oMi[closure.joint_b].homogeneous @ closure.placement_b
-            rows += [b[:3, 3] - a[:3, 3], (b[:3, :3] - a[:3, :3]).ravel()]
+            rows += [(b[:3, 3] - a[:3, 3]) / size, (b[:3, :3] - a[:3, :3]).ravel()]
         return np.concatenate(rows)
 
     for _ in range(50):
