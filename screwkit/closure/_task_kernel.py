@@ -131,7 +131,7 @@ def _cholesky_solve(matrix, rhs, size):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def close_chains_kernel(poses, values, targets, steps, task, free, scale, planar, planar_z, tree_start, dof_start,
+def close_chains_kernel(poses, values, targets, steps, task, free, planar, planar_z, tree_start, dof_start,
                         joint_rot, joint_trans, joint_axis, joint_prism, dof_prism, leg_rot, leg_trans, loop_code,
                         loop_axes, plat_rot, plat_trans, tolerance, iterations, step_tolerance, step_iterations,
                         max_step, residual):
@@ -194,7 +194,7 @@ def close_chains_kernel(poses, values, targets, steps, task, free, scale, planar
             for _ in range(iterations if last else step_iterations):
                 if not (norm >= limit and np.isfinite(norm)) or damping >= 1e4:
                     break
-                # Jacobian d(errors)/d(free pose coordinates, joint values), columns scaled
+                # Jacobian d(errors)/d(free pose coordinates, joint values), in rad and length scales
                 _pose_rates(pose, planar, free, rates)
                 _, platform_translation = _platform(pose, planar, planar_z)
                 for c in range(chains):
@@ -204,30 +204,30 @@ def close_chains_kernel(poses, values, targets, steps, task, free, scale, planar
                     arm2 = target_points[c, 2] - platform_translation[2]
                     for f in range(n_free):
                         w0, w1, w2 = rates[0, f], rates[1, f], rates[2, f]
-                        jacobian[r0, f] = w0 * scale[f]
-                        jacobian[r0 + 1, f] = w1 * scale[f]
-                        jacobian[r0 + 2, f] = w2 * scale[f]
-                        jacobian[r0 + 3, f] = (rates[3, f] + w1 * arm2 - w2 * arm1) * scale[f]
-                        jacobian[r0 + 4, f] = (rates[4, f] + w2 * arm0 - w0 * arm2) * scale[f]
-                        jacobian[r0 + 5, f] = (rates[5, f] + w0 * arm1 - w1 * arm0) * scale[f]
+                        jacobian[r0, f] = w0
+                        jacobian[r0 + 1, f] = w1
+                        jacobian[r0 + 2, f] = w2
+                        jacobian[r0 + 3, f] = rates[3, f] + w1 * arm2 - w2 * arm1
+                        jacobian[r0 + 4, f] = rates[4, f] + w2 * arm0 - w0 * arm2
+                        jacobian[r0 + 5, f] = rates[5, f] + w0 * arm1 - w1 * arm0
                     for d in range(dof_start[c], dof_start[c + 1]):
                         column = n_free + d
                         a0, a1, a2 = axes[d, 0], axes[d, 1], axes[d, 2]
                         if dof_prism[d]:
                             jacobian[r0, column] = jacobian[r0 + 1, column] = jacobian[r0 + 2, column] = 0.0
-                            jacobian[r0 + 3, column] = -a0 * scale[column]
-                            jacobian[r0 + 4, column] = -a1 * scale[column]
-                            jacobian[r0 + 5, column] = -a2 * scale[column]
+                            jacobian[r0 + 3, column] = -a0
+                            jacobian[r0 + 4, column] = -a1
+                            jacobian[r0 + 5, column] = -a2
                         else:
                             p0 = ends[c, 0] - points[d, 0]
                             p1 = ends[c, 1] - points[d, 1]
                             p2 = ends[c, 2] - points[d, 2]
-                            jacobian[r0, column] = -a0 * scale[column]
-                            jacobian[r0 + 1, column] = -a1 * scale[column]
-                            jacobian[r0 + 2, column] = -a2 * scale[column]
-                            jacobian[r0 + 3, column] = -(a1 * p2 - a2 * p1) * scale[column]
-                            jacobian[r0 + 4, column] = -(a2 * p0 - a0 * p2) * scale[column]
-                            jacobian[r0 + 5, column] = -(a0 * p1 - a1 * p0) * scale[column]
+                            jacobian[r0, column] = -a0
+                            jacobian[r0 + 1, column] = -a1
+                            jacobian[r0 + 2, column] = -a2
+                            jacobian[r0 + 3, column] = -(a1 * p2 - a2 * p1)
+                            jacobian[r0 + 4, column] = -(a2 * p0 - a0 * p2)
+                            jacobian[r0 + 5, column] = -(a0 * p1 - a1 * p0)
                 # normal equations, chain by chain (a chain's rows touch the free columns and its own)
                 normal[:, :] = 0.0
                 gradient[:] = 0.0
@@ -261,15 +261,15 @@ def close_chains_kernel(poses, values, targets, steps, task, free, scale, planar
                 for i in range(poses.shape[1]):
                     candidate_pose[i] = pose[i]
                 for f in range(n_free):
-                    candidate_pose[free[f]] -= gradient[f] * factor * scale[f]
+                    candidate_pose[free[f]] -= gradient[f] * factor
                 for d in range(n_values):
-                    candidate_values[d] = value[d] - gradient[n_free + d] * factor * scale[n_free + d]
+                    candidate_values[d] = value[d] - gradient[n_free + d] * factor
                 for c in range(chains):
                     if loop_code[c] == 4:  # spherical loop: compose the step on the left
                         s = dof_start[c + 1] - 3
-                        u0 = -gradient[n_free + s] * factor * scale[n_free + s]
-                        u1 = -gradient[n_free + s + 1] * factor * scale[n_free + s + 1]
-                        u2 = -gradient[n_free + s + 2] * factor * scale[n_free + s + 2]
+                        u0 = -gradient[n_free + s] * factor
+                        u1 = -gradient[n_free + s + 1] * factor
+                        u2 = -gradient[n_free + s + 2] * factor
                         composed = mul(exp_map(u0, u1, u2), exp_map(value[s], value[s + 1], value[s + 2]))
                         candidate_values[s], candidate_values[s + 1], candidate_values[s + 2] = log_map(composed)
                 candidate_norm = _errors(candidate_pose, candidate_values, planar, planar_z, tree_start, dof_start,

@@ -124,11 +124,10 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
     poses[:, lengths] /= length
     targets[:, lengths[task]] /= length
     flat[:, geometry["dof_prism"]] /= length
-    scale = np.ones(free.size + flat.shape[1])  # unknowns already in rad and length scales
     residual = np.empty(count)
 
     def work(block: slice) -> None:
-        close_chains_kernel(poses[block], flat[block], targets[block], steps[block], task, free, scale,
+        close_chains_kernel(poses[block], flat[block], targets[block], steps[block], task, free,
                             geometry["planar"], geometry["planar_z"], geometry["tree_start"], geometry["dof_start"],
                             geometry["joint_rot"], geometry["joint_trans"], geometry["joint_axis"],
                             geometry["joint_prism"], geometry["dof_prism"], geometry["leg_rot"], geometry["leg_trans"],

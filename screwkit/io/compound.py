@@ -45,6 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, assemble, joint_kind, path_to
+from screwkit.rotations import skew_matrix
 
 __all__ = ["NotReducible", "compound_groups", "platform_twists", "Reduction", "equivalent_constraint", "closed_samples",
            "compound_legs",
@@ -102,11 +103,6 @@ def compound_groups(model, legs: list[list[int]], couplings: list) -> list[tuple
     return [group for group in groups.values()]
 
 
-def _skew(vector: NDArray) -> NDArray:
-    x, y, z = vector
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-
-
 def platform_twists(model, data, joints: list[int], closures: list, platform: int, spine: bool, centre: NDArray,
                     scale: float) -> NDArray[np.float64]:
     """Orthonormal rows (k, 6) spanning the platform twists a set of joints allows with its closures closed.
@@ -125,7 +121,7 @@ def platform_twists(model, data, joints: list[int], closures: list, platform: in
     def working(joint: int) -> NDArray:
         jacobian = np.asarray(pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.WORLD))
         angular = jacobian[3:]
-        return np.vstack([angular, (jacobian[:3] - _skew(centre) @ angular) / scale])
+        return np.vstack([angular, (jacobian[:3] - skew_matrix(centre) @ angular) / scale])
 
     blocks = []
     for closure in closures:
@@ -134,7 +130,7 @@ def platform_twists(model, data, joints: list[int], closures: list, platform: in
                                        (closure.joint_b, closure.placement_b, -1.0)):
             world = np.asarray(data.oMi[joint].homogeneous) @ placement
             offset = (world[:3, 3] - centre) / scale
-            select = np.hstack([-_skew(offset), np.eye(3)]) if closure.kind == "3d" else np.eye(6)
+            select = np.hstack([-skew_matrix(offset), np.eye(3)]) if closure.kind == "3d" else np.eye(6)
             rows_q = rows_q + sign * select @ working(joint)[:, columns]
             if not spine and platform in path_to(model, joint):
                 rows_t = rows_t + sign * select
