@@ -72,12 +72,12 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
     locked_of (S, n) : for each submechanism and position k, the row of locked_sets holding
         the other n - 1 actuators of the submechanism.
     set_children (R, K), fault_rows (F, 2) : the actuator sets whose LMTI the reductions need
-        (see :func:`screwkit.transmission._reductions`): row t of ``set_children`` lists rows of
+        (see :func:`screwkit.actuator_sets.reductions`): row t of ``set_children`` lists rows of
         the OTIs and sets before it (OTIs of submechanisms first, then the sets in order, padded
         with -1) whose maximum is the LMTI of set t; ``fault_rows[f]`` is the range of those rows
         (OTIs included) holding the sets left after the f-th value of j, in combination order.
     locked_depth (L,), wedge_table (T, 1 + 3 WEDGE_TERMS), wedge_start (n + 1,) : for n >= 4, the output twists'
-        exterior products (see :func:`screwkit.transmission._wedge_tables`): the first position at
+        exterior products (see :func:`screwkit.actuator_sets.wedge_tables`): the first position at
         which each locked set differs from the one before, and one row per minor of level K in rows
         wedge_start[K]:wedge_start[K+1] (the minor, then source minor, column and sign of each of its
         WEDGE_TERMS expansion terms, padded with zero signs).

@@ -37,6 +37,7 @@ __all__ = [
     "oti_chain_a6",
     "oti_triple",
     "planar_indices",
+    "point_indices",
 ]
 
 
@@ -184,13 +185,13 @@ def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_me
                               empty if directions is None else directions, np.array(triples, dtype=np.int64),
                               float(threshold), float(rank_tolerance), iti_chains, oti_subs, independent)
     iti = iti_chains.min(axis=1)
-    f_o, worst = {}, {}
+    f_o, worst, remaining = {}, {}, {}
     for j, members in fault_members.items():
-        lmti_sets = oti_subs[:, members].max(axis=2)  # Eq. 38 for every set left after j faults
-        f_o[j] = lmti_sets.min(axis=1)  # Eq. 37
-        worst[j] = np.argmax(lmti_sets <= f_o[j][:, None] + WORST_FAULT_TIE, axis=1)  # the first worst set
+        remaining[j] = oti_subs[:, members].max(axis=2)  # Eq. 38 for every set left after j faults
+        f_o[j] = remaining[j].min(axis=1)  # Eq. 37
+        worst[j] = np.argmax(remaining[j] <= f_o[j][:, None] + WORST_FAULT_TIE, axis=1)  # the first worst set
     mutual = np.stack([independent[:, subs].any(axis=1) for subs in without], axis=1)
-    return iti_chains, iti, oti_subs, f_o, worst, mutual
+    return iti_chains, iti, oti_subs, f_o, worst, mutual, remaining
 
 
 def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
@@ -232,7 +233,8 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         ``f_o`` and ``f_io`` (dicts over j), ``worst_faults`` (dict over j of (..., j) failed
         chains of the first worst set, within :data:`screwkit.tolerances.WORST_FAULT_TIE`), ``mutual_interference``
         (..., k) (some 3 of the other chains have independent wrenches), ``submechanisms``
-        (tuple of triples).
+        (tuple of triples), ``remaining_lmti`` (dict over j of (..., C(k, j)): the LMTI of every set left after j
+        faults, Eq. 38, in combination order).
     """
     distal = np.asarray(distal, dtype=float)
     if distal.ndim < 2 or distal.shape[-1] != 2 or distal.shape[-2] < 3:
@@ -247,8 +249,10 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         directions = np.broadcast_to(np.asarray(directions, dtype=float), distal.shape)
     faults = tuple(range(1, count - 2)) if faults is None else tuple(faults)
     for j in faults:
-        if not 1 <= j <= count - 3:
+        if not 1 <= j <= max(count - 3, 1):
             raise ValueError(f"Expected the number of faults `j` in 1..{count - 3}, got {j}.")
+    if count == 3:
+        faults = ()  # no redundancy: F_O1 = 0 below
     triples = tuple(combinations(range(count), 3))
     index = {triple: s for s, triple in enumerate(triples)}
     fault_members = {j: np.array([[index[t] for t in combinations(remaining, 3)]
@@ -281,8 +285,66 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     oti_subs = gather([p[2] for p in pieces])
     f_o = {j: gather([p[3][j] for p in pieces]) for j in faults}
     worst = {j: failed_sets[j][gather([p[4][j] for p in pieces])] for j in faults}
+    remaining = {j: gather([p[6][j] for p in pieces]) for j in faults}
     if count == 3 and not faults:  # no redundancy: one failed actuator leaves the platform uncontrolled
         f_o, worst, faults = {1: np.zeros(batch)}, {1: np.zeros(batch + (1,), dtype=np.int64)}, (1,)
+        remaining = {1: np.zeros(batch + (count,))}
     return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti_subs, "lmti": oti_subs.max(axis=-1),
             "f_o": f_o, "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "worst_faults": worst,
-            "mutual_interference": gather([p[5] for p in pieces]), "submechanisms": triples}
+            "mutual_interference": gather([p[5] for p in pieces]), "submechanisms": triples,
+            "remaining_lmti": remaining}
+
+
+def point_indices(base: ArrayLike, elbows: ArrayLike, distal: ArrayLike, faults: tuple[int, ...] | None = None,
+                  rank_tolerance: float = RANK_TOLERANCE) -> dict:
+    r"""The textbook pressure angles of planar R-R-R legs meeting at one output point (a five-bar and its
+    redundant variants): 2 DOF, the point's rotations idle.
+
+    The actuation wrench of leg ``i`` is the force along its distal link ``f_i`` through the point (Eq. 21),
+    its input twist the base joint's rotation, so :math:`ITI_i = |\det[g_i\ f_i]|` (Eq. 23). With leg ``l``
+    locked, the point moves perpendicular to ``f_l``: the output twist of leg ``k`` in the pair ``(k, l)`` is that
+    translation and :math:`OTI_k = |\det[f_k\ f_l]|`, the same for both legs (the pressure angle between the
+    distal links); zero when the two are parallel (within ``rank_tolerance``). Then LMTI, F_Oj, F_IOj as
+    Eqs. 11-14 over pairs. Numpy only, vectorised over configurations (..., k, 2).
+
+    Returns
+    -------
+    dict
+        ``iti_chains`` (..., k), ``iti``, ``oti_submechanisms`` (..., C(k, 2)), ``lmti``, ``f_o``, ``f_io`` and
+        ``remaining_lmti`` (dicts over j), ``worst_faults`` (dict over j of (..., j), the first worst set),
+        ``mutual_interference`` (..., k), ``submechanisms`` (pairs).
+    """
+    base, elbows, distal = (np.asarray(value, dtype=float) for value in (base, elbows, distal))
+    count = distal.shape[-2]
+    upper = elbows - base
+    upper = upper / np.linalg.norm(upper, axis=-1, keepdims=True)
+    forces = distal_directions(elbows, distal)
+    iti_chains = np.abs(det2(upper, forces))
+    pairs = tuple(combinations(range(count), 2))
+    oti = np.stack([np.abs(det2(forces[..., k, :], forces[..., l, :])) for k, l in pairs], axis=-1)
+    oti = np.where(oti > rank_tolerance, oti, 0.0)
+    faults = tuple(range(1, count - 1)) if faults is None else tuple(faults)
+    for j in faults:
+        if not 1 <= j <= max(count - 2, 1):
+            raise ValueError(f"Expected the number of faults `j` in 1..{count - 2}, got {j}.")
+    if count == 2:
+        faults = ()  # no redundancy: F_O1 = 0 below
+    f_o, worst, remaining = {}, {}, {}
+    for j in faults:
+        left = list(combinations(range(count), count - j))
+        remaining[j] = np.stack([oti[..., [p for p, pair in enumerate(pairs) if set(pair) <= set(e)]].max(axis=-1)
+                                 for e in left], axis=-1)
+        f_o[j] = remaining[j].min(axis=-1)
+        first = np.argmax(remaining[j] <= f_o[j][..., None] + WORST_FAULT_TIE, axis=-1)
+        failed = np.array([sorted(set(range(count)) - set(e)) for e in left], dtype=np.int64).reshape(-1, j)
+        worst[j] = failed[first]
+    if count == 2 and not faults:  # no redundancy: one failed actuator leaves the point uncontrolled
+        faults = (1,)
+        f_o, worst = {1: np.zeros(oti.shape[:-1])}, {1: np.zeros(oti.shape[:-1] + (1,), dtype=np.int64)}
+        remaining = {1: np.zeros(oti.shape[:-1] + (2,))}
+    mutual = np.stack([(oti[..., [p for p, pair in enumerate(pairs) if k not in pair]] > 0).any(axis=-1)
+                       if count > 2 else np.zeros(oti.shape[:-1], dtype=bool) for k in range(count)], axis=-1)
+    iti = iti_chains.min(axis=-1)
+    return {"iti_chains": iti_chains, "iti": iti, "oti_submechanisms": oti, "lmti": oti.max(axis=-1), "f_o": f_o,
+            "f_io": {j: np.minimum(f_o[j], iti) for j in faults}, "worst_faults": worst, "remaining_lmti": remaining,
+            "mutual_interference": mutual, "submechanisms": pairs}

@@ -2,29 +2,39 @@ r"""Constraint wrenches, constraint singularities and the constraint transmissio
 
 A chain whose joints do not span every twist transmits **constraint wrenches** to the platform:
 the wrenches reciprocal to all its joint twists (a PRS leg: a force through the S centre along
-the R axis; a Delta leg: a couple normal to its parallelogram). Liu, Wu and Wang's constraint
-transmission index measures how well they hold the platform: lock the actuators, release one
-constraint wrench, and take the power coefficient of that wrench on the one twist it leaves free.
-screwkit computes it in its working coordinates (as :func:`screwkit.transmission.analyze`), so it
-is independent of the length unit, the scale and the world frame; the conventions below are
-screwkit's, stated in ``docs/theory.md`` (*Constraint wrenches and the CTI*):
+the R axis; a Delta leg: a couple). Liu, Wu and Wang's constraint transmission index measures how
+well they hold the platform: lock the actuators, release one constraint wrench, and take the
+power coefficient of that wrench on the one twist it leaves free; the CTI is the lowest over the
+constraint wrenches. screwkit computes it in its working coordinates (as
+:func:`screwkit.transmission.analyze`), so it is independent of the length unit, the scale and the
+world frame, and it is **symmetric in the chains**: no decision depends on the order in which they
+are listed. The conventions below are screwkit's, stated with their reasons in ``docs/theory.md``
+(*Constraint wrenches and the CTI*):
 
 * **Constraints common to every chain** (the out-of-plane wrenches of a planar mechanism, the two
-  horizontal couples of every Schoenflies leg) are kept but never released: no single chain holds
-  them. A mechanism with no other constraint wrench has no CTI ("not applicable": NaN).
-* The other constraint wrenches are taken chain by chain, in chain order; a chain whose constraint
-  wrenches depend on those of earlier chains (a duplicated constraint) is redundant and is not
-  released either. ``K`` are the released ones, an orthonormal basis per chain.
-* For a non-redundant set ``N`` of ``n`` actuators, the wrench system
-  :math:`W = [A_N; C_K; C_0]` (actuation, released and common constraints) is square at a regular
-  configuration; releasing :math:`C_j` leaves the twist :math:`T_j` reciprocal to every other row,
-  the column ``j`` of :math:`\operatorname{adj} W` (of :math:`W^{-1}`, halves swapped). Then
+  horizontal couples of every Schoenflies leg, the three forces through the centre of a spherical
+  wrist) are kept but never released: no chain holds them alone, releasing one chain's copy frees
+  nothing. A mechanism with no other constraint wrench has no CTI ("not applicable": NaN, with
+  :attr:`ConstraintPlan.reason`).
+* The other constraint wrenches of chain ``i`` (its **own** ones, ``C_i``) may hold more than the
+  platform needs (a 4-leg Delta: four couples of rank three). As the LMTI does for redundant
+  actuators (Eq. 11), the CTI takes the best of the **non-redundant constraint subsystems**: the
+  minimal sets ``L`` of chains whose own constraint wrenches, with the common ones, hold every
+  constraint of the mechanism (generic rank; :attr:`ConstraintPlan.subsystems`, all of them, in no
+  privileged order).
+* For a set ``N`` of ``n`` actuators and a subsystem ``L``, releasing chain ``i`` of ``L`` (its
+  ``C_i``) with the actuators of ``N`` locked and the other chains of ``L`` and the common
+  constraints kept frees the twists ``F_i`` reciprocal to every other wrench. Each freed twist is
+  paired with the constraint wrench of ``C_i`` that resists it along the principal directions of
+  the pairing (the singular vectors of ``C_i o F_i``, working coordinates; one pair when the chain
+  holds one constraint wrench), and
 
-  .. math:: \kappa_j = \frac{|C_j \circ T_j|}{|C_j \circ T_j|_{\max}}, \qquad
-            CTI_N = \min_{j \in K} \kappa_j,
+  .. math:: \kappa = \frac{|C \circ T|}{|C \circ T|_{\max}}, \qquad
+            CTI_{N,L} = \min_{i \in L,\ \text{pairs}} \kappa, \qquad CTI_N = \max_L CTI_{N,L},
 
-  with the characteristic point of :math:`C_j` the platform joint of its chain projected on its
-  axis (a couple gives :math:`|\hat m \cdot \hat\omega|`), and zero when :math:`W` is singular.
+  with the characteristic point of ``C`` the platform joint of its chain projected on its axis (a
+  couple gives :math:`|\hat m \cdot \hat\omega|`), and :math:`CTI_{N,L} = 0` when the wrenches of
+  ``N``, ``L`` and the common constraints do not span every wrench.
 * As the LMTI over actuator sets (Eq. 11): :math:`CTI = \max_N CTI_N`, and its fault-tolerant
   counterpart, screwkit's extension in the spirit of Eq. 12, :math:`F_{Cj} = \min_E \max_{N \subset E}
   CTI_N` over the actuator sets ``E`` left after ``j`` faults.
@@ -61,21 +71,35 @@ class ConstraintPlan:
         Constraint wrenches of each chain (6 minus the rank of its joint twists).
     common : int
         Dimension of the constraint wrenches common to every chain.
-    released : tuple of int
-        Chains whose (non-common) constraint wrenches are released one at a time.
-    released_counts : tuple of int
-        Non-common constraint wrenches of each released chain.
+    own_counts : tuple of int
+        Each chain's own (non-common) constraint wrenches.
+    rank : int
+        Rank of all the chains' own constraint wrenches together (generic): what a subsystem releases.
+    subsystems : tuple of tuple of int
+        The non-redundant constraint subsystems: every minimal set of chains whose own constraint
+        wrenches have rank :attr:`rank`, in combination order of the chains.
     """
 
     chain_counts: tuple[int, ...]
     common: int
-    released: tuple[int, ...]
-    released_counts: tuple[int, ...]
+    own_counts: tuple[int, ...] = ()
+    rank: int = 0
+    subsystems: tuple[tuple[int, ...], ...] = ()
 
     @property
     def count(self) -> int:
-        """Constraint wrenches released: none means the CTI does not apply."""
-        return sum(self.released_counts)
+        """Constraint wrenches a subsystem releases: none means the CTI does not apply."""
+        return self.rank if self.subsystems else 0
+
+    @property
+    def reason(self) -> str:
+        """Why the CTI does not apply ("" when it does)."""
+        if self.count:
+            return ""
+        if not any(self.chain_counts):
+            return "no chain holds a constraint wrench"
+        return (f"every chain holds the same {self.common} constraint wrench{'es' if self.common > 1 else ''} "
+                "(none is held by one chain alone)")
 
 
 def _unit_rows(rows: NDArray) -> NDArray:
@@ -125,9 +149,34 @@ def _orthonormal(rows: NDArray, count: int) -> NDArray:
     return right[..., :count, :]
 
 
+def _own_wrenches(constraints: list[NDArray], common: int, own_counts: tuple[int, ...]):
+    """The common basis (N, common, 6) and each chain's own constraint wrenches (orthonormal, common part removed)."""
+    count = constraints[0].shape[0]
+    shared = _common_basis(constraints, common) if common else np.zeros((count, 0, 6))
+    own = [_orthonormal(_without(chain, shared), c) for chain, c in zip(constraints, own_counts)]
+    return shared, own
+
+
+def _subsystems(own: list[NDArray], rank: int) -> tuple[tuple[int, ...], ...]:
+    """Every minimal set of chains whose own wrenches have generic rank ``rank``, in combination order.
+
+    A set is minimal when it has full rank and no proper subset does; as rank only grows with a set, that is a
+    full-rank set containing no minimal set found before it (sets are taken by increasing size)."""
+    holders = [i for i, rows in enumerate(own) if rows.shape[-2]]
+    found: list[tuple[int, ...]] = []
+    for size in range(1, len(holders) + 1):
+        for subset in combinations(holders, size):
+            if sum(own[i].shape[-2] for i in subset) < rank or any(set(f) <= set(subset) for f in found):
+                continue
+            stacked = np.concatenate([own[i] for i in subset], axis=-2)
+            if int(np.max(_rank(stacked, tolerances.RANK_TOLERANCE))) == rank:
+                found.append(subset)
+    return tuple(found)
+
+
 def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
     """The constraint structure of a mechanism from its chains' twists at sample configurations
-    (working coordinates)."""
+    (working coordinates). Symmetric in the chains: permuting them permutes the plan."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
     counts = tuple(int(6 - np.max(_rank(twists, tolerance))) for twists in chain_twists)
     wrenches = [chain_constraint_wrenches(twists, c) for twists, c in zip(chain_twists, counts)]
@@ -137,20 +186,12 @@ def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
         common = int(np.min(np.sum(eigenvalues <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)))
     else:
         common = 0
-    shared = _common_basis(wrenches, common) if common else np.zeros(wrenches[0].shape[:-2] + (0, 6))
-    released, released_counts = [], []
-    chosen = shared
-    for index, chain in enumerate(wrenches):
-        own = counts[index] - common
-        if own <= 0:
-            continue
-        candidate = _orthonormal(_without(chain, shared), own)
-        stacked = np.concatenate([chosen, candidate], axis=-2)
-        if int(np.max(_rank(stacked, tolerances.RANK_TOLERANCE))) == chosen.shape[-2] + own:  # generic rank
-            released.append(index)
-            released_counts.append(own)
-            chosen = stacked
-    return ConstraintPlan(counts, common, tuple(released), tuple(released_counts))
+    own_counts = tuple(max(c - common, 0) for c in counts)
+    if not any(own_counts):
+        return ConstraintPlan(counts, common, own_counts)
+    _, own = _own_wrenches(wrenches, common, own_counts)
+    rank = int(np.max(_rank(np.concatenate(own, axis=-2), tolerances.RANK_TOLERANCE)))
+    return ConstraintPlan(counts, common, own_counts, rank, _subsystems(own, rank))
 
 
 def _coefficient(wrench: NDArray, twist: NDArray, point: NDArray, threshold: NDArray) -> NDArray:
@@ -182,6 +223,62 @@ def _project_on_axis(wrench: NDArray, point: NDArray) -> NDArray:
     foot = np.cross(force, moment) / safe
     along = np.sum((point - foot) * force, -1, keepdims=True) / safe
     return np.where(norm_sq > 0, foot + along * force, point)
+
+
+def _released_pairs(own: NDArray, freed: NDArray, valid: NDArray | None = None):
+    """Principal pairs of a chain's own constraint wrenches (N, c, 6) and the twists (N, 6, d) their release
+    frees: wrenches ``V^T C`` and twists ``P`` from the singular vectors of the freed twists' pairing
+    ``C o F = U S V^T`` (orthonormal ``F``), so that each wrench is reciprocal to every freed twist but its own.
+    ``valid`` (N, d): which columns of ``freed`` are freed twists (the others are ignored). Returns wrenches
+    (N, d, 6), twists (N, d, 6) and a mask (N, d) of the pairs that exist."""
+    if valid is not None:
+        freed = freed * valid[:, None, :]
+    pairing = own @ _SWAP @ freed  # (N, c, d): C_k o F_l
+    left, singular, right = np.linalg.svd(pairing, full_matrices=False)  # d <= c where the system is regular
+    wrenches = np.swapaxes(left, -1, -2) @ own  # (N, d, 6)
+    twists = np.swapaxes(freed @ np.swapaxes(right, -1, -2), -1, -2)  # (N, d, 6)
+    exists = singular > tolerances.RANK_TOLERANCE * np.maximum(singular[..., :1], 1e-300)
+    return wrenches, twists, exists
+
+
+def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], members: tuple[int, ...],
+                   points: list[NDArray], threshold: NDArray) -> NDArray:
+    """:math:`CTI_{N,L}` (N,) of one actuator set (its unit wrenches ``actuation``, (N, n, 6)) and one subsystem
+    ``members``: the lowest power coefficient of a released constraint wrench on the twist it frees."""
+    blocks = [own[i] for i in members]
+    system = np.concatenate([actuation, *blocks, shared], axis=-2)
+    count = system.shape[0]
+    values = np.full(count, np.inf)
+    if system.shape[-2] == 6:  # the chains' own wrenches are independent: one inverse frees every chain at once
+        volume = np.prod(np.linalg.norm(system, axis=-1), axis=-1)
+        regular = np.abs(np.linalg.det(system)) > tolerances.RANK_TOLERANCE * volume
+        # W Y = I: column r of Y is orthogonal to every row but r, so as a twist (halves swapped) it is reciprocal
+        # to every wrench but row r; chain i's columns span the twists freed by releasing its rows.
+        inverse = np.linalg.inv(np.where(regular[:, None, None], system, np.eye(6)))
+        start = actuation.shape[-2]
+        freed_of = []
+        for block in blocks:
+            columns = _SWAP @ inverse[..., start:start + block.shape[-2]]
+            freed_of.append(np.linalg.qr(columns)[0])  # orthonormal, same span
+            start += block.shape[-2]
+        valid_of = [None] * len(blocks)
+    else:  # chains whose own wrenches overlap (each frees fewer twists than it holds wrenches): one null space each
+        regular = _rank(system, tolerances.RANK_TOLERANCE) == 6
+        freed_of, valid_of = [], []
+        for position in range(len(blocks)):
+            kept = [block for other, block in enumerate(blocks) if other != position]
+            rest = np.concatenate([actuation, *kept, shared], axis=-2)
+            padded = np.concatenate([_unit_rows(rest), np.zeros((count, max(0, 6 - rest.shape[-2]), 6))], axis=-2)
+            _, singular, right = np.linalg.svd(padded)
+            null = singular[..., -blocks[position].shape[-2]:] <= tolerances.RANK_TOLERANCE * singular[..., :1]
+            freed_of.append(_SWAP @ np.swapaxes(right[..., -blocks[position].shape[-2]:, :], -1, -2))
+            valid_of.append(null)
+    for index, block, freed, valid in zip(members, blocks, freed_of, valid_of):
+        wrenches, twists, exists = _released_pairs(block, freed, valid)
+        centres = _project_on_axis(wrenches, points[index][:, None, :])
+        kappa = _coefficient(wrenches, twists, centres, threshold[:, None])
+        values = np.minimum(values, np.where(exists, kappa, np.inf).min(axis=-1))
+    return np.where(regular & np.isfinite(values), values, 0.0)
 
 
 def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_points: list[NDArray],
@@ -236,41 +333,17 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         for j in fault_members:
             result[f"f_c{j}"] = nothing.copy()
         return result
-    shared = _common_basis(constraints, plan.common) if plan.common else np.zeros((count, 0, 6))
-    released, owners = [], []
-    for index, own in zip(plan.released, plan.released_counts):
-        basis = _orthonormal(_without(constraints[index], shared), own)
-        released.append(basis)
-        owners += [index] * own
-    released = np.concatenate(released, axis=-2)  # (N, c, 6)
-    points = np.stack([chain_points[index][:, -1] for index in owners], axis=-2)  # (N, c, 3)
-    centres = _project_on_axis(released, points)
+    shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
+    points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
     per_set = np.zeros((count, submechanisms.shape[0]))
     for s, members in enumerate(submechanisms):
-        system = np.concatenate([wrenches[:, members], released, shared], axis=-2)  # (N, 6, 6) when regular
-        if system.shape[-2] != 6:
-            continue  # not a square system: the constraints or actuators cannot hold the platform here
-        volume = np.prod(np.linalg.norm(system, axis=-1), axis=-1)
-        independent = np.abs(np.linalg.det(system)) > tolerances.RANK_TOLERANCE * volume
-        # Column r of W^-1 is orthogonal to every row of W but r: releasing row r frees that twist
-        # (as (v, omega) in the Euclidean sense; swapped to (omega, v)); its scale cancels in kappa.
-        inverse = np.linalg.inv(np.where(independent[:, None, None], system, np.eye(6)))
-        values = np.ones(count)
-        for k in range(released.shape[-2]):
-            twist = inverse[..., len(members) + k] @ _SWAP
-            kappa = _coefficient(released[:, k], twist, centres[:, k], threshold)
-            values = np.minimum(values, kappa)
-        per_set[:, s] = np.where(independent & ~singular, values, 0.0)
+        actuation = wrenches[:, members]
+        for subsystem in plan.subsystems:
+            per_set[:, s] = np.maximum(per_set[:, s], _subsystem_cti(actuation, shared, own, subsystem, points,
+                                                                     threshold))
+    per_set[singular] = 0.0
     result["cti_submechanisms"] = per_set
     result["cti"] = per_set.max(axis=-1)
     for j, members in fault_members.items():
         result[f"f_c{j}"] = per_set[:, members].max(axis=-1).min(axis=-1)
     return result
-
-
-def actuator_sets(actuator_count: int, dof: int, faults: tuple[int, ...]) -> dict[int, NDArray[np.int64]]:
-    """For each ``j``, the submechanisms (rows of the ``n``-combinations) in each set left after ``j`` faults."""
-    position = {sub: s for s, sub in enumerate(combinations(range(actuator_count), dof))}
-    return {j: np.array([[position[sub] for sub in combinations(remaining, dof)]
-                         for remaining in combinations(range(actuator_count), actuator_count - j)], dtype=np.int64)
-            for j in faults}

@@ -77,12 +77,13 @@ def link_fault_indices(chains: Sequence[ChainScrews], actuators: Sequence[tuple[
     Returns
     -------
     dict
-        ``f_o``, ``worst`` (indices into ``actuators``, (..., j)) and ``f_c``, each a dict by ``j``.
+        ``f_o``, ``worst`` (indices into ``actuators``, (..., j)), ``f_c`` and ``lmti`` (the LMTI of every set
+        left, (..., C(a, j)), in combination order), each a dict by ``j``.
     """
     chains = list(chains)
     a = len(actuators)
     cache: dict[frozenset[int], tuple[NDArray, NDArray]] = {}
-    f_o, worst, f_c = {}, {}, {}
+    f_o, worst, f_c, lmti_left = {}, {}, {}, {}
     for j in faults:
         sets = list(combinations(range(a), a - j))
         lmti, cti = [], []
@@ -93,10 +94,11 @@ def link_fault_indices(chains: Sequence[ChainScrews], actuators: Sequence[tuple[
             lmti.append(cache[removed][0])
             cti.append(cache[removed][1])
         lmti, cti = np.stack(lmti, axis=-1), np.stack(cti, axis=-1)
+        lmti_left[j] = lmti
         f_o[j] = lmti.min(axis=-1)
         first = np.argmax(lmti <= f_o[j][..., None] + tolerances.WORST_FAULT_TIE, axis=-1)
         failed = np.array([sorted(set(range(a)) - set(e)) for e in sets], dtype=np.int64).reshape(len(sets), j)
         worst[j] = failed[first]
         with np.errstate(invalid="ignore"):
             f_c[j] = np.fmin.reduce(cti, axis=-1)
-    return {"f_o": f_o, "worst": worst, "f_c": f_c}
+    return {"f_o": f_o, "worst": worst, "f_c": f_c, "lmti": lmti_left}

@@ -10,9 +10,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from screwkit.tolerances import WORST_FAULT_TIE
 from screwkit.units import is_angular
 
-__all__ = ["indices_to_dict", "indices_to_dataset", "json_number", "set_label"]
+__all__ = ["indices_to_dict", "indices_to_dataset", "json_number", "set_label", "tied"]
 
 
 def json_number(value: float) -> float | None:
@@ -28,6 +29,61 @@ def set_label(actuators: Sequence[int]) -> str:
     '1-2-3'
     """
     return "-".join(str(i + 1) for i in actuators)
+
+
+def tied(values, best: float, highest: bool = False) -> list[int]:
+    """Positions of ``values`` within :data:`~screwkit.tolerances.WORST_FAULT_TIE` of ``best`` (the lowest, or
+    the highest): values that are mathematically equal differ by rounding only, and count as ties."""
+    values = np.asarray(values, dtype=float)
+    close = values >= best - WORST_FAULT_TIE if highest else values <= best + WORST_FAULT_TIE
+    return [int(i) for i in np.flatnonzero(close)]
+
+
+def _submechanism_detail(indices, allowed: set[int]) -> dict:
+    """The best submechanism among those inside ``allowed`` (actuator indices), its OTI per actuator and the
+    actuators that limit it (ties included), and the other submechanisms tied with it (one configuration)."""
+    names = indices.actuators
+    members = [s for s, sub in enumerate(indices.submechanisms) if set(sub) <= allowed]
+    if not members:
+        return {"submechanism": [], "tied_submechanisms": [], "oti_actuators": {}, "limiting": []}
+    otis = np.asarray(indices.oti_submechanisms)[members]
+    best = tied(otis, float(otis.max()), highest=True)
+    chosen = members[best[0]]
+    sub = indices.submechanisms[chosen]
+    per_actuator = np.asarray(indices.oti_actuators)[chosen]
+    return {"submechanism": [names[k] for k in sub],
+            "tied_submechanisms": [[names[k] for k in indices.submechanisms[members[b]]] for b in best[1:]],
+            "oti_actuators": {names[k]: json_number(v) for k, v in zip(sub, per_actuator)},
+            "limiting": [names[sub[i]] for i in tied(per_actuator, float(per_actuator.min()))]}
+
+
+def _one_configuration(indices) -> dict:
+    """What a report of one reachable configuration adds to the indices: ties, the submechanisms that give the
+    LMTI and each F_Oj with their limiting actuators, the configuration and the working mode."""
+    report: dict[str, Any] = {"redundancy": indices.actuator_count - indices.dof}
+    names = indices.actuators
+    if indices.iti_actuators is not None:
+        report["iti_lowest"] = [names[i] for i in tied(indices.iti_actuators, indices.iti)]
+    if indices.oti_submechanisms is not None and indices.oti_actuators is not None:
+        report["lmti_detail"] = _submechanism_detail(indices, set(range(indices.actuator_count)))
+        faults = {}
+        for j in indices.faults:
+            ties = indices.worst_fault_ties(j)
+            left = set(range(indices.actuator_count)) - {indices.actuator_index(name) for name in ties[0]}
+            detail = {"worst": [list(names_) for names_ in ties], "left": [names[k] for k in sorted(left)]}
+            if indices.fault_type == "free-swinging":  # the LMTI of the set left is that of its submechanisms
+                detail.update(_submechanism_detail(indices, left))
+            faults[str(j)] = detail
+        report["fault_detail"] = faults
+    if indices.joint_values:
+        report["configuration"] = {
+            name: {"value": json_number(value if name in indices.prismatic_joints else np.rad2deg(value)),
+                   "unit": "m" if name in indices.prismatic_joints else "deg",
+                   "actuated": name in names}
+            for name, value in indices.joint_values.items()}
+    if indices.working_mode:
+        report["working_mode"] = dict(indices.working_mode)
+    return report
 
 
 def indices_to_dict(indices) -> dict:
@@ -70,8 +126,12 @@ def indices_to_dict(indices) -> dict:
     report["worst_faults"] = {str(j): (list(v) if not indices.batch_shape else np.asarray(v).tolist())
                               for j, v in worst.items()}
     report["fault_type"] = indices.fault_type
+    if not indices.batch_shape:
+        report["worst_fault_ties"] = {str(j): [list(names) for names in indices.worst_fault_ties(j)]
+                                      for j in indices.faults}
     if indices.cti is None or not indices.constraint_count:
-        report["cti"] = "not applicable"  # no constraint wrench held by one chain alone
+        report["cti"] = "not applicable"
+        report["cti_reason"] = indices.cti_reason or "no constraint wrench is held by one chain alone"
     else:
         report["cti"] = number(indices.cti)
         report["f_c"] = {str(j): number(v) for j, v in indices.f_c.items()}
@@ -85,6 +145,8 @@ def indices_to_dict(indices) -> dict:
     else:
         report["not_mutual_interference"] = list(indices.not_mutual_interference)
     report["threshold_m"] = indices.threshold
+    if not indices.batch_shape and indices.reachable:
+        report.update(_one_configuration(indices))
     return report
 
 

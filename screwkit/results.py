@@ -12,12 +12,14 @@ Only numpy is imported here (xarray when :meth:`Indices.to_dataset` is called).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from itertools import combinations
 from typing import Any, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.reports import indices_to_dataset, indices_to_dict, set_label
+from screwkit.tolerances import WORST_FAULT_TIE
 
 __all__ = ["Indices", "set_label", "PER_CONFIGURATION", "PER_CONFIGURATION_DICTS"]
 
@@ -25,7 +27,7 @@ PER_CONFIGURATION = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti
                      "actuation_wrenches", "output_twists", "poses", "reachable", "chain_status", "full_poses",
                      "cti", "cti_submechanisms", "instantaneous_dof", "constraint_singular")
 """Fields of :class:`Indices` with one entry per configuration (leading batch axes)."""
-PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c")
+PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "joint_values")
 """Fields of :class:`Indices` that map ``j`` to one entry per configuration."""
 
 
@@ -111,6 +113,18 @@ class Indices:
     fault_type : str
         ``"free-swinging"`` (failed actuators become passive joints, the paper's FSJF) or
         ``"link"`` (their chains disappear with their constraint wrenches, the paper's LF).
+    remaining_lmti : dict of int to ndarray (..., C(a, j))
+        For each ``j``, the LMTI of every actuator set left after ``j`` faults (the terms of Eq. 12), in
+        combination order of the sets left (:meth:`failed_sets`); empty unless computed with ``detail``.
+    joint_values : dict of str to float or ndarray (...)
+        Every joint's value (rad, m; spherical joints as rotation vectors) by ``chain:joint`` name, at
+        the configurations (:func:`screwkit.studies.indices_at_pose` fills it).
+    prismatic_joints : tuple of str
+        The names in :attr:`joint_values` whose values are lengths (m).
+    working_mode : dict of str to str
+        Per chain, the working mode (branch) its closure follows, in words.
+    cti_reason : str
+        Why the CTI does not apply, when it does not (:attr:`constraint_count` 0).
     """
 
     actuators: tuple[str, ...]
@@ -142,6 +156,11 @@ class Indices:
     instantaneous_dof: Any = None
     constraint_singular: Any = None
     fault_type: str = "free-swinging"
+    remaining_lmti: dict[int, NDArray[np.float64]] = field(default_factory=dict)
+    joint_values: dict[str, Any] = field(default_factory=dict)
+    prismatic_joints: tuple[str, ...] = ()
+    working_mode: dict[str, str] = field(default_factory=dict)
+    cti_reason: str = ""
     batch_shape: tuple[int, ...] = field(init=False)
 
     def __post_init__(self):
@@ -235,10 +254,13 @@ class Indices:
     def lmti_of(self, actuator_set: Sequence[int | str]) -> Any:
         """LMTI of a set of actuators (Eq. 11): the best OTI of its ``n``-subsets.
 
+        Zero for a set of fewer than ``n`` actuators: they cannot hold the platform (no
+        submechanism, as the paper's LMTI of a mechanism that is not fully constrained).
+
         Parameters
         ----------
         actuator_set : sequence of int or str
-            Actuators by index into :attr:`actuators` or by name, at least ``n`` of them.
+            Actuators by index into :attr:`actuators` or by name.
 
         Returns
         -------
@@ -247,10 +269,32 @@ class Indices:
         if self.oti_submechanisms is None:
             raise ValueError("These indices were computed without detail; recompute with detail=True for lmti_of.")
         chosen = sorted({self.actuator_index(actuator) for actuator in actuator_set})
-        if len(chosen) < self.dof:
-            raise ValueError(f"Expected at least n = {self.dof} actuators in `actuator_set`, got {len(chosen)}.")
         members = [s for s, sub in enumerate(self.submechanisms) if set(sub) <= set(chosen)]
+        if not members:
+            return _scalar_or_array(np.where(np.asarray(self.reachable), 0.0, np.nan))
         return _scalar_or_array(self.oti_submechanisms[..., members].max(axis=-1))
+
+    def failed_sets(self, faults: int) -> tuple[tuple[int, ...], ...]:
+        """The failed actuators (indices) of each set left after ``faults`` faults, in the combination order of
+        the sets left (that of :attr:`remaining_lmti`)."""
+        a = self.actuator_count
+        return tuple(tuple(sorted(set(range(a)) - set(left))) for left in combinations(range(a), a - faults))
+
+    def worst_fault_ties(self, faults: int) -> tuple[tuple[str, ...], ...]:
+        """Every worst case of ``faults`` faults at one configuration, by name: the failed actuators of each set
+        whose LMTI is within :data:`~screwkit.tolerances.WORST_FAULT_TIE` of ``F_Oj`` (the reported
+        :attr:`worst_faults` first). Only the reported one without ``detail``; none where unreachable."""
+        if self.batch_shape:
+            raise ValueError("worst_fault_ties is for one configuration; take .at(index) of a batch first.")
+        if not self.reachable:
+            return ()
+        first = tuple(self.worst_faults[faults])
+        if faults not in self.remaining_lmti:
+            return (first,)
+        values = np.asarray(self.remaining_lmti[faults])
+        tied = [tuple(self.actuators[k] for k in failed) for failed, value in zip(self.failed_sets(faults), values)
+                if value <= self.f_o[faults] + WORST_FAULT_TIE]
+        return (first,) + tuple(names for names in tied if names != first)
 
     def __repr__(self) -> str:
         where = f"{self.mechanism}, " if self.mechanism else ""

@@ -31,11 +31,8 @@ numbers of those coordinates. The one length is the singularity threshold *p*, c
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 from functools import cached_property
-from itertools import combinations
-from math import comb
 from typing import Sequence
 
 import numpy as np
@@ -45,8 +42,9 @@ from screwkit import tolerances
 from screwkit._chunks import map_chunks
 from screwkit._compile_notice import prepare_kernels
 from screwkit._validation import as_float_array, check_finite
+from screwkit.actuator_sets import fault_sets, remaining_lmti, set_plan, submechanisms_left
 from screwkit.chains import ChainScrews
-from screwkit.constraints import ConstraintPlan, actuator_sets, constraint_indices, plan_constraints
+from screwkit.constraints import ConstraintPlan, constraint_indices, plan_constraints
 from screwkit.link_faults import FAULT_TYPES, link_fault_indices
 from screwkit.motion import (
     MotionSpace,
@@ -66,13 +64,6 @@ DEFAULT_THRESHOLD = tolerances.SINGULARITY_THRESHOLD
 
 
 # ----------------------------------------------------------------------------------------
-# Results
-# ----------------------------------------------------------------------------------------
-def fault_sets(actuator_count: int, dof: int, faults: int) -> tuple[tuple[int, ...], ...]:
-    """The remaining-actuator sets ``E_i`` (Eq. 13) for ``faults`` failed actuators, in combination order."""
-    return tuple(combinations(range(actuator_count), actuator_count - faults))
-
-
 # ----------------------------------------------------------------------------------------
 # Analysis
 # ----------------------------------------------------------------------------------------
@@ -128,112 +119,20 @@ def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int =
     else:
         fault_list = tuple(sorted(set(int(j) for j in np.atleast_1d(faults))))
         for j in fault_list:
-            if not 1 <= j <= a - n:
+            if not 1 <= j <= max(a - n, 1):
                 raise ValueError(f"Expected the number of faults `j` in 1..a-n = 1..{a - n}, got {j}.")
+        if a == n:  # no redundancy: F_O1 = 0 (see analyze), no set of n actuators is left to reduce
+            fault_list = ()
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
     return _Plan(
         actuators=actuators, dof=n, space=space, complement=complement,
         chain_start=np.cumsum([0] + [c.n_joints for c in chains]).astype(np.int64),
         actuator_chain=np.array([c for c, _ in actuators], dtype=np.int64),
         actuator_joint=np.array([k for _, k in actuators], dtype=np.int64),
-        faults=fault_list, **_actuator_sets(a, n, fault_list),
+        faults=fault_list, **set_plan(a, n, fault_list),
         threshold=float(threshold), rank_tolerance=float(rank_tolerance),
         idle_count=idle_count)
 
-
-@functools.lru_cache(maxsize=32)
-def _actuator_sets(a: int, n: int, fault_list: tuple[int, ...]) -> dict:
-    """What a plan takes from a, n and the values of j alone (submechanisms, locked sets, fault reductions,
-    failed sets), cached: 17 ms for a = 12 and every j, once per process, not per chunk; shared, only read."""
-    submechanisms = list(combinations(range(a), n))
-    locked = list(combinations(range(a), n - 1))
-    locked_index = {subset: index for index, subset in enumerate(locked)}
-    set_children, fault_rows = _reductions(a, n, submechanisms, fault_list)
-    return dict(
-        submechanisms=np.array(submechanisms, dtype=np.int64).reshape(-1, n),
-        locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
-        locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
-                           dtype=np.int64).reshape(-1, n),
-        failed_sets={j: np.array([sorted(set(range(a)) - set(e)) for e in fault_sets(a, n, j)],
-                                 dtype=np.int64).reshape(-1, j) for j in fault_list},
-        set_children=set_children, fault_rows=fault_rows,
-        locked_depth=np.array([0] + [next(k for k in range(n - 1) if before[k] != after[k])
-                                     for before, after in zip(locked, locked[1:])], dtype=np.int64),
-        **_wedge_tables(n))
-
-
-WEDGE_TERMS = 5
-"""Expansion terms per minor in :func:`_wedge_tables`: at most n - 1 = 5 (twists have six coordinates)."""
-
-
-def _wedge_tables(n: int) -> dict:
-    """Expansion terms of the exterior products that give the output twists for n >= 4.
-
-    The minor of rows ``r_1..r_K`` on columns ``S = {s_0 < ... < s_(K-1)}`` expands along its last
-    row: ``sum_t (-1)^(K-1-t) m_(S - s_t) r_K[s_t]``, ``m`` the minors of the first ``K - 1`` rows
-    (level 1: the first row). Row ``i`` of ``wedge_table`` is one minor: the index of ``S`` among the
-    K-column sets, then for each term the index of ``S - s_t`` among the (K-1)-column sets, ``s_t``
-    and the sign, padded to ``WEDGE_TERMS`` terms with zero signs, so that the kernel sums every
-    minor in one fixed pass; level K's minors are rows ``wedge_start[K]:wedge_start[K+1]`` (none
-    below K = 2). At level n - 1 the minors are the cofactor vector's entries: no pivoting and no
-    division, each locked set's vector from its predecessor's minors (Sum_K C(n, K) K
-    multiply-adds per new row).
-    """
-    table, start = [], [0, 0, 0]
-    for size in range(2, max(n, 2)):
-        previous = {columns: index for index, columns in enumerate(combinations(range(n), size - 1))}
-        for target, columns in enumerate(combinations(range(n), size)):
-            terms = [(previous[columns[:t] + columns[t + 1:]], column, (-1) ** (size - 1 - t))
-                     for t, column in enumerate(columns)]
-            terms += [(0, 0, 0)] * (WEDGE_TERMS - len(terms))
-            table.append((target,) + tuple(value for term in terms for value in term))
-        start.append(len(table))
-    start += [len(table)] * (n + 1 - len(start))
-    return dict(wedge_table=np.array(table, dtype=np.int64).reshape(-1, 1 + 3 * WEDGE_TERMS),
-                wedge_start=np.array(start[:n + 1], dtype=np.int64))
-
-
-def _reductions(a: int, n: int, submechanisms: list[tuple[int, ...]], fault_list: tuple[int, ...]):
-    """The sets whose LMTIs give F_Oj, each as the maximum of earlier rows, whichever way costs fewer reads.
-
-    The kernel's rows are the submechanisms' OTIs (``S = C(a, n)`` of them), then one row per set
-    ``E`` of ``set_children``, the maximum over the rows it lists. *Table*: each set left after
-    ``j`` faults lists the C(a - j, n) submechanisms it contains (Sum_j C(a, j) C(a - j, n) reads).
-    *Lattice*: ``LMTI_E = max_{e in E} LMTI_{E - e}`` for ``|E| > n`` (every submechanism of ``E``
-    misses some ``e``), so every set of size n + 1, n + 2, ... lists its ``|E|`` subsets one
-    smaller (Sum_k k C(a, k) reads), far fewer when ``a - n`` is large (``coop_arms``, every j:
-    14,785 against 58,212). Both are exact (maxima and minima of the same numbers).
-
-    Returns ``set_children`` (R, K), the rows listed by each set (padded with -1), and ``fault_rows``
-    (F, 2), for the f-th ``j`` the range of rows (OTIs included) holding the sets left after ``j``
-    faults, in combination order.
-    """
-    if not fault_list:
-        return np.zeros((0, 0), dtype=np.int64), np.zeros((0, 2), dtype=np.int64)
-    largest = a - min(fault_list)
-    table_cost = sum(comb(a, j) * comb(a - j, n) for j in fault_list)
-    lattice_cost = sum(k * comb(a, k) for k in range(n + 1, largest + 1)) + sum(comb(a, j) for j in fault_list)
-    index = {sub: row for row, sub in enumerate(submechanisms)}
-    children, start = [], {}
-    if lattice_cost < table_cost:
-        start[n] = 0
-        for size in range(n + 1, largest + 1):
-            start[size] = len(index)
-            for members in combinations(range(a), size):
-                children.append([index[members[:k] + members[k + 1:]] for k in range(size)])
-                index[members] = len(index)
-        rows = [(start[a - j], start[a - j] + comb(a, a - j)) for j in fault_list]
-    else:
-        rows = []
-        for j in fault_list:
-            first = len(submechanisms) + len(children)
-            children += [[index[sub] for sub in combinations(remaining, n)] for remaining in fault_sets(a, n, j)]
-            rows.append((first, len(submechanisms) + len(children)))
-    width = max((len(kids) for kids in children), default=0)
-    set_children = np.full((len(children), width), -1, dtype=np.int64)
-    for row, kids in enumerate(children):
-        set_children[row, :len(kids)] = kids
-    return set_children, np.array(rows, dtype=np.int64).reshape(-1, 2)
 
 
 def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
@@ -330,6 +229,7 @@ def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, deta
     if detail:
         result.update(iti_actuators=out["iti_actuators"], oti_actuators=out["oti_actuators"],
                       oti_submechanisms=out["oti_submechanisms"], actuation_wrenches=out["actuation_wrenches"])
+        result.update({f"remaining{j}": lmti for j, lmti in remaining_lmti(plan, out["oti_submechanisms"]).items()})
         if keep_twists:
             result["output_twists"] = out["output_twists"]
     return result
@@ -363,7 +263,7 @@ def _joints_of_all_chains(arrays: list[NDArray]):
 def _constraint_plan(chains: list[ChainScrews], count: int) -> ConstraintPlan:
     """The constraint structure of the chains, found on up to 9 configurations spread over the batch."""
     if not count:
-        return ConstraintPlan(tuple(0 for _ in chains), 0, (), ())
+        return ConstraintPlan(tuple(0 for _ in chains), 0)
     _, working, _, _, _ = sampled_working_coordinates(chains)
     return plan_constraints(working)
 
@@ -398,7 +298,7 @@ def _at_constraint_singularities(plan: _Plan, result: dict, held: NDArray) -> No
     for j in plan.faults:
         result[f"f_o{j}"][rows] = 0.0
         result[f"worst{j}"][rows] = plan.failed_sets[j][0]
-    for key in ("oti_actuators", "oti_submechanisms"):
+    for key in ("oti_actuators", "oti_submechanisms", *(f"remaining{j}" for j in plan.faults)):
         if key in result:
             result[key][rows] = 0.0
     result["mutual_interference"][rows] = held
@@ -583,8 +483,8 @@ def analyze(
 
     # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
     constraint_plan = (_constraint_plan(chains, count) if plan.space.dof < 6
-                       else ConstraintPlan(tuple(0 for _ in chains), 0, (), ()))
-    fault_members = actuator_sets(a, plan.dof, plan.faults) if constraint_plan.count else {}
+                       else ConstraintPlan(tuple(0 for _ in chains), 0))
+    fault_members = submechanisms_left(a, plan.dof, plan.faults) if constraint_plan.count else {}
 
     def run(part: slice) -> dict:
         chunk_twists, chunk_points = twists(part), points(part)
@@ -601,7 +501,7 @@ def analyze(
                 _at_constraint_singularities(plan, result, result.pop("held_without"))
             if not detail:
                 for key in ("iti_actuators", "oti_actuators", "oti_submechanisms", "actuation_wrenches",
-                            "cti_submechanisms"):
+                            "cti_submechanisms", *(f"remaining{j}" for j in plan.faults)):
                     result.pop(key, None)
         return result
 
@@ -617,17 +517,20 @@ def analyze(
     not_applicable = np.broadcast_to(np.nan, batch_shape)  # no constraint wrench held by one chain alone: no CTI
     f_c = ({j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count
            else dict.fromkeys(plan.faults, not_applicable))
-    if not plan.faults and faults is None:  # no redundancy (a = n): one failed actuator leaves the platform
-        # uncontrolled, so no set of n working actuators remains: F_O1 = F_IO1 = 0 (the worst fault the first)
+    remaining = {j: batch_first(merged[f"remaining{j}"]) for j in plan.faults} if detail else {}
+    if a == plan.dof:  # no redundancy (a = n): one failed actuator leaves the platform
+        # uncontrolled, so no set of n working actuators remains: F_O1 = F_IO1 = 0 (every fault ties; the first named)
         f_o = {1: np.zeros(batch_shape)}
         worst = {1: np.zeros(batch_shape + (1,), dtype=np.int64)}
         f_c = {1: np.zeros(batch_shape) if constraint_plan.count else not_applicable}
+        remaining = {1: np.zeros(batch_shape + (a,))} if detail else {}
     if fault_type == "link" and plan.faults:
         options = {"analyze": dict(threshold=threshold, rank_tolerance=rank_tolerance, chunk_size=chunk_size,
                                    threads=threads, output_point=output_point, planar=planar),
                    "idle_count": 0 if idle is None else idle.shape[-2]}
         link = link_fault_indices(given_chains, plan.actuators, plan.faults, batch_shape, analyze, options)
         f_o, worst = link["f_o"], link["worst"]
+        remaining = link["lmti"] if detail else {}
         f_c = link["f_c"] if constraint_plan.count else f_c
     return Indices(
         actuators=names,
@@ -648,8 +551,11 @@ def analyze(
         cti=batch_first(merged["cti"]) if constraint_plan.count else not_applicable,
         f_c=f_c,
         cti_submechanisms=batch_first(merged["cti_submechanisms"]) if constraint_plan.count and detail else None,
-        constraint_count=constraint_plan.count,
+        constraint_count=constraint_plan.count if idle is None else 0,
+        cti_reason=(constraint_plan.reason if idle is None
+                    else "the output is a point: the CTI is defined for a frame output, whose every wrench acts on it"),
         instantaneous_dof=batch_first(merged["instantaneous_dof"]) if constraint_plan.count else None,
         constraint_singular=batch_first(merged["constraint_singular"]) if constraint_plan.count else None,
         fault_type=fault_type,
+        remaining_lmti=remaining,
     )

@@ -128,8 +128,8 @@ def test_with_json_errors_are_json_on_stdout():
     assert "is unreachable" in json.loads(result.stdout)["error"]
     missing = screwkit("info", "no/such/file.urdf", "--json")
     assert missing.returncode == 1 and json.loads(missing.stdout) == {
-        "error": "no/such/file.urdf: no such file (bundled mechanisms are: coop_arms, delta_4, five_bar_3, "
-                 "planar_4rpr, planar_5rrr, prs_3_ups, rss_hexapod_8, schoenflies_5, ups_hexapod_8)."}
+        "error": "no/such/file.urdf: no such file (bundled mechanisms are: coop_arms, delta_4, five_bar, five_bar_3, "
+                 "planar_4rpr, planar_5rrr, prs_3_ups, rss_hexapod_8, schoenflies_5, ups_hexapod_8, ups_stewart_6)."}
 
 
 def test_verify_compares_with_the_closed_forms():
@@ -143,8 +143,8 @@ def test_verify_compares_with_the_closed_forms():
 
 def test_list_names_the_bundled_robots():
     result = screwkit("list")
-    assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups",
-                                     "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8"]
+    assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr",
+                                     "prs_3_ups", "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6"]
 
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):

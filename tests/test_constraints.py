@@ -180,30 +180,21 @@ def test_cli_fault_option_reports_the_type():
     assert wrong.returncode != 0 and "--fault" in wrong.stderr
 
 
-def delta_cti(twists, points, dof=3):
-    """The CTI of R-U-U Delta legs from their explicit geometry: each leg's constraint couple a x w
-    (a the arm axis, w the universal joints' middle axis), its actuation force along the rod through the
-    platform joint; the couples of the first legs that span the couple space are released (screwkit's
-    convention for over-constrained mechanisms), in chain order."""
+def delta_cti(twists):
+    """The CTI of R-U-U Delta legs from their explicit geometry: each leg's constraint couple m_i = a_i x w_i
+    (a the arm axis, w the universal joints' middle axis). Any three legs whose couples are independent are a
+    non-redundant constraint subsystem; releasing leg i's couple with the other two kept frees the rotation
+    along m_j x m_k (whatever actuators are locked, as long as their forces are independent), so
+    kappa_i = |m_i . (m_j x m_k)| / |m_j x m_k|, and the CTI is the best subsystem's lowest kappa."""
     couples = [np.cross(t[0, :3], t[2, :3]) for t in twists]
     couples = [c / np.linalg.norm(c) for c in couples]
-    released = []
-    for c in couples:
-        if np.linalg.matrix_rank(np.array(released + [c]), tol=1e-9) == len(released) + 1:
-            released.append(c)
-    constraint_rows = np.array([np.concatenate([np.zeros(3), c]) for c in released])
-    rods = [(p[-1] - p[1]) / np.linalg.norm(p[-1] - p[1]) for p in points]
-    forces = np.array([np.concatenate([u, np.cross(p[-1], u)]) for u, p in zip(rods, points)])
     best = 0.0
-    for subset in combinations(range(len(twists)), dof):
-        system = np.vstack([forces[list(subset)], constraint_rows])
-        if np.linalg.matrix_rank(system, tol=1e-9) < 6:
-            continue
+    for legs in combinations(range(len(couples)), 3):
         kappas = []
-        for j, couple in enumerate(released):
-            _, _, right = np.linalg.svd(np.delete(system, dof + j, axis=0))
-            omega = right[-1][3:]  # the freed twist's rotation: (v, omega) order of the Euclidean null vector
-            kappas.append(abs(couple @ omega) / np.linalg.norm(omega))
+        for i in legs:
+            j, k = (other for other in legs if other != i)
+            freed = np.cross(couples[j], couples[k])
+            kappas.append(abs(couples[i] @ freed) / np.linalg.norm(freed))
         best = max(best, min(kappas))
     return best
 
@@ -216,9 +207,11 @@ def test_delta_cti_matches_the_explicit_geometry(pose_name):
     solution = solve(mechanism, mechanism.named_pose(pose_name)[None])
     result = analyze_solution(mechanism, solution)
     chains = chain_screws(mechanism, solution)
-    expected = delta_cti([c.twists[0] for c in chains], [c.points[0] for c in chains])
+    expected = delta_cti([c.twists[0] for c in chains])
     assert result.constraint_count == 3 and 0.0 < expected <= 1.0
     assert abs(result.cti[0] - expected) < TOLERANCE
+    # the couples' kappas do not depend on which actuators are locked: every regular set has the same CTI_N
+    np.testing.assert_allclose(result.cti_submechanisms[0], expected, atol=TOLERANCE, rtol=0)
 
 
 def test_a_3_prs_reports_3_dof_and_its_parasitic_motion():
@@ -296,3 +289,48 @@ def test_cli_sweep_and_map_say_their_fault_type(tmp_path):
         np.testing.assert_array_equal(sweep["f_o1"].values, 0.0)  # a lost PRS leg frees the platform
         np.testing.assert_array_equal(grid["f_o1"].values, 0.0)
         assert np.all(sweep["cti"].values > 0.9)
+
+
+def spherical_wrist_urdf(radius: float = 0.1) -> str:
+    """A spherical 3-RRR wrist (the agile eye at home): three R-R-R legs whose nine joint axes all pass through the
+    centre O (the platform frame's origin), leg i's base, middle and platform axes along e_i, e_(i+1), e_(i+2);
+    task coordinates roll, pitch, yaw."""
+    from screwkit.model.urdf_writer import UrdfWriter
+
+    centre = np.array([0.0, 0.0, 0.3])
+    writer = UrdfWriter("spherical_wrist", " spherical 3-RRR wrist, every joint axis through the centre ")
+    writer.link("base_link", ("box", (0.1, 0.1, 0.01)))
+    writer.link("platform", ("sphere", 0.02))
+    writer.joint("platform_joint", "floating", "base_link", "platform", xyz=centre)
+    for i in range(3):
+        axes = [np.eye(3)[(i + k) % 3] for k in range(3)]
+        points = [radius * a for a in axes]  # a point on each axis, relative to O
+        chain = f"leg_{i + 1}"
+        writer.link(f"{chain}_proximal", ("sphere", 0.01))
+        writer.link(f"{chain}_distal", ("sphere", 0.01))
+        writer.joint(f"{chain}_joint_base", "continuous", "base_link", f"{chain}_proximal", xyz=centre + points[0],
+                     axis=axes[0])
+        writer.joint(f"{chain}_joint_middle", "continuous", f"{chain}_proximal", f"{chain}_distal",
+                     xyz=points[1] - points[0], axis=axes[1])
+        writer.loop(f"{chain}_joint_platform", "revolute", chain, f"{chain}_distal", (points[2] - points[1], (0, 0, 0)),
+                    "platform", (points[2], (0, 0, 0)), axis=axes[2])
+        writer.transmission(f"{chain}_joint_base")
+    writer.task_coordinates(("roll", "pitch", "yaw"))
+    return writer.text()
+
+
+def test_a_spherical_wrist_has_no_cti_and_says_why(tmp_path):
+    """Every leg of a spherical wrist holds the same three constraint forces through its centre: no leg
+    holds a constraint alone, so the CTI does not apply (rather than reading 0 at every pose)."""
+    path = tmp_path / "spherical_wrist.urdf"
+    path.write_text(spherical_wrist_urdf())
+    mechanism = load_text(path.read_text(), str(path))
+    assert mechanism.dof == 3 and mechanism.task_coordinates == ("roll", "pitch", "yaw")
+    poses = mechanism.home_pose + np.deg2rad([[0.0, 0.0, 0.0], [10.0, -5.0, 15.0], [-20.0, 10.0, -25.0]])
+    result = indices_at_poses(mechanism, poses, detail=True)
+    assert result.reachable.all() and np.all(result.lmti > 0.0)
+    assert np.isnan(result.cti).all() and result.constraint_count == 0
+    assert result.cti_reason == "every chain holds the same 3 constraint wrenches (none is held by one chain alone)"
+    completed = screwkit("analyze", path)
+    assert completed.returncode == 0, completed.stderr
+    assert "CTI  not applicable: every chain holds the same 3 constraint wrenches" in completed.stdout

@@ -455,13 +455,13 @@ def test_worst_fault_is_the_first_set_within_the_tie_margin(name, faults):
     alone through the table of submechanisms: both are checked."""
     from itertools import combinations
 
+    from screwkit.actuator_sets import reductions
     from screwkit.tolerances import WORST_FAULT_TIE
-    from screwkit.transmission import _reductions
 
     result = analyze(build(name), threshold=THRESHOLD, faults=faults)
     a = result.actuator_count
     if name == "coop_arms":
-        children, _ = _reductions(a, result.dof, list(combinations(range(a), result.dof)), tuple(result.f_o))
+        children, _ = reductions(a, result.dof, list(combinations(range(a), result.dof)), tuple(result.f_o))
         assert (children.shape[1] <= a) == (faults != 1)  # lattice rows list at most a sets
     ties = 0
     for j in result.f_o:

@@ -93,9 +93,9 @@ def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
     """The output twists' expansion terms (level by level, as the kernel runs them) against numpy's determinants."""
     from itertools import combinations
 
-    from screwkit.transmission import WEDGE_TERMS, _wedge_tables
+    from screwkit.actuator_sets import WEDGE_TERMS, wedge_tables
 
-    tables = _wedge_tables(n)
+    tables = wedge_tables(n)
     table, start = tables["wedge_table"], tables["wedge_start"]
     rows = np.random.default_rng(n).normal(size=(n - 1, n))
     minors = {1: rows[0].copy()}

@@ -38,6 +38,7 @@ CLOSED_FORM_CASES = {
     "planar_4rpr": ((0.4, 0.4, 0.8), "planar_rpr"),
     "ups_hexapod_8": ((0.15, 0.15, 0.15, 0.2, 0.2, 0.3), "ups"),
     "rss_hexapod_8": ((0.08, 0.08, 0.08, 0.1, 0.1, 0.15), "rus"),
+    "ups_stewart_6": ((0.15, 0.15, 0.15, 0.2, 0.2, 0.3), "ups"),
 }
 
 
@@ -290,7 +291,7 @@ def test_solved_loops_close_in_pinocchio_forward_kinematics(name):
     mechanism_ = mechanism(name)
     scales = {"coop_arms": (0.03,) * 3 + (0.1,) * 3, "random_loops": (0.003,) * 3 + (0.01,) * 3,
               # lower mobility: offsets in the task coordinates only (x y z; x y; z roll pitch; x y z yaw)
-              "delta_4": (0.1,) * 3, "five_bar_3": (0.05,) * 2, "prs_3_ups": (0.02, 0.2, 0.2),
+              "delta_4": (0.1,) * 3, "five_bar_3": (0.05,) * 2, "five_bar": (0.05,) * 2, "prs_3_ups": (0.02, 0.2, 0.2),
               "schoenflies_5": (0.04,) * 3 + (0.2,)}
     scale = scales[name] if name in scales else CLOSED_FORM_CASES[name][0]
     solution = solve(mechanism_, random_poses(mechanism_, scale, 8, seed=6))

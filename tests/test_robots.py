@@ -17,8 +17,8 @@ from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.loader import bundled_names, bundled_path, load
 from screwkit.model.pinocchio_bridge import configuration_vector
 
-BUNDLED = ("coop_arms", "delta_4", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups", "rss_hexapod_8",
-           "schoenflies_5", "ups_hexapod_8")
+BUNDLED = ("coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups",
+           "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6")
 
 
 @lru_cache(maxsize=None)
@@ -315,7 +315,8 @@ def test_a_loop_left_open_by_the_file_is_closed_at_loading_and_said(tmp_path):
     text = _replace(bundled_text("planar_5rrr"), r'(<successor link="platform">\s*<origin xyz=")0\.1 ', r"\g<1>0.2 ")
     opened = load(write(tmp_path, text, "open.urdf"))
     assert len(opened.assembly_notes) == 1 and opened.assembly_notes[0].startswith(
-        "loop 'chain_1_joint_d' was 0.1 m and 0 rad open at the file's joint values: closed by moving chain 'chain_1'")
+        "loop 'chain_1_joint_d' was 0.1 m and 0 rad open at the file's joint values: closed by moving the joints of "
+        "chain 'chain_1' (most: ")
     frames = chain_forward_kinematics(opened.chains[0].geometry, opened.chains[0].reference_values)
     target_rotation, target_translation = opened.loop_targets(0, opened.home_rotation, opened.home_translation)
     np.testing.assert_allclose(frames.end_translation, target_translation, atol=1e-10)
@@ -324,7 +325,7 @@ def test_a_loop_left_open_by_the_file_is_closed_at_loading_and_said(tmp_path):
     out = tmp_path / "closed.urdf"
     result = screwkit("convert", tmp_path / "open.urdf", out)
     assert result.returncode == 0, result.stderr
-    assert "closed by moving chain 'chain_1'" in result.stderr
+    assert "closed by moving the joints of chain 'chain_1'" in result.stderr
     closed = load(out)
     assert closed.assembly_notes == ()  # the reference configuration written back closes the loop
     for first, second in zip(opened.chains, closed.chains):

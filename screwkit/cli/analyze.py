@@ -25,38 +25,84 @@ from screwkit.studies import indices_at_pose
 __all__ = ["analyze", "print_report"]
 
 
+def _names(names: list[str]) -> str:
+    return ", ".join(names)
+
+
+def _ties(groups: list[list[str]]) -> str:
+    """The first of tied worst cases, and how many more tie with it."""
+    others = len(groups) - 1
+    return _names(groups[0]) + (f" (tied with {others} other set{'s' if others > 1 else ''})" if others else "")
+
+
+def _limiting(detail: dict) -> str:
+    """``submechanism ..., limited by ...`` of a report's ``lmti_detail`` or ``fault_detail`` entry."""
+    if not detail.get("submechanism"):
+        return "no n actuators left to hold the platform"
+    tied = len(detail["tied_submechanisms"])
+    return (f"best submechanism {_names(detail['submechanism'])}"
+            + (f" (tied with {tied} other{'s' if tied > 1 else ''})" if tied else "")
+            + f", limited by {_names(detail['limiting'])}")
+
+
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
-    click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators, {report['dof']} DOF, at {pose}")
+    redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
+    click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators, {report['dof']} DOF "
+               f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}")
     if report.get("dependent"):
         click.echo("  dependent (parasitic) coordinates: "
                    + ", ".join(f"{k} = {v:.6g}" for k, v in report["dependent"].items()))
     if report.get("constraint_singular"):
         click.echo(f"  CONSTRAINT SINGULARITY: {report['instantaneous_dof']} instantaneous DOF at this pose, "
                    f"mobility {report['dof']}")
+    modes = report.get("working_mode", {})
+    if modes:
+        if len(set(modes.values())) == 1:
+            click.echo(f"  working mode: every chain {next(iter(modes.values()))}")
+        else:
+            click.echo("  working mode: " + "; ".join(f"{chain} {mode}" for chain, mode in modes.items()))
+    configuration = report.get("configuration", {})
+    if configuration:
+        actuated = [f"{name} = {entry['value'] + 0.0:.{6 if entry['unit'] == 'm' else 3}f} {entry['unit']}"
+                    for name, entry in configuration.items() if entry["actuated"]]
+        click.echo("  actuators: " + ", ".join(actuated))
     click.echo("")
     click.echo("ITI per actuator (Eq. 6)")
-    lowest = min(report["iti_actuators"], key=report["iti_actuators"].get)
+    lowest = report.get("iti_lowest") or [min(report["iti_actuators"], key=report["iti_actuators"].get)]
+    mark = "  <- lowest" + (" (tied)" if len(lowest) > 1 else "")
     for name, value in report["iti_actuators"].items():
-        click.echo(f"  {name:<32s} {value:.4f}{'  <- lowest' if name == lowest else ''}")
+        click.echo(f"  {name:<32s} {value:.4f}{mark if name in lowest else ''}")
     click.echo(f"ITI  (Eq. 7)                        {report['iti']:.4f}")
     click.echo(f"LMTI (Eq. 11, all actuators)        {report['lmti']:.4f}")
-    if len(report["actuators"]) == report["dof"]:
-        click.echo("No redundancy (a = n): one failed actuator leaves the platform uncontrolled, so F_O1 = F_IO1 = 0.")
-    elif report["fault_type"] != "free-swinging":
-        click.echo(f"Faults: {report['fault_type']} failures")
-    for j in report["f_o"]:
-        worst = ", ".join(report["worst_faults"].get(j, []))
-        click.echo(f"F_O{j:<2s}(Eq. 12) {report['f_o'][j]:.4f}   F_IO{j:<2s}(Eq. 14) {report['f_io'][j]:.4f}"
-                   f"   worst fault: {worst}")
+    if "lmti_detail" in report:
+        click.echo(f"  {_limiting(report['lmti_detail'])}")
+        others = report["lmti_detail"]["oti_actuators"]
+        if others:
+            click.echo("  OTI per actuator there (Eq. 8): " + ", ".join(f"{k} {v:.4f}" for k, v in others.items()))
+    if not redundancy:
+        click.echo("No redundancy (a = n): any failed actuator leaves the platform uncontrolled, so F_O1 = F_IO1 = 0.")
+    else:
+        if report["fault_type"] != "free-swinging":
+            click.echo(f"Faults: {report['fault_type']} failures")
+        ties = report.get("worst_fault_ties", {})
+        for j in report["f_o"]:
+            worst = _ties(ties[j]) if ties.get(j) else _names(report["worst_faults"].get(j, []))
+            click.echo(f"F_O{j:<2s}(Eq. 12) {report['f_o'][j]:.4f}   F_IO{j:<2s}(Eq. 14) {report['f_io'][j]:.4f}"
+                       f"   worst fault: {worst}")
+            detail = report.get("fault_detail", {}).get(j)
+            if detail and "submechanism" in detail:
+                click.echo(f"  after it: {_limiting(detail)}")
     if report["cti"] == "not applicable":
-        click.echo("CTI  not applicable: no constraint wrench is held by one chain alone")
+        click.echo(f"CTI  not applicable: {report['cti_reason']}")
     else:
         click.echo(f"CTI  (constraint transmission)      {report['cti']:.4f}")
         for j, value in report.get("f_c", {}).items():
             click.echo(f"F_C{j:<2s}(worst CTI, {j} fault(s))      {value:.4f}")
-    if report["not_mutual_interference"]:
+    if not redundancy:
+        click.echo("Every actuator is needed: none can fail with the platform still held (no mutual interference).")
+    elif report["not_mutual_interference"]:
         click.echo("Not mutual-interference actuators (every F_Oj is 0): "
                    + ", ".join(report["not_mutual_interference"]))
     else:
@@ -110,6 +156,8 @@ def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type:
     except ValueError as error:
         raise fail(str(error)) from None
     report = result.to_dict()
+    if loaded.assembly_notes:  # the file's loops were open as written (also said on stderr when loading)
+        report["assembly"] = list(loaded.assembly_notes)
     if loaded.import_report:  # a file of another tool: which body and which point the indices are for
         report["converted"] = list(loaded.import_report)
     if as_json:

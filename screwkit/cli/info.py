@@ -13,6 +13,7 @@ from screwkit.cli.options import (
     load_mechanism,
     mechanism_argument,
 )
+from screwkit.closure import working_modes
 from screwkit.units import is_angular, unit_of
 
 __all__ = ["info", "mechanism_info"]
@@ -25,6 +26,7 @@ def mechanism_info(mechanism) -> dict:
         return {name: float(np.rad2deg(value) if is_angular(name) else value) + 0.0
                 for name, value in zip(mechanism.task_coordinates, pose)}
 
+    modes = working_modes(mechanism)
     return {
         "mechanism": mechanism.name,
         "file": mechanism.path,
@@ -42,7 +44,8 @@ def mechanism_info(mechanism) -> dict:
         "actuators": list(mechanism.actuator_names),
         "chains": [{"name": chain.name, "joints": list(chain.joint_names),
                     "actuated": [chain.joint_names[k] for k in chain.actuated], "loop": chain.loop_name,
-                    "loop_type": chain.loop_type, "solver": chain.solver, "why": chain.solver_reason}
+                    "loop_type": chain.loop_type, "solver": chain.solver, "why": chain.solver_reason,
+                    "working_mode": modes[chain.name]}
                    for chain in mechanism.chains],
         "named_poses": {name: shown(pose) for name, pose in mechanism.named_poses.items()},
         "length_scale_m": mechanism.length_scale,
@@ -84,6 +87,7 @@ def info(mechanism: str, length_unit, as_json: bool) -> None:
         click.echo(f"    {chain['name']}: {' - '.join(chain['joints'])} (actuated: {', '.join(chain['actuated'])}); "
                    f"loop {chain['loop']} ({chain['loop_type']})")
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
+        click.echo(f"      working mode: {chain['working_mode']}")
     for note in report["assembly_notes"]:
         click.echo(f"  assembled: {note}")
     if report["import_report"]:

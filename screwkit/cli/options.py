@@ -185,6 +185,11 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
         mechanism = load(name, length_unit=length_unit)
     except ValueError as error:
         raise fail(str(error)) from None
+    context = click.get_current_context(silent=True)
+    if mechanism.assembly_notes and not (context and context.params.get("quiet")):
+        # a file whose loops are open as written describes another mechanism than the one analysed: say so
+        echo_error(f"{name}: loops open at the file's own joint values were closed at loading: "
+                   + "; ".join(mechanism.assembly_notes))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
                                      mechanism.dof))

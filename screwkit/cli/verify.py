@@ -15,9 +15,8 @@ from screwkit.cli.options import (
     load_mechanism,
     mechanism_argument,
 )
-from screwkit.closure import chain_screws, solve
-from screwkit.studies.poses import closed_form_indices, planar_points
-from screwkit.transmission import analyze
+from screwkit.closure import solve
+from screwkit.studies.poses import analyze_solution, closed_form_indices, planar_points
 
 __all__ = ["verify"]
 
@@ -40,10 +39,8 @@ def verify(mechanism: str, samples: int, seed: int, length_unit, as_json: bool) 
         raise fail(f"verify compares with the planar closed forms; {loaded.name!r} is spatial.")
     rng = np.random.default_rng(seed)
     home = loaded.home_pose
-    scale = loaded.length_scale
-    poses = home + np.column_stack([rng.uniform(-0.5, 0.5, samples * 4) * scale,
-                                    rng.uniform(-0.5, 0.5, samples * 4) * scale,
-                                    rng.uniform(-np.pi, np.pi, samples * 4)])
+    spread = np.where(loaded.angular, np.pi, 0.5 * loaded.length_scale)  # a turn, or half the length scale
+    poses = home + rng.uniform(-1.0, 1.0, (samples * 4, loaded.n_task)) * spread
     solution = solve(loaded, poses)
     keep = np.flatnonzero(solution.reachable)[:samples]
     if keep.size == 0:
@@ -53,8 +50,11 @@ def verify(mechanism: str, samples: int, seed: int, length_unit, as_json: bool) 
         planar_points(loaded, solution)
     except ValueError as error:
         raise fail(str(error)) from None
-    generic = analyze(chain_screws(loaded, solution))
-    closed = closed_form_indices(loaded, solution)
+    try:
+        generic = analyze_solution(loaded, solution, detail=True)
+        closed = closed_form_indices(loaded, solution)
+    except ValueError as error:
+        raise fail(str(error)) from None
     rows = [("ITI per actuator", generic.iti_actuators, closed.iti_actuators),
             ("OTI per submechanism", generic.oti_submechanisms, closed.oti_submechanisms),
             ("LMTI", generic.lmti, closed.lmti)]
@@ -71,7 +71,9 @@ def verify(mechanism: str, samples: int, seed: int, length_unit, as_json: bool) 
         click.echo(json.dumps({"mechanism": loaded.name, "poses": int(keep.size), "largest_deviation": worst,
                                "deviations": deviations, "differing_poses": differing}))
     else:
-        click.echo(f"{loaded.name}: generic screw path vs closed forms (Eqs. 23, 34-38, A4) on {keep.size} poses")
+        forms = ("textbook pressure angles of legs meeting at the output point (Eqs. 21, 23)"
+                 if loaded.output_point is not None else "closed forms (Eqs. 23, 34-38, A4)")
+        click.echo(f"{loaded.name}: generic screw path vs {forms} on {keep.size} poses")
         for label, deviation in deviations.items():
             click.echo(f"  {label:<22s} largest deviation {deviation:.2e}")
         for label, count in differing.items():

@@ -16,6 +16,7 @@ chain solvers; the spatial ones, and the joint screws, of large batches compiled
 :mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.screws`, :mod:`~screwkit.closure.threads`.
 """
 
+from screwkit.closure.assembly import working_modes
 from screwkit.closure.screws import chain_screws, joint_screws
 from screwkit.closure.solve import (
     Solution,
@@ -41,4 +42,5 @@ __all__ = [
     "chain_screws",
     "joint_screws",
     "thread_limit",
+    "working_modes",
 ]

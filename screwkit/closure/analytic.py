@@ -206,6 +206,11 @@ class PlanarRevoluteChain(PlanarClosedForm):
     """
 
     kind = "planar_rrr"
+    @staticmethod
+    def describe_branch(branch) -> str:
+        """The working mode in words."""
+        sign = float(np.atleast_1d(branch)[0])
+        return f"elbow {'left' if sign > 0 else 'right'} of the line from the base joint to the platform joint"
 
     @classmethod
     def from_geometry(cls, geometry: ChainGeometry, length: float = 1.0) -> PlanarRevoluteChain | Rejection:
@@ -273,6 +278,12 @@ class PlanarSliderChain(PlanarClosedForm):
     """
 
     kind = "planar_rpr"
+
+    @staticmethod
+    def describe_branch(branch) -> str:
+        """The working mode in words."""
+        sign = float(np.atleast_1d(branch)[0])
+        return f"slider pointing {'towards' if sign > 0 else 'away from'} the platform joint"
 
     @classmethod
     def from_geometry(cls, geometry: ChainGeometry, length: float = 1.0) -> PlanarSliderChain | Rejection:
@@ -443,6 +454,13 @@ class LegVectorChain(SpatialClosedForm):
 
     kind = "ups"
     kernel_kind = 0
+
+    @staticmethod
+    def describe_branch(branch) -> str:
+        """The working mode in words."""
+        universal, slider = (int(np.sign(value)) for value in np.atleast_1d(branch))
+        return (f"universal-joint branch sigma_U = {universal:+d}, slider pointing "
+                f"{'towards' if slider > 0 else 'away from'} the spherical joint (sigma_P = {slider:+d})")
     kernel_parameters = ("centre", "first_axis", "second_axis", "slider_direction", "leg_offset")
 
     @classmethod
@@ -494,6 +512,12 @@ class CrankRodChain(SpatialClosedForm):
 
     kind = "rus"
     kernel_kind = 1
+
+    @staticmethod
+    def describe_branch(branch) -> str:
+        """The working mode in words."""
+        crank, universal = (int(np.sign(value)) for value in np.atleast_1d(branch))
+        return f"crank branch sigma_R = {crank:+d}, universal-joint branch sigma_U = {universal:+d}"
     kernel_parameters = ("crank_point", "crank_axis", "crank_vector", "first_universal_axis", "second_universal_axis",
                          "rod_direction", "rod_length")
 

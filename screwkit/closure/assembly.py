@@ -41,7 +41,7 @@ from screwkit.tolerances import (
     NEWTON_TOLERANCE,
 )
 
-__all__ = ["assemble", "mobility"]
+__all__ = ["assemble", "mobility", "working_modes"]
 
 
 def _tidy(value: float) -> str:
@@ -99,11 +99,13 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
                 f"platform at its joint origin), and moving the chain's joints leaves them {_tidy(residual[0])} "
                 "(m and rad) apart.",
             )
-        moved = np.max(np.abs(solved[0] - values) / scale)
+        most = int(np.argmax(np.abs(solved[0] - values) / scale))
+        change = float(solved[0][most] - values[most])
         values = solved[0]
+        unit = "m" if geometry.dof_prismatic[most] else "rad"
         note = (f"loop {chain.loop_name!r} was {_tidy(position_gap)} m and {_tidy(rotation_gap)} rad open at the "
-                f"file's joint values: closed by moving chain {chain.name!r}'s joints (by at most {_tidy(moved)} rad "
-                "or length scales)")
+                f"file's joint values: closed by moving the joints of chain {chain.name!r} (most: "
+                f"{chain.joint_names[most]!r} by {_tidy(change)} {unit})")
     values = wrap_revolute_values(geometry, values)
     outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None])[0])
     if outside >= 0:
@@ -309,3 +311,18 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         return mechanism
     axes = infer_task_axes(mechanism, at_pose, at_values, mobility, candidates)
     return replace(mechanism, task_axes=axes, task_source="inferred")
+
+
+def working_modes(mechanism: Mechanism) -> dict[str, str]:
+    """Per chain, the working mode (branch) its closure keeps, in words: the closed form's branch, or for a
+    chain closed by damped Newton the reference assembly's, followed by continuation."""
+    modes = {}
+    for chain in mechanism.chains:
+        if chain.closed_form is not None:
+            modes[chain.name] = f"{chain.closed_form.describe_branch(chain.branch)} ({chain.solver})"
+        elif chain.branch is not None:
+            modes[chain.name] = (f"the reference assembly's, followed from it (sign of the chain's joint-twist "
+                                 f"determinant {int(chain.branch):+d}; damped Newton)")
+        else:
+            modes[chain.name] = "the reference assembly's, followed from it (damped Newton)"
+    return modes

@@ -324,6 +324,14 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
     missing = [c for c in np.flatnonzero(status == MISSES_CLOSURE)]
     missing.sort(key=lambda c: -float(residuals[c]) if np.isfinite(residuals[c]) else -np.inf)
     parts = []
+    shared = [float(residuals[c]) for c in missing]
+    if len(missing) > 1 and mechanism.dependent_indices and np.allclose(shared, shared[0], rtol=1e-9, atol=0.0):
+        # the dependent coordinates were solved with every chain together: one residual for all of them
+        dependent = ", ".join(mechanism.pose_coordinates[i] for i in mechanism.dependent_indices)
+        parts.append(f"no {dependent} closes chains {', '.join(repr(mechanism.chains[c].name) for c in missing)} "
+                     f"together (the closure of the dependent coordinates misses by {shared[0]:.6g}, Newton error "
+                     "norm in m and rad: the pose is outside the workspace)")
+        missing = []
     for c in missing:
         chain = mechanism.chains[c]
         unit = "m" if chain.closed_form is not None else "(Newton error norm, m and rad)"

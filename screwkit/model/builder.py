@@ -9,6 +9,7 @@ element and what was expected. Nothing here solves a closure: see :mod:`screwkit
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -24,7 +25,7 @@ from screwkit.model.pinocchio_bridge import (
 )
 from screwkit.model.urdf_reader import PLATFORM_JOINT_TYPES, UrdfDescription
 
-__all__ = ["Platform", "read_platform", "read_chains"]
+__all__ = ["Platform", "read_platform", "read_chains", "chain_order"]
 
 
 @dataclass(frozen=True)
@@ -101,8 +102,21 @@ def _loop_names(loop) -> tuple[str, ...]:
     return (loop.name,) * dofs
 
 
+def chain_order(name: str) -> tuple:
+    """The key that orders chains: their names in natural order (``leg_2`` before ``leg_10``).
+
+    Chains are ordered by name, not by where the file lists them, so that everything reported in chain
+    or actuator order (actuators, set labels, the first of tied worst faults) is the same for any
+    order of the legs in the file.
+
+    >>> sorted(["leg_10", "leg_2", "arm"], key=chain_order)
+    ['arm', 'leg_2', 'leg_10']
+    """
+    return tuple((0, int(part), "") if part.isdigit() else (1, 0, part) for part in re.split(r"(\d+)", name) if part)
+
+
 def read_chains(description: UrdfDescription, model, platform: Platform) -> tuple[Chain, ...]:
-    """Every chain, in ``<loop>`` order, with its geometry (base frame), limits and actuators."""
+    """Every chain, ordered by name (:func:`chain_order`), with its geometry (base frame), limits and actuators."""
     tag_robot = f"<robot name='{platform.name}'>"
     if not description.loops:
         raise description.fail(tag_robot, "no <loop> joint closes a chain onto the platform.")
@@ -190,6 +204,7 @@ def read_chains(description: UrdfDescription, model, platform: Platform) -> tupl
             tree_joint_ids=tuple(path),
             joint_limits=np.array(limits + [(-np.inf, np.inf)] * loop_dofs, dtype=float).reshape(-1, 2),
         ))
+    chains.sort(key=lambda chain: chain_order(chain.name))
     return _with_actuators(description, tuple(chains), platform.name)
 
 

@@ -68,7 +68,8 @@ class Mechanism:
     home_rotation, home_translation : ndarray, shapes (3, 3) and (3,)
         The platform frame in the base frame at the reference assembly.
     chains : tuple of Chain
-        In ``<loop>`` file order.
+        Ordered by name in natural order (``leg_2`` before ``leg_10``), whatever the order of the
+        ``<loop>`` elements (:func:`screwkit.model.builder.chain_order`).
     dof : int
         Mobility of the platform at the reference assembly (dimension of the intersection of
         the chains' twist spaces).

@@ -50,6 +50,10 @@ PLATFORM_JOINT_TYPES = ("floating", "planar")
 """Types of the joint that attaches the platform to the base."""
 AXIS_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar")
 """Joint types whose ``<axis>`` means something (a zero axis is refused on them only)."""
+LARGEST_COORDINATE = 1e9
+"""The largest magnitude of a number in an ``<origin>`` (in the file's length unit, or rad): a robot a
+million kilometres across in metres (or a thousand in millimetres), or an angle of 160 million turns,
+is a typo or a corrupted file, and its arithmetic would overflow; it is refused naming the element."""
 MAX_FILE_BYTES = 16 * 2**20
 """Largest mechanism file read (16 MiB); larger files are refused before parsing."""
 MAX_LINKS = 10_000
@@ -136,7 +140,7 @@ class UrdfDescription:
     joints : dict of str to JointElement
         Tree joints by name.
     loops : tuple of LoopElement
-        In file order (this is the chain order).
+        In file order (chains are then ordered by name, :func:`screwkit.model.builder.chain_order`).
     transmissions : tuple of TransmissionElement
     reference_configuration : dict of str to float
         Joint values of the reference assembly given in ``<reference_configuration>``.
@@ -435,6 +439,9 @@ class _Reader:
             values = np.array([])
         if values.shape != (3,) or not np.all(np.isfinite(values)):
             raise self.fail(tag, f"expected three finite numbers in '{attribute}', got {element.get(attribute)!r}.")
+        if np.max(np.abs(values)) > LARGEST_COORDINATE:
+            raise self.fail(tag, f"'{attribute}' = {element.get(attribute)!r} is absurd for a robot: expected "
+                                 f"numbers of magnitude at most {LARGEST_COORDINATE:g}.")
         return values
 
     def number(self, element: ElementTree.Element, tag: str, attribute: str) -> float:

@@ -192,9 +192,19 @@ def _planar_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]
     return {"footprint": float(values["base_radius"]), "link_length": float(max(values["upper"], values["lower"]))}
 
 
+def _region(region: dict, legs: int, dof: int) -> dict:
+    """A family's default region; without redundancy (``legs == dof``) F_O1 is zero everywhere, so the region is
+    where the LMTI (the OTI of the one submechanism) reaches the level."""
+    return region if legs > dof else {**region, "index": "lmti"}
+
+
+def _check_legs(family: str, legs: int, dof: int) -> None:
+    if legs < dof:
+        raise ValueError(f"Family {family} needs at least {dof} legs ({dof} DOF), got {legs}.")
+
+
 def planar_rrr(legs: int = 5) -> Family:
-    if legs < 4:
-        raise ValueError(f"Family planar_rrr needs at least 4 legs (3 DOF, redundantly actuated), got {legs}.")
+    _check_legs("planar_rrr", legs, 3)
     return Family(
         "planar_rrr", legs,
         (Parameter("base_radius", 0.5, 2.0, 1.0, "m", "radius e of the circle of base joints (the scale)"),
@@ -204,7 +214,7 @@ def planar_rrr(legs: int = 5) -> Family:
          _slots_parameter(legs, _planar_slots(legs)),
          Parameter("mirrored", 0, 1, 0, "", "working mode: 0 elbows on the +u_perp side, 1 mirrored", integer=True)),
         ("platform_radius", "upper", "lower"), _planar_writer, _planar_measures, planar=True,
-        region={"disc": (0.6, 0.05, 5.0), "level": 0.4},
+        region=_region({"disc": (0.6, 0.05, 5.0), "level": 0.4}, legs, 3),
         description="planar n-RRR: base joints on a circle at uniform angles, platform joints at uniform slots "
                     "assigned by a permutation, identical arms, base joints actuated")
 
@@ -273,26 +283,24 @@ def _hexapod_parameters(legs: int, height: float, slots: tuple[int, ...]) -> tup
 
 
 def ups_hexapod(legs: int = 8) -> Family:
-    if legs < 7:
-        raise ValueError(f"Family ups_hexapod needs at least 7 legs (6 DOF, redundantly actuated), got {legs}.")
+    _check_legs("ups_hexapod", legs, 6)
     return Family("ups_hexapod", legs, _hexapod_parameters(legs, 1.0, _default_slots(UPS_SLOTS, legs)),
                   ("platform_radius", "height", "base_spread", "platform_spread"), _ups_writer, _ups_measures,
-                  region={"grid": {"x": (-0.3, 0.3, 0.05), "y": (-0.3, 0.3, 0.05)}, "over": {"yaw": (-30, 40, 10)},
-                          "level": 0.35},
+                  region=_region({"grid": {"x": (-0.3, 0.3, 0.05), "y": (-0.3, 0.3, 0.05)},
+                                  "over": {"yaw": (-30, 40, 10)}, "level": 0.35}, legs, 6),
                   description="a-UPS hexapod: U joints on the base circle, actuated sliders, S joints on the "
                               "platform circle; slots at uniform angles, optionally gathered in pairs")
 
 
 def rss_hexapod(legs: int = 8) -> Family:
-    if legs < 7:
-        raise ValueError(f"Family rss_hexapod needs at least 7 legs (6 DOF, redundantly actuated), got {legs}.")
+    _check_legs("rss_hexapod", legs, 6)
     parameters = _hexapod_parameters(legs, 0.9, _default_slots(RSS_SLOTS, legs))
     crank = Parameter("crank", 0.2, 0.6, 0.4, "m", "length of every actuated crank (radial at the home pose)")
     return Family("rss_hexapod", legs, parameters[:1] + (crank,) + parameters[1:],
                   ("crank", "platform_radius", "height", "base_spread", "platform_spread"), _rss_writer,
                   _rss_measures,
-                  region={"grid": {"x": (-0.1, 0.1, 0.025), "y": (-0.1, 0.1, 0.025)}, "over": {"yaw": (-10, 15, 5)},
-                          "level": 0.3},
+                  region=_region({"grid": {"x": (-0.1, 0.1, 0.025), "y": (-0.1, 0.1, 0.025)},
+                                  "over": {"yaw": (-10, 15, 5)}, "level": 0.3}, legs, 6),
                   description="a-RSS hexapod: actuated cranks with axes tangent to the base circle, rods with "
                               "U and S joints to the platform circle")
 
@@ -321,8 +329,7 @@ def _delta_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]:
 
 
 def delta(legs: int = 4) -> Family:
-    if legs < 4:
-        raise ValueError(f"Family delta needs at least 4 legs (3 DOF, redundantly actuated), got {legs}.")
+    _check_legs("delta", legs, 3)
     widest = round(0.8 * 360 / legs, 6)
     return Family(
         "delta", legs,
@@ -334,7 +341,7 @@ def delta(legs: int = 4) -> Family:
          Parameter("spread", 0.0, widest, 0.0, "deg", "legs gathered in pairs: even legs turned by +spread/2, "
                    "odd ones by -spread/2")),
         ("arm", "rod", "depth"), _delta_writer, _delta_measures,
-        region={"grid": {"x": (-0.4, 0.4, 0.05), "y": (-0.4, 0.4, 0.05)}, "over": {}, "level": 0.5},
+        region=_region({"grid": {"x": (-0.4, 0.4, 0.05), "y": (-0.4, 0.4, 0.05)}, "over": {}, "level": 0.5}, legs, 3),
         description="Delta robot with a legs at uniform angles (optionally in pairs): actuated arms about axes "
                     "tangent to the base circle, parallelogram forearms modelled as R-U-U legs")
 

@@ -87,8 +87,8 @@ class Region:
     map_options: tuple[str, ...] = ()
 
     def __post_init__(self):
-        if not re.fullmatch(r"f_i?o[1-9][0-9]*", self.index):
-            raise ValueError(f"Expected a region index f_o<j> or f_io<j> (j >= 1), got {self.index!r}.")
+        if not re.fullmatch(r"f_i?o[1-9][0-9]*|lmti|iti", self.index):
+            raise ValueError(f"Expected a region index f_o<j> or f_io<j> (j >= 1), lmti or iti, got {self.index!r}.")
         if not math.isfinite(self.level):
             raise ValueError(f"Expected a finite region level, got {self.level}.")
 
@@ -123,7 +123,8 @@ class Region:
 
     @property
     def faults(self) -> int:
-        return int(self.index.rpartition("o")[2])
+        """The number of faults the region's index needs (1 for lmti and iti: the map computes F_O1 anyway)."""
+        return int(self.index.rpartition("o")[2]) if self.index.startswith("f_") else 1
 
     @property
     def orientations(self) -> str:

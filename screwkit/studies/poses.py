@@ -17,8 +17,8 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.closed_forms import planar_indices
-from screwkit.closure import chain_screws, solve, solve_one, thread_limit
+from screwkit.closed_forms import planar_indices, point_indices
+from screwkit.closure import chain_screws, solve, solve_one, thread_limit, working_modes
 from screwkit.link_faults import FAULT_TYPES
 from screwkit.model import Mechanism
 from screwkit.results import Indices
@@ -103,9 +103,22 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
 
     ITI per chain (Eq. 23; 1 for RPR chains, whose input is along the force), the OTI of every
     3-chain submechanism (Eqs. 34, A4), LMTI, F_Oj, F_IOj, the worst faults and the
-    mutual-interference actuators, all from :func:`screwkit.closed_forms.planar_indices`.
+    mutual-interference actuators, all from :func:`screwkit.closed_forms.planar_indices`; for R-R-R legs
+    meeting at a point output (a five-bar), the textbook pressure angles of
+    :func:`screwkit.closed_forms.point_indices`.
     """
     base, elbows, distal, prismatic = planar_points(mechanism, solution)
+    if mechanism.output_point is not None:
+        if prismatic:
+            raise ValueError(f"The point-output closed forms are for R-R-R legs; {mechanism.name!r} has R-P-R legs.")
+        closed = point_indices(base, elbows, distal, faults=faults)
+        return Indices(
+            actuators=mechanism.actuator_names, dof=2, submechanisms=closed["submechanisms"], iti=closed["iti"],
+            lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
+            mutual_interference=closed["mutual_interference"], threshold=threshold,
+            iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
+            remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates,
+            mechanism=mechanism.name)
     if prismatic:
         direction = distal - base
         closed = planar_indices(base, None, distal, threshold=threshold, faults=faults, threads=threads,
@@ -117,12 +130,12 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
         lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
         mutual_interference=closed["mutual_interference"], threshold=threshold,
         iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
-        task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name)
+        remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name)
 
 
 _ARRAYS = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms",
            "instantaneous_dof", "constraint_singular")
-_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c")
+_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti")
 
 
 def _blank(count: int, value) -> NDArray:
@@ -270,7 +283,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     a = len(mechanism.actuators)
     if meta is None:  # nothing reachable: the structure of the indices from the mechanism alone
         dof = mechanism.dof
-        faults_list = tuple(range(1, a - dof + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
+        faults_list = tuple(range(1, max(a - dof, 1) + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
         nothing = np.full(batch, np.nan)
         return Indices(actuators=mechanism.actuator_names, dof=dof,
                        submechanisms=tuple(combinations(range(a), dof)), iti=nothing, lmti=nothing.copy(),
@@ -292,7 +305,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
         task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
         chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
         full_poses=full_poses.reshape(batch + (mechanism.n_pose,)), pose_coordinates=mechanism.pose_coordinates,
-        constraint_count=meta.constraint_count, fault_type=meta.fault_type)
+        constraint_count=meta.constraint_count, fault_type=meta.fault_type, cti_reason=meta.cti_reason)
 
 
 def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float = SINGULARITY_THRESHOLD,
@@ -310,6 +323,12 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
     solution = solve_one(mechanism, pose, limits=limits)
     result = analyze_solution(mechanism, solution, threshold=threshold, faults=faults, keep_twists=keep_twists,
                               fault_type=fault_type)
+    values = {f"{chain.name}:{joint}": float(np.asarray(chain_values).reshape(-1)[k])
+              for chain, chain_values in zip(mechanism.chains, solution.joint_values)
+              for k, joint in enumerate(chain.joint_names)}
+    prismatic = tuple(f"{chain.name}:{joint}" for chain in mechanism.chains
+                      for joint, slides in zip(chain.joint_names, chain.prismatic) if slides)
     return replace(result, poses=pose, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
                    reachable=True, chain_status=solution.status, full_poses=solution.full_poses,
-                   pose_coordinates=mechanism.pose_coordinates)
+                   pose_coordinates=mechanism.pose_coordinates, joint_values=values, prismatic_joints=prismatic,
+                   working_mode=working_modes(mechanism))

@@ -203,6 +203,7 @@ class Frames:
     chain_points: list  # per chain (F, m_i, 3), world
     centres: NDArray  # (F, 3) platform origin, world
     result: Any  # batched over F
+    loop_points: list = None  # per chain (F, 3): the platform-side loop frame's origin, world (where the leg ends)
 
 
 def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> Frames:
@@ -218,11 +219,15 @@ def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> F
     screws = chain_screws(mechanism, solution)
     result = analyze_solution(mechanism, solution, threshold=threshold, keep_twists=True)
     configurations = configuration_vector(mechanism, solution.joint_values, solution.full_poses)
-    _, translation = mechanism.transforms_from_poses(solution.full_poses)
-    centres = translation @ np.asarray(mechanism.rotation_world_base).T + np.asarray(mechanism.translation_world_base)
+    rotation, translation = mechanism.transforms_from_poses(solution.full_poses)
+    to_world = np.asarray(mechanism.rotation_world_base).T, np.asarray(mechanism.translation_world_base)
+    centres = translation @ to_world[0] + to_world[1]
+    loop_points = [(translation + rotation @ chain.geometry.platform_loop_translation) @ to_world[0] + to_world[1]
+                   for chain in mechanism.chains]
     return Frames(poses=np.asarray(solution.poses),
                    configurations=np.asarray(configurations).reshape(poses.shape[0], -1),
-                   chain_points=[np.asarray(s.points) for s in screws], centres=centres, result=result)
+                   chain_points=[np.asarray(s.points) for s in screws], centres=centres, result=result,
+                   loop_points=loop_points)
 
 
 def best_submechanism(result, frame: int, failed: tuple[int, ...]) -> int | None:
@@ -298,7 +303,9 @@ def markers_of_frame(mechanism, frames: Frames, frame: int, failed: tuple[int, .
             markers.extend(twist_markers(mechanism, slot, actuator, twist, centre, length))
     for chain, position, failed_link in bare_links:
         points = frames.chain_points[chain][frame]
-        start, end = points[position], points[position + 1]
+        # the link after the last tree joint of a leg welded to the platform (no loop joint) ends on the platform
+        start = points[position]
+        end = points[position + 1] if position + 1 < len(points) else frames.loop_points[chain][frame]
         if np.linalg.norm(end - start) < 1e-9 * length:  # e.g. the cross of a universal joint
             continue
         name = node_label(mechanism.chains[chain].name)

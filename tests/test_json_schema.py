@@ -1,0 +1,102 @@
+"""Every ``--json`` output validates against the published JSON Schema of its command (``docs/schema/``).
+
+The commands run as users run them, in a subprocess, on redundant and non-redundant mechanisms, lower-mobility
+ones with constraint wrenches, point outputs, a converted MJCF file, a file whose loops are open as written,
+link faults, and errors. The schemas forbid unknown keys, so a new key in a report must be documented in its
+schema first.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from helpers import screwkit
+
+jsonschema = pytest.importorskip("jsonschema")
+
+SCHEMAS = Path(__file__).resolve().parents[1] / "docs" / "schema"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+def validate(command: str, arguments: list, schema: str | None = None) -> dict:
+    completed = screwkit(command, *arguments, "--json")
+    report = json.loads(completed.stdout)
+    name = "error" if completed.returncode else (schema or command)
+    jsonschema.validate(report, json.loads((SCHEMAS / f"{name}.schema.json").read_text()))
+    return report
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    from test_io import five_bar_mjcf
+
+    folder = tmp_path_factory.mktemp("json")
+    (folder / "five_bar.xml").write_text(five_bar_mjcf(legs=2))
+    text = (Path(__file__).resolve().parents[1] / "robots" / "planar_5rrr.urdf").read_text()
+    opened = text.replace('<child link="chain_1_link_l" />\n    <origin xyz="1 0 0"',
+                          '<child link="chain_1_link_l" />\n    <origin xyz="1.05 0 0"')
+    assert opened != text
+    (folder / "open.urdf").write_text(opened)
+    return folder
+
+
+@pytest.mark.parametrize("arguments", [
+    ["planar_5rrr", "--pose", "paper_fig_2a"],
+    ["planar_5rrr", "--pose", "paper_fig_2a", "--fault", "link"],
+    ["five_bar"],
+    ["ups_stewart_6", "--pose", "0.02", "0", "1", "3", "-2", "10"],
+    ["delta_4", "--pose", "off_centre"],
+    ["prs_3_ups"],
+    ["coop_arms"],
+    ["schoenflies_5"],
+])
+def test_analyze_reports_validate(arguments):
+    report = validate("analyze", arguments)
+    assert report["reachable"] and set(report["iti_actuators"]) == set(report["actuators"])
+
+
+def test_analyze_of_converted_and_open_files_validates(files):
+    converted = validate("analyze", [files / "five_bar.xml"])
+    assert converted["converted"] and converted["redundancy"] == 0
+    opened = validate("analyze", [files / "open.urdf"])
+    assert len(opened["assembly"]) == 1 and "chain_1_joint_d" in opened["assembly"][0]
+
+
+def test_unreachable_and_bad_input_give_the_error_schema(files):
+    for arguments in (["planar_5rrr", "--pose", "5", "5", "0"], ["no/such/file.urdf"], ["planar_5rrr", "--fault", "x"]):
+        report = validate("analyze", arguments)
+        assert set(report) == {"error"}
+
+
+@pytest.mark.parametrize("name", ["delta_4", "five_bar_3", "ups_stewart_6"])
+def test_info_validates(name):
+    report = validate("info", [name])
+    assert all(chain["working_mode"] for chain in report["chains"])
+
+
+def test_list_verify_convert_and_design_search_validate(files, tmp_path):
+    validate("list", [])
+    assert validate("verify", ["five_bar", "--samples", "50"])["largest_deviation"] < 1e-9
+    validate("convert", [files / "five_bar.xml", tmp_path / "five_bar.urdf"])
+    validate("design-search", ["planar_5rrr", "--permutations", "--phi-step", "60", "--quiet"])
+    validate("design-search", ["planar_rrr", "--budget", "4", "--quiet", "--step", "0.2", "--phi-step", "30"])
+
+
+def test_every_command_with_json_has_a_schema():
+    from screwkit.cli import COMMANDS
+
+    with_json = {name for name, command in COMMANDS.items() if "--json" in command_options(name)}
+    assert with_json == {path.name.removesuffix(".schema.json") for path in SCHEMAS.glob("*.schema.json")} - {"error"}
+
+
+def command_options(name: str) -> set[str]:
+    import click
+
+    from screwkit.cli import app
+
+    command = app.get_command(click.Context(app), name)
+    return {option for parameter in command.params for option in getattr(parameter, "opts", ())}
