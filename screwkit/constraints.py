@@ -226,57 +226,62 @@ def _project_on_axis(wrench: NDArray, point: NDArray) -> NDArray:
 
 
 def _released_pairs(own: NDArray, freed: NDArray, valid: NDArray | None = None):
-    """Principal pairs of a chain's own constraint wrenches (N, c, 6) and the twists (N, 6, d) their release
-    frees: wrenches ``V^T C`` and twists ``P`` from the singular vectors of the freed twists' pairing
+    """Principal pairs of a chain's own constraint wrenches (..., c, 6) and the twists (..., 6, d) their release
+    frees: wrenches ``U^T C`` and twists ``F V`` from the singular vectors of the pairing
     ``C o F = U S V^T`` (orthonormal ``F``), so that each wrench is reciprocal to every freed twist but its own.
-    ``valid`` (N, d): which columns of ``freed`` are freed twists (the others are ignored). Returns wrenches
-    (N, d, 6), twists (N, d, 6) and a mask (N, d) of the pairs that exist."""
+    ``valid`` (..., d): which columns of ``freed`` are freed twists (the others are ignored). Returns wrenches
+    (..., d, 6), twists (..., d, 6) and a mask (..., d) of the pairs that exist. One wrench and one freed
+    twist are their own pair."""
+    if own.shape[-2] == 1 and freed.shape[-1] == 1:
+        exists = np.ones(own.shape[:-2] + (1,), dtype=bool) if valid is None else valid
+        return own, np.swapaxes(freed, -1, -2), exists
     if valid is not None:
-        freed = freed * valid[:, None, :]
-    pairing = own @ _SWAP @ freed  # (N, c, d): C_k o F_l
+        freed = freed * valid[..., None, :]
+    pairing = own @ _SWAP @ freed  # (..., c, d): C_k o F_l
     left, singular, right = np.linalg.svd(pairing, full_matrices=False)  # d <= c where the system is regular
-    wrenches = np.swapaxes(left, -1, -2) @ own  # (N, d, 6)
-    twists = np.swapaxes(freed @ np.swapaxes(right, -1, -2), -1, -2)  # (N, d, 6)
+    wrenches = np.swapaxes(left, -1, -2) @ own  # (..., d, 6)
+    twists = np.swapaxes(freed @ np.swapaxes(right, -1, -2), -1, -2)  # (..., d, 6)
     exists = singular > tolerances.RANK_TOLERANCE * np.maximum(singular[..., :1], 1e-300)
     return wrenches, twists, exists
 
 
 def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], members: tuple[int, ...],
                    points: list[NDArray], threshold: NDArray) -> NDArray:
-    """:math:`CTI_{N,L}` (N,) of one actuator set (its unit wrenches ``actuation``, (N, n, 6)) and one subsystem
-    ``members``: the lowest power coefficient of a released constraint wrench on the twist it frees."""
-    blocks = [own[i] for i in members]
-    system = np.concatenate([actuation, *blocks, shared], axis=-2)
-    count = system.shape[0]
-    values = np.full(count, np.inf)
+    """:math:`CTI_{N,L}` (N, S) of every actuator set (their unit wrenches ``actuation``, (N, S, n, 6)) and one
+    subsystem ``members``: the lowest power coefficient of a released constraint wrench on the twist it frees.
+    ``shared`` (N, c0, 6), ``own`` per chain (N, c_i, 6), ``points`` per chain (N, 3), ``threshold`` (N,)."""
+    sets = actuation.shape[1]
+    blocks = [np.broadcast_to(own[i][:, None], own[i].shape[:1] + (sets,) + own[i].shape[1:]) for i in members]
+    common = np.broadcast_to(shared[:, None], shared.shape[:1] + (sets,) + shared.shape[1:])
+    system = np.concatenate([actuation, *blocks, common], axis=-2)  # (N, S, rows, 6)
+    values = np.full(system.shape[:2], np.inf)
     if system.shape[-2] == 6:  # the chains' own wrenches are independent: one inverse frees every chain at once
         volume = np.prod(np.linalg.norm(system, axis=-1), axis=-1)
         regular = np.abs(np.linalg.det(system)) > tolerances.RANK_TOLERANCE * volume
         # W Y = I: column r of Y is orthogonal to every row but r, so as a twist (halves swapped) it is reciprocal
         # to every wrench but row r; chain i's columns span the twists freed by releasing its rows.
-        inverse = np.linalg.inv(np.where(regular[:, None, None], system, np.eye(6)))
+        inverse = np.linalg.inv(np.where(regular[..., None, None], system, np.eye(6)))
         start = actuation.shape[-2]
         freed_of = []
         for block in blocks:
             columns = _SWAP @ inverse[..., start:start + block.shape[-2]]
-            freed_of.append(np.linalg.qr(columns)[0])  # orthonormal, same span
+            freed_of.append(columns if block.shape[-2] == 1 else np.linalg.qr(columns)[0])  # same span, orthonormal
             start += block.shape[-2]
         valid_of = [None] * len(blocks)
     else:  # chains whose own wrenches overlap (each frees fewer twists than it holds wrenches): one null space each
         regular = _rank(system, tolerances.RANK_TOLERANCE) == 6
         freed_of, valid_of = [], []
-        for position in range(len(blocks)):
-            kept = [block for other, block in enumerate(blocks) if other != position]
-            rest = np.concatenate([actuation, *kept, shared], axis=-2)
-            padded = np.concatenate([_unit_rows(rest), np.zeros((count, max(0, 6 - rest.shape[-2]), 6))], axis=-2)
-            _, singular, right = np.linalg.svd(padded)
-            null = singular[..., -blocks[position].shape[-2]:] <= tolerances.RANK_TOLERANCE * singular[..., :1]
-            freed_of.append(_SWAP @ np.swapaxes(right[..., -blocks[position].shape[-2]:, :], -1, -2))
-            valid_of.append(null)
+        for position, block in enumerate(blocks):
+            rest = np.concatenate([actuation, *(b for k, b in enumerate(blocks) if k != position), common], axis=-2)
+            padding = np.zeros(rest.shape[:2] + (max(0, 6 - rest.shape[-2]), 6))
+            _, singular, right = np.linalg.svd(np.concatenate([_unit_rows(rest), padding], axis=-2))
+            size = block.shape[-2]
+            valid_of.append(singular[..., -size:] <= tolerances.RANK_TOLERANCE * singular[..., :1])
+            freed_of.append(_SWAP @ np.swapaxes(right[..., -size:, :], -1, -2))
     for index, block, freed, valid in zip(members, blocks, freed_of, valid_of):
         wrenches, twists, exists = _released_pairs(block, freed, valid)
-        centres = _project_on_axis(wrenches, points[index][:, None, :])
-        kappa = _coefficient(wrenches, twists, centres, threshold[:, None])
+        centres = _project_on_axis(wrenches, points[index][:, None, None, :])
+        kappa = _coefficient(wrenches, twists, centres, threshold[:, None, None])
         values = np.minimum(values, np.where(exists, kappa, np.inf).min(axis=-1))
     return np.where(regular & np.isfinite(values), values, 0.0)
 
@@ -335,12 +340,10 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         return result
     shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
     points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
+    actuation = wrenches[:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
     per_set = np.zeros((count, submechanisms.shape[0]))
-    for s, members in enumerate(submechanisms):
-        actuation = wrenches[:, members]
-        for subsystem in plan.subsystems:
-            per_set[:, s] = np.maximum(per_set[:, s], _subsystem_cti(actuation, shared, own, subsystem, points,
-                                                                     threshold))
+    for subsystem in plan.subsystems:
+        per_set = np.maximum(per_set, _subsystem_cti(actuation, shared, own, subsystem, points, threshold))
     per_set[singular] = 0.0
     result["cti_submechanisms"] = per_set
     result["cti"] = per_set.max(axis=-1)
