@@ -70,6 +70,12 @@ def by_name(result, renamed: dict[str, str] | None = None) -> dict:
             values[("left", j, frozenset(names[k] for k in failed))] = column
         values[("worst", j)] = [frozenset(frozenset(name(a) for a in case) for case in result.at(i).worst_fault_ties(j))
                                 for i in range(result.batch_shape[0])]
+    for i in range(min(4, result.batch_shape[0])):  # the limiting actuators a report names, by name
+        detail = result.at(i).to_dict()["lmti_detail"]
+        best = [detail["submechanism"], *detail["tied_submechanisms"]]
+        values[("best", i)] = [frozenset(frozenset(name(a) for a in sub) for sub in best)]
+        if len(best) == 1:
+            values[("limiting", i)] = [frozenset(name(a) for a in detail["limiting"])]
     values["cti"] = result.cti
     values["instantaneous_dof"] = result.instantaneous_dof
     values["constraint_singular"] = result.constraint_singular
