@@ -25,6 +25,7 @@ LAYERS = {
     "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
     "screwkit.transmission": 0, "screwkit.units": 0, "screwkit.motion": 0, "screwkit.outputs": 0,
     "screwkit.constraints": 0, "screwkit.reports": 0, "screwkit.link_faults": 0, "screwkit.actuator_sets": 0,
+    "screwkit.reference": 0,
     "screwkit": 0,
     "screwkit.model": 1, "screwkit.closure": 2, "screwkit.io": 2, "screwkit.loader": 3, "screwkit.studies": 4,
     "screwkit.plots": 5, "screwkit.viewer": 5, "screwkit.cli": 6,

@@ -332,6 +332,33 @@ def test_a_loop_left_open_by_the_file_is_closed_at_loading_and_said(tmp_path):
         np.testing.assert_allclose(second.reference_values, first.reference_values, atol=1e-12)
 
 
+def test_every_command_says_in_one_line_that_a_file_was_opened_closed(tmp_path):
+    """A typo in a link length leaves a loop open: each command analyses the closed mechanism and says so in one
+    line on stderr (which loop, how far, which joint moved most), not silently; --quiet silences it."""
+    text = _replace(bundled_text("planar_5rrr"), r'(<child link="chain_1_link_l" />\s*<origin xyz=")1 ', r"\g<1>1.05 ")
+    path = write(tmp_path, text, "typo.urdf")
+    commands = [("info",), ("analyze",), ("analyze", "--json"),
+                ("sweep", "--phi", "0:30:10", "--out", tmp_path / "s.nc"),
+                ("map", "--radius", "0.05", "--step", "0.05", "--phi-step", "30", "--out", tmp_path / "m.nc"),
+                ("view", "--html", tmp_path / "v.html"), ("verify", "--samples", "20")]
+    for command, *options in commands:
+        result = screwkit(command, path, *options)
+        assert result.returncode == 0, result.stderr
+        said = [line for line in result.stderr.splitlines() if "were closed at loading" in line]
+        assert len(said) == 1 and "loop 'chain_1_joint_d' was 0.05 m and 0 rad open" in said[0], result.stderr
+        assert "(most: 'chain_1_joint_d' by " in said[0]
+    quiet = screwkit("sweep", path, "--phi", "0:30:10", "--out", tmp_path / "q.nc", "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+def test_an_absurd_number_in_a_file_is_one_line_naming_the_element(tmp_path):
+    text = bundled_text("planar_5rrr").replace('<origin xyz="1 0 0" rpy="0 0 -2.037561665842193" />',
+                                               '<origin xyz="1e308 0 0" rpy="0 0 -2.037561665842193" />', 1)
+    result = screwkit("analyze", write(tmp_path, text, "absurd.urdf"))
+    assert result.returncode == 1 and result.stderr.count("\n") == 1
+    assert "<joint name='chain_1_joint_b'><origin>: 'xyz' = '1e308 0 0' is absurd for a robot" in result.stderr
+
+
 def test_the_chain_attribute_names_the_chain_and_defaults_to_the_loop_name(tmp_path):
     text = bundled_text("planar_5rrr").replace(' chain="chain_1"', "")
     renamed = load(write(tmp_path, text))

@@ -1,0 +1,84 @@
+"""The compiled, batched pipeline equals the plain-numpy reference (:mod:`screwkit.reference`).
+
+Every bundled mechanism (frame and point outputs, lower mobility with constraint wrenches, redundant and not)
+and a random design of every family, at random reachable poses: the ITI of every actuator, the OTI of every
+actuator of every submechanism, the LMTI, every F_Oj and F_IOj, the mutual-interference actuators, the
+instantaneous DOF, the CTI and every F_Cj, to 1e-10.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_relabelling import random_designs
+
+from helpers import random_reachable_poses
+from screwkit.closure import chain_screws, solve
+from screwkit.loader import bundled_names, load
+from screwkit.reference import reference_indices
+from screwkit.studies.poses import analyze_solution, output_points
+
+TOLERANCE = 1e-10
+COUNT = 6
+
+
+@pytest.fixture(scope="module")
+def designs():
+    return random_designs()
+
+
+def compare(mechanism, poses):
+    solution = solve(mechanism, poses)
+    result = analyze_solution(mechanism, solution, detail=True)
+    chains = chain_screws(mechanism, solution)
+    points = output_points(mechanism, solution.full_poses)
+    normal = mechanism.rotation_world_base[:, 2] if mechanism.is_planar else None
+    for i in range(poses.shape[0]):
+        expected = reference_indices([c.twists[i] for c in chains], [c.points[i] for c in chains],
+                                     [c.actuated for c in chains], mechanism.dof,
+                                     output_point=None if points is None else points[i], planar_normal=normal)
+        got = result.at(i)
+        np.testing.assert_allclose(got.iti_actuators, expected["iti_actuators"], atol=TOLERANCE, rtol=0)
+        for s, members in enumerate(got.submechanisms):
+            np.testing.assert_allclose(got.oti_actuators[s], expected["oti_actuators"][members], atol=TOLERANCE,
+                                       rtol=0, err_msg=f"OTIs of submechanism {members}")
+        for key in ("iti", "lmti"):
+            assert abs(getattr(got, key) - expected[key]) <= TOLERANCE, key
+        assert got.f_o.keys() == expected["f_o"].keys()
+        for j in got.f_o:
+            assert abs(got.f_o[j] - expected["f_o"][j]) <= TOLERANCE and abs(got.f_io[j] - expected["f_io"][j]) \
+                <= TOLERANCE, j
+        assert list(got.mutual_interference) == expected["mutual_interference"]
+        if got.instantaneous_dof is not None:
+            assert got.instantaneous_dof == expected["instantaneous_dof"]
+        if got.constraint_count:
+            assert abs(got.cti - expected["cti"]) <= TOLERANCE
+            for j in got.f_c:
+                assert abs(got.f_c[j] - expected["f_c"][j]) <= TOLERANCE
+        else:
+            assert "cti" not in expected
+    return result
+
+
+@pytest.mark.parametrize("name", bundled_names())
+def test_the_compiled_pipeline_equals_the_reference_on_every_bundled_mechanism(name):
+    mechanism = load(name)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(len(name)), COUNT, spread=0.5)
+    compare(mechanism, np.concatenate([mechanism.home_pose[None], poses]))
+
+
+@pytest.mark.parametrize("index", range(8))
+def test_the_compiled_pipeline_equals_the_reference_on_random_designs(designs, index):
+    mechanism = designs[index]
+    compare(mechanism, random_reachable_poses(mechanism, np.random.default_rng(index), COUNT, spread=0.5))
+
+
+def test_the_reference_sees_a_constraint_singularity():
+    """The symmetric 4-PRS at home: four constraint forces of rank three, 3 instantaneous DOF for mobility 2."""
+    from screwkit.loader import load_text
+    from screwkit.robots.generate import PRS_UPS, prs_mechanism
+
+    mechanism = load_text(prs_mechanism("prs_4", dict(PRS_UPS, prs_angles_deg=(0.0, 90.0, 180.0, 270.0)),
+                                        with_ups=False), "prs_4")
+    result = compare(mechanism, mechanism.home_pose[None] + np.array([[0.0, 0.0], [0.01, 0.05]]))
+    assert result.constraint_singular[0] and not result.constraint_singular[1]
