@@ -109,6 +109,14 @@ def _say(message: str) -> None:
         print(f"screwkit: {message}", file=sys.stderr, flush=True)
 
 
+def _user_cache() -> Path | None:
+    """numba's user-wide cache folder (``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``); None without a home."""
+    try:
+        return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba"
+    except RuntimeError:  # no HOME and no entry in the password database
+        return None
+
+
 _caching: bool | None = None
 _caching_lock = threading.Lock()
 
@@ -128,13 +136,13 @@ def numba_cache() -> bool:
             return _caching
         package = Path(__file__).resolve().parent
         configured = os.environ.get("NUMBA_CACHE_DIR")
-        user = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba"
+        user = _user_cache()
         if configured:
             tried = [Path(configured)]
             _caching = _writable(tried[0])
         else:
-            tried = [package / "__pycache__", package / "closure" / "__pycache__", user]
-            _caching = all(_writable(folder) for folder in tried[:2]) or _writable(user)
+            tried = [package / "__pycache__", package / "closure" / "__pycache__"] + ([user] if user else [])
+            _caching = all(_writable(folder) for folder in tried[:2]) or (user is not None and _writable(user))
         if _caching:
             return True
         try:
@@ -171,8 +179,8 @@ def _first_line(source: Path, function: str) -> int | None:
 def _cache_folders(source: Path) -> list[Path]:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return [Path(os.environ["NUMBA_CACHE_DIR"])]
-    home = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return [source.parent / "__pycache__", home / "numba"]
+    user = _user_cache()
+    return [source.parent / "__pycache__"] + ([user] if user else [])
 
 
 def kernel_is_cached(module: str) -> bool:
