@@ -471,6 +471,7 @@ def test_a_folder_given_as_the_mechanism_is_named_a_folder(tmp_path, monkeypatch
     (tmp_path / "robots").mkdir()
     for given in (tmp_path / "robots", "robots", "robots/"):
         one_line_error(screwkit("info", given), f"{given}: is a folder; expected a mechanism file")
+    one_line_error(screwkit("convert", "robots", "out.urdf"), "File 'robots' is a directory")
 
 
 def test_the_python_api_refuses_complex_and_boolean_poses_and_names_what_arrived_instead_of_a_mechanism():
