@@ -18,6 +18,13 @@ more children run at once than there are cores: a kernel asked for while every c
 ends: three kernels of 5, 6 and 10 s then take about 11 s on two cores, where three processes
 sharing them take about 12.5 s and slow the longest (measured on the hexapod's first run: 17.3 s
 against 18.9 s, a wall ratio of 0.84).
+
+Where the cache lives is decided once per process by :func:`numba_cache`, before the first kernel is
+compiled or looked for: numba's own choice when it can write there (``NUMBA_CACHE_DIR`` when set,
+else ``__pycache__`` beside screwkit's sources, else ``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``
+by default); when it cannot (a read-only install with no writable home), a folder of this user in
+the temporary folder; when not even that, no cache (every run compiles). Each fallback is said in
+one line on stderr. The kernels' modules take ``njit`` from :mod:`screwkit._jit`, which asks it.
 """
 
 from __future__ import annotations
@@ -25,12 +32,13 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
-           "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "CLOSED_FORM_KERNEL"]
+           "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "CLOSED_FORM_KERNEL"]
 
 KERNELS = {
     "screwkit._wrench_kernel": ("wrench_kernel", 6),
@@ -76,6 +84,87 @@ def silence() -> None:
     _silent = True
 
 
+def _writable(folder: Path) -> bool:
+    """Whether numba could cache in ``folder``: created if missing, and a file can be made in it (as numba tests)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:
+        return False
+    return True
+
+
+def _own_folder(folder: Path) -> bool:
+    """A folder only this user can write (``folder`` is in a shared temporary folder: numba loads what it finds)."""
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        status = folder.stat()
+    except OSError:
+        return False
+    return status.st_uid == os.getuid() and not status.st_mode & 0o022 and _writable(folder)
+
+
+def _say(message: str) -> None:
+    if not _silent:
+        print(f"screwkit: {message}", file=sys.stderr, flush=True)
+
+
+def _user_cache() -> Path | None:
+    """numba's user-wide cache folder (``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``); None without a home."""
+    try:
+        return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba"
+    except RuntimeError:  # no HOME and no entry in the password database
+        return None
+
+
+_caching: bool | None = None
+_caching_lock = threading.Lock()
+
+
+def numba_cache() -> bool:
+    """Decide, once per process, where numba caches compiled kernels; ``False``: compile without a cache.
+
+    numba's own choice when it can write there: ``NUMBA_CACHE_DIR`` when set, else ``__pycache__``
+    beside screwkit's sources, else ``$XDG_CACHE_HOME/numba`` (``~/.cache/numba``). Otherwise
+    ``NUMBA_CACHE_DIR`` is set (for this process and the ones it starts) to
+    ``screwkit-numba-UID`` in the temporary folder (``TMPDIR``), and if that cannot be written
+    either, kernels compile on every run. A line on stderr says which.
+    """
+    global _caching
+    with _caching_lock:
+        if _caching is not None:
+            return _caching
+        package = Path(__file__).resolve().parent
+        configured = os.environ.get("NUMBA_CACHE_DIR")
+        user = _user_cache()
+        if configured:
+            tried = [Path(configured)]
+            _caching = _writable(tried[0])
+        else:
+            tried = [package / "__pycache__", package / "closure" / "__pycache__"] + ([user] if user else [])
+            _caching = all(_writable(folder) for folder in tried[:2]) or (user is not None and _writable(user))
+        if _caching:
+            return True
+        try:
+            fallback = Path(tempfile.gettempdir()) / f"screwkit-numba-{os.getuid()}"
+        except OSError:  # no usable temporary folder at all
+            fallback = Path(os.environ.get("TMPDIR") or "/tmp") / f"screwkit-numba-{os.getuid()}"
+        places = ", ".join(str(folder) for folder in tried)
+        if _own_folder(fallback):
+            os.environ["NUMBA_CACHE_DIR"] = str(fallback)
+            config = sys.modules.get("numba.core.config")
+            if config is not None:  # numba read the environment when it was imported
+                config.CACHE_DIR = str(fallback)
+            _caching = True
+            _say(f"numba cannot write its cache in {places}; compiled kernels are cached in {fallback} "
+                 "(set NUMBA_CACHE_DIR to choose)")
+        else:
+            _caching = False
+            _say(f"numba cannot write its cache in {places} nor {fallback}: kernels are compiled on every run "
+                 "(set NUMBA_CACHE_DIR to a writable folder)")
+        return _caching
+
+
 def _first_line(source: Path, function: str) -> int | None:
     """The line numba names the function's cache after: its first decorator (``co_firstlineno``)."""
     lines = source.read_text(encoding="utf-8").splitlines()
@@ -90,14 +179,16 @@ def _first_line(source: Path, function: str) -> int | None:
 def _cache_folders(source: Path) -> list[Path]:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return [Path(os.environ["NUMBA_CACHE_DIR"])]
-    home = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return [source.parent / "__pycache__", home / "numba"]
+    user = _user_cache()
+    return [source.parent / "__pycache__"] + ([user] if user else [])
 
 
 def kernel_is_cached(module: str) -> bool:
     """Whether numba's cache holds an index for the module's kernel entry (see :data:`KERNELS`)."""
     import importlib.util
 
+    if not numba_cache():
+        return False
     function, _ = KERNELS[module]
     spec = importlib.util.find_spec(module)
     if spec is None or spec.origin is None:
@@ -170,7 +261,7 @@ def compile_ahead(*modules: str) -> None:
         if not missing:
             return
         cores = _cores()
-        parallel = cores > 1
+        parallel = cores > 1 and numba_cache()  # children compile into the cache, for this process to load
         busy = sum(child.poll() is None for child in _children.values()) + len(_queued)
         if not _silent:
             names = ", ".join(KERNELS[module][0] for module in missing[:-1])

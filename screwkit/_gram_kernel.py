@@ -12,9 +12,9 @@ dependent. Its own module, so that a mechanism without such chains never compile
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 from screwkit._kernels import BLOCK, cross, pseudo_inverse, solve, working_point, working_twist
 
 __all__ = ["gram_kernel"]

@@ -30,9 +30,9 @@ changed constant of another module.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 
 __all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND",
            "add_swapped_combination", "carry_arrays", "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes",

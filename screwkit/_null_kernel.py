@@ -13,9 +13,9 @@ a planar mechanism never compiles the lane-innermost elimination
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 from screwkit._kernels import (
     BLOCK,
     CARRY_SIGNATURE,

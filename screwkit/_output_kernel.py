@@ -20,9 +20,9 @@ writes overlaps what it reads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 from screwkit._kernels import (
     BLOCK,
     CARRY_SIGNATURE,

@@ -7,9 +7,9 @@ function (numba, cached on disk) and not the generic transmission kernel.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 
 
 @njit(nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)

@@ -15,9 +15,9 @@ others (in parallel on a first run, :mod:`screwkit._compile_notice`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from screwkit._fastmath import FASTMATH
+from screwkit._jit import njit
 from screwkit._kernels import (
     BLOCK,
     CARRY_SIGNATURE,

@@ -100,16 +100,24 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     Raises
     ------
     ValueError
-        Unknown name or missing file, or a file that breaks the convention (the message names
-        the file, the element and the problem).
+        Unknown name, a missing file or a folder, or a file that breaks the convention (the
+        message names the file, the element and the problem).
+    TypeError
+        ``name_or_path`` is neither a string nor a path.
     """
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise TypeError(f"Expected the name of a bundled mechanism ({', '.join(bundled_names())}) or a file path, "
+                        f"got {type(name_or_path).__name__} {name_or_path!r}.")
     text = os.fspath(name_or_path)
     looks_like_path = (isinstance(name_or_path, os.PathLike) or text.endswith((".urdf", ".xml", ".mjcf"))
                        or os.sep in text or "/" in text)
-    if not looks_like_path:
+    if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
     else:
         path = Path(text)
+        if path.is_dir():
+            raise ValueError(f"{text}: is a folder; expected a mechanism file (.urdf, or .xml/.mjcf for MJCF) or "
+                             f"a bundled name ({', '.join(bundled_names())}).")
         if not path.is_file():
             raise ValueError(f"{text}: no such file (bundled mechanisms are: {', '.join(bundled_names())}).")
         if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it

@@ -31,7 +31,7 @@ import numpy as np
 from screwkit.studies.files import FORMATS, save_figure  # re-exported: figures are saved from here
 
 __all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure",
-           "pareto_figure", "save_figure"]
+           "pareto_figure", "save_figure", "colour_scale"]
 
 COLORMAP = "viridis"
 """The colour map of every figure (perceptually uniform and colour-blind safe; never ``jet``)."""
@@ -141,8 +141,14 @@ def _with_minimum(label: str, values) -> str:
     return label if low is None else f"{label} (min {low:.3f})"
 
 
-def _scale(vmin, vmax) -> tuple[float, float]:
-    """The colour scale: ``None`` -> the end of :data:`INDEX_RANGE`; checked finite and increasing."""
+def colour_scale(vmin: float | None = None, vmax: float | None = None) -> tuple[float, float]:
+    """The colour scale of a map: ``None`` -> the end of :data:`INDEX_RANGE`; checked finite and increasing.
+
+    Raises
+    ------
+    ValueError
+        If an end is not finite or ``vmin >= vmax``.
+    """
     low = INDEX_RANGE[0] if vmin is None else float(vmin)
     high = INDEX_RANGE[1] if vmax is None else float(vmax)
     if not (np.isfinite(low) and np.isfinite(high) and low < high):
@@ -450,7 +456,7 @@ def map_figure(dataset, variables=None, reference=None, *, vmin=None, vmax=None,
         or ``vmin >= vmax``.
     """
     plt = _pyplot()
-    low, high = _scale(vmin, vmax)
+    low, high = colour_scale(vmin, vmax)
     dataset, reference = _as_dataset(dataset), _as_dataset(reference)
     rows = [dataset] + ([reference] if reference is not None else [])
     if variables is None:
@@ -577,7 +583,7 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     from matplotlib.lines import Line2D
 
     plt = _pyplot()
-    low, high = _scale(vmin, vmax)
+    low, high = colour_scale(vmin, vmax)
     step, level = float(step), float(level)
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"Expected `step` > 0, got {step!r}.")

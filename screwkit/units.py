@@ -8,11 +8,35 @@ Only the standard library is imported here.
 
 from __future__ import annotations
 
+import math
+
 ANGULAR_COORDINATES = frozenset({"phi", "roll", "pitch", "yaw"})
 """Task coordinates that are angles (rad in Python, deg at the command line)."""
 
 LENGTH_UNITS = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001, "um": 1e-6, "km": 1000.0, "in": 0.0254, "ft": 0.3048}
 """Length units a mechanism file may be written in, as their length in metres."""
+
+
+MAX_ANGLE_TURNS = 100
+"""Largest angle a pose or a range may hold, either sign, in turns (36,000 deg, 200 pi rad). No joint range
+or sweep needs more; at that size a double still holds an angle to 1e-13 rad, whereas at 1e20 deg it cannot
+tell one turn from the next, so such an angle is refused rather than analysed as if it meant something."""
+
+
+def angle_limit(*, degrees: bool) -> float:
+    """The largest angle accepted (:data:`MAX_ANGLE_TURNS` turns), in deg or rad.
+
+    >>> angle_limit(degrees=True)
+    36000.0
+    """
+    return MAX_ANGLE_TURNS * (360.0 if degrees else 2 * math.pi)
+
+
+def angle_beyond_limit(where: str, value: float, *, degrees: bool) -> ValueError:
+    """The error of an angle larger than :func:`angle_limit` (``where``: what held it)."""
+    unit = "deg" if degrees else "rad"
+    return ValueError(f"Expected angles of at most {angle_limit(degrees=degrees):g} {unit} ({MAX_ANGLE_TURNS} turns) "
+                      f"either way in {where}, got {value:g} {unit}.")
 
 
 def is_angular(coordinate: str) -> bool:

@@ -15,6 +15,24 @@ def screwkit(*arguments, timeout=300, **options) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=timeout, **options)
 
 
+def one_line_error(result: subprocess.CompletedProcess, *needles: str, after: tuple[str, ...] = ()) -> str:
+    """The single ``Error: ...`` line of a failed command, checked to contain every needle.
+
+    It is the last line on stderr; before it there is nothing, or only lines starting with one of ``after``
+    (what a command says as it works, ``planar_5rrr: mapping ...``, before a failure mid-run). No traceback,
+    no warning, nothing on stdout.
+    """
+    assert result.returncode == 1, (result.returncode, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert lines and lines[-1].startswith("Error: "), result.stderr
+    assert all(line.startswith(after) for line in lines[:-1]), result.stderr
+    assert "Traceback" not in result.stderr and "Warning" not in result.stderr
+    for needle in needles:
+        assert needle in lines[-1], (needle, lines[-1])
+    assert result.stdout == ""
+    return lines[-1]
+
+
 def rotation_2d(angle):
     angle = np.asarray(angle, dtype=float)
     return np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], -2)

@@ -17,7 +17,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "screwkit"
 
 LAYERS = {
     # the math core and what it shares: numpy only
-    "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._kernels": 0,
+    "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._jit": 0,
+    "screwkit._kernels": 0,
     "screwkit._wrench_kernel": 0, "screwkit._output_kernel": 0, "screwkit._index_kernels": 0,
     "screwkit._gram_kernel": 0, "screwkit._null_kernel": 0,
     "screwkit._planar_kernel": 0,

@@ -9,12 +9,16 @@ things mid-run. Nothing here uses a default distributed client.
 
 from __future__ import annotations
 
+import contextlib
+import http.server
 import json
 import os
 import signal
 import socket
+import socketserver
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -22,7 +26,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import screwkit
+from helpers import one_line_error, screwkit
 
 distributed = pytest.importorskip("distributed")
 
@@ -42,9 +46,10 @@ def free_port() -> int:
 class Cluster:
     """``dask scheduler`` and ``dask worker`` processes on 127.0.0.1, each in its own process group."""
 
-    def __init__(self, folder: Path, workers: int, scheduler_environment: dict | None = None):
+    def __init__(self, folder: Path, workers: int, scheduler_environment: dict | None = None,
+                 port: int | None = None):
         self.folder = folder
-        self.port = free_port()
+        self.port = free_port() if port is None else port
         self.address = f"tcp://127.0.0.1:{self.port}"
         self.logs = []
         self.scheduler = self.start("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", str(self.port),
@@ -137,14 +142,11 @@ def assert_same_file(expected: Path, actual: Path) -> None:
 
 
 def one_line(result: subprocess.CompletedProcess | tuple, *needles: str) -> str:
-    code, stdout, stderr = (result.returncode, result.stdout, result.stderr) if hasattr(result, "stderr") else result
-    assert code == 1, (code, stderr)
-    lines = stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), stderr
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
-    assert stdout == ""
-    return lines[0]
+    """The one-line error of a command (:func:`helpers.one_line_error`), after at most the map's size line."""
+    if not hasattr(result, "stderr"):
+        code, stdout, stderr = result
+        result = subprocess.CompletedProcess([], code, stdout, stderr)
+    return one_line_error(result, *needles, after=("planar_5rrr: mapping ",))
 
 
 def test_map_on_the_cluster_equals_the_local_map(cluster, local_map, tmp_path):
@@ -187,31 +189,99 @@ def test_a_worker_killed_mid_run_loses_nothing(cluster, local_map, tmp_path):
     assert_same_file(local_map, out)
 
 
-def test_an_unreachable_scheduler_fails_in_seconds_with_one_line(tmp_path):
+def test_an_unreachable_scheduler_fails_with_one_line_naming_the_address_and_the_timeout(tmp_path):
+    """Nothing listens: the command tries for --connect-timeout seconds, then exits with one line that says so
+    (the time limit of the subprocesses only guards against a hang)."""
     address = f"tcp://127.0.0.1:{free_port()}"
     out = tmp_path / "remote.nc"
-    start = time.perf_counter()
-    result = screwkit(*MAP, "--scheduler", address, "--out", out)
-    default = time.perf_counter() - start
-    one_line(result, f"Cannot reach the Dask scheduler at {address} within 3 s")
-    assert default < 5.0, default
-    # --connect-timeout is honoured, both ways.
-    start = time.perf_counter()
-    result = screwkit(*MAP, "--scheduler", address, "--out", out, "--connect-timeout", "0.5")
-    short = time.perf_counter() - start
-    one_line(result, "within 0.5 s")
-    assert short < default - 1.0, (short, default)
-    start = time.perf_counter()
-    result = screwkit(*SEARCH[:-2], "--scheduler", address, "--connect-timeout", "4")
-    longer = time.perf_counter() - start
-    one_line(result, f"Cannot reach the Dask scheduler at {address} within 4 s")
-    assert longer >= 4.0, longer
+    one_line(screwkit(*MAP, "--scheduler", address, "--out", out, timeout=120),
+             f"Cannot reach the Dask scheduler at {address} within 3 s", "Connection refused")
+    one_line(screwkit(*MAP, "--scheduler", address, "--out", out, "--connect-timeout", "0.5", timeout=120),
+             "within 0.5 s")
+    one_line(screwkit(*SEARCH[:-2], "--scheduler", address, "--connect-timeout", "4", timeout=120),
+             f"Cannot reach the Dask scheduler at {address} within 4 s")
     # An address that is no address, and the same with --json.
-    result = screwkit(*MAP, "--scheduler", "nowhere", "--out", out)
-    one_line(result, "Dask scheduler address 'nowhere'")
-    result = screwkit(*SEARCH[:-1], "--scheduler", address, "--connect-timeout", "0.5")
+    one_line(screwkit(*MAP, "--scheduler", "nowhere", "--out", out), "Dask scheduler address 'nowhere'")
+    result = screwkit(*SEARCH[:-1], "--scheduler", address, "--connect-timeout", "0.5", timeout=120)
     assert result.returncode == 1 and result.stderr == ""
     assert "Cannot reach the Dask scheduler" in json.loads(result.stdout)["error"]
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_scheduler_started_within_the_connect_timeout_is_waited_for(tmp_path_factory, tmp_path):
+    """--connect-timeout is how long the command keeps trying: a scheduler started after the command is found."""
+    port = free_port()
+    out = tmp_path / "late.nc"
+    command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", "map", "planar_5rrr", "--radius",
+                                "0.1", "--step", "0.05", "--phi-step", "90", "--out", str(out), "--scheduler",
+                                f"tcp://127.0.0.1:{port}", "--connect-timeout", "120"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        late = Cluster(tmp_path_factory.mktemp("late"), workers=1, port=port)
+        try:
+            stdout, stderr = command.communicate(timeout=300)
+        finally:
+            late.stop()
+    finally:
+        if command.poll() is None:
+            command.kill()
+    assert command.returncode == 0, stderr
+    assert out.read_bytes().startswith(b"CDF")
+
+
+class _Replying(socketserver.BaseRequestHandler):
+    """Answers every connection at once as a web server answers a request it cannot parse, then waits."""
+
+    def handle(self):
+        try:
+            self.request.sendall(b"HTTP/1.0 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+            while self.request.recv(4096):
+                pass
+        except ConnectionError:  # the client hung up
+            pass
+
+
+class _Quiet(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *arguments):
+        pass
+
+
+@contextlib.contextmanager
+def listener(kind: str):
+    """A server on loopback that is not a Dask scheduler: ``http`` (a web server, waiting for a request line
+    as on a dashboard's port) or ``reply`` (one that answers at once, something else than Dask's frames)."""
+    server_class = http.server.ThreadingHTTPServer if kind == "http" else socketserver.ThreadingTCPServer
+    server = server_class(("127.0.0.1", 0), _Quiet if kind == "http" else _Replying)
+    server.daemon_threads = True
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.mark.parametrize("kind, found", [("http", "no Dask handshake within 1 s"),
+                                         ("reply", "its answer is not Dask's handshake")])
+def test_an_address_that_answers_but_is_not_dask_fails_within_the_timeout_with_one_line(tmp_path, kind, found):
+    """A web server on the port (the dashboard's, given by mistake) hung the command for good; one that answered
+    at once ended in a traceback of an allocation of 3 EiB. The subprocesses' time limit is a hang guard."""
+    out = tmp_path / "remote.nc"
+    with listener(kind) as address:
+        mapped = screwkit(*MAP, "--scheduler", address, "--connect-timeout", "1", "--out", out, timeout=120)
+        searched = screwkit(*SEARCH[:-1], "--scheduler", address, "--connect-timeout", "1", timeout=120)
+    one_line(mapped, f"The address {address} answers but is not a Dask scheduler", found)
+    assert searched.returncode == 1 and searched.stderr == ""
+    error = json.loads(searched.stdout)["error"]
+    assert error.startswith(f"The address {address} answers but is not a Dask scheduler") and found in error
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_tls_address_without_tls_settings_is_refused_with_one_line(tmp_path):
+    address = f"tls://127.0.0.1:{free_port()}"
+    one_line(screwkit(*MAP, "--scheduler", address, "--out", tmp_path / "remote.nc"),
+             f"Cannot connect to the Dask scheduler at {address}: a tls:// address needs TLS settings")
     assert os.listdir(tmp_path) == []
 
 
@@ -226,10 +296,8 @@ def test_a_scheduler_lost_mid_run_gives_one_line_and_no_file(tmp_path_factory, t
             done, total = lost.wait_until_some_finished(command)
             lost.close_client()
             lost.kill(lost.scheduler)
-            killed = time.perf_counter()
             assert command.poll() is None, "the kill came after the run"
-            stdout, stderr = command.communicate(timeout=60)
-            ended = time.perf_counter() - killed
+            stdout, stderr = command.communicate(timeout=60)  # a hang guard: it ends at once
         finally:
             if command.poll() is None:
                 command.kill()
@@ -238,7 +306,6 @@ def test_a_scheduler_lost_mid_run_gives_one_line_and_no_file(tmp_path_factory, t
     assert 5 <= done < total, (done, total)
     one_line((command.returncode, stdout, stderr), f"Lost the Dask scheduler at {lost.address} mid-run",
              "nothing was written")
-    assert ended < 15, ended
     assert os.listdir(tmp_path) == []  # no output, no temporary file
 
 

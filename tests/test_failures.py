@@ -2,8 +2,9 @@
 
 Each refusal is exactly one line on stderr (``Error: ...``) naming the file, element, chain or
 option, with exit status 1 and no traceback or warning; refusals of outputs and of huge maps
-come before any computation (well within a time the computation would exceed) and leave no
-file behind. The command runs in a subprocess with ``-W error`` (``helpers.screwkit``).
+come before any computation (a map states its size on stderr before it starts: the refusal is
+the only line) and leave no file behind. The command runs in a subprocess with ``-W error``
+(``helpers.screwkit``); its time limit only guards against a hang.
 """
 
 from __future__ import annotations
@@ -15,47 +16,26 @@ import re
 import shutil
 import subprocess
 import sys
-import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from helpers import in_millimetres, screwkit
+from helpers import in_millimetres, one_line_error, screwkit
 from screwkit.closure import UnreachablePose, solve, solve_one
 from screwkit.closure.solve import MISSES_CLOSURE, OUTSIDE_LIMITS
 from screwkit.loader import bundled_path, load
-from screwkit.model.urdf_reader import MAX_FILE_BYTES, MAX_LINKS, MAX_TREE_DEPTH, read_urdf
+from screwkit.model.urdf_reader import MAX_FILE_BYTES, MAX_LINKS, MAX_TREE_DEPTH
 from screwkit.model.urdf_writer import planar_rrr_urdf
 from screwkit.studies.maps import MAX_CONFIGURATIONS, MapSize, disc_grid, disc_size, map_size, planar_disc_map
 
 SLOW_MAP = ("map", "planar_5rrr", "--radius", "0.6", "--step", "0.005", "--phi-step", "1")
 """A map of 16 million configurations: about 20 s of computation on a 2-core machine."""
-QUICK = 5.0
-"""Seconds within which a refusal must come (the refused computation takes several times longer)."""
 
 
 def bundled_text(name: str) -> str:
     return bundled_path(name).read_text(encoding="utf-8")
-
-
-def one_line_error(result: subprocess.CompletedProcess, *needles: str) -> str:
-    """The single ``Error: ...`` line of a failed command, checked to contain every needle."""
-    assert result.returncode == 1, (result.returncode, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
-    assert "Traceback" not in result.stderr and "Warning" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
-    assert result.stdout == ""
-    return lines[0]
-
-
-def timed(*arguments, **options) -> tuple[subprocess.CompletedProcess, float]:
-    start = time.perf_counter()
-    result = screwkit(*arguments, **options)
-    return result, time.perf_counter() - start
 
 
 def write(path: Path, text: str) -> Path:
@@ -159,9 +139,7 @@ def deep_chain(count: int) -> str:
 def test_a_tree_too_deep_for_pinocchio_is_refused_instead_of_crashing(tmp_path):
     """Pinocchio's parser recurses once per level: 5,000 levels crashed the process (SIGSEGV)."""
     path = write(tmp_path / "deep.urdf", deep_chain(5000))
-    result, elapsed = timed("info", path)
-    one_line_error(result, str(path), f"more than the {MAX_TREE_DEPTH} levels", "MAX_TREE_DEPTH")
-    assert elapsed < QUICK
+    one_line_error(screwkit("info", path), str(path), f"more than the {MAX_TREE_DEPTH} levels", "MAX_TREE_DEPTH")
     allowed = write(tmp_path / "allowed.urdf", deep_chain(MAX_TREE_DEPTH - 1))  # the platform is one level down
     assert screwkit("info", allowed).returncode == 0
 
@@ -283,24 +261,24 @@ def test_indices_at_reachable_poses_do_not_depend_on_limits(mechanism, pose):
 # -- huge inputs ---------------------------------------------------------------------------------
 
 
-def test_a_map_too_large_for_memory_is_refused_in_seconds_with_its_size(tmp_path):
-    """--step 1e-5 once died allocating 107 GiB; --step 1e-4 started without a word and grew past 9.7 GB."""
+def test_a_map_too_large_for_memory_is_refused_before_it_starts_with_its_size(tmp_path):
+    """--step 1e-5 once died allocating 107 GiB; --step 1e-4 started without a word and grew past 9.7 GB.
+    The refusal is the only line: the map never stated its size, which it does before it starts."""
     out = tmp_path / "huge.nc"
-    result, elapsed = timed("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-5", "--out", out, timeout=60)
+    result = screwkit("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-5", "--out", out, timeout=120)
     line = one_line_error(result, "configurations", "grid points", "360 orientations", "GiB", "coarser grid")
-    assert elapsed < QUICK and not out.exists()
+    assert not out.exists()
     stated = int(re.search(r"([0-9,]+) configurations", line).group(1).replace(",", ""))
     assert stated == pytest.approx(math.pi * (0.6 / 1e-5) ** 2 * 360, rel=1e-3)  # pi r^2 / step^2 points x 360
     # Proceeding does not lift a refusal for memory.
-    result, elapsed = timed("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-5", "--yes", timeout=60)
-    one_line_error(result, "GiB")
+    one_line_error(screwkit("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-5", "--yes", timeout=120), "GiB")
 
 
 def test_a_map_above_the_configuration_limit_needs_yes(tmp_path):
     out = tmp_path / "large.nc"
-    result, elapsed = timed("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-4", "--out", out, timeout=60)
+    result = screwkit("map", "planar_5rrr", "--radius", "0.6", "--step", "1e-4", "--out", out, timeout=120)
     line = one_line_error(result, f"more than {MAX_CONFIGURATIONS:,}", "--yes")
-    assert elapsed < QUICK and not out.exists()
+    assert not out.exists()
     stated = int(re.search(r"([0-9,]+) configurations", line).group(1).replace(",", ""))
     assert stated > MAX_CONFIGURATIONS
 
@@ -365,55 +343,35 @@ def test_a_file_over_the_size_cap_is_refused_unread(tmp_path):
     """A 50 MB URDF of 189,081 links was read for 35 minutes."""
     big = write(tmp_path / "big.urdf", minimal_links(160_000))
     assert big.stat().st_size > MAX_FILE_BYTES
-    result, elapsed = timed("info", big)
-    one_line_error(result, str(big), f"{big.stat().st_size:,} bytes", f"{MAX_FILE_BYTES:,}", "MAX_FILE_BYTES")
-    assert elapsed < QUICK
-    # Refused before reading: a sparse 4 GiB file (zeros, not XML) is refused as fast, for its size alone.
+    one_line_error(screwkit("info", big), str(big), f"{big.stat().st_size:,} bytes", f"{MAX_FILE_BYTES:,}",
+                   "MAX_FILE_BYTES")
+    # Refused before reading: a sparse 4 GiB file (zeros, not XML) is refused for its size, not as bad XML.
     sparse = tmp_path / "sparse.urdf"
     with open(sparse, "wb") as handle:
         handle.truncate(4 * 2**30)
-    result, elapsed = timed("info", sparse)
-    one_line_error(result, str(sparse), f"{4 * 2**30:,} bytes")
-    assert elapsed < QUICK
+    one_line_error(screwkit("info", sparse, timeout=120), str(sparse), f"{4 * 2**30:,} bytes")
 
 
-def test_a_file_with_too_many_links_is_refused_in_seconds(tmp_path):
+def test_a_file_with_too_many_links_is_refused_before_pinocchio_builds_it(tmp_path):
     """Pinocchio's model building grows with the square of the links: 148,000 took 8.5 min."""
     path = write(tmp_path / "many.urdf", minimal_links(MAX_LINKS))
-    result, elapsed = timed("info", path)
-    one_line_error(result, str(path), f"{MAX_LINKS + 12:,} links", f"more than the {MAX_LINKS:,}", "MAX_LINKS")
-    assert elapsed < QUICK
+    one_line_error(screwkit("info", path), str(path), f"{MAX_LINKS + 12:,} links", f"more than the {MAX_LINKS:,}",
+                   "MAX_LINKS")
 
 
-def best_time(function, repeats: int = 3) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return min(times)
-
-
-def test_reading_is_linear_in_the_file_size(tmp_path):
-    small = write(tmp_path / "small.urdf", minimal_links(2000))
-    large = write(tmp_path / "large.urdf", minimal_links(8000))
-    ratio = large.stat().st_size / small.stat().st_size
-    assert 3.5 < ratio < 4.5
-    read_ratio = best_time(lambda: read_urdf(large)) / best_time(lambda: read_urdf(small))
-    assert read_ratio < 2 * ratio, read_ratio  # quadratic would be 16
-    # The largest file allowed loads in seconds, Pinocchio included.
+def test_the_largest_file_allowed_loads(tmp_path):
+    """Pinocchio included (how the reading time grows with the file: benchmarks/bench_reading.py)."""
     largest = write(tmp_path / "largest.urdf", minimal_links(MAX_LINKS - 12))
-    result, elapsed = timed("info", largest, "--json")
+    result = screwkit("info", largest, "--json")
     assert result.returncode == 0, result.stderr
-    assert elapsed < 15.0
+    assert json.loads(result.stdout)["mechanism"] == "planar_5rrr"
 
 
 # -- outputs -------------------------------------------------------------------------------------
 
 
-def assert_refused_early(result, elapsed, folder: Path, *needles: str, before: set | None = None) -> None:
-    one_line_error(result, *needles)
-    assert elapsed < QUICK, elapsed  # the map itself takes about 20 s
+def assert_refused_early(result, folder: Path, *needles: str, before: set | None = None) -> None:
+    one_line_error(result, *needles)  # the only line: the map did not start (it states its size first)
     after = set(os.listdir(folder)) if folder.is_dir() else set()
     assert after == (before or set()), after  # nothing written, no temporary file left
 
@@ -424,20 +382,20 @@ def assert_refused_early(result, elapsed, folder: Path, *needles: str, before: s
 ])
 def test_a_bad_output_is_refused_before_the_computation(tmp_path, name, problem):
     out = tmp_path / name
-    result, elapsed = timed(*SLOW_MAP, "--out", out, timeout=120)
-    assert_refused_early(result, elapsed, tmp_path, f"--out {out}", problem)
+    result = screwkit(*SLOW_MAP, "--out", out, timeout=120)
+    assert_refused_early(result, tmp_path, f"--out {out}", problem)
 
 
 def test_a_bad_figure_suffix_is_refused_before_the_computation(tmp_path):
     figure = tmp_path / "map.jpg"
-    result, elapsed = timed(*SLOW_MAP, "--out", tmp_path / "map.nc", "--figure", figure, timeout=120)
-    assert_refused_early(result, elapsed, tmp_path, f"--figure {figure}", ".png, .pdf, .svg")
+    result = screwkit(*SLOW_MAP, "--out", tmp_path / "map.nc", "--figure", figure, timeout=120)
+    assert_refused_early(result, tmp_path, f"--figure {figure}", ".png, .pdf, .svg")
 
 
 def test_an_output_that_is_a_folder_is_refused(tmp_path):
     (tmp_path / "map.nc").mkdir()
-    result, elapsed = timed(*SLOW_MAP, "--out", tmp_path / "map.nc", timeout=120)
-    assert_refused_early(result, elapsed, tmp_path, str(tmp_path / "map.nc"), "is a directory", "--help",
+    result = screwkit(*SLOW_MAP, "--out", tmp_path / "map.nc", timeout=120)
+    assert_refused_early(result, tmp_path, str(tmp_path / "map.nc"), "is a directory", "--help",
                          before={"map.nc"})
 
 
@@ -462,22 +420,21 @@ def unwritable_folder(tmp_path):
 
 def test_a_read_only_folder_is_refused_before_the_computation(unwritable_folder):
     out = unwritable_folder / "map.nc"
-    result, elapsed = timed(*SLOW_MAP, "--out", out, timeout=120)
-    assert_refused_early(result, elapsed, unwritable_folder, f"--out {out}", "cannot write in the folder")
+    result = screwkit(*SLOW_MAP, "--out", out, timeout=120)
+    assert_refused_early(result, unwritable_folder, f"--out {out}", "cannot write in the folder")
 
 
 def test_a_folder_that_takes_no_files_is_refused_before_the_computation():
     """/proc takes no new files, although os.access says it is writable for root."""
-    result, elapsed = timed(*SLOW_MAP, "--out", "/proc/map.nc", timeout=120)
+    result = screwkit(*SLOW_MAP, "--out", "/proc/map.nc", timeout=120)
     one_line_error(result, "--out /proc/map.nc", "cannot write in the folder /proc")
-    assert elapsed < QUICK
 
 
 def test_an_existing_output_is_replaced_only_with_overwrite(tmp_path):
     out = tmp_path / "map.nc"
     out.write_bytes(b"earlier result")
-    result, elapsed = timed(*SLOW_MAP, "--out", out, timeout=120)
-    assert_refused_early(result, elapsed, tmp_path, f"--out {out}", "the file exists; pass --overwrite",
+    result = screwkit(*SLOW_MAP, "--out", out, timeout=120)
+    assert_refused_early(result, tmp_path, f"--out {out}", "the file exists; pass --overwrite",
                          before={"map.nc"})
     assert out.read_bytes() == b"earlier result"
     replaced = screwkit("map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--phi-step", "30", "--out", out,
@@ -490,8 +447,8 @@ def test_a_read_only_existing_output_is_kept_even_with_overwrite(tmp_path):
     out = tmp_path / "map.nc"
     out.write_bytes(b"protected")
     out.chmod(0o444)
-    result, elapsed = timed(*SLOW_MAP, "--out", out, "--overwrite", timeout=120)
-    assert_refused_early(result, elapsed, tmp_path, f"--out {out}", "read-only", before={"map.nc"})
+    result = screwkit(*SLOW_MAP, "--out", out, "--overwrite", timeout=120)
+    assert_refused_early(result, tmp_path, f"--out {out}", "read-only", before={"map.nc"})
     assert out.read_bytes() == b"protected"
 
 

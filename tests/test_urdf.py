@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -129,11 +127,10 @@ def test_bad_documents_raise_one_line_errors_naming_file_and_element(document, e
 
 
 @pytest.mark.parametrize("document", [BILLION_LAUGHS, EXTERNAL_ENTITY, BILLION_LAUGHS.replace("DOCTYPE", "doctype")])
-def test_entity_declarations_are_refused_fast_without_expansion(document):
-    start = time.perf_counter()
+def test_entity_declarations_are_refused_without_expansion(document):
+    """Refused at the declaration itself (an expanded bomb takes gigabytes and minutes)."""
     with pytest.raises(ValueError, match=r"bomb\.urdf: <!DOCTYPE> at line 2: document type and entity declarations"):
         parse_urdf(document.encode(), "bomb.urdf")
-    assert time.perf_counter() - start < 1.0  # an expanded bomb takes gigabytes and minutes
 
 
 def test_entity_bomb_file_is_refused_before_pinocchio_sees_it(tmp_path):
@@ -141,10 +138,8 @@ def test_entity_bomb_file_is_refused_before_pinocchio_sees_it(tmp_path):
     path.write_text(BILLION_LAUGHS)
     from screwkit.loader import load
 
-    start = time.perf_counter()
     with pytest.raises(ValueError, match="document type and entity declarations are refused"):
         load(path)
-    assert time.perf_counter() - start < 1.0  # an expanded bomb takes gigabytes and minutes
 
 
 def test_bare_entity_declaration_is_refused():

@@ -27,6 +27,7 @@ COMMANDS = {
     "sweep": "screwkit.cli.sweep:sweep",
     "map": "screwkit.cli.map_command:map_command",
     "design-search": "screwkit.cli.design_search:design_search",
+    "plot": "screwkit.cli.plot:plot",
     "view": "screwkit.cli.view:view",
     "warmup": "screwkit.cli.warmup:warmup",
 }
@@ -73,6 +74,11 @@ def main() -> None:
     if code is not None and not isinstance(code, int):
         print(code, file=sys.stderr)
         code = 1
-    sys.stdout.flush()
+    try:
+        sys.stdout.flush()
+    except OSError as error:  # stdout is a file on a full disk (or a closed pipe): one line, not a traceback
+        if not code:  # (a failed command has said why already)
+            print(f"Error: Cannot write to stdout: {error.strerror or error}.", file=sys.stderr)
+        code = 1
     sys.stderr.flush()
     os._exit(code or 0)

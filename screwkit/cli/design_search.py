@@ -10,6 +10,7 @@ from click.core import ParameterSource
 
 from screwkit.cli.family_search import parse_assignments, parse_bounds, read_study, region_of, search_family
 from screwkit.cli.options import (
+    check_colour_scale,
     check_outputs,
     fail,
     json_option,
@@ -17,9 +18,11 @@ from screwkit.cli.options import (
     load_mechanism,
     overwrite_option,
     quiet_option,
+    scheduler_client,
 )
 from screwkit.studies import design as search
 from screwkit.studies.families import FAMILIES, family
+from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 from screwkit.studies.objectives import METRICS
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 
@@ -162,9 +165,10 @@ def _design_search(mechanism, search_permutations, optimise, legs, objectives, c
                    "--optimise, not --permutations.")
     if maxiter is not None and budget is not None:
         raise fail("Give --budget or --maxiter, not both.")
-    check_outputs({"--urdf": (urdf_path, (".urdf",)), "--table": (table_path, (".nc", ".csv")),
-                   "--figure": (figure_path, (".png", ".pdf", ".svg")),
-                   "--front-figure": (front_figure_path, (".png", ".pdf", ".svg"))}, overwrite, quiet)
+    check_outputs({"--urdf": (urdf_path, (".urdf",)), "--table": (table_path, DATA_SUFFIXES),
+                   "--figure": (figure_path, FIGURE_SUFFIXES), "--front-figure": (front_figure_path, FIGURE_SUFFIXES)},
+                  overwrite, quiet, others={"--state": state})
+    check_colour_scale(vmin, vmax)
     if family_mode:
         try:
             chosen = family(mechanism, legs)
@@ -181,11 +185,12 @@ def _design_search(mechanism, search_permutations, optimise, legs, objectives, c
             raise fail(str(error)) from None
         if search_permutations:
             current = tuple(int(s) for s in search.slots_of(template))
-            try:
-                _permutations(loaded, template, current, 1.0 if phi_step is None else phi_step, closed_forms,
-                              scheduler, connect_timeout, top, as_json, quiet)
-            except ClusterError as error:
-                raise fail(str(error)) from None
+            with scheduler_client(scheduler, connect_timeout) as client:  # the handshake before any work
+                try:
+                    _permutations(loaded, template, current, 1.0 if phi_step is None else phi_step, closed_forms,
+                                  client, connect_timeout, top, as_json, quiet)
+                except ClusterError as error:
+                    raise fail(str(error)) from None
             return
         try:
             count, values = search.family_values(template)
@@ -205,10 +210,11 @@ def _design_search(mechanism, search_permutations, optimise, legs, objectives, c
     varied_count = len(free or [n for n in chosen.free if n not in fixed])
     if maxiter is not None:
         budget = popsize * varied_count * (maxiter + 1)
-    search_family(chosen, region, objectives=objectives, constraints=constraints,
-                  free=free or [n for n in chosen.free if n not in fixed], fixed=fixed, initial=initial,
-                  bounds=parse_bounds(chosen, bound_texts), budget=384 if budget is None else budget, seed=seed,
-                  popsize=popsize, state=state, scheduler=scheduler, connect_timeout=connect_timeout,
-                  urdf_path=urdf_path, table_path=table_path, figure_path=figure_path,
-                  front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet,
-                  start_name=None if family_mode else loaded.name, top=top)
+    with scheduler_client(scheduler, connect_timeout) as client:  # the handshake before any work
+        search_family(chosen, region, objectives=objectives, constraints=constraints,
+                      free=free or [n for n in chosen.free if n not in fixed], fixed=fixed, initial=initial,
+                      bounds=parse_bounds(chosen, bound_texts), budget=384 if budget is None else budget, seed=seed,
+                      popsize=popsize, state=state, scheduler=client, connect_timeout=connect_timeout,
+                      urdf_path=urdf_path, table_path=table_path, figure_path=figure_path,
+                      front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet,
+                      start_name=None if family_mode else loaded.name, top=top)

@@ -198,7 +198,7 @@ def search_family(family: Family, region, *, objectives, constraints, free, fixe
                    f"region {region.describe()}")
     try:
         result = run_study(study, scheduler=scheduler, progress=False if quiet else None, state=state,
-                           connect_timeout=connect_timeout)
+                           connect_timeout=connect_timeout, notify=None if quiet else echo_error)
     except (StateError, ClusterError) as error:
         raise fail(str(error)) from None
     if not result.best:

@@ -8,7 +8,9 @@ import click
 
 from screwkit.cli.options import (
     GreedyOption,
+    check_colour_scale,
     check_outputs,
+    colour_scale_options,
     echo_error,
     fail,
     fault_option,
@@ -19,11 +21,13 @@ from screwkit.cli.options import (
     overwrite_option,
     parse_range,
     quiet_option,
+    scheduler_client,
     threshold_option,
 )
 from screwkit.cli.sweep import fixed_pose, write_outputs
 from screwkit.plots import map_figure
-from screwkit.studies.maps import index_map, planar_disc_map
+from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
+from screwkit.studies.maps import disc_size, index_map, map_size, planar_disc_map
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 from screwkit.units import is_angular
 
@@ -55,10 +59,7 @@ def grid_spec(mechanism, text: str, option: str, include_stop: bool):
               help="Spatial: the other coordinates, all task coordinates (m, deg) or a named pose; default home.")
 @click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
 @click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file: .png, .pdf or .svg.")
-@click.option("--vmin", type=float, default=None,
-              help="Lower end of the figure's colour scale (index value; default 0).")
-@click.option("--vmax", type=float, default=None,
-              help="Upper end of the figure's colour scale (index value; default 1).")
+@colour_scale_options
 @threshold_option
 @fault_option
 @click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
@@ -85,30 +86,48 @@ def map_command(mechanism, radius, step, phi_step, grids, overs, at, out, figure
     The size of the map is stated, and a map too large refused, before anything is computed.
     """
 
-    check_outputs({"--out": (out, (".nc", ".csv")), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
-                  overwrite, quiet)
+    check_outputs({"--out": (out, DATA_SUFFIXES), "--figure": (figure_path, FIGURE_SUFFIXES)}, overwrite, quiet)
+    check_colour_scale(vmin, vmax)
+    planar = radius is not None or step is not None
+    if planar:
+        if radius is None or step is None or grids or overs:
+            raise fail("A planar map takes --radius and --step (and --phi-step), not --grid/--over.")
+        if not 0 < phi_step <= 360:
+            raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
+    elif len(grids) != 2:
+        raise fail("Expected --radius/--step (planar) or exactly two --grid options.")
     loaded = load_mechanism(mechanism, length_unit)
-    options = dict(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms, limits=not ignore_limits,
-                   scheduler=scheduler, progress=False if quiet else None, connect_timeout=connect_timeout,
-                   configurations_per_task=task_size, as_dataset=False, proceed=yes)
-    start = time.perf_counter()
     try:
-        if radius is not None or step is not None:
-            if radius is None or step is None or grids or overs:
-                raise fail("A planar map takes --radius and --step (and --phi-step), not --grid/--over.")
-            if not 0 < phi_step <= 360:
-                raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
-            result = planar_disc_map(loaded, radius, step, phi_step, **options)
+        if planar:
+            if not loaded.is_planar:
+                raise fail(f"--radius and --step map a planar mechanism's disc; {loaded.name!r} is spatial: give "
+                           "--grid twice and --over.")
+            size = disc_size(loaded, radius, step, phi_step)
         else:
-            if len(grids) != 2:
-                raise fail("Expected --radius/--step (planar) or exactly two --grid options.")
             grid = dict(grid_spec(loaded, g, "--grid", True) for g in grids)
             if len(grid) != 2:
                 raise fail(f"Expected two different coordinates in --grid, got {' '.join(grids)}.")
             over = dict(grid_spec(loaded, o, "--over", False) for o in overs)
-            result = index_map(loaded, grid, over, fixed_pose(loaded, at), **options)
-    except (ValueError, ClusterError) as error:
+            at_pose = fixed_pose(loaded, at)
+            size = map_size(loaded, grid, over)
+        size.check(proceed=yes)
+    except ValueError as error:
         raise fail(str(error)) from None
+    with scheduler_client(scheduler, connect_timeout) as client:
+        if not quiet:  # before the work, whether or not stderr is a terminal
+            echo_error(f"{loaded.name}: mapping {size.description}")
+        options = dict(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms,
+                       limits=not ignore_limits, scheduler=client, progress=False if quiet else None,
+                       connect_timeout=connect_timeout, configurations_per_task=task_size, as_dataset=False,
+                       proceed=yes)
+        start = time.perf_counter()
+        try:
+            if planar:
+                result = planar_disc_map(loaded, radius, step, phi_step, **options)
+            else:
+                result = index_map(loaded, grid, over, at_pose, **options)
+        except (ValueError, ClusterError) as error:
+            raise fail(str(error)) from None
     elapsed = time.perf_counter() - start
     if not quiet:
         echo_error(f"{loaded.name}: {result.attrs['configurations']:,} configurations in {elapsed:.2f} s "

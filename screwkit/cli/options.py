@@ -7,6 +7,8 @@ on stdout with ``--json``) and exit status 1; outputs checked before any computa
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import sys
 from typing import Callable
@@ -16,10 +18,12 @@ import numpy as np
 
 from screwkit._compile_notice import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.loader import load
-from screwkit.studies.files import check_output
+from screwkit.plots import colour_scale
+from screwkit.studies.files import WriteError, check_distinct, check_output
 from screwkit.studies.maps import range_values
+from screwkit.studies.tasks import ClusterError, connect, disconnect
 from screwkit.tolerances import SINGULARITY_THRESHOLD
-from screwkit.units import LENGTH_UNITS, is_angular
+from screwkit.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 
 __all__ = [
     "GreedyOption",
@@ -32,10 +36,13 @@ __all__ = [
     "json_option",
     "quiet_option",
     "overwrite_option",
+    "colour_scale_options",
     "load_mechanism",
     "parse_pose",
     "parse_range",
     "check_outputs",
+    "check_colour_scale",
+    "scheduler_client",
     "fail",
     "echo_error",
 ]
@@ -63,10 +70,15 @@ class ScrewkitGroup(click.Group):
             message = error.format_message()
             if isinstance(error, click.UsageError) and error.ctx is not None:  # one line, not click's usage block
                 message = f"{message} See '{error.ctx.command_path} --help'."
-            if "--json" in arguments:
-                click.echo(json.dumps({"error": message}))
-            else:
-                click.echo(f"Error: {message}", err=True)
+            _report(message, arguments)
+            if standalone_mode:
+                sys.exit(1)
+            raise
+        except OSError as error:  # a write that failed (disk full, quota, read-only), of a file or of stdout
+            if not isinstance(error, WriteError) and error.errno not in _WRITE_FAILURES:
+                raise
+            _report(str(error) if isinstance(error, WriteError) else
+                    f"Cannot write {error.filename or 'to stdout'}: {error.strerror}.", arguments)
             if standalone_mode:
                 sys.exit(1)
             raise
@@ -78,6 +90,22 @@ class ScrewkitGroup(click.Group):
         if standalone_mode:
             sys.exit(result if isinstance(result, int) else 0)
         return result
+
+
+_WRITE_FAILURES = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}
+"""What a write that fails says: no space left, quota exceeded, file too large, read-only file system."""
+
+
+def _report(message: str, arguments: list[str]) -> None:
+    """An error as one line: ``Error: ...`` on stderr, or ``{"error": ...}`` on stdout with ``--json`` (on
+    stderr if stdout itself cannot be written)."""
+    if "--json" in arguments:
+        try:
+            click.echo(json.dumps({"error": message}))
+            return
+        except OSError:
+            pass
+    click.echo(f"Error: {message}", err=True)
 
 
 class GreedyOption(click.Option):
@@ -171,6 +199,14 @@ def overwrite_option(function: Callable) -> Callable:
     return click.option("--overwrite", is_flag=True, help="Replace output files that exist.")(function)
 
 
+def colour_scale_options(function: Callable) -> Callable:
+    """``--vmin`` and ``--vmax``: the ends of a map figure's colour scale (:func:`check_colour_scale`)."""
+    function = click.option("--vmax", type=float, default=None,
+                            help="Upper end of the figure's colour scale (index value; default 1).")(function)
+    return click.option("--vmin", type=float, default=None,
+                        help="Lower end of the figure's colour scale (index value; default 0).")(function)
+
+
 # -- parsing ---------------------------------------------------------------------------------------
 
 def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True):
@@ -228,13 +264,16 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
     """``START:STOP:STEP`` -> START, START+STEP, ... up to STOP (included only if ``include_stop``).
 
     The stop is compared with a tolerance of a millionth of a step. Angles are given in degrees
-    and returned in radians when ``angular``.
+    (within :func:`~screwkit.units.angle_limit`) and returned in radians when ``angular``.
     """
     parts = str(text).split(":")
     try:
         start, stop, step = (float(p) for p in parts)
     except ValueError:
         raise fail(f"Expected {option} as START:STOP:STEP (three numbers), got {text!r}.") from None
+    for end in (start, stop) if angular else ():
+        if abs(end) > angle_limit(degrees=True):
+            raise fail(str(angle_beyond_limit(option, end, degrees=True)))
     try:
         values = range_values(start, stop, step, include_stop=include_stop)
     except ValueError as error:
@@ -242,9 +281,16 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
     return np.deg2rad(values) if angular else values
 
 
-def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwrite: bool, quiet: bool) -> None:
-    """Check every output path before any computation (suffix, folder, existing file)."""
+def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwrite: bool, quiet: bool,
+                  others: dict[str, str | None] | None = None) -> None:
+    """Check every output path before any computation (suffix, folder, existing file), and that no two
+    outputs, nor an output and one of the ``others`` files the command reads or keeps (``--state``), are
+    the same file."""
 
+    try:
+        check_distinct({**{option: path for option, (path, _) in outputs.items()}, **(others or {})})
+    except ValueError as error:
+        raise fail(str(error)) from None
     for option, (path, suffixes) in outputs.items():
         if path is None:
             continue
@@ -255,3 +301,31 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
         if removed and not quiet:
             echo_error(f"removed {', '.join(removed)}: temporary file(s) left by an earlier run killed while writing "
                        f"{path}")
+
+
+def check_colour_scale(vmin: float | None, vmax: float | None) -> None:
+    """``--vmin`` / ``--vmax``, checked before any computation as the figure will check them."""
+    try:
+        colour_scale(vmin, vmax)
+    except ValueError:
+        low, high = colour_scale(None, None)
+        shown = [f"{option} {value:g}" if value is not None else f"{option} {default:g} (default)"
+                 for option, value, default in (("--vmin", vmin, low), ("--vmax", vmax, high))]
+        raise fail(f"Expected finite --vmin < --vmax (the ends of the colour scale, index values), got "
+                   f"{' '.join(shown)}.") from None
+
+
+@contextlib.contextmanager
+def scheduler_client(scheduler: str | None, connect_timeout: float):
+    """``--scheduler``: its client, connected and its handshake made before any work (``None``: local threads)."""
+    if scheduler is None:
+        yield None
+        return
+    try:
+        client = connect(scheduler, connect_timeout)
+    except ClusterError as error:
+        raise fail(str(error)) from None
+    try:
+        yield client
+    finally:
+        disconnect(client, connect_timeout)

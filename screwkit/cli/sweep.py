@@ -22,7 +22,7 @@ from screwkit.cli.options import (
     threshold_option,
 )
 from screwkit.plots import save_figure, sweep_figure
-from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, wide_table, write_dataset
 from screwkit.studies.sweep import sweep as run_sweep
 from screwkit.units import is_angular
 
@@ -85,8 +85,7 @@ def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fau
     found are summarised on stderr.
     """
 
-    check_outputs({"--out": (out, (".nc", ".csv")), "--figure": (figure_path, (".png", ".pdf", ".svg"))},
-                  overwrite, quiet)
+    check_outputs({"--out": (out, DATA_SUFFIXES), "--figure": (figure_path, FIGURE_SUFFIXES)}, overwrite, quiet)
     loaded = load_mechanism(mechanism, length_unit)
     if (phi_range is None) == (sweep_spec is None):
         raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")

@@ -17,8 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from screwkit._jit import njit
 from screwkit.closure._frames_kernel import apply, leg_frames, log_map, matrix_at, mul, rotation_about
 
 __all__ = ["spatial_closed_form_kernel", "joint_screws_kernel"]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from screwkit._jit import njit
 
 # Rotations are 9-tuples (row-major) and vectors 3-tuples: values, not arrays, so that the
 # forward kinematics allocates nothing and creates no array views.

@@ -20,8 +20,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from screwkit._jit import njit
 from screwkit.closure._frames_kernel import (
     apply,
     exp_map,

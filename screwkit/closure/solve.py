@@ -20,7 +20,7 @@ from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinem
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
 from screwkit.closure.threads import for_each_block
-from screwkit.model.mechanism import Mechanism
+from screwkit.model.mechanism import Mechanism, require_mechanism
 from screwkit.rotations import wrap_angle
 from screwkit.tolerances import NEWTON_TOLERANCE
 
@@ -241,6 +241,7 @@ def solve(
         Never raises for an unreachable pose: ``reachable`` is False there and ``status``,
         ``residuals`` and ``limit_joints`` say why (see :func:`solve_one`).
     """
+    require_mechanism(mechanism, "solve")
     poses = mechanism.check_poses(poses)
     if method not in ("auto", "newton"):
         raise ValueError(f"Expected `method` 'auto' or 'newton', got {method!r}.")
@@ -353,6 +354,7 @@ def solve_one(mechanism: Mechanism, pose: ArrayLike, **options) -> Solution:
     The message names every chain that fails, the one that misses its closure by the most
     first, and joints outside their limits with their values (``limits=False`` ignores them).
     """
+    require_mechanism(mechanism, "solve_one")
     pose = mechanism.check_poses(pose)
     if pose.ndim != 1:
         raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}.")
@@ -443,6 +445,7 @@ def forward(
     Solution
         At the poses found; ``reachable`` is False where Newton did not converge.
     """
+    require_mechanism(mechanism, "forward")
     selected = mechanism.actuator_positions(actuators)
     targets = np.asarray(actuator_values, dtype=float)
     if targets.shape[-1:] != (len(selected),):

@@ -16,6 +16,8 @@ from screwkit.model.mechanism import (
     PLANAR_TASK_COORDINATES,
     SPATIAL_TASK_COORDINATES,
     Mechanism,
+    require_mechanism,
 )
 
-__all__ = ["Mechanism", "Chain", "ChainGeometry", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
+__all__ = ["Mechanism", "require_mechanism", "Chain", "ChainGeometry", "PLANAR_TASK_COORDINATES",
+           "SPATIAL_TASK_COORDINATES"]

@@ -26,9 +26,9 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.model.chain import Chain, ChainGeometry
 from screwkit.model.urdf_reader import UrdfDescription
 from screwkit.rotations import rotation_about_axis, rotation_from_rpy, rpy_from_rotation
-from screwkit.units import is_angular
+from screwkit.units import angle_beyond_limit, angle_limit, is_angular
 
-__all__ = ["Mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
+__all__ = ["Mechanism", "require_mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
 
 PLANAR_TASK_COORDINATES = ("x", "y", "phi")
 """Task coordinates of a planar mechanism: platform position in the base x-y plane (m) and
@@ -214,10 +214,16 @@ class Mechanism:
 
     # -- poses ---------------------------------------------------------------------------
 
-    def check_poses(self, poses: ArrayLike) -> NDArray[np.float64]:
-        """Poses as a float array (..., n_task) with finite values, or a ValueError saying what arrived."""
+    def check_poses(self, poses: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
+        """Poses as a float array (..., n_task) of finite real values, angles within
+        :func:`~screwkit.units.angle_limit` (in degrees if ``degrees``), or a ValueError saying what arrived."""
         try:
-            poses = np.asarray(poses, dtype=float)
+            given = np.asarray(poses)
+            if given.dtype.kind in "bc":  # float() would take True as 1 and drop an imaginary part
+                kind = "boolean" if given.dtype.kind == "b" else "complex"
+                raise ValueError(f"expected real numbers (m, {'deg' if degrees else 'rad'}), got {kind} values "
+                                 f"({given.dtype})")
+            poses = given.astype(float)
         except (TypeError, ValueError) as error:
             raise ValueError(f"Expected numeric `poses` for mechanism {self.name!r}: {error}") from None
         if poses.ndim == 0 or poses.shape[-1] != self.n_task:
@@ -228,6 +234,11 @@ class Mechanism:
         if not np.all(np.isfinite(poses)):
             bad = tuple(int(i) for i in np.argwhere(~np.isfinite(poses))[0])
             raise ValueError(f"Expected finite values in `poses`, got {poses[bad]} at index {bad}.")
+        angles = poses[..., self.angular]
+        beyond = np.abs(angles) > angle_limit(degrees=degrees)
+        if np.any(beyond):
+            name = np.array(self.task_coordinates)[self.angular][np.argwhere(beyond)[0][-1]]
+            raise angle_beyond_limit(f"`poses` ({name})", float(angles[beyond][0]), degrees=degrees)
         return poses
 
     def named_pose(self, name: str) -> NDArray[np.float64]:
@@ -239,7 +250,7 @@ class Mechanism:
 
     def poses_from_degrees(self, values: ArrayLike) -> NDArray[np.float64]:
         """Task coordinates with angles in degrees -> radians (checked)."""
-        poses = self.check_poses(values).copy()
+        poses = self.check_poses(values, degrees=True).copy()
         poses[..., self.angular] = np.deg2rad(poses[..., self.angular])
         return poses
 
@@ -294,3 +305,14 @@ class Mechanism:
             chain_index = chain_names.index(chain_name)
             selected.append((chain_index, self.chains[chain_index].joint_names.index(joint_name)))
         return selected
+
+
+def require_mechanism(mechanism: Any, function: str) -> None:
+    """A TypeError naming what arrived where a :class:`Mechanism` is expected (a name: load it first)."""
+    if isinstance(mechanism, Mechanism):
+        return
+    if isinstance(mechanism, str):
+        raise TypeError(f"{function} expects a Mechanism, got the name {mechanism!r}: load it first, "
+                        f"mechanism = screwkit.loader.load({mechanism!r}).")
+    raise TypeError(f"{function} expects a Mechanism (from screwkit.loader.load), got {type(mechanism).__name__} "
+                    f"{mechanism!r:.60}.")

@@ -1,10 +1,14 @@
-"""Writing results to files: netCDF or CSV, atomically, with the output checked before any work.
+"""Writing results to files: one rule for every output, checked before any work, written atomically.
 
-:func:`check_output` is called before a computation starts: it refuses an unsupported suffix,
-a missing or read-only folder, and an existing file unless ``overwrite``; it also removes the
-temporary files that an earlier run killed mid-write left behind (and says which).
-:func:`write_dataset` then writes through a temporary file in the same folder, renamed into
-place, so a reader never sees a half-written file.
+:func:`output_suffix` is the rule for an output's name: its suffix, compared without regard to case
+(``M.NC`` is a netCDF file), decides what is written; the check before the work and the writer
+after it both ask it. :func:`check_output` is called before a computation starts: it refuses an
+unsupported suffix, a missing or read-only folder, and an existing file unless ``overwrite``; it
+also removes the temporary files that an earlier run killed mid-write left behind (and says which).
+:func:`check_distinct` refuses two options naming the same file. :func:`atomic_write` then writes
+through a temporary file in the same folder, flushed to disk and renamed into place, so a reader
+never sees a half-written file; a write that fails (disk full, quota, permission lost mid-run) is
+one :class:`WriteError` line and leaves neither a partial file nor a temporary one.
 """
 
 from __future__ import annotations
@@ -15,16 +19,40 @@ import re
 import time
 from typing import Callable
 
-__all__ = ["check_output", "write_dataset", "atomic_write", "atomic_text", "save_figure", "DATA_SUFFIXES",
-           "FIGURE_SUFFIXES", "FORMATS"]
+__all__ = ["check_output", "check_distinct", "output_suffix", "write_dataset", "read_result", "atomic_write",
+           "atomic_text", "save_figure", "WriteError", "DATA_SUFFIXES", "FIGURE_SUFFIXES", "FORMATS"]
 
 DATA_SUFFIXES = (".nc", ".csv")
-"""Data files screwkit writes: netCDF (``.nc``) or CSV."""
+"""Data files screwkit writes: netCDF (``.nc``) or CSV, in any case."""
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
-"""Figure files screwkit writes."""
-FORMATS = ("png", "pdf", "svg")
+"""Figure files screwkit writes, in any case."""
+FORMATS = tuple(suffix[1:] for suffix in FIGURE_SUFFIXES)
 """File types :func:`save_figure` writes."""
-_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp-(?P<pid>\d+)-\d+$")
+_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.tmp-(?P<pid>\d+)(-\d+|\.\w+)$")
+"""``.NAME.tmp-PID-NANOSECONDS`` (:func:`atomic_write`), or ``.ROOT.tmp-PID.SUFFIX``, the figures' temporary files
+of screwkit 0.1 before every output shared one rule."""
+
+
+class WriteError(OSError):
+    """An output could not be written (disk full, quota, permission lost): the message is one line naming the
+    file, and nothing of it was left behind."""
+
+
+def output_suffix(path: str | os.PathLike, suffixes: tuple[str, ...], what: str = "output") -> str:
+    """The suffix of ``path`` among ``suffixes``, in lower case, compared without regard to case.
+
+    Raises
+    ------
+    ValueError
+        ``path`` ends in none of them (the message names the path and the suffixes allowed).
+    """
+    path = os.fspath(path)
+    for suffix in suffixes:
+        if path.lower().endswith(suffix.lower()):
+            return suffix.lower()
+    found = os.path.splitext(path)[1]
+    raise ValueError(f"{path}: the {what} file must end in {', '.join(suffixes)} (any case), got "
+                     f"{repr(found) if found else 'no suffix'}.")
 
 
 def _alive(pid: int) -> bool:
@@ -41,11 +69,14 @@ def stale_temporaries(path: str | os.PathLike) -> list[str]:
     """Temporary files of earlier writes of ``path`` whose process is gone (killed mid-write)."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
+    name = os.path.basename(path)
+    root, suffix = os.path.splitext(name)
     found = []
-    for candidate in glob.glob(os.path.join(glob.escape(folder), f".{glob.escape(os.path.basename(path))}.tmp-*")):
-        match = _TEMPORARY.match(os.path.basename(candidate))
-        if match and not _alive(int(match.group("pid"))):
-            found.append(candidate)
+    for pattern in (f".{glob.escape(name)}.tmp-*", f".{glob.escape(root)}.tmp-*{glob.escape(suffix)}"):
+        for candidate in glob.glob(os.path.join(glob.escape(folder), pattern)):
+            match = _TEMPORARY.match(os.path.basename(candidate))
+            if match and not _alive(int(match.group("pid"))) and candidate not in found:
+                found.append(candidate)
     return found
 
 
@@ -61,8 +92,7 @@ def check_output(path: str | os.PathLike, suffixes: tuple[str, ...], *, overwrit
         ``overwrite`` (or a read-only one).
     """
     path = os.fspath(path)
-    if not path.lower().endswith(suffixes):
-        raise ValueError(f"{path}: the {what} file must end in {', '.join(suffixes)}.")
+    output_suffix(path, suffixes, what)
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise ValueError(f"{path}: the folder {folder} does not exist.")
@@ -85,6 +115,30 @@ def check_output(path: str | os.PathLike, suffixes: tuple[str, ...], *, overwrit
     return removed
 
 
+def _same_file(first: str, second: str) -> bool:
+    if os.path.realpath(first) == os.path.realpath(second):
+        return True
+    try:
+        return os.path.samefile(first, second)  # hard links, or names a case-insensitive folder takes as one
+    except OSError:
+        return False
+
+
+def check_distinct(paths: dict[str, str | os.PathLike | None]) -> None:
+    """Refuse two options that name the same file (``--state t.csv --table t.csv``): one would destroy the other.
+
+    Raises
+    ------
+    ValueError
+        One line naming both options and the file.
+    """
+    named = [(option, os.fspath(path)) for option, path in paths.items() if path is not None]
+    for index, (option, path) in enumerate(named):
+        for other, other_path in named[index + 1:]:
+            if _same_file(path, other_path):
+                raise ValueError(f"{option} {path} and {other} {other_path} name the same file: give each its own.")
+
+
 def _temporary_name(path: str) -> str:
     """A temporary file beside ``path``: ``.NAME.tmp-PID-NANOSECONDS`` (see :func:`stale_temporaries`)."""
     return os.path.join(os.path.dirname(os.path.abspath(path)),
@@ -102,16 +156,39 @@ def _check_folder_writable(path: str, folder: str) -> None:
     os.remove(probe)
 
 
+def _remove_quietly(path: str) -> None:
+    try:
+        os.remove(path)
+    except OSError:  # gone already, or the folder became read-only: a later run removes it (stale_temporaries)
+        pass
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> None:
-    """Call ``write(temporary)`` on a temporary file in the same folder, then rename it to ``path``."""
+    """Call ``write(temporary)`` on a temporary file in the same folder, flush it to disk, rename it to ``path``.
+
+    Raises
+    ------
+    WriteError
+        The file could not be written (disk full, quota, the folder made read-only mid-run, ...):
+        one line naming ``path``; the temporary file is removed and an existing ``path`` is untouched.
+    """
     path = os.fspath(path)
     temporary = _temporary_name(path)
     try:
         write(temporary)
+        descriptor = os.open(temporary, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)  # on disk before it takes the name: a crash leaves the old file or the new one
+        finally:
+            os.close(descriptor)
         os.replace(temporary, path)
+    except OSError as error:
+        reason = error.strerror or (str(error).splitlines()[0] if str(error) else type(error).__name__)
+        raise WriteError(f"Cannot write {path}: {reason}; no partial file was left"
+                         f"{' and the earlier file is unchanged' if os.path.exists(path) else ''}.") from None
     finally:
         if os.path.exists(temporary):
-            os.remove(temporary)
+            _remove_quietly(temporary)
 
 
 def atomic_text(path: str | os.PathLike, text: str) -> None:
@@ -148,27 +225,59 @@ def wide_table(dataset):
 
 
 def write_dataset(dataset, path) -> None:
-    """Write a netCDF (``.nc``) or CSV file atomically: a temporary file in the same folder, then rename.
+    """Write a netCDF (``.nc``) or CSV file (the suffix in any case) atomically (:func:`atomic_write`).
 
     ``dataset`` is an ``xarray.Dataset`` or a :class:`~screwkit.studies.maps.GridMap` (written
     to netCDF without xarray).
     """
     path = os.fspath(path)
-    if not path.endswith(DATA_SUFFIXES):
-        raise ValueError(f"{path}: the output file must end in {', '.join(DATA_SUFFIXES)}.")
+    kind = output_suffix(path, DATA_SUFFIXES)
     if hasattr(dataset, "write_netcdf"):
-        if path.endswith(".nc"):
+        if kind == ".nc":
             dataset.write_netcdf(path)
             return
         dataset = dataset.to_dataset()
-    if path.endswith(".csv"):
+    if kind == ".csv":
         atomic_write(path, lambda temporary: wide_table(dataset).to_csv(temporary, index=False))
     else:
         atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))
 
 
+def read_result(path) -> tuple[str, object]:
+    """A map or a sweep read back from the netCDF file :func:`write_dataset` wrote: ``("map" | "sweep", dataset)``.
+
+    A map's indices lie over two grid coordinates, a sweep's along one.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file: missing, a folder, not a netCDF file, or not a map or sweep of screwkit.
+    """
+    import xarray as xr
+
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        raise ValueError(f"{path}: is a folder; expected the netCDF file (.nc) of a map or a sweep.")
+    if not os.path.isfile(path):
+        raise ValueError(f"{path}: no such file.")
+    if not path.lower().endswith(".nc"):
+        raise ValueError(f"{path}: expected the netCDF file (.nc) of a map or a sweep (screwkit map/sweep --out "
+                         "FILE.nc).")
+    try:
+        with xr.open_dataset(path, engine="scipy") as dataset:
+            dataset = dataset.load()
+    except Exception as error:  # whatever the netCDF reader makes of a file that is not one
+        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise ValueError(f"{path}: cannot be read as a netCDF file ({reason}).") from None
+    dimensions = dataset["iti"].ndim if "iti" in dataset.data_vars else 0
+    if "lmti" not in dataset.data_vars or dimensions not in (1, 2):
+        raise ValueError(f"{path}: not a map or a sweep of screwkit (expected 'iti' and 'lmti' over one or two "
+                         f"coordinates, got variables {', '.join(sorted(map(str, dataset.data_vars))) or 'none'}).")
+    return ("map" if dimensions == 2 else "sweep"), dataset
+
+
 def save_figure(figure, path, *, dpi: float = 130) -> None:
-    """Save a figure as PNG, PDF or SVG, atomically (a temporary file in the same folder, then rename).
+    """Save a figure as PNG, PDF or SVG, atomically (:func:`atomic_write`).
 
     The bounding box is tight (``bbox_inches="tight"``), so nothing drawn outside the
     figure's nominal area (a long title, a legend, a colour-bar label) is cut off.
@@ -185,20 +294,10 @@ def save_figure(figure, path, *, dpi: float = 130) -> None:
     Raises
     ------
     ValueError
-        If the suffix is not one of :data:`FORMATS` (the message names the path).
+        If the suffix is not one of :data:`FIGURE_SUFFIXES` (the message names the path).
+    WriteError
+        If the file cannot be written.
     """
-    path = os.fspath(path)
-    root, extension = os.path.splitext(path)
-    kind = extension[1:].lower()
-    if kind not in FORMATS:
-        found = repr(extension) if extension else "no suffix"
-        raise ValueError(f"Cannot save a figure to {path!r}: expected a file ending in "
-                         f"{', '.join('.' + f for f in FORMATS[:-1])} or .{FORMATS[-1]}, got {found}.")
-    folder = os.path.dirname(os.path.abspath(path))
-    temporary = os.path.join(folder, f".{os.path.basename(root)}.tmp-{os.getpid()}.{kind}")
-    try:
-        figure.savefig(temporary, format=kind, dpi=dpi, bbox_inches="tight", pad_inches=0.05)
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
+    kind = output_suffix(path, FIGURE_SUFFIXES, "figure")[1:]
+    atomic_write(path, lambda temporary: figure.savefig(temporary, format=kind, dpi=dpi, bbox_inches="tight",
+                                                        pad_inches=0.05))

@@ -26,15 +26,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.loader import cached_mechanism
-from screwkit.model import Mechanism
+from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
 from screwkit.studies.poses import indices_at_poses
 from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.units import is_angular, unit_of
 
-__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "map_task",
-           "map_block", "orientation_set"]
+__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "disc_size",
+           "map_task", "map_block", "orientation_set"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -81,12 +81,17 @@ class MapSize:
         cells = self.grid_shape[0] * self.grid_shape[1]
         return int(cells * (8 * self.variables + 1) + 8 * sum(self.grid_shape))
 
+    @property
+    def description(self) -> str:
+        """``N configurations (P grid points x K orientations)``."""
+        return (f"{self.configurations:,} configurations ({self.grid_points:,} grid points x "
+                f"{self.orientations:,} orientations)")
+
     def check(self, *, max_configurations: int = MAX_CONFIGURATIONS, proceed: bool = False,
               available_bytes: int | None = None) -> None:
         """Refuse, with one line, a map that would not fit in memory or is larger than stated without ``proceed``."""
         available = _available_memory() if available_bytes is None else available_bytes
-        summary = (f"{self.configurations:,} configurations ({self.grid_points:,} grid points x "
-                   f"{self.orientations:,} orientations)")
+        summary = self.description
         if available is not None and self.memory_bytes > 0.8 * available:
             raise ValueError(f"The map has {summary}; its result alone needs {_bytes(self.memory_bytes)}, more than "
                              f"this machine can give ({_bytes(available)} available): use a coarser grid.")
@@ -347,6 +352,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
         orientation of the set) and ``reachable_fraction``.
     """
+    require_mechanism(mechanism, "index_map")
     names = mechanism.task_coordinates
     if len(grid) != 2:
         raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
@@ -411,15 +417,24 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
 
 
 def range_values(start: float, stop: float, step: float, *, include_stop: bool = False) -> NDArray[np.float64]:
-    """START, START + STEP, ... up to STOP (included only if ``include_stop``; compared with a
-    tolerance of a millionth of a step): the ranges of ``screwkit map --grid`` (stop included) and
-    ``--over`` (stop excluded)."""
+    """START, START + STEP, ... up to STOP: the ranges of ``screwkit map --grid`` (``include_stop``)
+    and ``--over`` (stop excluded).
+
+    With ``include_stop`` the step must divide STOP - START (to a millionth of a step), so that the
+    stop is on the grid; a step that does not is refused rather than the stop silently dropped (a grid's
+    points are evenly spaced: region areas are counts of points times the cell).
+    """
     if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or not step > 0 or not stop > start:
         raise ValueError("finite numbers, STEP > 0 and STOP > START")
     span = (stop - start) / step
     count = int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
     if count > 10**8:
         raise ValueError(f"at most 10^8 values ({count:,} asked; use a larger step)")
+    if include_stop and abs(span - round(span)) > 1e-6:
+        whole = max(1, math.floor(span))
+        raise ValueError(f"a STEP that divides STOP - START, since the stop is included ({stop - start:g} / {step:g} "
+                         f"= {span:.4g} steps; e.g. a stop of {start + whole * step:g}, or a step of "
+                         f"{(stop - start) / whole:.6g} or {(stop - start) / (whole + 1):.6g})")
     return start + step * np.arange(count)
 
 
@@ -462,6 +477,7 @@ def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_d
     is mapped at its positions alone and ``phi_step_degrees`` is not used. Other options as in
     :func:`index_map`.
     """
+    require_mechanism(mechanism, "planar_disc_map")
     if not mechanism.is_planar:
         raise ValueError(f"planar_disc_map needs a planar mechanism; {mechanism.name!r} is spatial (use index_map).")
     if phi_step_degrees > 360:

@@ -15,6 +15,13 @@ parameters alone, so the run is the same wherever it is evaluated. With a ``stat
 batch's metrics are appended to it as they come; a run started again with the same study and
 state replays the evaluations it finds there instead of recomputing them (the optimisers are
 seeded, so they ask for the same candidates), which resumes an interrupted run where it stopped.
+A batch is appended whole or not at all: a write that fails (disk full, quota) is cut back to the
+records before it; a last record cut off by a run killed while writing it is dropped when the
+state is read again (and computed again), and an empty state file starts a new search.
+
+The local worker processes end with the process that started them, however it ends (SIGKILL, the
+out-of-memory killer): each asks the kernel for a signal when its parent dies, or (where that
+cannot be asked) watches its parent.
 """
 
 from __future__ import annotations
@@ -23,6 +30,10 @@ import hashlib
 import json
 import math
 import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -30,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.studies.families import Family
+from screwkit.studies.files import atomic_text
 from screwkit.studies.objectives import MAXIMISED, METRICS, Region, region_metrics
 from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
 
@@ -201,26 +213,58 @@ def evaluate_candidate(family: Family, values: dict, region: Region) -> dict[str
     return region_metrics(mechanism, region, family.size(values))
 
 
+def _end_with_parent(parent: int) -> None:
+    """Initializer of the local evaluation processes: end when ``parent`` ends, however it ends.
+
+    Linux sends the process SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere a
+    thread checks every half second that the parent is still there. Either way no evaluation process
+    (nor the resource tracker they keep alive) outlives a search that was killed."""
+    asked = False
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            asked = libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # 1: PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    if not asked:
+        def watch() -> None:
+            while os.getppid() == parent:
+                time.sleep(0.5)
+            os._exit(1)
+
+        threading.Thread(target=watch, daemon=True).start()
+    if os.getppid() != parent:  # the parent died before the request was made
+        os._exit(1)
+
+
 class _Evaluations:
     """The study's evaluations by free-parameter vector (exact bits), appended to the state file."""
 
-    def __init__(self, study: Study, state: str | os.PathLike | None, scheduler, progress, connect_timeout: float):
+    def __init__(self, study: Study, state: str | os.PathLike | None, scheduler, progress, connect_timeout: float,
+                 notify: Callable[[str], None] | None = None):
         self.study, self.state, self.scheduler = study, state, scheduler
         self.connect_timeout = connect_timeout
+        self.notify = notify or (lambda message: None)
         self.known: dict[str, dict] = {}
         self.order: list[tuple[NDArray, dict]] = []  # every design asked, once, in the order asked
         self.seen: set[str] = set()
         self.replayed = 0
         self.computed = 0
-        if state is not None and os.path.exists(state):
+        self.stored = 0  # records in the state file
+        if state is not None and os.path.exists(state) and os.path.getsize(state) > 0:
             self._read(state)
         elif state is not None:
+            if os.path.exists(state):
+                self.notify(f"the design-search state {state} is empty (0 bytes): a new search starts in it")
+            header = json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
+                                 "family": study.family.name, "free": list(study.free)})
             try:
-                with open(state, "w", encoding="utf-8") as file:
-                    file.write(json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
-                                           "family": study.family.name, "free": list(study.free)}) + "\n")
+                atomic_text(state, header + "\n")
             except OSError as error:
-                raise StateError(f"Cannot write the design-search state {state}: {error.strerror}.") from None
+                raise StateError(f"Cannot write the design-search state {state}: "
+                                 f"{error.strerror or error}.") from None
         self.bar, self.pool = None, None
         if progress:
             from tqdm import tqdm
@@ -229,23 +273,67 @@ class _Evaluations:
 
     def _read(self, state) -> None:
         try:
-            with open(state, encoding="utf-8") as file:
-                lines = file.read().splitlines()
+            with open(state, "rb") as file:
+                content = file.read()
+            complete, _, cut = content.rpartition(b"\n")  # the bytes after the last newline: a cut-off record
+            lines = complete.decode("utf-8").split("\n")
             header = json.loads(lines[0])
-            records = []
-            for number, line in enumerate(lines[1:], start=2):
-                try:
-                    records.append(json.loads(line))
-                except ValueError:
-                    if number < len(lines):  # only the last line may be cut short (a run killed while writing)
-                        raise
-        except (OSError, ValueError, IndexError) as error:
+            records = [self._record(line, number) for number, line in enumerate(lines[1:], start=2)]
+        except (OSError, ValueError) as error:
             raise StateError(f"Cannot read the design-search state {state}: {error}") from None
+        if not isinstance(header, dict) or "screwkit_design_state" not in header:
+            raise StateError(f"{state} is not a design-search state (its first line is not the header of one); "
+                             "give a new --state file.")
         if header.get("study") != self.study.fingerprint():
             raise StateError(f"The state {state} belongs to another study (family {header.get('family')!r}, "
                              f"free {header.get('free')}); give a new --state file or the same study options.")
+        if cut:
+            try:
+                os.truncate(state, len(content) - len(cut))  # the next batch starts on a line of its own
+            except OSError as error:
+                raise StateError(f"Cannot drop the cut-off last record of the design-search state {state}: "
+                                 f"{error.strerror or error}.") from None
+            self.notify(f"dropped the cut-off last record of {state} (a run stopped while writing it); "
+                        "it is computed again")
         for record in records:
             self.known[record["key"]] = record["metrics"]
+        self.stored = len(records)
+
+    @staticmethod
+    def _record(line: str, number: int) -> dict:
+        """One record; from a line where an earlier version of screwkit appended a record to a cut-off one,
+        the record it ends with."""
+        try:
+            return json.loads(line)
+        except ValueError:
+            start = line.rfind('{"key"')
+            if start <= 0:
+                raise ValueError(f"line {number} is not a record") from None
+            return json.loads(line[start:])
+
+    def _append(self, records: list[tuple[str, dict]]) -> None:
+        """Append a batch of records whole, or (disk full, quota) not at all."""
+        data = "".join(json.dumps({"key": key, "metrics": metrics}) + "\n" for key, metrics in records).encode()
+        try:
+            descriptor = os.open(self.state, os.O_WRONLY | os.O_APPEND)
+        except OSError as error:
+            raise StateError(f"Cannot append to the design-search state {self.state}: "
+                             f"{error.strerror or error}.") from None
+        try:
+            size = os.fstat(descriptor).st_size
+            try:
+                written = 0
+                while written < len(data):
+                    written += os.write(descriptor, data[written:])
+                os.fsync(descriptor)
+            except OSError as error:
+                os.ftruncate(descriptor, size)
+                raise StateError(f"Cannot append to the design-search state {self.state}: "
+                                 f"{error.strerror or error}; it keeps the {self.stored} evaluations stored before, "
+                                 "and a run with it resumes from them.") from None
+        finally:
+            os.close(descriptor)
+        self.stored += len(records)
 
     def __call__(self, vectors: NDArray) -> list[dict]:
         keys = [np.asarray(v, dtype=np.float64).tobytes().hex() for v in vectors]
@@ -262,11 +350,7 @@ class _Evaluations:
             results = self._run(arguments)
             self.known.update(zip(missing, results))
             if self.state is not None:
-                with open(self.state, "a", encoding="utf-8") as file:
-                    file.write("".join(json.dumps({"key": key, "metrics": metrics}) + "\n"
-                                       for key, metrics in zip(missing, results)))
-                    file.flush()
-                    os.fsync(file.fileno())
+                self._append(list(zip(missing, results)))
         for key in new:
             self.seen.add(key)
             self.order.append((np.array(vectors[first[key]], dtype=float), self.known[key]))
@@ -290,7 +374,8 @@ class _Evaluations:
             from concurrent.futures import ProcessPoolExecutor
 
             # spawn: a forked copy of a process that already runs threads (numba, Dask) can deadlock
-            self.pool = ProcessPoolExecutor(os.cpu_count(), mp_context=multiprocessing.get_context("spawn"))
+            self.pool = ProcessPoolExecutor(os.cpu_count(), mp_context=multiprocessing.get_context("spawn"),
+                                            initializer=_end_with_parent, initargs=(os.getpid(),))
         return list(self.pool.map(evaluate_candidate, *zip(*arguments)))
 
     def close(self) -> None:
@@ -353,16 +438,28 @@ def _single(study: Study, evaluate: Callable) -> None:
     dimension = len(study.free)
     generations = max(0, study.budget // (study.popsize * dimension) - 1)  # after the first population
 
+    raised: list[Exception] = []
+
     def fitness(vectors: NDArray) -> NDArray:  # (d, S) -> (S,)
         scores = []
-        for metrics in evaluate(vectors.T):
+        try:
+            evaluated = evaluate(vectors.T)
+        except Exception as error:  # scipy raises a RuntimeError of its own instead: the cause is kept for the caller
+            raised.append(error)
+            raise
+        for metrics in evaluated:
             objectives, violation = _score(study, metrics)
             scores.append(INFEASIBLE + violation if violation > 0 else objectives[0])
         return np.array(scores)
 
-    differential_evolution(fitness, bounds=limits, x0=study.start, maxiter=generations, popsize=study.popsize,
-                           seed=study.seed, polish=False, tol=1e-6, integrality=integrality if integrality.any()
-                           else None, vectorized=True, updating="deferred")
+    try:
+        differential_evolution(fitness, bounds=limits, x0=study.start, maxiter=generations, popsize=study.popsize,
+                               seed=study.seed, polish=False, tol=1e-6, integrality=integrality if integrality.any()
+                               else None, vectorized=True, updating="deferred")
+    except RuntimeError:
+        if raised:
+            raise raised[0] from None
+        raise
 
 
 def _multiple(study: Study, evaluate: Callable) -> None:
@@ -393,7 +490,7 @@ def _multiple(study: Study, evaluate: Callable) -> None:
 
 
 def run_study(study: Study, *, scheduler=None, progress: bool | None = None, state: str | os.PathLike | None = None,
-              connect_timeout: float = CONNECT_TIMEOUT) -> StudyResult:
+              connect_timeout: float = CONNECT_TIMEOUT, notify: Callable[[str], None] | None = None) -> StudyResult:
     """Search ``study``; see the module's docstring.
 
     Parameters
@@ -404,15 +501,15 @@ def run_study(study: Study, *, scheduler=None, progress: bool | None = None, sta
         A progress bar on stderr (default: when stderr is a terminal).
     state : path, optional
         Evaluation log: created, or read back to resume (it must belong to the same study).
+    notify : callable, optional
+        Called with a line about the state file: an empty one started anew, a cut-off last record dropped.
 
     Raises
     ------
     StateError, ClusterError, ValueError
     """
-    import sys
-
     evaluations = _Evaluations(study, state, scheduler, sys.stderr.isatty() if progress is None else progress,
-                               connect_timeout)
+                               connect_timeout, notify)
     try:
         start_metrics = evaluations(study.start[None])[0]
         if study.budget > 0:

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.closed_forms import planar_indices, point_indices
 from screwkit.closure import chain_screws, solve, solve_one, thread_limit, working_modes
 from screwkit.link_faults import FAULT_TYPES
-from screwkit.model import Mechanism
+from screwkit.model import Mechanism, require_mechanism
 from screwkit.results import Indices
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.transmission import analyze
@@ -237,6 +237,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     Indices
         Batch shape of ``poses``; NaN (and no worst fault) where unreachable.
     """
+    require_mechanism(mechanism, "indices_at_poses")
     if fault_type not in FAULT_TYPES:
         raise ValueError(f"Expected `fault_type` in {', '.join(FAULT_TYPES)}, got {fault_type!r}.")
     poses = mechanism.check_poses(poses)
@@ -319,6 +320,7 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
         If the pose is unreachable: the message names the chains, the one that misses its
         closure by the most first, and joints outside their limits.
     """
+    require_mechanism(mechanism, "indices_at_pose")
     pose = mechanism.check_poses(pose)
     solution = solve_one(mechanism, pose, limits=limits)
     result = analyze_solution(mechanism, solution, threshold=threshold, faults=faults, keep_twists=keep_twists,

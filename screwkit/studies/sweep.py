@@ -14,7 +14,7 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.model import Mechanism
+from screwkit.model import Mechanism, require_mechanism
 from screwkit.results import set_label
 from screwkit.studies.poses import indices_at_poses
 from screwkit.tolerances import SINGULARITY_THRESHOLD
@@ -57,6 +57,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         and the LMTI of every set left after j faults).
     """
 
+    require_mechanism(mechanism, "sweep")
     if coordinate not in mechanism.task_coordinates:
         raise ValueError(f"Expected `coordinate` in {mechanism.task_coordinates}, got {coordinate!r}.")
     at = mechanism.check_poses(at)

@@ -4,9 +4,12 @@
 results in order. Tasks are pure functions of their inputs, so a task lost with a worker is
 recomputed on another (three retries); results come back only when every task is done, so a
 caller writes nothing until then. Failures of the cluster itself are one-line
-:class:`ClusterError` messages: an address that does not answer within ``connect_timeout``, a
-scheduler lost mid-run, a task given up by the scheduler because the workers running it died
-(more often than its ``distributed.scheduler.allowed-failures``).
+:class:`ClusterError` messages: an address that does not answer within ``connect_timeout``, one
+that answers but is not a Dask scheduler (a web server, the dashboard's port) or is ``tls://``
+without TLS settings, a scheduler lost mid-run, a task given up by the scheduler because the
+workers running it died (more often than its ``distributed.scheduler.allowed-failures``).
+:func:`connect` makes the connection (and so these checks) once, before any work; the client it
+returns serves every later :func:`run_tasks`.
 """
 
 from __future__ import annotations
@@ -15,14 +18,15 @@ import contextlib
 import hashlib
 import logging
 import os
+import socket
 import sys
 import time
 from typing import Any, Callable
 
-__all__ = ["run_tasks", "ClusterError", "CONNECT_TIMEOUT"]
+__all__ = ["run_tasks", "connect", "disconnect", "ClusterError", "CONNECT_TIMEOUT"]
 
 CONNECT_TIMEOUT = 3.0
-"""Seconds to wait for a Dask scheduler to answer before giving up (a command then fails within 5 s)."""
+"""Seconds to wait for a Dask scheduler to answer (and to give its handshake) before giving up."""
 
 
 class ClusterError(RuntimeError):
@@ -69,17 +73,98 @@ def _distributed_logs_muted():
             handler.removeFilter(keep)
 
 
-def _connect(scheduler: str, connect_timeout: float):
-    from distributed import Client
+def _first_line(error: BaseException) -> str:
+    text = str(error).strip()
+    return f"{type(error).__name__}: {text.splitlines()[0]}" if text else type(error).__name__
 
+
+def _reach(host: str, port: int, deadline: float) -> None:
+    """Open (and close) a TCP connection to host:port, trying again until ``deadline`` while nothing listens."""
+    pause = 0.01
+    while True:
+        try:
+            socket.create_connection((host, port), timeout=max(0.01, deadline - time.monotonic())).close()
+            return
+        except OSError:
+            if time.monotonic() + pause >= deadline:
+                raise
+            time.sleep(pause)
+            pause = min(2 * pause, 0.5)
+
+
+def _handshake(address: str, connection_args: dict, seconds: float) -> None:
+    """Dask's handshake with ``address`` within ``seconds``, in an event loop of its own (distributed's
+    ``connect`` waits for the handshake without a time limit once a connection is open)."""
+    import asyncio
+    import concurrent.futures
+
+    from distributed.comm import connect as open_comm
+
+    async def exchange():
+        comm = await asyncio.wait_for(open_comm(address, timeout=seconds, **connection_args), seconds)
+        await comm.close()
+
+    with concurrent.futures.ThreadPoolExecutor(1) as thread:  # a loop of its own, whatever runs in this thread
+        thread.submit(asyncio.run, exchange()).result()
+
+
+def connect(scheduler: str, connect_timeout: float = CONNECT_TIMEOUT):
+    """A ``distributed.Client`` of the scheduler at ``scheduler``, once it has answered as a Dask scheduler.
+
+    Within ``connect_timeout`` seconds: something must listen at the address (tried again while
+    nothing does, for a scheduler still starting), then answer Dask's handshake; a ``tls://``
+    address needs TLS settings in Dask's configuration. Close the client with :func:`disconnect`.
+
+    Raises
+    ------
+    ClusterError
+        One line naming the address and what was found there.
+    """
+    from distributed import Client
+    from distributed.comm import parse_address, parse_host_port
+    from distributed.security import Security
+
+    try:
+        scheme, location = parse_address(scheduler)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (TypeError, ValueError) as error:
+        raise ClusterError(f"Cannot use the Dask scheduler address {scheduler!r}: {error}") from None
+    connection_args = Security().get_connection_args("client")
+    if scheme == "tls" and connection_args.get("ssl_context") is None:
+        raise ClusterError(f"Cannot connect to the Dask scheduler at {scheduler}: a tls:// address needs TLS "
+                           "settings (distributed.comm.tls.ca-file, .client.cert and .client.key in Dask's "
+                           "configuration, e.g. DASK_DISTRIBUTED__COMM__TLS__CA_FILE), and none are set.")
+    deadline = time.monotonic() + connect_timeout
+    if host is not None:
+        try:
+            _reach(host, port, deadline)
+        except OSError as error:
+            raise ClusterError(f"Cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
+                               f"({_first_line(error)}).") from None
+        try:
+            _handshake(scheduler, connection_args, max(0.01, deadline - time.monotonic()))
+        except TimeoutError:
+            raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: no Dask handshake "
+                               f"within {connect_timeout:g} s (a web server, or the dashboard's port?).") from None
+        except Exception as error:  # what a server of another protocol says (read as Dask's frames), or its hang-up
+            raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: its answer is not "
+                               f"Dask's handshake ({_first_line(error)[:160]}).") from None
     try:
         return Client(scheduler, set_as_default=False, timeout=connect_timeout)
     except (OSError, TimeoutError) as error:
         raise ClusterError(f"Cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
-                           f"({type(error).__name__}: {str(error).splitlines()[0] if str(error) else 'no answer'}).")\
-            from None
-    except ValueError as error:
+                           f"({_first_line(error)}).") from None
+    except (TypeError, ValueError) as error:
         raise ClusterError(f"Cannot use the Dask scheduler address {scheduler!r}: {error}") from None
+
+
+def disconnect(client, connect_timeout: float = CONNECT_TIMEOUT) -> None:
+    """Close a client of :func:`connect`, quietly (the client of a scheduler that is gone can only time out)."""
+    with _distributed_logs_muted():
+        try:
+            client.close(timeout=connect_timeout)
+        except Exception:
+            pass
 
 
 def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any, connect_timeout: float, bar) -> list:
@@ -87,7 +172,7 @@ def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any,
 
     from distributed import Client, KilledWorker, as_completed
 
-    client = scheduler if isinstance(scheduler, Client) else _connect(scheduler, connect_timeout)
+    client = scheduler if isinstance(scheduler, Client) else connect(scheduler, connect_timeout)
     address = getattr(client.scheduler, "address", scheduler)
     try:
         stamp = time.time_ns()
@@ -106,11 +191,7 @@ def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any,
                                f"(KilledWorker: {str(error).split('. ')[0]}); nothing was written.") from None
     finally:
         if client is not scheduler:
-            with _distributed_logs_muted():
-                try:
-                    client.close(timeout=connect_timeout)
-                except Exception:  # closing a client whose scheduler is gone can only time out
-                    pass
+            disconnect(client, connect_timeout)
 
 
 def run_tasks(function: Callable, arguments: list[tuple], *, scheduler: Any = None, progress: bool | None = None,

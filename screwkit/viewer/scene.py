@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Self
@@ -14,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.loader import load
+from screwkit.studies.files import atomic_text
 from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.viewer.drawing import (
     BASE_COLOR,
@@ -226,8 +226,9 @@ def export_html(target, path: str | os.PathLike) -> Path:
     """Write a scene as one self-contained HTML page that works offline.
 
     The page is Meshcat's ``static_html()``: the viewer's JavaScript and every drawing
-    command inlined, no network access. It is written to a temporary file in the same
-    folder and moved into place (``os.replace``), so a reader never sees a partial file.
+    command inlined, no network access. It is written as every output is
+    (:func:`screwkit.studies.files.atomic_write`): a temporary file in the same folder, moved into
+    place, so a reader never sees a partial file.
 
     Parameters
     ----------
@@ -244,28 +245,8 @@ def export_html(target, path: str | os.PathLike) -> Path:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise ValueError(f"Cannot write {path}: the folder {folder} does not exist.")
-    html = viewer.static_html()
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(descriptor, "w", encoding="utf-8") as handle:
-            handle.write(html)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.chmod(temporary, 0o666 & ~_umask())
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise
+    atomic_text(path, viewer.static_html())
     return path
-
-
-def _umask() -> int:
-    with contextlib.suppress(OSError, ValueError):
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("Umask:"):
-                return int(line.split()[1], 8)
-    return 0o022
 
 
 def mechanism_of(mechanism):
