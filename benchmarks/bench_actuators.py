@@ -34,10 +34,10 @@ import numpy as np
 
 from screwkit.closure import chain_screws, solve
 from screwkit.closure.threads import thread_limit
-from screwkit.loader import load
+from screwkit.indices.analysis import analyze
+from screwkit.io.loader import load
 from screwkit.model.urdf_writer import planar_rrr_urdf
 from screwkit.robots.generate import UPS_HEXAPOD, ups_hexapod
-from screwkit.transmission import analyze
 
 
 def hexapod_file(folder: Path, legs: int) -> Path:

@@ -16,9 +16,9 @@ import time
 
 import numpy as np
 
-from screwkit.closed_forms import planar_indices
-from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.indices.closed_forms import planar_indices
+from screwkit.screw.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
 
 
 def reachable_points(rng, count, design):

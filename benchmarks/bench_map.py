@@ -51,9 +51,9 @@ def per_configuration_rate(samples: int) -> float:
     import pinocchio
 
     from screwkit.closure import chain_screws, solve_one
-    from screwkit.loader import load
+    from screwkit.indices.analysis import analyze
+    from screwkit.io.loader import load
     from screwkit.model.pinocchio_bridge import configuration_vector
-    from screwkit.transmission import analyze
 
     mechanism = load("planar_5rrr")
     data = mechanism.pinocchio_model.createData()

@@ -18,7 +18,7 @@ import numpy as np
 
 from screwkit.closure import chain_screws, solve
 from screwkit.closure.threads import thread_limit
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies.poses import analyze_solution
 
 MECHANISMS = ("ups_hexapod_8", "prs_3_ups", "delta_4", "schoenflies_5")

@@ -15,7 +15,7 @@ import tempfile
 import timeit
 from pathlib import Path
 
-from screwkit.loader import bundled_path, load
+from screwkit.io.loader import bundled_path, load
 from screwkit.model.urdf_reader import MAX_LINKS, read_urdf
 
 

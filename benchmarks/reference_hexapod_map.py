@@ -22,7 +22,7 @@ from itertools import combinations
 import numpy as np
 
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
-from screwkit.loader import load
+from screwkit.io.loader import load
 
 THRESHOLD = 1e-6
 

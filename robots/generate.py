@@ -21,12 +21,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
 from screwkit.model.delta_writer import delta_urdf
 from screwkit.model.hexapod_writer import hexapod_points as points_of_hexapod
 from screwkit.model.hexapod_writer import rss_hexapod_urdf, ups_hexapod_urdf
 from screwkit.model.prs_writer import prs_urdf
 from screwkit.model.urdf_writer import UrdfWriter, planar_rrr_urdf, rrr_leg
-from screwkit.rotations import rotation_from_rpy, rpy_from_rotation
 
 FOLDER = Path(__file__).resolve().parent
 Z_AXIS = np.array([0.0, 0.0, 1.0])
@@ -448,7 +448,7 @@ def _ur5_joints() -> list[dict]:
 
 def _ur5_tool_pose(joints: list[dict], values) -> tuple[NDArray, NDArray]:
     """tool0 frame in the arm base frame at joint ``values`` (product of URDF transforms)."""
-    from screwkit.rotations import rotation_about_axis
+    from screwkit.common.rotations import rotation_about_axis
 
     rotation, translation = np.eye(3), np.zeros(3)
     for index, joint in enumerate(joints):

@@ -636,7 +636,7 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
 def pareto_figure(result):
     """The objectives of every evaluation of a design search, the Pareto front and the start.
 
-    ``result`` is a :class:`screwkit.studies.optimise.StudyResult` with two or more objectives;
+    ``result`` is a :class:`screwkit.studies.design.optimise.StudyResult` with two or more objectives;
     the first two are plotted (grey: every evaluation, red: infeasible, blue line: the front)."""
     plt = _pyplot()
     first, second = result.study.objectives[:2]

@@ -97,8 +97,8 @@ def special_planar_rrr(rng: np.random.Generator, count: int, chains: int = 5):
 
 def moved(chains, rotation, translation):
     """Chain screws moved by one rigid motion (rotation, translation) of the whole mechanism."""
-    from screwkit.chains import ChainScrews
-    from screwkit.screws import transform_twist
+    from screwkit.screw.algebra import transform_twist
+    from screwkit.screw.chain_screws import ChainScrews
 
     return [ChainScrews(transform_twist(rotation, translation, c.twists), c.points @ rotation.T + translation,
                         c.actuated, c.name, joint_names=c.joint_names) for c in chains]
@@ -134,11 +134,11 @@ def random_reachable_poses(mechanism, rng: np.random.Generator, count: int, spre
 def bundled_chain_screws(name: str, count: int = 200, seed: int = 0):
     """Chain screws (world frame) of a bundled mechanism at ``count`` random reachable poses.
 
-    Returns ``(chains, poses)``: a list of :class:`screwkit.chains.ChainScrews` with batch
+    Returns ``(chains, poses)``: a list of :class:`screwkit.screw.chain_screws.ChainScrews` with batch
     shape (count,), and the poses.
     """
     from screwkit.closure import chain_screws, solve
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     mechanism = load(name)
     poses = random_reachable_poses(mechanism, np.random.default_rng(seed), count)

@@ -16,20 +16,16 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "screwkit"
 
 LAYERS = {
-    # the math core and what it shares: numpy only
-    "screwkit._chunks": 0, "screwkit._compile_notice": 0, "screwkit._fastmath": 0, "screwkit._jit": 0,
-    "screwkit._kernels": 0,
-    "screwkit._wrench_kernel": 0, "screwkit._output_kernel": 0, "screwkit._index_kernels": 0,
-    "screwkit._gram_kernel": 0, "screwkit._null_kernel": 0,
-    "screwkit._planar_kernel": 0,
-    "screwkit._validation": 0, "screwkit.chains": 0, "screwkit.closed_forms": 0, "screwkit.planar": 0,
-    "screwkit.results": 0, "screwkit.rotations": 0, "screwkit.screws": 0, "screwkit.tolerances": 0,
-    "screwkit.transmission": 0, "screwkit.units": 0, "screwkit.motion": 0, "screwkit.outputs": 0,
-    "screwkit.constraints": 0, "screwkit.reports": 0, "screwkit.link_faults": 0, "screwkit.actuator_sets": 0,
-    "screwkit.reference": 0,
-    "screwkit": 0,
-    "screwkit.model": 1, "screwkit.closure": 2, "screwkit.io": 2, "screwkit.loader": 3, "screwkit.studies": 4,
-    "screwkit.plots": 5, "screwkit.viewer": 5, "screwkit.cli": 6,
+    "screwkit.common": 0,  # tolerances, units, rotations, validation, the plumbing of compiled kernels
+    "screwkit.screw": 1,  # the screw algebra and what it builds (numpy only)
+    "screwkit.model": 1,  # what a file says
+    "screwkit.indices": 2,  # the paper's indices (numpy, numba when they first run)
+    "screwkit.closure": 2,  # closure solving
+    "screwkit.io": 3,  # files of other tools and loading
+    "screwkit.studies": 4,  # sweeps, maps, designs
+    "screwkit.plots": 5, "screwkit.viewer": 5,
+    "screwkit.cli": 6,
+    "screwkit": 7,  # the top-level API, imported lazily
 }
 """Layer of each module or package, bottom up: a module may import its own layer and those below."""
 
@@ -151,8 +147,9 @@ def test_modules_and_classes_stay_small():
 def test_the_core_imports_numpy_only():
     """The math core loads no Pinocchio, numba, Dask, matplotlib, Meshcat, xarray or scipy when imported."""
     heavy = ("pinocchio", "numba", "dask", "distributed", "matplotlib", "meshcat", "xarray", "scipy", "pandas")
-    code = ("import sys; import screwkit.screws, screwkit.transmission, screwkit.results, screwkit.closed_forms, "
-            "screwkit.planar, screwkit.chains, screwkit.tolerances, screwkit.units, screwkit.rotations; "
+    code = ("import sys; import screwkit.screw.algebra, screwkit.indices.analysis, screwkit.indices.results, "
+            "screwkit.indices.closed_forms, screwkit.screw.planar, screwkit.screw.chain_screws, "
+            "screwkit.common.tolerances, screwkit.common.units, screwkit.common.rotations; "
             f"print(sorted(m for m in {heavy!r} if m in sys.modules))")
     completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert completed.returncode == 0, completed.stderr

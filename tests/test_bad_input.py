@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from helpers import random_planar_rrr
-from screwkit.chains import ChainScrews
-from screwkit.planar import PlanarDesign, platform_points, rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.planar import PlanarDesign, platform_points, rrr_chain_screws
 
 
 @pytest.fixture
@@ -88,7 +88,8 @@ def test_lmti_of_checks_its_set(chains):
 
 def test_core_imports_numpy_only():
     """The math core pulls in none of the edge dependencies."""
-    code = ("import sys; import screwkit.transmission, screwkit.closed_forms, screwkit.planar, screwkit.screws; "
+    code = ("import sys; import screwkit.indices.analysis, screwkit.indices.closed_forms, screwkit.screw.planar, "
+            "screwkit.screw.algebra; "
             "bad = [m for m in ('pinocchio', 'matplotlib', 'dask', 'meshcat', 'xarray', 'numba', 'yourdfpy', 'sympy', "
             "'scipy') if m in sys.modules]; print(bad); sys.exit(1 if bad else 0)")
     completed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -11,9 +11,9 @@ import pytest
 
 from helpers import screwkit
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import load
-from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.io.loader import load
+from screwkit.screw.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
 
 
 def test_analyze_reproduces_the_paper_through_the_urdf():

@@ -9,8 +9,8 @@ from helpers import in_millimetres, in_unit, moved_in_the_world
 from screwkit.closure import chain_screws, solve
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.solve import _PoseCache
-from screwkit.loader import load
-from screwkit.rotations import rotation_from_rotation_vector
+from screwkit.common.rotations import rotation_from_rotation_vector
+from screwkit.io.loader import load
 
 BRANCHES = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
 
@@ -93,7 +93,7 @@ def test_compiled_closure_keeps_the_indices_in_other_units_scales_and_world_fram
     """The same indices, on batches that take the compiled closed forms and screws, from the file in metres,
     in millimetres, moved in the world, and with the mechanism itself scaled by 1e-3 and 1e3 (its poses'
     translations and the singularity threshold scaled alike)."""
-    from screwkit.loader import bundled_path
+    from screwkit.io.loader import bundled_path
     from screwkit.studies.poses import indices_at_poses
 
     mechanism = load(name)

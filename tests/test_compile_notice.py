@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-import screwkit._compile_notice as notice
+import screwkit.common.compiling as notice
 
 WRENCH, OUTPUT = notice.INDEX_KERNELS
 

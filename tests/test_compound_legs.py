@@ -23,7 +23,7 @@ from helpers import random_rotation, screwkit
 from screwkit.closure import actuator_values, solve
 from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies.poses import indices_at_poses
 
 TOLERANCE = 1e-9

@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 
 from helpers import moved, random_rotation, screwkit
-from screwkit.chains import ChainScrews
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import load_text
+from screwkit.indices.analysis import analyze
+from screwkit.io.loader import load_text
 from screwkit.robots.generate import PRS_UPS, prs_mechanism
+from screwkit.screw.chain_screws import ChainScrews
 from screwkit.studies.poses import analyze_solution, indices_at_poses
-from screwkit.transmission import analyze
 
 TOLERANCE = 1e-9
 
@@ -106,7 +106,7 @@ def test_4_prs_cti_matches_the_explicit_geometry(prs_4, tilt_degrees):
 
 
 def test_cti_is_not_applicable_without_own_constraint_wrenches():
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     for name in ("planar_5rrr", "ups_hexapod_8"):
         mechanism = load(name)
@@ -137,7 +137,7 @@ def test_cti_is_invariant_to_unit_and_frame(prs_3_ups):
 
 @pytest.mark.parametrize("name", ["planar_5rrr", "planar_4rpr", "ups_hexapod_8"])
 def test_link_and_free_swinging_faults_agree_without_own_constraints(name):
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     mechanism = load(name)
     rng = np.random.default_rng(7)
@@ -201,7 +201,7 @@ def delta_cti(twists):
 
 @pytest.mark.parametrize("pose_name", ["home", "raised", "off_centre"])
 def test_delta_cti_matches_the_explicit_geometry(pose_name):
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     mechanism = load("delta_4")
     solution = solve(mechanism, mechanism.named_pose(pose_name)[None])
@@ -257,7 +257,7 @@ def test_cli_pose_from_actuator_values(tmp_path):
     import json
 
     from screwkit.closure import actuator_values, solve_one
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     mechanism = load("prs_3_ups")
     pose = mechanism.named_pose("pitch_10") + np.array([0.005, np.deg2rad(3.0), 0.0])

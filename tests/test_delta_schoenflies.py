@@ -29,7 +29,7 @@ import pytest
 
 from helpers import platform_twist, screwkit
 from screwkit.closure import actuator_values, chain_screws, forward, solve
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.poses import analyze_solution
 
@@ -344,7 +344,7 @@ def test_prs_3_ups_parasitic_motion_is_torsion_free_with_the_tilt_and_torsion_cl
     p . t_i = -R2 (1 - cos theta) sin(2 alpha_i - 2 phi) / 2, solved for every leg by the shift above
     because 3 alpha_i = 270 deg (mod 360) for the three legs. A pure pitch theta (phi = 0) gives
     y = R2 (1 - cos theta) / 2, a pure roll (phi = -90 deg) y = -R2 (1 - cos theta) / 2."""
-    from screwkit.rotations import rotation_from_rpy
+    from screwkit.common.rotations import rotation_from_rpy
 
     prs = mechanism("prs_3_ups")
     assert prs.dof == 3 and prs.task_coordinates == ("z", "roll", "pitch")

@@ -24,13 +24,19 @@ import pytest
 import xarray as xr
 
 from helpers import screwkit
-from screwkit.loader import bundled_path, load
-from screwkit.planar import PlanarDesign
+from screwkit.io.loader import bundled_path, load
+from screwkit.screw.planar import PlanarDesign
 from screwkit.studies import indices_at_poses
-from screwkit.studies.design import family_values, fault_tolerant_area, planar_design
-from screwkit.studies.families import FAMILIES, family, permutation_of_rank, permutation_rank
-from screwkit.studies.objectives import default_region, disc_region, grid_region, inscribed_radius, region_metrics
-from screwkit.studies.optimise import Constraint, StateError, Study, pareto_front, run_study
+from screwkit.studies.design.families import FAMILIES, family, permutation_of_rank, permutation_rank
+from screwkit.studies.design.objectives import (
+    default_region,
+    disc_region,
+    grid_region,
+    inscribed_radius,
+    region_metrics,
+)
+from screwkit.studies.design.optimise import Constraint, StateError, Study, pareto_front, run_study
+from screwkit.studies.design.permutations import family_values, fault_tolerant_area, planar_design
 
 SMALL_DISC = ("--radius", "0.3", "--step", "0.1", "--phi-step", "30")
 """A planar region of 29 points x 12 angles: a search of 24 designs in a few seconds."""
@@ -361,7 +367,7 @@ def test_bad_search_options_give_one_line(tmp_path, arguments, message):
 def test_the_design_page_names_every_family_parameter_and_metric():
     from pathlib import Path
 
-    from screwkit.studies.objectives import METRICS
+    from screwkit.studies.design.objectives import METRICS
 
     page = (Path(__file__).resolve().parents[1] / "docs" / "design.md").read_text()
     for name in FAMILIES:
@@ -445,7 +451,7 @@ def scaled_hexapod_metrics(scale: float, quarter_turns: int) -> dict:
     """Metrics of an 8-UPS with spread slots, every length times ``scale`` and the mechanism turned by
     ``quarter_turns`` x 90 deg about the vertical (the square map turns onto itself), on the region
     scaled with it: x, y in +-0.2, three layers of z about the home height, yaw in +-30 deg."""
-    from screwkit.loader import load_text
+    from screwkit.io.loader import load_text
     from screwkit.model.hexapod_writer import hexapod_points, ups_hexapod_urdf
 
     base, platform = hexapod_points(8, 1.0, 0.45, (0, 4, 2, 7, 5, 3, 1, 6), base_spread=0.3, platform_spread=0.2)

@@ -40,12 +40,12 @@ def site(tmp_path_factory) -> Path:
 
 def test_site_builds_strict(site):
     for page in ("index.html", "theory/index.html", "urdf-convention/index.html", "tutorial/index.html",
-                 "cli/index.html", "paper/index.html", "performance/index.html", "api/transmission/index.html"):
+                 "cli/index.html", "paper/index.html", "performance/index.html", "api/indices/index.html"):
         assert (site / page).is_file(), page
 
 
 def test_api_reference_renders_docstring_math(site):
-    page = (site / "api" / "screws" / "index.html").read_text(encoding="utf-8")
+    page = (site / "api" / "screw" / "index.html").read_text(encoding="utf-8")
     assert "Reciprocal product of two screws" in page
     assert ".. math::" not in page and ":math:" not in page and ":func:" not in page
     # docstring math typeset as MathML at build time, no TeX left for a script to find
@@ -192,6 +192,7 @@ def test_sphinx_markup_conversion():
     assert convert(text) == "Before:\n\n\\[\nx = y\n\\]\n\nafter."
     assert convert("no math here") == "no math here"
     roles = module.sphinx_roles_to_code
-    assert roles("see :func:`analyze` and :class:`~screwkit.chains.ChainScrews`") == "see `analyze` and `ChainScrews`"
-    assert roles(":mod:`screwkit._kernels`, :meth:`TransmissionResult.lmti_of`") == (
-        "`screwkit._kernels`, `TransmissionResult.lmti_of`")
+    assert roles("see :func:`analyze` and :class:`~screwkit.screw.chain_screws.ChainScrews`") == \
+        "see `analyze` and `ChainScrews`"
+    assert roles(":mod:`screwkit.indices.compiled.algebra`, :meth:`TransmissionResult.lmti_of`") == (
+        "`screwkit.indices.compiled.algebra`, `TransmissionResult.lmti_of`")

@@ -25,7 +25,7 @@ import pytest
 from helpers import in_millimetres, one_line_error, screwkit
 from screwkit.closure import UnreachablePose, solve, solve_one
 from screwkit.closure.solve import MISSES_CLOSURE, OUTSIDE_LIMITS
-from screwkit.loader import bundled_path, load
+from screwkit.io.loader import bundled_path, load
 from screwkit.model.urdf_reader import MAX_FILE_BYTES, MAX_LINKS, MAX_TREE_DEPTH
 from screwkit.model.urdf_writer import planar_rrr_urdf
 from screwkit.studies.maps import MAX_CONFIGURATIONS, MapSize, disc_grid, disc_size, map_size, planar_disc_map

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from helpers import random_planar_rrr, special_planar_rrr
-from screwkit import closed_forms as cf
-from screwkit.planar import rpr_chain_screws, rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices import closed_forms as cf
+from screwkit.indices.analysis import analyze
+from screwkit.screw.planar import rpr_chain_screws, rrr_chain_screws
 
 TOLERANCE = 1e-9
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from helpers import moved, random_planar_rrr, random_rotation
-from screwkit.chains import ChainScrews
-from screwkit.planar import rrr_chain_screws
-from screwkit.screws import transform_twist
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.screw.algebra import transform_twist
+from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.planar import rrr_chain_screws
 
 
 def compare(first, second, tolerance=1e-9):

@@ -23,10 +23,10 @@ import numpy as np
 import pytest
 
 from helpers import bundled_chain_screws, random_rotation
-from screwkit import screws
-from screwkit.chains import ChainScrews
-from screwkit.planar import rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.screw import algebra as screws
+from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.planar import rrr_chain_screws
 
 SCALES = (1e-3, 1e-2, 1.0, 1e2, 1e3)
 THRESHOLD = 1e-6  # p at scale 1 (m); p = THRESHOLD * scale
@@ -326,7 +326,7 @@ def mechanism(request):
 def bundled_at_home(name):
     """Chain screws of a bundled mechanism at its home pose (batch of one)."""
     from screwkit.closure import chain_screws, solve
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     mechanism = load(name)
     return chain_screws(mechanism, solve(mechanism, mechanism.home_pose[None]))
@@ -455,8 +455,8 @@ def test_worst_fault_is_the_first_set_within_the_tie_margin(name, faults):
     alone through the table of submechanisms: both are checked."""
     from itertools import combinations
 
-    from screwkit.actuator_sets import reductions
-    from screwkit.tolerances import WORST_FAULT_TIE
+    from screwkit.common.tolerances import WORST_FAULT_TIE
+    from screwkit.indices.sets import reductions
 
     result = analyze(build(name), threshold=THRESHOLD, faults=faults)
     a = result.actuator_count
@@ -488,7 +488,7 @@ def test_closure_and_forward_kinematics_of_a_scaled_copy(tmp_path, name, scale):
 
     from helpers import random_reachable_poses
     from screwkit.closure import actuator_values, forward, solve
-    from screwkit.loader import bundled_path, load
+    from screwkit.io.loader import bundled_path, load
     from screwkit.model.urdf_reader import scale_lengths
     from screwkit.studies.poses import indices_at_poses
 

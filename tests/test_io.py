@@ -19,7 +19,7 @@ from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows
 from helpers import random_rotation, screwkit
 from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble, joint_kind
-from screwkit.loader import bundled_path, load
+from screwkit.io.loader import bundled_path, load
 from screwkit.studies.poses import indices_at_pose, indices_at_poses
 
 HOME = np.array([0.0, 0.35])

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit._kernels import BLOCK, LEADING_PIVOT_RATIO, null_vector, null_vectors_lanes
+from screwkit.indices.compiled.algebra import BLOCK, LEADING_PIVOT_RATIO, null_vector, null_vectors_lanes
 
 
 def cofactors(rows):
@@ -64,8 +64,8 @@ def test_null_vectors_of_every_lane_are_the_cofactor_vectors():
 def test_solve_matches_numpy_and_takes_its_pivot_tolerance():
     """solve on Gram matrices of unit columns (as the kernel builds them): numpy's solution when
     regular, False when a pivot is at or below the tolerance it is given (GRAM_PIVOT)."""
-    from screwkit._kernels import solve
-    from screwkit.tolerances import GRAM_PIVOT
+    from screwkit.common.tolerances import GRAM_PIVOT
+    from screwkit.indices.compiled.algebra import solve
 
     rng = np.random.default_rng(8)
     out, work = np.empty(8), np.empty((8, 8))
@@ -93,7 +93,7 @@ def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
     """The output twists' expansion terms (level by level, as the kernel runs them) against numpy's determinants."""
     from itertools import combinations
 
-    from screwkit.actuator_sets import WEDGE_TERMS, wedge_tables
+    from screwkit.indices.sets import WEDGE_TERMS, wedge_tables
 
     tables = wedge_tables(n)
     table, start = tables["wedge_table"], tables["wedge_start"]
@@ -122,7 +122,7 @@ def test_exterior_product_tables_give_every_minor_and_the_cofactor_vector(n):
 def test_pseudo_inverse_matches_numpy_on_symmetric_matrices_of_any_rank(size, rank):
     """The written-out Jacobi pseudo-inverse of the wrench kernel's idle-DoF fallback equals
     numpy's SVD-based pinv on Gram matrices of unit twists (positive semi-definite, rank deficient)."""
-    from screwkit._kernels import pseudo_inverse
+    from screwkit.indices.compiled.algebra import pseudo_inverse
 
     rng = np.random.default_rng(size * 10 + rank)
     for _ in range(20):

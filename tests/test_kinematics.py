@@ -19,10 +19,7 @@ from screwkit.closure import (
     thread_limit,
 )
 from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian, twists_from_axes_and_points
-from screwkit.loader import bundled_names, load, load_text
-from screwkit.model.pinocchio_bridge import configuration_vector, twist_from_pinocchio_motion
-from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import (
+from screwkit.common.rotations import (
     rotation_about_axis,
     rotation_from_rotation_vector,
     rotation_from_rpy,
@@ -31,6 +28,9 @@ from screwkit.rotations import (
     two_axis_pointing,
     wrap_angle,
 )
+from screwkit.io.loader import bundled_names, load, load_text
+from screwkit.model.pinocchio_bridge import configuration_vector, twist_from_pinocchio_motion
+from screwkit.model.urdf_writer import UrdfWriter
 
 CLOSED_FORM_CASES = {
     # mechanism: (scale of the random pose offsets around home, expected solver kind)

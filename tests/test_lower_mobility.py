@@ -32,7 +32,7 @@ import pytest
 
 from helpers import in_millimetres, moved_in_the_world, screwkit
 from screwkit.closure import solve_one
-from screwkit.loader import bundled_path, load, load_text
+from screwkit.io.loader import bundled_path, load, load_text
 from screwkit.studies.poses import indices_at_poses
 
 TOLERANCE = 1e-9
@@ -578,7 +578,7 @@ def test_indices_do_not_depend_on_the_unit_or_the_world_frame(tmp_path, name):
 def test_a_planar_point_output_turns_about_its_own_plane_normal_in_any_world_frame(tmp_path, monkeypatch):
     """The idle rotation of a planar point output is about the plane's normal, not the world z axis: with
     world z it would be one more shared twist, and which motion-space basis is kept would be arbitrary."""
-    from screwkit import transmission
+    from screwkit.indices import analysis as transmission
 
     reference_mechanism = mechanism("five_bar_3")
     poses = np.array(list(reference_mechanism.named_poses.values()))
@@ -603,7 +603,7 @@ def test_a_planar_point_output_turns_about_its_own_plane_normal_in_any_world_fra
 
 
 def test_idle_rotations_about_a_given_normal():
-    from screwkit.outputs import idle_rotations
+    from screwkit.screw.outputs import idle_rotations
 
     twists, points = idle_rotations(np.array([[1.0, 2.0, 3.0]]), np.array([0.0, 0.0, 2.0]))
     np.testing.assert_allclose(twists, [[[0, 0, 1, 2, -1, 0]]])

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from helpers import platform_twist
-from screwkit import screws
 from screwkit.closure import actuator_values, chain_screws, forward, solve
-from screwkit.loader import load
+from screwkit.indices.analysis import analyze
+from screwkit.io.loader import load
+from screwkit.screw import algebra as screws
 from screwkit.studies import indices_at_pose
-from screwkit.transmission import analyze
 
 
 @pytest.mark.parametrize("name", ["ups_hexapod_8", "rss_hexapod_8"])

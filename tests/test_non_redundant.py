@@ -17,7 +17,7 @@ import pytest
 
 from helpers import screwkit
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
 TOLERANCE = 1e-9

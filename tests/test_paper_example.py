@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit import closed_forms as cf
-from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices import closed_forms as cf
+from screwkit.indices.analysis import analyze
+from screwkit.screw.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
 
 
 def indices_at(poses, working_mode=1, **options):

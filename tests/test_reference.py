@@ -1,4 +1,4 @@
-"""The compiled, batched pipeline equals the plain-numpy reference (:mod:`screwkit.reference`).
+"""The compiled, batched pipeline equals the plain-numpy reference (:mod:`screwkit.screw.reference`).
 
 Every bundled mechanism (frame and point outputs, lower mobility with constraint wrenches, redundant and not)
 and a random design of every family, at random reachable poses: the ITI of every actuator, the OTI of every
@@ -14,8 +14,8 @@ from test_relabelling import random_designs
 
 from helpers import random_reachable_poses
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import bundled_names, load
-from screwkit.reference import reference_indices
+from screwkit.io.loader import bundled_names, load
+from screwkit.screw.reference import reference_indices
 from screwkit.studies.poses import analyze_solution, output_points
 
 TOLERANCE = 1e-10
@@ -75,7 +75,7 @@ def test_the_compiled_pipeline_equals_the_reference_on_random_designs(designs, i
 
 def test_the_reference_sees_a_constraint_singularity():
     """The symmetric 4-PRS at home: four constraint forces of rank three, 3 instantaneous DOF for mobility 2."""
-    from screwkit.loader import load_text
+    from screwkit.io.loader import load_text
     from screwkit.robots.generate import PRS_UPS, prs_mechanism
 
     mechanism = load_text(prs_mechanism("prs_4", dict(PRS_UPS, prs_angles_deg=(0.0, 90.0, 180.0, 270.0)),

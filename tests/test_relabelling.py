@@ -5,7 +5,7 @@ index -- ITI, LMTI, every F_Oj and F_IOj, the CTI and every F_Cj, the instantane
 per-actuator and per-set values, the worst faults (with their ties) and the limiting actuators follow the
 names. Checked at two levels:
 
-* the core (:func:`screwkit.transmission.analyze` on chain screws), where the chains are analysed in the
+* the core (:func:`screwkit.indices.analysis.analyze` on chain screws), where the chains are analysed in the
   order given: every bundled mechanism and random designs of every family (planar n-RRR, UPS and RSS
   hexapods, Deltas, 3-PRS + UPS), under random permutations of the chains and of the actuators within a
   chain, and random renamings, to 1e-12;
@@ -26,12 +26,12 @@ import numpy as np
 import pytest
 
 from helpers import random_reachable_poses, screwkit
-from screwkit.chains import ChainScrews
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import bundled_names, bundled_path, load, load_text
-from screwkit.studies.families import family
+from screwkit.indices.analysis import analyze
+from screwkit.io.loader import bundled_names, bundled_path, load, load_text
+from screwkit.screw.chain_screws import ChainScrews
+from screwkit.studies.design.families import family
 from screwkit.studies.poses import analyze_solution, output_points
-from screwkit.transmission import analyze
 
 TOLERANCE = 1e-12
 ACTUATOR_OTI_TOLERANCE = 1e-11

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from helpers import screwkit
-from screwkit.chains import ChainScrews
 from screwkit.closure import chain_screws, solve, solve_one
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
-from screwkit.loader import bundled_names, bundled_path, load
+from screwkit.io.loader import bundled_names, bundled_path, load
 from screwkit.model.pinocchio_bridge import configuration_vector
+from screwkit.screw.chain_screws import ChainScrews
 
 BUNDLED = ("coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr", "prs_3_ups",
            "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6")
@@ -397,7 +397,7 @@ def test_a_file_written_to_six_decimals_keeps_its_closed_forms(tmp_path):
             [0.2, 0.2, 0.5] if exact.is_planar else [0.03, 0.03, 0.03, 0.05, 0.05, 0.1])
         first, second = solve(exact, poses), solve(rounded, poses)
         assert first.reachable.all() and second.reachable.all()
-        from screwkit.transmission import analyze
+        from screwkit.indices.analysis import analyze
 
         one, two = analyze(chain_screws(exact, first)), analyze(chain_screws(rounded, second))
         np.testing.assert_allclose(two.iti_actuators, one.iti_actuators, atol=1e-5)

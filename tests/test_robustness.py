@@ -24,7 +24,7 @@ import pytest
 import xarray as xr
 
 from helpers import one_line_error, screwkit
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.maps import disc_size
 
@@ -485,9 +485,9 @@ def test_the_python_api_refuses_complex_and_boolean_poses_and_names_what_arrived
     with pytest.raises(TypeError, match=r"Expected the name of a bundled mechanism .* or a file path, got NoneType"):
         load(None)
     with pytest.raises(TypeError, match=r"indices_at_pose expects a Mechanism, got the name 'planar_5rrr': load it "
-                                        r"first, mechanism = screwkit.loader.load\('planar_5rrr'\)"):
+                                        r"first, mechanism = screwkit.io.loader.load\('planar_5rrr'\)"):
         indices_at_pose("planar_5rrr", [0.0, 0.0, 0.0])
-    with pytest.raises(TypeError, match=r"indices_at_poses expects a Mechanism \(from screwkit.loader.load\), got "
+    with pytest.raises(TypeError, match=r"indices_at_poses expects a Mechanism \(from screwkit.io.loader.load\), got "
                                         r"NoneType"):
         indices_at_poses(None, [[0.0, 0.0, 0.0]])
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from helpers import random_rotation
-from screwkit import screws
+from screwkit.screw import algebra as screws
 
 
 def random_screws(rng, count):

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from helpers import moved, random_rotation
-from screwkit import screws
-from screwkit.chains import ChainScrews
-from screwkit.planar import rpr_chain_screws
-from screwkit.transmission import analyze
+from screwkit.indices.analysis import analyze
+from screwkit.screw import algebra as screws
+from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.planar import rpr_chain_screws
 
 
 def revolute(axis, point):

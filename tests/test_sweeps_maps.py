@@ -14,15 +14,15 @@ import xarray as xr
 
 from helpers import screwkit
 from screwkit.cli.options import parse_range
-from screwkit.closed_forms import planar_indices
 from screwkit.closure import chain_screws, solve
-from screwkit.loader import load
-from screwkit.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
-from screwkit.studies.design import permutation_search, planar_design, rotation_class
+from screwkit.indices.analysis import analyze
+from screwkit.indices.closed_forms import planar_indices
+from screwkit.io.loader import load
+from screwkit.screw.planar import paper_5rrr, planar_joint_points, rrr_chain_screws
+from screwkit.studies.design.permutations import permutation_search, planar_design, rotation_class
 from screwkit.studies.files import write_dataset
 from screwkit.studies.maps import GridMap, index_map, planar_disc_map
 from screwkit.studies.sweep import sweep
-from screwkit.transmission import analyze
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """Symbolic proofs (sympy) that the generic derivation gives the paper's closed forms.
 
 The generic derivation is re-done here with exact symbols, step by step as
-:func:`screwkit.transmission.analyze` does it: joint twists -> actuation wrench from the
+:func:`screwkit.indices.analysis.analyze` does it: joint twists -> actuation wrench from the
 reciprocity conditions in the motion space (twists about the platform joint point) ->
 wrench matrix in motion coordinates -> adjugate columns as output twists -> power
 coefficient. Each identity is then checked as a polynomial identity (difference expands

@@ -7,14 +7,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from screwkit.closure import _frames_kernel as frames
-from screwkit.closure import _task_kernel as kernel
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
+from screwkit.closure.compiled import frames as frames
+from screwkit.closure.compiled import task as kernel
 from screwkit.closure.newton import pose_error
 from screwkit.closure.task_space import complete_poses, constraining_chains, pose_rates
 from screwkit.closure.threads import thread_limit
-from screwkit.loader import load
-from screwkit.rotations import rotation_from_rotation_vector, rotation_vector_from_rotation
+from screwkit.common.rotations import rotation_from_rotation_vector, rotation_vector_from_rotation
+from screwkit.io.loader import load
 
 LOWER_MOBILITY = ("prs_3_ups", "delta_4", "schoenflies_5")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit.loader import bundled_names, bundled_path
+from screwkit.io.loader import bundled_names, bundled_path
 from screwkit.model.urdf_reader import parse_urdf, read_urdf
 
 MINIMAL = """<?xml version="1.0"?>
@@ -136,7 +136,7 @@ def test_entity_declarations_are_refused_without_expansion(document):
 def test_entity_bomb_file_is_refused_before_pinocchio_sees_it(tmp_path):
     path = tmp_path / "bomb.urdf"
     path.write_text(BILLION_LAUGHS)
-    from screwkit.loader import load
+    from screwkit.io.loader import load
 
     with pytest.raises(ValueError, match="document type and entity declarations are refused"):
         load(path)

@@ -25,7 +25,7 @@ import pytest
 
 from helpers import screwkit
 from screwkit.closure import chain_screws, solve_one
-from screwkit.loader import load
+from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 from screwkit.viewer import (
     FAILED_COLOR,

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from screwkit.loader import load  # noqa: E402
+from screwkit.io.loader import load  # noqa: E402
 from screwkit.plots import COLORMAP, map_figure, save_figure, sweep_figure  # noqa: E402
 from screwkit.studies.maps import planar_disc_map  # noqa: E402
 from screwkit.studies.sweep import sweep  # noqa: E402

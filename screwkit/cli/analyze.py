@@ -46,7 +46,7 @@ def _limiting(detail: dict) -> str:
 
 
 def print_report(report: dict) -> None:
-    """The indices at one pose as text (from :meth:`screwkit.results.Indices.to_dict`)."""
+    """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
     click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators, {report['dof']} DOF "

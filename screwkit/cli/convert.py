@@ -9,7 +9,7 @@ import click
 
 from screwkit.cli.options import fail, json_option, overwrite_option, quiet_option
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
-from screwkit.loader import load, load_text
+from screwkit.io.loader import load, load_text
 from screwkit.studies.files import atomic_text, check_output
 
 __all__ = ["convert"]

@@ -20,10 +20,10 @@ from screwkit.cli.options import (
     quiet_option,
     scheduler_client,
 )
-from screwkit.studies import design as search
-from screwkit.studies.families import FAMILIES, family
+from screwkit.studies.design import permutations as search
+from screwkit.studies.design.families import FAMILIES, family
+from screwkit.studies.design.objectives import METRICS
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
-from screwkit.studies.objectives import METRICS
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
 
 __all__ = ["design_search"]

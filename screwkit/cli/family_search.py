@@ -11,11 +11,11 @@ import numpy as np
 
 from screwkit.cli.map_command import grid_spec
 from screwkit.cli.options import echo_error, fail
-from screwkit.studies.families import Family
-from screwkit.studies.objectives import METRICS, default_region, region_maps
-from screwkit.studies.optimise import Constraint, StateError, Study, run_study
+from screwkit.common.units import is_angular
+from screwkit.studies.design.families import Family
+from screwkit.studies.design.objectives import METRICS, default_region, region_maps
+from screwkit.studies.design.optimise import Constraint, StateError, Study, run_study
 from screwkit.studies.tasks import ClusterError
-from screwkit.units import is_angular
 
 __all__ = ["parse_assignments", "parse_bounds", "region_of", "search_family", "STUDY_KEYS", "read_study"]
 

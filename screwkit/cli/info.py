@@ -14,7 +14,7 @@ from screwkit.cli.options import (
     mechanism_argument,
 )
 from screwkit.closure import working_modes
-from screwkit.units import is_angular, unit_of
+from screwkit.common.units import is_angular, unit_of
 
 __all__ = ["info", "mechanism_info"]
 

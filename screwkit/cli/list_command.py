@@ -7,7 +7,7 @@ import json
 import click
 
 from screwkit.cli.options import json_option
-from screwkit.loader import bundled_names
+from screwkit.io.loader import bundled_names
 
 __all__ = ["list_command"]
 

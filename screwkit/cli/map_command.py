@@ -25,11 +25,11 @@ from screwkit.cli.options import (
     threshold_option,
 )
 from screwkit.cli.sweep import fixed_pose, write_outputs
+from screwkit.common.units import is_angular
 from screwkit.plots import map_figure
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 from screwkit.studies.maps import disc_size, index_map, map_size, planar_disc_map
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
-from screwkit.units import is_angular
 
 __all__ = ["map_command", "grid_spec"]
 

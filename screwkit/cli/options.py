@@ -16,14 +16,14 @@ from typing import Callable
 import click
 import numpy as np
 
-from screwkit._compile_notice import INDEX_KERNELS, compile_ahead, silence, stage_kernels
-from screwkit.loader import load
+from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
+from screwkit.io.loader import load
 from screwkit.plots import colour_scale
 from screwkit.studies.files import WriteError, check_distinct, check_output
 from screwkit.studies.maps import range_values
 from screwkit.studies.tasks import ClusterError, connect, disconnect
-from screwkit.tolerances import SINGULARITY_THRESHOLD
-from screwkit.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 
 __all__ = [
     "GreedyOption",
@@ -264,7 +264,7 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
     """``START:STOP:STEP`` -> START, START+STEP, ... up to STOP (included only if ``include_stop``).
 
     The stop is compared with a tolerance of a millionth of a step. Angles are given in degrees
-    (within :func:`~screwkit.units.angle_limit`) and returned in radians when ``angular``.
+    (within :func:`~screwkit.common.units.angle_limit`) and returned in radians when ``angular``.
     """
     parts = str(text).split(":")
     try:

@@ -21,10 +21,10 @@ from screwkit.cli.options import (
     quiet_option,
     threshold_option,
 )
+from screwkit.common.units import is_angular
 from screwkit.plots import save_figure, sweep_figure
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, wide_table, write_dataset
 from screwkit.studies.sweep import sweep as run_sweep
-from screwkit.units import is_angular
 
 __all__ = ["sweep", "fixed_pose", "write_outputs"]
 

@@ -6,7 +6,7 @@ import time
 
 import click
 
-from screwkit._compile_notice import (
+from screwkit.common.compiling import (
     CLOSED_FORM_KERNEL,
     GRAM_KERNEL,
     INDEX_KERNELS,
@@ -29,7 +29,7 @@ def warmup() -> None:
 
     from screwkit.closure import solve  # numba: when run, not for --help
     from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics  # idem
-    from screwkit.loader import load  # Pinocchio: loaded when the command runs, not for --help
+    from screwkit.io.loader import load  # Pinocchio: loaded when the command runs, not for --help
     from screwkit.studies.poses import indices_at_pose, indices_at_poses  # idem
 
     start = time.perf_counter()
@@ -37,9 +37,9 @@ def warmup() -> None:
     compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL, CLOSED_FORM_KERNEL)
     five, hexapod = load("planar_5rrr"), load("ups_hexapod_8")
     steps = {  # the kernels compiled here first, while the child processes compile the index kernels
-        ("screwkit._planar_kernel",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
-        ("screwkit.closure._task_kernel",): lambda: load("prs_3_ups"),
-        ("screwkit.closure._frames_kernel",): lambda: chain_forward_kinematics(
+        ("screwkit.indices.compiled.planar",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
+        ("screwkit.closure.compiled.task",): lambda: load("prs_3_ups"),
+        ("screwkit.closure.compiled.frames",): lambda: chain_forward_kinematics(
             five.chains[0].geometry, np.zeros((COMPILED_FROM, five.chains[0].geometry.n_dofs))),
         INDEX_KERNELS: lambda: indices_at_pose(five, five.home_pose),
         (NULL_KERNEL,): lambda: indices_at_pose(hexapod, hexapod.home_pose),

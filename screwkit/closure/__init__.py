@@ -6,18 +6,18 @@ Functions of an immutable :class:`~screwkit.model.Mechanism` and of configuratio
   batched damped Newton), keeping the working mode and the joint limits;
 * :func:`forward`: platform poses from actuator values;
 * :func:`chain_screws`: the world-frame joint screws of solved configurations, the input of
-  :func:`screwkit.transmission.analyze`;
+  :func:`screwkit.indices.analysis.analyze`;
 * :func:`thread_limit`: bound the threads closure solving uses (inside parallel tasks).
 
 Modules: :mod:`~screwkit.closure.chain_kinematics` (one chain's forward kinematics and
 twists), :mod:`~screwkit.closure.newton`, :mod:`~screwkit.closure.analytic` (closed-form
 chain solvers; the spatial ones, and the joint screws, of large batches compiled in
 ``_closed_form_kernel``), :mod:`~screwkit.closure.assembly` (the reference assembly and working modes),
-:mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.screws`, :mod:`~screwkit.closure.threads`.
+:mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.configuration_screws`, :mod:`~screwkit.closure.threads`.
 """
 
 from screwkit.closure.assembly import working_modes
-from screwkit.closure.screws import chain_screws, joint_screws
+from screwkit.closure.configuration_screws import chain_screws, joint_screws
 from screwkit.closure.solve import (
     Solution,
     UnreachablePose,

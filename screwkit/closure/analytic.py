@@ -9,7 +9,7 @@ that type) and solves whole batches of platform poses block by block, in threads
 * :class:`LegVectorChain` (``ups``): the leg vector, pointed by the universal joint (Paden-Kahan 2);
 * :class:`CrankRodChain` (``rus``): the crank angle from a circle-sphere intersection.
 
-Recognition uses :data:`screwkit.tolerances.CLOSURE_TOLERANCE`, the tolerance at which a file's
+Recognition uses :data:`screwkit.common.tolerances.CLOSURE_TOLERANCE`, the tolerance at which a file's
 loops must close, so a file written to 6 decimals keeps its closed forms.
 """
 
@@ -23,17 +23,17 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit._compile_notice import CLOSED_FORM_KERNEL, prepare_kernels
 from screwkit.closure.chain_kinematics import ChainFrames, chain_forward_kinematics, packed_chains
 from screwkit.closure.threads import for_each_block
-from screwkit.model.chain import ChainGeometry
-from screwkit.rotations import (
+from screwkit.common.compiling import CLOSED_FORM_KERNEL, prepare_kernels
+from screwkit.common.rotations import (
     rotation_about_axis,
     rotation_vector_from_rotation,
     two_axis_pointing,
     wrap_angle,
 )
-from screwkit.tolerances import CLOSURE_TOLERANCE
+from screwkit.common.tolerances import CLOSURE_TOLERANCE
+from screwkit.model.chain import ChainGeometry
 
 __all__ = [
     "ClosedFormResult",
@@ -364,10 +364,10 @@ class SpatialClosedForm:
 
     def solve_compiled(self, platform_rotation: NDArray, platform_translation: NDArray, branch) -> ClosedFormResult:
         """:meth:`solve` for platform frames (N, 3, 3), (N, 3) through the compiled kernel
-        (:mod:`screwkit.closure._closed_form_kernel`), block by block in threads: the same result,
+        (:mod:`screwkit.closure.compiled.closed_form`), block by block in threads: the same result,
         several times faster on large batches."""
         prepare_kernels((CLOSED_FORM_KERNEL,))
-        from screwkit.closure._closed_form_kernel import spatial_closed_form_kernel  # numba: large batches only
+        from screwkit.closure.compiled.closed_form import spatial_closed_form_kernel  # numba: large batches only
 
         geometry = self.geometry
         rotation = np.ascontiguousarray(platform_rotation, dtype=float)

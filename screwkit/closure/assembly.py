@@ -31,15 +31,15 @@ from screwkit.closure.task_space import (
     infer_task_axes,
     motion_space_at,
 )
-from screwkit.model.chain import Chain
-from screwkit.model.mechanism import Mechanism
-from screwkit.rotations import wrap_angle
-from screwkit.tolerances import (
+from screwkit.common.rotations import wrap_angle
+from screwkit.common.tolerances import (
     BRANCH_MATCH_TOLERANCE,
     CLOSURE_TOLERANCE,
     MOTION_SPACE_TOLERANCE,
     NEWTON_TOLERANCE,
 )
+from screwkit.model.chain import Chain
+from screwkit.model.mechanism import Mechanism
 
 __all__ = ["assemble", "mobility", "working_modes"]
 

@@ -2,7 +2,7 @@
 
 Everything works on whole batches of configurations: the batch lives on leading axes, and a
 Python loop only ever runs over joints, never over configurations. Computations are in the
-mechanism's **base frame**; :mod:`screwkit.closure.screws` moves results to the world frame.
+mechanism's **base frame**; :mod:`screwkit.closure.configuration_screws` moves results to the world frame.
 Joint screws are a unit direction (``axes``: the rotation axis of a revolute DoF, the sliding
 direction of a prismatic one) and a point on the joint (``points``: the joint frame origin);
 :func:`twists_from_axes_and_points` turns them into twists ``(omega, v)`` with ``v`` the
@@ -20,9 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit._compile_notice import announce_compilation
-from screwkit.model.chain import ChainGeometry
-from screwkit.rotations import (
+from screwkit.common.compiling import announce_compilation
+from screwkit.common.rotations import (
     angle_about_axis,
     rotation_about_axis,
     rotation_angle_to_align,
@@ -31,6 +30,7 @@ from screwkit.rotations import (
     skew_matrix,
     wrap_angle,
 )
+from screwkit.model.chain import ChainGeometry
 
 __all__ = [
     "ChainFrames",
@@ -51,7 +51,7 @@ LOOP_CODES = {"fixed": 0, "revolute": 1, "continuous": 1, "prismatic": 2, "unive
 
 COMPILED_FROM = 512
 """Batches of at least this many configurations go through the compiled forward kinematics
-(:mod:`screwkit.closure._frames_kernel`); smaller ones, such as single configurations while a
+(:mod:`screwkit.closure.compiled.frames`); smaller ones, such as single configurations while a
 model is built, stay in numpy so that no compiler is loaded for them."""
 
 
@@ -128,8 +128,8 @@ def packed_chains(geometries: list[ChainGeometry]) -> dict:
 
 def _compiled_frames(geometry: ChainGeometry, joint_values: NDArray) -> ChainFrames:
     """:func:`chain_forward_kinematics` through the compiled kernel, configuration by configuration."""
-    announce_compilation("screwkit.closure._frames_kernel")
-    from screwkit.closure._frames_kernel import chain_frames_kernel  # numba: loaded for large batches only
+    announce_compilation("screwkit.closure.compiled.frames")
+    from screwkit.closure.compiled.frames import chain_frames_kernel  # numba: loaded for large batches only
 
     batch, m = joint_values.shape[:-1], geometry.n_dofs
     flat = np.ascontiguousarray(joint_values.reshape(-1, m))

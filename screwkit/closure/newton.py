@@ -20,11 +20,11 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.model.chain import ChainGeometry
-from screwkit.rotations import (
+from screwkit.common.rotations import (
     rotation_from_rotation_vector,
     rotation_vector_from_rotation,
 )
+from screwkit.model.chain import ChainGeometry
 
 __all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "task_rows"]
 

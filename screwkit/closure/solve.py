@@ -20,9 +20,9 @@ from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinem
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
 from screwkit.closure.threads import for_each_block
+from screwkit.common.rotations import wrap_angle
+from screwkit.common.tolerances import NEWTON_TOLERANCE
 from screwkit.model.mechanism import Mechanism, require_mechanism
-from screwkit.rotations import wrap_angle
-from screwkit.tolerances import NEWTON_TOLERANCE
 
 __all__ = [
     "Solution",

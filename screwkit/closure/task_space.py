@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit._compile_notice import announce_compilation
 from screwkit.closure.chain_kinematics import (
     chain_forward_kinematics,
     packed_chains,
@@ -22,8 +21,9 @@ from screwkit.closure.chain_kinematics import (
     wrap_revolute_values,
 )
 from screwkit.closure.threads import for_each_block
+from screwkit.common.compiling import announce_compilation
+from screwkit.common.tolerances import MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 from screwkit.model.mechanism import Mechanism
-from screwkit.tolerances import MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 
 __all__ = [
     "pose_rates",
@@ -77,7 +77,7 @@ def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:
 
 def packed_geometry(mechanism: Mechanism, chains: tuple[int, ...]) -> dict:
     """The geometry of ``chains`` packed for the compiled closure (:func:`packed_chains`, and the planar plane)."""
-    announce_compilation("screwkit.closure._task_kernel")
+    announce_compilation("screwkit.closure.compiled.task")
     geometries = [mechanism.chains[index].geometry for index in chains]
     return dict(packed_chains(geometries), planar=mechanism.is_planar,
                 planar_z=float(mechanism.home_translation[2]),
@@ -92,15 +92,15 @@ BLOCK = 2048
 
 def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, tolerance, iterations,
                  step_tolerance, step_iterations, max_step):
-    """The compiled closure (:mod:`screwkit.closure._task_kernel`) over a batch, in thread blocks.
+    """The compiled closure (:mod:`screwkit.closure.compiled.task`) over a batch, in thread blocks.
 
     The kernel runs on the mechanism scaled to a unit length scale (every length, pose
     coordinate, target and slide value divided by it), so that its damping, step limit and
     tolerances mean the same for a mechanism and any scaled copy; the residual is in rad and
     length scales.
     """
-    announce_compilation("screwkit.closure._task_kernel")
-    from screwkit.closure._task_kernel import close_chains_kernel  # numba: loaded when a closure first runs
+    announce_compilation("screwkit.closure.compiled.task")
+    from screwkit.closure.compiled.task import close_chains_kernel  # numba: loaded when a closure first runs
 
     poses = np.array(full_poses, dtype=float, order="C", copy=True)
     count = poses.shape[0]
@@ -148,7 +148,7 @@ def close_constraining_chains(mechanism, chains, full_poses, values, free_axes, 
     (free pose coordinates, joint values of every constraining chain) with lengths in units of
     the length scale: the step solves ``(J^T J + (mu + |e|^2) I) dx = -J^T e`` for the closure
     errors ``e`` of every constraining chain, is limited to ``max_step`` and kept only if it
-    lowers ``|e|``. Compiled (:mod:`screwkit.closure._task_kernel`), one configuration at a time.
+    lowers ``|e|``. Compiled (:mod:`screwkit.closure.compiled.task`), one configuration at a time.
 
     Returns
     -------

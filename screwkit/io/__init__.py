@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from screwkit.common.units import metres_per
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.mjcf import read_mjcf
 from screwkit.io.star import convert_tree
-from screwkit.units import metres_per
 
 __all__ = ["read_mechanism_file", "is_foreign", "convert_tree", "ClosedTree", "Closure", "ImportReport",
            "ImportError_", "read_gepetto", "read_mjcf", "with_reference_configuration"]

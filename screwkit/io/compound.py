@@ -13,7 +13,7 @@ allows with that actuator locked. For a compound leg with one actuator:
 * the **twist system** S_g is the platform-twist part of the null space of the leg's closure
   Jacobian (:func:`platform_twists`: every joint rate of the leg and the platform twist as
   unknowns, one block of rows per closure of the leg, in the working coordinates of
-  :func:`screwkit.transmission.analyze`);
+  :func:`screwkit.indices.analysis.analyze`);
 * the **actuated path**, the tree path from the base through the actuator to the platform, is a
   serial chain, and every motion of the leg moves it: the platform twist of any leg motion is a
   combination of the path's joint twists, with the actuator's rate when the actuator moves and
@@ -44,8 +44,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import skew_matrix
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, assemble, joint_kind, path_to
-from screwkit.rotations import skew_matrix
 
 __all__ = ["NotReducible", "compound_groups", "platform_twists", "Reduction", "equivalent_constraint", "closed_samples",
            "compound_legs",

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_about_axis, rpy_from_rotation
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -54,7 +55,6 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.compound import Reduction, compound_legs
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rotation_about_axis, rpy_from_rotation
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
 
@@ -66,7 +66,7 @@ UNLIMITED_SLIDE = 1e6
 
 INDEPENDENCE_TOLERANCE = 1e-9
 """Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
-largest, for them to count as independent (as :data:`screwkit.tolerances.MOTION_SPACE_TOLERANCE`)."""
+largest, for them to count as independent (as :data:`screwkit.common.tolerances.MOTION_SPACE_TOLERANCE`)."""
 
 
 # -- the star --------------------------------------------------------------------------------------

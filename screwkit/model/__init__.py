@@ -8,7 +8,7 @@
 * :mod:`~screwkit.model.builder`: the chains of a file, through Pinocchio's tree;
 * :mod:`~screwkit.model.pinocchio_bridge`: everything asked of Pinocchio.
 
-Load a mechanism with :func:`screwkit.loader.load`.
+Load a mechanism with :func:`screwkit.io.loader.load`.
 """
 
 from screwkit.model.chain import Chain, ChainGeometry

@@ -1,7 +1,7 @@
 """Writing Delta robots with any number of legs in screwkit's URDF convention.
 
 Used by the bundled ``delta_4`` (``python -m screwkit.robots.generate``) and by the design family
-``delta`` of :mod:`screwkit.studies.families`. Each parallelogram forearm is modelled by Tsai's
+``delta`` of :mod:`screwkit.studies.design.families`. Each parallelogram forearm is modelled by Tsai's
 translational R-U-U leg (see :func:`delta_urdf` and ``robots/README.md``).
 """
 
@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
+from screwkit.common.rotations import rpy_from_rotation
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rpy_from_rotation
 
 __all__ = ["delta_leg", "delta_urdf"]
 

@@ -1,7 +1,7 @@
 """Writing a-UPS and a-RSS hexapods (any leg count a) in screwkit's URDF convention.
 
 Used by the bundled files (``python -m screwkit.robots.generate``) and by the design families of
-:mod:`screwkit.studies.families`. Base joints sit on a circle at z = 0, platform joints on a
+:mod:`screwkit.studies.design.families`. Base joints sit on a circle at z = 0, platform joints on a
 circle in the platform frame, both at the a angles of :func:`hexapod_points`; the platform is
 ``height`` above the base in the reference assembly, where every joint value is zero.
 """
@@ -13,8 +13,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rotation_from_rpy, rpy_from_rotation
 
 __all__ = ["slot_angles", "hexapod_points", "ups_hexapod_urdf", "rss_hexapod_urdf", "unit", "universal_axes"]
 

@@ -5,7 +5,7 @@ platform joint, the reference assembly, named poses) and what was derived from i
 was loaded (each chain's closure solver and working mode, the platform's DOF). It never
 changes: closure solving (:mod:`screwkit.closure`), screws and indices are functions of a
 mechanism and of configurations, as Pinocchio's algorithms are of its ``Model``.
-Build one with :func:`screwkit.loader.load`.
+Build one with :func:`screwkit.io.loader.load`.
 
 Frames and coordinates: a **full pose** is the platform frame relative to the **base link** frame
 (the parent link of the platform's floating/planar joint) in the pose coordinates
@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.common.rotations import rotation_about_axis, rotation_from_rpy, rpy_from_rotation
+from screwkit.common.units import angle_beyond_limit, angle_limit, is_angular
 from screwkit.model.chain import Chain, ChainGeometry
 from screwkit.model.urdf_reader import UrdfDescription
-from screwkit.rotations import rotation_about_axis, rotation_from_rpy, rpy_from_rotation
-from screwkit.units import angle_beyond_limit, angle_limit, is_angular
 
 __all__ = ["Mechanism", "require_mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
 
@@ -216,7 +216,7 @@ class Mechanism:
 
     def check_poses(self, poses: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
         """Poses as a float array (..., n_task) of finite real values, angles within
-        :func:`~screwkit.units.angle_limit` (in degrees if ``degrees``), or a ValueError saying what arrived."""
+        :func:`~screwkit.common.units.angle_limit` (in degrees if ``degrees``), or a ValueError saying what arrived."""
         try:
             given = np.asarray(poses)
             if given.dtype.kind in "bc":  # float() would take True as 1 and drop an imaginary part
@@ -313,6 +313,6 @@ def require_mechanism(mechanism: Any, function: str) -> None:
         return
     if isinstance(mechanism, str):
         raise TypeError(f"{function} expects a Mechanism, got the name {mechanism!r}: load it first, "
-                        f"mechanism = screwkit.loader.load({mechanism!r}).")
-    raise TypeError(f"{function} expects a Mechanism (from screwkit.loader.load), got {type(mechanism).__name__} "
+                        f"mechanism = screwkit.io.loader.load({mechanism!r}).")
+    raise TypeError(f"{function} expects a Mechanism (from screwkit.io.loader.load), got {type(mechanism).__name__} "
                     f"{mechanism!r:.60}.")

@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.rotations import quaternion_from_rotation
+from screwkit.common.rotations import quaternion_from_rotation
 
 __all__ = [
     "twist_from_pinocchio_motion",

@@ -2,7 +2,7 @@
 URDF convention (3 DOF: z, roll, pitch).
 
 Used by the bundled ``prs_3_ups`` (``python -m screwkit.robots.generate``) and by the design family
-``prs_ups`` of :mod:`screwkit.studies.families`.
+``prs_ups`` of :mod:`screwkit.studies.design.families`.
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import math
 
 import numpy as np
 
+from screwkit.common.rotations import rpy_from_rotation
 from screwkit.model.hexapod_writer import unit, universal_axes
 from screwkit.model.urdf_writer import UrdfWriter
-from screwkit.rotations import rpy_from_rotation
 
 __all__ = ["prs_urdf"]
 

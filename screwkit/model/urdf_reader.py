@@ -39,9 +39,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_from_rpy
+from screwkit.common.units import LENGTH_UNITS, metres_per
 from screwkit.model.chain import LOOP_JOINT_DOFS
-from screwkit.rotations import rotation_from_rpy
-from screwkit.units import LENGTH_UNITS, metres_per
 
 _DECLARATION = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
 TREE_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -206,7 +206,7 @@ def parse_urdf(document: str | bytes, source: str = "<string>", *, length_unit: 
         Name used in error messages (the file path).
     length_unit : str, optional
         The unit the document's lengths are written in (one of
-        :data:`screwkit.units.LENGTH_UNITS`); overrides the file's ``<units length=...>``;
+        :data:`screwkit.common.units.LENGTH_UNITS`); overrides the file's ``<units length=...>``;
         default metres.
     max_bytes : int
         Largest document accepted.

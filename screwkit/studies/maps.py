@@ -25,13 +25,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.loader import cached_mechanism
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.common.units import is_angular, unit_of
+from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
 from screwkit.studies.poses import indices_at_poses
 from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
-from screwkit.tolerances import SINGULARITY_THRESHOLD
-from screwkit.units import is_angular, unit_of
 
 __all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "disc_size",
            "map_task", "map_block", "orientation_set"]

@@ -2,8 +2,8 @@
 
 This is the layer sweeps, maps, design searches, the command line and the viewer stand on:
 :func:`indices_at_poses` solves the closures of a batch of poses, hands the screws of the
-reachable ones to :func:`screwkit.transmission.analyze` (or to the paper's planar closed forms)
-and returns one :class:`~screwkit.results.Indices` with NaN where a pose is unreachable;
+reachable ones to :func:`screwkit.indices.analysis.analyze` (or to the paper's planar closed forms)
+and returns one :class:`~screwkit.indices.results.Indices` with NaN where a pose is unreachable;
 :func:`indices_at_pose` does one pose and says why it is unreachable.
 """
 
@@ -17,13 +17,13 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.closed_forms import planar_indices, point_indices
 from screwkit.closure import chain_screws, solve, solve_one, thread_limit, working_modes
-from screwkit.link_faults import FAULT_TYPES
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.indices.analysis import analyze
+from screwkit.indices.closed_forms import planar_indices, point_indices
+from screwkit.indices.faults import FAULT_TYPES
+from screwkit.indices.results import Indices
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.results import Indices
-from screwkit.tolerances import SINGULARITY_THRESHOLD
-from screwkit.transmission import analyze
 
 __all__ = ["indices_at_poses", "indices_at_pose", "analyze_solution", "output_points", "planar_points",
            "closed_form_indices"]
@@ -39,7 +39,7 @@ def output_points(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float
 
 
 def analyze_solution(mechanism: Mechanism, solution, *, unreachable: str = "raise", **options) -> Indices:
-    """:func:`screwkit.transmission.analyze` on the screws of a solution, with the mechanism's output.
+    """:func:`screwkit.indices.analysis.analyze` on the screws of a solution, with the mechanism's output.
 
     ``unreachable`` as in :func:`screwkit.closure.chain_screws`; other options go to ``analyze``.
     A point output (``<output type="point">``) makes the rotations about the point idle.
@@ -103,9 +103,9 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
 
     ITI per chain (Eq. 23; 1 for RPR chains, whose input is along the force), the OTI of every
     3-chain submechanism (Eqs. 34, A4), LMTI, F_Oj, F_IOj, the worst faults and the
-    mutual-interference actuators, all from :func:`screwkit.closed_forms.planar_indices`; for R-R-R legs
+    mutual-interference actuators, all from :func:`screwkit.indices.closed_forms.planar_indices`; for R-R-R legs
     meeting at a point output (a five-bar), the textbook pressure angles of
-    :func:`screwkit.closed_forms.point_indices`.
+    :func:`screwkit.indices.closed_forms.point_indices`.
     """
     base, elbows, distal, prismatic = planar_points(mechanism, solution)
     if mechanism.output_point is not None:
@@ -171,7 +171,7 @@ hexapod's memory (5,461 configurations, 322 MiB for its 21 x 21 x 360 map) made 
 FULL_MOBILITY_CHUNK_WORK = 1 << 18
 """:data:`CHUNK_WORK` of a mechanism free in all six DoF. Its chunks take no samples of the motion
 space or the constraint structure (all twists, no constraint wrench: see
-:func:`screwkit.motion.motion_space`), which are most of the Python around the kernels of a chunk
+:func:`screwkit.screw.motion.motion_space`), which are most of the Python around the kernels of a chunk
 (about 7 ms per hexapod chunk). Its chunks can so be eight times smaller at the same speed, for an
 eighth of the memory: the 8-leg hexapod's 41 x 41 x 360 map peaked at 262 MiB in chunks of 1,024
 configurations, 280-288 MiB in chunks of 2,048 and 379-419 MiB in chunks of 9,709, in 6.5, 6.0-7.0
@@ -229,7 +229,7 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     limits : bool
         Whether poses that put a joint outside its position limits are unreachable (default).
     fault_type : {"free-swinging", "link"}
-        What a fault is (see :func:`screwkit.transmission.analyze`). The planar closed forms are for
+        What a fault is (see :func:`screwkit.indices.analysis.analyze`). The planar closed forms are for
         free-swinging faults, which give the same numbers as link faults on planar RRR/RPR chains.
 
     Returns

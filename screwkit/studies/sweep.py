@@ -14,11 +14,11 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.common.units import is_angular
+from screwkit.indices.results import set_label
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.results import set_label
 from screwkit.studies.poses import indices_at_poses
-from screwkit.tolerances import SINGULARITY_THRESHOLD
-from screwkit.units import is_angular
 
 __all__ = ["sweep"]
 
@@ -53,7 +53,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         each j ``remaining{j}`` (the actuator sets left after j faults). Variables:
         ``iti``, ``iti_actuator``, ``oti_submechanism``, ``lmti``, ``lmti_remaining{j}``,
         ``f_o{j}``, ``f_io{j}``, ``worst_fault{j}``, ``mutual_interference``, ``reachable``
-        (those of :meth:`screwkit.results.Indices.to_dataset` along the swept coordinate,
+        (those of :meth:`screwkit.indices.results.Indices.to_dataset` along the swept coordinate,
         and the LMTI of every set left after j faults).
     """
 

@@ -12,9 +12,9 @@ from typing import Any, Literal, Self
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.loader import load
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.io.loader import load
 from screwkit.studies.files import atomic_text
-from screwkit.tolerances import SINGULARITY_THRESHOLD
 from screwkit.viewer.drawing import (
     BASE_COLOR,
     PLATFORM_COLOR,
@@ -57,7 +57,7 @@ class Scene:
     poses : ndarray, shape (frames, n_task)
         The drawn poses (metres, radians): one for :func:`show`, the reachable poses of the
         sweep for :func:`animate_sweep`.
-    result : screwkit.transmission.TransmissionResult
+    result : screwkit.indices.analysis.TransmissionResult
         Indices at the poses (batch shape ``()`` for :func:`show`, ``(frames,)`` for a sweep).
     failed : tuple of int
         Failed actuators (indices into ``mechanism.actuators``).
@@ -146,7 +146,7 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
     Parameters
     ----------
     mechanism : Mechanism, str or path
-        A loaded mechanism, a bundled name or a URDF path (see :func:`screwkit.loader.load`).
+        A loaded mechanism, a bundled name or a URDF path (see :func:`screwkit.io.loader.load`).
     pose : array_like, shape (n_task,), optional
         Platform pose in metres and radians; default the home pose.
     failed : int, str or sequence of them, optional

@@ -1,0 +1,1 @@
+"""The compiled (numba) kernels of closure solving."""

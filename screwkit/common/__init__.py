@@ -1,0 +1,3 @@
+"""Shared by every layer: tolerances, units, rotations, input validation, chunked threads, and the plumbing of
+compiled kernels (numba's cache and compile notices).
+"""

@@ -1,0 +1,89 @@
+"""Every numerical tolerance of screwkit, named once, with its unit and meaning.
+
+Lengths are metres; "relative" tolerances are dimensionless. The math core compares
+dimensionless quantities only (screws are expressed about the centroid of the platform
+joints with lengths in units of a characteristic length of the configuration, see
+:mod:`screwkit.indices.analysis`), so that every decision it takes is independent of the length
+unit, the scale of the mechanism and the world frame. The one tolerance with a unit that
+enters the indices is the paper's singularity threshold *p*.
+Only the standard library is imported here.
+"""
+
+from __future__ import annotations
+
+# -- indices (math core) ----------------------------------------------------------------
+# Every tolerance below but SINGULARITY_THRESHOLD is dimensionless and is applied in working
+# coordinates: screws about the centroid c of the platform joints, lengths divided by
+# L = sqrt(mean_j |p_j - c|^2) over every joint point p_j of the configuration, so that a twist
+# (omega, v) becomes (omega, v_c / L) and a wrench (f, m) becomes (f, m_c / L). The compiled
+# kernel receives them as arguments (numba's disk cache would not see a changed constant).
+
+SINGULARITY_THRESHOLD = 1e-6
+"""The paper's singularity threshold *p* (m, the unit of the screws): a power coefficient is zero
+when the moment arm of its wrench about its characteristic point is at or below *p* (Sec. 4,
+1 um). The only length among the tolerances: it is compared as ``arm / L <= p / L``, so it must
+be scaled with the mechanism (a mechanism in millimetres needs ``p = 1e-3``)."""
+
+RANK_TOLERANCE = 1e-9
+"""Relative: the actuation wrenches of a non-redundant submechanism are dependent (its OTI is
+zero) when ``|det W|`` is at or below this times the product of the norms of the rows of ``W``
+(``W = [A_k o M_q]`` with an orthonormal basis ``M`` of the motion space, working coordinates)."""
+
+MOTION_SPACE_TOLERANCE = 1e-9
+"""Relative: a chain's joint twists, each scaled to unit norm in working coordinates, are
+dependent when a singular value of their matrix is at or below this times the largest."""
+
+MOTION_SPACE_EIGENVALUE = 1e-8
+"""Dimensionless: a twist belongs to the platform's motion space when ``sum_i (I - P_i)``
+(``P_i`` the orthogonal projector on chain i's twist space, working coordinates) has an
+eigenvalue at or below this along it (each ``I - P_i`` has eigenvalues 0 and 1)."""
+
+CONSTANT_BASIS_TOLERANCE = 1e-8
+"""Dimensionless: orthonormal motion-space bases (working coordinates) found at sample
+configurations span the same space when one differs from its projection on the other by at
+most this, entry by entry."""
+
+OUTSIDE_CONSTANT_SPACE = 1e-9
+"""Relative: a joint twist leaves a constant motion space when the norm of its component
+outside the space is larger than this times its norm (working coordinates); the configuration
+then gets its own motion space."""
+
+PURE_COUPLE = 1e-10
+"""Relative: a wrench is a pure couple (infinite pitch) when ``|f| * L`` is at or below this
+times ``|m|`` (the moment about the centroid; :func:`screwkit.screw.algebra.power_coefficient` takes
+it about the characteristic point with its ``length`` argument as ``L``)."""
+
+GRAM_PIVOT = 1e-12
+"""Relative: the Gram matrix of a chain's joint twists (about the platform joint, each scaled to
+unit norm in working coordinates, so its diagonal is 1) is singular (an idle DoF, e.g. the spin
+of an S-S rod) when a pivot of its elimination is at or below this times its largest diagonal
+entry."""
+
+PSEUDO_INVERSE_CONSISTENCY = 1e-9
+"""Relative: a pseudo-inverse solution of a singular Gram system (above) is kept when its
+largest residual is at most this times ``max(1, largest entry of the solution)``; otherwise the
+actuation wrench is zero (the actuated joint's twist depends on the chain's other twists)."""
+
+WORST_FAULT_TIE = 1e-12
+"""Dimensionless, absolute (indices lie in [0, 1]): the worst fault set reported with ``F_Oj`` is
+the first set, in combination order, whose LMTI is at most ``F_Oj`` plus this. Rounding can
+reorder sets whose LMTIs are mathematically equal; their differences are absolute, of order
+1e-16, also where the index is small, hence an absolute margin rather than one relative to the
+minimum."""
+
+# -- closure and model ------------------------------------------------------------------
+
+CLOSURE_TOLERANCE = 1e-6
+"""Metres and radians: the largest loop gap accepted at the reference configuration of a
+file, and the tolerance of recognising a chain's closed-form type (axes parallel, points
+coincident, axes along z), so that a file written to 6 decimals keeps its closed forms."""
+
+NEWTON_TOLERANCE = 1e-11
+"""Radians and length scales: a chain solved by damped Newton is closed when its loop error norm
+(rotation in rad, translation divided by the mechanism's length scale) is below this."""
+
+BRANCH_MATCH_TOLERANCE = 1e-4
+"""Radians, and metres relative to the mechanism's length scale: the closed-form branch closest
+to the reference assembly is its working mode when every joint value matches it to this. Working
+modes lie far apart; the reference values of a file whose loops close only to
+:data:`CLOSURE_TOLERANCE` differ from an exact closure by a few times that."""

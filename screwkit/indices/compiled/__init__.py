@@ -1,0 +1,3 @@
+"""The compiled (numba) kernels of the index pipeline; each has a plain-numpy counterpart in
+:mod:`screwkit.screw.reference`.
+"""

@@ -1,0 +1,140 @@
+"""Loading a mechanism: file -> description -> Pinocchio tree -> model -> reference assembly.
+
+:func:`load` takes a bundled name (:func:`bundled_names`) or a file path and returns the
+immutable :class:`~screwkit.model.Mechanism`. It is the one place where the model layer
+(reading the file, :mod:`screwkit.model`) and the closure layer (the reference assembly,
+:mod:`screwkit.closure`) meet; everything downstream takes the mechanism it returns.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from dataclasses import replace
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from screwkit.closure.assembly import assemble, task_space
+from screwkit.io import is_foreign, read_mechanism_file
+from screwkit.model.builder import read_chains, read_platform
+from screwkit.model.mechanism import Mechanism
+from screwkit.model.pinocchio_bridge import build_model
+from screwkit.model.urdf_reader import (
+    MAX_FILE_BYTES,
+    UrdfDescription,
+    parse_urdf,
+    read_urdf,
+)
+
+__all__ = ["load", "load_text", "mechanism_from_description", "bundled_names", "bundled_path"]
+
+
+def bundled_names() -> tuple[str, ...]:
+    """Names of the mechanisms shipped in :mod:`screwkit.robots`."""
+    folder = resources.files("screwkit.robots")
+    return tuple(sorted(item.name[: -len(".urdf")] for item in folder.iterdir() if item.name.endswith(".urdf")))
+
+
+def bundled_path(name: str) -> Path:
+    """Path of a bundled URDF; a ValueError lists the bundled names if ``name`` is not one."""
+    if name not in bundled_names():
+        raise ValueError(f"Unknown bundled mechanism {name!r}; bundled are: {', '.join(bundled_names())}.")
+    return Path(str(resources.files("screwkit.robots").joinpath(f"{name}.urdf")))
+
+
+def _named_poses(description: UrdfDescription, mechanism: Mechanism) -> dict[str, np.ndarray]:
+    """The reference assembly as ``home``, and the file's named poses, in task coordinates."""
+    poses = {"home": mechanism.task_poses(mechanism.home_full_pose)}
+    for name, values in description.named_poses.items():
+        tag = f"<named_pose name='{name}'>"
+        missing = [c for c in mechanism.task_coordinates if c not in values]
+        unknown = [c for c in values if c not in mechanism.pose_coordinates]
+        if missing or unknown:
+            raise description.fail(tag, f"expected the task coordinates {', '.join(mechanism.task_coordinates)} "
+                                        f"(m, rad), got {', '.join(values) or 'none'}.")
+        if name == "home":
+            raise description.fail(tag, "'home' is the reference assembly's pose; name this pose otherwise.")
+        poses[name] = np.array([values[c] for c in mechanism.task_coordinates])
+    return poses
+
+
+def mechanism_from_description(description: UrdfDescription) -> Mechanism:
+    """The mechanism of a file's description (see :func:`load`)."""
+    name = description.robot_name or Path(description.source).stem
+    model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
+    platform = read_platform(description, model, name)
+    chains = read_chains(description, model, platform)
+    draft = Mechanism(
+        name=name, path=description.source, description=description, pinocchio_model=model,
+        is_planar=platform.is_planar, pose_coordinates=platform.pose_coordinates, base_link=platform.base_link,
+        platform_link=platform.platform_link, platform_joint=platform.platform_joint,
+        platform_joint_id=platform.platform_joint_id, platform_frame_placement=platform.platform_frame_placement,
+        rotation_world_base=platform.rotation_world_base, translation_world_base=platform.translation_world_base,
+        home_rotation=platform.home_rotation, home_translation=platform.home_translation,
+        chains=chains, dof=0, length_scale=1.0, named_poses={}, length_unit=description.length_unit,
+        output_point=np.zeros(3) if description.output == "point" else None)
+    draft = replace(draft, named_poses={"home": draft.home_full_pose})  # the reference assembly, for assembling
+    mechanism = task_space(assemble(draft), getattr(description, "task_coordinates", None))
+    return replace(mechanism, named_poses=_named_poses(description, mechanism))
+
+
+def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
+         max_bytes: int = MAX_FILE_BYTES) -> Mechanism:
+    """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A bundled name, the path of a URDF following ``docs/urdf-convention.md``, of an MJCF file
+        (``.xml``, ``.mjcf``) or of a URDF tree with a Gepetto ``robot.yaml`` beside it (both
+        converted by :mod:`screwkit.io`; ``screwkit convert`` writes the conversion).
+    length_unit : str, optional
+        The unit the file's lengths are written in (``"mm"``, ...; see
+        :data:`screwkit.common.units.LENGTH_UNITS`); overrides the file's ``<units length=...>``.
+        Everything in screwkit is then in metres.
+    max_bytes : int
+        Largest file read (:data:`~screwkit.model.urdf_reader.MAX_FILE_BYTES`).
+
+    Raises
+    ------
+    ValueError
+        Unknown name, a missing file or a folder, or a file that breaks the convention (the
+        message names the file, the element and the problem).
+    TypeError
+        ``name_or_path`` is neither a string nor a path.
+    """
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise TypeError(f"Expected the name of a bundled mechanism ({', '.join(bundled_names())}) or a file path, "
+                        f"got {type(name_or_path).__name__} {name_or_path!r}.")
+    text = os.fspath(name_or_path)
+    looks_like_path = (isinstance(name_or_path, os.PathLike) or text.endswith((".urdf", ".xml", ".mjcf"))
+                       or os.sep in text or "/" in text)
+    if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
+        path = bundled_path(text)
+    else:
+        path = Path(text)
+        if path.is_dir():
+            raise ValueError(f"{text}: is a folder; expected a mechanism file (.urdf, or .xml/.mjcf for MJCF) or "
+                             f"a bundled name ({', '.join(bundled_names())}).")
+        if not path.is_file():
+            raise ValueError(f"{text}: no such file (bundled mechanisms are: {', '.join(bundled_names())}).")
+        if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it
+            if path.stat().st_size > max_bytes:
+                raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
+            converted, report = read_mechanism_file(path)
+            mechanism = load_text(converted, str(path), length_unit=length_unit)
+            return replace(mechanism, import_report=tuple(report.lines()))
+    return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes))
+
+
+def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None) -> Mechanism:
+    """Load a mechanism from the text of a URDF (``source`` names it in messages)."""
+    return mechanism_from_description(parse_urdf(text, source, length_unit=length_unit))
+
+
+@functools.lru_cache(maxsize=8)
+def cached_mechanism(digest: str, text: str, source: str) -> Mechanism:
+    """:func:`load_text`, remembered by the text's digest (for tasks that rebuild a mechanism from its text)."""
+    return load_text(text, source)

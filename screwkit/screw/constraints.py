@@ -1,0 +1,352 @@
+r"""Constraint wrenches, constraint singularities and the constraint transmission index (CTI).
+
+A chain whose joints do not span every twist transmits **constraint wrenches** to the platform:
+the wrenches reciprocal to all its joint twists (a PRS leg: a force through the S centre along
+the R axis; a Delta leg: a couple). Liu, Wu and Wang's constraint transmission index measures how
+well they hold the platform: lock the actuators, release one constraint wrench, and take the
+power coefficient of that wrench on the one twist it leaves free; the CTI is the lowest over the
+constraint wrenches. screwkit computes it in its working coordinates (as
+:func:`screwkit.indices.analysis.analyze`), so it is independent of the length unit, the scale and the
+world frame, and it is **symmetric in the chains**: no decision depends on the order in which they
+are listed. The conventions below are screwkit's, stated with their reasons in ``docs/theory.md``
+(*Constraint wrenches and the CTI*):
+
+* **Constraints common to every chain** (the out-of-plane wrenches of a planar mechanism, the two
+  horizontal couples of every Schoenflies leg, the three forces through the centre of a spherical
+  wrist) are kept but never released: no chain holds them alone, releasing one chain's copy frees
+  nothing. A mechanism with no other constraint wrench has no CTI ("not applicable": NaN, with
+  :attr:`ConstraintPlan.reason`).
+* The other constraint wrenches of chain ``i`` (its **own** ones, ``C_i``) may hold more than the
+  platform needs (a 4-leg Delta: four couples of rank three). As the LMTI does for redundant
+  actuators (Eq. 11), the CTI takes the best of the **non-redundant constraint subsystems**: the
+  minimal sets ``L`` of chains whose own constraint wrenches, with the common ones, hold every
+  constraint of the mechanism (generic rank; :attr:`ConstraintPlan.subsystems`, all of them, in no
+  privileged order).
+* For a set ``N`` of ``n`` actuators and a subsystem ``L``, releasing chain ``i`` of ``L`` (its
+  ``C_i``) with the actuators of ``N`` locked and the other chains of ``L`` and the common
+  constraints kept frees the twists ``F_i`` reciprocal to every other wrench. Each freed twist is
+  paired with the constraint wrench of ``C_i`` that resists it along the principal directions of
+  the pairing (the singular vectors of ``C_i o F_i``, working coordinates; one pair when the chain
+  holds one constraint wrench), and
+
+  .. math:: \kappa = \frac{|C \circ T|}{|C \circ T|_{\max}}, \qquad
+            CTI_{N,L} = \min_{i \in L,\ \text{pairs}} \kappa, \qquad CTI_N = \max_L CTI_{N,L},
+
+  with the characteristic point of ``C`` the platform joint of its chain projected on its axis (a
+  couple gives :math:`|\hat m \cdot \hat\omega|`), and :math:`CTI_{N,L} = 0` when the wrenches of
+  ``N``, ``L`` and the common constraints do not span every wrench.
+* As the LMTI over actuator sets (Eq. 11): :math:`CTI = \max_N CTI_N`, and its fault-tolerant
+  counterpart, screwkit's extension in the spirit of Eq. 12, :math:`F_{Cj} = \min_E \max_{N \subset E}
+  CTI_N` over the actuator sets ``E`` left after ``j`` faults.
+* The **instantaneous DOF** of a configuration is six minus the rank of all constraint wrenches;
+  where it exceeds the mechanism's mobility ``n`` the configuration is a **constraint
+  singularity** and its CTI is zero.
+
+Only numpy is imported here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import combinations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common import tolerances
+from screwkit.screw.motion import chain_decompositions
+
+__all__ = ["ConstraintPlan", "plan_constraints", "constraint_indices", "chain_constraint_wrenches"]
+
+_SWAP = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
+
+
+@dataclass(frozen=True)
+class ConstraintPlan:
+    """How a mechanism's constraint wrenches are organised (found on sample configurations).
+
+    Attributes
+    ----------
+    chain_counts : tuple of int
+        Constraint wrenches of each chain (6 minus the rank of its joint twists).
+    common : int
+        Dimension of the constraint wrenches common to every chain.
+    own_counts : tuple of int
+        Each chain's own (non-common) constraint wrenches.
+    rank : int
+        Rank of all the chains' own constraint wrenches together (generic): what a subsystem releases.
+    subsystems : tuple of tuple of int
+        The non-redundant constraint subsystems: every minimal set of chains whose own constraint
+        wrenches have rank :attr:`rank`, in combination order of the chains.
+    """
+
+    chain_counts: tuple[int, ...]
+    common: int
+    own_counts: tuple[int, ...] = ()
+    rank: int = 0
+    subsystems: tuple[tuple[int, ...], ...] = ()
+
+    @property
+    def count(self) -> int:
+        """Constraint wrenches a subsystem releases: none means the CTI does not apply."""
+        return self.rank if self.subsystems else 0
+
+    @property
+    def reason(self) -> str:
+        """Why the CTI does not apply ("" when it does)."""
+        if self.count:
+            return ""
+        if not any(self.chain_counts):
+            return "no chain holds a constraint wrench"
+        return (f"every chain holds the same {self.common} constraint wrench{'es' if self.common > 1 else ''} "
+                "(none is held by one chain alone)")
+
+
+def _unit_rows(rows: NDArray) -> NDArray:
+    norms = np.linalg.norm(rows, axis=-1, keepdims=True)
+    return rows / np.where(norms > 0.0, norms, 1.0)
+
+
+def chain_constraint_wrenches(twists: NDArray, count: int, decomposition: tuple | None = None) -> NDArray[np.float64]:
+    """The ``count`` constraint wrenches (N, count, 6) of a chain's joint twists (N, m, 6): an orthonormal
+    basis of the wrenches reciprocal to all of them (working coordinates). ``decomposition``: the chain's
+    :func:`screwkit.screw.motion.chain_decompositions` when already computed."""
+    if count == 0:
+        return np.zeros(twists.shape[:-2] + (0, 6))
+    _, right = decomposition if decomposition is not None else chain_decompositions([twists])[0]
+    return right[..., 6 - count:, :] @ _SWAP  # twists reciprocal to ... -> wrenches: swap the halves
+
+
+def _rank(rows: NDArray, tolerance: float) -> NDArray[np.int64]:
+    if rows.shape[-2] == 0:
+        return np.zeros(rows.shape[:-2], dtype=np.int64)
+    singular = np.linalg.svd(_unit_rows(rows), compute_uv=False)
+    return np.sum(singular > tolerance * np.maximum(singular[..., :1], 1e-300), axis=-1)
+
+
+def _common_basis(wrenches: list[NDArray], dimension: int) -> NDArray[np.float64]:
+    """Orthonormal basis (N, dimension, 6) of the wrenches every chain has (the intersection of their spans)."""
+    count = wrenches[0].shape[0]
+    total = np.zeros((count, 6, 6))
+    for chain in wrenches:
+        total += np.eye(6) - np.swapaxes(chain, -1, -2) @ chain
+    _, vectors = np.linalg.eigh(total)
+    return np.swapaxes(vectors[..., :dimension], -1, -2)
+
+
+def _without(rows: NDArray, basis: NDArray) -> NDArray:
+    """``rows`` (N, k, 6) with their components along the orthonormal ``basis`` (N, c, 6) removed."""
+    if basis.shape[-2] == 0:
+        return rows
+    return rows - (rows @ np.swapaxes(basis, -1, -2)) @ basis
+
+
+def _orthonormal(rows: NDArray, count: int) -> NDArray:
+    """An orthonormal basis (N, count, 6) of the span of ``rows`` (N, k, 6) (its leading directions)."""
+    if count == 0:
+        return np.zeros(rows.shape[:-2] + (0, 6))
+    _, _, right = np.linalg.svd(rows, full_matrices=False)
+    return right[..., :count, :]
+
+
+def _own_wrenches(constraints: list[NDArray], common: int, own_counts: tuple[int, ...]):
+    """The common basis (N, common, 6) and each chain's own constraint wrenches (orthonormal, common part removed)."""
+    count = constraints[0].shape[0]
+    shared = _common_basis(constraints, common) if common else np.zeros((count, 0, 6))
+    own = [_orthonormal(_without(chain, shared), c) for chain, c in zip(constraints, own_counts)]
+    return shared, own
+
+
+def _subsystems(own: list[NDArray], rank: int) -> tuple[tuple[int, ...], ...]:
+    """Every minimal set of chains whose own wrenches have generic rank ``rank``, in combination order.
+
+    A set is minimal when it has full rank and no proper subset does; as rank only grows with a set, that is a
+    full-rank set containing no minimal set found before it (sets are taken by increasing size)."""
+    holders = [i for i, rows in enumerate(own) if rows.shape[-2]]
+    found: list[tuple[int, ...]] = []
+    for size in range(1, len(holders) + 1):
+        for subset in combinations(holders, size):
+            if sum(own[i].shape[-2] for i in subset) < rank or any(set(f) <= set(subset) for f in found):
+                continue
+            stacked = np.concatenate([own[i] for i in subset], axis=-2)
+            if int(np.max(_rank(stacked, tolerances.RANK_TOLERANCE))) == rank:
+                found.append(subset)
+    return tuple(found)
+
+
+def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
+    """The constraint structure of a mechanism from its chains' twists at sample configurations
+    (working coordinates). Symmetric in the chains: permuting them permutes the plan."""
+    tolerance = tolerances.MOTION_SPACE_TOLERANCE
+    counts = tuple(int(6 - np.max(_rank(twists, tolerance))) for twists in chain_twists)
+    wrenches = [chain_constraint_wrenches(twists, c) for twists, c in zip(chain_twists, counts)]
+    if min(counts) > 0:
+        total = sum(np.eye(6) - np.swapaxes(w, -1, -2) @ w for w in wrenches)
+        eigenvalues = np.linalg.eigvalsh(total)
+        common = int(np.min(np.sum(eigenvalues <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)))
+    else:
+        common = 0
+    own_counts = tuple(max(c - common, 0) for c in counts)
+    if not any(own_counts):
+        return ConstraintPlan(counts, common, own_counts)
+    _, own = _own_wrenches(wrenches, common, own_counts)
+    rank = int(np.max(_rank(np.concatenate(own, axis=-2), tolerances.RANK_TOLERANCE)))
+    return ConstraintPlan(counts, common, own_counts, rank, _subsystems(own, rank))
+
+
+def _coefficient(wrench: NDArray, twist: NDArray, point: NDArray, threshold: NDArray) -> NDArray:
+    """Power coefficient of unit constraint wrenches on twists (the kernel's definition, working coordinates)."""
+    force, moment = wrench[..., :3], wrench[..., 3:]
+    omega, velocity = twist[..., :3], twist[..., 3:]
+    numerator = np.abs(np.sum(force * velocity, -1) + np.sum(moment * omega, -1))
+    force_norm = np.linalg.norm(force, axis=-1)
+    moment_norm = np.linalg.norm(moment, axis=-1)
+    forceful = force_norm > tolerances.PURE_COUPLE * moment_norm
+    safe = np.where(forceful, force_norm, 1.0)
+    pitch = np.where(forceful, np.sum(force * moment, -1) / safe**2, 0.0)
+    arm_vector = velocity + np.cross(omega, point) + pitch[..., None] * omega
+    omega_norm = np.linalg.norm(omega, axis=-1)
+    arm = np.where(forceful, np.linalg.norm(arm_vector, axis=-1), omega_norm)
+    scale = np.where(forceful, force_norm, moment_norm)
+    reference = np.where(forceful, omega_norm, 0.0)
+    singular = (arm <= threshold * reference) | (arm * scale <= 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = numerator / np.where(singular, 1.0, arm * scale)
+    return np.where(singular, 0.0, np.minimum(value, 1.0))
+
+
+def _project_on_axis(wrench: NDArray, point: NDArray) -> NDArray:
+    """The point of a wrench's axis nearest ``point`` (``point`` itself for a couple)."""
+    force, moment = wrench[..., :3], wrench[..., 3:]
+    norm_sq = np.sum(force * force, -1, keepdims=True)
+    safe = np.where(norm_sq > 0, norm_sq, 1.0)
+    foot = np.cross(force, moment) / safe
+    along = np.sum((point - foot) * force, -1, keepdims=True) / safe
+    return np.where(norm_sq > 0, foot + along * force, point)
+
+
+def _released_pairs(own: NDArray, freed: NDArray, valid: NDArray | None = None):
+    """Principal pairs of a chain's own constraint wrenches (..., c, 6) and the twists (..., 6, d) their release
+    frees: wrenches ``U^T C`` and twists ``F V`` from the singular vectors of the pairing
+    ``C o F = U S V^T`` (orthonormal ``F``), so that each wrench is reciprocal to every freed twist but its own.
+    ``valid`` (..., d): which columns of ``freed`` are freed twists (the others are ignored). Returns wrenches
+    (..., d, 6), twists (..., d, 6) and a mask (..., d) of the pairs that exist. One wrench and one freed
+    twist are their own pair."""
+    if own.shape[-2] == 1 and freed.shape[-1] == 1:
+        exists = np.ones(own.shape[:-2] + (1,), dtype=bool) if valid is None else valid
+        return own, np.swapaxes(freed, -1, -2), exists
+    if valid is not None:
+        freed = freed * valid[..., None, :]
+    pairing = own @ _SWAP @ freed  # (..., c, d): C_k o F_l
+    left, singular, right = np.linalg.svd(pairing, full_matrices=False)  # d <= c where the system is regular
+    wrenches = np.swapaxes(left, -1, -2) @ own  # (..., d, 6)
+    twists = np.swapaxes(freed @ np.swapaxes(right, -1, -2), -1, -2)  # (..., d, 6)
+    exists = singular > tolerances.RANK_TOLERANCE * np.maximum(singular[..., :1], 1e-300)
+    return wrenches, twists, exists
+
+
+def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], members: tuple[int, ...],
+                   points: list[NDArray], threshold: NDArray) -> NDArray:
+    """:math:`CTI_{N,L}` (N, S) of every actuator set (their unit wrenches ``actuation``, (N, S, n, 6)) and one
+    subsystem ``members``: the lowest power coefficient of a released constraint wrench on the twist it frees.
+    ``shared`` (N, c0, 6), ``own`` per chain (N, c_i, 6), ``points`` per chain (N, 3), ``threshold`` (N,)."""
+    sets = actuation.shape[1]
+    blocks = [np.broadcast_to(own[i][:, None], own[i].shape[:1] + (sets,) + own[i].shape[1:]) for i in members]
+    common = np.broadcast_to(shared[:, None], shared.shape[:1] + (sets,) + shared.shape[1:])
+    system = np.concatenate([actuation, *blocks, common], axis=-2)  # (N, S, rows, 6)
+    values = np.full(system.shape[:2], np.inf)
+    if system.shape[-2] == 6:  # the chains' own wrenches are independent: one inverse frees every chain at once
+        volume = np.prod(np.linalg.norm(system, axis=-1), axis=-1)
+        regular = np.abs(np.linalg.det(system)) > tolerances.RANK_TOLERANCE * volume
+        # W Y = I: column r of Y is orthogonal to every row but r, so as a twist (halves swapped) it is reciprocal
+        # to every wrench but row r; chain i's columns span the twists freed by releasing its rows.
+        inverse = np.linalg.inv(np.where(regular[..., None, None], system, np.eye(6)))
+        start = actuation.shape[-2]
+        freed_of = []
+        for block in blocks:
+            columns = _SWAP @ inverse[..., start:start + block.shape[-2]]
+            freed_of.append(columns if block.shape[-2] == 1 else np.linalg.qr(columns)[0])  # same span, orthonormal
+            start += block.shape[-2]
+        valid_of = [None] * len(blocks)
+    else:  # chains whose own wrenches overlap (each frees fewer twists than it holds wrenches): one null space each
+        regular = _rank(system, tolerances.RANK_TOLERANCE) == 6
+        freed_of, valid_of = [], []
+        for position, block in enumerate(blocks):
+            rest = np.concatenate([actuation, *(b for k, b in enumerate(blocks) if k != position), common], axis=-2)
+            padding = np.zeros(rest.shape[:2] + (max(0, 6 - rest.shape[-2]), 6))
+            _, singular, right = np.linalg.svd(np.concatenate([_unit_rows(rest), padding], axis=-2))
+            size = block.shape[-2]
+            valid_of.append(singular[..., -size:] <= tolerances.RANK_TOLERANCE * singular[..., :1])
+            freed_of.append(_SWAP @ np.swapaxes(right[..., -size:, :], -1, -2))
+    for index, block, freed, valid in zip(members, blocks, freed_of, valid_of):
+        wrenches, twists, exists = _released_pairs(block, freed, valid)
+        centres = _project_on_axis(wrenches, points[index][:, None, None, :])
+        kappa = _coefficient(wrenches, twists, centres, threshold[:, None, None])
+        values = np.minimum(values, np.where(exists, kappa, np.inf).min(axis=-1))
+    return np.where(regular & np.isfinite(values), values, 0.0)
+
+
+def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_points: list[NDArray],
+                       wrenches: NDArray, submechanisms: NDArray, dof: int, fault_members: dict,
+                       threshold: NDArray, decompositions: list | None = None) -> dict[str, NDArray]:
+    """CTI of every non-redundant actuator set, the mechanism's CTI, F_Cj, and the instantaneous DOF.
+
+    Parameters
+    ----------
+    plan : ConstraintPlan
+    chain_twists, chain_points : lists of (N, m_i, 6) and (N, m_i, 3)
+        Every chain's joint twists and points in working coordinates.
+    wrenches : ndarray (N, a, 6)
+        Unit actuation wrenches in working coordinates.
+    submechanisms : ndarray (S, n)
+    dof : int
+        The mechanism's mobility ``n``.
+    fault_members : dict of int to ndarray (E, M)
+        For each ``j``, the submechanisms (rows of ``submechanisms``) in each set left after j faults.
+    threshold : ndarray (N,)
+        The singularity threshold in working coordinates (*p* / *L*).
+    decompositions : list, optional
+        :func:`screwkit.screw.motion.chain_decompositions` of ``chain_twists`` when already computed.
+
+    Returns
+    -------
+    dict
+        ``cti`` (N,), ``cti_submechanisms`` (N, S), ``f_c{j}`` (N,), ``instantaneous_dof`` (N,)
+        and ``constraint_singular`` (N,); where some configuration is a constraint singularity,
+        ``held_without`` (number of singular configurations, a): whether the platform stays held
+        with each actuator free and every other one locked.
+    """
+    count = wrenches.shape[0]
+    if decompositions is None:
+        decompositions = [None] * len(chain_twists)
+    constraints = [chain_constraint_wrenches(t, c, d)
+                   for t, c, d in zip(chain_twists, plan.chain_counts, decompositions)]
+    stacked = np.concatenate(constraints, axis=-2) if constraints else np.zeros((count, 0, 6))
+    instantaneous = 6 - _rank(stacked, tolerances.MOTION_SPACE_TOLERANCE)
+    singular = instantaneous > dof
+    result = {"instantaneous_dof": instantaneous, "constraint_singular": singular}
+    if singular.any():  # which actuators leave the platform held when free (the kernel assumed n DOF)
+        rows = np.flatnonzero(singular)
+        held = np.zeros((rows.size, wrenches.shape[-2]), dtype=bool)
+        for k in range(wrenches.shape[-2]):
+            system = np.concatenate([np.delete(wrenches[rows], k, axis=-2), stacked[rows]], axis=-2)
+            held[:, k] = _rank(system, tolerances.RANK_TOLERANCE) == 6
+        result["held_without"] = held
+    if plan.count == 0:
+        nothing = np.full(count, np.nan)
+        result.update(cti=nothing, cti_submechanisms=np.full((count, submechanisms.shape[0]), np.nan))
+        for j in fault_members:
+            result[f"f_c{j}"] = nothing.copy()
+        return result
+    shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
+    points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
+    actuation = wrenches[:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
+    per_set = np.zeros((count, submechanisms.shape[0]))
+    for subsystem in plan.subsystems:
+        per_set = np.maximum(per_set, _subsystem_cti(actuation, shared, own, subsystem, points, threshold))
+    per_set[singular] = 0.0
+    result["cti_submechanisms"] = per_set
+    result["cti"] = per_set.max(axis=-1)
+    for j, members in fault_members.items():
+        result[f"f_c{j}"] = per_set[:, members].max(axis=-1).min(axis=-1)
+    return result

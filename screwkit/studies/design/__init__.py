@@ -1,0 +1,1 @@
+"""Design search: the paper's permutation selection, design families, region metrics and the optimiser."""

@@ -1,0 +1,296 @@
+"""What a design search measures: the fault-tolerant region of a map and the metrics drawn from it.
+
+A :class:`Region` is a map as ``screwkit map`` computes it (two grid coordinates, optionally
+stacked along a third in layers, the minimum of every index over an orientation set at each grid
+point), an index (``f_o1``, ``f_io1``, ...) and a level: the fault-tolerant region is where the
+minimum of that index over the orientation set is at least the level. :func:`region_metrics`
+evaluates a mechanism on it and returns every metric of :data:`METRICS`; each is reproduced by a
+fresh ``screwkit map`` of the candidate's file with :meth:`Region.map_arguments` (one per layer).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.common.units import is_angular
+from screwkit.model import Mechanism
+from screwkit.studies.maps import disc_grid, map_block, orientation_set, range_values
+
+__all__ = ["METRICS", "MAXIMISED", "UNITS", "Region", "disc_region", "grid_region", "default_region", "region_maps",
+           "region_metrics", "inscribed_radius"]
+
+METRICS = {
+    "area": "area of the fault-tolerant region of the map (m^2 on a grid of two lengths, rad^2 on a grid of two "
+            "angles, m rad on a mixed one; summed over layers)",
+    "volume": "volume of the fault-tolerant region: area of each layer times the layer step (m^3; needs layers)",
+    "inscribed": "radius of the largest disc (ball with layers) about a grid point that holds no grid point "
+                 "outside the fault-tolerant region nor beyond the map (m, or rad on a grid of angles; NaN on a "
+                 "grid that mixes lengths and angles)",
+    "cylinder": "radius of the largest disc about a grid point whose points are fault tolerant in every layer: "
+                "the largest vertical cylinder through the layers (unit and NaN as inscribed; without layers the "
+                "inscribed disc)",
+    "worst": "minimum of the index over the whole map (an unreachable point counts 0)",
+    "mean": "mean of the index over the whole map (an unreachable point counts 0)",
+    "iti_floor": "minimum of the ITI over the whole map (an unreachable point counts 0)",
+    "lmti_floor": "minimum of the LMTI over the whole map (an unreachable point counts 0)",
+    "footprint": "radius of the circle holding every base joint (and crank tip) (m, the family's measure)",
+    "link_length": "longest link or leg at the home pose (m, the family's measure)",
+}
+"""Every metric of a candidate, with its meaning and unit."""
+
+UNITS = {"area": "m^2", "volume": "m^3", "inscribed": "m", "cylinder": "m", "footprint": "m", "link_length": "m"}
+"""Units of the metrics that have one (the others are index values)."""
+
+MAXIMISED = {"area": True, "volume": True, "inscribed": True, "cylinder": True, "worst": True, "mean": True,
+             "iti_floor": True, "lmti_floor": True, "footprint": False, "link_length": False}
+"""The sense in which each metric is better: larger (True) or smaller (False)."""
+
+
+@dataclass(frozen=True)
+class Region:
+    """A map and the fault-tolerant level on it.
+
+    Attributes
+    ----------
+    grid : tuple of (str, ndarray)
+        The two grid coordinates and their values (m, rad).
+    over : tuple of (str, ndarray)
+        The orientation set's coordinates and values (rad); the set is their product.
+    mask : ndarray of bool (len(y), len(x)), optional
+        Grid points mapped (a disc); all when None.
+    layers : (str, ndarray), optional
+        A third coordinate stacking maps (volume); values in m.
+    index : str
+        ``f_o1``, ``f_io1``, ``f_o2``, ... (the index whose minimum over the orientation set is
+        compared with ``level``).
+    level : float
+    closed_forms : bool
+        Evaluate with the paper's planar closed forms (planar families).
+    map_options : tuple of str
+        ``screwkit map`` options that compute the same map (without the layer's ``--at``).
+    """
+
+    grid: tuple
+    over: tuple
+    index: str = "f_o1"
+    level: float = 0.4
+    mask: NDArray[np.bool_] | None = field(default=None, compare=False)
+    layers: tuple | None = None
+    closed_forms: bool = False
+    threshold: float = SINGULARITY_THRESHOLD
+    map_options: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        if not re.fullmatch(r"f_i?o[1-9][0-9]*|lmti|iti", self.index):
+            raise ValueError(f"Expected a region index f_o<j> or f_io<j> (j >= 1), lmti or iti, got {self.index!r}.")
+        if not math.isfinite(self.level):
+            raise ValueError(f"Expected a finite region level, got {self.level}.")
+
+    @property
+    def cell(self) -> float:
+        """Area of one grid cell, in :meth:`unit` ``("area")`` (m^2, rad^2 or m rad)."""
+        return float(np.prod([_step(values) for _, values in self.grid]))
+
+    @property
+    def length_unit(self) -> str:
+        """Unit of the grid's distances: ``m``, ``rad``, or ``""`` when the grid mixes lengths and angles."""
+        kinds = {is_angular(name) for name, _ in self.grid}
+        return "" if len(kinds) > 1 else ("rad" if kinds.pop() else "m")
+
+    def unit(self, metric: str) -> str:
+        """Unit of ``metric`` on this region (``index`` for index values)."""
+        if metric in ("area", "volume"):
+            units = [("rad" if is_angular(name) else "m") for name, _ in self.grid]
+            area = f"{units[0]}^2" if units[0] == units[1] else "m rad"
+            return area if metric == "area" else f"{area} m"
+        if metric in ("inscribed", "cylinder"):
+            return self.length_unit or "mixed"
+        return UNITS.get(metric, "index")
+
+    @property
+    def configurations(self) -> int:
+        """Poses a design is evaluated at: grid points (in the mask) x orientations x layers."""
+        points = int(np.count_nonzero(self.mask)) if self.mask is not None else int(np.prod(
+            [values.size for _, values in self.grid]))
+        orientations = int(np.prod([values.size for _, values in self.over])) if self.over else 1
+        return points * orientations * (self.layers[1].size if self.layers else 1)
+
+    @property
+    def faults(self) -> int:
+        """The number of faults the region's index needs (1 for lmti and iti: the map computes F_O1 anyway)."""
+        return int(self.index.rpartition("o")[2]) if self.index.startswith("f_") else 1
+
+    @property
+    def orientations(self) -> str:
+        """The orientation set in words."""
+        words = []
+        for name, values in self.over:
+            step = math.degrees(_step(values))
+            full = is_angular(name) and values.size > 1 and abs(values.size * step - 360) < 1e-6
+            words.append(f"a full turn of {name} ({step:g} deg steps)" if full else _span(name, values))
+        return "; ".join(words) or "the home orientation"
+
+    def describe(self) -> str:
+        layers = f", layers {_span(*self.layers)}" if self.layers else ""
+        grid = " x ".join(_span(name, values) for name, values in self.grid)
+        return f"{self.index} >= {self.level:g} over {self.orientations}, on {grid}{layers}"
+
+    def map_arguments(self, mechanism: Mechanism) -> list[list[str]]:
+        """The ``screwkit map`` options computing the same map, one list per layer."""
+        if not self.layers:
+            return [list(self.map_options)]
+        name, values = self.layers
+        home = mechanism.home_pose
+        out = []
+        for value in values:
+            at = [value if coordinate == name else home[i] for i, coordinate in enumerate(mechanism.task_coordinates)]
+            shown = [math.degrees(v) if is_angular(c) else v for c, v in zip(mechanism.task_coordinates, at)]
+            out.append([*self.map_options, "--at", *(repr(float(v)) for v in shown)])
+        return out
+
+
+def _step(values: NDArray) -> float:
+    return float(values[1] - values[0]) if values.size > 1 else 1.0
+
+
+def _span(name: str, values: NDArray) -> str:
+    unit, scale = ("deg", 180 / math.pi) if is_angular(name) else ("m", 1.0)
+    return f"{name} {values[0] * scale:g}..{values[-1] * scale:g} {unit} ({values.size} values)"
+
+
+def disc_region(radius: float, step: float, phi_step_degrees: float, *, index: str = "f_o1", level: float = 0.4,
+                closed_forms: bool = True, centre=(0.0, 0.0)) -> Region:
+    """The paper's Fig. 5 region of a planar mechanism: a disc about ``centre``, phi over a full turn."""
+    x_values, y_values, mask = disc_grid(radius, step, centre)
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
+    options = ("--radius", repr(float(radius)), "--step", repr(float(step)), "--phi-step",
+               repr(float(phi_step_degrees))) + (("--closed-forms",) if closed_forms else ())
+    return Region((("x", x_values), ("y", y_values)), (("phi", phi),), index, level, mask, None, closed_forms,
+                  map_options=options)
+
+
+def _range(name: str, spec, include_stop: bool) -> tuple[NDArray, str]:
+    """Values (m, rad) and ``screwkit map`` text of ``(start, stop, step)`` (deg for angles)."""
+    try:
+        start, stop, step = (float(v) for v in spec)
+    except (TypeError, ValueError):
+        raise ValueError(f"Expected (start, stop, step) for {name} in the region, got {spec!r}.") from None
+    try:
+        values = range_values(start, stop, step, include_stop=include_stop)
+    except ValueError as error:
+        raise ValueError(f"Expected {name} in the region with {error}, got {spec!r}.") from None
+    return (np.deg2rad(values) if is_angular(name) else values), f"{name}:{start!r}:{stop!r}:{step!r}"
+
+
+def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: str = "f_o1",
+                level: float = 0.4) -> Region:
+    """A spatial region, each coordinate as ``(start, stop, step)`` in m or deg, as ``screwkit map``
+    reads them: the two ``grid`` coordinates include their stop, the ``over`` (orientation set)
+    coordinates and ``layers`` (name, (start, stop, step)) exclude it."""
+    if len(grid) != 2:
+        raise ValueError(f"Expected a region grid of exactly two coordinates, got {list(grid)}.")
+    options, axes, orientations = [], [], []
+    for name, spec in grid.items():
+        values, text = _range(name, spec, True)
+        axes.append((name, values))
+        options += ["--grid", text]
+    for name, spec in over.items():
+        values, text = _range(name, spec, False)
+        orientations.append((name, values))
+        options += ["--over", text]
+    if layers is not None:
+        name, spec = layers
+        if is_angular(name):
+            raise ValueError(f"Expected a length coordinate for the region's layers, got {name!r}.")
+        layers = (name, _range(name, spec, False)[0])
+    return Region(tuple(axes), tuple(orientations), index, level, None, layers, False, map_options=tuple(options))
+
+
+def default_region(family, **changes) -> Region:
+    """The family's default region (:attr:`~screwkit.studies.design.families.Family.region`) with ``changes``
+    (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``)."""
+    spec = {**family.region, **{k: v for k, v in changes.items() if v is not None}}
+    if changes.get("grid") is not None:
+        spec.pop("disc", None)
+    index, level = spec.get("index", "f_o1"), spec.get("level", 0.4)
+    if "disc" in spec:
+        if spec.get("layers"):
+            raise ValueError("A disc region has no layers.")
+        radius, step, phi_step = spec["disc"]
+        return disc_region(radius, step, phi_step, index=index, level=level,
+                           closed_forms=spec.get("closed_forms", True))
+    if "grid" not in spec:
+        raise ValueError(f"Family {family.name!r} has no default region: give its grid.")
+    return grid_region(spec["grid"], spec.get("over", {}), layers=spec.get("layers"), index=index, level=level)
+
+
+def inscribed_radius(inside: NDArray[np.bool_], spacing) -> float:
+    """Largest distance from a grid point of ``inside`` to the nearest grid point outside it, the
+    grid's border counting as outside (m): a disc (ball) of any smaller radius about that point holds
+    no outside point. 0 when ``inside`` is empty."""
+    from scipy.ndimage import distance_transform_edt  # scipy.ndimage is only needed here
+
+    if not inside.any():
+        return 0.0
+    padded = np.pad(inside, 1, constant_values=False)
+    return float(np.max(distance_transform_edt(padded, sampling=spacing)))
+
+
+def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
+    """The map's variables (layers, y, x) of ``mechanism`` on ``region``: NaN outside its mask."""
+    names = mechanism.task_coordinates
+    (x_name, x_values), (y_name, y_values) = region.grid
+    for name in [x_name, y_name, *(n for n, _ in region.over), *((region.layers[0],) if region.layers else ())]:
+        if name not in names:
+            raise ValueError(f"The region uses {name!r}; mechanism {mechanism.name!r} has {', '.join(names)}.")
+    shape = (y_values.size, x_values.size)
+    mask = np.ones(shape, dtype=bool) if region.mask is None else region.mask
+    over_axes = tuple(names.index(name) for name, _ in region.over)
+    over_values = orientation_set(dict(region.over))
+    layer_values = region.layers[1] if region.layers else [None]
+    out: dict[str, NDArray] = {}
+    for k, value in enumerate(layer_values):
+        at = mechanism.home_pose.copy()
+        if value is not None:
+            at[names.index(region.layers[0])] = value
+        values = map_block(mechanism, at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes,
+                          over_values, region.threshold, (region.faults,), region.closed_forms)
+        for key, column in values.items():
+            grid = out.setdefault(key, np.full((len(layer_values),) + shape, np.nan))
+            grid[k][mask] = column
+    return out
+
+
+def region_metrics(mechanism: Mechanism, region: Region, size: dict[str, float] | None = None) -> dict[str, float]:
+    """Every metric of :data:`METRICS` (footprint and link length from ``size``, NaN without it)."""
+    maps = region_maps(mechanism, region)
+    if region.index not in maps:
+        raise ValueError(f"Unknown region index {region.index!r}; the map has {', '.join(sorted(maps))}.")
+    mask = np.broadcast_to(np.ones(maps["iti"].shape[1:], bool) if region.mask is None else region.mask,
+                           maps["iti"].shape)
+    index = np.where(mask, np.nan_to_num(maps[region.index], nan=0.0), np.nan)
+    inside = index >= region.level
+    layer_step = _step(region.layers[1]) if region.layers else None
+    area = float(np.sum(inside) * region.cell)
+    spacing = [_step(v) for _, v in region.grid][::-1]
+    if not region.length_unit or (layer_step and region.length_unit != "m"):  # distances across units: none
+        radius = cylinder = math.nan
+    else:
+        radius = inscribed_radius(inside, [layer_step, *spacing]) if layer_step else inscribed_radius(inside[0],
+                                                                                                      spacing)
+        cylinder = inscribed_radius(inside.all(axis=0), spacing)
+    metrics = {"area": area, "volume": area * layer_step if layer_step else math.nan, "inscribed": radius,
+               "cylinder": cylinder,
+               "worst": float(np.nanmin(index)), "mean": float(np.nanmean(index)),
+               "iti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["iti"], nan=0.0), np.nan))),
+               "lmti_floor": float(np.nanmin(np.where(mask, np.nan_to_num(maps["lmti"], nan=0.0), np.nan)))}
+    size = size or {}
+    metrics.update(footprint=float(size.get("footprint", math.nan)), link_length=float(size.get("link_length",
+                                                                                                  math.nan)))
+    return metrics

@@ -1,0 +1,208 @@
+"""Design search for planar n-RRR mechanisms: the paper's permutation selection and beyond.
+
+* :func:`planar_design` reads the parameters of a planar n-RRR from a loaded mechanism;
+* :func:`permutation_search` redoes the paper's selection (Sec. 4): every assignment of
+  the platform joint slots to the chains (n! of them) in both working modes, scored by the
+  minimum of F_O1 over a full rotation at the workspace centre, ranked;
+* :func:`family_values` places a planar n-RRR in the family ``planar_rrr``, whose design search
+  (the paper's future work) is :mod:`screwkit.studies.design.optimise`.
+
+Evaluations run through Dask (:func:`screwkit.studies.tasks.run_tasks`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from itertools import permutations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.closure import solve
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.indices.analysis import analyze
+from screwkit.indices.closed_forms import planar_indices
+from screwkit.model import Mechanism
+from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
+from screwkit.studies.design.families import permutation_rank
+from screwkit.studies.poses import planar_points
+from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+
+__all__ = ["planar_design", "slot_design", "slots_of", "rotation_score", "permutation_search", "rotation_class",
+           "DesignScore", "fault_tolerant_area", "family_values"]
+
+
+def planar_design(mechanism: Mechanism) -> PlanarDesign:
+    """The :class:`~screwkit.screw.planar.PlanarDesign` of a planar n-RRR mechanism at its home pose.
+
+    Base and platform joint points, arm lengths and working mode are read from the solved
+    reference assembly (base frame), so any planar RRR URDF can be searched.
+    """
+    if not mechanism.is_planar:
+        raise ValueError(f"Design search needs a planar n-RRR; {mechanism.name!r} is spatial.")
+    if mechanism.task_coordinates != ("x", "y", "phi"):
+        raise ValueError(f"Design search needs a planar n-RRR whose platform turns (x, y, phi); {mechanism.name!r} "
+                         f"has the task coordinates {', '.join(mechanism.task_coordinates)}.")
+    home = mechanism.home_pose
+    solution = solve(mechanism, home[None])
+    base, elbows, distal, prismatic = planar_points(mechanism, solution)
+    if prismatic:
+        raise ValueError(f"Design search needs RRR chains; {mechanism.name!r} has RPR chains.")
+    base, elbows, distal = base[0], elbows[0], distal[0]
+    cos, sin = np.cos(home[2]), np.sin(home[2])
+    local = (distal - home[:2]) @ np.array([[cos, -sin], [sin, cos]])  # R(phi)^T (d - r)
+    chord = distal - base
+    side = np.sign(chord[:, 0] * (elbows - base)[:, 1] - chord[:, 1] * (elbows - base)[:, 0])
+    return PlanarDesign(base, local, np.linalg.norm(elbows - base, axis=-1), np.linalg.norm(distal - elbows, axis=-1),
+                        np.where(side == 0, 1.0, side))
+
+
+def slots_of(design: PlanarDesign) -> NDArray[np.int64]:
+    """The slot of each chain's platform joint: slot s sits at angle s 2 pi / n in the platform frame."""
+    n = design.chain_count
+    angles = np.arctan2(design.platform[:, 1], design.platform[:, 0])
+    return np.round(angles / (2 * np.pi / n)).astype(int) % n
+
+
+def slot_design(design: PlanarDesign, permutation, working_mode: int | None = None,
+                platform_radius: float | None = None) -> PlanarDesign:
+    """A design whose chain i has its platform joint at slot ``permutation[i]`` (angle slot 2 pi / n).
+
+    The platform radius is the mean radius of ``design`` unless given; the working mode is
+    kept unless given (+1 or -1 for every chain).
+    """
+    n = design.chain_count
+    permutation = np.asarray(permutation, dtype=int)
+    if permutation.shape != (n,) or sorted(permutation.tolist()) != list(range(n)):
+        raise ValueError(f"Expected `permutation` to be a permutation of 0..{n - 1}, got {permutation.tolist()}.")
+    radius = float(np.mean(np.linalg.norm(design.platform, axis=-1))) if platform_radius is None else platform_radius
+    angles = permutation * 2 * np.pi / n
+    platform = radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    mode = design.working_mode if working_mode is None else np.full(n, float(working_mode))
+    return replace(design, platform=platform, working_mode=mode)
+
+
+def rotation_score(design: PlanarDesign, centre=(0.0, 0.0), phi_step_degrees: float = 1.0, *,
+                   faults: int = 1, threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False) -> float:
+    """Minimum of F_Oj over a full platform rotation at ``centre`` (NaN if some angle is unreachable)."""
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
+    poses = np.column_stack([np.full_like(phi, centre[0]), np.full_like(phi, centre[1]), phi])
+    base, elbows, distal, reachable = planar_joint_points(design, poses)
+    if not np.all(reachable):
+        return float("nan")
+    if closed_forms:
+        values = planar_indices(base, elbows, distal, threshold=threshold, faults=(faults,), threads=1)["f_o"][faults]
+    else:
+        values = analyze(rrr_chain_screws(base, elbows, distal), threshold=threshold, faults=faults,
+                         detail=False, threads=1).f_o[faults]
+    return float(values.min())
+
+
+@dataclass(frozen=True)
+class DesignScore:
+    """One candidate of :func:`permutation_search`."""
+
+    permutation: tuple[int, ...]
+    working_mode: int
+    score: float
+
+
+def _score_task(design, permutation, mode, phi_step, faults, threshold, closed_forms):
+    return rotation_score(slot_design(design, permutation, mode), phi_step_degrees=phi_step, faults=faults,
+                          threshold=threshold, closed_forms=closed_forms)
+
+
+def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, faults: int = 1,
+                       threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False,
+                       scheduler=None, progress=None, connect_timeout: float = CONNECT_TIMEOUT) -> list[DesignScore]:
+    """Every slot permutation in both working modes, ranked by the minimum of F_O1 over a full rotation.
+
+    As the paper's Sec. 4: base and platform joints on regular polygons, identical arms,
+    the n! assignments of platform slots to chains, each scored at the workspace centre
+    (the origin of the base frame). Designs that differ by a rotation of the slots
+    (``permutation + k mod n``) are the same mechanism rotated and get the same score.
+
+    Returns
+    -------
+    list of DesignScore
+        Best first (NaN scores, i.e. not fully rotatable, last).
+    """
+    n = design.chain_count
+    candidates = [(p, mode) for mode in (1, -1) for p in permutations(range(n))]
+    arguments = [(design, p, mode, phi_step_degrees, faults, threshold, closed_forms) for p, mode in candidates]
+    scores = run_tasks(_score_task, arguments, scheduler=scheduler, progress=progress, label="designs",
+                       connect_timeout=connect_timeout)
+    ranked = [DesignScore(tuple(int(i) for i in p), mode, float(s)) for (p, mode), s in zip(candidates, scores)]
+    # Scores equal to 1e-9 are ties (rotated or mirrored copies differ only by rounding);
+    # ties are listed working mode +1 first, then by permutation.
+    return sorted(ranked, key=lambda d: (np.isnan(d.score), -round(np.nan_to_num(d.score), 9), d.working_mode < 0,
+                                         d.permutation))
+
+
+def rotation_class(permutation) -> tuple[int, ...]:
+    """The smallest of the n slot rotations ``permutation + k mod n``: one label per rotated design."""
+    n = len(permutation)
+    return min(tuple((p + k) % n for p in permutation) for k in range(n))
+
+
+def fault_tolerant_area(design: PlanarDesign, *, level: float = 0.4, radius: float = 0.6, step: float = 0.05,
+                        phi_step_degrees: float = 5.0, faults: int = 1, threshold: float = SINGULARITY_THRESHOLD):
+    """Area (m^2) of the positions of a disc where the minimum of F_Oj over a full rotation is >= ``level``.
+
+    Evaluated with the planar closed forms on a grid of spacing ``step`` (each point counts
+    ``step^2``); a position where some angle is unreachable does not count.
+
+    Returns
+    -------
+    area : float
+    grid : ndarray (k, k)
+        Minimum over the rotation at every grid point (NaN outside the disc or unreachable).
+    """
+    count = int(np.floor(radius / step + 1e-9))
+    offsets = step * np.arange(-count, count + 1)
+    x, y = np.meshgrid(offsets, offsets)
+    inside = x**2 + y**2 <= radius**2 * (1 + 1e-12)
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
+    positions = np.column_stack([x[inside], y[inside]])
+    poses = np.concatenate([np.repeat(positions, phi.size, axis=0), np.tile(phi, positions.shape[0])[:, None]], axis=1)
+    base, elbows, distal, reachable = planar_joint_points(design, poses)
+    values = np.full(poses.shape[0], np.nan)
+    if reachable.any():
+        values[reachable] = planar_indices(base[reachable], elbows[reachable], distal[reachable], threshold=threshold,
+                                           faults=(faults,), threads=1)["f_o"][faults]
+    values = values.reshape(positions.shape[0], phi.size)
+    minimum = np.where(np.all(np.isfinite(values), axis=1), np.min(values, axis=1), np.nan)
+    grid = np.full(x.shape, np.nan)
+    grid[inside] = minimum
+    return float(np.sum(minimum >= level) * step**2), grid
+
+
+def family_values(design: PlanarDesign) -> tuple[int, dict[str, float]]:
+    """(legs, values) of ``design`` in the family ``planar_rrr`` (:mod:`screwkit.studies.design.families`).
+
+    Raises ValueError naming the first chain that does not fit the family (base joints on a circle
+    at the angles 2 pi i / n, platform joints on a circle at slot angles, identical arms, one
+    working mode)."""
+    n = design.chain_count
+    radius = float(np.mean(np.linalg.norm(design.base, axis=-1)))
+    angles = 2 * np.pi * np.arange(n) / n
+    expected = radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    platform_radius = float(np.mean(np.linalg.norm(design.platform, axis=-1)))
+    slots = slots_of(design)
+    slot_points = platform_radius * np.column_stack([np.cos(slots * 2 * np.pi / n), np.sin(slots * 2 * np.pi / n)])
+    for i in range(n):
+        for what, actual, wanted in (("base joint", design.base[i], expected[i]),
+                                     ("platform joint", design.platform[i], slot_points[i]),
+                                     ("proximal arm", design.upper[i], design.upper[0]),
+                                     ("distal arm", design.lower[i], design.lower[0]),
+                                     ("working mode", design.working_mode[i], design.working_mode[0])):
+            if not np.allclose(actual, wanted, rtol=0, atol=1e-9 * max(1.0, radius)):
+                raise ValueError(f"The design is not a member of the family planar_rrr: chain {i + 1}'s {what} "
+                                 f"is {np.round(actual, 6).tolist()}, the family's would be "
+                                 f"{np.round(wanted, 6).tolist()}.")
+    if sorted(slots.tolist()) != list(range(n)):
+        raise ValueError(f"The design is not a member of the family planar_rrr: platform slots {slots.tolist()} "
+                         "are not a permutation.")
+    return n, {"base_radius": radius, "platform_radius": platform_radius, "upper": float(design.upper[0]),
+               "lower": float(design.lower[0]), "slots": float(permutation_rank(slots.tolist())),
+               "mirrored": float(design.working_mode[0] < 0)}
