@@ -585,6 +585,7 @@ def screenshots(planar, hexapod, viewer, tmp_path_factory):
     return render(pages, folder, dump_dom=("planar_5rrr_sweep",)), folder, sweep
 
 
+@pytest.mark.browser
 def test_blank_page_fails_the_check(screenshots):
     rendered, folder, _ = screenshots
     blank = rendered["blank"][0]
@@ -594,6 +595,7 @@ def test_blank_page_fails_the_check(screenshots):
     assert np.ptp(middle(blank)) > 20  # the viewer did render: a background gradient and grid, not a white page
 
 
+@pytest.mark.browser
 @pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "planar_5rrr_sweep"])
 def test_offline_page_renders_the_mechanism(screenshots, name):
     rendered, folder, _ = screenshots
@@ -604,6 +606,7 @@ def test_offline_page_renders_the_mechanism(screenshots, name):
     assert changed > 0.05, f"{folder / (name + '.png')} differs from the empty scene in {changed:.2%} of the middle"
 
 
+@pytest.mark.browser
 def test_browser_plays_the_sweep_animation(screenshots):
     rendered, folder, sweep = screenshots
     dom = rendered["planar_5rrr_sweep"][1]

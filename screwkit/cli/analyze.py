@@ -20,6 +20,7 @@ from screwkit.cli.options import (
     threshold_option,
 )
 from screwkit.closure import forward
+from screwkit.indices.registry import INDICES
 from screwkit.studies import indices_at_pose
 
 __all__ = ["analyze", "print_report"]
@@ -100,6 +101,13 @@ def print_report(report: dict) -> None:
         click.echo(f"CTI  (constraint transmission)      {report['cti']:.4f}")
         for j, value in report.get("f_c", {}).items():
             click.echo(f"F_C{j:<2s}(worst CTI, {j} fault(s))      {value:.4f}")
+    for record in INDICES.values():  # indices added to the registry: every value, generically
+        if record.compute is None or record.name not in report:
+            continue
+        values = report[record.name]
+        for j, value in (values.items() if isinstance(values, dict) else [("", values)]):
+            shown = "n/a" if value is None or isinstance(value, str) else f"{value:.4f}"
+            click.echo(f"{record.label}{j} ({record.equation}) {shown}")
     if not redundancy:
         click.echo("Every actuator is needed: none can fail with the platform still held (no mutual interference).")
     elif report["not_mutual_interference"]:

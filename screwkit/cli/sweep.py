@@ -22,6 +22,7 @@ from screwkit.cli.options import (
     threshold_option,
 )
 from screwkit.common.units import is_angular
+from screwkit.indices.registry import column_record, is_column
 from screwkit.plots import save_figure, sweep_figure
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, wide_table, write_dataset
 from screwkit.studies.sweep import sweep as run_sweep
@@ -105,9 +106,10 @@ def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fau
     if not quiet:
         reachable = dataset["reachable"].values
         echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} reachable)")
-        for name in ["iti", "lmti", "cti"] + [v for v in dataset.data_vars if v.startswith(("f_o", "f_io", "f_c"))]:
-            if name not in dataset.data_vars:
-                continue
+        redundant = len(loaded.actuators) > loaded.dof
+        if not redundant:
+            echo_error("  no redundancy (a = n): F_O1 = F_IO1 = 0 everywhere")
+        for name in [v for v in dataset.data_vars if is_column(v) and (redundant or column_record(v)[1] is None)]:
             series = dataset[name].values
             if np.any(np.isfinite(series)):
                 at_min = dataset[coordinate].values[np.nanargmin(series)]

@@ -31,8 +31,7 @@ numbers of those coordinates. The one length is the singularity threshold *p*, c
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import replace
 from typing import Sequence
 
 import numpy as np
@@ -40,268 +39,33 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.common import tolerances
 from screwkit.common.chunks import map_chunks
-from screwkit.common.compiling import prepare_kernels
 from screwkit.common.validation import as_float_array, check_finite
 from screwkit.indices.faults import FAULT_TYPES, link_fault_indices
-from screwkit.indices.results import Indices
-from screwkit.indices.sets import fault_sets, remaining_lmti, set_plan, submechanisms_left
+from screwkit.indices.registry import INDICES
+from screwkit.indices.results import Indices, with_derived
+from screwkit.indices.sets import fault_sets, submechanisms_left
+from screwkit.indices.stages import (
+    ChunkSpaces,
+    analyze_chunk,
+    at_constraint_singularities,
+    constraint_chunk,
+    constraint_plan_of,
+    joints_of_all_chains,
+    make_plan,
+)
 from screwkit.screw.chain_screws import ChainScrews
-from screwkit.screw.constraints import ConstraintPlan, constraint_indices, plan_constraints
+from screwkit.screw.constraints import ConstraintPlan
 from screwkit.screw.motion import (
     MotionSpace,
-    chain_decompositions,
     motion_space,
-    null_spaces,
     sampled_working_coordinates,
-    working_coordinates,
 )
-from screwkit.screw.outputs import idle_rotations, quotient_bases, with_idle_joints
+from screwkit.screw.outputs import idle_rotations, with_idle_joints
 
 __all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets"]
 
 DEFAULT_THRESHOLD = tolerances.SINGULARITY_THRESHOLD
 """The paper's singularity threshold *p* on the moment arm: 1 um (in metres)."""
-
-
-# ----------------------------------------------------------------------------------------
-# ----------------------------------------------------------------------------------------
-# Analysis
-# ----------------------------------------------------------------------------------------
-@dataclass
-class _Plan:
-    """Everything about a mechanism that does not depend on the configuration."""
-
-    actuators: tuple[tuple[int, int], ...]
-    dof: int
-    space: MotionSpace
-    complement: NDArray[np.float64]
-    chain_start: NDArray[np.int64]
-    actuator_chain: NDArray[np.int64]
-    actuator_joint: NDArray[np.int64]
-    submechanisms: NDArray[np.int64]
-    locked_sets: NDArray[np.int64]
-    locked_of: NDArray[np.int64]
-    faults: tuple[int, ...]
-    failed_sets: dict[int, NDArray[np.int64]]
-    set_children: NDArray[np.int64]
-    fault_rows: NDArray[np.int64]
-    locked_depth: NDArray[np.int64]
-    wedge_table: NDArray[np.int64]
-    wedge_start: NDArray[np.int64]
-    threshold: float
-    rank_tolerance: float
-    idle_count: int = 0
-
-
-def _make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int = 0) -> _Plan:
-    if not threshold >= 0:
-        raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
-    if not rank_tolerance > 0:
-        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
-    space = motion_space(chains, None if dof is None else dof + idle_count)
-    n = space.dof - idle_count
-    if idle_count:  # a point output: the motion space modulo the idle rotations, configuration by configuration
-        if n < 1:
-            raise ValueError("The output point has no mobility: every platform motion is an idle rotation about it.")
-        space = MotionSpace(space.dof, None)
-    actuators = tuple((c, k) for c, chain in enumerate(chains) for k in chain.actuated)
-    a = len(actuators)
-    if a < n:
-        raise ValueError(f"Expected at least n = {n} actuators (the platform's DOF), got {a}.")
-    for chain in chains:
-        if chain.n_joints < n:
-            raise ValueError(
-                f"Chain {chain.name!r} has {chain.n_joints} joint DoFs, fewer than the platform's DOF n = {n}: "
-                "it cannot follow the platform."
-            )
-    if faults is None:
-        fault_list = tuple(range(1, a - n + 1))
-    else:
-        fault_list = tuple(sorted(set(int(j) for j in np.atleast_1d(faults))))
-        for j in fault_list:
-            if not 1 <= j <= max(a - n, 1):
-                raise ValueError(f"Expected the number of faults `j` in 1..a-n = 1..{a - n}, got {j}.")
-        if a == n:  # no redundancy: F_O1 = 0 (see analyze), no set of n actuators is left to reduce
-            fault_list = ()
-    complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
-    return _Plan(
-        actuators=actuators, dof=n, space=space, complement=complement,
-        chain_start=np.cumsum([0] + [c.n_joints for c in chains]).astype(np.int64),
-        actuator_chain=np.array([c for c, _ in actuators], dtype=np.int64),
-        actuator_joint=np.array([k for _, k in actuators], dtype=np.int64),
-        faults=fault_list, **set_plan(a, n, fault_list),
-        threshold=float(threshold), rank_tolerance=float(rank_tolerance),
-        idle_count=idle_count)
-
-
-
-def _run_kernel(plan: _Plan, twists, points, basis, complement, iti_override, oti_override, detail, keep_twists):
-    """The compiled kernels on one chunk; ``basis`` in working coordinates (see :func:`working_coordinates`)."""
-    prepare_kernels()
-    from screwkit.indices.compiled.driver import run_kernels  # numba: loaded when indices first run
-
-    count = twists.shape[0]
-    kept = count if detail else 0
-    a, (subs, n) = len(plan.actuators), plan.submechanisms.shape
-    out = {
-        "iti_actuators": np.zeros((kept, a)),
-        "oti_actuators": np.zeros((kept, subs, n)),
-        "oti_submechanisms": np.zeros((kept, subs)),
-        "summary": np.zeros((count, 2 + len(plan.faults))),
-        "worst": np.zeros((count, len(plan.faults)), dtype=np.int64),
-        "mutual_interference": np.zeros((count, a), dtype=bool),
-        "actuation_wrenches": np.zeros((kept, a, 6)),
-        "output_twists": np.zeros((count if keep_twists else 0, subs, n, 6)),
-        "outside": np.zeros(count, dtype=bool),
-    }
-    # The kernels' one signature: screws in any layout, the rest C-contiguous; all writable float64.
-    twists, points = (array if array.flags.writeable else array.copy() for array in (twists, points))
-    basis, complement = (array if array.flags.writeable and array.flags.c_contiguous else np.array(array, order="C")
-                         for array in (basis, complement))
-    run_kernels(plan, twists, points, basis, complement, iti_override, oti_override, out)
-    return out
-
-
-class _ChunkSpaces:
-    """A chunk's chains in working coordinates and their decompositions, computed once when first asked
-    (shared by the motion spaces and the constraint indices)."""
-
-    def __init__(self, plan: _Plan, twists, points):
-        self.plan, self.twists, self.points = plan, twists, points
-
-    @cached_property
-    def working(self):
-        starts = self.plan.chain_start
-        chain_twists = [self.twists[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        chain_points = [self.points[:, starts[c]:starts[c + 1]] for c in range(len(starts) - 1)]
-        return working_coordinates(chain_twists, chain_points)
-
-    @cached_property
-    def decompositions(self):
-        return chain_decompositions(self.working[0])
-
-
-def _analyze_chunk(plan: _Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None,
-                   spaces: _ChunkSpaces | None = None) -> dict:
-    """All indices for one chunk of configurations (arrays (N, J, 6) and (N, J, 3) over all joints);
-    ``spaces`` the chunk's working coordinates when they are needed for every configuration anyway."""
-    if plan.space.constant_basis is not None:
-        basis = plan.space.constant_basis[None]
-        out = _run_kernel(plan, twists, points, basis, plan.complement, iti_override, oti_override,
-                          detail, keep_twists)
-        redo = np.flatnonzero(out["outside"])
-    else:
-        out, redo = None, np.arange(twists.shape[0])
-    if redo.size:
-        # Configurations whose joint twists leave the constant space: their own motion space, in
-        # the working coordinates the kernel uses (same centroid and characteristic length).
-        if spaces is not None or redo.size == twists.shape[0]:
-            spaces = spaces or _ChunkSpaces(plan, twists, points)
-            working, _, centre, length = spaces.working
-            working = [chain[redo] for chain in working]
-            centre, length = centre[redo], length[redo]
-            decompositions = [(singular[redo], right[redo]) for singular, right in spaces.decompositions]
-        else:
-            working, _, centre, length = _ChunkSpaces(plan, twists[redo], points[redo]).working
-            decompositions = None
-        _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE,
-                               decompositions)
-        if plan.idle_count:
-            bases = quotient_bases(bases, idle[redo], centre, length, plan.dof)
-        again = _run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),
-                            None if iti_override is None else iti_override[redo],
-                            None if oti_override is None else oti_override[redo], detail, keep_twists)
-        if out is None:
-            out = again
-        else:
-            for key, value in again.items():
-                if out[key].shape[0]:
-                    out[key][redo] = value
-    summary = out["summary"]
-    result = {
-        "iti": summary[:, 0],  # Eq. 7
-        "lmti": summary[:, 1],  # Eq. 11 on the whole set
-        "mutual_interference": out["mutual_interference"],
-    }
-    for column, j in enumerate(plan.faults):
-        result[f"f_o{j}"] = summary[:, 2 + column]  # Eqs. 12-13
-        result[f"worst{j}"] = plan.failed_sets[j][out["worst"][:, column]]  # (N, j): the complement of the worst E_i
-    if detail:
-        result.update(iti_actuators=out["iti_actuators"], oti_actuators=out["oti_actuators"],
-                      oti_submechanisms=out["oti_submechanisms"], actuation_wrenches=out["actuation_wrenches"])
-        result.update({f"remaining{j}": lmti for j, lmti in remaining_lmti(plan, out["oti_submechanisms"]).items()})
-        if keep_twists:
-            result["output_twists"] = out["output_twists"]
-    return result
-
-
-def _joints_of_all_chains(arrays: list[NDArray]):
-    """A function giving, for a slice of the batch, the (n, J, k) array of every chain's joints.
-
-    When the chains are consecutive blocks along the joint axis of one array, whatever its
-    memory layout (the loader's screws are component-major, hand-built ones batch-first), the
-    slice is a view of that array and the kernel reads it in place; otherwise the chains'
-    slices are concatenated.
-    """
-    first = arrays[0]
-    width = sum(a.shape[1] for a in arrays)
-    strides = first.strides
-    address = first.__array_interface__["data"][0]
-    tiled = first.shape[0] > 0 and first.dtype == np.float64
-    for array in arrays:
-        tiled &= array.strides == strides and array.dtype == first.dtype
-        tiled &= array.__array_interface__["data"][0] == address
-        address += array.shape[1] * strides[1]
-    if tiled:
-        # Writable exactly when the chains' memory is (the kernel only reads it).
-        whole = np.lib.stride_tricks.as_strided(first, (first.shape[0], width, first.shape[2]), strides)
-        if all(np.shares_memory(whole, array) for array in arrays):
-            return lambda part: whole[part]
-    return lambda part: np.concatenate([a[part] for a in arrays], axis=1)
-
-
-def _constraint_plan(chains: list[ChainScrews], count: int) -> ConstraintPlan:
-    """The constraint structure of the chains, found on up to 9 configurations spread over the batch."""
-    if not count:
-        return ConstraintPlan(tuple(0 for _ in chains), 0)
-    _, working, _, _, _ = sampled_working_coordinates(chains)
-    return plan_constraints(working)
-
-
-def _constraint_chunk(plan: _Plan, constraint_plan: ConstraintPlan, spaces: _ChunkSpaces, wrenches,
-                      fault_members) -> dict:
-    """The CTI of a chunk (see :mod:`screwkit.screw.constraints`), in the kernel's working coordinates."""
-    working, working_points, centre, length = spaces.working
-    moments = wrenches[..., 3:] + np.cross(wrenches[..., :3], centre[:, None, :])  # about the centroid
-    working_wrenches = np.concatenate([wrenches[..., :3], moments / length[:, None, None]], axis=-1)
-    norms = np.linalg.norm(working_wrenches, axis=-1, keepdims=True)
-    working_wrenches = working_wrenches / np.where(norms > 0.0, norms, 1.0)
-    # With a point output the idle rotations are joints of the chains: the platform's instantaneous DOF
-    # counts them, and the CTI (defined for a frame output, every wrench acting on the platform) does not apply.
-    result = constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
-                                plan.dof + plan.idle_count, fault_members, plan.threshold / length,
-                                spaces.decompositions)
-    if plan.idle_count:
-        result["instantaneous_dof"] = result["instantaneous_dof"] - plan.idle_count
-        for key in result:
-            if key == "cti" or key == "cti_submechanisms" or key.startswith("f_c"):
-                result[key] = np.full(result[key].shape, np.nan)
-    return result
-
-
-def _at_constraint_singularities(plan: _Plan, result: dict, held: NDArray) -> None:
-    """Where the platform has more instantaneous DOF than its mobility ``n``, no ``n`` actuators hold it:
-    every OTI, LMTI and F_Oj is zero (the worst fault the first set, as for ties), and an actuator is a
-    mutual-interference one when the others with every constraint wrench still hold the platform."""
-    rows = np.flatnonzero(result["constraint_singular"])
-    result["lmti"][rows] = 0.0
-    for j in plan.faults:
-        result[f"f_o{j}"][rows] = 0.0
-        result[f"worst{j}"][rows] = plan.failed_sets[j][0]
-    for key in ("oti_actuators", "oti_submechanisms", *(f"remaining{j}" for j in plan.faults)):
-        if key in result:
-            result[key][rows] = 0.0
-    result["mutual_interference"][rows] = held
 
 
 def analyze(
@@ -441,6 +205,9 @@ def analyze(
     if fault_type == "link" and (iti_points is not None or oti_points is not None):
         raise ValueError("`iti_points` and `oti_points` apply to free-swinging faults only, not fault_type='link'.")
     given_chains = chains
+    # indices derived from the per-configuration detail (registry records with a `compute`) need that detail
+    derived = any(record.compute is not None for record in INDICES.values())
+    requested_detail, detail = detail, detail or derived
     for chain in chains:
         if not isinstance(chain, ChainScrews):
             raise ValueError(f"Expected `chains` to hold ChainScrews, got {type(chain).__name__}.")
@@ -466,7 +233,7 @@ def analyze(
         idle, idle_points = idle_rotations(point, planar)
         index, _, _, centre, length = sampled_working_coordinates(chains)
         chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
-    plan = _make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
+    plan = make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
     a = len(plan.actuators)
     overrides = {}
     for name, value in (("iti_points", iti_points), ("oti_points", oti_points)):
@@ -478,27 +245,27 @@ def analyze(
                 raise ValueError(f"Expected `{name}` with shape (..., {a}, 3), got {array.shape}.") from None
             # writable for the kernel
             overrides[name] = np.array(array.reshape(count, a, 3), dtype=np.float64, order="C")
-    twists = _joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
-    points = _joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
+    twists = joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
+    points = joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
     # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
-    constraint_plan = (_constraint_plan(chains, count) if plan.space.dof < 6
+    constraint_plan = (constraint_plan_of(chains, count) if plan.space.dof < 6
                        else ConstraintPlan(tuple(0 for _ in chains), 0))
     fault_members = submechanisms_left(a, plan.dof, plan.faults) if constraint_plan.count else {}
 
     def run(part: slice) -> dict:
         chunk_twists, chunk_points = twists(part), points(part)
-        spaces = _ChunkSpaces(plan, chunk_twists, chunk_points) if constraint_plan.count else None
-        result = _analyze_chunk(
+        spaces = ChunkSpaces(plan, chunk_twists, chunk_points) if constraint_plan.count else None
+        result = analyze_chunk(
             plan, chunk_twists, chunk_points,
             overrides["iti_points"][part] if "iti_points" in overrides else None,
             overrides["oti_points"][part] if "oti_points" in overrides else None,
             detail or constraint_plan.count > 0, keep_twists, None if idle is None else idle[part], spaces)
         if constraint_plan.count:
-            result.update(_constraint_chunk(plan, constraint_plan, spaces, result["actuation_wrenches"],
+            result.update(constraint_chunk(plan, constraint_plan, spaces, result["actuation_wrenches"],
                                             fault_members))
             if "held_without" in result:
-                _at_constraint_singularities(plan, result, result.pop("held_without"))
+                at_constraint_singularities(plan, result, result.pop("held_without"))
             if not detail:
                 for key in ("iti_actuators", "oti_actuators", "oti_submechanisms", "actuation_wrenches",
                             "cti_submechanisms", *(f"remaining{j}" for j in plan.faults)):
@@ -532,7 +299,7 @@ def analyze(
         f_o, worst = link["f_o"], link["worst"]
         remaining = link["lmti"] if detail else {}
         f_c = link["f_c"] if constraint_plan.count else f_c
-    return Indices(
+    result = Indices(
         actuators=names,
         dof=plan.dof,
         submechanisms=tuple(tuple(int(i) for i in sub) for sub in plan.submechanisms),
@@ -559,3 +326,10 @@ def analyze(
         fault_type=fault_type,
         remaining_lmti=remaining,
     )
+    if not derived:
+        return result
+    result = with_derived(result)
+    if requested_detail:
+        return result
+    return replace(result, iti_actuators=None, oti_actuators=None, oti_submechanisms=None, actuation_wrenches=None,
+                   output_twists=None, cti_submechanisms=None, remaining_lmti={})

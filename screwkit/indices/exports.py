@@ -12,8 +12,9 @@ import numpy as np
 
 from screwkit.common.tolerances import WORST_FAULT_TIE
 from screwkit.common.units import is_angular
+from screwkit.indices.registry import INDICES, applies
 
-__all__ = ["indices_to_dict", "indices_to_dataset", "json_number", "set_label", "tied"]
+__all__ = ["indices_to_dict", "indices_to_dataset", "json_number", "set_label", "tied", "worst_fault_ties"]
 
 
 def json_number(value: float) -> float | None:
@@ -29,6 +30,24 @@ def set_label(actuators: Sequence[int]) -> str:
     '1-2-3'
     """
     return "-".join(str(i + 1) for i in actuators)
+
+
+def worst_fault_ties(indices, faults: int) -> tuple[tuple[str, ...], ...]:
+    """Every worst case of ``faults`` faults at one configuration, by name: the failed actuators of each set
+    whose LMTI is within :data:`~screwkit.common.tolerances.WORST_FAULT_TIE` of ``F_Oj`` (the reported
+    ``worst_faults`` first). Only the reported one without ``detail``; none where unreachable."""
+    if indices.batch_shape:
+        raise ValueError("worst_fault_ties is for one configuration; take .at(index) of a batch first.")
+    if not indices.reachable:
+        return ()
+    first = tuple(indices.worst_faults[faults])
+    if faults not in indices.remaining_lmti:
+        return (first,)
+    values = np.asarray(indices.remaining_lmti[faults])
+    tied_sets = [tuple(indices.actuators[k] for k in failed)
+                 for failed, value in zip(indices.failed_sets(faults), values)
+                 if value <= indices.f_o[faults] + WORST_FAULT_TIE]
+    return (first,) + tuple(names for names in tied_sets if names != first)
 
 
 def tied(values, best: float, highest: bool = False) -> list[int]:
@@ -86,6 +105,14 @@ def _one_configuration(indices) -> dict:
     return report
 
 
+def _values(indices, record):
+    """The values of a registered index, or None for a derived index registered after they were computed."""
+    try:
+        return indices.index(record.name)
+    except ValueError:
+        return None
+
+
 def indices_to_dict(indices) -> dict:
     """What :meth:`screwkit.indices.results.Indices.to_dict` returns."""
 
@@ -115,13 +142,20 @@ def indices_to_dict(indices) -> dict:
     report["reachable"] = indices.reachable if not indices.batch_shape else np.asarray(indices.reachable).tolist()
     report["dof"] = indices.dof
     report["actuators"] = list(indices.actuators)
-    report["iti"] = number(indices.iti)
+    for record in INDICES.values():  # every index, one record each
+        if not applies(record, indices):
+            if not record.per_fault:
+                report[record.name] = "not applicable"
+            continue
+        values = _values(indices, record)
+        if values is not None:
+            report[record.name] = ({str(j): number(v) for j, v in values.items()} if record.per_fault
+                                   else number(values))
+    if not indices.constraint_count:
+        report["cti_reason"] = indices.cti_reason or "no constraint wrench is held by one chain alone"
     if indices.iti_actuators is not None:
         report["iti_actuators"] = {name: number(indices.iti_actuators[..., i])
                                    for i, name in enumerate(indices.actuators)}
-    report["lmti"] = number(indices.lmti)
-    report["f_o"] = {str(j): number(v) for j, v in indices.f_o.items()}
-    report["f_io"] = {str(j): number(v) for j, v in indices.f_io.items()}
     worst = indices.worst_faults
     report["worst_faults"] = {str(j): (list(v) if not indices.batch_shape else np.asarray(v).tolist())
                               for j, v in worst.items()}
@@ -129,12 +163,6 @@ def indices_to_dict(indices) -> dict:
     if not indices.batch_shape:
         report["worst_fault_ties"] = {str(j): [list(names) for names in indices.worst_fault_ties(j)]
                                       for j in indices.faults}
-    if indices.cti is None or not indices.constraint_count:
-        report["cti"] = "not applicable"
-        report["cti_reason"] = indices.cti_reason or "no constraint wrench is held by one chain alone"
-    else:
-        report["cti"] = number(indices.cti)
-        report["f_c"] = {str(j): number(v) for j, v in indices.f_c.items()}
     if indices.instantaneous_dof is not None:
         report["instantaneous_dof"] = (int(indices.instantaneous_dof) if not indices.batch_shape
                                        else np.asarray(indices.instantaneous_dof).tolist())
@@ -160,13 +188,16 @@ def indices_to_dataset(indices, dims: Sequence[str] | None = None, coords: dict 
     dims = tuple(dims)
     if len(dims) != len(batch):
         raise ValueError(f"Expected {len(batch)} names in `dims` for the batch shape {batch}, got {dims}.")
-    variables = {
-        "reachable": (dims, np.asarray(indices.reachable)),
-        "iti": (dims, np.asarray(indices.iti), {"long_name": "ITI (Eq. 7)"}),
-        "lmti": (dims, np.asarray(indices.lmti), {"long_name": "LMTI of all actuators (Eq. 11)"}),
-        "mutual_interference": (dims + ("actuator",), indices.mutual_interference,
-                                {"long_name": "mutual-interference actuator"}),
-    }
+    variables = {"reachable": (dims, np.asarray(indices.reachable))}
+    for record in INDICES.values():  # every index, one record each
+        values = _values(indices, record) if applies(record, indices) else None
+        if values is None:
+            continue
+        for j, value in (values.items() if record.per_fault else [(None, values)]):
+            variables[record.column(j)] = (dims, np.asarray(value), {"long_name": record.long_name(j),
+                                                                     "description": record.description})
+    variables["mutual_interference"] = (dims + ("actuator",), indices.mutual_interference,
+                                        {"long_name": "mutual-interference actuator"})
     if indices.iti_actuators is not None:
         variables["iti_actuator"] = (dims + ("actuator",), indices.iti_actuators,
                                      {"long_name": "ITI per actuator (Eq. 6)"})
@@ -175,14 +206,8 @@ def indices_to_dataset(indices, dims: Sequence[str] | None = None, coords: dict 
                                          {"long_name": "OTI of each non-redundant submechanism (Eq. 9)"})
     worst = indices.worst_faults
     for j in indices.faults:
-        variables[f"f_o{j}"] = (dims, np.asarray(indices.f_o[j]), {"long_name": f"F_O{j} (Eq. 12)"})
-        variables[f"f_io{j}"] = (dims, np.asarray(indices.f_io[j]), {"long_name": f"F_IO{j} (Eq. 14)"})
         variables[f"worst_fault{j}"] = (dims + (f"fault{j}",), np.asarray(worst[j], dtype=str),
                                         {"long_name": f"failed actuators of the worst case of {j} fault(s)"})
-    if indices.cti is not None and indices.constraint_count:
-        variables["cti"] = (dims, np.asarray(indices.cti), {"long_name": "constraint transmission index"})
-        for j, value in indices.f_c.items():
-            variables[f"f_c{j}"] = (dims, np.asarray(value), {"long_name": f"F_C{j} (worst CTI after {j} faults)"})
     if indices.instantaneous_dof is not None:
         variables["instantaneous_dof"] = (dims, np.asarray(indices.instantaneous_dof))
         variables["constraint_singular"] = (dims, np.asarray(indices.constraint_singular))

@@ -18,16 +18,16 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.tolerances import WORST_FAULT_TIE
-from screwkit.indices.exports import indices_to_dataset, indices_to_dict, set_label
+from screwkit.indices.exports import indices_to_dataset, indices_to_dict, set_label, worst_fault_ties
+from screwkit.indices.registry import INDICES, applies
 
-__all__ = ["Indices", "set_label", "PER_CONFIGURATION", "PER_CONFIGURATION_DICTS"]
+__all__ = ["Indices", "set_label", "with_derived", "PER_CONFIGURATION", "PER_CONFIGURATION_DICTS"]
 
 PER_CONFIGURATION = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_actuators", "oti_submechanisms",
                      "actuation_wrenches", "output_twists", "poses", "reachable", "chain_status", "full_poses",
                      "cti", "cti_submechanisms", "instantaneous_dof", "constraint_singular")
 """Fields of :class:`Indices` with one entry per configuration (leading batch axes)."""
-PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "joint_values")
+PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "joint_values", "derived")
 """Fields of :class:`Indices` that map ``j`` to one entry per configuration."""
 
 
@@ -114,17 +114,13 @@ class Indices:
         ``"free-swinging"`` (failed actuators become passive joints, the paper's FSJF) or
         ``"link"`` (their chains disappear with their constraint wrenches, the paper's LF).
     remaining_lmti : dict of int to ndarray (..., C(a, j))
-        For each ``j``, the LMTI of every actuator set left after ``j`` faults (the terms of Eq. 12), in
-        combination order of the sets left (:meth:`failed_sets`); empty unless computed with ``detail``.
-    joint_values : dict of str to float or ndarray (...)
-        Every joint's value (rad, m; spherical joints as rotation vectors) by ``chain:joint`` name, at
-        the configurations (:func:`screwkit.studies.indices_at_pose` fills it).
-    prismatic_joints : tuple of str
-        The names in :attr:`joint_values` whose values are lengths (m).
+        The LMTI of every set left after ``j`` faults (Eq. 12's terms, :meth:`failed_sets` order); with detail.
+    joint_values, prismatic_joints : dict of str to float, tuple of str
+        Every joint's value (rad, m) by ``chain:joint`` (:func:`~screwkit.studies.indices_at_pose`), and which are m.
     working_mode : dict of str to str
         Per chain, the working mode (branch) its closure follows, in words.
-    cti_reason : str
-        Why the CTI does not apply, when it does not (:attr:`constraint_count` 0).
+    cti_reason, derived : str, dict of str to float or ndarray (...)
+        Why the CTI does not apply; the registered derived indices (:mod:`screwkit.indices.registry`) by column.
     """
 
     actuators: tuple[str, ...]
@@ -161,6 +157,7 @@ class Indices:
     prismatic_joints: tuple[str, ...] = ()
     working_mode: dict[str, str] = field(default_factory=dict)
     cti_reason: str = ""
+    derived: dict[str, Any] = field(default_factory=dict)
     batch_shape: tuple[int, ...] = field(init=False)
 
     def __post_init__(self):
@@ -274,6 +271,22 @@ class Indices:
             return _scalar_or_array(np.where(np.asarray(self.reachable), 0.0, np.nan))
         return _scalar_or_array(self.oti_submechanisms[..., members].max(axis=-1))
 
+    def index(self, name: str) -> Any:
+        """The values of a registered index (:mod:`screwkit.indices.registry`): per configuration, or a dict by
+        ``j`` for a per-fault index."""
+        record = INDICES.get(name)
+        if record is None:
+            raise ValueError(f"Unknown index {name!r}; the indices are {', '.join(INDICES)}.")
+        if record.compute is None:  # the compiled kernels' indices are fields
+            return getattr(self, name)
+        missing = [column for column in ([record.column(j) for j in self.faults] if record.per_fault else [name])
+                   if column not in self.derived]
+        if missing:
+            raise ValueError(f"These indices have no {name!r}: it was registered after they were computed.")
+        if record.per_fault:
+            return {j: self.derived[record.column(j)] for j in self.faults}
+        return self.derived[name]
+
     def failed_sets(self, faults: int) -> tuple[tuple[int, ...], ...]:
         """The failed actuators (indices) of each set left after ``faults`` faults, in the combination order of
         the sets left (that of :attr:`remaining_lmti`)."""
@@ -281,20 +294,9 @@ class Indices:
         return tuple(tuple(sorted(set(range(a)) - set(left))) for left in combinations(range(a), a - faults))
 
     def worst_fault_ties(self, faults: int) -> tuple[tuple[str, ...], ...]:
-        """Every worst case of ``faults`` faults at one configuration, by name: the failed actuators of each set
-        whose LMTI is within :data:`~screwkit.common.tolerances.WORST_FAULT_TIE` of ``F_Oj`` (the reported
-        :attr:`worst_faults` first). Only the reported one without ``detail``; none where unreachable."""
-        if self.batch_shape:
-            raise ValueError("worst_fault_ties is for one configuration; take .at(index) of a batch first.")
-        if not self.reachable:
-            return ()
-        first = tuple(self.worst_faults[faults])
-        if faults not in self.remaining_lmti:
-            return (first,)
-        values = np.asarray(self.remaining_lmti[faults])
-        tied = [tuple(self.actuators[k] for k in failed) for failed, value in zip(self.failed_sets(faults), values)
-                if value <= self.f_o[faults] + WORST_FAULT_TIE]
-        return (first,) + tuple(names for names in tied if names != first)
+        """Every worst case of ``faults`` faults at one configuration, by name (:func:`~screwkit.indices.exports.
+        worst_fault_ties`)."""
+        return worst_fault_ties(self, faults)
 
     def __repr__(self) -> str:
         where = f"{self.mechanism}, " if self.mechanism else ""
@@ -335,3 +337,18 @@ class Indices:
             coordinates along the batch dimensions (m, deg).
         """
         return indices_to_dataset(self, dims, coords)
+
+
+def with_derived(result: Indices) -> Indices:
+    """``result`` with every registered derived index computed (the ``compute`` of each record of
+    :mod:`screwkit.indices.registry`, which may read the detail arrays: computed with ``detail``)."""
+    derived = {}
+    for record in INDICES.values():
+        if record.compute is None or not applies(record, result):
+            continue
+        values = record.compute(result)
+        if record.per_fault:
+            derived.update({record.column(j): _scalar_or_array(values[j]) for j in result.faults})
+        else:
+            derived[record.name] = _scalar_or_array(values)
+    return replace(result, derived=derived)

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular, unit_of
+from screwkit.indices.registry import index_columns
 from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
@@ -245,14 +246,7 @@ def map_block(mechanism: Mechanism, at, x_axis, x_values, y_axis, y_values, mask
                               threads=threads, limits=limits, fault_type=fault_type)
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
-    named = {"iti": result.iti, "lmti": result.lmti}
-    for j in result.faults:
-        named[f"f_o{j}"] = result.f_o[j]
-        named[f"f_io{j}"] = result.f_io[j]
-    if result.cti is not None and result.constraint_count:
-        named["cti"] = result.cti
-        named.update({f"f_c{j}": value for j, value in result.f_c.items()})
-    for name, values in named.items():
+    for name, values in index_columns(result).items():  # every registered index: the worst orientation (its `reduce`)
         out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
     return out
 

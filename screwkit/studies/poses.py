@@ -22,7 +22,7 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
-from screwkit.indices.results import Indices
+from screwkit.indices.results import Indices, with_derived
 from screwkit.model import Mechanism, require_mechanism
 
 __all__ = ["indices_at_poses", "indices_at_pose", "analyze_solution", "output_points", "planar_points",
@@ -111,31 +111,26 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
     if mechanism.output_point is not None:
         if prismatic:
             raise ValueError(f"The point-output closed forms are for R-R-R legs; {mechanism.name!r} has R-P-R legs.")
-        closed = point_indices(base, elbows, distal, faults=faults)
-        return Indices(
-            actuators=mechanism.actuator_names, dof=2, submechanisms=closed["submechanisms"], iti=closed["iti"],
-            lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
-            mutual_interference=closed["mutual_interference"], threshold=threshold,
-            iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
-            remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates,
-            mechanism=mechanism.name)
-    if prismatic:
+        closed, dof = point_indices(base, elbows, distal, faults=faults), 2
+    elif prismatic:
         direction = distal - base
         closed = planar_indices(base, None, distal, threshold=threshold, faults=faults, threads=threads,
                                 directions=direction / np.linalg.norm(direction, axis=-1, keepdims=True))
+        dof = 3
     else:
-        closed = planar_indices(base, elbows, distal, threshold=threshold, faults=faults, threads=threads)
-    return Indices(
-        actuators=mechanism.actuator_names, dof=3, submechanisms=closed["submechanisms"], iti=closed["iti"],
+        closed, dof = planar_indices(base, elbows, distal, threshold=threshold, faults=faults, threads=threads), 3
+    return with_derived(Indices(
+        actuators=mechanism.actuator_names, dof=dof, submechanisms=closed["submechanisms"], iti=closed["iti"],
         lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
         mutual_interference=closed["mutual_interference"], threshold=threshold,
         iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
-        remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name)
+        remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates,
+        mechanism=mechanism.name))
 
 
 _ARRAYS = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms",
            "instantaneous_dof", "constraint_singular")
-_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti")
+_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "derived")
 
 
 def _blank(count: int, value) -> NDArray:

@@ -36,8 +36,8 @@ def _carry_arrays(blocks: int, a: int, n: int) -> tuple[np.ndarray, ...]:
 def run_kernels(plan, twists, points, basis, complement, iti_override, oti_override, out: dict) -> None:
     """The kernels on a chunk, ``KERNEL_BATCH`` configurations at a time, into the arrays of ``out``.
 
-    ``plan`` is the chunk's :class:`screwkit.indices.analysis._Plan` (actuators, submechanisms, locked
-    sets, reductions, threshold); arrays as :func:`screwkit.indices.analysis._run_kernel` prepares them,
+    ``plan`` is the chunk's :class:`screwkit.indices.stages.Plan` (actuators, submechanisms, locked
+    sets, reductions, threshold); arrays as :func:`screwkit.indices.stages.run_kernel` prepares them,
     ``iti_override`` and ``oti_override`` (N, a, 3) or None. The first stage hands the later ones
     its per-block results (:func:`~screwkit.indices.compiled.algebra.carry_arrays`) for one batch at a time (kept
     in cache), rather than for the whole chunk.

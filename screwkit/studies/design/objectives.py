@@ -11,7 +11,6 @@ fresh ``screwkit map`` of the candidate's file with :meth:`Region.map_arguments`
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,6 +18,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
+from screwkit.indices.registry import column_record
 from screwkit.model import Mechanism
 from screwkit.studies.maps import disc_grid, map_block, orientation_set, range_values
 
@@ -87,8 +87,7 @@ class Region:
     map_options: tuple[str, ...] = ()
 
     def __post_init__(self):
-        if not re.fullmatch(r"f_i?o[1-9][0-9]*|lmti|iti", self.index):
-            raise ValueError(f"Expected a region index f_o<j> or f_io<j> (j >= 1), lmti or iti, got {self.index!r}.")
+        column_record(self.index)  # any registered index (screwkit.indices.registry), with j if per fault
         if not math.isfinite(self.level):
             raise ValueError(f"Expected a finite region level, got {self.level}.")
 
@@ -123,8 +122,8 @@ class Region:
 
     @property
     def faults(self) -> int:
-        """The number of faults the region's index needs (1 for lmti and iti: the map computes F_O1 anyway)."""
-        return int(self.index.rpartition("o")[2]) if self.index.startswith("f_") else 1
+        """The number of faults the region's index needs (1 for one without j: the map computes F_O1 anyway)."""
+        return column_record(self.index)[1] or 1
 
     @property
     def orientations(self) -> str:
