@@ -144,9 +144,9 @@ def test_a_gepetto_style_urdf_and_yaml_with_open_loops_is_assembled(tmp_path):
     assert all(gap > 0.01 for gap in report.gaps_before.values()), report.gaps_before  # q = 0 is open
     assert all(gap < 1e-9 for gap in report.gaps_after.values()), report.gaps_after
     assert report.locked == ["closure_2a"]  # coaxial with the welded pin closure_2b: the idle DoF
-    assert report.planar is False  # a 3d closure: spherical loop joint
+    assert report.planar is True  # every axis along z: planar, the 3d closure written as a pin about z
     assert report.output.startswith("the point where the chains meet on body 'distal_1'")
-    assert report.output.endswith("0 m from frame 'effector'")
+    assert report.output.endswith("0 m in the plane from frame 'effector'")
     mechanism = load(tmp_path / "robot.urdf")
     assert mechanism.dof == 2 and mechanism.actuator_names[0].endswith("mot1")
     points = poses_near_home()
@@ -169,18 +169,45 @@ def test_a_planar_gepetto_five_bar_is_written_planar_and_non_redundant_gives_zer
 
 
 @pytest.mark.parametrize("change, message", [
-    (lambda t: t.replace(' name="loop_2"', ""), "must have a name"),
     (lambda t: t.replace("<actuator>", "<actuator>").replace('<motor name="m_1" joint="a_1"/>', "")
      .replace('<motor name="m_2" joint="a_2"/>', "").replace('<motor name="m_3" joint="a_3"/>', ""),
      "drives a joint"),
-    (lambda t: t.replace("</body></worldbody>", '</body><body name="other"/></worldbody>'), "holds 2 bodies"),
     (lambda t: t.replace('name="effector"', 'name="marker"'), "which body is the platform"),
+    (lambda t: t.replace("<worldbody>", '<include file="missing.xml"/><worldbody>'), "missing.xml: cannot be read"),
 ])
 def test_an_mjcf_file_that_cannot_be_read_says_why(tmp_path, change, message):
     path = tmp_path / "bad.xml"
     path.write_text(change(five_bar_mjcf()))
     with pytest.raises(ValueError, match=message):
         load(path)
+
+
+def test_unnamed_closures_several_world_bodies_and_degrees_open_as_mujoco_reads_them(tmp_path):
+    """What Pinocchio's parser alone could not read: unnamed connects (it merges them), a second body under
+    <worldbody> (it reads the first only), angles in degrees (MuJoCo's default) and an <include>. The file opens
+    with the indices of the plain one."""
+    plain = tmp_path / "plain.xml"
+    plain.write_text(five_bar_mjcf())
+    text = five_bar_mjcf(name_equalities=False).replace('<compiler angle="radian"/>', "")
+    text = text.replace("</body></worldbody>", '</body><body name="camera_rig" pos="1 1 1"><geom type="sphere" '
+                        'size="0.01"/></body></worldbody>')
+    text = text.replace('<joint name="a_1" type="hinge"', '<joint name="a_1" type="hinge" range="-170 170"')
+    (tmp_path / "actuators.xml").write_text("<mujoco>" + text[text.index("<actuator>"):text.index("</mujoco>")]
+                                            + "</mujoco>")
+    text = text[:text.index("<actuator>")] + '<include file="actuators.xml"/></mujoco>'
+    written = tmp_path / "written.xml"
+    written.write_text(text)
+    _, report = read_mechanism_file(written)
+    assert any("2 unnamed closure(s) named" in note for note in report.notes), report.notes
+    assert any("2 bodies under <worldbody>" in note for note in report.notes)
+    assert any("angles in degrees" in note for note in report.notes)
+    first, second = load(plain), load(written)
+    assert [c.joint_names for c in first.chains] == [c.joint_names for c in second.chains]
+    np.testing.assert_allclose(second.chains[0].joint_limits[0], np.deg2rad([-170.0, 170.0]), atol=1e-12)
+    poses = poses_near_home()
+    a, b = (indices_at_poses(m, poses, detail=True) for m in (first, second))
+    np.testing.assert_allclose(b.iti_actuators, a.iti_actuators, atol=1e-12)
+    np.testing.assert_allclose(b.lmti, a.lmti, atol=1e-12)
 
 
 def test_an_actuator_on_a_leg_closed_onto_another_leg_is_refused_by_name(tmp_path):

@@ -53,6 +53,7 @@ class ClosedTree:
     output: str | None = None
     output_type: str | None = None  # "point", "frame" or None (decided as the module says)
     file_format: str = ""
+    notes: list[str] = field(default_factory=list)  # what reading the file changed (said in the report)
 
 
 @dataclass

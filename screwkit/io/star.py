@@ -22,10 +22,13 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
    with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
    assembled values, from its end backwards, until they are independent: the span of the leg's
    twists, so the platform's motion and every index, is unchanged; the report names them.
-5. **Output.** When every closure onto the platform meets it at one point and the mechanism
-   moves in a plane or is of lower mobility, the output is that point (a five-bar's distal
-   joint, where pressure angles are measured); otherwise the output frame. A mechanism whose
-   revolute axes are all parallel (and slides perpendicular to them) is written planar.
+5. **Output.** When every closure onto the platform meets it at one point and joins it by every
+   rotation about that point (ball joints; pins about the plane's normal in a planar mechanism),
+   the platform's rotations about the point are idle and the output is the point (a five-bar's
+   distal joint, where pressure angles are measured); otherwise the output frame, whatever points
+   the closures reference (welds at the platform body's origin make a 6-DOF platform, not a point).
+   A mechanism whose revolute axes are all parallel (and slides perpendicular to them) is written
+   planar, its ball closures as pins about the normal.
 
 The result is the text of a URDF in screwkit's convention and an
 :class:`~screwkit.io.closed_tree.ImportReport`.
@@ -193,16 +196,17 @@ def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]
 
 
 def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
-    """The common direction of every revolute axis when slides are perpendicular to it, else None."""
+    """The common direction of every revolute axis when slides are perpendicular to it, else None. Ball loops
+    (a ``connect``) do not count: in a mechanism whose other joints all move in one plane, only their rotation
+    about the plane's normal moves (:func:`_planar_loops` writes them so)."""
     model = tree.model
     axes = []
     for leg in legs:
         for joint in leg.joints:
             kind, axis = joint_kind(model, joint)
             axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
-        if leg.loop == "spherical":
-            return None
-        axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
+        if leg.loop != "spherical":
+            axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
     revolute = [axis for kind, axis in axes if kind == "revolute"]
     if not revolute:
         return None
@@ -213,6 +217,31 @@ def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
         if kind == "prismatic" and abs(axis @ normal) > 1e-9:
             return None
     return normal
+
+
+def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
+    """In a planar mechanism, every ball loop becomes the revolute joint about the plane's normal through its
+    centre: its two other rotations would turn legs out of the plane, which their joints forbid."""
+    for leg in legs:
+        if leg.loop == "spherical":
+            centre = leg.successor_world[:3, 3]
+            leg.loop = "revolute"
+            leg.axis = leg.successor_world[:3, :3].T @ normal  # in the loop frame
+            leg.loop_dofs = [("revolute", normal, centre)]
+
+
+def _idle_about_the_meeting_point(legs: list[_Leg], normal: NDArray | None) -> bool:
+    """Whether every leg closed onto the platform joins it by every rotation about the point where they meet (a
+    ball, or in a plane a pin about the normal): the platform's rotations about that point are then idle, and
+    the output is the point. A weld or a pin in another direction makes them the actuators' to control."""
+    for leg in legs[1:]:
+        if leg.loop == "spherical" and normal is None:
+            continue
+        if leg.loop == "revolute" and normal is not None and \
+                abs(abs(float(leg.loop_dofs[0][1] @ normal)) - 1.0) < 1e-9:
+            continue
+        return False
+    return True
 
 
 def _origin(matrix: NDArray) -> dict:
@@ -274,7 +303,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
-    report = ImportReport(source=tree.source, file_format=tree.file_format)
+    report = ImportReport(source=tree.source, file_format=tree.file_format, notes=list(tree.notes))
     report.gaps_before = closure_gaps(tree, tree.q_reference)
     q, scale = assemble(tree)
     report.gaps_after = closure_gaps(tree, q)
@@ -330,6 +359,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                                "base to the platform or to a closure).")
         motor_ids[joint] = name
     normal = _planar_normal(tree, data, legs)
+    if normal is not None:
+        _planar_loops(legs, normal)
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     meet = all(np.linalg.norm(c - centres[0]) < 1e-9 * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
@@ -342,7 +373,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.dropped = [model.names[j] for j in range(1, model.njoints) if j not in owner and j not in absorbed]
     report.planar = normal is not None
     output_world = homogeneous(data.oMf[frame_index])
-    point = tree.output_type == "point" or (tree.output_type is None and meet)
+    idle = _idle_about_the_meeting_point(legs, normal)
+    point = tree.output_type == "point" or (tree.output_type is None and meet and idle)
     if point and not meet:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
                            "point; they do not.")

@@ -1,0 +1,239 @@
+"""An MJCF file made ready for Pinocchio's parser, as MuJoCo reads it, and MuJoCo's closure geometry.
+
+Pinocchio's ``buildModelAndConstraintsFromMJCF`` reads the kinematic tree, but not everything a published
+MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML first, saying what it did:
+
+* ``<include file=...>`` elements are replaced by the included file's content (paths relative to the
+  including file, as MuJoCo resolves them);
+* several bodies under ``<worldbody>`` (a robot beside a camera rig, two halves of a mechanism) are wrapped in
+  one body at the origin (Pinocchio reads only the first);
+* unnamed ``<connect>``/``<weld>`` elements are named (Pinocchio merges unnamed ones);
+* angles in degrees (``<compiler angle="degree">``, MuJoCo's default) become radians: hinge and ball joints'
+  ``range``, ``ref`` and ``springref``, and every ``euler`` and ``axisangle`` (class defaults included);
+* ``meshdir``/``texturedir``/``assetdir`` are made absolute (the prepared file is read from elsewhere).
+
+:func:`closure_placements` then gives each equality the frames MuJoCo constrains, from the bodies and sites
+of the tree Pinocchio built: a ``weld`` with a ``relpose`` holds body2 at that pose in body1's frame (without
+one, the pose they have at ``qpos0``); a ``connect`` holds body1's ``anchor`` on body2 at the point where it
+is at ``qpos0``; site-based ones hold the two sites together. Only the standard library and numpy.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH"]
+
+MAX_INCLUDE_DEPTH = 20
+"""Deepest chain of ``<include>``s followed (a file including itself is refused before that)."""
+ANGLE_ATTRIBUTES = ("range", "ref", "springref")
+ORIENTED = ("body", "geom", "site", "frame", "camera", "light", "inertial")
+ASSET_DIRECTORIES = ("meshdir", "texturedir", "assetdir")
+
+
+class MjcfError(ValueError):
+    """An MJCF file that cannot be prepared (the message names the file and the element)."""
+
+
+def _parse(path: Path) -> ElementTree.Element:
+    try:
+        return ElementTree.parse(path).getroot()
+    except ElementTree.ParseError as error:
+        raise MjcfError(f"{path}: not well-formed XML ({error}).") from None
+    except OSError as error:
+        raise MjcfError(f"{path}: cannot be read ({error.strerror or error}).") from None
+
+
+def _resolve_includes(element: ElementTree.Element, folder: Path, stack: tuple[Path, ...]) -> None:
+    for position, child in enumerate(list(element)):
+        if child.tag != "include":
+            _resolve_includes(child, folder, stack)
+            continue
+        name = child.get("file")
+        if not name:
+            raise MjcfError(f"{stack[-1]}: <include> without a file attribute.")
+        path = (folder / name).resolve()
+        if path in stack or len(stack) > MAX_INCLUDE_DEPTH:
+            raise MjcfError(f"{stack[-1]}: <include file='{name}'> includes itself (or nests deeper than "
+                            f"{MAX_INCLUDE_DEPTH}).")
+        included = _parse(path)
+        if included.tag != "mujoco":
+            raise MjcfError(f"{path}: an included file's root must be <mujoco>, got <{included.tag}>.")
+        _resolve_includes(included, path.parent, stack + (path,))
+        element.remove(child)
+        for offset, grandchild in enumerate(list(included)):
+            element.insert(position + offset, grandchild)
+
+
+def _merged(root: ElementTree.Element, tag: str) -> ElementTree.Element | None:
+    """The first ``tag`` child, with the children of its later duplicates moved into it (MuJoCo merges them)."""
+    found = root.findall(tag)
+    for extra in found[1:]:
+        for child in list(extra):
+            found[0].append(child)
+        root.remove(extra)
+    return found[0] if found else None
+
+
+def _class_joint_types(root: ElementTree.Element) -> dict[str, str]:
+    """The joint type each default class gives (inherited from enclosing classes; MuJoCo's default: hinge)."""
+    types: dict[str, str] = {}
+
+    def visit(default: ElementTree.Element, inherited: str) -> None:
+        name = default.get("class", "main")
+        joint = default.find("joint")
+        kind = joint.get("type", inherited) if joint is not None else inherited
+        types[name] = kind
+        for child in default.findall("default"):
+            visit(child, kind)
+
+    for top in root.findall("default"):
+        visit(top, "hinge")
+    return types
+
+
+def _to_radians(root: ElementTree.Element) -> int:
+    """Every angle of a file in degrees, in radians; returns how many attributes changed."""
+    classes = _class_joint_types(root)
+    changed = 0
+
+    def scale(element: ElementTree.Element, attribute: str, which=slice(None)) -> None:
+        nonlocal changed
+        words = (element.get(attribute) or "").split()
+        if not words:
+            return
+        try:
+            values = [float(word) for word in words]
+        except ValueError:
+            return
+        indices = range(len(values))[which]
+        values = [math.radians(v) if i in indices else v for i, v in enumerate(values)]
+        element.set(attribute, " ".join(repr(v) for v in values))
+        changed += 1
+
+    def joint_type(element: ElementTree.Element, childclass: str) -> str:
+        return element.get("type") or classes.get(element.get("class") or childclass, "hinge")
+
+    def visit(element: ElementTree.Element, childclass: str, in_default: bool) -> None:
+        childclass = element.get("childclass", childclass)
+        if element.tag == "default":
+            childclass = element.get("class", childclass)
+        for child in element:
+            if child.tag == "joint" and joint_type(child, childclass) in ("hinge", "ball"):
+                for attribute in ANGLE_ATTRIBUTES:
+                    scale(child, attribute)
+            if child.tag in ORIENTED:
+                scale(child, "euler")
+                scale(child, "axisangle", slice(3, 4))
+            visit(child, childclass, in_default or child.tag == "default")
+
+    visit(root, "main", False)
+    return changed
+
+
+def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
+    """The text of an MJCF file as Pinocchio should read it, what was changed, and its element tree."""
+    path = Path(path)
+    root = _parse(path)
+    if root.tag != "mujoco":
+        hint = " (a URDF: give it the suffix .urdf)" if root.tag == "robot" else ""
+        raise MjcfError(f"{path}: the root element is <{root.tag}>, not <mujoco>{hint}.")
+    _resolve_includes(root, path.parent, (path.resolve(),))
+    notes = []
+    compiler = _merged(root, "compiler")
+    if compiler is None:
+        compiler = ElementTree.Element("compiler")
+        root.insert(0, compiler)
+    for attribute in ASSET_DIRECTORIES:
+        value = compiler.get(attribute)
+        if value is not None and not Path(value).is_absolute():
+            compiler.set(attribute, str((path.parent / value).resolve()))
+    if compiler.get("angle", "degree") == "degree":
+        count = _to_radians(root)
+        if count:
+            notes.append(f"angles in degrees (MuJoCo's default unit) read as such: {count} attribute(s) converted")
+        compiler.set("angle", "radian")
+    world = _merged(root, "worldbody")
+    bodies = [] if world is None else world.findall("body")
+    if not bodies:
+        raise MjcfError(f"{path}: <worldbody> holds no body: nothing to analyse.")
+    if len(bodies) > 1:
+        wrapper = ElementTree.Element("body", name="screwkit_world", pos="0 0 0")
+        for body in bodies:
+            world.remove(body)
+            wrapper.append(body)
+        world.append(wrapper)
+        notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
+                     "held in one, 'screwkit_world', at the origin")
+    equality = _merged(root, "equality")
+    unnamed = 0
+    for element in ([] if equality is None else list(equality)):
+        if element.tag in ("connect", "weld") and not element.get("name"):
+            unnamed += 1
+            element.set("name", f"{element.tag}_{unnamed}")
+    if unnamed:
+        notes.append(f"{unnamed} unnamed closure(s) named in file order (connect_1, weld_1, ...)")
+    _merged(root, "actuator")
+    text = ElementTree.tostring(root, encoding="unicode")
+    return text, notes, root
+
+
+# -- MuJoCo's closure geometry -------------------------------------------------------------------------
+
+
+def _quaternion_matrix(w: float, x: float, y: float, z: float) -> NDArray:
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _numbers(element: ElementTree.Element, attribute: str, count: int, default) -> list[float]:
+    words = (element.get(attribute) or "").split()
+    if not words:
+        return list(default)
+    try:
+        values = [float(word) for word in words]
+    except ValueError:
+        values = []
+    if len(values) != count:
+        raise MjcfError(f"<{element.tag} name='{element.get('name')}'>: expected {count} numbers in '{attribute}', "
+                        f"got {element.get(attribute)!r}.")
+    return values
+
+
+def closure_placements(element: ElementTree.Element, model, data, frame_of) -> tuple[int, NDArray, int, NDArray]:
+    """The two frames (joint id, 4x4 placement in that joint's frame) a ``connect`` or ``weld`` holds together, as
+    MuJoCo does. ``data`` holds the forward kinematics at ``qpos0``; ``frame_of(name, kind)`` the Pinocchio frame
+    (``kind`` "body" or "site")."""
+    if element.get("site1") or element.get("site2"):
+        placements = []
+        for attribute in ("site1", "site2"):
+            frame = frame_of(element.get(attribute), "site")
+            placements.append((frame.parentJoint, frame.placement.homogeneous.copy()))
+        (joint_a, place_a), (joint_b, place_b) = placements
+        return joint_a, place_a, joint_b, place_b
+    body1 = frame_of(element.get("body1"), "body")
+    body2 = frame_of(element.get("body2") or "world", "body")
+    world_1 = data.oMi[body1.parentJoint].homogeneous @ body1.placement.homogeneous
+    world_2 = data.oMi[body2.parentJoint].homogeneous @ body2.placement.homogeneous
+    if element.tag == "connect":
+        anchor = np.eye(4)
+        anchor[:3, 3] = _numbers(element, "anchor", 3, (0.0, 0.0, 0.0))
+        place_a = body1.placement.homogeneous @ anchor
+        on_body2 = np.linalg.inv(world_2) @ world_1 @ anchor  # where the anchor is on body2 at qpos0
+        return body1.parentJoint, place_a, body2.parentJoint, body2.placement.homogeneous @ on_body2
+    relpose = _numbers(element, "relpose", 7, ())
+    if relpose and any(relpose[3:]):  # body2's pose in body1's frame
+        relative = np.eye(4)
+        relative[:3, :3] = _quaternion_matrix(*relpose[3:])
+        relative[:3, 3] = relpose[:3]
+    else:  # the pose they have at qpos0
+        relative = np.linalg.inv(world_1) @ world_2
+    return body1.parentJoint, body1.placement.homogeneous @ relative, body2.parentJoint, body2.placement.homogeneous
