@@ -11,6 +11,7 @@ open at q = 0). Their indices are compared with the textbook pressure angles of 
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -172,7 +173,6 @@ def test_a_planar_gepetto_five_bar_is_written_planar_and_non_redundant_gives_zer
     (lambda t: t.replace("<actuator>", "<actuator>").replace('<motor name="m_1" joint="a_1"/>', "")
      .replace('<motor name="m_2" joint="a_2"/>', "").replace('<motor name="m_3" joint="a_3"/>', ""),
      "drives a joint"),
-    (lambda t: t.replace('name="effector"', 'name="marker"'), "which body is the platform"),
     (lambda t: t.replace("<worldbody>", '<include file="missing.xml"/><worldbody>'), "missing.xml: cannot be read"),
 ])
 def test_an_mjcf_file_that_cannot_be_read_says_why(tmp_path, change, message):
@@ -180,6 +180,42 @@ def test_an_mjcf_file_that_cannot_be_read_says_why(tmp_path, change, message):
     path.write_text(change(five_bar_mjcf()))
     with pytest.raises(ValueError, match=message):
         load(path)
+
+
+@pytest.mark.parametrize("old, new, element", [
+    ('<site name="effector" pos="', '<site name="effector" pos="np.float64(0.1) ', "<site name='effector'> pos="),
+    ('anchor="', 'anchor="0.1 ', "<connect name='loop_2'> anchor="),
+    ('axis="0.0 0.0 1.0"', 'axis="0.0 1.0"', "<joint name='a_1'> axis="),
+])
+def test_a_number_mujoco_cannot_read_is_refused_naming_the_element(tmp_path, old, new, element):
+    """Numbers MuJoCo refuses (a word that is not a number, too many or too few) are refused too, naming the
+    element and the attribute, not read as the numbers that parse."""
+    import mujoco
+
+    text_ = five_bar_mjcf().replace(old, new, 1)
+    with pytest.raises(ValueError, match="XML Error"):
+        mujoco.MjModel.from_xml_string(text_)
+    path = tmp_path / "bad.xml"
+    path.write_text(text_)
+    with pytest.raises(ValueError, match=f"bad.xml: {re.escape(element)}.*expected \\d finite number"):
+        load(path)
+
+
+def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_for(tmp_path):
+    """No frame named as an output: the body where most closures meet is the platform, said in the report; with
+    one closure both of its bodies tie, and the file is refused with the option that names the platform."""
+    plain, renamed = tmp_path / "plain.xml", tmp_path / "renamed.xml"
+    plain.write_text(five_bar_mjcf())
+    renamed.write_text(five_bar_mjcf().replace('name="effector"', 'name="marker"'))
+    _, report = read_mechanism_file(renamed)
+    assert any("platform inferred: body 'distal_1', where 2 closures meet" in note for note in report.notes), report
+    expected, got = (indices_at_pose(load(path), np.array(HOME)) for path in (plain, renamed))
+    np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=TOLERANCE)
+    np.testing.assert_allclose([got.lmti, got.f_o[1]], [expected.lmti, expected.f_o[1]], atol=TOLERANCE)
+    tie = tmp_path / "tie.xml"
+    tie.write_text(five_bar_mjcf(legs=2).replace('name="effector"', 'name="marker"'))
+    with pytest.raises(ValueError, match="which body is the platform.*--output FRAME"):
+        load(tie)
 
 
 def test_unnamed_closures_several_world_bodies_and_degrees_open_as_mujoco_reads_them(tmp_path):
@@ -348,3 +384,68 @@ def test_a_urdf_named_xml_and_output_options_on_a_screwkit_file_are_refused_in_o
     result = screwkit("convert", own, tmp_path / "out.urdf", "--output", "effector")
     assert result.returncode == 1 and "apply to MJCF files and URDF + robot.yaml" in result.stderr
     assert result.stderr.count("\n") == 1
+
+
+def _hinges_as_ball_pairs(text_: str, half_length: float, slip: float = 0.0) -> str:
+    """Each connect written as a CAD exporter writes a hinge for MuJoCo: two ball joints on its axis (here z),
+    ``half_length`` either side of the anchor; the second one's anchor moved by ``slip`` along x (rounding)."""
+    def doubled(match):
+        name, bodies, x, y, z = match.group(1), match.group(2), *map(float, match.group(3).split())
+        return (f'<connect name="{name}a" {bodies} anchor="{x!r} {y!r} {z - half_length!r}"/>'
+                f'<connect name="{name}b" {bodies} anchor="{x + slip!r} {y!r} {z + half_length!r}"/>')
+    return re.sub(r'<connect name="(\w+)" (body1="\w+" body2="\w+") anchor="([^"]+)"/>', doubled, text_)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1000.0])
+def test_a_hinge_written_as_two_ball_closures_on_its_axis_is_one_revolute_loop(tmp_path, scale):
+    """Two connects between the same two bodies are the hinge through them (not two legs sharing joints): the
+    five-bar opens with the indices of the one-connect file, in metres and in millimetres."""
+    plain, doubled = tmp_path / "plain.xml", tmp_path / "doubled.xml"
+    plain.write_text(five_bar_mjcf(scale=scale))
+    doubled.write_text(_hinges_as_ball_pairs(five_bar_mjcf(scale=scale), 0.05 * scale))
+    _, report = read_mechanism_file(doubled)
+    assert sum("on one line: the hinge through them" in note for note in report.notes) == 2, report.notes
+    expected, got = (indices_at_poses(load(path), poses_near_home() * scale, detail=True) for path in (plain, doubled))
+    np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=TOLERANCE)
+    np.testing.assert_allclose(got.lmti, expected.lmti, atol=TOLERANCE)
+    np.testing.assert_allclose(got.f_o[1], expected.f_o[1], atol=TOLERANCE)
+
+
+def _hinges_as_site_pairs(half_length: float, slip: float) -> str:
+    """The five-bar with each closure a hinge written as onshape-to-robot writes it: two connects between sites,
+    one site on each body, on the hinge axis ``half_length`` either side of the meeting point; the sites of the
+    second connect on the platform side moved by ``slip`` along x (a CAD exporter's rounding)."""
+    text_, elbows = five_bar_mjcf(), five_bar_elbows(HOME)
+    connects = []
+    for i in range(3):
+        x, y = (float(v) for v in HOME - elbows[i])
+        sites = "".join(f'<site name="s{i + 1}{end}" pos="{x + (slip if i == 0 and end == "b" else 0.0)!r} '
+                        f'{y!r} {sign * half_length!r}"/>' for end, sign in (("a", -1), ("b", 1)))
+        opening = rf'(<body name="distal_{i + 1}" pos="[^"]+">)'
+        text_ = re.sub(opening, lambda m, sites=sites: m.group(1) + sites, text_)
+        if i:
+            connects += [f'<connect site1="s{i + 1}{end}" site2="s1{end}"/>' for end in "ab"]
+    return re.sub(r"<equality>.*</equality>", "<equality>" + "".join(connects) + "</equality>", text_)
+
+
+def test_closures_that_disagree_by_a_rounding_close_as_well_as_they_can_and_say_by_how_much(tmp_path):
+    """A CAD file's redundant closures written with rounded numbers: the two ball joints of one hinge a tenth of a
+    micrometre apart on one body from where they are on the other. The file opens, the report says how far the
+    closures stay open, and the indices move by about as much; a millimetre off is a file that does not close,
+    refused with the closure and the gap."""
+    plain, exact, rounded, wrong = (tmp_path / f"{name}.xml" for name in ("plain", "exact", "rounded", "wrong"))
+    plain.write_text(five_bar_mjcf())
+    exact.write_text(_hinges_as_site_pairs(0.05, slip=0.0))
+    rounded.write_text(_hinges_as_site_pairs(0.05, slip=1e-7))
+    _, report = read_mechanism_file(exact)
+    assert not any("at best" in note for note in report.notes), report.notes
+    _, report = read_mechanism_file(rounded)
+    assert any("at best" in note and "disagree" in note for note in report.notes), report.notes
+    expected = indices_at_pose(load(plain), np.array(HOME))
+    for path, tolerance in ((exact, TOLERANCE), (rounded, 1e-5)):
+        got = indices_at_pose(load(path), np.array(HOME))
+        np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=tolerance)
+        assert abs(got.lmti - expected.lmti) < tolerance
+    wrong.write_text(_hinges_as_site_pairs(0.05, slip=1e-3))
+    with pytest.raises(ValueError, match=r"cannot be closed.*closure 'connect_\d' still misses by"):
+        load(wrong)

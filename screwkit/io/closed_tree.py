@@ -23,6 +23,10 @@ __all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "ASSEMBLY_TO
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
+INCONSISTENCY_TOLERANCE = 1e-5
+"""Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
+redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
+exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
 
 
 class ImportError_(ValueError):
@@ -224,6 +228,10 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
     if np.max(np.abs(final)) >= ASSEMBLY_TOLERANCE:
         gaps = closure_gaps(tree, q)
         worst = max(gaps, key=gaps.get)
+        if np.max(np.abs(final)) < INCONSISTENCY_TOLERANCE:
+            tree.notes.append(f"the closures close to {gaps[worst]:.3g} m at best (closure {worst!r}): the file's "
+                              "numbers disagree by that much (redundant closures written rounded)")
+            return q, scale
         raise ImportError_(f"{tree.source}: the loops cannot be closed near the file's joint values: closure "
                            f"{worst!r} still misses by {gaps[worst]:.3g} m after assembly (gaps: "
                            + ", ".join(f"{k} {v:.3g} m" for k, v in gaps.items()) + ").")

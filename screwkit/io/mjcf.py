@@ -48,8 +48,8 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
         prepared.write_text(text, encoding="utf-8")
         try:
             model, _, _ = pin.buildModelAndConstraintsFromMJCF(str(prepared))
-        except (RuntimeError, ValueError) as error:
-            raise ImportError_(f"{source}: Pinocchio cannot read it ({error}).") from None
+        except Exception as error:  # noqa: BLE001 - Pinocchio's parser raises anything (IndexError, ...): one line
+            raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
     references = {item.key(): np.array(item.data()) for item in model.referenceConfigurations}
     qpos0 = np.asarray(references.get("qpos0", pin.neutral(model)), dtype=float)
     data = model.createData()

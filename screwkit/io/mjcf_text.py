@@ -10,7 +10,11 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
 * unnamed ``<connect>``/``<weld>`` elements are named (Pinocchio merges unnamed ones);
 * angles in degrees (``<compiler angle="degree">``, MuJoCo's default) become radians: hinge and ball joints'
   ``range``, ``ref`` and ``springref``, and every ``euler`` and ``axisangle`` (class defaults included);
-* ``meshdir``/``texturedir``/``assetdir`` are made absolute (the prepared file is read from elsewhere).
+* several top-level ``<default>``, ``<equality>``, ``<actuator>`` sections are merged (MuJoCo merges them;
+  Pinocchio reads the first);
+* what kinematics does not need and Pinocchio cannot always read is left out: geoms, assets, plugins,
+  cameras, lights, sensors, tendons, contacts (a mechanism's bodies, joints, sites, inertias and closures are
+  all that is read).
 
 :func:`closure_placements` then gives each equality the frames MuJoCo constrains, from the bodies and sites
 of the tree Pinocchio built: a ``weld`` with a ``relpose`` holds body2 at that pose in body1's frame (without
@@ -27,13 +31,18 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH"]
+__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError"]
 
 MAX_INCLUDE_DEPTH = 20
 """Deepest chain of ``<include>``s followed (a file including itself is refused before that)."""
 ANGLE_ATTRIBUTES = ("range", "ref", "springref")
 ORIENTED = ("body", "geom", "site", "frame", "camera", "light", "inertial")
-ASSET_DIRECTORIES = ("meshdir", "texturedir", "assetdir")
+NOT_KINEMATICS = ("geom", "asset", "plugin", "extension", "camera", "light", "sensor", "tendon", "contact", "visual")
+NUMBER_COUNTS = {"pos": (3,), "quat": (4,), "axis": (3,), "euler": (3,), "axisangle": (4,), "xyaxes": (6,),
+                 "zaxis": (3,), "anchor": (3,), "relpose": (7,), "range": (2,), "ref": (1,), "springref": (1,),
+                 "gear": (1, 2, 3, 4, 5, 6)}
+"""How many numbers each attribute that places a body, a joint or a closure holds (MuJoCo refuses the file
+otherwise; a reader that took the numbers it could would place the mechanism somewhere else)."""
 
 
 class MjcfError(ValueError):
@@ -136,6 +145,25 @@ def _to_radians(root: ElementTree.Element) -> int:
     return changed
 
 
+def _check_numbers(root: ElementTree.Element, path: Path) -> None:
+    """Every attribute of NUMBER_COUNTS holds that many numbers, or the file is refused naming the element."""
+    for element in root.iter():
+        for attribute, counts in NUMBER_COUNTS.items():
+            text = element.get(attribute)
+            if text is None or element.tag in ("compiler", "option", "size", "flag"):
+                continue
+            words = text.split()
+            try:
+                finite = all(math.isfinite(float(word)) for word in words)
+            except ValueError:
+                finite = False
+            if not finite or len(words) not in counts:
+                expected = " to ".join(str(c) for c in (counts[0], counts[-1]) if c) if len(counts) > 1 else counts[0]
+                name = f" name='{element.get('name')}'" if element.get("name") else ""
+                raise MjcfError(f"{path}: <{element.tag}{name}> {attribute}={text!r}: expected {expected} finite "
+                                "number(s).")
+
+
 def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     """The text of an MJCF file as Pinocchio should read it, what was changed, and its element tree."""
     path = Path(path)
@@ -149,10 +177,14 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     if compiler is None:
         compiler = ElementTree.Element("compiler")
         root.insert(0, compiler)
-    for attribute in ASSET_DIRECTORIES:
-        value = compiler.get(attribute)
-        if value is not None and not Path(value).is_absolute():
-            compiler.set(attribute, str((path.parent / value).resolve()))
+    for attribute in ("meshdir", "texturedir", "assetdir"):
+        compiler.attrib.pop(attribute, None)  # no mesh is read
+    _merged(root, "default")
+    for parent in list(root.iter()):
+        for child in list(parent):
+            if child.tag in NOT_KINEMATICS:
+                parent.remove(child)
+    _check_numbers(root, path)
     if compiler.get("angle", "degree") == "degree":
         count = _to_radians(root)
         if count:

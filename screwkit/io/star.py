@@ -87,8 +87,21 @@ def _output_frame(tree: ClosedTree) -> int:
     for candidate in OUTPUT_NAMES:
         if candidate in lowered:
             return lowered.index(candidate)
+    # no frame named as an output: the body where the most closures meet (where every leg ends), if one does
+    counts: dict[int, int] = {}
+    for closure in tree.closures:
+        for joint in {closure.joint_a, closure.joint_b} - {0}:
+            counts[joint] = counts.get(joint, 0) + 1
+    ranked = sorted(counts.items(), key=lambda item: -item[1])
+    if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]):
+        joint = ranked[0][0]
+        for index, frame in enumerate(model.frames):
+            if frame.parentJoint == joint and str(frame.type) == "BODY":
+                tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
+                                  "(name another with --output FRAME)")
+                return index
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
-                       f"no frame is called {', '.join(OUTPUT_NAMES)}.")
+                       f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
 
 
 def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
@@ -165,6 +178,54 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
                        "one point (a spherical joint).")
+
+
+def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
+                   report: ImportReport) -> list[_Leg]:
+    """One leg per closure onto the platform; two ball closures between the same two bodies (a hinge written as two
+    ball joints on its axis, as CAD exporters write it for MuJoCo) are one revolute loop about the line through
+    them, three or more not on one line one weld."""
+    groups: dict[tuple[int, int], list[Closure]] = {}
+    for closure in closures:
+        groups.setdefault(tuple(sorted((closure.joint_a, closure.joint_b))), []).append(closure)
+    legs = []
+    for group in groups.values():
+        balls = [c for c in group if c.kind == "3d"]
+        if len(group) == 1 or len(balls) != len(group):
+            legs += [_loop_of(tree, data, closure, platform, scale) for closure in group]
+            continue
+        first = _loop_of(tree, data, balls[0], platform, scale)
+        points = [_loop_of(tree, data, c, platform, scale).successor_world[:3, 3] for c in balls]
+        spread = np.array(points) - points[0]
+        rank = np.linalg.matrix_rank(spread, tol=1e-9 * scale) if len(points) > 1 else 0
+        names = ", ".join(repr(c.name) for c in balls)
+        if rank == 0:
+            legs.append(first)
+            continue
+        if rank >= 2:
+            first.loop, first.loop_dofs, first.axis = "fixed", [], None
+            report.notes.append(f"ball closures {names} join the same two bodies at points not on one line: a weld")
+            legs.append(first)
+            continue
+        axis = spread[np.argmax(np.linalg.norm(spread, axis=1))]
+        axis = axis / np.linalg.norm(axis)
+        centre = np.mean(points, axis=0)
+        frame = np.eye(4)
+        frame[:3, :3] = _frame_with_z(axis)
+        frame[:3, 3] = centre
+        leg_end = homogeneous(data.oMi[first.source.joint_a])
+        legs.append(_Leg(first.joints, "revolute", inverse(leg_end) @ frame, frame, np.array([0.0, 0.0, 1.0]),
+                         [("revolute", axis, centre)], first.closure, source=first.source))
+        report.notes.append(f"ball closures {names} join the same two bodies on one line: the hinge through them")
+    return legs
+
+
+def _frame_with_z(axis: NDArray) -> NDArray:
+    """A rotation whose third column is ``axis`` (unit)."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    first = np.cross(helper, axis)
+    first /= np.linalg.norm(first)
+    return np.column_stack([first, np.cross(axis, first), axis])
 
 
 def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
@@ -303,7 +364,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
-    report = ImportReport(source=tree.source, file_format=tree.file_format, notes=list(tree.notes))
+    report = ImportReport(source=tree.source, file_format=tree.file_format)
     report.gaps_before = closure_gaps(tree, tree.q_reference)
     q, scale = assemble(tree)
     report.gaps_after = closure_gaps(tree, q)
@@ -314,6 +375,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
     frame_index = _output_frame(tree)
+    report.notes[:0] = tree.notes  # what reading, assembling and finding the platform said, before the rest
     output_frame = model.frames[frame_index]
     platform = int(output_frame.parentJoint)
     if platform == 0:
@@ -325,7 +387,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     onto_platform = [platform in path_to(model, c.joint_a) or platform in path_to(model, c.joint_b)
                      for c in tree.closures]
     couplings = [c for c, onto in zip(tree.closures, onto_platform) if not onto]
-    legs = [spine] + [_loop_of(tree, data, c, platform, scale) for c, onto in zip(tree.closures, onto_platform) if onto]
+    legs = [spine] + _platform_legs(tree, data, [c for c, onto in zip(tree.closures, onto_platform) if onto],
+                                    platform, scale, report)
     owner: dict[int, str] = {}
     for leg in legs:
         if not leg.joints:
