@@ -172,3 +172,17 @@ def test_every_subpackage_is_installed_by_a_plain_pip_install():
     listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
     found = {module_name(path.parent) for path in PACKAGE.rglob("__init__.py")}
     assert found <= listed, f"not in pyproject.toml's packages: {sorted(found - listed)}"
+
+
+def test_indices_are_built_by_one_constructor():
+    """``Indices.from_arrays`` is the one constructor: no module but the result type's own calls ``Indices(...)``
+    (where F_IOj is Eq. 14 of F_Oj and the ITI, the submechanisms every n-subset, shapes checked, derived indices
+    computed), so no producer of results can skip one of those."""
+    direct = []
+    for module, path in MODULES.items():
+        if module == "screwkit.indices.results":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "Indices":
+                direct.append(f"{module}:{node.lineno}")
+    assert not direct, "Indices(...) called directly (use Indices.from_arrays):\n" + "\n".join(direct)

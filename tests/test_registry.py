@@ -84,3 +84,26 @@ def _kept(count: int, faults: int):
     from itertools import combinations
 
     return list(combinations(range(count), count - faults))
+
+
+def test_indices_from_arrays_fills_eq_14_and_refuses_what_is_not_a_field():
+    """The constructor: F_IOj = min(F_Oj, ITI) (Eq. 14) and every n-subset when not given; a misspelt field, a
+    per-configuration field given as a keyword, a missing index or a batch of another shape is refused by name."""
+    from screwkit.indices.results import Indices
+
+    iti, f_o = np.array([0.2, 0.9, 0.5]), np.array([0.4, 0.3, np.nan])
+    arrays = {"iti": iti, "lmti": np.array([0.8, 0.7, 0.6]), "f_o": {1: f_o},
+              "worst_fault_indices": {1: np.zeros((3, 1), dtype=np.int64)},
+              "mutual_interference": np.zeros((3, 3), dtype=bool)}
+    result = Indices.from_arrays(("a:1", "b:1", "c:1"), 2, arrays, threshold=1e-3)
+    np.testing.assert_array_equal(result.f_io[1], [0.2, 0.3, np.nan])
+    assert result.submechanisms == ((0, 1), (0, 2), (1, 2)) and result.batch_shape == (3,)
+    with pytest.raises(TypeError, match="not fields of Indices: lmit"):
+        Indices.from_arrays(("a:1", "b:1", "c:1"), 2, {**arrays, "lmit": arrays["lmti"]}, threshold=1e-3)
+    with pytest.raises(TypeError, match="belong in arrays: cti"):
+        Indices.from_arrays(("a:1", "b:1", "c:1"), 2, arrays, threshold=1e-3, cti=iti)
+    with pytest.raises(TypeError, match="missing lmti"):
+        Indices.from_arrays(("a:1", "b:1", "c:1"), 2, {k: v for k, v in arrays.items() if k != "lmti"},
+                            threshold=1e-3)
+    with pytest.raises(ValueError, match=r"f_o\[1\] has shape \(2,\), not a batch of shape \(3,\)"):
+        Indices.from_arrays(("a:1", "b:1", "c:1"), 2, {**arrays, "f_o": {1: f_o[:2]}}, threshold=1e-3)

@@ -42,7 +42,7 @@ from screwkit.common.chunks import map_chunks
 from screwkit.common.validation import as_float_array, check_finite
 from screwkit.indices.faults import FAULT_TYPES, link_fault_indices
 from screwkit.indices.registry import INDICES
-from screwkit.indices.results import Indices, with_derived
+from screwkit.indices.results import Indices
 from screwkit.indices.sets import fault_sets, submechanisms_left
 from screwkit.indices.stages import (
     ChunkSpaces,
@@ -299,37 +299,25 @@ def analyze(
         f_o, worst = link["f_o"], link["worst"]
         remaining = link["lmti"] if detail else {}
         f_c = link["f_c"] if constraint_plan.count else f_c
-    result = Indices(
-        actuators=names,
-        dof=plan.dof,
-        submechanisms=tuple(tuple(int(i) for i in sub) for sub in plan.submechanisms),
-        iti=batch_first(merged["iti"]),
-        lmti=batch_first(merged["lmti"]),
-        f_o=f_o,
-        f_io={j: np.minimum(f_o[j], batch_first(merged["iti"])) for j in f_o},
-        worst_fault_indices=worst,
-        mutual_interference=batch_first(merged["mutual_interference"]),
-        threshold=plan.threshold,
-        iti_actuators=batch_first(merged["iti_actuators"]) if detail else None,
-        oti_actuators=batch_first(merged["oti_actuators"]) if detail else None,
-        oti_submechanisms=batch_first(merged["oti_submechanisms"]) if detail else None,
-        actuation_wrenches=batch_first(merged["actuation_wrenches"]) if detail else None,
-        output_twists=batch_first(merged["output_twists"]) if detail and keep_twists else None,
-        cti=batch_first(merged["cti"]) if constraint_plan.count else not_applicable,
-        f_c=f_c,
-        cti_submechanisms=batch_first(merged["cti_submechanisms"]) if constraint_plan.count and detail else None,
-        constraint_count=constraint_plan.count if idle is None else 0,
+    arrays = {"iti": batch_first(merged["iti"]), "lmti": batch_first(merged["lmti"]), "f_o": f_o,
+              "worst_fault_indices": worst, "mutual_interference": batch_first(merged["mutual_interference"]),
+              "f_c": f_c, "remaining_lmti": remaining,
+              "cti": batch_first(merged["cti"]) if constraint_plan.count else not_applicable}
+    if detail:
+        arrays.update({name: batch_first(merged[name]) for name in
+                       ("iti_actuators", "oti_actuators", "oti_submechanisms", "actuation_wrenches")})
+        if keep_twists:
+            arrays["output_twists"] = batch_first(merged["output_twists"])
+    if constraint_plan.count:
+        arrays.update({name: batch_first(merged[name]) for name in ("instantaneous_dof", "constraint_singular")})
+        if detail:
+            arrays["cti_submechanisms"] = batch_first(merged["cti_submechanisms"])
+    result = Indices.from_arrays(
+        names, plan.dof, arrays, threshold=plan.threshold, submechanisms=plan.submechanisms, derive=derived,
+        constraint_count=constraint_plan.count if idle is None else 0, fault_type=fault_type,
         cti_reason=(constraint_plan.reason if idle is None
-                    else "the output is a point: the CTI is defined for a frame output, whose every wrench acts on it"),
-        instantaneous_dof=batch_first(merged["instantaneous_dof"]) if constraint_plan.count else None,
-        constraint_singular=batch_first(merged["constraint_singular"]) if constraint_plan.count else None,
-        fault_type=fault_type,
-        remaining_lmti=remaining,
-    )
-    if not derived:
-        return result
-    result = with_derived(result)
-    if requested_detail:
+                    else "the output is a point: the CTI is defined for a frame output, whose every wrench acts on it"))
+    if not derived or requested_detail:
         return result
     return replace(result, iti_actuators=None, oti_actuators=None, oti_submechanisms=None, actuation_wrenches=None,
                    output_twists=None, cti_submechanisms=None, remaining_lmti={})

@@ -11,9 +11,9 @@ Only numpy is imported here (xarray when :meth:`Indices.to_dataset` is called).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from itertools import combinations
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +29,8 @@ PER_CONFIGURATION = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti
 """Fields of :class:`Indices` with one entry per configuration (leading batch axes)."""
 PER_CONFIGURATION_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "joint_values", "derived")
 """Fields of :class:`Indices` that map ``j`` to one entry per configuration."""
+REQUIRED = ("iti", "lmti", "f_o", "worst_fault_indices", "mutual_interference")
+"""The per-configuration fields :meth:`Indices.from_arrays` cannot do without."""
 
 
 def _scalar_or_array(value):
@@ -161,25 +163,28 @@ class Indices:
     batch_shape: tuple[int, ...] = field(init=False)
 
     def __post_init__(self):
-        shape = np.shape(self.iti)
-        object.__setattr__(self, "batch_shape", tuple(shape))
-        object.__setattr__(self, "actuators", tuple(str(name) for name in self.actuators))
-        object.__setattr__(self, "iti", _scalar_or_array(self.iti))
-        object.__setattr__(self, "lmti", _scalar_or_array(self.lmti))
-        object.__setattr__(self, "f_o", {int(j): _scalar_or_array(v) for j, v in self.f_o.items()})
-        object.__setattr__(self, "f_io", {int(j): _scalar_or_array(v) for j, v in self.f_io.items()})
-        object.__setattr__(self, "f_c", {int(j): _scalar_or_array(v) for j, v in self.f_c.items()})
-        if self.cti is not None:
-            object.__setattr__(self, "cti", _scalar_or_array(self.cti))
-        if self.instantaneous_dof is not None:
-            dofs = np.asarray(self.instantaneous_dof)
-            object.__setattr__(self, "instantaneous_dof", int(dofs) if dofs.ndim == 0 else dofs)
-        if self.constraint_singular is not None:
-            flags = np.asarray(self.constraint_singular, dtype=bool)
-            object.__setattr__(self, "constraint_singular", bool(flags) if flags.ndim == 0 else flags)
-        reachable = np.ones(shape, dtype=bool) if self.reachable is None else np.asarray(self.reachable, dtype=bool)
-        object.__setattr__(self, "reachable", bool(reachable) if reachable.ndim == 0 else reachable)
-        object.__setattr__(self, "threshold", float(self.threshold))
+        _normalise(self)
+
+    @classmethod
+    def from_arrays(cls, actuators: Sequence[str], dof: int, arrays: Mapping[str, Any], *, threshold: float,
+                    submechanisms: Sequence[Sequence[int]] | None = None, derive: bool = True,
+                    **about: Any) -> Indices:
+        """The constructor: the per-configuration ``arrays`` by field name (:data:`PER_CONFIGURATION` and
+        :data:`PER_CONFIGURATION_DICTS`; ``iti``, ``lmti``, ``f_o``, ``worst_fault_indices`` and
+        ``mutual_interference`` are required) and the fields that describe them (``about``: ``mechanism``,
+        ``task_coordinates``, ``fault_type``...).
+
+        ``f_io`` is Eq. 14 (``min(F_Oj, ITI)``) unless given; ``submechanisms`` are every ``n``-subset of the
+        actuators unless given; every registered derived index is computed unless ``derive`` is False. Every
+        array's leading shape is checked against ``iti``'s, and a name that is not a field is refused.
+        """
+        values = _checked_arrays(arrays, about, {f.name for f in fields(cls) if f.init})
+        if submechanisms is None:
+            submechanisms = combinations(range(len(actuators)), dof)
+        result = cls(actuators=tuple(actuators), dof=int(dof),
+                     submechanisms=tuple(tuple(int(i) for i in members) for members in submechanisms),
+                     threshold=threshold, **values, **about)
+        return with_derived(result) if derive else result
 
     # -- derived views ------------------------------------------------------------------
 
@@ -251,17 +256,9 @@ class Indices:
     def lmti_of(self, actuator_set: Sequence[int | str]) -> Any:
         """LMTI of a set of actuators (Eq. 11): the best OTI of its ``n``-subsets.
 
-        Zero for a set of fewer than ``n`` actuators: they cannot hold the platform (no
-        submechanism, as the paper's LMTI of a mechanism that is not fully constrained).
-
-        Parameters
-        ----------
-        actuator_set : sequence of int or str
-            Actuators by index into :attr:`actuators` or by name.
-
-        Returns
-        -------
-        float or ndarray (...)
+        ``actuator_set``: actuators by index into :attr:`actuators` or by name. Zero for a set of fewer than ``n``
+        actuators: they cannot hold the platform (no submechanism, as the paper's LMTI of a mechanism that is not
+        fully constrained). A float for one configuration, an array (...) for a batch.
         """
         if self.oti_submechanisms is None:
             raise ValueError("These indices were computed without detail; recompute with detail=True for lmti_of.")
@@ -337,6 +334,54 @@ class Indices:
             coordinates along the batch dimensions (m, deg).
         """
         return indices_to_dataset(self, dims, coords)
+
+
+def _normalise(result: Indices) -> None:
+    """Scalars of one configuration as Python numbers, names as str, ``reachable`` filled (frozen: set in place)."""
+    shape = np.shape(result.iti)
+    object.__setattr__(result, "batch_shape", tuple(shape))
+    object.__setattr__(result, "actuators", tuple(str(name) for name in result.actuators))
+    object.__setattr__(result, "iti", _scalar_or_array(result.iti))
+    object.__setattr__(result, "lmti", _scalar_or_array(result.lmti))
+    object.__setattr__(result, "f_o", {int(j): _scalar_or_array(v) for j, v in result.f_o.items()})
+    object.__setattr__(result, "f_io", {int(j): _scalar_or_array(v) for j, v in result.f_io.items()})
+    object.__setattr__(result, "f_c", {int(j): _scalar_or_array(v) for j, v in result.f_c.items()})
+    if result.cti is not None:
+        object.__setattr__(result, "cti", _scalar_or_array(result.cti))
+    if result.instantaneous_dof is not None:
+        dofs = np.asarray(result.instantaneous_dof)
+        object.__setattr__(result, "instantaneous_dof", int(dofs) if dofs.ndim == 0 else dofs)
+    if result.constraint_singular is not None:
+        flags = np.asarray(result.constraint_singular, dtype=bool)
+        object.__setattr__(result, "constraint_singular", bool(flags) if flags.ndim == 0 else flags)
+    reachable = np.ones(shape, dtype=bool) if result.reachable is None else np.asarray(result.reachable, dtype=bool)
+    object.__setattr__(result, "reachable", bool(reachable) if reachable.ndim == 0 else reachable)
+    object.__setattr__(result, "threshold", float(result.threshold))
+
+
+def _checked_arrays(arrays: Mapping[str, Any], about: Mapping[str, Any], known: set[str]) -> dict[str, Any]:
+    """The arrays of :meth:`Indices.from_arrays`, checked (names, required fields, batch shapes), with F_IOj."""
+    per_configuration = set(PER_CONFIGURATION) | set(PER_CONFIGURATION_DICTS)
+    unknown = sorted(set(arrays) - per_configuration) + sorted(set(about) - known)
+    if unknown:
+        raise TypeError(f"Indices.from_arrays: not fields of Indices: {', '.join(unknown)}")
+    misplaced = sorted(set(about) & per_configuration)
+    if misplaced:
+        raise TypeError(f"Indices.from_arrays: per-configuration fields belong in arrays: {', '.join(misplaced)}")
+    missing = [name for name in REQUIRED if arrays.get(name) is None]
+    if missing:
+        raise TypeError(f"Indices.from_arrays: missing {', '.join(missing)}")
+    batch = np.shape(arrays["iti"])
+    for name, value in arrays.items():
+        for key, entry in (value.items() if isinstance(value, dict) else [(None, value)]):
+            if entry is not None and np.shape(entry)[:len(batch)] != batch:
+                where = name if key is None else f"{name}[{key}]"
+                raise ValueError(f"Indices.from_arrays: {where} has shape {np.shape(entry)}, not a batch of "
+                                 f"shape {batch} (the shape of iti)")
+    values = {name: value for name, value in arrays.items() if value is not None}
+    if "f_io" not in values:
+        values["f_io"] = {j: np.minimum(f_o, arrays["iti"]) for j, f_o in arrays["f_o"].items()}
+    return values
 
 
 def with_derived(result: Indices) -> Indices:

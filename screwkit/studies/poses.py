@@ -10,7 +10,6 @@ and returns one :class:`~screwkit.indices.results.Indices` with NaN where a pose
 from __future__ import annotations
 
 from dataclasses import replace
-from itertools import combinations
 from math import comb
 from typing import Callable
 
@@ -22,7 +21,7 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
-from screwkit.indices.results import Indices, with_derived
+from screwkit.indices.results import Indices
 from screwkit.model import Mechanism, require_mechanism
 
 __all__ = ["indices_at_poses", "indices_at_pose", "analyze_solution", "output_points", "planar_points",
@@ -119,13 +118,14 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
         dof = 3
     else:
         closed, dof = planar_indices(base, elbows, distal, threshold=threshold, faults=faults, threads=threads), 3
-    return with_derived(Indices(
-        actuators=mechanism.actuator_names, dof=dof, submechanisms=closed["submechanisms"], iti=closed["iti"],
-        lmti=closed["lmti"], f_o=closed["f_o"], f_io=closed["f_io"], worst_fault_indices=closed["worst_faults"],
-        mutual_interference=closed["mutual_interference"], threshold=threshold,
-        iti_actuators=closed["iti_chains"], oti_submechanisms=closed["oti_submechanisms"],
-        remaining_lmti=closed["remaining_lmti"], task_coordinates=mechanism.task_coordinates,
-        mechanism=mechanism.name))
+    return Indices.from_arrays(
+        mechanism.actuator_names, dof,
+        {"iti": closed["iti"], "lmti": closed["lmti"], "f_o": closed["f_o"], "f_io": closed["f_io"],
+         "worst_fault_indices": closed["worst_faults"], "mutual_interference": closed["mutual_interference"],
+         "iti_actuators": closed["iti_chains"], "oti_submechanisms": closed["oti_submechanisms"],
+         "remaining_lmti": closed["remaining_lmti"]},
+        threshold=threshold, submechanisms=closed["submechanisms"], task_coordinates=mechanism.task_coordinates,
+        mechanism=mechanism.name)
 
 
 _ARRAYS = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms",
@@ -281,27 +281,29 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
         dof = mechanism.dof
         faults_list = tuple(range(1, max(a - dof, 1) + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
         nothing = np.full(batch, np.nan)
-        return Indices(actuators=mechanism.actuator_names, dof=dof,
-                       submechanisms=tuple(combinations(range(a), dof)), iti=nothing, lmti=nothing.copy(),
-                       f_o={j: nothing.copy() for j in faults_list}, f_io={j: nothing.copy() for j in faults_list},
-                       worst_fault_indices={j: np.full(batch + (j,), -1, dtype=np.int64) for j in faults_list},
-                       mutual_interference=np.zeros(batch + (a,), dtype=bool), threshold=threshold,
-                       iti_actuators=np.full(batch + (a,), np.nan) if detail else None,
-                       poses=poses, reachable=reachable.reshape(batch), task_coordinates=mechanism.task_coordinates,
-                       mechanism=mechanism.name, chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
-                       full_poses=full_poses.reshape(batch + (mechanism.n_pose,)),
-                       pose_coordinates=mechanism.pose_coordinates)
+        return Indices.from_arrays(
+            mechanism.actuator_names, dof,
+            {"iti": nothing, "lmti": nothing.copy(), "f_o": {j: nothing.copy() for j in faults_list},
+             "worst_fault_indices": {j: np.full(batch + (j,), -1, dtype=np.int64) for j in faults_list},
+             "mutual_interference": np.zeros(batch + (a,), dtype=bool),
+             "iti_actuators": np.full(batch + (a,), np.nan) if detail else None, "poses": poses,
+             "reachable": reachable.reshape(batch),
+             "chain_status": chain_status.reshape(batch + chain_status.shape[-1:]),
+             "full_poses": full_poses.reshape(batch + (mechanism.n_pose,))},
+            threshold=threshold, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
+            pose_coordinates=mechanism.pose_coordinates, derive=False)
     fields = {name: shaped(name) for name in _ARRAYS}
     fields.update({name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS})
     if not meta.constraint_count:
         fields.update(not_applicable)
-    return Indices(
-        actuators=mechanism.actuator_names, dof=meta.dof, submechanisms=meta.submechanisms, **fields,
-        threshold=threshold, poses=poses, reachable=reachable.reshape(batch),
+    fields.update(poses=poses, reachable=reachable.reshape(batch),
+                  chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
+                  full_poses=full_poses.reshape(batch + (mechanism.n_pose,)))
+    return Indices.from_arrays(
+        mechanism.actuator_names, meta.dof, fields, threshold=threshold, submechanisms=meta.submechanisms,
         task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
-        chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
-        full_poses=full_poses.reshape(batch + (mechanism.n_pose,)), pose_coordinates=mechanism.pose_coordinates,
-        constraint_count=meta.constraint_count, fault_type=meta.fault_type, cti_reason=meta.cti_reason)
+        pose_coordinates=mechanism.pose_coordinates, constraint_count=meta.constraint_count,
+        fault_type=meta.fault_type, cti_reason=meta.cti_reason, derive=False)
 
 
 def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float = SINGULARITY_THRESHOLD,
