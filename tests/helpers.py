@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
@@ -206,3 +207,46 @@ def platform_twist(mechanism, pose_minus, pose_plus, step):
     velocity_point = (p1 - p0) / (2 * step)
     middle = (p0 + p1) / 2
     return np.concatenate([omega, velocity_point - np.cross(omega, middle)])
+
+
+INDEX_FIELDS = ("iti", "iti_actuators", "oti_actuators", "oti_submechanisms", "lmti", "cti", "cti_submechanisms")
+"""Per-configuration index arrays of :class:`screwkit.Indices` compared by :func:`assert_indices_close`."""
+FAULT_FIELDS = ("f_o", "f_io", "f_c")
+EXACT_FIELDS = ("reachable", "mutual_interference", "instantaneous_dof", "constraint_singular")
+
+
+def assert_indices_close(reference, other, atol: float = 1e-12, *, fields=INDEX_FIELDS, worst_faults: bool = True,
+                         full_poses_atol: float | None = None) -> None:
+    """Two :class:`screwkit.Indices` hold the same indices: every index array of ``fields`` that ``reference``
+    has (``other`` has it too, or both lack it) to ``atol`` (absolute: the indices are in [0, 1]), every F_Oj,
+    F_IOj and F_Cj for the same ``j``, NaN where the other is NaN; the reachability, mutual-interference and
+    constraint-singularity flags exactly; the worst faults exactly unless ``worst_faults`` is False (ties
+    broken by another order); the full poses to ``full_poses_atol`` when given."""
+    for name in fields:
+        expected, found = getattr(reference, name), getattr(other, name)
+        assert (expected is None) == (found is None), f"{name}: {expected is None=} but {found is None=}"
+        if expected is not None:
+            np.testing.assert_allclose(found, expected, rtol=0, atol=atol, err_msg=name)
+    for name in FAULT_FIELDS:
+        expected, found = getattr(reference, name), getattr(other, name)
+        assert found.keys() == expected.keys(), (name, found.keys(), expected.keys())
+        for j in expected:
+            np.testing.assert_allclose(found[j], expected[j], rtol=0, atol=atol, err_msg=f"{name}{j}")
+    for name in EXACT_FIELDS:
+        expected, found = getattr(reference, name), getattr(other, name)
+        if expected is not None:
+            np.testing.assert_array_equal(found, expected, err_msg=name)
+    if worst_faults:
+        assert other.worst_fault_indices.keys() == reference.worst_fault_indices.keys()
+        for j, expected in reference.worst_fault_indices.items():
+            np.testing.assert_array_equal(other.worst_fault_indices[j], expected, err_msg=f"worst faults, j={j}")
+    if full_poses_atol is not None:
+        np.testing.assert_allclose(other.full_poses, reference.full_poses, rtol=0, atol=full_poses_atol)
+
+
+@functools.lru_cache(maxsize=None)
+def bundled(name: str):
+    """A bundled mechanism, loaded once per test process (mechanisms are not changed by the tests)."""
+    from screwkit.io.loader import load
+
+    return load(name)

@@ -21,15 +21,13 @@ from __future__ import annotations
 
 import json
 import math
-from functools import lru_cache
 from itertools import combinations
 
 import numpy as np
 import pytest
 
-from helpers import platform_twist, screwkit
+from helpers import bundled, platform_twist, screwkit
 from screwkit.closure import actuator_values, chain_screws, forward, solve
-from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.poses import analyze_solution
 
@@ -37,9 +35,7 @@ TOLERANCE = 1e-9
 Z = np.array([0.0, 0.0, 1.0])
 
 
-@lru_cache(maxsize=None)
-def mechanism(name: str):
-    return load(name)
+mechanism = bundled  # one load per test process
 
 
 def unit(vector):

@@ -22,7 +22,7 @@ import functools
 import numpy as np
 import pytest
 
-from helpers import bundled_chain_screws, random_rotation
+from helpers import assert_indices_close, bundled_chain_screws, random_rotation
 from screwkit.indices.analysis import analyze
 from screwkit.screw import algebra as screws
 from screwkit.screw.chain_screws import ChainScrews
@@ -255,16 +255,7 @@ def moved(chains, rotation, translation):
 
 def assert_same_indices(reference, other):
     """Every index to TOLERANCE, the worst faults and the mutual-interference flags exactly."""
-    np.testing.assert_allclose(other.iti_actuators, reference.iti_actuators, rtol=0, atol=TOLERANCE)
-    np.testing.assert_allclose(other.iti, reference.iti, rtol=0, atol=TOLERANCE)
-    np.testing.assert_allclose(other.oti_submechanisms, reference.oti_submechanisms, rtol=0, atol=TOLERANCE)
-    np.testing.assert_allclose(other.lmti, reference.lmti, rtol=0, atol=TOLERANCE)
-    assert other.f_o.keys() == reference.f_o.keys()
-    for j in reference.f_o:
-        np.testing.assert_allclose(other.f_o[j], reference.f_o[j], rtol=0, atol=TOLERANCE)
-        np.testing.assert_allclose(other.f_io[j], reference.f_io[j], rtol=0, atol=TOLERANCE)
-        np.testing.assert_array_equal(other.worst_fault_indices[j], reference.worst_fault_indices[j])
-    np.testing.assert_array_equal(other.mutual_interference, reference.mutual_interference)
+    assert_indices_close(reference, other, TOLERANCE, fields=("iti_actuators", "iti", "oti_submechanisms", "lmti"))
 
 
 def assert_wrenches_follow(reference, other, scale, rotation=None, translation=None):

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 
-from helpers import random_rotation, screwkit
+from helpers import assert_indices_close, random_rotation, screwkit
 from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble, joint_kind
 from screwkit.io.loader import bundled_path, load
@@ -210,8 +210,7 @@ def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_fo
     _, report = read_mechanism_file(renamed)
     assert any("platform inferred: body 'distal_1', where 2 closures meet" in note for note in report.notes), report
     expected, got = (indices_at_pose(load(path), np.array(HOME)) for path in (plain, renamed))
-    np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=TOLERANCE)
-    np.testing.assert_allclose([got.lmti, got.f_o[1]], [expected.lmti, expected.f_o[1]], atol=TOLERANCE)
+    assert_indices_close(expected, got, TOLERANCE)
     tie = tmp_path / "tie.xml"
     tie.write_text(five_bar_mjcf(legs=2).replace('name="effector"', 'name="marker"'))
     with pytest.raises(ValueError, match="which body is the platform.*--output FRAME"):
@@ -406,9 +405,7 @@ def test_a_hinge_written_as_two_ball_closures_on_its_axis_is_one_revolute_loop(t
     _, report = read_mechanism_file(doubled)
     assert sum("on one line: the hinge through them" in note for note in report.notes) == 2, report.notes
     expected, got = (indices_at_poses(load(path), poses_near_home() * scale, detail=True) for path in (plain, doubled))
-    np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=TOLERANCE)
-    np.testing.assert_allclose(got.lmti, expected.lmti, atol=TOLERANCE)
-    np.testing.assert_allclose(got.f_o[1], expected.f_o[1], atol=TOLERANCE)
+    assert_indices_close(expected, got, TOLERANCE)
 
 
 def _hinges_as_site_pairs(half_length: float, slip: float) -> str:

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from helpers import bundled
 from screwkit.closure import (
     actuator_values,
     chain_screws,
@@ -44,7 +45,7 @@ CLOSED_FORM_CASES = {
 
 @lru_cache(maxsize=None)
 def mechanism(name: str):
-    return load(name) if name != "random_loops" else random_loops_mechanism()
+    return bundled(name) if name != "random_loops" else random_loops_mechanism()
 
 
 LOOP_KINDS = (("universal", 4), ("prismatic", 5), ("spherical", 3), ("revolute", 5), ("fixed", 6))

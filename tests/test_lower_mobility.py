@@ -24,13 +24,12 @@ from __future__ import annotations
 import json
 import math
 import re
-from functools import lru_cache
 from itertools import combinations
 
 import numpy as np
 import pytest
 
-from helpers import in_millimetres, moved_in_the_world, screwkit
+from helpers import assert_indices_close, bundled, in_millimetres, moved_in_the_world, screwkit
 from screwkit.closure import solve_one
 from screwkit.io.loader import bundled_path, load, load_text
 from screwkit.studies.poses import indices_at_poses
@@ -39,9 +38,7 @@ TOLERANCE = 1e-9
 Z = np.array([0.0, 0.0, 1.0])
 
 
-@lru_cache(maxsize=None)
-def mechanism(name: str):
-    return load(name)
+mechanism = bundled  # one load per test process
 
 
 # ---------------------------------------------------------------------------------------------
@@ -535,19 +532,8 @@ def test_planar_disc_map_of_a_point_output(tmp_path):
 
 
 def assert_same_indices(reference, other):
-    np.testing.assert_array_equal(other.reachable, reference.reachable)
-    np.testing.assert_allclose(other.full_poses, reference.full_poses, rtol=0, atol=1e-9)
-    for key in ("iti", "iti_actuators", "oti_submechanisms", "lmti", "cti", "cti_submechanisms"):
-        if getattr(reference, key) is None:
-            assert getattr(other, key) is None, key
-            continue
-        np.testing.assert_allclose(getattr(other, key), getattr(reference, key), rtol=0, atol=TOLERANCE, err_msg=key)
-    for key in ("f_o", "f_io", "f_c"):
-        assert getattr(other, key).keys() == getattr(reference, key).keys()
-        for j, value in getattr(reference, key).items():
-            np.testing.assert_allclose(getattr(other, key)[j], value, rtol=0, atol=TOLERANCE, err_msg=f"{key}{j}")
-    for j, value in reference.worst_fault_indices.items():
-        np.testing.assert_array_equal(other.worst_fault_indices[j], value)
+    fields = ("iti", "iti_actuators", "oti_submechanisms", "lmti", "cti", "cti_submechanisms")
+    assert_indices_close(reference, other, TOLERANCE, fields=fields, full_poses_atol=1e-9)
 
 
 @pytest.mark.parametrize("name", NEW_MECHANISMS)

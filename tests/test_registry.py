@@ -107,3 +107,19 @@ def test_indices_from_arrays_fills_eq_14_and_refuses_what_is_not_a_field():
                             threshold=1e-3)
     with pytest.raises(ValueError, match=r"f_o\[1\] has shape \(2,\), not a batch of shape \(3,\)"):
         Indices.from_arrays(("a:1", "b:1", "c:1"), 2, {**arrays, "f_o": {1: f_o[:2]}}, threshold=1e-3)
+
+
+def test_assert_indices_close_fails_on_any_index_that_differs():
+    """The shared comparison of the tests can fail: an F_O1, an ITI, a worst fault or a flag off is found."""
+    from dataclasses import replace
+
+    from helpers import assert_indices_close
+
+    result = indices_at_pose(load("planar_5rrr"), load("planar_5rrr").home_pose)
+    assert_indices_close(result, result)
+    for change in ({"f_o": {1: result.f_o[1] + 1e-9}}, {"iti_actuators": result.iti_actuators + 1e-9},
+                   {"worst_fault_indices": {1: (result.worst_fault_indices[1] + 1) % 4}},
+                   {"mutual_interference": ~np.asarray(result.mutual_interference)},
+                   {"oti_submechanisms": None}):
+        with pytest.raises(AssertionError):
+            assert_indices_close(result, replace(result, **change))

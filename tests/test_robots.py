@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 import re
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import bundled, screwkit
 from screwkit.closure import chain_screws, solve, solve_one
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import bundled_names, bundled_path, load
@@ -21,9 +20,7 @@ BUNDLED = ("coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "pla
            "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6")
 
 
-@lru_cache(maxsize=None)
-def mechanism(name: str):
-    return load(name)
+mechanism = bundled  # one load per test process
 
 
 def bundled_text(name: str) -> str:
