@@ -18,7 +18,7 @@ import pytest
 from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 
 from helpers import assert_indices_close, random_rotation, screwkit
-from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
+from screwkit.io import ImportError_, LegWithLoops, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble, joint_kind
 from screwkit.io.loader import bundled_path, load
 from screwkit.studies.poses import indices_at_pose, indices_at_poses
@@ -369,7 +369,8 @@ def test_a_ball_joint_inside_a_leg_is_refused_by_name(tmp_path):
     assert 'name="b_2" type="ball"' in text
     path = tmp_path / "ball.xml"
     path.write_text(text)
-    with pytest.raises(ImportError_, match=r"joint 'b_2' \(spherical\) inside a leg: write it as 1-DoF joints"):
+    with pytest.raises(LegWithLoops, match=r"joint 'b_2' \(spherical\) inside a leg: not a serial chain of 1-DoF "
+                       r"joints; `screwkit analyze FILE`.*analyses it as a graph"):
         read_mechanism_file(path)
 
 

@@ -100,3 +100,14 @@ def command_options(name: str) -> set[str]:
 
     command = app.get_command(click.Context(app), name)
     return {option for parameter in command.params for option in getattr(parameter, "opts", ())}
+
+
+def test_a_mechanism_whose_legs_have_loops_inside_reports_valid_json(tmp_path):
+    """A Delta of ball-jointed rods (a graph, at the file's configuration): its report follows the schema."""
+    from delta_rods import delta_rods_mjcf
+
+    path = tmp_path / "delta_rods.xml"
+    path.write_text(delta_rods_mjcf())
+    report = validate("analyze", [path])
+    assert report["dof"] == 3 and report["pose"] == {} and len(report["actuators"]) == 4
+    assert any("graph" in line for line in report["converted"])

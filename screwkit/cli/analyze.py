@@ -21,6 +21,7 @@ from screwkit.cli.options import (
 )
 from screwkit.closure import forward
 from screwkit.indices.registry import INDICES
+from screwkit.io import GraphMechanism
 from screwkit.studies import indices_at_pose
 
 __all__ = ["analyze", "print_report"]
@@ -48,7 +49,7 @@ def _limiting(detail: dict) -> str:
 
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
-    pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
+    pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items()) or "the file's configuration"
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
     click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators, {report['dof']} DOF "
                f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}")
@@ -155,7 +156,10 @@ def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type:
             as_json: bool) -> None:
     """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose."""
 
-    loaded = load_mechanism(mechanism, length_unit)
+    loaded = load_mechanism(mechanism, length_unit, graphs=True)
+    if isinstance(loaded, GraphMechanism):
+        return _analyze_graph(loaded, pose is not None or actuator_values is not None, threshold, fault_type,
+                              as_json)
     target = parse_pose(loaded, pose)
     if actuator_values is not None:
         target = pose_from_actuators(loaded, actuator_values, target)
@@ -174,3 +178,20 @@ def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type:
         print_report(report)
         for line in loaded.import_report[:1]:
             click.echo(f"(converted from {line})", err=True)
+
+
+def _analyze_graph(graph: GraphMechanism, posed: bool, threshold: float, fault_type: str, as_json: bool) -> None:
+    """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration."""
+    if posed:
+        raise fail(f"{graph.tree.source}: its legs have loops inside them, analysed at the file's configuration only "
+                   "(poses of such legs are not solved yet): leave out --pose and --actuators.")
+    try:
+        result = graph.indices(threshold=threshold, fault_type=fault_type)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    report = {**result.to_dict(), "mechanism": graph.name, "pose": {}, "converted": graph.report.lines()}
+    if as_json:
+        click.echo(json.dumps(report))
+    else:
+        print_report(report)
+        click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)

@@ -19,6 +19,7 @@ import numpy as np
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
+from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
 from screwkit.io.loader import load
 from screwkit.plots import colour_scale
 from screwkit.studies.files import WriteError, check_distinct, check_output
@@ -209,16 +210,27 @@ def colour_scale_options(function: Callable) -> Callable:
 
 # -- parsing ---------------------------------------------------------------------------------------
 
-def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True):
+def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True, graphs: bool = False):
     """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded.
 
     ``indices``: the command computes indices, so a first run says at once that the index kernel
-    is about to be compiled, and starts compiling it (before Pinocchio is even imported)."""
+    is about to be compiled, and starts compiling it (before Pinocchio is even imported). ``graphs``: a file
+    whose legs have loops inside them is returned as a :class:`~screwkit.io.GraphMechanism` (analysed at the
+    file's configuration) instead of refused."""
     if indices:
         compile_ahead(*INDEX_KERNELS)
 
     try:
         mechanism = load(name, length_unit=length_unit)
+    except LegWithLoops as error:
+        if not graphs:
+            raise fail(str(error)) from None
+        if length_unit not in (None, "m"):
+            raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
+        try:
+            return graph_mechanism(read_closed_tree(name))
+        except ValueError as graph_error:
+            raise fail(str(graph_error)) from None
     except ValueError as error:
         raise fail(str(error)) from None
     context = click.get_current_context(silent=True)

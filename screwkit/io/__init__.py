@@ -7,7 +7,8 @@
 
 The conversion itself (assembly, platform, legs, loop joints, idle joints, output) is
 :func:`screwkit.io.star.convert_tree`; legs joined to each other (compound legs) are
-:mod:`screwkit.io.compound`'s.
+:mod:`screwkit.io.compound`'s; legs with loops inside them (parallelograms of ball-jointed rods) are analysed
+as a graph at the file's configuration by :func:`graph_mechanism` (:mod:`screwkit.io.graph`).
 """
 
 from __future__ import annotations
@@ -15,13 +16,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from screwkit.common.units import metres_per
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
 from screwkit.io.gepetto import read_gepetto, yaml_beside
+from screwkit.io.graph import GraphMechanism, graph_mechanism
 from screwkit.io.mjcf import read_mjcf
 from screwkit.io.star import convert_tree
 
-__all__ = ["read_mechanism_file", "is_foreign", "convert_tree", "ClosedTree", "Closure", "ImportReport",
-           "ImportError_", "read_gepetto", "read_mjcf", "with_reference_configuration"]
+__all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
+           "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
+           "read_mjcf", "with_reference_configuration"]
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
@@ -37,24 +40,29 @@ def is_foreign(path: Path) -> bool:
     return False
 
 
+def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
+    """The closed tree of an MJCF file or a URDF + robot.yaml (``output``, ``output_type``: as
+    :func:`read_mechanism_file`)."""
+    path = Path(path)
+    if output_type not in (None, "point", "frame"):
+        raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
+    if path.suffix.lower() in MJCF_SUFFIXES:
+        return read_mjcf(path, output=output, output_type=output_type)
+    yaml_path = yaml_beside(path)
+    if yaml_path is None:
+        raise ImportError_(f"{path}: no robot.yaml beside it: not a Gepetto closed-loop robot.")
+    return read_gepetto(path, yaml_path, output=output, output_type=output_type)
+
+
 def read_mechanism_file(path: Path, *, output: str | None = None,
                         output_type: str | None = None) -> tuple[str, ImportReport]:
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
-    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says).
+    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says). A leg with loops inside it
+    raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses it).
     """
-    path = Path(path)
-    if output_type not in (None, "point", "frame"):
-        raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
-    if path.suffix.lower() in MJCF_SUFFIXES:
-        tree = read_mjcf(path, output=output, output_type=output_type)
-    else:
-        yaml_path = yaml_beside(path)
-        if yaml_path is None:
-            raise ImportError_(f"{path}: no robot.yaml beside it: not a Gepetto closed-loop robot.")
-        tree = read_gepetto(path, yaml_path, output=output, output_type=output_type)
-    return convert_tree(tree)
+    return convert_tree(read_closed_tree(path, output=output, output_type=output_type))
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

@@ -18,8 +18,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse",
-           "joint_kind", "joint_value", "path_to", "closure_gaps", "assemble"]
+__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "LegWithLoops", "GRAPH_HINT",
+           "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to", "closure_gaps",
+           "assemble"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -31,6 +32,17 @@ exporter) disagree by that much. The assembly then closes them as well as they c
 
 class ImportError_(ValueError):
     """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
+
+
+class LegWithLoops(ImportError_):
+    """A leg with loops inside it (a parallelogram of ball-jointed rods, a ball joint inside a leg): not a serial
+    chain, so not written in screwkit's convention; :mod:`screwkit.io.graph` analyses it at the file's
+    configuration."""
+
+
+GRAPH_HINT = ("; `screwkit analyze FILE` (or screwkit.io.graph_mechanism) analyses it as a graph at the file's "
+              "configuration: poses, maps and sweeps need serial legs")
+"""What a :class:`LegWithLoops` message adds."""
 
 
 @dataclass(frozen=True)

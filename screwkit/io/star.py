@@ -44,10 +44,12 @@ from numpy.typing import NDArray
 
 from screwkit.common.rotations import rotation_about_axis, rpy_from_rotation
 from screwkit.io.closed_tree import (
+    GRAPH_HINT,
     ClosedTree,
     Closure,
     ImportError_,
     ImportReport,
+    LegWithLoops,
     assemble,
     closure_gaps,
     homogeneous,
@@ -75,7 +77,7 @@ largest, for them to count as independent (as :data:`screwkit.common.tolerances.
 # -- the star --------------------------------------------------------------------------------------
 
 
-def _output_frame(tree: ClosedTree) -> int:
+def output_frame(tree: ClosedTree) -> int:
     model = tree.model
     names = [frame.name for frame in model.frames]
     if tree.output is not None:
@@ -374,12 +376,12 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     data = model.createData()
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
-    frame_index = _output_frame(tree)
+    frame_index = output_frame(tree)
     report.notes[:0] = tree.notes  # what reading, assembling and finding the platform said, before the rest
-    output_frame = model.frames[frame_index]
-    platform = int(output_frame.parentJoint)
+    frame = model.frames[frame_index]
+    platform = int(frame.parentJoint)
     if platform == 0:
-        raise ImportError_(f"{tree.source}: the output frame {output_frame.name!r} is on the fixed base.")
+        raise ImportError_(f"{tree.source}: the output frame {frame.name!r} is on the fixed base.")
     bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
     body = bodies.get(platform, model.names[platform])
     report.platform_body = body
@@ -396,15 +398,15 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         for joint in leg.joints:
             kind, _ = joint_kind(model, joint)
             if kind not in ("revolute", "prismatic"):
-                raise ImportError_(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: write it as "
-                                   "1-DoF joints (a ball joint as three hinges).")
+                raise LegWithLoops(f"{tree.source}: joint {model.names[joint]!r} ({kind}) inside a leg: not a "
+                                   "serial chain of 1-DoF joints" + GRAPH_HINT + ".")
     for leg in legs:
         for joint in leg.joints:
             if joint in owner:
                 first = f"closure {owner[joint]!r}" if owner[joint] else "the platform body's own path"
-                raise ImportError_(f"{tree.source}: closure {leg.closure!r} and {first} share joint "
-                                   f"{model.names[joint]!r}: a loop that leaves another leg's path (a closed-loop "
-                                   "transmission inside a leg), which screwkit cannot write as legs from the base.")
+                raise LegWithLoops(f"{tree.source}: closure {leg.closure!r} and {first} share joint "
+                                   f"{model.names[joint]!r}: a loop inside a leg (a parallelogram of rods, a "
+                                   "transmission), which screwkit cannot write as serial legs" + GRAPH_HINT + ".")
             owner[joint] = leg.closure
     motor_ids = {}
     for name in tree.motors:
@@ -447,9 +449,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             offset = offset - (offset @ normal) * normal
         report.output = (f"the point where the chains meet on body {body!r} (closure {tree.closures[0].name!r}), "
                          f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
-                         f"frame {output_frame.name!r}")
+                         f"frame {frame.name!r}")
     else:
-        report.output = f"frame {output_frame.name!r} on body {body!r}"
+        report.output = f"frame {frame.name!r} on body {body!r}"
     base_rotation = _base_rotation(normal)
     world_base = np.eye(4)
     world_base[:3, :3] = base_rotation
