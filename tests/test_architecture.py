@@ -132,11 +132,11 @@ def test_function_local_imports_of_the_package_say_why():
 
 
 def test_modules_and_classes_stay_small():
-    """No module above ~600 lines (the compiled kernels included), no class above ~300 lines."""
+    """No module above ~540 lines (the compiled kernels included; ~500 is the aim), no class above ~300 lines."""
     too_long = []
     for module, path in MODULES.items():
         source = path.read_text(encoding="utf-8")
-        if source.count("\n") > 660:
+        if source.count("\n") > 540:
             too_long.append(f"{module}: {source.count(chr(10))} lines")
         for node in ast.walk(ast.parse(source)):
             if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno > 300:

@@ -21,12 +21,8 @@ from screwkit.io import is_foreign, read_mechanism_file
 from screwkit.model.builder import read_chains, read_platform
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.pinocchio_bridge import build_model
-from screwkit.model.urdf_reader import (
-    MAX_FILE_BYTES,
-    UrdfDescription,
-    parse_urdf,
-    read_urdf,
-)
+from screwkit.model.urdf_description import UrdfDescription
+from screwkit.model.urdf_reader import MAX_FILE_BYTES, parse_urdf, read_urdf
 
 __all__ = ["load", "load_text", "mechanism_from_description", "bundled_names", "bundled_path"]
 

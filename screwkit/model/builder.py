@@ -23,7 +23,7 @@ from screwkit.model.pinocchio_bridge import (
     neutral_with_jacobians,
     placement_arrays,
 )
-from screwkit.model.urdf_reader import PLATFORM_JOINT_TYPES, UrdfDescription
+from screwkit.model.urdf_description import PLATFORM_JOINT_TYPES, UrdfDescription
 
 __all__ = ["Platform", "read_platform", "read_chains", "chain_order"]
 

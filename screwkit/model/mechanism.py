@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.rotations import rotation_about_axis, rotation_from_rpy, rpy_from_rotation
 from screwkit.common.units import angle_beyond_limit, angle_limit, is_angular
 from screwkit.model.chain import Chain, ChainGeometry
-from screwkit.model.urdf_reader import UrdfDescription
+from screwkit.model.urdf_description import UrdfDescription
 
 __all__ = ["Mechanism", "require_mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
 

@@ -1,0 +1,136 @@
+"""What the safe XML pass reads from a URDF file, as frozen records: :class:`UrdfDescription` and the
+elements it holds (:class:`JointElement`, :class:`LoopElement`, :class:`TransmissionElement`, their
+:class:`Origin`), with the joint types of the convention and :func:`file_error`, the form of every error.
+
+They are read by :func:`screwkit.model.urdf_reader.parse_urdf`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common.rotations import rotation_from_rpy
+
+TREE_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+"""Joint types of the URDF specification."""
+PLATFORM_JOINT_TYPES = ("floating", "planar")
+"""Types of the joint that attaches the platform to the base."""
+AXIS_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar")
+"""Joint types whose ``<axis>`` means something (a zero axis is refused on them only)."""
+
+
+@dataclass(frozen=True)
+class Origin:
+    """A URDF ``<origin>``: translation ``xyz`` (m) and fixed-axis ``rpy`` angles (rad)."""
+
+    xyz: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    rpy: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+
+    @property
+    def rotation(self) -> NDArray[np.float64]:
+        """Rotation matrix ``Rz(yaw) Ry(pitch) Rx(roll)``."""
+        return rotation_from_rpy(self.rpy)
+
+    @property
+    def translation(self) -> NDArray[np.float64]:
+        """Translation vector."""
+        return np.asarray(self.xyz, dtype=float)
+
+
+@dataclass(frozen=True)
+class JointElement:
+    """A tree ``<joint>`` as written in the file."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: Origin
+    axis: NDArray[np.float64]
+    limits: tuple[float, float] = (-np.inf, np.inf)
+    """Position limits (rad or m): ``<limit lower upper>`` of revolute and prismatic joints, else unlimited."""
+
+
+@dataclass(frozen=True)
+class LoopElement:
+    """A URDF+ ``<loop>`` joint closing a chain.
+
+    The loop-joint frame is ``predecessor_origin`` in the predecessor link frame and
+    ``successor_origin`` in the successor link frame; at the reference configuration the two
+    frames coincide up to the loop joint's own motion. ``axes`` are unit vectors in the loop
+    frame (``axis`` and, for a universal joint, ``axis2``).
+    """
+
+    name: str
+    type: str
+    predecessor: str
+    predecessor_origin: Origin
+    successor: str
+    successor_origin: Origin
+    axes: tuple[NDArray[np.float64], ...]
+    chain: str
+
+
+@dataclass(frozen=True)
+class TransmissionElement:
+    """A ``<transmission>`` and the joints it drives."""
+
+    name: str
+    joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class UrdfDescription:
+    """What the safe XML pass read from one URDF document.
+
+    Attributes
+    ----------
+    source : str
+        File path (or ``"<string>"``) used in error messages.
+    text : str
+        The document, checked to contain no DTD, for :func:`pinocchio.buildModelFromXML`.
+    robot_name : str
+    links : tuple of str
+    joints : dict of str to JointElement
+        Tree joints by name.
+    loops : tuple of LoopElement
+        In file order (chains are then ordered by name, :func:`screwkit.model.builder.chain_order`).
+    transmissions : tuple of TransmissionElement
+    reference_configuration : dict of str to float
+        Joint values of the reference assembly given in ``<reference_configuration>``.
+    named_poses : dict of str to dict of str to float
+        ``<named_pose name="..." x="..." ...>``: task coordinate values (m, rad) by pose name.
+    length_unit : str
+        The unit the file was written in (its lengths are converted to metres here).
+    task_coordinates : tuple of str or None
+        ``<task_coordinates names="z roll pitch"/>``: the independent coordinates a pose is
+        given in, for a mechanism of lower mobility (None: inferred).
+    output : str
+        ``"frame"`` (the platform frame, the default) or ``"point"`` (``<output type="point"/>``:
+        the platform frame's origin is a point output, rotations about it are idle).
+    """
+
+    source: str
+    text: str
+    robot_name: str
+    links: tuple[str, ...]
+    joints: dict[str, JointElement]
+    loops: tuple[LoopElement, ...]
+    transmissions: tuple[TransmissionElement, ...]
+    reference_configuration: dict[str, float]
+    named_poses: dict[str, dict[str, float]] = field(default_factory=dict)
+    length_unit: str = "m"
+    task_coordinates: tuple[str, ...] | None = None
+    output: str = "frame"
+
+    def fail(self, element: str, problem: str) -> ValueError:
+        """A one-line error naming this file, an element and a problem."""
+        return file_error(self.source, element, problem)
+
+
+def file_error(source: str, element: str, problem: str) -> ValueError:
+    """``ValueError("<file>: <element>: <problem>")``, the form of every URDF error."""
+    return ValueError(f"{source}: {element}: {problem}")
