@@ -1,7 +1,8 @@
 """Closed-loop mechanisms written by other tools, read into screwkit's model.
 
-* :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser) or a URDF
-  tree with a Gepetto ``robot.yaml`` beside it, as the text of a URDF in screwkit's convention
+* :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser), a URDF
+  tree with a Gepetto ``robot.yaml`` beside it, or an onshape-to-robot URDF whose loops are
+  ``closing_`` frame pairs (:mod:`screwkit.io.onshape`), as the text of a URDF in screwkit's convention
   and an :class:`~screwkit.io.closed_tree.ImportReport`;
 * :func:`is_foreign`: whether a path is such a file (the loader then imports it).
 
@@ -20,21 +21,23 @@ from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportRep
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.graph import GraphMechanism, graph_mechanism
 from screwkit.io.mjcf import read_mjcf
+from screwkit.io.onshape import has_closing_frames, read_onshape
 from screwkit.io.star import convert_tree
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_mjcf", "with_reference_configuration"]
+           "read_onshape", "read_mjcf", "with_reference_configuration"]
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
 
 def is_foreign(path: Path) -> bool:
-    """An MJCF file, or a URDF with a Gepetto ``robot.yaml`` beside it and no ``<loop>`` of its own."""
+    """An MJCF file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
+    onshape-to-robot ``closing_`` frame pairs."""
     path = Path(path)
     if path.suffix.lower() in MJCF_SUFFIXES:
         return True
-    if path.suffix.lower() == ".urdf" and yaml_beside(path) is not None:
+    if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)):
         head = path.read_bytes()[:4_000_000]
         return b"<loop" not in head
     return False
@@ -49,9 +52,12 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     if path.suffix.lower() in MJCF_SUFFIXES:
         return read_mjcf(path, output=output, output_type=output_type)
     yaml_path = yaml_beside(path)
-    if yaml_path is None:
-        raise ImportError_(f"{path}: no robot.yaml beside it: not a Gepetto closed-loop robot.")
-    return read_gepetto(path, yaml_path, output=output, output_type=output_type)
+    if yaml_path is not None:
+        return read_gepetto(path, yaml_path, output=output, output_type=output_type)
+    if has_closing_frames(path):
+        return read_onshape(path, output=output, output_type=output_type)
+    raise ImportError_(f"{path}: no robot.yaml beside it and no closing_ frame pairs: not a closed-loop tree "
+                       "screwkit reads.")
 
 
 def read_mechanism_file(path: Path, *, output: str | None = None,

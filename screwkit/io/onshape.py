@@ -1,0 +1,102 @@
+"""URDFs exported by onshape-to-robot: loops closed by ``closing_<name>_1`` / ``closing_<name>_2`` frame pairs.
+
+onshape-to-robot writes each mate named ``closing_<name>`` of the CAD assembly as two dummy links
+(``closing_<name>_1`` and ``closing_<name>_2``, each on a fixed joint) attached to the two parts it
+mated, at the point the mate joins them. A URDF has no element for what the mate was (its MuJoCo export
+writes a ball mate as one ``<connect>``, a revolute as two, a fastened one as a ``<weld>``), nor for
+which joints are driven. So, without a ``robot.yaml`` beside the file (:mod:`screwkit.io.gepetto`, which
+says both), this module reads:
+
+* every ``closing_`` pair as a ball joint (``3d``: the two origins coincide), the least it can be; the
+  conversion then makes two balls between the same two bodies the hinge through them, and a planar
+  mechanism's balls pins about the plane's normal (:mod:`screwkit.io.star`);
+* the actuated joints as the branches from the base suggest them: on each branch of the tree that
+  leaves the base and reaches a closure, its prismatic joint on the way to the closures when it has
+  exactly one (a Stewart platform's leg), else its first joint (a motor on the base).
+
+Both guesses are said in the import report, with how to say otherwise (a ``robot.yaml`` with
+``closed_loop``, ``type`` and ``name_mot``).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous, joint_kind, path_to
+
+__all__ = ["CLOSING", "closing_pairs", "read_onshape"]
+
+CLOSING = re.compile(r"closing_(.+)_([12])")
+"""The name of a closing frame: ``closing_<name>_1`` or ``closing_<name>_2``."""
+
+
+def closing_pairs(names) -> dict[str, tuple[str, str]]:
+    """``name -> (closing_<name>_1, closing_<name>_2)`` for every complete pair among ``names``."""
+    sides: dict[str, dict[str, str]] = {}
+    for name in names:
+        match = CLOSING.fullmatch(name)
+        if match:
+            sides.setdefault(match.group(1), {})[match.group(2)] = name
+    return {key: (pair["1"], pair["2"]) for key, pair in sorted(sides.items()) if set(pair) == {"1", "2"}}
+
+
+def has_closing_frames(path: Path) -> bool:
+    """Whether a URDF file names at least one complete ``closing_`` pair of links (read as text, quickly)."""
+    head = path.read_bytes()[:4_000_000].decode("utf-8", errors="replace")
+    return bool(closing_pairs(re.findall(r"<link\s+name\s*=\s*[\"']([^\"']+)[\"']", head)))
+
+
+def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
+    """The closed tree of an onshape-to-robot URDF whose loops are ``closing_`` frame pairs."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    try:
+        model = pin.buildModelFromUrdf(str(urdf))
+    except (RuntimeError, ValueError) as error:
+        raise ImportError_(f"{urdf}: Pinocchio cannot read the tree ({error}).") from None
+    frames = {frame.name: frame for frame in model.frames if frame.type == pin.FrameType.BODY}
+    pairs = closing_pairs(frames)
+    unpaired = sorted(name for name in frames if CLOSING.fullmatch(name)
+                      and not any(name in pair for pair in pairs.values()))
+    if unpaired:
+        raise ImportError_(f"{urdf}: closing frame(s) {', '.join(unpaired)} without their other half "
+                           "(onshape-to-robot writes closing_<name>_1 and closing_<name>_2).")
+    if not pairs:
+        raise ImportError_(f"{urdf}: no closing_<name>_1 / closing_<name>_2 frame pair: no loop to close.")
+    closures = []
+    for key, (first, second) in pairs.items():
+        a, b = frames[first], frames[second]
+        closures.append(Closure(f"closing_{key}", int(a.parentJoint), homogeneous(a.placement),
+                                int(b.parentJoint), homogeneous(b.placement), "3d"))
+    motors = guessed_motors(model, closures)
+    if not motors:
+        raise ImportError_(f"{urdf}: no 1-DoF joint leaves the base on the way to a closure: nothing to actuate "
+                           "(a robot.yaml beside the file can list the actuated joints as name_mot).")
+    tree = ClosedTree(str(urdf), model, closures, motors, pin.neutral(model), output, output_type,
+                      "onshape-to-robot URDF (closing_ frame pairs)")
+    tree.notes.append(f"closing_ pairs read as ball joints (a URDF does not say the mate's type): "
+                      f"{', '.join(c.name for c in closures)}; a robot.yaml beside the file (type: 3d or 6d) says "
+                      "otherwise")
+    tree.notes.append(f"actuators guessed from the branches leaving the base (a URDF does not say which joints are "
+                      f"driven): {', '.join(motors)}; a robot.yaml beside the file (name_mot) says otherwise")
+    return tree
+
+
+def guessed_motors(model, closures: list[Closure]) -> list[str]:
+    """On each branch leaving the base towards a closure: its one prismatic joint on the way, else its first joint."""
+    branches: dict[int, list[int]] = {}
+    for closure in closures:
+        for joint in (closure.joint_a, closure.joint_b):
+            path = path_to(model, joint)
+            if path:
+                members = branches.setdefault(path[0], [])
+                members += [j for j in path if j not in members]
+    motors = []
+    for first, members in sorted(branches.items()):
+        kinds = {joint: joint_kind(model, joint)[0] for joint in members}
+        prismatic = [joint for joint in members if kinds[joint] == "prismatic"]
+        chosen = prismatic[0] if len(prismatic) == 1 else first
+        if kinds[chosen] in ("revolute", "prismatic"):
+            motors.append(str(model.names[chosen]))
+    return motors

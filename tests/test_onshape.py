@@ -1,0 +1,140 @@
+"""URDFs as onshape-to-robot exports them: loops closed by ``closing_<name>_1`` / ``_2`` frame pairs, no robot.yaml.
+
+The files are written here the way the exporter writes them (a dummy link per closing frame on a fixed joint
+``closing_<name>_<k>_frame``, the two frames of a pair turned against each other as CAD mate connectors are,
+revolute joints with ``<limit effort velocity/>`` and no bounds, an ``effector`` frame link, inertias), and
+checked against the textbook pressure angles of the five-bar (independent closed forms).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from test_io import HOME, assert_textbook, poses_near_home, text
+from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
+
+from helpers import screwkit
+from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.studies.poses import indices_at_poses
+
+TOLERANCE = 1e-9
+INERTIAL = ('<inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="1e-9"/>'
+            '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>')
+
+
+def onshape_urdf(links: list[tuple[str, str, str, tuple, float, tuple]], frames: list[tuple[str, str, tuple, tuple]]):
+    """A URDF as onshape-to-robot writes it: ``links`` (name, joint, kind, xyz, yaw, parent), ``frames``
+    (name, parent link, xyz, rpy) as dummy links on fixed joints ``<name>_frame``."""
+    out = ['<robot name="onshape">', f'<link name="base">{INERTIAL}</link>']
+    for name, joint, kind, xyz, yaw, parent in links:
+        limit = ('<limit effort="1" velocity="20"/>' if kind == "revolute"
+                 else '<limit effort="1" velocity="20" lower="-1" upper="1"/>')
+        axis = "0 0 1" if kind == "revolute" else "1 0 0"
+        out.append(f'<link name="{name}">{INERTIAL}</link>')
+        out.append(f'<joint name="{joint}" type="{kind}"><origin xyz="{text(xyz)}" rpy="0 -0 {yaw!r}"/>'
+                   f'<parent link="{parent}"/><child link="{name}"/><axis xyz="{axis}"/>'
+                   f'{limit}<joint_properties friction="0.0"/></joint>')
+    for name, parent, xyz, rpy in frames:
+        out.append(f'<link name="{name}">{INERTIAL}</link>')
+        out.append(f'<joint name="{name}_frame" type="fixed"><origin xyz="{text(xyz)}" rpy="{text(rpy)}"/>'
+                   f'<parent link="{parent}"/><child link="{name}"/><axis xyz="0 0 0"/></joint>')
+    return "\n".join(out + ["</robot>"]) + "\n"
+
+
+def five_bar_onshape(legs: int = 3) -> str:
+    """The five-bar of tests/test_io.py: legs 2.. close on leg 1's distal link by ``closing_loop<i>`` pairs."""
+    elbows = five_bar_elbows(HOME)
+    links, frames = [], []
+    for i in range(legs):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        first = float(np.arctan2(*(elbow - base)[::-1]))
+        second = float(np.arctan2(*(HOME - elbow)[::-1]))
+        links.append((f"branch1_{i + 1}", f"motor{i + 1}", "revolute", (*base, 0.0), first, "base"))
+        links.append((f"branch2_{i + 1}", f"passive{i + 1}", "revolute", (PROXIMAL, 0.0, 0.0), second - first,
+                      f"branch1_{i + 1}"))
+        if i:
+            frames.append((f"closing_loop{i + 1}_1", f"branch2_{i + 1}", (DISTAL, 0.0, 0.0), (0.0, 0.0, 0.0)))
+            frames.append((f"closing_loop{i + 1}_2", "branch2_1", (DISTAL, 0.0, 0.0), (np.pi, 0.0, np.pi / 2)))
+    frames.append(("effector", "branch2_1", (DISTAL, 0.0, 0.0), (np.pi, 0.0, 0.0)))
+    return onshape_urdf(links, frames)
+
+
+def test_an_onshape_five_bar_opens_as_written_with_the_textbook_pressure_angles(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_onshape())
+    converted, report = read_mechanism_file(path)
+    assert report.file_format == "onshape-to-robot URDF (closing_ frame pairs)" and report.planar
+    assert report.motors == ["motor1", "motor2", "motor3"]
+    lines = "\n".join(report.lines())
+    assert "closing_ pairs read as ball joints (a URDF does not say the mate's type): closing_loop2, closing_loop3" \
+        in lines
+    assert "actuators guessed from the branches leaving the base" in lines and "name_mot" in lines
+    mechanism = load(path)
+    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+def test_a_non_redundant_onshape_five_bar_has_the_textbook_indices_and_no_fault_tolerance(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_onshape(legs=2))
+    mechanism = load(path)
+    assert mechanism.is_planar and mechanism.dof == 2 and len(mechanism.actuators) == 2
+    points = poses_near_home()
+    result = indices_at_poses(mechanism, points, detail=True)
+    for k, point in enumerate(points):
+        expected = five_bar_expected(point, legs=(0, 1))
+        np.testing.assert_allclose(result.iti_actuators[k], expected["iti_actuators"], atol=TOLERANCE)
+        np.testing.assert_allclose(result.lmti[k], expected["lmti"], atol=TOLERANCE)
+    assert np.all(result.f_o[1] == 0.0)
+
+
+def test_a_leg_with_one_prismatic_joint_is_guessed_driven_by_it(tmp_path):
+    """A planar 3-RPR written by the exporter: each leg R (base) - P - R, the platform hanging from leg 1."""
+    base = [(-0.4, 0.0), (0.4, 0.0), (0.0, 0.6)]
+    attach = [(-0.1, -0.05), (0.1, -0.05), (0.0, 0.1)]  # on the platform, its frame at (0, 0.25)
+    centre = np.array([0.0, 0.25])
+    links, frames = [], []
+    for i, (b, a) in enumerate(zip(base, attach)):
+        target = centre + np.array(a)
+        direction = target - np.array(b)
+        yaw = float(np.arctan2(direction[1], direction[0]))
+        links.append((f"leg{i + 1}", f"pivot{i + 1}", "revolute", (*b, 0.0), yaw, "base"))
+        links.append((f"rod{i + 1}", f"slide{i + 1}", "prismatic", (0.0, 0.0, 0.0), 0.0, f"leg{i + 1}"))
+        length = float(np.linalg.norm(direction))
+        if i == 0:
+            links.append(("platform", "wrist1", "revolute", (length, 0.0, 0.0), -yaw, "rod1"))
+        else:
+            frames.append((f"closing_wrist{i + 1}_1", f"rod{i + 1}", (length, 0.0, 0.0), (0.0, 0.0, 0.0)))
+            frames.append((f"closing_wrist{i + 1}_2", "platform", (a[0] - attach[0][0], a[1] - attach[0][1], 0.0),
+                           (0.0, 0.0, 0.3)))
+    path = tmp_path / "rpr.urdf"
+    path.write_text(onshape_urdf(links, frames))
+    tree = read_closed_tree(path)
+    assert tree.motors == ["slide1", "slide2", "slide3"]
+    mechanism = load(path)
+    assert mechanism.dof == 3 and mechanism.is_planar
+    assert [name.split(":")[-1] for name in mechanism.actuator_names] == ["slide1", "slide2", "slide3"]
+
+
+def test_a_closing_frame_without_its_other_half_is_refused_by_name(tmp_path):
+    text_ = five_bar_onshape().replace("closing_loop3_2", "closing_loop3_b")
+    path = tmp_path / "robot.urdf"
+    path.write_text(text_)
+    with pytest.raises(ImportError_, match=r"closing frame\(s\) closing_loop3_1 without their other half"):
+        read_mechanism_file(path)
+
+
+@pytest.mark.cli
+def test_analyze_opens_an_onshape_export_on_the_command_line(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_onshape())
+    result = screwkit("analyze", path, "--json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    expected = five_bar_expected(HOME)
+    assert report["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
+    assert any("actuators guessed" in line for line in report["converted"])
