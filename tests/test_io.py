@@ -448,3 +448,19 @@ def test_closures_that_disagree_by_a_rounding_close_as_well_as_they_can_and_say_
     wrong.write_text(_hinges_as_site_pairs(0.05, slip=1e-3))
     with pytest.raises(ValueError, match=r"cannot be closed.*closure 'connect_\d' still misses by"):
         load(wrong)
+
+
+def test_a_reference_assembly_outside_a_joint_limit_is_refused_by_name_or_read_with_limits_off(tmp_path):
+    """A CAD export whose range misses the assembled value by a rounding: refused naming the source, the joint and
+    the way out; read with ``limits=False`` (the command line's --ignore-limits), the note says what was ignored."""
+    path = tmp_path / "limited.xml"
+    path.write_text(five_bar_mjcf().replace('<joint name="a_1" type="hinge"', '<joint name="a_1" type="hinge" '
+                                                                           'range="0.001 1"'))
+    with pytest.raises(ValueError, match=re.escape(f"{path}: <joint name='a_1'>: the reference assembly puts the "
+                                                   "joint at 0, outside its limits [0.001, 1] (--ignore-limits")):
+        load(path)
+    mechanism = load(path, limits=False)
+    assert mechanism.assembly_notes == ("joint 'a_1': the reference assembly puts the joint at 0, outside its "
+                                        "limits [0.001, 1], ignored",)
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True, limits=False), points)

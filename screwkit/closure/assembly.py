@@ -63,15 +63,16 @@ def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
     return max(float(np.max(np.linalg.norm(np.concatenate(points), axis=-1))), 1e-12)
 
 
-def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
-                      length_scale: float) -> tuple[NDArray[np.float64], str | None]:
+def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_scale: float,
+                      limits: bool = True) -> tuple[NDArray[np.float64], str | None]:
     """Joint values of the reference assembly, and a note when the file's values left the loop open.
 
     The file's tree joint values (``<reference_configuration>`` or 0) with the loop joint's best
     fit; when the loop frames stay apart (a CAD export, a hand-edited file), the leg's joints are
     moved to close it with the platform where the file puts it (damped Newton from those values,
     so the working mode is usually the nearest one) and the gap closed is returned as a note. A ValueError
-    names the loop when it cannot be closed.
+    names the loop when it cannot be closed, or the joint the assembly puts outside its limits (with ``limits``
+    False that is a note instead).
     """
     description, geometry = mechanism.description, chain.geometry
     tree_values = np.array([description.reference_configuration.get(name, 0.0)
@@ -110,9 +111,12 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain,
     outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None])[0])
     if outside >= 0:
         lower, upper = chain.joint_limits[outside]
-        raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
-                               f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "
-                               f"limits [{_tidy(lower)}, {_tidy(upper)}].")
+        where = (f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "
+                 f"limits [{_tidy(lower)}, {_tidy(upper)}]")
+        if limits:
+            raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
+                                   f"{where} (--ignore-limits, or limits=False, reads it all the same).")
+        note = "; ".join(filter(None, [note, f"joint {chain.joint_names[outside]!r}: {where}, ignored"]))
     return values, note
 
 
@@ -174,17 +178,18 @@ def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
     return len(rows) - int(np.sum(singular > MOTION_SPACE_TOLERANCE))
 
 
-def assemble(mechanism: Mechanism) -> Mechanism:
+def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
     """The mechanism with its reference assembly, solvers, working modes, length scale and DOF.
 
     ``mechanism`` holds chains as read from the file (geometry, joints, limits, actuators);
-    the result is the complete, immutable model.
+    the result is the complete, immutable model. ``limits`` False: a reference assembly outside a joint's
+    limits is a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes`, not an error.
     """
     length_scale = _length_scale(mechanism, mechanism.chains)
     mechanism = replace(mechanism, length_scale=length_scale)
     chains, notes = [], []
     for index, chain in enumerate(mechanism.chains):
-        values, note = _reference_values(mechanism, index, chain, length_scale)
+        values, note = _reference_values(mechanism, index, chain, length_scale, limits)
         if note:
             notes.append(note)
         if mechanism.is_planar:

@@ -56,7 +56,7 @@ def _named_poses(description: UrdfDescription, mechanism: Mechanism) -> dict[str
     return poses
 
 
-def mechanism_from_description(description: UrdfDescription) -> Mechanism:
+def mechanism_from_description(description: UrdfDescription, *, limits: bool = True) -> Mechanism:
     """The mechanism of a file's description (see :func:`load`)."""
     name = description.robot_name or Path(description.source).stem
     model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
@@ -72,12 +72,12 @@ def mechanism_from_description(description: UrdfDescription) -> Mechanism:
         chains=chains, dof=0, length_scale=1.0, named_poses={}, length_unit=description.length_unit,
         output_point=np.zeros(3) if description.output == "point" else None)
     draft = replace(draft, named_poses={"home": draft.home_full_pose})  # the reference assembly, for assembling
-    mechanism = task_space(assemble(draft), getattr(description, "task_coordinates", None))
+    mechanism = task_space(assemble(draft, limits), getattr(description, "task_coordinates", None))
     return replace(mechanism, named_poses=_named_poses(description, mechanism))
 
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
-         max_bytes: int = MAX_FILE_BYTES) -> Mechanism:
+         max_bytes: int = MAX_FILE_BYTES, limits: bool = True) -> Mechanism:
     """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
 
     Parameters
@@ -92,6 +92,10 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         Everything in screwkit is then in metres.
     max_bytes : int
         Largest file read (:data:`~screwkit.model.urdf_reader.MAX_FILE_BYTES`).
+    limits : bool
+        False: a reference assembly that puts a joint outside its limits (a CAD export rounded by a
+        millimetre) is read all the same, and said in ``assembly_notes``; the limits still apply to the
+        poses analysed unless those are asked without them too.
 
     Raises
     ------
@@ -120,14 +124,14 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path)
-            mechanism = load_text(converted, str(path), length_unit=length_unit)
+            mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
-    return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes))
+    return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes), limits=limits)
 
 
-def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None) -> Mechanism:
-    """Load a mechanism from the text of a URDF (``source`` names it in messages)."""
-    return mechanism_from_description(parse_urdf(text, source, length_unit=length_unit))
+def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None, limits: bool = True) -> Mechanism:
+    """Load a mechanism from the text of a URDF (``source`` names it in messages; ``limits``: as :func:`load`)."""
+    return mechanism_from_description(parse_urdf(text, source, length_unit=length_unit), limits=limits)
 
 
 @functools.lru_cache(maxsize=8)
