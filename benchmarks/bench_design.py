@@ -1,4 +1,4 @@
-"""Evaluations per second of ``screwkit design-search`` for each bundled family, whole processes.
+"""Evaluations per second of ``screwkit design-search family`` for each bundled family, whole processes.
 
 Usage: python benchmarks/bench_design.py [--budget 192] [--runs 3]
 
@@ -22,8 +22,9 @@ FAMILIES = ("planar_rrr", "ups_hexapod", "rss_hexapod", "delta", "prs_ups")
 
 def run(family: str, budget: int) -> tuple[float, int]:
     start = time.perf_counter()
-    completed = subprocess.run([sys.executable, "-m", "screwkit.cli", "design-search", family, "--budget",
-                                str(budget), "--json", "--quiet"], capture_output=True, text=True, check=True)
+    command = [sys.executable, "-m", "screwkit.cli", "design-search", "family", family, "--budget", str(budget),
+               "--json", "--quiet"]
+    completed = subprocess.run(command, capture_output=True, text=True, check=True)
     return time.perf_counter() - start, json.loads(completed.stdout)["evaluations"]
 
 

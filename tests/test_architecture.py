@@ -186,3 +186,49 @@ def test_indices_are_built_by_one_constructor():
             if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "Indices":
                 direct.append(f"{module}:{node.lineno}")
     assert not direct, "Indices(...) called directly (use Indices.from_arrays):\n" + "\n".join(direct)
+
+
+MAX_PARAMETERS = 10
+"""Parameters of a function at most (positional and keyword-only, ``self`` and ``cls`` not counted, nor
+``*args`` and ``**kwargs``): options that travel together are one record (an ``AnalysisOptions``, an
+``Execution``, a ``MapBlock``, a command's option group)."""
+LONG_SIGNATURES = {
+    # The top-level API (screwkit.analyze, screwkit.indices_at_poses): each keyword an independent setting with
+    # its default, documented one by one and passed by name in users' code, the tests and the notebooks; a record
+    # there would make every caller build one for the call most users make. The counts may not grow.
+    "screwkit.indices.analysis.analyze": 14,
+    "screwkit.studies.poses.indices_at_poses": 11,
+}
+"""Functions allowed more parameters, and how many."""
+KERNELS = ("screwkit.indices.compiled", "screwkit.closure.compiled")
+"""The numba kernels: plain arrays in, plain arrays out, by design (not counted)."""
+
+
+def signatures():
+    """(qualified name, parameter count) of every function and method outside the compiled kernels."""
+    for module, path in MODULES.items():
+        if module.startswith(KERNELS):
+            continue
+
+        def visit(node, prefix):
+            for child in ast.iter_child_nodes(node):
+                if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    arguments = child.args
+                    names = [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
+                    yield f"{prefix}.{child.name}", len([n for n in names if n not in ("self", "cls")])
+                    yield from visit(child, f"{prefix}.{child.name}")
+                elif isinstance(child, ast.ClassDef):
+                    yield from visit(child, f"{prefix}.{child.name}")
+                else:
+                    yield from visit(child, prefix)
+
+        yield from visit(ast.parse(path.read_text(encoding="utf-8")), module)
+
+
+def test_no_function_takes_more_than_ten_parameters():
+    counts = dict(signatures())
+    long = {name: count for name, count in counts.items()
+            if count > MAX_PARAMETERS and count > LONG_SIGNATURES.get(name, MAX_PARAMETERS)}
+    assert not long, "group the options that travel together in a record: " + ", ".join(
+        f"{name} ({count} parameters)" for name, count in sorted(long.items()))
+    assert set(LONG_SIGNATURES) <= set(counts), "an allowed long signature is gone: take it off LONG_SIGNATURES"

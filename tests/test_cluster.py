@@ -33,7 +33,7 @@ distributed = pytest.importorskip("distributed")
 DASK = str(Path(sys.executable).with_name("dask"))
 MAP = ("map", "planar_5rrr", "--radius", "0.5", "--step", "0.01", "--phi-step", "2", "--task-size", "4000")
 """1.4 million configurations in over 300 tasks: a few seconds on two single-threaded workers."""
-SEARCH = ("design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json", "--quiet")
+SEARCH = ("design-search", "permutations", "planar_5rrr", "--phi-step", "10", "--json", "--quiet")
 
 
 def free_port() -> int:
@@ -333,7 +333,7 @@ def test_a_task_given_up_by_the_scheduler_gives_one_line_and_no_file(tmp_path_fa
     assert os.listdir(tmp_path) == []
 
 
-FAMILY_SEARCH = ("design-search", "ups_hexapod", "--grid", "x:-0.1:0.1:0.05", "--grid", "y:-0.1:0.1:0.05",
+FAMILY_SEARCH = ("design-search", "family", "ups_hexapod", "--grid", "x:-0.1:0.1:0.05", "--grid", "y:-0.1:0.1:0.05",
                  "--over", "yaw:-20:40:20", "--free", "platform_radius", "--free", "height", "--objective", "mean",
                  "--budget", "64", "--popsize", "4", "--json", "--quiet")
 """A family search of up to 65 hexapod designs in 9 batches (the start, then 8 populations of 8; the mean index

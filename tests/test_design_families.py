@@ -1,4 +1,4 @@
-"""Parametric families, region metrics and design searches (``screwkit design-search FAMILY``).
+"""Parametric families, region metrics and design searches (``screwkit design-search family FAMILY``).
 
 Each family's writer is checked against an independent construction (the bundled files, the
 planar closed forms, leg lines written from the geometry); each metric against a brute force;
@@ -37,6 +37,10 @@ from screwkit.studies.design.objectives import (
 )
 from screwkit.studies.design.optimise import Constraint, StateError, Study, pareto_front, run_study
 from screwkit.studies.design.permutations import family_values, fault_tolerant_area, planar_design
+from screwkit.studies.tasks import Execution
+
+QUIET = Execution(progress=False)
+"""Local threads, no progress bar."""
 
 SMALL_DISC = ("--radius", "0.3", "--step", "0.1", "--phi-step", "30")
 """A planar region of 29 points x 12 angles: a search of 24 designs in a few seconds."""
@@ -227,16 +231,16 @@ def comparable(records):
 def test_a_resumed_search_equals_an_uninterrupted_one(tmp_path):
     study = Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), budget=24, popsize=4)
     state = tmp_path / "state.jsonl"
-    short = run_study(replace(study, budget=12), state=state, progress=False)
+    short = run_study(replace(study, budget=12), state=state, execution=QUIET)
     assert short.computed == 12 and short.replayed == 0
-    resumed = run_study(study, state=state, progress=False)
-    fresh = run_study(study, progress=False)
+    resumed = run_study(study, state=state, execution=QUIET)
+    fresh = run_study(study, execution=QUIET)
     assert resumed.replayed == 12 and resumed.computed == 12
     assert comparable(resumed.best) == comparable(fresh.best)
     assert comparable(resumed.evaluations) == comparable(fresh.evaluations)
     other = replace(study, region=disc_region(0.3, 0.1, 15.0))
     with pytest.raises(StateError, match="belongs to another study"):
-        run_study(other, state=state, progress=False)
+        run_study(other, state=state, execution=QUIET)
 
 
 def test_every_family_evaluates_its_default_region():
@@ -266,7 +270,7 @@ def remapped_area(tmp_path, urdf, map_command: str, index: str, level: float, ce
 ])
 def test_the_best_design_remapped_by_a_fresh_map_has_the_reported_area(tmp_path, arguments, cell):
     urdf = tmp_path / "best.urdf"
-    result = screwkit("design-search", *arguments, "--budget", "16", "--popsize", "4", "--urdf", urdf,
+    result = screwkit("design-search", "family", *arguments, "--budget", "16", "--popsize", "4", "--urdf", urdf,
                       "--table", tmp_path / "all.csv", "--figure", tmp_path / "maps.png", "--json")
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
@@ -282,7 +286,7 @@ def test_the_best_design_remapped_by_a_fresh_map_has_the_reported_area(tmp_path,
 
 
 def test_a_pareto_search_writes_its_front(tmp_path):
-    result = screwkit("design-search", "ups_hexapod", *SMALL_GRID, "--level", "0.33", "--objective", "worst",
+    result = screwkit("design-search", "family", "ups_hexapod", *SMALL_GRID, "--level", "0.33", "--objective", "worst",
                       "--objective", "footprint", "--free", "base_radius", "--free", "platform_radius",
                       "--constraint", "lmti_floor>=0.5", "--budget", "16", "--popsize", "4",
                       "--front-figure", tmp_path / "front.png", "--table", tmp_path / "front.nc", "--json")
@@ -306,14 +310,15 @@ def test_a_pareto_search_writes_its_front(tmp_path):
 
 def test_optimise_searches_the_planar_family_from_the_file(tmp_path):
     base = ("--budget", "12", "--popsize", "4", *SMALL_DISC, "--json", "--quiet")
-    from_file = screwkit("design-search", "planar_5rrr", "--optimise", *base)
-    from_family = screwkit("design-search", "planar_rrr", *base)
+    from_file = screwkit("design-search", "optimise", "planar_5rrr", *base)
+    from_family = screwkit("design-search", "family", "planar_rrr", *base)
     assert from_file.returncode == 0 and from_family.returncode == 0, from_file.stderr + from_family.stderr
     assert json.loads(from_file.stdout)["best"] == json.loads(from_family.stdout)["best"]
 
 
 def test_an_interrupted_search_resumes_from_its_state(tmp_path):
-    arguments = ("design-search", "planar_rrr", *SMALL_DISC, "--budget", "48", "--popsize", "4", "--json", "--quiet")
+    arguments = ("design-search", "family", "planar_rrr", *SMALL_DISC, "--budget", "48", "--popsize", "4", "--json",
+                 "--quiet")
     state = tmp_path / "state.jsonl"
     command = subprocess.Popen([sys.executable, "-m", "screwkit.cli", *arguments, "--state", str(state)],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
@@ -338,20 +343,24 @@ def test_an_interrupted_search_resumes_from_its_state(tmp_path):
 
 
 @pytest.mark.parametrize("arguments, message", [
-    (("planar_rrr", "--set", "upper=3"), "--set upper=3: Expected upper in [0.5, 1.5] m, got 3"),
-    (("planar_rrr", "--objective", "volume"), "The objective volume needs a region with layers."),
-    (("ups_hexapod", "--grid", "x:-0.1:0.1:0.1", "--grid", "q:0:1:1"), "Unknown coordinate 'q' in --grid"),
-    (("ups_hexapod", "--radius", "0.2"), "--radius, --step and --phi-step map a planar family's disc"),
-    (("planar_rrr", "--front-figure", "{tmp}/f.png"), "--front-figure needs two or more --objective."),
-    (("planar_rrr", "--legs", "2"), "Family planar_rrr needs at least 3 legs (3 DOF), got 2."),
-    (("fivebar", "--budget", "2"),
-     "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta, prs_ups), or a mechanism"),
-    (("ups_hexapod_8", "--optimise"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
-    (("five_bar_3", "--optimise"), "'five_bar_3' has the task coordinates x, y."),
-    (("planar_5rrr", "--permutations", "--objective", "area"), "--objective, --budget go with a family search"),
-    (("planar_rrr", "--state", "{tmp}/other.jsonl"), "belongs to another study"),
-    (("planar_rrr", "--state", "{tmp}/missing/state.jsonl"), "Cannot write the design-search state"),
-    (("ups_hexapod", "--grid", "x:-1:1:0.0001", "--grid", "y:-1:1:0.001"), "configurations per design"),
+    (("family", "planar_rrr", "--set", "upper=3"), "--set upper=3: Expected upper in [0.5, 1.5] m, got 3"),
+    (("family", "planar_rrr", "--objective", "volume"), "The objective volume needs a region with layers."),
+    (("family", "ups_hexapod", "--grid", "x:-0.1:0.1:0.1", "--grid", "q:0:1:1"), "Unknown coordinate 'q' in --grid"),
+    (("family", "ups_hexapod", "--radius", "0.2"), "--radius, --step and --phi-step map a planar family's disc"),
+    (("family", "planar_rrr", "--front-figure", "{tmp}/f.png"), "--front-figure needs two or more --objective."),
+    (("family", "planar_rrr", "--legs", "2"), "Family planar_rrr needs at least 3 legs (3 DOF), got 2."),
+    (("family", "planar_rrr", "--maxiter", "2"), "Give --budget or --maxiter, not both."),
+    (("family", "fivebar"), "Expected a family (planar_rrr, ups_hexapod, rss_hexapod, delta, prs_ups), got 'fivebar'"),
+    (("family", "planar_5rrr"), "design-search optimise MECHANISM"),
+    (("optimise", "ups_hexapod_8"), "Design search needs a planar n-RRR; 'ups_hexapod_8' is spatial."),
+    (("optimise", "five_bar_3"), "'five_bar_3' has the task coordinates x, y."),
+    (("optimise", "planar_rrr"), "planar_rrr is a family: design-search family planar_rrr searches it"),
+    (("permutations", "planar_5rrr", "--objective", "area"), "--objective"),
+    (("optimise", "planar_5rrr", "--legs", "3"), "--legs"),
+    (("family", "planar_rrr", "--state", "{tmp}/other.jsonl"), "belongs to another study"),
+    (("family", "planar_rrr", "--state", "{tmp}/missing/state.jsonl"), "Cannot write the design-search state"),
+    (("family", "ups_hexapod", "--grid", "x:-1:1:0.0001", "--grid", "y:-1:1:0.001"), "configurations per design"),
+    (("planar_5rrr", "--permutations", "--optimise"), "Expected one of --permutations or --optimise, not both"),
 ])
 def test_bad_search_options_give_one_line(tmp_path, arguments, message):
     other = tmp_path / "other.jsonl"
@@ -362,6 +371,29 @@ def test_bad_search_options_give_one_line(tmp_path, arguments, message):
     lines = result.stderr.strip().splitlines()
     assert lines[-1].startswith("Error: ") and message in lines[-1], result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_the_flat_form_of_earlier_releases_still_runs_with_a_note(tmp_path):
+    """``design-search MECHANISM --permutations`` (``--optimise``, or a FAMILY alone) is its subcommand for one
+    release: the same output, and a one-line note on stderr unless --quiet."""
+    for old, new in ((("planar_5rrr", "--permutations", "--phi-step", "90"),
+                      ("permutations", "planar_5rrr", "--phi-step", "90")),
+                     (("planar_rrr", *SMALL_DISC, "--budget", "0"),
+                      ("family", "planar_rrr", *SMALL_DISC, "--budget", "0")),
+                     (("planar_5rrr", *SMALL_DISC, "--optimise", "--budget", "0"),
+                      ("optimise", "planar_5rrr", *SMALL_DISC, "--budget", "0"))):
+        flat, current = screwkit("design-search", *old, "--json"), screwkit("design-search", *new, "--json")
+        assert flat.returncode == current.returncode == 0, flat.stderr + current.stderr
+        assert flat.stdout == current.stdout
+        note = f"Deprecated: `design-search {'FAMILY' if new[0] == 'family' else 'MECHANISM'}"
+        assert flat.stderr.startswith(note) and f"is now `design-search {new[0]} " in flat.stderr, flat.stderr
+        assert "Deprecated" not in current.stderr
+        quiet = screwkit("design-search", *old, "--json", "--quiet")
+        assert quiet.returncode == 0 and quiet.stderr == "" and quiet.stdout == current.stdout
+    study = tmp_path / "study.yaml"
+    study.write_text("family: planar_rrr\nradius: 0.3\nstep: 0.1\nphi_step: 30\nbudget: 0\n")
+    flat = screwkit("design-search", "--study", study, "--json", "--quiet")
+    assert flat.returncode == 0 and json.loads(flat.stdout)["evaluations"] == 1, flat.stderr
 
 
 def test_the_design_page_names_every_family_parameter_and_metric():
@@ -382,16 +414,16 @@ def test_a_study_file_is_the_same_search_as_its_options(tmp_path):
     study = tmp_path / "study.yaml"
     study.write_text("family: planar_rrr\nobjectives: [area]\nset: {mirrored: 1}\nstart: {upper: 0.9}\n"
                      "bounds: {lower: [0.8, 1.2]}\nradius: 0.3\nstep: 0.1\nphi_step: 30\nbudget: 12\npopsize: 4\n")
-    from_file = screwkit("design-search", "--study", study, "--json", "--quiet")
-    from_options = screwkit("design-search", "planar_rrr", "--objective", "area", "--set", "mirrored=1", "--start",
-                            "upper=0.9", "--bounds", "lower=0.8:1.2", *SMALL_DISC, "--budget", "12", "--popsize", "4",
-                            "--json", "--quiet")
+    from_file = screwkit("design-search", "family", "--study", study, "--json", "--quiet")
+    from_options = screwkit("design-search", "family", "planar_rrr", "--objective", "area", "--set", "mirrored=1",
+                            "--start", "upper=0.9", "--bounds", "lower=0.8:1.2", *SMALL_DISC, "--budget", "12",
+                            "--popsize", "4", "--json", "--quiet")
     assert from_file.returncode == 0 and from_options.returncode == 0, from_file.stderr + from_options.stderr
     assert json.loads(from_file.stdout) == json.loads(from_options.stdout)
-    overridden = json.loads(screwkit("design-search", "--study", study, "--budget", "0", "--json").stdout)
+    overridden = json.loads(screwkit("design-search", "family", "--study", study, "--budget", "0", "--json").stdout)
     assert overridden["evaluations"] == 1 and overridden["start"]["values"]["upper"] == 0.9
     study.write_text("family: planar_rrr\ncolour: blue\n")
-    bad = screwkit("design-search", "--study", study)
+    bad = screwkit("design-search", "family", "--study", study)
     assert bad.returncode == 1 and "Error: Unknown key 'colour' in the study file" in bad.stderr
 
 
@@ -477,9 +509,9 @@ def test_region_metrics_follow_the_scale_and_not_the_frame(scale, quarter_turns)
 
 def test_a_volume_search_gives_one_map_command_per_layer(tmp_path):
     urdf = tmp_path / "best.urdf"
-    result = screwkit("design-search", "delta", "--grid", "x:-0.2:0.2:0.1", "--grid", "y:-0.2:0.2:0.1", "--layers",
-                      "z:-0.9:-0.6:0.1", "--objective", "volume", "--budget", "6", "--popsize", "2", "--urdf", urdf,
-                      "--figure", tmp_path / "maps.png", "--json", "--quiet")
+    result = screwkit("design-search", "family", "delta", "--grid", "x:-0.2:0.2:0.1", "--grid", "y:-0.2:0.2:0.1",
+                      "--layers", "z:-0.9:-0.6:0.1", "--objective", "volume", "--budget", "6", "--popsize", "2",
+                      "--urdf", urdf, "--figure", tmp_path / "maps.png", "--json", "--quiet")
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)
     assert len(summary["map_commands"]) == 3 and all("--at" in command for command in summary["map_commands"])

@@ -155,11 +155,15 @@ def test_mathml_hook_conversion():
     assert hook.render_math("<p>no math</p>") == "<p>no math</p>"
 
 
-def _commands(group: click.Group):
-    context = click.Context(group, info_name="screwkit")
+def _commands(group: click.Group, context: click.Context | None = None, prefix: str = ""):
+    """(name, command, context) of every command, a group's subcommands as ``group subcommand``."""
+    context = context or click.Context(group, info_name="screwkit")
     for name in group.list_commands(context):
         command = group.get_command(context, name)
-        yield name, command, click.Context(command, info_name=name, parent=context)
+        inner = click.Context(command, info_name=name, parent=context)
+        yield f"{prefix}{name}", command, inner
+        if isinstance(command, click.Group):
+            yield from _commands(command, inner, f"{prefix}{name} ")
 
 
 def test_cli_page_names_every_command_and_option(site):

@@ -29,6 +29,7 @@ from screwkit.io.loader import bundled_path, load
 from screwkit.model.urdf_reader import MAX_FILE_BYTES, MAX_LINKS, MAX_TREE_DEPTH
 from screwkit.model.urdf_writer import planar_rrr_urdf
 from screwkit.studies.maps import MAX_CONFIGURATIONS, MapSize, disc_grid, disc_size, map_size, planar_disc_map
+from screwkit.studies.tasks import Execution
 
 SLOW_MAP = ("map", "planar_5rrr", "--radius", "0.6", "--step", "0.005", "--phi-step", "1")
 """A map of 16 million configurations: about 20 s of computation on a 2-core machine."""
@@ -296,8 +297,9 @@ def test_map_sizes_are_known_before_allocating_and_checked():
         size.check(max_configurations=100, available_bytes=2**40)
     size.check(max_configurations=100, proceed=True, available_bytes=2**40)
     with pytest.raises(ValueError, match=r"pass --yes"):
-        planar_disc_map(five, 0.3, 0.05, 30.0, max_configurations=100, progress=False)
-    small = planar_disc_map(five, 0.3, 0.05, 30.0, max_configurations=100, proceed=True, progress=False)
+        planar_disc_map(five, 0.3, 0.05, 30.0, max_configurations=100, execution=Execution(progress=False))
+    small = planar_disc_map(five, 0.3, 0.05, 30.0, max_configurations=100, proceed=True,
+                            execution=Execution(progress=False))
     assert small.attrs["configurations"] == size.configurations
     # Memory: the result must fit, whatever `proceed` says.
     needed = size.memory_bytes
@@ -472,7 +474,8 @@ def test_temporary_files_of_killed_runs_are_removed_and_named(tmp_path):
 @pytest.mark.parametrize("arguments", [
     ("map", "planar_5rrr", "--radius", "0.3", "--step", "0.1", "--phi-step", "400"),
     ("map", "planar_5rrr", "--radius", "0.3", "--step", "0.1", "--phi-step", "0"),
-    ("design-search", "planar_5rrr", "--permutations", "--phi-step", "400"),
+    ("design-search", "permutations", "planar_5rrr", "--phi-step", "400"),
+    ("design-search", "family", "planar_rrr", "--phi-step", "400"),
 ])
 def test_a_phi_step_beyond_a_turn_is_refused(arguments):
     one_line_error(screwkit(*arguments), "Expected 0 < --phi-step <= 360 (deg)")
@@ -517,8 +520,8 @@ EVERY_COMMAND = {
     "map": ("map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--phi-step", "30", "--out", "{tmp}/map.nc"),
     "map-spatial": ("map", "ups_hexapod_8", "--grid", "x:-0.02:0.02:0.02", "--grid", "y:-0.02:0.02:0.02",
                     "--over", "yaw:0:360:90"),
-    "design-search-permutations": ("design-search", "planar_5rrr", "--permutations", "--phi-step", "30"),
-    "design-search-optimise": ("design-search", "planar_5rrr", "--optimise", "--maxiter", "1", "--popsize", "2",
+    "design-search-permutations": ("design-search", "permutations", "planar_5rrr", "--phi-step", "30"),
+    "design-search-optimise": ("design-search", "optimise", "planar_5rrr", "--maxiter", "1", "--popsize", "2",
                                "--step", "0.2", "--urdf", "{tmp}/best.urdf"),
     "view": ("view", "planar_5rrr", "--html", "{tmp}/view.html"),
 }

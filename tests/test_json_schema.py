@@ -82,8 +82,8 @@ def test_list_verify_convert_and_design_search_validate(files, tmp_path):
     validate("list", [])
     assert validate("verify", ["five_bar", "--samples", "50"])["largest_deviation"] < 1e-9
     validate("convert", [files / "five_bar.xml", tmp_path / "five_bar.urdf"])
-    validate("design-search", ["planar_5rrr", "--permutations", "--phi-step", "60", "--quiet"])
-    validate("design-search", ["planar_rrr", "--budget", "4", "--quiet", "--step", "0.2", "--phi-step", "30"])
+    validate("design-search", ["permutations", "planar_5rrr", "--phi-step", "60", "--quiet"])
+    validate("design-search", ["family", "planar_rrr", "--budget", "4", "--quiet", "--step", "0.2", "--phi-step", "30"])
 
 
 def test_every_command_with_json_has_a_schema():
@@ -99,7 +99,8 @@ def command_options(name: str) -> set[str]:
     from screwkit.cli import app
 
     command = app.get_command(click.Context(app), name)
-    return {option for parameter in command.params for option in getattr(parameter, "opts", ())}
+    commands = [command, *getattr(command, "commands", {}).values()]  # a group: its subcommands' options too
+    return {option for each in commands for parameter in each.params for option in getattr(parameter, "opts", ())}
 
 
 def test_a_mechanism_whose_legs_have_loops_inside_reports_valid_json(tmp_path):

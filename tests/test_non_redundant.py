@@ -102,12 +102,13 @@ def test_verify_and_design_search_where_they_apply():
     assert "textbook pressure angles" in verified.stdout
     spatial = screwkit("verify", "ups_stewart_6")
     assert spatial.returncode == 1 and spatial.stderr.count("\n") == 1 and "spatial" in spatial.stderr
-    refused = screwkit("design-search", "five_bar", "--permutations")
+    refused = screwkit("design-search", "permutations", "five_bar")
     assert refused.returncode == 1 and refused.stderr.count("\n") == 1 and "x, y" in refused.stderr
     for family, legs, region in (("planar_rrr", "3", ["--step", "0.2", "--phi-step", "30"]),
                                  ("ups_hexapod", "6", ["--grid", "x:-0.1:0.1:0.1", "--grid", "y:-0.1:0.1:0.1",
                                                        "--over", "yaw:0:10:10", "--level", "0.1"])):
-        searched = screwkit("design-search", family, "--legs", legs, "--budget", "4", "--json", "--quiet", *region)
+        searched = screwkit("design-search", "family", family, "--legs", legs, "--budget", "4", "--json", "--quiet",
+                            *region)
         assert searched.returncode == 0, searched.stdout + searched.stderr
         report = json.loads(searched.stdout)
         assert report["legs"] == int(legs) and report["region"].startswith("lmti >= ")

@@ -25,6 +25,7 @@ from screwkit.plots import (  # noqa: E402
     COLORMAP,
     INDEX_RANGE,
     MAX_LABELLED_CURVES,
+    MapGrid,
     design_comparison_figure,
     map_figure,
     save_figure,
@@ -420,9 +421,8 @@ def test_design_comparison_on_a_rectangular_grid_of_angles():
     rng = np.random.default_rng(1)
     grids = [rng.uniform(0, 1, (4, 5)) for _ in range(2)]
     grids[1][0, 0] = np.nan
-    figure = design_comparison_figure(*grids, 1.0, 0.5, "start", index="f_io1", over="yaw",
-                                      axes_labels=("roll (rad)", "pitch (rad)"), area_unit="rad\u00b2",
-                                      coordinates=(roll, pitch))
+    layout = MapGrid(1.0, coordinates=(roll, pitch), axes_labels=("roll (rad)", "pitch (rad)"), area_unit="rad\u00b2")
+    figure = design_comparison_figure(*grids, layout, 0.5, "start", index="f_io1", over="yaw")
     panels = [ax for ax in figure.axes if ax.get_title()]
     for ax, grid in zip(panels, grids):
         area = np.sum(grid[np.isfinite(grid)] >= 0.5) * 0.1 * 0.2

@@ -16,7 +16,8 @@ from screwkit.indices.registry import INDICES, IndexRecord, column_label, index_
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.design.objectives import disc_region, region_metrics
-from screwkit.studies.maps import map_block
+from screwkit.studies.maps import MapBlock, map_block
+from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.sweep import sweep
 
 TOY = IndexRecord("toy_margin", "TOY", "a test's toy", "LMTI minus ITI", compute=lambda r: r.lmti - r.iti)
@@ -50,8 +51,8 @@ def test_a_registered_index_reaches_every_output(toys):
     assert column_label("toy_margin") == "TOY (a test's toy)"
 
     over = np.deg2rad(np.arange(0.0, 360.0, 30.0))[:, None]
-    block = map_block(mechanism, mechanism.home_pose, 0, np.array([0.0, 0.1]), 1, np.array([0.0]),
-                      np.ones((1, 2), dtype=bool), (2,), over, 1e-6, None, False)
+    block = map_block(mechanism, MapBlock(mechanism.home_pose, 0, np.array([0.0, 0.1]), 1, np.array([0.0]),
+                                          np.ones((1, 2), dtype=bool), (2,), over), AnalysisOptions(threshold=1e-6))
     for x, got in zip((0.0, 0.1), block["toy_margin"]):
         around = indices_at_poses(mechanism, np.column_stack([np.full(12, x), np.zeros(12), over[:, 0]]))
         assert got == pytest.approx(np.min(around.lmti - around.iti), abs=1e-15)

@@ -30,7 +30,7 @@ from screwkit.studies.maps import disc_size
 
 SMALL_DISC = ("--radius", "0.3", "--step", "0.1", "--phi-step", "30")
 """A planar family's region of 29 points x 12 angles: a design in a fraction of a second."""
-SEARCH = ("design-search", "planar_rrr", *SMALL_DISC, "--popsize", "4")
+SEARCH = ("design-search", "family", "planar_rrr", *SMALL_DISC, "--popsize", "4")
 """A search of the planar family: 12 designs per generation (3 varied parameters x 4)."""
 SMALL_MAP = ("map", "planar_5rrr", "--radius", "0.1", "--step", "0.05", "--phi-step", "90")
 """13 grid points x 4 orientations."""

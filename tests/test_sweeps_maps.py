@@ -22,7 +22,12 @@ from screwkit.screw.planar import paper_5rrr, planar_joint_points, rrr_chain_scr
 from screwkit.studies.design.permutations import permutation_search, planar_design, rotation_class
 from screwkit.studies.files import write_dataset
 from screwkit.studies.maps import GridMap, index_map, planar_disc_map
+from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.sweep import sweep
+from screwkit.studies.tasks import Execution
+
+QUIET = Execution(progress=False)
+"""Local threads, no progress bar."""
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +75,7 @@ def test_sweep_at_the_centre_matches_fig_4(five):
 
 
 def test_disc_map_values_are_minima_over_the_rotation(five, tmp_path):
-    dataset = planar_disc_map(five, 2.0, 0.25, 15.0, progress=False)
+    dataset = planar_disc_map(five, 2.0, 0.25, 15.0, execution=QUIET)
     assert set(dataset.coords) >= {"x", "y"}
     assert {"iti", "lmti", "f_o1", "f_io1", "f_o2", "f_io2"} <= set(dataset.data_vars)
     iti = dataset["iti"].values
@@ -84,7 +89,7 @@ def test_disc_map_values_are_minima_over_the_rotation(five, tmp_path):
             continue
         for name, value in expected.items():
             assert float(point[name]) == pytest.approx(value, abs=1e-12)
-    closed = planar_disc_map(five, 2.0, 0.25, 15.0, closed_forms=True, progress=False)
+    closed = planar_disc_map(five, 2.0, 0.25, 15.0, analysis=AnalysisOptions(closed_forms=True), execution=QUIET)
     for name in ("iti", "lmti", "f_o1", "f_io1"):
         np.testing.assert_allclose(dataset[name], closed[name], atol=1e-9)
     path = tmp_path / "map.nc"
@@ -96,7 +101,7 @@ def test_disc_map_values_are_minima_over_the_rotation(five, tmp_path):
 
 def test_map_written_without_xarray_reads_back_as_the_dataset(five, tmp_path):
     """The command line writes the plain GridMap with scipy; xarray reads it back as index_map's dataset."""
-    grid = planar_disc_map(five, 0.5, 0.25, 30.0, progress=False, as_dataset=False)
+    grid = planar_disc_map(five, 0.5, 0.25, 30.0, execution=QUIET, as_dataset=False)
     assert isinstance(grid, GridMap)
     dataset = grid.to_dataset()
     write_dataset(grid, tmp_path / "plain.nc")
@@ -113,7 +118,7 @@ def test_map_written_without_xarray_reads_back_as_the_dataset(five, tmp_path):
 def test_map_as_csv_has_one_row_per_grid_point(five, tmp_path):
     import pandas as pd
 
-    grid = planar_disc_map(five, 0.2, 0.1, 30.0, progress=False, as_dataset=False)
+    grid = planar_disc_map(five, 0.2, 0.1, 30.0, execution=QUIET, as_dataset=False)
     dataset = grid.to_dataset()
     write_dataset(grid, tmp_path / "map.csv")
     table = pd.read_csv(tmp_path / "map.csv")
@@ -128,7 +133,7 @@ def test_spatial_map_over_an_orientation_set():
     hexapod = load("ups_hexapod_8")
     grid = {"x": np.array([-0.1, 0.0, 0.1]), "y": np.array([-0.05, 0.05])}
     over = {"yaw": np.deg2rad([0.0, 10.0, 20.0]), "roll": np.deg2rad([-5.0, 5.0])}
-    dataset = index_map(hexapod, grid, over, progress=False)
+    dataset = index_map(hexapod, grid, over, execution=QUIET)
     assert dataset["f_o1"].shape == (2, 3)
     home = np.asarray(hexapod.home_pose, dtype=float)
     poses = np.array([[0.1, -0.05, home[2], roll, 0.0, yaw] for yaw in over["yaw"] for roll in over["roll"]])
@@ -146,20 +151,20 @@ def cluster():
 
 def test_distributed_map_equals_local(five, cluster):
     """The same tasks give bit-identical results on a 2-worker cluster and on local threads."""
-    local = planar_disc_map(five, 0.4, 0.1, 10.0, progress=False, configurations_per_task=2000)
-    remote = planar_disc_map(five, 0.4, 0.1, 10.0, scheduler=cluster.scheduler.address, progress=False,
-                             configurations_per_task=2000)
+    local = planar_disc_map(five, 0.4, 0.1, 10.0, execution=Execution(progress=False, configurations_per_task=2000))
+    remote = planar_disc_map(five, 0.4, 0.1, 10.0, execution=Execution(
+        scheduler=cluster.scheduler.address, progress=False, configurations_per_task=2000))
     for name in local.data_vars:
         np.testing.assert_array_equal(local[name].values, remote[name].values)
 
 
 def test_a_worker_lost_mid_run_loses_nothing(five, cluster):
-    local = planar_disc_map(five, 0.5, 0.05, 10.0, progress=False, configurations_per_task=400)
+    local = planar_disc_map(five, 0.5, 0.05, 10.0, execution=Execution(progress=False, configurations_per_task=400))
     outcome = {}
 
     def run():
-        outcome["map"] = planar_disc_map(five, 0.5, 0.05, 10.0, scheduler=cluster, progress=False,
-                                         configurations_per_task=400)
+        outcome["map"] = planar_disc_map(five, 0.5, 0.05, 10.0, execution=Execution(
+            scheduler=cluster, progress=False, configurations_per_task=400))
 
     before = cluster.run(os.getpid)
     thread = threading.Thread(target=run)
@@ -180,7 +185,7 @@ def test_a_worker_lost_mid_run_loses_nothing(five, cluster):
 
 
 def test_permutation_search_ranks_the_papers_design_first(five):
-    ranked = permutation_search(planar_design(five), phi_step_degrees=5.0, progress=False)
+    ranked = permutation_search(planar_design(five), phi_step_degrees=5.0, execution=QUIET)
     assert len(ranked) == 240
     best = round(ranked[0].score, 9)
     winners = {(d.permutation, d.working_mode) for d in ranked if round(d.score, 9) == best}
@@ -207,7 +212,7 @@ def test_cli_sweep_map_and_design_search(tmp_path):
         assert dataset["f_o1"].dims == ("y", "x")
     again = screwkit("map", "planar_5rrr", "--radius", "0.2", "--step", "0.1", "--out", tmp_path / "m.nc")
     assert again.returncode == 1 and "m.nc: the file exists; pass --overwrite to replace it." in again.stderr
-    result = screwkit("design-search", "planar_5rrr", "--permutations", "--phi-step", "10", "--json", "--quiet")
+    result = screwkit("design-search", "permutations", "planar_5rrr", "--phi-step", "10", "--json", "--quiet")
     assert result.returncode == 0, result.stderr
     designs = json.loads(result.stdout)["designs"]
     assert len(designs) == 240 and set(designs[0]) >= {"permutation", "working_mode", "score"}
@@ -215,7 +220,7 @@ def test_cli_sweep_map_and_design_search(tmp_path):
 
 
 def test_optimised_design_is_no_worse_and_its_urdf_loads(five, tmp_path):
-    result = screwkit("design-search", "planar_5rrr", "--optimise", "--maxiter", "1", "--popsize", "2",
+    result = screwkit("design-search", "optimise", "planar_5rrr", "--maxiter", "1", "--popsize", "2",
                       "--step", "0.1", "--phi-step", "15", "--urdf", tmp_path / "best.urdf", "--json")
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout)

@@ -24,6 +24,7 @@ from screwkit.io.loader import load  # noqa: E402
 from screwkit.plots import COLORMAP, map_figure, save_figure, sweep_figure  # noqa: E402
 from screwkit.studies.maps import planar_disc_map  # noqa: E402
 from screwkit.studies.sweep import sweep  # noqa: E402
+from screwkit.studies.tasks import Execution  # noqa: E402
 
 FOLDER = Path(__file__).resolve().parent
 
@@ -68,7 +69,7 @@ def main() -> None:
     save_figure(figure, FOLDER / "fig4_sweep.png", dpi=90)
     plt.close(figure)
 
-    fig5 = planar_disc_map(mechanism, 0.6, 0.02, 1.0, progress=False)
+    fig5 = planar_disc_map(mechanism, 0.6, 0.02, 1.0, execution=Execution(progress=False))
     figure = map_figure(fig5, ["iti", "lmti", "f_o1"])
     save_figure(figure, FOLDER / "map_5rrr.png")
     plt.close(figure)

@@ -9,15 +9,13 @@ import numpy as np
 
 from screwkit.cli.options import (
     GreedyOption,
+    analysis_options,
     fail,
-    fault_option,
-    ignore_limits_option,
     json_option,
     length_unit_option,
     load_mechanism,
     mechanism_argument,
     parse_pose,
-    threshold_option,
 )
 from screwkit.closure import forward
 from screwkit.indices.registry import INDICES
@@ -147,24 +145,21 @@ def pose_from_actuators(mechanism, text: str, start):
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
                    "it keeps.")
-@threshold_option
-@fault_option
-@ignore_limits_option
+@analysis_options(closed_forms=False)
 @length_unit_option
 @json_option
-def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type: str, ignore_limits: bool, length_unit,
-            as_json: bool) -> None:
+def analyze(mechanism: str, pose, actuator_values, analysis, length_unit, as_json: bool) -> None:
     """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose."""
 
     loaded = load_mechanism(mechanism, length_unit, graphs=True)
     if isinstance(loaded, GraphMechanism):
-        return _analyze_graph(loaded, pose is not None or actuator_values is not None, threshold, fault_type,
-                              as_json)
+        return _analyze_graph(loaded, pose is not None or actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)
     if actuator_values is not None:
         target = pose_from_actuators(loaded, actuator_values, target)
     try:
-        result = indices_at_pose(loaded, target, threshold=threshold, limits=not ignore_limits, fault_type=fault_type)
+        result = indices_at_pose(loaded, target, threshold=analysis.threshold, limits=analysis.limits,
+                                 fault_type=analysis.fault_type)
     except ValueError as error:
         raise fail(str(error)) from None
     report = result.to_dict()
@@ -180,13 +175,13 @@ def analyze(mechanism: str, pose, actuator_values, threshold: float, fault_type:
             click.echo(f"(converted from {line})", err=True)
 
 
-def _analyze_graph(graph: GraphMechanism, posed: bool, threshold: float, fault_type: str, as_json: bool) -> None:
+def _analyze_graph(graph: GraphMechanism, posed: bool, analysis, as_json: bool) -> None:
     """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration."""
     if posed:
         raise fail(f"{graph.tree.source}: its legs have loops inside them, analysed at the file's configuration only "
                    "(poses of such legs are not solved yet): leave out --pose and --actuators.")
     try:
-        result = graph.indices(threshold=threshold, fault_type=fault_type)
+        result = graph.indices(threshold=analysis.threshold, fault_type=analysis.fault_type)
     except ValueError as error:
         raise fail(str(error)) from None
     report = {**result.to_dict(), "mechanism": graph.name, "pose": {}, "converted": graph.report.lines()}

@@ -1,4 +1,6 @@
-"""``screwkit design-search``: the paper's permutation selection, and searching a parametric family."""
+"""``screwkit design-search``: searching a parametric family, the paper's permutation selection, and the
+planar family from a file's design, as three subcommands sharing their option groups
+(:mod:`screwkit.cli.design_options`)."""
 
 from __future__ import annotations
 
@@ -6,215 +8,230 @@ import json
 
 import click
 import numpy as np
-from click.core import ParameterSource
 
-from screwkit.cli.family_search import parse_assignments, parse_bounds, read_study, region_of, search_family
+from screwkit.cli.design_options import (
+    RegionOptions,
+    Report,
+    SearchOptions,
+    check_phi_step,
+    design_outputs_options,
+    parse_assignments,
+    parse_bounds,
+    region_of,
+    region_options,
+    report_options,
+    search_options,
+    study_option,
+)
+from screwkit.cli.family_search import run_search
 from screwkit.cli.options import (
-    check_colour_scale,
-    check_outputs,
+    connected,
+    echo_error,
+    execution_options,
     fail,
-    json_option,
     length_unit_option,
     load_mechanism,
-    overwrite_option,
-    quiet_option,
-    scheduler_client,
+    mechanism_argument,
 )
-from screwkit.studies.design import permutations as search
-from screwkit.studies.design.families import FAMILIES, family
-from screwkit.studies.design.objectives import METRICS
-from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
-from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError
+from screwkit.studies.design.families import FAMILIES, Family, family
+from screwkit.studies.design.optimise import Constraint, Study
+from screwkit.studies.design.permutations import (
+    family_values,
+    permutation_search,
+    planar_design,
+    rotation_class,
+    slots_of,
+)
+from screwkit.studies.tasks import ClusterError
 
-__all__ = ["design_search"]
+__all__ = ["design_search", "SUBCOMMANDS"]
+
+SUBCOMMANDS = ("family", "permutations", "optimise")
+"""The subcommands, in the order ``--help`` lists them."""
+
+LEGACY_FLAGS = {"--permutations": "permutations", "--optimise": "optimise"}
+"""The flags of the flat form (``design-search MECHANISM --permutations``) and the subcommand each became."""
 
 
-def _permutations(loaded, template, current, phi_step, closed_forms, scheduler, connect_timeout, top, as_json, quiet):
+class DesignSearchGroup(click.Group):
+    """The subcommands; the flat form of earlier releases (``design-search FAMILY|MECHANISM [--permutations |
+    --optimise] ...``) is still read, for one release, as its subcommand, with a note on stderr."""
 
-    ranked = search.permutation_search(template, phi_step_degrees=phi_step, closed_forms=closed_forms,
-                                       scheduler=scheduler, progress=False if quiet else None,
-                                       connect_timeout=connect_timeout)
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(SUBCOMMANDS)
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        if args and args[0] not in self.commands and args[0] not in ctx.help_option_names:
+            args = _from_flat_form(args)
+        return super().parse_args(ctx, args)
+
+
+def _from_flat_form(args: list[str]) -> list[str]:
+    """``design-search X --permutations ...`` -> ``permutations X ...`` (``--optimise``: ``optimise``, neither:
+    ``family``), said on stderr unless ``--quiet``."""
+    flags = [arg for arg in args if arg in LEGACY_FLAGS]
+    if len(set(flags)) > 1:
+        raise fail("Expected one of --permutations or --optimise, not both (they are the subcommands "
+                   "design-search permutations and design-search optimise).")
+    subcommand = LEGACY_FLAGS[flags[0]] if flags else "family"
+    rest = [arg for arg in args if arg not in LEGACY_FLAGS]
+    if "--quiet" not in rest:
+        old = f"design-search MECHANISM {flags[0]}" if flags else "design-search FAMILY"
+        new = f"design-search {subcommand} {'FAMILY' if subcommand == 'family' else 'MECHANISM'}"
+        echo_error(f"Deprecated: `{old}` is now `{new}` (the flat form goes in the next release).")
+    return [subcommand, *rest]
+
+
+@click.group("design-search", cls=DesignSearchGroup)
+def design_search() -> None:
+    """Search designs for fault tolerance.
+
+    family FAMILY: vary a parametric family's parameters (planar_rrr, ups_hexapod, rss_hexapod, delta,
+    prs_ups) to optimise one or more metrics of the fault-tolerant region of a map (differential evolution, or
+    NSGA-II for a Pareto front), e.g. design-search family ups_hexapod --objective area --budget 200, or
+    design-search family --study study.yaml. permutations MECHANISM (a planar n-RRR): rank every slot
+    assignment (the paper's selection). optimise MECHANISM: search the planar_rrr family from a planar n-RRR's
+    design.
+    """
+
+
+def _check(search_options: SearchOptions, outputs, report: Report) -> None:
+    """What a search checks before any work: its options, and its outputs (no file written yet)."""
+    search_options.check()
+    outputs.check(report.quiet, search_options.state)
+
+
+def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, region: RegionOptions, outputs,
+         execution, report: Report, start_name: str | None = None) -> None:
+    """Search ``chosen`` from ``fixed`` and ``initial`` values over the region, then report."""
+    try:
+        start_mechanism = chosen.mechanism({**fixed, **initial}) if region.spatial else None
+    except ValueError as error:
+        raise fail(f"The start design: {error}") from None
+    where = region_of(chosen, start_mechanism, region)
+    free = options.free or [name for name in chosen.free if name not in fixed]
+    try:
+        study = Study(chosen, where, tuple(options.objectives) or ("area",), free=tuple(free) or None, fixed=fixed,
+                      initial=initial, bounds=parse_bounds(chosen, options.bounds),
+                      constraints=tuple(Constraint.parse(c) for c in options.constraints),
+                      budget=options.evaluations(len(free)), seed=options.seed, popsize=options.popsize)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    with connected(execution) as execution:  # the handshake before any work
+        run_search(study, options.state, execution, outputs, report, start_name)
+
+
+@design_search.command("family", short_help="Search a parametric family: one objective or a Pareto front.")
+@study_option
+@click.argument("family_name", metavar="[FAMILY]", required=False)
+@click.option("--legs", type=click.IntRange(min=1), help="Number of legs (default: 5 planar, 8 hexapods).")
+@search_options
+@region_options
+@design_outputs_options
+@execution_options()
+@report_options
+def family_search(family_name, legs, search, region, outputs, execution, report) -> None:
+    """Search a parametric FAMILY for the largest fault-tolerant region (or a Pareto front).
+
+    FAMILY is planar_rrr, ups_hexapod, rss_hexapod, delta or prs_ups (docs/design.md): its parameters
+    vary to optimise one or more metrics of the fault-tolerant region of a map, by differential evolution
+    (one objective) or NSGA-II (a Pareto front), seeded and resumable (--state), e.g.
+    design-search family ups_hexapod --objective area --budget 200, or design-search family --study study.yaml.
+    """
+    if family_name is None:
+        raise fail("Expected a FAMILY argument (or a study file with a family).")
+    if family_name not in FAMILIES:
+        raise fail(f"Expected a family ({', '.join(FAMILIES)}), got {family_name!r}; a planar n-RRR's design is "
+                   "searched with design-search permutations MECHANISM or design-search optimise MECHANISM.")
+    _check(search, outputs, report)
+    try:
+        chosen = family(family_name, legs)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    fixed, initial = parse_assignments(chosen, search.assignments, "--set"), parse_assignments(chosen, search.starts,
+                                                                                             "--start")
+    _run(chosen, fixed, initial, search, region, outputs, execution, report)
+
+
+def _planar_design(mechanism: str, length_unit: str | None):
+    if mechanism in FAMILIES:
+        raise fail(f"{mechanism} is a family: design-search family {mechanism} searches it; this subcommand takes "
+                   "a mechanism (planar_5rrr, a file).")
+    loaded = load_mechanism(mechanism, length_unit)
+    try:
+        return loaded, planar_design(loaded)
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
+@design_search.command("optimise", short_help="Search the planar_rrr family from a planar n-RRR's design.")
+@mechanism_argument
+@search_options
+@region_options
+@design_outputs_options
+@execution_options()
+@length_unit_option
+@report_options
+def optimise(mechanism, search, region, outputs, execution, length_unit, report) -> None:
+    """Search the planar_rrr family from the design of MECHANISM, a planar n-RRR.
+
+    The family's start is the file's platform radius and arm lengths (base, slots and working mode kept);
+    the options are those of design-search family.
+    """
+    _check(search, outputs, report)
+    loaded, template = _planar_design(mechanism, length_unit)
+    try:
+        count, values = family_values(template)
+    except ValueError as error:
+        raise fail(f"design-search optimise: {error}") from None
+    chosen = family("planar_rrr", count)
+    varied = search.free or chosen.free
+    fixed = {name: value for name, value in values.items() if name not in varied}
+    fixed.update(parse_assignments(chosen, search.assignments, "--set"))
+    initial = {name: values[name] for name in varied if name not in fixed}
+    initial.update(parse_assignments(chosen, search.starts, "--start"))
+    _run(chosen, fixed, initial, search, region, outputs, execution, report, start_name=loaded.name)
+
+
+@design_search.command("permutations", short_help="Rank the slot permutations of a planar n-RRR (the paper).")
+@mechanism_argument
+@click.option("--phi-step", type=float, default=1.0, show_default=True,
+              help="Step of the full rotation at the centre the designs are scored over (deg).")
+@click.option("--closed-forms", is_flag=True, help="Score with the paper's planar closed forms.")
+@execution_options()
+@length_unit_option
+@report_options
+def permutations(mechanism, phi_step, closed_forms, execution, length_unit, report: Report) -> None:
+    """Rank every assignment of platform slots to the chains of MECHANISM (a planar n-RRR), in both working
+    modes: the paper's design selection, each scored by the minimum F_O1 over a full rotation at the centre."""
+    check_phi_step(phi_step)
+    loaded, template = _planar_design(mechanism, length_unit)
+    current = tuple(int(s) for s in slots_of(template))
+    with connected(execution) as execution:  # the handshake before any work
+        try:
+            ranked = permutation_search(template, phi_step_degrees=phi_step, closed_forms=closed_forms,
+                                        execution=execution)
+        except ClusterError as error:
+            raise fail(str(error)) from None
+    _print_ranking(loaded, template, current, phi_step, ranked, report)
+
+
+def _print_ranking(loaded, template, current, phi_step, ranked, report: Report) -> None:
     best = ranked[0].score
     rows = [{"permutation": list(d.permutation), "working_mode": d.working_mode, "score": d.score,
              "rank": 1 + sum(round(o.score, 9) > round(d.score, 9) for o in ranked if np.isfinite(o.score)),
-             "rotation_class": list(search.rotation_class(d.permutation))} for d in ranked]
+             "rotation_class": list(rotation_class(d.permutation))} for d in ranked]
     mode = int(template.working_mode[0])
     mine = next(r for r in rows if tuple(r["permutation"]) == current and r["working_mode"] == mode)
-    if as_json:
+    if report.as_json:
         click.echo(json.dumps({"mechanism": loaded.name, "current": list(current), "phi_step_deg": phi_step,
                                "designs": rows}))
         return
     click.echo(f"{loaded.name}: {len(ranked)} designs (slot permutations x 2 working modes); score = min F_O1 "
                f"over a full rotation at the centre, {phi_step:g} deg steps")
     click.echo(f"{'rank':>4s}  {'permutation':<18s} {'mode':>4s}  {'score':>7s}")
-    for row in rows[:top]:
+    for row in rows[:report.top]:
         mark = "  <- this file's design" if row is mine else ""
         click.echo(f"{row['rank']:>4d}  {str(row['permutation']):<18s} {row['working_mode']:>+4d}  "
                    f"{row['score']:.4f}{mark}")
     click.echo(f"this file's design {list(current)} ranks {mine['rank']} (best score {best:.4f})")
-
-
-@click.command("design-search")
-@click.argument("mechanism", metavar="FAMILY|MECHANISM", required=False)
-@click.option("--study", "study_path", type=click.Path(dir_okay=False),
-              help="A study file (.yaml or .json) whose keys stand for this command's options (family, objectives, "
-                   "constraints, free, set, start, bounds, budget, seed, popsize, radius, step, phi_step, grid, over, "
-                   "layers, index, level); options given on the command line win.")
-@click.option("--permutations", "search_permutations", is_flag=True,
-              help="MECHANISM: rank every assignment of platform slots to chains in both working modes "
-                   "(the paper's selection).")
-@click.option("--optimise", is_flag=True,
-              help="MECHANISM: search the planar_rrr family from this planar n-RRR (its platform radius and arm "
-                   "lengths; base, slots and working mode kept).")
-@click.option("--legs", type=click.IntRange(min=1), help="FAMILY: number of legs (default: 5 planar, 8 hexapods).")
-@click.option("--objective", "objectives", multiple=True, type=click.Choice(list(METRICS)),
-              help="Metric to optimise (repeat for a Pareto front; default: area). See docs/design.md.")
-@click.option("--constraint", "constraints", multiple=True, metavar="METRIC>=VALUE|METRIC<=VALUE",
-              help="A bound every design kept must meet, e.g. footprint<=1.2 (repeatable).")
-@click.option("--free", multiple=True, metavar="NAME", help="A parameter to vary (repeatable; default: the family's).")
-@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE", help="Fix a parameter (repeatable).")
-@click.option("--start", "starts", multiple=True, metavar="NAME=VALUE",
-              help="Starting value of a varied parameter (repeatable; default: the family's default).")
-@click.option("--bounds", "bound_texts", multiple=True, metavar="NAME=LOWER:UPPER",
-              help="Narrow a varied parameter's bounds (repeatable).")
-@click.option("--budget", type=click.IntRange(min=0), help="Designs evaluated (count; default: 384).")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search (same seed, same run).")
-@click.option("--state", type=click.Path(dir_okay=False),
-              help="Evaluation log: written as the search goes; run again with it to resume an interrupted search.")
-@click.option("--radius", type=float, help="Planar region: radius of the disc (m; default 0.6).")
-@click.option("--grid", "grids", multiple=True, metavar="COORDINATE:START:STOP:STEP",
-              help="Spatial region: a map coordinate, stop included (twice), as screwkit map --grid.")
-@click.option("--over", "overs", multiple=True, metavar="COORDINATE:START:STOP:STEP",
-              help="Spatial region: the orientation set, stop excluded, as screwkit map --over (repeatable).")
-@click.option("--layers", metavar="COORDINATE:START:STOP:STEP",
-              help="Spatial region: stack maps along a third coordinate (stop excluded) for a volume.")
-@click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|...",
-              help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1).")
-@click.option("--phi-step", type=float, default=None,
-              help="Step of the full rotation (deg; --permutations: 1, planar region: 5).")
-@click.option("--top", type=click.IntRange(min=2), default=12, show_default=True,
-              help="Designs listed: --permutations ranks, the Pareto front (evenly spread along it) (count).")
-@click.option("--level", type=float, default=None,
-              help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar).")
-@click.option("--maxiter", type=click.IntRange(min=1),
-              help="One objective: generations of differential evolution (sets the budget to popsize x parameters x "
-                   "(maxiter + 1)).")
-@click.option("--popsize", type=click.IntRange(min=2), default=8, show_default=True,
-              help="Population size per varied parameter (count).")
-@click.option("--step", type=float, default=None, help="Planar region: grid step of the disc (m; default 0.05).")
-@click.option("--urdf", "urdf_path", type=click.Path(dir_okay=False),
-              help="Write the best design here (.urdf; several objectives: the front's best in the first).")
-@click.option("--table", "table_path", type=click.Path(dir_okay=False),
-              help="Every evaluation, its parameters and metrics, the best flagged (.nc or .csv).")
-@click.option("--figure", "figure_path", type=click.Path(dir_okay=False),
-              help="Maps of the start and the best design side by side (.png, .pdf or .svg).")
-@click.option("--front-figure", "front_figure_path", type=click.Path(dir_okay=False),
-              help="Several objectives: the Pareto front over every evaluation (.png, .pdf or .svg).")
-@click.option("--vmin", type=float, default=None, help="--figure: lower end of the colour scale (index value).")
-@click.option("--vmax", type=float, default=None, help="--figure: upper end of the colour scale (index value).")
-@click.option("--closed-forms", is_flag=True, help="--permutations: score with the planar closed forms.")
-@click.option("--scheduler", metavar="ADDRESS",
-              help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 (default: local threads).")
-@click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
-              show_default=True,
-              help="Seconds to wait for the --scheduler to answer.")
-@length_unit_option
-@json_option
-@overwrite_option
-@quiet_option
-@click.pass_context
-def design_search(context, study_path, **options) -> None:
-    """Search designs for fault tolerance.
-
-    FAMILY (planar_rrr, ups_hexapod, rss_hexapod, delta, prs_ups): vary the family's parameters to optimise one
-    or more metrics of the fault-tolerant region of a map (differential evolution, or NSGA-II for
-    a Pareto front), e.g. design-search ups_hexapod --objective area --budget 200, or
-    design-search --study study.yaml. MECHANISM (a planar n-RRR): --permutations ranks every slot
-    assignment (the paper's selection); --optimise searches the planar_rrr family from it.
-    """
-    if study_path:
-        for name, value in read_study(study_path).items():
-            given = context.get_parameter_source(name) not in (ParameterSource.DEFAULT, None)
-            if not given:
-                options[name] = value
-    if options["mechanism"] is None:
-        raise fail("Expected a FAMILY or MECHANISM argument (or a study file with a family).")
-    _design_search(**options)
-
-
-def _design_search(mechanism, search_permutations, optimise, legs, objectives, constraints, free, assignments, starts,
-                   bound_texts, budget, seed, state, radius, grids, overs, layers, region_index, phi_step, top, level,
-                   maxiter, popsize, step, urdf_path, table_path, figure_path, front_figure_path, vmin, vmax,
-                   closed_forms, scheduler, connect_timeout, length_unit, as_json, overwrite, quiet) -> None:
-    family_mode = mechanism in FAMILIES
-    if family_mode and (search_permutations or optimise):
-        raise fail(f"{mechanism} is a family: --permutations and --optimise take a mechanism (planar_5rrr, a file).")
-    if not family_mode and search_permutations == optimise:
-        raise fail(f"Expected a family ({', '.join(FAMILIES)}), or a mechanism with exactly one of --permutations "
-                   "or --optimise.")
-    if phi_step is not None and not 0 < phi_step <= 360:
-        raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
-    if search_permutations and (urdf_path or figure_path or table_path or front_figure_path):
-        raise fail("--urdf, --table, --figure and --front-figure go with a family search or --optimise.")
-    searched = {"--objective": objectives, "--constraint": constraints, "--free": free, "--set": assignments,
-                "--start": starts, "--bounds": bound_texts, "--budget": budget, "--state": state, "--grid": grids,
-                "--over": overs, "--layers": layers, "--index": region_index, "--level": level, "--radius": radius,
-                "--step": step, "--maxiter": maxiter}
-    if search_permutations and any(value not in (None, ()) for value in searched.values()):
-        raise fail(f"{', '.join(k for k, v in searched.items() if v not in (None, ()))} go with a family search or "
-                   "--optimise, not --permutations.")
-    if maxiter is not None and budget is not None:
-        raise fail("Give --budget or --maxiter, not both.")
-    check_outputs({"--urdf": (urdf_path, (".urdf",)), "--table": (table_path, DATA_SUFFIXES),
-                   "--figure": (figure_path, FIGURE_SUFFIXES), "--front-figure": (front_figure_path, FIGURE_SUFFIXES)},
-                  overwrite, quiet, others={"--state": state})
-    check_colour_scale(vmin, vmax)
-    if family_mode:
-        try:
-            chosen = family(mechanism, legs)
-        except ValueError as error:
-            raise fail(str(error)) from None
-        fixed, initial = parse_assignments(chosen, assignments, "--set"), parse_assignments(chosen, starts, "--start")
-    else:
-        if legs is not None:
-            raise fail("--legs goes with a family.")
-        loaded = load_mechanism(mechanism, length_unit)
-        try:
-            template = search.planar_design(loaded)
-        except ValueError as error:
-            raise fail(str(error)) from None
-        if search_permutations:
-            current = tuple(int(s) for s in search.slots_of(template))
-            with scheduler_client(scheduler, connect_timeout) as client:  # the handshake before any work
-                try:
-                    _permutations(loaded, template, current, 1.0 if phi_step is None else phi_step, closed_forms,
-                                  client, connect_timeout, top, as_json, quiet)
-                except ClusterError as error:
-                    raise fail(str(error)) from None
-            return
-        try:
-            count, values = search.family_values(template)
-        except ValueError as error:
-            raise fail(f"--optimise: {error}") from None
-        chosen = family("planar_rrr", count)
-        varied = free or chosen.free
-        fixed = {name: value for name, value in values.items() if name not in varied}
-        fixed.update(parse_assignments(chosen, assignments, "--set"))
-        initial = {name: values[name] for name in varied if name not in fixed}
-        initial.update(parse_assignments(chosen, starts, "--start"))
-    try:
-        start_mechanism = chosen.mechanism({**fixed, **initial}) if (grids or overs or layers) else None
-    except ValueError as error:
-        raise fail(f"The start design: {error}") from None
-    region = region_of(chosen, start_mechanism, radius, step, phi_step, grids, overs, layers, region_index, level)
-    varied_count = len(free or [n for n in chosen.free if n not in fixed])
-    if maxiter is not None:
-        budget = popsize * varied_count * (maxiter + 1)
-    with scheduler_client(scheduler, connect_timeout) as client:  # the handshake before any work
-        search_family(chosen, region, objectives=objectives, constraints=constraints,
-                      free=free or [n for n in chosen.free if n not in fixed], fixed=fixed, initial=initial,
-                      bounds=parse_bounds(chosen, bound_texts), budget=384 if budget is None else budget, seed=seed,
-                      popsize=popsize, state=state, scheduler=client, connect_timeout=connect_timeout,
-                      urdf_path=urdf_path, table_path=table_path, figure_path=figure_path,
-                      front_figure_path=front_figure_path, vmin=vmin, vmax=vmax, as_json=as_json, quiet=quiet,
-                      start_name=None if family_mode else loaded.name, top=top)

@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import functools
+import inspect
 import json
 import sys
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import click
@@ -22,9 +25,10 @@ from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit,
 from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
 from screwkit.io.loader import load
 from screwkit.plots import colour_scale
-from screwkit.studies.files import WriteError, check_distinct, check_output
+from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, WriteError, check_distinct, check_output
 from screwkit.studies.maps import range_values
-from screwkit.studies.tasks import ClusterError, connect, disconnect
+from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError, Execution, connect, disconnect
 
 __all__ = [
     "GreedyOption",
@@ -38,12 +42,17 @@ __all__ = [
     "quiet_option",
     "overwrite_option",
     "colour_scale_options",
+    "option_group",
+    "analysis_options",
+    "execution_options",
+    "outputs_options",
+    "Outputs",
     "load_mechanism",
     "parse_pose",
     "parse_range",
     "check_outputs",
     "check_colour_scale",
-    "scheduler_client",
+    "connected",
     "fail",
     "echo_error",
 ]
@@ -208,6 +217,109 @@ def colour_scale_options(function: Callable) -> Callable:
                         help="Lower end of the figure's colour scale (index value; default 0).")(function)
 
 
+# -- option groups: options that travel together, handed to the command as one record ---------------
+
+def option_group(name: str, build: Callable, *options: Callable) -> Callable:
+    """Decorate a command with ``options`` and hand it their values as one argument, ``name``.
+
+    ``build`` takes the options' values by their destinations (those of its parameters that the
+    command has: a group may leave one out) and returns the record the command receives instead,
+    so that a command takes a few records rather than every option one by one. A group's options
+    are defined once and shared by every command that has them.
+    """
+    keys = tuple(inspect.signature(build).parameters)
+
+    def decorate(function: Callable) -> Callable:
+        @functools.wraps(function)
+        def command(*args, **values):
+            values[name] = build(**{key: values.pop(key) for key in keys if key in values})
+            return function(*args, **values)
+
+        for option in reversed(options):
+            command = option(command)
+        return command
+
+    return decorate
+
+
+def _quiet() -> bool:
+    context = click.get_current_context(silent=True)
+    return bool(context and context.params.get("quiet"))
+
+
+def _analysis(threshold: float, fault_type: str, ignore_limits: bool, closed_forms: bool = False) -> AnalysisOptions:
+    return AnalysisOptions(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms,
+                           limits=not ignore_limits)
+
+
+def analysis_options(*, closed_forms: bool = True) -> Callable:
+    """``--threshold``, ``--fault``, ``--closed-forms`` (unless not ``closed_forms``) and ``--ignore-limits``:
+    what is computed at every pose, as ``analysis``, an :class:`~screwkit.studies.options.AnalysisOptions`."""
+    closed = click.option("--closed-forms", is_flag=True,
+                          help="Use the paper's planar closed forms instead of the generic path.")
+    return option_group("analysis", _analysis, threshold_option, fault_option, *((closed,) if closed_forms else ()),
+                        ignore_limits_option)
+
+
+def _execution(scheduler: str | None, connect_timeout: float, task_size: int | None = None) -> Execution:
+    return Execution(scheduler=scheduler, connect_timeout=connect_timeout, configurations_per_task=task_size,
+                     progress=False if _quiet() else None)
+
+
+def execution_options(*, task_size: bool = False) -> Callable:
+    """``--scheduler``, ``--connect-timeout`` (and ``--task-size``): where the tasks run, as ``execution``, a
+    :class:`~screwkit.studies.tasks.Execution` (a progress bar when stderr is a terminal, unless ``--quiet``);
+    :func:`connected` connects to its scheduler."""
+    options = [
+        click.option("--scheduler", metavar="ADDRESS",
+                     help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 "
+                          "(default: local threads)."),
+        click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
+                     show_default=True, help="Seconds to wait for the --scheduler to answer."),
+    ]
+    if task_size:
+        options.append(click.option(
+            "--task-size", type=click.IntRange(min=1),
+            help="Configurations (grid points x orientations) per task (default: at most 131,072 and at least "
+                 "16,384, and 4 tasks per core of this machine where the map is large enough)."))
+    return option_group("execution", _execution, *options)
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """The files a command writes: its data (``--out``), its figure (``--figure``, with the ends of its
+    colour scale), and whether existing files are replaced (``--overwrite``)."""
+
+    out: str | None = None
+    figure: str | None = None
+    vmin: float | None = None
+    vmax: float | None = None
+    overwrite: bool = False
+
+    def check(self, quiet: bool) -> None:
+        """Every output checked before any computation (:func:`check_outputs`, :func:`check_colour_scale`)."""
+        check_outputs({"--out": (self.out, DATA_SUFFIXES), "--figure": (self.figure, FIGURE_SUFFIXES)},
+                      self.overwrite, quiet)
+        check_colour_scale(self.vmin, self.vmax)
+
+
+def _outputs(out: str | None, figure_path: str | None, overwrite: bool, vmin: float | None = None,
+             vmax: float | None = None) -> Outputs:
+    return Outputs(out=out, figure=figure_path, vmin=vmin, vmax=vmax, overwrite=overwrite)
+
+
+def outputs_options(*, colour_scale: bool = False) -> Callable:
+    """``--out``, ``--figure`` (with ``--vmin`` and ``--vmax`` if ``colour_scale``) and ``--overwrite``, as
+    ``outputs``, an :class:`Outputs`."""
+    return option_group(
+        "outputs", _outputs,
+        click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv."),
+        click.option("--figure", "figure_path", type=click.Path(dir_okay=False),
+                     help="Figure file: .png, .pdf or .svg."),
+        *((colour_scale_options,) if colour_scale else ()),
+        overwrite_option)
+
+
 # -- parsing ---------------------------------------------------------------------------------------
 
 def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True, graphs: bool = False):
@@ -328,16 +440,17 @@ def check_colour_scale(vmin: float | None, vmax: float | None) -> None:
 
 
 @contextlib.contextmanager
-def scheduler_client(scheduler: str | None, connect_timeout: float):
-    """``--scheduler``: its client, connected and its handshake made before any work (``None``: local threads)."""
-    if scheduler is None:
-        yield None
+def connected(execution: Execution):
+    """``--scheduler``: the execution with its scheduler's client, connected and its handshake made before any
+    work (no ``--scheduler``: local threads, as it is)."""
+    if execution.scheduler is None:
+        yield execution
         return
     try:
-        client = connect(scheduler, connect_timeout)
+        client = connect(execution.scheduler, execution.connect_timeout)
     except ClusterError as error:
         raise fail(str(error)) from None
     try:
-        yield client
+        yield replace(execution, scheduler=client)
     finally:
-        disconnect(client, connect_timeout)
+        disconnect(client, execution.connect_timeout)

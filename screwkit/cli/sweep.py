@@ -7,24 +7,22 @@ import numpy as np
 
 from screwkit.cli.options import (
     GreedyOption,
-    check_outputs,
+    Outputs,
+    analysis_options,
     echo_error,
     fail,
-    fault_option,
-    ignore_limits_option,
     length_unit_option,
     load_mechanism,
     mechanism_argument,
-    overwrite_option,
+    outputs_options,
     parse_pose,
     parse_range,
     quiet_option,
-    threshold_option,
 )
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import column_record, is_column
 from screwkit.plots import save_figure, sweep_figure
-from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, wide_table, write_dataset
+from screwkit.studies.files import wide_table, write_dataset
 from screwkit.studies.sweep import sweep as run_sweep
 
 __all__ = ["sweep", "fixed_pose", "write_outputs"]
@@ -37,12 +35,12 @@ def fixed_pose(mechanism, at: str | None) -> np.ndarray:
     return parse_pose(mechanism, at, "--at")
 
 
-def write_outputs(dataset, out, figure_path, figure_function, quiet: bool, **figure_options) -> None:
+def write_outputs(dataset, outputs: Outputs, figure_function, quiet: bool, **figure_options) -> None:
     """Write the data file and the figure (both checked before the computation), saying so on stderr.
 
     With neither, the data go to stdout as a CSV table.
     """
-
+    out, figure_path = outputs.out, outputs.figure
     if not out and not figure_path:
         if hasattr(dataset, "to_dataset"):
             dataset = dataset.to_dataset()
@@ -69,24 +67,18 @@ def write_outputs(dataset, out, figure_path, figure_function, quiet: bool, **fig
                    "(deg; the stop is excluded: 0:360:1 is 360 angles).")
 @click.option("--sweep", "sweep_spec", metavar="COORDINATE:START:STOP:STEP",
               help="The swept coordinate and its range, m or deg; the stop is excluded (yaw:0:360:1 is 360 angles).")
-@click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv.")
-@click.option("--figure", "figure_path", type=click.Path(dir_okay=False), help="Figure file: .png, .pdf or .svg.")
-@threshold_option
-@fault_option
-@click.option("--closed-forms", is_flag=True, help="Use the paper's planar closed forms instead of the generic path.")
-@ignore_limits_option
+@outputs_options()
+@analysis_options()
 @length_unit_option
-@overwrite_option
 @quiet_option
-def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fault_type, closed_forms, ignore_limits,
-          length_unit, overwrite, quiet) -> None:
+def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, length_unit, quiet) -> None:
     """Sweep one pose coordinate: every series of the paper's Figure 4 along it.
 
     The data go to --out (or, with neither --out nor --figure, to stdout as CSV); the minima
     found are summarised on stderr.
     """
 
-    check_outputs({"--out": (out, DATA_SUFFIXES), "--figure": (figure_path, FIGURE_SUFFIXES)}, overwrite, quiet)
+    outputs.check(quiet)
     loaded = load_mechanism(mechanism, length_unit)
     if (phi_range is None) == (sweep_spec is None):
         raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
@@ -99,8 +91,7 @@ def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fau
                    f"{', '.join(loaded.task_coordinates)}.")
     values = parse_range(text, "--phi" if phi_range else "--sweep", angular=is_angular(coordinate))
     try:
-        dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, threshold=threshold,
-                            closed_forms=closed_forms, limits=not ignore_limits, fault_type=fault_type)
+        dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, **analysis.keywords())
     except ValueError as error:
         raise fail(str(error)) from None
     if not quiet:
@@ -114,4 +105,4 @@ def sweep(mechanism, at, phi_range, sweep_spec, out, figure_path, threshold, fau
             if np.any(np.isfinite(series)):
                 at_min = dataset[coordinate].values[np.nanargmin(series)]
                 echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
-    write_outputs(dataset, out, figure_path, sweep_figure, quiet)
+    write_outputs(dataset, outputs, sweep_figure, quiet)

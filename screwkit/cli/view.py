@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import click
 import numpy as np
@@ -15,6 +16,7 @@ from screwkit.cli.options import (
     length_unit_option,
     load_mechanism,
     mechanism_argument,
+    option_group,
     overwrite_option,
     parse_pose,
     parse_range,
@@ -24,6 +26,22 @@ from screwkit.cli.options import (
 from screwkit.viewer import animate_sweep, export_html, show
 
 __all__ = ["view"]
+
+
+@dataclass(frozen=True)
+class Animation:
+    """``--sweep-phi`` (None: one pose, no animation) and its keyframes per second."""
+
+    sweep_phi: str | None
+    frame_rate: float
+
+
+@dataclass(frozen=True)
+class Colouring:
+    """What the chains are coloured by, and the singularity threshold of the indices (m)."""
+
+    color_by: str
+    threshold: float
 
 
 def _echo_legend(scene) -> None:
@@ -56,18 +74,22 @@ def _echo_legend(scene) -> None:
               help="A failed actuator: 0-based index, CHAIN:JOINT, joint or chain name. Repeatable.")
 @click.option("--html", "html_path", type=click.Path(dir_okay=False),
               help="Write a self-contained offline HTML file (.html) and exit instead of serving.")
-@click.option("--sweep-phi", "sweep_phi", metavar="START:STOP:STEP",
-              help="Animate a planar sweep of phi (deg; the stop is excluded) at the x y of --pose.")
-@click.option("--frame-rate", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
-              help="--sweep-phi: keyframes per second (1/s).")
-@click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
-              help="Colour chains by their lowest ITI or by the OTI of their best working submechanism.")
-@threshold_option
+@option_group(
+    "animation", Animation,
+    click.option("--sweep-phi", "sweep_phi", metavar="START:STOP:STEP",
+                 help="Animate a planar sweep of phi (deg; the stop is excluded) at the x y of --pose."),
+    click.option("--frame-rate", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
+                 help="--sweep-phi: keyframes per second (1/s)."))
+@option_group(
+    "colouring", Colouring,
+    click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
+                 help="Colour chains by their lowest ITI or by the OTI of their best working submechanism."),
+    threshold_option)
 @length_unit_option
 @click.option("--open", "open_browser", is_flag=True, help="Open the viewer in the default browser.")
 @overwrite_option
 @quiet_option
-def view(mechanism: str, pose, failed, html_path, sweep_phi, frame_rate, color_by, threshold, length_unit,
+def view(mechanism: str, pose, failed, html_path, animation: Animation, colouring: Colouring, length_unit,
          open_browser, overwrite, quiet) -> None:
     """Show MECHANISM in a Meshcat viewer (served on 127.0.0.1), coloured by its indices.
 
@@ -81,16 +103,16 @@ def view(mechanism: str, pose, failed, html_path, sweep_phi, frame_rate, color_b
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
     try:
-        if sweep_phi is not None:
+        if animation.sweep_phi is not None:
             if not loaded.is_planar:
                 raise fail(f"--sweep-phi sweeps a planar mechanism; {loaded.name!r} is spatial.")
-            angles = parse_range(sweep_phi, "--sweep-phi", angular=True)
+            angles = parse_range(animation.sweep_phi, "--sweep-phi", angular=True)
             poses = np.repeat(target[None], angles.size, axis=0)
             poses[:, 2] = angles
-            scene = animate_sweep(loaded, poses, failed=failures, threshold=threshold, color_by=color_by,
-                                  frame_rate=frame_rate)
+            scene = animate_sweep(loaded, poses, failed=failures, threshold=colouring.threshold,
+                                  color_by=colouring.color_by, frame_rate=animation.frame_rate)
         else:
-            scene = show(loaded, target, failed=failures, threshold=threshold, color_by=color_by)
+            scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by)
     except (ValueError, RuntimeError) as error:
         raise fail(str(error)) from None
     with scene:

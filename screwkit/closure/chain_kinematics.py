@@ -16,6 +16,7 @@ velocity of the point at the origin. The chain is closed when
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntEnum
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,6 +35,7 @@ from screwkit.model.chain import ChainGeometry
 
 __all__ = [
     "ChainFrames",
+    "LoopCode",
     "LOOP_CODES",
     "chain_forward_kinematics",
     "chain_jacobian",
@@ -46,8 +48,20 @@ __all__ = [
 
 _IDENTITY = np.eye(3)
 
-LOOP_CODES = {"fixed": 0, "revolute": 1, "continuous": 1, "prismatic": 2, "universal": 3, "spherical": 4}
-"""Code of each loop joint type in the packed geometry of the compiled kernels."""
+class LoopCode(IntEnum):
+    """The loop joint of a chain as the compiled kernels (:mod:`screwkit.closure.compiled`) read it
+    from the packed geometry's ``loop_code`` (plain integers there: ``code == 4`` is spherical)."""
+
+    FIXED = 0
+    REVOLUTE = 1  # a continuous joint too
+    PRISMATIC = 2
+    UNIVERSAL = 3  # two axes at one point
+    SPHERICAL = 4
+
+
+LOOP_CODES = {"fixed": LoopCode.FIXED, "revolute": LoopCode.REVOLUTE, "continuous": LoopCode.REVOLUTE,
+              "prismatic": LoopCode.PRISMATIC, "universal": LoopCode.UNIVERSAL, "spherical": LoopCode.SPHERICAL}
+"""Code of each loop joint type (URDF type name -> :class:`LoopCode`)."""
 
 COMPILED_FROM = 512
 """Batches of at least this many configurations go through the compiled forward kinematics
@@ -121,7 +135,7 @@ def packed_chains(geometries: list[ChainGeometry]) -> dict:
         joint_prism=np.array([p for g in geometries for p in g.joint_prismatic], dtype=np.bool_),
         leg_rot=np.array([g.leg_loop_rotation for g in geometries], dtype=float).reshape(-1, 3, 3),
         leg_trans=np.array([g.leg_loop_translation for g in geometries], dtype=float).reshape(-1, 3),
-        loop_code=np.array([LOOP_CODES[g.loop_type] for g in geometries], dtype=np.int64),
+        loop_code=np.array([int(LOOP_CODES[g.loop_type]) for g in geometries], dtype=np.int64),  # ints for numba
         loop_axes=loop_axes,
     )
 

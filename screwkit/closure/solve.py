@@ -10,12 +10,14 @@ the closed mechanism) by Newton steps on the pose with the analytic chain Jacobi
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import IntEnum
 from functools import cached_property
 from typing import Literal, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.closure.analytic import KernelKind
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics, chain_jacobian
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
@@ -27,6 +29,7 @@ from screwkit.model.mechanism import Mechanism, require_mechanism
 __all__ = [
     "Solution",
     "UnreachablePose",
+    "ChainStatus",
     "solve",
     "solve_one",
     "forward",
@@ -37,8 +40,16 @@ __all__ = [
     "outside_limits",
 ]
 
-REACHABLE, MISSES_CLOSURE, OUTSIDE_LIMITS = 0, 1, 2
-"""Codes of :attr:`Solution.status`: closed, no closure in the working mode, a joint outside its limits."""
+class ChainStatus(IntEnum):
+    """Codes of :attr:`Solution.status` (an int8 array): each chain at each pose."""
+
+    REACHABLE = 0  # closed
+    MISSES_CLOSURE = 1  # no closure in the working mode
+    OUTSIDE_LIMITS = 2  # closed with a joint outside its limits
+
+
+REACHABLE, MISSES_CLOSURE, OUTSIDE_LIMITS = ChainStatus
+"""The codes by their names alone (:class:`ChainStatus`)."""
 
 
 class UnreachablePose(ValueError):
@@ -59,14 +70,14 @@ class Solution:
         Every chain closed in the requested working mode with its joints within their limits.
     chain_reachable : ndarray of bool, shape (..., n_chains)
     status : ndarray of int8, shape (..., n_chains)
-        Per chain: 0 closed, 1 misses its closure (no assembly in the working mode), 2 closed
-        but a joint is outside its position limits.
+        Per chain, a :class:`ChainStatus`: 0 closed, 1 misses its closure (no assembly in the working
+        mode), 2 closed but a joint is outside its position limits.
     residuals : ndarray, shape (..., n_chains)
         Where the closure failed, by how far the chain misses (m for closed forms, the final
         Newton error norm in m and rad otherwise); else the remaining closure error (0 for
         closed forms).
     limit_joints : ndarray of int, shape (..., n_chains)
-        Where ``status`` is 2, the index (into the chain's joints) of the first joint outside
+        Where ``status`` is ``OUTSIDE_LIMITS`` (2), the index (into the chain's joints) of the first joint outside
         its limits; else -1.
     joint_axes, joint_points : tuple of ndarray, each shape (..., m_i, 3)
         Per chain, joint axes and points in the **base** frame (component-major views for the
@@ -172,7 +183,7 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
     cache = _PoseCache(mechanism, flat_poses) if cache is None else cache
     if solver.planar:
         return solver.solve(*cache.planar, branch)
-    if flat_poses.shape[0] >= COMPILED_FROM and solver.kernel_kind >= 0:  # a chain type the kernel knows
+    if flat_poses.shape[0] >= COMPILED_FROM and solver.kernel_kind is not KernelKind.NONE:  # the kernel knows it
         return solver.solve_compiled(*cache.platform, branch)
     return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
 
@@ -499,7 +510,8 @@ def forward(
         full_poses=solution.full_poses,
         reachable=solution.reachable & converged,
         chain_reachable=solution.chain_reachable & converged[..., None],
-        status=np.where(converged[..., None], solution.status, np.maximum(solution.status, 1)).astype(np.int8),
+        status=np.where(converged[..., None], solution.status,
+                        np.maximum(solution.status, MISSES_CLOSURE)).astype(np.int8),
         residuals=solution.residuals,
         limit_joints=solution.limit_joints,
         joint_axes=solution.joint_axes,

@@ -11,6 +11,8 @@ constraining chains together, with continuation from the reference assembly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -90,8 +92,20 @@ BLOCK = 2048
 """Configurations per thread block of the compiled closure."""
 
 
-def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, tolerance, iterations,
-                 step_tolerance, step_iterations, max_step):
+@dataclass(frozen=True)
+class ClosureSteps:
+    """How the compiled closure iterates: Levenberg-Marquardt to ``tolerance`` in at most ``iterations``
+    at the last step of a continuation, to ``step_tolerance`` in ``step_iterations`` at the steps before
+    it, each step of the unknowns at most ``max_step`` (rad and length scales)."""
+
+    tolerance: float
+    iterations: int
+    step_tolerance: float
+    step_iterations: int
+    max_step: float
+
+
+def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, steps, settings: ClosureSteps):
     """The compiled closure (:mod:`screwkit.closure.compiled.task`) over a batch, in thread blocks.
 
     The kernel runs on the mechanism scaled to a unit length scale (every length, pose
@@ -99,6 +113,8 @@ def _run_closure(mechanism, chains, full_poses, values, free_axes, targets, step
     tolerances mean the same for a mechanism and any scaled copy; the residual is in rad and
     length scales.
     """
+    tolerance, iterations, max_step = settings.tolerance, settings.iterations, settings.max_step
+    step_tolerance, step_iterations = settings.step_tolerance, settings.step_iterations
     announce_compilation("screwkit.closure.compiled.task")
     from screwkit.closure.compiled.task import close_chains_kernel  # numba: loaded when a closure first runs
 
@@ -159,8 +175,8 @@ def close_constraining_chains(mechanism, chains, full_poses, values, free_axes, 
     """
     full_poses = np.asarray(full_poses, dtype=float)
     task = [axis for axis in range(mechanism.n_pose) if axis not in free_axes]
-    return _run_closure(mechanism, chains, full_poses, values, tuple(free_axes), full_poses[:, task], 1, tolerance,
-                        iterations, tolerance, iterations, max_step)
+    return _run_closure(mechanism, chains, full_poses, values, tuple(free_axes), full_poses[:, task], 1,
+                        ClosureSteps(tolerance, iterations, tolerance, iterations, max_step))
 
 
 def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: NDArray | None = None,
@@ -199,7 +215,7 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
     largest = np.nan_to_num(np.max(distance, axis=-1, initial=0.0), nan=0.0, posinf=6.4)
     steps = np.clip(np.ceil(largest / 0.1), 1, 64).astype(np.int64)
     poses, values, converged, residual = _run_closure(mechanism, chains, start_poses, start_values, free, task_poses,
-                                                      steps, tolerance, iterations, 1e-8, 12, 0.5)
+                                                      steps, ClosureSteps(tolerance, iterations, 1e-8, 12, 0.5))
     values = [wrap_revolute_values(mechanism.chains[i].geometry, v) for i, v in zip(chains, values)]
     return poses, values, converged, residual * mechanism.length_scale
 

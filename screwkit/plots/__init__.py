@@ -25,7 +25,7 @@ imported from here.
 
 from __future__ import annotations
 
-from screwkit.plots.maps import design_comparison_figure, map_figure, pareto_figure
+from screwkit.plots.maps import MapGrid, design_comparison_figure, map_figure, pareto_figure
 from screwkit.plots.style import ANGULAR_COORDINATES as ANGULAR_COORDINATES
 from screwkit.plots.style import BOLD as BOLD
 from screwkit.plots.style import COLORMAP, INDEX_RANGE, colour_scale
@@ -40,5 +40,5 @@ from screwkit.plots.style import UNREACHABLE_COLOR as UNREACHABLE_COLOR
 from screwkit.plots.sweeps import sweep_figure
 from screwkit.studies.files import FORMATS, save_figure  # re-exported: figures are saved from here
 
-__all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure",
+__all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure", "MapGrid",
            "pareto_figure", "save_figure", "colour_scale"]

@@ -7,6 +7,7 @@ matplotlib is imported inside the functions.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -175,9 +176,18 @@ def map_figure(dataset, variables=None, reference=None, *, vmin=None, vmax=None,
     return figure
 
 
-def design_comparison_figure(reference_grid, optimised_grid, step, level, name, *, vmin=None, vmax=None,
-                             index="f_o1", over="a full rotation", axes_labels=("x (m)", "y (m)"), area_unit="m\u00b2",
-                             coordinates=None):
+@dataclass(frozen=True)
+class MapGrid:
+    """Where the grids of :func:`design_comparison_figure` lie (its ``layout``)."""
+
+    step: float
+    coordinates: tuple | None = None
+    axes_labels: tuple[str, str] = ("x (m)", "y (m)")
+    area_unit: str = "m\u00b2"
+
+
+def design_comparison_figure(reference_grid, optimised_grid, layout, level, name, *, vmin=None, vmax=None,
+                             index="f_o1", over="a full rotation"):
     """Side-by-side maps of the minimum of ``index`` (F_O1) over ``over`` for a reference and an optimised design.
 
     Each panel shows one grid (centred on the origin) in :data:`COLORMAP` on a shared colour
@@ -192,8 +202,10 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     reference_grid, optimised_grid : array_like, shape (k, k)
         Minimum of F_O1 over the rotation at each grid point, rows along y, columns along x,
         with the origin at the centre; NaN outside the disc or where unreachable.
-    step : float
-        Grid spacing (m).
+    layout : float or MapGrid
+        The spacing (m) of a square grid centred on the origin, or a :class:`MapGrid`: that ``step``,
+        or the x and y values of a rectangular grid (``coordinates``: evenly spaced, every NaN point
+        unreachable, ``step`` unused), the labels of its axes and the unit of its areas (rad² for angles).
     level : float
         The contour and area threshold of F_O1.
     name : str
@@ -203,11 +215,6 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
         ([0, 1], not the data range), so both designs and other figures compare.
     index, over : str
         The index mapped (``f_o1``, ``f_io2``, ...) and the orientation set, for the labels.
-    axes_labels, area_unit : str
-        Labels of the grid's axes and the unit of its areas (a grid of angles: rad, rad²).
-    coordinates : (array_like, array_like), optional
-        The grid's x and y values (a rectangular map, evenly spaced; ``step`` is then unused and
-        every NaN point is unreachable). Default: a grid of ``step`` centred on the origin.
 
     Returns
     -------
@@ -224,7 +231,8 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
 
     plt = pyplot()
     low, high = colour_scale(vmin, vmax)
-    step, level = float(step), float(level)
+    layout = layout if isinstance(layout, MapGrid) else MapGrid(layout)
+    step, level = float(layout.step), float(level)
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"Expected `step` > 0, got {step!r}.")
     grids = [np.asarray(g, dtype=float) for g in (reference_grid, optimised_grid)]
@@ -237,14 +245,14 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
     image = None
     for ax, grid, title, letter in ((axes[0], grids[0], f"{name} (reference)", "(a)"),
                                     (axes[1], grids[1], "optimised", "(b)")):
-        if coordinates is None:
+        if layout.coordinates is None:
             x = step * (np.arange(grid.shape[1]) - grid.shape[1] // 2)
             y = step * (np.arange(grid.shape[0]) - grid.shape[0] // 2)
             inscribed = step * min(grid.shape[0] // 2, grid.shape[1] // 2)
             grey = ~np.isfinite(grid) & (np.hypot(*np.meshgrid(x, y)) <= inscribed * (1 + 1e-9))
             cell = step**2
         else:
-            x, y = (np.asarray(values, dtype=float) for values in coordinates)
+            x, y = (np.asarray(values, dtype=float) for values in layout.coordinates)
             grey = ~np.isfinite(grid)
             cell = abs((x[1] - x[0]) * (y[1] - y[0])) if x.size > 1 and y.size > 1 else 0.0
         if grey.any():
@@ -257,10 +265,10 @@ def design_comparison_figure(reference_grid, optimised_grid, step, level, name, 
             ax.contour(x, y, below, levels=[level], colors="white", linewidths=1.4).set(path_effects=halo)
         area = float(np.sum(finite >= level) * cell)
         ax.set_title(wrap_text(f"{letter} {title}\narea where min {label} \u2265 {level:g}: "
-                           f"{area:.4f} {area_unit}", 3.8, TITLE_SIZE), fontsize=TITLE_SIZE)
+                           f"{area:.4f} {layout.area_unit}", 3.8, TITLE_SIZE), fontsize=TITLE_SIZE)
         ax.set_aspect("equal")
-        ax.set_xlabel(axes_labels[0])
-        ax.set_ylabel(axes_labels[1])
+        ax.set_xlabel(layout.axes_labels[0])
+        ax.set_ylabel(layout.axes_labels[1])
         handles = [Line2D([], [], color="white", linewidth=1.4, path_effects=halo, label=f"{label} = {level:g}")]
         if grey.any():
             from matplotlib.patches import Patch

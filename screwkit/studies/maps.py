@@ -25,17 +25,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular, unit_of
 from screwkit.indices.registry import index_columns
 from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
+from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.poses import indices_at_poses
-from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+from screwkit.studies.tasks import Execution, run_tasks
 
 __all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "disc_size",
-           "map_task", "map_block", "orientation_set"]
+           "map_task", "map_block", "MapBlock", "orientation_set"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -199,14 +199,12 @@ def portable(mechanism: Mechanism) -> tuple[str, str, str]:
     return hashlib.sha256(text.encode()).hexdigest(), text, str(mechanism.path)
 
 
-def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_axes, over_values, threshold,
-             faults, closed_forms, limits=True, fault_type="free-swinging", threads=1) -> dict:
-    """Minimum of each index over the orientation set at the grid points of one block.
+@dataclass(frozen=True, eq=False)
+class MapBlock:
+    """One task of a map: a rectangular block of the grid and the orientation set at each of its points.
 
-    Parameters
+    Attributes
     ----------
-    mechanism_text : tuple
-        From :func:`portable`.
     at : ndarray (n_task,)
         The fixed coordinates.
     x_axis, y_axis : int
@@ -219,6 +217,43 @@ def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_
         Task coordinates making up the orientation set.
     over_values : ndarray (K, len(over_axes))
         Every orientation of the set.
+    """
+
+    at: NDArray[np.float64]
+    x_axis: int
+    x_values: NDArray[np.float64]
+    y_axis: int
+    y_values: NDArray[np.float64]
+    mask: NDArray[np.bool_]
+    over_axes: tuple[int, ...]
+    over_values: NDArray[np.float64]
+
+    def poses(self) -> NDArray[np.float64]:
+        """Every pose of the block (P, K, n_task): the P masked points in row-major order, K orientations each."""
+        rows, columns = np.nonzero(self.mask)
+        base = np.repeat(np.asarray(self.at, dtype=float)[None], rows.size, axis=0)
+        base[:, self.x_axis] = self.x_values[columns]
+        base[:, self.y_axis] = self.y_values[rows]
+        poses = np.repeat(base[:, None, :], self.over_values.shape[0], axis=1)
+        for column, axis in enumerate(self.over_axes):
+            poses[:, :, axis] = self.over_values[None, :, column]
+        return poses
+
+
+def map_task(mechanism_text: tuple[str, str, str], block: MapBlock, analysis: AnalysisOptions,
+             threads: int = 1) -> dict:
+    """Minimum of each index over the orientation set at the grid points of one block.
+
+    Parameters
+    ----------
+    mechanism_text : tuple
+        From :func:`portable`.
+    block : MapBlock
+        The block's grid points and orientation set.
+    analysis : AnalysisOptions
+        What is computed at every pose.
+    threads : int
+        Threads of the index kernel.
 
     Returns
     -------
@@ -227,23 +262,12 @@ def map_task(mechanism_text, at, x_axis, x_values, y_axis, y_values, mask, over_
         ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is unreachable) and
         ``reachable_fraction``.
     """
-    return map_block(cached_mechanism(*mechanism_text), at, x_axis, x_values, y_axis, y_values, mask, over_axes,
-                     over_values, threshold, faults, closed_forms, limits, fault_type, threads)
+    return map_block(cached_mechanism(*mechanism_text), block, analysis, threads)
 
 
-def map_block(mechanism: Mechanism, at, x_axis, x_values, y_axis, y_values, mask, over_axes, over_values, threshold,
-              faults, closed_forms, limits=True, fault_type="free-swinging", threads=1) -> dict:
+def map_block(mechanism: Mechanism, block: MapBlock, analysis: AnalysisOptions, threads: int = 1) -> dict:
     """:func:`map_task` on a loaded mechanism (in the calling process)."""
-    rows, columns = np.nonzero(mask)
-    base = np.repeat(np.asarray(at, dtype=float)[None], rows.size, axis=0)
-    base[:, x_axis] = x_values[columns]
-    base[:, y_axis] = y_values[rows]
-    orientations = over_values.shape[0]
-    poses = np.repeat(base[:, None, :], orientations, axis=1)
-    for column, axis in enumerate(over_axes):
-        poses[:, :, axis] = over_values[None, :, column]
-    result = indices_at_poses(mechanism, poses, threshold=threshold, faults=faults, closed_forms=closed_forms,
-                              threads=threads, limits=limits, fault_type=fault_type)
+    result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
     for name, values in index_columns(result).items():  # every registered index: the worst orientation (its `reduce`)
@@ -306,9 +330,7 @@ def map_size(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, A
 
 def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, ArrayLike],
               at: ArrayLike | None = None, *, mask: NDArray[np.bool_] | None = None,
-              threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False,
-              limits: bool = True, fault_type: str = "free-swinging", scheduler=None, progress: bool | None = None,
-              connect_timeout: float = CONNECT_TIMEOUT, configurations_per_task: int | None = None,
+              analysis: AnalysisOptions | None = None, execution: Execution | None = None,
               as_dataset: bool = True, proceed: bool = False, max_configurations: int = MAX_CONFIGURATIONS):
     """Minimum of every index over an orientation set on a 2-D grid of two task coordinates.
 
@@ -324,16 +346,13 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         Values of the other coordinates (default: the home pose).
     mask : ndarray of bool, shape (len(y), len(x)), optional
         Grid points to evaluate (others are NaN).
-    threshold, faults, closed_forms, limits, fault_type :
-        As in :func:`screwkit.studies.indices_at_poses`.
-    scheduler : str or distributed.Client, optional
-        ``dask.distributed`` scheduler address (default: local threads).
-    progress : bool, optional
-        Progress bar on stderr (default: when stderr is a terminal).
-    connect_timeout : float
-        Seconds to wait for the scheduler.
-    configurations_per_task : int, optional
-        Grid points times orientations per task (default: :func:`task_size` of the map).
+    analysis : AnalysisOptions, optional
+        What is computed at every pose: threshold, faults, fault type, closed forms, joint limits
+        (as in :func:`screwkit.studies.indices_at_poses`; default :class:`AnalysisOptions()`).
+    execution : Execution, optional
+        The ``dask.distributed`` scheduler (default: local threads), the progress bar on stderr
+        (default: when stderr is a terminal), the seconds to wait for the scheduler, and the grid
+        points times orientations per task (default: :func:`task_size` of the map).
     as_dataset : bool
         Return an ``xarray.Dataset`` (default) or the plain :class:`GridMap`.
     proceed, max_configurations :
@@ -362,23 +381,24 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != shape:
             raise ValueError(f"Expected `mask` with shape {shape} (y, x), got {mask.shape}.")
-    size = map_size(mechanism, grid, over, mask, faults)
+    analysis = AnalysisOptions() if analysis is None else analysis
+    execution = Execution() if execution is None else execution
+    size = map_size(mechanism, grid, over, mask, analysis.faults)
     size.check(max_configurations=max_configurations, proceed=proceed)
     mask = np.ones(shape, dtype=bool) if mask is None else mask
     at = mechanism.check_poses(mechanism.home_pose if at is None else at)
     over_axes = tuple(names.index(name) for name in over)
     over_values = orientation_set(over)
+    configurations_per_task = execution.configurations_per_task
     if configurations_per_task is None:
         configurations_per_task = task_size(size.configurations)
     per_task = max(1, configurations_per_task // max(1, over_values.shape[0]))
-    faults = None if faults is None else tuple(np.atleast_1d(faults).tolist())
     text = portable(mechanism)
     blocks = _blocks(mask, per_task)
-    arguments = [(text, at, names.index(x_name), x_values[columns], names.index(y_name), y_values[rows],
-                  mask[rows, columns], over_axes, over_values, threshold, faults, closed_forms, limits, fault_type)
+    arguments = [(text, MapBlock(at, names.index(x_name), x_values[columns], names.index(y_name), y_values[rows],
+                                 mask[rows, columns], over_axes, over_values), analysis)
                  for rows, columns in blocks]
-    results = run_tasks(map_task, arguments, scheduler=scheduler, progress=progress, label="map",
-                        connect_timeout=connect_timeout)
+    results = run_tasks(map_task, arguments, execution, label="map")
     keys = results[0].keys() if results else ("iti", "lmti", "reachable_fraction")
     variables = {key: np.full(shape, np.nan) for key in keys}
     for (rows, columns), result in zip(blocks, results):
@@ -398,14 +418,14 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         long_names={key: f"minimum of {key} over the orientation set"
                     for key in variables if key != "reachable_fraction"},
         attrs=dict(
-            mechanism=mechanism.name, threshold_m=threshold,
-            method="closed forms" if closed_forms else "generic screw path",
+            mechanism=mechanism.name, threshold_m=analysis.threshold,
+            method="closed forms" if analysis.closed_forms else "generic screw path",
             orientation_set="; ".join(
                 f"{name}: {len(np.unique(over_values[:, i]))} values from {shown(name, over_values[:, i].min()):g} "
                 f"to {shown(name, over_values[:, i].max()):g} {unit_of(name)}" for i, name in enumerate(over))
             or "the fixed pose only",
             fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
-            joint_limits="respected" if limits else "ignored", fault_type=fault_type,
+            joint_limits="respected" if analysis.limits else "ignored", fault_type=analysis.fault_type,
             configurations=int(size.configurations)))
     return grid_map.to_dataset() if as_dataset else grid_map
 
@@ -463,13 +483,13 @@ def disc_size(mechanism: Mechanism, radius: float, step: float, phi_step_degrees
 
 
 def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_degrees: float, *, centre=None,
-                    proceed: bool = False, **options):
+                    proceed: bool = False, **keywords):
     """The paper's Fig. 5 map: x, y on a disc about ``centre`` (default the home pose), phi over a full turn.
 
     ``step`` is the grid spacing (m) and ``phi_step_degrees`` the angular step of the
     rotation 0 <= phi < 360 deg. A planar point output (task coordinates x, y: its rotation is idle)
-    is mapped at its positions alone and ``phi_step_degrees`` is not used. Other options as in
-    :func:`index_map`.
+    is mapped at its positions alone and ``phi_step_degrees`` is not used. Other keywords
+    (``analysis``, ``execution``, ``as_dataset``, ``max_configurations``) as in :func:`index_map`.
     """
     require_mechanism(mechanism, "planar_disc_map")
     if not mechanism.is_planar:
@@ -477,14 +497,14 @@ def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_d
     if phi_step_degrees > 360:
         raise ValueError(f"Expected a phi step of at most 360 deg, got {phi_step_degrees:g}.")
     disc_size(mechanism, radius, step, phi_step_degrees).check(
-        proceed=proceed, max_configurations=options.get("max_configurations", MAX_CONFIGURATIONS))
+        proceed=proceed, max_configurations=keywords.get("max_configurations", MAX_CONFIGURATIONS))
     home = mechanism.home_pose
     centre = home[:2] if centre is None else np.asarray(centre, dtype=float)
     x_values, y_values, mask = disc_grid(radius, step, centre)
     rotating = "phi" in mechanism.task_coordinates
     over = {"phi": np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))} if rotating else {}
     result = index_map(mechanism, {"x": x_values, "y": y_values}, over, home, mask=mask, proceed=proceed,
-                       **options)
+                       **keywords)
     result.attrs.update(radius_m=radius, step_m=step)
     if rotating:
         result.attrs.update(phi_step_deg=phi_step_degrees)

@@ -21,12 +21,36 @@ import os
 import socket
 import sys
 import time
+from dataclasses import dataclass
 from typing import Any, Callable
 
-__all__ = ["run_tasks", "connect", "disconnect", "ClusterError", "CONNECT_TIMEOUT"]
+__all__ = ["run_tasks", "connect", "disconnect", "ClusterError", "CONNECT_TIMEOUT", "Execution"]
 
 CONNECT_TIMEOUT = 3.0
 """Seconds to wait for a Dask scheduler to answer (and to give its handshake) before giving up."""
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where and how a study's tasks run: the same record from the command line to :func:`run_tasks`.
+
+    Attributes
+    ----------
+    scheduler : str or distributed.Client, optional
+        Address of a running ``dask.distributed`` scheduler (``tcp://host:8786``) or a client of
+        :func:`connect`; default: Dask's local threaded scheduler.
+    progress : bool, optional
+        A progress bar on stderr; default: only when stderr is a terminal.
+    connect_timeout : float
+        Seconds to wait for the scheduler to answer.
+    configurations_per_task : int, optional
+        Configurations per task of a map (default: :func:`screwkit.studies.maps.task_size`).
+    """
+
+    scheduler: Any = None
+    progress: bool | None = None
+    connect_timeout: float = CONNECT_TIMEOUT
+    configurations_per_task: int | None = None
 
 
 class ClusterError(RuntimeError):
@@ -194,8 +218,8 @@ def _run_distributed(function: Callable, arguments: list[tuple], scheduler: Any,
             disconnect(client, connect_timeout)
 
 
-def run_tasks(function: Callable, arguments: list[tuple], *, scheduler: Any = None, progress: bool | None = None,
-              label: str = "tasks", connect_timeout: float = CONNECT_TIMEOUT) -> list:
+def run_tasks(function: Callable, arguments: list[tuple], execution: Execution | None = None, *,
+              label: str = "tasks") -> list:
     """Run ``function(*args)`` for every tuple of ``arguments`` and return the results in order.
 
     Parameters
@@ -203,29 +227,25 @@ def run_tasks(function: Callable, arguments: list[tuple], *, scheduler: Any = No
     function : callable
         A module-level function (workers import it by name).
     arguments : list of tuple
-    scheduler : str or distributed.Client, optional
-        Address of a running ``dask.distributed`` scheduler (``tcp://host:8786``) or an
-        existing client; default: Dask's local threaded scheduler.
-    progress : bool, optional
-        A progress bar (tqdm, on stderr); default: only when stderr is a terminal.
+    execution : Execution, optional
+        The scheduler (default: Dask's local threaded scheduler), the progress bar (tqdm, on
+        stderr; default: only when stderr is a terminal) and the seconds to wait for the scheduler.
     label : str
         The progress bar's label.
-    connect_timeout : float
-        Seconds to wait for the scheduler to answer.
 
     Raises
     ------
     ClusterError
         The scheduler does not answer, or is lost before every task is done.
     """
-    if progress is None:
-        progress = sys.stderr.isatty()
+    execution = Execution() if execution is None else execution
+    progress = sys.stderr.isatty() if execution.progress is None else execution.progress
     from tqdm import tqdm
 
     bar = tqdm(total=len(arguments), desc=label, disable=not progress, file=sys.stderr, leave=False, delay=2.0)
     try:
-        if scheduler is None:
+        if execution.scheduler is None:
             return _run_local(function, arguments, bar)
-        return _run_distributed(function, arguments, scheduler, connect_timeout, bar)
+        return _run_distributed(function, arguments, execution.scheduler, execution.connect_timeout, bar)
     finally:
         bar.close()

@@ -177,8 +177,7 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
     if pose.ndim != 1:
         raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}; "
                          "use animate_sweep for several poses.")
-    return _draw(mechanism, pose[None], failed, threshold, color_by, viewer, open_browser, frame_rate=None,
-                 strict=True, squeeze=True)
+    return _draw(mechanism, pose[None], failed, threshold, color_by, viewer, open_browser, None)
 
 
 def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
@@ -218,8 +217,8 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
     poses = mechanism.check_poses(poses).reshape(-1, mechanism.n_task)
     if not frame_rate > 0:
         raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
-    return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, frame_rate=float(frame_rate),
-                 strict=False, squeeze=False, loop=loop)
+    return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser,
+                 _Animation(float(frame_rate), loop))
 
 
 def export_html(target, path: str | os.PathLike) -> Path:
@@ -269,8 +268,17 @@ def meshcat_viewer_of(target):
                      f"got {type(target).__name__}.")
 
 
-def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, *, frame_rate, strict, squeeze,
-          loop=True) -> Scene:
+@dataclass(frozen=True)
+class _Animation:
+    """The keyframes of :func:`animate_sweep`: per second, and whether they repeat."""
+
+    frame_rate: float
+    loop: bool
+
+
+def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None) -> Scene:
+    """Draw :func:`show`'s one pose (``animation`` None: an unreachable pose is an error) or
+    :func:`animate_sweep`'s poses (the unreachable ones skipped)."""
     import pinocchio
 
     import_meshcat()
@@ -279,7 +287,8 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, *
     if color_by not in ("iti", "oti"):
         raise ValueError(f"Expected `color_by` 'iti' or 'oti', got {color_by!r}.")
     failed = resolve_actuators(mechanism, failed)
-    frames = solve_frames(mechanism, poses, threshold, strict)
+    one_pose = animation is None
+    frames = solve_frames(mechanism, poses, threshold, one_pose)
     count = frames.poses.shape[0]
     result = frames.result
     best = tuple(best_submechanism(result, frame, failed) for frame in range(count))
@@ -335,21 +344,22 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, *
         for path in set(all_markers) - {marker.path for marker in markers[0]}:
             meshcat_viewer[path].set_property("visible", False)
         display_offset = frame_view(meshcat_viewer, mechanism, frames)
-        if frame_rate is not None:
-            animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, frame_rate, loop)
+        if animation is not None:
+            animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, animation.frame_rate,
+                    animation.loop)
     except BaseException:
         if server is not None:
             with contextlib.suppress(Exception):
                 meshcat_viewer.window.zmq_socket.close(linger=0)
             server.stop()
         raise
-    if squeeze:
+    if one_pose:
         result = result.at(0)
     scene = Scene(mechanism=mechanism, poses=frames.poses, result=result, failed=failed, color_by=color_by,
                   chain_values=chain_values, chain_colors=chain_colors, best_submechanisms=tuple(
                       None if b is None else tuple(result.submechanisms[b]) for b in best),
                   frame_markers=markers, visualizer=visualizer, viewer=meshcat_viewer, server=server,
-                  frame_rate=frame_rate, display_offset=display_offset)
+                  frame_rate=None if one_pose else animation.frame_rate, display_offset=display_offset)
     if open_browser:
         meshcat_viewer.open()
     return scene

@@ -22,12 +22,13 @@ from __future__ import annotations
 from screwkit.closure.analytic.planar import PlanarClosedForm as PlanarClosedForm
 from screwkit.closure.analytic.planar import PlanarRevoluteChain, PlanarSliderChain
 from screwkit.closure.analytic.results import ClosedFormResult, Rejection
-from screwkit.closure.analytic.spatial import CrankRodChain, LegVectorChain
+from screwkit.closure.analytic.spatial import CrankRodChain, KernelKind, LegVectorChain
 from screwkit.closure.analytic.spatial import SpatialClosedForm as SpatialClosedForm
 from screwkit.model.chain import ChainGeometry
 
 __all__ = [
     "ClosedFormResult",
+    "KernelKind",
     "Rejection",
     "PlanarRevoluteChain",
     "PlanarSliderChain",

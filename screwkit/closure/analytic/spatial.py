@@ -9,6 +9,7 @@ through the compiled kernel (:mod:`screwkit.closure.compiled.closed_form`).
 
 from __future__ import annotations
 
+from enum import IntEnum
 from functools import cached_property
 
 import numpy as np
@@ -45,6 +46,15 @@ def _line_intersection(
     return 0.5 * (first_closest + second_closest)
 
 
+class KernelKind(IntEnum):
+    """The chain type of a spatial closed form in the compiled kernel
+    (:func:`screwkit.closure.compiled.closed_form.spatial_closed_form_kernel`'s ``kind``, an integer there)."""
+
+    NONE = -1  # no compiled form: numpy only
+    UPS = 0  # U-P-S: the leg vector
+    RUS = 1  # R-U-S: crank and rod
+
+
 class SpatialClosedForm:
     """Common part of the spatial closed forms (targets are platform-side loop frames).
 
@@ -55,7 +65,7 @@ class SpatialClosedForm:
     kind = ""
     planar = False
     n_branches = 2
-    kernel_kind = -1  # the chain type in the compiled kernel (-1: none, numpy only), and the attributes it takes
+    kernel_kind = KernelKind.NONE  # the chain type in the compiled kernel, and the attributes it takes
     kernel_parameters: tuple[str, ...] = ()
 
     def solve_compiled(self, platform_rotation: NDArray, platform_translation: NDArray, branch) -> ClosedFormResult:
@@ -81,7 +91,7 @@ class SpatialClosedForm:
 
         def work(block: slice) -> None:
             spatial_closed_form_kernel(
-                self.kernel_kind, parameters, signs, rotation[block], translation[block], loop_rotation,
+                int(self.kernel_kind), parameters, signs, rotation[block], translation[block], loop_rotation,
                 loop_translation, packed["tree_start"], packed["dof_start"], packed["joint_rot"],
                 packed["joint_trans"], packed["joint_axis"], packed["joint_prism"], packed["leg_rot"],
                 packed["leg_trans"], packed["loop_code"], packed["loop_axes"], values[block], axes[block],
@@ -149,7 +159,7 @@ class LegVectorChain(SpatialClosedForm):
     """
 
     kind = "ups"
-    kernel_kind = 0
+    kernel_kind = KernelKind.UPS
 
     @staticmethod
     def describe_branch(branch) -> str:
@@ -207,7 +217,7 @@ class CrankRodChain(SpatialClosedForm):
     """
 
     kind = "rus"
-    kernel_kind = 1
+    kernel_kind = KernelKind.RUS
 
     @staticmethod
     def describe_branch(branch) -> str:

@@ -20,7 +20,8 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import column_record
 from screwkit.model import Mechanism
-from screwkit.studies.maps import disc_grid, map_block, orientation_set, range_values
+from screwkit.studies.maps import MapBlock, disc_grid, map_block, orientation_set, range_values
+from screwkit.studies.options import AnalysisOptions
 
 __all__ = ["METRICS", "MAXIMISED", "UNITS", "Region", "disc_region", "grid_region", "default_region", "region_maps",
            "region_metrics", "inscribed_radius"]
@@ -253,13 +254,14 @@ def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
     over_axes = tuple(names.index(name) for name, _ in region.over)
     over_values = orientation_set(dict(region.over))
     layer_values = region.layers[1] if region.layers else [None]
+    analysis = AnalysisOptions(threshold=region.threshold, faults=(region.faults,), closed_forms=region.closed_forms)
     out: dict[str, NDArray] = {}
     for k, value in enumerate(layer_values):
         at = mechanism.home_pose.copy()
         if value is not None:
             at[names.index(region.layers[0])] = value
-        values = map_block(mechanism, at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes,
-                          over_values, region.threshold, (region.faults,), region.closed_forms)
+        block = MapBlock(at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes, over_values)
+        values = map_block(mechanism, block, analysis)
         for key, column in values.items():
             grid = out.setdefault(key, np.full((len(layer_values),) + shape, np.nan))
             grid[k][mask] = column

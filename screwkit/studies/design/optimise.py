@@ -35,7 +35,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from screwkit.studies.design.families import Family
 from screwkit.studies.design.objectives import MAXIMISED, METRICS, Region, region_metrics
 from screwkit.studies.files import atomic_text
-from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+from screwkit.studies.tasks import Execution, run_tasks
 
 __all__ = ["Constraint", "Study", "StudyResult", "run_study", "evaluate_candidate", "pareto_front", "StateError"]
 
@@ -242,10 +242,10 @@ def _end_with_parent(parent: int) -> None:
 class _Evaluations:
     """The study's evaluations by free-parameter vector (exact bits), appended to the state file."""
 
-    def __init__(self, study: Study, state: str | os.PathLike | None, scheduler, progress, connect_timeout: float,
+    def __init__(self, study: Study, state: str | os.PathLike | None, execution: Execution,
                  notify: Callable[[str], None] | None = None):
-        self.study, self.state, self.scheduler = study, state, scheduler
-        self.connect_timeout = connect_timeout
+        self.study, self.state = study, state
+        self.execution = replace(execution, progress=False)  # the search's own bar counts the designs
         self.notify = notify or (lambda message: None)
         self.known: dict[str, dict] = {}
         self.order: list[tuple[NDArray, dict]] = []  # every design asked, once, in the order asked
@@ -266,7 +266,7 @@ class _Evaluations:
                 raise StateError(f"Cannot write the design-search state {state}: "
                                  f"{error.strerror or error}.") from None
         self.bar, self.pool = None, None
-        if progress:
+        if sys.stderr.isatty() if execution.progress is None else execution.progress:
             from tqdm import tqdm
 
             self.bar = tqdm(total=study.budget, desc="designs", unit="design", leave=False)
@@ -366,9 +366,8 @@ class _Evaluations:
         family = self.study.family
         importable = all(f.__module__ != "__main__" and "<locals>" not in f.__qualname__
                          for f in (family.writer, family.measures))  # what a spawned process can import
-        if self.scheduler is not None or len(arguments) < 2 or (os.cpu_count() or 1) < 2 or not importable:
-            return run_tasks(evaluate_candidate, arguments, scheduler=self.scheduler, progress=False,
-                             connect_timeout=self.connect_timeout)
+        if self.execution.scheduler is not None or len(arguments) < 2 or (os.cpu_count() or 1) < 2 or not importable:
+            return run_tasks(evaluate_candidate, arguments, self.execution)
         if self.pool is None:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
@@ -489,16 +488,15 @@ def _multiple(study: Study, evaluate: Callable) -> None:
              ("n_eval", max(study.budget, size)), seed=study.seed, verbose=False)
 
 
-def run_study(study: Study, *, scheduler=None, progress: bool | None = None, state: str | os.PathLike | None = None,
-              connect_timeout: float = CONNECT_TIMEOUT, notify: Callable[[str], None] | None = None) -> StudyResult:
+def run_study(study: Study, *, execution: Execution | None = None, state: str | os.PathLike | None = None,
+              notify: Callable[[str], None] | None = None) -> StudyResult:
     """Search ``study``; see the module's docstring.
 
     Parameters
     ----------
-    scheduler : str or distributed.Client, optional
-        Dask scheduler evaluating the candidates (default: local threads).
-    progress : bool, optional
-        A progress bar on stderr (default: when stderr is a terminal).
+    execution : Execution, optional
+        The Dask scheduler evaluating the candidates (default: local threads, or local processes),
+        a progress bar on stderr (default: when stderr is a terminal), the seconds to wait for the scheduler.
     state : path, optional
         Evaluation log: created, or read back to resume (it must belong to the same study).
     notify : callable, optional
@@ -508,8 +506,7 @@ def run_study(study: Study, *, scheduler=None, progress: bool | None = None, sta
     ------
     StateError, ClusterError, ValueError
     """
-    evaluations = _Evaluations(study, state, scheduler, sys.stderr.isatty() if progress is None else progress,
-                               connect_timeout, notify)
+    evaluations = _Evaluations(study, state, Execution() if execution is None else execution, notify)
     try:
         start_metrics = evaluations(study.start[None])[0]
         if study.budget > 0:

@@ -26,7 +26,7 @@ from screwkit.model import Mechanism
 from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
 from screwkit.studies.design.families import permutation_rank
 from screwkit.studies.poses import planar_points
-from screwkit.studies.tasks import CONNECT_TIMEOUT, run_tasks
+from screwkit.studies.tasks import Execution, run_tasks
 
 __all__ = ["planar_design", "slot_design", "slots_of", "rotation_score", "permutation_search", "rotation_class",
            "DesignScore", "fault_tolerant_area", "family_values"]
@@ -114,13 +114,15 @@ def _score_task(design, permutation, mode, phi_step, faults, threshold, closed_f
 
 def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, faults: int = 1,
                        threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False,
-                       scheduler=None, progress=None, connect_timeout: float = CONNECT_TIMEOUT) -> list[DesignScore]:
+                       execution: Execution | None = None) -> list[DesignScore]:
     """Every slot permutation in both working modes, ranked by the minimum of F_O1 over a full rotation.
 
     As the paper's Sec. 4: base and platform joints on regular polygons, identical arms,
     the n! assignments of platform slots to chains, each scored at the workspace centre
     (the origin of the base frame). Designs that differ by a rotation of the slots
     (``permutation + k mod n``) are the same mechanism rotated and get the same score.
+    ``execution``: where the designs are scored (default: local threads, a progress bar when
+    stderr is a terminal).
 
     Returns
     -------
@@ -130,8 +132,7 @@ def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, f
     n = design.chain_count
     candidates = [(p, mode) for mode in (1, -1) for p in permutations(range(n))]
     arguments = [(design, p, mode, phi_step_degrees, faults, threshold, closed_forms) for p, mode in candidates]
-    scores = run_tasks(_score_task, arguments, scheduler=scheduler, progress=progress, label="designs",
-                       connect_timeout=connect_timeout)
+    scores = run_tasks(_score_task, arguments, execution, label="designs")
     ranked = [DesignScore(tuple(int(i) for i in p), mode, float(s)) for (p, mode), s in zip(candidates, scores)]
     # Scores equal to 1e-9 are ties (rotated or mirrored copies differ only by rounding);
     # ties are listed working mode +1 first, then by permutation.

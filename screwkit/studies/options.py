@@ -1,0 +1,53 @@
+"""What a study computes at every pose, as one record passed from the command line to the tasks.
+
+:class:`AnalysisOptions` holds the settings of :func:`screwkit.studies.indices_at_poses` that a sweep, a
+map or a design region passes on unchanged (the singularity threshold, the numbers of faults, the fault
+type, the planar closed forms, the joint limits); where the work runs is a
+:class:`screwkit.studies.tasks.Execution`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.indices.faults import FAULT_TYPES
+
+__all__ = ["AnalysisOptions"]
+
+
+@dataclass(frozen=True)
+class AnalysisOptions:
+    """The indices asked for at every pose of a study.
+
+    Attributes
+    ----------
+    threshold : float
+        Singularity threshold *p* on the moment arm (m).
+    faults : tuple of int, optional
+        The numbers of faults ``j`` (default all); an int or any sequence is kept as a tuple.
+    fault_type : {"free-swinging", "link"}
+        What a failed actuator does (see :func:`screwkit.indices.analysis.analyze`).
+    closed_forms : bool
+        The paper's planar closed forms instead of the generic screw path.
+    limits : bool
+        Whether a pose that puts a joint outside its position limits is unreachable.
+    """
+
+    threshold: float = SINGULARITY_THRESHOLD
+    faults: tuple[int, ...] | None = None
+    fault_type: str = "free-swinging"
+    closed_forms: bool = False
+    limits: bool = True
+
+    def __post_init__(self):
+        if self.fault_type not in FAULT_TYPES:
+            raise ValueError(f"Expected `fault_type` in {', '.join(FAULT_TYPES)}, got {self.fault_type!r}.")
+        if self.faults is not None:
+            object.__setattr__(self, "faults", tuple(int(j) for j in np.atleast_1d(self.faults).tolist()))
+
+    def keywords(self) -> dict:
+        """The same settings as the keywords of :func:`screwkit.studies.indices_at_poses`."""
+        return asdict(self)
