@@ -460,7 +460,32 @@ def test_a_reference_assembly_outside_a_joint_limit_is_refused_by_name_or_read_w
                                                    "joint at 0, outside its limits [0.001, 1] (--ignore-limits")):
         load(path)
     mechanism = load(path, limits=False)
-    assert mechanism.assembly_notes == ("joint 'a_1': the reference assembly puts the joint at 0, outside its "
-                                        "limits [0.001, 1], ignored",)
+    assert mechanism.assembly_notes == ("limits ignored: joint 'a_1': the reference assembly puts the joint at 0, "
+                                        "outside its limits [0.001, 1]",)
     points = poses_near_home()
     assert_textbook(indices_at_poses(mechanism, points, detail=True, limits=False), points)
+
+
+def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_command(tmp_path):
+    """analyze, info and convert: refused in one line naming the joint without --ignore-limits; with it the file
+    is read, stderr says what was ignored, and convert writes a file that reads the same with --ignore-limits."""
+    path = tmp_path / "limited.xml"
+    path.write_text(five_bar_mjcf().replace('<joint name="a_1" type="hinge"', '<joint name="a_1" type="hinge" '
+                                                                           'range="0.001 1"'))
+    for command in (("analyze", path), ("info", path), ("convert", path, tmp_path / "refused.urdf")):
+        result = screwkit(*command)
+        assert result.returncode == 1 and result.stderr.count("\n") == 1, result.stderr
+        assert "<joint name='a_1'>: the reference assembly puts the joint at 0, outside its limits" in result.stderr
+        assert "--ignore-limits" in result.stderr
+    assert not (tmp_path / "refused.urdf").exists()
+    analysed = screwkit("analyze", path, "--ignore-limits", "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    assert "limits ignored: joint 'a_1'" in analysed.stderr
+    assert json.loads(analysed.stdout)["lmti"] == pytest.approx(five_bar_expected(HOME)["lmti"], abs=TOLERANCE)
+    assert screwkit("info", path, "--ignore-limits", "--json").returncode == 0
+    out = tmp_path / "converted.urdf"
+    converted = screwkit("convert", path, out, "--ignore-limits", "--json")
+    assert converted.returncode == 0, converted.stderr
+    assert any(note.startswith("limits ignored: joint") for note in json.loads(converted.stdout)["notes"])
+    again = json.loads(screwkit("analyze", out, "--ignore-limits", "--json").stdout)
+    assert again["lmti"] == pytest.approx(json.loads(analysed.stdout)["lmti"], abs=1e-12)

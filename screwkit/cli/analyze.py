@@ -151,7 +151,7 @@ def pose_from_actuators(mechanism, text: str, start):
 def analyze(mechanism: str, pose, actuator_values, analysis, length_unit, as_json: bool) -> None:
     """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose."""
 
-    loaded = load_mechanism(mechanism, length_unit, graphs=True)
+    loaded = load_mechanism(mechanism, length_unit, graphs=True, limits=analysis.limits)
     if isinstance(loaded, GraphMechanism):
         return _analyze_graph(loaded, pose is not None or actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)

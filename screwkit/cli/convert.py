@@ -7,7 +7,8 @@ from pathlib import Path
 
 import click
 
-from screwkit.cli.options import fail, json_option, overwrite_option, quiet_option
+from screwkit.cli.options import fail, ignore_limits_option, json_option, overwrite_option, quiet_option
+from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
 from screwkit.io.loader import load, load_text
 from screwkit.studies.files import atomic_text, check_output
@@ -24,13 +25,17 @@ __all__ = ["convert"]
 @click.option("--output-type", type=click.Choice(["point", "frame"]), default=None,
               help="A point output (where the chains meet) or the output frame; default: the point when every "
                    "closure meets the platform at one point, else the frame.")
+@ignore_limits_option
 @overwrite_option
 @quiet_option
 @json_option
-def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool, quiet: bool, as_json: bool) -> None:
+def convert(source: Path, out: Path, output_frame, output_type, ignore_limits: bool, overwrite: bool, quiet: bool,
+            as_json: bool) -> None:
     """Write SOURCE (an MJCF file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
     URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
-    already in the convention whose joint values leave loops open is written back with them closed."""
+    already in the convention whose joint values leave loops open is written back with them closed. With
+    --ignore-limits, a reference assembly outside a joint's limits is written all the same (the limits as in
+    SOURCE: the file written then needs --ignore-limits too)."""
     if not source.is_file():
         raise fail(f"{source}: no such file.")
     if source.suffix.lower() not in (".xml", ".mjcf", ".urdf"):
@@ -46,16 +51,18 @@ def convert(source: Path, out: Path, output_frame, output_type, overwrite: bool,
             if output_frame is not None or output_type is not None:
                 raise fail(f"{source}: --output and --output-type apply to MJCF files and URDF + robot.yaml; this "
                            "file is in screwkit's convention (its output is its platform).")
-            own = load(source)
+            own = load(source, limits=not ignore_limits)
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))
             report.notes = [f"assembled: {note}" for note in own.assembly_notes] or ["every loop closes as written"]
-        mechanism = load_text(text, str(out))  # what is written must load
+        mechanism = load_text(text, str(source), limits=not ignore_limits)  # what is written must load
     except (ImportError_, ValueError) as error:
         raise fail(str(error)) from None
-    if mechanism.assembly_notes:
-        raise fail(f"{out}: the converted file still leaves loops open: {'; '.join(mechanism.assembly_notes)}")
+    still_open = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
+    if still_open:
+        raise fail(f"{out}: the converted file still leaves loops open: {'; '.join(still_open)}")
+    report.notes += [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
     atomic_text(out, text)
     summary = {"source": str(source), "written": str(out), "format": report.file_format,
                "platform_body": report.platform_body, "output": report.output, "planar": report.planar,

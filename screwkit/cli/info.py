@@ -8,6 +8,7 @@ import click
 import numpy as np
 
 from screwkit.cli.options import (
+    ignore_limits_option,
     json_option,
     length_unit_option,
     load_mechanism,
@@ -57,11 +58,12 @@ def mechanism_info(mechanism) -> dict:
 @click.command()
 @mechanism_argument
 @length_unit_option
+@ignore_limits_option
 @json_option
-def info(mechanism: str, length_unit, as_json: bool) -> None:
+def info(mechanism: str, length_unit, ignore_limits: bool, as_json: bool) -> None:
     """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
     actuators, named poses (m, deg)."""
-    loaded = load_mechanism(mechanism, length_unit, indices=False)
+    loaded = load_mechanism(mechanism, length_unit, indices=False, limits=not ignore_limits)
     report = mechanism_info(loaded)
     if as_json:
         click.echo(json.dumps(report))

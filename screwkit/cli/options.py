@@ -19,6 +19,7 @@ from typing import Callable
 import click
 import numpy as np
 
+from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
@@ -322,18 +323,20 @@ def outputs_options(*, colour_scale: bool = False) -> Callable:
 
 # -- parsing ---------------------------------------------------------------------------------------
 
-def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True, graphs: bool = False):
+def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True, graphs: bool = False,
+                   limits: bool = True):
     """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded.
 
     ``indices``: the command computes indices, so a first run says at once that the index kernel
     is about to be compiled, and starts compiling it (before Pinocchio is even imported). ``graphs``: a file
     whose legs have loops inside them is returned as a :class:`~screwkit.io.GraphMechanism` (analysed at the
-    file's configuration) instead of refused."""
+    file's configuration) instead of refused. ``limits`` False (``--ignore-limits``): a reference assembly outside
+    a joint's limits is read all the same, and said on stderr."""
     if indices:
         compile_ahead(*INDEX_KERNELS)
 
     try:
-        mechanism = load(name, length_unit=length_unit)
+        mechanism = load(name, length_unit=length_unit, limits=limits)
     except LegWithLoops as error:
         if not graphs:
             raise fail(str(error)) from None
@@ -346,10 +349,13 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
     except ValueError as error:
         raise fail(str(error)) from None
     context = click.get_current_context(silent=True)
-    if mechanism.assembly_notes and not (context and context.params.get("quiet")):
+    opened = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
+    ignored = [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
+    if opened and not (context and context.params.get("quiet")):
         # a file whose loops are open as written describes another mechanism than the one analysed: say so
-        echo_error(f"{name}: loops open at the file's own joint values were closed at loading: "
-                   + "; ".join(mechanism.assembly_notes))
+        echo_error(f"{name}: loops open at the file's own joint values were closed at loading: " + "; ".join(opened))
+    if ignored and not (context and context.params.get("quiet")):
+        echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
                                      mechanism.dof))

@@ -41,8 +41,12 @@ from screwkit.common.tolerances import (
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["assemble", "mobility", "working_modes"]
+__all__ = ["assemble", "mobility", "working_modes", "LIMITS_IGNORED"]
 
+
+LIMITS_IGNORED = "limits ignored: "
+"""How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that is not an open loop starts: a
+reference assembly outside a joint's limits, read with ``limits=False``."""
 
 def _tidy(value: float) -> str:
     """A number for messages: 6 significant digits, round-off below 1e-12 shown as 0."""
@@ -64,8 +68,9 @@ def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
 
 
 def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_scale: float,
-                      limits: bool = True) -> tuple[NDArray[np.float64], str | None]:
-    """Joint values of the reference assembly, and a note when the file's values left the loop open.
+                      limits: bool = True) -> tuple[NDArray[np.float64], list[str]]:
+    """Joint values of the reference assembly, and notes: when the file's values left the loop open, and (with
+    ``limits`` False) when they are outside a joint's limits.
 
     The file's tree joint values (``<reference_configuration>`` or 0) with the loop joint's best
     fit; when the loop frames stay apart (a CAD export, a hand-edited file), the leg's joints are
@@ -116,8 +121,9 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
         if limits:
             raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
                                    f"{where} (--ignore-limits, or limits=False, reads it all the same).")
-        note = "; ".join(filter(None, [note, f"joint {chain.joint_names[outside]!r}: {where}, ignored"]))
-    return values, note
+        limit_note = f"{LIMITS_IGNORED}joint {chain.joint_names[outside]!r}: {where}"
+        return values, [n for n in (note, limit_note) if n]
+    return values, [note] if note else []
 
 
 def _check_planar(mechanism: Mechanism, chain: Chain, values: NDArray) -> None:
@@ -189,9 +195,8 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
     mechanism = replace(mechanism, length_scale=length_scale)
     chains, notes = [], []
     for index, chain in enumerate(mechanism.chains):
-        values, note = _reference_values(mechanism, index, chain, length_scale, limits)
-        if note:
-            notes.append(note)
+        values, chain_notes = _reference_values(mechanism, index, chain, length_scale, limits)
+        notes += chain_notes
         if mechanism.is_planar:
             _check_planar(mechanism, chain, values)
         frames = chain_forward_kinematics(chain.geometry, values)
