@@ -489,3 +489,23 @@ def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_co
     assert any(note.startswith("limits ignored: joint") for note in json.loads(converted.stdout)["notes"])
     again = json.loads(screwkit("analyze", out, "--ignore-limits", "--json").stdout)
     assert again["lmti"] == pytest.approx(json.loads(analysed.stdout)["lmti"], abs=1e-12)
+
+
+def test_the_output_frame_a_message_asks_for_is_an_option_of_every_command(tmp_path):
+    """A two-leg five-bar with no output frame: its two bodies tie, the one-line error asks for --output FRAME,
+    and analyze, info and sweep take it (the marker site names distal_1: the textbook five-bar)."""
+    tie = tmp_path / "tie.xml"
+    tie.write_text(five_bar_mjcf(legs=2).replace('name="effector"', 'name="marker"'))
+    refused = screwkit("analyze", tie)
+    assert refused.returncode == 1 and refused.stderr.count("\n") == 1 and "--output FRAME" in refused.stderr
+    analysed = screwkit("analyze", tie, "--output", "marker", "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    report = json.loads(analysed.stdout)
+    expected = five_bar_expected(HOME, legs=(0, 1))
+    assert report["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
+    info = screwkit("info", tie, "--output", "marker", "--output-type", "point", "--json")
+    assert info.returncode == 0 and json.loads(info.stdout)["dof"] == 2, info.stderr
+    swept = screwkit("sweep", tie, "--output", "marker", "--sweep", "x:-0.01:0.01:0.01", "--quiet")
+    assert swept.returncode == 0, swept.stderr
+    own = screwkit("analyze", "five_bar_3", "--output", "effector")
+    assert own.returncode == 1 and "applies to files of other tools" in own.stderr and own.stderr.count("\n") == 1

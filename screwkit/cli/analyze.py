@@ -12,10 +12,10 @@ from screwkit.cli.options import (
     analysis_options,
     fail,
     json_option,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
     parse_pose,
+    reading_options,
 )
 from screwkit.closure import forward
 from screwkit.indices.registry import INDICES
@@ -146,12 +146,12 @@ def pose_from_actuators(mechanism, text: str, start):
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
                    "it keeps.")
 @analysis_options(closed_forms=False)
-@length_unit_option
+@reading_options
 @json_option
-def analyze(mechanism: str, pose, actuator_values, analysis, length_unit, as_json: bool) -> None:
+def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: bool) -> None:
     """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose."""
 
-    loaded = load_mechanism(mechanism, length_unit, graphs=True, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, graphs=True, limits=analysis.limits)
     if isinstance(loaded, GraphMechanism):
         return _analyze_graph(loaded, pose is not None or actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)

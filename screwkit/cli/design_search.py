@@ -29,9 +29,9 @@ from screwkit.cli.options import (
     echo_error,
     execution_options,
     fail,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
+    reading_options,
 )
 from screwkit.studies.design.families import FAMILIES, Family, family
 from screwkit.studies.design.optimise import Constraint, Study
@@ -153,11 +153,11 @@ def family_search(family_name, legs, search, region, outputs, execution, report)
     _run(chosen, fixed, initial, search, region, outputs, execution, report)
 
 
-def _planar_design(mechanism: str, length_unit: str | None):
+def _planar_design(mechanism: str, reading):
     if mechanism in FAMILIES:
         raise fail(f"{mechanism} is a family: design-search family {mechanism} searches it; this subcommand takes "
                    "a mechanism (planar_5rrr, a file).")
-    loaded = load_mechanism(mechanism, length_unit)
+    loaded = load_mechanism(mechanism, reading)
     try:
         return loaded, planar_design(loaded)
     except ValueError as error:
@@ -170,16 +170,16 @@ def _planar_design(mechanism: str, length_unit: str | None):
 @region_options
 @design_outputs_options
 @execution_options()
-@length_unit_option
+@reading_options
 @report_options
-def optimise(mechanism, search, region, outputs, execution, length_unit, report) -> None:
+def optimise(mechanism, search, region, outputs, execution, reading, report) -> None:
     """Search the planar_rrr family from the design of MECHANISM, a planar n-RRR.
 
     The family's start is the file's platform radius and arm lengths (base, slots and working mode kept);
     the options are those of design-search family.
     """
     _check(search, outputs, report)
-    loaded, template = _planar_design(mechanism, length_unit)
+    loaded, template = _planar_design(mechanism, reading)
     try:
         count, values = family_values(template)
     except ValueError as error:
@@ -199,13 +199,13 @@ def optimise(mechanism, search, region, outputs, execution, length_unit, report)
               help="Step of the full rotation at the centre the designs are scored over (deg).")
 @click.option("--closed-forms", is_flag=True, help="Score with the paper's planar closed forms.")
 @execution_options()
-@length_unit_option
+@reading_options
 @report_options
-def permutations(mechanism, phi_step, closed_forms, execution, length_unit, report: Report) -> None:
+def permutations(mechanism, phi_step, closed_forms, execution, reading, report: Report) -> None:
     """Rank every assignment of platform slots to the chains of MECHANISM (a planar n-RRR), in both working
     modes: the paper's design selection, each scored by the minimum F_O1 over a full rotation at the centre."""
     check_phi_step(phi_step)
-    loaded, template = _planar_design(mechanism, length_unit)
+    loaded, template = _planar_design(mechanism, reading)
     current = tuple(int(s) for s in slots_of(template))
     with connected(execution) as execution:  # the handshake before any work
         try:

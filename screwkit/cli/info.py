@@ -10,9 +10,9 @@ import numpy as np
 from screwkit.cli.options import (
     ignore_limits_option,
     json_option,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
+    reading_options,
 )
 from screwkit.closure import working_modes
 from screwkit.common.units import is_angular, unit_of
@@ -57,13 +57,13 @@ def mechanism_info(mechanism) -> dict:
 
 @click.command()
 @mechanism_argument
-@length_unit_option
+@reading_options
 @ignore_limits_option
 @json_option
-def info(mechanism: str, length_unit, ignore_limits: bool, as_json: bool) -> None:
+def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
     actuators, named poses (m, deg)."""
-    loaded = load_mechanism(mechanism, length_unit, indices=False, limits=not ignore_limits)
+    loaded = load_mechanism(mechanism, reading, indices=False, limits=not ignore_limits)
     report = mechanism_info(loaded)
     if as_json:
         click.echo(json.dumps(report))

@@ -15,13 +15,13 @@ from screwkit.cli.options import (
     echo_error,
     execution_options,
     fail,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
     option_group,
     outputs_options,
     parse_range,
     quiet_option,
+    reading_options,
 )
 from screwkit.cli.sweep import fixed_pose, write_outputs
 from screwkit.common.units import is_angular
@@ -129,9 +129,9 @@ def _map(loaded, area: MapArea, analysis, execution, proceed: bool, quiet: bool)
 @analysis_options()
 @execution_options(task_size=True)
 @click.option("--yes", is_flag=True, help="Proceed with a map of more than 2e9 configurations.")
-@length_unit_option
+@reading_options
 @quiet_option
-def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution, yes, length_unit, quiet) -> None:
+def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution, yes, reading, quiet) -> None:
     """Minimum of every index over an orientation set at each point of a grid (Fig. 5).
 
     Planar: --radius R --step S --phi-step D maps a disc about the home position with phi
@@ -142,6 +142,6 @@ def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution,
 
     outputs.check(quiet)
     area.check()
-    loaded = load_mechanism(mechanism, length_unit, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
     result = _map(loaded, area, analysis, execution, yes, quiet)
     write_outputs(result, outputs, map_figure, quiet, vmin=outputs.vmin, vmax=outputs.vmax)

@@ -36,6 +36,8 @@ __all__ = [
     "ScrewkitGroup",
     "mechanism_argument",
     "length_unit_option",
+    "reading_options",
+    "Reading",
     "threshold_option",
     "fault_option",
     "ignore_limits_option",
@@ -177,6 +179,40 @@ def length_unit_option(function: Callable) -> Callable:
     return click.option("--length-unit", type=click.Choice(list(LENGTH_UNITS)), default=None,
                         help="Length unit the MECHANISM file is written in (default: its <units length=...>, else m); "
                              "everything shown is in m.")(function)
+
+
+@dataclass(frozen=True)
+class Reading:
+    """How MECHANISM's file is read: its length unit, and for a file of another tool the frame whose body is the
+    platform and whether the output is a point or that frame (``--length-unit``, ``--output``, ``--output-type``)."""
+
+    length_unit: str | None = None
+    output: str | None = None
+    output_type: str | None = None
+
+
+def _reading(length_unit: str | None, output_frame: str | None, output_type: str | None) -> Reading:
+    return Reading(length_unit, output_frame, output_type)
+
+
+def reading_options(function: Callable) -> Callable:
+    """``--length-unit``, ``--output FRAME``, ``--output-type``: how MECHANISM is read, as ``reading``, a
+    :class:`Reading` (the options :func:`screwkit.io.read_mechanism_file` and ``screwkit convert`` take)."""
+    return option_group("reading", _reading, length_unit_option, output_frame_option, output_type_option)(function)
+
+
+def output_frame_option(function: Callable) -> Callable:
+    return click.option("--output", "output_frame", default=None, metavar="FRAME",
+                        help="For a file of another tool: the frame (MJCF: site or body) whose body is the platform; "
+                             "default a frame named effector, end_effector, eff, ee, tool, tcp, foot or platform, "
+                             "else the body where most closures meet.")(function)
+
+
+def output_type_option(function: Callable) -> Callable:
+    return click.option("--output-type", type=click.Choice(["point", "frame"]), default=None,
+                        help="For a file of another tool: a point output (where the chains meet) or the output "
+                             "frame; default: the point when every closure meets the platform at one point and its "
+                             "rotations about it are idle, else the frame.")(function)
 
 
 def threshold_option(function: Callable) -> Callable:
@@ -323,9 +359,10 @@ def outputs_options(*, colour_scale: bool = False) -> Callable:
 
 # -- parsing ---------------------------------------------------------------------------------------
 
-def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool = True, graphs: bool = False,
+def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: bool = True, graphs: bool = False,
                    limits: bool = True):
-    """Load MECHANISM (a bundled name or a file); a one-line error if it cannot be loaded.
+    """Load MECHANISM (a bundled name or a file) as ``reading`` says (a :class:`Reading`, or just a length unit);
+    a one-line error if it cannot be loaded.
 
     ``indices``: the command computes indices, so a first run says at once that the index kernel
     is about to be compiled, and starts compiling it (before Pinocchio is even imported). ``graphs``: a file
@@ -334,16 +371,18 @@ def load_mechanism(name: str, length_unit: str | None = None, *, indices: bool =
     a joint's limits is read all the same, and said on stderr."""
     if indices:
         compile_ahead(*INDEX_KERNELS)
-
+    reading = reading if isinstance(reading, Reading) else Reading(length_unit=reading)
+    length_unit = reading.length_unit
     try:
-        mechanism = load(name, length_unit=length_unit, limits=limits)
+        mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
+                         output_type=reading.output_type)
     except LegWithLoops as error:
         if not graphs:
             raise fail(str(error)) from None
         if length_unit not in (None, "m"):
             raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
         try:
-            return graph_mechanism(read_closed_tree(name))
+            return graph_mechanism(read_closed_tree(name, output=reading.output, output_type=reading.output_type))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     except ValueError as error:

@@ -11,13 +11,13 @@ from screwkit.cli.options import (
     analysis_options,
     echo_error,
     fail,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
     outputs_options,
     parse_pose,
     parse_range,
     quiet_option,
+    reading_options,
 )
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import column_record, is_column
@@ -69,9 +69,9 @@ def write_outputs(dataset, outputs: Outputs, figure_function, quiet: bool, **fig
               help="The swept coordinate and its range, m or deg; the stop is excluded (yaw:0:360:1 is 360 angles).")
 @outputs_options()
 @analysis_options()
-@length_unit_option
+@reading_options
 @quiet_option
-def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, length_unit, quiet) -> None:
+def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, reading, quiet) -> None:
     """Sweep one pose coordinate: every series of the paper's Figure 4 along it.
 
     The data go to --out (or, with neither --out nor --figure, to stdout as CSV); the minima
@@ -79,7 +79,7 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, leng
     """
 
     outputs.check(quiet)
-    loaded = load_mechanism(mechanism, length_unit, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
     if (phi_range is None) == (sweep_spec is None):
         raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
     if phi_range is not None:

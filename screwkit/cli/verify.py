@@ -11,9 +11,9 @@ import numpy as np
 from screwkit.cli.options import (
     fail,
     json_option,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
+    reading_options,
 )
 from screwkit.closure import solve
 from screwkit.studies.poses import analyze_solution, closed_form_indices, planar_points
@@ -26,15 +26,15 @@ __all__ = ["verify"]
 @click.option("--samples", type=click.IntRange(min=1, max=10**7), default=10_000, show_default=True,
               help="Random reachable configurations to compare (count).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random poses.")
-@length_unit_option
+@reading_options
 @json_option
-def verify(mechanism: str, samples: int, seed: int, length_unit, as_json: bool) -> None:
+def verify(mechanism: str, samples: int, seed: int, reading, as_json: bool) -> None:
     """Compare the generic screw path with the paper's planar closed forms on random poses.
 
     Exit status 1 when some index differs by more than 1e-9.
     """
 
-    loaded = load_mechanism(mechanism, length_unit)
+    loaded = load_mechanism(mechanism, reading)
     if not loaded.is_planar:
         raise fail(f"verify compares with the planar closed forms; {loaded.name!r} is spatial.")
     rng = np.random.default_rng(seed)

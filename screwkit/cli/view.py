@@ -13,7 +13,6 @@ from screwkit.cli.options import (
     check_outputs,
     echo_error,
     fail,
-    length_unit_option,
     load_mechanism,
     mechanism_argument,
     option_group,
@@ -21,6 +20,7 @@ from screwkit.cli.options import (
     parse_pose,
     parse_range,
     quiet_option,
+    reading_options,
     threshold_option,
 )
 from screwkit.viewer import animate_sweep, export_html, show
@@ -85,11 +85,11 @@ def _echo_legend(scene) -> None:
     click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
                  help="Colour chains by their lowest ITI or by the OTI of their best working submechanism."),
     threshold_option)
-@length_unit_option
+@reading_options
 @click.option("--open", "open_browser", is_flag=True, help="Open the viewer in the default browser.")
 @overwrite_option
 @quiet_option
-def view(mechanism: str, pose, failed, html_path, animation: Animation, colouring: Colouring, length_unit,
+def view(mechanism: str, pose, failed, html_path, animation: Animation, colouring: Colouring, reading,
          open_browser, overwrite, quiet) -> None:
     """Show MECHANISM in a Meshcat viewer (served on 127.0.0.1), coloured by its indices.
 
@@ -99,7 +99,7 @@ def view(mechanism: str, pose, failed, html_path, animation: Animation, colourin
     """
 
     check_outputs({"--html": (html_path, (".html", ".htm"))}, overwrite, quiet)
-    loaded = load_mechanism(mechanism, length_unit)
+    loaded = load_mechanism(mechanism, reading)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
     try:

@@ -77,7 +77,8 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
 
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
-         max_bytes: int = MAX_FILE_BYTES, limits: bool = True) -> Mechanism:
+         max_bytes: int = MAX_FILE_BYTES, limits: bool = True, output: str | None = None,
+         output_type: str | None = None) -> Mechanism:
     """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
 
     Parameters
@@ -96,6 +97,10 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         False: a reference assembly that puts a joint outside its limits (a CAD export rounded by a
         millimetre) is read all the same, and said in ``assembly_notes``; the limits still apply to the
         poses analysed unless those are asked without them too.
+    output, output_type : str, optional
+        For a file of another tool: the frame whose body is the platform and ``"point"`` or ``"frame"``
+        (as :func:`screwkit.io.read_mechanism_file`); a file in screwkit's convention names its own platform,
+        so they are refused there.
 
     Raises
     ------
@@ -123,9 +128,12 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
-            converted, report = read_mechanism_file(path)
+            converted, report = read_mechanism_file(path, output=output, output_type=output_type)
             mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
+    if output is not None or output_type is not None:
+        raise ValueError(f"{path}: an output frame or type applies to files of other tools (MJCF, URDF + robot.yaml, "
+                         "onshape-to-robot URDFs); this file is in screwkit's convention (its output is its platform).")
     return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes), limits=limits)
 
 
