@@ -171,8 +171,8 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
         click.echo(json.dumps(report))
     else:
         print_report(report)
-        for line in loaded.import_report[:1]:
-            click.echo(f"(converted from {line})", err=True)
+    for number, line in enumerate(loaded.import_report):  # what was inferred, so that a wrong guess is seen
+        click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
 
 
 def _analyze_graph(graph: GraphMechanism, posed: bool, analysis, as_json: bool) -> None:
