@@ -2,7 +2,8 @@
 
 * :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser), a URDF
   tree with a Gepetto ``robot.yaml`` beside it, or an onshape-to-robot URDF whose loops are
-  ``closing_`` frame pairs (:mod:`screwkit.io.onshape`), as the text of a URDF in screwkit's convention
+  ``closing_`` frame pairs (:mod:`screwkit.io.onshape`) or a URDF whose loops are ``<gazebo><joint>``
+  elements (:mod:`screwkit.io.gazebo`), as the text of a URDF in screwkit's convention
   and an :class:`~screwkit.io.closed_tree.ImportReport`;
 * :func:`is_foreign`: whether a path is such a file (the loader then imports it).
 
@@ -18,6 +19,7 @@ from pathlib import Path
 
 from screwkit.common.units import metres_per
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
+from screwkit.io.gazebo import has_gazebo_joints, read_gazebo
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.graph import GraphMechanism, graph_mechanism
 from screwkit.io.mjcf import read_mjcf
@@ -26,18 +28,19 @@ from screwkit.io.star import convert_tree
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_onshape", "read_mjcf", "with_reference_configuration"]
+           "read_onshape", "read_gazebo", "read_mjcf", "with_reference_configuration"]
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
 
 def is_foreign(path: Path) -> bool:
     """An MJCF file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
-    onshape-to-robot ``closing_`` frame pairs."""
+    onshape-to-robot ``closing_`` frame pairs or ``<gazebo><joint>`` elements."""
     path = Path(path)
     if path.suffix.lower() in MJCF_SUFFIXES:
         return True
-    if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)):
+    if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)
+                                           or has_gazebo_joints(path)):
         head = path.read_bytes()[:4_000_000]
         return b"<loop" not in head
     return False
@@ -56,8 +59,10 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
         return read_gepetto(path, yaml_path, output=output, output_type=output_type)
     if has_closing_frames(path):
         return read_onshape(path, output=output, output_type=output_type)
-    raise ImportError_(f"{path}: no robot.yaml beside it and no closing_ frame pairs: not a closed-loop tree "
-                       "screwkit reads.")
+    if has_gazebo_joints(path):
+        return read_gazebo(path, output=output, output_type=output_type)
+    raise ImportError_(f"{path}: no robot.yaml beside it, no closing_ frame pairs and no <gazebo><joint>: not a "
+                       "closed-loop tree screwkit reads.")
 
 
 def read_mechanism_file(path: Path, *, output: str | None = None,

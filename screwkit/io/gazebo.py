@@ -1,0 +1,128 @@
+"""URDFs whose loops are closed by Gazebo joints: ``<gazebo><joint>`` elements (SDFormat joints) closing the tree.
+
+URDF cannot write a loop; Gazebo users write the joints that close one as SDFormat joints inside a
+``<gazebo>`` element of the URDF, which Gazebo adds to the model and every URDF parser (Pinocchio's
+included) skips::
+
+    <gazebo>
+      <joint name="loop_2" type="revolute">
+        <parent>distal_2</parent>
+        <child>distal_1</child>
+        <pose>0.3 0 0 0 0 0</pose>              <!-- in the child link's frame (SDFormat) -->
+        <axis><xyz>0 0 1</xyz></axis>           <!-- in the joint's frame -->
+      </joint>
+    </gazebo>
+
+Each such joint is a closure at the file's configuration (the tree's joints at 0, as Gazebo spawns
+it): a ``ball`` one point that both links keep (``3d``), a ``fixed`` one the whole frame (``6d``), a
+``revolute`` (or ``continuous``) one two points on its axis, which :mod:`screwkit.io.star` makes the
+hinge through them (a pin about the normal in a planar mechanism). Other types are refused by name.
+The actuated joints are those of the URDF's ``<transmission>`` elements, else guessed as for
+onshape-to-robot files (:func:`screwkit.io.onshape.guessed_motors`, said in the import report).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+
+from screwkit.common.rotations import rotation_from_rpy
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous, inverse
+from screwkit.io.onshape import guessed_motors
+
+__all__ = ["has_gazebo_joints", "read_gazebo"]
+
+HINGE_TYPES = ("revolute", "continuous")
+TYPES = (*HINGE_TYPES, "ball", "fixed")
+
+
+def has_gazebo_joints(path: Path) -> bool:
+    """Whether a URDF file has a ``<joint>`` inside a ``<gazebo>`` element (read as text, quickly)."""
+    head = path.read_bytes()[:4_000_000]
+    return b"<gazebo" in head and _gazebo_joints(head) != []
+
+
+def _gazebo_joints(text: bytes) -> list:
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError:
+        return []
+    return [joint for gazebo in root.findall("gazebo") for joint in gazebo.findall("joint")]
+
+
+def _numbers(element, tag: str, count: int, default: str, where: str) -> np.ndarray:
+    node = element.find(tag)
+    text = default if node is None or not (node.text or "").strip() else node.text
+    try:
+        values = np.array([float(word) for word in text.split()])
+    except ValueError:
+        values = np.array([])
+    if values.size != count or not np.all(np.isfinite(values)):
+        raise ImportError_(f"{where}: <{tag}> must hold {count} finite numbers, got {text.strip()!r}.")
+    return values
+
+
+def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
+    """The closed tree of a URDF whose loops are ``<gazebo><joint>`` elements."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    root = ElementTree.fromstring(urdf.read_bytes())
+    try:
+        model = pin.buildModelFromUrdf(str(urdf))
+    except (RuntimeError, ValueError) as error:
+        raise ImportError_(f"{urdf}: Pinocchio cannot read the tree ({error}).") from None
+    data = model.createData()
+    q = pin.neutral(model)
+    pin.framesForwardKinematics(model, data, q)
+    bodies = {frame.name: index for index, frame in enumerate(model.frames) if frame.type == pin.FrameType.BODY}
+    scale = max(float(np.max(np.abs([np.asarray(frame.translation) for frame in data.oMf]))), 1e-3)
+    closures = []
+    for element in _gazebo_joints(urdf.read_bytes()):
+        name = element.get("name") or f"gazebo_joint_{len(closures) + 1}"
+        where = f"{urdf}: <gazebo><joint name='{name}'>"
+        kind = element.get("type", "")
+        if kind not in TYPES:
+            raise ImportError_(f"{where}: type {kind!r} cannot close a loop here (expected one of {', '.join(TYPES)}).")
+        links = []
+        for tag in ("parent", "child"):
+            node = element.find(tag)
+            link = (node.text or "").strip() if node is not None else ""
+            if link not in bodies:
+                raise ImportError_(f"{where}: <{tag}> names {link!r}, not a link of the tree.")
+            links.append(bodies[link])
+        pose = _numbers(element, "pose", 6, "0 0 0 0 0 0", where)
+        in_child = np.eye(4)
+        in_child[:3, :3], in_child[:3, 3] = rotation_from_rpy(pose[3:]), pose[:3]
+        parent, child = (model.frames[index] for index in links)
+        world_child = homogeneous(data.oMf[links[1]])
+        parent_from_world = inverse(homogeneous(data.oMf[links[0]]))
+        points = [in_child]
+        if kind in HINGE_TYPES:  # a hinge: two points on its axis, made the hinge through them by the conversion
+            axis = _numbers(element.find("axis") if element.find("axis") is not None else element, "xyz", 3,
+                            "0 0 1", where)
+            if np.linalg.norm(axis) < 1e-12:
+                raise ImportError_(f"{where}: <axis><xyz> is zero.")
+            second = in_child.copy()
+            second[:3, 3] = in_child[:3, 3] + scale * in_child[:3, :3] @ (axis / np.linalg.norm(axis))
+            points.append(second)
+        for number, placement in enumerate(points):  # each side in its joint's frame, coinciding at q
+            on_parent = homogeneous(parent.placement) @ parent_from_world @ world_child @ placement
+            on_child = homogeneous(child.placement) @ placement
+            closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
+                                    on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d"))
+    transmitted = [joint.text.strip() for transmission in root.findall("transmission")
+                   for joint in transmission.findall("joint") if joint.text and joint.text.strip()]
+    transmitted += [joint.get("name") for transmission in root.findall("transmission")
+                    for joint in transmission.findall("joint") if joint.get("name")]
+    motors = list(dict.fromkeys(transmitted)) or guessed_motors(model, closures)
+    unknown = [motor for motor in motors if motor not in list(model.names)]
+    if unknown:
+        raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree.")
+    tree = ClosedTree(str(urdf), model, closures, motors, q, output, output_type,
+                      "URDF + Gazebo joints (<gazebo><joint>)")
+    if not transmitted:
+        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
+                          f"{', '.join(motors)}")
+    return tree

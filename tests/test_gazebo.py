@@ -1,0 +1,83 @@
+"""URDFs whose loops are closed by Gazebo joints (``<gazebo><joint>``, SDFormat joints inside a URDF).
+
+The five-bar of tests/test_io.py written as a Gazebo user writes it: the tree of its legs in URDF, each further
+leg's distal link joined to leg 1's by a revolute SDFormat joint (pose in the child link's frame, axis in the
+joint's), with and without ``<transmission>`` elements; checked against the textbook pressure angles.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_io import HOME, assert_textbook, poses_near_home, text
+from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows
+from test_onshape import onshape_urdf
+
+from screwkit.common.rotations import rotation_from_rpy
+from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.studies.poses import indices_at_poses
+
+EFFECTOR_RPY = (np.pi, 0.0, 0.3)
+
+
+def five_bar_gazebo(legs: int = 3, kind: str = "revolute", transmissions: bool = True, pose_rpy=(0.0, 0.0, 0.4)):
+    """The five-bar's tree and one Gazebo joint per further leg, its child the ``effector`` link (on distal_1 at the
+    output point, turned upside down and about its normal): the pose is the joint frame in that link, turned by
+    ``pose_rpy``, and the axis is written in the joint frame so that it is the plane's normal. Read in the parent
+    link's frame instead (distal_i, whose origin is its elbow), the loops would not close where they do."""
+    elbows = five_bar_elbows(HOME)
+    links = []
+    for i in range(legs):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        first = float(np.arctan2(*(elbow - base)[::-1]))
+        second = float(np.arctan2(*(HOME - elbow)[::-1]))
+        links.append((f"proximal_{i + 1}", f"mot{i + 1}", "revolute", (*base, 0.0), first, "base"))
+        links.append((f"distal_{i + 1}", f"free{i + 1}", "revolute", (PROXIMAL, 0.0, 0.0), second - first,
+                      f"proximal_{i + 1}"))
+    urdf = onshape_urdf(links, [("effector", "distal_1", (DISTAL, 0.0, 0.0), EFFECTOR_RPY)])
+    joint_in_distal = rotation_from_rpy(np.array(EFFECTOR_RPY)) @ rotation_from_rpy(np.array(pose_rpy))
+    axis = joint_in_distal.T @ np.array([0.0, 0.0, 1.0])  # distal_1's z is the plane's normal
+    joints = "".join(
+        f'<joint name="loop_{i + 1}" type="{kind}"><parent>distal_{i + 1}</parent><child>effector</child>'
+        f'<pose>0 0 0 {text(pose_rpy)}</pose><axis><xyz>{text(axis)}</xyz></axis></joint>'
+        for i in range(1, legs))
+    extra = f"<gazebo>{joints}</gazebo>"
+    if transmissions:
+        extra += "".join(f'<transmission name="t{i + 1}"><type>transmission_interface/SimpleTransmission</type>'
+                         f'<joint name="mot{i + 1}"/></transmission>' for i in range(legs))
+    return urdf.replace("</robot>", extra + "</robot>")
+
+
+@pytest.mark.parametrize("transmissions", [True, False])
+def test_a_five_bar_closed_by_gazebo_joints_has_the_textbook_pressure_angles(tmp_path, transmissions):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo(transmissions=transmissions))
+    converted, report = read_mechanism_file(path)
+    assert report.file_format == "URDF + Gazebo joints (<gazebo><joint>)" and report.planar
+    assert report.motors == ["mot1", "mot2", "mot3"]
+    assert any("the hinge through them" in note for note in report.notes), report.notes
+    guessed = any("actuators guessed" in note for note in report.notes)
+    assert guessed is not transmissions
+    mechanism = load(path)
+    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+def test_ball_gazebo_joints_close_the_five_bar_too(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo(kind="ball"))
+    mechanism = load(path)
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+def test_a_gazebo_joint_of_a_type_that_cannot_close_a_loop_or_naming_no_link_is_refused_by_name(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo(kind="screw"))
+    with pytest.raises(ImportError_, match=r"<gazebo><joint name='loop_2'>: type 'screw' cannot close a loop here"):
+        read_closed_tree(path)
+    path.write_text(five_bar_gazebo().replace("<parent>distal_3</parent>", "<parent>distal_9</parent>"))
+    with pytest.raises(ImportError_, match=r"<gazebo><joint name='loop_3'>: <parent> names 'distal_9', not a link"):
+        read_closed_tree(path)
