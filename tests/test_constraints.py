@@ -17,7 +17,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import moved, random_rotation, screwkit
+from helpers import assert_indices_close, moved, random_rotation, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.indices.analysis import analyze
 from screwkit.io.loader import load_text
@@ -291,17 +291,18 @@ def test_cli_sweep_and_map_say_their_fault_type(tmp_path):
         assert np.all(sweep["cti"].values > 0.9)
 
 
-def spherical_wrist_urdf(radius: float = 0.1) -> str:
+def spherical_wrist_urdf(radius: float = 0.1, frame_offset=(0.0, 0.0, 0.0), declared: bool = True) -> str:
     """A spherical 3-RRR wrist (the agile eye at home): three R-R-R legs whose nine joint axes all pass through the
-    centre O (the platform frame's origin), leg i's base, middle and platform axes along e_i, e_(i+1), e_(i+2);
-    task coordinates roll, pitch, yaw."""
+    centre O (the platform frame's origin, or O + ``frame_offset``), leg i's base, middle and platform axes along
+    e_i, e_(i+1), e_(i+2); task coordinates roll, pitch, yaw (declared unless not ``declared``)."""
     from screwkit.model.urdf_writer import UrdfWriter
 
     centre = np.array([0.0, 0.0, 0.3])
     writer = UrdfWriter("spherical_wrist", " spherical 3-RRR wrist, every joint axis through the centre ")
     writer.link("base_link", ("box", (0.1, 0.1, 0.01)))
     writer.link("platform", ("sphere", 0.02))
-    writer.joint("platform_joint", "floating", "base_link", "platform", xyz=centre)
+    offset = np.asarray(frame_offset, dtype=float)
+    writer.joint("platform_joint", "floating", "base_link", "platform", xyz=centre + offset)
     for i in range(3):
         axes = [np.eye(3)[(i + k) % 3] for k in range(3)]
         points = [radius * a for a in axes]  # a point on each axis, relative to O
@@ -313,10 +314,22 @@ def spherical_wrist_urdf(radius: float = 0.1) -> str:
         writer.joint(f"{chain}_joint_middle", "continuous", f"{chain}_proximal", f"{chain}_distal",
                      xyz=points[1] - points[0], axis=axes[1])
         writer.loop(f"{chain}_joint_platform", "revolute", chain, f"{chain}_distal", (points[2] - points[1], (0, 0, 0)),
-                    "platform", (points[2], (0, 0, 0)), axis=axes[2])
+                    "platform", (points[2] - offset, (0, 0, 0)), axis=axes[2])
         writer.transmission(f"{chain}_joint_base")
-    writer.task_coordinates(("roll", "pitch", "yaw"))
+    if declared:
+        writer.task_coordinates(("roll", "pitch", "yaw"))
     return writer.text()
+
+
+@pytest.mark.parametrize("frame_offset", [(0.0, 0.0, 0.0), (0.03, -0.02, 0.05)])
+def test_a_spherical_wrist_is_given_three_rotations_whatever_point_its_frame_is_at(frame_offset):
+    """No <task_coordinates>: the motion space has no twist without rotation, so the task coordinates are the
+    three rotations, not the translations of a frame origin off the centre; the indices equal the declared ones."""
+    inferred = load_text(spherical_wrist_urdf(frame_offset=frame_offset, declared=False), "wrist.urdf")
+    declared = load_text(spherical_wrist_urdf(frame_offset=frame_offset), "wrist.urdf")
+    assert inferred.task_coordinates == ("roll", "pitch", "yaw") and inferred.task_source == "inferred"
+    poses = declared.home_pose + np.deg2rad([[0.0, 0.0, 0.0], [10.0, -5.0, 15.0]])
+    assert_indices_close(indices_at_poses(declared, poses), indices_at_poses(inferred, poses), 1e-12)
 
 
 def test_a_spherical_wrist_has_no_cti_and_says_why(tmp_path):

@@ -262,19 +262,34 @@ def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values) -> 
 
 def infer_task_axes(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int,
                     candidates=None) -> tuple[int, ...]:
-    """The first ``dof`` pose coordinates, in order, whose rates are independent on the motion space.
+    """``dof`` pose coordinates whose rates are independent on the motion space, following that space.
 
-    ``joint_values`` holds one (m_i,) array per chain at the closed configuration ``full_pose``;
-    ``candidates`` restricts the coordinates tried (the translations of a point output).
+    The platform's translations without rotation come first: as many translation coordinates as the motion
+    space has twists with no rotation (three for a Delta, none for a spherical wrist whatever point its frame
+    is at), chosen in order among those independent on that subspace; then the rotation coordinates
+    independent on the whole space, in order (a hexapod's roll, pitch, yaw, a spherical wrist's three rotations
+    rather than the translations of its frame's origin off the centre), then any others. ``joint_values``
+    holds one (m_i,) array per chain at the closed configuration ``full_pose``; ``candidates`` restricts the
+    coordinates tried (the translations of a point output), in order, with no such split.
     """
     dofs, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
     space = basis[0][:, :int(dofs[0])]
+    order = list(range(mechanism.n_pose)) if candidates is None else list(candidates)
     chosen: list[int] = []
-    for axis in (range(mechanism.n_pose) if candidates is None else candidates):
-        trial = space[chosen + [axis]]
-        singular = np.linalg.svd(trial, compute_uv=False)
-        if singular.size and singular[-1] > TASK_RANK_TOLERANCE:
-            chosen.append(axis)
+    if len(order) == mechanism.n_pose and space.shape[1]:
+        angular = np.asarray(mechanism.pose_angular, dtype=bool)
+        _, singular, rows = np.linalg.svd(space[angular], full_matrices=True)
+        turning = int(np.sum(singular > TASK_RANK_TOLERANCE))
+        translations = space @ rows[turning:].T  # the motions that turn the platform by nothing
+        for axis in (axis for axis in order if not angular[axis]):
+            if len(chosen) == translations.shape[1]:
+                break
+            if np.linalg.svd(translations[chosen + [axis]], compute_uv=False)[-1] > TASK_RANK_TOLERANCE:
+                chosen.append(axis)
+        order = [axis for axis in order if angular[axis]] + [axis for axis in order if not angular[axis]]
+    for axis in order:
         if len(chosen) == dof:
             break
-    return tuple(chosen)
+        if axis not in chosen and np.linalg.svd(space[chosen + [axis]], compute_uv=False)[-1] > TASK_RANK_TOLERANCE:
+            chosen.append(axis)
+    return tuple(sorted(chosen))
