@@ -138,3 +138,18 @@ def test_analyze_opens_an_onshape_export_on_the_command_line(tmp_path):
     expected = five_bar_expected(HOME)
     assert report["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
     assert any("actuators guessed" in line for line in report["converted"])
+
+
+def test_the_task_coordinates_a_source_urdf_declares_are_kept(tmp_path):
+    """<task_coordinates> in the exported URDF (screwkit's element) reaches the converted file: honoured when the
+    motion allows it, refused by the element's name when it does not (a point output has no orientation)."""
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_onshape().replace("</robot>", '<task_coordinates names="y x"/></robot>'))
+    converted, report = read_mechanism_file(path)
+    assert '<task_coordinates names="y x"' in converted
+    assert "task coordinates as the source declares them: y x" in report.notes
+    mechanism = load(path)
+    assert mechanism.task_coordinates == ("x", "y") and mechanism.task_source == "declared"
+    path.write_text(five_bar_onshape().replace("</robot>", '<task_coordinates names="x phi"/></robot>'))
+    with pytest.raises(ValueError, match="<task_coordinates>"):
+        load(path)

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Closure", "ClosedTree", "ImportReport", "ImportError_", "LegWithLoops", "GRAPH_HINT",
-           "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to", "closure_gaps",
-           "assemble"]
+__all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
+           "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
+           "closure_gaps", "assemble"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -70,6 +70,19 @@ class ClosedTree:
     output_type: str | None = None  # "point", "frame" or None (decided as the module says)
     file_format: str = ""
     notes: list[str] = field(default_factory=list)  # what reading the file changed (said in the report)
+    task_coordinates: tuple[str, ...] | None = None  # a URDF source's <task_coordinates names="...">, kept
+
+
+def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
+    """The names of a URDF's ``<task_coordinates names="...">`` (screwkit's element), if it has one."""
+    import xml.etree.ElementTree as ElementTree
+
+    try:
+        root = ElementTree.fromstring(urdf_text)
+    except ElementTree.ParseError:
+        return None
+    names = [element.get("names", "").split() for element in root.findall("task_coordinates")]
+    return tuple(names[-1]) if names and names[-1] else None
 
 
 @dataclass

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.common.rotations import rotation_from_rpy
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous, inverse
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, declared_task_coordinates, homogeneous, inverse
 from screwkit.io.onshape import guessed_motors
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
@@ -121,7 +121,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     if unknown:
         raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree.")
     tree = ClosedTree(str(urdf), model, closures, motors, q, output, output_type,
-                      "URDF + Gazebo joints (<gazebo><joint>)")
+                      "URDF + Gazebo joints (<gazebo><joint>)", task_coordinates=declared_task_coordinates(
+                          urdf.read_bytes()))
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
                           f"{', '.join(motors)}")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, declared_task_coordinates, homogeneous
 
 __all__ = ["read_gepetto", "yaml_beside"]
 
@@ -70,4 +70,4 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
         closures.append(Closure(f"{pair[0]}-{pair[1]}", sides[0][0], sides[0][1], sides[1][0], sides[1][1],
                                 str(kind).lower()))
     return ClosedTree(source, model, closures, [str(m) for m in motors], pin.neutral(model), output, output_type,
-                      "URDF + Gepetto robot.yaml")
+                      "URDF + Gepetto robot.yaml", task_coordinates=declared_task_coordinates(urdf.read_bytes()))

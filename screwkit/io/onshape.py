@@ -23,7 +23,15 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous, joint_kind, path_to
+from screwkit.io.closed_tree import (
+    ClosedTree,
+    Closure,
+    ImportError_,
+    declared_task_coordinates,
+    homogeneous,
+    joint_kind,
+    path_to,
+)
 
 __all__ = ["CLOSING", "closing_pairs", "read_onshape"]
 
@@ -74,7 +82,8 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
         raise ImportError_(f"{urdf}: no 1-DoF joint leaves the base on the way to a closure: nothing to actuate "
                            "(a robot.yaml beside the file can list the actuated joints as name_mot).")
     tree = ClosedTree(str(urdf), model, closures, motors, pin.neutral(model), output, output_type,
-                      "onshape-to-robot URDF (closing_ frame pairs)")
+                      "onshape-to-robot URDF (closing_ frame pairs)",
+                      task_coordinates=declared_task_coordinates(urdf.read_bytes()))
     tree.notes.append(f"closing_ pairs read as ball joints (a URDF does not say the mate's type): "
                       f"{', '.join(c.name for c in closures)}; a robot.yaml beside the file (type: 3d or 6d) says "
                       "otherwise")

@@ -519,5 +519,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.motors = list(motor_ids.values())
     if point:
         writer.output("point")
+    if tree.task_coordinates:  # the source's own choice, checked when the written file is loaded
+        writer.task_coordinates(tree.task_coordinates)
+        report.notes.append(f"task coordinates as the source declares them: {' '.join(tree.task_coordinates)}")
     writer.reference_configuration(reference)
     return writer.text(), report
