@@ -12,6 +12,7 @@ every bundled mechanism the equivalent chain of the graph derivation gives the p
 
 from __future__ import annotations
 
+import json
 from itertools import combinations
 
 import numpy as np
@@ -171,17 +172,55 @@ def test_a_leg_whose_actuator_moves_inside_its_loop_is_refused_naming_it(tmp_pat
         graph_mechanism(read_mjcf(path))
 
 
-def test_the_command_line_analyses_a_rod_level_delta_as_written_and_refuses_a_pose_in_one_line(tmp_path):
+def frame_position(graph) -> np.ndarray:
+    """Where the graph's output frame is (world, m)."""
+    import pinocchio as pin
+
+    from screwkit.io.star import output_frame
+
+    data = graph.tree.model.createData()
+    pin.framesForwardKinematics(graph.tree.model, data, graph.q)
+    return np.asarray(data.oMf[output_frame(graph.tree)].translation)
+
+
+@pytest.mark.parametrize("centre", POSES[1:])
+def test_other_poses_are_solved_from_the_file_s_configuration_with_the_textbook_indices(tmp_path, centre):
+    """The Delta written at POSES[0], moved by the platform to another pose: the textbook indices there, and those
+    of the same Delta written at that pose (so also its working mode)."""
+    _, graph = open_delta(tmp_path)
+    moved = graph.at_pose(frame_position(graph) + np.subtract(centre, POSES[0]))
+    expected, result = textbook(centre), moved.indices()
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+    _, written = open_delta(tmp_path, centre, name="there.xml")
+    assert_indices_close(written.indices(), result, TOLERANCE)
+    with pytest.raises(ValueError, match=r"no closed configuration near the current one puts the output frame at "):
+        graph.at_pose(frame_position(graph) + np.array([0.0, 0.0, -5.0]))
+    with pytest.raises(ValueError, match=r"rpy \[0\.0, 0\.0, 30\.0\] deg"):
+        graph.at_pose(frame_position(graph), np.radians([0.0, 0.0, 30.0]))  # a Delta's platform does not turn
+
+
+def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_poses(tmp_path):
     """``screwkit analyze FILE`` opens the file as written (the graph at the file's configuration) and prints the
-    textbook indices; ``--pose`` is refused in one line (poses of legs with loops are not solved yet)."""
-    path, _ = open_delta(tmp_path)
+    textbook indices; ``--pose x y z`` moves the output frame there; --actuators and unreachable poses are refused
+    in one line."""
+    path, graph = open_delta(tmp_path)
     expected = textbook(POSES[0])
     completed = screwkit("analyze", path)
     assert completed.returncode == 0, completed.stderr
     assert "4 actuators, 3 DOF (1 redundant), at the file's configuration" in completed.stdout
     assert f"LMTI (Eq. 11, all actuators)        {expected['lmti']:.4f}" in completed.stdout
     assert "analysed as a graph" in completed.stderr and "Traceback" not in completed.stderr
-    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-0.4", "0", "0", "0"),
-                   "loops inside them", "leave out --pose")
+    target = frame_position(graph) + np.subtract(POSES[1], POSES[0])
+    posed = screwkit("analyze", path, "--pose", *[repr(float(v)) for v in target], "--json")
+    assert posed.returncode == 0, posed.stderr
+    report = json.loads(posed.stdout)
+    assert report["lmti"] == pytest.approx(textbook(POSES[1])["lmti"], abs=TOLERANCE)
+    assert report["pose"] == pytest.approx(dict(zip("xyz", target)), abs=1e-12)
+    one_line_error(screwkit("analyze", path, "--actuators", "0", "0", "0", "0"), "loops inside them",
+                   "leave out --actuators")
+    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration near the current",
+                   "out of reach")
+    one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes the output frame's x y z")
     converted = screwkit("convert", path, tmp_path / "out.urdf")
     one_line_error(converted, "inside a leg", "screwkit analyze FILE")

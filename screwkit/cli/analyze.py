@@ -18,6 +18,7 @@ from screwkit.cli.options import (
     reading_options,
 )
 from screwkit.closure import forward
+from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
 from screwkit.io import GraphMechanism
 from screwkit.studies import indices_at_pose
@@ -140,7 +141,8 @@ def pose_from_actuators(mechanism, text: str, start):
 @mechanism_argument
 @click.option("--pose", cls=GreedyOption, metavar="VALUES|NAME",
               help="Platform pose: x y phi (planar) or x y z roll pitch yaw, in m and deg, or a named pose "
-                   "(screwkit info lists them). Default: the file's home pose.")
+                   "(screwkit info lists them). Default: the file's home pose. Legs with loops inside them: the "
+                   "output frame's x y z [roll pitch yaw].")
 @click.option("--actuators", "actuator_values", cls=GreedyOption, metavar="VALUES",
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
@@ -153,7 +155,7 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
 
     loaded = load_mechanism(mechanism, reading, graphs=True, limits=analysis.limits)
     if isinstance(loaded, GraphMechanism):
-        return _analyze_graph(loaded, pose is not None or actuator_values is not None, analysis, as_json)
+        return _analyze_graph(loaded, pose, actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)
     if actuator_values is not None:
         target = pose_from_actuators(loaded, actuator_values, target)
@@ -175,16 +177,35 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
 
 
-def _analyze_graph(graph: GraphMechanism, posed: bool, analysis, as_json: bool) -> None:
-    """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration."""
-    if posed:
-        raise fail(f"{graph.tree.source}: its legs have loops inside them, analysed at the file's configuration only "
-                   "(poses of such legs are not solved yet): leave out --pose and --actuators.")
+def _analyze_graph(graph: GraphMechanism, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:
+    """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration, or with the output
+    frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
+    if by_actuators:
+        raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by the output frame only: leave out "
+                   "--actuators (give --pose x y z [roll pitch yaw]).")
+    shown = {}
+    if pose is not None:
+        try:
+            values = [float(word) for word in pose.split()]
+        except ValueError:
+            values = []
+        if len(values) not in (3, 6) or not np.all(np.isfinite(values)):
+            raise fail(f"{graph.tree.source}: its legs have loops inside them: --pose takes the output frame's "
+                       f"x y z (m) and optionally roll pitch yaw (deg), got {pose!r}.")
+        for angle in values[3:]:
+            if abs(angle) > angle_limit(degrees=True):
+                raise fail(str(angle_beyond_limit("--pose", angle, degrees=True)))
+        rpy = np.radians(values[3:]) if len(values) == 6 else None
+        try:
+            graph = graph.at_pose(values[:3], rpy)
+        except ValueError as error:
+            raise fail(str(error)) from None
+        shown = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), values))
     try:
         result = graph.indices(threshold=analysis.threshold, fault_type=analysis.fault_type)
     except ValueError as error:
         raise fail(str(error)) from None
-    report = {**result.to_dict(), "mechanism": graph.name, "pose": {}, "converted": graph.report.lines()}
+    report = {**result.to_dict(), "mechanism": graph.name, "pose": shown, "converted": graph.report.lines()}
     if as_json:
         click.echo(json.dumps(report))
     else:

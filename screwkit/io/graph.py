@@ -32,7 +32,9 @@ The rows of an equivalent chain other than the actuator's carry the leg's platfo
 own point they set the working length ``L`` of :func:`~screwkit.indices.analysis.analyze`.
 
 The indices are those of the configuration the file's closures assemble into (:func:`screwkit.io.closed_tree.
-assemble`); the output is the platform frame. Poses other than the file's are not solved for such legs yet.
+assemble`), or of another platform pose (:meth:`GraphMechanism.at_pose`: the same closures plus one that holds the
+output frame at the pose, solved from the file's configuration, so the working mode is the nearest one); the
+output is the platform frame.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_from_rpy
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -50,6 +53,7 @@ from screwkit.io.closed_tree import (
     ImportReport,
     assemble,
     closure_gaps,
+    homogeneous,
     joint_kind,
     joint_value,
     path_to,
@@ -79,8 +83,9 @@ class GraphLeg:
 
 @dataclass(frozen=True)
 class GraphMechanism:
-    """A closed-loop graph assembled at the file's configuration ``q``: its platform (joint id), its legs, and the
-    chain screws of its legs' equivalent chains with their ITI and OTI points (:func:`graph_mechanism`)."""
+    """A closed-loop graph assembled at a configuration ``q`` (the file's, or a pose's): its platform (joint id), its
+    legs, and the chain screws of its legs' equivalent chains with their ITI and OTI points
+    (:func:`graph_mechanism`)."""
 
     name: str
     tree: ClosedTree
@@ -94,8 +99,40 @@ class GraphMechanism:
     oti_points: NDArray[np.float64]
     report: ImportReport
 
+    def at_pose(self, position, rpy=None) -> GraphMechanism:
+        """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default
+        the one it has), closed from this configuration (the nearest working mode). A ValueError names the pose
+        when no closed configuration near this one puts the frame there."""
+        import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+        model = self.tree.model
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, self.q)
+        frame_id = output_frame(self.tree)
+        target = homogeneous(data.oMf[frame_id])
+        position = np.asarray(position, dtype=float).reshape(-1)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise ValueError(f"Expected a finite position (x, y, z), got {position.tolist()}.")
+        target[:3, 3] = position
+        if rpy is not None:
+            target[:3, :3] = rotation_from_rpy(np.asarray(rpy, dtype=float))
+        frame = model.frames[frame_id]
+        holding = Closure("pose", 0, target, int(frame.parentJoint), homogeneous(frame.placement), "6d")
+        posed = replace(self.tree, closures=[*self.tree.closures, holding], q_reference=self.q, notes=[])
+        try:
+            q, _ = assemble(posed)
+        except ImportError_:
+            raise ValueError(f"{self.tree.source}: no closed configuration near the current one puts the output frame "
+                             f"at {np.round(position, 9).tolist()} m"
+                             + ("" if rpy is None else f", rpy {np.round(np.degrees(rpy), 9).tolist()} deg")
+                             + " (out of reach, or a rotation the legs do not allow).") from None
+        if posed.notes:  # closed only to a rounding: the pose is not exactly reachable
+            raise ValueError(f"{self.tree.source}: the output frame cannot be put exactly at "
+                             f"{np.round(position, 9).tolist()} m: {posed.notes[-1]}.")
+        return graph_mechanism(self.tree, q=q, scale=self.scale)
+
     def indices(self, **options):
-        """Every index at the file's configuration (:func:`screwkit.indices.analysis.analyze`'s options)."""
+        """Every index at this configuration (:func:`screwkit.indices.analysis.analyze`'s options)."""
         from screwkit.indices.analysis import analyze  # the index layer, above io: only when indices are asked
 
         options.setdefault("detail", True)
@@ -110,7 +147,7 @@ class GraphMechanism:
                     values[name] = joint_value(model, joint, self.q)
                     if kind == "prismatic":
                         prismatic.append(name)
-        mode = "as the file's closures assemble from its joint values"
+        mode = "as the file's closures assemble from its joint values (at another pose: the nearest to it)"
         return replace(result, mechanism=self.name, joint_values=values, prismatic_joints=tuple(prismatic),
                        working_mode={leg.name: mode for leg in self.legs})
 
@@ -234,13 +271,15 @@ def _equivalent_chain(tree: ClosedTree, data, leg: GraphLeg, platform: int, cent
     return ChainScrews(world, points, (0,), leg.name, names), iti_point, oti_point
 
 
-def graph_mechanism(tree: ClosedTree) -> GraphMechanism:
-    """The closed tree assembled at the file's configuration, its legs and their equivalent chains."""
+def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | None = None) -> GraphMechanism:
+    """The closed tree assembled at the file's configuration (or at ``q``, a closed configuration, with the length
+    scale ``scale``), its legs and their equivalent chains."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
     report = ImportReport(source=tree.source, file_format=tree.file_format)
-    q, scale = assemble(tree)
+    if q is None or scale is None:
+        q, scale = assemble(tree)
     frame = model.frames[output_frame(tree)]
     report.notes[:0] = tree.notes
     platform = int(frame.parentJoint)
