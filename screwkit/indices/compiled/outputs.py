@@ -9,8 +9,14 @@ level, each locked set starting from the minors it shares with the set before it
 no division), the OTIs of every non-redundant submechanism (Eqs. 8-9, with the identity
 |A_k o T_k| = |det W| of Eq. A3, so that a submechanism's OTI is |det W| over its longest moment
 arm), the LMTI of all actuators (Eq. 11), F_Oj for each j (Eqs. 12-13) with the worst fault set,
-and the mutual-interference actuators. Its own module, so that it compiles apart from
-:mod:`screwkit.indices.compiled.wrenches` (in parallel on a first run, :mod:`screwkit.common.compiling`).
+and the mutual-interference actuators. The kernel is a short driver over named stages, each a few passes
+over all the items of one kind in a block: the actuators (:func:`screwkit.indices.compiled.actuators.actuator_stage`),
+the locked sets (:func:`locked_stage`), the submechanisms (:func:`submechanism_stage`) and the reductions over
+actuator sets (:func:`reduction_stage`). numba inlines every stage
+(``inline="always"``), so that the kernel compiles as one function, with the results, bit for bit, of the loops
+written out (see :mod:`screwkit.indices.compiled.actuators` on the cost of an inlined call). Its own module, so that
+it compiles apart from :mod:`screwkit.indices.compiled.wrenches` (in parallel on a first run,
+:mod:`screwkit.common.compiling`).
 
 Loops over the configurations of a block (lanes) write one array each where they are hot: the
 compiler vectorises a loop only when it can rule out, with few runtime checks, that what it
@@ -23,6 +29,7 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.indices.compiled.actuators import actuator_scratch, actuator_stage
 from screwkit.indices.compiled.algebra import (
     BLOCK,
     CARRY_SIGNATURE,
@@ -30,8 +37,6 @@ from screwkit.indices.compiled.algebra import (
     cross,
     motion_lanes_of,
     power_coefficient,
-    working_point,
-    working_twist,
 )
 
 __all__ = ["output_kernel"]
@@ -53,6 +58,331 @@ def output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r):
     return arm_square(output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r],
                       output_twist[locked, 3, r], output_twist[locked, 4, r], output_twist[locked, 5, r],
                       point_lanes[act, 0, r], point_lanes[act, 1, r], point_lanes[act, 2, r], pitch_lanes[act, r])
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def identity_basis(basis):
+    """Whether the motion basis is the identity (one basis, n = 6): a platform free in all six DoF, M^T y = y."""
+    n = basis.shape[1]
+    identity = basis.shape[0] == 1 and n == 6
+    for q in range(n):
+        for k in range(6):
+            identity = identity and basis[0, q, k] == (1.0 if q == k else 0.0)
+    return identity
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def submechanism_members(submechanisms, a):
+    """member[s, act]: whether actuator ``act`` belongs to submechanism s."""
+    member = np.zeros((submechanisms.shape[0], a), dtype=np.bool_)
+    for s in range(submechanisms.shape[0]):
+        for i in range(submechanisms.shape[1]):
+            member[s, submechanisms[s, i]] = True
+    return member
+
+
+# --- Per set of n - 1 locked actuators: the output twist reciprocal to their wrenches (a column of adj(W) of
+# every submechanism containing the set).
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def exterior_products(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, n, width, wedge,
+                      output):
+    """Every locked set's cofactor vector for n >= 4, the exterior product of its rows: level K of ``wedge`` holds
+    the K x K minors of the first K rows (one per K-column set, combination order), each from level K - 1 by
+    expansion along row K. Lexicographic neighbours share their first rows, so only the levels past the first row
+    that changed are recomputed."""
+    for locked in range(locked_sets.shape[0]):
+        for level in range(max(locked_depth[locked], 1) + 1, n):
+            row = locked_sets[locked, level - 1]
+            if level == 2:  # level 1's minors: the first row's entries
+                for q in range(n):
+                    for r in range(width):
+                        wedge[1, q, r] = wrench_matrix[locked_sets[locked, 0], q, r]
+            # Each minor's WEDGE_TERMS terms (padded with zero signs) summed in one pass over the lanes: one store
+            # per minor, a loop the compiler vectorises.
+            for target in range(wedge_start[level], wedge_start[level + 1]):
+                u0, c0, s0 = wedge_table[target, 1], wedge_table[target, 2], float(wedge_table[target, 3])
+                u1, c1, s1 = wedge_table[target, 4], wedge_table[target, 5], float(wedge_table[target, 6])
+                u2, c2, s2 = wedge_table[target, 7], wedge_table[target, 8], float(wedge_table[target, 9])
+                u3, c3, s3 = wedge_table[target, 10], wedge_table[target, 11], float(wedge_table[target, 12])
+                u4, c4, s4 = wedge_table[target, 13], wedge_table[target, 14], float(wedge_table[target, 15])
+                minor = wedge_table[target, 0]
+                for r in range(width):
+                    wedge[level, minor, r] = (s0 * wedge[level - 1, u0, r] * wrench_matrix[row, c0, r]
+                                              + s1 * wedge[level - 1, u1, r] * wrench_matrix[row, c1, r]
+                                              + s2 * wedge[level - 1, u2, r] * wrench_matrix[row, c2, r]
+                                              + s3 * wedge[level - 1, u3, r] * wrench_matrix[row, c3, r]
+                                              + s4 * wedge[level - 1, u4, r] * wrench_matrix[row, c4, r])
+        for q in range(n):  # output[locked, q]: minor n - 1 - q of the last level, signed
+            sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
+            for r in range(width):
+                output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def locked_cofactors(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, n, width, wedge, output):
+    """output[locked, q] = (-1)^(n-1+q) det(the locked rows of W without column q): the cofactor vector y of every
+    locked set, in motion coordinates (no pivoting, no division)."""
+    if n > 3:  # the exterior product of the locked rows
+        exterior_products(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, n, width, wedge, output)
+    for locked in range(locked_sets.shape[0] if n <= 3 else 0):
+        if n == 3:  # the cross product of the two locked rows, written out
+            i0 = locked_sets[locked, 0]
+            i1 = locked_sets[locked, 1]
+            for r in range(width):
+                output[locked, 0, r], output[locked, 1, r], output[locked, 2, r] = cross(
+                    wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
+                    wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
+        elif n == 1:  # no locked row: the one motion
+            for r in range(width):
+                output[locked, 0, r] = 1.0
+        elif n == 2:  # one locked row (x, y): (-y, x)
+            i0 = locked_sets[locked, 0]
+            for r in range(width):
+                output[locked, 0, r] = -wrench_matrix[i0, 1, r]
+                output[locked, 1, r] = wrench_matrix[i0, 0, r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def locked_output_twists(output, motion_lanes, identity, width, output_twist, omega_squares):
+    """The output twist M^T y of every locked set (working coordinates; ``output_twist`` is ``output`` itself when
+    the basis is the identity), once per set: every submechanism holding the set uses it; and its |omega|^2."""
+    for locked in range(output.shape[0]):
+        if not identity:
+            for k in range(6):
+                for r in range(width):
+                    output_twist[locked, k, r] = 0.0
+            for q in range(motion_lanes.shape[0]):
+                for k in range(6):
+                    for r in range(width):
+                        output_twist[locked, k, r] += motion_lanes[q, k, r] * output[locked, q, r]
+        for r in range(width):
+            w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
+            omega_squares[locked, r] = w0 * w0 + w1 * w1 + w2 * w2
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def locked_stage(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, motion_lanes, identity, width,
+                 wedge, output, output_twist, omega_squares):
+    """Every locked set's cofactor vector y (motion coordinates, ``output``), output twist M^T y (working
+    coordinates) and its |omega|^2."""
+    locked_cofactors(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, motion_lanes.shape[0], width,
+                     wedge, output)
+    locked_output_twists(output, motion_lanes, identity, width, output_twist, omega_squares)
+
+
+# --- Per non-redundant submechanism: |A_k o T_k| = |det W| for each k (A3), its OTIs (Eqs. 8-9).
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def submechanism_determinants(submechanisms, locked_of, wrench_matrix, output, row_norms, rank_tolerance, width,
+                             determinant, volume, independent):
+    """det W of every submechanism s (its first row against its first locked set's cofactors), and whether its wrenches
+    are independent: |det W| above ``rank_tolerance`` times the product of its rows' norms."""
+    for s in range(submechanisms.shape[0]):
+        n = submechanisms.shape[1]
+        first = locked_of[s, 0]
+        leader = submechanisms[s, 0]
+        for r in range(width):
+            volume[r] = 1.0
+            determinant[s, r] = 0.0
+        for i in range(n):
+            act = submechanisms[s, i]
+            for r in range(width):
+                volume[r] *= row_norms[act, r]
+        for q in range(n):
+            for r in range(width):
+                determinant[s, r] += wrench_matrix[leader, q, r] * output[first, q, r]
+        for r in range(width):
+            independent[s, r] = abs(determinant[s, r]) > rank_tolerance * volume[r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def longest_arm_squares(submechanisms, locked_of, output_twist, omega_squares, point_lanes, pitch_lanes, has_force,
+                       thresholds, width, longest_sq):
+    """The longest squared moment arm of each submechanism s's wrenches on their output twists, infinite where one is
+    at or below its threshold (a zero OTI, as in :func:`~screwkit.indices.compiled.algebra.power_coefficient`)."""
+    for s in range(submechanisms.shape[0]):
+        for r in range(width):
+            longest_sq[s, r] = 0.0
+        for position in range(submechanisms.shape[1]):
+            act = submechanisms[s, position]
+            locked = locked_of[s, position]
+            for r in range(width):
+                # The OTI's moment arm: the output twist's velocity at the characteristic point plus h omega
+                # (v + omega x p + h omega), or |omega| for a couple (both computed, one kept, so that the lanes stay
+                # branch-free).
+                forceful = has_force[act, r]
+                omega_sq = omega_squares[locked, r]
+                arm_sq = (output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r) if forceful
+                          else omega_sq)
+                reference_sq = omega_sq if forceful else 0.0
+                # one store per lane, so that the compiler vectorises the loop
+                zero = arm_sq <= thresholds[r] * thresholds[r] * reference_sq or arm_sq <= 0.0
+                longest_sq[s, r] = max(longest_sq[s, r], np.inf if zero else arm_sq)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def actuator_otis(submechanisms, locked_of, output_twist, omega_squares, point_lanes, pitch_lanes, has_force,
+                  thresholds, determinant, independent, first_index, width, oti_out):
+    """OTI_k of every actuator k of every submechanism s (Eq. 8, |A_k o T_k| = |det W|) into ``oti_out``."""
+    for s in range(submechanisms.shape[0]):
+        for position in range(submechanisms.shape[1]):
+            act = submechanisms[s, position]
+            locked = locked_of[s, position]
+            for r in range(width):
+                omega = np.sqrt(omega_squares[locked, r])
+                arm = (np.sqrt(output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r))
+                       if has_force[act, r] else omega)
+                reference = omega if has_force[act, r] else 0.0
+                oti_out[first_index + r, s, position] = (
+                    power_coefficient(determinant[s, r], arm, reference, thresholds[r]) if independent[s, r] else 0.0)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def world_output_twists(locked_of, output_twist, first_index, width, centres, lengths, twist_out):
+    """Submechanism s's output twists back in world units and origin (v_0 = L v' - omega x c) into ``twist_out``."""
+    for s in range(locked_of.shape[0]):
+        for position in range(locked_of.shape[1]):
+            locked = locked_of[s, position]
+            for r in range(width):
+                index = first_index + r
+                for k in range(6):
+                    total = output_twist[locked, k, r]
+                    twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
+                x0, x1, x2 = cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
+                                   twist_out[index, s, position, 2], centres[0, r], centres[1, r], centres[2, r])
+                twist_out[index, s, position, 3] -= x0
+                twist_out[index, s, position, 4] -= x1
+                twist_out[index, s, position, 5] -= x2
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def submechanism_otis(determinant, independent, longest_sq, width, lmti_lanes):
+    """The OTI of every submechanism s (Eq. 9), min_k |det W| / arm_k (each at most 1) = |det W| / max_k arm_k: one root
+    and one division per submechanism; zero if any arm is at or below its threshold."""
+    for s in range(independent.shape[0]):
+        for r in range(width):
+            value = (abs(determinant[s, r]) / np.sqrt(longest_sq[s, r])
+                     if independent[s, r] and longest_sq[s, r] < np.inf else 0.0)
+            lmti_lanes[s, r] = 1.0 if value > 1.0 else value
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def submechanism_stage(submechanisms, locked_of, wrench_matrix, output, row_norms, rank_tolerance, output_twist,
+                       omega_squares, point_lanes, pitch_lanes, has_force, first_index, width, thresholds, centres,
+                       lengths, determinant, volume, longest_sq, independent, lmti_lanes, oti_out, twist_out,
+                       oti_sub_out):
+    """Every non-redundant submechanism's det W and independence, its OTI (Eq. 9) into the first rows of
+    ``lmti_lanes``; when their outputs have rows, its actuators' OTIs (Eq. 8), output twists (world) and OTI."""
+    submechanism_determinants(submechanisms, locked_of, wrench_matrix, output, row_norms, rank_tolerance, width,
+                              determinant, volume, independent)
+    longest_arm_squares(submechanisms, locked_of, output_twist, omega_squares, point_lanes, pitch_lanes, has_force,
+                        thresholds, width, longest_sq)
+    if oti_out.shape[0] > 0:
+        actuator_otis(submechanisms, locked_of, output_twist, omega_squares, point_lanes, pitch_lanes, has_force,
+                      thresholds, determinant, independent, first_index, width, oti_out)
+    if twist_out.shape[0] > 0:
+        world_output_twists(locked_of, output_twist, first_index, width, centres, lengths, twist_out)
+    submechanism_otis(determinant, independent, longest_sq, width, lmti_lanes)
+    if oti_sub_out.shape[0] > 0:
+        for s in range(submechanisms.shape[0]):
+            for r in range(width):
+                oti_sub_out[first_index + r, s] = lmti_lanes[s, r]
+
+
+# --- Reductions over actuator sets.
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def iti_and_lmti(iti_lanes, lmti_lanes, subs, first_index, width, lowest, highest, summary_out, iti_out):
+    """The ITI (Eq. 7, the lowest of the actuators') and the LMTI of all actuators (Eq. 11, the highest OTI of the
+    submechanisms) into ``summary_out``; each actuator's ITI into ``iti_out``."""
+    for r in range(width):
+        lowest[r] = 1.0
+        highest[r] = 0.0
+    for act in range(iti_lanes.shape[0]):
+        for r in range(width):
+            lowest[r] = min(lowest[r], iti_lanes[act, r])
+    for s in range(subs):
+        for r in range(width):
+            highest[r] = max(highest[r], lmti_lanes[s, r])
+    for r in range(width):
+        summary_out[first_index + r, 0] = lowest[r]
+        summary_out[first_index + r, 1] = highest[r]
+    if iti_out.shape[0] > 0:
+        for r in range(width):
+            for act in range(iti_lanes.shape[0]):
+                iti_out[first_index + r, act] = iti_lanes[act, r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def set_lmtis(set_children, subs, width, set_lmti, lmti_lanes):
+    """The LMTI of every set the reductions need: row t of ``set_children`` is a set whose LMTI is the max over
+    earlier rows of ``lmti_lanes`` (submechanisms' OTIs, or sets one smaller); its value goes to row subs + t."""
+    for row in range(set_children.shape[0]):
+        for r in range(width):
+            set_lmti[r] = -np.inf
+        for t in range(set_children.shape[1]):
+            child = set_children[row, t]
+            if child < 0:
+                break
+            for r in range(width):
+                set_lmti[r] = max(set_lmti[r], lmti_lanes[child, r])
+        for r in range(width):
+            lmti_lanes[subs + row, r] = set_lmti[r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def fault_indices(fault_rows, lmti_lanes, worst_fault_tie, first_index, width, fault_index, tie_limit, first_set,
+                  summary_out, worst_out):
+    """F_Oj (Eqs. 12-13): the worst, over the sets E left after j faults (rows fault_rows[f] of ``lmti_lanes``),
+    of LMTI_E; and the worst set, the first in combination order whose LMTI is within ``worst_fault_tie`` of F_Oj
+    (numpy's argmin, robust to rounding between equal LMTIs)."""
+    for f in range(fault_rows.shape[0]):
+        first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
+        for r in range(width):
+            fault_index[r] = np.inf
+        for e in range(first_row, last_row):
+            for r in range(width):
+                fault_index[r] = min(fault_index[r], lmti_lanes[e, r])
+        for r in range(width):
+            tie_limit[r] = fault_index[r] + worst_fault_tie
+            first_set[r] = -1
+        for e in range(first_row, last_row):
+            for r in range(width):
+                if first_set[r] < 0 and lmti_lanes[e, r] <= tie_limit[r]:
+                    first_set[r] = e - first_row
+        for r in range(width):
+            summary_out[first_index + r, 2 + f] = fault_index[r]
+            worst_out[first_index + r, f] = max(first_set[r], 0)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def mutual_interference(member, independent, first_index, width, mutual, mutual_out):
+    """Whether each actuator is a mutual-interference actuator: some submechanism without it is non-singular (the
+    other actuators alone fully constrain the platform)."""
+    for act in range(member.shape[1]):
+        for r in range(width):
+            mutual[r] = False
+        for s in range(member.shape[0]):
+            if not member[s, act]:
+                for r in range(width):
+                    mutual[r] = mutual[r] or independent[s, r]
+        for r in range(width):
+            mutual_out[first_index + r, act] = mutual[r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def reduction_stage(iti_lanes, lmti_lanes, subs, set_children, fault_rows, member, independent, worst_fault_tie,
+                    first_index, width, reduction_lanes, first_set, mutual, summary_out, iti_out, worst_out,
+                    mutual_out):
+    """The ITI and LMTI of all actuators (Eqs. 7, 11), the LMTI of every set the reductions need, F_Oj with the
+    worst set (Eqs. 12-13) and the mutual-interference actuators; ``reduction_lanes`` (5, BLOCK) is scratch."""
+    iti_and_lmti(iti_lanes, lmti_lanes, subs, first_index, width, reduction_lanes[0], reduction_lanes[1],
+                 summary_out, iti_out)
+    set_lmtis(set_children, subs, width, reduction_lanes[2], lmti_lanes)
+    fault_indices(fault_rows, lmti_lanes, worst_fault_tie, first_index, width, reduction_lanes[3], reduction_lanes[4],
+                  first_set, summary_out, worst_out)
+    mutual_interference(member, independent, first_index, width, mutual, mutual_out)
 
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
@@ -96,346 +426,39 @@ def output_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_
         |A'_k o T'_k| = |det W|). The per-block inputs are the earlier stages'
         (:func:`screwkit.indices.compiled.algebra.carry_arrays`; the passive rows are not used here).
     """
-    count = summary_out.shape[0]
-    a = force_rows.shape[1]
-    n = basis.shape[1]
-    subs = submechanisms.shape[0]
-    blocks = (count + BLOCK - 1) // BLOCK
-    wrench_lanes = np.empty((a, 6, BLOCK))
-    motion_lanes = np.empty((n, 6, BLOCK))
-    joint_lanes = np.empty((12, BLOCK))  # an actuator's joint twist, the point after it and d
-    point_lanes = np.empty((a, 3, BLOCK))  # each actuator's OTI characteristic point
-    pitch_lanes = np.empty((a, BLOCK))  # and its wrench's pitch (0 for a couple)
-    inverse_lengths = np.empty(BLOCK)
-    iti_local = np.zeros((a, BLOCK))
-    has_force = np.zeros((a, BLOCK), dtype=np.bool_)
-    wrench_matrix = np.zeros((a, n, BLOCK))
-    row_norms = np.zeros((a, BLOCK))
-    pure_couple_sq = pure_couple * pure_couple
-    output = np.empty((locked_sets.shape[0], n, BLOCK))
+    count, a, n = summary_out.shape[0], force_rows.shape[1], basis.shape[1]
+    subs, locked_count = submechanisms.shape[0], locked_sets.shape[0]
+    # Scratch, allocated once per call, with a last "lane" axis over the configurations of a block.
+    motion_lanes, inverse_lengths = np.empty((n, 6, BLOCK)), np.empty(BLOCK)
+    joint_lanes, wrench_lanes, point_lanes, pitch_lanes, has_force, iti_lanes, wrench_matrix, row_norms = (
+        actuator_scratch(a, n))
+    output = np.empty((locked_count, n, BLOCK))  # each locked set's cofactor vector y (motion coordinates)
     wedge = np.zeros((max(n, 1), 20, BLOCK))  # minors of the first K locked rows, at most C(6, 3) = 20 per level
-    omega_squares = np.empty((locked_sets.shape[0], BLOCK))  # |omega|^2 of each output twist
-    oti_local = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs, then the LMTIs of the sets
-    independent = np.empty((subs, BLOCK), dtype=np.bool_)
-    determinant = np.empty(BLOCK)
-    volume = np.empty(BLOCK)
-    lane0 = np.empty(BLOCK)
-    lane1 = np.empty(BLOCK)
-    lane2 = np.empty(BLOCK)
-    best = np.empty(BLOCK)
-    mutual = np.empty(BLOCK, dtype=np.bool_)
-    first_set = np.empty(BLOCK, dtype=np.int64)
-    identity = basis.shape[0] == 1 and n == 6  # a platform free in all six DoF: M^T y = y
-    for q in range(n):
-        for k in range(6):
-            identity = identity and basis[0, q, k] == (1.0 if q == k else 0.0)
-    # M^T y of each locked set (working coordinates): y itself when the basis is the identity
-    output_twist = output if identity else np.empty((locked_sets.shape[0], 6, BLOCK))
-    member = np.zeros((subs, a), dtype=np.bool_)
-    for s in range(subs):
-        for i in range(n):
-            member[s, submechanisms[s, i]] = True
-    for block in range(blocks):
+    identity = identity_basis(basis)
+    output_twist = output if identity else np.empty((locked_count, 6, BLOCK))  # M^T y (working coordinates)
+    omega_squares = np.empty((locked_count, BLOCK))  # |omega|^2 of each output twist
+    lmti_lanes = np.empty((subs + set_children.shape[0], BLOCK))  # OTIs of the submechanisms, LMTIs of the sets
+    independent = np.empty((subs, BLOCK), dtype=np.bool_)  # whether each submechanism's wrenches are independent
+    determinant, volume, longest_sq = np.empty((subs, BLOCK)), np.empty(BLOCK), np.empty((subs, BLOCK))
+    reduction_lanes, member = np.empty((5, BLOCK)), submechanism_members(submechanisms, a)
+    first_set, mutual = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK, dtype=np.bool_)
+    for block in range((count + BLOCK - 1) // BLOCK):
         first_index = block * BLOCK
-        last_index = min(count, first_index + BLOCK)
-        width = last_index - first_index
-        forces = force_rows[block]
-        thresholds = threshold_rows[block]
-        lengths = length_rows[block]
-        centres = centre_rows[block]
+        width = min(count, first_index + BLOCK) - first_index
+        thresholds, lengths, centres = threshold_rows[block], length_rows[block], centre_rows[block]
         for r in range(width):
             inverse_lengths[r] = 1.0 / lengths[r]
         motion_lanes_of(basis, first_index, width, motion_lanes)
-        for act in range(a):
-            # The actuated joint's twist, the point of the joint after it and the platform joint d,
-            # in working coordinates (as the first stage computed them).
-            start = chain_start[actuator_chain[act]]
-            own = start + actuator_joint[act]
-            last = chain_start[actuator_chain[act] + 1] - 1
-            after = own + 1 if own < last else own
-            for r in range(width):
-                c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
-                (joint_lanes[0, r], joint_lanes[1, r], joint_lanes[2, r], joint_lanes[3, r], joint_lanes[4, r],
-                 joint_lanes[5, r]) = working_twist(all_twists, first_index + r, own, c0, c1, c2, inverse)
-                joint_lanes[6, r], joint_lanes[7, r], joint_lanes[8, r] = working_point(
-                    all_points, first_index + r, after, c0, c1, c2, inverse)
-                joint_lanes[9, r], joint_lanes[10, r], joint_lanes[11, r] = working_point(
-                    all_points, first_index + r, last, c0, c1, c2, inverse)
-            # --- unit wrench about the centroid, its ITI (Eq. 6) and its OTI characteristic point.
-            for r in range(width):
-                d0, d1, d2 = joint_lanes[9, r], joint_lanes[10, r], joint_lanes[11, r]
-                f0, f1, f2 = forces[act, 0, r], forces[act, 1, r], forces[act, 2, r]
-                x0, x1, x2 = cross(d0, d1, d2, f0, f1, f2)  # m_c = m_d + d x f
-                m0 = forces[act, 3, r] + x0
-                m1 = forces[act, 4, r] + x1
-                m2 = forces[act, 5, r] + x2
-                force_sq = f0 * f0 + f1 * f1 + f2 * f2
-                moment_sq = m0 * m0 + m1 * m1 + m2 * m2
-                # A pure couple: |f| <= PURE_COUPLE |m_c| / L (working coordinates, moment about c).
-                forceful = force_sq > pure_couple_sq * moment_sq and force_sq > 0.0
-                scale = np.sqrt(force_sq) if forceful else np.sqrt(moment_sq)
-                work_done = (f0 * joint_lanes[3, r] + f1 * joint_lanes[4, r] + f2 * joint_lanes[5, r]
-                             + m0 * joint_lanes[0, r] + m1 * joint_lanes[1, r] + m2 * joint_lanes[2, r])
-                factor = ((-1.0 if work_done < 0.0 else 1.0) / scale) if scale > 0.0 else 0.0
-                f0 *= factor
-                f1 *= factor
-                f2 *= factor
-                m0 *= factor
-                m1 *= factor
-                m2 *= factor
-                wrench_lanes[act, 0, r] = f0
-                wrench_lanes[act, 1, r] = f1
-                wrench_lanes[act, 2, r] = f2
-                wrench_lanes[act, 3, r] = m0
-                wrench_lanes[act, 4, r] = m1
-                wrench_lanes[act, 5, r] = m2
-                forceful = forceful and scale > 0.0
-                has_force[act, r] = forceful
-                pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
-                pitch_lanes[act, r] = pitch
-                # Characteristic points: projections on the wrench axis (unit force).
-                axis0, axis1, axis2 = cross(f0, f1, f2, m0, m1, m2)
-                if iti_override.shape[0] > 0:
-                    p0 = (iti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
-                    p1 = (iti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
-                    p2 = (iti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
-                else:
-                    p0, p1, p2 = joint_lanes[6, r], joint_lanes[7, r], joint_lanes[8, r]
-                    if forceful:
-                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
-                        p0 = axis0 + along * f0
-                        p1 = axis1 + along * f1
-                        p2 = axis2 + along * f2
-                # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
-                w0, w1, w2 = joint_lanes[0, r], joint_lanes[1, r], joint_lanes[2, r]
-                omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-                arm = np.sqrt(arm_square(w0, w1, w2, joint_lanes[3, r], joint_lanes[4, r], joint_lanes[5, r],
-                                         p0, p1, p2, pitch)) if forceful else omega
-                reference = omega if forceful else 0.0
-                iti_local[act, r] = power_coefficient(work_done * factor, arm, reference, thresholds[r])
-                if oti_override.shape[0] > 0:
-                    p0 = (oti_override[first_index + r, act, 0] - centres[0, r]) * inverse_lengths[r]
-                    p1 = (oti_override[first_index + r, act, 1] - centres[1, r]) * inverse_lengths[r]
-                    p2 = (oti_override[first_index + r, act, 2] - centres[2, r]) * inverse_lengths[r]
-                else:
-                    p0, p1, p2 = d0, d1, d2
-                    if forceful:
-                        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
-                        p0 = axis0 + along * f0
-                        p1 = axis1 + along * f1
-                        p2 = axis2 + along * f2
-                point_lanes[act, 0, r] = p0
-                point_lanes[act, 1, r] = p1
-                point_lanes[act, 2, r] = p2
-            # The row of the wrench matrix in motion coordinates, A_k o M_q.
-            for r in range(width):
-                row_norms[act, r] = 0.0
-            for q in range(n):
-                for r in range(width):
-                    value = (wrench_lanes[act, 0, r] * motion_lanes[q, 3, r]
-                             + wrench_lanes[act, 1, r] * motion_lanes[q, 4, r]
-                             + wrench_lanes[act, 2, r] * motion_lanes[q, 5, r]
-                             + wrench_lanes[act, 3, r] * motion_lanes[q, 0, r]
-                             + wrench_lanes[act, 4, r] * motion_lanes[q, 1, r]
-                             + wrench_lanes[act, 5, r] * motion_lanes[q, 2, r])
-                    wrench_matrix[act, q, r] = value
-                    row_norms[act, r] += value * value
-            for r in range(width):
-                row_norms[act, r] = np.sqrt(row_norms[act, r])
-            if wrench_out.shape[0] > 0:  # back to world units and origin: m_0 = L m' + c x f
-                for r in range(width):
-                    f0, f1, f2 = wrench_lanes[act, 0, r], wrench_lanes[act, 1, r], wrench_lanes[act, 2, r]
-                    x0, x1, x2 = cross(centres[0, r], centres[1, r], centres[2, r], f0, f1, f2)
-                    length = lengths[r]
-                    unit = 1.0 if has_force[act, r] else inverse_lengths[r]  # a couple: unit moment in world units
-                    wrench_out[first_index + r, act, 0] = f0 * unit
-                    wrench_out[first_index + r, act, 1] = f1 * unit
-                    wrench_out[first_index + r, act, 2] = f2 * unit
-                    wrench_out[first_index + r, act, 3] = (wrench_lanes[act, 3, r] * length + x0) * unit
-                    wrench_out[first_index + r, act, 4] = (wrench_lanes[act, 4, r] * length + x1) * unit
-                    wrench_out[first_index + r, act, 5] = (wrench_lanes[act, 5, r] * length + x2) * unit
-        # --- output twists: for each set of n - 1 locked actuators, the twist reciprocal to
-        # their wrenches (a column of adj(W) of every submechanism containing the set).
-        for locked in range(locked_sets.shape[0]):
-            if n == 3:  # the cross product of the two locked rows, written out
-                i0 = locked_sets[locked, 0]
-                i1 = locked_sets[locked, 1]
-                for r in range(width):
-                    output[locked, 0, r], output[locked, 1, r], output[locked, 2, r] = cross(
-                        wrench_matrix[i0, 0, r], wrench_matrix[i0, 1, r], wrench_matrix[i0, 2, r],
-                        wrench_matrix[i1, 0, r], wrench_matrix[i1, 1, r], wrench_matrix[i1, 2, r])
-            elif n == 1:  # no locked row: the one motion
-                for r in range(width):
-                    output[locked, 0, r] = 1.0
-            elif n == 2:  # one locked row (x, y): (-y, x)
-                i0 = locked_sets[locked, 0]
-                for r in range(width):
-                    output[locked, 0, r] = -wrench_matrix[i0, 1, r]
-                    output[locked, 1, r] = wrench_matrix[i0, 0, r]
-            else:
-                # The cofactor vector as the exterior product of the locked rows: level K holds the
-                # K x K minors of the first K rows (one per K-column set, combination order), each
-                # from level K - 1 by expansion along row K; lexicographic neighbours share their
-                # first rows, so only the levels past the first changed row are recomputed.
-                for level in range(max(locked_depth[locked], 1) + 1, n):
-                    row = locked_sets[locked, level - 1]
-                    if level == 2:  # level 1's minors: the first row's entries
-                        for q in range(n):
-                            for r in range(width):
-                                wedge[1, q, r] = wrench_matrix[locked_sets[locked, 0], q, r]
-                    # Each minor's WEDGE_TERMS terms (padded with zero signs) summed in one pass over
-                    # the lanes: one store per minor, a loop the compiler vectorises.
-                    for target in range(wedge_start[level], wedge_start[level + 1]):
-                        u0, c0, s0 = wedge_table[target, 1], wedge_table[target, 2], float(wedge_table[target, 3])
-                        u1, c1, s1 = wedge_table[target, 4], wedge_table[target, 5], float(wedge_table[target, 6])
-                        u2, c2, s2 = wedge_table[target, 7], wedge_table[target, 8], float(wedge_table[target, 9])
-                        u3, c3, s3 = wedge_table[target, 10], wedge_table[target, 11], float(wedge_table[target, 12])
-                        u4, c4, s4 = wedge_table[target, 13], wedge_table[target, 14], float(wedge_table[target, 15])
-                        minor = wedge_table[target, 0]
-                        for r in range(width):
-                            wedge[level, minor, r] = (s0 * wedge[level - 1, u0, r] * wrench_matrix[row, c0, r]
-                                                      + s1 * wedge[level - 1, u1, r] * wrench_matrix[row, c1, r]
-                                                      + s2 * wedge[level - 1, u2, r] * wrench_matrix[row, c2, r]
-                                                      + s3 * wedge[level - 1, u3, r] * wrench_matrix[row, c3, r]
-                                                      + s4 * wedge[level - 1, u4, r] * wrench_matrix[row, c4, r])
-                # out[q] = (-1)^(n-1+q) det(rows without column q): minor n - 1 - q of the last level
-                for q in range(n):
-                    sign = 1.0 if (n - 1 + q) % 2 == 0 else -1.0
-                    for r in range(width):
-                        output[locked, q, r] = sign * wedge[n - 1, n - 1 - q, r]
-            # The output twist M^T y, once per locked set: every submechanism holding the set uses it.
-            if not identity:
-                for k in range(6):
-                    for r in range(width):
-                        output_twist[locked, k, r] = 0.0
-                for q in range(n):
-                    for k in range(6):
-                        for r in range(width):
-                            output_twist[locked, k, r] += motion_lanes[q, k, r] * output[locked, q, r]
-            for r in range(width):
-                w0, w1, w2 = output_twist[locked, 0, r], output_twist[locked, 1, r], output_twist[locked, 2, r]
-                omega_squares[locked, r] = w0 * w0 + w1 * w1 + w2 * w2
-        # --- every non-redundant submechanism once: |A_k o T_k| = |det W| for each k (A3).
-        for s in range(subs):
-            first = locked_of[s, 0]
-            leader = submechanisms[s, 0]
-            for r in range(width):
-                volume[r] = 1.0
-                determinant[r] = 0.0
-                best[r] = 0.0  # the longest moment arm, squared
-            for i in range(n):
-                act = submechanisms[s, i]
-                for r in range(width):
-                    volume[r] *= row_norms[act, r]
-            for q in range(n):
-                for r in range(width):
-                    determinant[r] += wrench_matrix[leader, q, r] * output[first, q, r]
-            for r in range(width):
-                independent[s, r] = abs(determinant[r]) > rank_tolerance * volume[r]
-            for position in range(n):
-                act = submechanisms[s, position]
-                locked = locked_of[s, position]
-                for r in range(width):
-                    # The OTI's moment arm: the output twist's velocity at the characteristic point
-                    # plus h omega (v + omega x p + h omega), or |omega| for a couple (both computed,
-                    # one kept, so that the lanes stay branch-free).
-                    forceful = has_force[act, r]
-                    omega_sq = omega_squares[locked, r]
-                    arm_sq = (output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r) if forceful
-                              else omega_sq)
-                    reference_sq = omega_sq if forceful else 0.0
-                    # power_coefficient's zero (the arm at or below p |omega|, or zero) as an infinite
-                    # arm; one store per lane, so that the compiler vectorises the loop
-                    zero = arm_sq <= thresholds[r] * thresholds[r] * reference_sq or arm_sq <= 0.0
-                    best[r] = max(best[r], np.inf if zero else arm_sq)
-                if oti_out.shape[0] > 0:
-                    for r in range(width):
-                        omega = np.sqrt(omega_squares[locked, r])
-                        arm = (np.sqrt(output_arm_square(output_twist, locked, point_lanes, pitch_lanes, act, r))
-                               if has_force[act, r] else omega)
-                        reference = omega if has_force[act, r] else 0.0
-                        oti_out[first_index + r, s, position] = (
-                            power_coefficient(determinant[r], arm, reference, thresholds[r])
-                            if independent[s, r] else 0.0)
-                if twist_out.shape[0] > 0:
-                    for r in range(width):
-                        index = first_index + r
-                        for k in range(6):
-                            total = output_twist[locked, k, r]
-                            twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
-                        # back to world units and origin: v_0 = L v' - omega x c
-                        x0, x1, x2 = cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
-                                            twist_out[index, s, position, 2], centres[0, r], centres[1, r],
-                                            centres[2, r])
-                        twist_out[index, s, position, 3] -= x0
-                        twist_out[index, s, position, 4] -= x1
-                        twist_out[index, s, position, 5] -= x2
-            # The OTI (Eq. 9), min_k |det W| / arm_k (each at most 1) = |det W| / max_k arm_k: one
-            # root and one division per submechanism; zero if any arm is at or below its threshold.
-            for r in range(width):
-                value = abs(determinant[r]) / np.sqrt(best[r]) if independent[s, r] and best[r] < np.inf else 0.0
-                best[r] = 1.0 if value > 1.0 else value
-                oti_local[s, r] = best[r]
-            if oti_sub_out.shape[0] > 0:
-                for r in range(width):
-                    oti_sub_out[first_index + r, s] = best[r]
-        # --- ITI (Eq. 7) and LMTI of all actuators (Eq. 11).
-        for r in range(width):
-            lane0[r] = 1.0
-            lane1[r] = 0.0
-        for act in range(a):
-            for r in range(width):
-                lane0[r] = min(lane0[r], iti_local[act, r])
-        for s in range(subs):
-            for r in range(width):
-                lane1[r] = max(lane1[r], oti_local[s, r])
-        for r in range(width):
-            summary_out[first_index + r, 0] = lane0[r]
-            summary_out[first_index + r, 1] = lane1[r]
-        if iti_out.shape[0] > 0:
-            for r in range(width):
-                for act in range(a):
-                    iti_out[first_index + r, act] = iti_local[act, r]
-        # --- F_Oj: the worst, over the sets E left after j faults, of LMTI_E = max OTI_N, N in E.
-        # The worst set reported is the first, in combination order, whose LMTI is within
-        # worst_fault_tie of F_Oj: numpy's argmin, robust to rounding between equal LMTIs.
-        # Each row of set_children is a set whose LMTI is the max over earlier rows (submechanisms'
-        # OTIs, or sets one smaller); its value goes after the OTIs.
-        for row in range(set_children.shape[0]):
-            for r in range(width):
-                lane2[r] = -np.inf
-            for t in range(set_children.shape[1]):
-                child = set_children[row, t]
-                if child < 0:
-                    break
-                for r in range(width):
-                    lane2[r] = max(lane2[r], oti_local[child, r])
-            for r in range(width):
-                oti_local[subs + row, r] = lane2[r]
-        for f in range(fault_rows.shape[0]):
-            first_row, last_row = fault_rows[f, 0], fault_rows[f, 1]
-            for r in range(width):
-                best[r] = np.inf
-            for e in range(first_row, last_row):
-                for r in range(width):
-                    best[r] = min(best[r], oti_local[e, r])
-            for r in range(width):
-                lane2[r] = best[r] + worst_fault_tie
-                first_set[r] = -1
-            for e in range(first_row, last_row):
-                for r in range(width):
-                    if first_set[r] < 0 and oti_local[e, r] <= lane2[r]:
-                        first_set[r] = e - first_row
-            for r in range(width):
-                summary_out[first_index + r, 2 + f] = best[r]
-                worst_out[first_index + r, f] = max(first_set[r], 0)
-        # --- mutual interference: the other actuators alone fully constrain the platform.
-        for act in range(a):
-            for r in range(width):
-                mutual[r] = False
-            for s in range(subs):
-                if not member[s, act]:
-                    for r in range(width):
-                        mutual[r] = mutual[r] or independent[s, r]
-            for r in range(width):
-                mutual_out[first_index + r, act] = mutual[r]
+        actuator_stage(all_twists, all_points, chain_start, actuator_chain, actuator_joint, force_rows[block],
+                       pure_couple * pure_couple, iti_override, oti_override, motion_lanes, first_index, width,
+                       centres, lengths, inverse_lengths, thresholds, joint_lanes, wrench_lanes, point_lanes,
+                       pitch_lanes, has_force, iti_lanes, wrench_matrix, row_norms, wrench_out)
+        locked_stage(locked_sets, locked_depth, wedge_table, wedge_start, wrench_matrix, motion_lanes, identity, width,
+                     wedge, output, output_twist, omega_squares)
+        submechanism_stage(submechanisms, locked_of, wrench_matrix, output, row_norms, rank_tolerance, output_twist,
+                           omega_squares, point_lanes, pitch_lanes, has_force, first_index, width, thresholds,
+                           centres, lengths, determinant, volume, longest_sq, independent, lmti_lanes, oti_out,
+                           twist_out, oti_sub_out)
+        reduction_stage(iti_lanes, lmti_lanes, subs, set_children, fault_rows, member, independent, worst_fault_tie,
+                        first_index, width, reduction_lanes, first_set, mutual, summary_out, iti_out, worst_out,
+                        mutual_out)
