@@ -232,3 +232,25 @@ def test_no_function_takes_more_than_ten_parameters():
     assert not long, "group the options that travel together in a record: " + ", ".join(
         f"{name} ({count} parameters)" for name, count in sorted(long.items()))
     assert set(LONG_SIGNATURES) <= set(counts), "an allowed long signature is gone: take it off LONG_SIGNATURES"
+
+
+MAX_KERNEL_FUNCTION_LINES = 80
+"""Lines of a function of the compiled kernels at most (its decorators not counted, its docstring counted): a kernel
+is a short driver over named stages (numba inlines them, ``inline="always"``), each readable on one screen."""
+
+
+def test_no_kernel_function_is_longer_than_eighty_lines():
+    """Every function of the compiled packages (``KERNELS``) fits in ``MAX_KERNEL_FUNCTION_LINES`` lines."""
+    long = []
+    for module, path in MODULES.items():
+        if not module.startswith(KERNELS):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_KERNEL_FUNCTION_LINES:
+                    long.append(f"{module}.{node.name} ({path.name}:{node.lineno}): {lines} lines")
+    assert not long, (f"kernel functions above {MAX_KERNEL_FUNCTION_LINES} lines: cut them into named stages "
+                      "(@njit(..., inline='always'), each a pass over a block) under a short driver:\n"
+                      + "\n".join(long))
+    assert any(module.startswith(KERNELS) for module in MODULES), f"no module of {KERNELS} found"

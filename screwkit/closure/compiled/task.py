@@ -10,6 +10,11 @@ configuration, and the normal equations are built chain by chain (a chain's six 
 the free coordinates and its own joints) and solved by Cholesky. The Python loop over
 configurations of the numpy version becomes a compiled one: nothing else changes.
 
+:func:`close_chains_kernel` is a short driver over named stages that numba inlines (``inline="always"``, so
+that it compiles as one function, with the results, bit for bit, of the loops written out in it): the
+continuation's predictor (:func:`_predict_step`), the Jacobian (:func:`_jacobian`), the damped normal
+equations (:func:`_normal_equations`), the trial step (:func:`_candidate`) and its acceptance (:func:`_accept`).
+
 Geometry comes packed (:func:`screwkit.closure.task_space.packed_geometry`): tree joints of all
 chains stacked with offsets, loop joints coded 0 fixed, 1 revolute, 2 prismatic, 3 universal,
 4 spherical.
@@ -130,6 +135,148 @@ def _cholesky_solve(matrix, rhs, size):
     return True
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _scratch(chains, n_free, n_values, pose_size, task_size):
+    """The scratch of one call: joint axes, points, chain ends and targets, errors (current and candidate), pose
+    rates, Jacobian, normal matrix, gradient, candidate pose and values, the task coordinates at the start and the
+    previous step's pose and values."""
+    size = n_free + n_values
+    rows = 6 * chains
+    return (np.empty((n_values, 3)), np.empty((n_values, 3)), np.empty((n_values, 3)), np.empty((n_values, 3)),
+            np.empty((chains, 3)), np.empty((chains, 3)), np.empty((chains, 3)), np.empty((chains, 3)),
+            np.empty(rows), np.empty(rows), np.empty((6, max(n_free, 1))), np.zeros((rows, size)),
+            np.empty((size, size)), np.empty(size), np.empty(pose_size), np.empty(n_values), np.empty(task_size),
+            np.empty(pose_size), np.empty(n_values))
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _predict_step(pose, value, target, task, free, start_task, step, count, previous_pose, previous_values):
+    """Start of continuation step ``step`` of ``count``: the secant predictor (the last step's change again, equal
+    steps in task coordinates) for the free coordinates and joint values, the task coordinates moved to their
+    fraction of the way from ``start_task`` to ``target``."""
+    if step > 1:
+        for f in range(free.size):
+            change = pose[free[f]] - previous_pose[free[f]]
+            previous_pose[free[f]] = pose[free[f]]
+            pose[free[f]] += change
+        for d in range(value.size):
+            change = value[d] - previous_values[d]
+            previous_values[d] = value[d]
+            value[d] += change
+    else:
+        previous_pose[:] = pose
+        previous_values[:] = value
+    fraction = step / count
+    for k in range(task.size):
+        pose[task[k]] = start_task[k] + fraction * (target[k] - start_task[k])
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _jacobian(pose, planar, planar_z, free, rates, target_points, ends, axes, points, dof_start, dof_prism, jacobian):
+    """d(errors)/d(free pose coordinates, joint values), in rad and length scales, chain by chain."""
+    n_free = free.size
+    _pose_rates(pose, planar, free, rates)
+    _, platform_translation = _platform(pose, planar, planar_z)
+    for c in range(dof_start.size - 1):
+        r0 = 6 * c
+        arm0 = target_points[c, 0] - platform_translation[0]
+        arm1 = target_points[c, 1] - platform_translation[1]
+        arm2 = target_points[c, 2] - platform_translation[2]
+        for f in range(n_free):
+            w0, w1, w2 = rates[0, f], rates[1, f], rates[2, f]
+            jacobian[r0, f] = w0
+            jacobian[r0 + 1, f] = w1
+            jacobian[r0 + 2, f] = w2
+            jacobian[r0 + 3, f] = rates[3, f] + w1 * arm2 - w2 * arm1
+            jacobian[r0 + 4, f] = rates[4, f] + w2 * arm0 - w0 * arm2
+            jacobian[r0 + 5, f] = rates[5, f] + w0 * arm1 - w1 * arm0
+        for d in range(dof_start[c], dof_start[c + 1]):
+            column = n_free + d
+            a0, a1, a2 = axes[d, 0], axes[d, 1], axes[d, 2]
+            if dof_prism[d]:
+                jacobian[r0, column] = jacobian[r0 + 1, column] = jacobian[r0 + 2, column] = 0.0
+                jacobian[r0 + 3, column] = -a0
+                jacobian[r0 + 4, column] = -a1
+                jacobian[r0 + 5, column] = -a2
+            else:
+                p0 = ends[c, 0] - points[d, 0]
+                p1 = ends[c, 1] - points[d, 1]
+                p2 = ends[c, 2] - points[d, 2]
+                jacobian[r0, column] = -a0
+                jacobian[r0 + 1, column] = -a1
+                jacobian[r0 + 2, column] = -a2
+                jacobian[r0 + 3, column] = -(a1 * p2 - a2 * p1)
+                jacobian[r0 + 4, column] = -(a2 * p0 - a0 * p2)
+                jacobian[r0 + 5, column] = -(a0 * p1 - a1 * p0)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _normal_equations(jacobian, error, n_free, dof_start, damping, norm, normal, gradient):
+    """normal = J^T J + (damping + norm^2) I (both triangles) and gradient = J^T error, chain by chain (a chain's
+    rows touch the free columns and its own)."""
+    size = gradient.size
+    normal[:, :] = 0.0
+    gradient[:] = 0.0
+    for c in range(dof_start.size - 1):
+        r0 = 6 * c
+        touched = n_free + dof_start[c + 1] - dof_start[c]
+        for a in range(touched):
+            i = a if a < n_free else a + dof_start[c]
+            g = 0.0
+            for r in range(r0, r0 + 6):
+                g += jacobian[r, i] * error[r]
+            gradient[i] += g
+            for b in range(a + 1):
+                j = b if b < n_free else b + dof_start[c]
+                s = 0.0
+                for r in range(r0, r0 + 6):
+                    s += jacobian[r, i] * jacobian[r, j]
+                normal[i, j] += s
+    shift = damping + norm * norm
+    for i in range(size):
+        normal[i, i] += shift
+        for j in range(i):
+            normal[j, i] = normal[i, j]
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _candidate(pose, value, gradient, max_step, free, dof_start, loop_code, candidate_pose, candidate_values):
+    """The trial point: the Newton step ``gradient`` (scaled so that no entry exceeds ``max_step``) taken from
+    (pose, value), composed on the left for the three values of a spherical loop."""
+    n_free = free.size
+    largest = 0.0
+    for i in range(gradient.size):
+        largest = max(largest, abs(gradient[i]))
+    factor = min(1.0, max_step / max(largest, 1e-300))
+    for i in range(pose.size):
+        candidate_pose[i] = pose[i]
+    for f in range(n_free):
+        candidate_pose[free[f]] -= gradient[f] * factor
+    for d in range(value.size):
+        candidate_values[d] = value[d] - gradient[n_free + d] * factor
+    for c in range(loop_code.size):
+        if loop_code[c] == 4:  # spherical loop: compose the step on the left
+            s = dof_start[c + 1] - 3
+            u0 = -gradient[n_free + s] * factor
+            u1 = -gradient[n_free + s + 1] * factor
+            u2 = -gradient[n_free + s + 2] * factor
+            composed = mul(exp_map(u0, u1, u2), exp_map(value[s], value[s + 1], value[s + 2]))
+            candidate_values[s], candidate_values[s + 1], candidate_values[s + 2] = log_map(composed)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _accept(pose, value, error, axes, points, ends, target_points, candidate_pose, candidate_values, candidate_error,
+            candidate_axes, candidate_points, candidate_ends, candidate_targets):
+    """The trial point becomes the current one, with its errors and what the Jacobian reads."""
+    pose[:] = candidate_pose
+    value[:] = candidate_values
+    error[:] = candidate_error
+    axes[:, :] = candidate_axes
+    points[:, :] = candidate_points
+    ends[:, :] = candidate_ends
+    target_points[:, :] = candidate_targets
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def close_chains_kernel(poses, values, targets, steps, task, free, planar, planar_z, tree_start, dof_start,
                         joint_rot, joint_trans, joint_axis, joint_prism, dof_prism, leg_rot, leg_trans, loop_code,
@@ -143,25 +290,9 @@ def close_chains_kernel(poses, values, targets, steps, task, free, planar, plana
     ``step_iterations`` for the intermediate steps, ``tolerance`` and ``iterations`` for the
     last). ``residual[n]`` receives the final closure error norm.
     """
-    chains = loop_code.size
-    n_free = free.size
-    n_values = values.shape[1]
-    size = n_free + n_values
-    rows = 6 * chains
-    axes, candidate_axes = np.empty((n_values, 3)), np.empty((n_values, 3))
-    points, candidate_points = np.empty((n_values, 3)), np.empty((n_values, 3))
-    ends, candidate_ends = np.empty((chains, 3)), np.empty((chains, 3))
-    target_points, candidate_targets = np.empty((chains, 3)), np.empty((chains, 3))
-    error, candidate_error = np.empty(rows), np.empty(rows)
-    rates = np.empty((6, max(n_free, 1)))
-    jacobian = np.zeros((rows, size))
-    normal = np.empty((size, size))
-    gradient = np.empty(size)
-    candidate_pose = np.empty(poses.shape[1])
-    candidate_values = np.empty(n_values)
-    start_task = np.empty(task.size)
-    previous_pose = np.empty(poses.shape[1])
-    previous_values = np.empty(n_values)
+    (axes, candidate_axes, points, candidate_points, ends, candidate_ends, target_points, candidate_targets, error,
+     candidate_error, rates, jacobian, normal, gradient, candidate_pose, candidate_values, start_task, previous_pose,
+     previous_values) = _scratch(loop_code.size, free.size, values.shape[1], poses.shape[1], task.size)
     for n in range(poses.shape[0]):
         pose = poses[n]
         value = values[n]
@@ -170,21 +301,8 @@ def close_chains_kernel(poses, values, targets, steps, task, free, planar, plana
         count = steps[n]
         norm = np.inf
         for step in range(1, count + 1):
-            if step > 1:  # secant predictor: the last step's change again (equal steps in task coordinates)
-                for f in range(n_free):
-                    change = pose[free[f]] - previous_pose[free[f]]
-                    previous_pose[free[f]] = pose[free[f]]
-                    pose[free[f]] += change
-                for d in range(n_values):
-                    change = value[d] - previous_values[d]
-                    previous_values[d] = value[d]
-                    value[d] += change
-            else:
-                previous_pose[:] = pose
-                previous_values[:] = value
-            fraction = step / count
-            for k in range(task.size):
-                pose[task[k]] = start_task[k] + fraction * (targets[n, k] - start_task[k])
+            _predict_step(pose, value, targets[n], task, free, start_task, step, count, previous_pose,
+                          previous_values)
             last = step == count
             limit = tolerance if last else step_tolerance
             norm = _errors(pose, value, planar, planar_z, tree_start, dof_start, joint_rot, joint_trans, joint_axis,
@@ -194,96 +312,21 @@ def close_chains_kernel(poses, values, targets, steps, task, free, planar, plana
             for _ in range(iterations if last else step_iterations):
                 if not (norm >= limit and np.isfinite(norm)) or damping >= 1e4:
                     break
-                # Jacobian d(errors)/d(free pose coordinates, joint values), in rad and length scales
-                _pose_rates(pose, planar, free, rates)
-                _, platform_translation = _platform(pose, planar, planar_z)
-                for c in range(chains):
-                    r0 = 6 * c
-                    arm0 = target_points[c, 0] - platform_translation[0]
-                    arm1 = target_points[c, 1] - platform_translation[1]
-                    arm2 = target_points[c, 2] - platform_translation[2]
-                    for f in range(n_free):
-                        w0, w1, w2 = rates[0, f], rates[1, f], rates[2, f]
-                        jacobian[r0, f] = w0
-                        jacobian[r0 + 1, f] = w1
-                        jacobian[r0 + 2, f] = w2
-                        jacobian[r0 + 3, f] = rates[3, f] + w1 * arm2 - w2 * arm1
-                        jacobian[r0 + 4, f] = rates[4, f] + w2 * arm0 - w0 * arm2
-                        jacobian[r0 + 5, f] = rates[5, f] + w0 * arm1 - w1 * arm0
-                    for d in range(dof_start[c], dof_start[c + 1]):
-                        column = n_free + d
-                        a0, a1, a2 = axes[d, 0], axes[d, 1], axes[d, 2]
-                        if dof_prism[d]:
-                            jacobian[r0, column] = jacobian[r0 + 1, column] = jacobian[r0 + 2, column] = 0.0
-                            jacobian[r0 + 3, column] = -a0
-                            jacobian[r0 + 4, column] = -a1
-                            jacobian[r0 + 5, column] = -a2
-                        else:
-                            p0 = ends[c, 0] - points[d, 0]
-                            p1 = ends[c, 1] - points[d, 1]
-                            p2 = ends[c, 2] - points[d, 2]
-                            jacobian[r0, column] = -a0
-                            jacobian[r0 + 1, column] = -a1
-                            jacobian[r0 + 2, column] = -a2
-                            jacobian[r0 + 3, column] = -(a1 * p2 - a2 * p1)
-                            jacobian[r0 + 4, column] = -(a2 * p0 - a0 * p2)
-                            jacobian[r0 + 5, column] = -(a0 * p1 - a1 * p0)
-                # normal equations, chain by chain (a chain's rows touch the free columns and its own)
-                normal[:, :] = 0.0
-                gradient[:] = 0.0
-                for c in range(chains):
-                    r0 = 6 * c
-                    touched = n_free + dof_start[c + 1] - dof_start[c]
-                    for a in range(touched):
-                        i = a if a < n_free else a + dof_start[c]
-                        g = 0.0
-                        for r in range(r0, r0 + 6):
-                            g += jacobian[r, i] * error[r]
-                        gradient[i] += g
-                        for b in range(a + 1):
-                            j = b if b < n_free else b + dof_start[c]
-                            s = 0.0
-                            for r in range(r0, r0 + 6):
-                                s += jacobian[r, i] * jacobian[r, j]
-                            normal[i, j] += s
-                shift = damping + norm * norm
-                for i in range(size):
-                    normal[i, i] += shift
-                    for j in range(i):
-                        normal[j, i] = normal[i, j]
-                if not _cholesky_solve(normal, gradient, size):
+                _jacobian(pose, planar, planar_z, free, rates, target_points, ends, axes, points, dof_start, dof_prism,
+                          jacobian)
+                _normal_equations(jacobian, error, free.size, dof_start, damping, norm, normal, gradient)
+                if not _cholesky_solve(normal, gradient, gradient.size):
                     damping *= 10.0
                     continue
-                largest = 0.0
-                for i in range(size):
-                    largest = max(largest, abs(gradient[i]))
-                factor = min(1.0, max_step / max(largest, 1e-300))
-                for i in range(poses.shape[1]):
-                    candidate_pose[i] = pose[i]
-                for f in range(n_free):
-                    candidate_pose[free[f]] -= gradient[f] * factor
-                for d in range(n_values):
-                    candidate_values[d] = value[d] - gradient[n_free + d] * factor
-                for c in range(chains):
-                    if loop_code[c] == 4:  # spherical loop: compose the step on the left
-                        s = dof_start[c + 1] - 3
-                        u0 = -gradient[n_free + s] * factor
-                        u1 = -gradient[n_free + s + 1] * factor
-                        u2 = -gradient[n_free + s + 2] * factor
-                        composed = mul(exp_map(u0, u1, u2), exp_map(value[s], value[s + 1], value[s + 2]))
-                        candidate_values[s], candidate_values[s + 1], candidate_values[s + 2] = log_map(composed)
+                _candidate(pose, value, gradient, max_step, free, dof_start, loop_code, candidate_pose,
+                           candidate_values)
                 candidate_norm = _errors(candidate_pose, candidate_values, planar, planar_z, tree_start, dof_start,
                                          joint_rot, joint_trans, joint_axis, joint_prism, leg_rot, leg_trans,
                                          loop_code, loop_axes, plat_rot, plat_trans, candidate_axes,
                                          candidate_points, candidate_ends, candidate_targets, candidate_error)
                 if candidate_norm < norm:
-                    pose[:] = candidate_pose
-                    value[:] = candidate_values
-                    error[:] = candidate_error
-                    axes[:, :] = candidate_axes
-                    points[:, :] = candidate_points
-                    ends[:, :] = candidate_ends
-                    target_points[:, :] = candidate_targets
+                    _accept(pose, value, error, axes, points, ends, target_points, candidate_pose, candidate_values,
+                            candidate_error, candidate_axes, candidate_points, candidate_ends, candidate_targets)
                     norm = candidate_norm
                     damping = max(damping * 0.1, 1e-12)
                 else:

@@ -136,26 +136,12 @@ LEADING_PIVOT_RATIO = 1e-2
 conditioned block) get their null vector from :func:`null_vector`'s full pivoting instead."""
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
-def null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch, smallest, largest,
-                        scalar_rows, scalar_work, scalar_columns, scalar_out):
-    """out[:size, r] = generalised cross product of the rows rows[:size-1, :size, r], every lane r at once.
-
-    The vector of :func:`null_vector` (``out[q] = (-1)^(size-1+q) det(rows without column q)``),
-    computed lane-innermost so that the compiler vectorises it across configurations: Gaussian
-    elimination with partial pivoting of the leading (size-1) x (size-1) block, the last column
-    carried along (pivot choices and row swaps as per-lane blends); then ``out`` is
-    ``det(leading block)`` times the null vector whose last entry is 1, by back substitution.
-    Lanes whose leading block is poorly conditioned (smallest pivot below
-    :data:`LEADING_PIVOT_RATIO` of the largest) are redone one by one with :func:`null_vector`.
-    ``work`` (size-1, size, BLOCK), ``pivot``, ``determinant``, ``scratch``, ``smallest``,
-    ``largest`` (BLOCK) and the ``scalar_*`` arrays are scratch.
-    """
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def eliminate_lanes(work, size, width, pivot, determinant, scratch, smallest, largest):
+    """Gaussian elimination with partial pivoting of the leading (size-1) x (size-1) block of ``work``, every lane
+    at once, the last column carried along: pivot choices and row swaps as per-lane blends. ``determinant``
+    receives the block's determinant, ``smallest`` and ``largest`` its smallest and largest pivot magnitudes."""
     m = size - 1
-    for i in range(m):
-        for j in range(size):
-            for r in range(width):
-                work[i, j, r] = rows[i, j, r]
     for r in range(width):
         determinant[r] = 1.0
         smallest[r] = np.inf
@@ -195,7 +181,13 @@ def null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch
             for j in range(k + 1, size):
                 for r in range(width):
                     work[i, j, r] -= pivot[r] * work[k, j, r]
-    # back substitution: U y = -u (u the last column), out = det * (y, 1)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def back_substitute_lanes(work, size, width, out, determinant, scratch):
+    """out[:size, r] = determinant[r] (y, 1), U y = -u by back substitution (U the eliminated leading block of
+    ``work``, u its last column), every lane at once."""
+    m = size - 1
     for r in range(width):
         out[m, r] = 1.0
     for i in range(m - 1, -1, -1):
@@ -210,6 +202,14 @@ def null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch
     for q in range(size):
         for r in range(width):
             out[q, r] *= determinant[r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def redo_poorly_conditioned(rows, size, width, out, smallest, largest, scalar_rows, scalar_work, scalar_columns,
+                            scalar_out):
+    """Lanes whose leading block is poorly conditioned (smallest pivot not above :data:`LEADING_PIVOT_RATIO` of the
+    largest, or zero) get ``out[:, r]`` from :func:`null_vector`'s full pivoting, one by one."""
+    m = size - 1
     for r in range(width):
         if not smallest[r] > LEADING_PIVOT_RATIO * largest[r]:  # poorly conditioned (or zero) block
             for i in range(m):
@@ -218,6 +218,31 @@ def null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch
             null_vector(scalar_rows, size, scalar_out, scalar_work, scalar_columns)
             for q in range(size):
                 out[q, r] = scalar_out[q]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def null_vectors_lanes(rows, size, width, out, work, pivot, determinant, scratch, smallest, largest,
+                        scalar_rows, scalar_work, scalar_columns, scalar_out):
+    """out[:size, r] = generalised cross product of the rows rows[:size-1, :size, r], every lane r at once.
+
+    The vector of :func:`null_vector` (``out[q] = (-1)^(size-1+q) det(rows without column q)``),
+    computed lane-innermost so that the compiler vectorises it across configurations: Gaussian
+    elimination with partial pivoting of the leading (size-1) x (size-1) block, the last column
+    carried along (pivot choices and row swaps as per-lane blends, :func:`eliminate_lanes`); then ``out`` is
+    ``det(leading block)`` times the null vector whose last entry is 1, by back substitution
+    (:func:`back_substitute_lanes`). Lanes whose leading block is poorly conditioned (smallest pivot below
+    :data:`LEADING_PIVOT_RATIO` of the largest) are redone one by one with :func:`null_vector`
+    (:func:`redo_poorly_conditioned`). ``work`` (size-1, size, BLOCK), ``pivot``, ``determinant``, ``scratch``,
+    ``smallest``, ``largest`` (BLOCK) and the ``scalar_*`` arrays are scratch.
+    """
+    for i in range(size - 1):
+        for j in range(size):
+            for r in range(width):
+                work[i, j, r] = rows[i, j, r]
+    eliminate_lanes(work, size, width, pivot, determinant, scratch, smallest, largest)
+    back_substitute_lanes(work, size, width, out, determinant, scratch)
+    redo_poorly_conditioned(rows, size, width, out, smallest, largest, scalar_rows, scalar_work, scalar_columns,
+                            scalar_out)
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")

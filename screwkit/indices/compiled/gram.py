@@ -7,6 +7,12 @@ their actuators, the minimum-norm wrench ``SWAP J' (J'^T J')^-1 e_k`` over the c
 twists ``J'`` about its platform joint, in the working coordinates the first kernel chose
 (:mod:`screwkit.indices.compiled.algebra`), with a pseudo-inverse, kept if consistent, when the joint twists are
 dependent. Its own module, so that a mechanism without such chains never compiles it.
+
+The kernel is a short driver over named stages, each a pass over the lanes of a block for one actuator:
+its chain's unit joint twists about its platform joint (:func:`chain_unit_twist_lanes`), their Gram matrices
+(:func:`gram_matrix_lanes`) and the minimum-norm wrenches (:func:`minimum_norm_wrenches`, with
+:func:`consistent_pseudo_solution` for dependent joint twists). numba inlines them (``inline="always"``): the
+kernel compiles as one function, with the results, bit for bit, of the loops written out in it.
 """
 
 from __future__ import annotations
@@ -26,6 +32,119 @@ _SIGNATURE = (
 )
 
 
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def gram_scratch(capacity):
+    """The scratch of one actuator, allocated once per call (chains of at most ``capacity`` joint DoFs): its
+    chain's joint twists (capacity, 6, BLOCK) and platform joint d (3, BLOCK) in working coordinates, 1 / L
+    (BLOCK), the unit twists about d (capacity, 6, BLOCK), their Gram matrices (capacity, capacity, BLOCK), then
+    one lane's Gram matrix, elimination work, eigenvectors, eigenvalues, right-hand side and solution, and a lane
+    of sums."""
+    return (np.empty((capacity, 6, BLOCK)), np.empty((3, BLOCK)), np.empty(BLOCK), np.empty((capacity, 6, BLOCK)),
+            np.empty((capacity, capacity, BLOCK)), np.empty((capacity, capacity)), np.empty((capacity, capacity)),
+            np.empty((capacity, capacity)), np.empty(capacity), np.zeros(capacity), np.empty(capacity),
+            np.empty(BLOCK))
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def chain_unit_twist_lanes(all_twists, all_points, first_index, width, start, m, centres, inverse_lengths, local,
+                           platform, shifted_lanes):
+    """The m joint twists of the chain starting at joint ``start`` about the centroid, and its platform joint d
+    (its last joint's point), lengths in units of L (as the first kernel computes them); then ``shifted_lanes``,
+    those twists about d each scaled to unit norm (a column scaling: the same wrench, and the Gram pivot test
+    compares dimensionless numbers), lane by lane."""
+    for j in range(m):
+        for r in range(width):
+            c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
+            (local[j, 0, r], local[j, 1, r], local[j, 2, r], local[j, 3, r], local[j, 4, r],
+             local[j, 5, r]) = working_twist(all_twists, first_index + r, start + j, c0, c1, c2, inverse)
+    for r in range(width):
+        platform[0, r], platform[1, r], platform[2, r] = working_point(
+            all_points, first_index + r, start + m - 1, centres[0, r], centres[1, r], centres[2, r],
+            inverse_lengths[r])
+    for j in range(m):
+        for r in range(width):
+            w0, w1, w2 = local[j, 0, r], local[j, 1, r], local[j, 2, r]
+            x0, x1, x2 = cross(w0, w1, w2, platform[0, r], platform[1, r],
+                               platform[2, r])
+            u0 = local[j, 3, r] + x0
+            u1 = local[j, 4, r] + x1
+            u2 = local[j, 5, r] + x2
+            norm = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2 + u0 * u0 + u1 * u1 + u2 * u2)
+            inverse = 1.0 / norm if norm > 0.0 else 0.0
+            shifted_lanes[j, 0, r] = w0 * inverse
+            shifted_lanes[j, 1, r] = w1 * inverse
+            shifted_lanes[j, 2, r] = w2 * inverse
+            shifted_lanes[j, 3, r] = u0 * inverse
+            shifted_lanes[j, 4, r] = u1 * inverse
+            shifted_lanes[j, 5, r] = u2 * inverse
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def gram_matrix_lanes(shifted_lanes, m, width, lane0, gram_lanes):
+    """gram_lanes[:m, :m, r] = J'^T J' of lane r, J' the m unit twists ``shifted_lanes[:m, :, r]``."""
+    for i in range(m):
+        for j in range(i + 1):
+            for r in range(width):
+                lane0[r] = 0.0
+            for k in range(6):
+                for r in range(width):
+                    lane0[r] += shifted_lanes[i, k, r] * shifted_lanes[j, k, r]
+            for r in range(width):
+                gram_lanes[i, j, r] = lane0[r]
+                gram_lanes[j, i, r] = lane0[r]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def consistent_pseudo_solution(gram, m, column, rhs, solution, work, eigenvectors, eigenvalues,
+                               pseudo_inverse_consistency):
+    """``solution`` = column ``column`` of the pseudo-inverse of the singular gram[:m, :m] (dependent joint
+    twists: an idle DoF), kept if consistent (gram solution = rhs within ``pseudo_inverse_consistency`` of its
+    largest entry, at least 1), else zero."""
+    pseudo = pseudo_inverse(gram, m, work, eigenvectors, eigenvalues)
+    worst = 0.0
+    for i in range(m):
+        solution[i] = pseudo[i, column]
+    for i in range(m):
+        total = 0.0
+        for j in range(m):
+            total += gram[i, j] * solution[j]
+        worst = max(worst, abs(total - rhs[i]))
+    largest = 1.0
+    for i in range(m):
+        largest = max(largest, abs(solution[i]))
+    if worst > pseudo_inverse_consistency * largest:
+        for i in range(m):
+            solution[i] = 0.0
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def minimum_norm_wrenches(gram_lanes, shifted_lanes, m, column, first_index, width, outside, gram_pivot,
+                          pseudo_inverse_consistency, gram, work, eigenvectors, eigenvalues, rhs, solution, force):
+    """force[:, r] += SWAP J' (J'^T J')^-1 e_column, the minimum-norm wrench about d (J' the unit twists
+    ``shifted_lanes``, J'^T J' ``gram_lanes``), configuration by configuration; the configurations flagged
+    ``outside`` are left alone (recomputed with their own motion space)."""
+    for r in range(width):
+        if outside[first_index + r]:
+            continue  # recomputed with its own motion space
+        for i in range(m):
+            for j in range(m):
+                gram[i, j] = gram_lanes[i, j, r]
+            rhs[i] = 0.0
+        rhs[column] = 1.0
+        regular = solve(gram, m, rhs, solution, work, gram_pivot)
+        if not regular:
+            consistent_pseudo_solution(gram, m, column, rhs, solution, work, eigenvectors, eigenvalues,
+                                       pseudo_inverse_consistency)
+        for j in range(m):  # the wrench about d: SWAP of the combination
+            y = solution[j]
+            force[0, r] += y * shifted_lanes[j, 3, r]
+            force[1, r] += y * shifted_lanes[j, 4, r]
+            force[2, r] += y * shifted_lanes[j, 5, r]
+            force[3, r] += y * shifted_lanes[j, 0, r]
+            force[4, r] += y * shifted_lanes[j, 1, r]
+            force[5, r] += y * shifted_lanes[j, 2, r]
+
+
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, n, gram_pivot,
                 pseudo_inverse_consistency, outside, force_rows, length_rows, centre_rows):
@@ -42,114 +161,30 @@ def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_jo
         space; left alone here).
     force_rows, length_rows, centre_rows : the first kernel's per-block wrenches (zero for these
         actuators), lengths L and centroids c (:func:`screwkit.indices.compiled.algebra.carry_arrays`).
+
+    Per block and actuator of such a chain: :func:`chain_unit_twist_lanes`, :func:`gram_matrix_lanes`,
+    :func:`minimum_norm_wrenches`.
     """
     count = all_twists.shape[0]
-    chains = chain_start.shape[0] - 1
-    a = actuator_chain.shape[0]
-    blocks = (count + BLOCK - 1) // BLOCK
     capacity = 1
-    for c in range(chains):
+    for c in range(chain_start.shape[0] - 1):
         capacity = max(capacity, chain_start[c + 1] - chain_start[c])
-    local = np.empty((capacity, 6, BLOCK))  # the chain's joint twists in working coordinates
-    platform = np.empty((3, BLOCK))  # its platform joint d in working coordinates
-    inverse_lengths = np.empty(BLOCK)
-    shifted_lanes = np.empty((capacity, 6, BLOCK))  # a chain's unit twists about d
-    gram_lanes = np.empty((capacity, capacity, BLOCK))
-    gram = np.empty((capacity, capacity))
-    work = np.empty((capacity, capacity))
-    eigenvectors = np.empty((capacity, capacity))
-    eigenvalues = np.empty(capacity)
-    rhs = np.zeros(capacity)
-    solution = np.empty(capacity)
-    lane0 = np.empty(BLOCK)
-    for block in range(blocks):
+    (local, platform, inverse_lengths, shifted_lanes, gram_lanes, gram, work, eigenvectors, eigenvalues, rhs,
+     solution, lane0) = gram_scratch(capacity)
+    for block in range((count + BLOCK - 1) // BLOCK):
         first_index = block * BLOCK
         width = min(count, first_index + BLOCK) - first_index
-        forces = force_rows[block]
-        lengths = length_rows[block]
         centres = centre_rows[block]
         for r in range(width):
-            inverse_lengths[r] = 1.0 / lengths[r]
-        for act in range(a):
-            chain = actuator_chain[act]
-            start = chain_start[chain]
-            m = chain_start[chain + 1] - start
+            inverse_lengths[r] = 1.0 / length_rows[block, r]
+        for act in range(actuator_chain.shape[0]):
+            start = chain_start[actuator_chain[act]]
+            m = chain_start[actuator_chain[act] + 1] - start
             if m == n:
                 continue  # the first kernel's
-            own = start + actuator_joint[act]
-            last = start + m - 1
-            force = forces[act]
-            # --- the chain's twists about the centroid and its platform joint, lengths in units of
-            # L (as the first kernel computes them).
-            for j in range(m):
-                for r in range(width):
-                    c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
-                    (local[j, 0, r], local[j, 1, r], local[j, 2, r], local[j, 3, r], local[j, 4, r],
-                     local[j, 5, r]) = working_twist(all_twists, first_index + r, start + j, c0, c1, c2, inverse)
-            for r in range(width):
-                platform[0, r], platform[1, r], platform[2, r] = working_point(
-                    all_points, first_index + r, last, centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r])
-            # Minimum-norm solution SWAP J' (J'^T J')^-1 e_k, J' the chain's twists about d in
-            # working coordinates, each scaled to unit norm (a column scaling: the same wrench,
-            # and the Gram pivot test compares dimensionless numbers). J' and its Gram matrix
-            # across the lanes, then the solve configuration by configuration.
-            for j in range(m):
-                for r in range(width):
-                    w0, w1, w2 = local[j, 0, r], local[j, 1, r], local[j, 2, r]
-                    x0, x1, x2 = cross(w0, w1, w2, platform[0, r], platform[1, r],
-                                        platform[2, r])
-                    u0 = local[j, 3, r] + x0
-                    u1 = local[j, 4, r] + x1
-                    u2 = local[j, 5, r] + x2
-                    norm = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2 + u0 * u0 + u1 * u1 + u2 * u2)
-                    inverse = 1.0 / norm if norm > 0.0 else 0.0
-                    shifted_lanes[j, 0, r] = w0 * inverse
-                    shifted_lanes[j, 1, r] = w1 * inverse
-                    shifted_lanes[j, 2, r] = w2 * inverse
-                    shifted_lanes[j, 3, r] = u0 * inverse
-                    shifted_lanes[j, 4, r] = u1 * inverse
-                    shifted_lanes[j, 5, r] = u2 * inverse
-            for i in range(m):
-                for j in range(i + 1):
-                    for r in range(width):
-                        lane0[r] = 0.0
-                    for k in range(6):
-                        for r in range(width):
-                            lane0[r] += shifted_lanes[i, k, r] * shifted_lanes[j, k, r]
-                    for r in range(width):
-                        gram_lanes[i, j, r] = lane0[r]
-                        gram_lanes[j, i, r] = lane0[r]
-            for r in range(width):
-                if outside[first_index + r]:
-                    continue  # recomputed with its own motion space
-                for i in range(m):
-                    for j in range(m):
-                        gram[i, j] = gram_lanes[i, j, r]
-                    rhs[i] = 0.0
-                rhs[own - start] = 1.0
-                regular = solve(gram, m, rhs, solution, work, gram_pivot)
-                if not regular:
-                    # Dependent joint twists (an idle DoF): pseudo-inverse, kept if consistent.
-                    pseudo = pseudo_inverse(gram, m, work, eigenvectors, eigenvalues)
-                    worst = 0.0
-                    for i in range(m):
-                        solution[i] = pseudo[i, own - start]
-                    for i in range(m):
-                        total = 0.0
-                        for j in range(m):
-                            total += gram[i, j] * solution[j]
-                        worst = max(worst, abs(total - rhs[i]))
-                    largest = 1.0
-                    for i in range(m):
-                        largest = max(largest, abs(solution[i]))
-                    if worst > pseudo_inverse_consistency * largest:
-                        for i in range(m):
-                            solution[i] = 0.0
-                for j in range(m):  # the wrench about d: SWAP of the combination
-                    y = solution[j]
-                    force[0, r] += y * shifted_lanes[j, 3, r]
-                    force[1, r] += y * shifted_lanes[j, 4, r]
-                    force[2, r] += y * shifted_lanes[j, 5, r]
-                    force[3, r] += y * shifted_lanes[j, 0, r]
-                    force[4, r] += y * shifted_lanes[j, 1, r]
-                    force[5, r] += y * shifted_lanes[j, 2, r]
+            chain_unit_twist_lanes(all_twists, all_points, first_index, width, start, m, centres, inverse_lengths,
+                                   local, platform, shifted_lanes)
+            gram_matrix_lanes(shifted_lanes, m, width, lane0, gram_lanes)
+            minimum_norm_wrenches(gram_lanes, shifted_lanes, m, actuator_joint[act], first_index, width, outside,
+                                  gram_pivot, pseudo_inverse_consistency, gram, work, eigenvectors, eigenvalues, rhs,
+                                  solution, force_rows[block, act])
