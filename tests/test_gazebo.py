@@ -7,12 +7,15 @@ joint's), with and without ``<transmission>`` elements; checked against the text
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from test_io import HOME, assert_textbook, poses_near_home, text
-from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows
+from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 from test_onshape import onshape_urdf
 
+from helpers import one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy
 from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
 from screwkit.io.loader import load
@@ -81,3 +84,21 @@ def test_a_gazebo_joint_of_a_type_that_cannot_close_a_loop_or_naming_no_link_is_
     path.write_text(five_bar_gazebo().replace("<parent>distal_3</parent>", "<parent>distal_9</parent>"))
     with pytest.raises(ImportError_, match=r"<gazebo><joint name='loop_3'>: <parent> names 'distal_9', not a link"):
         read_closed_tree(path)
+
+
+def test_convert_and_analyze_open_a_gazebo_closed_urdf_on_the_command_line(tmp_path):
+    """The commands users run: convert writes the mechanism in screwkit's convention, analyze of the source and of
+    the written file give the textbook LMTI, and a bad Gazebo joint is one line."""
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo())
+    written = tmp_path / "converted.urdf"
+    converted = screwkit("convert", path, written, "--json")
+    assert converted.returncode == 0, converted.stderr
+    assert json.loads(converted.stdout)["format"] == "URDF + Gazebo joints (<gazebo><joint>)"
+    expected = five_bar_expected(HOME)["lmti"]
+    for source in (path, written):
+        analysed = screwkit("analyze", source, "--json")
+        assert analysed.returncode == 0, analysed.stderr
+        assert json.loads(analysed.stdout)["lmti"] == pytest.approx(expected, abs=1e-9)
+    path.write_text(five_bar_gazebo(kind="screw"))
+    one_line_error(screwkit("analyze", path), "<gazebo><joint name='loop_2'>: type 'screw' cannot close a loop")
