@@ -102,3 +102,15 @@ def test_convert_and_analyze_open_a_gazebo_closed_urdf_on_the_command_line(tmp_p
         assert json.loads(analysed.stdout)["lmti"] == pytest.approx(expected, abs=1e-9)
     path.write_text(five_bar_gazebo(kind="screw"))
     one_line_error(screwkit("analyze", path), "<gazebo><joint name='loop_2'>: type 'screw' cannot close a loop")
+
+
+def test_a_pose_or_axis_written_in_another_frame_is_refused_rather_than_misread(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo().replace("<pose>", '<pose relative_to="distal_2">', 1))
+    with pytest.raises(ImportError_, match=r"loop_2'>: a pose relative_to or an axis expressed_in another frame"):
+        read_closed_tree(path)
+    path.write_text(five_bar_gazebo().replace("<xyz>", '<xyz expressed_in="__model__">', 1))
+    with pytest.raises(ImportError_, match=r"loop_2'>: a pose relative_to or an axis expressed_in another frame"):
+        read_closed_tree(path)
+    path.write_text(five_bar_gazebo().replace("<pose>", '<pose relative_to="effector">', 1))
+    read_closed_tree(path)  # the child link named explicitly: the default

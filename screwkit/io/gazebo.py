@@ -92,6 +92,12 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             if link not in bodies:
                 raise ImportError_(f"{where}: <{tag}> names {link!r}, not a link of the tree.")
             links.append(bodies[link])
+        frames = {"pose": element.find("pose"), "axis": element.find("axis/xyz")}
+        relative = frames["pose"].get("relative_to", "") if frames["pose"] is not None else ""
+        expressed = frames["axis"].get("expressed_in", "") if frames["axis"] is not None else ""
+        if relative not in ("", element.findtext("child", "").strip()) or expressed not in ("", name):
+            raise ImportError_(f"{where}: a pose relative_to or an axis expressed_in another frame is not read: write "
+                               "the pose in the child link's frame and the axis in the joint's (SDFormat's defaults).")
         pose = _numbers(element, "pose", 6, "0 0 0 0 0 0", where)
         in_child = np.eye(4)
         in_child[:3, :3], in_child[:3, 3] = rotation_from_rpy(pose[3:]), pose[:3]
