@@ -467,7 +467,8 @@ def test_a_reference_assembly_outside_a_joint_limit_is_refused_by_name_or_read_w
 
 def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_command(tmp_path):
     """analyze, info and convert: refused in one line naming the joint without --ignore-limits; with it the file
-    is read, stderr says what was ignored, and convert writes a file that reads the same with --ignore-limits."""
+    is read (by map's tasks too), stderr says what was ignored, and convert writes a file that reads the same with
+    --ignore-limits."""
     path = tmp_path / "limited.xml"
     path.write_text(five_bar_mjcf().replace('<joint name="a_1" type="hinge"', '<joint name="a_1" type="hinge" '
                                                                            'range="0.001 1"'))
@@ -482,6 +483,9 @@ def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_co
     assert "limits ignored: joint 'a_1'" in analysed.stderr
     assert json.loads(analysed.stdout)["lmti"] == pytest.approx(five_bar_expected(HOME)["lmti"], abs=TOLERANCE)
     assert screwkit("info", path, "--ignore-limits", "--json").returncode == 0
+    mapped = screwkit("map", path, "--ignore-limits", "--grid", "x:-0.02:0.02:0.01", "--grid", "y:0.33:0.37:0.01",
+                      "--quiet", "--out", tmp_path / "map.nc")  # the tasks read the file as it was loaded
+    assert mapped.returncode == 0 and (tmp_path / "map.nc").is_file(), mapped.stderr
     out = tmp_path / "converted.urdf"
     converted = screwkit("convert", path, out, "--ignore-limits", "--json")
     assert converted.returncode == 0, converted.stderr

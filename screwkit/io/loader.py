@@ -143,6 +143,6 @@ def load_text(text: str, source: str = "<string>", *, length_unit: str | None = 
 
 
 @functools.lru_cache(maxsize=8)
-def cached_mechanism(digest: str, text: str, source: str) -> Mechanism:
+def cached_mechanism(digest: str, text: str, source: str, limits: bool = True) -> Mechanism:
     """:func:`load_text`, remembered by the text's digest (for tasks that rebuild a mechanism from its text)."""
-    return load_text(text, source)
+    return load_text(text, source, limits=limits)

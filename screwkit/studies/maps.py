@@ -262,7 +262,8 @@ def map_task(mechanism_text: tuple[str, str, str], block: MapBlock, analysis: An
         ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is unreachable) and
         ``reachable_fraction``.
     """
-    return map_block(cached_mechanism(*mechanism_text), block, analysis, threads)
+    # read as it was loaded: limits ignored at loading (--ignore-limits) are ignored where the task runs too
+    return map_block(cached_mechanism(*mechanism_text, limits=analysis.limits), block, analysis, threads)
 
 
 def map_block(mechanism: Mechanism, block: MapBlock, analysis: AnalysisOptions, threads: int = 1) -> dict:
