@@ -59,9 +59,12 @@ def open_delta(tmp_path, centre=POSES[0], azimuths=AZIMUTHS, name="delta.xml", t
     return path, graph_mechanism(read_mjcf(path))
 
 
-def test_mujoco_reads_the_rod_level_delta_as_screwkit_does(tmp_path):
-    """Every body where MuJoCo puts it and every closure closed at qpos0 (the file is written closed)."""
-    path, graph = open_delta(tmp_path)
+@pytest.mark.parametrize("placed", [False, True])
+def test_mujoco_reads_the_rod_level_delta_as_screwkit_does(tmp_path, placed):
+    """Every body where MuJoCo puts it and every closure closed at qpos0 (the file is written closed); also with the
+    robot's one world body turned and moved (whose placement Pinocchio's parser alone drops)."""
+    transform = (1.0, random_rotation(np.random.default_rng(6)), np.array([0.3, -0.2, 0.5])) if placed else None
+    path, graph = open_delta(tmp_path, transform=transform)
     mj_model, mj_data = mujoco_state(path)
     tree = graph.tree
     assert_same_bodies(tree, mj_model, mj_data, tree.q_reference)
@@ -198,6 +201,27 @@ def test_other_poses_are_solved_from_the_file_s_configuration_with_the_textbook_
         graph.at_pose(frame_position(graph) + np.array([0.0, 0.0, -5.0]))
     with pytest.raises(ValueError, match=r"rpy \[0\.0, 0\.0, 30\.0\] deg"):
         graph.at_pose(frame_position(graph), np.radians([0.0, 0.0, 30.0]))  # a Delta's platform does not turn
+
+
+def test_another_pose_gives_the_same_indices_in_millimetres_in_another_frame_and_with_the_legs_reordered(tmp_path):
+    """at_pose moved by the same displacement (scaled and turned with the world) in a scaled, moved copy and in one
+    whose legs are listed in another order: the indices of the original at its moved pose."""
+    _, graph = open_delta(tmp_path)
+    step = np.subtract(POSES[1], POSES[0])
+    reference = graph.at_pose(frame_position(graph) + step).indices()
+    rotation = random_rotation(np.random.default_rng(5))
+    for scale, turn, shift in ((1e-3, rotation, np.array([0.01, 0.0, -0.02])), (1e3, rotation, np.zeros(3))):
+        _, moved = open_delta(tmp_path, transform=(scale, turn, shift), name="moved.xml")
+        result = moved.at_pose(frame_position(moved) + scale * turn @ step).indices(threshold=1e-6 * scale)
+        assert_indices_close(reference, result, TOLERANCE, fields=("iti", "iti_actuators", "oti_submechanisms",
+                                                                   "lmti", "cti"))
+    order = [2, 0, 3, 1]
+    _, relabelled = open_delta(tmp_path, azimuths=AZIMUTHS[order], name="relabelled.xml")
+    result = relabelled.at_pose(frame_position(relabelled) + step).indices()
+    by_azimuth = dict(zip(np.round(np.degrees(AZIMUTHS[order])), result.iti_actuators))
+    np.testing.assert_allclose([by_azimuth[a] for a in np.round(np.degrees(AZIMUTHS))], reference.iti_actuators,
+                               atol=TOLERANCE)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [reference.lmti, reference.f_o[1]], atol=TOLERANCE)
 
 
 def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_poses(tmp_path):

@@ -38,6 +38,8 @@ MAX_INCLUDE_DEPTH = 20
 ANGLE_ATTRIBUTES = ("range", "ref", "springref")
 ORIENTED = ("body", "geom", "site", "frame", "camera", "light", "inertial")
 NOT_KINEMATICS = ("geom", "asset", "plugin", "extension", "camera", "light", "sensor", "tendon", "contact", "visual")
+PLACEMENT_ATTRIBUTES = ("pos", "quat", "axisangle", "euler", "xyaxes", "zaxis")
+"""How a body is placed in its parent (MJCF): on the one body under ``<worldbody>``, they move the whole robot."""
 NUMBER_COUNTS = {"pos": (3,), "quat": (4,), "axis": (3,), "euler": (3,), "axisangle": (4,), "xyaxes": (6,),
                  "zaxis": (3,), "anchor": (3,), "relpose": (7,), "range": (2,), "ref": (1,), "springref": (1,),
                  "gear": (1, 2, 3, 4, 5, 6)}
@@ -194,14 +196,19 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     bodies = [] if world is None else world.findall("body")
     if not bodies:
         raise MjcfError(f"{path}: <worldbody> holds no body: nothing to analyse.")
-    if len(bodies) > 1:
+    placed = any(bodies[0].get(key) is not None for key in PLACEMENT_ATTRIBUTES if key != "pos") or any(
+        float(word) != 0.0 for word in (bodies[0].get("pos") or "0").split())
+    if len(bodies) > 1 or placed:  # Pinocchio drops the placement of the one body under <worldbody>: hold it in one
         wrapper = ElementTree.Element("body", name="screwkit_world", pos="0 0 0")
+        # an inertia of its own: Pinocchio asks one of every body when <compiler inertiafromgeom="false">
+        ElementTree.SubElement(wrapper, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
         for body in bodies:
             world.remove(body)
             wrapper.append(body)
         world.append(wrapper)
-        notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
-                     "held in one, 'screwkit_world', at the origin")
+        if len(bodies) > 1:
+            notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
+                         "held in one, 'screwkit_world', at the origin")
     equality = _merged(root, "equality")
     unnamed = 0
     for element in ([] if equality is None else list(equality)):
