@@ -12,8 +12,8 @@ import json
 import numpy as np
 import pytest
 from test_io import HOME, assert_textbook, poses_near_home, text
-from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
-from test_onshape import onshape_urdf
+from test_lower_mobility import DISTAL, five_bar_expected
+from test_onshape import MOVED, assert_moved_textbook, five_bar_links, onshape_urdf
 
 from helpers import one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy
@@ -24,21 +24,17 @@ from screwkit.studies.poses import indices_at_poses
 EFFECTOR_RPY = (np.pi, 0.0, 0.3)
 
 
-def five_bar_gazebo(legs: int = 3, kind: str = "revolute", transmissions: bool = True, pose_rpy=(0.0, 0.0, 0.4)):
+def five_bar_gazebo(legs: int = 3, kind: str = "revolute", transmissions: bool = True, pose_rpy=(0.0, 0.0, 0.4),
+                    transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None):
     """The five-bar's tree and one Gazebo joint per further leg, its child the ``effector`` link (on distal_1 at the
     output point, turned upside down and about its normal): the pose is the joint frame in that link, turned by
     ``pose_rpy``, and the axis is written in the joint frame so that it is the plane's normal. Read in the parent
-    link's frame instead (distal_i, whose origin is its elbow), the loops would not close where they do."""
-    elbows = five_bar_elbows(HOME)
-    links = []
-    for i in range(legs):
-        base, elbow = FIVE_BAR_BASE[i], elbows[i]
-        first = float(np.arctan2(*(elbow - base)[::-1]))
-        second = float(np.arctan2(*(HOME - elbow)[::-1]))
-        links.append((f"proximal_{i + 1}", f"mot{i + 1}", "revolute", (*base, 0.0), first, "base"))
-        links.append((f"distal_{i + 1}", f"free{i + 1}", "revolute", (PROXIMAL, 0.0, 0.0), second - first,
-                      f"proximal_{i + 1}"))
-    urdf = onshape_urdf(links, [("effector", "distal_1", (DISTAL, 0.0, 0.0), EFFECTOR_RPY)])
+    link's frame instead (distal_i, whose origin is its elbow), the loops would not close where they do. Moved by
+    ``transform``, legs written in ``order``, motors named ``motor(i)``, as :func:`test_onshape.five_bar_links`."""
+    motor = motor or (lambda i: f"mot{i + 1}")
+    names = (lambda i: f"proximal_{i + 1}", motor, lambda i: f"distal_{i + 1}", lambda i: f"free{i + 1}")
+    links = five_bar_links(legs, names, transform, order)
+    urdf = onshape_urdf(links, [("effector", "distal_1", (transform[0] * DISTAL, 0.0, 0.0), EFFECTOR_RPY)])
     joint_in_distal = rotation_from_rpy(np.array(EFFECTOR_RPY)) @ rotation_from_rpy(np.array(pose_rpy))
     axis = joint_in_distal.T @ np.array([0.0, 0.0, 1.0])  # distal_1's z is the plane's normal
     joints = "".join(
@@ -48,7 +44,7 @@ def five_bar_gazebo(legs: int = 3, kind: str = "revolute", transmissions: bool =
     extra = f"<gazebo>{joints}</gazebo>"
     if transmissions:
         extra += "".join(f'<transmission name="t{i + 1}"><type>transmission_interface/SimpleTransmission</type>'
-                         f'<joint name="mot{i + 1}"/></transmission>' for i in range(legs))
+                         f'<joint name="{motor(i)}"/></transmission>' for i in range(legs))
     return urdf.replace("</robot>", extra + "</robot>")
 
 
@@ -66,6 +62,16 @@ def test_a_five_bar_closed_by_gazebo_joints_has_the_textbook_pressure_angles(tmp
     assert mechanism.dof == 2 and len(mechanism.actuators) == 3
     points = poses_near_home()
     assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+@pytest.mark.parametrize("transform", MOVED)
+def test_a_gazebo_five_bar_in_another_unit_and_frame_with_its_legs_reordered_and_renamed(tmp_path, transform):
+    """Scaled by 1e-3 and 1e3, turned and shifted in the world, legs written in reverse and motors renamed: the same
+    pressure angles, each following its own leg (the hinge's second point is placed at the file's own scale)."""
+    path = tmp_path / "robot.urdf"
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path.write_text(five_bar_gazebo(transform=transform, order=(2, 1, 0), motor=names.get))
+    assert_moved_textbook(load(path), transform, {name: leg for leg, name in names.items()}.get)
 
 
 def test_ball_gazebo_joints_close_the_five_bar_too(tmp_path):

@@ -44,22 +44,65 @@ def onshape_urdf(links: list[tuple[str, str, str, tuple, float, tuple]], frames:
     return "\n".join(out + ["</robot>"]) + "\n"
 
 
-def five_bar_onshape(legs: int = 3) -> str:
-    """The five-bar of tests/test_io.py: legs 2.. close on leg 1's distal link by ``closing_loop<i>`` pairs."""
+MOVED = [(1e-3, 0.7, (0.2, -0.1, 0.05)), (1e3, -2.1, (-40.0, 25.0, 3.0))]
+"""(scale, turn about the normal, shift) of the five-bar's world: millimetres-like and kilometres-like copies."""
+
+
+def five_bar_links(legs: int, names, transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None) -> list:
+    """The five-bar's legs as ``onshape_urdf`` links: leg i's proximal link ``names[0](i)`` on motor ``names[1](i)``
+    at its base, its distal link ``names[2](i)`` on the passive joint ``names[3](i)``; the world scaled, turned about
+    the normal and shifted by ``transform``; the legs written in ``order`` (default 0, 1, ...)."""
+    scale, turn, shift = transform
+    rotation = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
     elbows = five_bar_elbows(HOME)
-    links, frames = [], []
-    for i in range(legs):
+    links = []
+    for i in (range(legs) if order is None else order):
         base, elbow = FIVE_BAR_BASE[i], elbows[i]
         first = float(np.arctan2(*(elbow - base)[::-1]))
         second = float(np.arctan2(*(HOME - elbow)[::-1]))
-        links.append((f"branch1_{i + 1}", f"motor{i + 1}", "revolute", (*base, 0.0), first, "base"))
-        links.append((f"branch2_{i + 1}", f"passive{i + 1}", "revolute", (PROXIMAL, 0.0, 0.0), second - first,
-                      f"branch1_{i + 1}"))
-        if i:
-            frames.append((f"closing_loop{i + 1}_1", f"branch2_{i + 1}", (DISTAL, 0.0, 0.0), (0.0, 0.0, 0.0)))
-            frames.append((f"closing_loop{i + 1}_2", "branch2_1", (DISTAL, 0.0, 0.0), (np.pi, 0.0, np.pi / 2)))
-    frames.append(("effector", "branch2_1", (DISTAL, 0.0, 0.0), (np.pi, 0.0, 0.0)))
+        at = scale * rotation @ base + np.array(shift[:2])
+        links.append((names[0](i), names[1](i), "revolute", (*at, shift[2]), first + turn, "base"))
+        links.append((names[2](i), names[3](i), "revolute", (scale * PROXIMAL, 0.0, 0.0), second - first,
+                      names[0](i)))
+    return links
+
+
+def moved_points(points, transform):
+    """Points of the five-bar's plane in the world of ``transform`` (as :func:`five_bar_links` moves it)."""
+    scale, turn, shift = transform
+    rotation = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    return scale * np.asarray(points) @ rotation.T + np.array(shift[:2])
+
+
+def five_bar_onshape(legs: int = 3, transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None) -> str:
+    """The five-bar of tests/test_io.py: legs 2.. close on leg 1's distal link by ``closing_loop<i>`` pairs; moved
+    by ``transform``, its legs written in ``order``, its motors named ``motor(i)`` (default motor<i+1>)."""
+    motor = motor or (lambda i: f"motor{i + 1}")
+    names = (lambda i: f"branch1_{i + 1}", motor, lambda i: f"branch2_{i + 1}", lambda i: f"passive{i + 1}")
+    links, frames = five_bar_links(legs, names, transform, order), []
+    distal = (transform[0] * DISTAL, 0.0, 0.0)
+    for i in range(1, legs):
+        frames.append((f"closing_loop{i + 1}_1", f"branch2_{i + 1}", distal, (0.0, 0.0, 0.0)))
+        frames.append((f"closing_loop{i + 1}_2", "branch2_1", distal, (np.pi, 0.0, np.pi / 2)))
+    frames.append(("effector", "branch2_1", distal, (np.pi, 0.0, 0.0)))
     return onshape_urdf(links, frames)
+
+
+def assert_moved_textbook(mechanism, transform, motor_leg, tolerance=TOLERANCE):
+    """The textbook pressure angles at points near HOME, the mechanism moved by ``transform``: the ITI of each
+    actuator follows its leg (``motor_leg``: the leg of a motor's joint name), the LMTI and F_O1 agree, and the worst
+    single fault is the leg the textbook names."""
+    points = poses_near_home()
+    result = indices_at_poses(mechanism, moved_points(points, transform), detail=True)
+    legs = [motor_leg(name.split(":")[-1]) for name in mechanism.actuator_names]
+    for k, point in enumerate(points):
+        expected = five_bar_expected(point)
+        np.testing.assert_allclose(result.iti_actuators[k], expected["iti_actuators"][legs], atol=tolerance)
+        np.testing.assert_allclose([result.lmti[k], result.f_o[1][k]], [expected["lmti"], expected["f_o1"]],
+                                   atol=tolerance)
+        kept = [(0, 1), (0, 2), (1, 2)][int(np.argmin(expected["oti_submechanisms"]))]
+        failed = {0, 1, 2}.difference(kept).pop()
+        assert [legs[a] for a in np.atleast_1d(result.worst_fault_indices[1][k])] == [failed]
 
 
 def test_an_onshape_five_bar_opens_as_written_with_the_textbook_pressure_angles(tmp_path):
@@ -76,6 +119,18 @@ def test_an_onshape_five_bar_opens_as_written_with_the_textbook_pressure_angles(
     assert mechanism.dof == 2 and len(mechanism.actuators) == 3
     points = poses_near_home()
     assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+@pytest.mark.parametrize("transform", MOVED)
+def test_an_onshape_five_bar_in_another_unit_and_frame_with_its_legs_reordered_and_renamed(tmp_path, transform):
+    """Scaled by 1e-3 and 1e3, turned and shifted in the world, legs written in reverse and motors renamed: the same
+    pressure angles, each following its own leg."""
+    path = tmp_path / "robot.urdf"
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path.write_text(five_bar_onshape(transform=transform, order=(2, 1, 0), motor=names.get))
+    mechanism = load(path)
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["drive_a", "drive_b", "drive_c"]
+    assert_moved_textbook(mechanism, transform, {name: leg for leg, name in names.items()}.get)
 
 
 def test_a_non_redundant_onshape_five_bar_has_the_textbook_indices_and_no_fault_tolerance(tmp_path):
