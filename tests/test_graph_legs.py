@@ -197,7 +197,7 @@ def test_other_poses_are_solved_from_the_file_s_configuration_with_the_textbook_
     np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
     _, written = open_delta(tmp_path, centre, name="there.xml")
     assert_indices_close(written.indices(), result, TOLERANCE)
-    with pytest.raises(ValueError, match=r"no closed configuration near the current one puts the output frame at "):
+    with pytest.raises(ValueError, match=r"no closed configuration reached from the current one puts the output "):
         graph.at_pose(frame_position(graph) + np.array([0.0, 0.0, -5.0]))
     with pytest.raises(ValueError, match=r"rpy \[0\.0, 0\.0, 30\.0\] deg"):
         graph.at_pose(frame_position(graph), np.radians([0.0, 0.0, 30.0]))  # a Delta's platform does not turn
@@ -243,7 +243,7 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
     assert report["pose"] == pytest.approx(dict(zip("xyz", target)), abs=1e-12)
     one_line_error(screwkit("analyze", path, "--actuators", "0", "0", "0", "0"), "loops inside them",
                    "leave out --actuators")
-    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration near the current",
+    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration reached from the",
                    "out of reach")
     one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes the output frame's x y z")
     converted = screwkit("convert", path, tmp_path / "out.urdf")

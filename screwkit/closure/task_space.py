@@ -35,6 +35,7 @@ __all__ = [
     "packed_geometry",
     "motion_space_at",
     "infer_task_axes",
+    "choose_task_axes",
 ]
 
 TASK_RANK_TOLERANCE = 1e-6
@@ -274,10 +275,15 @@ def infer_task_axes(mechanism: Mechanism, full_pose: NDArray, joint_values, dof:
     """
     dofs, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
     space = basis[0][:, :int(dofs[0])]
-    order = list(range(mechanism.n_pose)) if candidates is None else list(candidates)
+    return choose_task_axes(space, np.asarray(mechanism.pose_angular, dtype=bool), dof, candidates)
+
+
+def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None) -> tuple[int, ...]:
+    """The rule of :func:`infer_task_axes` on ``space`` (n_pose, d): the pose-coordinate rates of a basis of the
+    motion space (lengths in units of the length scale), ``angular`` which coordinates are angles."""
+    order = list(range(space.shape[0])) if candidates is None else list(candidates)
     chosen: list[int] = []
-    if len(order) == mechanism.n_pose and space.shape[1]:
-        angular = np.asarray(mechanism.pose_angular, dtype=bool)
+    if len(order) == space.shape[0] and space.shape[1]:
         _, singular, rows = np.linalg.svd(space[angular], full_matrices=True)
         turning = int(np.sum(singular > TASK_RANK_TOLERANCE))
         translations = space @ rows[turning:].T  # the motions that turn the platform by nothing

@@ -101,6 +101,7 @@ class ImportReport:
     gaps_after: dict = field(default_factory=dict)
     motors: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    task_coordinates: str = ""
 
     def lines(self) -> list[str]:
         """The report as lines of text."""
@@ -112,6 +113,8 @@ class ImportReport:
                        f"{self.gaps_after[name]:.1e} after assembly")
         out += [f"  chain {line}" for line in self.chains]
         out.append(f"  actuators: {', '.join(self.motors)}")
+        if self.task_coordinates:
+            out.append(f"  task coordinates: {self.task_coordinates}")
         if self.locked:
             out.append(f"  idle joints locked at their assembled values: {', '.join(self.locked)}")
         if self.dropped:

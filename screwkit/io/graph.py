@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.rotations import rotation_from_rpy
+from screwkit.closure.task_space import choose_task_axes
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -58,11 +58,14 @@ from screwkit.io.closed_tree import (
     joint_value,
     path_to,
 )
-from screwkit.io.compound import platform_twists
+from screwkit.io.compound import TWIST_RANK_TOLERANCE
+from screwkit.io.graph_kinematics import TreeKinematics, rpy_of, rpy_rates_inverse, solve_poses
 from screwkit.io.star import output_frame
+from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
 from screwkit.screw.chain_screws import ChainScrews
 
-__all__ = ["GraphLeg", "GraphMechanism", "graph_legs", "graph_mechanism", "IN_LOOP_TOLERANCE"]
+__all__ = ["GraphLeg", "GraphMechanism", "LegScrews", "graph_legs", "graph_mechanism", "leg_screws",
+           "equivalent_chains", "dimension_groups", "IN_LOOP_TOLERANCE"]
 
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
@@ -85,7 +88,8 @@ class GraphLeg:
 class GraphMechanism:
     """A closed-loop graph assembled at a configuration ``q`` (the file's, or a pose's): its platform (joint id), its
     legs, and the chain screws of its legs' equivalent chains with their ITI and OTI points
-    (:func:`graph_mechanism`)."""
+    (:func:`graph_mechanism`); the output frame and its task coordinates (indices into x, y, z, roll, pitch, yaw of
+    the frame in the world)."""
 
     name: str
     tree: ClosedTree
@@ -98,44 +102,69 @@ class GraphMechanism:
     iti_points: NDArray[np.float64]
     oti_points: NDArray[np.float64]
     report: ImportReport
+    kinematics: TreeKinematics
+    frame_id: int
+    task_axes: tuple[int, ...]
 
-    def at_pose(self, position, rpy=None) -> GraphMechanism:
+    @property
+    def task_coordinates(self) -> tuple[str, ...]:
+        """Names of the task coordinates (``x y z`` for a Delta, ``roll pitch yaw`` for a spherical wrist)."""
+        return tuple(SPATIAL_TASK_COORDINATES[axis] for axis in self.task_axes)
+
+    def frame_pose(self, q: NDArray | None = None) -> NDArray[np.float64]:
+        """x, y, z (m) and roll, pitch, yaw (rad) of the output frame in the world at configurations q (..., nq;
+        default this one's)."""
+        q = self.q if q is None else np.asarray(q, dtype=float)
+        frame = self.tree.model.frames[self.frame_id]
+        transforms = self.kinematics.transforms(q.reshape(-1, self.kinematics.nq))[:, int(frame.parentJoint)]
+        world = transforms @ homogeneous(frame.placement)
+        pose = np.concatenate([world[:, :3, 3], rpy_of(world[:, :3, :3])], axis=1)
+        return pose.reshape(q.shape[:-1] + (6,))
+
+    def task_pose(self) -> NDArray[np.float64]:
+        """The task coordinates of this configuration."""
+        return self.frame_pose()[list(self.task_axes)]
+
+    def solve(self, poses, *, limits: bool = True) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Closed configurations (n, nq) with the task coordinates at ``poses`` (n, len(task_axes); m, rad, world),
+        each reached by continuation from this configuration (:func:`screwkit.io.graph_kinematics.solve_poses`),
+        and which are reached."""
+        poses = np.asarray(poses, dtype=float)
+        if poses.ndim != 2 or poses.shape[1] != len(self.task_axes) or not np.all(np.isfinite(poses)):
+            raise ValueError(f"Expected finite poses of shape (n, {len(self.task_axes)}) "
+                             f"({' '.join(self.task_coordinates)}), got shape {poses.shape}.")
+        targets = np.repeat(self.frame_pose()[None], poses.shape[0], axis=0)
+        targets[:, list(self.task_axes)] = poses
+        return solve_poses(self.tree, self.q, self.scale, self.frame_id, targets, self.task_axes, limits=limits,
+                           kinematics=self.kinematics)
+
+    def at_pose(self, position, rpy=None, *, limits: bool = True) -> GraphMechanism:
         """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default
-        the one it has), closed from this configuration (the nearest working mode). A ValueError names the pose
-        when no closed configuration near this one puts the frame there."""
-        import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-        model = self.tree.model
-        data = model.createData()
-        pin.framesForwardKinematics(model, data, self.q)
-        frame_id = output_frame(self.tree)
-        target = homogeneous(data.oMf[frame_id])
+        the one it has), reached by continuation from this configuration (the working mode followed). A
+        ValueError names the pose when the frame cannot be put there (out of reach, a rotation the legs do not
+        allow, or a joint beyond its limits)."""
         position = np.asarray(position, dtype=float).reshape(-1)
         if position.shape != (3,) or not np.all(np.isfinite(position)):
             raise ValueError(f"Expected a finite position (x, y, z), got {position.tolist()}.")
-        target[:3, 3] = position
+        target = self.frame_pose()
+        target[:3] = position
         if rpy is not None:
-            target[:3, :3] = rotation_from_rpy(np.asarray(rpy, dtype=float))
-        frame = model.frames[frame_id]
-        holding = Closure("pose", 0, target, int(frame.parentJoint), homogeneous(frame.placement), "6d")
-        posed = replace(self.tree, closures=[*self.tree.closures, holding], q_reference=self.q, notes=[])
-        try:
-            q, _ = assemble(posed)
-        except ImportError_:
-            raise ValueError(f"{self.tree.source}: no closed configuration near the current one puts the output frame "
-                             f"at {np.round(position, 9).tolist()} m"
+            target[3:] = np.asarray(rpy, dtype=float)
+        q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
+                                 limits=limits, kinematics=self.kinematics)
+        if not reached[0]:
+            raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
+                             f"output frame at {np.round(position, 9).tolist()} m"
                              + ("" if rpy is None else f", rpy {np.round(np.degrees(rpy), 9).tolist()} deg")
-                             + " (out of reach, or a rotation the legs do not allow).") from None
-        if posed.notes:  # closed only to a rounding: the pose is not exactly reachable
-            raise ValueError(f"{self.tree.source}: the output frame cannot be put exactly at "
-                             f"{np.round(position, 9).tolist()} m: {posed.notes[-1]}.")
-        return graph_mechanism(self.tree, q=q, scale=self.scale)
+                             + " (out of reach, a rotation the legs do not allow, or a joint beyond its limits).")
+        return graph_mechanism(self.tree, q=q[0], scale=self.scale)
 
     def indices(self, **options):
         """Every index at this configuration (:func:`screwkit.indices.analysis.analyze`'s options)."""
         from screwkit.indices.analysis import analyze  # the index layer, above io: only when indices are asked
 
         options.setdefault("detail", True)
+        options.setdefault("dof", len(self.task_axes))
         result = analyze(self.chains, iti_points=self.iti_points, oti_points=self.oti_points, **options)
         model = self.tree.model
         values, prismatic = {}, []
@@ -217,70 +246,240 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     return sorted(legs, key=lambda leg: leg.name)
 
 
-def _attachments(tree: ClosedTree, data, leg: GraphLeg, body: int) -> list[NDArray]:
-    """World points where the leg's joints (to its children) and closures meet ``body``."""
-    model = tree.model
-    points = [np.asarray(data.oMi[j].translation) for j in leg.joints if model.parents[j] == body]
+def _columns(kinematics: TreeKinematics, joints) -> NDArray[np.int64]:
+    """Velocity coordinates of ``joints``, in joint order."""
+    width = {"revolute": 1, "unbounded": 1, "prismatic": 1, "ball": 3, "free": 6}
+    return np.array([kinematics.idx_v[j] + k for j in sorted(set(joints)) for k in range(width[kinematics.kinds[j]])],
+                    dtype=np.int64)
+
+
+def _select(offset: NDArray, kind: str) -> NDArray:
+    """(n, r, 6): the rows taking a working twist of a body to the velocity of a closure frame on it (its point's
+    velocity for ``3d``, the whole twist about that point for ``6d``)."""
+    count = offset.shape[0]
+    if kind != "3d":
+        return np.broadcast_to(np.eye(6), (count, 6, 6))
+    skew = np.zeros((count, 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -offset[:, 2], offset[:, 1], -offset[:, 0]
+    skew[:, 1, 0], skew[:, 2, 0], skew[:, 2, 1] = offset[:, 2], -offset[:, 1], offset[:, 0]
+    return np.concatenate([-skew, np.broadcast_to(np.eye(3), (count, 3, 3))], axis=2)
+
+
+def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArray]:
+    """Orthonormal rows (n, 6, 6) spanning the platform twists ``joints`` of ``leg`` allow with its closures closed
+    (working coordinates; the first ``dims[n]`` rows of configuration n), and ``dims`` (n,).
+
+    Unknowns: the rates of ``joints`` and the platform twist T. Each closure adds the relative velocity of its two
+    frames (6 rows for ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves
+    with T plus the joints of ``joints`` beyond the platform, unless the leg is the platform's spine (the
+    platform's own path is among its joints): then T is tied to the platform body's twist."""
+    model, kinematics = state.model, state.kinematics
+    columns = _columns(kinematics, joints)
+    count = state.working.shape[0]
+    blocks = []
+    for closure in leg.closures:
+        rows_q, rows_t = 0.0, 0.0
+        for joint, placement, sign in ((closure.joint_a, closure.placement_a, 1.0),
+                                       (closure.joint_b, closure.placement_b, -1.0)):
+            world = state.transforms[:, joint] @ placement
+            select = _select((world[:, :3, 3] - state.centre) / state.scale, closure.kind)
+            moves = kinematics.supports(model, joint)[columns]
+            rows_q = rows_q + sign * select @ np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
+            if not leg.spine and state.platform in path_to(model, joint):
+                rows_t = rows_t + sign * select
+        rows_q = np.broadcast_to(rows_q, (count, 6 if closure.kind != "3d" else 3, len(columns)))
+        blocks.append(np.concatenate([rows_q, np.broadcast_to(rows_t, rows_q.shape[:2] + (6,))], axis=2))
+    if leg.spine:
+        moves = kinematics.supports(model, state.platform)[columns]
+        own = np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
+        blocks.append(np.concatenate([own, np.broadcast_to(-np.eye(6), (count, 6, 6))], axis=2))
+    matrix = np.concatenate(blocks, axis=1)
+    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
+    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(count), 1.0)
+    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
+    null = right[:, :, -6:] * (np.arange(right.shape[1])[None, :] >= rank[:, None])[:, :, None]
+    _, values, rows = np.linalg.svd(null, full_matrices=False)
+    return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
+
+
+def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
+    """World points (n, 3) where the leg's joints (to its children) and closures meet ``body``."""
+    model = state.model
+    points = [state.transforms[:, j, :3, 3] for j in leg.joints if model.parents[j] == body]
     for closure in leg.closures:
         for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
             if joint == body:
-                points.append((np.asarray(data.oMi[joint].homogeneous) @ placement)[:3, 3])
+                points.append((state.transforms[:, joint] @ placement)[:, :3, 3])
     return points
 
 
-def _equivalent_chain(tree: ClosedTree, data, leg: GraphLeg, platform: int, centre: NDArray, scale: float):
-    """The leg's equivalent chain (actuated joint's twist, then a basis of the twists the leg allows with the
-    actuator locked) in world coordinates, with its ITI and OTI points."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+@dataclass(frozen=True)
+class _State:
+    """A batch of closed configurations: joint frames (n, njoints, 4, 4), every velocity coordinate's twist in
+    working coordinates about the platform joint (n, nv, 6), that centre (n, 3) and the length scale."""
 
+    model: object
+    kinematics: TreeKinematics
+    platform: int
+    transforms: NDArray[np.float64]
+    working: NDArray[np.float64]
+    centre: NDArray[np.float64]
+    scale: float
+
+    @classmethod
+    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float) -> _State:
+        transforms = kinematics.transforms(q)
+        twists = kinematics.twists(transforms)
+        centre = transforms[:, platform, :3, 3]
+        omega = twists[..., :3]
+        working = np.concatenate([omega, (twists[..., 3:] + np.cross(omega, centre[:, None, :])) / scale], axis=-1)
+        return cls(tree.model, kinematics, platform, transforms, working, centre, scale)
+
+
+@dataclass(frozen=True)
+class LegScrews:
+    """One leg's equivalent chain at a batch of configurations: the actuated joint's unit twist (n, 6), a basis of
+    the twists the leg allows with it locked (n, 6, 6; the first ``locked_dims[n]`` rows), both in working
+    coordinates; the actuated joint's point, the ITI and OTI points (n, 3, world) and how far the actuated
+    joint's twist lies from the leg's twist system (n,)."""
+
+    own: NDArray[np.float64]
+    locked: NDArray[np.float64]
+    locked_dims: NDArray[np.int64]
+    allowed: NDArray[np.float64]
+    allowed_dims: NDArray[np.int64]
+    actuator_point: NDArray[np.float64]
+    iti_point: NDArray[np.float64]
+    oti_point: NDArray[np.float64]
+    outside: NDArray[np.float64]
+
+
+def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
+    """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
+    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
+    out = []
+    for leg in legs:
+        actuator = leg.actuators[0]
+        allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
+        locked, locked_dims = _twist_spaces(state, [j for j in leg.joints if j != actuator], leg)
+        own = state.working[:, kinematics.idx_v[actuator]]
+        own = own / np.linalg.norm(own, axis=1, keepdims=True)
+        valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
+        projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
+        iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
+        if leg.spine:
+            oti.append(state.transforms[:, platform, :3, 3])
+        if not iti or not oti:
+            raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint after its actuator or none on the "
+                               "platform.")
+        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, state.transforms[:, actuator, :3, 3],
+                             np.mean(iti, axis=0), np.mean(oti, axis=0), np.linalg.norm(own - projection, axis=1)))
+    return out, state
+
+
+def equivalent_chains(legs, screws: list[LegScrews], state: _State, rows: NDArray, model):
+    """The legs' equivalent chains (world coordinates) at the configurations ``rows`` of a batch, which share every
+    leg's twist-system dimension: ChainScrews of batch shape (len(rows),), ITI and OTI points (len(rows), legs,
+    3)."""
+    chains = []
+    centre, scale = state.centre[rows][:, None, :], state.scale
+    for leg, leg_screw in zip(legs, screws):
+        dims = int(leg_screw.locked_dims[rows[0]])
+        working = np.concatenate([leg_screw.own[rows][:, None, :], leg_screw.locked[rows][:, :dims]], axis=1)
+        world = np.concatenate([working[..., :3], working[..., 3:] * scale + np.cross(centre, working[..., :3])],
+                               axis=-1)
+        points = np.concatenate([leg_screw.actuator_point[rows][:, None, :],
+                                 np.repeat(leg_screw.oti_point[rows][:, None, :], dims, axis=1)], axis=1)
+        names = (model.names[leg.actuators[0]],) + tuple(f"{leg.name}_twist_{k + 1}" for k in range(dims))
+        chains.append(ChainScrews(world, points, (0,), leg.name, names))
+    iti = np.stack([s.iti_point[rows] for s in screws], axis=1)
+    oti = np.stack([s.oti_point[rows] for s in screws], axis=1)
+    return chains, iti, oti
+
+
+def dimension_groups(screws: list[LegScrews]) -> list[NDArray[np.int64]]:
+    """Configurations of a batch grouped by the dimensions of every leg's locked twist system (one group unless
+    some configurations are singular)."""
+    signature = np.stack([s.locked_dims for s in screws], axis=1)
+    _, inverse = np.unique(signature, axis=0, return_inverse=True)
+    return [np.flatnonzero(inverse.reshape(-1) == group) for group in range(int(inverse.max()) + 1)]
+
+
+def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
+    """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
+    motion away (else the actuator moves inside a loop of the leg)."""
     model = tree.model
-    if len(leg.actuators) != 1:
-        raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                           f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
-                           "one (a leg with loops and several actuators has no per-actuator twist system yet).")
-    actuator = leg.actuators[0]
-    kind, _ = joint_kind(model, actuator)
-    if kind not in ("revolute", "prismatic"):
-        raise ImportError_(f"{tree.source}: actuated joint {model.names[actuator]!r} is {kind}: an actuator drives "
-                           "one revolute or prismatic joint.")
-    closures = list(leg.closures)
-    allowed = platform_twists(model, data, list(leg.joints), closures, platform, leg.spine, centre, scale)
-    locked = platform_twists(model, data, [j for j in leg.joints if j != actuator], closures, platform, leg.spine,
-                             centre, scale)
-    jacobian = np.asarray(pin.getJointJacobian(model, data, actuator, pin.ReferenceFrame.WORLD))
-    column = jacobian[:, model.joints[actuator].idx_v]
-    omega, velocity = column[3:], column[:3]
-    own = np.concatenate([omega, (velocity - np.cross(centre, omega)) / scale])
-    own = own / np.linalg.norm(own)
-    outside = np.linalg.norm(own - own @ allowed.T @ allowed) if len(allowed) else 1.0
-    if outside > IN_LOOP_TOLERANCE or len(locked) != len(allowed) - 1:
-        raise ImportError_(f"{tree.source}: actuated joint {model.names[actuator]!r} moves inside a loop of leg "
-                           f"{leg.name!r} (its twist is not a motion the leg allows: the leg has no serial input); "
-                           "analysable when the actuated joint joins the base to the rest of its leg.")
-    rows = np.vstack([own, locked])
-    world = np.concatenate([rows[:, :3], rows[:, 3:] * scale + np.cross(centre, rows[:, :3])], axis=1)
-    iti = _attachments(tree, data, leg, actuator)
-    oti = _attachments(tree, data, leg, platform)
-    if leg.spine:
-        oti.append(np.asarray(data.oMi[platform].translation))
-    if not iti or not oti:
-        raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint after its actuator or none on the platform.")
-    iti_point, oti_point = np.mean(iti, axis=0), np.mean(oti, axis=0)
-    points = np.vstack([np.asarray(data.oMi[actuator].translation)] + [oti_point] * len(locked))
-    names = (model.names[actuator],) + tuple(f"{leg.name}_twist_{k + 1}" for k in range(len(locked)))
-    return ChainScrews(world, points, (0,), leg.name, names), iti_point, oti_point
+    for leg, screw in zip(legs, screws):
+        if len(leg.actuators) != 1:
+            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
+                               f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
+                               "one (a leg with loops and several actuators has no per-actuator twist system yet).")
+        if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
+            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} moves inside a "
+                               f"loop of leg {leg.name!r} (its twist is not a motion the leg allows: the leg has no "
+                               "serial input); analysable when the actuated joint joins the base to the rest of its "
+                               "leg.")
+
+
+def _check_actuators(tree: ClosedTree, legs) -> None:
+    model = tree.model
+    for leg in legs:
+        if len(leg.actuators) != 1:
+            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
+                               f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
+                               "one (a leg with loops and several actuators has no per-actuator twist system yet).")
+        kind, _ = joint_kind(model, leg.actuators[0])
+        if kind not in ("revolute", "prismatic"):
+            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
+                               "actuator drives one revolute or prismatic joint.")
+
+
+def _motion_space(screws: list[LegScrews]) -> NDArray[np.float64]:
+    """Orthonormal rows (d, 6) spanning the platform twists every leg allows (working coordinates), at the first
+    configuration of a batch."""
+    complements = []
+    for screw in screws:
+        rows = screw.allowed[0][:int(screw.allowed_dims[0])]
+        _, values, right = np.linalg.svd(np.vstack([rows, np.zeros((6 - len(rows), 6))]) if len(rows) < 6 else rows)
+        complements.append(right[int(np.sum(values > TWIST_RANK_TOLERANCE)):])
+    stacked = np.vstack(complements)
+    if not len(stacked):
+        return np.eye(6)
+    _, values, right = np.linalg.svd(np.vstack([stacked, np.zeros((max(6 - len(stacked), 0), 6))]))
+    return right[int(np.sum(values > TWIST_RANK_TOLERANCE)):]
+
+
+def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple[int, ...]:
+    """The output frame's task coordinates among x, y, z, roll, pitch, yaw: the file's declared ones, else chosen
+    from the motion space (:func:`screwkit.closure.task_space.choose_task_axes`)."""
+    frame = state.transforms[0, tree.model.frames[frame_id].parentJoint] @ homogeneous(
+        tree.model.frames[frame_id].placement)
+    offset = (frame[:3, 3] - state.centre[0]) / state.scale
+    omega = motion[:, :3]
+    rates = np.concatenate([motion[:, 3:] + np.cross(omega, offset),
+                            (rpy_rates_inverse(rpy_of(frame[None, :3, :3]))[0] @ omega.T).T], axis=1).T
+    if tree.task_coordinates:
+        unknown = [name for name in tree.task_coordinates if name not in SPATIAL_TASK_COORDINATES]
+        axes = tuple(sorted(SPATIAL_TASK_COORDINATES.index(n) for n in tree.task_coordinates if n not in unknown))
+        singular = np.linalg.svd(rates[list(axes)], compute_uv=False) if axes else np.zeros(0)
+        if unknown or len(axes) != len(motion) or (singular.size and singular[-1] <= 1e-6):
+            raise ImportError_(f"{tree.source}: <task_coordinates> {' '.join(tree.task_coordinates)}: expected "
+                               f"{len(motion)} independent coordinates of the platform's motion among "
+                               f"{' '.join(SPATIAL_TASK_COORDINATES)}.")
+        return axes
+    return choose_task_axes(rates, np.array([False] * 3 + [True] * 3), len(motion))
 
 
 def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | None = None) -> GraphMechanism:
     """The closed tree assembled at the file's configuration (or at ``q``, a closed configuration, with the length
     scale ``scale``), its legs and their equivalent chains."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
     model = tree.model
     report = ImportReport(source=tree.source, file_format=tree.file_format)
-    if q is None or scale is None:
+    at_file = q is None or scale is None
+    if at_file:
         q, scale = assemble(tree)
-    frame = model.frames[output_frame(tree)]
+    frame_id = output_frame(tree)
+    frame = model.frames[frame_id]
     report.notes[:0] = tree.notes
     platform = int(frame.parentJoint)
     if platform == 0:
@@ -290,25 +489,23 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
-    data = model.createData()
-    pin.computeJointJacobians(model, data, q)
-    pin.forwardKinematics(model, data, q)
-    centre = np.asarray(data.oMi[platform].translation)
-    chains, iti_points, oti_points = [], [], []
-    for leg in legs:
-        chain, iti, oti = _equivalent_chain(tree, data, leg, platform, centre, scale)
-        chains.append(chain)
-        iti_points.append(iti)
-        oti_points.append(oti)
+    _check_actuators(tree, legs)
+    kinematics = TreeKinematics.of(model, tree.source)
+    screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
+    if at_file:
+        _check_legs(tree, legs, screws)
+    chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
+    chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
+    motion = _motion_space(screws)
+    task_axes = _task_axes(tree, state, frame_id, motion)
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.motors = [model.names[leg.actuators[0]] for leg in legs]
     report.chains = [f"{leg.name}: {len(leg.joints)} joints ({', '.join(model.names[j] for j in leg.joints)}), "
                      f"{len(leg.closures)} closure(s), twist system of dimension {len(chain.twists)}"
                      for leg, chain in zip(legs, chains)]
-    report.notes.append("legs with loops inside them: analysed as a graph at the file's configuration "
-                        "(screwkit.io.graph)")
+    report.notes.append("legs with loops inside them: analysed as a graph (screwkit.io.graph)")
     report.output = f"the frame of body {report.platform_body!r}"
+    report.task_coordinates = " ".join(SPATIAL_TASK_COORDINATES[a] for a in task_axes)
     return GraphMechanism(Path(tree.source).stem, tree, q, scale, platform, report.platform_body, tuple(legs),
-                          tuple(chains), np.array(iti_points), np.array(oti_points), report)
-
+                          tuple(chains), iti_points[0], oti_points[0], report, kinematics, frame_id, task_axes)

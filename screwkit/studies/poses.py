@@ -9,7 +9,7 @@ and returns one :class:`~screwkit.indices.results.Indices` with NaN where a pose
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from math import comb
 from typing import Callable
 
@@ -22,9 +22,11 @@ from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
 from screwkit.indices.results import Indices
+from screwkit.io.graph import GraphMechanism, dimension_groups, equivalent_chains, leg_screws
 from screwkit.model import Mechanism, require_mechanism
 
-__all__ = ["indices_at_poses", "indices_at_pose", "analyze_solution", "output_points", "planar_points",
+__all__ = ["indices_at_poses", "indices_at_pose", "graph_indices_at_poses", "GRAPH_CHUNK", "analyze_solution",
+           "output_points", "planar_points",
            "closed_form_indices"]
 
 
@@ -269,6 +271,44 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
             if progress is not None:
                 progress(part.stop - part.start)
 
+    described = _Described(mechanism.actuator_names, mechanism.dof, mechanism.task_coordinates, mechanism.name,
+                           mechanism.pose_coordinates)
+    return _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
+                          faults=faults, detail=detail, threshold=threshold)
+
+
+@dataclass(frozen=True)
+class _Described:
+    """What a batch of indices says of its mechanism."""
+
+    actuator_names: tuple[str, ...]
+    dof: int
+    task_coordinates: tuple[str, ...]
+    mechanism_name: str
+    pose_coordinates: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class _Gathered:
+    """A batch's shape, poses, and per flat configuration its reachability, chain status and full pose."""
+
+    batch: tuple[int, ...]
+    poses: NDArray
+    reachable: NDArray
+    chain_status: NDArray
+    full_poses: NDArray
+
+
+def _batch_indices(arrays: dict, meta: Indices | None, gathered: _Gathered, described: _Described, *, faults,
+                   detail: bool, threshold: float) -> Indices:
+    """One :class:`Indices` of the batch's shape from the arrays :func:`_scatter` filled (``meta`` the last chunk's
+    result, None when nothing was reachable)."""
+    batch, poses, reachable, chain_status, full_poses = (gathered.batch, gathered.poses, gathered.reachable,
+                                                         gathered.chain_status, gathered.full_poses)
+    actuator_names, dof, task_coordinates, mechanism_name, pose_coordinates = (
+        described.actuator_names, described.dof, described.task_coordinates, described.mechanism_name,
+        described.pose_coordinates)
+
     # no CTI (no constraint wrench held by one chain alone): NaN everywhere, as a view of one NaN
     not_applicable = {} if meta is None else {"cti": np.broadcast_to(np.nan, batch),
                                               "f_c": dict.fromkeys(meta.faults, np.broadcast_to(np.nan, batch))}
@@ -276,33 +316,32 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     def shaped(key):
         return arrays[key].reshape(batch + arrays[key].shape[1:]) if key in arrays else None
 
-    a = len(mechanism.actuators)
+    a = len(actuator_names)
     if meta is None:  # nothing reachable: the structure of the indices from the mechanism alone
-        dof = mechanism.dof
         faults_list = tuple(range(1, max(a - dof, 1) + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
         nothing = np.full(batch, np.nan)
         return Indices.from_arrays(
-            mechanism.actuator_names, dof,
+            actuator_names, dof,
             {"iti": nothing, "lmti": nothing.copy(), "f_o": {j: nothing.copy() for j in faults_list},
              "worst_fault_indices": {j: np.full(batch + (j,), -1, dtype=np.int64) for j in faults_list},
              "mutual_interference": np.zeros(batch + (a,), dtype=bool),
              "iti_actuators": np.full(batch + (a,), np.nan) if detail else None, "poses": poses,
              "reachable": reachable.reshape(batch),
              "chain_status": chain_status.reshape(batch + chain_status.shape[-1:]),
-             "full_poses": full_poses.reshape(batch + (mechanism.n_pose,))},
-            threshold=threshold, task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
-            pose_coordinates=mechanism.pose_coordinates, derive=False)
+             "full_poses": full_poses.reshape(batch + (full_poses.shape[-1],))},
+            threshold=threshold, task_coordinates=task_coordinates, mechanism=mechanism_name,
+            pose_coordinates=pose_coordinates, derive=False)
     fields = {name: shaped(name) for name in _ARRAYS}
     fields.update({name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS})
     if not meta.constraint_count:
         fields.update(not_applicable)
     fields.update(poses=poses, reachable=reachable.reshape(batch),
                   chain_status=chain_status.reshape(batch + chain_status.shape[-1:]),
-                  full_poses=full_poses.reshape(batch + (mechanism.n_pose,)))
+                  full_poses=full_poses.reshape(batch + (full_poses.shape[-1],)))
     return Indices.from_arrays(
-        mechanism.actuator_names, meta.dof, fields, threshold=threshold, submechanisms=meta.submechanisms,
-        task_coordinates=mechanism.task_coordinates, mechanism=mechanism.name,
-        pose_coordinates=mechanism.pose_coordinates, constraint_count=meta.constraint_count,
+        actuator_names, meta.dof, fields, threshold=threshold, submechanisms=meta.submechanisms,
+        task_coordinates=task_coordinates, mechanism=mechanism_name,
+        pose_coordinates=pose_coordinates, constraint_count=meta.constraint_count,
         fault_type=meta.fault_type, cti_reason=meta.cti_reason, derive=False)
 
 
@@ -331,3 +370,57 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
                    reachable=True, chain_status=solution.status, full_poses=solution.full_poses,
                    pose_coordinates=mechanism.pose_coordinates, joint_values=values, prismatic_joints=prismatic,
                    working_mode=working_modes(mechanism))
+
+
+GRAPH_CHUNK = 4096
+"""Poses of a closed-loop graph solved and analysed at a time by :func:`graph_indices_at_poses` (its closure
+Jacobians take about 10 kB a pose for a rod-level Delta)."""
+
+
+def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,
+                           threshold: float = SINGULARITY_THRESHOLD, faults=None, limits: bool = True,
+                           threads: int | None = None, chunk_size: int = GRAPH_CHUNK,
+                           progress: Callable[[int], None] | None = None) -> Indices:
+    """Every index of a closed-loop graph (:mod:`screwkit.io.graph`) at a batch of task-coordinate poses.
+
+    ``poses`` (..., len(graph.task_axes)) are the output frame's task coordinates (``graph.task_coordinates``; m
+    and rad, world frame). Each is closed by continuation from the graph's configuration
+    (:meth:`~screwkit.io.GraphMechanism.solve`), its legs' equivalent chains derived batched
+    (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
+    NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw.
+    """
+    poses = np.asarray(poses, dtype=float)
+    n_task = len(graph.task_axes)
+    if poses.shape[-1:] != (n_task,) or not np.all(np.isfinite(poses)):
+        raise ValueError(f"Expected finite poses of shape (..., {n_task}) ({' '.join(graph.task_coordinates)}), "
+                         f"got shape {poses.shape}.")
+    batch = poses.shape[:-1]
+    flat = poses.reshape(-1, n_task)
+    count = flat.shape[0]
+    reachable = np.zeros(count, dtype=bool)
+    full_poses = np.full((count, 6), np.nan)
+    arrays: dict = {}
+    meta: Indices | None = None
+    model = graph.tree.model
+    for start in range(0, count, chunk_size):
+        part = slice(start, min(start + chunk_size, count))
+        q, reached = graph.solve(flat[part], limits=limits)
+        index = np.flatnonzero(reached)
+        reachable[index + start] = True
+        full_poses[index + start] = graph.frame_pose(q[index])
+        if index.size:
+            screws, state = leg_screws(graph.tree, graph.kinematics, graph.platform, graph.legs, q[index],
+                                       graph.scale)
+            for rows in dimension_groups(screws):
+                chains, iti, oti = equivalent_chains(graph.legs, screws, state, rows, model)
+                result = analyze(chains, iti_points=iti, oti_points=oti, detail=detail, threshold=threshold,
+                                 faults=faults, threads=threads, dof=n_task)
+                meta = result
+                _scatter(arrays, count, index[rows] + start, result)
+        if progress is not None:
+            progress(part.stop - part.start)
+    chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
+    names = tuple(f"{leg.name}:{model.names[leg.actuators[0]]}" for leg in graph.legs)
+    described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
+    return _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
+                          faults=faults, detail=detail, threshold=threshold)

@@ -1,0 +1,178 @@
+"""Closed-loop graphs at many poses at once (:mod:`screwkit.io.graph_kinematics`,
+:func:`screwkit.studies.poses.graph_indices_at_poses`).
+
+The batched forward kinematics and joint twists are those Pinocchio computes, for every joint type the module
+takes; its integration moves each frame along the twists (finite differences); the batched indices of the
+rod-level Delta are those of :meth:`GraphMechanism.at_pose` pose by pose (<= 1e-12) and the textbook pressure
+angles over a grid (<= 1e-9); the same in millimetres, in another world frame and with the legs listed in another
+order; unreachable poses are NaN, and a Stewart platform opened through the graph moves in all six coordinates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from delta_rods import delta_rods_mjcf
+from test_gallery import GALLERY
+from test_graph_legs import AZIMUTHS, POSES, textbook
+
+from helpers import random_rotation
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.graph_kinematics import TreeKinematics
+from screwkit.io.mjcf import read_mjcf
+from screwkit.studies.poses import graph_indices_at_poses
+
+TOLERANCE = 1e-9
+
+
+def open_delta(tmp_path, centre=POSES[0], azimuths=AZIMUTHS, name="delta.xml", transform=None):
+    path = tmp_path / name
+    path.write_text(delta_rods_mjcf(centre, azimuths, transform=transform))
+    return graph_mechanism(read_mjcf(path))
+
+
+def random_configurations(model, count: int, rng) -> np.ndarray:
+    """Configurations spread over each joint's range (Pinocchio's integration from the neutral one)."""
+    import pinocchio as pin
+
+    neutral = pin.neutral(model)
+    return np.array([pin.integrate(model, neutral, rng.uniform(-1.5, 1.5, model.nv)) for _ in range(count)])
+
+
+def sample_models(tmp_path):
+    """The rod-level Delta (revolute and ball joints) and Pinocchio's humanoid sample (a free joint and revolutes)
+    with one joint made prismatic and one unbounded revolute, read from URDF text."""
+    import pinocchio as pin
+
+    delta = open_delta(tmp_path).tree.model
+    urdf = """<robot name="mixed"><link name="base"/>
+      <link name="a"/><link name="b"/><link name="c"/>
+      <joint name="slide" type="prismatic"><parent link="base"/><child link="a"/><origin xyz="0.1 0.2 0.3"
+        rpy="0.3 -0.2 0.5"/><axis xyz="0.6 0 0.8"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="spin" type="continuous"><parent link="a"/><child link="b"/><origin xyz="0.4 0 -0.1"
+        rpy="0.1 0.2 0.3"/><axis xyz="0 1 0"/></joint>
+      <joint name="hinge" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0 0.3 0.2"/>
+        <axis xyz="0.48 0.6 0.64"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint></robot>"""
+    mixed = pin.buildModelFromXML(urdf, pin.JointModelFreeFlyer())
+    return {"delta": delta, "mixed": mixed}
+
+
+@pytest.mark.parametrize("which", ["delta", "mixed"])
+def test_batched_kinematics_are_pinocchio_s(tmp_path, which):
+    """Joint placements and WORLD Jacobian columns as Pinocchio computes them, at random configurations."""
+    import pinocchio as pin
+
+    model = sample_models(tmp_path)[which]
+    kinematics = TreeKinematics.of(model)
+    q = random_configurations(model, 5, np.random.default_rng(1))
+    transforms = kinematics.transforms(q)
+    twists = kinematics.twists(transforms)
+    data = model.createData()
+    for n in range(len(q)):
+        pin.computeJointJacobians(model, data, q[n])
+        for joint in range(1, model.njoints):
+            np.testing.assert_allclose(transforms[n, joint], data.oMi[joint].homogeneous, atol=1e-12)
+        jacobian = np.asarray(pin.getJointJacobian(model, data, model.njoints - 1, pin.ReferenceFrame.WORLD))
+        path = np.flatnonzero(np.abs(jacobian).sum(axis=0) > 0)
+        np.testing.assert_allclose(twists[n][path][:, :3], jacobian[3:, path].T, atol=1e-12)
+        np.testing.assert_allclose(twists[n][path][:, 3:], jacobian[:3, path].T, atol=1e-12)
+
+
+@pytest.mark.parametrize("which", ["delta", "mixed"])
+def test_integration_moves_every_frame_along_its_twists(tmp_path, which):
+    """A small step of each velocity coordinate moves every body as the twists say (central differences), so the
+    Newton steps of the closure solver and its Jacobian agree; revolute and ball steps are Pinocchio's own."""
+    import pinocchio as pin
+
+    model = sample_models(tmp_path)[which]
+    kinematics = TreeKinematics.of(model)
+    q = random_configurations(model, 1, np.random.default_rng(2))
+    twists = kinematics.twists(kinematics.transforms(q))[0]
+    step = 1e-6
+    for coordinate in range(model.nv):
+        move = np.zeros((1, model.nv))
+        move[0, coordinate] = step
+        ahead = kinematics.transforms(kinematics.integrate(q, move))[0]
+        behind = kinematics.transforms(kinematics.integrate(q, -move))[0]
+        # the body the coordinate's joint moves (a serial chain's last one, moved by every coordinate)
+        joint = model.njoints - 1 if which == "mixed" else int(kinematics.column_joint[coordinate])
+        omega, v = twists[coordinate, :3], twists[coordinate, 3:]
+        point = kinematics.transforms(q)[0, joint, :3, 3]
+        velocity = (ahead[joint, :3, 3] - behind[joint, :3, 3]) / (2 * step)
+        np.testing.assert_allclose(velocity, v + np.cross(omega, point), atol=1e-6)
+    if which == "delta":  # no free joint: every step is Pinocchio's own integration
+        v = np.random.default_rng(3).normal(size=(1, model.nv)) * 0.3
+        np.testing.assert_allclose(kinematics.integrate(q, v)[0], pin.integrate(model, q[0], v[0]), atol=1e-12)
+
+
+def test_batched_indices_are_those_of_each_pose_alone_and_the_textbook_pressure_angles(tmp_path):
+    graph = open_delta(tmp_path)
+    assert graph.task_coordinates == ("x", "y", "z")
+    home = graph.task_pose()
+    rng = np.random.default_rng(7)
+    moves = rng.uniform(-0.06, 0.06, (40, 3))
+    result = graph_indices_at_poses(graph, home + moves, detail=True, chunk_size=16)
+    assert result.reachable.all()
+    for k in range(0, 40, 5):
+        alone = graph.at_pose(home + moves[k]).indices()
+        np.testing.assert_allclose(result.iti_actuators[k], alone.iti_actuators, atol=1e-12)
+        np.testing.assert_allclose([result.lmti[k], result.f_o[1][k]], [alone.lmti, alone.f_o[1]], atol=1e-12)
+        expected = textbook(np.add(POSES[0], moves[k]))
+        np.testing.assert_allclose(result.iti_actuators[k], expected["iti"], atol=TOLERANCE)
+        np.testing.assert_allclose([result.lmti[k], result.f_o[1][k]], [expected["lmti"], expected["f_o1"]],
+                                   atol=TOLERANCE)
+    np.testing.assert_allclose(result.full_poses[:, :3], home + moves, atol=1e-12)
+    np.testing.assert_allclose(result.full_poses[:, 3:], 0.0, atol=1e-12)  # a Delta's platform does not turn
+
+
+def test_batched_indices_in_millimetres_in_another_frame_and_with_the_legs_reordered(tmp_path):
+    graph = open_delta(tmp_path)
+    moves = np.random.default_rng(8).uniform(-0.05, 0.05, (12, 3))
+    reference = graph_indices_at_poses(graph, graph.task_pose() + moves)
+    rotation = random_rotation(np.random.default_rng(9))
+    for scale, turn, shift in ((1e-3, rotation, np.array([0.01, 0.0, -0.02])), (1e3, np.eye(3), np.zeros(3)),
+                               (1.0, rotation, np.array([0.3, -1.2, 2.0]))):
+        moved = open_delta(tmp_path, transform=(scale, turn, shift), name="moved.xml")
+        assert moved.task_coordinates == ("x", "y", "z")
+        result = graph_indices_at_poses(moved, moved.task_pose() + scale * moves @ turn.T, threshold=1e-6 * scale)
+        np.testing.assert_allclose(result.lmti, reference.lmti, atol=TOLERANCE)
+        np.testing.assert_allclose(result.f_o[1], reference.f_o[1], atol=TOLERANCE)
+        np.testing.assert_allclose(result.cti, reference.cti, atol=TOLERANCE)
+    order = [2, 0, 3, 1]
+    relabelled = open_delta(tmp_path, azimuths=AZIMUTHS[order], name="relabelled.xml")
+    result = graph_indices_at_poses(relabelled, relabelled.task_pose() + moves)
+    for name in ("lmti", "cti"):
+        np.testing.assert_allclose(getattr(result, name), getattr(reference, name), atol=TOLERANCE)
+    np.testing.assert_allclose(result.f_o[1], reference.f_o[1], atol=TOLERANCE)
+
+
+def test_unreachable_poses_are_nan_and_bad_poses_are_refused(tmp_path):
+    graph = open_delta(tmp_path)
+    home = graph.task_pose()
+    result = graph_indices_at_poses(graph, np.array([home, home + [0.0, 0.0, -5.0], home + [0.01, 0.0, 0.0]]))
+    assert result.reachable.tolist() == [True, False, True]
+    assert np.isnan(result.lmti[1]) and np.isfinite(result.lmti[[0, 2]]).all()
+    with pytest.raises(ValueError, match=r"Expected finite poses of shape \(\.\.\., 3\) \(x y z\)"):
+        graph_indices_at_poses(graph, np.zeros((2, 6)))
+    with pytest.raises(ValueError, match="Expected finite poses"):
+        graph_indices_at_poses(graph, np.array([[np.nan, 0.0, 0.0]]))
+
+
+def test_a_stewart_platform_through_the_graph_moves_in_six_coordinates():
+    """Its task coordinates are the frame's six; a batch of small moves gives the indices of each pose alone (the
+    file's joint limits ignored: some of these moves turn a passive joint written with limits 0..2 pi below 0, and
+    then neither path reaches them)."""
+    graph = graph_mechanism(read_mjcf(GALLERY / "stewart_cad.xml"))
+    assert graph.task_coordinates == ("x", "y", "z", "roll", "pitch", "yaw")
+    home = graph.task_pose()
+    moves = np.random.default_rng(10).uniform(-1.0, 1.0, (6, 6)) * np.array([0.01] * 3 + [0.05] * 3)
+    result = graph_indices_at_poses(graph, home + moves, limits=False)
+    assert result.reachable.all()
+    limited = graph_indices_at_poses(graph, home + moves)
+    for k in range(6):
+        alone = graph.at_pose(home[:3] + moves[k, :3], home[3:] + moves[k, 3:], limits=False).indices()
+        np.testing.assert_allclose([result.lmti[k], result.iti[k]], [alone.lmti, alone.iti], atol=1e-12)
+        if not limited.reachable[k]:
+            with pytest.raises(ValueError, match="a joint beyond its limits"):
+                graph.at_pose(home[:3] + moves[k, :3], home[3:] + moves[k, 3:])
+    assert not limited.reachable.all()
