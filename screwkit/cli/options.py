@@ -420,9 +420,9 @@ def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarra
         raise fail(f"Expected numbers or a named pose after {option}, got {text!r}.") from None
     if len(numbers) != mechanism.n_task:
         units = ", ".join(f"{name} ({'deg' if is_angular(name) else 'm'})" for name in mechanism.task_coordinates)
-        raise fail(f"Expected {option} with {mechanism.n_task} values ({units}) or a named pose "
-                   f"({', '.join(mechanism.named_poses)}) for mechanism {mechanism.name!r}, "
-                   f"got {len(numbers)}: {text}.")
+        named = f" or a named pose ({', '.join(mechanism.named_poses)})" if mechanism.named_poses else ""
+        raise fail(f"Expected {option} with {mechanism.n_task} values ({units}){named} for mechanism "
+                   f"{mechanism.name!r}, got {len(numbers)}: {text}.")
     try:
         return mechanism.poses_from_degrees(numbers)
     except ValueError as error:

@@ -79,7 +79,7 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, read
     """
 
     outputs.check(quiet)
-    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
     if (phi_range is None) == (sweep_spec is None):
         raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
     if phi_range is not None:

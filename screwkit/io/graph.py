@@ -67,6 +67,7 @@ from screwkit.screw.chain_screws import ChainScrews
 __all__ = ["GraphLeg", "GraphMechanism", "LegScrews", "graph_legs", "graph_mechanism", "leg_screws",
            "equivalent_chains", "dimension_groups", "IN_LOOP_TOLERANCE"]
 
+ANGLES = ("roll", "pitch", "yaw")
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
 which the joint moves inside a loop of the leg (its twist is not a motion of the leg)."""
@@ -111,6 +112,56 @@ class GraphMechanism:
         """Names of the task coordinates (``x y z`` for a Delta, ``roll pitch yaw`` for a spherical wrist)."""
         return tuple(SPATIAL_TASK_COORDINATES[axis] for axis in self.task_axes)
 
+    @property
+    def n_task(self) -> int:
+        return len(self.task_axes)
+
+    @property
+    def dof(self) -> int:
+        """The platform's mobility (its task coordinates' count)."""
+        return len(self.task_axes)
+
+    @property
+    def actuators(self) -> tuple[str, ...]:
+        """``leg:joint`` of every actuator, as the indices name them."""
+        return tuple(f"{leg.name}:{self.tree.model.names[leg.actuators[0]]}" for leg in self.legs)
+
+    @property
+    def is_planar(self) -> bool:
+        return False
+
+    @property
+    def named_poses(self) -> dict:
+        return {}
+
+    @property
+    def home_pose(self) -> NDArray[np.float64]:
+        """The task coordinates of this configuration (the file's, for a graph as read)."""
+        return self.task_pose()
+
+    def named_pose(self, name: str) -> NDArray[np.float64]:
+        raise ValueError(f"Unknown pose {name!r} of mechanism {self.name!r}: a closed-loop graph has no named poses.")
+
+    def check_poses(self, poses, *, degrees: bool = False) -> NDArray[np.float64]:
+        """Poses as a float array (..., n_task) of finite values, or a ValueError naming the coordinates."""
+        try:
+            poses = np.asarray(poses, dtype=float)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"Expected numeric poses for mechanism {self.name!r}: {error}") from None
+        if poses.ndim == 0 or poses.shape[-1] != self.n_task or not np.all(np.isfinite(poses)):
+            units = ", ".join(f"{name} ({'deg' if degrees and name in ANGLES else 'rad' if name in ANGLES else 'm'})"
+                              for name in self.task_coordinates)
+            raise ValueError(f"Expected finite poses of shape (..., {self.n_task}) ({units}) for mechanism "
+                             f"{self.name!r}, got shape {poses.shape}.")
+        return poses
+
+    def poses_from_degrees(self, values) -> NDArray[np.float64]:
+        """Task coordinates with angles in degrees -> radians (checked)."""
+        poses = self.check_poses(values, degrees=True).copy()
+        angular = np.array([name in ANGLES for name in self.task_coordinates])
+        poses[..., angular] = np.deg2rad(poses[..., angular])
+        return poses
+
     def frame_pose(self, q: NDArray | None = None) -> NDArray[np.float64]:
         """x, y, z (m) and roll, pitch, yaw (rad) of the output frame in the world at configurations q (..., nq;
         default this one's)."""
@@ -129,10 +180,7 @@ class GraphMechanism:
         """Closed configurations (n, nq) with the task coordinates at ``poses`` (n, len(task_axes); m, rad, world),
         each reached by continuation from this configuration (:func:`screwkit.io.graph_kinematics.solve_poses`),
         and which are reached."""
-        poses = np.asarray(poses, dtype=float)
-        if poses.ndim != 2 or poses.shape[1] != len(self.task_axes) or not np.all(np.isfinite(poses)):
-            raise ValueError(f"Expected finite poses of shape (n, {len(self.task_axes)}) "
-                             f"({' '.join(self.task_coordinates)}), got shape {poses.shape}.")
+        poses = self.check_poses(poses).reshape(-1, self.n_task)
         targets = np.repeat(self.frame_pose()[None], poses.shape[0], axis=0)
         targets[:, list(self.task_axes)] = poses
         return solve_poses(self.tree, self.q, self.scale, self.frame_id, targets, self.task_axes, limits=limits,

@@ -389,11 +389,8 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
     NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw.
     """
-    poses = np.asarray(poses, dtype=float)
-    n_task = len(graph.task_axes)
-    if poses.shape[-1:] != (n_task,) or not np.all(np.isfinite(poses)):
-        raise ValueError(f"Expected finite poses of shape (..., {n_task}) ({' '.join(graph.task_coordinates)}), "
-                         f"got shape {poses.shape}.")
+    poses = graph.check_poses(poses)
+    n_task = graph.n_task
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]

@@ -17,8 +17,9 @@ from numpy.typing import ArrayLike
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
 from screwkit.indices.results import set_label
+from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.studies.poses import indices_at_poses
+from screwkit.studies.poses import graph_indices_at_poses, indices_at_poses
 
 __all__ = ["sweep"]
 
@@ -30,7 +31,9 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
 
     Parameters
     ----------
-    mechanism : Mechanism
+    mechanism : Mechanism or GraphMechanism
+        A mechanism whose legs have loops inside them (:class:`~screwkit.io.GraphMechanism`) is solved at each
+        value by continuation from its configuration (:func:`~screwkit.studies.poses.graph_indices_at_poses`).
     at : array_like, shape (n_task,)
         The fixed pose (metres, radians); its ``coordinate`` entry is replaced by ``values``.
     coordinate : str
@@ -57,7 +60,12 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         and the LMTI of every set left after j faults).
     """
 
-    require_mechanism(mechanism, "sweep")
+    graph = isinstance(mechanism, GraphMechanism)
+    if graph and (closed_forms or fault_type != "free-swinging"):
+        raise ValueError(f"{mechanism.name}: a mechanism whose legs have loops inside them is analysed by the generic "
+                         "screw path with free-swinging faults (no closed forms, no link faults).")
+    if not graph:
+        require_mechanism(mechanism, "sweep")
     if coordinate not in mechanism.task_coordinates:
         raise ValueError(f"Expected `coordinate` in {mechanism.task_coordinates}, got {coordinate!r}.")
     at = mechanism.check_poses(at)
@@ -67,8 +75,12 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
     axis = mechanism.task_coordinates.index(coordinate)
     poses = np.repeat(at[None], values.size, axis=0)
     poses[:, axis] = values
-    result = indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
-                              closed_forms=closed_forms, limits=limits, fault_type=fault_type)
+    if graph:
+        result = graph_indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
+                                        limits=limits)
+    else:
+        result = indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
+                                  closed_forms=closed_forms, limits=limits, fault_type=fault_type)
     angular = is_angular(coordinate)
     shown = np.rad2deg(values) if angular else values
     dataset = result.to_dataset(dims=(coordinate,),
