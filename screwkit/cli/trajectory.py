@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import dataclass
 
 import click
 import numpy as np
@@ -17,6 +18,7 @@ from screwkit.cli.options import (
     json_option,
     load_mechanism,
     mechanism_argument,
+    option_group,
     outputs_options,
     parse_pose,
     quiet_option,
@@ -27,7 +29,7 @@ from screwkit.studies.paths import PathFileError, circle_path, line_path, read_p
 from screwkit.studies.trajectory import AGGREGATES
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
-__all__ = ["trajectory", "generated_path", "print_summary"]
+__all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions"]
 
 DEFAULT_SAMPLES = 201
 
@@ -91,34 +93,92 @@ def print_summary(summary: dict) -> None:
         echo_error(f"  worst {j} failure(s) for this path: " + ("; ".join("+".join(t) for t in ties) or "none"))
 
 
+@dataclass(frozen=True)
+class PathSource:
+    """Where the path comes from: a file (PATH), or ``--line`` / ``--circle`` with ``--samples``."""
+
+    path_file: str | None = None
+    line: str | None = None
+    circle: str | None = None
+    samples: int = DEFAULT_SAMPLES
+
+    def check(self) -> None:
+        """Exactly one source, and a file that exists, before the mechanism is even loaded."""
+        given = [name for name, value in (("PATH", self.path_file), ("--line", self.line), ("--circle", self.circle))
+                 if value]
+        if len(given) != 1:
+            raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B or --circle CENTRE RADIUS, "
+                       f"got {', '.join(given) or 'none'}.")
+        if self.path_file is not None and not os.path.isfile(self.path_file):
+            raise fail(f"{self.path_file}: "
+                       f"{'is a folder, not a path file' if os.path.isdir(self.path_file) else 'no such file'}.")
+
+    def read(self, mechanism):
+        """The :class:`~screwkit.studies.paths.Path` (a one-line error naming the file if it cannot be used)."""
+        if self.path_file is None:
+            return generated_path(mechanism, self.line, self.circle, self.samples)
+        try:
+            return read_path(mechanism, self.path_file)
+        except PathFileError as error:
+            raise fail(str(error)) from None
+
+
+@dataclass(frozen=True)
+class FaultOptions:
+    """What counts as controllable after failures, how closely it is located, and the average case."""
+
+    level: float = 0.4
+    tolerance: float | None = None
+    aggregate: str = "min"
+    probabilities: str | None = None
+
+    def keywords(self) -> dict:
+        if self.probabilities is not None and self.aggregate != "mean":
+            raise fail("--probabilities weight the mean: give --aggregate mean with them.")
+        try:
+            weights = None if self.probabilities is None else [float(p) for p in self.probabilities.split()]
+        except ValueError:
+            raise fail(f"Expected numbers after --probabilities, got {self.probabilities!r}.") from None
+        return dict(level=self.level, tolerance=self.tolerance, aggregate=self.aggregate, probabilities=weights)
+
+
+path_source_options = option_group(
+    "source", PathSource,
+    click.argument("path_file", metavar="[PATH]", required=False, type=click.Path(dir_okay=True)),
+    click.option("--line", cls=GreedyOption, metavar="A B",
+                 help="A straight path from pose A to pose B: two named poses, or every task coordinate of A then of "
+                      "B (m, deg)."),
+    click.option("--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
+                 help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) "
+                      "and the radius (m); the other coordinates stay at the centre's."),
+    click.option("--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
+                 help="Samples of a --line or --circle path, both ends included."))
+fault_options = option_group(
+    "faults", FaultOptions,
+    click.option("--level", type=click.FloatRange(min=0, max=1, min_open=True), default=0.4, show_default=True,
+                 help="The LMTI the actuators left after a failure must keep for the platform to count as "
+                      "controllable."),
+    click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
+                 help="How closely crossings of the level and singular points are located, in m of arc length "
+                      "(default 1e-6 times the mechanism's length scale)."),
+    click.option("--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
+                 help="min: the paper's worst case over the failures (Eq. 12); mean: also their mean "
+                      "(f_o_mean<j>, screwkit's extension)."),
+    click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
+                 help="With --aggregate mean: each actuator's failure probability, weighting the mean."))
+
+
 @click.command("trajectory")
 @mechanism_argument
-@click.argument("path_file", metavar="[PATH]", required=False, type=click.Path(dir_okay=True))
-@click.option("--line", cls=GreedyOption, metavar="A B",
-              help="A straight path from pose A to pose B: two named poses, or every task coordinate of A then of B "
-                   "(m, deg).")
-@click.option("--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
-              help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) and "
-                   "the radius (m); the other coordinates stay at the centre's.")
-@click.option("--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
-              help="Samples of a --line or --circle path, both ends included.")
-@click.option("--level", type=click.FloatRange(min=0, max=1, min_open=True), default=0.4, show_default=True,
-              help="The LMTI the actuators left after a failure must keep for the platform to count as controllable.")
-@click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
-              help="How closely crossings of the level and singular points are located, in m of arc length "
-                   "(default 1e-6 times the mechanism's length scale).")
-@click.option("--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
-              help="min: the paper's worst case over the failures (Eq. 12); mean: also their mean (f_o_mean<j>, "
-                   "screwkit's extension).")
-@click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
-              help="With --aggregate mean: each actuator's failure probability, weighting the mean.")
+@path_source_options
+@fault_options
 @outputs_options()
 @analysis_options()
 @reading_options
 @json_option
 @quiet_option
-def trajectory(mechanism, path_file, line, circle, samples, level, tolerance, aggregate, probabilities,
-               outputs: Outputs, analysis, reading, as_json, quiet) -> None:
+def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Outputs, analysis, reading, as_json,
+               quiet) -> None:
     """Every index along a path, and the stretches each actuator failure leaves uncontrollable.
 
     PATH is a CSV file with a column per task coordinate (m, deg; `screwkit info MECHANISM` names them) and
@@ -127,24 +187,13 @@ def trajectory(mechanism, path_file, line, circle, samples, level, tolerance, ag
     --out (.nc or .csv; with neither --out, --figure nor --json, to stdout as CSV), the summary to stderr
     (or stdout with --json).
     """
-    given = [name for name, value in (("PATH", path_file), ("--line", line), ("--circle", circle)) if value]
-    if len(given) != 1:
-        raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B or --circle CENTRE RADIUS, got "
-                   f"{', '.join(given) or 'none'}.")
+    source.check()
     outputs.check(quiet or as_json)
-    if path_file is not None and not os.path.isfile(path_file):  # before the mechanism is even loaded
-        raise fail(f"{path_file}: {'is a folder, not a path file' if os.path.isdir(path_file) else 'no such file'}.")
-    if probabilities is not None and aggregate != "mean":
-        raise fail("--probabilities weight the mean: give --aggregate mean with them.")
+    keywords = faults.keywords()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    path = source.read(loaded)
     try:
-        path = read_path(loaded, path_file) if path_file is not None else \
-            generated_path(loaded, line, circle, samples)
-        weights = None if probabilities is None else [float(p) for p in probabilities.split()]
-        result = run_trajectory(loaded, path, level=level, tolerance=tolerance, aggregate=aggregate,
-                                probabilities=weights, analysis=analysis)
-    except PathFileError as error:
-        raise fail(str(error)) from None
+        result = run_trajectory(loaded, path, analysis=analysis, **keywords)
     except ValueError as error:
         raise fail(str(error)) from None
     summary = result.summary()

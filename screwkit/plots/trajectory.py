@@ -8,7 +8,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.plots.style import BOLD, COLORMAP, F_IO_STYLE, LEGEND_SIZE, MANY, TITLE_SIZE, UNREACHABLE_COLOR, pyplot, wrap_text
+from screwkit.plots.style import (
+    BOLD,
+    COLORMAP,
+    F_IO_STYLE,
+    LEGEND_SIZE,
+    MANY,
+    TITLE_SIZE,
+    UNREACHABLE_COLOR,
+    pyplot,
+    wrap_text,
+)
 
 __all__ = ["trajectory_figure"]
 
