@@ -86,6 +86,14 @@ def test_list_verify_convert_and_design_search_validate(files, tmp_path):
     validate("design-search", ["family", "planar_rrr", "--budget", "4", "--quiet", "--step", "0.2", "--phi-step", "30"])
 
 
+def test_trajectory_validates(tmp_path):
+    """A path leaving the workspace (an event), with the mean: every key of the summary is in the schema."""
+    report = validate("trajectory", ["planar_5rrr", "--line", "0", "0", "0", "0", "1.5", "0", "--samples", "16",
+                                     "--aggregate", "mean"])
+    assert report["events"] and "f_o_mean1" in report["margins"]
+    assert "missing.csv: no such file" in validate("trajectory", ["planar_5rrr", tmp_path / "missing.csv"])["error"]
+
+
 def test_every_command_with_json_has_a_schema():
     from screwkit.cli import COMMANDS
 

@@ -26,6 +26,7 @@ COMMANDS = {
     "verify": "screwkit.cli.verify:verify",
     "sweep": "screwkit.cli.sweep:sweep",
     "map": "screwkit.cli.map_command:map_command",
+    "trajectory": "screwkit.cli.trajectory:trajectory",
     "design-search": "screwkit.cli.design_search:design_search",
     "plot": "screwkit.cli.plot:plot",
     "view": "screwkit.cli.view:view",

@@ -18,7 +18,8 @@ Conventions shared by every figure:
 
 matplotlib is imported inside the functions (the Agg backend when there is no display).
 
-The figures of sweeps are in :mod:`screwkit.plots.sweeps`, those of maps and designs in
+The figures of sweeps are in :mod:`screwkit.plots.sweeps`, that of a trajectory in
+:mod:`screwkit.plots.trajectory`, those of maps and designs in
 :mod:`screwkit.plots.maps`, the style they share in :mod:`screwkit.plots.style`; every name is
 imported from here.
 """
@@ -38,7 +39,9 @@ from screwkit.plots.style import THIN as THIN
 from screwkit.plots.style import TITLE_SIZE as TITLE_SIZE
 from screwkit.plots.style import UNREACHABLE_COLOR as UNREACHABLE_COLOR
 from screwkit.plots.sweeps import sweep_figure
+from screwkit.plots.trajectory import trajectory_figure
 from screwkit.studies.files import FORMATS, save_figure  # re-exported: figures are saved from here
 
-__all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "map_figure", "design_comparison_figure", "MapGrid",
+__all__ = ["COLORMAP", "INDEX_RANGE", "FORMATS", "sweep_figure", "trajectory_figure", "map_figure",
+           "design_comparison_figure", "MapGrid",
            "pareto_figure", "save_figure", "colour_scale"]

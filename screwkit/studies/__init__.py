@@ -4,6 +4,9 @@
   screws -> :class:`~screwkit.indices.results.Indices`;
 * :func:`~screwkit.studies.sweep.sweep`: the paper's Fig. 4 series along one coordinate;
 * :mod:`~screwkit.studies.maps`: the Fig. 5 maps (minimum over an orientation set on a grid);
+* :func:`~screwkit.studies.trajectory.trajectory`: every index along a path (:mod:`~screwkit.studies.paths`) and
+  the stretches each actuator failure leaves uncontrollable, refined between samples
+  (:mod:`~screwkit.studies.refinement`);
 * :mod:`~screwkit.studies.design.permutations`: the paper's permutation selection;
 * :mod:`~screwkit.studies.design.families`, :mod:`~screwkit.studies.design.objectives`,
   :mod:`~screwkit.studies.design.optimise`: parametric mechanism families, the metrics of a map's

@@ -1,0 +1,220 @@
+"""``screwkit trajectory``: every index along a path, and what each actuator failure leaves controllable."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+
+import click
+import numpy as np
+
+from screwkit.cli.options import (
+    GreedyOption,
+    Outputs,
+    analysis_options,
+    echo_error,
+    fail,
+    json_option,
+    load_mechanism,
+    mechanism_argument,
+    option_group,
+    outputs_options,
+    parse_pose,
+    quiet_option,
+    reading_options,
+)
+from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path
+from screwkit.studies.trajectory import AGGREGATES
+from screwkit.studies.trajectory import trajectory as run_trajectory
+
+__all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions"]
+
+DEFAULT_SAMPLES = 201
+
+
+def _poses(mechanism, words: list[str], count: int, option: str) -> list[np.ndarray]:
+    """``count`` poses from words: named poses, or ``count`` times every task coordinate (m, deg)."""
+    if len(words) == count and not any(_number(word) for word in words):
+        return [parse_pose(mechanism, word, option) for word in words]
+    n = mechanism.n_task
+    if len(words) != count * n or not all(_number(word) for word in words):
+        units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
+        raise fail(f"Expected {option} with {count} named pose(s) or {count} x {n} numbers ({units}) for "
+                   f"{mechanism.name!r}, got {' '.join(words) or 'nothing'}.")
+    return [parse_pose(mechanism, " ".join(words[i * n:(i + 1) * n]), option) for i in range(count)]
+
+
+def _number(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
+
+
+def generated_path(mechanism, line: str | None, circle: str | None, samples: int):
+    """``--line A B`` or ``--circle CENTRE RADIUS`` with ``--samples``, as a :class:`~screwkit.studies.paths.Path`."""
+    try:
+        if line is not None:
+            start, stop = _poses(mechanism, line.split(), 2, "--line")
+            return line_path(mechanism, start, stop, samples)
+        words = circle.split()
+        if len(words) < 2 or not _number(words[-1]):
+            raise fail(f"Expected --circle CENTRE RADIUS (a named pose or every task coordinate, then the radius in "
+                       f"m), got {circle!r}.")
+        (centre,) = _poses(mechanism, words[:-1], 1, "--circle")
+        return circle_path(mechanism, centre, float(words[-1]), samples)
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
+def print_summary(summary: dict) -> None:
+    """The summary of a trajectory on stderr: margins, every failure's lost stretches, worst failures, events."""
+    echo_error(f"{summary['mechanism']}: {summary['samples']} samples, {summary['length_m']:.6g} m of path "
+               f"(angles weighted by {summary['length_scale_m']:.6g} m/rad), {summary['reachable_samples']} "
+               f"reachable; level {summary['level']:g}, tolerance {summary['tolerance_m']:.3g} m")
+    for event in summary["events"]:
+        echo_error(f"  {'UNREACHABLE' if event['kind'] == 'closure' else 'JOINT LIMIT'} from "
+                   f"{event['start_m']:.6g} m to {event['stop_m']:.6g} m (samples {event['samples'][0]}-"
+                   f"{event['samples'][1]}): {event['reason']}")
+    for name, margin in summary["margins"].items():
+        where = f"sample {margin['sample']}" if margin["sample"] is not None else "refined between samples"
+        echo_error(f"  min {name:<11s} {margin['value']:.4f} at {margin['arc_length_m']:.6g} m ({where})")
+    for case in summary["faults"]:
+        lost = ", ".join(f"[{a:.6g}, {b:.6g}]" for a, b in case["lost_m"]) or "never"
+        first = "" if case["first_loss_m"] is None else f", first at {case['first_loss_m']:.6g} m"
+        singular = "" if not case["singular_at_m"] else \
+            ", singular at " + ", ".join(f"{z:.6g}" for z in case["singular_at_m"]) + " m"
+        minimum = "n/a" if case["minimum"] is None else f"{case['minimum']:.4f}"
+        echo_error(f"  fail {'+'.join(case['failed'])}: min {minimum}; lost {lost}{first}{singular}")
+    for j, ties in summary["worst"].items():
+        echo_error(f"  worst {j} failure(s) for this path: " + ("; ".join("+".join(t) for t in ties) or "none"))
+
+
+@dataclass(frozen=True)
+class PathSource:
+    """Where the path comes from: a file (PATH), or ``--line`` / ``--circle`` with ``--samples``."""
+
+    path_file: str | None = None
+    line: str | None = None
+    circle: str | None = None
+    samples: int = DEFAULT_SAMPLES
+
+    def check(self) -> None:
+        """Exactly one source, and a file that exists, before the mechanism is even loaded."""
+        given = [name for name, value in (("PATH", self.path_file), ("--line", self.line), ("--circle", self.circle))
+                 if value]
+        if len(given) != 1:
+            raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B or --circle CENTRE RADIUS, "
+                       f"got {', '.join(given) or 'none'}.")
+        if self.path_file is not None and not os.path.isfile(self.path_file):
+            raise fail(f"{self.path_file}: "
+                       f"{'is a folder, not a path file' if os.path.isdir(self.path_file) else 'no such file'}.")
+
+    def read(self, mechanism):
+        """The :class:`~screwkit.studies.paths.Path` (a one-line error naming the file if it cannot be used)."""
+        if self.path_file is None:
+            return generated_path(mechanism, self.line, self.circle, self.samples)
+        try:
+            return read_path(mechanism, self.path_file)
+        except PathFileError as error:
+            raise fail(str(error)) from None
+
+
+@dataclass(frozen=True)
+class FaultOptions:
+    """What counts as controllable after failures, how closely it is located, and the average case."""
+
+    level: float = 0.4
+    tolerance: float | None = None
+    aggregate: str = "min"
+    probabilities: str | None = None
+
+    def keywords(self) -> dict:
+        if self.probabilities is not None and self.aggregate != "mean":
+            raise fail("--probabilities weight the mean: give --aggregate mean with them.")
+        try:
+            weights = None if self.probabilities is None else [float(p) for p in self.probabilities.split()]
+        except ValueError:
+            raise fail(f"Expected numbers after --probabilities, got {self.probabilities!r}.") from None
+        return dict(level=self.level, tolerance=self.tolerance, aggregate=self.aggregate, probabilities=weights)
+
+
+path_source_options = option_group(
+    "source", PathSource,
+    click.argument("path_file", metavar="[PATH]", required=False, type=click.Path(dir_okay=True)),
+    click.option("--line", cls=GreedyOption, metavar="A B",
+                 help="A straight path from pose A to pose B: two named poses, or every task coordinate of A then of "
+                      "B (m, deg)."),
+    click.option("--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
+                 help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) "
+                      "and the radius (m); the other coordinates stay at the centre's."),
+    click.option("--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
+                 help="Samples of a --line or --circle path, both ends included."))
+fault_options = option_group(
+    "faults", FaultOptions,
+    click.option("--level", type=click.FloatRange(min=0, max=1, min_open=True), default=0.4, show_default=True,
+                 help="The LMTI the actuators left after a failure must keep for the platform to count as "
+                      "controllable."),
+    click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
+                 help="How closely crossings of the level and singular points are located, in m of arc length "
+                      "(default 1e-6 times the mechanism's length scale)."),
+    click.option("--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
+                 help="min: the paper's worst case over the failures (Eq. 12); mean: also their mean "
+                      "(f_o_mean<j>, screwkit's extension)."),
+    click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
+                 help="With --aggregate mean: each actuator's failure probability, weighting the mean."))
+
+
+@click.command("trajectory")
+@mechanism_argument
+@path_source_options
+@fault_options
+@outputs_options()
+@analysis_options()
+@reading_options
+@json_option
+@quiet_option
+def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Outputs, analysis, reading, as_json,
+               quiet) -> None:
+    """Every index along a path, and the stretches each actuator failure leaves uncontrollable.
+
+    PATH is a CSV file with a column per task coordinate (m, deg; `screwkit info MECHANISM` names them) and
+    optionally t (s), or a netCDF file with such variables; or the path is generated with --line or --circle.
+    Crossings of --level and singular points between samples are refined to --tolerance. The indices go to
+    --out (.nc or .csv; with neither --out, --figure nor --json, to stdout as CSV), the summary to stderr
+    (or stdout with --json).
+    """
+    source.check()
+    outputs.check(quiet or as_json)
+    keywords = faults.keywords()
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    path = source.read(loaded)
+    try:
+        result = run_trajectory(loaded, path, analysis=analysis, **keywords)
+    except ValueError as error:
+        raise fail(str(error)) from None
+    summary = result.summary()
+    if as_json:
+        click.echo(json.dumps(summary))
+    elif not quiet:
+        print_summary(summary)
+    _write(result, outputs, quiet or as_json, to_stdout=not as_json)
+
+
+def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:
+    """The data file and the figure (checked before the computation); with neither, the CSV table on stdout."""
+    if outputs.out:
+        write_dataset(result.to_dataset(), outputs.out)
+        if not quiet:
+            echo_error(f"wrote {outputs.out}")
+    if outputs.figure:
+        from screwkit.plots import save_figure, trajectory_figure  # matplotlib only when a figure is asked for
+
+        save_figure(trajectory_figure(result), outputs.figure)
+        if not quiet:
+            echo_error(f"wrote {outputs.figure}")
+    if not outputs.out and not outputs.figure and to_stdout:
+        click.echo(wide_table(result.to_dataset()).to_csv(index=False), nl=False)

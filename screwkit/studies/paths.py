@@ -1,0 +1,231 @@
+"""Paths of the platform: samples of task coordinates, their arc length, points between samples, path files.
+
+A path is a sequence of poses (task coordinates, m and rad) joined by straight segments *in task
+coordinates*: between two samples every coordinate varies linearly, angles included (no wrapping:
+350 deg to 10 deg turns back through 180 deg; write 370 deg to turn forward). Its length is
+measured in the same coordinates, angles weighted by the mechanism's length scale ``L``
+(:attr:`screwkit.model.Mechanism.length_scale`, m), as closure solving weighs them:
+
+.. math::
+
+    s_{i+1} - s_i = \\sqrt{\\lVert \\Delta \\mathbf{p} \\rVert^2 + L^2 \\lVert \\Delta \\boldsymbol{\\theta} \\rVert^2}
+
+so the arc length is in metres, a pure rotation has a length, and a mechanism scaled by ``k`` has
+every arc length scaled by ``k``. :meth:`Path.at` gives the pose at any arc length on that
+piecewise-linear path, which is where the refinement of :mod:`screwkit.studies.trajectory` evaluates.
+
+:func:`line_path` and :func:`circle_path` generate paths; :func:`read_path` reads a CSV or netCDF file
+(angles in degrees unless a netCDF variable says ``units: rad``) and says in one line what is wrong
+with it.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.common.units import is_angular
+from screwkit.model import Mechanism
+
+__all__ = ["Path", "path_from_poses", "line_path", "circle_path", "read_path", "PathFileError", "TIME_COLUMN"]
+
+TIME_COLUMN = "t"
+"""The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
+
+
+class PathFileError(ValueError):
+    """A path file that cannot be used: the message is one line naming the file and what is wrong."""
+
+
+@dataclass(frozen=True)
+class Path:
+    """A sampled path of a mechanism's platform.
+
+    Attributes
+    ----------
+    poses : ndarray (n, n_task)
+        The samples, task coordinates in m and rad.
+    arc_length : ndarray (n,)
+        Arc length at each sample from the first (m; angles weighted by ``length_scale``), non-decreasing.
+    length_scale : float
+        The weight of angles in the arc length (m per rad): the mechanism's length scale.
+    times : ndarray (n,) or None
+        The time of each sample (s), increasing, when the path has them.
+    """
+
+    poses: NDArray[np.float64]
+    arc_length: NDArray[np.float64]
+    length_scale: float
+    times: NDArray[np.float64] | None = None
+
+    @property
+    def length(self) -> float:
+        """The path's length (m)."""
+        return float(self.arc_length[-1])
+
+    @property
+    def samples(self) -> int:
+        return int(self.poses.shape[0])
+
+    def at(self, arc_length: ArrayLike) -> NDArray[np.float64]:
+        """The poses (..., n_task) at arc lengths (...) on the piecewise-linear path (clipped to its ends)."""
+        wanted = np.clip(np.asarray(arc_length, dtype=float), 0.0, self.length)
+        segment = np.clip(np.searchsorted(self.arc_length, wanted, side="right") - 1, 0, self.samples - 2)
+        start, stop = self.arc_length[segment], self.arc_length[segment + 1]
+        span = stop - start
+        fraction = np.where(span > 0, (wanted - start) / np.where(span > 0, span, 1.0), 0.0)
+        first, second = self.poses[segment], self.poses[segment + 1]
+        return first + fraction[..., None] * (second - first)
+
+    def time_at(self, arc_length: ArrayLike) -> NDArray[np.float64] | None:
+        """The times at arc lengths, linear along each segment; None for a path without times."""
+        if self.times is None:
+            return None
+        return np.interp(arc_length, self.arc_length, self.times)
+
+
+def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | None = None) -> Path:
+    """A :class:`Path` through ``poses`` (n, n_task; m, rad), checked: at least two samples, finite,
+    a length above zero, ``times`` (n,) increasing when given."""
+    poses = mechanism.check_poses(poses)
+    if poses.ndim != 2 or poses.shape[0] < 2:
+        raise ValueError(f"Expected a path of at least 2 poses with shape (n, {mechanism.n_task}), got "
+                         f"{poses.shape}.")
+    weights = np.where(mechanism.angular, mechanism.length_scale, 1.0)
+    steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)
+    arc_length = np.concatenate([[0.0], np.cumsum(steps)])
+    if not arc_length[-1] > 0:
+        raise ValueError("Expected a path that moves: every pose of the path is the same.")
+    if times is not None:
+        times = np.asarray(times, dtype=float)
+        if times.shape != (poses.shape[0],):
+            raise ValueError(f"Expected one time per pose ({poses.shape[0]}), got shape {times.shape}.")
+        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+            raise ValueError("Expected finite, increasing times along the path.")
+    return Path(poses, arc_length, float(mechanism.length_scale), times)
+
+
+def line_path(mechanism: Mechanism, start: ArrayLike, stop: ArrayLike, samples: int) -> Path:
+    """``samples`` poses evenly spaced on the straight segment from ``start`` to ``stop`` (task coordinates, m
+    and rad), both included."""
+    if samples < 2:
+        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    start, stop = mechanism.check_poses(start), mechanism.check_poses(stop)
+    fractions = np.linspace(0.0, 1.0, samples)[:, None]
+    return path_from_poses(mechanism, start + fractions * (stop - start))
+
+
+def circle_path(mechanism: Mechanism, centre: ArrayLike, radius: float, samples: int) -> Path:
+    """``samples`` poses on the circle of ``radius`` (m) about ``centre`` (task coordinates) in the x-y plane of
+    the task coordinates, the other coordinates fixed at the centre's; a full turn from ``+x``, counter-clockwise,
+    the first pose repeated at the end."""
+    if samples < 2:
+        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    names = mechanism.task_coordinates
+    if "x" not in names or "y" not in names:
+        raise ValueError(f"A circle lies in the x-y plane; {mechanism.name!r} has task coordinates "
+                         f"{', '.join(names)}.")
+    if not (math.isfinite(radius) and radius > 0):
+        raise ValueError(f"Expected a circle radius > 0 (m), got {radius:g}.")
+    centre = mechanism.check_poses(centre)
+    angle = np.linspace(0.0, 2 * np.pi, samples)
+    poses = np.repeat(centre[None], samples, axis=0)
+    poses[:, names.index("x")] += radius * np.cos(angle)
+    poses[:, names.index("y")] += radius * np.sin(angle)
+    return path_from_poses(mechanism, poses)
+
+
+def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
+    """A path from a CSV or netCDF file: a column (variable) per task coordinate of ``mechanism`` (m, and deg
+    for angles; a netCDF variable with ``units: rad`` in rad) and an optional :data:`TIME_COLUMN` (s).
+
+    Other columns are ignored (so the output of ``screwkit trajectory --out`` reads back as a path).
+
+    Raises
+    ------
+    PathFileError
+        One line naming the file: missing, a folder, an unknown suffix, unreadable, a column missing,
+        a value that is not a finite number, fewer than two samples, times not increasing.
+    """
+    name = os.fspath(path)
+    if os.path.isdir(name):
+        raise PathFileError(f"{name}: is a folder, not a path file (.csv or .nc).")
+    if not os.path.isfile(name):
+        raise PathFileError(f"{name}: no such file.")
+    suffix = os.path.splitext(name)[1].lower()
+    if suffix not in (".csv", ".nc"):
+        raise PathFileError(f"{name}: a path file must end in .csv or .nc, got {suffix or 'no suffix'!r}.")
+    columns = _read_netcdf(name) if suffix == ".nc" else _read_csv(name)
+    wanted = mechanism.task_coordinates
+    missing = [coordinate for coordinate in wanted if coordinate not in columns]
+    if missing:
+        raise PathFileError(f"{name}: no column {', '.join(repr(m) for m in missing)}; a path of "
+                            f"{mechanism.name!r} has columns {', '.join(wanted)} (m, deg) and optionally "
+                            f"{TIME_COLUMN!r} (s), got {', '.join(columns) or 'none'}.")
+    for column in (*wanted, TIME_COLUMN):
+        if column in columns and columns[column][2]:
+            raise PathFileError(f"{name}: {columns[column][2]}")
+    poses = np.column_stack([columns[c][0] for c in wanted])
+    if poses.shape[0] < 2:
+        raise PathFileError(f"{name}: {poses.shape[0]} sample(s); a path needs at least 2.")
+    in_degrees = [is_angular(c) and columns[c][1] != "rad" for c in wanted]
+    poses[:, in_degrees] = np.deg2rad(poses[:, in_degrees])
+    times = columns[TIME_COLUMN][0] if TIME_COLUMN in columns else None
+    try:
+        return path_from_poses(mechanism, poses, times)
+    except ValueError as error:
+        raise PathFileError(f"{name}: {error}") from None
+
+
+def _read_csv(name: str) -> dict[str, tuple[NDArray[np.float64], str, str]]:
+    """Every column of a CSV file: its numbers, no unit, and what is wrong with its first value that is not a
+    finite number ("" if none)."""
+    try:
+        with open(name, newline="", encoding="utf-8") as handle:
+            rows = list(csv.reader(handle))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise PathFileError(f"{name}: cannot be read as a CSV file ({error}).") from None
+    rows = [row for row in rows if any(cell.strip() for cell in row)]
+    if not rows:
+        raise PathFileError(f"{name}: is empty; expected a header row of column names and a row per sample.")
+    header = [cell.strip() for cell in rows[0]]
+    columns: dict[str, tuple[NDArray[np.float64], str, str]] = {}
+    for position, column in enumerate(header):
+        values, problem = np.empty(len(rows) - 1), ""
+        for line, row in enumerate(rows[1:], start=2):
+            text = row[position].strip() if position < len(row) else ""
+            try:
+                values[line - 2] = float(text)
+            except ValueError:
+                values[line - 2] = np.nan
+            if not problem and not math.isfinite(values[line - 2]):
+                problem = f"line {line}, column {column!r}: expected a finite number, got {text!r}."
+        columns[column] = (values, "", problem)
+    return columns
+
+
+def _read_netcdf(name: str) -> dict[str, tuple[NDArray[np.float64], str, str]]:
+    """Every one-dimensional numeric variable (and coordinate) of a netCDF file, with its ``units`` and what is
+    wrong with its first value that is not a finite number ("" if none)."""
+    import xarray as xr  # only for netCDF path files
+
+    try:
+        with xr.open_dataset(name, engine="scipy") as dataset:
+            dataset = dataset.load()
+    except Exception as error:  # whatever the netCDF reader makes of a file that is not one
+        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise PathFileError(f"{name}: cannot be read as a netCDF file ({reason}).") from None
+    columns = {}
+    for key, variable in {**dataset.coords, **dataset.data_vars}.items():
+        if variable.ndim == 1 and np.issubdtype(variable.dtype, np.number):
+            values = np.asarray(variable.values, dtype=float)
+            bad = np.flatnonzero(~np.isfinite(values))
+            problem = (f"variable {key!r}, sample {int(bad[0])}: expected a finite number, got {values[bad[0]]}."
+                       if bad.size else "")
+            columns[str(key)] = (values, str(variable.attrs.get("units", "")), problem)
+    return columns

@@ -1,0 +1,432 @@
+"""Fault tolerance along a path: will a planned motion stay controllable if actuators fail on the way?
+
+:func:`trajectory` computes every index at the samples of a :class:`~screwkit.studies.paths.Path` in one
+batched call of :func:`~screwkit.studies.poses.indices_at_poses` (the closures keep the working mode of the
+reference assembly at every sample, as ``analyze`` does), then, for every set ``E`` of ``j`` failed actuators
+(``j`` up to the redundancy ``a - n``), follows the LMTI of the actuators left, :math:`{}^{A \\setminus E}LMTI`,
+whose minimum over the sets is :math:`F_{Oj}` (Eq. 12):
+
+* the **stretches** of arc length where it is at least ``level`` (the remaining actuators keep the platform
+  controllable with that transmission) and those where it is not, the **first point** where control is lost,
+  its **minimum** along the path and where, and the **worst failure** of the path (the lowest minimum; ties
+  within :data:`~screwkit.common.tolerances.WORST_FAULT_TIE` all named);
+* between samples, nothing is taken on trust: a dip that the samples show as a local minimum is searched for
+  its true minimum (golden section; a singular pose between two samples is found at zero), and every change
+  of side of ``level`` is bisected, until located to ``tolerance`` in arc length
+  (:mod:`~screwkit.studies.refinement`); every round evaluates all its brackets in one batched call;
+* the **margin** of each index (its minimum over the samples and where; F_Oj's also over the refined minima);
+* the **events** of the path: where it leaves the reachable set, because a chain cannot close in its working
+  mode or because a joint crosses its limit, located by bisection and explained chain by chain.
+
+With ``aggregate="mean"`` the average case is reported beside the worst case: the mean of the LMTI left over
+the sets of ``j`` failures, or their probability-weighted mean (screwkit's extension of Eq. 12, which the
+paper mentions and leaves aside; see docs/trajectory.md).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from math import prod
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.closure import UnreachablePose, solve_one
+from screwkit.closure.solve import ChainStatus
+from screwkit.common.tolerances import WORST_FAULT_TIE
+from screwkit.indices.exports import set_label
+from screwkit.indices.registry import index_columns
+from screwkit.indices.results import Indices
+from screwkit.model import Mechanism, require_mechanism
+from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.paths import Path, path_from_poses
+from screwkit.studies.poses import indices_at_poses
+from screwkit.studies.refinement import bisected_crossings, bracketed_minima, local_minima
+
+__all__ = ["trajectory", "TrajectoryResult", "FaultCase", "Margin", "PathEvent", "failure_weights", "singular_dips",
+           "AGGREGATES", "RELATIVE_TOLERANCE"]
+
+AGGREGATES = ("min", "mean")
+"""How the sets of ``j`` failures are combined into one index: the paper's worst case (Eq. 12), or also their
+(weighted) mean."""
+RELATIVE_TOLERANCE = 1e-6
+"""Default refinement tolerance, in units of the mechanism's length scale (so a scaled mechanism has its
+tolerance scaled with it)."""
+
+
+@dataclass(frozen=True)
+class FaultCase:
+    """One set of failed actuators along the path.
+
+    Attributes
+    ----------
+    faults : int
+        ``j``, the number of failed actuators.
+    failed : tuple of str
+        The failed actuators by name.
+    controllable, lost : ndarray (k, 2)
+        Stretches ``[start, stop]`` of arc length (m) where the LMTI of the actuators left is at least the
+        level, and where it is not (below it, or the pose unreachable); together they cover the path.
+    first_loss : float or None
+        Arc length (m) where control is first lost; None if never.
+    minimum, at : float
+        The lowest LMTI left along the path (over the samples and the refined dips; NaN if no pose is
+        reachable) and its arc length.
+    singular_at : tuple of float
+        Arc lengths (m) where the LMTI left vanishes: a sample where it is zero, or a dip refined to zero
+        (:func:`singular_dips`), located to the tolerance.
+    """
+
+    faults: int
+    failed: tuple[str, ...]
+    controllable: NDArray[np.float64]
+    lost: NDArray[np.float64]
+    first_loss: float | None
+    minimum: float
+    at: float
+    singular_at: tuple[float, ...] = ()
+
+    @property
+    def label(self) -> str:
+        return "+".join(self.failed)
+
+
+@dataclass(frozen=True)
+class Margin:
+    """The minimum of one index along the path, its arc length (m) and sample (None: a refined minimum between
+    samples)."""
+
+    value: float
+    arc_length: float
+    sample: int | None
+
+
+@dataclass(frozen=True)
+class PathEvent:
+    """Where the path cannot be followed in the working mode: ``kind`` is ``"closure"`` (a chain cannot close)
+    or ``"joint limit"``; ``start``/``stop`` the stretch of arc length (m, located to the tolerance), ``samples``
+    its first and last sample, ``reason`` the chains and joints at its first sample."""
+
+    kind: str
+    start: float
+    stop: float
+    samples: tuple[int, int]
+    reason: str
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryResult:
+    """Everything :func:`trajectory` finds along a path.
+
+    Attributes
+    ----------
+    mechanism : str
+    path : Path
+    indices : Indices
+        Every index at the samples (with detail: per actuator, per submechanism, per set left).
+    level, tolerance : float
+        The level of controllability and the refinement tolerance (m of arc length).
+    cases : tuple of FaultCase
+        Every set of failed actuators, ``j`` ascending, in :meth:`Indices.failed_sets` order.
+    worst : dict of int to tuple of tuple of str
+        For each ``j``, the failures worst for this path (the lowest minimum; ties all named).
+    margins : dict of str to Margin
+        Per index column (``iti``, ``f_o1``, ..., ``f_o_mean1`` with the mean), its minimum along the path.
+    events : tuple of PathEvent
+    aggregate : str
+        ``"min"`` or ``"mean"`` (:data:`AGGREGATES`).
+    mean : dict of int to ndarray (n,)
+        With ``aggregate="mean"``: the (weighted) mean over the sets of ``j`` failures of the LMTI left.
+    weights : dict of int to ndarray (C(a, j),)
+        The weight of each set of ``j`` failures in the mean (:func:`failure_weights`).
+    evaluations : int
+        Poses evaluated by the refinement, beyond the samples.
+    """
+
+    mechanism: str
+    path: Path
+    indices: Indices
+    level: float
+    tolerance: float
+    cases: tuple[FaultCase, ...]
+    worst: dict[int, tuple[tuple[str, ...], ...]]
+    margins: dict[str, Margin]
+    events: tuple[PathEvent, ...]
+    aggregate: str = "min"
+    mean: dict[int, NDArray[np.float64]] = field(default_factory=dict)
+    weights: dict[int, NDArray[np.float64]] = field(default_factory=dict)
+    evaluations: int = 0
+
+    def case(self, *failed: str) -> FaultCase:
+        """The :class:`FaultCase` of the failed actuators named (``chain:joint``)."""
+        wanted = tuple(sorted(failed))
+        for case in self.cases:
+            if tuple(sorted(case.failed)) == wanted:
+                return case
+        raise ValueError(f"No fault case {'+'.join(failed)}; the actuators are {', '.join(self.indices.actuators)}.")
+
+    def summary(self) -> dict:
+        """A JSON-ready summary: the path, the margins, every fault case, the worst failures, the events."""
+        def number(value):
+            return None if value is None or not np.isfinite(value) else float(value)
+
+        path = self.path
+        return {
+            "mechanism": self.mechanism, "samples": path.samples, "length_m": path.length,
+            "length_scale_m": path.length_scale, "level": self.level, "tolerance_m": self.tolerance,
+            "aggregate": self.aggregate,
+            "duration_s": None if path.times is None else float(path.times[-1] - path.times[0]),
+            "reachable_samples": int(np.count_nonzero(self.indices.reachable)),
+            "margins": {name: {"value": number(m.value), "arc_length_m": number(m.arc_length), "sample": m.sample}
+                        for name, m in self.margins.items()},
+            "faults": [{"j": c.faults, "failed": list(c.failed), "minimum": number(c.minimum),
+                        "at_m": number(c.at), "first_loss_m": number(c.first_loss),
+                        "singular_at_m": list(c.singular_at),
+                        "lost_m": c.lost.tolist(), "controllable_m": c.controllable.tolist()} for c in self.cases],
+            "worst": {str(j): [list(t) for t in ties] for j, ties in self.worst.items()},
+            "events": [{"kind": e.kind, "start_m": e.start, "stop_m": e.stop, "samples": list(e.samples),
+                        "reason": e.reason} for e in self.events],
+            "refinement_evaluations": self.evaluations,
+        }
+
+    def to_dataset(self):
+        """The indices along the path as an ``xarray.Dataset`` over ``sample`` (coordinates ``arc_length`` in m,
+        ``t`` in s when given, the task coordinates in m and deg): every index, ``lmti_left{j}`` over ``failed{j}``
+        (the LMTI of the actuators left after each set of ``j`` failures), ``f_o_mean{j}`` with the mean; the
+        summary (:meth:`summary`) as the JSON attribute ``summary``."""
+        coords = {"arc_length": ("sample", self.path.arc_length, {"units": "m", "long_name": "arc length"})}
+        if self.path.times is not None:
+            coords["t"] = ("sample", self.path.times, {"units": "s"})
+        dataset = self.indices.to_dataset(dims=("sample",), coords=coords)
+        for j in self.indices.faults:
+            labels = [set_label(failed) for failed in self.indices.failed_sets(j)]
+            dimension = f"failed{j}"
+            dataset.coords[dimension] = (dimension, labels)
+            dataset[f"lmti_left{j}"] = (("sample", dimension), self.indices.remaining_lmti[j],
+                                        {"long_name": f"LMTI of the actuators left after each set of {j} failure(s) "
+                                                      f"(F_O{j} is their minimum, Eq. 12)"})
+            if j in self.mean:
+                dataset[f"f_o_mean{j}"] = ("sample", self.mean[j],
+                                           {"long_name": f"F_O{j} mean (screwkit's extension of Eq. 12)"})
+        dataset.attrs.update(mechanism=self.mechanism, level=self.level, tolerance_m=self.tolerance,
+                             length_m=self.path.length, aggregate=self.aggregate,
+                             summary=json.dumps(self.summary()))
+        return dataset
+
+
+def failure_weights(actuator_count: int, faults: int, probabilities: ArrayLike | None = None
+                    ) -> NDArray[np.float64]:
+    """The weight of each set of ``faults`` failed actuators (:meth:`Indices.failed_sets` order) in the mean.
+
+    Equal weights without ``probabilities``; with the failure probability :math:`p_i` of each actuator
+    (independent failures), the probability that exactly the set ``E`` failed given that ``j`` did:
+
+    .. math::
+
+        w_E = \\frac{\\prod_{i \\in E} p_i \\prod_{i \\notin E} (1 - p_i)}
+                   {\\sum_{|E'| = j} \\prod_{i \\in E'} p_i \\prod_{i \\notin E'} (1 - p_i)}
+    """
+    from itertools import combinations
+
+    sets = [tuple(sorted(set(range(actuator_count)) - set(left)))
+            for left in combinations(range(actuator_count), actuator_count - faults)]
+    if probabilities is None:
+        return np.full(len(sets), 1.0 / len(sets))
+    p = np.asarray(probabilities, dtype=float)
+    if p.shape != (actuator_count,) or not np.all((p >= 0) & (p <= 1)):
+        raise ValueError(f"Expected one failure probability in [0, 1] per actuator ({actuator_count}), got "
+                         f"{np.asarray(probabilities).tolist()}.")
+    weights = np.array([prod(p[i] if i in failed else 1.0 - p[i] for i in range(actuator_count)) for failed in sets])
+    if not weights.sum() > 0:
+        raise ValueError(f"No set of {faults} failure(s) has a positive probability with failure probabilities "
+                         f"{p.tolist()}.")
+    return weights / weights.sum()
+
+
+def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None, level: float = 0.4,
+               tolerance: float | None = None, aggregate: str = "min", probabilities: ArrayLike | None = None,
+               analysis: AnalysisOptions | None = None, threads: int | None = None) -> TrajectoryResult:
+    """Every index along a path, and what each actuator failure leaves controllable, refined between samples.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    path : Path or array_like (n, n_task)
+        The samples (task coordinates, m and rad; :mod:`screwkit.studies.paths`), at least two.
+    times : array_like (n,), optional
+        The time of each sample (s), for a path given as poses.
+    level : float
+        The LMTI the actuators left must keep for the platform to count as controllable (default 0.4).
+    tolerance : float, optional
+        How closely (m of arc length) crossings of the level and minima between samples are located
+        (default :data:`RELATIVE_TOLERANCE` times the mechanism's length scale).
+    aggregate : {"min", "mean"}
+        ``"mean"`` also reports the (weighted) mean over the sets of ``j`` failures (``f_o_mean{j}``).
+    probabilities : array_like (a,), optional
+        Failure probability of each actuator, weighting the mean (:func:`failure_weights`).
+    analysis : AnalysisOptions, optional
+        Threshold, numbers of faults, fault type, closed forms, joint limits.
+    threads : int, optional
+        Threads of the index kernel.
+    """
+    require_mechanism(mechanism, "trajectory")
+    path = path if isinstance(path, Path) else path_from_poses(mechanism, path, times)
+    analysis = analysis or AnalysisOptions()
+    if aggregate not in AGGREGATES:
+        raise ValueError(f"Expected `aggregate` in {', '.join(AGGREGATES)}, got {aggregate!r}.")
+    if not np.isfinite(level) or not 0 < level <= 1:
+        raise ValueError(f"Expected a level in (0, 1], got {level!r}.")
+    tolerance = RELATIVE_TOLERANCE * mechanism.length_scale if tolerance is None else float(tolerance)
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"Expected a tolerance > 0 (m of arc length), got {tolerance!r}.")
+
+    keywords = dict(analysis.keywords(), detail=True, threads=threads)
+    samples = indices_at_poses(mechanism, path.poses, **keywords)
+    faults = samples.faults
+    failed_sets = [(j, failed) for j in faults for failed in samples.failed_sets(j)]
+    evaluations = [0]
+
+    def table(result: Indices) -> NDArray[np.float64]:
+        """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series."""
+        columns = [result.remaining_lmti[j] for j in faults]
+        reachable = np.where(np.asarray(result.reachable), 1.0, np.nan)[:, None]
+        return np.concatenate([*columns, reachable], axis=1)
+
+    def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
+        evaluations[0] += positions.size
+        return table(indices_at_poses(mechanism, path.at(positions), **keywords))[np.arange(positions.size), series]
+
+    values = table(samples)
+    reach_series = values.shape[1] - 1
+
+    def above(found: NDArray, series: NDArray) -> NDArray[np.bool_]:
+        return np.where(series == reach_series, np.isfinite(found), np.nan_to_num(found, nan=-np.inf) >= level)
+
+    s = path.arc_length
+    rows, series = local_minima(values[:, :reach_series])
+    minima_at, minima = bracketed_minima(evaluate, s[np.maximum(rows - 1, 0)], s[np.minimum(rows + 1, len(s) - 1)],
+                                         series, tolerance)
+    singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
+    points = _series_points(s, values, rows, series, minima_at, minima)
+    states = [above(v, np.full(v.shape, k)) for k, (_, v) in enumerate(points)]
+    brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
+    where = np.array([k for k, _ in brackets], dtype=np.int64)
+    low, high = bisected_crossings(evaluate, np.array([points[k][0][i] for k, i in brackets]),
+                                   np.array([points[k][0][i + 1] for k, i in brackets]), where, above, tolerance)
+    crossing = {(k, i): (lo + hi) / 2 for (k, i), lo, hi in zip(brackets, low, high)}
+
+    cases = []
+    for k, (j, failed) in enumerate(failed_sets):
+        at, v = points[k]
+        controllable, lost = _stretches(at, states[k], {i: crossing[(kk, i)] for kk, i in brackets if kk == k})
+        finite = np.isfinite(v)
+        lowest = int(np.argmin(np.where(finite, v, np.inf)))
+        zeros = np.concatenate([s[values[:, k] == 0], minima_at[(series == k) & singular]])
+        cases.append(FaultCase(j, tuple(samples.actuators[i] for i in failed), controllable, lost,
+                               float(lost[0, 0]) if len(lost) else None,
+                               float(v[lowest]) if finite.any() else np.nan, float(at[lowest]),
+                               tuple(float(z) for z in np.sort(zeros))))
+    reach_at, reach_state = points[reach_series]
+    _, unreachable = _stretches(reach_at, reach_state, {i: crossing[(kk, i)] for kk, i in brackets
+                                                        if kk == reach_series})
+    weights = {j: failure_weights(samples.actuator_count, j, probabilities) for j in faults}
+    mean = {j: samples.remaining_lmti[j] @ weights[j] for j in faults} if aggregate == "mean" else {}
+    return TrajectoryResult(
+        mechanism=mechanism.name, path=path, indices=samples, level=float(level), tolerance=tolerance,
+        cases=tuple(cases), worst=_worst(cases, faults), margins=_margins(samples, s, cases, mean),
+        events=_events(mechanism, path, samples, unreachable, analysis), aggregate=aggregate, mean=mean,
+        weights=weights if aggregate == "mean" else {}, evaluations=evaluations[0])
+
+
+def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, series: NDArray,
+                  tolerance: float) -> NDArray[np.bool_]:
+    """Which refined minima are zeros of their series: the value found is at most its rise one ``tolerance``
+    either side (a V-shaped dip whose two sides, extended, meet within the tolerance at zero), whereas a smooth
+    minimum above zero rises only by the square of the tolerance there. One batched evaluation."""
+    if minima_at.size == 0:
+        return np.zeros(0, dtype=bool)
+    sides = np.clip(np.concatenate([minima_at - tolerance, minima_at + tolerance]), 0.0, path.length)
+    found = evaluate(sides, np.concatenate([series, series]))
+    found = np.where(np.isnan(found), np.inf, found)
+    rise = np.maximum(found[:minima.size], found[minima.size:]) - minima
+    return np.isfinite(minima) & (minima <= rise)
+
+
+def _series_points(s, values, rows, series, minima_at, minima):
+    """Per series: the sample positions and values, with the refined minima inserted in order."""
+    points = []
+    for k in range(values.shape[1]):
+        mine = series == k
+        at = np.concatenate([s, minima_at[mine]])
+        v = np.concatenate([values[:, k], minima[mine]])
+        order = np.argsort(at, kind="stable")
+        points.append((at[order], v[order]))
+    return points
+
+
+def _stretches(at: NDArray, state: NDArray, crossings: dict[int, float]) -> tuple[NDArray, NDArray]:
+    """The stretches ``(true, false)`` of a predicate known at ``at``, changing at ``crossings[i]`` between
+    points ``i`` and ``i + 1``: arrays (k, 2) of [start, stop]."""
+    edges = [float(at[0])] + [crossings[i] for i in sorted(crossings)] + [float(at[-1])]
+    first = bool(state[0])
+    runs = np.array([edges[:-1], edges[1:]]).T.reshape(-1, 2)
+    kinds = np.array([(first if r % 2 == 0 else not first) for r in range(len(runs))], dtype=bool)
+    return runs[kinds], runs[~kinds]
+
+
+def _worst(cases: list[FaultCase], faults) -> dict[int, tuple[tuple[str, ...], ...]]:
+    """For each ``j``: every failure that meets a singularity on the path (tied at zero), else the lowest minimum
+    and its ties within :data:`WORST_FAULT_TIE`."""
+    worst = {}
+    for j in faults:
+        mine = [c for c in cases if c.faults == j and np.isfinite(c.minimum)]
+        singular = [c.failed for c in mine if c.singular_at]
+        if singular or not mine:
+            worst[j] = tuple(singular)
+            continue
+        lowest = min(c.minimum for c in mine)
+        worst[j] = tuple(c.failed for c in mine if c.minimum <= lowest + WORST_FAULT_TIE)
+    return worst
+
+
+def _margins(samples: Indices, s: NDArray, cases: list[FaultCase], mean: dict) -> dict[str, Margin]:
+    """The minimum of every index column along the path; F_Oj's over the refined minima too."""
+    columns = dict(index_columns(samples))
+    columns.update({f"f_o_mean{j}": values for j, values in mean.items()})
+    margins = {}
+    for name, values in columns.items():
+        values = np.asarray(values, dtype=float)
+        if not np.any(np.isfinite(values)):
+            continue  # not applicable (a CTI without constraint wrenches) or nothing reachable
+        index = int(np.nanargmin(values))
+        margins[name] = Margin(float(values[index]), float(s[index]), index)
+    for j in samples.faults:
+        refined = [c for c in cases if c.faults == j and np.isfinite(c.minimum)]
+        if refined and f"f_o{j}" in margins:
+            lowest = min(refined, key=lambda c: c.minimum)
+            if lowest.minimum < margins[f"f_o{j}"].value:
+                margins[f"f_o{j}"] = Margin(lowest.minimum, lowest.at, None)
+    return margins
+
+
+def _events(mechanism: Mechanism, path: Path, samples: Indices, unreachable: NDArray,
+            analysis: AnalysisOptions) -> tuple[PathEvent, ...]:
+    """A :class:`PathEvent` per stretch where the path is unreachable, with why at its first sample."""
+    events = []
+    s = path.arc_length
+    status = np.asarray(samples.chain_status)
+    for start, stop in unreachable:
+        inside = np.flatnonzero((s >= start) & (s <= stop) & ~np.asarray(samples.reachable))
+        if not inside.size:
+            continue
+        first, last = int(inside[0]), int(inside[-1])
+        kind = "closure" if np.any(status[first] == ChainStatus.MISSES_CLOSURE) else "joint limit"
+        try:
+            solve_one(mechanism, path.poses[first], limits=analysis.limits)
+            reason = "unreachable"
+        except UnreachablePose as error:
+            reason = str(error)
+        events.append(PathEvent(kind, float(start), float(stop), (first, last), reason))
+    return tuple(events)
+

@@ -1,0 +1,273 @@
+"""Fault tolerance along a path: the indices at the samples are analyze's, the stretches each failure leaves below
+the level agree with a dense sampling, a singular pose between two samples is located to the tolerance, and a
+scaled mechanism gives the same stretches scaled; the path files and the command line."""
+
+from __future__ import annotations
+
+import json
+from itertools import product
+
+import numpy as np
+import pytest
+
+from helpers import assert_indices_close, bundled, in_millimetres, one_line_error, screwkit
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
+from screwkit.io.loader import bundled_path, load_text
+from screwkit.studies import indices_at_pose, indices_at_poses
+from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path
+from screwkit.studies.trajectory import failure_weights, trajectory
+
+FIG_4 = np.array([0.0, 0.0, 0.0])
+"""The centre of the paper's Fig. 4 (x = y = 0; phi swept there)."""
+START, STOP = np.array([-0.3, -0.2, np.deg2rad(-45.0)]), np.array([0.3, 0.2, np.deg2rad(45.0)])
+"""A straight path of the 5-RRR through the Fig. 4 pose, at its middle."""
+LEVEL = 0.6
+
+
+@pytest.fixture(scope="module")
+def five_path():
+    five = bundled("planar_5rrr")
+    return five, trajectory(five, line_path(five, START, STOP, 41), level=LEVEL)
+
+
+def test_the_indices_at_every_sample_are_those_of_analyze(five_path):
+    five, result = five_path
+    poses = result.path.poses
+    np.testing.assert_allclose(poses[20], FIG_4, atol=1e-15)  # the Fig. 4 pose is a sample
+    for i in range(poses.shape[0]):
+        alone = indices_at_pose(five, poses[i])
+        assert_indices_close(alone, result.indices.at(i), atol=1e-12,
+                             fields=("iti", "iti_actuators", "oti_submechanisms", "lmti"))
+        for j in (1, 2):
+            np.testing.assert_allclose(result.indices.remaining_lmti[j][i], alone.remaining_lmti[j], atol=1e-12)
+    assert result.margins["iti"].value == pytest.approx(np.min(result.indices.iti), abs=0)
+    assert result.margins["f_o1"].value <= np.min(result.indices.f_o[1])
+
+
+def _dense_lost(values: np.ndarray, s: np.ndarray, level: float) -> np.ndarray:
+    """Stretches [start, stop] where ``values`` < level on a dense sampling, ends at the midpoints of a change."""
+    below = ~(np.nan_to_num(values, nan=-1.0) >= level)
+    change = np.flatnonzero(below[1:] != below[:-1])
+    edges = np.concatenate([[s[0]], (s[change] + s[change + 1]) / 2, [s[-1]]])
+    runs = np.column_stack([edges[:-1], edges[1:]])
+    state = below[np.concatenate([[0], change + 1])]
+    return runs[state]
+
+
+def test_the_lost_stretches_agree_with_a_dense_sampling(five_path):
+    """400,000 samples of the same path, batched: every stretch each failure leaves below the level, and every
+    singular point, within the refinement's tolerance plus the dense step."""
+    five, result = five_path
+    dense_s = np.linspace(0.0, result.path.length, 400_001)
+    dense = indices_at_poses(five, result.path.at(dense_s), detail=True)
+    step = dense_s[1]
+    lost_somewhere = 0
+    for case in result.cases:
+        failed = tuple(result.indices.actuators.index(name) for name in case.failed)
+        column = result.indices.failed_sets(case.faults).index(failed)
+        values = dense.remaining_lmti[case.faults][:, column]
+        expected = _dense_lost(values, dense_s, LEVEL)
+        assert case.lost.shape == expected.shape, (case.label, case.lost, expected)
+        np.testing.assert_allclose(case.lost, expected, rtol=0, atol=result.tolerance + step, err_msg=case.label)
+        lost_somewhere += len(case.lost) > 0
+        assert case.minimum <= np.nanmin(values) + 1e-9
+        assert abs(case.at - dense_s[np.nanargmin(values)]) <= result.tolerance + step or case.minimum < 1e-5
+        for zero in case.singular_at:  # a singular point: the dense sampling is near zero there
+            near = np.abs(dense_s - zero) <= result.tolerance + step
+            assert np.nanmin(values[near]) < 1e-4, (case.label, zero)
+        covered = np.concatenate([case.lost, case.controllable])
+        assert np.sum(covered[:, 1] - covered[:, 0]) == pytest.approx(result.path.length, abs=1e-12)
+    assert lost_somewhere >= 5  # the path is a test of something: failures lose control along it
+    assert sum(bool(c.singular_at) for c in result.cases) >= 3
+
+
+def test_a_singular_pose_between_two_samples_is_located_to_the_tolerance():
+    """The 4-RPR at phi = 0, platform at (0, -0.9): the platform joints of legs 1 and 2 at y = -1, their lines
+    the base edge y = -1, collinear, so the sets {1, 2, 3} and {1, 2, 4} left after a failure of leg 4 or 3 are
+    singular there (Sec. 2: collinear lines give OTI = 0). A path from y = -0.5 to -0.95 in 7 samples has it
+    between its samples 5 and 6 (y = -0.875 and -0.95), at arc length 0.4."""
+    rpr = bundled("planar_4rpr")
+    path = np.column_stack([np.zeros(7), np.linspace(-0.5, -0.95, 7), np.zeros(7)])
+    assert not np.any(np.isclose(path[:, 1], -0.9))
+    result = trajectory(rpr, path, tolerance=1e-7)
+    singular = {case.failed: case.singular_at for case in result.cases}
+    for leg in ("leg_3", "leg_4"):
+        (found,) = singular[(f"{leg}:{leg}_joint_slider",)]
+        assert abs(found - 0.4) <= 1e-7, found
+        assert result.case(f"{leg}:{leg}_joint_slider").minimum < 1e-6
+    for leg in ("leg_1", "leg_2"):
+        assert singular[(f"{leg}:{leg}_joint_slider",)] == ()
+    assert set(result.worst[1]) == {("leg_3:leg_3_joint_slider",), ("leg_4:leg_4_joint_slider",)}
+    assert result.margins["f_o1"].sample is None and result.margins["f_o1"].value < 1e-6
+    # the samples alone would have missed it: none is near zero
+    assert np.min(result.indices.f_o[1]) > 0.02
+    coarse = trajectory(rpr, path, tolerance=1e-3)  # the tolerance is what it says, not finer by chance
+    assert abs(coarse.case("leg_3:leg_3_joint_slider").singular_at[0] - 0.4) <= 1e-3
+
+
+def test_a_mechanism_in_millimetres_has_the_same_stretches_scaled():
+    """The 5-RRR scaled by 1000 (its file in mm read as m) with the path and the threshold scaled: the same
+    stretches, singular points and margins, arc lengths times 1000 (default tolerance scales with it)."""
+    five = bundled("planar_5rrr")
+    large = load_text(in_millimetres(bundled_path("planar_5rrr").read_text()), "planar_5rrr_mm.urdf")
+    scale = np.array([1000.0, 1000.0, 1.0])
+    small = trajectory(five, line_path(five, START, STOP, 41), level=LEVEL)
+    big = trajectory(large, line_path(large, START * scale, STOP * scale, 41), level=LEVEL,
+                     analysis=AnalysisOptions(threshold=1000 * SINGULARITY_THRESHOLD))
+    assert big.tolerance == pytest.approx(1000 * small.tolerance, rel=1e-12)
+    assert big.path.length == pytest.approx(1000 * small.path.length, rel=1e-12)
+    for one, other in zip(small.cases, big.cases):
+        assert one.failed == other.failed
+        np.testing.assert_allclose(other.lost, 1000 * one.lost, rtol=0, atol=big.tolerance)
+        np.testing.assert_allclose(other.singular_at, 1000 * np.array(one.singular_at), rtol=0, atol=big.tolerance)
+    assert big.worst == small.worst
+    for name, margin in small.margins.items():
+        assert big.margins[name].value == pytest.approx(margin.value, abs=1e-9), name
+
+
+def test_the_average_case_is_the_weighted_mean_over_the_failures(five_path):
+    """F_Oj mean: the mean of the LMTI left over the sets of j failures; weighted by the probability of exactly
+    that set failing given j failures, counted here over all 2^5 failure patterns."""
+    five, _ = five_path
+    path = line_path(five, START, STOP, 9)
+    plain = trajectory(five, path, aggregate="mean")
+    for j in (1, 2):
+        np.testing.assert_allclose(plain.mean[j], plain.indices.remaining_lmti[j].mean(axis=1), atol=1e-15)
+        assert np.all(plain.mean[j] >= plain.indices.f_o[j])
+        assert plain.margins[f"f_o_mean{j}"].value == pytest.approx(np.min(plain.mean[j]), abs=0)
+    p = np.array([0.1, 0.2, 0.05, 0.3, 0.5])
+    weighted = trajectory(five, path, aggregate="mean", probabilities=p)
+    for j in (1, 2):
+        sets = plain.indices.failed_sets(j)
+        chances = np.zeros(len(sets))
+        for pattern in product((False, True), repeat=5):
+            failed = tuple(i for i in range(5) if pattern[i])
+            if len(failed) == j:
+                chances[sets.index(failed)] += np.prod(np.where(pattern, p, 1 - p))
+        np.testing.assert_allclose(failure_weights(5, j, p), chances / chances.sum(), rtol=1e-12)
+        np.testing.assert_allclose(weighted.mean[j], plain.indices.remaining_lmti[j] @ (chances / chances.sum()),
+                                   atol=1e-12)
+    assert not np.allclose(weighted.mean[1], plain.mean[1])
+    assert trajectory(five, path).mean == {}  # the worst case alone unless asked
+    with pytest.raises(ValueError, match="failure probability in \\[0, 1\\] per actuator \\(5\\)"):
+        failure_weights(5, 1, [0.1, 0.2])
+
+
+def test_a_path_leaving_the_workspace_reports_where():
+    """The 5-RRR's platform pushed along +y out of reach: one closure event, its start located to the tolerance
+    (the last reachable arc length on a dense sampling), the chains that cannot close named; control is lost there
+    for every failure."""
+    five = bundled("planar_5rrr")
+    path = path_from_poses(five, np.column_stack([np.zeros(16), np.linspace(0.0, 1.5, 16), np.zeros(16)]))
+    result = trajectory(five, path)
+    (event,) = result.events
+    assert event.kind == "closure" and "misses closure" in event.reason and event.stop == pytest.approx(1.5)
+    dense_s = np.linspace(0.0, 1.5, 300_001)
+    reachable = indices_at_poses(five, path.at(dense_s)).reachable
+    edge = dense_s[np.flatnonzero(~reachable)[0]]
+    assert abs(event.start - edge) <= result.tolerance + dense_s[1]
+    for case in result.cases:
+        assert case.lost[-1, 1] == pytest.approx(1.5) and case.lost[-1, 0] <= event.start + result.tolerance
+
+
+def test_a_hexapod_path_runs_and_agrees_with_its_samples():
+    hexapod = bundled("ups_hexapod_8")
+    home = hexapod.home_pose
+    stop = home + np.array([0.05, -0.03, 0.02, np.deg2rad(5.0), np.deg2rad(-3.0), np.deg2rad(20.0)])
+    result = trajectory(hexapod, line_path(hexapod, home, stop, 40), aggregate="mean")
+    assert len(result.cases) == 8 + 28 and set(result.worst) == {1, 2}
+    direct = indices_at_poses(hexapod, result.path.poses)
+    for j in (1, 2):
+        np.testing.assert_allclose(result.indices.f_o[j], direct.f_o[j], rtol=0, atol=1e-12)
+    for case in result.cases:
+        covered = np.concatenate([case.lost, case.controllable])
+        assert np.sum(covered[:, 1] - covered[:, 0]) == pytest.approx(result.path.length, abs=1e-12)
+    dataset = result.to_dataset()
+    assert dataset["lmti_left2"].shape == (40, 28) and "f_o_mean2" in dataset
+    assert json.loads(dataset.attrs["summary"])["worst"] == {str(j): [list(t) for t in ties]
+                                                              for j, ties in result.worst.items()}
+
+
+def test_generated_paths():
+    five = bundled("planar_5rrr")
+    circle = circle_path(five, [0.1, 0.0, 0.3], 0.2, 9)
+    np.testing.assert_allclose(circle.poses[0], circle.poses[-1], atol=1e-15)
+    np.testing.assert_allclose(np.hypot(circle.poses[:, 0] - 0.1, circle.poses[:, 1]), 0.2, atol=1e-15)
+    assert circle.length == pytest.approx(8 * 2 * 0.2 * np.sin(np.pi / 8), rel=1e-12)  # the inscribed octagon
+    turn = line_path(five, [0, 0, 0], [0, 0, 1.0], 3)  # a pure rotation has a length: L per radian
+    assert turn.length == pytest.approx(five.length_scale, rel=1e-12)
+    with pytest.raises(ValueError, match="x-y plane; 'prs_3_ups' has task coordinates z, roll, pitch"):
+        circle_path(bundled("prs_3_ups"), bundled("prs_3_ups").home_pose, 0.1, 10)
+    with pytest.raises(ValueError, match="every pose of the path is the same"):
+        path_from_poses(five, np.zeros((3, 3)))
+
+
+BAD_FILES = {
+    "missing.csv": (None, "missing.csv: no such file."),
+    "columns.csv": ("x,y,theta\n0,0,0\n0.1,0,0\n", "no column 'phi'; a path of 'planar_5rrr' has columns x, y, phi"),
+    "nan.csv": ("t,x,y,phi\n0,0,0,0\n1,0.1,nan,0\n", "line 3, column 'y': expected a finite number, got 'nan'."),
+    "one.csv": ("x,y,phi\n0,0,0\n", "1 sample(s); a path needs at least 2."),
+    "times.csv": ("t,x,y,phi\n0,0,0,0\n0,0.1,0,0\n", "Expected finite, increasing times along the path."),
+    "path.txt": ("x,y,phi\n0,0,0\n", "a path file must end in .csv or .nc, got '.txt'."),
+}
+
+
+@pytest.mark.parametrize("name", BAD_FILES)
+def test_a_bad_path_file_is_one_line_naming_it(tmp_path, name):
+    text, message = BAD_FILES[name]
+    if text is not None:
+        (tmp_path / name).write_text(text)
+    with pytest.raises(PathFileError) as error:
+        read_path(bundled("planar_5rrr"), tmp_path / name)
+    assert str(error.value).startswith(str(tmp_path / name)) and message in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_a_path_file_reads_in_degrees_with_times(tmp_path):
+    five = bundled("planar_5rrr")
+    (tmp_path / "p.csv").write_text("t,x,y,phi,comment\n0,0,0,0,a\n2,0.1,0,90,b\n")
+    path = read_path(five, tmp_path / "p.csv")
+    np.testing.assert_allclose(path.poses, [[0, 0, 0], [0.1, 0, np.pi / 2]])
+    np.testing.assert_allclose(path.times, [0, 2])
+    np.testing.assert_allclose(path.time_at([path.length / 2]), [1.0])
+
+
+@pytest.mark.parametrize("name", ["missing.csv", "columns.csv", "nan.csv", "one.csv"])
+def test_the_command_refuses_a_bad_path_file_in_one_line(tmp_path, name):
+    text, message = BAD_FILES[name]
+    if text is not None:
+        (tmp_path / name).write_text(text)
+    one_line_error(screwkit("trajectory", "planar_5rrr", tmp_path / name, "--out", tmp_path / "out.nc"),
+                   str(tmp_path / name), message)
+    assert not (tmp_path / "out.nc").exists()
+
+
+def test_the_command_writes_the_path_its_summary_and_figure(tmp_path):
+    """--line through the Fig. 4 pose: the JSON summary is the Python result's; the CSV written reads back as the
+    same path (its x, y, phi columns in m and deg) and gives the same result; the netCDF holds the summary."""
+    five = bundled("planar_5rrr")
+    arguments = ("--line", "-0.3", "-0.2", "-45", "0.3", "0.2", "45", "--samples", "41", "--level", str(LEVEL))
+    done = screwkit("trajectory", "planar_5rrr", *arguments, "--json", "--out", tmp_path / "t.csv",
+                    "--figure", tmp_path / "t.png")
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    summary = json.loads(done.stdout)
+    expected = trajectory(five, line_path(five, START, STOP, 41), level=LEVEL).summary()
+    assert summary["worst"] == expected["worst"]
+    for found, wanted in zip(summary["faults"], expected["faults"]):
+        np.testing.assert_allclose(np.reshape(found["lost_m"], (-1, 2)), np.reshape(wanted["lost_m"], (-1, 2)),
+                                   atol=1e-9)
+    assert (tmp_path / "t.png").stat().st_size > 10_000
+    again = screwkit("trajectory", "planar_5rrr", tmp_path / "t.csv", "--level", str(LEVEL), "--json",
+                     "--out", tmp_path / "t.nc")
+    assert again.returncode == 0, again.stderr
+    reread = json.loads(again.stdout)
+    assert reread["worst"] == summary["worst"] and reread["samples"] == 41
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "t.nc", engine="scipy") as dataset:
+        assert json.loads(dataset.attrs["summary"])["worst"] == summary["worst"]
+        assert dataset["lmti_left1"].shape == (41, 5)
+    one_line_error(screwkit("trajectory", "planar_5rrr", *arguments, "--out", tmp_path / "t.nc"),
+                   "t.nc: the file exists")
+    one_line_error(screwkit("trajectory", "planar_5rrr"), "Expected exactly one of PATH")
