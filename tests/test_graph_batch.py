@@ -203,7 +203,8 @@ def test_the_command_line_sweeps_a_rod_level_delta_as_written(tmp_path):
     path.write_text(delta_rods_mjcf(POSES[0], AZIMUTHS))
     home = open_delta(tmp_path).task_pose()
     out = tmp_path / "sweep.nc"
-    completed = screwkit("sweep", path, "--sweep", f"z:{float(home[2]) - 0.06!r}:{float(home[2]) + 0.06!r}:0.02", "--out", out)
+    low, high = float(home[2]) - 0.06, float(home[2]) + 0.06
+    completed = screwkit("sweep", path, "--sweep", f"z:{low!r}:{high!r}:0.02", "--out", out)
     assert completed.returncode == 0, completed.stderr
     assert "swept z over 6 values (6 reachable)" in completed.stderr and "Traceback" not in completed.stderr
     with xr.open_dataset(out) as dataset:

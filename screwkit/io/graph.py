@@ -60,6 +60,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics, rpy_of, rpy_rates_inverse, solve_poses
+from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
 from screwkit.io.star import output_frame
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
 from screwkit.screw.chain_screws import ChainScrews
@@ -71,18 +72,6 @@ ANGLES = ("roll", "pitch", "yaw")
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
 which the joint moves inside a loop of the leg (its twist is not a motion of the leg)."""
-
-
-@dataclass(frozen=True)
-class GraphLeg:
-    """One leg of a closed-loop graph: its joints (Pinocchio joint ids, the platform's own joint when the platform
-    hangs on the leg: ``spine``), the closures with an end on it, and its actuated joints."""
-
-    name: str
-    joints: tuple[int, ...]
-    closures: tuple[Closure, ...]
-    spine: bool
-    actuators: tuple[int, ...]
 
 
 @dataclass(frozen=True)
@@ -292,165 +281,6 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
             raise ImportError_(f"{tree.source}: actuated joint {name!r} is on no leg (a leg joins the base to the "
                                "platform).")
     return sorted(legs, key=lambda leg: leg.name)
-
-
-def _columns(kinematics: TreeKinematics, joints) -> NDArray[np.int64]:
-    """Velocity coordinates of ``joints``, in joint order."""
-    width = {"revolute": 1, "unbounded": 1, "prismatic": 1, "ball": 3, "free": 6}
-    return np.array([kinematics.idx_v[j] + k for j in sorted(set(joints)) for k in range(width[kinematics.kinds[j]])],
-                    dtype=np.int64)
-
-
-def _select(offset: NDArray, kind: str) -> NDArray:
-    """(n, r, 6): the rows taking a working twist of a body to the velocity of a closure frame on it (its point's
-    velocity for ``3d``, the whole twist about that point for ``6d``)."""
-    count = offset.shape[0]
-    if kind != "3d":
-        return np.broadcast_to(np.eye(6), (count, 6, 6))
-    skew = np.zeros((count, 3, 3))
-    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -offset[:, 2], offset[:, 1], -offset[:, 0]
-    skew[:, 1, 0], skew[:, 2, 0], skew[:, 2, 1] = offset[:, 2], -offset[:, 1], offset[:, 0]
-    return np.concatenate([-skew, np.broadcast_to(np.eye(3), (count, 3, 3))], axis=2)
-
-
-def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArray]:
-    """Orthonormal rows (n, 6, 6) spanning the platform twists ``joints`` of ``leg`` allow with its closures closed
-    (working coordinates; the first ``dims[n]`` rows of configuration n), and ``dims`` (n,).
-
-    Unknowns: the rates of ``joints`` and the platform twist T. Each closure adds the relative velocity of its two
-    frames (6 rows for ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves
-    with T plus the joints of ``joints`` beyond the platform, unless the leg is the platform's spine (the
-    platform's own path is among its joints): then T is tied to the platform body's twist."""
-    model, kinematics = state.model, state.kinematics
-    columns = _columns(kinematics, joints)
-    count = state.working.shape[0]
-    blocks = []
-    for closure in leg.closures:
-        rows_q, rows_t = 0.0, 0.0
-        for joint, placement, sign in ((closure.joint_a, closure.placement_a, 1.0),
-                                       (closure.joint_b, closure.placement_b, -1.0)):
-            world = state.transforms[:, joint] @ placement
-            select = _select((world[:, :3, 3] - state.centre) / state.scale, closure.kind)
-            moves = kinematics.supports(model, joint)[columns]
-            rows_q = rows_q + sign * select @ np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
-            if not leg.spine and state.platform in path_to(model, joint):
-                rows_t = rows_t + sign * select
-        rows_q = np.broadcast_to(rows_q, (count, 6 if closure.kind != "3d" else 3, len(columns)))
-        blocks.append(np.concatenate([rows_q, np.broadcast_to(rows_t, rows_q.shape[:2] + (6,))], axis=2))
-    if leg.spine:
-        moves = kinematics.supports(model, state.platform)[columns]
-        own = np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
-        blocks.append(np.concatenate([own, np.broadcast_to(-np.eye(6), (count, 6, 6))], axis=2))
-    matrix = np.concatenate(blocks, axis=1)
-    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
-    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(count), 1.0)
-    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
-    null = right[:, :, -6:] * (np.arange(right.shape[1])[None, :] >= rank[:, None])[:, :, None]
-    _, values, rows = np.linalg.svd(null, full_matrices=False)
-    return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
-
-
-def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
-    """World points (n, 3) where the leg's joints (to its children) and closures meet ``body``."""
-    model = state.model
-    points = [state.transforms[:, j, :3, 3] for j in leg.joints if model.parents[j] == body]
-    for closure in leg.closures:
-        for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
-            if joint == body:
-                points.append((state.transforms[:, joint] @ placement)[:, :3, 3])
-    return points
-
-
-@dataclass(frozen=True)
-class _State:
-    """A batch of closed configurations: joint frames (n, njoints, 4, 4), every velocity coordinate's twist in
-    working coordinates about the platform joint (n, nv, 6), that centre (n, 3) and the length scale."""
-
-    model: object
-    kinematics: TreeKinematics
-    platform: int
-    transforms: NDArray[np.float64]
-    working: NDArray[np.float64]
-    centre: NDArray[np.float64]
-    scale: float
-
-    @classmethod
-    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float) -> _State:
-        transforms = kinematics.transforms(q)
-        twists = kinematics.twists(transforms)
-        centre = transforms[:, platform, :3, 3]
-        omega = twists[..., :3]
-        working = np.concatenate([omega, (twists[..., 3:] + np.cross(omega, centre[:, None, :])) / scale], axis=-1)
-        return cls(tree.model, kinematics, platform, transforms, working, centre, scale)
-
-
-@dataclass(frozen=True)
-class LegScrews:
-    """One leg's equivalent chain at a batch of configurations: the actuated joint's unit twist (n, 6), a basis of
-    the twists the leg allows with it locked (n, 6, 6; the first ``locked_dims[n]`` rows), both in working
-    coordinates; the actuated joint's point, the ITI and OTI points (n, 3, world) and how far the actuated
-    joint's twist lies from the leg's twist system (n,)."""
-
-    own: NDArray[np.float64]
-    locked: NDArray[np.float64]
-    locked_dims: NDArray[np.int64]
-    allowed: NDArray[np.float64]
-    allowed_dims: NDArray[np.int64]
-    actuator_point: NDArray[np.float64]
-    iti_point: NDArray[np.float64]
-    oti_point: NDArray[np.float64]
-    outside: NDArray[np.float64]
-
-
-def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
-    """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
-    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
-    out = []
-    for leg in legs:
-        actuator = leg.actuators[0]
-        allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
-        locked, locked_dims = _twist_spaces(state, [j for j in leg.joints if j != actuator], leg)
-        own = state.working[:, kinematics.idx_v[actuator]]
-        own = own / np.linalg.norm(own, axis=1, keepdims=True)
-        valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
-        projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
-        iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
-        if leg.spine:
-            oti.append(state.transforms[:, platform, :3, 3])
-        if not iti or not oti:
-            raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint after its actuator or none on the "
-                               "platform.")
-        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, state.transforms[:, actuator, :3, 3],
-                             np.mean(iti, axis=0), np.mean(oti, axis=0), np.linalg.norm(own - projection, axis=1)))
-    return out, state
-
-
-def equivalent_chains(legs, screws: list[LegScrews], state: _State, rows: NDArray, model):
-    """The legs' equivalent chains (world coordinates) at the configurations ``rows`` of a batch, which share every
-    leg's twist-system dimension: ChainScrews of batch shape (len(rows),), ITI and OTI points (len(rows), legs,
-    3)."""
-    chains = []
-    centre, scale = state.centre[rows][:, None, :], state.scale
-    for leg, leg_screw in zip(legs, screws):
-        dims = int(leg_screw.locked_dims[rows[0]])
-        working = np.concatenate([leg_screw.own[rows][:, None, :], leg_screw.locked[rows][:, :dims]], axis=1)
-        world = np.concatenate([working[..., :3], working[..., 3:] * scale + np.cross(centre, working[..., :3])],
-                               axis=-1)
-        points = np.concatenate([leg_screw.actuator_point[rows][:, None, :],
-                                 np.repeat(leg_screw.oti_point[rows][:, None, :], dims, axis=1)], axis=1)
-        names = (model.names[leg.actuators[0]],) + tuple(f"{leg.name}_twist_{k + 1}" for k in range(dims))
-        chains.append(ChainScrews(world, points, (0,), leg.name, names))
-    iti = np.stack([s.iti_point[rows] for s in screws], axis=1)
-    oti = np.stack([s.oti_point[rows] for s in screws], axis=1)
-    return chains, iti, oti
-
-
-def dimension_groups(screws: list[LegScrews]) -> list[NDArray[np.int64]]:
-    """Configurations of a batch grouped by the dimensions of every leg's locked twist system (one group unless
-    some configurations are singular)."""
-    signature = np.stack([s.locked_dims for s in screws], axis=1)
-    _, inverse = np.unique(signature, axis=0, return_inverse=True)
-    return [np.flatnonzero(inverse.reshape(-1) == group) for group in range(int(inverse.max()) + 1)]
 
 
 def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
