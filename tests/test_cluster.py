@@ -158,6 +158,24 @@ def test_map_on_the_cluster_equals_the_local_map(cluster, local_map, tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["remote.nc"]
 
 
+def test_a_map_of_a_closed_loop_graph_on_the_cluster_equals_the_local_map(cluster, tmp_path):
+    """A rod-level Delta (legs with loops inside them): the workers read the file at its path and solve each pose
+    from the file's configuration, as the local threads do."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from delta_rods import delta_rods_mjcf
+
+    path = tmp_path / "delta.xml"
+    path.write_text(delta_rods_mjcf((0.02, -0.03, -0.45), np.radians([90.0, 180.0, 270.0, 0.0])))
+    arguments = ("map", path, "--grid", "x:-0.03:0.13:0.02", "--grid", "y:-0.1:0.1:0.02", "--at", "0 0 -0.45",
+                 "--task-size", "20")
+    local, remote = tmp_path / "local.nc", tmp_path / "remote.nc"
+    assert screwkit(*arguments, "--out", local).returncode == 0
+    result = screwkit(*arguments, "--scheduler", cluster.address, "--out", remote)
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr, result.stderr
+    assert_same_file(local, remote)
+
+
 def test_design_search_on_the_cluster_equals_the_local_search(cluster):
     local = screwkit(*SEARCH)
     remote = screwkit(*SEARCH, "--scheduler", cluster.address)

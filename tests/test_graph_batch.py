@@ -20,6 +20,8 @@ from helpers import one_line_error, random_rotation, screwkit
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.graph_kinematics import TreeKinematics
 from screwkit.io.mjcf import read_mjcf
+from screwkit.studies.graph_source import cached_graph, graph_source
+from screwkit.studies.maps import index_map
 from screwkit.studies.poses import graph_indices_at_poses
 from screwkit.studies.sweep import sweep
 
@@ -213,3 +215,47 @@ def test_the_command_line_sweeps_a_rod_level_delta_as_written(tmp_path):
             np.testing.assert_allclose(dataset["lmti"].values[k], expected["lmti"], atol=TOLERANCE)
     one_line_error(screwkit("sweep", path, "--sweep", "yaw:0:10:1"), "Unknown coordinate 'yaw'", "has x, y, z")
     one_line_error(screwkit("sweep", path, "--sweep", "z:-0.5:-0.4:0.05", "--closed-forms"), "no closed forms")
+
+
+def test_a_map_of_a_graph_is_the_textbook_indices_at_every_grid_point(tmp_path):
+    """index_map of the rod-level Delta over x, y at the file's height: each point's indices are the textbook
+    pressure angles there (one orientation: a Delta's platform does not turn)."""
+    graph = open_delta(tmp_path)
+    home = graph.task_pose()
+    xs, ys = home[0] + np.array([-0.04, 0.0, 0.05]), home[1] + np.array([-0.03, 0.02])
+    dataset = index_map(graph, {"x": xs, "y": ys}, {})
+    for row, y in enumerate(ys):
+        for column, x in enumerate(xs):
+            expected = textbook(np.add(POSES[0], [x - home[0], y - home[1], 0.0]))
+            np.testing.assert_allclose(dataset["lmti"].values[row, column], expected["lmti"], atol=TOLERANCE)
+            np.testing.assert_allclose(dataset["f_o1"].values[row, column], expected["f_o1"], atol=TOLERANCE)
+    assert (dataset["reachable_fraction"].values == 1.0).all()
+
+
+def test_a_map_task_rebuilds_the_graph_from_its_file_and_refuses_a_changed_file(tmp_path):
+    graph = open_delta(tmp_path)
+    source = graph_source(graph)
+    rebuilt = cached_graph(source)
+    np.testing.assert_array_equal(rebuilt.q, graph.q)
+    path = tmp_path / "delta.xml"
+    path.write_text(path.read_text() + "\n")
+    cached_graph.cache_clear()
+    with pytest.raises(ValueError, match=r"delta\.xml: the file changed while the map was computed"):
+        cached_graph(source)
+    path.unlink()
+    with pytest.raises(ValueError, match=r"delta\.xml: cannot be read where the map's task runs"):
+        cached_graph(source)
+
+
+def test_info_says_what_was_inferred_of_a_graph(tmp_path):
+    """``screwkit info FILE``: the task coordinates inferred from the motion space, the platform, the legs with their
+    joints, closures and solver, and the import report; as a subprocess."""
+    path = tmp_path / "delta.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], AZIMUTHS))
+    completed = screwkit("info", path)
+    assert completed.returncode == 0, completed.stderr
+    text = completed.stdout
+    assert "DOF 3; task coordinates: x (m), y (m), z (m) (inferred from the motion space)" in text
+    assert "platform 'platform' on 'platform_ball'" in text and "4 actuators: arm_1:motor_1" in text
+    assert "arm_2: motor_2 - ball_2a - ball_2b (actuated: motor_2); loop rod_2a_end, rod_2b_end (graph)" in text
+    assert "named poses" not in text and "Traceback" not in completed.stderr

@@ -120,3 +120,6 @@ def test_a_mechanism_whose_legs_have_loops_inside_reports_valid_json(tmp_path):
     report = validate("analyze", [path])
     assert report["dof"] == 3 and report["pose"] == {} and len(report["actuators"]) == 4
     assert any("graph" in line for line in report["converted"])
+    info = validate("info", [path])
+    assert info["dof"] == 3 and [c["name"] for c in info["task_coordinates"]] == ["x", "y", "z"]
+    assert [chain["loop_type"] for chain in info["chains"]] == ["graph"] * 4

@@ -16,12 +16,43 @@ from screwkit.cli.options import (
 )
 from screwkit.closure import working_modes
 from screwkit.common.units import is_angular, unit_of
+from screwkit.io import GraphMechanism
+from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
 
-__all__ = ["info", "mechanism_info"]
+__all__ = ["info", "mechanism_info", "graph_info"]
+
+
+def graph_info(graph: GraphMechanism) -> dict:
+    """:func:`mechanism_info` of a closed-loop graph: its legs (joints, closures), the platform and task coordinates
+    inferred from the graph, how poses are solved."""
+    model = graph.tree.model
+    mode = ("the one reached from the file's configuration by moving the platform straight to the pose "
+            "(continuation)")
+    return {
+        "mechanism": graph.name, "file": str(graph.tree.source), "length_unit": "m", "dof": graph.dof,
+        "task_coordinates": [{"name": name, "unit": unit_of(name)} for name in graph.task_coordinates],
+        "task_coordinates_source": "declared" if graph.tree.task_coordinates else "inferred",
+        "dependent_coordinates": [{"name": name, "unit": unit_of(name)} for name in SPATIAL_TASK_COORDINATES
+                                  if name not in graph.task_coordinates],
+        "instantaneous_dof_at_home": graph.dof, "output": "frame",
+        "platform": {"link": graph.platform_body, "joint": model.names[graph.platform], "base_link": "world",
+                     "planar": False},
+        "actuators": list(graph.actuators),
+        "chains": [{"name": leg.name, "joints": [model.names[j] for j in leg.joints],
+                    "actuated": [model.names[j] for j in leg.actuators],
+                    "loop": ", ".join(closure.name for closure in leg.closures), "loop_type": "graph",
+                    "solver": "graph", "why": "a leg with loops inside it: every closure of the mechanism solved at "
+                                              "once, batched (screwkit.io.graph_kinematics)",
+                    "working_mode": mode} for leg in graph.legs],
+        "named_poses": {}, "length_scale_m": graph.scale, "assembly_notes": list(graph.tree.notes),
+        "import_report": graph.report.lines(),
+    }
 
 
 def mechanism_info(mechanism) -> dict:
     """A JSON-ready description of a mechanism: DOF, task coordinates, chains, solvers, actuators, named poses."""
+    if isinstance(mechanism, GraphMechanism):
+        return graph_info(mechanism)
 
     def shown(pose):
         return {name: float(np.rad2deg(value) if is_angular(name) else value) + 0.0
@@ -63,7 +94,7 @@ def mechanism_info(mechanism) -> dict:
 def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
     actuators, named poses (m, deg)."""
-    loaded = load_mechanism(mechanism, reading, indices=False, limits=not ignore_limits)
+    loaded = load_mechanism(mechanism, reading, indices=False, limits=not ignore_limits, graphs=True)
     report = mechanism_info(loaded)
     if as_json:
         click.echo(json.dumps(report))
@@ -81,8 +112,9 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
                    "instantaneous DOF")
     if report["output"] == "point":
         click.echo("  output: the platform frame's origin, a point (rotations about it are idle)")
+    kind = "planar" if loaded.is_planar else "a leg's body" if isinstance(loaded, GraphMechanism) else "floating"
     click.echo(f"  platform {report['platform']['link']!r} on {report['platform']['joint']!r} "
-               f"({'planar' if loaded.is_planar else 'floating'}) from {report['platform']['base_link']!r}")
+               f"({kind}) from {report['platform']['base_link']!r}")
     click.echo(f"  {len(report['actuators'])} actuators: {', '.join(report['actuators'])}")
     click.echo("  chains:")
     for chain in report["chains"]:
@@ -96,6 +128,7 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
         click.echo("  converted from " + report["import_report"][0])
         for line in report["import_report"][1:]:
             click.echo(f"  {line}")
-    click.echo("  named poses (m, deg):")
+    if report["named_poses"]:
+        click.echo("  named poses (m, deg):")
     for name, pose in report["named_poses"].items():
         click.echo(f"    {name}: " + ", ".join(f"{k} = {v:.6g}" for k, v in pose.items()))

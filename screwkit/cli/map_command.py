@@ -142,6 +142,6 @@ def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution,
 
     outputs.check(quiet)
     area.check()
-    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
     result = _map(loaded, area, analysis, execution, yes, quiet)
     write_outputs(result, outputs, map_figure, quiet, vmin=outputs.vmin, vmax=outputs.vmax)

@@ -40,8 +40,8 @@ class LegWithLoops(ImportError_):
     configuration."""
 
 
-GRAPH_HINT = ("; `screwkit analyze FILE` (or screwkit.io.graph_mechanism) analyses it as a graph at the file's "
-              "configuration: poses, maps and sweeps need serial legs")
+GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep` and `map` (or screwkit.io.graph_mechanism) analyse it as a "
+              "graph; `convert` and the commands of serial legs do not")
 """What a :class:`LegWithLoops` message adds."""
 
 

@@ -27,11 +27,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.common.units import is_angular, unit_of
 from screwkit.indices.registry import index_columns
+from screwkit.io.graph import GraphMechanism
 from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
+from screwkit.studies.graph_source import GraphSource, cached_graph, graph_source
 from screwkit.studies.options import AnalysisOptions
-from screwkit.studies.poses import indices_at_poses
+from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.tasks import Execution, run_tasks
 
 __all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "disc_size",
@@ -192,8 +194,11 @@ def _netcdf_attribute(value):
     return value
 
 
-def portable(mechanism: Mechanism) -> tuple[str, str, str]:
-    """What a task needs to rebuild the mechanism anywhere: (digest, URDF text in metres, source name)."""
+def portable(mechanism: Mechanism | GraphMechanism):
+    """What a task needs to rebuild the mechanism anywhere: (digest, URDF text in metres, source name); a
+    :class:`GraphSource` for a closed-loop graph."""
+    if isinstance(mechanism, GraphMechanism):
+        return graph_source(mechanism)
     text = mechanism.description.text
     text = text if isinstance(text, str) else text.decode()
     return hashlib.sha256(text.encode()).hexdigest(), text, str(mechanism.path)
@@ -262,13 +267,21 @@ def map_task(mechanism_text: tuple[str, str, str], block: MapBlock, analysis: An
         ``f_o{j}``, ``f_io{j}`` (NaN where some orientation is unreachable) and
         ``reachable_fraction``.
     """
+    if isinstance(mechanism_text, GraphSource):
+        return map_block(cached_graph(mechanism_text), block, analysis, threads)
     # read as it was loaded: limits ignored at loading (--ignore-limits) are ignored where the task runs too
     return map_block(cached_mechanism(*mechanism_text, limits=analysis.limits), block, analysis, threads)
 
 
-def map_block(mechanism: Mechanism, block: MapBlock, analysis: AnalysisOptions, threads: int = 1) -> dict:
+def map_block(mechanism: Mechanism | GraphMechanism, block: MapBlock, analysis: AnalysisOptions,
+              threads: int = 1) -> dict:
     """:func:`map_task` on a loaded mechanism (in the calling process)."""
-    result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
+    if isinstance(mechanism, GraphMechanism):
+        check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
+        result = graph_indices_at_poses(mechanism, block.poses(), threads=threads, threshold=analysis.threshold,
+                                        faults=analysis.faults, limits=analysis.limits)
+    else:
+        result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
     for name, values in index_columns(result).items():  # every registered index: the worst orientation (its `reduce`)
@@ -337,7 +350,9 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
 
     Parameters
     ----------
-    mechanism : Mechanism
+    mechanism : Mechanism or GraphMechanism
+        A mechanism whose legs have loops inside them is solved at each pose by continuation from its file's
+        configuration (:func:`~screwkit.studies.poses.graph_indices_at_poses`).
     grid : dict of str to array_like
         Exactly two task coordinates and their values (metres / radians); the first is the
         map's x axis, the second its y axis.
@@ -366,7 +381,11 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
         orientation of the set) and ``reachable_fraction``.
     """
-    require_mechanism(mechanism, "index_map")
+    analysis = AnalysisOptions() if analysis is None else analysis
+    if isinstance(mechanism, GraphMechanism):
+        check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
+    else:
+        require_mechanism(mechanism, "index_map")
     names = mechanism.task_coordinates
     if len(grid) != 2:
         raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
@@ -382,7 +401,6 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != shape:
             raise ValueError(f"Expected `mask` with shape {shape} (y, x), got {mask.shape}.")
-    analysis = AnalysisOptions() if analysis is None else analysis
     execution = Execution() if execution is None else execution
     size = map_size(mechanism, grid, over, mask, analysis.faults)
     size.check(max_configurations=max_configurations, proceed=proceed)

@@ -25,8 +25,8 @@ from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism, dimension_groups, equivalent_chains, leg_screws
 from screwkit.model import Mechanism, require_mechanism
 
-__all__ = ["indices_at_poses", "indices_at_pose", "graph_indices_at_poses", "GRAPH_CHUNK", "analyze_solution",
-           "output_points", "planar_points",
+__all__ = ["indices_at_poses", "indices_at_pose", "graph_indices_at_poses", "check_graph_analysis", "GRAPH_CHUNK",
+           "analyze_solution", "output_points", "planar_points",
            "closed_form_indices"]
 
 
@@ -375,6 +375,13 @@ def indices_at_pose(mechanism: Mechanism, pose: ArrayLike, *, threshold: float =
 GRAPH_CHUNK = 4096
 """Poses of a closed-loop graph solved and analysed at a time by :func:`graph_indices_at_poses` (its closure
 Jacobians take about 10 kB a pose for a rod-level Delta)."""
+
+
+def check_graph_analysis(graph: GraphMechanism, closed_forms: bool = False, fault_type: str = "free-swinging") -> None:
+    """A ValueError when a study asks a closed-loop graph for what it does not have."""
+    if closed_forms or fault_type != "free-swinging":
+        raise ValueError(f"{graph.name}: a mechanism whose legs have loops inside them is analysed by the generic "
+                         "screw path with free-swinging faults (no closed forms, no link faults).")
 
 
 def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,

@@ -19,7 +19,7 @@ from screwkit.common.units import is_angular
 from screwkit.indices.results import set_label
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.studies.poses import graph_indices_at_poses, indices_at_poses
+from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 
 __all__ = ["sweep"]
 
@@ -61,10 +61,9 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
     """
 
     graph = isinstance(mechanism, GraphMechanism)
-    if graph and (closed_forms or fault_type != "free-swinging"):
-        raise ValueError(f"{mechanism.name}: a mechanism whose legs have loops inside them is analysed by the generic "
-                         "screw path with free-swinging faults (no closed forms, no link faults).")
-    if not graph:
+    if graph:
+        check_graph_analysis(mechanism, closed_forms, fault_type)
+    else:
         require_mechanism(mechanism, "sweep")
     if coordinate not in mechanism.task_coordinates:
         raise ValueError(f"Expected `coordinate` in {mechanism.task_coordinates}, got {coordinate!r}.")
