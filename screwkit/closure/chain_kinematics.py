@@ -163,6 +163,76 @@ def _compiled_frames(geometry: ChainGeometry, joint_values: NDArray) -> ChainFra
                        end_rotation.reshape(batch + (3, 3)), end_translation.reshape(batch + (3,)))
 
 
+def _skew_one(vector: NDArray) -> NDArray:
+    """:func:`~screwkit.common.rotations.skew_matrix` of one vector."""
+    x, y, z = vector
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _turn_one(rotation: NDArray, axis: NDArray, angle: float) -> NDArray:
+    """:func:`_turn` of one rotation, with the same arithmetic."""
+    skew = _skew_one(axis)
+    return rotation + np.sin(angle) * (rotation @ skew) + (1.0 - np.cos(angle)) * (rotation @ (skew @ skew))
+
+
+def _rotation_from_rotation_vector_one(vector: NDArray) -> NDArray:
+    """:func:`~screwkit.common.rotations.rotation_from_rotation_vector` of one vector, with the same arithmetic."""
+    angle = np.linalg.norm(vector, axis=-1)
+    square = np.square(angle)  # as the batched ``angle**2`` computes it
+    if angle < 1e-6:
+        sine_term, cosine_term = 1.0 - square / 6.0, 0.5 - square / 24.0
+    else:
+        sine_term, cosine_term = np.sin(angle) / angle, (1.0 - np.cos(angle)) / square
+    skew = _skew_one(vector)
+    return _IDENTITY + sine_term * skew + cosine_term * (skew @ skew)
+
+
+def _single_frames(geometry: ChainGeometry, joint_values: NDArray, batch: tuple[int, ...]) -> ChainFrames:
+    """:func:`chain_forward_kinematics` of one configuration (m,), returned with the leading ``batch`` axes
+    (all of length 1): the same products in the same order as the batched path, without its broadcasting,
+    which costs more than the arithmetic for one configuration (the reference assembly of a model)."""
+    m, n_tree = geometry.n_dofs, geometry.n_tree_joints
+    axes, points = np.empty((m, 3)), np.empty((m, 3))
+    rotation, translation = _IDENTITY, np.zeros(3)
+    for index in range(n_tree):
+        translation = translation + rotation @ geometry.joint_translations[index]
+        rotation = rotation @ geometry.joint_rotations[index]
+        axis = rotation @ geometry.joint_axes[index]
+        axes[index] = axis
+        if geometry.joint_prismatic[index]:
+            translation = translation + axis * joint_values[index]
+        else:
+            rotation = _turn_one(rotation, geometry.joint_axes[index], joint_values[index])
+        points[index] = translation
+    translation = translation + rotation @ geometry.leg_loop_translation
+    rotation = rotation @ geometry.leg_loop_rotation
+    leg_rotation, leg_translation = rotation, translation
+    loop_values = joint_values[n_tree:]
+    loop_type = geometry.loop_type
+    if loop_type in ("revolute", "continuous"):
+        axes[n_tree] = rotation @ geometry.loop_axes[0]
+        points[n_tree] = translation
+        rotation = _turn_one(rotation, geometry.loop_axes[0], loop_values[0])
+    elif loop_type == "prismatic":
+        axis = rotation @ geometry.loop_axes[0]
+        axes[n_tree] = axis
+        translation = translation + axis * loop_values[0]
+        points[n_tree] = translation
+    elif loop_type == "universal":
+        axes[n_tree] = rotation @ geometry.loop_axes[0]
+        points[n_tree : n_tree + 2] = translation
+        rotation = _turn_one(rotation, geometry.loop_axes[0], loop_values[0])
+        axes[n_tree + 1] = rotation @ geometry.loop_axes[1]
+        rotation = _turn_one(rotation, geometry.loop_axes[1], loop_values[1])
+    elif loop_type == "spherical":
+        axes[n_tree : n_tree + 3] = rotation.T
+        points[n_tree : n_tree + 3] = translation
+        rotation = rotation @ _rotation_from_rotation_vector_one(loop_values)
+    return ChainFrames(axes.reshape(batch + (m, 3)), points.reshape(batch + (m, 3)),
+                       leg_rotation.reshape(batch + (3, 3)), leg_translation.reshape(batch + (3,)),
+                       rotation.reshape(batch + (3, 3)), translation.reshape(batch + (3,)))
+
+
 def chain_forward_kinematics(geometry: ChainGeometry, joint_values: ArrayLike, *,
                              compiled: bool | None = None) -> ChainFrames:
     """Forward kinematics of one chain for a batch of joint values (..., m), base frame.
@@ -180,8 +250,11 @@ def chain_forward_kinematics(geometry: ChainGeometry, joint_values: ArrayLike, *
             f"got {joint_values.shape}."
         )
     batch = joint_values.shape[:-1]
-    if compiled or (compiled is None and int(np.prod(batch, dtype=np.int64)) >= COMPILED_FROM):
+    count = int(np.prod(batch, dtype=np.int64))
+    if compiled or (compiled is None and count >= COMPILED_FROM):
         return _compiled_frames(geometry, joint_values)
+    if count == 1:
+        return _single_frames(geometry, joint_values.reshape(geometry.n_dofs), batch)
     axes = np.empty(batch + (geometry.n_dofs, 3))
     points = np.empty(batch + (geometry.n_dofs, 3))
     rotation = np.broadcast_to(_IDENTITY, batch + (3, 3))
@@ -323,6 +396,30 @@ def _linear_combination(out: NDArray, terms: list) -> None:
             out += coefficient * plane
 
 
+def _combination(terms: list) -> float:
+    """:func:`_linear_combination` of numbers: zero coefficients skipped, the first term as ``plane * coefficient``."""
+    total = None
+    for coefficient, value in terms:
+        if coefficient == 0.0:
+            continue
+        total = value * coefficient if total is None else total + coefficient * value
+    return 0.0 if total is None else total
+
+
+def _single_twists(axes: NDArray, points: NDArray, prismatic) -> NDArray[np.float64]:
+    """:func:`twists_from_axes_and_points` of one configuration (m, 3), with the same arithmetic in numbers."""
+    twists = np.zeros((axes.shape[0], 6))
+    for joint, (axis, point) in enumerate(zip(axes.tolist(), points.tolist())):
+        start = 3 if prismatic[joint] else 0
+        twists[joint, start : start + 3] = [value if value != 0.0 else 0.0 for value in axis]
+        if prismatic[joint]:
+            continue
+        (ax, ay, az), (px, py, pz) = axis, point
+        twists[joint, 3:] = (_combination([(az, py), (-ay, pz)]), _combination([(ax, pz), (-az, px)]),
+                             _combination([(ay, px), (-ax, py)]))
+    return twists
+
+
 def twists_from_axes_and_points(
     axes: NDArray, points: NDArray, prismatic: tuple[bool, ...] | NDArray, out: NDArray | None = None
 ) -> NDArray[np.float64]:
@@ -339,6 +436,8 @@ def twists_from_axes_and_points(
     component-major array (6, m, ...), receives the result (several chains can so share one
     block of memory that the index kernel reads in place).
     """
+    if out is None and np.ndim(axes) == 2 and np.ndim(points) == 2:
+        return _single_twists(np.asarray(axes, dtype=float), np.asarray(points, dtype=float), prismatic)
     axes_components = np.moveaxis(np.asarray(axes, dtype=float), (-1, -2), (0, 1))
     points_components = np.moveaxis(np.asarray(points, dtype=float), (-1, -2), (0, 1))
     prismatic = np.asarray(prismatic, dtype=bool)

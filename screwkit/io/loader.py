@@ -56,10 +56,12 @@ def _named_poses(description: UrdfDescription, mechanism: Mechanism) -> dict[str
     return poses
 
 
-def mechanism_from_description(description: UrdfDescription, *, limits: bool = True) -> Mechanism:
-    """The mechanism of a file's description (see :func:`load`)."""
+def mechanism_from_description(description: UrdfDescription, *, limits: bool = True, model=None) -> Mechanism:
+    """The mechanism of a file's description (see :func:`load`); ``model``: its Pinocchio model when it is
+    already built (:func:`~screwkit.model.pinocchio_bridge.model_from_description`), else built from its text."""
     name = description.robot_name or Path(description.source).stem
-    model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
+    if model is None:
+        model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
     platform = read_platform(description, model, name)
     chains = read_chains(description, model, platform)
     draft = Mechanism(

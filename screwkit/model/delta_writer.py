@@ -12,9 +12,10 @@ import math
 import numpy as np
 
 from screwkit.common.rotations import rpy_from_rotation
+from screwkit.model.urdf_document import UrdfDocument
 from screwkit.model.urdf_writer import UrdfWriter
 
-__all__ = ["delta_leg", "delta_urdf"]
+__all__ = ["delta_leg", "delta_document", "delta_urdf"]
 
 Z_AXIS = np.array([0.0, 0.0, 1.0])
 
@@ -45,6 +46,11 @@ def delta_leg(parameters: dict, position, angle: float) -> dict:
 
 
 def delta_urdf(name: str, parameters: dict, comment: str = "") -> str:
+    """The URDF text of :func:`delta_document`."""
+    return delta_document(name, parameters, comment).text()
+
+
+def delta_document(name: str, parameters: dict, comment: str = "") -> UrdfDocument:
     """A Delta robot (3 DOF: x, y, z) with a leg at each of ``parameters["leg_angles_deg"]``.
 
     Leg i: actuated revolute ``leg_i_joint_arm`` about a_i (horizontal, tangent to the base circle)
@@ -83,4 +89,4 @@ def delta_urdf(name: str, parameters: dict, comment: str = "") -> str:
         writer.transmission(f"{chain}_joint_arm")
     for pose_name, (x, y, z) in parameters.get("named_poses", {}).items():
         writer.named_pose(pose_name, {"x": x, "y": y, "z": z})
-    return writer.text()
+    return writer.document()

@@ -14,9 +14,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
+from screwkit.model.urdf_document import UrdfDocument
 from screwkit.model.urdf_writer import UrdfWriter
 
-__all__ = ["slot_angles", "hexapod_points", "ups_hexapod_urdf", "rss_hexapod_urdf", "unit", "universal_axes"]
+__all__ = ["slot_angles", "hexapod_points", "ups_hexapod_document", "ups_hexapod_urdf", "rss_hexapod_document",
+           "rss_hexapod_urdf", "unit", "universal_axes"]
 
 Z_AXIS = np.array([0.0, 0.0, 1.0])
 
@@ -59,6 +61,12 @@ def _radius(points: NDArray) -> float:
 
 
 def ups_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float, comment: str = "") -> str:
+    """The URDF text of :func:`ups_hexapod_document`."""
+    return ups_hexapod_document(name, base, platform, height, comment).text()
+
+
+def ups_hexapod_document(name: str, base: NDArray, platform: NDArray, height: float,
+                         comment: str = "") -> UrdfDocument:
     """An a-UPS hexapod: U at ``base`` (a, 3), actuated slider along the leg, S at ``platform`` (a, 3,
     platform frame). Slider limits: -0.5 to +0.8 times the reference leg length."""
     writer = UrdfWriter(name, comment)
@@ -84,11 +92,17 @@ def ups_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float,
                     f"{chain}_piston", ((length, 0, 0), (0, 0, 0)),
                     "platform", (platform[i], rpy_from_rotation(leg_rotation)))  # fmt: skip
         writer.transmission(f"{chain}_joint_slider")
-    return writer.text()
+    return writer.document()
 
 
 def rss_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float, crank: float,
                      comment: str = "") -> str:
+    """The URDF text of :func:`rss_hexapod_document`."""
+    return rss_hexapod_document(name, base, platform, height, crank, comment).text()
+
+
+def rss_hexapod_document(name: str, base: NDArray, platform: NDArray, height: float, crank: float,
+                         comment: str = "") -> UrdfDocument:
     """An a-RSS hexapod (modelled R-U-S: the rod's idle spin is removed): actuated crank pivots at
     ``base`` (a, 3) with horizontal axes tangent to the base circle, cranks of length ``crank``
     pointing radially outwards in the reference assembly, S at ``platform`` (a, 3, platform frame)."""
@@ -121,4 +135,4 @@ def rss_hexapod_urdf(name: str, base: NDArray, platform: NDArray, height: float,
                     f"{chain}_rod", ((rod_length, 0, 0), (0, 0, 0)),
                     "platform", (platform[i], rpy_from_rotation(rod_rotation)))  # fmt: skip
         writer.transmission(f"{chain}_joint_crank")
-    return writer.text()
+    return writer.document()

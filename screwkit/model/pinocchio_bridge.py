@@ -21,6 +21,7 @@ from screwkit.common.rotations import quaternion_from_rotation
 __all__ = [
     "twist_from_pinocchio_motion",
     "build_model",
+    "model_from_description",
     "body_frame",
     "joint_axis_local",
     "configuration_vector",
@@ -48,6 +49,95 @@ def build_model(text: str, fail):
     except Exception as error:  # Pinocchio raises plain RuntimeErrors
         message = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
         raise fail(f"Pinocchio cannot build the model: {message}") from None
+
+
+_AXIS_MODELS = {  # joint type -> (name prefix of the joint models about x, y, z, the unaligned model's name)
+    "revolute": ("JointModelR", "JointModelRevoluteUnaligned"),
+    "continuous": ("JointModelRUB", "JointModelRevoluteUnboundedUnaligned"),
+    "prismatic": ("JointModelP", "JointModelPrismaticUnaligned"),
+}
+
+
+def _joint_model(pinocchio, joint):
+    """The Pinocchio joint model its URDF parser makes of a tree joint (an axis equal to x, y or z: the
+    specialised model; else the unaligned one)."""
+    if joint.type == "floating":
+        return pinocchio.JointModelFreeFlyer()
+    if joint.type == "planar":
+        return pinocchio.JointModelPlanar()
+    prefix, unaligned = _AXIS_MODELS[joint.type]
+    for letter, unit in zip("XYZ", np.eye(3)):
+        if np.array_equal(joint.axis, unit):
+            return getattr(pinocchio, prefix + letter)()
+    return getattr(pinocchio, unaligned)(np.asarray(joint.axis, dtype=float))
+
+
+def _placement(pinocchio, origin):
+    """A URDF ``<origin>`` as Pinocchio's parser makes it: the rpy angles through urdfdom's unit quaternion."""
+    roll, pitch, yaw = (0.5 * float(angle) for angle in origin.rpy)
+    sr, cr, sp, cp, sy, cy = np.sin(roll), np.cos(roll), np.sin(pitch), np.cos(pitch), np.sin(yaw), np.cos(yaw)
+    x = sr * cp * cy - cr * sp * sy
+    y = cr * sp * cy + sr * cp * sy
+    z = cr * cp * sy - sr * sp * cy
+    w = cr * cp * cy + sr * sp * sy
+    norm = np.sqrt(x * x + y * y + z * z + w * w)
+    quaternion = pinocchio.Quaternion(w / norm, x / norm, y / norm, z / norm)
+    return pinocchio.SE3(quaternion.matrix(), np.asarray(origin.xyz, dtype=float))
+
+
+def _parser_limits(joint, nq: int, nv: int) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Effort, velocity, lower and upper configuration limits of a joint as Pinocchio's URDF parser sets them:
+    the file's for revolute and prismatic joints; +-1.01 on unit-complex and quaternion parts, else unbounded."""
+    if joint.type in ("revolute", "prismatic", "continuous"):
+        effort, velocity = (np.array([value], dtype=float) for value in joint.drive_limits)
+    else:
+        effort, velocity = np.full(nv, np.inf), np.full(nv, np.inf)
+    if joint.type in ("revolute", "prismatic"):
+        return effort, velocity, np.array([joint.limits[0]], dtype=float), np.array([joint.limits[1]], dtype=float)
+    unbounded = {"continuous": 0, "planar": 2, "floating": 3}[joint.type]  # coordinates before the unit parts
+    lower, upper = np.full(nq, -1.01), np.full(nq, 1.01)
+    lower[:unbounded], upper[:unbounded] = -np.inf, np.inf
+    return effort, velocity, lower, upper
+
+
+def model_from_description(description):
+    """The Pinocchio model :func:`build_model` makes of the description's text, built without the text.
+
+    For descriptions a writer built (:meth:`screwkit.model.urdf_document.UrdfDocument.description`): tree
+    joints revolute, continuous, prismatic, floating or planar, links without inertia. As Pinocchio's URDF
+    parser (through urdfdom) does: the root link is a body frame of the universe, the tree is walked depth
+    first with the child joints of a link in the order of their names, each joint followed by its frame
+    and its child link's body frame; joint limits as the parser sets them.
+    """
+    import pinocchio
+
+    children: dict[str, list] = {}
+    for joint in description.joints.values():
+        if joint.type not in ("revolute", "continuous", "prismatic", "floating", "planar"):
+            raise description.fail(f"<joint name='{joint.name}'>",
+                                   f"a {joint.type} joint: the model is built from the text for it.")
+        children.setdefault(joint.parent, []).append(joint)
+    child_links = {joint.child for joint in description.joints.values()}
+    root = next(link for link in description.links if link not in child_links)
+    model = pinocchio.Model()
+    model.name = description.robot_name
+    model.addFrame(pinocchio.Frame(root, 0, 0, pinocchio.SE3.Identity(), pinocchio.FrameType.BODY))
+
+    def add_subtree(link: str) -> None:
+        parent_frame_id = model.getFrameId(link, pinocchio.FrameType.BODY)
+        parent_frame = model.frames[parent_frame_id]
+        for joint in sorted(children.get(link, ()), key=lambda joint: joint.name):
+            joint_model = _joint_model(pinocchio, joint)
+            placement = parent_frame.placement * _placement(pinocchio, joint.origin)
+            joint_id = model.addJoint(parent_frame.parentJoint, joint_model, placement, joint.name,
+                                      *_parser_limits(joint, joint_model.nq, joint_model.nv))
+            joint_frame = model.addJointFrame(joint_id, parent_frame_id)
+            model.appendBodyToJoint(joint_id, pinocchio.Inertia.Zero(), pinocchio.SE3.Identity())
+            model.addBodyFrame(joint.child, joint_id, pinocchio.SE3.Identity(), joint_frame)
+            add_subtree(joint.child)
+
+    add_subtree(root)
+    return model
 
 
 def body_frame(model, link: str):

@@ -13,14 +13,22 @@ import numpy as np
 
 from screwkit.common.rotations import rpy_from_rotation
 from screwkit.model.hexapod_writer import unit, universal_axes
+from screwkit.model.urdf_document import UrdfDocument
 from screwkit.model.urdf_writer import UrdfWriter
 
-__all__ = ["prs_urdf"]
+__all__ = ["prs_document", "prs_urdf"]
 
 
 def prs_urdf(name: str, parameters: dict, with_ups: bool = True, comment: str = "",
              task_coordinates: tuple[str, ...] | None = None,
              named_poses: dict[str, dict[str, float]] | None = None) -> str:
+    """The URDF text of :func:`prs_document`."""
+    return prs_document(name, parameters, with_ups, comment, task_coordinates, named_poses).text()
+
+
+def prs_document(name: str, parameters: dict, with_ups: bool = True, comment: str = "",
+                 task_coordinates: tuple[str, ...] | None = None,
+                 named_poses: dict[str, dict[str, float]] | None = None) -> UrdfDocument:
     """A 3-PRS (vertical actuated sliders, R axes tangential, S at the platform), optionally with a fourth,
     actuated U-P-S leg that adds no constraint (3 DOF: z, roll, pitch; 4 actuators).
 
@@ -84,4 +92,4 @@ def prs_urdf(name: str, parameters: dict, with_ups: bool = True, comment: str = 
         writer.task_coordinates(task_coordinates)
     for pose_name, values in (named_poses or {}).items():
         writer.named_pose(pose_name, values)
-    return writer.text()
+    return writer.document()

@@ -8,6 +8,8 @@ They are read by :func:`screwkit.model.urdf_reader.parse_urdf`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,6 +54,8 @@ class JointElement:
     axis: NDArray[np.float64]
     limits: tuple[float, float] = (-np.inf, np.inf)
     """Position limits (rad or m): ``<limit lower upper>`` of revolute and prismatic joints, else unlimited."""
+    drive_limits: tuple[float, float] = (np.inf, np.inf)
+    """``<limit effort velocity>`` (N or N m, m/s or rad/s), as Pinocchio reads them; unlimited when absent."""
 
 
 @dataclass(frozen=True)
@@ -90,8 +94,6 @@ class UrdfDescription:
     ----------
     source : str
         File path (or ``"<string>"``) used in error messages.
-    text : str
-        The document, checked to contain no DTD, for :func:`pinocchio.buildModelFromXML`.
     robot_name : str
     links : tuple of str
     joints : dict of str to JointElement
@@ -111,10 +113,15 @@ class UrdfDescription:
     output : str
         ``"frame"`` (the platform frame, the default) or ``"point"`` (``<output type="point"/>``:
         the platform frame's origin is a point output, rotations about it are idle).
+    read_text : str
+        The document as read (in metres), checked to contain no DTD; empty for a description built
+        from a :class:`~screwkit.model.urdf_document.UrdfDocument`.
+    document : UrdfDocument or None
+        The records a writer built this description from (:meth:`UrdfDocument.description`), which
+        write :attr:`text` when it is asked for; None for a description read from a text.
     """
 
     source: str
-    text: str
     robot_name: str
     links: tuple[str, ...]
     joints: dict[str, JointElement]
@@ -125,6 +132,14 @@ class UrdfDescription:
     length_unit: str = "m"
     task_coordinates: tuple[str, ...] | None = None
     output: str = "frame"
+    read_text: str = field(default="", repr=False)
+    document: Any = field(default=None, repr=False, compare=False)
+
+    @cached_property
+    def text(self) -> str:
+        """The URDF text in metres (for :func:`pinocchio.buildModelFromXML` and the viewer): the text read, or
+        the one the document writes, on first use."""
+        return self.document.text() if self.document is not None else self.read_text
 
     def fail(self, element: str, problem: str) -> ValueError:
         """A one-line error naming this file, an element and a problem."""

@@ -38,6 +38,15 @@ level and crashes the process on a stack overflow at a few hundred levels in a t
 small stack (about 230 with 512 KiB, 3,800 with 8 MiB), so deeper trees are refused."""
 
 
+def _lenient_number(element: ElementTree.Element | None, attribute: str) -> float:
+    """A number that screwkit does not use itself (an effort limit): inf when absent or unreadable."""
+    try:
+        value = float(element.get(attribute))
+    except (AttributeError, TypeError, ValueError):
+        return np.inf
+    return value if np.isfinite(value) else np.inf
+
+
 class ElementReader:
     """Element-by-element reading with file-and-element error messages."""
 
@@ -102,7 +111,7 @@ class ElementReader:
                 raise self.fail(f"<output type='{output}'>", "expected type 'frame' or 'point'.")
         return UrdfDescription(
             source=self.source,
-            text=text,
+            read_text=text,
             robot_name=robot_name,
             links=tuple(links),
             joints=joints,
@@ -250,6 +259,7 @@ class ElementReader:
             origin=self.origin(element, tag),
             axis=np.array([1.0, 0.0, 0.0]) if axis is None else axis,
             limits=limits,
+            drive_limits=(_lenient_number(limit, "effort"), _lenient_number(limit, "velocity")),
         )
 
     def read_loop(self, element: ElementTree.Element, links: set[str]) -> LoopElement:

@@ -1,124 +1,100 @@
 """Writing mechanisms in screwkit's URDF convention (``docs/urdf-convention.md``).
 
-:class:`UrdfWriter` builds one document with ElementTree: links with primitive visuals, tree
-joints, URDF+ ``<loop>`` joints closing the chains, ``<transmission>`` elements marking the
-actuators, the optional ``<reference_configuration>`` and ``<named_pose>`` elements. Numbers
-are written as the shortest text that reads back as the same float. :func:`planar_rrr_urdf`
-writes a whole planar n-RRR (the bundled ``planar_5rrr`` and the designs of
-``screwkit design-search``).
+:class:`UrdfWriter` builds one :class:`~screwkit.model.urdf_document.UrdfDocument`: links with primitive
+visuals, tree joints, URDF+ ``<loop>`` joints closing the chains, ``<transmission>`` elements marking the
+actuators, the optional ``<reference_configuration>`` and ``<named_pose>`` elements. The document gives
+the description a file of it would be read as (:meth:`UrdfWriter.description`, no text written) and its
+text (:meth:`UrdfWriter.text`), where numbers are the shortest text that reads back as the same float.
+:func:`planar_rrr_document` builds a whole planar n-RRR (the bundled ``planar_5rrr`` and the designs of
+``screwkit design-search``), :func:`planar_rrr_urdf` writes it.
 """
 
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["UrdfWriter", "planar_rrr_urdf", "elbow"]
+from screwkit.model.urdf_description import UrdfDescription
+from screwkit.model.urdf_document import (
+    ExtensionRecord,
+    JointRecord,
+    LinkRecord,
+    LoopRecord,
+    TransmissionRecord,
+    UrdfDocument,
+    written_number,
+    written_triple,
+)
+
+__all__ = ["UrdfWriter", "planar_rrr_document", "planar_rrr_urdf", "elbow"]
 
 
-def _number(value: float) -> str:
-    """Shortest text that reads back as the same float (integers without '.0', tiny values as 0)."""
-    value = float(value)
-    if abs(value) < 1e-15:
-        return "0"
-    if value.is_integer():
-        return str(int(value))
-    return repr(value)
-
-
-def _triple(values) -> str:
-    return " ".join(_number(value) for value in values)
+def _pose(pose) -> tuple:
+    xyz, rpy = pose
+    return written_triple(xyz), written_triple(rpy)
 
 
 class UrdfWriter:
-    """Builds one URDF document with ElementTree."""
+    """Builds one mechanism document, element by element (:class:`~screwkit.model.urdf_document.UrdfDocument`)."""
 
     def __init__(self, name: str, comment: str):
-        self.robot = ElementTree.Element("robot", name=name)
-        # "--" may not appear inside an XML comment.
-        self.robot.append(ElementTree.Comment(comment.replace("--", "- -")))
+        self.name, self.comment = name, comment
+        self.records: list = []
 
     def link(self, name: str, shape: tuple | None = None, xyz=(0, 0, 0), rpy=(0, 0, 0)) -> None:
         """A link; ``shape`` is ("box", size3), ("cylinder", radius, length) or ("sphere", radius)."""
-        link = ElementTree.SubElement(self.robot, "link", name=name)
-        if shape is None:
-            return
-        visual = ElementTree.SubElement(link, "visual")
-        ElementTree.SubElement(visual, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        geometry = ElementTree.SubElement(visual, "geometry")
-        if shape[0] == "box":
-            ElementTree.SubElement(geometry, "box", size=_triple(shape[1]))
-        elif shape[0] == "cylinder":
-            ElementTree.SubElement(geometry, "cylinder", radius=_number(shape[1]), length=_number(shape[2]))
-        else:
-            ElementTree.SubElement(geometry, "sphere", radius=_number(shape[1]))
+        self.records.append(LinkRecord(name, shape, written_triple(xyz), written_triple(rpy)))
 
     def rod(self, name: str, length: float, radius: float = 0.015) -> None:
         """A link drawn as a cylinder from its origin along its x axis."""
         self.link(name, ("cylinder", radius, length), xyz=(length / 2, 0, 0), rpy=(0, math.pi / 2, 0))
 
     def joint(self, name, joint_type, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=None, limit=None) -> None:
-        joint = ElementTree.SubElement(self.robot, "joint", name=name, type=joint_type)
-        ElementTree.SubElement(joint, "parent", link=parent)
-        ElementTree.SubElement(joint, "child", link=child)
-        ElementTree.SubElement(joint, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        if axis is not None:
-            ElementTree.SubElement(joint, "axis", xyz=_triple(axis))
-        if limit is not None:
-            lower, upper, effort, velocity = limit
-            ElementTree.SubElement(
-                joint, "limit", lower=_number(lower), upper=_number(upper), effort=_number(effort),
-                velocity=_number(velocity)
-            )
+        self.records.append(JointRecord(
+            name, joint_type, parent, child, written_triple(xyz), written_triple(rpy),
+            None if axis is None else written_triple(axis),
+            None if limit is None else tuple(written_number(value) for value in limit)))
 
     def loop(
         self, name, loop_type, chain, predecessor, predecessor_pose, successor, successor_pose, axis=None,
         second_axis=None
     ) -> None:
         """A URDF+ loop joint; poses are (xyz, rpy) of the loop frame in each link frame."""
-        loop = ElementTree.SubElement(self.robot, "loop", name=name, type=loop_type, chain=chain)
-        for tag, link, (xyz, rpy) in (
-            ("predecessor", predecessor, predecessor_pose),
-            ("successor", successor, successor_pose),
-        ):
-            side = ElementTree.SubElement(loop, tag, link=link)
-            ElementTree.SubElement(side, "origin", xyz=_triple(xyz), rpy=_triple(rpy))
-        if axis is not None:
-            ElementTree.SubElement(loop, "axis", xyz=_triple(axis))
-        if second_axis is not None:
-            ElementTree.SubElement(loop, "axis2", xyz=_triple(second_axis))
+        self.records.append(LoopRecord(name, loop_type, chain, predecessor, _pose(predecessor_pose), successor,
+                                       _pose(successor_pose), None if axis is None else written_triple(axis),
+                                       None if second_axis is None else written_triple(second_axis)))
 
     def transmission(self, joint: str) -> None:
-        transmission = ElementTree.SubElement(self.robot, "transmission", name=f"{joint}_transmission")
-        ElementTree.SubElement(transmission, "type").text = "transmission_interface/SimpleTransmission"
-        joint_element = ElementTree.SubElement(transmission, "joint", name=joint)
-        ElementTree.SubElement(joint_element, "hardwareInterface").text = "hardware_interface/EffortJointInterface"
-        actuator = ElementTree.SubElement(transmission, "actuator", name=f"{joint}_motor")
-        ElementTree.SubElement(actuator, "mechanicalReduction").text = "1"
+        self.records.append(TransmissionRecord(joint))
 
     def task_coordinates(self, names) -> None:
         """``<task_coordinates names="z roll pitch"/>``: the independent coordinates of a lower-mobility mechanism."""
-        ElementTree.SubElement(self.robot, "task_coordinates", names=" ".join(names))
+        self.records.append(ExtensionRecord("task_coordinates", tuple(names)))
 
     def output(self, output_type: str) -> None:
         """``<output type="point"/>``: the platform frame's origin is a point output (``"frame"``: the default)."""
-        ElementTree.SubElement(self.robot, "output", type=output_type)
+        self.records.append(ExtensionRecord("output", output_type))
 
     def named_pose(self, name: str, values: dict[str, float]) -> None:
         """A ``<named_pose>``: task coordinate values (m, rad) by coordinate name."""
-        ElementTree.SubElement(self.robot, "named_pose", name=name, **{k: _number(v) for k, v in values.items()})
+        self.records.append(ExtensionRecord("named_pose", {k: written_number(v) for k, v in values.items()}, name))
 
     def reference_configuration(self, values: dict[str, float]) -> None:
-        element = ElementTree.SubElement(self.robot, "reference_configuration")
-        for name, value in values.items():
-            ElementTree.SubElement(element, "joint", name=name, value=_number(value))
+        self.records.append(ExtensionRecord("reference_configuration",
+                                            {k: written_number(v) for k, v in values.items()}))
+
+    def document(self) -> UrdfDocument:
+        """The document written so far."""
+        return UrdfDocument(self.name, self.comment, tuple(self.records))
+
+    def description(self, source: str = "<string>") -> UrdfDescription:
+        """What reading :meth:`text` gives, without writing it (see :meth:`UrdfDocument.description`)."""
+        return self.document().description(source)
 
     def text(self) -> str:
-        ElementTree.indent(self.robot, space="  ")
-        return '<?xml version="1.0"?>\n' + ElementTree.tostring(self.robot, encoding="unicode") + "\n"
+        return self.document().text()
 
 
 def _angle(vector: NDArray) -> float:
@@ -157,7 +133,15 @@ def rrr_leg(writer: UrdfWriter, chain: str, base: NDArray, end: NDArray, platfor
 def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, distal, working_mode=1.0,
                     comment: str = "", named_poses: dict[str, tuple[float, ...]] | None = None,
                     output: str = "frame") -> str:
-    """URDF of a planar n-RRR: base joints ``base`` (n, 2), platform joints ``platform`` (n, 2) in the
+    """The URDF text of :func:`planar_rrr_document`."""
+    return planar_rrr_document(name, base, platform, proximal, distal, working_mode, comment, named_poses,
+                               output).text()
+
+
+def planar_rrr_document(name: str, base: NDArray, platform: NDArray, proximal, distal, working_mode=1.0,
+                        comment: str = "", named_poses: dict[str, tuple[float, ...]] | None = None,
+                        output: str = "frame") -> UrdfDocument:
+    """A planar n-RRR: base joints ``base`` (n, 2), platform joints ``platform`` (n, 2) in the
     platform frame, arm lengths (scalars or (n,)), elbows on the ``working_mode`` side (+1: +u_perp)
     in the reference assembly (platform at x = y = phi = 0). Base joints are actuated."""
     base, platform = np.asarray(base, dtype=float), np.asarray(platform, dtype=float)
@@ -177,5 +161,5 @@ def planar_rrr_urdf(name: str, base: NDArray, platform: NDArray, proximal, dista
         writer.output(output)
     for pose_name, values in (named_poses or {}).items():
         writer.named_pose(pose_name, dict(zip(("x", "y", "phi") if output == "frame" else ("x", "y"), values)))
-    return writer.text()
+    return writer.document()
 

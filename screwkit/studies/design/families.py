@@ -26,10 +26,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from screwkit.model.delta_writer import delta_urdf
-from screwkit.model.hexapod_writer import hexapod_points, rss_hexapod_urdf, slot_angles, ups_hexapod_urdf
-from screwkit.model.prs_writer import prs_urdf
-from screwkit.model.urdf_writer import planar_rrr_urdf
+from screwkit.model.delta_writer import delta_document
+from screwkit.model.hexapod_writer import hexapod_points, rss_hexapod_document, slot_angles, ups_hexapod_document
+from screwkit.model.pinocchio_bridge import model_from_description
+from screwkit.model.prs_writer import prs_document
+from screwkit.model.urdf_document import UrdfDocument
+from screwkit.model.urdf_writer import planar_rrr_document
 
 __all__ = ["Parameter", "Family", "FAMILIES", "family", "permutation_rank", "permutation_of_rank"]
 
@@ -75,7 +77,9 @@ class Family:
     free : tuple of str
         The parameters a search varies unless told otherwise (the others keep their defaults).
     writer : callable
-        ``writer(legs, values, name) -> URDF text``, values in the parameters' units.
+        ``writer(legs, values, name) -> UrdfDocument`` (or a URDF text), values in the parameters' units:
+        the bundled families build :class:`~screwkit.model.urdf_document.UrdfDocument` records with the
+        library's writers, from which the model is built directly and the file of a kept design written.
     measures : callable
         ``measures(legs, values) -> dict`` of ``footprint`` (m: radius of the circle holding every
         base joint, and crank tip at the home pose) and ``link_length`` (m: the longest link or leg in the reference
@@ -115,15 +119,29 @@ class Family:
             out[name] = self.parameter(name).check(value, f"family {self.name}")
         return out
 
-    def urdf(self, values: Mapping[str, float] | None = None, name: str | None = None) -> str:
-        """The URDF text of the candidate with ``values`` (others at their defaults)."""
+    def document(self, values: Mapping[str, float] | None = None, name: str | None = None) -> UrdfDocument | str:
+        """What the writer makes of the candidate with ``values`` (others at their defaults): a
+        :class:`~screwkit.model.urdf_document.UrdfDocument` (the bundled families), or a URDF text."""
         return self.writer(self.legs, self.values(values), name or f"{self.name}_{self.legs}")
 
-    def mechanism(self, values: Mapping[str, float] | None = None, name: str | None = None):
-        """The loaded :class:`~screwkit.model.Mechanism` of the candidate with ``values``."""
-        from screwkit.io.loader import load_text  # studies sits above the loader; import on use keeps this light
+    def urdf(self, values: Mapping[str, float] | None = None, name: str | None = None) -> str:
+        """The URDF text of the candidate with ``values`` (others at their defaults), for a design that is kept."""
+        written = self.document(values, name)
+        return written if isinstance(written, str) else written.text()
 
-        return load_text(self.urdf(values, name), source=f"family {self.name} {self.values(values)}")
+    def mechanism(self, values: Mapping[str, float] | None = None, name: str | None = None):
+        """The loaded :class:`~screwkit.model.Mechanism` of the candidate with ``values``.
+
+        Built from the writer's document directly (its description and the Pinocchio model made from it:
+        no text is written or parsed); equal to loading :meth:`urdf` (``tests/test_design_direct.py``).
+        A writer that returns a URDF text is loaded from the text."""
+        from screwkit.io.loader import load_text, mechanism_from_description  # import on use keeps this light
+
+        written, source = self.document(values, name), f"family {self.name} {self.values(values)}"
+        if isinstance(written, str):
+            return load_text(written, source=source)
+        description = written.description(source)
+        return mechanism_from_description(description, model=model_from_description(description))
 
     def size(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
         """The family's size measures of a candidate (``footprint``, ``link_length``, m)."""
@@ -175,7 +193,7 @@ def _planar_points(legs: int, values: Mapping[str, float]):
     return base, platform
 
 
-def _planar_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+def _planar_writer(legs: int, values: Mapping[str, float], name: str) -> UrdfDocument:
     base, platform = _planar_points(legs, values)
     mode = -1.0 if values["mirrored"] else 1.0
     for i in range(legs):  # the reference assembly must exist: the arms reach the platform joint
@@ -184,7 +202,7 @@ def _planar_writer(legs: int, values: Mapping[str, float], name: str) -> str:
             raise ValueError(f"Family planar_rrr: leg {i + 1} cannot reach its platform joint at the home pose "
                              f"(distance {reach:.4g} m, arms {values['upper']:g} and {values['lower']:g} m).")
     summary = ", ".join(f"{k} = {v:g}" for k, v in values.items())
-    return planar_rrr_urdf(name, base, platform, values["upper"], values["lower"], mode,
+    return planar_rrr_document(name, base, platform, values["upper"], values["lower"], mode,
                            comment=f" Planar {legs}-RRR of the family planar_rrr: {summary} ")
 
 
@@ -246,9 +264,9 @@ def _hexapod_comment(kind: str, legs: int, values: Mapping[str, float]) -> str:
             f"platform slots {permutation_of_rank(legs, values['slots'])} ")
 
 
-def _ups_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+def _ups_writer(legs: int, values: Mapping[str, float], name: str) -> UrdfDocument:
     base, platform = _hexapod_geometry(legs, values)
-    return ups_hexapod_urdf(name, base, platform, values["height"], _hexapod_comment("UPS", legs, values))
+    return ups_hexapod_document(name, base, platform, values["height"], _hexapod_comment("UPS", legs, values))
 
 
 def _ups_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]:
@@ -257,9 +275,9 @@ def _ups_measures(legs: int, values: Mapping[str, float]) -> dict[str, float]:
     return {"footprint": float(values["base_radius"]), "link_length": float(np.max(legs_length))}
 
 
-def _rss_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+def _rss_writer(legs: int, values: Mapping[str, float], name: str) -> UrdfDocument:
     base, platform = _hexapod_geometry(legs, values)
-    return rss_hexapod_urdf(name, base, platform, values["height"], values["crank"],
+    return rss_hexapod_document(name, base, platform, values["height"], values["crank"],
                             _hexapod_comment("RSS", legs, values))
 
 
@@ -316,9 +334,9 @@ def _delta_parameters(legs: int, values: Mapping[str, float]) -> dict:
             "arm": values["arm"], "rod": values["rod"], "home": (0.0, 0.0, -values["depth"])}
 
 
-def _delta_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+def _delta_writer(legs: int, values: Mapping[str, float], name: str) -> UrdfDocument:
     summary = ", ".join(f"{k} = {v:g}" for k, v in values.items())
-    return delta_urdf(name, _delta_parameters(legs, values),
+    return delta_document(name, _delta_parameters(legs, values),
                       f" Delta robot with {legs} legs of the family delta (R-U-U forearms): {summary} "
                       "(lengths m, spread deg) ")
 
@@ -357,9 +375,9 @@ def _prs_parameters(values: Mapping[str, float]) -> dict:
             "ups_base_radius": values["ups_base_radius"], "stroke": (-0.15, 0.15)}
 
 
-def _prs_writer(legs: int, values: Mapping[str, float], name: str) -> str:
+def _prs_writer(legs: int, values: Mapping[str, float], name: str) -> UrdfDocument:
     summary = ", ".join(f"{k} = {v:g}" for k, v in values.items())
-    return prs_urdf(name, _prs_parameters(values), True,
+    return prs_document(name, _prs_parameters(values), True,
                     f" 3-PRS + UPS of the family prs_ups (chains at 90, 210, 330 deg): {summary} (lengths m, angle "
                     "deg) ", task_coordinates=("z", "roll", "pitch"))
 
