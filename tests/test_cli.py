@@ -144,7 +144,9 @@ def test_verify_compares_with_the_closed_forms():
 def test_list_names_the_bundled_robots():
     result = screwkit("list")
     assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr",
-                                     "prs_3_ups", "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6"]
+                                     "prs_3_ups", "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6",
+                                     "delta_rods_4", "(legs", "with", "loops", "inside", "them:", "analyze,", "info,",
+                                     "sweep,", "map)"]
 
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):

@@ -64,6 +64,14 @@ def test_generator_reproduces_the_committed_files(tmp_path):
         assert number.sub("#", written) == number.sub("#", committed), name
         np.testing.assert_allclose([float(x) for x in number.findall(written)],
                                    [float(x) for x in number.findall(committed)], rtol=1e-13, atol=1e-15, err_msg=name)
+    from screwkit.io.loader import bundled_graph_names, bundled_path
+
+    assert bundled_graph_names() == ("delta_rods_4",)
+    for name in bundled_graph_names():
+        written, committed = (tmp_path / f"{name}.xml").read_text(), bundled_path(name).read_text()
+        assert number.sub("#", written) == number.sub("#", committed), name
+        np.testing.assert_allclose([float(x) for x in number.findall(written)],
+                                   [float(x) for x in number.findall(committed)], rtol=1e-13, atol=1e-15, err_msg=name)
 
 
 # -- planar 5-RRR: the paper's Table 2 -----------------------------------------------------

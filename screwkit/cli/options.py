@@ -24,7 +24,7 @@ from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, sta
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
-from screwkit.io.loader import load
+from screwkit.io.loader import bundled_graph_names, bundled_path, load
 from screwkit.plots import colour_scale
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, WriteError, check_distinct, check_output
 from screwkit.studies.maps import range_values
@@ -382,7 +382,8 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         if length_unit not in (None, "m"):
             raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
         try:
-            return graph_mechanism(read_closed_tree(name, output=reading.output, output_type=reading.output_type))
+            source = bundled_path(name) if name in bundled_graph_names() else name
+            return graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     except ValueError as error:

@@ -33,10 +33,20 @@ def bundled_names() -> tuple[str, ...]:
     return tuple(sorted(item.name[: -len(".urdf")] for item in folder.iterdir() if item.name.endswith(".urdf")))
 
 
+def bundled_graph_names() -> tuple[str, ...]:
+    """Names of the closed-loop graphs shipped in :mod:`screwkit.robots` (MJCF files whose legs have loops inside
+    them, opened by :func:`screwkit.io.graph_mechanism`: ``delta_rods_4``)."""
+    folder = resources.files("screwkit.robots")
+    return tuple(sorted(item.name[: -len(".xml")] for item in folder.iterdir() if item.name.endswith(".xml")))
+
+
 def bundled_path(name: str) -> Path:
-    """Path of a bundled URDF; a ValueError lists the bundled names if ``name`` is not one."""
+    """Path of a bundled URDF (or MJCF graph); a ValueError lists the bundled names if ``name`` is not one."""
+    if name in bundled_graph_names():
+        return Path(str(resources.files("screwkit.robots").joinpath(f"{name}.xml")))
     if name not in bundled_names():
-        raise ValueError(f"Unknown bundled mechanism {name!r}; bundled are: {', '.join(bundled_names())}.")
+        raise ValueError(f"Unknown bundled mechanism {name!r}; bundled are: "
+                         f"{', '.join(bundled_names() + bundled_graph_names())}.")
     return Path(str(resources.files("screwkit.robots").joinpath(f"{name}.urdf")))
 
 
@@ -120,6 +130,8 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
                        or os.sep in text or "/" in text)
     if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
+        if path.suffix == ".xml":  # a bundled graph: as its file (refused with LegWithLoops, for graph_mechanism)
+            read_mechanism_file(path, output=output, output_type=output_type)
     else:
         path = Path(text)
         if path.is_dir():
