@@ -11,9 +11,12 @@ import numpy as np
 import pytest
 
 from helpers import assert_indices_close, bundled, in_millimetres, one_line_error, screwkit
+from screwkit.closure import solve
+from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import bundled_path, load_text
 from screwkit.studies import indices_at_pose, indices_at_poses
+from screwkit.studies.branches import joint_steps, suspect_segments
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path
 from screwkit.studies.trajectory import failure_weights, trajectory
@@ -104,6 +107,58 @@ def test_a_singular_pose_between_two_samples_is_located_to_the_tolerance():
     assert np.min(result.indices.f_o[1]) > 0.02
     coarse = trajectory(rpr, path, tolerance=1e-3)  # the tolerance is what it says, not finer by chance
     assert abs(coarse.case("leg_3:leg_3_joint_slider").singular_at[0] - 0.4) <= 1e-3
+
+
+CROSSING = np.sqrt(2) * 0.08
+"""Arc length where the diagonal paths of :func:`_over_the_base_joint` put a platform joint on its base joint."""
+
+
+def _over_the_base_joint(mechanism, platform_at_crossing, offset=0.0, samples=4):
+    """A diagonal path (along x = y) whose platform passes through ``platform_at_crossing`` (x, y) at arc length
+    :data:`CROSSING` (or ``offset`` m beside it, perpendicular), no sample on it."""
+    side = offset / np.sqrt(2)
+    centre = np.array([platform_at_crossing[0] + side, platform_at_crossing[1] - side, 0.0])
+    return line_path(mechanism, centre - [0.08, 0.08, 0.0], centre + [0.08, 0.08, 0.0], samples)
+
+
+@pytest.mark.parametrize("name, platform, chain, joint, limits", [
+    ("planar_5rrr", (0.9, 0.0), "chain_1", "chain_1_joint_b", True),
+    ("planar_4rpr", (-0.8, -0.9), "leg_1", "leg_1_joint_base", False)])
+def test_a_branch_change_between_two_samples_is_reported_where_it_happens(name, platform, chain, joint, limits):
+    """Closed form: at platform (0.9, 0, 0) the 5-RRR's platform joint d_1 = (1, 0) is on its base joint b_1 (equal
+    arms: the chain folded). Along a line through it, the line from b_1 to d_1 turns by half a turn, and the elbow
+    the closed form keeps "on the left" of that line jumps to the other side: the actuated joint jumps by 180 deg,
+    which no smooth motion does. The 4-RPR's leg 1 likewise at platform (-0.8, -0.9, 0): its slider through zero
+    length, the base joint turning by half a turn. 4 samples, none near; the change located to the tolerance."""
+    mechanism = bundled(name)
+    result = trajectory(mechanism, _over_the_base_joint(mechanism, platform), tolerance=1e-7,
+                        analysis=AnalysisOptions(limits=limits))
+    assert result.indices.reachable.all()
+    (event,) = result.events
+    assert event.kind == "branch" and event.samples == (1, 2)
+    assert event.start - 1e-12 <= CROSSING <= event.stop + 1e-12 and event.stop - event.start <= 1e-7
+    assert f"chain {chain!r} changes working mode: joint {joint!r} jumps" in event.reason
+    number = [c.name for c in mechanism.chains].index(chain)
+    position = mechanism.chains[number].joint_names.index(joint)
+    before, after = solve(mechanism, result.path.at([event.start - 1e-6, event.stop + 1e-6]),
+                          limits=limits).joint_values[number][:, position]
+    jump = np.rad2deg(abs(wrap_angle(after - before)))
+    assert jump == pytest.approx(180.0, abs=0.01)
+
+
+def test_a_fast_but_smooth_turn_near_the_base_joint_is_no_branch_change(five_path):
+    """The same 5-RRR path 0.03 m beside b_1: between samples 1 and 2 the actuated joint turns by most of half a
+    turn (the screen suspects the segment), but smoothly: the bisection sees the step shrink, and nothing is
+    reported; nor on the path through the Fig. 4 pose."""
+    five = bundled("planar_5rrr")
+    path = _over_the_base_joint(five, (0.9, 0.0), offset=0.03)
+    values = solve(five, path.poses).joint_values[0][:, :2]
+    steps = joint_steps(five, 0, values[:-1], values[1:])
+    assert suspect_segments(steps, np.diff(path.arc_length)).tolist() == [False, True, False]
+    assert abs(np.rad2deg(steps[1, 0])) > 90
+    assert trajectory(five, path).events == ()
+    assert five_path[1].events == ()
+    assert set(five_path[1].working_modes) == {f"chain_{i}" for i in range(1, 6)}
 
 
 def test_a_mechanism_in_millimetres_has_the_same_stretches_scaled():

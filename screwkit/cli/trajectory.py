@@ -76,6 +76,9 @@ def print_summary(summary: dict) -> None:
                f"(angles weighted by {summary['length_scale_m']:.6g} m/rad), {summary['reachable_samples']} "
                f"reachable; level {summary['level']:g}, tolerance {summary['tolerance_m']:.3g} m")
     for event in summary["events"]:
+        if event["kind"] == "branch":
+            echo_error(f"  BRANCH CHANGE: {event['reason']}")
+            continue
         echo_error(f"  {'UNREACHABLE' if event['kind'] == 'closure' else 'JOINT LIMIT'} from "
                    f"{event['start_m']:.6g} m to {event['stop_m']:.6g} m (samples {event['samples'][0]}-"
                    f"{event['samples'][1]}): {event['reason']}")
