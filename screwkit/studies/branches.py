@@ -15,11 +15,12 @@ robot can make without leaving the path. :func:`branch_changes` finds such jumps
    fix the chain's configuration) against the step the neighbouring segments predict, their rates times this
    segment's arc length. A segment is suspect where the step misses that prediction by more than the prediction
    itself (plus :data:`STEP_FLOOR`): a jump of the size of the joints' own motion over a sample step is seen.
-2. **Bisection** (all suspects at once, one closure solve per round). The suspect segment is split (at its golden
-   section, :data:`SPLIT`), keeping the part with the larger joint step, until it is at most ``tolerance`` long. A smooth motion's step shrinks
-   with the bracket, however fast the joints turn near a singularity; a jump does not. A change of working mode
-   is reported where the last bracket still holds at least :data:`JUMP_SHARE` of the first step; a point between
-   the samples where the chain does not close at all is reported as a closure the path cannot follow.
+2. **Bisection** (all suspects at once, one closure solve per round). The suspect segment is split (at its
+   golden section, :data:`SPLIT`), keeping the part with the larger joint step, until it is at most
+   ``tolerance`` long. A smooth motion's step shrinks with the bracket, however fast the joints turn near a
+   singularity; a jump does not. A change of working mode is reported where the last bracket still holds at
+   least :data:`JUMP_SHARE` of the first step; a point between the samples where the chain does not close at all
+   is reported as a closure the path cannot follow.
 """
 
 from __future__ import annotations
