@@ -13,6 +13,7 @@ from screwkit.cli.options import (
     GreedyOption,
     Outputs,
     analysis_options,
+    check_average,
     echo_error,
     fail,
     json_option,
@@ -27,7 +28,6 @@ from screwkit.cli.options import (
 from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import wide_table, write_dataset
 from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path, through_path
-from screwkit.studies.trajectory import AGGREGATES
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
 __all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions"]
@@ -152,21 +152,14 @@ class PathSource:
 
 @dataclass(frozen=True)
 class FaultOptions:
-    """What counts as controllable after failures, how closely it is located, and the average case."""
+    """What counts as controllable after failures, and how closely it is located (the average case is
+    ``--aggregate``, an analysis option as in ``analyze``, ``sweep`` and ``map``)."""
 
     level: float = 0.4
     tolerance: float | None = None
-    aggregate: str = "min"
-    probabilities: str | None = None
 
     def keywords(self) -> dict:
-        if self.probabilities is not None and self.aggregate != "mean":
-            raise fail("--probabilities weight the mean: give --aggregate mean with them.")
-        try:
-            weights = None if self.probabilities is None else [float(p) for p in self.probabilities.split()]
-        except ValueError:
-            raise fail(f"Expected numbers after --probabilities, got {self.probabilities!r}.") from None
-        return dict(level=self.level, tolerance=self.tolerance, aggregate=self.aggregate, probabilities=weights)
+        return dict(level=self.level, tolerance=self.tolerance)
 
 
 path_source_options = option_group(
@@ -195,12 +188,7 @@ fault_options = option_group(
                       "controllable."),
     click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
                  help="How closely crossings of the level and singular points are located, in m of arc length "
-                      "(default 1e-6 times the mechanism's length scale)."),
-    click.option("--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
-                 help="min: the paper's worst case over the failures (Eq. 12); mean: also their mean "
-                      "(f_o_mean<j>, screwkit's extension)."),
-    click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
-                 help="With --aggregate mean: each actuator's failure probability, weighting the mean."))
+                      "(default 1e-6 times the mechanism's length scale)."))
 
 
 @click.command("trajectory")
@@ -208,7 +196,7 @@ fault_options = option_group(
 @path_source_options
 @fault_options
 @outputs_options()
-@analysis_options()
+@analysis_options(average=True)
 @reading_options
 @json_option
 @quiet_option
@@ -227,9 +215,11 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     outputs.check(quiet or as_json)
     keywords = faults.keywords()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    check_average(analysis, loaded)
     path = source.read(loaded)
     try:
-        result = run_trajectory(loaded, path, analysis=analysis, **keywords)
+        result = run_trajectory(loaded, path, analysis=analysis, aggregate=analysis.aggregate,
+                                probabilities=analysis.probabilities, **keywords)
     except ValueError as error:
         raise fail(str(error)) from None
     summary = result.summary()

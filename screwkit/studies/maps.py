@@ -268,10 +268,12 @@ def map_task(mechanism_text: tuple[str, str, str], block: MapBlock, analysis: An
 
 def map_block(mechanism: Mechanism, block: MapBlock, analysis: AnalysisOptions, threads: int = 1) -> dict:
     """:func:`map_task` on a loaded mechanism (in the calling process)."""
-    result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
+    with analysis.indices():  # the average case too, if asked, wherever the task runs
+        result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
+        columns = index_columns(result)
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
-    for name, values in index_columns(result).items():  # every registered index: the worst orientation (its `reduce`)
+    for name, values in columns.items():  # every registered index: the worst orientation (its `reduce`)
         out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
     return out
 

@@ -22,14 +22,13 @@ whose minimum over the sets is :math:`F_{Oj}` (Eq. 12):
 
 With ``aggregate="mean"`` the average case is reported beside the worst case: the mean of the LMTI left over
 the sets of ``j`` failures, or their probability-weighted mean (screwkit's extension of Eq. 12, which the
-paper mentions and leaves aside; see docs/trajectory.md).
+paper mentions and leaves aside; :mod:`screwkit.indices.average`, the same for ``analyze``, sweeps and maps).
 """
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from math import prod
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.solve import ChainStatus
 from screwkit.common.tolerances import WORST_FAULT_TIE
+from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.exports import set_label
 from screwkit.indices.registry import index_columns
 from screwkit.indices.results import Indices
@@ -50,9 +50,6 @@ from screwkit.studies.refinement import bisected_crossings, bracketed_minima, lo
 __all__ = ["trajectory", "TrajectoryResult", "FaultCase", "Margin", "PathEvent", "failure_weights", "singular_dips",
            "AGGREGATES", "RELATIVE_TOLERANCE"]
 
-AGGREGATES = ("min", "mean")
-"""How the sets of ``j`` failures are combined into one index: the paper's worst case (Eq. 12), or also their
-(weighted) mean."""
 RELATIVE_TOLERANCE = 1e-6
 """Default refinement tolerance, in units of the mechanism's length scale (so a scaled mechanism has its
 tolerance scaled with it)."""
@@ -224,35 +221,6 @@ class TrajectoryResult:
         return dataset
 
 
-def failure_weights(actuator_count: int, faults: int, probabilities: ArrayLike | None = None
-                    ) -> NDArray[np.float64]:
-    """The weight of each set of ``faults`` failed actuators (:meth:`Indices.failed_sets` order) in the mean.
-
-    Equal weights without ``probabilities``; with the failure probability :math:`p_i` of each actuator
-    (independent failures), the probability that exactly the set ``E`` failed given that ``j`` did:
-
-    .. math::
-
-        w_E = \\frac{\\prod_{i \\in E} p_i \\prod_{i \\notin E} (1 - p_i)}
-                   {\\sum_{|E'| = j} \\prod_{i \\in E'} p_i \\prod_{i \\notin E'} (1 - p_i)}
-    """
-    from itertools import combinations
-
-    sets = [tuple(sorted(set(range(actuator_count)) - set(left)))
-            for left in combinations(range(actuator_count), actuator_count - faults)]
-    if probabilities is None:
-        return np.full(len(sets), 1.0 / len(sets))
-    p = np.asarray(probabilities, dtype=float)
-    if p.shape != (actuator_count,) or not np.all((p >= 0) & (p <= 1)):
-        raise ValueError(f"Expected one failure probability in [0, 1] per actuator ({actuator_count}), got "
-                         f"{np.asarray(probabilities).tolist()}.")
-    weights = np.array([prod(p[i] if i in failed else 1.0 - p[i] for i in range(actuator_count)) for failed in sets])
-    if not weights.sum() > 0:
-        raise ValueError(f"No set of {faults} failure(s) has a positive probability with failure probabilities "
-                         f"{p.tolist()}.")
-    return weights / weights.sum()
-
-
 def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None, level: float = 0.4,
                tolerance: float | None = None, aggregate: str = "min", probabilities: ArrayLike | None = None,
                analysis: AnalysisOptions | None = None, threads: int | None = None) -> TrajectoryResult:
@@ -345,7 +313,8 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     events = _events(mechanism, path, samples, unreachable, analysis) + tuple(
         PathEvent(c.kind, c.start, c.stop, c.samples, describe(mechanism, c)) for c in changes)
     weights = {j: failure_weights(samples.actuator_count, j, probabilities) for j in faults}
-    mean = {j: samples.remaining_lmti[j] @ weights[j] for j in faults} if aggregate == "mean" else {}
+    mean = mean_remaining_lmti(samples.remaining_lmti, samples.actuator_count, probabilities) \
+        if aggregate == "mean" else {}
     return TrajectoryResult(
         mechanism=mechanism.name, path=path, indices=samples, level=float(level), tolerance=tolerance,
         cases=tuple(cases), worst=_worst(cases, faults), margins=_margins(samples, s, cases, mean),
