@@ -47,6 +47,7 @@ def files(tmp_path_factory):
 @pytest.mark.parametrize("arguments", [
     ["planar_5rrr", "--pose", "paper_fig_2a"],
     ["planar_5rrr", "--pose", "paper_fig_2a", "--fault", "link"],
+    ["planar_5rrr", "--pose", "paper_fig_2a", "--aggregate", "mean", "--probabilities", "0.1", "0.2", "0", "0.3", "1"],
     ["five_bar"],
     ["ups_stewart_6", "--pose", "0.02", "0", "1", "3", "-2", "10"],
     ["delta_4", "--pose", "off_centre"],

@@ -11,11 +11,15 @@ import numpy as np
 import pytest
 
 from helpers import assert_indices_close, bundled, in_millimetres, one_line_error, screwkit
+from screwkit.closure import actuator_values, solve
+from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import bundled_path, load_text
 from screwkit.studies import indices_at_pose, indices_at_poses
+from screwkit.studies.actuator_paths import path_from_actuators, read_actuator_path
+from screwkit.studies.branches import joint_steps, suspect_segments
 from screwkit.studies.options import AnalysisOptions
-from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path
+from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path, through_path
 from screwkit.studies.trajectory import failure_weights, trajectory
 
 FIG_4 = np.array([0.0, 0.0, 0.0])
@@ -104,6 +108,58 @@ def test_a_singular_pose_between_two_samples_is_located_to_the_tolerance():
     assert np.min(result.indices.f_o[1]) > 0.02
     coarse = trajectory(rpr, path, tolerance=1e-3)  # the tolerance is what it says, not finer by chance
     assert abs(coarse.case("leg_3:leg_3_joint_slider").singular_at[0] - 0.4) <= 1e-3
+
+
+CROSSING = np.sqrt(2) * 0.08
+"""Arc length where the diagonal paths of :func:`_over_the_base_joint` put a platform joint on its base joint."""
+
+
+def _over_the_base_joint(mechanism, platform_at_crossing, offset=0.0, samples=4):
+    """A diagonal path (along x = y) whose platform passes through ``platform_at_crossing`` (x, y) at arc length
+    :data:`CROSSING` (or ``offset`` m beside it, perpendicular), no sample on it."""
+    side = offset / np.sqrt(2)
+    centre = np.array([platform_at_crossing[0] + side, platform_at_crossing[1] - side, 0.0])
+    return line_path(mechanism, centre - [0.08, 0.08, 0.0], centre + [0.08, 0.08, 0.0], samples)
+
+
+@pytest.mark.parametrize("name, platform, chain, joint, limits", [
+    ("planar_5rrr", (0.9, 0.0), "chain_1", "chain_1_joint_b", True),
+    ("planar_4rpr", (-0.8, -0.9), "leg_1", "leg_1_joint_base", False)])
+def test_a_branch_change_between_two_samples_is_reported_where_it_happens(name, platform, chain, joint, limits):
+    """Closed form: at platform (0.9, 0, 0) the 5-RRR's platform joint d_1 = (1, 0) is on its base joint b_1 (equal
+    arms: the chain folded). Along a line through it, the line from b_1 to d_1 turns by half a turn, and the elbow
+    the closed form keeps "on the left" of that line jumps to the other side: the actuated joint jumps by 180 deg,
+    which no smooth motion does. The 4-RPR's leg 1 likewise at platform (-0.8, -0.9, 0): its slider through zero
+    length, the base joint turning by half a turn. 4 samples, none near; the change located to the tolerance."""
+    mechanism = bundled(name)
+    result = trajectory(mechanism, _over_the_base_joint(mechanism, platform), tolerance=1e-7,
+                        analysis=AnalysisOptions(limits=limits))
+    assert result.indices.reachable.all()
+    (event,) = result.events
+    assert event.kind == "branch" and event.samples == (1, 2)
+    assert event.start - 1e-12 <= CROSSING <= event.stop + 1e-12 and event.stop - event.start <= 1e-7
+    assert f"chain {chain!r} changes working mode: joint {joint!r} jumps" in event.reason
+    number = [c.name for c in mechanism.chains].index(chain)
+    position = mechanism.chains[number].joint_names.index(joint)
+    before, after = solve(mechanism, result.path.at([event.start - 1e-6, event.stop + 1e-6]),
+                          limits=limits).joint_values[number][:, position]
+    jump = np.rad2deg(abs(wrap_angle(after - before)))
+    assert jump == pytest.approx(180.0, abs=0.01)
+
+
+def test_a_fast_but_smooth_turn_near_the_base_joint_is_no_branch_change(five_path):
+    """The same 5-RRR path 0.03 m beside b_1: between samples 1 and 2 the actuated joint turns by most of half a
+    turn (the screen suspects the segment), but smoothly: the bisection sees the step shrink, and nothing is
+    reported; nor on the path through the Fig. 4 pose."""
+    five = bundled("planar_5rrr")
+    path = _over_the_base_joint(five, (0.9, 0.0), offset=0.03)
+    values = solve(five, path.poses).joint_values[0][:, :2]
+    steps = joint_steps(five, 0, values[:-1], values[1:])
+    assert suspect_segments(steps, np.diff(path.arc_length)).tolist() == [False, True, False]
+    assert abs(np.rad2deg(steps[1, 0])) > 90
+    assert trajectory(five, path).events == ()
+    assert five_path[1].events == ()
+    assert set(five_path[1].working_modes) == {f"chain_{i}" for i in range(1, 6)}
 
 
 def test_a_mechanism_in_millimetres_has_the_same_stretches_scaled():
@@ -271,3 +327,85 @@ def test_the_command_writes_the_path_its_summary_and_figure(tmp_path):
     one_line_error(screwkit("trajectory", "planar_5rrr", *arguments, "--out", tmp_path / "t.nc"),
                    "t.nc: the file exists")
     one_line_error(screwkit("trajectory", "planar_5rrr"), "Expected exactly one of PATH")
+
+
+def test_a_path_through_poses_is_straight_between_them_with_each_pose_a_sample():
+    five = bundled("planar_5rrr")
+    corners = np.array([[-0.2, 0.0, 0.0], [0.0, 0.2, np.deg2rad(30.0)], [0.25, 0.0, 0.0]])
+    path = through_path(five, corners, 20)
+    for corner in corners:  # every pose given is a sample
+        assert np.min(np.linalg.norm(path.poses - corner, axis=1)) < 1e-15
+    weights = np.array([1.0, 1.0, five.length_scale])
+    lengths = np.linalg.norm(np.diff(corners, axis=0) * weights, axis=1)
+    assert path.length == pytest.approx(lengths.sum(), rel=1e-12)
+    steps = np.diff(path.arc_length)
+    assert steps.max() <= path.length / 19 + 1e-12 and path.samples in (20, 21, 22)
+    middle = path.arc_length < lengths[0]  # on the first segment: on the straight line between the first two poses
+    fraction = path.arc_length[middle] / lengths[0]
+    np.testing.assert_allclose(path.poses[middle], corners[0] + fraction[:, None] * (corners[1] - corners[0]),
+                               atol=1e-14)
+    with pytest.raises(ValueError, match="at least 2 samples"):
+        through_path(five, corners, 1)
+
+
+def _actuator_file(tmp_path, five, path, times=True):
+    """The actuator values of the 5-RRR along ``path`` (deg), as the CSV a user would give, with times."""
+    values = np.rad2deg(actuator_values(five, solve(five, path.poses).joint_values))
+    columns = [f"chain_{i}" for i in range(1, 6)]
+    rows = np.column_stack([np.linspace(0.0, 4.0, path.samples), values]) if times else values
+    np.savetxt(tmp_path / "q.csv", rows, delimiter=",", header=",".join((["t"] if times else []) + columns),
+               comments="")
+    return tmp_path / "q.csv", values
+
+
+def test_a_path_in_actuator_values_is_the_path_of_the_poses_they_drive(tmp_path):
+    """The actuator values of the path through the Fig. 4 pose (inverse kinematics) give back its poses by forward
+    kinematics (continuation from the reference assembly) to 1e-9, and so the same trajectory; values that
+    disagree with each other are refused naming the sample."""
+    five = bundled("planar_5rrr")
+    path = line_path(five, START, STOP, 41)
+    file, values = _actuator_file(tmp_path, five, path)
+    driven = read_actuator_path(five, file)
+    np.testing.assert_allclose(driven.poses, path.poses, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(driven.times, np.linspace(0.0, 4.0, 41))
+    back = path_from_actuators(five, np.deg2rad(values))
+    np.testing.assert_allclose(back.poses, path.poses, rtol=0, atol=1e-9)
+    values[7, 2] += 1.0  # chain 3 one degree off at sample 7: no pose gives all five
+    with pytest.raises(ValueError, match="^sample 7: no pose near the previous sample's gives the actuator values"):
+        path_from_actuators(five, np.deg2rad(values))
+
+
+def test_the_command_takes_a_path_through_poses_or_in_actuator_values(tmp_path):
+    five = bundled("planar_5rrr")
+    through = screwkit("trajectory", "planar_5rrr", "--through", "-0.2", "0", "0", "0", "0.2", "30", "0.25", "0", "0",
+                       "--samples", "21", "--json")
+    assert through.returncode == 0, through.stderr
+    expected = trajectory(five, through_path(five, [[-0.2, 0, 0], [0, 0.2, np.deg2rad(30)], [0.25, 0, 0]], 21))
+    summary = json.loads(through.stdout)
+    assert summary["samples"] == expected.path.samples and summary["worst"] == expected.summary()["worst"]
+    assert summary["length_m"] == pytest.approx(expected.path.length, rel=1e-12)
+
+    file, values = _actuator_file(tmp_path, five, line_path(five, START, STOP, 41))
+    driven = screwkit("trajectory", "planar_5rrr", file, "--actuators", "--level", str(LEVEL), "--json")
+    assert driven.returncode == 0, driven.stderr
+    summary = json.loads(driven.stdout)
+    expected = trajectory(five, line_path(five, START, STOP, 41), level=LEVEL).summary()
+    assert summary["worst"] == expected["worst"] and summary["duration_s"] == 4.0
+    for found, wanted in zip(summary["faults"], expected["faults"]):
+        np.testing.assert_allclose(np.reshape(found["lost_m"], (-1, 2)), np.reshape(wanted["lost_m"], (-1, 2)),
+                                   atol=1e-7)
+
+    values[7, 2] += 1.0
+    np.savetxt(tmp_path / "bad.csv", values, delimiter=",", header="chain_1,chain_2,chain_3,chain_4,chain_5",
+               comments="")
+    one_line_error(screwkit("trajectory", "planar_5rrr", tmp_path / "bad.csv", "--actuators"),
+                   f"{tmp_path / 'bad.csv'}: sample 7: no pose near the previous sample's gives the actuator values")
+    (tmp_path / "poses.csv").write_text("x,y,phi\n0,0,0\n0.1,0,0\n")
+    one_line_error(screwkit("trajectory", "planar_5rrr", tmp_path / "poses.csv", "--actuators"),
+                   "no column 'chain_1:chain_1_joint_b'", "has columns chain_1, chain_2, chain_3, chain_4, chain_5")
+    one_line_error(screwkit("trajectory", "planar_5rrr", "--line", "0", "0", "0", "0.1", "0", "0", "--actuators"),
+                   "--actuators says that PATH holds actuator values")
+    one_line_error(screwkit("trajectory", "planar_5rrr", "--through", "0", "0", "0"),
+                   "Expected --through with at least 2 poses")
+    one_line_error(screwkit("trajectory", "planar_5rrr", "--through", "0", "0", "0", "0.1", "0"),
+                   "Expected --through with at least 2 poses (named poses, or 3 numbers each", "got 0 0 0 0.1 0.")

@@ -10,6 +10,7 @@ import numpy as np
 from screwkit.cli.options import (
     GreedyOption,
     analysis_options,
+    check_average,
     fail,
     json_option,
     load_mechanism,
@@ -147,13 +148,21 @@ def pose_from_actuators(mechanism, text: str, start):
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
                    "it keeps.")
-@analysis_options(closed_forms=False)
+@analysis_options(closed_forms=False, average=True)
 @reading_options
 @json_option
 def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: bool) -> None:
-    """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose."""
+    """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose (with --aggregate mean,
+    also the average case of F_Oj over the failures)."""
 
     loaded = load_mechanism(mechanism, reading, graphs=True, limits=analysis.limits)
+    check_average(analysis, loaded)
+    with analysis.indices():  # the average case registered, if asked, for the report
+        _analyze(loaded, pose, actuator_values, analysis, as_json)
+
+
+def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
+    """The body of :func:`analyze` on a loaded mechanism."""
     if isinstance(loaded, GraphMechanism):
         return _analyze_graph(loaded, pose, actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)

@@ -11,6 +11,7 @@ from screwkit.cli.options import (
     GreedyOption,
     Outputs,
     analysis_options,
+    check_average,
     connected,
     echo_error,
     execution_options,
@@ -126,7 +127,7 @@ def _map(loaded, area: MapArea, analysis, execution, proceed: bool, quiet: bool)
 @mechanism_argument
 @map_area_options
 @outputs_options(colour_scale=True)
-@analysis_options()
+@analysis_options(average=True)
 @execution_options(task_size=True)
 @click.option("--yes", is_flag=True, help="Proceed with a map of more than 2e9 configurations.")
 @reading_options
@@ -137,11 +138,14 @@ def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution,
     Planar: --radius R --step S --phi-step D maps a disc about the home position with phi
     over a full turn. Spatial: --grid x:-0.2:0.2:0.02 --grid y:-0.2:0.2:0.02
     --over yaw:0:360:15, optionally more --over (roll:-10:10:5) and --at (x y z roll pitch yaw).
+    --aggregate mean also maps the average case of F_Oj over the failures (f_o_mean<j>).
     The size of the map is stated, and a map too large refused, before anything is computed.
     """
 
     outputs.check(quiet)
     area.check()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
-    result = _map(loaded, area, analysis, execution, yes, quiet)
-    write_outputs(result, outputs, map_figure, quiet, vmin=outputs.vmin, vmax=outputs.vmax)
+    check_average(analysis, loaded)
+    with analysis.indices():  # the average case registered, if asked: mapped (its worst orientation) and written
+        result = _map(loaded, area, analysis, execution, yes, quiet)
+        write_outputs(result, outputs, map_figure, quiet, vmin=outputs.vmin, vmax=outputs.vmax)

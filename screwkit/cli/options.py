@@ -23,6 +23,7 @@ from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
+from screwkit.indices.average import AGGREGATES, failure_weights
 from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
 from screwkit.io.loader import bundled_graph_names, bundled_path, load
 from screwkit.plots import colour_scale
@@ -32,6 +33,7 @@ from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError, Execution, connect, disconnect
 
 __all__ = [
+    "check_average",
     "GreedyOption",
     "ScrewkitGroup",
     "mechanism_argument",
@@ -284,18 +286,45 @@ def _quiet() -> bool:
     return bool(context and context.params.get("quiet"))
 
 
-def _analysis(threshold: float, fault_type: str, ignore_limits: bool, closed_forms: bool = False) -> AnalysisOptions:
+def _analysis(threshold: float, fault_type: str, ignore_limits: bool, closed_forms: bool = False,
+              aggregate: str = "min", probabilities: str | None = None) -> AnalysisOptions:
+    if probabilities is not None and aggregate != "mean":
+        raise fail("--probabilities weight the mean: give --aggregate mean with them.")
+    try:
+        weights = None if probabilities is None else tuple(float(p) for p in probabilities.split())
+    except ValueError:
+        raise fail(f"Expected numbers after --probabilities, got {probabilities!r}.") from None
     return AnalysisOptions(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms,
-                           limits=not ignore_limits)
+                           limits=not ignore_limits, aggregate=aggregate, probabilities=weights)
 
 
-def analysis_options(*, closed_forms: bool = True) -> Callable:
-    """``--threshold``, ``--fault``, ``--closed-forms`` (unless not ``closed_forms``) and ``--ignore-limits``:
-    what is computed at every pose, as ``analysis``, an :class:`~screwkit.studies.options.AnalysisOptions`."""
+aggregate_option = click.option(
+    "--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
+    help="min: the paper's worst case over the sets of j failed actuators (F_Oj, Eq. 12); mean: also their mean "
+         "(f_o_mean<j>, screwkit's extension of Eq. 12).")
+probabilities_option = click.option(
+    "--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
+    help="With --aggregate mean: each actuator's failure probability (in the order `screwkit info` lists the "
+         "actuators), weighting the mean by the probability of each set of failures.")
+
+
+def analysis_options(*, closed_forms: bool = True, average: bool = False) -> Callable:
+    """``--threshold``, ``--fault``, ``--closed-forms`` (unless not ``closed_forms``), ``--ignore-limits`` and with
+    ``average`` ``--aggregate`` and ``--probabilities``: what is computed at every pose, as ``analysis``, an
+    :class:`~screwkit.studies.options.AnalysisOptions`."""
     closed = click.option("--closed-forms", is_flag=True,
                           help="Use the paper's planar closed forms instead of the generic path.")
     return option_group("analysis", _analysis, threshold_option, fault_option, *((closed,) if closed_forms else ()),
-                        ignore_limits_option)
+                        ignore_limits_option, *((aggregate_option, probabilities_option) if average else ()))
+
+
+def check_average(analysis: AnalysisOptions, mechanism) -> None:
+    """One failure probability per actuator of ``mechanism`` (a one-line error before any work)."""
+    if analysis.probabilities is not None:
+        try:
+            failure_weights(len(mechanism.actuator_names), 1, analysis.probabilities)
+        except ValueError as error:
+            raise fail(f"--probabilities: {error}") from None
 
 
 def _execution(scheduler: str | None, connect_timeout: float, task_size: int | None = None) -> Execution:

@@ -9,6 +9,7 @@ from screwkit.cli.options import (
     GreedyOption,
     Outputs,
     analysis_options,
+    check_average,
     echo_error,
     fail,
     load_mechanism,
@@ -68,7 +69,7 @@ def write_outputs(dataset, outputs: Outputs, figure_function, quiet: bool, **fig
 @click.option("--sweep", "sweep_spec", metavar="COORDINATE:START:STOP:STEP",
               help="The swept coordinate and its range, m or deg; the stop is excluded (yaw:0:360:1 is 360 angles).")
 @outputs_options()
-@analysis_options()
+@analysis_options(average=True)
 @reading_options
 @quiet_option
 def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, reading, quiet) -> None:
@@ -80,6 +81,7 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, read
 
     outputs.check(quiet)
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
+    check_average(analysis, loaded)
     if (phi_range is None) == (sweep_spec is None):
         raise fail("Expected exactly one of --phi START:STOP:STEP or --sweep COORDINATE:START:STOP:STEP.")
     if phi_range is not None:
@@ -90,19 +92,21 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, read
         raise fail(f"Unknown coordinate {coordinate!r} to sweep; {loaded.name!r} has "
                    f"{', '.join(loaded.task_coordinates)}.")
     values = parse_range(text, "--phi" if phi_range else "--sweep", angular=is_angular(coordinate))
-    try:
-        dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, **analysis.keywords())
-    except ValueError as error:
-        raise fail(str(error)) from None
-    if not quiet:
-        reachable = dataset["reachable"].values
-        echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} reachable)")
-        redundant = len(loaded.actuators) > loaded.dof
-        if not redundant:
-            echo_error("  no redundancy (a = n): F_O1 = F_IO1 = 0 everywhere")
-        for name in [v for v in dataset.data_vars if is_column(v) and (redundant or column_record(v)[1] is None)]:
-            series = dataset[name].values
-            if np.any(np.isfinite(series)):
-                at_min = dataset[coordinate].values[np.nanargmin(series)]
-                echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
-    write_outputs(dataset, outputs, sweep_figure, quiet)
+    with analysis.indices():  # the average case registered, if asked: computed, summarised, written
+        try:
+            dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, **analysis.keywords())
+        except ValueError as error:
+            raise fail(str(error)) from None
+        if not quiet:
+            reachable = dataset["reachable"].values
+            echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} "
+                       "reachable)")
+            redundant = len(loaded.actuators) > loaded.dof
+            if not redundant:
+                echo_error("  no redundancy (a = n): F_O1 = F_IO1 = 0 everywhere")
+            for name in [v for v in dataset.data_vars if is_column(v) and (redundant or column_record(v)[1] is None)]:
+                series = dataset[name].values
+                if np.any(np.isfinite(series)):
+                    at_min = dataset[coordinate].values[np.nanargmin(series)]
+                    echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
+        write_outputs(dataset, outputs, sweep_figure, quiet)

@@ -13,6 +13,7 @@ from screwkit.cli.options import (
     GreedyOption,
     Outputs,
     analysis_options,
+    check_average,
     echo_error,
     fail,
     json_option,
@@ -24,9 +25,9 @@ from screwkit.cli.options import (
     quiet_option,
     reading_options,
 )
+from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import wide_table, write_dataset
-from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path
-from screwkit.studies.trajectory import AGGREGATES
+from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path, through_path
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
 __all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions"]
@@ -54,20 +55,36 @@ def _number(word: str) -> bool:
     return True
 
 
-def generated_path(mechanism, line: str | None, circle: str | None, samples: int):
-    """``--line A B`` or ``--circle CENTRE RADIUS`` with ``--samples``, as a :class:`~screwkit.studies.paths.Path`."""
+def generated_path(mechanism, source: PathSource):
+    """``--line A B``, ``--circle CENTRE RADIUS`` or ``--through POSE POSE ...`` with ``--samples``, as a
+    :class:`~screwkit.studies.paths.Path`."""
+    samples = source.samples
     try:
-        if line is not None:
-            start, stop = _poses(mechanism, line.split(), 2, "--line")
+        if source.line is not None:
+            start, stop = _poses(mechanism, source.line.split(), 2, "--line")
             return line_path(mechanism, start, stop, samples)
-        words = circle.split()
+        if source.through is not None:
+            return through_path(mechanism, _through(mechanism, source.through.split()), samples)
+        words = source.circle.split()
         if len(words) < 2 or not _number(words[-1]):
             raise fail(f"Expected --circle CENTRE RADIUS (a named pose or every task coordinate, then the radius in "
-                       f"m), got {circle!r}.")
+                       f"m), got {source.circle!r}.")
         (centre,) = _poses(mechanism, words[:-1], 1, "--circle")
         return circle_path(mechanism, centre, float(words[-1]), samples)
     except ValueError as error:
         raise fail(str(error)) from None
+
+
+def _through(mechanism, words: list[str]) -> list[np.ndarray]:
+    """The poses of ``--through``: named poses, or every task coordinate of each pose in turn; at least two."""
+    n = mechanism.n_task
+    numbers = any(_number(word) for word in words)
+    count = len(words) // n if numbers else len(words)
+    if count < 2 or (numbers and len(words) % n):
+        units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
+        raise fail(f"Expected --through with at least 2 poses (named poses, or {n} numbers each: {units}) for "
+                   f"{mechanism.name!r}, got {' '.join(words) or 'nothing'}.")
+    return _poses(mechanism, words, count, "--through")
 
 
 def print_summary(summary: dict) -> None:
@@ -76,6 +93,9 @@ def print_summary(summary: dict) -> None:
                f"(angles weighted by {summary['length_scale_m']:.6g} m/rad), {summary['reachable_samples']} "
                f"reachable; level {summary['level']:g}, tolerance {summary['tolerance_m']:.3g} m")
     for event in summary["events"]:
+        if event["kind"] == "branch":
+            echo_error(f"  BRANCH CHANGE: {event['reason']}")
+            continue
         echo_error(f"  {'UNREACHABLE' if event['kind'] == 'closure' else 'JOINT LIMIT'} from "
                    f"{event['start_m']:.6g} m to {event['stop_m']:.6g} m (samples {event['samples'][0]}-"
                    f"{event['samples'][1]}): {event['reason']}")
@@ -95,20 +115,25 @@ def print_summary(summary: dict) -> None:
 
 @dataclass(frozen=True)
 class PathSource:
-    """Where the path comes from: a file (PATH), or ``--line`` / ``--circle`` with ``--samples``."""
+    """Where the path comes from: a file (PATH: poses, or actuator values with ``--actuators``), or ``--line``,
+    ``--circle`` or ``--through`` with ``--samples``."""
 
     path_file: str | None = None
     line: str | None = None
     circle: str | None = None
+    through: str | None = None
     samples: int = DEFAULT_SAMPLES
+    actuators: bool = False
 
     def check(self) -> None:
         """Exactly one source, and a file that exists, before the mechanism is even loaded."""
-        given = [name for name, value in (("PATH", self.path_file), ("--line", self.line), ("--circle", self.circle))
-                 if value]
+        given = [name for name, value in (("PATH", self.path_file), ("--line", self.line), ("--circle", self.circle),
+                                          ("--through", self.through)) if value]
         if len(given) != 1:
-            raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B or --circle CENTRE RADIUS, "
-                       f"got {', '.join(given) or 'none'}.")
+            raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B, --circle CENTRE RADIUS or "
+                       f"--through POSE POSE ..., got {', '.join(given) or 'none'}.")
+        if self.actuators and self.path_file is None:
+            raise fail(f"--actuators says that PATH holds actuator values: give a PATH file, not {given[0]}.")
         if self.path_file is not None and not os.path.isfile(self.path_file):
             raise fail(f"{self.path_file}: "
                        f"{'is a folder, not a path file' if os.path.isdir(self.path_file) else 'no such file'}.")
@@ -116,8 +141,10 @@ class PathSource:
     def read(self, mechanism):
         """The :class:`~screwkit.studies.paths.Path` (a one-line error naming the file if it cannot be used)."""
         if self.path_file is None:
-            return generated_path(mechanism, self.line, self.circle, self.samples)
+            return generated_path(mechanism, self)
         try:
+            if self.actuators:
+                return read_actuator_path(mechanism, self.path_file)
             return read_path(mechanism, self.path_file)
         except PathFileError as error:
             raise fail(str(error)) from None
@@ -125,21 +152,14 @@ class PathSource:
 
 @dataclass(frozen=True)
 class FaultOptions:
-    """What counts as controllable after failures, how closely it is located, and the average case."""
+    """What counts as controllable after failures, and how closely it is located (the average case is
+    ``--aggregate``, an analysis option as in ``analyze``, ``sweep`` and ``map``)."""
 
     level: float = 0.4
     tolerance: float | None = None
-    aggregate: str = "min"
-    probabilities: str | None = None
 
     def keywords(self) -> dict:
-        if self.probabilities is not None and self.aggregate != "mean":
-            raise fail("--probabilities weight the mean: give --aggregate mean with them.")
-        try:
-            weights = None if self.probabilities is None else [float(p) for p in self.probabilities.split()]
-        except ValueError:
-            raise fail(f"Expected numbers after --probabilities, got {self.probabilities!r}.") from None
-        return dict(level=self.level, tolerance=self.tolerance, aggregate=self.aggregate, probabilities=weights)
+        return dict(level=self.level, tolerance=self.tolerance)
 
 
 path_source_options = option_group(
@@ -151,8 +171,16 @@ path_source_options = option_group(
     click.option("--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
                  help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) "
                       "and the radius (m); the other coordinates stay at the centre's."),
+    click.option("--through", cls=GreedyOption, metavar="POSE POSE ...",
+                 help="A piecewise-linear path through two or more poses (named poses, or every task coordinate of "
+                      "each in turn, m and deg): straight in task coordinates between consecutive poses, --samples "
+                      "evenly spaced in arc length plus every pose given."),
     click.option("--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
-                 help="Samples of a --line or --circle path, both ends included."))
+                 help="Samples of a --line, --circle or --through path, both ends included."),
+    click.option("--actuators", is_flag=True,
+                 help="PATH holds actuator values (a column per actuator, named by its chain or chain:joint; deg, "
+                      "m; optionally t): the platform poses come from forward kinematics along the path, from the "
+                      "reference assembly."))
 fault_options = option_group(
     "faults", FaultOptions,
     click.option("--level", type=click.FloatRange(min=0, max=1, min_open=True), default=0.4, show_default=True,
@@ -160,12 +188,7 @@ fault_options = option_group(
                       "controllable."),
     click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
                  help="How closely crossings of the level and singular points are located, in m of arc length "
-                      "(default 1e-6 times the mechanism's length scale)."),
-    click.option("--aggregate", type=click.Choice(AGGREGATES), default="min", show_default=True,
-                 help="min: the paper's worst case over the failures (Eq. 12); mean: also their mean "
-                      "(f_o_mean<j>, screwkit's extension)."),
-    click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
-                 help="With --aggregate mean: each actuator's failure probability, weighting the mean."))
+                      "(default 1e-6 times the mechanism's length scale)."))
 
 
 @click.command("trajectory")
@@ -173,7 +196,7 @@ fault_options = option_group(
 @path_source_options
 @fault_options
 @outputs_options()
-@analysis_options()
+@analysis_options(average=True)
 @reading_options
 @json_option
 @quiet_option
@@ -182,7 +205,8 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     """Every index along a path, and the stretches each actuator failure leaves uncontrollable.
 
     PATH is a CSV file with a column per task coordinate (m, deg; `screwkit info MECHANISM` names them) and
-    optionally t (s), or a netCDF file with such variables; or the path is generated with --line or --circle.
+    optionally t (s), or a netCDF file with such variables (with --actuators, a column per actuator instead); or
+    the path is generated with --line, --circle or --through (straight in task coordinates between poses).
     Crossings of --level and singular points between samples are refined to --tolerance. The indices go to
     --out (.nc or .csv; with neither --out, --figure nor --json, to stdout as CSV), the summary to stderr
     (or stdout with --json).
@@ -191,9 +215,11 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     outputs.check(quiet or as_json)
     keywords = faults.keywords()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    check_average(analysis, loaded)
     path = source.read(loaded)
     try:
-        result = run_trajectory(loaded, path, analysis=analysis, **keywords)
+        result = run_trajectory(loaded, path, analysis=analysis, aggregate=analysis.aggregate,
+                                probabilities=analysis.probabilities, **keywords)
     except ValueError as error:
         raise fail(str(error)) from None
     summary = result.summary()

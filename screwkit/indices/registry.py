@@ -12,11 +12,13 @@ Each index has one value per configuration, or, with ``per_fault``, one per numb
 
 from __future__ import annotations
 
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
-__all__ = ["IndexRecord", "INDICES", "register", "unregister", "registered", "index_columns", "column_record",
+__all__ = ["IndexRecord", "INDICES", "register", "unregister", "registered", "shared", "index_columns",
+           "column_record",
            "column_label", "is_column", "applies"]
 
 
@@ -92,6 +94,31 @@ def registered(record: IndexRecord) -> Iterator[IndexRecord]:
         yield record
     finally:
         unregister(record.name)
+
+
+_SHARED: dict[str, int] = {}
+_SHARED_LOCK = threading.Lock()
+
+
+@contextmanager
+def shared(record: IndexRecord) -> Iterator[IndexRecord]:
+    """:func:`registered`, for a record that tasks running at once (threads of one study) each register: the first
+    registers it, the last to leave unregisters it; another record of the same name is refused as by
+    :func:`register`."""
+    with _SHARED_LOCK:
+        if INDICES.get(record.name) is record and record.name in _SHARED:
+            _SHARED[record.name] += 1
+        else:
+            register(record)
+            _SHARED[record.name] = 1
+    try:
+        yield record
+    finally:
+        with _SHARED_LOCK:
+            _SHARED[record.name] -= 1
+            if not _SHARED[record.name]:
+                del _SHARED[record.name]
+                unregister(record.name)
 
 
 def applies(record: IndexRecord, result) -> bool:

@@ -116,6 +116,10 @@ class GraphMechanism:
         return tuple(f"{leg.name}:{self.tree.model.names[leg.actuators[0]]}" for leg in self.legs)
 
     @property
+    def actuator_names(self) -> tuple[str, ...]:
+        return self.actuators
+
+    @property
     def is_planar(self) -> bool:
         return False
 

@@ -6,7 +6,8 @@
 * :mod:`~screwkit.studies.maps`: the Fig. 5 maps (minimum over an orientation set on a grid);
 * :func:`~screwkit.studies.trajectory.trajectory`: every index along a path (:mod:`~screwkit.studies.paths`) and
   the stretches each actuator failure leaves uncontrollable, refined between samples
-  (:mod:`~screwkit.studies.refinement`);
+  (:mod:`~screwkit.studies.refinement`), its changes of working mode (:mod:`~screwkit.studies.branches`), paths
+  given as actuator values (:mod:`~screwkit.studies.actuator_paths`);
 * :mod:`~screwkit.studies.design.permutations`: the paper's permutation selection;
 * :mod:`~screwkit.studies.design.families`, :mod:`~screwkit.studies.design.objectives`,
   :mod:`~screwkit.studies.design.optimise`: parametric mechanism families, the metrics of a map's

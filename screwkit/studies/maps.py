@@ -276,15 +276,17 @@ def map_task(mechanism_text: tuple[str, str, str], block: MapBlock, analysis: An
 def map_block(mechanism: Mechanism | GraphMechanism, block: MapBlock, analysis: AnalysisOptions,
               threads: int = 1) -> dict:
     """:func:`map_task` on a loaded mechanism (in the calling process)."""
-    if isinstance(mechanism, GraphMechanism):
-        check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
-        result = graph_indices_at_poses(mechanism, block.poses(), threads=threads, threshold=analysis.threshold,
-                                        faults=analysis.faults, limits=analysis.limits)
-    else:
-        result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
+    with analysis.indices():  # the average case too, if asked, wherever the task runs
+        if isinstance(mechanism, GraphMechanism):
+            check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
+            result = graph_indices_at_poses(mechanism, block.poses(), threads=threads, threshold=analysis.threshold,
+                                            faults=analysis.faults, limits=analysis.limits)
+        else:
+            result = indices_at_poses(mechanism, block.poses(), threads=threads, **analysis.keywords())
+        columns = index_columns(result)
     everywhere = result.reachable.all(axis=1)
     out = {"reachable_fraction": result.reachable.mean(axis=1)}
-    for name, values in index_columns(result).items():  # every registered index: the worst orientation (its `reduce`)
+    for name, values in columns.items():  # every registered index: the worst orientation (its `reduce`)
         out[name] = np.where(everywhere, np.min(np.where(result.reachable, values, np.inf), axis=1), np.nan)
     return out
 

@@ -14,16 +14,19 @@ so the arc length is in metres, a pure rotation has a length, and a mechanism sc
 every arc length scaled by ``k``. :meth:`Path.at` gives the pose at any arc length on that
 piecewise-linear path, which is where the refinement of :mod:`screwkit.studies.trajectory` evaluates.
 
-:func:`line_path` and :func:`circle_path` generate paths; :func:`read_path` reads a CSV or netCDF file
-(angles in degrees unless a netCDF variable says ``units: rad``) and says in one line what is wrong
-with it.
+:func:`line_path`, :func:`circle_path` and :func:`through_path` (piecewise linear through given poses)
+generate paths; :func:`read_path` reads a CSV or netCDF file (angles in degrees unless a netCDF variable says
+``units: rad``) and says in one line what is wrong with it (:func:`read_columns`, which also reads the actuator
+values of :mod:`~screwkit.studies.actuator_paths`).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +35,8 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.units import is_angular
 from screwkit.model import Mechanism
 
-__all__ = ["Path", "path_from_poses", "line_path", "circle_path", "read_path", "PathFileError", "TIME_COLUMN"]
+__all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
+           "PathFileError", "TIME_COLUMN"]
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
@@ -140,6 +144,17 @@ def circle_path(mechanism: Mechanism, centre: ArrayLike, radius: float, samples:
     return path_from_poses(mechanism, poses)
 
 
+def through_path(mechanism: Mechanism, poses: ArrayLike, samples: int) -> Path:
+    """The piecewise-linear path through ``poses`` (k >= 2, (k, n_task); m, rad), straight in task coordinates
+    between consecutive poses: ``samples`` points evenly spaced in arc length over the whole path, and every pose
+    given (its corners are samples)."""
+    if samples < 2:
+        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    corners = path_from_poses(mechanism, poses)
+    return path_from_poses(mechanism, corners.at(np.union1d(np.linspace(0.0, corners.length, samples),
+                                                            corners.arc_length)))
+
+
 def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
     """A path from a CSV or netCDF file: a column (variable) per task coordinate of ``mechanism`` (m, and deg
     for angles; a netCDF variable with ``units: rad`` in rad) and an optional :data:`TIME_COLUMN` (s).
@@ -153,6 +168,26 @@ def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
         a value that is not a finite number, fewer than two samples, times not increasing.
     """
     name = os.fspath(path)
+    wanted = mechanism.task_coordinates
+    poses, times = read_columns(name, wanted, [is_angular(c) for c in wanted],
+                                f"a path of {mechanism.name!r} has columns {', '.join(wanted)} (m, deg)")
+    try:
+        return path_from_poses(mechanism, poses, times)
+    except ValueError as error:
+        raise PathFileError(f"{name}: {error}") from None
+
+
+def read_columns(name: str, wanted, angular, expected: str) -> tuple[NDArray[np.float64], NDArray | None]:
+    """The columns ``wanted`` of a CSV or netCDF path file (n, k), angles (``angular``) read in deg (rad for a
+    netCDF variable with ``units: rad``) and returned in rad, and the :data:`TIME_COLUMN` if there is one.
+    ``expected`` says what a path has (for the message on a missing column).
+
+    Raises
+    ------
+    PathFileError
+        One line naming the file: missing, a folder, an unknown suffix, unreadable, a column missing, a value
+        that is not a finite number, fewer than two samples.
+    """
     if os.path.isdir(name):
         raise PathFileError(f"{name}: is a folder, not a path file (.csv or .nc).")
     if not os.path.isfile(name):
@@ -160,42 +195,62 @@ def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
     suffix = os.path.splitext(name)[1].lower()
     if suffix not in (".csv", ".nc"):
         raise PathFileError(f"{name}: a path file must end in .csv or .nc, got {suffix or 'no suffix'!r}.")
-    columns = _read_netcdf(name) if suffix == ".nc" else _read_csv(name)
-    wanted = mechanism.task_coordinates
-    missing = [coordinate for coordinate in wanted if coordinate not in columns]
+    columns = _read_netcdf(name) if suffix == ".nc" else _read_csv(name, (*wanted, TIME_COLUMN))
+    missing = [column for column in wanted if column not in columns]
     if missing:
-        raise PathFileError(f"{name}: no column {', '.join(repr(m) for m in missing)}; a path of "
-                            f"{mechanism.name!r} has columns {', '.join(wanted)} (m, deg) and optionally "
+        raise PathFileError(f"{name}: no column {', '.join(repr(m) for m in missing)}; {expected} and optionally "
                             f"{TIME_COLUMN!r} (s), got {', '.join(columns) or 'none'}.")
     for column in (*wanted, TIME_COLUMN):
         if column in columns and columns[column][2]:
             raise PathFileError(f"{name}: {columns[column][2]}")
-    poses = np.column_stack([columns[c][0] for c in wanted])
-    if poses.shape[0] < 2:
-        raise PathFileError(f"{name}: {poses.shape[0]} sample(s); a path needs at least 2.")
-    in_degrees = [is_angular(c) and columns[c][1] != "rad" for c in wanted]
-    poses[:, in_degrees] = np.deg2rad(poses[:, in_degrees])
-    times = columns[TIME_COLUMN][0] if TIME_COLUMN in columns else None
-    try:
-        return path_from_poses(mechanism, poses, times)
-    except ValueError as error:
-        raise PathFileError(f"{name}: {error}") from None
+    values = np.column_stack([columns[c][0] for c in wanted])
+    if values.shape[0] < 2:
+        raise PathFileError(f"{name}: {values.shape[0]} sample(s); a path needs at least 2.")
+    in_degrees = [bool(a) and columns[c][1] != "rad" for c, a in zip(wanted, angular)]
+    values[:, in_degrees] = np.deg2rad(values[:, in_degrees])
+    return values, (columns[TIME_COLUMN][0] if TIME_COLUMN in columns else None)
 
 
-def _read_csv(name: str) -> dict[str, tuple[NDArray[np.float64], str, str]]:
-    """Every column of a CSV file: its numbers, no unit, and what is wrong with its first value that is not a
-    finite number ("" if none)."""
+def _read_csv(name: str, wanted) -> dict[str, tuple[NDArray[np.float64] | None, str, str]]:
+    """The columns ``wanted`` of a CSV file (the others by name only): their numbers, no unit, and what is wrong
+    with their first value that is not a finite number ("" if none). A file of plain numbers is read by numpy's
+    parser; anything else (quotes, a cell missing or not a number) cell by cell, to say where."""
     try:
         with open(name, newline="", encoding="utf-8") as handle:
-            rows = list(csv.reader(handle))
+            text = handle.read()
+        rows = csv.reader(io.StringIO(text))
+        header, skipped = None, 0
+        for row in rows:
+            skipped += 1
+            if any(cell.strip() for cell in row):
+                header = [cell.strip() for cell in row]
+                break
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise PathFileError(f"{name}: cannot be read as a CSV file ({error}).") from None
-    rows = [row for row in rows if any(cell.strip() for cell in row)]
-    if not rows:
+    if header is None:
         raise PathFileError(f"{name}: is empty; expected a header row of column names and a row per sample.")
-    header = [cell.strip() for cell in rows[0]]
-    columns: dict[str, tuple[NDArray[np.float64], str, str]] = {}
-    for position, column in enumerate(header):
+    positions = {column: position for position, column in enumerate(header) if column in wanted}
+    columns: dict[str, tuple[NDArray[np.float64] | None, str, str]] = dict.fromkeys(header, (None, "", ""))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an empty table warns; it is refused below as one sample too few
+            table = np.loadtxt(io.StringIO(text), delimiter=",", skiprows=skipped, dtype=float, comments=None,
+                               usecols=list(positions.values()) or None, ndmin=2)
+        if table.shape[1] == len(positions) and np.all(np.isfinite(table)):
+            columns.update({column: (table[:, k], "", "") for k, column in enumerate(positions)})
+            return columns
+    except ValueError:
+        pass
+    return _read_csv_cells(name, text, positions, columns)
+
+
+def _read_csv_cells(name: str, text: str, positions: dict[str, int], columns: dict) -> dict:
+    """:func:`_read_csv` cell by cell: the first value of each column that is not a finite number, and where."""
+    try:
+        rows = [row for row in csv.reader(io.StringIO(text)) if any(cell.strip() for cell in row)]
+    except csv.Error as error:
+        raise PathFileError(f"{name}: cannot be read as a CSV file ({error}).") from None
+    for column, position in positions.items():
         values, problem = np.empty(len(rows) - 1), ""
         for line, row in enumerate(rows[1:], start=2):
             text = row[position].strip() if position < len(row) else ""

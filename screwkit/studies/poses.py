@@ -25,8 +25,8 @@ from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism, dimension_groups, equivalent_chains, leg_screws
 from screwkit.model import Mechanism, require_mechanism
 
-__all__ = ["indices_at_poses", "indices_at_pose", "graph_indices_at_poses", "check_graph_analysis", "GRAPH_CHUNK",
-           "analyze_solution", "output_points", "planar_points",
+__all__ = ["indices_at_poses", "indices_at_pose", "indices_and_joint_values", "graph_indices_at_poses",
+           "check_graph_analysis", "GRAPH_CHUNK", "analyze_solution", "output_points", "planar_points",
            "closed_form_indices"]
 
 
@@ -234,6 +234,27 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     Indices
         Batch shape of ``poses``; NaN (and no worst fault) where unreachable.
     """
+    settings = dict(detail=detail, threshold=threshold, faults=faults, chunk_size=chunk_size, progress=progress,
+                    threads=threads, closed_forms=closed_forms, limits=limits, fault_type=fault_type)
+    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=False)[0]
+
+
+def indices_and_joint_values(mechanism: Mechanism, poses: ArrayLike, **settings
+                             ) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
+    """:func:`indices_at_poses` (the same keywords), and per chain the joint values (..., m_i) of the closures
+    it solved (:attr:`~screwkit.closure.Solution.joint_values`; NaN where the chain does not close), which a
+    path needs to see its working mode (:mod:`screwkit.studies.branches`) without solving the closures twice."""
+    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=True)
+
+
+def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, keep_joint_values: bool):
+    """The work of :func:`indices_at_poses`, chunk by chunk, keeping the joint values when asked."""
+    unknown = set(settings) - set(_SETTINGS)
+    if unknown:
+        raise TypeError(f"Unknown keyword(s) of indices_at_poses: {', '.join(sorted(unknown))}.")
+    options = {**_SETTINGS, **settings}
+    detail, threshold, faults, chunk_size, progress, threads, closed_forms, limits, fault_type = (
+        options[name] for name in _SETTINGS)
     require_mechanism(mechanism, "indices_at_poses")
     if fault_type not in FAULT_TYPES:
         raise ValueError(f"Expected `fault_type` in {', '.join(FAULT_TYPES)}, got {fault_type!r}.")
@@ -250,6 +271,8 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     full_poses = np.empty((count, mechanism.n_pose))
     arrays: dict = {}
     meta: Indices | None = None
+    joint_values = [np.full((count, chain.geometry.n_dofs), np.nan) for chain in mechanism.chains] \
+        if keep_joint_values else None
     with thread_limit(threads):  # closures and screws on no more threads than the kernel
         for start in range(0, count, chunk_size):
             part = slice(start, min(start + chunk_size, count))
@@ -258,6 +281,9 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
             reachable[index] = True
             chain_status[part] = solution.status
             full_poses[part] = solution.full_poses
+            if joint_values is not None:
+                for kept, values in zip(joint_values, solution.joint_values):
+                    kept[part] = values
             if index.size:
                 if closed_forms:
                     result = replace(closed_form_indices(mechanism, solution, threshold, faults, threads),
@@ -273,8 +299,18 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
 
     described = _Described(mechanism.actuator_names, mechanism.dof, mechanism.task_coordinates, mechanism.name,
                            mechanism.pose_coordinates)
-    return _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
-                          faults=faults, detail=detail, threshold=threshold)
+    result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
+                            faults=faults, detail=detail, threshold=threshold)
+    if joint_values is None:
+        return result, None
+    return result, tuple(values.reshape(batch + values.shape[-1:]) for values in joint_values)
+
+
+_SETTINGS = dict(detail=False, threshold=SINGULARITY_THRESHOLD, faults=None, chunk_size=None, progress=None,
+                 threads=None, closed_forms=False, limits=True, fault_type="free-swinging")
+"""The keywords of :func:`indices_at_poses` and their defaults."""
+
+
 
 
 @dataclass(frozen=True)

@@ -16,40 +16,40 @@ whose minimum over the sets is :math:`F_{Oj}` (Eq. 12):
   (:mod:`~screwkit.studies.refinement`); every round evaluates all its brackets in one batched call;
 * the **margin** of each index (its minimum over the samples and where; F_Oj's also over the refined minima);
 * the **events** of the path: where it leaves the reachable set, because a chain cannot close in its working
-  mode or because a joint crosses its limit, located by bisection and explained chain by chain.
+  mode or because a joint crosses its limit, located by bisection and explained chain by chain; and where a
+  chain changes working mode between two samples (its joint values jump, :mod:`~screwkit.studies.branches`),
+  located to the tolerance, never silently jumped.
 
 With ``aggregate="mean"`` the average case is reported beside the worst case: the mean of the LMTI left over
 the sets of ``j`` failures, or their probability-weighted mean (screwkit's extension of Eq. 12, which the
-paper mentions and leaves aside; see docs/trajectory.md).
+paper mentions and leaves aside; :mod:`screwkit.indices.average`, the same for ``analyze``, sweeps and maps).
 """
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from math import prod
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.closure import UnreachablePose, solve_one
+from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.solve import ChainStatus
 from screwkit.common.tolerances import WORST_FAULT_TIE
+from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.exports import set_label
 from screwkit.indices.registry import index_columns
 from screwkit.indices.results import Indices
 from screwkit.model import Mechanism, require_mechanism
+from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.paths import Path, path_from_poses
-from screwkit.studies.poses import indices_at_poses
+from screwkit.studies.poses import indices_and_joint_values, indices_at_poses
 from screwkit.studies.refinement import bisected_crossings, bracketed_minima, local_minima
 
 __all__ = ["trajectory", "TrajectoryResult", "FaultCase", "Margin", "PathEvent", "failure_weights", "singular_dips",
            "AGGREGATES", "RELATIVE_TOLERANCE"]
 
-AGGREGATES = ("min", "mean")
-"""How the sets of ``j`` failures are combined into one index: the paper's worst case (Eq. 12), or also their
-(weighted) mean."""
 RELATIVE_TOLERANCE = 1e-6
 """Default refinement tolerance, in units of the mechanism's length scale (so a scaled mechanism has its
 tolerance scaled with it)."""
@@ -104,9 +104,10 @@ class Margin:
 
 @dataclass(frozen=True)
 class PathEvent:
-    """Where the path cannot be followed in the working mode: ``kind`` is ``"closure"`` (a chain cannot close)
-    or ``"joint limit"``; ``start``/``stop`` the stretch of arc length (m, located to the tolerance), ``samples``
-    its first and last sample, ``reason`` the chains and joints at its first sample."""
+    """Where the path cannot be followed in the working mode: ``kind`` is ``"closure"`` (a chain cannot close),
+    ``"joint limit"`` or ``"branch"`` (a chain's joint values jump: it changes working mode); ``start``/``stop``
+    the stretch of arc length (m, located to the tolerance), ``samples`` its first and last sample (for a branch
+    change, the samples either side), ``reason`` the chains and joints concerned."""
 
     kind: str
     start: float
@@ -134,6 +135,9 @@ class TrajectoryResult:
     margins : dict of str to Margin
         Per index column (``iti``, ``f_o1``, ..., ``f_o_mean1`` with the mean), its minimum along the path.
     events : tuple of PathEvent
+        In order of arc length.
+    working_modes : dict of str to str
+        Per chain, the working mode its closures keep (:func:`screwkit.closure.working_modes`).
     aggregate : str
         ``"min"`` or ``"mean"`` (:data:`AGGREGATES`).
     mean : dict of int to ndarray (n,)
@@ -153,6 +157,7 @@ class TrajectoryResult:
     worst: dict[int, tuple[tuple[str, ...], ...]]
     margins: dict[str, Margin]
     events: tuple[PathEvent, ...]
+    working_modes: dict[str, str] = field(default_factory=dict)
     aggregate: str = "min"
     mean: dict[int, NDArray[np.float64]] = field(default_factory=dict)
     weights: dict[int, NDArray[np.float64]] = field(default_factory=dict)
@@ -185,6 +190,7 @@ class TrajectoryResult:
                         "singular_at_m": list(c.singular_at),
                         "lost_m": c.lost.tolist(), "controllable_m": c.controllable.tolist()} for c in self.cases],
             "worst": {str(j): [list(t) for t in ties] for j, ties in self.worst.items()},
+            "working_modes": self.working_modes,
             "events": [{"kind": e.kind, "start_m": e.start, "stop_m": e.stop, "samples": list(e.samples),
                         "reason": e.reason} for e in self.events],
             "refinement_evaluations": self.evaluations,
@@ -213,35 +219,6 @@ class TrajectoryResult:
                              length_m=self.path.length, aggregate=self.aggregate,
                              summary=json.dumps(self.summary()))
         return dataset
-
-
-def failure_weights(actuator_count: int, faults: int, probabilities: ArrayLike | None = None
-                    ) -> NDArray[np.float64]:
-    """The weight of each set of ``faults`` failed actuators (:meth:`Indices.failed_sets` order) in the mean.
-
-    Equal weights without ``probabilities``; with the failure probability :math:`p_i` of each actuator
-    (independent failures), the probability that exactly the set ``E`` failed given that ``j`` did:
-
-    .. math::
-
-        w_E = \\frac{\\prod_{i \\in E} p_i \\prod_{i \\notin E} (1 - p_i)}
-                   {\\sum_{|E'| = j} \\prod_{i \\in E'} p_i \\prod_{i \\notin E'} (1 - p_i)}
-    """
-    from itertools import combinations
-
-    sets = [tuple(sorted(set(range(actuator_count)) - set(left)))
-            for left in combinations(range(actuator_count), actuator_count - faults)]
-    if probabilities is None:
-        return np.full(len(sets), 1.0 / len(sets))
-    p = np.asarray(probabilities, dtype=float)
-    if p.shape != (actuator_count,) or not np.all((p >= 0) & (p <= 1)):
-        raise ValueError(f"Expected one failure probability in [0, 1] per actuator ({actuator_count}), got "
-                         f"{np.asarray(probabilities).tolist()}.")
-    weights = np.array([prod(p[i] if i in failed else 1.0 - p[i] for i in range(actuator_count)) for failed in sets])
-    if not weights.sum() > 0:
-        raise ValueError(f"No set of {faults} failure(s) has a positive probability with failure probabilities "
-                         f"{p.tolist()}.")
-    return weights / weights.sum()
 
 
 def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None, level: float = 0.4,
@@ -282,7 +259,7 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
         raise ValueError(f"Expected a tolerance > 0 (m of arc length), got {tolerance!r}.")
 
     keywords = dict(analysis.keywords(), detail=True, threads=threads)
-    samples = indices_at_poses(mechanism, path.poses, **keywords)
+    samples, joint_values = indices_and_joint_values(mechanism, path.poses, **keywords)
     faults = samples.faults
     failed_sets = [(j, failed) for j in faults for failed in samples.failed_sets(j)]
     evaluations = [0]
@@ -330,12 +307,19 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     reach_at, reach_state = points[reach_series]
     _, unreachable = _stretches(reach_at, reach_state, {i: crossing[(kk, i)] for kk, i in brackets
                                                         if kk == reach_series})
+    changes = branch_changes(mechanism, s, joint_values, lambda at: solve(mechanism, path.at(at),
+                                                                          limits=analysis.limits).joint_values,
+                             tolerance)
+    events = _events(mechanism, path, samples, unreachable, analysis) + tuple(
+        PathEvent(c.kind, c.start, c.stop, c.samples, describe(mechanism, c)) for c in changes)
     weights = {j: failure_weights(samples.actuator_count, j, probabilities) for j in faults}
-    mean = {j: samples.remaining_lmti[j] @ weights[j] for j in faults} if aggregate == "mean" else {}
+    mean = mean_remaining_lmti(samples.remaining_lmti, samples.actuator_count, probabilities) \
+        if aggregate == "mean" else {}
     return TrajectoryResult(
         mechanism=mechanism.name, path=path, indices=samples, level=float(level), tolerance=tolerance,
         cases=tuple(cases), worst=_worst(cases, faults), margins=_margins(samples, s, cases, mean),
-        events=_events(mechanism, path, samples, unreachable, analysis), aggregate=aggregate, mean=mean,
+        events=tuple(sorted(events, key=lambda e: (e.start, e.kind))), working_modes=working_modes(mechanism),
+        aggregate=aggregate, mean=mean,
         weights=weights if aggregate == "mean" else {}, evaluations=evaluations[0])
 
 

@@ -1,0 +1,132 @@
+"""Paths given as actuator values: the platform poses they drive, by forward kinematics along the path.
+
+:func:`path_from_actuators` turns a sequence of actuator values (one value per actuator and sample) into a
+:class:`~screwkit.studies.paths.Path` of platform poses with :func:`screwkit.closure.forward` (Newton steps on the
+pose, every actuator held at its value: for a redundantly actuated mechanism the values must agree with each
+other, as those of one pose do). The forward kinematics has several solutions (assembly modes); the one followed
+is the one reached from ``start`` (default: the reference assembly's pose), by continuation along the path:
+
+1. a coarse pass, sample after sample: at most :data:`COARSE_SEGMENTS` + 1 samples evenly spread along the path,
+   each solved from the pose of the one before;
+2. then, round after round, the sample halfway between two solved samples, from the pose of the first of them:
+   every round one batched call, about log2(n / :data:`COARSE_SEGMENTS`) rounds in all.
+
+:func:`read_actuator_path` reads the values from a CSV or netCDF file (a column per actuator, named as
+:attr:`~screwkit.model.Mechanism.actuator_names` names them or by its chain's name when the chain has one actuator;
+deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in one line what is wrong.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.closure import forward
+from screwkit.model import Mechanism
+from screwkit.studies.paths import Path, PathFileError, path_from_poses, read_columns
+
+__all__ = ["path_from_actuators", "read_actuator_path", "actuator_columns", "COARSE_SEGMENTS"]
+
+COARSE_SEGMENTS = 64
+"""Segments of the coarse pass of the continuation, solved one after the other."""
+
+
+def actuator_columns(mechanism: Mechanism) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The column of each actuator in a path file (``chain:joint``) and its short alias (the chain's name, when
+    the chain has one actuator; else the full name again)."""
+    names = mechanism.actuator_names
+    chains = [name.split(":")[0] for name in names]
+    aliases = tuple(chain if chains.count(chain) == 1 else name for chain, name in zip(chains, names))
+    return names, aliases
+
+
+def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLike | None = None, *,
+                        start: ArrayLike | None = None) -> Path:
+    """The path of the platform driven by actuator ``values`` (n, a) (rad, m; :attr:`Mechanism.actuators` order).
+
+    Raises
+    ------
+    ValueError
+        A sample whose values no pose near its neighbour's gives (values that disagree with each other, or
+        outside the workspace of the assembly mode followed): the first such sample, by number.
+    """
+    values = np.asarray(values, dtype=float)
+    count = len(mechanism.actuators)
+    if values.ndim != 2 or values.shape[1] != count or values.shape[0] < 2:
+        raise ValueError(f"Expected actuator values with shape (n >= 2, {count}), got {values.shape}.")
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"Expected finite actuator values, got {values[~np.isfinite(values)][0]} at sample "
+                         f"{int(np.flatnonzero(~np.all(np.isfinite(values), axis=1))[0])}.")
+    n = values.shape[0]
+    poses = np.full((n, mechanism.n_task), np.nan)
+    start = mechanism.home_pose if start is None else mechanism.check_poses(start)
+    coarse = np.unique(np.linspace(0, n - 1, min(n, COARSE_SEGMENTS + 1)).round().astype(np.int64))
+    previous = start
+    for i in coarse:  # one after the other
+        poses[i] = _reached(mechanism, values[i:i + 1], previous[None], np.array([i]))[0]
+        previous = poses[i]
+    solved = coarse
+    while solved.size < n:  # halfway between solved samples, from the first of them, batched
+        gaps = np.flatnonzero(np.diff(solved) > 1)
+        middle = (solved[gaps] + solved[gaps + 1]) // 2
+        poses[middle] = _reached(mechanism, values[middle], poses[solved[gaps]], middle)
+        solved = np.sort(np.concatenate([solved, middle]))
+    return path_from_poses(mechanism, poses, times)
+
+
+def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: NDArray) -> NDArray[np.float64]:
+    """The poses where the actuators take ``values`` (k, a), from ``initial`` poses; ValueError naming the first
+    sample not reached."""
+    solution = forward(mechanism, values, initial)
+    missed = np.flatnonzero(~np.asarray(solution.reachable))
+    if missed.size:
+        first = int(samples[missed[0]])
+        shown = ", ".join(f"{v:.6g}" for v in np.where(_angular(mechanism), np.rad2deg(values[missed[0]]),
+                                                       values[missed[0]]))
+        raise ValueError(f"sample {first}: no pose near the previous sample's gives the actuator values ({shown}; "
+                         "deg, m): they disagree with each other, or leave the workspace of the assembly followed.")
+    return solution.poses
+
+
+def _angular(mechanism: Mechanism) -> NDArray[np.bool_]:
+    return np.array([not mechanism.chains[c].prismatic[j] for c, j in mechanism.actuator_positions(None)])
+
+
+def read_actuator_path(mechanism: Mechanism, path: str | os.PathLike, *, start: ArrayLike | None = None) -> Path:
+    """The platform path driven by the actuator values of a CSV or netCDF file (:func:`path_from_actuators`).
+
+    Raises
+    ------
+    PathFileError
+        One line naming the file: what :func:`~screwkit.studies.paths.read_columns` refuses, times not increasing,
+        or a sample whose values no pose gives.
+    """
+    name = os.fspath(path)
+    names, aliases = actuator_columns(mechanism)
+    header = _header(name)
+    wanted = [alias if name_ not in header and alias in header else name_ for name_, alias in zip(names, aliases)]
+    listed = ", ".join(alias for alias in aliases)
+    values, times = read_columns(name, wanted, _angular(mechanism),
+                                 f"a path of {mechanism.name!r} in actuator values has columns {listed} (deg for a "
+                                 "revolute actuator, m for a prismatic one; or chain:joint)")
+    try:
+        return path_from_actuators(mechanism, values, times, start=start)
+    except ValueError as error:
+        raise PathFileError(f"{name}: {error}") from None
+
+
+def _header(name: str) -> set[str]:
+    """The column names of a CSV file's first line, or the variables of a netCDF file (nothing for a file that
+    cannot be read: :func:`~screwkit.studies.paths.read_columns` says why)."""
+    try:
+        if name.lower().endswith(".nc"):
+            from scipy.io import netcdf_file
+
+            with netcdf_file(name, "r", mmap=False) as handle:
+                return set(handle.variables)
+        with open(name, encoding="utf-8") as handle:
+            return {cell.strip() for cell in handle.readline().split(",")}
+    except Exception:  # whatever a file that is not one raises: read_columns says what is wrong with it
+        return set()
