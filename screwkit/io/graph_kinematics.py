@@ -250,9 +250,15 @@ class _Residual:
         return transforms[:, self.frame_joint] @ self.frame_placement
 
     def __call__(self, q: NDArray, target: NDArray, jacobian: bool = True):
+        count = q.shape[0]
         transforms = self.kinematics.transforms(q)
-        twists = self.kinematics.twists(transforms) if jacobian else None
-        rows, blocks = [], []
+        rows: list[NDArray] = []
+        height = sum(6 if closure.kind == "6d" else 3 for closure in self.closures) + len(self.task_axes)
+        matrix = np.zeros((count, height, self.kinematics.nv)) if jacobian else None
+        if jacobian:  # every twist in the units of the unknowns (a translation's per length scale)
+            twists = self.kinematics.twists(transforms) * self.unit[None, :, None]
+            twists[..., 3:] /= self.scale  # velocities in units of the length scale
+        top = 0
         for closure in self.closures:
             a = transforms[:, closure.joint_a] @ closure.placement_a
             b = transforms[:, closure.joint_b] @ closure.placement_b
@@ -261,16 +267,16 @@ class _Residual:
                 rows.append(np.einsum("nij,nj->ni", a[:, :3, :3],
                                       _rotation_vector(np.swapaxes(a[:, :3, :3], 1, 2) @ b[:, :3, :3])))
             if jacobian:
-                velocity = np.zeros((q.shape[0], 3, self.kinematics.nv))
-                turning = np.zeros((q.shape[0], 3, self.kinematics.nv))
                 for joint, point, sign in ((closure.joint_b, b[:, :3, 3], 1.0), (closure.joint_a, a[:, :3, 3], -1.0)):
                     columns = self.columns(joint)
+                    if not columns.size:
+                        continue
                     omega, v = twists[:, columns, :3], twists[:, columns, 3:]
-                    velocity[:, :, columns] += sign * np.swapaxes(v + np.cross(omega, point[:, None, :]), 1, 2)
-                    turning[:, :, columns] += sign * np.swapaxes(omega, 1, 2)
-                blocks.append(velocity / self.scale)
-                if closure.kind == "6d":
-                    blocks.append(turning)
+                    at_point = v + np.cross(omega, point[:, None, :] / self.scale)
+                    matrix[:, top:top + 3, columns] += sign * np.swapaxes(at_point, 1, 2)
+                    if closure.kind == "6d":
+                        matrix[:, top + 3:top + 6, columns] += sign * np.swapaxes(omega, 1, 2)
+            top += 6 if closure.kind == "6d" else 3
         if self.task_axes:
             frame = self.frame(transforms)
             pose = np.concatenate([frame[:, :3, 3] / self.scale, rpy_of(frame[:, :3, :3])], axis=1)
@@ -280,14 +286,10 @@ class _Residual:
             if jacobian:
                 columns = self.columns(self.frame_joint)
                 omega, v = twists[:, columns, :3], twists[:, columns, 3:]
-                rates = np.zeros((q.shape[0], 6, self.kinematics.nv))
-                rates[:, :3, columns] = np.swapaxes(v + np.cross(omega, frame[:, None, :3, 3]), 1, 2) / self.scale
-                rates[:, 3:, columns] = rpy_rates_inverse(pose[:, 3:]) @ np.swapaxes(omega, 1, 2)
-                blocks.append(rates[:, list(self.task_axes)])
-        residual = np.concatenate(rows, axis=1)
-        if not jacobian:
-            return residual, None
-        return residual, np.concatenate(blocks, axis=1) * self.unit
+                rates = np.concatenate([np.swapaxes(v + np.cross(omega, frame[:, None, :3, 3] / self.scale), 1, 2),
+                                        rpy_rates_inverse(pose[:, 3:]) @ np.swapaxes(omega, 1, 2)], axis=1)
+                matrix[:, top:, columns] = rates[:, list(self.task_axes)]
+        return np.concatenate(rows, axis=1), matrix
 
 
 def _least_squares(residual: _Residual, kinematics: TreeKinematics, q: NDArray, target: NDArray, iterations: int,
