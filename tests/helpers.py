@@ -250,3 +250,23 @@ def bundled(name: str):
     from screwkit.io.loader import load
 
     return load(name)
+
+
+def couple_cti(couples) -> float:
+    """The CTI of legs whose only constraint wrench is a couple m_i, from the couples alone: any three independent
+    couples are a non-redundant constraint subsystem; releasing leg i's couple with the other two kept frees the
+    rotation along m_j x m_k (whatever actuators are locked, as long as their forces are independent), so
+    kappa_i = |m_i . (m_j x m_k)| / |m_j x m_k|, and the CTI is the best subsystem's lowest kappa."""
+    from itertools import combinations
+
+    couples = np.asarray(couples, dtype=float)
+    couples = couples / np.linalg.norm(couples, axis=1, keepdims=True)
+    best = 0.0
+    for legs in combinations(range(len(couples)), 3):
+        kappas = []
+        for i in legs:
+            j, k = (other for other in legs if other != i)
+            freed = np.cross(couples[j], couples[k])
+            kappas.append(abs(couples[i] @ freed) / np.linalg.norm(freed))
+        best = max(best, min(kappas))
+    return best

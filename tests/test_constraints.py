@@ -17,7 +17,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import assert_indices_close, moved, random_rotation, screwkit
+from helpers import assert_indices_close, couple_cti, moved, random_rotation, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.indices.analysis import analyze
 from screwkit.io.loader import load_text
@@ -182,21 +182,8 @@ def test_cli_fault_option_reports_the_type():
 
 def delta_cti(twists):
     """The CTI of R-U-U Delta legs from their explicit geometry: each leg's constraint couple m_i = a_i x w_i
-    (a the arm axis, w the universal joints' middle axis). Any three legs whose couples are independent are a
-    non-redundant constraint subsystem; releasing leg i's couple with the other two kept frees the rotation
-    along m_j x m_k (whatever actuators are locked, as long as their forces are independent), so
-    kappa_i = |m_i . (m_j x m_k)| / |m_j x m_k|, and the CTI is the best subsystem's lowest kappa."""
-    couples = [np.cross(t[0, :3], t[2, :3]) for t in twists]
-    couples = [c / np.linalg.norm(c) for c in couples]
-    best = 0.0
-    for legs in combinations(range(len(couples)), 3):
-        kappas = []
-        for i in legs:
-            j, k = (other for other in legs if other != i)
-            freed = np.cross(couples[j], couples[k])
-            kappas.append(abs(couples[i] @ freed) / np.linalg.norm(freed))
-        best = max(best, min(kappas))
-    return best
+    (a the arm axis, w the universal joints' middle axis), then :func:`helpers.couple_cti`."""
+    return couple_cti([np.cross(t[0, :3], t[2, :3]) for t in twists])
 
 
 @pytest.mark.parametrize("pose_name", ["home", "raised", "off_centre"])

@@ -11,13 +11,11 @@ that of its R-U-U couples a_i x w_i (tests/test_constraints.py). MuJoCo reads th
 
 from __future__ import annotations
 
-from itertools import combinations
-
 import numpy as np
 import pytest
 from test_gallery import assert_same_bodies, mujoco_residuals, mujoco_state
 
-from helpers import screwkit
+from helpers import couple_cti, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.io import graph_mechanism, read_closed_tree
 from screwkit.io.loader import bundled_path, load
@@ -31,22 +29,6 @@ def poses(mechanism) -> np.ndarray:
     named = np.array(list(mechanism.named_poses.values()))
     spread = np.random.default_rng(11).uniform(-1.0, 1.0, (12, 3)) * np.array([0.15, 0.15, 0.15])
     return np.vstack([named, mechanism.home_pose + spread])
-
-
-def couple_cti(couples: np.ndarray) -> float:
-    """The CTI of legs whose only constraint wrench is a couple m_i: any three independent couples are a
-    non-redundant subsystem; releasing m_i with m_j, m_k kept frees the rotation along m_j x m_k, so
-    kappa_i = |m_i . (m_j x m_k)| / |m_j x m_k|; the best subsystem's least kappa."""
-    couples = couples / np.linalg.norm(couples, axis=1, keepdims=True)
-    best = 0.0
-    for legs in combinations(range(len(couples)), 3):
-        kappas = []
-        for i in legs:
-            j, k = (other for other in legs if other != i)
-            freed = np.cross(couples[j], couples[k])
-            kappas.append(abs(couples[i] @ freed) / np.linalg.norm(freed))
-        best = max(best, min(kappas))
-    return best
 
 
 @pytest.fixture(scope="module")
