@@ -64,9 +64,12 @@ def mujoco_state(path: Path, qpos=None):
 def mujoco_residuals(model, data) -> dict[str, np.ndarray]:
     """Every equality's residual as MuJoCo defines it, from MuJoCo's compiled equality data: a connect's two anchor
     points (or sites) apart, a weld's body2 apart from body1 times its relative pose (position and rotation)."""
-    out = {}
+    out, unnamed = {}, 0
     for k in range(model.neq):
         name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EQUALITY, k)
+        if name is None:  # named in file order as screwkit names them (connect_1, weld_2, ...)
+            unnamed += 1
+            name = f"{'connect' if int(model.eq_type[k]) == int(mujoco.mjtEq.mjEQ_CONNECT) else 'weld'}_{unnamed}"
         first, second, values = model.eq_obj1id[k], model.eq_obj2id[k], model.eq_data[k]
         sites = int(model.eq_objtype[k]) == int(mujoco.mjtObj.mjOBJ_SITE)
         if int(model.eq_type[k]) == int(mujoco.mjtEq.mjEQ_CONNECT):
@@ -124,9 +127,9 @@ def assert_same_bodies(tree, mj_model, mj_data, q):
     checked = 0
     for k in range(1, mj_model.nbody):
         name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_BODY, k)
-        if name is None or not model.existFrame(name):
+        if name is None or not model.existFrame(name, pin.FrameType.BODY):
             continue
-        placement = data.oMf[model.getFrameId(name)]
+        placement = data.oMf[model.getFrameId(name, pin.FrameType.BODY)]
         np.testing.assert_allclose(placement.translation, mj_data.xpos[k], atol=TOLERANCE, rtol=0, err_msg=name)
         np.testing.assert_allclose(placement.rotation, mj_data.xmat[k].reshape(3, 3), atol=TOLERANCE, rtol=0,
                                    err_msg=name)

@@ -1,0 +1,325 @@
+"""Published robot descriptions, opened as their authors wrote them (``tests/data/gallery/published``, origins and
+licences in its ``SOURCES.md``).
+
+* Gepetto's example-parallel-robots (BSD-3-Clause), URDF + robot.yaml: the five-bar ``5bar_linkage``, the planar
+  Delta ``robot_delta`` (revolute parallelograms) and the 6-SPS leg ``wl16_like``. Their indices are checked against
+  numbers computed here with Pinocchio's forward kinematics and numpy alone, at the configuration the file's
+  closures assemble into (closed to 1e-12 as Pinocchio measures it, the motor values those screwkit analyses): the
+  textbook pressure angles of the five-bar and of the Delta (ITI = |u . t|, OTI_i = |u_i . (n x u_j)|, u the distal
+  link's direction, t the elbow's velocity direction, n the plane's normal), and the leg-line OTIs of the
+  Stewart-like leg (the output twist of leg k reciprocal to the other five leg forces, measured at leg k's foot
+  joint).
+* Pollen Robotics' Reachy Mini (Apache-2.0), an onshape-to-robot export of a 6-RSS Stewart head as MJCF and as a
+  URDF with closing_ frames, and Agility Robotics' Cassie from MuJoCo Menagerie (MIT), a biped whose legs hold
+  closed-loop transmissions: MuJoCo's reading (meshes left out, which MuJoCo needs and kinematics does not) and
+  screwkit's agree on every body and every closure at the file's configuration, at random ones and after screwkit's
+  assembly; neither is analysed yet, and the tests hold the one-line reasons screwkit gives.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, screwkit_residuals
+
+from screwkit.io import ImportError_, read_closed_tree
+from screwkit.io.closed_tree import assemble
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.loader import load
+from screwkit.io.mjcf import read_mjcf
+from screwkit.studies import indices_at_pose
+
+PUBLISHED = GALLERY / "published"
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "other-formats.md"
+GEPETTO = PUBLISHED / "example_parallel_robots"
+TOLERANCE = 1e-9
+
+
+# --- Gepetto's robots: indices from the geometry ---------------------------------------------------------------
+
+def assembled(path: Path):
+    """The tree of a URDF + robot.yaml closed by screwkit's assembly, checked closed with Pinocchio alone, and its
+    joint placements."""
+    tree = read_closed_tree(path)
+    q, _ = assemble(tree)
+    gaps = screwkit_residuals(tree, q)
+    assert max(float(np.max(np.abs(gap))) for gap in gaps.values()) < 1e-12
+    data = tree.model.createData()
+    pin.forwardKinematics(tree.model, data, q)
+    return tree, q, data
+
+
+def joint_point(tree, data, name: str) -> np.ndarray:
+    return data.oMi[tree.model.getJointId(name)].translation.copy()
+
+
+def joint_axis(tree, data, name: str) -> np.ndarray:
+    """The world axis of a revolute joint about (or prismatic joint along) its own z (every joint of these files)."""
+    joint = tree.model.getJointId(name)
+    assert tree.model.joints[joint].shortname().endswith("Z"), name
+    return data.oMi[joint].rotation[:, 2].copy()
+
+
+def path_to_root(model, joint: int) -> list[int]:
+    """The joints from ``joint`` up to the base, ``joint`` first."""
+    out = [joint]
+    while model.parents[out[-1]] > 0:
+        out.append(int(model.parents[out[-1]]))
+    return out
+
+
+def unit(vector) -> np.ndarray:
+    return np.asarray(vector) / np.linalg.norm(vector)
+
+
+def planar_pressure_angles(motors, elbows, ends, normal) -> dict:
+    """ITI and OTI of a two-motor planar mechanism whose legs transmit a force along their distal links (elbow to
+    end) to a platform that only translates in the plane (a point, or a body kept parallel): the textbook
+    pressure angles, numpy alone. The links of a CAD model sit in layers along the axes: the angles are those of
+    the links projected on the plane of motion (a force along the unprojected link differs from the projected one
+    by a force along the normal, which the legs' parallel axes resist)."""
+    def in_plane(vector):
+        return unit(vector - (vector @ normal) * normal)
+
+    rods = [in_plane(end - elbow) for elbow, end in zip(elbows, ends)]
+    tangents = [in_plane(np.cross(normal, elbow - motor)) for motor, elbow in zip(motors, elbows)]
+    iti = [abs(rod @ tangent) for rod, tangent in zip(rods, tangents)]
+    oti = [abs(rods[0] @ unit(np.cross(normal, rods[1]))), abs(rods[1] @ unit(np.cross(normal, rods[0])))]
+    return {"iti": np.array(iti), "oti": np.array(oti), "lmti": min(oti)}
+
+
+def gallery_docs() -> str:
+    """The Gallery section of docs/other-formats.md, whose quoted outputs the tests hold."""
+    text = DOCS.read_text(encoding="utf-8")
+    return text[text.index("## Gallery"):]
+
+
+def assert_documented(result, path: Path) -> None:
+    """The LMTI that the Gallery section quotes for ``path`` is the one computed."""
+    section = gallery_docs()
+    block = section[section.index(f"screwkit analyze {path.relative_to(DOCS.parents[1])}"):]
+    assert f"LMTI (Eq. 11, all actuators)        {result.lmti:.4f}" in block.split("```bash")[0]
+
+
+def assert_refusal_documented(error: pytest.ExceptionInfo) -> None:
+    """The refusal's message (after the file's name) is quoted in the Gallery section as screwkit prints it."""
+    assert str(error.value).split(": ", 1)[1] in gallery_docs()
+
+
+def screwkit_at_home(path: Path, tree, q):
+    """screwkit's indices at the file's home pose, after checking that its motors sit where the assembly put them."""
+    mechanism = load(path)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    motors = [name.split(":")[-1] for name in result.actuators]
+    values = {name.split(":")[-1]: value for name, value in result.joint_values.items()}
+    for motor in motors:
+        np.testing.assert_allclose(values[motor], q[tree.model.joints[tree.model.getJointId(motor)].idx_q],
+                                   atol=1e-9, err_msg=motor)
+    return result, motors
+
+
+def test_gepetto_five_bar_gives_the_textbook_pressure_angles():
+    """5bar_linkage: leg 1 mot1-free1 ends on the pin closedloop1_A, leg 2 mot2-free2 on closedloop1_B (the 6d
+    closure holds the two pins coaxial): the output is the pin's point."""
+    path = GEPETTO / "5bar_linkage" / "robot.urdf"
+    tree, q, data = assembled(path)
+    point = joint_point(tree, data, "closedloop1_A")
+    np.testing.assert_allclose(joint_point(tree, data, "closedloop1_B"), point, atol=1e-12)
+    expected = planar_pressure_angles([joint_point(tree, data, m) for m in ("mot1", "mot2")],
+                                      [joint_point(tree, data, e) for e in ("free1", "free2")], [point, point],
+                                      joint_axis(tree, data, "mot1"))
+    result, motors = screwkit_at_home(path, tree, q)
+    assert motors == ["mot1", "mot2"] and result.dof == 2
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], expected["oti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=TOLERANCE)
+    assert 0.1 < expected["lmti"] < 0.99  # a pose where the angles say something
+    assert_documented(result, path)
+
+
+def test_gepetto_planar_delta_with_revolute_parallelograms_gives_the_textbook_pressure_angles():
+    """robot_delta: rod 1 (mot1_rod1, free1_rod1, free2_rod1) carries the effector; rod 2 (mot1_rod2, free1_rod2)
+    is pinned to it at closedloop2_A/B; the passive rod 3 closes two parallelograms that keep the effector from
+    turning, so each leg transmits the force along its distal link and the effector translates."""
+    path = GEPETTO / "robot_delta" / "robot.urdf"
+    tree, q, data = assembled(path)
+    ends = [joint_point(tree, data, "free2_rod1"), joint_point(tree, data, "closedloop2_A")]
+    expected = planar_pressure_angles([joint_point(tree, data, m) for m in ("mot1_rod1", "mot1_rod2")],
+                                      [joint_point(tree, data, e) for e in ("free1_rod1", "free1_rod2")], ends,
+                                      joint_axis(tree, data, "mot1_rod1"))
+    result, motors = screwkit_at_home(path, tree, q)
+    assert motors == ["mot1_rod1", "mot1_rod2"] and result.dof == 2
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], expected["oti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=TOLERANCE)
+    assert 0.1 < expected["lmti"] < 0.99
+    assert_documented(result, path)
+
+
+def test_gepetto_sps_leg_gives_the_leg_line_otis():
+    """wl16_like: six S-P-S legs (three hip revolutes through one point, a prismatic motor, a ball at the foot);
+    the actuation wrench of a leg is the force along its line, hip centre to foot ball centre, so ITI = 1 and OTI_k
+    is |line_k . v_k| / |v_k|, v_k the velocity at leg k's foot ball centre of the foot twist reciprocal to the
+    other five leg forces (the closure frames sit on the leg lines but not at the balls' centres)."""
+    path = GEPETTO / "wl16_like" / "robot.urdf"
+    tree, q, data = assembled(path)
+    model = tree.model
+    pin.framesForwardKinematics(model, data, q)
+    feet = {}
+    for closure in tree.closures:  # each closure joins a motor leg's end to a ball of the foot: the ball's centre
+        sides = [path_to_root(model, closure.joint_a), path_to_root(model, closure.joint_b)]
+        ball = [j for side in sides for j in side if model.names[j].startswith("foot_part_axis_")]
+        leg = next(side for side in sides if not set(side) & set(ball))  # the foot side runs through leg 6 too
+        motor = [model.names[j] for j in leg if model.names[j].startswith("motor_")]
+        assert len(motor) == 1 and len(ball) == 3, closure.name
+        feet[motor[0]] = data.oMi[ball[-1]].translation.copy()  # the ball's first revolute (three through a point)
+    feet["motor_6"] = joint_point(tree, data, "part_4_foot_part_rev0")  # leg 6 carries the foot on its own ball
+    result, motors = screwkit_at_home(path, tree, q)
+    assert sorted(feet) == sorted(motors) and result.dof == 6
+    lines, centres = [], []
+    for motor in motors:
+        hip_joint = model.parents[model.parents[model.parents[model.getJointId(motor)]]]
+        hip = data.oMi[hip_joint].translation
+        direction = unit(feet[motor] - hip)
+        np.testing.assert_allclose(abs(direction @ joint_axis(tree, data, motor)), 1.0, atol=1e-9)  # along the slide
+        lines.append(np.concatenate([direction, np.cross(feet[motor], direction)]))
+        centres.append(feet[motor])
+    otis = []
+    for k in range(6):
+        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
+        twist = np.linalg.svd(others)[2][-1]
+        velocity = twist[3:] + np.cross(twist[:3], centres[k])
+        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    np.testing.assert_allclose(result.iti_actuators, np.ones(6), atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, min(otis), atol=TOLERANCE)
+    assert_documented(result, path)
+
+
+# --- MJCF exports: MuJoCo's geometry, and what screwkit says of them -------------------------------------------
+
+REACHY = PUBLISHED / "reachy_mini" / "reachy_mini.xml"
+CASSIE = PUBLISHED / "agility_cassie" / "cassie.xml"
+
+
+def without_meshes(text: str) -> str:
+    """The MJCF text without what MuJoCo would load from disk (mesh, texture and material assets, mesh geoms,
+    ``meshdir``): bodies, joints, inertials, sites and equalities untouched. For MuJoCo only: screwkit reads the
+    file as written."""
+    root = ET.fromstring(text)
+    for parent in root.iter():
+        for child in list(parent):
+            if (parent.tag == "asset" and child.tag in ("mesh", "texture", "material")) or \
+                    (child.tag == "geom" and (child.get("type") == "mesh" or child.get("mesh"))):
+                parent.remove(child)
+        if parent.tag == "geom":
+            parent.attrib.pop("material", None)
+        if parent.tag == "compiler":
+            parent.attrib.pop("meshdir", None)
+            parent.attrib.pop("texturedir", None)
+    return ET.tostring(root, encoding="unicode")
+
+
+def mujoco_model(path: Path) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(without_meshes(path.read_text()))
+
+
+def mujoco_data(model: mujoco.MjModel, qpos) -> mujoco.MjData:
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    return data
+
+
+def pinocchio_q(tree, mj_model, qpos) -> np.ndarray:
+    """MuJoCo's qpos as Pinocchio's q, joint by joint: free joints (x y z, quaternion w x y z in MuJoCo, x y z w in
+    Pinocchio), balls (w x y z / x y z w), hinges and slides."""
+    model = tree.model
+    q = pin.neutral(model)
+    for k in range(mj_model.njnt):
+        kind, start = int(mj_model.jnt_type[k]), int(mj_model.jnt_qposadr[k])
+        name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, k)
+        if kind == int(mujoco.mjtJoint.mjJNT_FREE):
+            body = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_BODY, int(mj_model.jnt_bodyid[k]))
+            joint = model.joints[model.getJointId(name or f"{body}_free")]
+            q[joint.idx_q:joint.idx_q + 7] = np.r_[qpos[start:start + 3], qpos[start + 4:start + 7], qpos[start + 3]]
+        elif kind == int(mujoco.mjtJoint.mjJNT_BALL):
+            joint = model.joints[model.getJointId(name)]
+            q[joint.idx_q:joint.idx_q + 4] = np.r_[qpos[start + 1:start + 4], qpos[start]]
+        else:
+            q[model.joints[model.getJointId(name)].idx_q] = qpos[start]
+    return q
+
+
+def mujoco_qpos(tree, mj_model, q) -> np.ndarray:
+    """The inverse of :func:`pinocchio_q`."""
+    model, qpos = tree.model, mj_model.qpos0.copy()
+    for k in range(mj_model.njnt):
+        kind, start = int(mj_model.jnt_type[k]), int(mj_model.jnt_qposadr[k])
+        name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, k)
+        if kind == int(mujoco.mjtJoint.mjJNT_FREE):
+            body = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_BODY, int(mj_model.jnt_bodyid[k]))
+            at = model.joints[model.getJointId(name or f"{body}_free")].idx_q
+            qpos[start:start + 7] = np.r_[q[at:at + 3], q[at + 6], q[at + 3:at + 6]]
+        elif kind == int(mujoco.mjtJoint.mjJNT_BALL):
+            at = model.joints[model.getJointId(name)].idx_q
+            qpos[start:start + 4] = np.r_[q[at + 3], q[at:at + 3]]
+        else:
+            qpos[start] = q[model.joints[model.getJointId(name)].idx_q]
+    return qpos
+
+
+@pytest.mark.parametrize("path", [REACHY, CASSIE], ids=["reachy_mini", "agility_cassie"])
+def test_mujoco_reads_the_published_mjcf_exports_as_screwkit_does(path):
+    """Reachy Mini: sites closed by unnamed <connect>s, ball joints, quaternions to six digits; Cassie: no <compiler
+    angle> (degrees), eulerseq zyx, xyaxes frames, hinge refs, a free joint, ball joints, a home keyframe."""
+    tree = read_mjcf(path)
+    mj_model = mujoco_model(path)
+    assert mj_model.nq == tree.model.nq
+    rng = np.random.default_rng(27)
+    keyframe = mj_model.key_qpos[0].copy() if mj_model.nkey else mj_model.qpos0.copy()
+    np.testing.assert_allclose(pinocchio_q(tree, mj_model, keyframe), tree.q_reference, atol=1e-12)
+    configurations = [mj_model.qpos0.copy(), keyframe]
+    for _ in range(3):
+        qpos = keyframe.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.uniform(-0.2, 0.2, mj_model.nv), 1.0)
+        configurations.append(qpos)
+    for qpos in configurations:
+        mj_data = mujoco_data(mj_model, qpos)
+        q = pinocchio_q(tree, mj_model, qpos)
+        assert_same_bodies(tree, mj_model, mj_data, q)
+        theirs, ours = mujoco_residuals(mj_model, mj_data), screwkit_residuals(tree, q)
+        assert theirs.keys() == ours.keys() and len(ours) == mj_model.neq
+        for closure in theirs:
+            np.testing.assert_allclose(ours[closure], theirs[closure], atol=TOLERANCE, rtol=0, err_msg=closure)
+    closed, _ = assemble(tree)
+    residuals = mujoco_residuals(mj_model, mujoco_data(mj_model, mujoco_qpos(tree, mj_model, closed)))
+    assert max(float(np.max(np.abs(r))) for r in residuals.values()) < TOLERANCE
+
+
+def test_reachy_mini_is_refused_for_the_body_yaw_joint_under_its_stewart_platform():
+    """The head is a 6-RSS Stewart platform on a body turned by the yaw_body motor: every leg runs through
+    yaw_body, so the tree has one leg from the base (with loops and 7 motors) instead of six."""
+    with pytest.raises(ImportError_, match=r"leg 'body_down_3dprint' has loops inside it and 7 actuators") as error:
+        graph_mechanism(read_closed_tree(REACHY))
+    assert_refusal_documented(error)
+    with pytest.raises(ImportError_, match=r"actuated joint 'yaw_body' moves inside a loop of leg "
+                                           r"'body_down_3dprint'") as error:
+        graph_mechanism(read_closed_tree(REACHY.with_name("robot.urdf")))
+    assert_refusal_documented(error)
+
+
+def test_cassie_needs_its_output_named_and_is_refused_for_its_transmissions():
+    """A biped: no frame screwkit recognises as the platform; with a foot named, the whole robot (free joint, both
+    legs, ten motors) is one leg with loops inside it."""
+    with pytest.raises(ImportError_, match=r"which body is the platform\?") as error:
+        graph_mechanism(read_closed_tree(CASSIE))
+    assert_refusal_documented(error)
+    with pytest.raises(ImportError_, match=r"leg 'cassie-pelvis' has loops inside it and 10 actuators") as error:
+        graph_mechanism(read_closed_tree(CASSIE, output="left-foot"))
+    assert_refusal_documented(error)
