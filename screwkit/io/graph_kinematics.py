@@ -32,12 +32,16 @@ from numpy.typing import NDArray
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
 __all__ = ["TreeKinematics", "solve_poses", "rpy_of", "rpy_rates_inverse", "STAGE_LENGTH", "MAX_ITERATIONS",
-           "FINAL_TOLERANCE"]
+           "STAGE_TOLERANCE", "FINAL_TOLERANCE"]
 
 STAGE_LENGTH = 0.05
 """Largest move of a continuation stage: task coordinates in units of the length scale, and radians."""
 MAX_ITERATIONS = 60
 """Levenberg-Marquardt iterations of the last stage (the stages before take a quarter of them)."""
+STAGE_TOLERANCE = 1e-4
+"""Residual to which a continuation stage before the last closes its poses: near enough to stay in the working
+mode's basin for the next stage (each moves the platform by :data:`STAGE_LENGTH` at most), without the last
+Newton steps of a tight closure."""
 FINAL_TOLERANCE = 1e-14
 """Residual to which the last stage closes a pose (Newton's last steps are cheap and take the configuration to
 rounding, so that one pose solved alone and in a batch agree to it); a pose counts as reached below
@@ -355,7 +359,7 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
         last = stage == stages
         q, norm = _least_squares(residual, kinematics, q, origin + move * (stage / stages),
                                  MAX_ITERATIONS if last else MAX_ITERATIONS // 4,
-                                 FINAL_TOLERANCE if last else ASSEMBLY_TOLERANCE)
+                                 FINAL_TOLERANCE if last else STAGE_TOLERANCE)
     floor = float(np.linalg.norm(residual(start, np.concatenate([origin])[None], jacobian=False)[0]))
     reached = norm < max(ASSEMBLY_TOLERANCE * 10, 2 * floor)
     if limits:
