@@ -23,6 +23,7 @@ from test_onshape import MOVED, assert_moved_textbook
 
 from helpers import one_line_error, random_rotation, screwkit
 from screwkit.io import ImportError_, LegWithLoops, graph_mechanism, is_foreign, read_closed_tree, read_mechanism_file
+from screwkit.io.closed_tree import closure_gaps
 from screwkit.io.loader import load
 from screwkit.io.sdformat_text import read_model, world_poses
 from screwkit.studies.poses import indices_at_poses
@@ -200,3 +201,45 @@ def test_analyze_and_info_open_sdformat_files_on_the_command_line(tmp_path):
     write(tmp_path, five_bar_sdf().replace('type="continuous"', 'type="gearbox"', 1), "bad.sdf")
     one_line_error(screwkit("analyze", tmp_path / "bad.sdf"), "bad.sdf: <joint name='free1'>: type 'gearbox' is not "
                    "read")
+
+
+def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles():
+    """tests/data/sdformat/five_bar.sdf, written by hand (link frames at the joints, unturned): ITI_i the sine of
+    the angle between leg i's proximal and distal links, the OTI of a pair the sine between their distal links."""
+    from pathlib import Path
+
+    from screwkit.studies import indices_at_pose
+
+    bases = np.array([[-0.1, 0.0], [0.1, 0.0], [0.2, 0.65]])
+    elbows = np.array([[-0.25, 0.15], [0.25, 0.15], [0.35, 0.4]])
+    point = np.array([0.0, 0.35])
+
+    def sine(u, v):
+        return abs(u[0] * v[1] - u[1] * v[0]) / np.linalg.norm(u) / np.linalg.norm(v)
+
+    mechanism = load(Path(__file__).parent / "data" / "sdformat" / "five_bar.sdf")
+    assert mechanism.is_planar and mechanism.dof == 2
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    distal = point - elbows
+    np.testing.assert_allclose(result.iti_actuators, [sine(e - b, d) for b, e, d in zip(bases, elbows, distal)],
+                               atol=TOLERANCE)
+    pairs = {(0, 1): sine(distal[0], distal[1]), (0, 2): sine(distal[0], distal[2]), (1, 2): sine(distal[1], distal[2])}
+    np.testing.assert_allclose(result.lmti, max(pairs.values()), atol=TOLERANCE)
+    np.testing.assert_allclose(result.f_o[1], min(pairs[(1, 2)], pairs[(0, 2)], pairs[(0, 1)]), atol=TOLERANCE)
+
+
+@pytest.mark.parametrize(("kind", "tree_joint", "closures"), [
+    ("prismatic", "loop_3", ["loop_3"]), ("universal", "loop_3_axis", ["loop_3_axis2_a", "loop_3_axis2_b"])])
+def test_a_universal_or_prismatic_joint_closing_a_loop_keeps_its_first_motion_in_the_tree(tmp_path, kind, tree_joint,
+                                                                                          closures):
+    """A prismatic loop joint: its slide in the tree on a body welded to the child; a universal one: its first axis
+    in the tree, its second a hinge. Both close at the file's configuration (structure only: no textbook here)."""
+    text = five_bar_sdf().replace('name="loop_3" type="revolute"', f'name="loop_3" type="{kind}"')
+    text = text.replace('<axis><xyz>0 0 -1</xyz></axis></joint>', '<axis><xyz>0 0 -1</xyz></axis><axis2><xyz>1 0 0'
+                        '</xyz></axis2></joint>')
+    tree = read_closed_tree(write(tmp_path, text))
+    assert tree.model.existJointName(tree_joint)
+    assert [c.name for c in tree.closures if c.name.startswith("loop_3")] == closures
+    assert max(closure_gaps(tree, tree.q_reference).values()) < TOLERANCE
+    parent = tree.model.names[tree.model.parents[tree.model.getJointId(tree_joint)]]
+    assert parent == "free3"
