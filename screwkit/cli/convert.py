@@ -31,15 +31,16 @@ __all__ = ["convert"]
 @json_option
 def convert(source: Path, out: Path, output_frame, output_type, ignore_limits: bool, overwrite: bool, quiet: bool,
             as_json: bool) -> None:
-    """Write SOURCE (an MJCF file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
+    """Write SOURCE (an MJCF or SDFormat file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
     URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
     already in the convention whose joint values leave loops open is written back with them closed. With
     --ignore-limits, a reference assembly outside a joint's limits is written all the same (the limits as in
     SOURCE: the file written then needs --ignore-limits too)."""
     if not source.is_file():
         raise fail(f"{source}: no such file.")
-    if source.suffix.lower() not in (".xml", ".mjcf", ".urdf"):
-        raise fail(f"{source}: expected an MJCF file (.xml, .mjcf) or a URDF with a robot.yaml beside it.")
+    if source.suffix.lower() not in (".xml", ".mjcf", ".sdf", ".urdf"):
+        raise fail(f"{source}: expected an MJCF file (.xml, .mjcf), an SDFormat file (.sdf) or a URDF with a "
+                   "robot.yaml beside it.")
     try:
         check_output(out, (".urdf",), overwrite=overwrite)
     except ValueError as error:

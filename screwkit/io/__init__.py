@@ -3,7 +3,8 @@
 * :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser), a URDF
   tree with a Gepetto ``robot.yaml`` beside it, or an onshape-to-robot URDF whose loops are
   ``closing_`` frame pairs (:mod:`screwkit.io.onshape`) or a URDF whose loops are ``<gazebo><joint>``
-  elements (:mod:`screwkit.io.gazebo`), as the text of a URDF in screwkit's convention
+  elements (:mod:`screwkit.io.gazebo`), or an SDFormat model (``.sdf``) whose loops are native joints
+  (:mod:`screwkit.io.sdformat`), as the text of a URDF in screwkit's convention
   and an :class:`~screwkit.io.closed_tree.ImportReport`;
 * :func:`is_foreign`: whether a path is such a file (the loader then imports it).
 
@@ -24,20 +25,21 @@ from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.graph import GraphMechanism, graph_mechanism
 from screwkit.io.mjcf import read_mjcf
 from screwkit.io.onshape import has_closing_frames, read_onshape
+from screwkit.io.sdformat import SDFORMAT_SUFFIXES, read_sdformat
 from screwkit.io.star import convert_tree
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_onshape", "read_gazebo", "read_mjcf", "with_reference_configuration"]
+           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "with_reference_configuration"]
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
 
 def is_foreign(path: Path) -> bool:
-    """An MJCF file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
+    """An MJCF or SDFormat file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
     onshape-to-robot ``closing_`` frame pairs or ``<gazebo><joint>`` elements."""
     path = Path(path)
-    if path.suffix.lower() in MJCF_SUFFIXES:
+    if path.suffix.lower() in MJCF_SUFFIXES + SDFORMAT_SUFFIXES:
         return True
     if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)
                                            or has_gazebo_joints(path)):
@@ -47,13 +49,15 @@ def is_foreign(path: Path) -> bool:
 
 
 def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
-    """The closed tree of an MJCF file or a URDF + robot.yaml (``output``, ``output_type``: as
+    """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``: as
     :func:`read_mechanism_file`)."""
     path = Path(path)
     if output_type not in (None, "point", "frame"):
         raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
     if path.suffix.lower() in MJCF_SUFFIXES:
         return read_mjcf(path, output=output, output_type=output_type)
+    if path.suffix.lower() in SDFORMAT_SUFFIXES:
+        return read_sdformat(path, output=output, output_type=output_type)
     yaml_path = yaml_beside(path)
     if yaml_path is not None:
         return read_gepetto(path, yaml_path, output=output, output_type=output_type)

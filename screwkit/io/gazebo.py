@@ -19,6 +19,8 @@ it): a ``ball`` one point that both links keep (``3d``), a ``fixed`` one the who
 hinge through them (a pin about the normal in a planar mechanism). Other types are refused by name.
 The actuated joints are those of the URDF's ``<transmission>`` elements, else guessed as for
 onshape-to-robot files (:func:`screwkit.io.onshape.guessed_motors`, said in the import report).
+The joint elements are read as :mod:`screwkit.io.sdformat_text` reads an SDFormat file's (from which
+:mod:`screwkit.io.sdformat` builds whole models, loops written as native joints).
 """
 
 from __future__ import annotations
@@ -28,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from screwkit.common.rotations import rotation_from_rpy
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, declared_task_coordinates, homogeneous, inverse
 from screwkit.io.onshape import guessed_motors
+from screwkit.io.sdformat_text import parse_joint
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
 
@@ -50,18 +52,6 @@ def _gazebo_joints(text: bytes) -> list:
     except ElementTree.ParseError:
         return []
     return [joint for gazebo in root.findall("gazebo") for joint in gazebo.findall("joint")]
-
-
-def _numbers(element, tag: str, count: int, default: str, where: str) -> np.ndarray:
-    node = element.find(tag)
-    text = default if node is None or not (node.text or "").strip() else node.text
-    try:
-        values = np.array([float(word) for word in text.split()])
-    except ValueError:
-        values = np.array([])
-    if values.size != count or not np.all(np.isfinite(values)):
-        raise ImportError_(f"{where}: <{tag}> must hold {count} finite numbers, got {text.strip()!r}.")
-    return values
 
 
 def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -85,33 +75,23 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
         kind = element.get("type", "")
         if kind not in TYPES:
             raise ImportError_(f"{where}: type {kind!r} cannot close a loop here (expected one of {', '.join(TYPES)}).")
+        joint = parse_joint(element, where)
         links = []
-        for tag in ("parent", "child"):
-            node = element.find(tag)
-            link = (node.text or "").strip() if node is not None else ""
+        for tag, link in (("parent", joint.parent), ("child", joint.child)):
             if link not in bodies:
                 raise ImportError_(f"{where}: <{tag}> names {link!r}, not a link of the tree.")
             links.append(bodies[link])
-        frames = {"pose": element.find("pose"), "axis": element.find("axis/xyz")}
-        relative = frames["pose"].get("relative_to", "") if frames["pose"] is not None else ""
-        expressed = frames["axis"].get("expressed_in", "") if frames["axis"] is not None else ""
-        if relative not in ("", element.findtext("child", "").strip()) or expressed not in ("", name):
+        if joint.relative_to not in ("", joint.child) or joint.axes[0].expressed_in not in ("", name):
             raise ImportError_(f"{where}: a pose relative_to or an axis expressed_in another frame is not read: write "
                                "the pose in the child link's frame and the axis in the joint's (SDFormat's defaults).")
-        pose = _numbers(element, "pose", 6, "0 0 0 0 0 0", where)
-        in_child = np.eye(4)
-        in_child[:3, :3], in_child[:3, 3] = rotation_from_rpy(pose[3:]), pose[:3]
+        in_child = joint.pose
         parent, child = (model.frames[index] for index in links)
         world_child = homogeneous(data.oMf[links[1]])
         parent_from_world = inverse(homogeneous(data.oMf[links[0]]))
         points = [in_child]
         if kind in HINGE_TYPES:  # a hinge: two points on its axis, made the hinge through them by the conversion
-            axis = _numbers(element.find("axis") if element.find("axis") is not None else element, "xyz", 3,
-                            "0 0 1", where)
-            if np.linalg.norm(axis) < 1e-12:
-                raise ImportError_(f"{where}: <axis><xyz> is zero.")
             second = in_child.copy()
-            second[:3, 3] = in_child[:3, 3] + scale * in_child[:3, :3] @ (axis / np.linalg.norm(axis))
+            second[:3, 3] = in_child[:3, 3] + scale * in_child[:3, :3] @ joint.axes[0].xyz
             points.append(second)
         for number, placement in enumerate(points):  # each side in its joint's frame, coinciding at q
             on_parent = homogeneous(parent.placement) @ parent_from_world @ world_child @ placement

@@ -97,7 +97,8 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     ----------
     name_or_path : str or path
         A bundled name, the path of a URDF following ``docs/urdf-convention.md``, of an MJCF file
-        (``.xml``, ``.mjcf``) or of a URDF tree with a Gepetto ``robot.yaml`` beside it (both
+        (``.xml``, ``.mjcf``), of an SDFormat file (``.sdf``) or of a URDF tree with a Gepetto ``robot.yaml``
+        beside it (all
         converted by :mod:`screwkit.io`; ``screwkit convert`` writes the conversion).
     length_unit : str, optional
         The unit the file's lengths are written in (``"mm"``, ...; see
@@ -126,7 +127,7 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         raise TypeError(f"Expected the name of a bundled mechanism ({', '.join(bundled_names())}) or a file path, "
                         f"got {type(name_or_path).__name__} {name_or_path!r}.")
     text = os.fspath(name_or_path)
-    looks_like_path = (isinstance(name_or_path, os.PathLike) or text.endswith((".urdf", ".xml", ".mjcf"))
+    looks_like_path = (isinstance(name_or_path, os.PathLike) or text.endswith((".urdf", ".xml", ".mjcf", ".sdf"))
                        or os.sep in text or "/" in text)
     if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
@@ -135,19 +136,21 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     else:
         path = Path(text)
         if path.is_dir():
-            raise ValueError(f"{text}: is a folder; expected a mechanism file (.urdf, or .xml/.mjcf for MJCF) or "
+            raise ValueError(f"{text}: is a folder; expected a mechanism file (.urdf, .xml/.mjcf for MJCF, .sdf for "
+                             "SDFormat) or "
                              f"a bundled name ({', '.join(bundled_names())}).")
         if not path.is_file():
             raise ValueError(f"{text}: no such file (bundled mechanisms are: {', '.join(bundled_names())}).")
-        if is_foreign(path):  # MJCF, or a URDF tree with a Gepetto robot.yaml beside it
+        if is_foreign(path):  # MJCF, SDFormat, or a URDF of another tool (robot.yaml, closing_ frames, Gazebo joints)
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path, output=output, output_type=output_type)
             mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
     if output is not None or output_type is not None:
-        raise ValueError(f"{path}: an output frame or type applies to files of other tools (MJCF, URDF + robot.yaml, "
-                         "onshape-to-robot URDFs); this file is in screwkit's convention (its output is its platform).")
+        raise ValueError(f"{path}: an output frame or type applies to files of other tools (MJCF, SDFormat, URDF + "
+                         "robot.yaml, onshape-to-robot URDFs); this file is in screwkit's convention (its output is "
+                         "its platform).")
     return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes), limits=limits)
 
 

@@ -1,0 +1,255 @@
+"""SDFormat models (``.sdf``): closed loops written natively, as joints between links, read as written.
+
+An SDFormat ``<model>`` is a graph: any link may be joined to any other, so a parallel robot is written with every
+one of its joints, loops included (a five-bar's two distal links both jointed to the effector). This module reads
+the model's links, joints and ``<frame>`` elements with SDFormat's pose semantics (:mod:`screwkit.io.sdformat_text`:
+``relative_to``, ``expressed_in``, ``degrees``, quaternions, the model's pose in the world), then:
+
+* **the base**: the world, when a joint's ``<parent>`` is ``world``; otherwise the canonical link (the model's
+  ``canonical_link``, else its first) is fixed in the world, and the report says so;
+* **the tree**: a breadth-first spanning tree of the joint graph from the base, the joints taken in file order
+  (so loops close where the legs meet, farthest from the base), built as a Pinocchio model at zero joint values
+  (SDFormat's reference): revolute and continuous joints as revolute ones about their axis, prismatic,
+  ball (spherical), fixed (the link welded to its parent body), universal and revolute2 as two revolute joints
+  ``<name>_axis`` (parent side) and ``<name>_axis2``;
+* **the loops**: every other joint closes a loop, as :mod:`screwkit.io.gazebo` closes ``<gazebo><joint>``
+  elements: a ball joint one point both links keep (``3d``), a fixed one the whole frame (``6d``), a revolute or
+  continuous one two points on its axis (``<name>_a``, ``<name>_b``; the conversion makes them the hinge through
+  them); a universal one its first revolute joint in the tree and the second as such a hinge; a prismatic one
+  the slide in the tree on a body welded (``6d``) to the child;
+* **the actuated joints**: those with a ``<screwkit:actuated/>`` child (a custom element, its namespace declared on
+  ``<sdf>``, e.g. ``xmlns:screwkit="https://screwkit.org/sdformat"``: SDFormat keeps such elements, Gazebo
+  ignores them), and those a joint-controller ``<plugin>`` of the model drives (a plugin whose ``filename`` or
+  ``name`` says joint and controller, e.g. Gazebo's ``JointPositionController``, by its ``<joint_name>``); with
+  neither, guessed as for onshape-to-robot files (:func:`screwkit.io.onshape.guessed_motors`), said in the report.
+
+Types other than these (``screw``, ``gearbox``) are refused by name.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, inverse
+from screwkit.io.onshape import guessed_motors
+from screwkit.io.sdformat_text import WORLD, SdfJoint, SdfModel, attached_link, read_model, world_poses
+
+__all__ = ["read_sdformat", "SDFORMAT_SUFFIXES", "TYPES", "actuated_joints"]
+
+SDFORMAT_SUFFIXES = (".sdf",)
+HINGES = ("revolute", "continuous")
+TWO_AXES = ("universal", "revolute2")
+TYPES = (*HINGES, "prismatic", "ball", *TWO_AXES, "fixed")
+CONTROLLER = re.compile(r"joint.*controller", re.IGNORECASE)
+"""A joint-controller plugin's ``filename`` or ``name`` (its ``<joint_name>`` joints are driven)."""
+
+
+def _local_name(tag: str) -> tuple[str, str]:
+    """(namespace, local name) of an ElementTree tag."""
+    return (tag[1:].split("}", 1)[0], tag.split("}", 1)[1]) if tag.startswith("{") else ("", tag)
+
+
+def actuated_joints(sdf: SdfModel) -> list[str]:
+    """Joints marked ``<screwkit:actuated/>``, then those of the model's joint-controller plugins (file order)."""
+    marked = [joint.get("name", "") for joint in sdf.element.findall("joint")
+              if any(_local_name(child.tag)[1] == "actuated" and "screwkit" in _local_name(child.tag)[0]
+                     for child in joint)]
+    driven = [(node.text or "").strip() for plugin in sdf.element.findall("plugin")
+              if CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
+              for node in plugin.iter("joint_name") if (node.text or "").strip()]
+    return list(dict.fromkeys(marked + driven))
+
+
+def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
+    """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node)."""
+    base = WORLD if any(WORLD in pair for pair in ends.values()) else sdf.canonical
+    visited, queue, tree, loops, used = {base}, [base], [], [], set()
+    while queue:
+        node = queue.pop(0)
+        for joint in sdf.joints:
+            parent, child = ends[joint.name]
+            if joint.name in used or node not in (parent, child):
+                continue
+            used.add(joint.name)
+            other = child if node == parent else parent
+            if other in visited:
+                loops.append(joint)
+            else:
+                visited.add(other)
+                queue.append(other)
+                tree.append((joint, node, other))
+    loose = [link for link in sdf.links if link not in visited]
+    if loose:
+        fixed = "the world" if base == WORLD else f"the canonical link {base!r}"
+        raise ImportError_(f"{sdf.source}: <link name='{loose[0]}'> is joined to nothing on the way to {fixed} (links "
+                           f"joined to nothing fixed: {', '.join(loose)}).")
+    return tree, loops, base
+
+
+class _TreeBuilder:
+    """A Pinocchio model built joint by joint at zero joint values, each link placed at its SDFormat world pose."""
+
+    def __init__(self, sdf: SdfModel, poses: dict[str, NDArray]):
+        import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+        self.pin, self.sdf, self.poses = pin, sdf, poses
+        self.model = pin.Model()
+        self.model.name = sdf.name
+        self.joint_world = {0: np.eye(4)}  # each Pinocchio joint's frame in the world at zero joint values
+        self.placed = {WORLD: (0, 0)}  # node -> (Pinocchio joint, frame): where each link is attached
+        self.limits: dict[int, tuple[float, float]] = {}
+
+    def _se3(self, joint: int, world: NDArray):
+        matrix = inverse(self.joint_world[joint]) @ world
+        return self.pin.SE3(matrix[:3, :3].copy(), matrix[:3, 3].copy())
+
+    def axis_in_joint(self, joint: SdfJoint, number: int) -> NDArray:
+        """Axis ``number`` (0: ``<axis>``, 1: ``<axis2>``) of a joint in its own frame."""
+        axis = joint.axes[number]
+        if not axis.expressed_in or axis.expressed_in == joint.name:
+            return axis.xyz
+        if axis.expressed_in not in self.poses:
+            raise ImportError_(f"{joint.where}: <axis><xyz expressed_in={axis.expressed_in!r}>: not a frame of the "
+                               "model.")
+        return self.poses[joint.name][:3, :3].T @ self.poses[axis.expressed_in][:3, :3] @ axis.xyz
+
+    def ground(self, link: str) -> None:
+        """A link fixed in the world (the canonical link, when no joint reaches the world)."""
+        frame = self.model.addBodyFrame(link, 0, self._se3(0, self.poses[link]), 0)
+        self.placed[link] = (0, frame)
+
+    def add_joint(self, parent: int, name: str, kind: str, axis: NDArray, world: NDArray,
+                  limits: tuple[float, float] | None = None) -> int:
+        """A 1-DoF (revolute, prismatic) or ball joint on Pinocchio joint ``parent``, its frame at ``world``."""
+        pin = self.pin
+        models = {"revolute": pin.JointModelRevoluteUnaligned, "prismatic": pin.JointModelPrismaticUnaligned}
+        joint_model = pin.JointModelSpherical() if kind == "ball" else models[kind](np.asarray(axis, dtype=float))
+        index = self.model.addJoint(parent, joint_model, self._se3(parent, world), name)
+        self.joint_world[index] = world
+        if kind != "ball":
+            self.limits[index] = limits if limits is not None else (-np.inf, np.inf)
+        return index
+
+    def tree_joint(self, joint: SdfJoint, parent_node: str, child_node: str) -> None:
+        """A joint of the spanning tree from ``parent_node`` to ``child_node`` (reversed if those are the SDFormat
+        child and parent: the same motion, its value's sign changed)."""
+        parent, parent_frame = self.placed[parent_node]
+        world = self.poses[joint.name]
+        if joint.kind == "fixed":
+            frame = self.model.addFrame(self.pin.Frame(joint.name, parent, parent_frame, self._se3(parent, world),
+                                                       self.pin.FrameType.FIXED_JOINT))
+            self.placed[child_node] = (parent, self.model.addBodyFrame(
+                child_node, parent, self._se3(parent, self.poses[child_node]), frame))
+            return
+        reverse = child_node != attached_link(self.sdf, joint.child)
+        steps = [(joint.name, "ball" if joint.kind == "ball" else "prismatic" if joint.kind == "prismatic"
+                  else "revolute", 0)]
+        if joint.kind in TWO_AXES:
+            steps = [(f"{joint.name}_axis", "revolute", 0), (f"{joint.name}_axis2", "revolute", 1)]
+            steps = steps[::-1] if reverse else steps
+        index = parent
+        for name, kind, number in steps:
+            limits = joint.axes[number].limits
+            if limits is not None and reverse:
+                limits = (-limits[1], -limits[0])
+            index = self.add_joint(index, name, kind, self.axis_in_joint(joint, number), world, limits)
+            parent_frame = self.model.addJointFrame(index, parent_frame)
+        self.placed[child_node] = (index, self.model.addBodyFrame(
+            child_node, index, self._se3(index, self.poses[child_node]), parent_frame))
+
+    def frames(self) -> None:
+        """The model's ``<frame>`` elements, on the links they are attached to."""
+        for name in self.sdf.frames:
+            joint, frame = self.placed[attached_link(self.sdf, name)]
+            self.model.addFrame(self.pin.Frame(name, joint, frame, self._se3(joint, self.poses[name]),
+                                               self.pin.FrameType.OP_FRAME))
+
+    def finish(self):
+        """The model, with its joints' limits (none: unbounded)."""
+        lower, upper = self.model.lowerPositionLimit.copy(), self.model.upperPositionLimit.copy()
+        for index, (low, high) in self.limits.items():
+            lower[self.model.joints[index].idx_q], upper[self.model.joints[index].idx_q] = low, high
+        self.model.lowerPositionLimit, self.model.upperPositionLimit = lower, upper
+        return self.model
+
+
+def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str], scale: float) -> list[Closure]:
+    """The closures of a joint outside the spanning tree (the module docstring says which)."""
+    world = builder.poses[joint.name]
+    (parent, _), (child, _) = builder.placed[ends[0]], builder.placed[ends[1]]
+    if joint.kind in TWO_AXES:  # the first revolute joint in the tree, on the parent side; the second a hinge
+        parent = builder.add_joint(parent, f"{joint.name}_axis", "revolute", builder.axis_in_joint(joint, 0), world,
+                                   joint.axes[0].limits)
+        joint = SdfJoint(f"{joint.name}_axis2", "revolute", joint.parent, joint.child, joint.pose, joint.relative_to,
+                         joint.axes[1:], joint.where)
+        builder.poses[joint.name] = world
+    elif joint.kind == "prismatic":  # the slide in the tree, on a body welded to the child
+        parent = builder.add_joint(parent, joint.name, "prismatic", builder.axis_in_joint(joint, 0), world,
+                                   joint.axes[0].limits)
+
+    def closure(name: str, at: NDArray, kind: str) -> Closure:
+        return Closure(name, parent, inverse(builder.joint_world[parent]) @ at, child,
+                       inverse(builder.joint_world[child]) @ at, kind)
+
+    if joint.kind in ("ball", "fixed", "prismatic"):
+        return [closure(joint.name, world, "3d" if joint.kind == "ball" else "6d")]
+    second = world.copy()  # a hinge: two points on its axis, made the hinge through them by the conversion
+    second[:3, 3] += scale * world[:3, :3] @ builder.axis_in_joint(joint, 0)
+    return [closure(f"{joint.name}_a", world, "3d"), closure(f"{joint.name}_b", second, "3d")]
+
+
+def _ends(sdf: SdfModel) -> dict[str, tuple[str, str]]:
+    ends = {}
+    for joint in sdf.joints:
+        if joint.kind not in TYPES:
+            raise ImportError_(f"{joint.where}: type {joint.kind!r} is not read (expected one of {', '.join(TYPES)}).")
+        if joint.child == WORLD:
+            raise ImportError_(f"{joint.where}: <child> is the world; write the world as the <parent>.")
+        for tag, end in (("parent", joint.parent), ("child", joint.child)):
+            if end != WORLD and end not in sdf.poses:
+                raise ImportError_(f"{joint.where}: <{tag}> names {end!r}, not a link, joint or frame of the model.")
+        pair = tuple(WORLD if end == WORLD else attached_link(sdf, end) for end in (joint.parent, joint.child))
+        if pair[0] == pair[1]:
+            raise ImportError_(f"{joint.where}: <parent> and <child> are on the same link {pair[0]!r}.")
+        ends[joint.name] = pair
+    return ends
+
+
+def read_sdformat(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
+    """The closed tree of an SDFormat file's model (its loops closed by native joints; the module docstring)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    sdf = read_model(Path(path))
+    poses = world_poses(sdf)
+    ends = _ends(sdf)
+    tree_joints, loops, base = _spanning_tree(sdf, ends)
+    builder = _TreeBuilder(sdf, poses)
+    notes = []
+    if base != WORLD:
+        builder.ground(base)
+        notes.append(f"no joint to the world: the canonical link {base!r} is the fixed base")
+    for joint, parent_node, child_node in tree_joints:
+        builder.tree_joint(joint, parent_node, child_node)
+    builder.frames()
+    origins = np.array([poses[link][:3, 3] for link in sdf.links])
+    scale = float(np.max(np.linalg.norm(origins - origins.mean(axis=0), axis=1), initial=0.0)) or 1.0
+    closures = [c for joint in loops for c in _loop_closures(builder, joint, ends[joint.name], scale)]
+    model = builder.finish()
+    stated = actuated_joints(sdf)
+    for name in stated:
+        where = next((joint.where for joint in sdf.joints if joint.name == name), f"{sdf.source}: <plugin>")
+        if not model.existJointName(name) or model.joints[model.getJointId(name)].nv != 1:
+            kinds = {joint.name: joint.kind for joint in sdf.joints}
+            raise ImportError_(f"{where}: joint {name!r} is marked actuated but is "
+                               + (f"a {kinds[name]} joint, not a 1-DoF one." if name in kinds else
+                                  "not a joint of the model."))
+    motors = stated or guessed_motors(model, closures)
+    if not stated:
+        notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/> and no joint "
+                     f"controller plugin): {', '.join(motors)}")
+    return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
+                      "SDFormat (joints closing loops)", notes)

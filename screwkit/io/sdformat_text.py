@@ -1,0 +1,262 @@
+"""SDFormat text: one ``<model>``'s links, joints and frames, and their poses resolved in the world.
+
+What :mod:`screwkit.io.sdformat` builds a closed tree from, and what :mod:`screwkit.io.gazebo` reads a
+``<gazebo><joint>`` with. SDFormat's pose semantics (1.7 and later):
+
+* a ``<pose>`` holds ``x y z roll pitch yaw`` (radians, or degrees with ``degrees="true"``), or ``x y z qx qy qz
+  qw`` with ``rotation_format="quat_xyzw"``; it is written in the frame its ``relative_to`` names, by default: the
+  model frame ``__model__`` for a link, the child link for a joint, the ``attached_to`` frame for a ``<frame>``
+  (itself ``__model__`` by default); the model's own ``<pose>`` places the model in the world;
+* a joint's ``<axis><xyz>`` (and ``<axis2>``) is written in the joint frame, or in the frame its ``expressed_in``
+  names (``__model__`` when a file of SDFormat 1.6 or earlier says ``<use_parent_model_frame>true``);
+* a joint's ``<parent>`` may be ``world``; a link, joint or frame name is a frame, and ``__model__`` is attached
+  to the canonical link (the model's ``canonical_link``, else its first link).
+
+:func:`world_poses` gives every frame's pose in the world at zero joint values, as SDFormat's own semantic pose
+resolution does. Constructs this reading does not follow are refused with the file and element named: nested
+models, ``<include>``, several models, a ``placement_frame``, unknown frames and cycles of ``relative_to``.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ElementTree
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common.rotations import rotation_from_rpy
+from screwkit.io.closed_tree import ImportError_
+
+__all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
+           "attached_link", "WORLD", "MODEL_FRAME"]
+
+WORLD = "world"
+MODEL_FRAME = "__model__"
+UNLIMITED = 1e16
+"""SDFormat's default joint limits (``-1e16``, ``1e16``): at or beyond it, a joint has no limit."""
+
+
+def numbers(text: str | None, count: int, default: str, where: str, tag: str) -> NDArray[np.float64]:
+    """``count`` finite numbers of an element's text (``default`` when it is empty); one line naming ``where``."""
+    text = default if text is None or not text.strip() else text
+    try:
+        values = np.array([float(word) for word in text.split()])
+    except ValueError:
+        values = np.array([])
+    if values.size != count or not np.all(np.isfinite(values)):
+        raise ImportError_(f"{where}: <{tag}> must hold {count} finite numbers, got {text.strip()!r}.")
+    return values
+
+
+def parse_pose(node, where: str) -> tuple[NDArray[np.float64], str]:
+    """A ``<pose>`` element (or None: the identity) as a 4x4 matrix, and its ``relative_to`` ("" if not given)."""
+    matrix = np.eye(4)
+    if node is None:
+        return matrix, ""
+    quaternion = node.get("rotation_format", "euler_rpy") == "quat_xyzw"
+    if node.get("rotation_format", "euler_rpy") not in ("euler_rpy", "quat_xyzw"):
+        raise ImportError_(f"{where}: <pose rotation_format={node.get('rotation_format')!r}> (expected euler_rpy or "
+                           "quat_xyzw).")
+    values = numbers(node.text, 7 if quaternion else 6, "0 0 0 0 0 0 1" if quaternion else "0 0 0 0 0 0", where,
+                     "pose")
+    matrix[:3, 3] = values[:3]
+    if quaternion:
+        x, y, z, w = values[3:] / np.linalg.norm(values[3:])
+        matrix[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                          [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                          [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    else:
+        degrees = node.get("degrees", "false").strip().lower() in ("true", "1")
+        matrix[:3, :3] = rotation_from_rpy(np.radians(values[3:]) if degrees else values[3:])
+    return matrix, node.get("relative_to", "").strip()
+
+
+@dataclass(frozen=True)
+class SdfAxis:
+    """A joint axis: its ``xyz`` (unit) in the frame ``expressed_in`` ("" = the joint frame), its limits or None."""
+
+    xyz: NDArray[np.float64]
+    expressed_in: str
+    limits: tuple[float, float] | None
+
+
+@dataclass(frozen=True)
+class SdfJoint:
+    """An SDFormat ``<joint>``: its pose (4x4) in the frame ``relative_to`` ("" = the child), its axes."""
+
+    name: str
+    kind: str
+    parent: str
+    child: str
+    pose: NDArray[np.float64]
+    relative_to: str
+    axes: tuple[SdfAxis, ...]
+    where: str
+
+
+def _axis(element, tag: str, where: str, legacy: bool) -> SdfAxis:
+    node = element.find(tag)
+    xyz_node = node.find("xyz") if node is not None else None
+    xyz = numbers(xyz_node.text if xyz_node is not None else None, 3, "0 0 1", where, f"{tag}><xyz")
+    if np.linalg.norm(xyz) < 1e-12:
+        raise ImportError_(f"{where}: <{tag}><xyz> is zero.")
+    expressed = xyz_node.get("expressed_in", "").strip() if xyz_node is not None else ""
+    if legacy and node is not None and node.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1"):
+        expressed = expressed or MODEL_FRAME
+    limits = None
+    if node is not None and node.find("limit") is not None:
+        lower = node.find("limit").findtext("lower", "").strip() or str(-UNLIMITED)
+        upper = node.find("limit").findtext("upper", "").strip() or str(UNLIMITED)
+        bounds = numbers(f"{lower} {upper}", 2, "", where, f"{tag}><limit")
+        if abs(bounds[0]) < UNLIMITED and abs(bounds[1]) < UNLIMITED and bounds[0] < bounds[1]:
+            limits = (float(bounds[0]), float(bounds[1]))
+    return SdfAxis(xyz / np.linalg.norm(xyz), expressed, limits)
+
+
+def parse_joint(element, where: str, legacy: bool = False) -> SdfJoint:
+    """An SDFormat ``<joint>`` element as written (``where``: the file and element, for messages; ``legacy``: a
+    file of SDFormat 1.6 or earlier, whose ``<use_parent_model_frame>`` is read)."""
+    name = element.get("name", "")
+    ends = []
+    for tag in ("parent", "child"):
+        node = element.find(tag)
+        end = (node.text or "").strip() if node is not None else ""
+        if not end:
+            raise ImportError_(f"{where}: no <{tag}>.")
+        ends.append(end)
+    pose, relative = parse_pose(element.find("pose"), where)
+    axes = tuple(_axis(element, tag, where, legacy) for tag in ("axis", "axis2"))
+    return SdfJoint(name, element.get("type", ""), ends[0], ends[1], pose, relative, axes, where)
+
+
+@dataclass
+class SdfModel:
+    """One ``<model>`` of an SDFormat file: where each frame's pose is written (``poses``: name -> (relative_to,
+    4x4)), the links in file order, the joints, the ``<frame>`` elements (name -> attached_to), the canonical link,
+    and the model element itself (for what :mod:`screwkit.io.sdformat` reads further: plugins, markers)."""
+
+    source: str
+    name: str
+    element: object
+    links: list[str]
+    joints: list[SdfJoint]
+    frames: dict[str, str]
+    canonical: str
+    poses: dict[str, tuple[str, NDArray[np.float64]]] = field(default_factory=dict)
+    where: dict[str, str] = field(default_factory=dict)
+
+
+def _the_model(path: Path, root) -> object:
+    if root.tag != "sdf":
+        raise ImportError_(f"{path}: the root element is <{root.tag}>, not <sdf>: not an SDFormat file.")
+    for scope in [root] + root.findall("world"):
+        for include in scope.findall("include"):
+            raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
+                               "not read; write the model in the file.")
+    models = root.findall("model") + root.findall("world/model")
+    if len(models) != 1:
+        names = ", ".join(repr(model.get("name")) for model in models)
+        raise ImportError_(f"{path}: {len(models)} <model> elements ({names or 'none'}); screwkit reads one model.")
+    model = models[0]
+    for nested in model.iter("model"):
+        if nested is not model:
+            raise ImportError_(f"{path}: <model name='{model.get('name')}'><model name='{nested.get('name')}'>: "
+                               "nested models are not read; write their links and joints in the outer model.")
+    if model.get("placement_frame"):
+        raise ImportError_(f"{path}: <model name='{model.get('name')}' placement_frame=...>: not read; write the "
+                           "model's <pose> in the world.")
+    return model
+
+
+def read_model(path: Path) -> SdfModel:
+    """The one model of an SDFormat file (in ``<sdf>`` or in its one ``<world>``), as written."""
+    path = Path(path)
+    try:
+        root = ElementTree.fromstring(path.read_bytes())
+    except ElementTree.ParseError as error:
+        raise ImportError_(f"{path}: not well-formed XML ({error}).") from None
+    element = _the_model(path, root)
+    legacy = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2]
+                   if part.isdigit()) < (1, 7)
+    label = f"{path}: <model name='{element.get('name')}'>"
+    links = [link.get("name", "") for link in element.findall("link")]
+    if not links:
+        raise ImportError_(f"{label}: no <link>.")
+    model = SdfModel(str(path), element.get("name", ""), element, links, [], {}, element.get("canonical_link") or
+                     links[0])
+    pose, relative = parse_pose(element.find("pose"), label)
+    if relative not in ("", WORLD):
+        raise ImportError_(f"{label}: <pose relative_to={relative!r}>: a model's pose is read in the world only.")
+    model.poses[MODEL_FRAME] = (WORLD, pose)
+    model.where[MODEL_FRAME] = label
+    for link in element.findall("link"):
+        where = f"{path}: <link name='{link.get('name')}'>"
+        pose, relative = parse_pose(link.find("pose"), where)
+        _declare(model, link.get("name", ""), relative or MODEL_FRAME, pose, where)
+    for joint in element.findall("joint"):
+        parsed = parse_joint(joint, f"{path}: <joint name='{joint.get('name')}'>", legacy)
+        model.joints.append(parsed)
+        _declare(model, parsed.name, parsed.relative_to or parsed.child, parsed.pose, parsed.where)
+    for frame in element.findall("frame"):
+        where = f"{path}: <frame name='{frame.get('name')}'>"
+        attached = frame.get("attached_to", "").strip() or MODEL_FRAME
+        pose, relative = parse_pose(frame.find("pose"), where)
+        _declare(model, frame.get("name", ""), relative or attached, pose, where)
+        model.frames[frame.get("name", "")] = attached
+    if model.canonical not in links:
+        raise ImportError_(f"{label}: canonical_link {model.canonical!r} is not one of its links.")
+    return model
+
+
+def _declare(model: SdfModel, name: str, relative_to: str, pose: NDArray, where: str) -> None:
+    if not name or name in (WORLD, MODEL_FRAME) or name.startswith("__"):
+        raise ImportError_(f"{where}: a frame needs a name other than world and those starting with __.")
+    if name in model.poses:
+        raise ImportError_(f"{where}: the name {name!r} is already {model.where[name].split(': ', 1)[1]} (links, "
+                           "joints and frames share one namespace).")
+    model.poses[name] = (relative_to, pose)
+    model.where[name] = where
+
+
+def world_poses(model: SdfModel) -> dict[str, NDArray[np.float64]]:
+    """Every frame's pose (4x4) in the world at zero joint values: links, joints, frames, ``__model__``."""
+    resolved: dict[str, NDArray] = {WORLD: np.eye(4)}
+
+    def resolve(name: str, seen: tuple[str, ...]) -> NDArray:
+        if name in resolved:
+            return resolved[name]
+        relative, pose = model.poses[name]
+        if relative not in model.poses and relative != WORLD:
+            raise ImportError_(f"{model.where[name]}: its pose is relative_to {relative!r}, not a frame of the model.")
+        if relative in seen + (name,):
+            raise ImportError_(f"{model.where[name]}: its pose's relative_to goes round a cycle ("
+                               + " -> ".join(seen + (name, relative)) + ").")
+        resolved[name] = resolve(relative, seen + (name,)) @ pose
+        return resolved[name]
+
+    for name in model.poses:
+        resolve(name, ())
+    return resolved
+
+
+def attached_link(model: SdfModel, name: str) -> str:
+    """The link a frame moves with (``world`` for the world): a link itself, a joint's child, a frame's
+    ``attached_to``, ``__model__``'s canonical link."""
+    seen = []
+    joints = {joint.name: joint for joint in model.joints}
+    while name not in model.links and name != WORLD:
+        if name in seen:
+            raise ImportError_(f"{model.where[name]}: attached_to goes round a cycle ({' -> '.join(seen + [name])}).")
+        seen.append(name)
+        if name == MODEL_FRAME:
+            name = model.canonical
+        elif name in joints:
+            name = joints[name].child
+        elif name in model.frames:
+            name = model.frames[name]
+        else:
+            where = model.where.get(seen[-2], model.source) if len(seen) > 1 else model.source
+            raise ImportError_(f"{where}: names {name!r}, not a link, joint or frame of the model.")
+    return name

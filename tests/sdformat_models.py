@@ -1,0 +1,132 @@
+"""Parallel robots written in SDFormat as their users write them: every joint native, loops included (test helper).
+
+* :func:`five_bar_sdf`: the five-bar of tests/test_io.py (geometry from tests/test_lower_mobility.py), each distal
+  link jointed to the ``effector`` by a revolute joint; the world scaled, turned and shifted through the model's
+  ``<pose>`` (in degrees), links placed relative to one another, the effector's pose a quaternion, axes written in
+  the joint frame or in ``__model__``, motors marked ``<screwkit:actuated/>`` or driven by controller plugins;
+* :func:`delta_sdf`: the rod-level Delta of tests/delta_rods.py, its link frames where that file's MJCF bodies
+  are (so MuJoCo's reading of the MJCF is a reference for this file's link poses), rods placed relative to their
+  arms and the platform's joints written in the platform or in the rods' frames.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from delta_rods import SPACING, delta_geometry, quaternion
+from test_io import HOME, text
+from test_lower_mobility import FIVE_BAR_BASE, PROXIMAL, five_bar_elbows
+
+from screwkit.common.rotations import rotation_from_rpy
+
+NAMESPACE = 'xmlns:screwkit="https://screwkit.org/sdformat"'
+EFFECTOR_RPY = (np.pi, 0.0, 0.3)
+"""The effector link's frame in the model frame: upside down (its z against the plane's normal), turned."""
+
+
+def rotation_z(angle: float) -> np.ndarray:
+    return rotation_from_rpy(np.array([0.0, 0.0, angle]))
+
+
+def quaternion_text(rotation) -> str:
+    """``qx qy qz qw`` of a rotation matrix (SDFormat's quat_xyzw order)."""
+    w, x, y, z = quaternion(rotation)
+    return text((x, y, z, w))
+
+
+def five_bar_sdf(transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None, legs=3, marker="screwkit") -> str:
+    """The five-bar at HOME: ``transform`` (scale, turn about the normal, shift) in the model's pose, legs written in
+    ``order``, motors named ``motor(i)``; ``marker``: "screwkit" (``<screwkit:actuated/>``), "plugin"
+    (JointPositionController plugins) or "" (none: guessed)."""
+    scale, turn, shift = transform
+    motor = motor or (lambda i: f"mot{i + 1}")
+    elbows = five_bar_elbows(HOME)
+    links, joints = ['<link name="base"/>'], ['<joint name="anchor" type="fixed"><parent>world</parent>'
+                                              '<child>base</child></joint>']
+    actuated = "<screwkit:actuated/>" if marker == "screwkit" else ""
+    for i in (range(legs) if order is None else order):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        first = float(np.arctan2(*(elbow - base)[::-1]))
+        second = float(np.arctan2(*(HOME - elbow)[::-1]))
+        links.append(f'<link name="proximal_{i + 1}"><pose>{text((*(scale * base), 0.0))} 0 0 {first!r}</pose></link>')
+        links.append(f'<link name="distal_{i + 1}"><pose relative_to="proximal_{i + 1}">{scale * PROXIMAL!r} 0 0 0 0 '
+                     f'{second - first!r}</pose></link>')
+        joints.append(f'<joint name="{motor(i)}" type="revolute"><parent>base</parent><child>proximal_{i + 1}</child>'
+                      f'<axis><xyz>0 0 1</xyz><limit><lower>-3</lower><upper>3</upper></limit></axis>{actuated}'
+                      '</joint>')
+        joints.append(f'<joint name="free{i + 1}" type="continuous"><parent>proximal_{i + 1}</parent>'
+                      f'<child>distal_{i + 1}</child><axis><xyz>0 0 1</xyz></axis></joint>')
+        axis = ('<xyz expressed_in="__model__">0 0 1</xyz>' if i % 2 else '<xyz>0 0 -1</xyz>')
+        joints.append(f'<joint name="loop_{i + 1}" type="revolute"><parent>distal_{i + 1}</parent><child>effector'
+                      f'</child><pose>0 0 0 0 0 {0.2 * i!r}</pose><axis>{axis}</axis></joint>')
+    effector = rotation_from_rpy(np.array(EFFECTOR_RPY))
+    links.append(f'<link name="effector"><pose rotation_format="quat_xyzw">{text((*(scale * HOME), 0.0))} '
+                 f'{quaternion_text(effector)}</pose></link>')
+    plugins = "".join(f'<plugin filename="gz-sim-joint-position-controller-system" name="gz::sim::systems::'
+                      f'JointPositionController"><joint_name>{motor(i)}</joint_name></plugin>'
+                      for i in range(legs)) if marker == "plugin" else ""
+    pose = f'<pose degrees="true">{text(shift)} 0 0 {float(np.degrees(turn))!r}</pose>'
+    return (f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="five_bar">{pose}'
+            + "".join(links + joints) + plugins + "</model></sdf>\n")
+
+
+def five_bar_world_poses(transform=(1.0, 0.0, (0.0, 0.0, 0.0)), legs=3) -> dict[str, np.ndarray]:
+    """Each link's pose in the world, computed from the geometry (not from the file's pose chain)."""
+    scale, turn, shift = transform
+    elbows = five_bar_elbows(HOME)
+
+    def pose(point, rotation):
+        matrix = np.eye(4)
+        matrix[:3, :3] = rotation_z(turn) @ rotation
+        matrix[:3, 3] = np.array(shift) + rotation_z(turn) @ np.array([*(scale * np.asarray(point)), 0.0])
+        return matrix
+
+    out = {"base": pose((0.0, 0.0), np.eye(3)), "effector": pose(HOME, rotation_from_rpy(np.array(EFFECTOR_RPY)))}
+    for i in range(legs):
+        base, elbow = FIVE_BAR_BASE[i], elbows[i]
+        out[f"proximal_{i + 1}"] = pose(base, rotation_z(float(np.arctan2(*(elbow - base)[::-1]))))
+        out[f"distal_{i + 1}"] = pose(elbow, rotation_z(float(np.arctan2(*(HOME - elbow)[::-1]))))
+    return out
+
+
+def delta_sdf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None, plugin=True) -> str:
+    """The rod-level Delta (tests/delta_rods.py) in SDFormat, at ``centre``; ``transform`` = (scale, rotation,
+    translation) places its base link in the world, as :func:`delta_rods.delta_rods_mjcf` places its base body.
+    Link frames: the base's rotation everywhere (as the MJCF bodies); arms at the motors, rods at the elbow end of
+    each rod, the platform at rod 1a's far end (the MJCF's platform body)."""
+    scale, rotation, translation = (1.0, np.eye(3), np.zeros(3)) if transform is None else transform
+    azimuths = np.radians([90.0, 180.0, 270.0, 0.0]) if azimuths is None else np.asarray(azimuths, dtype=float)
+    base, axes, elbows, attach = delta_geometry(centre, azimuths)
+    half = SPACING / 2
+    platform_at = attach[0] - half * axes[0]
+
+    def at(vector):
+        return text(scale * np.asarray(vector, dtype=float))
+
+    links = [f'<link name="base"><pose rotation_format="quat_xyzw">{text(translation)} {quaternion_text(rotation)}'
+             '</pose></link>']
+    joints = ['<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>']
+    ends = []
+    for i, (b, a, e, p) in enumerate(zip(base, axes, elbows, attach), start=1):
+        links.append(f'<link name="arm_{i}"><pose relative_to="base">{at(b)} 0 0 0</pose></link>')
+        marker = "" if plugin else "<screwkit:actuated/>"
+        joints.append(f'<joint name="motor_{i}" type="revolute"><parent>base</parent><child>arm_{i}</child>'
+                      f'<axis><xyz expressed_in="base">{text(a)}</xyz></axis>{marker}</joint>')
+        for side, sign in (("a", -1.0), ("b", 1.0)):
+            start, end = e + sign * half * a, p + sign * half * a
+            links.append(f'<link name="rod_{i}{side}"><pose relative_to="arm_{i}">{at(start - b)} 0 0 0</pose>'
+                         '</link>')
+            joints.append(f'<joint name="ball_{i}{side}" type="ball"><parent>arm_{i}</parent><child>rod_{i}{side}'
+                          '</child></joint>')
+            where = (f'<pose relative_to="rod_{i}{side}">{at(end - start)} 0 0 0</pose>' if side == "b"
+                     else f'<pose>{at(end - platform_at)} 0 0 0</pose>')
+            ends.append(f'<joint name="end_{i}{side}" type="ball"><parent>rod_{i}{side}</parent><child>platform'
+                        f'</child>{where}</joint>')
+    links.append(f'<link name="platform"><pose relative_to="rod_1a">{at(platform_at - elbows[0] + half * axes[0])} '
+                 '0 0 0</pose></link>')
+    links.append(f'<frame name="centre" attached_to="platform"><pose>{at(np.asarray(centre) - platform_at)} 0 0 0'
+                 '</pose></frame>')
+    plugins = "".join(f'<plugin filename="gz-sim-joint-position-controller-system" name="gz::sim::systems::'
+                      f'JointPositionController"><joint_name>motor_{i}</joint_name></plugin>'
+                      for i in range(1, len(base) + 1)) if plugin else ""
+    return (f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="delta_rods">'
+            + "".join(links + joints + ends) + plugins + "</model></sdf>\n")

@@ -1,0 +1,245 @@
+"""SDFormat models (``.sdf``) whose loops are native joints, opened as written (tests/sdformat_models.py writes them).
+
+No SDFormat library installs from pip on this platform (``sdformat14-py-bindings`` installs but its extension needs
+``libsdformat14.so.14`` and ``libgz-math7.so.7``, which it does not ship; ``sdformat-mjcf`` imports ``sdformat13``,
+which pip does not have), so the poses screwkit reads are checked against poses computed from the geometry by hand
+(the five-bar) and against MuJoCo's reading of the same Delta written in MJCF (tests/delta_rods.py). The indices are
+the textbook pressure angles: the five-bar's (tests/test_lower_mobility.py) leg by leg, in another unit and world
+frame, legs reversed and motors renamed; the rod-level Delta's (tests/test_graph_legs.py), through the graph path.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from delta_rods import delta_rods_mjcf
+from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses
+from test_graph_legs import POSES, textbook
+from test_io import HOME, assert_textbook, poses_near_home
+from test_lower_mobility import five_bar_expected
+from test_onshape import MOVED, assert_moved_textbook
+
+from helpers import one_line_error, random_rotation, screwkit
+from screwkit.io import ImportError_, LegWithLoops, graph_mechanism, is_foreign, read_closed_tree, read_mechanism_file
+from screwkit.io.closed_tree import closure_gaps
+from screwkit.io.loader import load
+from screwkit.io.sdformat_text import read_model, world_poses
+from screwkit.studies.poses import indices_at_poses
+
+TOLERANCE = 1e-9
+
+
+def write(tmp_path, text: str, name: str = "robot.sdf"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def frame_poses(tree) -> dict[str, np.ndarray]:
+    """Every frame of screwkit's Pinocchio model in the world at the file's configuration (4x4)."""
+    import pinocchio as pin
+
+    data = tree.model.createData()
+    pin.framesForwardKinematics(tree.model, data, tree.q_reference)
+    return {frame.name: data.oMf[k].homogeneous for k, frame in enumerate(tree.model.frames)}
+
+
+@pytest.mark.parametrize("marker", ["screwkit", "plugin", ""])
+def test_a_five_bar_written_in_sdformat_opens_as_written_with_the_textbook_pressure_angles(tmp_path, marker):
+    path = write(tmp_path, five_bar_sdf(marker=marker))
+    assert is_foreign(path)
+    converted, report = read_mechanism_file(path)
+    assert report.file_format == "SDFormat (joints closing loops)" and report.planar
+    assert report.motors == ["mot1", "mot2", "mot3"]
+    assert sum("the hinge through them" in note for note in report.notes) == 2, report.notes
+    assert any("actuators guessed" in note for note in report.notes) is (marker == "")
+    mechanism = load(path)
+    assert mechanism.is_planar and mechanism.dof == 2 and len(mechanism.actuators) == 3
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
+@pytest.mark.parametrize("transform", MOVED)
+def test_an_sdformat_five_bar_in_another_unit_and_frame_with_its_legs_reversed_and_motors_renamed(tmp_path, transform):
+    """Scaled by 1e-3 and 1e3, turned and shifted in the world by the model's pose (in degrees), legs written in
+    reverse and motors renamed: the same pressure angles, each following its own leg."""
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path = write(tmp_path, five_bar_sdf(transform, order=(2, 1, 0), motor=names.get))
+    mechanism = load(path)
+    assert mechanism.is_planar
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["drive_a", "drive_b", "drive_c"]
+    assert_moved_textbook(mechanism, transform, {name: leg for leg, name in names.items()}.get)
+
+
+@pytest.mark.parametrize("transform", [(1.0, 0.0, (0.0, 0.0, 0.0)), *MOVED])
+def test_the_five_bar_s_links_and_joints_are_where_the_geometry_puts_them(tmp_path, transform):
+    """Links, by the geometry computed by hand (not through the file's chain of relative_to poses); joints where
+    SDFormat puts them (the child link's frame, turned as the file says); each loop joint's two sides coincide."""
+    path = write(tmp_path, five_bar_sdf(transform, order=(2, 1, 0)))
+    tree = read_closed_tree(path)
+    read = frame_poses(tree)
+    expected = five_bar_world_poses(transform)
+    resolved = world_poses(read_model(path))
+    for name, pose in expected.items():
+        np.testing.assert_allclose(read[name], pose, atol=TOLERANCE * transform[0], rtol=0, err_msg=name)
+        np.testing.assert_allclose(resolved[name], pose, atol=TOLERANCE * transform[0], rtol=0, err_msg=name)
+    for i in range(3):  # motors at the proximal links' origins (their own frames); loop joints at the effector's
+        np.testing.assert_allclose(read[f"mot{i + 1}"], expected[f"proximal_{i + 1}"], atol=TOLERANCE * transform[0])
+        np.testing.assert_allclose(resolved[f"loop_{i + 1}"][:3, 3], expected["effector"][:3, 3],
+                                   atol=TOLERANCE * transform[0])
+    import pinocchio as pin
+
+    data = tree.model.createData()
+    pin.forwardKinematics(tree.model, data, tree.q_reference)
+    for closure in tree.closures:
+        a = data.oMi[closure.joint_a].homogeneous @ closure.placement_a
+        b = data.oMi[closure.joint_b].homogeneous @ closure.placement_b
+        np.testing.assert_allclose(a, b, atol=TOLERANCE * transform[0], err_msg=closure.name)
+
+
+@pytest.mark.parametrize("placed", [False, True])
+def test_the_delta_s_links_are_where_mujoco_puts_the_same_delta_written_in_mjcf(tmp_path, placed):
+    """The rod-level Delta written in both formats, its base turned and moved (or not): every link of the SDFormat
+    file where MuJoCo puts the body of that name, and the frame ``centre`` where the MJCF's site is."""
+    import mujoco
+
+    transform = (1.0, random_rotation(np.random.default_rng(6)), np.array([0.3, -0.2, 0.5])) if placed else None
+    tree = read_closed_tree(write(tmp_path, delta_sdf(transform=transform)))
+    (tmp_path / "delta.xml").write_text(delta_rods_mjcf(transform=transform))
+    mj_model = mujoco.MjModel.from_xml_path(str(tmp_path / "delta.xml"))
+    mj_data = mujoco.MjData(mj_model)
+    mujoco.mj_kinematics(mj_model, mj_data)
+    read = frame_poses(tree)
+    names = [mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_BODY, k) for k in range(1, mj_model.nbody)]
+    assert len(names) == 14 and set(names) <= set(read)
+    for k, name in enumerate(names, start=1):
+        np.testing.assert_allclose(read[name][:3, 3], mj_data.xpos[k], atol=TOLERANCE, rtol=0, err_msg=name)
+        np.testing.assert_allclose(read[name][:3, :3], mj_data.xmat[k].reshape(3, 3), atol=TOLERANCE, err_msg=name)
+    site = mujoco.mj_name2id(mj_model, mujoco.mjtObj.mjOBJ_SITE, "centre")
+    np.testing.assert_allclose(read["centre"][:3, 3], mj_data.site_xpos[site], atol=TOLERANCE, rtol=0)
+
+
+@pytest.mark.parametrize("centre", POSES)
+def test_a_rod_level_delta_in_sdformat_has_the_textbook_pressure_angles_through_the_graph(tmp_path, centre):
+    path = write(tmp_path, delta_sdf(centre))
+    with pytest.raises(LegWithLoops, match=r"inside a leg"):
+        read_mechanism_file(path)
+    tree = read_closed_tree(path)
+    assert tree.motors == ["motor_1", "motor_2", "motor_3", "motor_4"]
+    assert [closure.kind for closure in tree.closures] == ["3d"] * 7  # eight ball joints on the platform, one in
+    result = graph_mechanism(tree).indices()  # the tree
+    expected = textbook(centre)
+    assert result.dof == 3
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    found = dict(zip(result.submechanisms, result.oti_submechanisms))
+    for members, value in expected["oti"].items():
+        np.testing.assert_allclose(found[members], value, atol=TOLERANCE, err_msg=str(members))
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+
+
+def test_motors_marked_in_the_file_and_the_marker_on_a_joint_that_cannot_drive(tmp_path):
+    tree = read_closed_tree(write(tmp_path, delta_sdf(plugin=False)))
+    assert tree.motors == ["motor_1", "motor_2", "motor_3", "motor_4"] and tree.notes == []
+    text = delta_sdf(plugin=False).replace('type="ball"><parent>arm_2</parent>',
+                                           'type="ball"><screwkit:actuated/><parent>arm_2</parent>', 1)
+    with pytest.raises(ImportError_, match=r"robot.sdf: <joint name='ball_2a'>: joint 'ball_2a' is marked actuated "
+                                           r"but is a ball joint"):
+        read_closed_tree(write(tmp_path, text))
+
+
+BAD = [
+    (lambda t: t.replace('name="loop_2" type="revolute"', 'name="loop_2" type="screw"'),
+     r"<joint name='loop_2'>: type 'screw' is not read \(expected one of revolute, continuous"),
+    (lambda t: t.replace("<link name=\"base\"/>", '<link name="base"/><model name="gripper"><link name="g"/></model>'),
+     r"<model name='five_bar'><model name='gripper'>: nested models are not read"),
+    (lambda t: t.replace("<model ", "<include><uri>model://arm</uri></include><model "),
+     r"<include> of 'model://arm': included models are not read"),
+    (lambda t: t.replace('relative_to="proximal_2"', 'relative_to="proximal_9"'),
+     r"<link name='distal_2'>: its pose is relative_to 'proximal_9', not a frame of the model"),
+    (lambda t: t.replace('<link name="base"/>', '<link name="base"><pose relative_to="anchor"/></link>'),
+     r"<joint name='anchor'>: its pose's relative_to goes round a cycle \(base -> anchor -> base\)"),
+    (lambda t: t.replace("</model></sdf>", '</model><model name="other"><link name="x"/></model></sdf>'),
+     r"2 <model> elements \('five_bar', 'other'\); screwkit reads one model"),
+    (lambda t: t.replace("<parent>proximal_3</parent>", "<parent>elsewhere</parent>"),
+     r"<joint name='free3'>: <parent> names 'elsewhere', not a link, joint or frame of the model"),
+    (lambda t: t.replace('<link name="effector"><pose rotation_format="quat_xyzw">',
+                         '<link name="effector"><pose rotation_format="quat_xyzw">1 '),
+     r"<link name='effector'>: <pose> must hold 7 finite numbers"),
+    (lambda t: t.replace("<parent>world</parent><child>base</child>", "<parent>world</parent><child>base</child>")
+     .replace("<child>proximal_1</child>", "<child>base</child>"),
+     r"<joint name='mot1'>: <parent> and <child> are on the same link 'base'"),
+]
+
+
+@pytest.mark.parametrize(("edit", "message"), BAD)
+def test_constructs_this_reading_does_not_follow_are_refused_naming_the_file_and_element(tmp_path, edit, message):
+    path = write(tmp_path, edit(five_bar_sdf()))
+    with pytest.raises(ImportError_, match=r"robot.sdf: " + message) as error:
+        read_closed_tree(path)
+    assert "\n" not in str(error.value)
+
+
+@pytest.mark.cli
+def test_analyze_and_info_open_sdformat_files_on_the_command_line(tmp_path):
+    five_bar = write(tmp_path, five_bar_sdf(), "five_bar.sdf")
+    analysed = screwkit("analyze", five_bar, "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    assert json.loads(analysed.stdout)["lmti"] == pytest.approx(five_bar_expected(HOME)["lmti"], abs=TOLERANCE)
+    info = screwkit("info", five_bar)
+    assert info.returncode == 0, info.stderr
+    assert "SDFormat (joints closing loops)" in info.stdout and "planar" in info.stdout
+    delta = write(tmp_path, delta_sdf(), "delta.sdf")
+    expected = textbook(POSES[0])
+    analysed = screwkit("analyze", delta)
+    assert analysed.returncode == 0, analysed.stderr
+    assert f"LMTI (Eq. 11, all actuators)        {expected['lmti']:.4f}" in analysed.stdout
+    info = screwkit("info", delta)
+    assert info.returncode == 0, info.stderr
+    assert "SDFormat (joints closing loops)" in info.stdout and "legs with loops inside them" in info.stdout
+    write(tmp_path, five_bar_sdf().replace('type="continuous"', 'type="gearbox"', 1), "bad.sdf")
+    one_line_error(screwkit("analyze", tmp_path / "bad.sdf"), "bad.sdf: <joint name='free1'>: type 'gearbox' is not "
+                   "read")
+
+
+def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles():
+    """tests/data/sdformat/five_bar.sdf, written by hand (link frames at the joints, unturned): ITI_i the sine of
+    the angle between leg i's proximal and distal links, the OTI of a pair the sine between their distal links."""
+    from pathlib import Path
+
+    from screwkit.studies import indices_at_pose
+
+    bases = np.array([[-0.1, 0.0], [0.1, 0.0], [0.2, 0.65]])
+    elbows = np.array([[-0.25, 0.15], [0.25, 0.15], [0.35, 0.4]])
+    point = np.array([0.0, 0.35])
+
+    def sine(u, v):
+        return abs(u[0] * v[1] - u[1] * v[0]) / np.linalg.norm(u) / np.linalg.norm(v)
+
+    mechanism = load(Path(__file__).parent / "data" / "sdformat" / "five_bar.sdf")
+    assert mechanism.is_planar and mechanism.dof == 2
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    distal = point - elbows
+    np.testing.assert_allclose(result.iti_actuators, [sine(e - b, d) for b, e, d in zip(bases, elbows, distal)],
+                               atol=TOLERANCE)
+    pairs = {(0, 1): sine(distal[0], distal[1]), (0, 2): sine(distal[0], distal[2]), (1, 2): sine(distal[1], distal[2])}
+    np.testing.assert_allclose(result.lmti, max(pairs.values()), atol=TOLERANCE)
+    np.testing.assert_allclose(result.f_o[1], min(pairs[(1, 2)], pairs[(0, 2)], pairs[(0, 1)]), atol=TOLERANCE)
+
+
+@pytest.mark.parametrize(("kind", "tree_joint", "closures"), [
+    ("prismatic", "loop_3", ["loop_3"]), ("universal", "loop_3_axis", ["loop_3_axis2_a", "loop_3_axis2_b"])])
+def test_a_universal_or_prismatic_joint_closing_a_loop_keeps_its_first_motion_in_the_tree(tmp_path, kind, tree_joint,
+                                                                                          closures):
+    """A prismatic loop joint: its slide in the tree on a body welded to the child; a universal one: its first axis
+    in the tree, its second a hinge. Both close at the file's configuration (structure only: no textbook here)."""
+    text = five_bar_sdf().replace('name="loop_3" type="revolute"', f'name="loop_3" type="{kind}"')
+    text = text.replace('<axis><xyz>0 0 -1</xyz></axis></joint>', '<axis><xyz>0 0 -1</xyz></axis><axis2><xyz>1 0 0'
+                        '</xyz></axis2></joint>')
+    tree = read_closed_tree(write(tmp_path, text))
+    assert tree.model.existJointName(tree_joint)
+    assert [c.name for c in tree.closures if c.name.startswith("loop_3")] == closures
+    assert max(closure_gaps(tree, tree.q_reference).values()) < TOLERANCE
+    parent = tree.model.names[tree.model.parents[tree.model.getJointId(tree_joint)]]
+    assert parent == "free3"
