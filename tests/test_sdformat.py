@@ -203,6 +203,28 @@ def test_analyze_and_info_open_sdformat_files_on_the_command_line(tmp_path):
                    "read")
 
 
+def test_map_verify_and_sweep_of_a_serial_leg_sdformat_file_and_a_graph_sweep(tmp_path):
+    """The commands of serial legs on a five-bar written as SDFormat (map against indices_at_poses at its grid
+    points, verify's closed forms), and a sweep of the rod-level Delta written as SDFormat (a graph)."""
+    import xarray as xr
+
+    five_bar = write(tmp_path, five_bar_sdf(), "five_bar.sdf")
+    mechanism = load(five_bar)
+    out = tmp_path / "map.nc"
+    mapped = screwkit("map", five_bar, "--radius", "0.04", "--step", "0.02", "--out", out)
+    assert mapped.returncode == 0, mapped.stderr
+    with xr.open_dataset(out) as dataset:
+        xs, ys = np.meshgrid(dataset["x"].values, dataset["y"].values)
+        inside = np.isfinite(dataset["lmti"].values)
+        expected = indices_at_poses(mechanism, np.stack([xs[inside], ys[inside]], axis=-1))
+        np.testing.assert_allclose(dataset["lmti"].values[inside], expected.lmti, atol=1e-12)
+    verified = screwkit("verify", five_bar, "--samples", "200")
+    assert verified.returncode == 0 and "largest deviation" in verified.stdout, verified.stderr
+    delta = write(tmp_path, delta_sdf(), "delta.sdf")
+    swept = screwkit("sweep", delta, "--sweep", f"z:{POSES[0][2] - 0.02!r}:{POSES[0][2] + 0.02!r}:0.02")
+    assert swept.returncode == 0 and "swept z over 2 values (2 reachable)" in swept.stderr, swept.stderr
+
+
 def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles():
     """tests/data/sdformat/five_bar.sdf, written by hand (link frames at the joints, unturned): ITI_i the sine of
     the angle between leg i's proximal and distal links, the OTI of a pair the sine between their distal links."""
