@@ -18,6 +18,7 @@ licences in its ``SOURCES.md``).
 
 from __future__ import annotations
 
+import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -27,6 +28,7 @@ import pinocchio as pin
 import pytest
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, screwkit_residuals
 
+from helpers import one_line_error, screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
@@ -308,10 +310,15 @@ def test_reachy_mini_is_refused_for_the_body_yaw_joint_under_its_stewart_platfor
     with pytest.raises(ImportError_, match=r"leg 'body_down_3dprint' has loops inside it and 7 actuators") as error:
         graph_mechanism(read_closed_tree(REACHY))
     assert_refusal_documented(error)
-    with pytest.raises(ImportError_, match=r"actuated joint 'yaw_body' moves inside a loop of leg "
-                                           r"'body_down_3dprint'") as error:
+    with pytest.raises(ImportError_, match=r"locking actuated joint 'yaw_body' leaves the platform of leg "
+                                           r"'body_down_3dprint' as free as before") as error:
         graph_mechanism(read_closed_tree(REACHY.with_name("robot.urdf")))
     assert_refusal_documented(error)
+    urdf = load(REACHY.with_name("robot.urdf"), lock=("yaw_body",))  # serial R-S-S legs, motors guessed again
+    graph = graph_mechanism(read_closed_tree(REACHY, lock=("yaw_body",)))
+    assert sorted(a.split(":")[1] for a in urdf.actuator_names) == [f"stewart_{k}" for k in range(1, 7)]
+    # two exports of one CAD model, their numbers printed to other digits: the same LMTI to 1e-6
+    np.testing.assert_allclose(indices_at_pose(urdf, urdf.home_pose).lmti, graph.indices().lmti, atol=1e-6)
 
 
 def test_cassie_needs_its_output_named_and_is_refused_for_its_transmissions():
@@ -323,3 +330,72 @@ def test_cassie_needs_its_output_named_and_is_refused_for_its_transmissions():
     with pytest.raises(ImportError_, match=r"leg 'cassie-pelvis' has loops inside it and 10 actuators") as error:
         graph_mechanism(read_closed_tree(CASSIE, output="left-foot"))
     assert_refusal_documented(error)
+
+
+def test_reachy_mini_with_its_yaw_stage_locked_gives_the_leg_line_indices_of_its_stewart_head(tmp_path):
+    """``--lock yaw_body`` holds the turntable every leg stands on: six R-S-S legs remain (a crank motor, a rod
+    ball-jointed at both ends; leg 6 carries the head on its rod's far ball). Each leg's actuation wrench is the
+    force along its rod, crank ball centre B to head ball centre D, so ITI_k = |u_k . t_k| (t_k the direction of
+    B's velocity about the crank axis) and OTI_k = |u_k . v_k| / |v_k|, v_k the velocity at D_k of the head twist
+    reciprocal to the other five rod forces: Pinocchio's forward kinematics and numpy, at the configuration the
+    file's loops assemble into."""
+    graph = graph_mechanism(read_closed_tree(REACHY, lock=("yaw_body",)))
+    model = graph.tree.model
+    assert not model.existJointName("yaw_body") and len(graph.legs) == 6 and graph.dof == 6
+    data = model.createData()
+    pin.forwardKinematics(model, data, graph.q)
+    itis, lines, ends = [], [], []
+    for leg in graph.legs:
+        motor, ball = leg.joints[0], leg.joints[1]
+        assert model.names[motor].startswith("stewart_") and model.joints[ball].shortname() == "JointModelSpherical"
+        if leg.closures:
+            closure = leg.closures[0]
+            joint, placement = ((closure.joint_a, closure.placement_a) if closure.joint_a != graph.platform
+                                else (closure.joint_b, closure.placement_b))
+            end = (data.oMi[joint].homogeneous @ placement)[:3, 3]
+        else:  # the leg the head hangs from: its rod's far ball
+            end = data.oMi[leg.joints[2]].translation.copy()
+        crank, axis = data.oMi[motor].translation, data.oMi[motor].rotation[:, 2]
+        start = data.oMi[ball].translation
+        rod = unit(end - start)
+        itis.append(abs(rod @ unit(np.cross(axis, start - crank))))
+        lines.append(np.concatenate([rod, np.cross(end, rod)]))
+        ends.append(end)
+    otis = []
+    for k in range(6):
+        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
+        twist = np.linalg.svd(others)[2][-1]
+        velocity = twist[3:] + np.cross(twist[:3], ends[k])
+        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    result = graph.indices()
+    np.testing.assert_allclose(result.iti_actuators, itis, atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, min(otis), atol=TOLERANCE)
+    assert 0.1 < min(otis) < 0.99 and 0.1 < min(itis) < 0.99
+    completed = screwkit("analyze", REACHY, "--lock", "yaw_body", "--json")
+    assert completed.returncode == 0, completed.stderr
+    assert json.loads(completed.stdout)["lmti"] == pytest.approx(result.lmti, abs=1e-12)
+    one_line_error(screwkit("analyze", REACHY, "--lock", "no_such_joint"), "--lock no_such_joint: no joint of that")
+    one_line_error(screwkit("analyze", REACHY), "--lock yaw_body analyses the legs on the body it turns")
+
+
+def test_a_map_of_reachy_mini_with_its_yaw_stage_locked_rebuilds_the_locked_graph_in_its_tasks(tmp_path):
+    """``map --lock``: the map's tasks rebuild the graph from the file with the same joints locked; each grid
+    point's indices are those of graph_indices_at_poses at that pose (the head's orientation as in the file)."""
+    import xarray as xr
+
+    from screwkit.studies.poses import graph_indices_at_poses
+
+    graph = graph_mechanism(read_closed_tree(REACHY, lock=("yaw_body",)))
+    home = graph.task_pose()
+    out = tmp_path / "map.nc"
+    xs = [float(home[0]) - 0.004, float(home[0]) + 0.004]
+    completed = screwkit("map", REACHY, "--lock", "yaw_body", "--grid", f"x:{xs[0]!r}:{xs[1]!r}:0.004", "--grid",
+                         f"y:{float(home[1])!r}:{float(home[1]) + 0.004!r}:0.004", "--out", out, "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    with xr.open_dataset(out) as dataset:
+        x, y = np.meshgrid(dataset["x"].values, dataset["y"].values)
+        poses = np.repeat(home[None], x.size, axis=0)
+        poses[:, 0], poses[:, 1] = x.ravel(), y.ravel()
+        expected = graph_indices_at_poses(graph, poses)
+        np.testing.assert_allclose(dataset["lmti"].values.ravel(), expected.lmti, atol=1e-12)

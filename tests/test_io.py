@@ -511,4 +511,4 @@ def test_the_output_frame_a_message_asks_for_is_an_option_of_every_command(tmp_p
     swept = screwkit("sweep", tie, "--output", "marker", "--sweep", "x:-0.01:0.01:0.01", "--quiet")
     assert swept.returncode == 0, swept.stderr
     own = screwkit("analyze", "five_bar_3", "--output", "effector")
-    assert own.returncode == 1 and "applies to files of other tools" in own.stderr and own.stderr.count("\n") == 1
+    assert own.returncode == 1 and "apply to files of other tools" in own.stderr and own.stderr.count("\n") == 1

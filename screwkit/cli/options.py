@@ -19,6 +19,7 @@ from typing import Callable
 import click
 import numpy as np
 
+from screwkit.cli.reading import Reading, lock_option, output_frame_option, output_type_option, reading_record
 from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
@@ -183,38 +184,12 @@ def length_unit_option(function: Callable) -> Callable:
                              "everything shown is in m.")(function)
 
 
-@dataclass(frozen=True)
-class Reading:
-    """How MECHANISM's file is read: its length unit, and for a file of another tool the frame whose body is the
-    platform and whether the output is a point or that frame (``--length-unit``, ``--output``, ``--output-type``)."""
-
-    length_unit: str | None = None
-    output: str | None = None
-    output_type: str | None = None
-
-
-def _reading(length_unit: str | None, output_frame: str | None, output_type: str | None) -> Reading:
-    return Reading(length_unit, output_frame, output_type)
-
-
 def reading_options(function: Callable) -> Callable:
-    """``--length-unit``, ``--output FRAME``, ``--output-type``: how MECHANISM is read, as ``reading``, a
-    :class:`Reading` (the options :func:`screwkit.io.read_mechanism_file` and ``screwkit convert`` take)."""
-    return option_group("reading", _reading, length_unit_option, output_frame_option, output_type_option)(function)
-
-
-def output_frame_option(function: Callable) -> Callable:
-    return click.option("--output", "output_frame", default=None, metavar="FRAME",
-                        help="For a file of another tool: the frame (MJCF: site or body) whose body is the platform; "
-                             "default a frame named effector, end_effector, eff, ee, tool, tcp, foot or platform, "
-                             "else the body where most closures meet.")(function)
-
-
-def output_type_option(function: Callable) -> Callable:
-    return click.option("--output-type", type=click.Choice(["point", "frame"]), default=None,
-                        help="For a file of another tool: a point output (where the chains meet) or the output "
-                             "frame; default: the point when every closure meets the platform at one point and its "
-                             "rotations about it are idle, else the frame.")(function)
+    """``--length-unit``, ``--output FRAME``, ``--output-type``, ``--lock JOINT``: how MECHANISM is read, as
+    ``reading``, a :class:`Reading` (the options :func:`screwkit.io.read_mechanism_file` and ``screwkit convert``
+    take)."""
+    return option_group("reading", reading_record, length_unit_option, output_frame_option, output_type_option,
+                        lock_option)(function)
 
 
 def threshold_option(function: Callable) -> Callable:
@@ -404,7 +379,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     length_unit = reading.length_unit
     try:
         mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
-                         output_type=reading.output_type)
+                         output_type=reading.output_type, lock=reading.lock)
     except LegWithLoops as error:
         if not graphs:
             raise fail(str(error)) from None
@@ -412,7 +387,8 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
             raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
         try:
             source = bundled_path(name) if name in bundled_graph_names() else name
-            return graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type))
+            return graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
+                                                    lock=reading.lock))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     except ValueError as error:

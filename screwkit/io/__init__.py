@@ -23,6 +23,7 @@ from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportRep
 from screwkit.io.gazebo import has_gazebo_joints, read_gazebo
 from screwkit.io.gepetto import read_gepetto, yaml_beside
 from screwkit.io.graph import GraphMechanism, graph_mechanism
+from screwkit.io.locking import lock_joints
 from screwkit.io.mjcf import read_mjcf
 from screwkit.io.onshape import has_closing_frames, read_onshape
 from screwkit.io.sdformat import SDFORMAT_SUFFIXES, read_sdformat
@@ -48,10 +49,14 @@ def is_foreign(path: Path) -> bool:
     return False
 
 
-def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
-    """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``: as
-    :func:`read_mechanism_file`)."""
-    path = Path(path)
+def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None,
+                     lock: tuple[str, ...] = ()) -> ClosedTree:
+    """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
+    ``lock``: as :func:`read_mechanism_file`)."""
+    return lock_joints(_read_tree(Path(path), output, output_type), lock)
+
+
+def _read_tree(path: Path, output: str | None, output_type: str | None) -> ClosedTree:
     if output_type not in (None, "point", "frame"):
         raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
     if path.suffix.lower() in MJCF_SUFFIXES:
@@ -69,15 +74,17 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
                        "closed-loop tree screwkit reads.")
 
 
-def read_mechanism_file(path: Path, *, output: str | None = None,
-                        output_type: str | None = None) -> tuple[str, ImportReport]:
+def read_mechanism_file(path: Path, *, output: str | None = None, output_type: str | None = None,
+                        lock: tuple[str, ...] = ()) -> tuple[str, ImportReport]:
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
-    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says). A leg with loops inside it
-    raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses it).
+    ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says); ``lock``: joints held at their
+    values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part). A leg
+    with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
+    it).
     """
-    return convert_tree(read_closed_tree(path, output=output, output_type=output_type))
+    return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock))
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

@@ -71,6 +71,7 @@ class ClosedTree:
     file_format: str = ""
     notes: list[str] = field(default_factory=list)  # what reading the file changed (said in the report)
     task_coordinates: tuple[str, ...] | None = None  # a URDF source's <task_coordinates names="...">, kept
+    locked: tuple[str, ...] = ()  # joints held at their values in the file (screwkit.io.locking)
 
 
 def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
@@ -264,3 +265,4 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
                            f"{worst!r} still misses by {gaps[worst]:.3g} m after assembly (gaps: "
                            + ", ".join(f"{k} {v:.3g} m" for k, v in gaps.items()) + ").")
     return q, scale
+

@@ -296,20 +296,32 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet).")
+        actuator = leg.actuators[0]
+        name = model.names[actuator]
+        carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
+        if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
+            raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
+                               f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
+                               "(motors the file does not name, or a leg with no input); if it is a serial stage "
+                               f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
         if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
-            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} moves inside a "
-                               f"loop of leg {leg.name!r} (its twist is not a motion the leg allows: the leg has no "
-                               "serial input); analysable when the actuated joint joins the base to the rest of its "
-                               "leg.")
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
+                               "twist is not a motion the leg allows: the leg has no serial input); analysable when "
+                               "the actuated joint joins the base to the rest of its leg.")
 
 
 def _check_actuators(tree: ClosedTree, legs) -> None:
     model = tree.model
     for leg in legs:
         if len(leg.actuators) != 1:
+            stage = [model.names[a] for a in leg.actuators
+                     if all(a in path_to(model, other) for other in leg.actuators if other != a)]
+            advice = (f"; the actuated joint {stage[0]!r} carries every other one (a serial stage before the "
+                      f"parallel part): --lock {stage[0]} analyses the legs on the body it turns" if stage else "")
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
-                               "one (a leg with loops and several actuators has no per-actuator twist system yet).")
+                               "one (a leg with loops and several actuators has no per-actuator twist system yet)"
+                               f"{advice}.")
         kind, _ = joint_kind(model, leg.actuators[0])
         if kind not in ("revolute", "prismatic"):
             raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "

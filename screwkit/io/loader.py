@@ -90,7 +90,7 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
          max_bytes: int = MAX_FILE_BYTES, limits: bool = True, output: str | None = None,
-         output_type: str | None = None) -> Mechanism:
+         output_type: str | None = None, lock: tuple[str, ...] = ()) -> Mechanism:
     """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
 
     Parameters
@@ -114,6 +114,9 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         For a file of another tool: the frame whose body is the platform and ``"point"`` or ``"frame"``
         (as :func:`screwkit.io.read_mechanism_file`); a file in screwkit's convention names its own platform,
         so they are refused there.
+    lock : tuple of str
+        For a file of another tool: joints held at their values in the file (``--lock``; a serial stage before the
+        parallel part, :func:`screwkit.io.locking.lock_joints`).
 
     Raises
     ------
@@ -132,7 +135,7 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
         if path.suffix == ".xml":  # a bundled graph: as its file (refused with LegWithLoops, for graph_mechanism)
-            read_mechanism_file(path, output=output, output_type=output_type)
+            read_mechanism_file(path, output=output, output_type=output_type, lock=lock)
     else:
         path = Path(text)
         if path.is_dir():
@@ -144,13 +147,13 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         if is_foreign(path):  # MJCF, SDFormat, or a URDF of another tool (robot.yaml, closing_ frames, Gazebo joints)
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
-            converted, report = read_mechanism_file(path, output=output, output_type=output_type)
+            converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock)
             mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
-    if output is not None or output_type is not None:
-        raise ValueError(f"{path}: an output frame or type applies to files of other tools (MJCF, SDFormat, URDF + "
-                         "robot.yaml, onshape-to-robot URDFs); this file is in screwkit's convention (its output is "
-                         "its platform).")
+    if output is not None or output_type is not None or lock:
+        raise ValueError(f"{path}: an output frame or type, or locked joints, apply to files of other tools (MJCF, "
+                         "SDFormat, URDF + robot.yaml, onshape-to-robot URDFs); this file is in screwkit's convention "
+                         "(its output is its platform).")
     return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes), limits=limits)
 
 

@@ -22,6 +22,7 @@ class GraphSource:
     output: str | None
     output_type: str | None
     digest: str
+    lock: tuple[str, ...] = ()
 
 
 @functools.lru_cache(maxsize=4)
@@ -33,10 +34,11 @@ def cached_graph(source: GraphSource) -> GraphMechanism:
         raise ValueError(f"{source.path}: cannot be read where the map's task runs ({error.strerror}).") from None
     if hashlib.sha256(data).hexdigest() != source.digest:
         raise ValueError(f"{source.path}: the file changed while the map was computed.")
-    return graph_mechanism(read_closed_tree(Path(source.path), output=source.output, output_type=source.output_type))
+    return graph_mechanism(read_closed_tree(Path(source.path), output=source.output, output_type=source.output_type,
+                                            lock=source.lock))
 
 
 def graph_source(graph: GraphMechanism) -> GraphSource:
     """What a task elsewhere needs to rebuild ``graph`` as read (:func:`cached_graph`)."""
     digest = hashlib.sha256(Path(graph.tree.source).read_bytes()).hexdigest()
-    return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest)
+    return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest, graph.tree.locked)

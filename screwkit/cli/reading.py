@@ -1,0 +1,48 @@
+"""How MECHANISM's file is read: the record of the reading options and the options of files of other tools."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import click
+
+__all__ = ["Reading", "reading_record", "lock_option", "output_frame_option", "output_type_option", "LOCK_HELP"]
+
+
+@dataclass(frozen=True)
+class Reading:
+    """How MECHANISM's file is read: its length unit, and for a file of another tool the frame whose body is the
+    platform and whether the output is a point or that frame (``--length-unit``, ``--output``, ``--output-type``),
+    and the joints held at their values in the file (``--lock``)."""
+
+    length_unit: str | None = None
+    output: str | None = None
+    output_type: str | None = None
+    lock: tuple[str, ...] = ()
+
+
+def reading_record(length_unit: str | None, output_frame: str | None, output_type: str | None, lock) -> Reading:
+    return Reading(length_unit, output_frame, output_type, tuple(lock or ()))
+
+
+LOCK_HELP = ("For a file of another tool: hold this joint at its value in the file (repeatable): a serial stage "
+             "before the parallel part, such as a turntable every leg stands on.")
+
+
+def lock_option(function: Callable) -> Callable:
+    return click.option("--lock", multiple=True, metavar="JOINT", help=LOCK_HELP)(function)
+
+
+def output_frame_option(function: Callable) -> Callable:
+    return click.option("--output", "output_frame", default=None, metavar="FRAME",
+                        help="For a file of another tool: the frame (MJCF: site or body) whose body is the platform; "
+                             "default a frame named effector, end_effector, eff, ee, tool, tcp, foot or platform, "
+                             "else the body where most closures meet.")(function)
+
+
+def output_type_option(function: Callable) -> Callable:
+    return click.option("--output-type", type=click.Choice(["point", "frame"]), default=None,
+                        help="For a file of another tool: a point output (where the chains meet) or the output "
+                             "frame; default: the point when every closure meets the platform at one point and its "
+                             "rotations about it are idle, else the frame.")(function)
