@@ -233,7 +233,7 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
 def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:
     """The data file and the figure (checked before the computation); with neither, the CSV table on stdout."""
     if outputs.out:
-        write_dataset(result.to_dataset(), outputs.out)
+        write_dataset(result.plain_dataset(), outputs.out)  # netCDF without xarray (CSV through it)
         if not quiet:
             echo_error(f"wrote {outputs.out}")
     if outputs.figure:
