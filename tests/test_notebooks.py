@@ -1,7 +1,7 @@
 """The notebooks in notebooks/ execute from top to bottom, on small grids.
 
 Each notebook reads ``SCREWKIT_NOTEBOOK_QUICK=1`` in its first cell and then uses coarse grids
-and sweeps (all four together take about a minute and a half). The kernel is the interpreter running the
+and sweeps (the first four together take about a minute and a half). The kernel is the interpreter running the
 tests (a kernel spec written for this run), its working directory a temporary folder, so files
 the notebooks write (HTML exports) land there. Notebooks are committed without outputs.
 """
@@ -36,7 +36,7 @@ def kernel_folder(tmp_path_factory) -> Path:
 def test_notebooks_exist():
     assert [path.name for path in NOTEBOOKS] == [
         "01_reproduce_the_paper.ipynb", "02_plug_in_a_mechanism.ipynb", "03_meshcat_inspection.ipynb",
-        "04_any_mobility.ipynb", "05_design_search.ipynb"]
+        "04_any_mobility.ipynb", "05_design_search.ipynb", "06_trajectory.ipynb"]
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)

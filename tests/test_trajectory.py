@@ -245,6 +245,66 @@ def test_a_hexapod_path_runs_and_agrees_with_its_samples():
                                                               for j, ties in result.worst.items()}
 
 
+def _netcdf_layout(path) -> dict:
+    """Everything a netCDF-3 file holds, as scipy reads it: dimensions, global attributes, per variable its
+    dimensions, type, attributes and values."""
+    from scipy.io import netcdf_file
+
+    with netcdf_file(path, "r", mmap=False) as handle:
+        def attributes(owner):
+            return {key: repr(value) for key, value in owner._attributes.items()}
+
+        return {"dimensions": dict(handle.dimensions), "attributes": attributes(handle),
+                "variables": {name: (variable.dimensions, variable.typecode(), attributes(variable),
+                                     np.array(variable.data).tobytes()) for name, variable in handle.variables.items()}}
+
+
+@pytest.mark.parametrize("name", ["planar_5rrr", "delta_4"])
+def test_the_netcdf_written_without_xarray_is_the_file_xarray_writes(tmp_path, name):
+    """``plain_dataset().write_netcdf`` (what --out writes, without importing xarray) gives, byte for byte in every
+    variable and attribute, the file ``to_dataset().to_netcdf`` writes; xarray reads back the same dataset. A path
+    with times, leaving the workspace (NaN indices, empty worst-fault names), with the mean (f_o_mean{j}); the
+    Delta adds the CTI, integer and boolean variables."""
+    import xarray as xr
+
+    mechanism = bundled(name)
+    start = mechanism.home_pose
+    stop = start + (np.array([0.0, 1.5, 0.0]) if name == "planar_5rrr" else np.array([0.0, 0.0, -1.0]))
+    poses = np.linspace(start, stop, 12)
+    result = trajectory(mechanism, path_from_poses(mechanism, poses, np.linspace(0.0, 2.0, 12)), aggregate="mean")
+    assert not np.all(result.indices.reachable) and np.any(result.indices.reachable)
+    result.to_dataset().to_netcdf(tmp_path / "xarray.nc", engine="scipy")
+    result.plain_dataset().write_netcdf(tmp_path / "plain.nc")
+    assert _netcdf_layout(tmp_path / "plain.nc") == _netcdf_layout(tmp_path / "xarray.nc")
+    with xr.open_dataset(tmp_path / "xarray.nc", engine="scipy") as expected, \
+            xr.open_dataset(tmp_path / "plain.nc", engine="scipy") as found:
+        xr.testing.assert_identical(found.load(), expected.load())
+        assert {k: v.dtype for k, v in found.variables.items()} == {k: v.dtype for k, v in expected.variables.items()}
+    xr.testing.assert_identical(result.plain_dataset().to_dataset(), result.to_dataset())
+
+
+def test_the_command_writes_its_netcdf_without_importing_xarray(tmp_path):
+    """The data written by --out .nc is the Python result's, and xarray, pandas and dask are never imported."""
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    five = bundled("planar_5rrr")
+    done = subprocess.run([sys.executable, "-X", "importtime", "-m", "screwkit.cli", "trajectory", "planar_5rrr",
+                           "--line", "-0.3", "-0.2", "-45", "0.3", "0.2", "45", "--samples", "9", "--quiet",
+                           "--out", tmp_path / "t.nc"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    imported = {line.rsplit("|", 1)[-1].strip() for line in done.stderr.splitlines() if line.startswith("import time")}
+    assert not imported & {"xarray", "pandas", "dask", "dask.array"}, sorted(imported & {"xarray", "pandas", "dask"})
+    result = trajectory(five, line_path(five, START, STOP, 9))
+    result.to_dataset().to_netcdf(tmp_path / "expected.nc", engine="scipy")
+    with xr.open_dataset(tmp_path / "expected.nc", engine="scipy") as expected, \
+            xr.open_dataset(tmp_path / "t.nc", engine="scipy") as found:
+        xr.testing.assert_allclose(found.load().drop_attrs(), expected.load().drop_attrs(), rtol=0, atol=1e-12)
+        assert json.loads(found.attrs["summary"])["worst"] == json.loads(expected.attrs["summary"])["worst"]
+
+
 def test_generated_paths():
     five = bundled("planar_5rrr")
     circle = circle_path(five, [0.1, 0.0, 0.3], 0.2, 9)

@@ -23,10 +23,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import one_line_error, screwkit
 from screwkit.closure import chain_screws, solve_one
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
+from screwkit.studies.paths import line_path
 from screwkit.viewer import (
     FAILED_COLOR,
     animate_sweep,
@@ -377,6 +378,35 @@ def test_animate_sweep_keyframes_follow_the_poses(planar, viewer):
     assert all(not command["animations"] for command in after)  # the still scene cleared it
 
 
+def test_path_animation_colours_each_chain_by_its_index_frame_by_frame(planar, viewer):
+    """Along a path, the material colour of every drawn part of a working chain is a keyframe track equal, frame by
+    frame, to the colour of that chain in the still scene of the pose; a failed chain stays red, untracked."""
+    path = line_path(planar, [-0.3, -0.2, np.deg2rad(-45.0)], [0.3, 0.2, np.deg2rad(45.0)], 7)
+    scene = animate_sweep(planar, path, failed=["chain_3"], viewer=viewer, frame_rate=4)
+    np.testing.assert_allclose(scene.poses, path.poses)
+    commands = scene_commands(scene.static_html())
+    animated = [i for i, c in enumerate(commands) if c["type"] == "set_animation" and c["animations"]]
+    assert len(animated) == 1
+    # after the drawing: a page binds the colour tracks to the objects drawn, not to placeholders they replace
+    assert animated[0] > max(i for i, c in enumerate(commands) if c["type"] == "set_object")
+    clips = {item["path"]: item["clip"] for item in commands[animated[0]]["animations"]}
+    coloured = {path_: {t["name"]: t for t in clip["tracks"]}[".material.color"] for path_, clip in clips.items()
+                if any(t["name"] == ".material.color" for t in clip["tracks"])}
+    visuals = full_path(f"{ROOT_PATH}/mechanism/visuals")
+    for chain in ("chain_1", "chain_2", "chain_4", "chain_5"):
+        assert f"{visuals}/{chain}_link_a_0/<object>" in coloured and f"{visuals}/{chain}_link_l_0/<object>" in coloured
+    assert not [p for p in coloured if "chain_3" in p or "platform" in p or "base" in p], sorted(coloured)
+    keys = coloured[f"{visuals}/chain_4_link_a_0/<object>"]["keys"]
+    assert coloured[f"{visuals}/chain_4_link_a_0/<object>"]["type"] == "color"
+    assert [key["time"] for key in keys] == list(range(7))
+    np.testing.assert_allclose([key["value"] for key in keys], colors_from_values(scene.chain_values[:, 3])[:, :3])
+    assert np.ptp(scene.chain_values[:, 3]) > 0.3  # the index does change along this path
+    for frame in (0, 5):  # each keyframe's colour is the still scene's at that pose
+        still = show(planar, path.poses[frame], failed=["chain_3"], viewer=viewer)
+        np.testing.assert_allclose(keys[frame]["value"], still.chain_colors[3][:3], atol=1e-12)
+        np.testing.assert_allclose(still.chain_colors[2], FAILED_COLOR)
+
+
 def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):
     scene = show(planar, PLANAR_POSE, viewer=viewer)
     target = tmp_path / "scene.html"
@@ -421,6 +451,34 @@ def test_cli_view_writes_html_and_animations(tmp_path):
         outcome = screwkit("view", *arguments)
         assert outcome.returncode == 1 and message in outcome.stderr, outcome.stderr
         assert len(outcome.stderr.strip().splitlines()) == 1
+
+
+def test_cli_view_animates_a_path_and_refuses_a_bad_path_file(tmp_path):
+    page = tmp_path / "path.html"
+    outcome = screwkit("view", "planar_5rrr", "--line", "-0.3", "-0.2", "-45", "0.3", "0.2", "45", "--samples", "5",
+                       "--failed", "chain_3", "--color-by", "oti", "--html", page)
+    assert outcome.returncode == 0, outcome.stderr
+    assert "first of 5 frames" in outcome.stdout and "failed: chain_3:chain_3_joint_b" in outcome.stdout
+    animation = [c for c in scene_commands(page.read_text()) if c["type"] == "set_animation"][0]["animations"]
+    clips = {item["path"]: item["clip"] for item in animation}
+    platform = {t["name"]: t for t in clips[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]["tracks"]}
+    np.testing.assert_allclose([key["value"][:2] for key in platform[".position"]["keys"]],
+                               np.linspace([-0.3, -0.2], [0.3, 0.2], 5), atol=1e-12)
+    assert any(t["name"] == ".material.color" for clip in clips.values() for t in clip["tracks"])
+    table = tmp_path / "path.csv"
+    table.write_text("x,y,phi\n-0.1,0,0\n0,0.05,10\n0.1,0,20\n")
+    outcome = screwkit("view", "planar_5rrr", "--path", table, "--html", tmp_path / "file.html")
+    assert outcome.returncode == 0, outcome.stderr
+    assert "first of 3 frames" in outcome.stdout
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y\n0,0\n0.1,0\n")
+    for arguments, needles in (
+        (["--path", bad], ("bad.csv", "no column 'phi'")),
+        (["--path", tmp_path / "missing.csv"], ("missing.csv: no such file",)),
+        (["--path", table, "--sweep-phi", "0:10:5"], ("at most one of", "--sweep-phi, --path")),
+    ):
+        one_line_error(screwkit("view", "planar_5rrr", *arguments, "--html", tmp_path / "never.html"), *needles)
+    assert not (tmp_path / "never.html").exists()
 
 
 def test_cli_view_serves_on_loopback_until_interrupted():
@@ -553,7 +611,7 @@ const probed = {{}};
 for (const [name, path] of Object.entries({json.dumps(paths)})) {{
   const node = viewer.scene_tree.find(path).object;
   probed[name] = {{position: node.position.toArray(), quaternion: node.quaternion.toArray(),
-                  visible: node.visible}};
+                  visible: node.visible, colour: node.material ? node.material.color.toArray() : null}};
 }}
 document.title = "PROBE" + JSON.stringify(probed) + "PROBE";
 </script>
@@ -563,6 +621,7 @@ document.title = "PROBE" + JSON.stringify(probed) + "PROBE";
 
 
 SWEEP_FRAME = 6  # probed keyframe of the animation (phi = 10 deg)
+PATH_FRAME = 7  # probed keyframe of the path animation
 
 
 @pytest.fixture(scope="module")
@@ -577,12 +636,20 @@ def screenshots(planar, hexapod, viewer, tmp_path_factory):
              "centre": ["meshcat", ROOT_PATH, "output_twists", "0", "centre"]}
     (folder / "planar_5rrr_sweep.html").write_text(
         with_animation_probe(sweep.static_html(), SWEEP_FRAME / 10, paths))
+    path = line_path(planar, [-0.3, -0.2, np.deg2rad(-45.0)], [0.3, 0.2, np.deg2rad(45.0)], 9)
+    along = animate_sweep(planar, path, failed=["chain_3"], viewer=viewer, frame_rate=10)
+    visuals = ["meshcat", ROOT_PATH, "mechanism", "visuals"]
+    (folder / "planar_5rrr_path.html").write_text(with_animation_probe(along.static_html(), PATH_FRAME / 10, {
+        "platform": visuals + ["platform_0"], "chain_4": visuals + ["chain_4_link_a_0", "<object>"],
+        "chain_3": visuals + ["chain_3_link_a_0", "<object>"]}))
     viewer[ROOT_PATH].delete()  # the same viewer (background, grid, last camera) without the mechanism
     show(planar, PLANAR_POSE, viewer=viewer)  # also clears the animation
     viewer[ROOT_PATH].delete()
     export_html(viewer, folder / "blank.html")
-    pages = {name: folder / f"{name}.html" for name in ("planar_5rrr", "ups_hexapod_8", "blank", "planar_5rrr_sweep")}
-    return render(pages, folder, dump_dom=("planar_5rrr_sweep",)), folder, sweep
+    pages = {name: folder / f"{name}.html"
+             for name in ("planar_5rrr", "ups_hexapod_8", "blank", "planar_5rrr_sweep", "planar_5rrr_path")}
+    return (render(pages, folder, dump_dom=("planar_5rrr_sweep", "planar_5rrr_path")), folder,
+            {"sweep": sweep, "path": along})
 
 
 @pytest.mark.browser
@@ -596,7 +663,7 @@ def test_blank_page_fails_the_check(screenshots):
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "planar_5rrr_sweep"])
+@pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "planar_5rrr_sweep", "planar_5rrr_path"])
 def test_offline_page_renders_the_mechanism(screenshots, name):
     rendered, folder, _ = screenshots
     image, blank = rendered[name][0], rendered["blank"][0]
@@ -608,7 +675,8 @@ def test_offline_page_renders_the_mechanism(screenshots, name):
 
 @pytest.mark.browser
 def test_browser_plays_the_sweep_animation(screenshots):
-    rendered, folder, sweep = screenshots
+    rendered, folder, scenes = screenshots
+    sweep = scenes["sweep"]
     dom = rendered["planar_5rrr_sweep"][1]
     match = re.search(r"PROBE(.*?)PROBE", dom)
     assert match, f"the probe did not run in the page; see {folder / 'planar_5rrr_sweep.dom.html'}"
@@ -623,3 +691,17 @@ def test_browser_plays_the_sweep_animation(screenshots):
     centre = markers[f"{ROOT_PATH}/output_twists/0/centre"]
     np.testing.assert_allclose(probed["centre"]["position"], centre.start, atol=1e-6)
     assert probed["wrench"]["visible"] and probed["centre"]["visible"]
+
+
+@pytest.mark.browser
+def test_browser_plays_the_path_animation_with_the_chain_colours(screenshots):
+    rendered, folder, scenes = screenshots
+    along = scenes["path"]
+    match = re.search(r"PROBE(.*?)PROBE", rendered["planar_5rrr_path"][1])
+    assert match, f"the probe did not run in the page; see {folder / 'planar_5rrr_path.dom.html'}"
+    probed = json.loads(html.unescape(match.group(1)))
+    np.testing.assert_allclose(probed["platform"]["position"][:2], along.poses[PATH_FRAME][:2], atol=1e-6)
+    np.testing.assert_allclose(probed["chain_4"]["colour"], colors_from_values(along.chain_values[PATH_FRAME, 3])[:3],
+                               atol=1e-6)  # the colour of its index at that pose, not of the first frame
+    assert np.abs(along.chain_values[PATH_FRAME, 3] - along.chain_values[0, 3]) > 0.2
+    np.testing.assert_allclose(probed["chain_3"]["colour"], FAILED_COLOR[:3], atol=1e-6)  # the failed chain: red

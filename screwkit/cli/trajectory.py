@@ -30,7 +30,8 @@ from screwkit.studies.files import wide_table, write_dataset
 from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path, through_path
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
-__all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions"]
+__all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions", "line_option",
+           "circle_option", "through_option", "samples_option"]
 
 DEFAULT_SAMPLES = 201
 
@@ -162,21 +163,25 @@ class FaultOptions:
         return dict(level=self.level, tolerance=self.tolerance)
 
 
+line_option = click.option(
+    "--line", cls=GreedyOption, metavar="A B",
+    help="A straight path from pose A to pose B: two named poses, or every task coordinate of A then of B (m, deg).")
+circle_option = click.option(
+    "--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
+    help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) and the "
+         "radius (m); the other coordinates stay at the centre's.")
+through_option = click.option(
+    "--through", cls=GreedyOption, metavar="POSE POSE ...",
+    help="A piecewise-linear path through two or more poses (named poses, or every task coordinate of each in "
+         "turn, m and deg): straight in task coordinates between consecutive poses, --samples evenly spaced in arc "
+         "length plus every pose given.")
+samples_option = click.option(
+    "--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
+    help="Samples of a --line, --circle or --through path, both ends included.")
 path_source_options = option_group(
     "source", PathSource,
     click.argument("path_file", metavar="[PATH]", required=False, type=click.Path(dir_okay=True)),
-    click.option("--line", cls=GreedyOption, metavar="A B",
-                 help="A straight path from pose A to pose B: two named poses, or every task coordinate of A then of "
-                      "B (m, deg)."),
-    click.option("--circle", cls=GreedyOption, metavar="CENTRE RADIUS",
-                 help="A full circle in the x-y plane: the centre (a named pose or every task coordinate, m and deg) "
-                      "and the radius (m); the other coordinates stay at the centre's."),
-    click.option("--through", cls=GreedyOption, metavar="POSE POSE ...",
-                 help="A piecewise-linear path through two or more poses (named poses, or every task coordinate of "
-                      "each in turn, m and deg): straight in task coordinates between consecutive poses, --samples "
-                      "evenly spaced in arc length plus every pose given."),
-    click.option("--samples", type=click.IntRange(min=2), default=DEFAULT_SAMPLES, show_default=True,
-                 help="Samples of a --line, --circle or --through path, both ends included."),
+    line_option, circle_option, through_option, samples_option,
     click.option("--actuators", is_flag=True,
                  help="PATH holds actuator values (a column per actuator, named by its chain or chain:joint; deg, "
                       "m; optionally t): the platform poses come from forward kinematics along the path, from the "
@@ -233,7 +238,7 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
 def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:
     """The data file and the figure (checked before the computation); with neither, the CSV table on stdout."""
     if outputs.out:
-        write_dataset(result.to_dataset(), outputs.out)
+        write_dataset(result.plain_dataset(), outputs.out)  # netCDF without xarray (CSV through it)
         if not quiet:
             echo_error(f"wrote {outputs.out}")
     if outputs.figure:

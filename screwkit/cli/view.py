@@ -23,17 +23,39 @@ from screwkit.cli.options import (
     reading_options,
     threshold_option,
 )
+from screwkit.cli.trajectory import PathSource, circle_option, line_option, samples_option, through_option
 from screwkit.viewer import animate_sweep, export_html, show
 
 __all__ = ["view"]
 
 
+MAX_FRAMES = 500
+"""A path of more samples is animated at this many, evenly spaced in arc length (one keyframe each)."""
+
+
 @dataclass(frozen=True)
-class Animation:
-    """``--sweep-phi`` (None: one pose, no animation) and its keyframes per second."""
+class Motion:
+    """What is animated: ``--sweep-phi``, or a path (``--path``, ``--line``, ``--circle``, ``--through``), or nothing
+    (one pose); and the keyframes per second."""
 
     sweep_phi: str | None
+    path: PathSource | None
     frame_rate: float
+
+
+def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, line: str | None, circle: str | None,
+            through: str | None, samples: int) -> Motion:
+    """The :class:`Motion`: at most one of its sources, a path file that exists (checked before anything loads)."""
+    given = [name for name, value in (("--sweep-phi", sweep_phi), ("--path", path_file), ("--line", line),
+                                      ("--circle", circle), ("--through", through)) if value]
+    if len(given) > 1:
+        raise fail(f"Expected at most one of --sweep-phi, --path, --line, --circle and --through, got "
+                   f"{', '.join(given)}.")
+    source = None
+    if given and given[0] != "--sweep-phi":
+        source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples)
+        source.check()
+    return Motion(sweep_phi, source, frame_rate)
 
 
 @dataclass(frozen=True)
@@ -44,19 +66,40 @@ class Colouring:
     threshold: float
 
 
+def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool) -> np.ndarray | None:
+    """The poses of ``--sweep-phi`` or of the path (at most :data:`MAX_FRAMES`), or None (one pose)."""
+    if motion.sweep_phi is not None:
+        if not mechanism.is_planar:
+            raise fail(f"--sweep-phi sweeps a planar mechanism; {mechanism.name!r} is spatial.")
+        angles = parse_range(motion.sweep_phi, "--sweep-phi", angular=True)
+        poses = np.repeat(target[None], angles.size, axis=0)
+        poses[:, 2] = angles
+        return poses
+    if motion.path is None:
+        return None
+    path = motion.path.read(mechanism)
+    if path.samples <= MAX_FRAMES:
+        return path.poses
+    if not quiet:
+        echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in arc length.")
+    return path.at(np.linspace(0.0, path.length, MAX_FRAMES))
+
+
 def _echo_legend(scene) -> None:
     """The chains' values and the drawn twists (stdout: the data of the picture)."""
     mechanism = scene.mechanism
     frames = scene.poses.shape[0]
     what = "lowest ITI of its working actuators" if scene.color_by == "iti" else "OTI of its best working submechanism"
-    extra = f" (first of {frames} frames)" if frames > 1 else ""
+    extra = f" (first of {frames} frames, then the lowest over them)" if frames > 1 else ""
     click.echo(f"{mechanism.name}: chains coloured by the {what}{extra}; viridis 0 purple .. 1 yellow")
     names = mechanism.actuator_names
     for index, chain in enumerate(mechanism.chains):
-        value = scene.chain_values[0, index]
+        values = scene.chain_values[:, index]
         failed = [names[i] for i in scene.failed if mechanism.actuators[i][0] == chain.name]
         note = f"  failed: {', '.join(failed)}" if failed else ""
-        shown = "-" if np.isnan(value) else f"{value:.4f}"
+        shown = "-" if np.isnan(values[0]) else f"{values[0]:.4f}"
+        if frames > 1:
+            shown += "  -" if np.all(np.isnan(values)) else f"  {np.nanmin(values):.4f}"
         click.echo(f"  {chain.name:<24s} {shown}{note}")
     best = scene.best_submechanisms[0]
     if best is None:
@@ -75,11 +118,16 @@ def _echo_legend(scene) -> None:
 @click.option("--html", "html_path", type=click.Path(dir_okay=False),
               help="Write a self-contained offline HTML file (.html) and exit instead of serving.")
 @option_group(
-    "animation", Animation,
+    "motion", _motion,
     click.option("--sweep-phi", "sweep_phi", metavar="START:STOP:STEP",
                  help="Animate a planar sweep of phi (deg; the stop is excluded) at the x y of --pose."),
+    click.option("--path", "path_file", type=click.Path(dir_okay=True), metavar="PATH",
+                 help="Animate the platform along a path: a CSV or netCDF file of task coordinates, as `screwkit "
+                      f"trajectory` reads it (more than {MAX_FRAMES} samples: {MAX_FRAMES} frames evenly spaced in "
+                      "arc length); the chains' colours follow their index frame by frame."),
+    line_option, circle_option, through_option, samples_option,
     click.option("--frame-rate", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
-                 help="--sweep-phi: keyframes per second (1/s)."))
+                 help="--sweep-phi and paths: keyframes per second (1/s)."))
 @option_group(
     "colouring", Colouring,
     click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
@@ -89,28 +137,26 @@ def _echo_legend(scene) -> None:
 @click.option("--open", "open_browser", is_flag=True, help="Open the viewer in the default browser.")
 @overwrite_option
 @quiet_option
-def view(mechanism: str, pose, failed, html_path, animation: Animation, colouring: Colouring, reading,
+def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Colouring, reading,
          open_browser, overwrite, quiet) -> None:
     """Show MECHANISM in a Meshcat viewer (served on 127.0.0.1), coloured by its indices.
 
     Chains are coloured by index (viridis: 0 purple, 1 yellow), actuation wrench lines are
     orange, output twist axes and instantaneous centres of the best submechanism magenta,
-    failed actuators red. The legend goes to stdout, the server's address to stderr.
+    failed actuators red. --sweep-phi, or a path (--path, --line, --circle or --through, as
+    `screwkit trajectory` takes them), animates the platform, its screws and the chains' colours
+    frame by frame. The legend goes to stdout, the server's address to stderr.
     """
 
     check_outputs({"--html": (html_path, (".html", ".htm"))}, overwrite, quiet)
     loaded = load_mechanism(mechanism, reading)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
+    poses = _animated_poses(loaded, motion, target, quiet)
     try:
-        if animation.sweep_phi is not None:
-            if not loaded.is_planar:
-                raise fail(f"--sweep-phi sweeps a planar mechanism; {loaded.name!r} is spatial.")
-            angles = parse_range(animation.sweep_phi, "--sweep-phi", angular=True)
-            poses = np.repeat(target[None], angles.size, axis=0)
-            poses[:, 2] = angles
+        if poses is not None:
             scene = animate_sweep(loaded, poses, failed=failures, threshold=colouring.threshold,
-                                  color_by=colouring.color_by, frame_rate=animation.frame_rate)
+                                  color_by=colouring.color_by, frame_rate=motion.frame_rate)
         else:
             scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by)
     except (ValueError, RuntimeError) as error:

@@ -14,7 +14,8 @@ from screwkit.common.tolerances import WORST_FAULT_TIE
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import INDICES, applies
 
-__all__ = ["indices_to_dict", "indices_to_dataset", "json_number", "set_label", "tied", "worst_fault_ties"]
+__all__ = ["indices_to_dict", "indices_to_dataset", "indices_variables", "json_number", "set_label", "tied",
+           "worst_fault_ties"]
 
 
 def json_number(value: float) -> float | None:
@@ -179,9 +180,19 @@ def indices_to_dict(indices) -> dict:
 
 
 def indices_to_dataset(indices, dims: Sequence[str] | None = None, coords: dict | None = None):
-    """What :meth:`screwkit.indices.results.Indices.to_dataset` returns."""
+    """What :meth:`screwkit.indices.results.Indices.to_dataset` returns: :func:`indices_variables` in xarray."""
     import xarray as xr
 
+    variables, all_coords, attrs = indices_variables(indices, dims, coords)
+    dataset = xr.Dataset({k: xr.Variable(*v) for k, v in variables.items()}, coords=all_coords)
+    dataset.attrs.update(attrs)
+    return dataset
+
+
+def indices_variables(indices, dims: Sequence[str] | None = None,
+                      coords: dict | None = None) -> tuple[dict[str, tuple], dict[str, tuple], dict[str, Any]]:
+    """The content of :func:`indices_to_dataset` as plain numpy arrays, without xarray: the variables and the
+    coordinates, each ``(dims, values[, attrs])`` as ``xarray.Variable`` takes them, and the global attributes."""
     batch = indices.batch_shape
     if dims is None:
         dims = ("pose",) if len(batch) == 1 else tuple(f"pose_{i}" for i in range(len(batch)))
@@ -220,8 +231,7 @@ def indices_to_dataset(indices, dims: Sequence[str] | None = None, coords: dict 
             if name not in dims:
                 all_coords[name] = (dims, values, {"units": "deg" if is_angular(name) else "m"})
     all_coords.update(coords or {})
-    dataset = xr.Dataset({k: xr.Variable(*v) for k, v in variables.items()}, coords=all_coords)
-    dataset.attrs.update(threshold_m=indices.threshold, dof=indices.dof, fault_type=indices.fault_type)
+    attrs: dict[str, Any] = dict(threshold_m=indices.threshold, dof=indices.dof, fault_type=indices.fault_type)
     if indices.mechanism:
-        dataset.attrs["mechanism"] = indices.mechanism
-    return dataset
+        attrs["mechanism"] = indices.mechanism
+    return variables, all_coords, attrs

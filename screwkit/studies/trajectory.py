@@ -37,17 +37,19 @@ from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.solve import ChainStatus
 from screwkit.common.tolerances import WORST_FAULT_TIE
 from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
-from screwkit.indices.exports import set_label
+from screwkit.indices.exports import indices_variables, set_label
 from screwkit.indices.registry import index_columns
 from screwkit.indices.results import Indices
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.branches import branch_changes, describe
+from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.paths import Path, path_from_poses
 from screwkit.studies.poses import indices_and_joint_values, indices_at_poses
 from screwkit.studies.refinement import bisected_crossings, bracketed_minima, local_minima
 
 __all__ = ["trajectory", "TrajectoryResult", "FaultCase", "Margin", "PathEvent", "failure_weights", "singular_dips",
+           "remaining_lmti",
            "AGGREGATES", "RELATIVE_TOLERANCE"]
 
 RELATIVE_TOLERANCE = 1e-6
@@ -200,25 +202,28 @@ class TrajectoryResult:
         """The indices along the path as an ``xarray.Dataset`` over ``sample`` (coordinates ``arc_length`` in m,
         ``t`` in s when given, the task coordinates in m and deg): every index, ``lmti_left{j}`` over ``failed{j}``
         (the LMTI of the actuators left after each set of ``j`` failures), ``f_o_mean{j}`` with the mean; the
-        summary (:meth:`summary`) as the JSON attribute ``summary``."""
+        summary (:meth:`summary`) as the JSON attribute ``summary``. :meth:`plain_dataset` without xarray."""
+        return self.plain_dataset().to_dataset()
+
+    def plain_dataset(self) -> PlainDataset:
+        """What :meth:`to_dataset` holds, as plain arrays: ``--out`` writes it to netCDF without importing xarray
+        (:meth:`PlainDataset.write_netcdf`), and ``xarray.open_dataset`` reads back the same dataset."""
         coords = {"arc_length": ("sample", self.path.arc_length, {"units": "m", "long_name": "arc length"})}
         if self.path.times is not None:
             coords["t"] = ("sample", self.path.times, {"units": "s"})
-        dataset = self.indices.to_dataset(dims=("sample",), coords=coords)
+        variables, coords, attrs = indices_variables(self.indices, ("sample",), coords)
         for j in self.indices.faults:
-            labels = [set_label(failed) for failed in self.indices.failed_sets(j)]
             dimension = f"failed{j}"
-            dataset.coords[dimension] = (dimension, labels)
-            dataset[f"lmti_left{j}"] = (("sample", dimension), self.indices.remaining_lmti[j],
-                                        {"long_name": f"LMTI of the actuators left after each set of {j} failure(s) "
-                                                      f"(F_O{j} is their minimum, Eq. 12)"})
+            coords[dimension] = (dimension, [set_label(failed) for failed in self.indices.failed_sets(j)])
+            variables[f"lmti_left{j}"] = (("sample", dimension), remaining_lmti(self.indices, j),
+                                          {"long_name": f"LMTI of the actuators left after each set of {j} "
+                                                        f"failure(s) (F_O{j} is their minimum, Eq. 12)"})
             if j in self.mean:
-                dataset[f"f_o_mean{j}"] = ("sample", self.mean[j],
-                                           {"long_name": f"F_O{j} mean (screwkit's extension of Eq. 12)"})
-        dataset.attrs.update(mechanism=self.mechanism, level=self.level, tolerance_m=self.tolerance,
-                             length_m=self.path.length, aggregate=self.aggregate,
-                             summary=json.dumps(self.summary()))
-        return dataset
+                variables[f"f_o_mean{j}"] = ("sample", self.mean[j],
+                                             {"long_name": f"F_O{j} mean (screwkit's extension of Eq. 12)"})
+        attrs.update(mechanism=self.mechanism, level=self.level, tolerance_m=self.tolerance,
+                     length_m=self.path.length, aggregate=self.aggregate, summary=json.dumps(self.summary()))
+        return PlainDataset(variables, coords, attrs)
 
 
 def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None, level: float = 0.4,
@@ -266,7 +271,7 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
 
     def table(result: Indices) -> NDArray[np.float64]:
         """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series."""
-        columns = [result.remaining_lmti[j] for j in faults]
+        columns = [remaining_lmti(result, j) for j in faults]
         reachable = np.where(np.asarray(result.reachable), 1.0, np.nan)[:, None]
         return np.concatenate([*columns, reachable], axis=1)
 
@@ -321,6 +326,15 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
         events=tuple(sorted(events, key=lambda e: (e.start, e.kind))), working_modes=working_modes(mechanism),
         aggregate=aggregate, mean=mean,
         weights=weights if aggregate == "mean" else {}, evaluations=evaluations[0])
+
+
+def remaining_lmti(result: Indices, faults: int) -> NDArray[np.float64]:
+    """The LMTI left after each set of ``faults`` failures, (..., C(a, j)): NaN throughout a batch without a
+    reachable pose (which carries none)."""
+    found = (result.remaining_lmti or {}).get(faults)
+    if found is not None:
+        return np.asarray(found)
+    return np.full(tuple(result.batch_shape) + (len(result.failed_sets(faults)),), np.nan)
 
 
 def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, series: NDArray,

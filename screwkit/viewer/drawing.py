@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from screwkit.viewer.markers import (
     FAILED_COLOR,
     FAILED_MARKER_COLOR,
+    ROOT_PATH,
     TWIST_COLOR,
     WRENCH_COLOR,
     Frames,
@@ -23,6 +24,7 @@ from screwkit.viewer.markers import (
 )
 
 __all__ = [
+    "ANIMATION_PATH",
     "BASE_COLOR",
     "PLATFORM_COLOR",
     "load_visual_model",
@@ -37,6 +39,8 @@ __all__ = [
 
 
 BASE_COLOR = (0.80, 0.80, 0.82, 1.0)
+ANIMATION_PATH = f"/meshcat/{ROOT_PATH}/animation"
+"""Where the server keeps a scene's animation (:func:`animate`): after the drawing, and deleted with it."""
 
 
 PLATFORM_COLOR = (0.30, 0.32, 0.38, 1.0)
@@ -210,7 +214,10 @@ def clear_animation(viewer) -> None:
     viewer.window.screwkit_animated = False
 
 
-def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_markers, frame_rate, loop) -> None:
+def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_markers, frame_rate, loop,
+            colours: dict[str, NDArray] | None = None) -> None:
+    """One keyframe per frame: the links, and the markers (shown or hidden); with ``colours`` (per Meshcat path of a
+    drawn object, its RGB(A) colour at each frame, (frames, 3 or 4)), the material colour of each follows too."""
     import meshcat.animation
     import pinocchio
     from meshcat import transformations
@@ -245,6 +252,28 @@ def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_marke
                                              float(quaternion[0])])
                 if marker.kind == "link":
                     keyframe[path].set_property("scale", "vector3", [float(s) for s in scale])
-    viewer.set_animation(animation, play=True, repetitions=10**6 if loop else 1)
+            for path, values in (colours or {}).items():  # the mesh itself: three.js binds its .material.color
+                keyframe[f"{path}/<object>"].set_property("material.color", "color",
+                                                           [float(c) for c in values[frame][:3]])
+    viewer.window.send(_animation_command(animation, play=True, repetitions=10**6 if loop else 1))
     viewer.window.screwkit_animated = True
+
+
+def _animation_command(animation, play: bool, repetitions: int):
+    """Meshcat's ``set_animation`` command, kept by the server at :data:`ANIMATION_PATH` rather than at the root.
+
+    The server replays what it keeps node by node, parents first (a browser that connects later, and
+    ``static_html``): kept at the root, the animation would come before the drawing, and its colour tracks would
+    bind to placeholders that the drawing then replaces (a ``set_object`` replaces the node's object); kept at a
+    node made after everything it animates, it comes after them.
+    """
+    from meshcat.commands import SetAnimation
+
+    class SetAnimationAt(SetAnimation):
+        __slots__ = ()
+
+        def lower(self):
+            return {**super().lower(), "path": ANIMATION_PATH}
+
+    return SetAnimationAt(animation, play=play, repetitions=repetitions)
 

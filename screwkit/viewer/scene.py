@@ -1,4 +1,4 @@
-"""Scenes: a mechanism drawn in Meshcat at one pose (:func:`show`) or along a sweep
+"""Scenes: a mechanism drawn in Meshcat at one pose (:func:`show`) or along a sweep or a path
 (:func:`animate_sweep`), and exported as one offline HTML page (:func:`export_html`)."""
 
 from __future__ import annotations
@@ -66,7 +66,8 @@ class Scene:
         The index each chain is coloured by (NaN: none); the drawn colours are those of the
         first frame.
     chain_colors : ndarray, shape (n_chains, 4)
-        RGBA drawn for each chain (failed chains: :data:`FAILED_COLOR`).
+        RGBA drawn for each chain (failed chains: :data:`FAILED_COLOR`); an animation turns
+        them to the colours of ``chain_values`` frame by frame.
     best_submechanisms : tuple
         Per frame, the best working submechanism (actuator indices) or None.
     frame_markers : tuple of tuple of Marker
@@ -183,19 +184,22 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
 def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
                   color_by: Literal["iti", "oti"] = "iti", viewer=None, frame_rate: float = 10.0,
                   loop: bool = True, open_browser: bool = False) -> Scene:
-    """Animate the mechanism along a sweep of poses, with its screws following.
+    """Animate the mechanism along a sweep of poses or a path, with its screws and colours following.
 
     The first reachable pose is drawn as by :func:`show` (chain colours from its indices);
     a Meshcat animation then moves the links, the wrench lines, the twist axes and the
     instantaneous centres through the reachable poses (unreachable ones are skipped), one
-    keyframe per pose. Markers that do not exist in a frame (a centre at infinity, a twist
-    of a frame without a working submechanism) are hidden in it.
+    keyframe per pose, and turns the colour of every working chain to that of its index at
+    the pose (``scene.chain_values``; a failed chain stays red). Markers that do not exist
+    in a frame (a centre at infinity, a twist of a frame without a working submechanism) are
+    hidden in it.
 
     Parameters
     ----------
     mechanism : Mechanism, str or path
-    poses : array_like, shape (frames, n_task)
-        Platform poses in metres and radians, in the order to play them.
+    poses : array_like, shape (frames, n_task), or Path
+        Platform poses in metres and radians, in the order to play them, or a
+        :class:`~screwkit.studies.paths.Path` (its samples).
     failed, threshold, color_by, viewer, open_browser
         As for :func:`show`.
     frame_rate : float
@@ -214,7 +218,7 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
         No reachable pose, or bad arguments.
     """
     mechanism = mechanism_of(mechanism)
-    poses = mechanism.check_poses(poses).reshape(-1, mechanism.n_task)
+    poses = mechanism.check_poses(getattr(poses, "poses", poses)).reshape(-1, mechanism.n_task)
     if not frame_rate > 0:
         raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
     return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser,
@@ -321,7 +325,9 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
         visualizer = MeshcatVisualizer(model, None, visual_model)
         visualizer.initViewer(viewer=meshcat_viewer)
         visualizer.loadViewerModel(rootNodeName=f"{ROOT_PATH}/mechanism")
+        chain_of_node = {}  # drawn in its chain's colour: the colour an animation changes frame by frame
         for geometry, owner in zip(visual_model.geometryObjects, owners):
+            node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
             if owner == "base":
                 color = BASE_COLOR
             elif owner == "platform":
@@ -330,7 +336,7 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
                 color = FAILED_COLOR
             else:
                 color = tuple(chain_colors[owner])
-            node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
+                chain_of_node[node] = owner
             meshcat_viewer[node].set_property("color", [float(c) for c in color])
         visualizer.display(frames.configurations[0])
         all_markers = {}
@@ -339,14 +345,17 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
                 all_markers.setdefault(marker.path, marker)
         for marker in all_markers.values():
             create_marker(meshcat_viewer, marker, mechanism, chain_colors)
+            if marker.kind in ("link", "joint") and not marker.failed:
+                chain_of_node[marker.path] = marker.chain
         for marker in markers[0]:
             meshcat_viewer[marker.path].set_transform(marker_matrix(marker))
         for path in set(all_markers) - {marker.path for marker in markers[0]}:
             meshcat_viewer[path].set_property("visible", False)
         display_offset = frame_view(meshcat_viewer, mechanism, frames)
         if animation is not None:
+            frame_colors = colors_from_values(chain_values)  # (frames, chains, 4)
             animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, animation.frame_rate,
-                    animation.loop)
+                    animation.loop, {node: frame_colors[:, chain] for node, chain in chain_of_node.items()})
     except BaseException:
         if server is not None:
             with contextlib.suppress(Exception):

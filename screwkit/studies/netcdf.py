@@ -1,0 +1,157 @@
+"""A dataset as plain numpy arrays, written to netCDF-3 as xarray writes it, without importing xarray.
+
+xarray, pandas and dask.array take about a second to import, and xarray's netCDF writer another second on a
+100,000-sample path: a command that only writes a file needs neither. :class:`PlainDataset` holds what an
+``xarray.Dataset`` would (variables and coordinates as ``(dims, values[, attrs])``, global attributes);
+:meth:`PlainDataset.write_netcdf` writes it with ``scipy.io.netcdf_file`` in xarray's own encoding of netCDF-3,
+so that ``xarray.open_dataset`` reads back exactly what :meth:`PlainDataset.to_dataset` would have written:
+
+* floats as themselves with ``_FillValue`` NaN;
+* booleans as bytes with the attribute ``dtype: bool``;
+* 64-bit integers as 32-bit ones (netCDF-3 has no other), refused if they do not fit;
+* strings encoded in UTF-8 as characters along one more dimension ``string{N}`` (``N`` the longest, in
+  bytes), with the attribute ``_Encoding: utf-8``;
+* every coordinate that is not a dimension named in the ``coordinates`` attribute of each variable that
+  spans its dimensions (the others in the global ``coordinates``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from screwkit.studies.files import atomic_write, output_suffix
+
+__all__ = ["PlainDataset", "netcdf_attribute"]
+
+
+@dataclass
+class PlainDataset:
+    """What an ``xarray.Dataset`` holds, as plain arrays.
+
+    Attributes
+    ----------
+    variables, coords : dict of str to tuple
+        ``(dims, values)`` or ``(dims, values, attrs)``, as ``xarray.Variable`` takes them.
+    attrs : dict
+        Global attributes (str, numbers).
+    """
+
+    variables: dict[str, tuple]
+    coords: dict[str, tuple]
+    attrs: dict[str, Any] = field(default_factory=dict)
+
+    def to_dataset(self):
+        """The ``xarray.Dataset``."""
+        import xarray as xr
+
+        dataset = xr.Dataset({k: xr.Variable(*v) for k, v in self.variables.items()}, coords=self.coords)
+        dataset.attrs.update(self.attrs)
+        return dataset
+
+    def write_netcdf(self, path) -> None:
+        """Write a netCDF-3 file (``scipy.io.netcdf_file``) atomically, in xarray's encoding (module docstring).
+
+        Raises
+        ------
+        ValueError
+            A variable of a type netCDF-3 cannot hold, or integers beyond 32 bits.
+        """
+        from scipy.io import netcdf_file
+
+        output_suffix(path, (".nc",))
+        everything = {name: _variable(name, entry) for name, entry in {**self.coords, **self.variables}.items()}
+        sizes = {}
+        for name, (dims, values, _) in everything.items():
+            for dim, size in zip(dims, values.shape):
+                if sizes.setdefault(dim, size) != size:
+                    raise ValueError(f"Variable {name!r}: dimension {dim!r} of size {size}, elsewhere {sizes[dim]}.")
+        placed = _coordinates(self.coords, self.variables)
+
+        def write(temporary):
+            with netcdf_file(temporary, "w", version=2) as handle:
+                for dim, size in sizes.items():
+                    handle.createDimension(dim, size)
+                for name, (dims, values, attrs) in everything.items():
+                    variable = handle.createVariable(name, values.dtype.char if values.dtype.char != "S" else "c", dims)
+                    variable[:] = values
+                    for key, value in attrs.items():
+                        setattr(variable, key, netcdf_attribute(value))
+                    if name in placed:
+                        variable.coordinates = placed[name]
+                for key, value in self.attrs.items():
+                    if key in handle.__dict__:
+                        raise ValueError(f"Cannot write a global attribute named {key!r} to netCDF.")
+                    setattr(handle, key, netcdf_attribute(value))
+                if placed.get(None):
+                    handle.coordinates = placed[None]
+
+        atomic_write(path, write)
+
+
+def netcdf_attribute(value):
+    """An attribute in the type xarray's own netCDF-3 writer gives it (floats stay double, booleans are bytes)."""
+    if isinstance(value, (bool, np.bool_)):
+        return np.int8(value)
+    if isinstance(value, (int, np.integer)):
+        return np.int32(value) if abs(int(value)) < 2**31 else np.float64(value)
+    if isinstance(value, (float, np.floating)):
+        return np.float64(value)
+    return value
+
+
+def _variable(name: str, entry: tuple) -> tuple[tuple[str, ...], np.ndarray, dict]:
+    """``(dims, values, attrs)`` of one variable in netCDF-3's types, with the attributes xarray adds."""
+    dims, values, attrs = (tuple(entry) + ({},))[:3]
+    dims = (dims,) if isinstance(dims, str) else tuple(dims)
+    values = np.asarray(values)
+    attrs = dict(attrs or {})
+    if values.ndim != len(dims):
+        raise ValueError(f"Variable {name!r}: {len(dims)} dimension(s) {dims} for values of shape {values.shape}.")
+    kind = values.dtype.kind
+    if kind == "b":
+        return dims, values.astype(np.int8), {**attrs, "dtype": "bool"}
+    if kind == "f":
+        return dims, values, {**attrs, "_FillValue": values.dtype.type(np.nan)}
+    if kind == "i":
+        if values.size and (values.min() < -2**31 or values.max() >= 2**31):
+            raise ValueError(f"Variable {name!r}: integers beyond 32 bits cannot be written to netCDF-3.")
+        return dims, values.astype(np.int32) if values.dtype.itemsize > 4 else values, attrs
+    if kind in "UO":
+        encoded = _utf8(values.astype(str))
+        width = max(encoded.dtype.itemsize, 1)
+        characters = encoded.astype(f"S{width}").reshape(values.shape + (1,)).view("S1")
+        return dims + (f"string{width}",), characters, {**attrs, "_Encoding": "utf-8"}
+    raise ValueError(f"Variable {name!r}: values of type {values.dtype} cannot be written to netCDF-3.")
+
+
+def _utf8(values: np.ndarray) -> np.ndarray:
+    """Strings encoded in UTF-8, as bytes as long as the longest (as ``np.char.encode`` gives them): ASCII in one
+    cast, anything else one distinct string at a time."""
+    longest = int(np.char.str_len(values).max()) if values.size else 0
+    try:
+        return values.astype(f"S{max(longest, 1)}")
+    except UnicodeEncodeError:
+        unique, inverse = np.unique(values, return_inverse=True)
+        return np.array([text.encode("utf-8") for text in unique], dtype=bytes)[inverse].reshape(values.shape)
+
+
+def _coordinates(coords: dict[str, tuple], variables: dict[str, tuple]) -> dict[str | None, str]:
+    """xarray's ``coordinates`` attributes: per variable, the non-dimension coordinates over some of its dimensions
+    (sorted); under None, those no variable names."""
+    def dims_of(entry):
+        return {entry[0]} if isinstance(entry[0], str) else set(entry[0])
+
+    auxiliary = {name: dims_of(entry) for name, entry in coords.items() if dims_of(entry) != {name}}
+    placed, used = {}, set()
+    for name, entry in variables.items():
+        mine = sorted(c for c, c_dims in auxiliary.items() if c_dims <= dims_of(entry) and name not in dims_of(entry))
+        if mine:
+            placed[name] = " ".join(mine)
+            used.update(mine)
+    leftover = sorted(set(auxiliary) - used)
+    if leftover:
+        placed[None] = " ".join(leftover)
+    return placed
