@@ -38,13 +38,15 @@ import time
 from pathlib import Path
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
-           "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "CLOSED_FORM_KERNEL"]
+           "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "SPACE_KERNEL",
+           "CLOSED_FORM_KERNEL"]
 
 KERNELS = {
     "screwkit.indices.compiled.wrenches": ("wrench_kernel", 6),
     "screwkit.indices.compiled.outputs": ("output_kernel", 12),
     "screwkit.indices.compiled.null": ("null_kernel", 7),
     "screwkit.indices.compiled.gram": ("gram_kernel", 5),
+    "screwkit.indices.compiled.spaces": ("space_kernel", 3),
     "screwkit.indices.compiled.planar": ("planar_closed_form_kernel", 2),
     "screwkit.closure.compiled.task": ("close_chains_kernel", 18),
     "screwkit.closure.compiled.frames": ("chain_frames_kernel", 3),
@@ -57,6 +59,10 @@ INDEX_KERNELS = ("screwkit.indices.compiled.wrenches", "screwkit.indices.compile
 first run); the null-vector and Gram stages are compiled only for mechanisms that need them."""
 
 NULL_KERNEL, GRAM_KERNEL = "screwkit.indices.compiled.null", "screwkit.indices.compiled.gram"
+
+SPACE_KERNEL = "screwkit.indices.compiled.spaces"
+"""The chain decompositions and motion spaces of mechanisms of fewer than six DoF, for chunks of 512
+configurations or more."""
 
 CLOSED_FORM_KERNEL = "screwkit.closure.compiled.closed_form"
 """The spatial closed forms (U-P-S, R-U-S chains) of large batches."""

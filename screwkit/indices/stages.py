@@ -14,13 +14,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common import tolerances
-from screwkit.common.compiling import prepare_kernels
+from screwkit.common.compiling import SPACE_KERNEL, prepare_kernels
 from screwkit.indices.sets import remaining_lmti, set_plan
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.constraints import ConstraintPlan, constraint_indices, plan_constraints
 from screwkit.screw.motion import (
     MotionSpace,
     chain_decompositions,
+    motion_bases,
     motion_space,
     null_spaces,
     sampled_working_coordinates,
@@ -127,6 +128,13 @@ def run_kernel(plan: Plan, twists, points, basis, complement, iti_override, oti_
     return out
 
 
+SPACES_COMPILED_FROM = 512
+"""Chunks of at least this many configurations take their chain decompositions and motion spaces from the
+compiled :func:`screwkit.indices.compiled.spaces.space_kernel`; smaller ones from numpy
+(:func:`screwkit.screw.motion.chain_decompositions`, :func:`screwkit.screw.motion.null_spaces`), which needs
+no compiling."""
+
+
 class ChunkSpaces:
     """A chunk's chains in working coordinates and their decompositions, computed once when first asked
     (shared by the motion spaces and the constraint indices)."""
@@ -142,8 +150,33 @@ class ChunkSpaces:
         return working_coordinates(chain_twists, chain_points)
 
     @cached_property
+    def compiled(self):
+        """The space kernel's singular values (C, N, 6), right singular vectors (C, N, 6, 6), eigenvalues (N, 6)
+        and eigenvectors (N, 6, 6) for a chunk of :data:`SPACES_COMPILED_FROM` configurations or more; else None."""
+        count, chains = self.twists.shape[0], len(self.plan.chain_start) - 1
+        if count < SPACES_COMPILED_FROM:
+            return None
+        prepare_kernels((SPACE_KERNEL,))
+        from screwkit.indices.compiled.spaces import space_kernel  # numba: compiled for lower mobility only
+
+        out = (np.empty((chains, count, 6)), np.empty((chains, count, 6, 6)), np.empty((count, 6)),
+               np.empty((count, 6, 6)))
+        space_kernel(np.concatenate(self.working[0], axis=1), self.plan.chain_start,
+                     tolerances.MOTION_SPACE_TOLERANCE, *out)
+        return out
+
+    @cached_property
     def decompositions(self):
-        return chain_decompositions(self.working[0])
+        if self.compiled is None:
+            return chain_decompositions(self.working[0])
+        singular, right = self.compiled[:2]
+        return [(singular[c], right[c]) for c in range(singular.shape[0])]
+
+    def null_spaces(self, dof: int):
+        """:func:`screwkit.screw.motion.null_spaces` of every configuration of the chunk."""
+        if self.compiled is None:
+            return null_spaces(self.working[0], dof, tolerances.MOTION_SPACE_TOLERANCE, self.decompositions)
+        return motion_bases(self.compiled[2], self.compiled[3], dof)
 
 
 def analyze_chunk(plan: Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None,
@@ -160,17 +193,23 @@ def analyze_chunk(plan: Plan, twists, points, iti_override, oti_override, detail
     if redo.size:
         # Configurations whose joint twists leave the constant space: their own motion space, in
         # the working coordinates the kernel uses (same centroid and characteristic length).
-        if spaces is not None or redo.size == twists.shape[0]:
+        every = redo.size == twists.shape[0]
+        if every:  # every configuration: no copies
+            redo = slice(None)
             spaces = spaces or ChunkSpaces(plan, twists, points)
-            working, _, centre, length = spaces.working
-            working = [chain[redo] for chain in working]
-            centre, length = centre[redo], length[redo]
-            decompositions = [(singular[redo], right[redo]) for singular, right in spaces.decompositions]
+            _, _, centre, length = spaces.working
+            _, bases = spaces.null_spaces(plan.dof + plan.idle_count)
         else:
-            working, _, centre, length = ChunkSpaces(plan, twists[redo], points[redo]).working
-            decompositions = None
-        _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE,
-                               decompositions)
+            if spaces is not None:
+                working, _, centre, length = spaces.working
+                working = [chain[redo] for chain in working]
+                centre, length = centre[redo], length[redo]
+                decompositions = [(singular[redo], right[redo]) for singular, right in spaces.decompositions]
+            else:
+                working, _, centre, length = ChunkSpaces(plan, twists[redo], points[redo]).working
+                decompositions = None
+            _, bases = null_spaces(working, plan.dof + plan.idle_count, tolerances.MOTION_SPACE_TOLERANCE,
+                                   decompositions)
         if plan.idle_count:
             bases = quotient_bases(bases, idle[redo], centre, length, plan.dof)
         again = run_kernel(plan, twists[redo], points[redo], np.ascontiguousarray(bases), np.empty((0, 6)),

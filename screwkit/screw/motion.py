@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 from screwkit.common import tolerances
 from screwkit.screw.chain_screws import ChainScrews
 
-__all__ = ["MotionSpace", "motion_space", "null_spaces", "chain_decompositions", "chain_projector_complements",
-           "working_coordinates", "sampled_working_coordinates"]
+__all__ = ["MotionSpace", "motion_space", "null_spaces", "motion_bases", "chain_decompositions",
+           "chain_projector_complements", "working_coordinates", "sampled_working_coordinates"]
 
 
 @dataclass(frozen=True)
@@ -94,6 +94,13 @@ def null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolera
                 decompositions: list | None = None):
     """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i) (working coordinates)."""
     values, vectors = np.linalg.eigh(chain_projector_complements(chain_twists, tolerance, decompositions))
+    return motion_bases(values, vectors, dof)
+
+
+def motion_bases(values: NDArray, vectors: NDArray, dof: int | None):
+    """Per-configuration motion spaces from the eigenvalues (K, 6), ascending, and eigenvectors (K, 6, 6) of
+    sum_i (I - P_i): their dimensions (eigenvalues at most ``MOTION_SPACE_EIGENVALUE``) and bases (K, n, 6), n
+    ``dof`` or else the largest dimension."""
     dims = np.sum(values <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)
     count = int(dims.max()) if dof is None else dof
     return dims, np.swapaxes(vectors[..., :count], -1, -2)
