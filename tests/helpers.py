@@ -270,3 +270,19 @@ def couple_cti(couples) -> float:
             kappas.append(abs(couples[i] @ freed) / np.linalg.norm(freed))
         best = max(best, min(kappas))
     return best
+
+
+def leg_line_otis(starts, ends) -> np.ndarray:
+    """The OTIs of six legs whose actuation wrenches are forces along their lines, ``starts[k]`` to ``ends[k]``, on a
+    platform free in six DoF: OTI_k = |u_k . v_k| / |v_k|, v_k the velocity at ``ends[k]`` of the platform twist
+    reciprocal to the other five forces (numpy alone)."""
+    starts, ends = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
+    directions = (ends - starts) / np.linalg.norm(ends - starts, axis=1, keepdims=True)
+    lines = np.concatenate([directions, np.cross(ends, directions)], axis=1)
+    otis = []
+    for k in range(len(lines)):
+        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
+        twist = np.linalg.svd(others)[2][-1]  # (omega, v): reciprocal to the five other leg forces
+        velocity = twist[3:] + np.cross(twist[:3], ends[k])
+        otis.append(abs(directions[k] @ velocity) / np.linalg.norm(velocity))
+    return np.array(otis)

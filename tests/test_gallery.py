@@ -20,6 +20,7 @@ import pinocchio as pin
 import pytest
 from test_io import five_bar_mjcf
 
+from helpers import leg_line_otis
 from screwkit.io.closed_tree import assemble
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
@@ -183,18 +184,8 @@ def test_a_stewart_platform_written_by_a_cad_exporter_is_a_6_dof_platform_with_i
     pose = mechanism.home_pose + np.array([0.005, -0.004, 0.01, 0.04, -0.03, 0.08])
     result = indices_at_pose(mechanism, pose)
     chains = chain_screws(mechanism, solve(mechanism, pose[None]))
-    lines, centres = [], []
-    for chain in chains:
-        base, top = chain.points[0, 0], chain.points[0, -1]  # the U centre and the top joint's centre
-        direction = (top - base) / np.linalg.norm(top - base)
-        lines.append(np.concatenate([direction, np.cross(top, direction)]))
-        centres.append(top)
-    otis = []
-    for k in range(6):
-        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
-        twist = np.linalg.svd(others)[2][-1]
-        velocity = twist[3:] + np.cross(twist[:3], centres[k])
-        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    # each leg's force along the line from its U centre to its top joint's centre
+    otis = leg_line_otis([chain.points[0, 0] for chain in chains], [chain.points[0, -1] for chain in chains])
     names = [name.split(":")[0] for name in result.actuators]
     assert names == [chain.name for chain in chains]
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)

@@ -28,7 +28,7 @@ import pinocchio as pin
 import pytest
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, screwkit_residuals
 
-from helpers import one_line_error, screwkit
+from helpers import leg_line_otis, one_line_error, screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
@@ -183,20 +183,13 @@ def test_gepetto_sps_leg_gives_the_leg_line_otis():
     feet["motor_6"] = joint_point(tree, data, "part_4_foot_part_rev0")  # leg 6 carries the foot on its own ball
     result, motors = screwkit_at_home(path, tree, q)
     assert sorted(feet) == sorted(motors) and result.dof == 6
-    lines, centres = [], []
+    hips = []
     for motor in motors:
         hip_joint = model.parents[model.parents[model.parents[model.getJointId(motor)]]]
-        hip = data.oMi[hip_joint].translation
-        direction = unit(feet[motor] - hip)
+        hips.append(data.oMi[hip_joint].translation.copy())
+        direction = unit(feet[motor] - hips[-1])
         np.testing.assert_allclose(abs(direction @ joint_axis(tree, data, motor)), 1.0, atol=1e-9)  # along the slide
-        lines.append(np.concatenate([direction, np.cross(feet[motor], direction)]))
-        centres.append(feet[motor])
-    otis = []
-    for k in range(6):
-        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
-        twist = np.linalg.svd(others)[2][-1]
-        velocity = twist[3:] + np.cross(twist[:3], centres[k])
-        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    otis = leg_line_otis(hips, [feet[motor] for motor in motors])
     np.testing.assert_allclose(result.iti_actuators, np.ones(6), atol=TOLERANCE)
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
     np.testing.assert_allclose(result.lmti, min(otis), atol=TOLERANCE)
@@ -344,7 +337,7 @@ def test_reachy_mini_with_its_yaw_stage_locked_gives_the_leg_line_indices_of_its
     assert not model.existJointName("yaw_body") and len(graph.legs) == 6 and graph.dof == 6
     data = model.createData()
     pin.forwardKinematics(model, data, graph.q)
-    itis, lines, ends = [], [], []
+    itis, starts, ends = [], [], []
     for leg in graph.legs:
         motor, ball = leg.joints[0], leg.joints[1]
         assert model.names[motor].startswith("stewart_") and model.joints[ball].shortname() == "JointModelSpherical"
@@ -359,14 +352,9 @@ def test_reachy_mini_with_its_yaw_stage_locked_gives_the_leg_line_indices_of_its
         start = data.oMi[ball].translation
         rod = unit(end - start)
         itis.append(abs(rod @ unit(np.cross(axis, start - crank))))
-        lines.append(np.concatenate([rod, np.cross(end, rod)]))
+        starts.append(start.copy())
         ends.append(end)
-    otis = []
-    for k in range(6):
-        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
-        twist = np.linalg.svd(others)[2][-1]
-        velocity = twist[3:] + np.cross(twist[:3], ends[k])
-        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    otis = leg_line_otis(starts, ends)
     result = graph.indices()
     np.testing.assert_allclose(result.iti_actuators, itis, atol=TOLERANCE)
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)

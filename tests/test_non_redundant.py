@@ -15,7 +15,7 @@ import json
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import leg_line_otis, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -46,16 +46,7 @@ def test_stewart_platform_otis_are_the_leg_lines():
     chains = chain_screws(mechanism, solve(mechanism, pose[None]))
     universal = [chain.points[0, 0] for chain in chains]
     spherical = [chain.points[0, -1] for chain in chains]
-    lines = []
-    for u, s in zip(universal, spherical):
-        direction = (s - u) / np.linalg.norm(s - u)
-        lines.append(np.concatenate([direction, np.cross(s, direction)]))
-    otis = []
-    for k in range(6):
-        others = np.array([np.concatenate([line[3:], line[:3]]) for j, line in enumerate(lines) if j != k])
-        twist = np.linalg.svd(others)[2][-1]  # (omega, v): reciprocal to the five other leg forces
-        velocity = twist[3:] + np.cross(twist[:3], spherical[k])  # of the S centre of leg k
-        otis.append(abs(lines[k][:3] @ velocity) / np.linalg.norm(velocity))
+    otis = leg_line_otis(universal, spherical)  # velocities of the S centres
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
     assert abs(result.lmti - min(otis)) < TOLERANCE and 0.2 < result.lmti < 1.0
     assert result.iti == pytest.approx(1.0) and result.f_o == {1: 0.0}

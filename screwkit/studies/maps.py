@@ -32,6 +32,7 @@ from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
 from screwkit.studies.graph_source import GraphSource, cached_graph, graph_source
+from screwkit.studies.netcdf import netcdf_attribute
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.tasks import Execution, run_tasks
@@ -178,20 +179,9 @@ class GridMap:
                 for key, value in self.attrs.items():
                     if key in handle.__dict__:
                         raise ValueError(f"Cannot write a global attribute named {key!r} to netCDF.")
-                    setattr(handle, key, _netcdf_attribute(value))
+                    setattr(handle, key, netcdf_attribute(value))
 
         atomic_write(path, write)
-
-
-def _netcdf_attribute(value):
-    """A global attribute in the type xarray's own netCDF-3 writer gives it (floats stay double)."""
-    if isinstance(value, (bool, np.bool_)):
-        return np.int8(value)
-    if isinstance(value, (int, np.integer)):
-        return np.int32(value) if abs(int(value)) < 2**31 else np.float64(value)
-    if isinstance(value, (float, np.floating)):
-        return np.float64(value)
-    return value
 
 
 def portable(mechanism: Mechanism | GraphMechanism):
