@@ -53,6 +53,15 @@ def textbook(centre, azimuths=AZIMUTHS) -> dict:
     return {"iti": iti, "oti": oti, "lmti": lmti, "f_o1": f_o1, "rods": rods, "axes": axes, "elbows": elbows}
 
 
+def assert_delta_textbook(result, expected: dict) -> None:
+    """``result`` holds :func:`textbook`'s ITI per actuator, OTI of every 3-subset, LMTI and F_O1 (<= 1e-9)."""
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    found = dict(zip(result.submechanisms, result.oti_submechanisms))
+    for members, value in expected["oti"].items():
+        np.testing.assert_allclose(found[members], value, atol=TOLERANCE, err_msg=str(members))
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+
+
 def open_delta(tmp_path, centre=POSES[0], azimuths=AZIMUTHS, name="delta.xml", transform=None):
     path = tmp_path / name
     path.write_text(delta_rods_mjcf(centre, azimuths, transform=transform))
@@ -97,13 +106,7 @@ def test_each_leg_transmits_a_force_along_its_rods_and_constrains_the_parallelog
 @pytest.mark.parametrize("centre", POSES)
 def test_the_indices_are_the_textbook_pressure_angles_of_a_delta(tmp_path, centre):
     _, graph = open_delta(tmp_path, centre)
-    expected = textbook(centre)
-    result = graph.indices()
-    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
-    found = dict(zip(result.submechanisms, result.oti_submechanisms))
-    for members, value in expected["oti"].items():
-        np.testing.assert_allclose(found[members], value, atol=TOLERANCE, err_msg=str(members))
-    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+    assert_delta_textbook(graph.indices(), textbook(centre))
 
 
 def test_the_same_indices_in_millimetres_in_another_frame_and_with_the_legs_listed_in_another_order(tmp_path):
