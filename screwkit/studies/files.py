@@ -19,8 +19,8 @@ import re
 import time
 from typing import Callable
 
-__all__ = ["check_output", "check_distinct", "output_suffix", "write_dataset", "read_result", "atomic_write",
-           "atomic_text", "save_figure", "WriteError", "DATA_SUFFIXES", "FIGURE_SUFFIXES", "FORMATS"]
+__all__ = ["check_output", "check_distinct", "output_suffix", "write_dataset", "read_result", "open_netcdf",
+           "atomic_write", "atomic_text", "save_figure", "WriteError", "DATA_SUFFIXES", "FIGURE_SUFFIXES", "FORMATS"]
 
 DATA_SUFFIXES = (".nc", ".csv")
 """Data files screwkit writes: netCDF (``.nc``) or CSV, in any case."""
@@ -243,6 +243,19 @@ def write_dataset(dataset, path) -> None:
         atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))
 
 
+def open_netcdf(path: str, error: type[Exception] = ValueError):
+    """The xarray Dataset of a netCDF file, loaded and closed; ``error`` with one line naming the file when it
+    cannot be read as one."""
+    import xarray as xr  # only where a netCDF file is read back
+
+    try:
+        with xr.open_dataset(path, engine="scipy") as dataset:
+            return dataset.load()
+    except Exception as failure:  # whatever the netCDF reader makes of a file that is not one
+        reason = str(failure).splitlines()[0] if str(failure) else type(failure).__name__
+        raise error(f"{path}: cannot be read as a netCDF file ({reason}).") from None
+
+
 def read_result(path) -> tuple[str, object]:
     """A map or a sweep read back from the netCDF file :func:`write_dataset` wrote: ``("map" | "sweep", dataset)``.
 
@@ -253,8 +266,6 @@ def read_result(path) -> tuple[str, object]:
     ValueError
         One line naming the file: missing, a folder, not a netCDF file, or not a map or sweep of screwkit.
     """
-    import xarray as xr
-
     path = os.fspath(path)
     if os.path.isdir(path):
         raise ValueError(f"{path}: is a folder; expected the netCDF file (.nc) of a map or a sweep.")
@@ -263,12 +274,7 @@ def read_result(path) -> tuple[str, object]:
     if not path.lower().endswith(".nc"):
         raise ValueError(f"{path}: expected the netCDF file (.nc) of a map or a sweep (screwkit map/sweep --out "
                          "FILE.nc).")
-    try:
-        with xr.open_dataset(path, engine="scipy") as dataset:
-            dataset = dataset.load()
-    except Exception as error:  # whatever the netCDF reader makes of a file that is not one
-        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
-        raise ValueError(f"{path}: cannot be read as a netCDF file ({reason}).") from None
+    dataset = open_netcdf(path)
     dimensions = dataset["iti"].ndim if "iti" in dataset.data_vars else 0
     if "lmti" not in dataset.data_vars or dimensions not in (1, 2):
         raise ValueError(f"{path}: not a map or a sweep of screwkit (expected 'iti' and 'lmti' over one or two "

@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.common.units import is_angular
 from screwkit.model import Mechanism
+from screwkit.studies.files import open_netcdf
 
 __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
            "PathFileError", "TIME_COLUMN"]
@@ -267,14 +268,7 @@ def _read_csv_cells(name: str, text: str, positions: dict[str, int], columns: di
 def _read_netcdf(name: str) -> dict[str, tuple[NDArray[np.float64], str, str]]:
     """Every one-dimensional numeric variable (and coordinate) of a netCDF file, with its ``units`` and what is
     wrong with its first value that is not a finite number ("" if none)."""
-    import xarray as xr  # only for netCDF path files
-
-    try:
-        with xr.open_dataset(name, engine="scipy") as dataset:
-            dataset = dataset.load()
-    except Exception as error:  # whatever the netCDF reader makes of a file that is not one
-        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
-        raise PathFileError(f"{name}: cannot be read as a netCDF file ({reason}).") from None
+    dataset = open_netcdf(name, PathFileError)
     columns = {}
     for key, variable in {**dataset.coords, **dataset.data_vars}.items():
         if variable.ndim == 1 and np.issubdtype(variable.dtype, np.number):
