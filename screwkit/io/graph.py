@@ -291,11 +291,7 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
     """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
     motion away (else the actuator moves inside a loop of the leg)."""
     model = tree.model
-    for leg, screw in zip(legs, screws):
-        if len(leg.actuators) != 1:
-            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                               f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
-                               "one (a leg with loops and several actuators has no per-actuator twist system yet).")
+    for leg, screw in zip(legs, screws):  # one actuator each (_check_actuators)
         actuator = leg.actuators[0]
         name = model.names[actuator]
         carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
@@ -311,6 +307,8 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
 
 
 def _check_actuators(tree: ClosedTree, legs) -> None:
+    """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
+    actuator is named, with the option that holds it)."""
     model = tree.model
     for leg in legs:
         if len(leg.actuators) != 1:
