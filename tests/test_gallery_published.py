@@ -387,3 +387,17 @@ def test_a_map_of_reachy_mini_with_its_yaw_stage_locked_rebuilds_the_locked_grap
         poses[:, 0], poses[:, 1] = x.ravel(), y.ravel()
         expected = graph_indices_at_poses(graph, poses)
         np.testing.assert_allclose(dataset["lmti"].values.ravel(), expected.lmti, atol=1e-12)
+
+
+def test_convert_writes_reachy_mini_s_urdf_with_its_yaw_stage_locked(tmp_path):
+    """``convert --lock``: the onshape-to-robot URDF with ``yaw_body`` held is six serial R-S-S legs in screwkit's
+    convention; the written file loads with the six horn motors and the indices of the file it came from."""
+    source = REACHY.with_name("robot.urdf")
+    out = tmp_path / "reachy_locked.urdf"
+    completed = screwkit("convert", source, out, "--lock", "yaw_body", "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    written, read = load(out), load(source, lock=("yaw_body",))
+    assert sorted(a.split(":")[1] for a in written.actuator_names) == [f"stewart_{k}" for k in range(1, 7)]
+    np.testing.assert_allclose(indices_at_pose(written, written.home_pose).lmti,
+                               indices_at_pose(read, read.home_pose).lmti, atol=1e-12)
+    one_line_error(screwkit("convert", source, tmp_path / "other.urdf"), "--lock yaw_body")

@@ -404,9 +404,12 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         for joint in leg.joints:
             if joint in owner:
                 first = f"closure {owner[joint]!r}" if owner[joint] else "the platform body's own path"
-                raise LegWithLoops(f"{tree.source}: closure {leg.closure!r} and {first} share joint "
-                                   f"{model.names[joint]!r}: a loop inside a leg (a parallelogram of rods, a "
-                                   "transmission), which screwkit cannot write as serial legs" + GRAPH_HINT + ".")
+                name = model.names[joint]
+                stage = (f"; {name!r} is actuated: if it is a serial stage before the parallel part, --lock {name} "
+                         "analyses the legs on the body it turns" if name in tree.motors else "")
+                raise LegWithLoops(f"{tree.source}: closure {leg.closure!r} and {first} share joint {name!r}: a "
+                                   "loop inside a leg (a parallelogram of rods, a transmission), which screwkit "
+                                   "cannot write as serial legs" + GRAPH_HINT + stage + ".")
             owner[joint] = leg.closure
     motor_ids = {}
     for name in tree.motors:
