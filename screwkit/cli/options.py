@@ -23,9 +23,7 @@ from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, stage_kernels
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
-from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
 from screwkit.io.loader import load
-from screwkit.plots import colour_scale
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, WriteError, check_distinct, check_output
 from screwkit.studies.maps import range_values
 from screwkit.studies.options import AnalysisOptions
@@ -376,8 +374,10 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     try:
         mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
                          output_type=reading.output_type)
-    except LegWithLoops as error:
-        if not graphs:
+    except ValueError as error:
+        from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree  # readers of other tools: when used
+
+        if not isinstance(error, LegWithLoops) or not graphs:
             raise fail(str(error)) from None
         if length_unit not in (None, "m"):
             raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
@@ -385,8 +385,6 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
             return graph_mechanism(read_closed_tree(name, output=reading.output, output_type=reading.output_type))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
-    except ValueError as error:
-        raise fail(str(error)) from None
     context = click.get_current_context(silent=True)
     opened = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
     ignored = [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
@@ -474,6 +472,8 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
 
 def check_colour_scale(vmin: float | None, vmax: float | None) -> None:
     """``--vmin`` / ``--vmax``, checked before any computation as the figure will check them."""
+    from screwkit.plots import colour_scale  # the figures' package: only for a command that draws one
+
     try:
         colour_scale(vmin, vmax)
     except ValueError:
