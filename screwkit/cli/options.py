@@ -24,8 +24,6 @@ from screwkit.common.compiling import INDEX_KERNELS, compile_ahead, silence, sta
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.io.loader import load
-from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, WriteError, check_distinct, check_output
-from screwkit.studies.maps import range_values
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError, Execution, connect, disconnect
 
@@ -86,6 +84,8 @@ class ScrewkitGroup(click.Group):
                 sys.exit(1)
             raise
         except OSError as error:  # a write that failed (disk full, quota, read-only), of a file or of stdout
+            from screwkit.studies.files import WriteError  # the output files' module: loaded by commands writing one
+
             if not isinstance(error, WriteError) and error.errno not in _WRITE_FAILURES:
                 raise
             _report(str(error) if isinstance(error, WriteError) else
@@ -333,6 +333,8 @@ class Outputs:
 
     def check(self, quiet: bool) -> None:
         """Every output checked before any computation (:func:`check_outputs`, :func:`check_colour_scale`)."""
+        from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES  # the output files: commands writing them
+
         check_outputs({"--out": (self.out, DATA_SUFFIXES), "--figure": (self.figure, FIGURE_SUFFIXES)},
                       self.overwrite, quiet)
         check_colour_scale(self.vmin, self.vmax)
@@ -441,6 +443,8 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
     for end in (start, stop) if angular else ():
         if abs(end) > angle_limit(degrees=True):
             raise fail(str(angle_beyond_limit(option, end, degrees=True)))
+    from screwkit.studies.maps import range_values  # the maps' module: only for a command taking ranges
+
     try:
         values = range_values(start, stop, step, include_stop=include_stop)
     except ValueError as error:
@@ -453,6 +457,7 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
     """Check every output path before any computation (suffix, folder, existing file), and that no two
     outputs, nor an output and one of the ``others`` files the command reads or keeps (``--state``), are
     the same file."""
+    from screwkit.studies.files import check_distinct, check_output  # the output files: commands writing them
 
     try:
         check_distinct({**{option: path for option, (path, _) in outputs.items()}, **(others or {})})
