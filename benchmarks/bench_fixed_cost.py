@@ -19,8 +19,8 @@ Usage: python benchmarks/bench_fixed_cost.py [--repeat 7] [--baseline PATH] [--p
    taken pair by pair (median, min, max), so that a drift of the machine's speed moves both.
 2. With ``--phases``: ``analyze planar_5rrr`` step by step in one process (imports, the mechanism read back
    from the cache or parsed, numba, its compiler context (set up when the first kernel is loaded: it imports
-   scipy.linalg, for numba's BLAS check), the index kernels, computing, the report), medians of ``--repeat`` new
-   processes.
+   scipy.linalg, for numba's BLAS check), the index kernels, computing, the report): the process's CPU time
+   (steady on a shared machine where wall times are not), medians of ``--repeat`` new processes.
 """
 
 from __future__ import annotations
@@ -50,9 +50,9 @@ screwkit's kernels does."""
 
 PHASES = r'''
 import contextlib, io, json, sys, time
-marks = [("start", time.perf_counter())]
+marks = [("start", time.process_time())]
 def mark(name):
-    marks.append((name, time.perf_counter()))
+    marks.append((name, time.process_time()))
 import numpy; mark("import numpy")
 import click, screwkit.cli, screwkit.cli.analyze as command; mark("import click and the command's modules")
 from screwkit.io.loader import load, bundled_path, mechanism_from_description
@@ -145,8 +145,8 @@ def phases(repeat: int) -> None:
         subprocess.run(run, check=True, capture_output=True, env=environment, cwd=folder)  # cache entry, floor kernel
         measures = [json.loads(subprocess.run(run, check=True, capture_output=True, text=True, env=environment,
                                               cwd=folder).stdout) for _ in range(repeat)]
-        start = [measured([sys.executable, "-c", "pass"], CHECKOUT)[0] * 1000 for _ in range(repeat)]
-    print(f"analyze planar_5rrr, step by step in one process (ms, median (min-max) of {repeat} processes):")
+        start = [measured([sys.executable, "-c", "pass"], CHECKOUT)[1] * 1000 for _ in range(repeat)]
+    print(f"analyze planar_5rrr, step by step in one process (CPU ms, median (min-max) of {repeat} processes):")
     print(f"  {'python -c pass (a whole process)':58s} {spread(start, 0):>16s}")
     for index, (name, _) in enumerate(measures[0]):
         print(f"  {name:58s} {spread([measure[index][1] for measure in measures], 0):>16s}")
