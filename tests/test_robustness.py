@@ -412,6 +412,11 @@ def test_a_read_only_install_with_no_writable_home_computes_caching_in_the_tempo
     assert mapped.stderr.splitlines()[0].startswith(notice)  # said in one line, and nothing compiled again
     assert "compiling" not in mapped.stderr and (folders["out"] / "m.nc").is_file()
     assert any(cache.rglob("*.nbi")) and not any((folders["home"]).iterdir())
+    # the loaded mechanisms are kept in the temporary folder too (a private folder), and read back silently
+    models = folders["tmp"] / f"screwkit-models-{os.getuid()}"
+    assert any(models.glob("*.mechanism")) and models.stat().st_mode & 0o777 == 0o700
+    again = run_there("analyze", "planar_5rrr", "--pose", "paper_fig_2a", "--json")
+    assert again.returncode == 0 and again.stderr == "" and again.stdout == analysed.stdout, again.stderr
 
 
 def test_a_read_only_install_with_nowhere_to_cache_compiles_without_a_cache(tmp_path):

@@ -21,7 +21,7 @@ from screwkit.cli.options import (
 from screwkit.closure import forward
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
-from screwkit.io import GraphMechanism
+from screwkit.model import Mechanism
 from screwkit.studies import indices_at_pose
 
 __all__ = ["analyze", "print_report"]
@@ -163,7 +163,7 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
 
 def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
     """The body of :func:`analyze` on a loaded mechanism."""
-    if isinstance(loaded, GraphMechanism):
+    if not isinstance(loaded, Mechanism):  # a GraphMechanism: legs with loops inside them
         return _analyze_graph(loaded, pose, actuator_values is not None, analysis, as_json)
     target = parse_pose(loaded, pose)
     if actuator_values is not None:
@@ -186,7 +186,7 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
 
 
-def _analyze_graph(graph: GraphMechanism, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:
+def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:
     """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration, or with the output
     frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
     if by_actuators:

@@ -25,11 +25,7 @@ from screwkit.common.compiling import INDEX_KERNELS, SPACE_KERNEL, compile_ahead
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.indices.average import AGGREGATES, failure_weights
-from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree
 from screwkit.io.loader import bundled_graph_names, bundled_path, load
-from screwkit.plots import colour_scale
-from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES, WriteError, check_distinct, check_output
-from screwkit.studies.maps import range_values
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError, Execution, connect, disconnect
 
@@ -91,6 +87,8 @@ class ScrewkitGroup(click.Group):
                 sys.exit(1)
             raise
         except OSError as error:  # a write that failed (disk full, quota, read-only), of a file or of stdout
+            from screwkit.studies.files import WriteError  # the output files' module: loaded by commands writing one
+
             if not isinstance(error, WriteError) and error.errno not in _WRITE_FAILURES:
                 raise
             _report(str(error) if isinstance(error, WriteError) else
@@ -339,6 +337,8 @@ class Outputs:
 
     def check(self, quiet: bool) -> None:
         """Every output checked before any computation (:func:`check_outputs`, :func:`check_colour_scale`)."""
+        from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES  # the output files: commands writing them
+
         check_outputs({"--out": (self.out, DATA_SUFFIXES), "--figure": (self.figure, FIGURE_SUFFIXES)},
                       self.overwrite, quiet)
         check_colour_scale(self.vmin, self.vmax)
@@ -380,8 +380,10 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     try:
         mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
                          output_type=reading.output_type, lock=reading.lock)
-    except LegWithLoops as error:
-        if not graphs:
+    except ValueError as error:
+        from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree  # readers of other tools: when used
+
+        if not isinstance(error, LegWithLoops) or not graphs:
             raise fail(str(error)) from None
         if length_unit not in (None, "m"):
             raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
@@ -391,8 +393,6 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
                                                     lock=reading.lock))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
-    except ValueError as error:
-        raise fail(str(error)) from None
     context = click.get_current_context(silent=True)
     opened = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
     ignored = [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
@@ -449,6 +449,8 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
     for end in (start, stop) if angular else ():
         if abs(end) > angle_limit(degrees=True):
             raise fail(str(angle_beyond_limit(option, end, degrees=True)))
+    from screwkit.studies.maps import range_values  # the maps' module: only for a command taking ranges
+
     try:
         values = range_values(start, stop, step, include_stop=include_stop)
     except ValueError as error:
@@ -461,6 +463,7 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
     """Check every output path before any computation (suffix, folder, existing file), and that no two
     outputs, nor an output and one of the ``others`` files the command reads or keeps (``--state``), are
     the same file."""
+    from screwkit.studies.files import check_distinct, check_output  # the output files: commands writing them
 
     try:
         check_distinct({**{option: path for option, (path, _) in outputs.items()}, **(others or {})})
@@ -480,6 +483,8 @@ def check_outputs(outputs: dict[str, tuple[str | None, tuple[str, ...]]], overwr
 
 def check_colour_scale(vmin: float | None, vmax: float | None) -> None:
     """``--vmin`` / ``--vmax``, checked before any computation as the figure will check them."""
+    from screwkit.plots import colour_scale  # the figures' package: only for a command that draws one
+
     try:
         colour_scale(vmin, vmax)
     except ValueError:

@@ -39,7 +39,8 @@ def warmup() -> None:
     five, hexapod = load("planar_5rrr"), load("ups_hexapod_8")
     steps = {  # the kernels compiled here first, while the child processes compile the index kernels
         ("screwkit.indices.compiled.planar",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
-        ("screwkit.closure.compiled.task",): lambda: load("prs_3_ups"),
+        # (a mechanism read back from the cache of loaded mechanisms is not assembled again: solve a pose)
+        ("screwkit.closure.compiled.task",): lambda: solve(prs := load("prs_3_ups"), prs.home_pose[None]),
         ("screwkit.closure.compiled.frames",): lambda: chain_forward_kinematics(
             five.chains[0].geometry, np.zeros((COMPILED_FROM, five.chains[0].geometry.n_dofs))),
         INDEX_KERNELS: lambda: indices_at_pose(five, five.home_pose),

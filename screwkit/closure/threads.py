@@ -2,7 +2,7 @@
 
 numpy releases the GIL inside its loops, so cache-sized blocks of a large batch run side by
 side on several threads (:func:`for_each_block`). A caller that already runs one task per core
-(a map's Dask tasks, the index kernel given ``threads``) bounds them with
+(a map's tasks, the index kernel given ``threads``) bounds them with
 :func:`thread_limit`, so that thread pools are not nested on the same cores.
 """
 
@@ -26,7 +26,7 @@ _THREAD_LIMIT: ContextVar[int] = ContextVar("screwkit_thread_limit", default=_WO
 def thread_limit(threads: int | None) -> Iterator[None]:
     """Within the block, closure solving and screw building use at most ``threads`` threads.
 
-    For callers that already run one task per core (a map's Dask tasks): nested thread
+    For callers that already run one task per core (a map's tasks): nested thread
     pools would only compete for the same cores. ``None`` leaves the default (all cores, up
     to 4). The limit is per thread (a context variable).
     """

@@ -24,7 +24,8 @@ compiled or looked for: numba's own choice when it can write there (``NUMBA_CACH
 else ``__pycache__`` beside screwkit's sources, else ``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``
 by default); when it cannot (a read-only install with no writable home), a folder of this user in
 the temporary folder; when not even that, no cache (every run compiles). Each fallback is said in
-one line on stderr. The kernels' modules take ``njit`` from :mod:`screwkit.common.jit`, which asks it.
+one line on stderr (the folders are found by :mod:`screwkit.common.caches`, which places screwkit's own caches
+the same way). The kernels' modules take ``njit`` from :mod:`screwkit.common.jit`, which asks it.
 """
 
 from __future__ import annotations
@@ -32,10 +33,11 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 from pathlib import Path
+
+from screwkit.common.caches import own_folder, private_temporary_folder, user_cache_home, writable
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
            "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "SPACE_KERNEL",
@@ -90,37 +92,9 @@ def silence() -> None:
     _silent = True
 
 
-def _writable(folder: Path) -> bool:
-    """Whether numba could cache in ``folder``: created if missing, and a file can be made in it (as numba tests)."""
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        tempfile.TemporaryFile(dir=folder).close()
-    except OSError:
-        return False
-    return True
-
-
-def _own_folder(folder: Path) -> bool:
-    """A folder only this user can write (``folder`` is in a shared temporary folder: numba loads what it finds)."""
-    try:
-        folder.mkdir(mode=0o700, exist_ok=True)
-        status = folder.stat()
-    except OSError:
-        return False
-    return status.st_uid == os.getuid() and not status.st_mode & 0o022 and _writable(folder)
-
-
 def _say(message: str) -> None:
     if not _silent:
         print(f"screwkit: {message}", file=sys.stderr, flush=True)
-
-
-def _user_cache() -> Path | None:
-    """numba's user-wide cache folder (``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``); None without a home."""
-    try:
-        return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba"
-    except RuntimeError:  # no HOME and no entry in the password database
-        return None
 
 
 _caching: bool | None = None
@@ -142,21 +116,18 @@ def numba_cache() -> bool:
             return _caching
         package = Path(__file__).resolve().parent
         configured = os.environ.get("NUMBA_CACHE_DIR")
-        user = _user_cache()
+        user = _numba_user_cache()
         if configured:
             tried = [Path(configured)]
-            _caching = _writable(tried[0])
+            _caching = writable(tried[0])
         else:
             tried = [package / "__pycache__", package / "closure" / "__pycache__"] + ([user] if user else [])
-            _caching = all(_writable(folder) for folder in tried[:2]) or (user is not None and _writable(user))
+            _caching = all(writable(folder) for folder in tried[:2]) or (user is not None and writable(user))
         if _caching:
             return True
-        try:
-            fallback = Path(tempfile.gettempdir()) / f"screwkit-numba-{os.getuid()}"
-        except OSError:  # no usable temporary folder at all
-            fallback = Path(os.environ.get("TMPDIR") or "/tmp") / f"screwkit-numba-{os.getuid()}"
+        fallback = private_temporary_folder("numba")
         places = ", ".join(str(folder) for folder in tried)
-        if _own_folder(fallback):
+        if own_folder(fallback):
             os.environ["NUMBA_CACHE_DIR"] = str(fallback)
             config = sys.modules.get("numba.core.config")
             if config is not None:  # numba read the environment when it was imported
@@ -182,10 +153,16 @@ def _first_line(source: Path, function: str) -> int | None:
     return None
 
 
+def _numba_user_cache() -> Path | None:
+    """numba's user-wide cache folder (``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``); None without a home."""
+    home = user_cache_home()
+    return home / "numba" if home is not None else None
+
+
 def _cache_folders(source: Path) -> list[Path]:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return [Path(os.environ["NUMBA_CACHE_DIR"])]
-    user = _user_cache()
+    user = _numba_user_cache()
     return [source.parent / "__pycache__"] + ([user] if user else [])
 
 

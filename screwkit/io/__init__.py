@@ -16,22 +16,49 @@ as a graph at the file's configuration by :func:`graph_mechanism` (:mod:`screwki
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from screwkit.common.units import metres_per
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
-from screwkit.io.gazebo import has_gazebo_joints, read_gazebo
-from screwkit.io.gepetto import read_gepetto, yaml_beside
-from screwkit.io.graph import GraphMechanism, graph_mechanism
-from screwkit.io.locking import lock_joints
-from screwkit.io.mjcf import read_mjcf
-from screwkit.io.onshape import has_closing_frames, read_onshape
-from screwkit.io.sdformat import SDFORMAT_SUFFIXES, read_sdformat
-from screwkit.io.star import convert_tree
+
+if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file in screwkit's convention reads none
+    from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
+    from screwkit.io.gazebo import read_gazebo
+    from screwkit.io.gepetto import read_gepetto
+    from screwkit.io.graph import GraphMechanism, graph_mechanism
+    from screwkit.io.locking import lock_joints
+    from screwkit.io.mjcf import read_mjcf
+    from screwkit.io.onshape import read_onshape
+    from screwkit.io.sdformat import read_sdformat
+    from screwkit.io.star import convert_tree
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "with_reference_configuration"]
+           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "lock_joints", "with_reference_configuration"]
+
+_READERS = {
+    **dict.fromkeys(("ClosedTree", "Closure", "ImportError_", "ImportReport", "LegWithLoops"),
+                    "screwkit.io.closed_tree"),
+    **dict.fromkeys(("GraphMechanism", "graph_mechanism"), "screwkit.io.graph"),
+    "read_gazebo": "screwkit.io.gazebo", "read_gepetto": "screwkit.io.gepetto", "read_mjcf": "screwkit.io.mjcf",
+    "read_onshape": "screwkit.io.onshape", "convert_tree": "screwkit.io.star", "lock_joints": "screwkit.io.locking",
+    "read_sdformat": "screwkit.io.sdformat",
+}
+"""Where each name of the readers of other tools lives: imported when first used (PEP 562), since loading a file
+in screwkit's convention (and every bundled mechanism) needs none of them (about 20 ms, YAML and XML readers)."""
+
+
+def __getattr__(name: str):
+    if name in _READERS:
+        value = getattr(importlib.import_module(_READERS[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'screwkit.io' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_READERS))
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
@@ -39,6 +66,11 @@ MJCF_SUFFIXES = (".xml", ".mjcf")
 def is_foreign(path: Path) -> bool:
     """An MJCF or SDFormat file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
     onshape-to-robot ``closing_`` frame pairs or ``<gazebo><joint>`` elements."""
+    from screwkit.io.gazebo import has_gazebo_joints  # the readers: only for a file given by its path
+    from screwkit.io.gepetto import yaml_beside  # (idem)
+    from screwkit.io.onshape import has_closing_frames  # (idem)
+    from screwkit.io.sdformat import SDFORMAT_SUFFIXES  # (idem)
+
     path = Path(path)
     if path.suffix.lower() in MJCF_SUFFIXES + SDFORMAT_SUFFIXES:
         return True
@@ -53,10 +85,19 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
                      lock: tuple[str, ...] = ()) -> ClosedTree:
     """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
     ``lock``: as :func:`read_mechanism_file`)."""
+    from screwkit.io.locking import lock_joints  # the readers: only for a file of another tool
+
     return lock_joints(_read_tree(Path(path), output, output_type), lock)
 
 
 def _read_tree(path: Path, output: str | None, output_type: str | None) -> ClosedTree:
+    from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
+    from screwkit.io.gazebo import has_gazebo_joints, read_gazebo  # (idem)
+    from screwkit.io.gepetto import read_gepetto, yaml_beside  # (idem)
+    from screwkit.io.mjcf import read_mjcf  # (idem)
+    from screwkit.io.onshape import has_closing_frames, read_onshape  # (idem)
+    from screwkit.io.sdformat import SDFORMAT_SUFFIXES, read_sdformat  # (idem)
+
     if output_type not in (None, "point", "frame"):
         raise ValueError(f"Expected output type 'point' or 'frame', got {output_type!r}.")
     if path.suffix.lower() in MJCF_SUFFIXES:
@@ -84,6 +125,8 @@ def read_mechanism_file(path: Path, *, output: str | None = None, output_type: s
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).
     """
+    from screwkit.io.star import convert_tree  # the conversion: only for a file of another tool
+
     return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock))
 
 

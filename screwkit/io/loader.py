@@ -3,7 +3,9 @@
 :func:`load` takes a bundled name (:func:`bundled_names`) or a file path and returns the
 immutable :class:`~screwkit.model.Mechanism`. It is the one place where the model layer
 (reading the file, :mod:`screwkit.model`) and the closure layer (the reference assembly,
-:mod:`screwkit.closure`) meet; everything downstream takes the mechanism it returns.
+:mod:`screwkit.closure`) meet; everything downstream takes the mechanism it returns. A file in screwkit's
+convention that was loaded before (the same bytes, read the same way, by the same code) is read back from the
+cache of loaded mechanisms (:mod:`screwkit.io.model_cache`) instead.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 from screwkit.closure.assembly import assemble, task_space
 from screwkit.io import is_foreign, read_mechanism_file
+from screwkit.io.model_cache import load_cached
 from screwkit.model.builder import read_chains, read_platform
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.pinocchio_bridge import build_model
@@ -27,6 +30,7 @@ from screwkit.model.urdf_reader import MAX_FILE_BYTES, parse_urdf, read_urdf
 __all__ = ["load", "load_text", "mechanism_from_description", "bundled_names", "bundled_path"]
 
 
+@functools.cache
 def bundled_names() -> tuple[str, ...]:
     """Names of the mechanisms shipped in :mod:`screwkit.robots`."""
     folder = resources.files("screwkit.robots")
@@ -154,7 +158,18 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         raise ValueError(f"{path}: an output frame or type, or locked joints, apply to files of other tools (MJCF, "
                          "SDFormat, URDF + robot.yaml, onshape-to-robot URDFs); this file is in screwkit's convention "
                          "(its output is its platform).")
-    return mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes), limits=limits)
+    return load_cached(_content(path, max_bytes), ("file", str(path), length_unit, limits, max_bytes),
+                       lambda: mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes),
+                                                          limits=limits))
+
+
+def _content(path: Path, max_bytes: int) -> bytes | None:
+    """The file's bytes, for the cache's key; None when it is not to be read (too large, unreadable: the reader
+    says why)."""
+    try:
+        return path.read_bytes() if path.stat().st_size <= max_bytes else None
+    except OSError:
+        return None
 
 
 def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None, limits: bool = True) -> Mechanism:
@@ -164,5 +179,6 @@ def load_text(text: str, source: str = "<string>", *, length_unit: str | None = 
 
 @functools.lru_cache(maxsize=8)
 def cached_mechanism(digest: str, text: str, source: str, limits: bool = True) -> Mechanism:
-    """:func:`load_text`, remembered by the text's digest (for tasks that rebuild a mechanism from its text)."""
-    return load_text(text, source, limits=limits)
+    """:func:`load_text`, remembered by the text's digest in this process and kept in the cache of loaded
+    mechanisms (:mod:`screwkit.io.model_cache`), for tasks that rebuild a mechanism from its text."""
+    return load_cached(text.encode(), ("text", source, limits), lambda: load_text(text, source, limits=limits))

@@ -28,7 +28,8 @@ from screwkit.common.units import angle_beyond_limit, angle_limit, is_angular
 from screwkit.model.chain import Chain, ChainGeometry
 from screwkit.model.urdf_description import UrdfDescription
 
-__all__ = ["Mechanism", "require_mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES"]
+__all__ = ["Mechanism", "require_mechanism", "PLANAR_TASK_COORDINATES", "SPATIAL_TASK_COORDINATES",
+           "PINOCCHIO_TREE"]
 
 PLANAR_TASK_COORDINATES = ("x", "y", "phi")
 """Task coordinates of a planar mechanism: platform position in the base x-y plane (m) and
@@ -36,6 +37,8 @@ its rotation about the base z axis (rad)."""
 SPATIAL_TASK_COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 """Task coordinates of a spatial mechanism: platform position (m) and orientation
 ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (rad, fixed axes, the URDF ``rpy`` convention)."""
+PINOCCHIO_TREE = ("pinocchio_model", "platform_frame_placement")
+"""The attributes of a :class:`Mechanism` that are Pinocchio objects (left out of its stored state)."""
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -99,6 +102,10 @@ class Mechanism:
     import_report : tuple of str
         For a file of another tool (MJCF, URDF + robot.yaml): what the conversion did, line by line
         (platform body, output point or frame and why, loops assembled, joints locked).
+
+    A mechanism read back from the cache of loaded mechanisms (:meth:`from_stored_state`) builds
+    :attr:`pinocchio_model` and :attr:`platform_frame_placement` from its description's text when they are
+    first used: computing indices needs neither, so such a load does not import Pinocchio.
     """
 
     name: str
@@ -127,6 +134,34 @@ class Mechanism:
     instantaneous_dof: int = 0
     assembly_notes: tuple[str, ...] = ()
     import_report: tuple[str, ...] = ()
+
+    # -- stored state (the cache of loaded mechanisms) ---------------------------------------
+
+    def stored_state(self) -> dict[str, Any]:
+        """Every attribute but the Pinocchio tree (:data:`PINOCCHIO_TREE`), to be pickled: numbers, names and
+        screwkit's own records only, so that reading it back imports neither Pinocchio nor the file's parser."""
+        return {name: value for name, value in vars(self).items() if name not in PINOCCHIO_TREE}
+
+    @classmethod
+    def from_stored_state(cls, state: dict[str, Any]) -> Mechanism:
+        """The mechanism of a :meth:`stored_state`; its Pinocchio tree is built from the description when first
+        used."""
+        mechanism = object.__new__(cls)
+        vars(mechanism).update(state)
+        return mechanism
+
+    def __getattr__(self, name: str) -> Any:
+        # called only for an attribute that is not set: the Pinocchio tree of a mechanism from a stored state
+        if name in PINOCCHIO_TREE and "description" in vars(self) and "platform_link" in vars(self):
+            from screwkit.model.pinocchio_bridge import body_frame, build_model  # Pinocchio: only when asked for
+
+            description = self.description
+            model = build_model(description.text, lambda problem: description.fail(f"<robot name='{self.name}'>",
+                                                                                   problem))
+            object.__setattr__(self, "pinocchio_model", model)
+            object.__setattr__(self, "platform_frame_placement", body_frame(model, self.platform_link).placement)
+            return vars(self)[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     # -- derived -------------------------------------------------------------------------
 

@@ -7,8 +7,8 @@ paper's Fig. 5. :func:`planar_disc_map` is the paper's case: x, y on a disc, phi
 full turn.
 
 The grid is cut into rectangular blocks of about :data:`CONFIGURATIONS_PER_TASK`
-configurations, run as tasks through Dask (:func:`screwkit.studies.tasks.run_tasks`): the local
-threaded scheduler by default, or a running ``dask.distributed`` cluster. A task receives only
+configurations, run as tasks (:func:`screwkit.studies.tasks.run_tasks`): on local threads by default, or on a
+running ``dask.distributed`` cluster. A task receives only
 its block's coordinates and mask and returns only the block's minima, so memory beyond the
 output grid does not grow with the number of configurations; :func:`map_size` states the size
 of a map before anything is allocated. Tasks are pure functions of their inputs (the URDF text

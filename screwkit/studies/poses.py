@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from math import comb
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -22,8 +22,10 @@ from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
 from screwkit.indices.results import Indices
-from screwkit.io.graph import GraphMechanism, dimension_groups, equivalent_chains, leg_screws
 from screwkit.model import Mechanism, require_mechanism
+
+if TYPE_CHECKING:  # the graph reader is imported when a graph is analysed (it is no part of the other paths)
+    from screwkit.io.graph import GraphMechanism
 
 __all__ = ["indices_at_poses", "indices_at_pose", "indices_and_joint_values", "graph_indices_at_poses",
            "check_graph_analysis", "GRAPH_CHUNK", "analyze_solution", "output_points", "planar_points",
@@ -432,6 +434,8 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
     NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw.
     """
+    from screwkit.io.graph import dimension_groups, equivalent_chains, leg_screws  # graphs only: off other paths
+
     poses = graph.check_poses(poses)
     n_task = graph.n_task
     batch = poses.shape[:-1]
