@@ -33,15 +33,24 @@ def quaternion_text(rotation) -> str:
     return text((x, y, z, w))
 
 
-def five_bar_sdf(transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None, legs=3, marker="screwkit") -> str:
+def five_bar_sdf(transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None, legs=3, marker="screwkit",
+                 stage: bool = False) -> str:
     """The five-bar at HOME: ``transform`` (scale, turn about the normal, shift) in the model's pose, legs written in
     ``order``, motors named ``motor(i)``; ``marker``: "screwkit" (``<screwkit:actuated/>``), "plugin"
-    (JointPositionController plugins) or "" (none: guessed)."""
+    (JointPositionController plugins) or "" (none: guessed). ``stage``: the legs stand on a ``stage`` link that a
+    passive revolute joint ``table`` (its axis tilted, through a point off the origin) joins to the base: every leg
+    passes through it, a serial stage before the parallel part (``--lock table`` holds it)."""
     scale, turn, shift = transform
     motor = motor or (lambda i: f"mot{i + 1}")
     elbows = five_bar_elbows(HOME)
     links, joints = ['<link name="base"/>'], ['<joint name="anchor" type="fixed"><parent>world</parent>'
                                               '<child>base</child></joint>']
+    ground = "stage" if stage else "base"
+    if stage:
+        links.append('<link name="stage"/>')
+        joints.append(f'<joint name="table" type="revolute"><parent>base</parent><child>stage</child><pose>'
+                      f'{text((0.3 * scale, -0.2 * scale, 0.1 * scale))} 0 0 0</pose><axis><xyz>0.3 -0.2 1</xyz>'
+                      '<limit><lower>-3</lower><upper>3</upper></limit></axis></joint>')
     actuated = "<screwkit:actuated/>" if marker == "screwkit" else ""
     for i in (range(legs) if order is None else order):
         base, elbow = FIVE_BAR_BASE[i], elbows[i]
@@ -50,9 +59,9 @@ def five_bar_sdf(transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None, 
         links.append(f'<link name="proximal_{i + 1}"><pose>{text((*(scale * base), 0.0))} 0 0 {first!r}</pose></link>')
         links.append(f'<link name="distal_{i + 1}"><pose relative_to="proximal_{i + 1}">{scale * PROXIMAL!r} 0 0 0 0 '
                      f'{second - first!r}</pose></link>')
-        joints.append(f'<joint name="{motor(i)}" type="revolute"><parent>base</parent><child>proximal_{i + 1}</child>'
-                      f'<axis><xyz>0 0 1</xyz><limit><lower>-3</lower><upper>3</upper></limit></axis>{actuated}'
-                      '</joint>')
+        joints.append(f'<joint name="{motor(i)}" type="revolute"><parent>{ground}</parent>'
+                      f'<child>proximal_{i + 1}</child><axis><xyz>0 0 1</xyz><limit><lower>-3</lower><upper>3</upper>'
+                      f'</limit></axis>{actuated}</joint>')
         joints.append(f'<joint name="free{i + 1}" type="continuous"><parent>proximal_{i + 1}</parent>'
                       f'<child>distal_{i + 1}</child><axis><xyz>0 0 1</xyz></axis></joint>')
         axis = ('<xyz expressed_in="__model__">0 0 1</xyz>' if i % 2 else '<xyz>0 0 -1</xyz>')

@@ -261,3 +261,36 @@ def test_a_universal_or_prismatic_joint_closing_a_loop_keeps_its_first_motion_in
     assert max(closure_gaps(tree, tree.q_reference).values()) < TOLERANCE
     parent = tree.model.names[tree.model.parents[tree.model.getJointId(tree_joint)]]
     assert parent == "free3"
+
+
+@pytest.mark.parametrize("transform", [(1.0, 0.0, (0.0, 0.0, 0.0)), *MOVED])
+def test_a_five_bar_on_a_turntable_with_the_table_locked_is_the_five_bar_in_any_unit_frame_and_leg_order(
+        tmp_path, transform):
+    """Every leg stands on a ``stage`` that a passive, tilted ``table`` joint turns: the whole robot is one leg
+    until ``--lock table`` holds it. Locked, it is the five-bar: the textbook pressure angles, each following its
+    own leg, whatever the unit (1e-3, 1e3), the world frame, the order the legs are written in and the motors'
+    names. The graph path, which analyses the platform's frame, refuses it in one line: the effector turns freely on
+    the pin where the legs meet, so no actuator controls its frame (its indices would be zero everywhere)."""
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path = write(tmp_path, five_bar_sdf(transform, order=(2, 1, 0), motor=names.get, stage=True))
+    with pytest.raises(LegWithLoops, match="every actuator rides on 'table'.*--lock table analyses"):
+        load(path)
+    with pytest.raises(ImportError_, match="joint 'table' carries every actuator.*--lock table analyses"):
+        graph_mechanism(read_closed_tree(path))
+    mechanism = load(path, lock=("table",))
+    assert mechanism.is_planar and mechanism.dof == 2
+    assert_moved_textbook(mechanism, transform, {name: leg for leg, name in names.items()}.get)
+    with pytest.raises(ImportError_, match="the platform 'effector' moves with every actuator locked"):
+        graph_mechanism(read_closed_tree(path, lock=("table",)))  # the effector turns freely on its pin: no frame
+
+
+def test_analyze_of_an_sdformat_five_bar_on_a_turntable_names_lock_and_locked_gives_the_pressure_angles(tmp_path):
+    """The command line, as a subprocess, on the millimetre copy: without ``--lock`` one line naming the option;
+    with it the textbook LMTI and F_O1 at the file's pose."""
+    path = write(tmp_path, five_bar_sdf(MOVED[0], stage=True))
+    one_line_error(screwkit("analyze", path), "--lock table analyses the legs on the body it turns")
+    completed = screwkit("analyze", path, "--lock", "table", "--json")
+    assert completed.returncode == 0, completed.stderr
+    report, expected = json.loads(completed.stdout), five_bar_expected(HOME)
+    assert report["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
+    assert report["f_o"]["1"] == pytest.approx(expected["f_o1"], abs=TOLERANCE)

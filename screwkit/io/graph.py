@@ -306,16 +306,35 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
                                "the actuated joint joins the base to the rest of its leg.")
 
 
+def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
+    """The platform's frame is the output of a graph: refused when a point is asked for, or when the platform still
+    moves with every actuator locked (an effector turning freely on the pin where the legs meet: its frame is no
+    output any actuator controls, and its indices would be zero everywhere)."""
+    if tree.output_type == "point":
+        raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
+                           f"frame of their platform {body!r} only.")
+    idle = _motion_space(screws, locked=True)
+    if len(idle):
+        raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
+                           "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
+                           "meet): its frame is no output of this mechanism; analysable through serial legs as a "
+                           "point output, not through the graph.")
+
+
 def _check_actuators(tree: ClosedTree, legs) -> None:
     """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
     actuator is named, with the option that holds it)."""
     model = tree.model
     for leg in legs:
         if len(leg.actuators) != 1:
-            stage = [model.names[a] for a in leg.actuators
-                     if all(a in path_to(model, other) for other in leg.actuators if other != a)]
-            advice = (f"; the actuated joint {stage[0]!r} carries every other one (a serial stage before the "
-                      f"parallel part): --lock {stage[0]} analyses the legs on the body it turns" if stage else "")
+            stage = [model.names[j] for j in leg.joints  # joints carrying every actuator of the leg, from the base
+                     if len(leg.actuators) > 1 and joint_kind(model, j)[0] in ("revolute", "prismatic")
+                     and all(j in path_to(model, a) for a in leg.actuators if a != j)]
+            carrier = (f"the actuated joint {stage[0]!r} carries every other one" if stage and stage[0] in [
+                model.names[a] for a in leg.actuators] else f"joint {stage[0]!r} carries every actuator of it"
+                if stage else "")
+            advice = (f"; {carrier} (a serial stage before the parallel part): --lock {stage[0]} analyses the legs "
+                      "on the body it turns" if stage else "")
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet)"
@@ -326,12 +345,13 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
                                "actuator drives one revolute or prismatic joint.")
 
 
-def _motion_space(screws: list[LegScrews]) -> NDArray[np.float64]:
+def _motion_space(screws: list[LegScrews], locked: bool = False) -> NDArray[np.float64]:
     """Orthonormal rows (d, 6) spanning the platform twists every leg allows (working coordinates), at the first
-    configuration of a batch."""
+    configuration of a batch; ``locked``: with every actuator locked (the motions no actuator controls)."""
     complements = []
     for screw in screws:
-        rows = screw.allowed[0][:int(screw.allowed_dims[0])]
+        rows = (screw.locked[0][:int(screw.locked_dims[0])] if locked else
+                screw.allowed[0][:int(screw.allowed_dims[0])])
         _, values, right = np.linalg.svd(np.vstack([rows, np.zeros((6 - len(rows), 6))]) if len(rows) < 6 else rows)
         complements.append(right[int(np.sum(values > TWIST_RANK_TOLERANCE)):])
     stacked = np.vstack(complements)
@@ -386,6 +406,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
     if at_file:
         _check_legs(tree, legs, screws)
+        _check_output(tree, screws, report.platform_body)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     motion = _motion_space(screws)

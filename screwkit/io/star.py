@@ -405,8 +405,13 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             if joint in owner:
                 first = f"closure {owner[joint]!r}" if owner[joint] else "the platform body's own path"
                 name = model.names[joint]
+                carries_all = tree.motors and all(  # a passive joint every motor rides on: a stage before the legs
+                    joint in path_to(model, model.getJointId(motor)) for motor in tree.motors
+                    if model.existJointName(motor))
                 stage = (f"; {name!r} is actuated: if it is a serial stage before the parallel part, --lock {name} "
-                         "analyses the legs on the body it turns" if name in tree.motors else "")
+                         "analyses the legs on the body it turns" if name in tree.motors else
+                         f"; every actuator rides on {name!r}: if it is a serial stage before the parallel part, "
+                         f"--lock {name} analyses the legs on the body it turns" if carries_all else "")
                 raise LegWithLoops(f"{tree.source}: closure {leg.closure!r} and {first} share joint {name!r}: a "
                                    "loop inside a leg (a parallelogram of rods, a transmission), which screwkit "
                                    "cannot write as serial legs" + GRAPH_HINT + stage + ".")
