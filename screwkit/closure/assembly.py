@@ -145,14 +145,22 @@ def _matching_branch(mechanism: Mechanism, index: int, solver) -> tuple[int, ...
     probe = replace(mechanism, chains=mechanism.chains[:index] + (replace(chain, closed_form=solver),)
                     + mechanism.chains[index + 1:])
     prismatic = np.asarray(chain.geometry.dof_prismatic)
+    branches = [tuple(1 if (code >> bit) & 1 == 0 else -1 for bit in range(solver.n_branches))
+                for code in range(2**solver.n_branches)]
+    if solver.planar:  # one working mode at a time
+        results = [run_closed_form(probe, index, mechanism.home_full_pose[None], branch) for branch in branches]
+        reachable = [bool(result.reachable[0]) for result in results]
+        values = [(result.values() if callable(result.values) else result.values)[0] for result in results]
+    else:  # every working mode in one batch: the home pose once per mode
+        poses = np.repeat(mechanism.home_full_pose[None], len(branches), 0)
+        result = solver.solve(*probe.loop_targets(index, *probe.transforms_from_poses(poses)),
+                              np.array(branches, dtype=float))
+        reachable, values = list(result.reachable), list(result.values)
     best, closest = None, np.inf
-    for code in range(2**solver.n_branches):
-        branch = tuple(1 if (code >> bit) & 1 == 0 else -1 for bit in range(solver.n_branches))
-        result = run_closed_form(probe, index, mechanism.home_full_pose[None], branch)
-        if not result.reachable[0]:
+    for branch, closed, value in zip(branches, reachable, values):
+        if not closed:
             continue
-        values = result.values() if callable(result.values) else result.values
-        difference = values[0] - chain.reference_values
+        difference = value - chain.reference_values
         difference[~prismatic] = wrap_angle(difference[~prismatic])
         difference[prismatic] /= mechanism.length_scale
         distance = float(np.max(np.abs(difference), initial=0.0))

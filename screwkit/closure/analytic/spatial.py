@@ -106,8 +106,12 @@ class SpatialClosedForm:
         return packed_chains([self.geometry])
 
     def solve(self, target_rotation: NDArray, target_translation: NDArray, branch) -> ClosedFormResult:
-        """Solve flat batches of targets, shapes (N, 3, 3) and (N, 3), block by block in threads."""
-        branch = tuple(float(sign) for sign in np.atleast_1d(branch))
+        """Solve flat batches of targets, shapes (N, 3, 3) and (N, 3), block by block in threads; ``branch``: one
+        working mode (a sign per branch) or one per target (N, n_branches)."""
+        if np.ndim(branch) == 2:  # a working mode per target (the assembly tries every mode in one batch)
+            branch = tuple(np.ascontiguousarray(column, dtype=float) for column in np.asarray(branch).T)
+        else:
+            branch = tuple(float(sign) for sign in np.atleast_1d(branch))
         geometry = self.geometry
         count, n_tree = target_translation.shape[0], geometry.n_tree_joints
         values = np.empty((count, geometry.n_dofs))
@@ -116,7 +120,8 @@ class SpatialClosedForm:
         gap = np.empty(count)
 
         def work(block: slice) -> None:
-            tree_values, gap[block] = self._tree_values(target_translation[block], branch)
+            signs = tuple(sign[block] if isinstance(sign, np.ndarray) else sign for sign in branch)
+            tree_values, gap[block] = self._tree_values(target_translation[block], signs)
             padded = np.concatenate([tree_values, np.zeros(tree_values.shape[:-1] + (geometry.n_dofs - n_tree,))], -1)
             frames = chain_forward_kinematics(geometry, padded)  # spherical axes do not depend on its values
             values[block, :n_tree] = tree_values
@@ -198,7 +203,7 @@ class LegVectorChain(SpatialClosedForm):
         leg = target_translation - self.centre
         distance = np.linalg.norm(leg, axis=-1)
         safe = np.where(distance > 0.0, distance, 1.0)
-        direction = slider_sign * leg / safe[..., None]
+        direction = np.asarray(slider_sign)[..., None] * leg / safe[..., None]
         first, second, pointing_gap = two_axis_pointing(
             self.first_axis, self.second_axis, self.slider_direction, direction, universal_sign
         )
