@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from helpers import screwkit
+from helpers import one_line_error, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.indices.analysis import analyze
 from screwkit.io.loader import load
@@ -120,6 +120,25 @@ def test_bad_input_is_one_line(arguments, message):
     assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
     assert message in lines[0], lines[0]
     assert result.stdout == ""
+
+
+def test_a_chain_folded_onto_its_base_joint_is_one_line_without_a_warning():
+    """The 5-RRR's first chain has equal links: with its end on its base joint's axis its joint values are not
+    determined. The pose is computed from the model (its end where its base joint is); the command says why in one
+    line, with no RuntimeWarning of the arithmetic before it."""
+    from screwkit.closure.chain_kinematics import chain_forward_kinematics
+    from screwkit.io.loader import load
+
+    mechanism = load("planar_5rrr")
+    chain = mechanism.chains[0]
+    frames = chain_forward_kinematics(chain.geometry, chain.reference_values)
+    lengths = np.linalg.norm(np.diff(frames.points[:3], axis=0), axis=1)
+    assert lengths[0] == pytest.approx(lengths[1], rel=1e-12)  # folded, the end can sit on the base joint
+    home = mechanism.home_full_pose
+    assert home[2] == 0.0
+    x, y = np.round(frames.points[0][:2] - (frames.points[2][:2] - home[:2]), 12)  # the end on the base joint
+    result = screwkit("analyze", "planar_5rrr", "--pose", repr(float(x)), repr(float(y)), "0")
+    one_line_error(result, "chain 'chain_1' closes only to rounding", "where its joint values are not determined")
 
 
 def test_with_json_errors_are_json_on_stdout():

@@ -347,7 +347,11 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
     for c in missing:
         chain = mechanism.chains[c]
         unit = "m" if chain.closed_form is not None else "(Newton error norm, m and rad)"
-        parts.append(f"chain {chain.name!r} misses closure by {residuals[c]:.6g} {unit}")
+        if chain.closed_form is not None and residuals[c] < 1e-12 * mechanism.length_scale:
+            parts.append(f"chain {chain.name!r} closes only to rounding (the pose is on the boundary of its reach, "
+                         "or its end on the axis of its base joint, where its joint values are not determined)")
+        else:
+            parts.append(f"chain {chain.name!r} misses closure by {residuals[c]:.6g} {unit}")
     for c in np.flatnonzero(status == OUTSIDE_LIMITS):
         chain = mechanism.chains[c]
         joint = int(solution.limit_joints[index][c])

@@ -169,12 +169,13 @@ class PlanarRevoluteChain(PlanarClosedForm):
             height_squared = (first * first) * inverse - along * along  # (height / distance)^2
         reachable = height_squared >= 0.0
         height = np.sqrt(np.maximum(height_squared, 0.0))
-        if branch > 0:
-            points[0, 1] = base_x + along * delta_x - height * delta_y
-            points[1, 1] = base_y + along * delta_y + height * delta_x
-        else:
-            points[0, 1] = base_x + along * delta_x + height * delta_y
-            points[1, 1] = base_y + along * delta_y - height * delta_x
+        with np.errstate(invalid="ignore"):  # the end on the base joint (delta 0): NaN, an unreachable pose
+            if branch > 0:
+                points[0, 1] = base_x + along * delta_x - height * delta_y
+                points[1, 1] = base_y + along * delta_y + height * delta_x
+            else:
+                points[0, 1] = base_x + along * delta_x + height * delta_y
+                points[1, 1] = base_y + along * delta_y - height * delta_x
         gap[:] = 0.0
         if not np.all(reachable):
             unreachable = ~reachable

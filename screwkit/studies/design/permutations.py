@@ -7,7 +7,7 @@
 * :func:`family_values` places a planar n-RRR in the family ``planar_rrr``, whose design search
   (the paper's future work) is :mod:`screwkit.studies.design.optimise`.
 
-Evaluations run through Dask (:func:`screwkit.studies.tasks.run_tasks`).
+Evaluations run as tasks (:func:`screwkit.studies.tasks.run_tasks`: local threads, or a Dask cluster).
 """
 
 from __future__ import annotations
