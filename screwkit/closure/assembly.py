@@ -142,18 +142,18 @@ def _check_planar(mechanism: Mechanism, chain: Chain, values: NDArray) -> None:
 def _matching_branch(mechanism: Mechanism, index: int, solver) -> tuple[int, ...] | None:
     """The closed-form branch closest to the reference assembly, if it reproduces it (else None)."""
     chain = mechanism.chains[index]
-    probe = replace(mechanism, chains=mechanism.chains[:index] + (replace(chain, closed_form=solver),)
-                    + mechanism.chains[index + 1:])
     prismatic = np.asarray(chain.geometry.dof_prismatic)
     branches = [tuple(1 if (code >> bit) & 1 == 0 else -1 for bit in range(solver.n_branches))
                 for code in range(2**solver.n_branches)]
     if solver.planar:  # one working mode at a time
+        probe = replace(mechanism, chains=mechanism.chains[:index] + (replace(chain, closed_form=solver),)
+                        + mechanism.chains[index + 1:])
         results = [run_closed_form(probe, index, mechanism.home_full_pose[None], branch) for branch in branches]
         reachable = [bool(result.reachable[0]) for result in results]
         values = [(result.values() if callable(result.values) else result.values)[0] for result in results]
     else:  # every working mode in one batch: the home pose once per mode
         poses = np.repeat(mechanism.home_full_pose[None], len(branches), 0)
-        result = solver.solve(*probe.loop_targets(index, *probe.transforms_from_poses(poses)),
+        result = solver.solve(*mechanism.loop_targets(index, *mechanism.transforms_from_poses(poses)),
                               np.array(branches, dtype=float))
         reachable, values = list(result.reachable), list(result.values)
     best, closest = None, np.inf
