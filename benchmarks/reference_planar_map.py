@@ -10,9 +10,9 @@ line b_i -> d_i it has in the file's reference assembly; a pose is unreachable w
 actuation wrench is the force along the distal link f_i = (d_i - c_i) / l_i through the platform joint d_i (a
 planar wrench f_x, f_y, m_z), ITI = min_i |det [g_i f_i]| (Eqs. 6-7, 23), and for each of the ten 3-chain
 submechanisms one batched 3x3 inverse of its wrench matrix, output twists as its columns (by cofactors: the
-adjugate over the determinant, as the paper's Eq. A3 has one determinant per submechanism; ``--numpy-
-inverse``: np.linalg.inv, about twice the time), zero where the determinant is below 1e-12, OTI_k = |A_k o
-O_k| / |v + w z x d_k| (zero at or below the singularity threshold p = 1 um, the command's default
+adjugate over the determinant, as the paper's Eq. A3 has one determinant per submechanism;
+``--numpy-inverse``: np.linalg.inv, about twice the time), zero where the determinant is below 1e-12, OTI_k =
+|A_k o O_k| / |v + w z x d_k| (zero at or below the singularity threshold p = 1 um, the command's default
 ``--threshold``, Eqs. 26-33), the submechanism's OTI the minimum over its chains; LMTI, F_O1 and F_O2 (Eqs.
 11-13) and F_IOj = min(F_Oj, ITI) (Eq. 14). Each map holds the minimum over phi at every grid point, NaN where
 some orientation is unreachable (and outside the disc). The joints of the bundled file are continuous (no
