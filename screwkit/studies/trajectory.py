@@ -291,7 +291,8 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
                                          series, tolerance)
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
     points = _series_points(s, values, rows, series, minima_at, minima)
-    states = [above(v, np.full(v.shape, k)) for k, (_, v) in enumerate(points)]
+    states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
+              for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
     brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
     where = np.array([k for k, _ in brackets], dtype=np.int64)
     low, high = bisected_crossings(evaluate, np.array([points[k][0][i] for k, i in brackets]),
@@ -354,12 +355,16 @@ def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, ser
 def _series_points(s, values, rows, series, minima_at, minima):
     """Per series: the sample positions and values, with the refined minima inserted in order."""
     points = []
+    columns = np.ascontiguousarray(values.T)
     for k in range(values.shape[1]):
         mine = series == k
-        at = np.concatenate([s, minima_at[mine]])
-        v = np.concatenate([values[:, k], minima[mine]])
-        order = np.argsort(at, kind="stable")
-        points.append((at[order], v[order]))
+        if not mine.any():
+            points.append((s, columns[k]))
+            continue
+        order = np.argsort(minima_at[mine], kind="stable")
+        at, v = minima_at[mine][order], minima[mine][order]
+        where = np.searchsorted(s, at, side="right")  # after the samples at the same arc length, in order
+        points.append((np.insert(s, where, at), np.insert(columns[k], where, v)))
     return points
 
 
