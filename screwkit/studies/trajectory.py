@@ -270,10 +270,16 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     evaluations = [0]
 
     def table(result: Indices) -> NDArray[np.float64]:
-        """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series."""
+        """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series (n, K + 1),
+        a view of an array holding each series in a row (so that each is contiguous)."""
         columns = [remaining_lmti(result, j) for j in faults]
-        reachable = np.where(np.asarray(result.reachable), 1.0, np.nan)[:, None]
-        return np.concatenate([*columns, reachable], axis=1)
+        rows = np.empty((sum(c.shape[1] for c in columns) + 1, len(result.reachable)))
+        at = 0
+        for c in columns:
+            rows[at:at + c.shape[1]] = c.T
+            at += c.shape[1]
+        rows[at] = np.where(np.asarray(result.reachable), 1.0, np.nan)
+        return rows.T
 
     def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
         evaluations[0] += positions.size
