@@ -10,7 +10,8 @@ from typing import Callable, TypeVar
 
 Result = TypeVar("Result")
 
-_PREFIX = "screwkit-chunks"
+CHUNK_THREAD_PREFIX = "screwkit-chunks"
+"""The name of the threads of :func:`chunk_pool` (a call made on one of them runs its chunks in turn)."""
 _POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
 
@@ -23,7 +24,7 @@ def chunk_pool(threads: int) -> ThreadPoolExecutor:
     with _POOLS_LOCK:
         pool = _POOLS.get(key)
         if pool is None:
-            pool = _POOLS[key] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix=_PREFIX)
+            pool = _POOLS[key] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix=CHUNK_THREAD_PREFIX)
         return pool
 
 
@@ -41,6 +42,6 @@ def map_chunks(function: Callable[[slice], Result], count: int, chunk_size: int,
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     chunk_size = max(1, min(chunk_size, -(-count // threads)))
     parts = [slice(start, min(start + chunk_size, count)) for start in range(0, count, chunk_size)]
-    if threads > 1 and len(parts) > 1 and not threading.current_thread().name.startswith(_PREFIX):
+    if threads > 1 and len(parts) > 1 and not threading.current_thread().name.startswith(CHUNK_THREAD_PREFIX):
         return list(chunk_pool(int(threads)).map(function, parts))
     return [function(part) for part in parts]
