@@ -247,16 +247,19 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=False)[0]
 
 
-def indices_and_joint_values(mechanism: Mechanism, poses: ArrayLike, **settings
+def indices_and_joint_values(mechanism: Mechanism, poses: ArrayLike, *, tree_only: bool = False, **settings
                              ) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
     """:func:`indices_at_poses` (the same keywords), and per chain the joint values (..., m_i) of the closures
     it solved (:attr:`~screwkit.closure.Solution.joint_values`; NaN where the chain does not close), which a
-    path needs to see its working mode (:mod:`screwkit.studies.branches`) without solving the closures twice."""
-    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=True)
+    path needs to see its working mode (:mod:`screwkit.studies.branches`) without solving the closures twice.
+    With ``tree_only``, only the values of each chain's tree joints (..., t_i), the first ``t_i``: all that a
+    branch change is seen on (half the memory for a leg closed by a spherical joint)."""
+    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values="tree" if tree_only else True)
 
 
-def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, keep_joint_values: bool):
-    """The work of :func:`indices_at_poses`, chunk by chunk, keeping the joint values when asked."""
+def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, keep_joint_values: bool | str):
+    """The work of :func:`indices_at_poses`, chunk by chunk, keeping the joint values when asked (``"tree"``: of
+    the tree joints only)."""
     unknown = set(settings) - set(_SETTINGS)
     if unknown:
         raise TypeError(f"Unknown keyword(s) of indices_at_poses: {', '.join(sorted(unknown))}.")
@@ -279,8 +282,9 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     full_poses = np.empty((count, mechanism.n_pose))
     arrays: dict = {}
     meta: Indices | None = None
-    joint_values = [np.full((count, chain.geometry.n_dofs), np.nan) for chain in mechanism.chains] \
-        if keep_joint_values else None
+    kept_joints = [chain.geometry.n_tree_joints if keep_joint_values == "tree" else chain.geometry.n_dofs
+                   for chain in mechanism.chains]
+    joint_values = [np.full((count, joints), np.nan) for joints in kept_joints] if keep_joint_values else None
 
     def chunk(part: slice):
         """The closures of one chunk and the indices of its reachable poses (None if it has none)."""
@@ -301,8 +305,8 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
             chain_status[part] = solution.status
             full_poses[part] = solution.full_poses
             if joint_values is not None:
-                for kept, values in zip(joint_values, solution.joint_values):
-                    kept[part] = values
+                for kept, values, joints in zip(joint_values, solution.joint_values, kept_joints):
+                    kept[part] = values[..., :joints]
             if result is not None:
                 meta = result
                 _scatter(arrays, count, index, result)
@@ -328,7 +332,7 @@ def _chunks_in_order(chunk: Callable, parts: list[slice], threads: int | None):
 
     With ``threads`` (default: every core) above one and at least :data:`CHUNKS_PER_THREAD` chunks per thread,
     the chunks run side by side on the threads kept for the process
-    (:func:`~screwkit.common.chunks.chunk_pool`), at most two per thread at a time (their memory bounded),
+    (:func:`~screwkit.common.chunks.chunk_pool`), one more than the threads at a time (their memory bounded),
     each on its thread alone: the closures and screws in one block of threads, and the index kernel's cuts of
     the chunk (:func:`~screwkit.common.chunks.map_chunks`, the same cuts as on several threads) in turn, so that
     every number is the one a chunk at a time gives. The closures and screws then run on every core, not only
@@ -347,7 +351,7 @@ def _chunks_in_order(chunk: Callable, parts: list[slice], threads: int | None):
     pending = deque()
     waiting = iter(parts)
     try:
-        for part in islice(waiting, 2 * workers):
+        for part in islice(waiting, workers + 1):
             pending.append(pool.submit(alone, part))
         while pending:
             done = pending.popleft().result()
