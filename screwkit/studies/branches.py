@@ -89,15 +89,29 @@ def suspect_segments(steps: NDArray, lengths: NDArray) -> NDArray[np.bool_]:
     where the chain does not close) are not suspected, nor used as neighbours."""
     with np.errstate(invalid="ignore", divide="ignore"):
         rates = np.where(lengths[:, None] > 0, steps / lengths[:, None], np.nan)
-    previous = np.concatenate([np.full((1, steps.shape[1]), np.nan), rates[:-1]])
-    following = np.concatenate([rates[1:], np.full((1, steps.shape[1]), np.nan)])
-    neighbours = np.stack([previous, following])
-    known = np.all(np.isfinite(neighbours), axis=-1)  # (2, n - 1)
-    count = known.sum(axis=0)
-    mean_rate = np.where(known[..., None], neighbours, 0.0).sum(axis=0) / np.maximum(count, 1)[:, None]
-    predicted = mean_rate * lengths[:, None]
-    miss = np.max(np.abs(steps - predicted), axis=-1)
-    return np.isfinite(miss) & (miss > np.max(np.abs(predicted), axis=-1) + STEP_FLOOR)
+    # the same sums and maxima as over the stacked neighbours, taken column by column (a chain has few joints)
+    finite = np.ones(rates.shape[0], dtype=bool)
+    for column in rates.T:
+        finite &= np.isfinite(column)
+    previous, following = np.zeros_like(rates), np.zeros_like(rates)
+    previous[1:] = np.where(finite[:-1, None], rates[:-1], 0.0)
+    following[:-1] = np.where(finite[1:, None], rates[1:], 0.0)
+    count = np.zeros(rates.shape[0], dtype=np.int64)
+    count[1:] += finite[:-1]
+    count[:-1] += finite[1:]
+    predicted = (previous + following) / np.maximum(count, 1)[:, None] * lengths[:, None]
+    miss = _row_max(np.abs(steps - predicted))
+    return np.isfinite(miss) & (miss > _row_max(np.abs(predicted)) + STEP_FLOOR)
+
+
+def _row_max(values: NDArray) -> NDArray[np.float64]:
+    """The maximum of each row (NaN if any is NaN), a column at a time."""
+    if values.shape[-1] == 0:
+        return np.max(values, axis=-1)
+    largest = values[:, 0].copy()
+    for column in values.T[1:]:
+        np.maximum(largest, column, out=largest)
+    return largest
 
 
 def branch_changes(mechanism: Mechanism, arc_length: NDArray, joint_values, solve_at: Callable,

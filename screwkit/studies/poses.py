@@ -9,7 +9,12 @@ and returns one :class:`~screwkit.indices.results.Indices` with NaN where a pose
 
 from __future__ import annotations
 
+import os
+import threading
+from collections import deque
+from concurrent.futures import wait
 from dataclasses import dataclass, replace
+from itertools import islice
 from math import comb
 from typing import TYPE_CHECKING, Callable
 
@@ -17,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure import chain_screws, solve, solve_one, thread_limit, working_modes
+from screwkit.common.chunks import CHUNK_THREAD_PREFIX, chunk_pool
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
@@ -241,16 +247,19 @@ def indices_at_poses(mechanism: Mechanism, poses: ArrayLike, *, detail: bool = F
     return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=False)[0]
 
 
-def indices_and_joint_values(mechanism: Mechanism, poses: ArrayLike, **settings
+def indices_and_joint_values(mechanism: Mechanism, poses: ArrayLike, *, tree_only: bool = False, **settings
                              ) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
     """:func:`indices_at_poses` (the same keywords), and per chain the joint values (..., m_i) of the closures
     it solved (:attr:`~screwkit.closure.Solution.joint_values`; NaN where the chain does not close), which a
-    path needs to see its working mode (:mod:`screwkit.studies.branches`) without solving the closures twice."""
-    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values=True)
+    path needs to see its working mode (:mod:`screwkit.studies.branches`) without solving the closures twice.
+    With ``tree_only``, only the values of each chain's tree joints (..., t_i), the first ``t_i``: all that a
+    branch change is seen on (half the memory for a leg closed by a spherical joint)."""
+    return _indices_in_chunks(mechanism, poses, settings, keep_joint_values="tree" if tree_only else True)
 
 
-def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, keep_joint_values: bool):
-    """The work of :func:`indices_at_poses`, chunk by chunk, keeping the joint values when asked."""
+def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, keep_joint_values: bool | str):
+    """The work of :func:`indices_at_poses`, chunk by chunk, keeping the joint values when asked (``"tree"``: of
+    the tree joints only)."""
     unknown = set(settings) - set(_SETTINGS)
     if unknown:
         raise TypeError(f"Unknown keyword(s) of indices_at_poses: {', '.join(sorted(unknown))}.")
@@ -273,27 +282,32 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     full_poses = np.empty((count, mechanism.n_pose))
     arrays: dict = {}
     meta: Indices | None = None
-    joint_values = [np.full((count, chain.geometry.n_dofs), np.nan) for chain in mechanism.chains] \
-        if keep_joint_values else None
+    kept_joints = [chain.geometry.n_tree_joints if keep_joint_values == "tree" else chain.geometry.n_dofs
+                   for chain in mechanism.chains]
+    joint_values = [np.full((count, joints), np.nan) for joints in kept_joints] if keep_joint_values else None
+
+    def chunk(part: slice):
+        """The closures of one chunk and the indices of its reachable poses (None if it has none)."""
+        solution = solve(mechanism, flat[part], limits=limits)
+        if not np.any(solution.reachable):
+            return solution, None
+        if closed_forms:
+            return solution, replace(closed_form_indices(mechanism, solution, threshold, faults, threads),
+                                     fault_type=fault_type)  # the same numbers for both types on these chains
+        return solution, analyze_solution(mechanism, solution, unreachable="drop", detail=detail,
+                                          threshold=threshold, faults=faults, threads=threads, fault_type=fault_type)
+
+    parts = [slice(start, min(start + chunk_size, count)) for start in range(0, count, chunk_size)]
     with thread_limit(threads):  # closures and screws on no more threads than the kernel
-        for start in range(0, count, chunk_size):
-            part = slice(start, min(start + chunk_size, count))
-            solution = solve(mechanism, flat[part], limits=limits)
-            index = np.flatnonzero(np.asarray(solution.reachable)) + start
+        for part, (solution, result) in zip(parts, _chunks_in_order(chunk, parts, threads)):
+            index = np.flatnonzero(np.asarray(solution.reachable)) + part.start
             reachable[index] = True
             chain_status[part] = solution.status
             full_poses[part] = solution.full_poses
             if joint_values is not None:
-                for kept, values in zip(joint_values, solution.joint_values):
-                    kept[part] = values
-            if index.size:
-                if closed_forms:
-                    result = replace(closed_form_indices(mechanism, solution, threshold, faults, threads),
-                                     fault_type=fault_type)  # the same numbers for both types on these chains
-                else:
-                    result = analyze_solution(mechanism, solution, unreachable="drop", detail=detail,
-                                              threshold=threshold, faults=faults, threads=threads,
-                                              fault_type=fault_type)
+                for kept, values, joints in zip(joint_values, solution.joint_values, kept_joints):
+                    kept[part] = values[..., :joints]
+            if result is not None:
                 meta = result
                 _scatter(arrays, count, index, result)
             if progress is not None:
@@ -306,6 +320,49 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     if joint_values is None:
         return result, None
     return result, tuple(values.reshape(batch + values.shape[-1:]) for values in joint_values)
+
+
+CHUNKS_PER_THREAD = 4
+"""A batch of at least this many chunks per thread has its chunks computed side by side, a chunk per thread
+(:func:`_chunks_in_order`), as a map's tasks are; a smaller one a chunk at a time, each on every thread."""
+
+
+def _chunks_in_order(chunk: Callable, parts: list[slice], threads: int | None):
+    """``chunk(part)`` for every part, yielded in order.
+
+    With ``threads`` (default: every core) above one and at least :data:`CHUNKS_PER_THREAD` chunks per thread,
+    the chunks run side by side on the threads kept for the process
+    (:func:`~screwkit.common.chunks.chunk_pool`), one more than the threads at a time (their memory bounded),
+    each on its thread alone: the closures and screws in one block of threads, and the index kernel's cuts of
+    the chunk (:func:`~screwkit.common.chunks.map_chunks`, the same cuts as on several threads) in turn, so that
+    every number is the one a chunk at a time gives. The closures and screws then run on every core, not only
+    the index kernel, and no thread waits for another between chunks."""
+    workers = (os.cpu_count() or 1) if threads is None else int(threads)
+    inside = threading.current_thread().name.startswith(CHUNK_THREAD_PREFIX)
+    if workers <= 1 or len(parts) < CHUNKS_PER_THREAD * workers or inside:
+        yield from (chunk(part) for part in parts)
+        return
+
+    def alone(part: slice):
+        with thread_limit(1):
+            return chunk(part)
+
+    pool = chunk_pool(workers)
+    pending = deque()
+    waiting = iter(parts)
+    try:
+        for part in islice(waiting, workers + 1):
+            pending.append(pool.submit(alone, part))
+        while pending:
+            done = pending.popleft().result()
+            following = next(waiting, None)
+            if following is not None:
+                pending.append(pool.submit(alone, following))
+            yield done
+    finally:  # an error (or a caller that stops early): nothing left running
+        for future in pending:
+            future.cancel()
+        wait(pending)
 
 
 _SETTINGS = dict(detail=False, threshold=SINGULARITY_THRESHOLD, faults=None, chunk_size=None, progress=None,

@@ -36,11 +36,18 @@ def local_minima(values: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArra
     side and not above the other neighbour, with a value above zero (a zero is already the lowest): the dips a
     finer sampling could find lower. The first and last samples count when below their one neighbour.
     Returns ``(rows, series)``."""
-    finite = np.where(np.isfinite(values), values, np.inf)
-    before = np.vstack([np.full((1, values.shape[1]), np.inf), finite[:-1]])
-    after = np.vstack([finite[1:], np.full((1, values.shape[1]), np.inf)])
-    dip = (finite <= before) & (finite <= after) & ((finite < before) | (finite < after))
-    dip &= np.isfinite(finite) & (finite > 0)
+    values = np.asarray(values, dtype=float)
+    finite = np.isfinite(values)
+    dip = finite & (values > 0)
+    if not finite.all():
+        values = np.where(finite, values, np.inf)
+    # against each neighbour (+infinity where there is none, at the ends): not above either, below one
+    below = np.ones_like(dip)
+    if values.shape[0] > 1:
+        dip[1:] &= values[1:] <= values[:-1]
+        dip[:-1] &= values[:-1] <= values[1:]
+        below[1:-1] = (values[1:-1] < values[:-2]) | (values[1:-1] < values[2:])
+    dip &= below
     rows, series = np.nonzero(dip)
     return rows.astype(np.int64), series.astype(np.int64)
 

@@ -264,34 +264,44 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
         raise ValueError(f"Expected a tolerance > 0 (m of arc length), got {tolerance!r}.")
 
     keywords = dict(analysis.keywords(), detail=True, threads=threads)
-    samples, joint_values = indices_and_joint_values(mechanism, path.poses, **keywords)
+    samples, joint_values = indices_and_joint_values(mechanism, path.poses, tree_only=True, **keywords)
     faults = samples.faults
     failed_sets = [(j, failed) for j in faults for failed in samples.failed_sets(j)]
     evaluations = [0]
 
     def table(result: Indices) -> NDArray[np.float64]:
-        """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series."""
+        """Per pose, the LMTI left after every set of failures, then 1 (reachable) or NaN: the series (n, K + 1),
+        a view of an array holding each series in a row (so that each is contiguous)."""
         columns = [remaining_lmti(result, j) for j in faults]
-        reachable = np.where(np.asarray(result.reachable), 1.0, np.nan)[:, None]
-        return np.concatenate([*columns, reachable], axis=1)
+        rows = np.empty((sum(c.shape[1] for c in columns) + 1, len(result.reachable)))
+        at = 0
+        for c in columns:
+            rows[at:at + c.shape[1]] = c.T
+            at += c.shape[1]
+        rows[at] = np.where(np.asarray(result.reachable), 1.0, np.nan)
+        return rows.T
 
     def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
         evaluations[0] += positions.size
         return table(indices_at_poses(mechanism, path.at(positions), **keywords))[np.arange(positions.size), series]
 
-    values = table(samples)
-    reach_series = values.shape[1] - 1
+    # the series at the samples, as views of the indices' own arrays (a column each; no copy of them all)
+    blocks = [remaining_lmti(samples, j) for j in faults]
+    columns = [block[:, c] for block in blocks for c in range(block.shape[1])]
+    columns.append(np.where(np.asarray(samples.reachable), 1.0, np.nan))
+    reach_series = len(columns) - 1
 
     def above(found: NDArray, series: NDArray) -> NDArray[np.bool_]:
         return np.where(series == reach_series, np.isfinite(found), np.nan_to_num(found, nan=-np.inf) >= level)
 
     s = path.arc_length
-    rows, series = local_minima(values[:, :reach_series])
+    rows, series = _local_minima_of_blocks(blocks)
     minima_at, minima = bracketed_minima(evaluate, s[np.maximum(rows - 1, 0)], s[np.minimum(rows + 1, len(s) - 1)],
                                          series, tolerance)
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
-    points = _series_points(s, values, rows, series, minima_at, minima)
-    states = [above(v, np.full(v.shape, k)) for k, (_, v) in enumerate(points)]
+    points = _series_points(s, columns, rows, series, minima_at, minima)
+    states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
+              for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
     brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
     where = np.array([k for k, _ in brackets], dtype=np.int64)
     low, high = bisected_crossings(evaluate, np.array([points[k][0][i] for k, i in brackets]),
@@ -304,7 +314,7 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
         controllable, lost = _stretches(at, states[k], {i: crossing[(kk, i)] for kk, i in brackets if kk == k})
         finite = np.isfinite(v)
         lowest = int(np.argmin(np.where(finite, v, np.inf)))
-        zeros = np.concatenate([s[values[:, k] == 0], minima_at[(series == k) & singular]])
+        zeros = np.concatenate([s[columns[k] == 0], minima_at[(series == k) & singular]])
         cases.append(FaultCase(j, tuple(samples.actuators[i] for i in failed), controllable, lost,
                                float(lost[0, 0]) if len(lost) else None,
                                float(v[lowest]) if finite.any() else np.nan, float(at[lowest]),
@@ -351,15 +361,30 @@ def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, ser
     return np.isfinite(minima) & (minima <= rise)
 
 
-def _series_points(s, values, rows, series, minima_at, minima):
-    """Per series: the sample positions and values, with the refined minima inserted in order."""
+def _local_minima_of_blocks(blocks: list[NDArray]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`~screwkit.studies.refinement.local_minima` of the blocks (n, C_j) side by side, in its order (by row,
+    then series), without putting them side by side."""
+    found = [local_minima(block) for block in blocks]
+    offsets = np.cumsum([0] + [block.shape[1] for block in blocks])
+    rows = np.concatenate([np.zeros(0, dtype=np.int64)] + [r for r, _ in found])
+    series = np.concatenate([np.zeros(0, dtype=np.int64)] + [c + o for (_, c), o in zip(found, offsets)])
+    order = np.lexsort((series, rows))
+    return rows[order], series[order]
+
+
+def _series_points(s, columns, rows, series, minima_at, minima):
+    """Per series (``columns``, its values at the samples): the sample positions and values, with the refined
+    minima inserted in order."""
     points = []
-    for k in range(values.shape[1]):
+    for k in range(len(columns)):
         mine = series == k
-        at = np.concatenate([s, minima_at[mine]])
-        v = np.concatenate([values[:, k], minima[mine]])
-        order = np.argsort(at, kind="stable")
-        points.append((at[order], v[order]))
+        if not mine.any():
+            points.append((s, columns[k]))
+            continue
+        order = np.argsort(minima_at[mine], kind="stable")
+        at, v = minima_at[mine][order], minima[mine][order]
+        where = np.searchsorted(s, at, side="right")  # after the samples at the same arc length, in order
+        points.append((np.insert(s, where, at), np.insert(columns[k], where, v)))
     return points
 
 

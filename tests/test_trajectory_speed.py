@@ -1,0 +1,118 @@
+"""What was made faster for a long path (issue 29) gives the numbers and bytes it gave before.
+
+Each faster way is checked against the plain definition it replaced, bit for bit: chunks side by side against
+a chunk at a time, the local minima and the branch screening against their stacked forms, a CSV read straight
+from the file against its whole text, the streamed netCDF writer against scipy's own.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers import bundled
+from screwkit.studies import netcdf, poses
+from screwkit.studies.branches import STEP_FLOOR, suspect_segments
+from screwkit.studies.netcdf import PlainDataset
+from screwkit.studies.paths import _read_csv_text, _read_plain_csv, read_path
+from screwkit.studies.refinement import local_minima
+
+
+def _stacked_local_minima(values):
+    finite = np.where(np.isfinite(values), values, np.inf)
+    before = np.vstack([np.full((1, values.shape[1]), np.inf), finite[:-1]])
+    after = np.vstack([finite[1:], np.full((1, values.shape[1]), np.inf)])
+    dip = (finite <= before) & (finite <= after) & ((finite < before) | (finite < after))
+    dip &= np.isfinite(finite) & (finite > 0)
+    return np.nonzero(dip)
+
+
+def _stacked_suspects(steps, lengths):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rates = np.where(lengths[:, None] > 0, steps / lengths[:, None], np.nan)
+    previous = np.concatenate([np.full((1, steps.shape[1]), np.nan), rates[:-1]])
+    following = np.concatenate([rates[1:], np.full((1, steps.shape[1]), np.nan)])
+    neighbours = np.stack([previous, following])
+    known = np.all(np.isfinite(neighbours), axis=-1)
+    mean_rate = np.where(known[..., None], neighbours, 0.0).sum(axis=0) / np.maximum(known.sum(axis=0), 1)[:, None]
+    predicted = mean_rate * lengths[:, None]
+    miss = np.max(np.abs(steps - predicted), axis=-1)
+    return np.isfinite(miss) & (miss > np.max(np.abs(predicted), axis=-1) + STEP_FLOOR)
+
+
+def test_local_minima_and_branch_screening_are_their_stacked_definitions():
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        values = rng.choice([0.0, -1.0, 0.25, 0.5, 1.0, 2.0, np.nan, np.inf, -np.inf], size=rng.integers(1, 8, 2))
+        found = local_minima(values)
+        for got, wanted in zip(found, _stacked_local_minima(values)):
+            np.testing.assert_array_equal(got, wanted)
+        steps = rng.choice([0.0, -0.0, 1e-10, 0.1, -0.3, 1.0, np.nan, 5.0], size=rng.integers(1, 8, 2))
+        lengths = rng.choice([0.0, 1e-9, 0.1, 1.0], size=steps.shape[0])
+        np.testing.assert_array_equal(suspect_segments(steps, lengths), _stacked_suspects(steps, lengths))
+
+
+@pytest.mark.parametrize("name, count, chunk", [("ups_hexapod_8", 9000, 1024), ("delta_4", 5000, 600)])
+def test_chunks_side_by_side_give_the_numbers_of_a_chunk_at_a_time(monkeypatch, name, count, chunk):
+    """Many chunks on two threads, each alone on its thread, against the same chunks one at a time (the index
+    kernel's cuts the same: below 512 configurations for the Delta, where its motion spaces take numpy)."""
+    mechanism = bundled(name)
+    rng = np.random.default_rng(3)
+    home = np.asarray(mechanism.home_pose, dtype=float)
+    spread = np.where(mechanism.angular, np.deg2rad(5.0), 0.03)
+    batch = home + rng.uniform(-1, 1, (count, home.size)) * spread
+    side_by_side, joints = poses.indices_and_joint_values(mechanism, batch, detail=True, chunk_size=chunk, threads=2)
+    monkeypatch.setattr(poses, "CHUNKS_PER_THREAD", 10**9)
+    in_turn, joints_in_turn = poses.indices_and_joint_values(mechanism, batch, detail=True, chunk_size=chunk,
+                                                             threads=2)
+    assert np.count_nonzero(in_turn.reachable) > count // 2
+    for field in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "reachable", "chain_status", "full_poses"):
+        assert np.asarray(getattr(side_by_side, field)).tobytes() == np.asarray(getattr(in_turn, field)).tobytes()
+    for j in in_turn.faults:
+        assert side_by_side.f_o[j].tobytes() == in_turn.f_o[j].tobytes()
+        assert side_by_side.remaining_lmti[j].tobytes() == in_turn.remaining_lmti[j].tobytes()
+    for a, b in zip(joints, joints_in_turn):
+        assert a.tobytes() == b.tobytes()
+    _, tree = poses.indices_and_joint_values(mechanism, batch[:chunk], tree_only=True)
+    _, full = poses.indices_and_joint_values(mechanism, batch[:chunk])
+    for values, chain, every in zip(tree, mechanism.chains, full):
+        assert values.shape == (chunk, chain.geometry.n_tree_joints)
+        assert values.tobytes() == np.ascontiguousarray(every[:, :chain.geometry.n_tree_joints]).tobytes()
+
+
+def test_a_plain_csv_read_from_the_file_is_read_as_from_its_text(tmp_path):
+    hexapod = bundled("ups_hexapod_8")
+    rng = np.random.default_rng(5)
+    rows = np.asarray(hexapod.home_pose) + rng.normal(0, 0.01, (300, 6))
+    rows[:, 3:] = np.rad2deg(rows[:, 3:])
+    file = tmp_path / "path.csv"
+    np.savetxt(file, np.column_stack([np.arange(300.0), rows, rng.random(300)]), delimiter=",",
+               header="t,x,y,z,roll,pitch,yaw,other", comments="\n")  # a blank line before the header
+    wanted = (*hexapod.task_coordinates, "t")
+    plain, text = _read_plain_csv(str(file), wanted), _read_csv_text(str(file), wanted)
+    assert plain is not None and plain.keys() == text.keys()
+    for column in plain:
+        assert plain[column][1:] == text[column][1:]
+        assert (plain[column][0] is None) == (text[column][0] is None)
+        if plain[column][0] is not None:
+            assert plain[column][0].tobytes() == text[column][0].tobytes()
+    np.testing.assert_array_equal(read_path(hexapod, file).poses[:, :3], rows[:, :3])
+    file.write_bytes(file.read_bytes().replace(b"\n", b"\r\n"))  # another line end: read as a whole text
+    assert _read_plain_csv(str(file), wanted) is None
+    np.testing.assert_array_equal(read_path(hexapod, file).poses[:, :3], rows[:, :3])
+
+
+def test_the_streamed_netcdf_writer_writes_scipys_bytes(tmp_path, monkeypatch):
+    rng = np.random.default_rng(9)
+    n = netcdf.STREAM_BLOCK + 123  # more than one block
+    dataset = PlainDataset(
+        {"value": ("sample", rng.random(n), {"units": "m"}), "table": (("sample", "k"), rng.random((n, 3))),
+         "flag": ("sample", rng.random(n) > 0.5), "count": ("sample", rng.integers(-5, 5, n)),
+         "name": ("k", np.array(["a", "bb", "ccc"]))},
+        {"sample": ("sample", np.arange(n, dtype=float)), "k": ("k", np.arange(3))}, {"title": "x", "level": 0.4})
+    dataset.write_netcdf(tmp_path / "streamed.nc")
+    from scipy.io import netcdf_file
+
+    monkeypatch.setattr(netcdf, "_WRITER", netcdf_file)
+    dataset.write_netcdf(tmp_path / "scipy.nc")
+    assert (tmp_path / "streamed.nc").read_bytes() == (tmp_path / "scipy.nc").read_bytes()
