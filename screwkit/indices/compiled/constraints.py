@@ -36,13 +36,23 @@ _SIGNATURE = ("void(float64[:, :, ::1], int64[::1], int64[::1], int64, float64[:
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def constraint_rank(constraints, index, count, tolerance, columns, scratch):
     """Rank of the unit constraint wrenches constraints[index, :count]: singular values above ``tolerance`` times
-    the largest (``numpy.linalg.svd`` of the unit rows). ``scratch``: vectors (6, 6), norms (6), order (6, int),
+    the largest (``numpy.linalg.svd`` of the unit rows). Six of them or fewer are rotated as the columns of their
+    transpose (fewer pairs than the six components'). ``scratch``: vectors (6, 6), norms (6), order (6, int),
     singular (6), right (6, 6)."""
     vectors, norms, order, singular, right = scratch
     unit_columns(constraints, index, 0, count, columns)
-    singular_vectors(columns, count, 6, NULL_COLUMN * NULL_COLUMN * count, vectors, norms, order, singular, right)
+    width = min(count, 6)
+    if count <= 6:
+        for j in range(count):  # transposed in place: the lower triangle first, the rest below it
+            for k in range(j + 1, 6):
+                columns[j, k], columns[k, j] = columns[k, j], columns[j, k]
+        singular_vectors(columns, 6, count, NULL_COLUMN * NULL_COLUMN * count, vectors, norms, order, singular,
+                         right)
+    else:
+        singular_vectors(columns, count, 6, NULL_COLUMN * NULL_COLUMN * count, vectors, norms, order, singular,
+                         right)
     rank = 0
-    for i in range(6):
+    for i in range(width):
         if singular[i] > tolerance * max(singular[0], 1e-300):
             rank += 1
     return rank
@@ -104,81 +114,132 @@ def own_wrenches(constraints, index, wrench_start, own_counts, common, own, shar
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def system_rows(wrenches, index, actuators, own, own_counts, members, shared, common, system):
-    """system[:6] = the actuation wrenches of one actuator set, the own constraint wrenches of the chains of one
-    subsystem (in chain order) and the common ones; returns the product of the rows' norms (the volume)."""
-    row = 0
-    for k in range(actuators.shape[0]):
+def held_rows(wrenches, index, actuators, shared, common, rows):
+    """rows[:n + common] = the actuation wrenches of one actuator set and the common constraint wrenches (what
+    every subsystem keeps); returns the product of their norms."""
+    n = actuators.shape[0]
+    for k in range(n):
         for p in range(6):
-            system[row, p] = wrenches[index, actuators[k], p]
-        row += 1
-    for c in range(own_counts.shape[0]):
-        if members[c]:
-            for r in range(own_counts[c]):
-                for p in range(6):
-                    system[row, p] = own[c, r, p]
-                row += 1
+            rows[k, p] = wrenches[index, actuators[k], p]
     for r in range(common):
         for p in range(6):
-            system[row, p] = shared[r, p]
-        row += 1
+            rows[n + r, p] = shared[r, p]
     volume = 1.0
-    for r in range(6):
+    for r in range(n + common):
         total = 0.0
         for p in range(6):
-            total += system[r, p] * system[r, p]
+            total += rows[r, p] * rows[r, p]
         volume *= np.sqrt(total)
     return volume
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def factor(system, permutation):
-    """LU factorisation with partial pivoting of the 6 x 6 ``system`` in place (``P system = L U``, the row
+def complement(rows, size, reflectors, basis):
+    """basis[:, :6 - size] = an orthonormal basis of the vectors orthogonal to rows[:size] (Householder QR of
+    their transpose, the reflectors' vectors in ``reflectors``); returns the product of the magnitudes of R's
+    diagonal, sqrt(det(rows rows^T)), zero when the rows are dependent."""
+    volume = 1.0
+    for j in range(size):  # reflector j: from the rows, with the earlier reflectors applied
+        for i in range(6):
+            reflectors[j, i] = rows[j, i]
+        for earlier in range(j):
+            along = 0.0
+            for i in range(earlier, 6):
+                along += reflectors[earlier, i] * reflectors[j, i]
+            for i in range(earlier, 6):
+                reflectors[j, i] -= 2.0 * along * reflectors[earlier, i]
+        norm = 0.0
+        for i in range(j, 6):
+            norm += reflectors[j, i] * reflectors[j, i]
+        norm = np.sqrt(norm)
+        if norm == 0.0:
+            return 0.0
+        volume *= norm
+        alpha = -norm if reflectors[j, j] >= 0.0 else norm
+        for i in range(j):
+            reflectors[j, i] = 0.0
+        reflectors[j, j] -= alpha
+        scale = np.sqrt(2.0 * norm * (norm + abs(reflectors[j, j] + alpha)))  # |v| (v = x - alpha e_j)
+        for i in range(j, 6):
+            reflectors[j, i] /= scale
+    for k in range(6 - size):  # Q e_(size + k) = H_0 ... H_(size - 1) e_(size + k)
+        for i in range(6):
+            basis[i, k] = 1.0 if i == size + k else 0.0
+        for j in range(size - 1, -1, -1):
+            along = 0.0
+            for i in range(j, 6):
+                along += reflectors[j, i] * basis[i, k]
+            for i in range(j, 6):
+                basis[i, k] -= 2.0 * along * reflectors[j, i]
+    return volume
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def own_in_complement(own, own_counts, basis, size, reduced):
+    """reduced[r, :size] = each chain's own wrench r (chains in turn) in the basis of the complement of the held
+    rows (:func:`complement`): for a subsystem, the square block of the system the held rows leave."""
+    row = 0
+    for c in range(own_counts.shape[0]):
+        for r in range(own_counts[c]):
+            for k in range(size):
+                total = 0.0
+                for p in range(6):
+                    total += own[c, r, p] * basis[p, k]
+                reduced[row, k] = total
+            row += 1
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def factor(matrix, size, permutation):
+    """LU factorisation with partial pivoting of matrix[:size, :size] in place (``P matrix = L U``, the row
     permutation in ``permutation``), as LAPACK's getrf; returns the determinant (zero at a zero pivot)."""
     determinant = 1.0
-    for i in range(6):
+    for i in range(size):
         permutation[i] = i
-    for k in range(6):
-        pivot, best = k, abs(system[k, k])
-        for i in range(k + 1, 6):
-            if abs(system[i, k]) > best:
-                pivot, best = i, abs(system[i, k])
+    for k in range(size):
+        pivot, best = k, abs(matrix[k, k])
+        for i in range(k + 1, size):
+            if abs(matrix[i, k]) > best:
+                pivot, best = i, abs(matrix[i, k])
         if best == 0.0:
             return 0.0
         if pivot != k:
-            for j in range(6):
-                system[k, j], system[pivot, j] = system[pivot, j], system[k, j]
+            for j in range(size):
+                matrix[k, j], matrix[pivot, j] = matrix[pivot, j], matrix[k, j]
             permutation[k], permutation[pivot] = permutation[pivot], permutation[k]
             determinant = -determinant
-        determinant *= system[k, k]
-        for i in range(k + 1, 6):
-            system[i, k] /= system[k, k]
-            for j in range(k + 1, 6):
-                system[i, j] -= system[i, k] * system[k, j]
+        determinant *= matrix[k, k]
+        for i in range(k + 1, size):
+            matrix[i, k] /= matrix[k, k]
+            for j in range(k + 1, size):
+                matrix[i, j] -= matrix[i, k] * matrix[k, j]
     return determinant
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def freed_twists(lu, permutation, start, size, freed, column):
-    """freed[:, j] (j < size) = column start + j of the inverse of the factored system, its halves swapped: the
-    twist reciprocal to every row but row start + j (chain's wrench j). Orthonormalised (Gram-Schmidt, twice)
-    when the chain holds several (the same span, as the numpy path's QR)."""
-    for j in range(size):
-        for i in range(6):  # L y = P e_(start + j)
+def freed_twists(lu, permutation, size, start, count, basis, freed, column):
+    """freed[:, j] (j < count) = the twist reciprocal to every wrench of the system but the chain's own wrench j
+    (row start + j of the factored square block ``lu``, size x size): ``basis`` times column start + j of the
+    block's inverse, its halves swapped. Orthonormalised (Gram-Schmidt, twice) when the chain holds several
+    (the same span, as the numpy path's QR)."""
+    for j in range(count):
+        for i in range(size):  # L y = P e_(start + j)
             total = 1.0 if permutation[i] == start + j else 0.0
             for k in range(i):
                 total -= lu[i, k] * column[k]
             column[i] = total
-        for i in range(5, -1, -1):  # U x = y
+        for i in range(size - 1, -1, -1):  # U x = y
             total = column[i]
-            for k in range(i + 1, 6):
+            for k in range(i + 1, size):
                 total -= lu[i, k] * column[k]
             column[i] = total / lu[i, i]
-        for i in range(3):
-            freed[i, j] = column[i + 3]
-            freed[i + 3, j] = column[i]
-    if size > 1:
-        for j in range(size):
+        for i in range(6):
+            total = 0.0
+            for k in range(size):
+                total += basis[i, k] * column[k]
+            freed[(i + 3) % 6, j] = total
+    if count > 1:
+        for j in range(count):
             for _ in range(2):
                 for i in range(j):
                     along = 0.0
@@ -259,27 +320,38 @@ def coefficient(wrench, twist, point, threshold, pure_couple):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def subsystem_cti(index, system, own_counts, members, own, points, threshold, tolerances, work):
-    """:math:`CTI_{N,L}` of one configuration, actuator set and subsystem, its six wrenches in ``system`` (of
-    product of norms ``volume``): zero when they do not span every wrench, else the lowest power coefficient of a
-    released constraint wrench on the twist it frees (as ``_subsystem_cti``)."""
-    volume, rank_tolerance, pure_couple, start = tolerances
-    permutation, freed, column, pairing, wrenches, twists, exists, scratch = work
-    determinant = factor(system, permutation)
+def subsystem_cti(index, own_counts, members, own, points, threshold, held, work):
+    """:math:`CTI_{N,L}` of one configuration, actuator set and subsystem ``members``: zero when the set's and the
+    subsystem's wrenches do not span every wrench, else the lowest power coefficient of a released constraint
+    wrench on the twist it frees (as ``_subsystem_cti``). ``held``: the product of the held rows' norms and
+    their sqrt(det(rows rows^T)) (:func:`complement`), the size of the complement, the tolerances."""
+    volume, held_volume, size, rank_tolerance, pure_couple = held
+    permutation, basis, reduced, block, freed, column, pairing, wrenches, twists, exists, scratch = work
+    row, chain_row = 0, 0
+    for c in range(own_counts.shape[0]):  # the square block: the subsystem's own wrenches in the complement
+        if members[c]:
+            for r in range(own_counts[c]):
+                volume *= np.sqrt(own[c, r, 0] ** 2 + own[c, r, 1] ** 2 + own[c, r, 2] ** 2 + own[c, r, 3] ** 2
+                                  + own[c, r, 4] ** 2 + own[c, r, 5] ** 2)
+                for k in range(size):
+                    block[row, k] = reduced[chain_row + r, k]
+                row += 1
+        chain_row += own_counts[c]
+    determinant = held_volume * factor(block, size, permutation)  # |det| of the whole system
     if not abs(determinant) > rank_tolerance * volume:
         return 0.0
-    value = np.inf
+    value, start = np.inf, 0
     for c in range(own_counts.shape[0]):
-        size = own_counts[c]
-        if not members[c] or size == 0:
+        count = own_counts[c]
+        if not members[c] or count == 0:
             continue
-        freed_twists(system, permutation, start, size, freed, column)
-        released_pairs(own[c], size, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch)
-        for i in range(size):
+        freed_twists(block, permutation, size, start, count, basis, freed, column)
+        released_pairs(own[c], count, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch)
+        for i in range(count):
             if exists[i]:
                 value = min(value, coefficient(wrenches[i], twists[i], points[index, c], threshold[index],
                                                pure_couple))
-        start += size
+        start += count
     return value if value < np.inf else 0.0
 
 
@@ -305,19 +377,23 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
     count = wrench_start[wrench_start.shape[0] - 1]
     columns = np.empty((max(count, 6), 6))
     own = np.empty((own_counts.shape[0], 6, 6))
-    shared, total, system = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6))
+    shared, total, rows, reflectors = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6))
     scratch = (np.empty((6, 6)), np.empty(6), np.empty(6, dtype=np.int64), np.empty(6), np.empty((6, 6)))
-    work = (np.empty(6, dtype=np.int64), np.empty((6, 6)), np.empty(6), np.empty((6, 6)), np.empty((6, 6)),
-            np.empty((6, 6)), np.empty(6, dtype=np.bool_), scratch)
-    n = submechanisms.shape[1]
+    work = (np.empty(6, dtype=np.int64), np.empty((6, 6)), np.empty((max(np.sum(own_counts), 1), 6)),
+            np.empty((6, 6)), np.empty((6, 6)), np.empty(6), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)),
+            np.empty(6, dtype=np.bool_), scratch)
+    held = submechanisms.shape[1] + common
     for index in range(constraints.shape[0]):
         instantaneous[index] = 6 - constraint_rank(constraints, index, count, motion_tolerance, columns, scratch)
         own_wrenches(constraints, index, wrench_start, own_counts, common, own, shared, columns, total, scratch)
         for s in range(submechanisms.shape[0]):
+            volume = held_rows(wrenches, index, submechanisms[s], shared, common, rows)
+            held_volume = complement(rows, held, reflectors, work[1])
+            own_in_complement(own, own_counts, work[1], 6 - held, work[2])
             best = 0.0
-            for subsystem in range(members.shape[0]):
-                volume = system_rows(wrenches, index, submechanisms[s], own, own_counts, members[subsystem], shared,
-                                     common, system)
-                best = max(best, subsystem_cti(index, system, own_counts, members[subsystem], own, points, threshold,
-                                               (volume, rank_tolerance, pure_couple, n), work))
+            if held_volume > 0.0:
+                for subsystem in range(members.shape[0]):
+                    best = max(best, subsystem_cti(index, own_counts, members[subsystem], own, points, threshold,
+                                                   (volume, held_volume, 6 - held, rank_tolerance, pure_couple),
+                                                   work))
             per_set[index, s] = best
