@@ -12,8 +12,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import bundled, bundled_chain_screws
-from screwkit.closure import solve
+from helpers import bundled, bundled_chain_screws, random_reachable_poses
 from screwkit.indices.sets import submechanisms_left
 from screwkit.indices.stages import CONSTRAINTS_COMPILED_FROM, compiled_constraint_stage, constraint_plan_of
 from screwkit.screw.constraints import constraint_indices, plan_constraints
@@ -21,6 +20,7 @@ from screwkit.studies.poses import indices_at_poses
 
 SWAP = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 COUNT = CONSTRAINTS_COMPILED_FROM + 88
+"""Configurations of a constructed system: one chunk, through the kernel."""
 
 
 def unit(rows):
@@ -146,12 +146,7 @@ def test_analysis_through_the_constraint_kernel_equals_the_numpy_path(name):
     """Every constraint index of 600 random reachable poses in one chunk (the kernels) and in chunks of 100
     (numpy); schoenflies_5 has no CTI (only common couples) and keeps NaN."""
     mechanism = bundled(name)
-    rng = np.random.default_rng(5)
-    span = np.array([0.1 * mechanism.length_scale if coordinate in ("x", "y", "z") else 0.2
-                     for coordinate in mechanism.task_coordinates])
-    poses = mechanism.home_pose + rng.uniform(-1.0, 1.0, (3000, mechanism.n_task)) * span
-    poses = poses[solve(mechanism, poses).reachable][:600]
-    assert poses.shape[0] >= CONSTRAINTS_COMPILED_FROM
+    poses = random_reachable_poses(mechanism, np.random.default_rng(5), 600, spread=2.0)
     chains, _ = bundled_chain_screws(name, count=20)
     submechanisms = np.array(list(combinations(range(sum(len(c.actuated) for c in chains)), mechanism.dof)))
     compiled = compiled_constraint_stage(constraint_plan_of(chains, 20), submechanisms, poses.shape[0])

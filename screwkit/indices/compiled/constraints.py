@@ -6,16 +6,22 @@ constraint subsystems are *square*: the ``n`` actuation wrenches of a set, the o
 chains of a subsystem and the common ones are six wrenches (the numpy branch of one inverse; overlapping own
 wrenches keep the numpy path). Per configuration: the rank of all the chains' constraint wrenches (the
 instantaneous DOF, one-sided Jacobi rotations, :func:`constraint_rank`); the common constraint wrenches and each
-chain's own ones (:func:`own_wrenches`); then, for every actuator set and subsystem, the six wrenches' LU
-factorisation (:func:`factor`: determinant, regularity), the twists freed by releasing each chain (columns of the
-inverse, :func:`freed_twists`), the principal pairs of wrench and freed twist (:func:`released_pairs`) and their
-power coefficients (:func:`coefficient`), the lowest of which is :math:`CTI_{N,L}`. numpy takes several LAPACK
-calls and a dozen broadcast passes per set and subsystem; here one configuration of a 4-leg Delta (16 systems)
-takes a few microseconds.
+chain's own ones (:func:`own_wrenches`); then, for every actuator set, an orthonormal basis of the complement of
+the rows every subsystem keeps (the set's actuation wrenches and the common constraint wrenches; Householder
+reflections, :func:`complement`, whose R gives their part of the determinant) and each chain's own wrenches in that
+basis (:func:`own_in_complement`); for every subsystem, the square block of its own wrenches there, factored
+(:func:`factor`: with the held part, the determinant of the whole system and so its regularity), the twists freed
+by releasing each chain (the basis times columns of the block's inverse: the columns of the whole system's inverse,
+:func:`freed_twists`), the principal pairs of wrench and freed twist (:func:`released_pairs`) and their power
+coefficients (:func:`coefficient`), the lowest of which is :math:`CTI_{N,L}`. numpy takes several LAPACK calls
+and a dozen broadcast passes per set and subsystem; here one configuration of a 4-leg Delta (4 sets, 4
+subsystems) takes a few microseconds.
 
-Values agree with numpy's to rounding: the freed twists and the principal pairs are spans, found here by other
-but equally stable means (an orthonormal basis by Gram-Schmidt rather than Householder QR, Jacobi rather than
-LAPACK's SVD), and every power coefficient is independent of the basis chosen within them and of signs.
+Values agree with numpy's to rounding (over the conditioning of the systems): the determinant and the freed
+twists come from another but equally stable factorisation than numpy's 6 x 6 LU, the freed twists and the
+principal pairs are spans, found here by other means (an orthonormal basis by Gram-Schmidt rather than Householder
+QR, Jacobi rather than LAPACK's SVD), and every power coefficient is independent of the basis chosen within them
+and of signs.
 """
 
 from __future__ import annotations
@@ -59,6 +65,16 @@ def constraint_rank(constraints, index, count, tolerance, columns, scratch):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def remove_component(rows, row, units, unit):
+    """rows[row] less its component along the unit vector units[unit] (six components)."""
+    along = 0.0
+    for p in range(6):
+        along += rows[row, p] * units[unit, p]
+    for p in range(6):
+        rows[row, p] -= along * units[unit, p]
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def common_wrenches(constraints, index, wrench_start, common, shared, total, scratch):
     """shared[:common] = an orthonormal basis of the wrenches every chain holds: the eigenvectors of the
     ``common`` smallest eigenvalues of sum_i (I - C_i^T C_i) (as ``_common_basis``)."""
@@ -94,11 +110,7 @@ def own_wrenches(constraints, index, wrench_start, own_counts, common, own, shar
             for p in range(6):
                 columns[r, p] = constraints[index, wrench_start[c] + r, p]
             for k in range(common):
-                along = 0.0
-                for p in range(6):
-                    along += columns[r, p] * shared[k, p]
-                for p in range(6):
-                    columns[r, p] -= along * shared[k, p]
+                remove_component(columns, r, shared, k)
             for p in range(6):
                 frobenius += columns[r, p] * columns[r, p]
         if not common:
@@ -114,13 +126,13 @@ def own_wrenches(constraints, index, wrench_start, own_counts, common, own, shar
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def held_rows(wrenches, index, actuators, shared, common, rows):
-    """rows[:n + common] = the actuation wrenches of one actuator set and the common constraint wrenches (what
-    every subsystem keeps); returns the product of their norms."""
-    n = actuators.shape[0]
+def held_rows(wrenches, index, submechanisms, actuators, shared, common, rows):
+    """rows[:n + common] = the actuation wrenches of one actuator set (row ``actuators`` of ``submechanisms``) and
+    the common constraint wrenches (what every subsystem keeps); returns the product of their norms."""
+    n = submechanisms.shape[1]
     for k in range(n):
         for p in range(6):
-            rows[k, p] = wrenches[index, actuators[k], p]
+            rows[k, p] = wrenches[index, submechanisms[actuators, k], p]
     for r in range(common):
         for p in range(6):
             rows[n + r, p] = shared[r, p]
@@ -218,7 +230,7 @@ def factor(matrix, size, permutation):
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def freed_twists(lu, permutation, size, start, count, basis, freed, column):
-    """freed[:, j] (j < count) = the twist reciprocal to every wrench of the system but the chain's own wrench j
+    """freed[j] (j < count) = the twist reciprocal to every wrench of the system but the chain's own wrench j
     (row start + j of the factored square block ``lu``, size x size): ``basis`` times column start + j of the
     block's inverse, its halves swapped. Orthonormalised (Gram-Schmidt, twice) when the chain holds several
     (the same span, as the numpy path's QR)."""
@@ -233,39 +245,35 @@ def freed_twists(lu, permutation, size, start, count, basis, freed, column):
             for k in range(i + 1, size):
                 total -= lu[i, k] * column[k]
             column[i] = total / lu[i, i]
-        for i in range(6):
+        for i in range(6):  # the halves swapped: a twist (omega, v)
             total = 0.0
             for k in range(size):
                 total += basis[i, k] * column[k]
-            freed[(i + 3) % 6, j] = total
+            freed[j, i + 3 if i < 3 else i - 3] = total
     if count > 1:
         for j in range(count):
             for _ in range(2):
                 for i in range(j):
-                    along = 0.0
-                    for k in range(6):
-                        along += freed[k, i] * freed[k, j]
-                    for k in range(6):
-                        freed[k, j] -= along * freed[k, i]
+                    remove_component(freed, j, freed, i)
             norm = 0.0
             for k in range(6):
-                norm += freed[k, j] * freed[k, j]
+                norm += freed[j, k] * freed[j, k]
             norm = np.sqrt(norm)
             for k in range(6):
-                freed[k, j] = freed[k, j] / norm if norm > 0.0 else 0.0
+                freed[j, k] = freed[j, k] / norm if norm > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def released_pairs(own, size, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch):
-    """The principal pairs of a chain's own wrenches own[:size] and the twists freed[:, :size] their release frees
+def released_pairs(own, chain, size, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch):
+    """The principal pairs of a chain's own wrenches own[chain, :size] and the twists freed[:size] their release frees
     (as ``_released_pairs``): wrenches U^T C and twists F V from the singular vectors of the pairing
     ``C o F = U S V^T``; ``exists[i]``: singular value i above ``rank_tolerance`` times the largest. One wrench
     and one freed twist are their own pair."""
     vectors, norms, order, singular, right = scratch
     if size == 1:
         for p in range(6):
-            wrenches[0, p] = own[0, p]
-            twists[0, p] = freed[p, 0]
+            wrenches[0, p] = own[chain, 0, p]
+            twists[0, p] = freed[0, p]
         exists[0] = True
         return
     frobenius = 0.0
@@ -273,7 +281,7 @@ def released_pairs(own, size, freed, rank_tolerance, pairing, wrenches, twists, 
         for j in range(size):
             total = 0.0
             for p in range(3):
-                total += own[k, p] * freed[p + 3, j] + own[k, p + 3] * freed[p, j]
+                total += own[chain, k, p] * freed[j, p + 3] + own[chain, k, p + 3] * freed[j, p]
             pairing[k, j] = total
             frobenius += total * total
     singular_vectors(pairing, size, size, NULL_COLUMN * NULL_COLUMN * frobenius, vectors, norms, order, singular,
@@ -284,21 +292,24 @@ def released_pairs(own, size, freed, rank_tolerance, pairing, wrenches, twists, 
         for p in range(6):
             wrench, twist = 0.0, 0.0
             for k in range(size):
-                wrench += pairing[k, order[i]] * inverse * own[k, p]
-                twist += freed[p, k] * right[i, k]
+                wrench += pairing[k, order[i]] * inverse * own[chain, k, p]
+                twist += freed[k, p] * right[i, k]
             wrenches[i, p] = wrench
             twists[i, p] = twist
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def coefficient(wrench, twist, point, threshold, pure_couple):
-    """Power coefficient of the unit constraint wrench on the twist (as ``_coefficient``), its characteristic
-    point ``point`` projected on the wrench's axis (as ``_project_on_axis``; a couple: |m . omega| / |m||omega|)."""
-    f0, f1, f2, m0, m1, m2 = wrench[0], wrench[1], wrench[2], wrench[3], wrench[4], wrench[5]
-    w0, w1, w2, v0, v1, v2 = twist[0], twist[1], twist[2], twist[3], twist[4], twist[5]
+def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_couple):
+    """Power coefficient of the unit constraint wrench ``wrenches[pair]`` on the twist ``twists[pair]`` (as
+    ``_coefficient``), its characteristic point, the chain's platform joint ``points[index, chain]``, projected on
+    the wrench's axis (as ``_project_on_axis``; a couple: |m . omega| / |m||omega|)."""
+    f0, f1, f2 = wrenches[pair, 0], wrenches[pair, 1], wrenches[pair, 2]
+    m0, m1, m2 = wrenches[pair, 3], wrenches[pair, 4], wrenches[pair, 5]
+    w0, w1, w2 = twists[pair, 0], twists[pair, 1], twists[pair, 2]
+    v0, v1, v2 = twists[pair, 3], twists[pair, 4], twists[pair, 5]
     numerator = abs(f0 * v0 + f1 * v1 + f2 * v2 + m0 * w0 + m1 * w1 + m2 * w2)
     norm_sq = f0 * f0 + f1 * f1 + f2 * f2
-    p0, p1, p2 = point[0], point[1], point[2]
+    p0, p1, p2 = points[index, chain, 0], points[index, chain, 1], points[index, chain, 2]
     if norm_sq > 0.0:  # the point of the axis nearest the chain's platform joint
         c0, c1, c2 = (f1 * m2 - f2 * m1) / norm_sq, (f2 * m0 - f0 * m2) / norm_sq, (f0 * m1 - f1 * m0) / norm_sq
         along = ((p0 - c0) * f0 + (p1 - c1) * f1 + (p2 - c2) * f2) / norm_sq
@@ -320,19 +331,22 @@ def coefficient(wrench, twist, point, threshold, pure_couple):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def subsystem_cti(index, own_counts, members, own, points, threshold, held, work):
-    """:math:`CTI_{N,L}` of one configuration, actuator set and subsystem ``members``: zero when the set's and the
-    subsystem's wrenches do not span every wrench, else the lowest power coefficient of a released constraint
-    wrench on the twist it frees (as ``_subsystem_cti``). ``held``: the product of the held rows' norms and
-    their sqrt(det(rows rows^T)) (:func:`complement`), the size of the complement, the tolerances."""
+def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold, held, work):
+    """:math:`CTI_{N,L}` of one configuration, actuator set and subsystem (row ``subsystem`` of ``members``): zero
+    when the set's and the subsystem's wrenches do not span every wrench, else the lowest power coefficient of a
+    released constraint wrench on the twist it frees (as ``_subsystem_cti``). ``held``: the product of the held
+    rows' norms and their sqrt(det(rows rows^T)) (:func:`complement`), the size of the complement, the
+    tolerances."""
     volume, held_volume, size, rank_tolerance, pure_couple = held
     permutation, basis, reduced, block, freed, column, pairing, wrenches, twists, exists, scratch = work
     row, chain_row = 0, 0
     for c in range(own_counts.shape[0]):  # the square block: the subsystem's own wrenches in the complement
-        if members[c]:
+        if members[subsystem, c]:
             for r in range(own_counts[c]):
-                volume *= np.sqrt(own[c, r, 0] ** 2 + own[c, r, 1] ** 2 + own[c, r, 2] ** 2 + own[c, r, 3] ** 2
-                                  + own[c, r, 4] ** 2 + own[c, r, 5] ** 2)
+                norm = 0.0
+                for p in range(6):
+                    norm += own[c, r, p] * own[c, r, p]
+                volume *= np.sqrt(norm)
                 for k in range(size):
                     block[row, k] = reduced[chain_row + r, k]
                 row += 1
@@ -343,14 +357,13 @@ def subsystem_cti(index, own_counts, members, own, points, threshold, held, work
     value, start = np.inf, 0
     for c in range(own_counts.shape[0]):
         count = own_counts[c]
-        if not members[c] or count == 0:
+        if not members[subsystem, c] or count == 0:
             continue
         freed_twists(block, permutation, size, start, count, basis, freed, column)
-        released_pairs(own[c], count, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch)
+        released_pairs(own, c, count, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch)
         for i in range(count):
             if exists[i]:
-                value = min(value, coefficient(wrenches[i], twists[i], points[index, c], threshold[index],
-                                               pure_couple))
+                value = min(value, coefficient(wrenches, twists, i, points, index, c, threshold[index], pure_couple))
         start += count
     return value if value < np.inf else 0.0
 
@@ -387,13 +400,13 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
         instantaneous[index] = 6 - constraint_rank(constraints, index, count, motion_tolerance, columns, scratch)
         own_wrenches(constraints, index, wrench_start, own_counts, common, own, shared, columns, total, scratch)
         for s in range(submechanisms.shape[0]):
-            volume = held_rows(wrenches, index, submechanisms[s], shared, common, rows)
+            volume = held_rows(wrenches, index, submechanisms, s, shared, common, rows)
             held_volume = complement(rows, held, reflectors, work[1])
             own_in_complement(own, own_counts, work[1], 6 - held, work[2])
             best = 0.0
             if held_volume > 0.0:
                 for subsystem in range(members.shape[0]):
-                    best = max(best, subsystem_cti(index, own_counts, members[subsystem], own, points, threshold,
+                    best = max(best, subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
                                                    (volume, held_volume, 6 - held, rank_tolerance, pure_couple),
                                                    work))
             per_set[index, s] = best
