@@ -49,7 +49,7 @@ KERNELS = {
     "screwkit.indices.compiled.null": ("null_kernel", 7),
     "screwkit.indices.compiled.gram": ("gram_kernel", 5),
     "screwkit.indices.compiled.spaces": ("space_kernel", 3),
-    "screwkit.indices.compiled.constraints": ("constraint_kernel", 4),
+    "screwkit.indices.compiled.constraints": ("constraint_kernel", 12),
     "screwkit.indices.compiled.planar": ("planar_closed_form_kernel", 2),
     "screwkit.closure.compiled.task": ("close_chains_kernel", 18),
     "screwkit.closure.compiled.frames": ("chain_frames_kernel", 3),

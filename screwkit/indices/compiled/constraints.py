@@ -39,7 +39,7 @@ _SIGNATURE = ("void(float64[:, :, ::1], int64[::1], int64[::1], int64, float64[:
               "int64[:, ::1], int64[:, ::1], float64[::1], float64, float64, float64, int64[::1], float64[:, ::1])")
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def constraint_rank(constraints, index, count, tolerance, columns, scratch):
     """Rank of the unit constraint wrenches constraints[index, :count]: singular values above ``tolerance`` times
     the largest (``numpy.linalg.svd`` of the unit rows). Six of them or fewer are rotated as the columns of their
@@ -48,15 +48,13 @@ def constraint_rank(constraints, index, count, tolerance, columns, scratch):
     vectors, norms, order, singular, right = scratch
     unit_columns(constraints, index, 0, count, columns)
     width = min(count, 6)
+    rows = 6 if count <= 6 else count
     if count <= 6:
         for j in range(count):  # transposed in place: the lower triangle first, the rest below it
             for k in range(j + 1, 6):
                 columns[j, k], columns[k, j] = columns[k, j], columns[j, k]
-        singular_vectors(columns, 6, count, NULL_COLUMN * NULL_COLUMN * count, vectors, norms, order, singular,
-                         right)
-    else:
-        singular_vectors(columns, count, 6, NULL_COLUMN * NULL_COLUMN * count, vectors, norms, order, singular,
-                         right)
+    singular_vectors(columns, rows, 6 if count > 6 else count, NULL_COLUMN * NULL_COLUMN * count, vectors, norms,
+                     order, singular, right)
     rank = 0
     for i in range(width):
         if singular[i] > tolerance * max(singular[0], 1e-300):
@@ -93,7 +91,7 @@ def common_wrenches(constraints, index, wrench_start, common, shared, total, scr
             shared[k, p] = eigenvectors[p, k]
 
 
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def own_wrenches(constraints, index, wrench_start, own_counts, common, own, shared, columns, total, scratch):
     """own[c, :own_counts[c]] = an orthonormal basis of chain c's constraint wrenches with their components along
     the common ones (``shared[:common]``, :func:`common_wrenches`) removed (as ``_own_wrenches``). Without common
