@@ -225,7 +225,8 @@ def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the
             _, stderr = process.communicate()
         assert stderr == "", (option, stderr)
     kernels = ["planar_closed_form_kernel", "close_chains_kernel", "chain_frames_kernel", "wrench_kernel",
-               "output_kernel", "null_kernel", "spatial_closed_form_kernel", "gram_kernel", "space_kernel"]
+               "output_kernel", "null_kernel", "spatial_closed_form_kernel", "gram_kernel", "space_kernel",
+               "constraint_kernel"]
     for _ in range(2):  # the first run compiles what no earlier test has; the second finds everything cached
         warm = screwkit("warmup", timeout=600)
         assert warm.returncode == 0, warm.stderr

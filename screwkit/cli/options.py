@@ -21,7 +21,14 @@ import numpy as np
 
 from screwkit.cli.reading import Reading, lock_option, output_frame_option, output_type_option, reading_record
 from screwkit.closure.assembly import LIMITS_IGNORED
-from screwkit.common.compiling import INDEX_KERNELS, SPACE_KERNEL, compile_ahead, silence, stage_kernels
+from screwkit.common.compiling import (
+    CONSTRAINT_KERNEL,
+    INDEX_KERNELS,
+    SPACE_KERNEL,
+    compile_ahead,
+    silence,
+    stage_kernels,
+)
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.indices.average import AGGREGATES, failure_weights
@@ -403,7 +410,8 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
-                                     mechanism.dof), *(SPACE_KERNEL,) * (mechanism.dof < 6 and not mechanism.is_planar))
+                                     mechanism.dof),
+                     *(SPACE_KERNEL, CONSTRAINT_KERNEL) * (mechanism.dof < 6 and not mechanism.is_planar))
     return mechanism
 
 

@@ -8,6 +8,7 @@ import click
 
 from screwkit.common.compiling import (
     CLOSED_FORM_KERNEL,
+    CONSTRAINT_KERNEL,
     GRAM_KERNEL,
     INDEX_KERNELS,
     KERNELS,
@@ -35,7 +36,7 @@ def warmup() -> None:
 
     start = time.perf_counter()
     cached = {module: kernel_is_cached(module) for module in KERNELS}
-    compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL, SPACE_KERNEL, CLOSED_FORM_KERNEL)
+    compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL, SPACE_KERNEL, CONSTRAINT_KERNEL, CLOSED_FORM_KERNEL)
     five, hexapod = load("planar_5rrr"), load("ups_hexapod_8")
     steps = {  # the kernels compiled here first, while the child processes compile the index kernels
         ("screwkit.indices.compiled.planar",): lambda: indices_at_poses(five, five.home_pose[None], closed_forms=True),
@@ -47,8 +48,8 @@ def warmup() -> None:
         (NULL_KERNEL,): lambda: indices_at_pose(hexapod, hexapod.home_pose),
         (CLOSED_FORM_KERNEL,): lambda: solve(hexapod, np.repeat(hexapod.home_pose[None], COMPILED_FROM, axis=0)),
         (GRAM_KERNEL,): lambda: indices_at_pose(three := load("five_bar_3"), three.home_pose),
-        (SPACE_KERNEL,): lambda: indices_at_poses(prs := load("prs_3_ups"),
-                                                  np.repeat(prs.home_pose[None], COMPILED_FROM, axis=0), threads=1),
+        (SPACE_KERNEL, CONSTRAINT_KERNEL): lambda: indices_at_poses(
+            prs := load("prs_3_ups"), np.repeat(prs.home_pose[None], COMPILED_FROM, axis=0), threads=1),
     }
     for modules, step in steps.items():
         step()

@@ -41,7 +41,7 @@ from screwkit.common.caches import own_folder, private_temporary_folder, user_ca
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
            "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "SPACE_KERNEL",
-           "CLOSED_FORM_KERNEL"]
+           "CONSTRAINT_KERNEL", "CLOSED_FORM_KERNEL"]
 
 KERNELS = {
     "screwkit.indices.compiled.wrenches": ("wrench_kernel", 6),
@@ -49,6 +49,7 @@ KERNELS = {
     "screwkit.indices.compiled.null": ("null_kernel", 7),
     "screwkit.indices.compiled.gram": ("gram_kernel", 5),
     "screwkit.indices.compiled.spaces": ("space_kernel", 3),
+    "screwkit.indices.compiled.constraints": ("constraint_kernel", 12),
     "screwkit.indices.compiled.planar": ("planar_closed_form_kernel", 2),
     "screwkit.closure.compiled.task": ("close_chains_kernel", 18),
     "screwkit.closure.compiled.frames": ("chain_frames_kernel", 3),
@@ -64,6 +65,10 @@ NULL_KERNEL, GRAM_KERNEL = "screwkit.indices.compiled.null", "screwkit.indices.c
 
 SPACE_KERNEL = "screwkit.indices.compiled.spaces"
 """The chain decompositions and motion spaces of mechanisms of fewer than six DoF, for chunks of 512
+configurations or more."""
+
+CONSTRAINT_KERNEL = "screwkit.indices.compiled.constraints"
+"""The instantaneous DOF and CTI of mechanisms whose constraint subsystems are square, for chunks of 512
 configurations or more."""
 
 CLOSED_FORM_KERNEL = "screwkit.closure.compiled.closed_form"

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common import tolerances
-from screwkit.common.compiling import SPACE_KERNEL, prepare_kernels
+from screwkit.common.compiling import CONSTRAINT_KERNEL, SPACE_KERNEL, prepare_kernels
 from screwkit.indices.sets import remaining_lmti, set_plan
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.constraints import ConstraintPlan, constraint_indices, plan_constraints
@@ -30,7 +30,8 @@ from screwkit.screw.motion import (
 from screwkit.screw.outputs import quotient_bases
 
 __all__ = ["Plan", "make_plan", "run_kernel", "ChunkSpaces", "analyze_chunk", "joints_of_all_chains",
-           "constraint_plan_of", "constraint_chunk", "at_constraint_singularities"]
+           "constraint_plan_of", "constraint_chunk", "at_constraint_singularities", "CONSTRAINTS_COMPILED_FROM",
+           "compiled_constraint_stage"]
 
 
 @dataclass
@@ -282,15 +283,54 @@ def constraint_chunk(plan: Plan, constraint_plan: ConstraintPlan, spaces: ChunkS
     working_wrenches = working_wrenches / np.where(norms > 0.0, norms, 1.0)
     # With a point output the idle rotations are joints of the chains: the platform's instantaneous DOF
     # counts them, and the CTI (defined for a frame output, every wrench acting on the platform) does not apply.
+    stage = compiled_constraint_stage(constraint_plan, plan.submechanisms, length.shape[0])
     result = constraint_indices(constraint_plan, working, working_points, working_wrenches, plan.submechanisms,
                                 plan.dof + plan.idle_count, fault_members, plan.threshold / length,
-                                spaces.decompositions)
+                                spaces.decompositions, stage)
     if plan.idle_count:
         result["instantaneous_dof"] = result["instantaneous_dof"] - plan.idle_count
         for key in result:
             if key == "cti" or key == "cti_submechanisms" or key.startswith("f_c"):
                 result[key] = np.full(result[key].shape, np.nan)
     return result
+
+
+CONSTRAINTS_COMPILED_FROM = 512
+"""Chunks of at least this many configurations take their instantaneous DOF and CTI from the compiled
+:func:`screwkit.indices.compiled.constraints.constraint_kernel` when every constraint subsystem is square (see
+:func:`compiled_constraint_stage`); smaller ones, and other mechanisms, from numpy
+(:func:`screwkit.screw.constraints.constraint_indices`), which needs no compiling."""
+
+
+def compiled_constraint_stage(constraint_plan: ConstraintPlan, submechanisms: NDArray, count: int):
+    """The ``stage`` of :func:`screwkit.screw.constraints.constraint_indices` that runs the compiled constraint
+    kernel, for a chunk of ``count`` >= :data:`CONSTRAINTS_COMPILED_FROM` configurations of a mechanism whose
+    actuator sets with each subsystem's own constraint wrenches and the common ones are six wrenches (the numpy
+    code's branch of one inverse per system); else None (the numpy code)."""
+    n = submechanisms.shape[1]
+    own_counts = np.array(constraint_plan.own_counts, dtype=np.int64)
+    members = np.zeros((len(constraint_plan.subsystems), own_counts.size), dtype=np.int64)
+    for row, subsystem in enumerate(constraint_plan.subsystems):
+        members[row, list(subsystem)] = 1
+    square = bool(members.size) and np.all(n + constraint_plan.common + members @ own_counts == 6)
+    if count < CONSTRAINTS_COMPILED_FROM or not constraint_plan.count or not square:
+        return None
+    wrench_start = np.cumsum((0,) + constraint_plan.chain_counts).astype(np.int64)
+    sets = np.ascontiguousarray(submechanisms, dtype=np.int64)
+
+    def stage(constraints, points, wrenches, threshold):
+        prepare_kernels((CONSTRAINT_KERNEL,))
+        from screwkit.indices.compiled.constraints import constraint_kernel  # numba: compiled for the CTI only
+
+        instantaneous, per_set = np.empty(constraints.shape[0], dtype=np.int64), np.empty((constraints.shape[0],
+                                                                                           sets.shape[0]))
+        constraint_kernel(np.ascontiguousarray(constraints), wrench_start, own_counts, constraint_plan.common,
+                          np.ascontiguousarray(points), np.ascontiguousarray(wrenches), sets, members,
+                          np.ascontiguousarray(threshold, dtype=np.float64), tolerances.MOTION_SPACE_TOLERANCE,
+                          tolerances.RANK_TOLERANCE, tolerances.PURE_COUPLE, instantaneous, per_set)
+        return instantaneous, per_set
+
+    return stage
 
 
 def at_constraint_singularities(plan: Plan, result: dict, held: NDArray) -> None:

@@ -288,7 +288,7 @@ def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], memb
 
 def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_points: list[NDArray],
                        wrenches: NDArray, submechanisms: NDArray, dof: int, fault_members: dict,
-                       threshold: NDArray, decompositions: list | None = None) -> dict[str, NDArray]:
+                       threshold: NDArray, decompositions: list | None = None, stage=None) -> dict[str, NDArray]:
     """CTI of every non-redundant actuator set, the mechanism's CTI, F_Cj, and the instantaneous DOF.
 
     Parameters
@@ -307,6 +307,11 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         The singularity threshold in working coordinates (*p* / *L*).
     decompositions : list, optional
         :func:`screwkit.screw.motion.chain_decompositions` of ``chain_twists`` when already computed.
+    stage : callable, optional
+        What computes, from every chain's constraint wrenches (N, K, 6), their platform joints (N, C, 3),
+        ``wrenches`` and ``threshold``, the instantaneous DOF (N,) and :math:`CTI_N` of every actuator set (N, S)
+        before constraint singularities are zeroed, in place of the numpy code below (the compiled kernel of
+        :mod:`screwkit.indices.compiled.constraints`, for large chunks); only asked when the CTI applies.
 
     Returns
     -------
@@ -322,7 +327,11 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
     constraints = [chain_constraint_wrenches(t, c, d)
                    for t, c, d in zip(chain_twists, plan.chain_counts, decompositions)]
     stacked = np.concatenate(constraints, axis=-2) if constraints else np.zeros((count, 0, 6))
-    instantaneous = 6 - _rank(stacked, tolerances.MOTION_SPACE_TOLERANCE)
+    points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
+    if stage is not None and plan.count:
+        instantaneous, per_set = stage(stacked, np.stack(points, axis=1), wrenches, threshold)
+    else:
+        instantaneous, per_set = 6 - _rank(stacked, tolerances.MOTION_SPACE_TOLERANCE), None
     singular = instantaneous > dof
     result = {"instantaneous_dof": instantaneous, "constraint_singular": singular}
     if singular.any():  # which actuators leave the platform held when free (the kernel assumed n DOF)
@@ -338,12 +347,12 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         for j in fault_members:
             result[f"f_c{j}"] = nothing.copy()
         return result
-    shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
-    points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
-    actuation = wrenches[:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
-    per_set = np.zeros((count, submechanisms.shape[0]))
-    for subsystem in plan.subsystems:
-        per_set = np.maximum(per_set, _subsystem_cti(actuation, shared, own, subsystem, points, threshold))
+    if per_set is None:
+        shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
+        actuation = wrenches[:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
+        per_set = np.zeros((count, submechanisms.shape[0]))
+        for subsystem in plan.subsystems:
+            per_set = np.maximum(per_set, _subsystem_cti(actuation, shared, own, subsystem, points, threshold))
     per_set[singular] = 0.0
     result["cti_submechanisms"] = per_set
     result["cti"] = per_set.max(axis=-1)

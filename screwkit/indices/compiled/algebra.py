@@ -33,6 +33,7 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.indices.compiled.jacobi import rotate_symmetric
 
 __all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND",
            "add_swapped_combination", "carry_arrays", "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes",
@@ -298,10 +299,10 @@ PSEUDO_INVERSE_RCOND = 1e-15
 def pseudo_inverse(matrix, size, out, vectors, values):
     """out[:size, :size] = the Moore-Penrose pseudo-inverse of the symmetric matrix[:size, :size].
 
-    Cyclic Jacobi rotations diagonalise a copy (``matrix = V diag(values) V^T``); eigenvalues at
-    or below :data:`PSEUDO_INVERSE_RCOND` times the largest in magnitude count as zero, as in
-    ``numpy.linalg.pinv`` (for a symmetric matrix its singular values are the eigenvalues'
-    magnitudes). Written out rather than ``np.linalg.pinv``, whose compiled LAPACK wrapper alone
+    Cyclic Jacobi rotations (:func:`screwkit.indices.compiled.jacobi.rotate_symmetric`) diagonalise a copy
+    (``matrix = V diag(values) V^T``); eigenvalues at or below :data:`PSEUDO_INVERSE_RCOND` times the largest in
+    magnitude count as zero, as in ``numpy.linalg.pinv`` (for a symmetric matrix its singular values are the
+    eigenvalues' magnitudes). Written out rather than ``np.linalg.pinv``, whose compiled LAPACK wrapper alone
     took about 3 s of the kernel's first compilation. ``vectors`` (at least size x size) and
     ``values`` (size) are scratch; returns ``out``.
     """
@@ -320,30 +321,8 @@ def pseudo_inverse(matrix, size, out, vectors, values):
             break
         for p in range(size - 1):
             for q in range(p + 1, size):
-                apq = out[p, q]
-                if apq == 0.0:
-                    continue
-                theta = (out[q, q] - out[p, p]) / (2.0 * apq)
-                t = (1.0 if theta >= 0.0 else -1.0) / (abs(theta) + np.sqrt(theta * theta + 1.0))
-                c = 1.0 / np.sqrt(t * t + 1.0)
-                s = t * c
-                for k in range(size):  # columns p and q
-                    akp = out[k, p]
-                    akq = out[k, q]
-                    out[k, p] = c * akp - s * akq
-                    out[k, q] = s * akp + c * akq
-                for k in range(size):  # rows p and q
-                    apk = out[p, k]
-                    aqk = out[q, k]
-                    out[p, k] = c * apk - s * aqk
-                    out[q, k] = s * apk + c * aqk
-                out[p, q] = 0.0
-                out[q, p] = 0.0
-                for k in range(size):
-                    vkp = vectors[k, p]
-                    vkq = vectors[k, q]
-                    vectors[k, p] = c * vkp - s * vkq
-                    vectors[k, q] = s * vkp + c * vkq
+                if out[p, q] != 0.0:
+                    rotate_symmetric(out, size, vectors, p, q)
     largest = 0.0
     for i in range(size):
         values[i] = out[i, i]

@@ -22,16 +22,9 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.indices.compiled.jacobi import NULL_COLUMN, singular_vectors, symmetric_eigen, unit_columns
 
-__all__ = ["space_kernel", "JACOBI_TOLERANCE", "JACOBI_SWEEPS", "NULL_COLUMN"]
-
-JACOBI_TOLERANCE = 1e-15
-"""A pair of columns (rows) counts as orthogonal when their product is at most this times their norms' product."""
-JACOBI_SWEEPS = 60
-"""Sweeps of rotations at most (a 6 x 6 matrix converges in 5 to 8)."""
-NULL_COLUMN = 1e-15
-"""A column of the one-sided rotations whose norm is at most this times the matrix's (Frobenius) is null: rounding
-noise, not rotated further (its singular value is far below any rank tolerance)."""
+__all__ = ["space_kernel"]
 
 # The one signature: working twists (N, J, 6) in any layout, the rest C-contiguous.
 _SIGNATURE = ("void(float64[:, :, :], int64[::1], float64, float64[:, :, ::1], float64[:, :, :, ::1], "
@@ -39,94 +32,13 @@ _SIGNATURE = ("void(float64[:, :, :], int64[::1], float64, float64[:, :, ::1], f
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def unit_columns(twists, index, start, m, columns):
-    """columns[:m, k] = component k of the chain's joint twists (joints start .. start + m) scaled to unit norm
-    (a zero twist stays zero): the chain's twist matrix, transposed, its columns the six components."""
-    for j in range(m):
-        total = 0.0
-        for k in range(6):
-            total += twists[index, start + j, k] * twists[index, start + j, k]
-        norm = np.sqrt(total)
-        inverse = 1.0 / norm if norm > 0.0 else 1.0
-        for k in range(6):
-            columns[j, k] = twists[index, start + j, k] * inverse
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def rotate_pair(matrix, rows, p, q, c, s):
-    """Columns p and q of matrix[:rows] rotated: (c a_p - s a_q, s a_p + c a_q)."""
-    for k in range(rows):
-        x = matrix[k, p]
-        y = matrix[k, q]
-        matrix[k, p] = c * x - s * y
-        matrix[k, q] = s * x + c * y
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def rotation_of(alpha, beta, gamma):
-    """(c, s) of the Jacobi rotation that zeroes the product ``gamma`` of two columns of squared norms alpha, beta
-    (or the off-diagonal entry of a symmetric 2 x 2 block [[alpha, gamma], [gamma, beta]])."""
-    zeta = (beta - alpha) / (2.0 * gamma)
-    t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
-    c = 1.0 / np.sqrt(1.0 + t * t)
-    return c, c * t
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def chain_singular_vectors(columns, m, vectors, norms, order, singular, right):
     """Singular values (descending, ``singular``) and right singular vectors (rows of ``right``) of the m x 6
-    matrix ``columns`` (destroyed), by one-sided Jacobi rotations of its six columns (Hestenes): the rotations,
-    accumulated in ``vectors``, make the columns orthogonal; their norms are the singular values. As numpy's
-    SVD of the rows padded with zero rows to six (more rows than six: the six leading singular values)."""
-    for i in range(6):
-        for j in range(6):
-            vectors[i, j] = 1.0 if i == j else 0.0
-    floor = NULL_COLUMN * NULL_COLUMN * m  # of a squared column norm; the m unit rows hold m in all
-    for _ in range(JACOBI_SWEEPS):
-        for p in range(6):  # the squared column norms, afresh each sweep (updated by the rotations within it)
-            total = 0.0
-            for k in range(m):
-                total += columns[k, p] * columns[k, p]
-            norms[p] = total
-        rotated = False
-        for p in range(5):
-            for q in range(p + 1, 6):
-                alpha, beta, gamma = norms[p], norms[q], 0.0
-                for k in range(m):
-                    gamma += columns[k, p] * columns[k, q]
-                if abs(gamma) <= JACOBI_TOLERANCE * np.sqrt(alpha * beta) or min(alpha, beta) <= floor:
-                    continue  # orthogonal, or a null column (rounding: no direction to keep orthogonal)
-                rotated = True
-                c, s = rotation_of(alpha, beta, gamma)
-                rotate_pair(columns, m, p, q, c, s)
-                rotate_pair(vectors, 6, p, q, c, s)
-                norms[p] = alpha - s / c * gamma
-                norms[q] = beta + s / c * gamma
-        if not rotated:
-            break
-    for p in range(6):
-        total = 0.0
-        for k in range(m):
-            total += columns[k, p] * columns[k, p]
-        norms[p] = np.sqrt(total)
-    sorted_order(norms, order, True)
-    for i in range(6):
-        singular[i] = norms[order[i]]
-        for k in range(6):
-            right[i, k] = vectors[k, order[i]]
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def sorted_order(values, order, descending):
-    """order[:6] = the indices of values[:6] sorted (stable insertion sort), descending or ascending."""
-    for i in range(6):
-        order[i] = i
-    for i in range(1, 6):
-        j = i
-        while j > 0 and ((values[order[j]] > values[order[j - 1]]) if descending
-                         else (values[order[j]] < values[order[j - 1]])):
-            order[j], order[j - 1] = order[j - 1], order[j]
-            j -= 1
+    matrix ``columns`` of unit rows (destroyed), by one-sided Jacobi rotations of its six columns
+    (:func:`screwkit.indices.compiled.jacobi.singular_vectors`): as numpy's SVD of the rows padded with zero rows
+    to six (more rows than six: the six leading singular values)."""
+    singular_vectors(columns, m, 6, NULL_COLUMN * NULL_COLUMN * m,  # the m unit rows hold m in all
+                     vectors, norms, order, singular, right)
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -138,44 +50,6 @@ def add_complement_projector(singular, right, tolerance, total):
             for p in range(6):
                 for q in range(6):
                     total[p, q] += right[i, p] * right[i, q]
-
-
-@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def symmetric_eigen(matrix, vectors, diagonal, order, values, sorted_vectors):
-    """Eigenvalues (ascending, ``values``) and eigenvectors (columns of ``sorted_vectors``) of the symmetric 6 x 6
-    ``matrix`` (destroyed), by cyclic Jacobi rotations, as ``numpy.linalg.eigh``."""
-    for i in range(6):
-        for j in range(6):
-            vectors[i, j] = 1.0 if i == j else 0.0
-    for _ in range(JACOBI_SWEEPS):
-        off, scale = 0.0, 0.0
-        for i in range(6):
-            scale += matrix[i, i] * matrix[i, i]
-            for j in range(i + 1, 6):
-                off += matrix[i, j] * matrix[i, j]
-        if off <= JACOBI_TOLERANCE * JACOBI_TOLERANCE * scale:
-            break
-        for p in range(5):
-            for q in range(p + 1, 6):
-                if matrix[p, q] == 0.0:
-                    continue
-                c, s = rotation_of(matrix[p, p], matrix[q, q], matrix[p, q])
-                rotate_pair(matrix, 6, p, q, c, s)
-                for k in range(6):  # rows p and q
-                    x = matrix[p, k]
-                    y = matrix[q, k]
-                    matrix[p, k] = c * x - s * y
-                    matrix[q, k] = s * x + c * y
-                matrix[p, q] = 0.0
-                matrix[q, p] = 0.0
-                rotate_pair(vectors, 6, p, q, c, s)
-    for i in range(6):
-        diagonal[i] = matrix[i, i]
-    sorted_order(diagonal, order, False)
-    for i in range(6):
-        values[i] = diagonal[order[i]]
-        for k in range(6):
-            sorted_vectors[k, i] = vectors[k, order[i]]
 
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
