@@ -200,15 +200,19 @@ def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the
     loaded (the process is stopped there: compiling takes tens of seconds); with the cache, warmup finds every
     kernel cached."""
     import os
+    import signal
+
+    def stop(process):  # the command and the children compiling its kernels (each command finds the cache empty)
+        os.killpg(process.pid, signal.SIGKILL)
+        return process.communicate()
 
     environment = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty_cache"))
     process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", "analyze", "planar_5rrr"], env=environment,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         first = process.stderr.readline()
     finally:
-        process.kill()
-        process.communicate()
+        stop(process)
     assert first.startswith("screwkit: compiling wrench_kernel and output_kernel in 2 processes (first run only, "
                             "about"), first
     quiet_commands = (["analyze", "planar_5rrr", "--json"],
@@ -216,13 +220,12 @@ def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the
                        str(tmp_path / "m.nc"), "--quiet"])
     for command in quiet_commands:  # stderr stays empty: no notice either
         option = command[-1]
-        process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", *command],
-                                   env=environment, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", *command], env=environment,
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
         try:
             _, stderr = process.communicate(timeout=8.0)
         except subprocess.TimeoutExpired:  # still compiling: what it wrote so far
-            process.kill()
-            _, stderr = process.communicate()
+            _, stderr = stop(process)
         assert stderr == "", (option, stderr)
     kernels = ["planar_closed_form_kernel", "close_chains_kernel", "chain_frames_kernel", "wrench_kernel",
                "output_kernel", "null_kernel", "spatial_closed_form_kernel", "gram_kernel", "space_kernel",

@@ -76,7 +76,8 @@ def is_foreign(path: Path) -> bool:
         return True
     if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)
                                            or has_gazebo_joints(path)):
-        head = path.read_bytes()[:4_000_000]
+        with open(path, "rb") as handle:  # the head alone
+            head = handle.read(4_000_000)
         return b"<loop" not in head
     return False
 

@@ -42,7 +42,8 @@ TYPES = (*HINGE_TYPES, "ball", "fixed")
 
 def has_gazebo_joints(path: Path) -> bool:
     """Whether a URDF file has a ``<joint>`` inside a ``<gazebo>`` element (read as text, quickly)."""
-    head = path.read_bytes()[:4_000_000]
+    with open(path, "rb") as handle:  # the head alone (a file over the size cap is refused unread)
+        head = handle.read(4_000_000)
     return b"<gazebo" in head and _gazebo_joints(head) != []
 
 

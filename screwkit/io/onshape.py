@@ -51,7 +51,8 @@ def closing_pairs(names) -> dict[str, tuple[str, str]]:
 
 def has_closing_frames(path: Path) -> bool:
     """Whether a URDF file names at least one complete ``closing_`` pair of links (read as text, quickly)."""
-    head = path.read_bytes()[:4_000_000].decode("utf-8", errors="replace")
+    with open(path, "rb") as handle:  # the head alone (a file over the size cap is refused unread)
+        head = handle.read(4_000_000).decode("utf-8", errors="replace")
     return bool(closing_pairs(re.findall(r"<link\s+name\s*=\s*[\"']([^\"']+)[\"']", head)))
 
 

@@ -101,7 +101,8 @@ def fault_tolerance(oti_sets: dict, actuators: int, dof: int) -> dict:
     """LMTI (Eq. 11) and, for every number of faults ``j``, F_Oj (Eqs. 12-13) from the OTI of each set of ``n``
     actuators (Eq. 9); a set of fewer than ``n`` actuators holds nothing (0)."""
     def lmti(kept):
-        return max((value for members, value in oti_sets.items() if set(members) <= set(kept)), default=0.0)
+        kept = set(kept)
+        return max((value for members, value in oti_sets.items() if kept.issuperset(members)), default=0.0)
 
     faults = range(1, max(actuators - dof, 1) + 1)
     return {"lmti": lmti(range(actuators)),
