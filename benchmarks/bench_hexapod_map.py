@@ -51,6 +51,19 @@ def measured(arguments: list[str]) -> tuple[float, float, float]:
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
 
 
+def side_by_side(command: list[str], script: list[str], small_command: list[str], small_script: list[str],
+                 repeat: int) -> tuple[dict, dict]:
+    """The command and the script run in turn ``repeat`` times, after one unmeasured run of each (compiled kernels,
+    warm file cache), then each once on its small case: ``measured`` figures by name, and the fixed costs."""
+    for arguments in (command, script):
+        measured(arguments)
+    runs = {"command": [], "script": []}
+    for _ in range(repeat):
+        runs["command"].append(measured(command))
+        runs["script"].append(measured(script))
+    return runs, {"command": measured(small_command), "script": measured(small_script)}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--step", type=float, default=0.005)
@@ -63,13 +76,7 @@ def main() -> None:
         command, script = commands(args.step, args.half, args.yaw_step, folder)
         small_command, small_script = commands(args.half, args.half, 120.0, folder / "small")
         (folder / "small").mkdir()
-        for arguments in (command, script):  # compiled kernels, warm file cache
-            measured(arguments)
-        runs = {"command": [], "script": []}
-        for _ in range(args.repeat):
-            runs["command"].append(measured(command))
-            runs["script"].append(measured(script))
-        fixed = {"command": measured(small_command), "script": measured(small_script)}
+        runs, fixed = side_by_side(command, script, small_command, small_script, args.repeat)
         import xarray  # the map's file: read once both have run
 
         reference = np.load(folder / "reference.npz")

@@ -18,13 +18,12 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from bench_hexapod_map import side_by_side  # the same measurement, side by side
 
 HERE = Path(__file__).resolve().parent
 TARGET_WALL = 0.8
@@ -38,19 +37,6 @@ def commands(radius: float, step: float, phi_step: float, folder: Path) -> tuple
                "--out", str(folder / "map.nc")]
     script = [sys.executable, str(HERE / "reference_planar_map.py"), *area, "--out", str(folder / "reference.npz")]
     return command, script
-
-
-def measured(arguments: list[str]) -> tuple[float, float, float]:
-    """Wall (s), CPU (s) and peak resident memory (MiB) of one run of a new process."""
-    start = time.perf_counter()
-    process = subprocess.Popen(arguments, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(process.pid, 0)
-    wall = time.perf_counter() - start
-    errors = process.stderr.read().decode()
-    process.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise SystemExit(f"{' '.join(arguments)} failed:\n{errors}")
-    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
 
 
 def met(value: float, limit: float) -> str:
@@ -70,13 +56,7 @@ def main() -> None:
         command, script = commands(args.radius, args.step, args.phi_step, folder)
         small_command, small_script = commands(args.step, args.step, 120.0, folder / "small")
         (folder / "small").mkdir()
-        for arguments in (command, script):  # compiled kernels, warm file cache
-            measured(arguments)
-        runs = {"command": [], "script": []}
-        for _ in range(args.repeat):
-            runs["command"].append(measured(command))
-            runs["script"].append(measured(script))
-        fixed = {"command": measured(small_command), "script": measured(small_script)}
+        runs, fixed = side_by_side(command, script, small_command, small_script, args.repeat)
         import xarray  # the map's file: read once both have run
 
         reference = np.load(folder / "reference.npz")
