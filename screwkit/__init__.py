@@ -23,7 +23,7 @@ wrenches, the plain-numpy reference of the pipeline), :mod:`screwkit.model` (wha
 
 from __future__ import annotations
 
-import importlib
+from screwkit.common.lazy import lazy_attributes
 
 __version__ = "0.1.0"
 
@@ -38,14 +38,4 @@ _API = {
 }
 
 
-def __getattr__(name: str):
-    """The top-level API, imported on first use (a module attribute's ``__getattr__``, PEP 562)."""
-    if name in _API:
-        value = getattr(importlib.import_module(_API[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'screwkit' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(list(globals()) + list(_API))
+__getattr__, __dir__ = lazy_attributes("screwkit", _API, globals())

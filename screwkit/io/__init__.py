@@ -16,10 +16,10 @@ as a graph at the file's configuration by :func:`graph_mechanism` (:mod:`screwki
 
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from screwkit.common.lazy import lazy_attributes
 from screwkit.common.units import metres_per
 
 if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file in screwkit's convention reads none
@@ -49,16 +49,7 @@ _READERS = {
 in screwkit's convention (and every bundled mechanism) needs none of them (about 20 ms, YAML and XML readers)."""
 
 
-def __getattr__(name: str):
-    if name in _READERS:
-        value = getattr(importlib.import_module(_READERS[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'screwkit.io' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_READERS))
+__getattr__, __dir__ = lazy_attributes("screwkit.io", _READERS, globals())
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 
