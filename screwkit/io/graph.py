@@ -327,14 +327,16 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
     model = tree.model
     for leg in legs:
         if len(leg.actuators) != 1:
-            stage = [model.names[j] for j in leg.joints  # joints carrying every actuator of the leg, from the base
+            stage = [j for j in leg.joints  # joints carrying every actuator of the leg, from the base
                      if len(leg.actuators) > 1 and joint_kind(model, j)[0] in ("revolute", "prismatic")
                      and all(j in path_to(model, a) for a in leg.actuators if a != j)]
-            carrier = (f"the actuated joint {stage[0]!r} carries every other one" if stage and stage[0] in [
-                model.names[a] for a in leg.actuators] else f"joint {stage[0]!r} carries every actuator of it"
-                if stage else "")
-            advice = (f"; {carrier} (a serial stage before the parallel part): --lock {stage[0]} analyses the legs "
-                      "on the body it turns" if stage else "")
+            advice = ""
+            if stage:
+                name = model.names[stage[0]]
+                carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
+                           else f"joint {name!r} carries every actuator of it")
+                advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
+                          "on the body it turns")
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet)"
