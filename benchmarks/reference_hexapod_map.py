@@ -63,13 +63,19 @@ def indices(base, platform, poses):
         numerator = np.abs(np.einsum("nki,nki->nk", matrix[..., :3], v) + np.einsum("nki,nki->nk", matrix[..., 3:], w))
         value = np.where(arm <= THRESHOLD * np.linalg.norm(w, axis=-1), 0.0, numerator / np.where(arm > 0, arm, 1.0))
         oti[:, s] = np.where(singular, 0.0, np.minimum(value, 1.0).min(axis=1))
-    lmti = oti.max(axis=1)
+    faults = fault_tolerance(oti, subsets, legs)
+    return oti.max(axis=1), faults[1], faults[2]
+
+
+def fault_tolerance(oti, subsets, legs, failures=(1, 2)):
+    """F_Oj for each j of ``failures`` (Eq. 12): over the sets of j failed legs, the minimum of the best OTI of the
+    submechanisms (``subsets``, columns of ``oti``) the other legs still make."""
     faults = {}
-    for j in (1, 2):
+    for j in failures:
         sets = [[s for s, subset in enumerate(subsets) if set(subset) <= set(kept)]
                 for kept in combinations(range(legs), legs - j)]
         faults[j] = np.min([oti[:, members].max(axis=1) for members in sets], axis=0)
-    return lmti, faults[1], faults[2]
+    return faults
 
 
 def main() -> None:

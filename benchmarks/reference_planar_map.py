@@ -30,6 +30,7 @@ import time
 from itertools import combinations
 
 import numpy as np
+from reference_hexapod_map import fault_tolerance  # Eq. 12, the same minima
 
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import load
@@ -108,11 +109,7 @@ def indices(base, platform, proximal, distal, side, poses, threshold=THRESHOLD, 
         value = np.where(arm <= threshold * np.abs(w), 0.0, numerator / np.where(arm > 0, arm, 1.0))
         oti[:, s] = np.where(singular, 0.0, np.minimum(value, 1.0).min(axis=1))
     lmti = oti.max(axis=1)
-    faults = {}
-    for j in (1, 2):
-        sets = [[s for s, subset in enumerate(subsets) if set(subset) <= set(kept)]
-                for kept in combinations(range(chains), chains - j)]
-        faults[j] = np.min([oti[:, members].max(axis=1) for members in sets], axis=0)
+    faults = fault_tolerance(oti, subsets, chains)
     return (iti, lmti, faults[1], faults[2], np.minimum(faults[1], iti), np.minimum(faults[2], iti)), reachable
 
 
