@@ -125,6 +125,16 @@ def screwkit_at_home(path: Path, tree, q):
     return result, motors
 
 
+def assert_pressure_angles(result, expected: dict, path: Path) -> None:
+    """Each actuator's ITI, the OTIs of the whole mechanism and the LMTI are the textbook pressure angles'
+    (``expected``: :func:`planar_pressure_angles`), at a pose where they say something, and the docs quote them."""
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], expected["oti"], atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=TOLERANCE)
+    assert 0.1 < expected["lmti"] < 0.99  # a pose where the angles say something
+    assert_documented(result, path)
+
+
 def test_gepetto_five_bar_gives_the_textbook_pressure_angles():
     """5bar_linkage: leg 1 mot1-free1 ends on the pin closedloop1_A, leg 2 mot2-free2 on closedloop1_B (the 6d
     closure holds the two pins coaxial): the output is the pin's point."""
@@ -137,11 +147,7 @@ def test_gepetto_five_bar_gives_the_textbook_pressure_angles():
                                       joint_axis(tree, data, "mot1"))
     result, motors = screwkit_at_home(path, tree, q)
     assert motors == ["mot1", "mot2"] and result.dof == 2
-    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
-    np.testing.assert_allclose(result.oti_actuators[0], expected["oti"], atol=TOLERANCE)
-    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=TOLERANCE)
-    assert 0.1 < expected["lmti"] < 0.99  # a pose where the angles say something
-    assert_documented(result, path)
+    assert_pressure_angles(result, expected, path)
 
 
 def test_gepetto_planar_delta_with_revolute_parallelograms_gives_the_textbook_pressure_angles():
@@ -156,11 +162,7 @@ def test_gepetto_planar_delta_with_revolute_parallelograms_gives_the_textbook_pr
                                       joint_axis(tree, data, "mot1_rod1"))
     result, motors = screwkit_at_home(path, tree, q)
     assert motors == ["mot1_rod1", "mot1_rod2"] and result.dof == 2
-    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=TOLERANCE)
-    np.testing.assert_allclose(result.oti_actuators[0], expected["oti"], atol=TOLERANCE)
-    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=TOLERANCE)
-    assert 0.1 < expected["lmti"] < 0.99
-    assert_documented(result, path)
+    assert_pressure_angles(result, expected, path)
 
 
 def test_gepetto_sps_leg_gives_the_leg_line_otis():
