@@ -1,13 +1,96 @@
 """numba's ``njit`` for screwkit's compiled kernels, caching where :func:`screwkit.common.compiling.numba_cache`
-decides (without a cache when no folder can be written)."""
+decides (without a cache when no folder can be written), and never serving machine code older than its sources.
+
+numba keeps a cached kernel while the stamp of the kernel's own source file is unchanged. A kernel here inlines
+stages and helpers from other modules (:mod:`screwkit.indices.compiled.jacobi`, ``algebra``, ``actuators``, the
+frames of :mod:`screwkit.closure.compiled`, the tolerances it reads as constants), so a change to one of those alone
+would leave numba serving the machine code compiled from the old one: in an editable install updated by ``git
+pull``, silently the old numbers. The cache locators installed here (numba's own, the same folders) add to that
+stamp a digest of every source a kernel is compiled from (:data:`KERNEL_SOURCES`), so any change to any of them
+compiles every kernel anew.
+"""
 
 from __future__ import annotations
+
+import functools
+import hashlib
+from pathlib import Path
 
 from numba import njit as numba_njit
 
 from screwkit.common.compiling import numba_cache
 
-__all__ = ["njit"]
+__all__ = ["njit", "KERNEL_SOURCES", "kernel_sources", "kernel_sources_digest"]
+
+PACKAGE = Path(__file__).resolve().parents[1]
+
+#: What the kernels are compiled from, relative to the package: every module of the compiled folders, and the
+#: modules outside them whose functions or constants they compile in (``tests/test_kernel_cache.py`` checks that
+#: every module a compiled module imports is here, or is plumbing that only Python runs).
+KERNEL_SOURCES = ("indices/compiled/*.py", "closure/compiled/*.py", "common/fastmath.py", "common/tolerances.py",
+                  "common/jit.py")
+
+
+def kernel_sources(package: Path = PACKAGE) -> list[Path]:
+    """The files of :data:`KERNEL_SOURCES` in ``package``, sorted."""
+    return sorted({path for pattern in KERNEL_SOURCES for path in package.glob(pattern)})
+
+
+@functools.cache
+def kernel_sources_digest(package: Path = PACKAGE) -> str:
+    """SHA-256 of the names and contents of :func:`kernel_sources` (read once per process)."""
+    digest = hashlib.sha256()
+    for path in kernel_sources(package):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+@functools.cache
+def _kernel_source_set() -> frozenset[Path]:
+    return frozenset(kernel_sources())
+
+
+def _is_kernel_source(py_file: str) -> bool:
+    try:
+        return Path(py_file).resolve() in _kernel_source_set()
+    except OSError:
+        return False
+
+
+def _stamped(locator: type) -> type:
+    """numba's cache ``locator`` for screwkit's kernels, its source stamp extended by the sources' digest."""
+
+    class SourcesStamped(locator):
+        screwkit_sources = True
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            return super().from_function(py_func, py_file) if _is_kernel_source(py_file) else None
+
+        def get_source_stamp(self):
+            return super().get_source_stamp(), kernel_sources_digest()
+
+    SourcesStamped.__name__ = SourcesStamped.__qualname__ = f"SourcesStamped{locator.__name__}"
+    return SourcesStamped
+
+
+def install_locators() -> bool:
+    """Put the stamped locators before numba's own (once); False if this numba has not the expected classes, in
+    which case numba's own stamp (the kernel's file alone) applies."""
+    from numba.core import caching
+
+    implementation = getattr(caching, "CacheImpl", None)
+    names = ("UserProvidedCacheLocator", "InTreeCacheLocator", "UserWideCacheLocator")
+    bases = [getattr(caching, name, None) for name in names]
+    classes = getattr(implementation, "_locator_classes", None)
+    if classes is None or None in bases:
+        return False
+    if not any(getattr(locator, "screwkit_sources", False) for locator in classes):
+        implementation._locator_classes = [*map(_stamped, bases), *classes]
+    return True
+
+
+install_locators()
 
 
 def njit(*args, **options):

@@ -10,8 +10,8 @@ characteristic point of its OTI (:func:`unit_wrench_lanes`); its row of the wren
 These functions have no signature of their own: numba inlines them (``inline="always"``) into
 :func:`~screwkit.indices.compiled.outputs.output_kernel`, which compiles as one function, with the results, bit for
 bit, of the loops written out in it. Stages are passes over all the items of a block rather than functions called
-per item: each inlined call costs reference counts on its array arguments, once per block this way. numba's cache
-does not see a change to this module alone: after editing it, clear the cache (or touch ``outputs.py``).
+per item: each inlined call costs reference counts on its array arguments, once per block this way. A change to
+this module alone compiles the kernels anew (their cache stamp covers every kernel source: :mod:`screwkit.common.jit`).
 """
 
 from __future__ import annotations
