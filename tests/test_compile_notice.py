@@ -64,3 +64,26 @@ def test_several_kernels_start_longest_first_and_the_notice_states_the_makespan(
     notice.prepare_kernels((WRENCH, OUTPUT, notice.NULL_KERNEL, notice.GRAM_KERNEL))
     assert list(stand_in_children) == [OUTPUT, notice.NULL_KERNEL, WRENCH, notice.GRAM_KERNEL]
     assert not notice._children and not notice._queued
+
+
+def test_one_pose_does_not_compile_the_kernels_of_large_chunks_ahead(monkeypatch):
+    """``analyze`` (one pose) starts the index kernels ahead but not the lower-mobility kernels of chunks of
+    ``SPACES_COMPILED_FROM`` poses or more, which one pose never reaches (23 s of CPU on a first run); a command
+    of many poses starts them for a spatial mechanism of fewer than six DOF."""
+    import json
+
+    from click.testing import CliRunner
+
+    import screwkit.cli.options as options
+    from screwkit.cli import app
+
+    asked: list[str] = []
+    monkeypatch.setattr(options, "compile_ahead", lambda *modules: asked.extend(modules))
+    done = CliRunner().invoke(app, ["analyze", "delta_4", "--json"])
+    assert done.exit_code == 0, done.output
+    assert json.loads(done.output)["dof"] == 3
+    assert set(notice.INDEX_KERNELS) <= set(asked)
+    assert notice.SPACE_KERNEL not in asked and notice.CONSTRAINT_KERNEL not in asked
+    asked.clear()
+    options.load_mechanism("delta_4")  # what map, sweep and trajectory ask
+    assert {notice.SPACE_KERNEL, notice.CONSTRAINT_KERNEL} <= set(asked)

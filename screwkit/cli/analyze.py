@@ -155,7 +155,7 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
     """Every index (ITI, LMTI, F_Oj, F_IOj, worst faults, CTI) of MECHANISM at one pose (with --aggregate mean,
     also the average case of F_Oj over the failures)."""
 
-    loaded = load_mechanism(mechanism, reading, graphs=True, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, graphs=True, limits=analysis.limits, batches=False)  # one pose
     check_average(analysis, loaded)
     with analysis.indices():  # the average case registered, if asked, for the report
         _analyze(loaded, pose, actuator_values, analysis, as_json)

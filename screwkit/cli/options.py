@@ -371,12 +371,14 @@ def outputs_options(*, colour_scale: bool = False) -> Callable:
 # -- parsing ---------------------------------------------------------------------------------------
 
 def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: bool = True, graphs: bool = False,
-                   limits: bool = True):
+                   limits: bool = True, batches: bool = True):
     """Load MECHANISM (a bundled name or a file) as ``reading`` says (a :class:`Reading`, or just a length unit);
     a one-line error if it cannot be loaded.
 
     ``indices``: the command computes indices, so a first run says at once that the index kernel
-    is about to be compiled, and starts compiling it (before Pinocchio is even imported). ``graphs``: a file
+    is about to be compiled, and starts compiling it (before Pinocchio is even imported); ``batches`` False: the
+    command computes a few poses only, fewer than the chunks the lower-mobility kernels serve
+    (:data:`~screwkit.indices.stages.SPACES_COMPILED_FROM`), so those are not compiled ahead. ``graphs``: a file
     whose legs have loops inside them is returned as a :class:`~screwkit.io.GraphMechanism` (analysed at the
     file's configuration) instead of refused. ``limits`` False (``--ignore-limits``): a reference assembly outside
     a joint's limits is read all the same, and said on stderr."""
@@ -411,7 +413,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
                                      mechanism.dof),
-                     *(SPACE_KERNEL, CONSTRAINT_KERNEL) * (mechanism.dof < 6 and not mechanism.is_planar))
+                     *(SPACE_KERNEL, CONSTRAINT_KERNEL) * (batches and mechanism.dof < 6 and not mechanism.is_planar))
     return mechanism
 
 
