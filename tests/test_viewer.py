@@ -27,7 +27,7 @@ from helpers import one_line_error, screwkit
 from screwkit.closure import chain_screws, solve_one
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
-from screwkit.studies.paths import line_path
+from screwkit.studies.paths import line_path, path_from_poses
 from screwkit.viewer import (
     FAILED_COLOR,
     animate_sweep,
@@ -407,6 +407,44 @@ def test_path_animation_colours_each_chain_by_its_index_frame_by_frame(planar, v
         np.testing.assert_allclose(still.chain_colors[2], FAILED_COLOR)
 
 
+def test_a_path_with_times_plays_at_its_own_times(planar, viewer):
+    """Keyframe k of a timed path is at its time less the first (Meshcat: key time / fps seconds), whatever the frame
+    rate; an unreachable sample is skipped with its time."""
+    poses = np.array([[-0.1, 0.0, 0.0], [0.0, 0.05, 0.17], [0.1, 0.0, 0.35], [3.0, 0.0, 0.0], [0.12, 0.01, 0.3]])
+    times = np.array([1.0, 1.5, 3.0, 3.5, 5.0])
+    kept = [0, 1, 2, 4]
+    for rate in (4.0, 25.0):
+        scene = animate_sweep(planar, path_from_poses(planar, poses, times), viewer=viewer, frame_rate=rate)
+        np.testing.assert_allclose(scene.times, times[kept])
+        np.testing.assert_allclose(scene.poses, poses[kept])
+        animation = [c["animations"] for c in scene_commands(scene.static_html())
+                     if c["type"] == "set_animation" and c["animations"]][-1]
+        platform = full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")
+        clip = {item["path"]: item["clip"] for item in animation}[platform]
+        keys = {track["name"]: track for track in clip["tracks"]}[".position"]["keys"]
+        np.testing.assert_allclose([key["time"] / clip["fps"] for key in keys], times[kept] - times[0], atol=1e-12)
+        np.testing.assert_allclose([key["value"][:2] for key in keys], poses[kept, :2], atol=1e-12)
+    untimed = animate_sweep(planar, poses[kept], viewer=viewer, frame_rate=4.0)  # without times: one per 1/4 s
+    assert untimed.times is None
+    with pytest.raises(ValueError, match="increasing"):
+        animate_sweep(planar, poses[kept], viewer=viewer, times=[0.0, 1.0, 1.0, 2.0])
+
+
+def test_a_long_timed_path_is_animated_at_frames_even_in_time(planar, tmp_path, monkeypatch):
+    """More samples than MAX_FRAMES with a time column: frames evenly spaced in time, each the path's pose then
+    (the platform speeds up: x = 0.01 t^2, so arc length and time are not proportional)."""
+    import screwkit.cli.view as view_command
+
+    times = np.arange(12.0)
+    table = tmp_path / "timed.csv"
+    table.write_text("t,x,y,phi\n" + "".join(f"{t},{0.01 * t * t - 0.5},0,0\n" for t in times))
+    monkeypatch.setattr(view_command, "MAX_FRAMES", 5)
+    motion = view_command._motion(None, 10.0, str(table), None, None, None, 100)
+    poses, at = view_command._animated_poses(planar, motion, planar.home_pose, quiet=True)
+    np.testing.assert_allclose(at, np.linspace(0.0, 11.0, 5))
+    np.testing.assert_allclose(poses[:, 0], np.interp(at, times, 0.01 * times**2 - 0.5), atol=1e-12)
+
+
 def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):
     scene = show(planar, PLANAR_POSE, viewer=viewer)
     target = tmp_path / "scene.html"
@@ -470,6 +508,16 @@ def test_cli_view_animates_a_path_and_refuses_a_bad_path_file(tmp_path):
     outcome = screwkit("view", "planar_5rrr", "--path", table, "--html", tmp_path / "file.html")
     assert outcome.returncode == 0, outcome.stderr
     assert "first of 3 frames" in outcome.stdout
+    timed = tmp_path / "timed.csv"  # a time column: played at its times
+    timed.write_text("t,x,y,phi\n2,-0.1,0,0\n2.5,0,0.05,10\n4,0.1,0,20\n")
+    outcome = screwkit("view", "planar_5rrr", "--path", timed, "--html", tmp_path / "timed.html")
+    assert outcome.returncode == 0, outcome.stderr
+    assert "Animated at the path's own times: 2 s." in outcome.stderr
+    animation = [c for c in scene_commands((tmp_path / "timed.html").read_text())
+                 if c["type"] == "set_animation" and c["animations"]][-1]["animations"]
+    clip = {item["path"]: item["clip"] for item in animation}[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]
+    keys = {t["name"]: t for t in clip["tracks"]}[".position"]["keys"]
+    np.testing.assert_allclose([key["time"] / clip["fps"] for key in keys], [0.0, 0.5, 2.0], atol=1e-12)
     bad = tmp_path / "bad.csv"
     bad.write_text("x,y\n0,0\n0.1,0\n")
     for arguments, needles in (

@@ -30,7 +30,8 @@ __all__ = ["view"]
 
 
 MAX_FRAMES = 500
-"""A path of more samples is animated at this many, evenly spaced in arc length (one keyframe each)."""
+"""A path of more samples is animated at this many (one keyframe each), evenly spaced in time when it has a time
+column, else in arc length."""
 
 
 @dataclass(frozen=True)
@@ -66,23 +67,31 @@ class Colouring:
     threshold: float
 
 
-def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool) -> np.ndarray | None:
-    """The poses of ``--sweep-phi`` or of the path (at most :data:`MAX_FRAMES`), or None (one pose)."""
+def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool):
+    """The poses of ``--sweep-phi`` or of the path (at most :data:`MAX_FRAMES`) and their times (a path's time
+    column, else None), or None (one pose)."""
     if motion.sweep_phi is not None:
         if not mechanism.is_planar:
             raise fail(f"--sweep-phi sweeps a planar mechanism; {mechanism.name!r} is spatial.")
         angles = parse_range(motion.sweep_phi, "--sweep-phi", angular=True)
         poses = np.repeat(target[None], angles.size, axis=0)
         poses[:, 2] = angles
-        return poses
+        return poses, None
     if motion.path is None:
         return None
     path = motion.path.read(mechanism)
+    if path.times is not None and not quiet:
+        echo_error(f"Animated at the path's own times: {path.times[-1] - path.times[0]:g} s.")
     if path.samples <= MAX_FRAMES:
-        return path.poses
+        return path.poses, path.times
+    if path.times is None:
+        if not quiet:
+            echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in arc length.")
+        return path.at(np.linspace(0.0, path.length, MAX_FRAMES)), None
     if not quiet:
-        echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in arc length.")
-    return path.at(np.linspace(0.0, path.length, MAX_FRAMES))
+        echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in time.")
+    times = np.linspace(path.times[0], path.times[-1], MAX_FRAMES)
+    return path.at(np.interp(times, path.times, path.arc_length)), times
 
 
 def _echo_legend(scene) -> None:
@@ -123,11 +132,13 @@ def _echo_legend(scene) -> None:
                  help="Animate a planar sweep of phi (deg; the stop is excluded) at the x y of --pose."),
     click.option("--path", "path_file", type=click.Path(dir_okay=True), metavar="PATH",
                  help="Animate the platform along a path: a CSV or netCDF file of task coordinates, as `screwkit "
-                      f"trajectory` reads it (more than {MAX_FRAMES} samples: {MAX_FRAMES} frames evenly spaced in "
-                      "arc length); the chains' colours follow their index frame by frame."),
+                      f"trajectory` reads it, played at its time column's times if it has one (more than {MAX_FRAMES} "
+                      f"samples: {MAX_FRAMES} frames evenly spaced in time, else in arc length); the chains' colours "
+                      "follow their index frame by frame."),
     line_option, circle_option, through_option, samples_option,
     click.option("--frame-rate", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
-                 help="--sweep-phi and paths: keyframes per second (1/s)."))
+                 help="--sweep-phi and paths: keyframes per second (1/s); a path with a time column plays at "
+                      "its own times instead."))
 @option_group(
     "colouring", Colouring,
     click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
@@ -152,11 +163,12 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
     loaded = load_mechanism(mechanism, reading)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
-    poses = _animated_poses(loaded, motion, target, quiet)
+    animated = _animated_poses(loaded, motion, target, quiet)
     try:
-        if poses is not None:
+        if animated is not None:
+            poses, times = animated
             scene = animate_sweep(loaded, poses, failed=failures, threshold=colouring.threshold,
-                                  color_by=colouring.color_by, frame_rate=motion.frame_rate)
+                                  color_by=colouring.color_by, frame_rate=motion.frame_rate, times=times)
         else:
             scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by)
     except (ValueError, RuntimeError) as error:

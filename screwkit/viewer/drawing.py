@@ -215,9 +215,11 @@ def clear_animation(viewer) -> None:
 
 
 def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_markers, frame_rate, loop,
-            colours: dict[str, NDArray] | None = None) -> None:
+            colours: dict[str, NDArray] | None = None, times: NDArray | None = None) -> None:
     """One keyframe per frame: the links, and the markers (shown or hidden); with ``colours`` (per Meshcat path of a
-    drawn object, its RGB(A) colour at each frame, (frames, 3 or 4)), the material colour of each follows too."""
+    drawn object, its RGB(A) colour at each frame, (frames, 3 or 4)), the material colour of each follows too.
+    Keyframe ``k`` is at ``k / frame_rate`` seconds, or with ``times`` (seconds, increasing, one per frame) at
+    ``times[k] - times[0]``: Meshcat then plays the motion at its own pace, interpolating between keyframes."""
     import meshcat.animation
     import pinocchio
     from meshcat import transformations
@@ -225,10 +227,12 @@ def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_marke
     model, data = visualizer.model, visualizer.data
     visual_data = visualizer.visual_data
     animation = meshcat.animation.Animation(default_framerate=frame_rate)
+    at = (np.arange(len(frames.configurations)) if times is None
+          else (np.asarray(times, dtype=float) - times[0]) * frame_rate)  # keyframe numbers (Meshcat: frame / fps s)
     for frame, configuration in enumerate(frames.configurations):
         pinocchio.forwardKinematics(model, data, configuration)
         pinocchio.updateGeometryPlacements(model, data, visual_model, visual_data)
-        with animation.at_frame(viewer, frame) as keyframe:
+        with animation.at_frame(viewer, int(at[frame]) if times is None else float(at[frame])) as keyframe:
             for index, geometry in enumerate(visual_model.geometryObjects):
                 node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
                 keyframe[node].set_transform(visual_data.oMg[index].homogeneous)

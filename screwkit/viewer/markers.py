@@ -204,11 +204,13 @@ class Frames:
     centres: NDArray  # (F, 3) platform origin, world
     result: Any  # batched over F
     loop_points: list = None  # per chain (F, 3): the platform-side loop frame's origin, world (where the leg ends)
+    kept: NDArray = None  # (F,) which of the poses asked for these frames are (the reachable ones)
 
 
 def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> Frames:
     solution = solve(mechanism, poses)
     reachable = np.asarray(solution.reachable)
+    kept = np.flatnonzero(reachable)
     if not np.all(reachable):
         if strict:
             solve_one(mechanism, poses[int(np.flatnonzero(~reachable)[0])])  # raises, naming the chains
@@ -227,7 +229,7 @@ def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> F
     return Frames(poses=np.asarray(solution.poses),
                    configurations=np.asarray(configurations).reshape(poses.shape[0], -1),
                    chain_points=[np.asarray(s.points) for s in screws], centres=centres, result=result,
-                   loop_points=loop_points)
+                   loop_points=loop_points, kept=kept)
 
 
 def best_submechanism(result, frame: int, failed: tuple[int, ...]) -> int | None:

@@ -82,6 +82,9 @@ class Scene:
         Translation of the drawing (``/meshcat``, grid and axes) in the viewer, which puts the
         mechanism's centre on Meshcat's fixed orbit target; markers are in the mechanism's
         world frame.
+    times : ndarray, shape (frames,), or None
+        Seconds at which each animated pose is reached when the animation follows the poses' own times (a path
+        with a time column, or ``times``); None otherwise.
     """
 
     mechanism: Any
@@ -98,6 +101,7 @@ class Scene:
     server: ViewerServer | None = None
     frame_rate: float | None = None
     display_offset: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    times: NDArray[np.float64] | None = None
 
     @property
     def pose(self) -> NDArray[np.float64]:
@@ -183,7 +187,7 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
 
 def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
                   color_by: Literal["iti", "oti"] = "iti", viewer=None, frame_rate: float = 10.0,
-                  loop: bool = True, open_browser: bool = False) -> Scene:
+                  loop: bool = True, open_browser: bool = False, times: ArrayLike | None = None) -> Scene:
     """Animate the mechanism along a sweep of poses or a path, with its screws and colours following.
 
     The first reachable pose is drawn as by :func:`show` (chain colours from its indices);
@@ -199,13 +203,16 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
     mechanism : Mechanism, str or path
     poses : array_like, shape (frames, n_task), or Path
         Platform poses in metres and radians, in the order to play them, or a
-        :class:`~screwkit.studies.paths.Path` (its samples).
+        :class:`~screwkit.studies.paths.Path` (its samples; with its times, if it has any).
     failed, threshold, color_by, viewer, open_browser
         As for :func:`show`.
     frame_rate : float
-        Keyframes per second.
+        Keyframes per second (without times); with times, the clip's time base (keyframe numbers per second).
     loop : bool
         Repeat the animation (else play it once).
+    times : array_like, shape (frames,), optional
+        Seconds at which the platform is at each pose (finite, increasing; default: a path's own times, else
+        none): the animation then plays the motion at its own pace, pose ``k`` at ``times[k] - times[0]``.
 
     Returns
     -------
@@ -218,11 +225,19 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
         No reachable pose, or bad arguments.
     """
     mechanism = mechanism_of(mechanism)
+    if times is None:
+        times = getattr(poses, "times", None)
     poses = mechanism.check_poses(getattr(poses, "poses", poses)).reshape(-1, mechanism.n_task)
     if not frame_rate > 0:
         raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
+    if times is not None:
+        times = np.asarray(times, dtype=float)
+        if times.shape != (poses.shape[0],):
+            raise ValueError(f"Expected one time per pose ({poses.shape[0]}) in `times`, got shape {times.shape}.")
+        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+            raise ValueError("Expected finite, increasing `times`.")
     return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser,
-                 _Animation(float(frame_rate), loop))
+                 _Animation(float(frame_rate), loop, times))
 
 
 def export_html(target, path: str | os.PathLike) -> Path:
@@ -274,10 +289,11 @@ def meshcat_viewer_of(target):
 
 @dataclass(frozen=True)
 class _Animation:
-    """The keyframes of :func:`animate_sweep`: per second, and whether they repeat."""
+    """The keyframes of :func:`animate_sweep`: per second, whether they repeat, and the poses' times (s) if given."""
 
     frame_rate: float
     loop: bool
+    times: NDArray | None = None
 
 
 def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None) -> Scene:
@@ -355,7 +371,8 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
         if animation is not None:
             frame_colors = colors_from_values(chain_values)  # (frames, chains, 4)
             animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, animation.frame_rate,
-                    animation.loop, {node: frame_colors[:, chain] for node, chain in chain_of_node.items()})
+                    animation.loop, {node: frame_colors[:, chain] for node, chain in chain_of_node.items()},
+                    None if animation.times is None else animation.times[frames.kept])
     except BaseException:
         if server is not None:
             with contextlib.suppress(Exception):
@@ -368,7 +385,8 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
                   chain_values=chain_values, chain_colors=chain_colors, best_submechanisms=tuple(
                       None if b is None else tuple(result.submechanisms[b]) for b in best),
                   frame_markers=markers, visualizer=visualizer, viewer=meshcat_viewer, server=server,
-                  frame_rate=None if one_pose else animation.frame_rate, display_offset=display_offset)
+                  frame_rate=None if one_pose else animation.frame_rate, display_offset=display_offset,
+                  times=None if one_pose or animation.times is None else animation.times[frames.kept])
     if open_browser:
         meshcat_viewer.open()
     return scene
