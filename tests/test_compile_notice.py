@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import screwkit.common.compiling as notice
@@ -87,3 +88,29 @@ def test_one_pose_does_not_compile_the_kernels_of_large_chunks_ahead(monkeypatch
     asked.clear()
     options.load_mechanism("delta_4")  # what map, sweep and trajectory ask
     assert {notice.SPACE_KERNEL, notice.CONSTRAINT_KERNEL} <= set(asked)
+
+
+@pytest.mark.parametrize("name", ["delta_4", "prs_3_ups", "schoenflies_5", "ups_hexapod_8", "coop_arms", "five_bar",
+                                  "planar_5rrr", "five_bar_3"])
+def test_the_kernels_compiled_ahead_are_those_a_large_batch_uses(name, monkeypatch):
+    """``constraint_kernels`` (what a command of many poses compiles ahead beside the index kernels) names exactly
+    the lower-mobility kernels that a chunk of SPACES_COMPILED_FROM poses about the home pose asks for: none for
+    the Schoenflies robot, whose chains hold only common constraint wrenches."""
+    import screwkit.indices.stages as stages
+    from screwkit.io.loader import load
+    from screwkit.studies import indices_at_poses
+    from screwkit.studies.kernels import constraint_kernels
+
+    mechanism = load(name)
+    asked: list[str] = []
+    prepare = stages.prepare_kernels
+    monkeypatch.setattr(stages, "prepare_kernels", lambda modules=(): (asked.extend(modules), prepare(modules)))
+    count = max(stages.SPACES_COMPILED_FROM, stages.CONSTRAINTS_COMPILED_FROM)
+    span = np.array([0.01 * mechanism.length_scale if c in ("x", "y", "z") else 0.02
+                     for c in mechanism.task_coordinates])
+    poses = mechanism.home_pose + np.random.default_rng(3).uniform(-1.0, 1.0, (count, mechanism.n_task)) * span
+    result = indices_at_poses(mechanism, poses, threads=1)
+    assert np.mean(result.reachable) > 0.9
+    lower = {notice.SPACE_KERNEL, notice.CONSTRAINT_KERNEL}
+    assert set(constraint_kernels(mechanism)) == set(asked) & lower
+    assert (name == "schoenflies_5") <= (not asked)

@@ -22,9 +22,7 @@ import numpy as np
 from screwkit.cli.reading import Reading, lock_option, output_frame_option, output_type_option, reading_record
 from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import (
-    CONSTRAINT_KERNEL,
     INDEX_KERNELS,
-    SPACE_KERNEL,
     compile_ahead,
     silence,
     stage_kernels,
@@ -411,9 +409,11 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     if ignored and not (context and context.params.get("quiet")):
         echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
+        from screwkit.studies.kernels import constraint_kernels  # the closures and indices: commands computing them
+
         compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
                                      mechanism.dof),
-                     *(SPACE_KERNEL, CONSTRAINT_KERNEL) * (batches and mechanism.dof < 6 and not mechanism.is_planar))
+                     *(constraint_kernels(mechanism) if batches else ()))
     return mechanism
 
 

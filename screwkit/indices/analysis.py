@@ -62,10 +62,44 @@ from screwkit.screw.motion import (
 )
 from screwkit.screw.outputs import idle_rotations, with_idle_joints
 
-__all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets"]
+__all__ = ["MotionSpace", "analyze", "motion_space", "fault_sets", "constraint_structure"]
 
 DEFAULT_THRESHOLD = tolerances.SINGULARITY_THRESHOLD
 """The paper's singularity threshold *p* on the moment arm: 1 um (in metres)."""
+
+
+def _structure(chains: list[ChainScrews], batch_shape: tuple[int, ...], count: int, dof, faults, threshold,
+               rank_tolerance, output_point, planar):
+    """The chains :func:`analyze` works on (with the idle rotations of a point output as passive joints), the idle
+    rotations (None for a frame output), its :class:`~screwkit.indices.stages.Plan` and the constraint plan."""
+    idle = None
+    if output_point is not None:
+        point = check_finite(as_float_array(output_point, "output_point"), "output_point")
+        try:
+            point = np.broadcast_to(point, batch_shape + (3,)).reshape(count, 3)
+        except ValueError:
+            raise ValueError(f"Expected `output_point` with shape (..., 3), got {point.shape}.") from None
+        idle, idle_points = idle_rotations(point, planar)
+        index, _, _, centre, length = sampled_working_coordinates(chains)
+        chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
+    plan = make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
+    # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
+    constraint_plan = (constraint_plan_of(chains, count) if plan.space.dof < 6
+                       else ConstraintPlan(tuple(0 for _ in chains), 0))
+    return chains, idle, plan, constraint_plan
+
+
+def constraint_structure(chains: Sequence[ChainScrews], *, dof: int | None = None,
+                         output_point: ArrayLike | None = None, planar: bool | ArrayLike = False):
+    """What :func:`analyze` finds of these chains' structure (taking its arguments): the constraint plan (``count``
+    0: no chain holds a constraint wrench of its own), the number ``n`` of actuators of a submechanism, and whether
+    the motion space is the same at every configuration of the batch (else each configuration takes its own)."""
+    chains = list(chains)
+    batch_shape = chains[0].batch_shape
+    count = int(np.prod(batch_shape, dtype=np.int64))
+    _, _, plan, constraint_plan = _structure(chains, batch_shape, count, dof, None, DEFAULT_THRESHOLD,
+                                             tolerances.RANK_TOLERANCE, output_point, planar)
+    return constraint_plan, plan.dof, plan.space.constant_basis is not None
 
 
 def analyze(
@@ -223,17 +257,8 @@ def analyze(
     if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     count = int(np.prod(batch_shape, dtype=np.int64))
-    idle = None
-    if output_point is not None:
-        point = check_finite(as_float_array(output_point, "output_point"), "output_point")
-        try:
-            point = np.broadcast_to(point, batch_shape + (3,)).reshape(count, 3)
-        except ValueError:
-            raise ValueError(f"Expected `output_point` with shape (..., 3), got {point.shape}.") from None
-        idle, idle_points = idle_rotations(point, planar)
-        index, _, _, centre, length = sampled_working_coordinates(chains)
-        chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
-    plan = make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
+    chains, idle, plan, constraint_plan = _structure(chains, batch_shape, count, dof, faults, threshold,
+                                                     rank_tolerance, output_point, planar)
     a = len(plan.actuators)
     overrides = {}
     for name, value in (("iti_points", iti_points), ("oti_points", oti_points)):
@@ -248,9 +273,6 @@ def analyze(
     twists = joints_of_all_chains([chain.twists.reshape((count,) + chain.twists.shape[-2:]) for chain in chains])
     points = joints_of_all_chains([chain.points.reshape((count,) + chain.points.shape[-2:]) for chain in chains])
 
-    # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
-    constraint_plan = (constraint_plan_of(chains, count) if plan.space.dof < 6
-                       else ConstraintPlan(tuple(0 for _ in chains), 0))
     fault_members = submechanisms_left(a, plan.dof, plan.faults) if constraint_plan.count else {}
 
     def run(part: slice) -> dict:

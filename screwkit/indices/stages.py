@@ -31,7 +31,7 @@ from screwkit.screw.outputs import quotient_bases
 
 __all__ = ["Plan", "make_plan", "run_kernel", "ChunkSpaces", "analyze_chunk", "joints_of_all_chains",
            "constraint_plan_of", "constraint_chunk", "at_constraint_singularities", "CONSTRAINTS_COMPILED_FROM",
-           "compiled_constraint_stage"]
+           "square_subsystems", "compiled_constraint_stage"]
 
 
 @dataclass
@@ -302,6 +302,22 @@ CONSTRAINTS_COMPILED_FROM = 512
 (:func:`screwkit.screw.constraints.constraint_indices`), which needs no compiling."""
 
 
+def subsystem_members(constraint_plan: ConstraintPlan) -> NDArray[np.int64]:
+    """(subsystems, chains): 1 where a chain's own constraint wrenches belong to a subsystem."""
+    members = np.zeros((len(constraint_plan.subsystems), len(constraint_plan.own_counts)), dtype=np.int64)
+    for row, subsystem in enumerate(constraint_plan.subsystems):
+        members[row, list(subsystem)] = 1
+    return members
+
+
+def square_subsystems(constraint_plan: ConstraintPlan, n: int) -> bool:
+    """Whether ``n`` actuation wrenches, each subsystem's own constraint wrenches and the common ones are six
+    wrenches for every subsystem: what the compiled constraint kernel serves."""
+    members = subsystem_members(constraint_plan)
+    own_counts = np.array(constraint_plan.own_counts, dtype=np.int64)
+    return bool(members.size) and bool(np.all(n + constraint_plan.common + members @ own_counts == 6))
+
+
 def compiled_constraint_stage(constraint_plan: ConstraintPlan, submechanisms: NDArray, count: int):
     """The ``stage`` of :func:`screwkit.screw.constraints.constraint_indices` that runs the compiled constraint
     kernel, for a chunk of ``count`` >= :data:`CONSTRAINTS_COMPILED_FROM` configurations of a mechanism whose
@@ -309,11 +325,8 @@ def compiled_constraint_stage(constraint_plan: ConstraintPlan, submechanisms: ND
     code's branch of one inverse per system); else None (the numpy code)."""
     n = submechanisms.shape[1]
     own_counts = np.array(constraint_plan.own_counts, dtype=np.int64)
-    members = np.zeros((len(constraint_plan.subsystems), own_counts.size), dtype=np.int64)
-    for row, subsystem in enumerate(constraint_plan.subsystems):
-        members[row, list(subsystem)] = 1
-    square = bool(members.size) and np.all(n + constraint_plan.common + members @ own_counts == 6)
-    if count < CONSTRAINTS_COMPILED_FROM or not constraint_plan.count or not square:
+    members = subsystem_members(constraint_plan)
+    if count < CONSTRAINTS_COMPILED_FROM or not constraint_plan.count or not square_subsystems(constraint_plan, n):
         return None
     wrench_start = np.cumsum((0,) + constraint_plan.chain_counts).astype(np.int64)
     sets = np.ascontiguousarray(submechanisms, dtype=np.int64)

@@ -525,3 +525,4 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
     return _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
                           faults=faults, detail=detail, threshold=threshold)
+
