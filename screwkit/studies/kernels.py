@@ -18,11 +18,19 @@ __all__ = ["constraint_kernels"]
 def constraint_kernels(mechanism: Mechanism) -> tuple[str, ...]:
     """The kernels that large chunks of this mechanism's configurations use beyond the index kernels, for
     :func:`~screwkit.common.compiling.compile_ahead`: the space kernel when the motion space changes with the
-    configuration (a point output's idle rotations included, as :func:`~screwkit.studies.poses.analyze_solution` adds them) or some chain
-    holds constraint wrenches of its own, and the constraint kernel when, moreover, the constraint subsystems are
-    square (:func:`~screwkit.indices.stages.square_subsystems`). Found at the home pose and 8 poses about it
-    (seeded); both when fewer than two of them assemble (a kernel not compiled ahead is compiled when first
-    used)."""
+    configuration (a point output's idle rotations included, as
+    :func:`~screwkit.studies.poses.analyze_solution` adds them) or some chain holds constraint wrenches of its own,
+    and the constraint kernel when, moreover, the constraint subsystems are square
+    (:func:`~screwkit.indices.stages.square_subsystems`). Found at the home pose and 8 poses about it (seeded);
+    both when fewer than two of them assemble or the structure cannot be found (a kernel not compiled ahead is
+    compiled when first used)."""
+    try:
+        return _constraint_kernels(mechanism)
+    except Exception:  # a hint for compiling ahead, never an error: the command reports what is wrong itself
+        return SPACE_KERNEL, CONSTRAINT_KERNEL
+
+
+def _constraint_kernels(mechanism: Mechanism) -> tuple[str, ...]:
     span = np.where(mechanism.angular, 0.02, 0.01 * mechanism.length_scale)
     poses = mechanism.home_pose + np.random.default_rng(0).uniform(-1.0, 1.0, (9, mechanism.n_task)) * span
     poses[0] = mechanism.home_pose
