@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 import screwkit
-from screwkit.common.jit import PACKAGE, kernel_sources, kernel_sources_digest
+from screwkit.common.compiling import PACKAGE, kernel_sources, kernel_sources_digest
 
 # imported by compiled modules for Python-side plumbing only (which kernels to prepare), never compiled in
 PLUMBING = {"screwkit.common.compiling"}
@@ -63,18 +63,21 @@ def test_the_digest_follows_the_contents(tmp_path):
 PROBE = """
 import json, numpy as np
 import screwkit
+from screwkit.common.compiling import kernel_is_cached
+cached = kernel_is_cached("screwkit.indices.compiled.planar")  # before numba sees the index
 from screwkit.indices.compiled.planar import planar_closed_form_kernel as kernel
 from screwkit.studies import indices_at_poses
 mechanism = screwkit.load("planar_5rrr")
 result = indices_at_poses(mechanism, np.array([[-0.2, 0.0, 0.785], [0.1, 0.05, 0.3]]), closed_forms=True)
-print(json.dumps({"file": screwkit.__file__, "hits": sum(kernel.stats.cache_hits.values()),
+print(json.dumps({"file": screwkit.__file__, "cached": cached, "hits": sum(kernel.stats.cache_hits.values()),
                   "misses": sum(kernel.stats.cache_misses.values()), "lmti": result.lmti.tolist()}))
 """
 
 
 def test_a_helper_changed_alone_compiles_the_kernel_anew(tmp_path):
     """On a copy of the package with a cache of its own: cached, then a helper module the kernel compiles in
-    (``common/fastmath.py``, not the kernel's file) edited alone: compiled again, then cached again."""
+    (``common/fastmath.py``, not the kernel's file) edited alone: compiled again, then cached again; and
+    ``kernel_is_cached`` (what decides the notice and the compiling ahead) says so before each run."""
     copy = tmp_path / "code"
     shutil.copytree(PACKAGE, copy / "screwkit", ignore=shutil.ignore_patterns("__pycache__"))
     environment = {**os.environ, "PYTHONPATH": str(copy), "NUMBA_CACHE_DIR": str(tmp_path / "numba"),
@@ -89,11 +92,13 @@ def test_a_helper_changed_alone_compiles_the_kernel_anew(tmp_path):
     first = probe()
     assert Path(first["file"]).resolve().is_relative_to(copy.resolve())  # the copy runs, not the checkout
     assert Path(screwkit.__file__).resolve().is_relative_to(PACKAGE.parent)
-    assert first["misses"] == 1 and first["hits"] == 0
+    assert first["misses"] == 1 and first["hits"] == 0 and not first["cached"]
     again = probe()
-    assert again["hits"] == 1 and again["misses"] == 0 and again["lmti"] == first["lmti"]
+    assert again["hits"] == 1 and again["misses"] == 0 and again["lmti"] == first["lmti"] and again["cached"]
     helper = copy / "screwkit" / "common" / "fastmath.py"
     helper.write_text(helper.read_text() + "\n# a helper edited alone\n")
     edited = probe()
     assert edited["misses"] == 1 and edited["hits"] == 0, "the old machine code was served after a helper changed"
-    assert probe()["hits"] == 1
+    assert not edited["cached"]  # the index of the old sources is not taken for a cached kernel
+    last = probe()
+    assert last["hits"] == 1 and last["cached"]

@@ -30,6 +30,8 @@ the same way). The kernels' modules take ``njit`` from :mod:`screwkit.common.jit
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 import subprocess
 import sys
@@ -41,7 +43,7 @@ from screwkit.common.caches import own_folder, private_temporary_folder, user_ca
 
 __all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
            "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "SPACE_KERNEL",
-           "CONSTRAINT_KERNEL", "CLOSED_FORM_KERNEL"]
+           "CONSTRAINT_KERNEL", "CLOSED_FORM_KERNEL", "KERNEL_SOURCES", "kernel_sources", "kernel_sources_digest"]
 
 KERNELS = {
     "screwkit.indices.compiled.wrenches": ("wrench_kernel", 6),
@@ -73,6 +75,30 @@ configurations or more."""
 
 CLOSED_FORM_KERNEL = "screwkit.closure.compiled.closed_form"
 """The spatial closed forms (U-P-S, R-U-S chains) of large batches."""
+
+
+PACKAGE = Path(__file__).resolve().parents[1]
+
+KERNEL_SOURCES = ("indices/compiled/*.py", "closure/compiled/*.py", "common/fastmath.py", "common/tolerances.py",
+                  "common/jit.py")
+"""What the kernels are compiled from, relative to the package: every module of the compiled folders, and the modules
+outside them whose functions or constants they compile in (``tests/test_kernel_cache.py`` checks that every module
+a compiled module imports is here, or is plumbing that only Python runs). Their digest is part of every kernel's
+cache stamp (:mod:`screwkit.common.jit`)."""
+
+
+def kernel_sources(package: Path = PACKAGE) -> list[Path]:
+    """The files of :data:`KERNEL_SOURCES` in ``package``, sorted."""
+    return sorted({path for pattern in KERNEL_SOURCES for path in package.glob(pattern)})
+
+
+@functools.cache
+def kernel_sources_digest(package: Path = PACKAGE) -> str:
+    """SHA-256 of the names and contents of :func:`kernel_sources` (read once per process), hexadecimal."""
+    digest = hashlib.sha256()
+    for path in kernel_sources(package):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
 
 
 def stage_kernels(joint_counts, n: int) -> tuple[str, ...]:
@@ -172,7 +198,9 @@ def _cache_folders(source: Path) -> list[Path]:
 
 
 def kernel_is_cached(module: str) -> bool:
-    """Whether numba's cache holds an index for the module's kernel entry (see :data:`KERNELS`)."""
+    """Whether numba's cache holds an index for the module's kernel entry (see :data:`KERNELS`) saved from the
+    present sources: the index holds the stamp it was saved with, which names :func:`kernel_sources_digest` as
+    text (:mod:`screwkit.common.jit`); an index of older sources is one numba will not use."""
     import importlib.util
 
     if not numba_cache():
@@ -184,9 +212,16 @@ def kernel_is_cached(module: str) -> bool:
     source = Path(spec.origin)
     line = _first_line(source, function)
     name = f"{source.stem}.{function}-{line}.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    digest = kernel_sources_digest().encode()
     for folder in _cache_folders(source):
-        if (folder / name).is_file() or (folder.is_dir() and any(folder.rglob(name))):
-            return True
+        direct = folder / name
+        found = [direct] if direct.is_file() else list(folder.rglob(name)) if folder.is_dir() else []
+        for index in found:
+            try:
+                if digest in index.read_bytes():
+                    return True
+            except OSError:
+                continue
     return False
 
 

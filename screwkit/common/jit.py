@@ -6,43 +6,22 @@ stages and helpers from other modules (:mod:`screwkit.indices.compiled.jacobi`, 
 frames of :mod:`screwkit.closure.compiled`, the tolerances it reads as constants), so a change to one of those alone
 would leave numba serving the machine code compiled from the old one: in an editable install updated by ``git
 pull``, silently the old numbers. The cache locators installed here (numba's own, the same folders) add to that
-stamp a digest of every source a kernel is compiled from (:data:`KERNEL_SOURCES`), so any change to any of them
-compiles every kernel anew.
+stamp the digest of every source a kernel is compiled from
+(:func:`~screwkit.common.compiling.kernel_sources_digest`), so any change to any of them compiles every kernel anew;
+:func:`~screwkit.common.compiling.kernel_is_cached` reads the same digest in the index, so the first run after such a
+change says it compiles, as a first run does.
 """
 
 from __future__ import annotations
 
 import functools
-import hashlib
 from pathlib import Path
 
 from numba import njit as numba_njit
 
-from screwkit.common.compiling import numba_cache
+from screwkit.common.compiling import kernel_sources, kernel_sources_digest, numba_cache
 
-__all__ = ["njit", "KERNEL_SOURCES", "kernel_sources", "kernel_sources_digest"]
-
-PACKAGE = Path(__file__).resolve().parents[1]
-
-#: What the kernels are compiled from, relative to the package: every module of the compiled folders, and the
-#: modules outside them whose functions or constants they compile in (``tests/test_kernel_cache.py`` checks that
-#: every module a compiled module imports is here, or is plumbing that only Python runs).
-KERNEL_SOURCES = ("indices/compiled/*.py", "closure/compiled/*.py", "common/fastmath.py", "common/tolerances.py",
-                  "common/jit.py")
-
-
-def kernel_sources(package: Path = PACKAGE) -> list[Path]:
-    """The files of :data:`KERNEL_SOURCES` in ``package``, sorted."""
-    return sorted({path for pattern in KERNEL_SOURCES for path in package.glob(pattern)})
-
-
-@functools.cache
-def kernel_sources_digest(package: Path = PACKAGE) -> str:
-    """SHA-256 of the names and contents of :func:`kernel_sources` (read once per process)."""
-    digest = hashlib.sha256()
-    for path in kernel_sources(package):
-        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return digest.hexdigest()
+__all__ = ["njit", "install_locators"]
 
 
 @functools.cache
