@@ -534,7 +534,8 @@ def test_cli_view_serves_on_loopback_until_interrupted():
     import signal
 
     process = subprocess.Popen([sys.executable, "-m", "screwkit.cli", "view", "planar_5rrr", "--failed", "chain_3"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONFAULTHANDLER": "1"})  # SIGABRT: every thread's stack
     try:
         port = None
         deadline = time.monotonic() + 120
@@ -552,7 +553,12 @@ def test_cli_view_serves_on_loopback_until_interrupted():
         sockets = [item for child in servers for item in listening_sockets(child)]
         assert ("127.0.0.1", port) in sockets and all(address == "127.0.0.1" for address, _ in sockets), sockets
         process.send_signal(signal.SIGINT)
-        stdout, stderr = process.communicate(timeout=60)
+        try:
+            stdout, stderr = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:  # where it hangs, for the report (seen once in CI, never reproduced)
+            process.send_signal(signal.SIGABRT)
+            stdout, stderr = process.communicate(timeout=30)
+            pytest.fail(f"still running 60 s after SIGINT; its threads at SIGABRT:\n{stderr[-6000:]}")
     finally:
         if process.poll() is None:
             process.kill()
