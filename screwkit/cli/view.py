@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import time
 from dataclasses import dataclass
 
@@ -117,6 +118,12 @@ def _echo_legend(scene) -> None:
         click.echo("Output twists of the best working submechanism: " + ", ".join(names[i] for i in best))
 
 
+def _interrupt(signum, frame) -> None:
+    """SIGTERM as Ctrl+C: without it, the process would end without stopping its Meshcat server, which would go on
+    serving with no parent."""
+    raise KeyboardInterrupt
+
+
 @click.command("view")
 @mechanism_argument
 @click.option("--pose", cls=GreedyOption, metavar="VALUES|NAME",
@@ -184,6 +191,7 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
                 echo_error(f"wrote {written}")
             return
         try:  # from the moment the URL is shown, Ctrl+C stops the server and exits cleanly
+            signal.signal(signal.SIGTERM, _interrupt)  # a `kill`, a service manager: as Ctrl+C
             echo_error(f"Serving at {scene.url} (127.0.0.1 only); press Ctrl+C to stop.")
             if open_browser:
                 scene.viewer.open()
