@@ -70,7 +70,7 @@ def test_several_kernels_start_longest_first_and_the_notice_states_the_makespan(
 def test_one_pose_does_not_compile_the_kernels_of_large_chunks_ahead(monkeypatch):
     """``analyze`` (one pose) starts the index kernels ahead but not the lower-mobility kernels of chunks of
     ``SPACES_COMPILED_FROM`` poses or more, which one pose never reaches (23 s of CPU on a first run); a command
-    of many poses starts them for a spatial mechanism of fewer than six DOF."""
+    of many poses starts those its mechanism uses (both, for the Delta)."""
     import json
 
     from click.testing import CliRunner
@@ -113,4 +113,5 @@ def test_the_kernels_compiled_ahead_are_those_a_large_batch_uses(name, monkeypat
     assert np.mean(result.reachable) > 0.9
     lower = {notice.SPACE_KERNEL, notice.CONSTRAINT_KERNEL}
     assert set(constraint_kernels(mechanism)) == set(asked) & lower
-    assert (name == "schoenflies_5") <= (not asked)
+    if name == "schoenflies_5":  # the case that compiled both for nothing
+        assert not set(asked) & lower
