@@ -37,7 +37,7 @@ from screwkit.model import Mechanism
 from screwkit.studies.files import open_netcdf
 
 __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
-           "PathFileError", "TIME_COLUMN"]
+           "PathFileError", "TIME_COLUMN", "checked_times"]
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
@@ -106,13 +106,19 @@ def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | N
     arc_length = np.concatenate([[0.0], np.cumsum(steps)])
     if not arc_length[-1] > 0:
         raise ValueError("Expected a path that moves: every pose of the path is the same.")
-    if times is not None:
-        times = np.asarray(times, dtype=float)
-        if times.shape != (poses.shape[0],):
-            raise ValueError(f"Expected one time per pose ({poses.shape[0]}), got shape {times.shape}.")
-        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-            raise ValueError("Expected finite, increasing times along the path.")
-    return Path(poses, arc_length, float(mechanism.length_scale), times)
+    return Path(poses, arc_length, float(mechanism.length_scale), checked_times(times, poses.shape[0]))
+
+
+def checked_times(times: ArrayLike | None, count: int) -> NDArray[np.float64] | None:
+    """``times`` (s) as floats, one per pose of ``count``, finite and increasing; None for None."""
+    if times is None:
+        return None
+    times = np.asarray(times, dtype=float)
+    if times.shape != (count,):
+        raise ValueError(f"Expected one time per pose ({count}), got shape {times.shape}.")
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ValueError("Expected finite, increasing times along the path.")
+    return times
 
 
 def line_path(mechanism: Mechanism, start: ArrayLike, stop: ArrayLike, samples: int) -> Path:

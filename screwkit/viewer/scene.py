@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import load
 from screwkit.studies.files import atomic_text
+from screwkit.studies.paths import checked_times
 from screwkit.viewer.drawing import (
     BASE_COLOR,
     PLATFORM_COLOR,
@@ -230,14 +231,8 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
     poses = mechanism.check_poses(getattr(poses, "poses", poses)).reshape(-1, mechanism.n_task)
     if not frame_rate > 0:
         raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
-    if times is not None:
-        times = np.asarray(times, dtype=float)
-        if times.shape != (poses.shape[0],):
-            raise ValueError(f"Expected one time per pose ({poses.shape[0]}) in `times`, got shape {times.shape}.")
-        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-            raise ValueError("Expected finite, increasing `times`.")
     return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser,
-                 _Animation(float(frame_rate), loop, times))
+                 _Animation(float(frame_rate), loop, checked_times(times, poses.shape[0])))
 
 
 def export_html(target, path: str | os.PathLike) -> Path:
