@@ -64,6 +64,36 @@ def side_by_side(command: list[str], script: list[str], small_command: list[str]
     return runs, {"command": measured(small_command), "script": measured(small_script)}
 
 
+def measured_maps(commands, large: tuple, small: tuple, repeat: int, compare):
+    """``commands(*large, folder)`` and ``commands(*small, folder)`` (the map command and the script, writing
+    ``map.nc`` and ``reference.npz`` in ``folder``) measured by :func:`side_by_side` in a temporary folder, and
+    ``compare(reference, mapped)`` on the large case's two files before the folder goes: the runs, the fixed
+    costs and what ``compare`` returns."""
+    with tempfile.TemporaryDirectory() as folder:
+        folder = Path(folder)
+        command, script = commands(*large, folder)
+        (folder / "small").mkdir()
+        small_command, small_script = commands(*small, folder / "small")
+        runs, fixed = side_by_side(command, script, small_command, small_script, repeat)
+        import xarray  # the map's file: read once both have run
+
+        reference = np.load(folder / "reference.npz")
+        with xarray.open_dataset(folder / "map.nc") as mapped:
+            return runs, fixed, compare(reference, mapped)
+
+
+def print_ratios(runs: dict) -> dict[str, list[float]]:
+    """The command's wall and CPU times over the script's, pair by pair, printed (median, min, max); returned."""
+    ratios = {}
+    for index, label in enumerate(("wall", "CPU")):
+        ratios[label] = [a[index] / b[index] for a, b in zip(runs["command"], runs["script"])]
+        median = statistics.median(ratios[label])
+        speed = f"{1 / median:.1f}x faster" if median < 1 else f"{median:.1f}x slower"
+        print(f"command / script, {label} (pair by pair): median {median:.3f}, min {min(ratios[label]):.3f}, "
+              f"max {max(ratios[label]):.3f}  ({speed})")
+    return ratios
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--step", type=float, default=0.005)
@@ -71,18 +101,10 @@ def main() -> None:
     parser.add_argument("--yaw-step", type=float, default=1.0)
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory() as folder:
-        folder = Path(folder)
-        command, script = commands(args.step, args.half, args.yaw_step, folder)
-        small_command, small_script = commands(args.half, args.half, 120.0, folder / "small")
-        (folder / "small").mkdir()
-        runs, fixed = side_by_side(command, script, small_command, small_script, args.repeat)
-        import xarray  # the map's file: read once both have run
-
-        reference = np.load(folder / "reference.npz")
-        with xarray.open_dataset(folder / "map.nc") as mapped:
-            difference = max(float(np.nanmax(np.abs(reference[key] - mapped[key].values)))
-                             for key in ("lmti", "f_o1", "f_o2"))
+    runs, fixed, difference = measured_maps(
+        commands, (args.step, args.half, args.yaw_step), (args.half, args.half, 120.0), args.repeat,
+        lambda reference, mapped: max(float(np.nanmax(np.abs(reference[key] - mapped[key].values)))
+                                      for key in ("lmti", "f_o1", "f_o2")))
     points = int(round(2 * args.half / args.step)) + 1
     yaws = int(round(360 / args.yaw_step))
     print(f"ups_hexapod_8 map, {points} x {points} grid, {yaws} yaws: {points * points * yaws:,} configurations; "
@@ -91,10 +113,7 @@ def main() -> None:
     for name in ("command", "script"):
         wall, cpu, peak = (statistics.median(values) for values in zip(*runs[name]))
         print(f"{name:10s} {wall:8.2f} {cpu:8.2f} {peak:9.0f}   {fixed[name][0]:.2f} s, {fixed[name][2]:.0f} MiB")
-    for index, label in enumerate(("wall", "CPU")):
-        ratios = [a[index] / b[index] for a, b in zip(runs["command"], runs["script"])]
-        print(f"command / script, {label} (pair by pair): median {statistics.median(ratios):.3f}, "
-              f"min {min(ratios):.3f}, max {max(ratios):.3f}  ({1 / statistics.median(ratios):.1f}x faster)")
+    print_ratios(runs)
     peak = {name: statistics.median(run[2] for run in runs[name]) for name in runs}
     allowed = peak["script"] + fixed["command"][2] - fixed["script"][2]
     print(f"peak memory: command {peak['command']:.0f} MiB; the script's {peak['script']:.0f} MiB plus the difference "

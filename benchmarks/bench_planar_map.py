@@ -19,11 +19,10 @@ import argparse
 import os
 import statistics
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
-from bench_hexapod_map import side_by_side  # the same measurement, side by side
+from bench_hexapod_map import measured_maps, print_ratios  # the same measurement, side by side
 
 HERE = Path(__file__).resolve().parent
 TARGET_WALL = 0.8
@@ -43,6 +42,21 @@ def met(value: float, limit: float) -> str:
     return "met" if value <= limit else "not met"
 
 
+def compare(reference, mapped) -> tuple[list[str], list[str], float, bool, int]:
+    """The variables both maps have, those only one has, their largest difference where both are finite, whether
+    they are NaN at the same points, and the grid points reached."""
+    names = [name for name in mapped.data_vars if name in reference.files]
+    missing = sorted(set(mapped.data_vars) ^ (set(reference.files) - {"x", "y"}))
+    difference, same_nan = 0.0, True
+    for name in names:
+        ours, theirs = mapped[name].values, reference[name]
+        same_nan &= bool(np.array_equal(np.isnan(ours), np.isnan(theirs)))
+        finite = np.isfinite(ours) & np.isfinite(theirs)
+        if finite.any():
+            difference = max(difference, float(np.max(np.abs(ours[finite] - theirs[finite]))))
+    return names, missing, difference, same_nan, int(np.isfinite(mapped["reachable_fraction"].values).sum())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--radius", type=float, default=0.6)
@@ -51,26 +65,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     load_before = os.getloadavg()
-    with tempfile.TemporaryDirectory() as folder:
-        folder = Path(folder)
-        command, script = commands(args.radius, args.step, args.phi_step, folder)
-        small_command, small_script = commands(args.step, args.step, 120.0, folder / "small")
-        (folder / "small").mkdir()
-        runs, fixed = side_by_side(command, script, small_command, small_script, args.repeat)
-        import xarray  # the map's file: read once both have run
-
-        reference = np.load(folder / "reference.npz")
-        with xarray.open_dataset(folder / "map.nc") as mapped:
-            names = [name for name in mapped.data_vars if name in reference.files]
-            missing = sorted(set(mapped.data_vars) ^ (set(reference.files) - {"x", "y"}))
-            difference, same_nan = 0.0, True
-            for name in names:
-                ours, theirs = mapped[name].values, reference[name]
-                same_nan &= bool(np.array_equal(np.isnan(ours), np.isnan(theirs)))
-                finite = np.isfinite(ours) & np.isfinite(theirs)
-                if finite.any():
-                    difference = max(difference, float(np.max(np.abs(ours[finite] - theirs[finite]))))
-            points = int(np.isfinite(mapped["reachable_fraction"].values).sum())
+    runs, fixed, (names, missing, difference, same_nan, points) = measured_maps(
+        commands, (args.radius, args.step, args.phi_step), (args.step, args.step, 120.0), args.repeat, compare)
     orientations = len(np.arange(0.0, 360.0 - 1e-9, args.phi_step))
     load_after = os.getloadavg()
     print(f"planar_5rrr map (Fig. 5), disc of radius {args.radius:g} m, step {args.step:g} m, phi step "
@@ -84,13 +80,7 @@ def main() -> None:
         medians[name] = wall, cpu, peak = [statistics.median(values) for values in zip(*runs[name])]
         print(f"{name:10s} {wall:8.2f} {cpu:8.2f} {peak:9.0f}   {fixed[name][0]:.2f} s, {fixed[name][1]:.2f} s, "
               f"{fixed[name][2]:.0f} MiB")
-    ratios = {}
-    for index, label in enumerate(("wall", "CPU")):
-        ratios[label] = [a[index] / b[index] for a, b in zip(runs["command"], runs["script"])]
-        median = statistics.median(ratios[label])
-        speed = f"{1 / median:.1f}x faster" if median < 1 else f"{median:.1f}x slower"
-        print(f"command / script, {label} (pair by pair): median {median:.3f}, min {min(ratios[label]):.3f}, "
-              f"max {max(ratios[label]):.3f}  ({speed})")
+    ratios = print_ratios(runs)
     memory = medians["command"][2] / medians["script"][2]
     print(f"peak memory, command / script: {memory:.2f} ({medians['command'][2]:.0f} against "
           f"{medians['script'][2]:.0f} MiB)")
