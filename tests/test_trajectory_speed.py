@@ -116,3 +116,17 @@ def test_the_streamed_netcdf_writer_writes_scipys_bytes(tmp_path, monkeypatch):
     monkeypatch.setattr(netcdf, "_WRITER", netcdf_file)
     dataset.write_netcdf(tmp_path / "scipy.nc")
     assert (tmp_path / "streamed.nc").read_bytes() == (tmp_path / "scipy.nc").read_bytes()
+
+
+@pytest.mark.parametrize("texts", [
+    ["leg_1:slider", "", "leg_12:leg_12_joint", "x"],  # ASCII, the empty string of an unreachable pose
+    ["jambe_é:rotule", "a", "", "腿"],  # not ASCII: one distinct string at a time
+    [""], ["", ""],
+])
+def test_strings_are_encoded_as_numpy_encodes_them(texts):
+    rng = np.random.default_rng(3)
+    values = np.array(texts)[rng.integers(0, len(texts), (50, 3))]
+    expected = np.char.encode(values, "utf-8")
+    encoded = netcdf._utf8(values)
+    assert encoded.dtype == expected.dtype and encoded.shape == values.shape
+    np.testing.assert_array_equal(encoded, expected)

@@ -166,7 +166,7 @@ def _variable(name: str, entry: tuple) -> tuple[tuple[str, ...], np.ndarray, dic
             raise ValueError(f"Variable {name!r}: integers beyond 32 bits cannot be written to netCDF-3.")
         return dims, values.astype(np.int32) if values.dtype.itemsize > 4 else values, attrs
     if kind in "UO":
-        encoded = _utf8(values.astype(str))
+        encoded = _utf8(values if kind == "U" else values.astype(str))
         width = max(encoded.dtype.itemsize, 1)
         characters = encoded.astype(f"S{width}").reshape(values.shape + (1,)).view("S1")
         return dims + (f"string{width}",), characters, {**attrs, "_Encoding": "utf-8"}
@@ -174,14 +174,18 @@ def _variable(name: str, entry: tuple) -> tuple[tuple[str, ...], np.ndarray, dic
 
 
 def _utf8(values: np.ndarray) -> np.ndarray:
-    """Strings encoded in UTF-8, as bytes as long as the longest (as ``np.char.encode`` gives them): ASCII in one
-    cast, anything else one distinct string at a time."""
-    longest = int(np.char.str_len(values).max()) if values.size else 0
-    try:
-        return values.astype(f"S{max(longest, 1)}")
-    except UnicodeEncodeError:
+    """Strings encoded in UTF-8, as bytes as long as the longest (as ``np.char.encode`` gives them): ASCII by
+    narrowing numpy's code points (four bytes each) to one byte each, anything else one distinct string at a time."""
+    width = values.dtype.itemsize // 4
+    if width == 0 or values.size == 0:
+        return np.zeros(values.shape, dtype="S1")
+    codes = np.ascontiguousarray(values).view(np.uint32).reshape(values.shape + (width,))
+    if int(codes.max()) >= 128:
         unique, inverse = np.unique(values, return_inverse=True)
         return np.array([text.encode("utf-8") for text in unique], dtype=bytes)[inverse].reshape(values.shape)
+    used = np.flatnonzero(codes.reshape(-1, width).any(axis=0))
+    longest = int(used[-1]) + 1 if used.size else 1  # trailing zeros are numpy's padding, not characters
+    return np.ascontiguousarray(codes[..., :longest]).astype(np.uint8).view(f"S{longest}").reshape(values.shape)
 
 
 def _coordinates(coords: dict[str, tuple], variables: dict[str, tuple]) -> dict[str | None, str]:

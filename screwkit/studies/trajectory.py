@@ -11,9 +11,10 @@ whose minimum over the sets is :math:`F_{Oj}` (Eq. 12):
   its **minimum** along the path and where, and the **worst failure** of the path (the lowest minimum; ties
   within :data:`~screwkit.common.tolerances.WORST_FAULT_TIE` all named);
 * between samples, nothing is taken on trust: a dip that the samples show as a local minimum is searched for
-  its true minimum (golden section; a singular pose between two samples is found at zero), and every change
-  of side of ``level`` is bisected, until located to ``tolerance`` in arc length
-  (:mod:`~screwkit.studies.refinement`); every round evaluates all its brackets in one batched call;
+  its true minimum (a singular pose between two samples is found at zero), and every change of side of
+  ``level`` is searched for, until located to ``tolerance`` in arc length (:mod:`~screwkit.studies.refinement`:
+  each from the guess the samples give, a parabola's vertex, a kink's, a straight line's crossing, then a grid
+  of points a round); every round evaluates all its brackets in one batched call;
 * the **margin** of each index (its minimum over the samples and where; F_Oj's also over the refined minima);
 * the **events** of the path: where it leaves the reachable set, because a chain cannot close in its working
   mode or because a joint crosses its limit, located by bisection and explained chain by chain; and where a
@@ -46,7 +47,14 @@ from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.paths import Path, path_from_poses
 from screwkit.studies.poses import indices_and_joint_values, indices_at_poses
-from screwkit.studies.refinement import bisected_crossings, bracketed_minima, local_minima
+from screwkit.studies.refinement import (
+    bisected_crossings,
+    bracketed_minima,
+    kink_vertex,
+    linear_crossing,
+    local_minima,
+    parabola_vertex,
+)
 
 __all__ = ["trajectory", "TrajectoryResult", "FaultCase", "Margin", "PathEvent", "failure_weights", "singular_dips",
            "remaining_lmti",
@@ -296,16 +304,27 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
 
     s = path.arc_length
     rows, series = _local_minima_of_blocks(blocks)
-    minima_at, minima = bracketed_minima(evaluate, s[np.maximum(rows - 1, 0)], s[np.minimum(rows + 1, len(s) - 1)],
-                                         series, tolerance)
+    around = np.clip(rows[:, None] + np.arange(-2, 3), 0, len(s) - 1)  # two samples either side
+    inside = (around[:, 0] == rows - 2) & (around[:, -1] == rows + 2)
+    values = np.array([columns[k][r] for k, r in zip(series, around)]).reshape(around.shape)
+    with np.errstate(invalid="ignore"):
+        guesses = np.where(inside[:, None], np.stack([parabola_vertex(s[around[:, 1:4]], values[:, 1:4]),
+                                                      kink_vertex(s[around[:, [0, 1, 3, 4]]],
+                                                                  values[:, [0, 1, 3, 4]])], axis=1), np.nan)
+    ends = (rows == 0) | (rows == len(s) - 1)  # a dip at an end of the path: there, or near it
+    guesses[ends, 0] = s[rows[ends]]
+    before, after = np.maximum(rows - 1, 0), np.minimum(rows + 1, len(s) - 1)
+    minima_at, minima = bracketed_minima(evaluate, s[before], s[after], series, tolerance, guesses)
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
     points = _series_points(s, columns, rows, series, minima_at, minima)
     states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
               for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
     brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
     where = np.array([k for k, _ in brackets], dtype=np.int64)
-    low, high = bisected_crossings(evaluate, np.array([points[k][0][i] for k, i in brackets]),
-                                   np.array([points[k][0][i + 1] for k, i in brackets]), where, above, tolerance)
+    ends = np.array([(points[k][0][i], points[k][0][i + 1], points[k][1][i], points[k][1][i + 1])
+                     for k, i in brackets]).reshape(-1, 4).T
+    guess = np.where(where == reach_series, np.nan, linear_crossing(*ends, level))
+    low, high = bisected_crossings(evaluate, ends[0], ends[1], where, above, tolerance, guess)
     crossing = {(k, i): (lo + hi) / 2 for (k, i), lo, hi in zip(brackets, low, high)}
 
     cases = []
