@@ -107,3 +107,15 @@ def test_crossings_are_located_to_the_tolerance_and_keep_the_states_of_their_end
     for f, a, b in zip(functions, low, high):
         assert above(f(a), 0) != above(f(b), 0)
     assert evaluate.rounds <= (2 if use_guess else 1) + _rounds_of_grid(float(np.max(upper - lower)), 1 / (GRID + 1))
+
+
+def test_a_tolerance_finer_than_the_floating_point_spacing_ends_at_that_spacing():
+    """Positions near 0.4 are 5.6e-17 apart: a tolerance of 1e-20 cannot be met, and the searches stop (they once
+    could go round for ever) with the smallest bracket the positions allow."""
+    function, true = MINIMA[2]
+    at, _ = bracketed_minima(Counted([function]), np.array([0.3]), np.array([0.4]), np.zeros(1, dtype=np.int64),
+                             1e-20, np.array([[np.nan]]))
+    assert abs(at[0] - true) <= 4 * np.spacing(true)
+    low, high = bisected_crossings(Counted([lambda x: x - true]), np.array([0.3]), np.array([0.4]),
+                                   np.zeros(1, dtype=np.int64), lambda v, _: v >= 0, 1e-20)
+    assert low[0] <= true <= high[0] and high[0] - low[0] <= 4 * np.spacing(true)

@@ -95,7 +95,8 @@ def bracketed_minima(evaluate: Evaluate, lower: NDArray, upper: NDArray, series:
         centre = np.where(np.isfinite(guesses), guesses, ((a + b) / 2)[:, None])
         points = np.concatenate([centre - SIDE * tolerance, centre, centre + SIDE * tolerance], axis=1)
     while todo.size:
-        if guesses is None:
+        grid = guesses is None  # (a round of guesses may leave its bracket as it was: the grid rounds go on)
+        if grid:
             points = a[todo, None] + (b - a)[todo, None] * _GRID_SHARES
         points = np.sort(np.clip(points, a[todo, None], b[todo, None]), axis=1)
         guesses = None
@@ -105,9 +106,10 @@ def bracketed_minima(evaluate: Evaluate, lower: NDArray, upper: NDArray, series:
         better = value < best_value[todo]
         best[todo[better]], best_value[todo[better]] = at[better], value[better]
         # the nearest distinct points either side of the lowest (a guess may repeat another, or a bracket's end)
+        width = b[todo] - a[todo] if grid else np.full(todo.size, np.inf)
         a[todo] = np.maximum(a[todo], np.max(np.where(points < at[:, None], points, -np.inf), axis=1))
         b[todo] = np.minimum(b[todo], np.min(np.where(points > at[:, None], points, np.inf), axis=1))
-        todo = todo[b[todo] - a[todo] > tolerance]
+        todo = todo[_still_open(b[todo] - a[todo], width, tolerance)]
     return best, np.where(np.isinf(best_value), np.nan, best_value)
 
 
@@ -143,13 +145,16 @@ def bisected_crossings(evaluate: Evaluate, lower: NDArray, upper: NDArray, serie
                       np.concatenate([series, np.repeat(series, points.shape[1])]))
     state = found[:low.size]
     todo = np.arange(low.size)
+    grid = guess is None  # (a round of guesses may leave its bracket as it was: the grid rounds go on)
     while True:
         changed = found[-points.size:].reshape(points.shape) != state[todo, None]
         rows = np.arange(todo.size)
         first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), points.shape[1])  # the first point changed
         ends = np.concatenate([low[todo, None], points, high[todo, None]], axis=1)
+        width = high[todo] - low[todo] if grid else np.full(todo.size, np.inf)
+        grid = True
         low[todo], high[todo] = ends[rows, first], ends[rows, first + 1]
-        todo = todo[high[todo] - low[todo] > tolerance]
+        todo = todo[_still_open(high[todo] - low[todo], width, tolerance)]
         if not todo.size:
             return low, high
         points = low[todo, None] + (high - low)[todo, None] * _GRID_SHARES
@@ -188,6 +193,12 @@ def linear_crossing(x0: NDArray, x1: NDArray, f0: NDArray, f1: NDArray, level: f
     with np.errstate(invalid="ignore", divide="ignore"):
         at = x0 + (level - f0) / (f1 - f0) * (x1 - x0)
     return np.where(np.isfinite(at), at, np.nan)
+
+
+def _still_open(width: NDArray, before: NDArray, tolerance: float) -> NDArray[np.bool_]:
+    """Brackets to search on: wider than the tolerance, and narrowed by the last round (a tolerance finer than the
+    spacing of floating-point numbers at the positions cannot be met: the bracket stops at that spacing)."""
+    return (width > tolerance) & (width < before)
 
 
 def _finite(values: NDArray) -> NDArray[np.float64]:
