@@ -403,3 +403,32 @@ def test_convert_writes_reachy_mini_s_urdf_with_its_yaw_stage_locked(tmp_path):
     np.testing.assert_allclose(indices_at_pose(written, written.home_pose).lmti,
                                indices_at_pose(read, read.home_pose).lmti, atol=1e-12)
     one_line_error(screwkit("convert", source, tmp_path / "other.urdf"), "--lock yaw_body")
+
+
+@pytest.mark.parametrize("name, xyz, rpy", [("robot_delta", (0.7, -1.3, 0.0), (0.0, 0.0, 0.9)),
+                                            ("wl16_like", (2.0, 0.5, -3.0), (0.4, -0.3, 1.1))])
+def test_a_file_whose_joint_values_do_not_close_assembles_the_same_in_another_world_frame(tmp_path, name, xyz, rpy):
+    """Both files' joint values leave their closures 1 to 3 cm open: the assembly moves them to the closed
+    configuration nearest in its own units, lengths in the mechanism's length scale. That scale is the mechanism's
+    size (the joints' spread about their centroid), not their distance from the world's origin, which it once
+    included: moved to another world frame, the file assembled elsewhere on the mechanism and its indices changed
+    in the third decimal."""
+    source = GEPETTO / name / "robot.urdf"
+    text = source.read_text(encoding="utf-8")
+    root = ET.fromstring(text)
+    children = {joint.find("child").get("link") for joint in root.iter("joint")}
+    (base,) = [link.get("name") for link in root.iter("link") if link.get("name") not in children]
+    placement = f'<origin xyz="{" ".join(map(repr, xyz))}" rpy="{" ".join(map(repr, rpy))}"/>'
+    moved = text.replace(f'<link name="{base}">', '<link name="new_world"/><joint name="new_world_to_base" '
+                         f'type="fixed"><parent link="new_world"/><child link="{base}"/>{placement}</joint>'
+                         f'<link name="{base}">', 1)
+    assert moved != text
+    folder = tmp_path / name
+    folder.mkdir()
+    (folder / "robot.urdf").write_text(moved, encoding="utf-8")
+    (folder / "robot.yaml").write_text((source.parent / "robot.yaml").read_text(encoding="utf-8"), encoding="utf-8")
+    scales = [assemble(read_closed_tree(path))[1] for path in (source, folder / "robot.urdf")]
+    assert scales[1] == pytest.approx(scales[0], rel=1e-12)
+    here, there = (indices_at_pose(m := load(path), m.home_pose) for path in (source, folder / "robot.urdf"))
+    np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, atol=1e-9)
+    np.testing.assert_allclose([there.lmti, there.iti], [here.lmti, here.iti], atol=1e-9)

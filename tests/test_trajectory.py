@@ -17,7 +17,7 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import bundled_path, load_text
 from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.actuator_paths import path_from_actuators, read_actuator_path
-from screwkit.studies.branches import joint_steps, suspect_segments
+from screwkit.studies.branches import chain_joints, joint_steps, suspect_segments
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path, through_path
 from screwkit.studies.trajectory import failure_weights, trajectory
@@ -154,7 +154,7 @@ def test_a_fast_but_smooth_turn_near_the_base_joint_is_no_branch_change(five_pat
     five = bundled("planar_5rrr")
     path = _over_the_base_joint(five, (0.9, 0.0), offset=0.03)
     values = solve(five, path.poses).joint_values[0][:, :2]
-    steps = joint_steps(five, 0, values[:-1], values[1:])
+    steps = joint_steps(chain_joints(five)[0], values[:-1], values[1:])
     assert suspect_segments(steps, np.diff(path.arc_length)).tolist() == [False, True, False]
     assert abs(np.rad2deg(steps[1, 0])) > 90
     assert trajectory(five, path).events == ()

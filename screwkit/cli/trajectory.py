@@ -25,6 +25,7 @@ from screwkit.cli.options import (
     quiet_option,
     reading_options,
 )
+from screwkit.model import Mechanism
 from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import wide_table, write_dataset
 from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path, through_path
@@ -145,6 +146,9 @@ class PathSource:
             return generated_path(mechanism, self)
         try:
             if self.actuators:
+                if not isinstance(mechanism, Mechanism):  # a GraphMechanism: legs with loops inside them
+                    raise fail(f"{mechanism.tree.source}: its legs have loops inside them, posed by the output frame "
+                               "only: give PATH in its task coordinates (m, deg), without --actuators.")
                 return read_actuator_path(mechanism, self.path_file)
             return read_path(mechanism, self.path_file)
         except PathFileError as error:
@@ -214,12 +218,13 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     the path is generated with --line, --circle or --through (straight in task coordinates between poses).
     Crossings of --level and singular points between samples are refined to --tolerance. The indices go to
     --out (.nc or .csv; with neither --out, --figure nor --json, to stdout as CSV), the summary to stderr
-    (or stdout with --json).
+    (or stdout with --json). A mechanism whose legs have loops inside them is closed at each sample by
+    continuation from its file's configuration (its path in task coordinates only).
     """
     source.check()
     outputs.check(quiet or as_json)
     keywords = faults.keywords()
-    loaded = load_mechanism(mechanism, reading, limits=analysis.limits)
+    loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
     check_average(analysis, loaded)
     path = source.read(loaded)
     try:

@@ -40,8 +40,8 @@ class LegWithLoops(ImportError_):
     configuration."""
 
 
-GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep` and `map` (or screwkit.io.graph_mechanism) analyse it as a "
-              "graph; `convert` and the commands of serial legs do not")
+GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep`, `map` and `trajectory` (or screwkit.io.graph_mechanism) "
+              "analyse it as a graph; `convert` and the commands of serial legs do not")
 """What a :class:`LegWithLoops` message adds."""
 
 
@@ -177,7 +177,9 @@ def path_to(model, joint: int) -> list[int]:
 
 
 def _length_scale(model, data) -> float:
-    points = np.array([np.asarray(data.oMi[j].translation) for j in range(model.njoints)])
+    """The root-mean-square distance of the joints from their centroid: the mechanism's own size, the same in any
+    world frame (the universe joint, at the world's origin, is not one of them)."""
+    points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
     spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
     return float(spread) if spread > 0.0 else 1.0
 

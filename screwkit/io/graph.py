@@ -106,6 +106,17 @@ class GraphMechanism:
         return len(self.task_axes)
 
     @property
+    def angular(self) -> NDArray[np.bool_]:
+        """Which task coordinates are angles."""
+        return np.array([name in ANGLES for name in self.task_coordinates], dtype=bool)
+
+    @property
+    def length_scale(self) -> float:
+        """The mechanism's length scale (m): what its closures measure lengths in, and what weighs angles against
+        lengths along a path."""
+        return float(self.scale)
+
+    @property
     def dof(self) -> int:
         """The platform's mobility (its task coordinates' count)."""
         return len(self.task_axes)
@@ -151,7 +162,7 @@ class GraphMechanism:
     def poses_from_degrees(self, values) -> NDArray[np.float64]:
         """Task coordinates with angles in degrees -> radians (checked)."""
         poses = self.check_poses(values, degrees=True).copy()
-        angular = np.array([name in ANGLES for name in self.task_coordinates])
+        angular = self.angular
         poses[..., angular] = np.deg2rad(poses[..., angular])
         return poses
 

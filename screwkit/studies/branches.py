@@ -7,14 +7,18 @@ over itself: on the paper's 5-RRR (equal arms), when a platform joint passes ove
 the left of the line from the base joint to the platform joint" changes sides with the line, and the closed form
 puts the elbow back on the left: a jump of half a turn of the actuated joint, between two samples of a smooth
 motion of the platform. Newton from the reference assembly can land on another assembly at one pose than at the
-next. Indices computed on both sides are each right for their assembly; the motion between them is not one a
-robot can make without leaving the path. :func:`branch_changes` finds such jumps and locates them:
+next, and so can the continuation that closes a leg with loops inside it from its file's configuration (each
+pose reached along its own straight line). Indices computed on both sides are each right for their assembly;
+the motion between them is not one a robot can make without leaving the path. :func:`branch_changes` finds
+such jumps and locates them:
 
-1. **Screen** (every pair of consecutive samples, every chain, batched). The step of the chain's tree joint values
-   (revolute steps wrapped to (-pi, pi], slides divided by the length scale; the tree joints and the platform pose
-   fix the chain's configuration) against the step the neighbouring segments predict, their rates times this
-   segment's arc length. A segment is suspect where the step misses that prediction by more than the prediction
-   itself (plus :data:`STEP_FLOOR`): a jump of the size of the joints' own motion over a sample step is seen.
+1. **Screen** (every pair of consecutive samples, every chain, batched). The step of the values of the joints a
+   chain's working mode is seen on (:class:`ChainJoints`: a serial chain's tree joints, which with the platform
+   pose fix its configuration; a leg with loops inside it, its revolute and prismatic joints), revolute steps
+   wrapped to (-pi, pi], slides divided by the length scale, against the step the neighbouring segments
+   predict, their rates times this segment's arc length. A segment is suspect where the step misses that
+   prediction by more than the prediction itself (plus :data:`STEP_FLOOR`): a jump of the size of the joints'
+   own motion over a sample step is seen.
 2. **Bisection** (all suspects at once, one closure solve per round). The suspect segment is split (at its
    golden section, :data:`SPLIT`), keeping the part with the larger joint step, until it is at most
    ``tolerance`` long. A smooth motion's step shrinks with the bracket, however fast the joints turn near a
@@ -26,7 +30,7 @@ robot can make without leaving the path. :func:`branch_changes` finds such jumps
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +38,8 @@ from numpy.typing import NDArray
 from screwkit.common.rotations import wrap_angle
 from screwkit.model import Mechanism
 
-__all__ = ["BranchChange", "branch_changes", "describe", "joint_steps", "suspect_segments", "STEP_FLOOR", "JUMP_SHARE"]
+__all__ = ["BranchChange", "ChainJoints", "branch_changes", "chain_joints", "describe", "joint_steps",
+           "suspect_segments", "STEP_FLOOR", "JUMP_SHARE"]
 
 STEP_FLOOR = 1e-9
 """Joint steps (rad, or length scales for a slide) below which nothing is suspected."""
@@ -45,6 +50,24 @@ point exactly on it."""
 JUMP_SHARE = 0.25
 """The share of a suspect segment's joint step that its last bracket (``tolerance`` long) must still hold for the
 step to be a jump (a smooth motion keeps about ``tolerance / segment`` of it)."""
+
+
+@dataclass(frozen=True)
+class ChainJoints:
+    """What a chain's working mode is seen on along a path: its name, the joints whose values a branch change makes
+    jump (a serial chain's tree joints, which with the platform pose fix its configuration; a leg with loops
+    inside it, its revolute and prismatic joints) and which of them slide."""
+
+    name: str
+    joints: tuple[str, ...]
+    prismatic: tuple[bool, ...]
+
+
+def chain_joints(mechanism: Mechanism) -> tuple[ChainJoints, ...]:
+    """The :class:`ChainJoints` of a mechanism's chains: each chain's tree joints."""
+    return tuple(ChainJoints(chain.name, tuple(chain.joint_names[:chain.geometry.n_tree_joints]),
+                             tuple(bool(p) for p in chain.geometry.dof_prismatic[:chain.geometry.n_tree_joints]))
+                 for chain in mechanism.chains)
 
 
 @dataclass(frozen=True)
@@ -63,21 +86,16 @@ class BranchChange:
     after: float = np.nan
 
 
-def _tree_values(mechanism: Mechanism, joint_values) -> list[NDArray[np.float64]]:
-    """Per chain, its tree joint values (N, t_i), slides in length scales."""
-    kept = []
-    for chain, values in zip(mechanism.chains, joint_values):
-        tree = chain.geometry.n_tree_joints
-        scale = np.where(np.asarray(chain.geometry.dof_prismatic[:tree]), mechanism.length_scale, 1.0)
-        kept.append(np.asarray(values, dtype=float)[..., :tree] / scale)
-    return kept
+def _scaled(chains: Sequence[ChainJoints], length_scale: float, joint_values) -> list[NDArray[np.float64]]:
+    """Per chain, its joint values (N, t_i), slides in length scales."""
+    return [np.asarray(values, dtype=float) / np.where(np.asarray(chain.prismatic, dtype=bool), length_scale, 1.0)
+            for chain, values in zip(chains, joint_values)]
 
 
-def joint_steps(mechanism: Mechanism, chain: int, before: NDArray, after: NDArray) -> NDArray[np.float64]:
-    """The steps (..., t) of a chain's tree joint values from ``before`` to ``after`` (as from
-    :func:`_tree_values`): revolute steps wrapped to (-pi, pi], slides in length scales."""
-    tree = mechanism.chains[chain].geometry.n_tree_joints
-    revolute = ~np.asarray(mechanism.chains[chain].geometry.dof_prismatic[:tree])
+def joint_steps(chain: ChainJoints, before: NDArray, after: NDArray) -> NDArray[np.float64]:
+    """The steps (..., t) of a chain's joint values from ``before`` to ``after`` (as from :func:`_scaled`): revolute
+    steps wrapped to (-pi, pi], slides in length scales."""
+    revolute = ~np.asarray(chain.prismatic, dtype=bool)
     steps = after - before
     steps[..., revolute] = wrap_angle(steps[..., revolute])
     return steps
@@ -114,51 +132,55 @@ def _row_max(values: NDArray) -> NDArray[np.float64]:
     return largest
 
 
-def branch_changes(mechanism: Mechanism, arc_length: NDArray, joint_values, solve_at: Callable,
-                   tolerance: float) -> list[BranchChange]:
+def branch_changes(chains: Sequence[ChainJoints], length_scale: float, arc_length: NDArray, joint_values,
+                   solve_at: Callable, tolerance: float) -> list[BranchChange]:
     """Every jump of a chain's joint values between consecutive samples, located to ``tolerance`` (m of arc length).
 
     Parameters
     ----------
     arc_length : ndarray (n,)
         The samples' arc lengths.
-    joint_values : sequence of ndarray (n, m_i)
-        Per chain, its joint values at the samples (NaN where it does not close).
+    chains : sequence of ChainJoints
+        The joints each chain's working mode is seen on (:func:`chain_joints`).
+    length_scale : float
+        The mechanism's length scale (m), the unit of a slide's step.
+    joint_values : sequence of ndarray (n, t_i)
+        Per chain, the values of those joints at the samples (NaN where it does not close).
     solve_at : callable
-        ``solve_at(arc_lengths)`` -> per chain the joint values (k, m_i) at those arc lengths.
+        ``solve_at(arc_lengths)`` -> per chain the values (k, t_i) of those joints at those arc lengths.
     """
-    tree = _tree_values(mechanism, joint_values)
+    tree = _scaled(chains, length_scale, joint_values)
     lengths = np.diff(arc_length)
     brackets = []  # (chain, segment)
     for chain, values in enumerate(tree):
         if values.shape[-1] == 0:
             continue
-        steps = joint_steps(mechanism, chain, values[:-1], values[1:])
+        steps = joint_steps(chains[chain], values[:-1], values[1:])
         brackets += [(chain, int(i)) for i in np.flatnonzero(suspect_segments(steps, lengths))]
     if not brackets:
         return []
-    chains = np.array([c for c, _ in brackets])
+    of = np.array([c for c, _ in brackets])
     segments = np.array([i for _, i in brackets])
     low, high = arc_length[segments].astype(float), arc_length[segments + 1].astype(float)
     left = [tree[c][i] for c, i in brackets]
     right = [tree[c][i + 1] for c, i in brackets]
-    first = np.array([np.max(np.abs(joint_steps(mechanism, c, a, b))) for c, a, b in zip(chains, left, right)])
+    first = np.array([np.max(np.abs(joint_steps(chains[c], a, b))) for c, a, b in zip(of, left, right)])
     found: list[BranchChange] = []
     jumps: list[int] = []
     active = np.arange(len(brackets))
     while active.size:
         middle = low[active] + SPLIT * (high[active] - low[active])
-        at_middle = _tree_values(mechanism, solve_at(middle))
+        at_middle = _scaled(chains, length_scale, solve_at(middle))
         keep = []
         for row, k in enumerate(active):
-            c = chains[k]
+            c = of[k]
             value = at_middle[c][row]
             if not np.all(np.isfinite(value)):
                 found.append(BranchChange("closure", int(c), (int(segments[k]), int(segments[k]) + 1),
                                           float(middle[row]), float(middle[row])))
                 continue
-            before = np.max(np.abs(joint_steps(mechanism, c, left[k], value)))
-            after = np.max(np.abs(joint_steps(mechanism, c, value, right[k])))
+            before = np.max(np.abs(joint_steps(chains[c], left[k], value)))
+            after = np.max(np.abs(joint_steps(chains[c], value, right[k])))
             if before >= after:
                 high[k], right[k] = middle[row], value
             else:
@@ -171,39 +193,39 @@ def branch_changes(mechanism: Mechanism, arc_length: NDArray, joint_values, solv
             elif largest >= JUMP_SHARE * first[k]:
                 jumps.append(k)
         active = np.array(keep, dtype=np.int64)
-    found += _jumps(mechanism, [(int(chains[k]), int(segments[k]), low[k], high[k]) for k in jumps], solve_at,
-                    tolerance, arc_length[-1])
+    found += _jumps(chains, length_scale, [(int(of[k]), int(segments[k]), low[k], high[k]) for k in jumps],
+                    solve_at, tolerance, arc_length[-1])
     return sorted(found, key=lambda change: (change.start, change.chain))
 
 
-def _jumps(mechanism: Mechanism, located: list, solve_at: Callable, tolerance: float, length: float
-           ) -> list[BranchChange]:
+def _jumps(chains: Sequence[ChainJoints], length_scale: float, located: list, solve_at: Callable, tolerance: float,
+           length: float) -> list[BranchChange]:
     """The :class:`BranchChange` of each located jump ``(chain, segment, low, high)``: the joint that jumps the
     most, with its values (rad or m) one ``tolerance`` either side of the bracket (at its ends the pose may be
     the singular one, where the branch is undefined); one batched solve."""
     if not located:
         return []
     ends = np.array([[low - tolerance, high + tolerance] for _, _, low, high in located]).clip(0.0, length)
-    values = _tree_values(mechanism, solve_at(ends.reshape(-1)))
+    values = _scaled(chains, length_scale, solve_at(ends.reshape(-1)))
     changes = []
     for row, (chain, segment, low, high) in enumerate(located):
         left, right = values[chain][2 * row], values[chain][2 * row + 1]
-        joint = int(np.argmax(np.abs(joint_steps(mechanism, chain, left, right))))
-        scale = mechanism.length_scale if mechanism.chains[chain].geometry.dof_prismatic[joint] else 1.0
+        joint = int(np.argmax(np.abs(joint_steps(chains[chain], left, right))))
+        scale = length_scale if chains[chain].prismatic[joint] else 1.0
         changes.append(BranchChange("branch", chain, (segment, segment + 1), float(low), float(high), joint,
                                     float(left[joint] * scale), float(right[joint] * scale)))
     return changes
 
 
-def describe(mechanism: Mechanism, change: BranchChange) -> str:
+def describe(chains: Sequence[ChainJoints], change: BranchChange) -> str:
     """One line: which chain changes working mode (or cannot close) and how."""
-    chain = mechanism.chains[change.chain]
+    chain = chains[change.chain]
     if change.kind == "closure":
         return (f"chain {chain.name!r} cannot close at {change.start:.6g} m, between samples {change.samples[0]} "
                 f"and {change.samples[1]} where it closes: the path leaves its working mode's workspace there")
-    slides = chain.geometry.dof_prismatic[change.joint]
+    slides = chain.prismatic[change.joint]
     shown = (lambda v: f"{v:.6g} m") if slides else (lambda v: f"{np.rad2deg(v):.6g} deg")
-    return (f"chain {chain.name!r} changes working mode: joint {chain.joint_names[change.joint]!r} jumps from "
+    return (f"chain {chain.name!r} changes working mode: joint {chain.joints[change.joint]!r} jumps from "
             f"{shown(change.before)} to {shown(change.after)} at {(change.start + change.stop) / 2:.6g} m (located to "
             f"{change.stop - change.start:.2g} m, between samples {change.samples[0]} and {change.samples[1]}): "
             f"its closure on one side is not the continuation of the other side's")

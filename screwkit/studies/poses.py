@@ -482,14 +482,16 @@ def check_graph_analysis(graph: GraphMechanism, closed_forms: bool = False, faul
 def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,
                            threshold: float = SINGULARITY_THRESHOLD, faults=None, limits: bool = True,
                            threads: int | None = None, chunk_size: int = GRAPH_CHUNK,
-                           progress: Callable[[int], None] | None = None) -> Indices:
+                           progress: Callable[[int], None] | None = None, configurations: bool = False):
     """Every index of a closed-loop graph (:mod:`screwkit.io.graph`) at a batch of task-coordinate poses.
 
     ``poses`` (..., len(graph.task_axes)) are the output frame's task coordinates (``graph.task_coordinates``; m
     and rad, world frame). Each is closed by continuation from the graph's configuration
     (:meth:`~screwkit.io.GraphMechanism.solve`), its legs' equivalent chains derived batched
     (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
-    NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw.
+    NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw. With
+    ``configurations``, ``(indices, q)``: also the closed configurations (..., nq) solved (NaN where unreachable),
+    which a path needs to see its working mode without solving twice.
     """
     from screwkit.io.graph import dimension_groups, equivalent_chains, leg_screws  # graphs only: off other paths
 
@@ -503,11 +505,14 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     arrays: dict = {}
     meta: Indices | None = None
     model = graph.tree.model
+    kept = np.full((count, graph.kinematics.nq), np.nan) if configurations else None
     for start in range(0, count, chunk_size):
         part = slice(start, min(start + chunk_size, count))
         q, reached = graph.solve(flat[part], limits=limits)
         index = np.flatnonzero(reached)
         reachable[index + start] = True
+        if kept is not None:
+            kept[index + start] = q[index]
         full_poses[index + start] = graph.frame_pose(q[index])
         if index.size:
             screws, state = leg_screws(graph.tree, graph.kinematics, graph.platform, graph.legs, q[index],
@@ -523,6 +528,7 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
     names = tuple(f"{leg.name}:{model.names[leg.actuators[0]]}" for leg in graph.legs)
     described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
-    return _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
-                          faults=faults, detail=detail, threshold=threshold)
+    result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
+                            faults=faults, detail=detail, threshold=threshold)
+    return (result, kept.reshape(batch + kept.shape[-1:])) if configurations else result
 

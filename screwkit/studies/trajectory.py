@@ -34,19 +34,18 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
-from screwkit.closure.solve import ChainStatus
 from screwkit.common.tolerances import WORST_FAULT_TIE
 from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.exports import indices_variables, set_label
 from screwkit.indices.registry import index_columns
 from screwkit.indices.results import Indices
+from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.path_mechanisms import GraphPath, SerialPath, path_mechanism
 from screwkit.studies.paths import Path, path_from_poses
-from screwkit.studies.poses import indices_and_joint_values, indices_at_poses
 from screwkit.studies.refinement import (
     bisected_crossings,
     bracketed_minima,
@@ -234,14 +233,17 @@ class TrajectoryResult:
         return PlainDataset(variables, coords, attrs)
 
 
-def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None, level: float = 0.4,
-               tolerance: float | None = None, aggregate: str = "min", probabilities: ArrayLike | None = None,
-               analysis: AnalysisOptions | None = None, threads: int | None = None) -> TrajectoryResult:
+def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *, times: ArrayLike | None = None,
+               level: float = 0.4, tolerance: float | None = None, aggregate: str = "min",
+               probabilities: ArrayLike | None = None, analysis: AnalysisOptions | None = None,
+               threads: int | None = None) -> TrajectoryResult:
     """Every index along a path, and what each actuator failure leaves controllable, refined between samples.
 
     Parameters
     ----------
-    mechanism : Mechanism
+    mechanism : Mechanism or GraphMechanism
+        A mechanism whose legs have loops inside them (:class:`~screwkit.io.GraphMechanism`) has each sample closed
+        by continuation from its file's configuration (:mod:`screwkit.studies.path_mechanisms`).
     path : Path or array_like (n, n_task)
         The samples (task coordinates, m and rad; :mod:`screwkit.studies.paths`), at least two.
     times : array_like (n,), optional
@@ -260,7 +262,8 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     threads : int, optional
         Threads of the index kernel.
     """
-    require_mechanism(mechanism, "trajectory")
+    if not isinstance(mechanism, GraphMechanism):
+        require_mechanism(mechanism, "trajectory")
     path = path if isinstance(path, Path) else path_from_poses(mechanism, path, times)
     analysis = analysis or AnalysisOptions()
     if aggregate not in AGGREGATES:
@@ -271,8 +274,8 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise ValueError(f"Expected a tolerance > 0 (m of arc length), got {tolerance!r}.")
 
-    keywords = dict(analysis.keywords(), detail=True, threads=threads)
-    samples, joint_values = indices_and_joint_values(mechanism, path.poses, tree_only=True, **keywords)
+    along = path_mechanism(mechanism, analysis, dict(analysis.keywords(), detail=True, threads=threads))
+    samples, joint_values = along.samples(path.poses)
     faults = samples.faults
     failed_sets = [(j, failed) for j in faults for failed in samples.failed_sets(j)]
     evaluations = [0]
@@ -291,7 +294,7 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
 
     def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
         evaluations[0] += positions.size
-        return table(indices_at_poses(mechanism, path.at(positions), **keywords))[np.arange(positions.size), series]
+        return table(along.indices(path.at(positions)))[np.arange(positions.size), series]
 
     # the series at the samples, as views of the indices' own arrays (a column each; no copy of them all)
     blocks = [remaining_lmti(samples, j) for j in faults]
@@ -341,18 +344,18 @@ def trajectory(mechanism: Mechanism, path: Path | ArrayLike, *, times: ArrayLike
     reach_at, reach_state = points[reach_series]
     _, unreachable = _stretches(reach_at, reach_state, {i: crossing[(kk, i)] for kk, i in brackets
                                                         if kk == reach_series})
-    changes = branch_changes(mechanism, s, joint_values, lambda at: solve(mechanism, path.at(at),
-                                                                          limits=analysis.limits).joint_values,
-                             tolerance)
-    events = _events(mechanism, path, samples, unreachable, analysis) + tuple(
-        PathEvent(c.kind, c.start, c.stop, c.samples, describe(mechanism, c)) for c in changes)
+    chains = along.chains
+    changes = branch_changes(chains, mechanism.length_scale, s, joint_values,
+                             lambda at: along.joint_values(path.at(at)), tolerance)
+    events = _events(along, path, samples, unreachable) + tuple(
+        PathEvent(c.kind, c.start, c.stop, c.samples, describe(chains, c)) for c in changes)
     weights = {j: failure_weights(samples.actuator_count, j, probabilities) for j in faults}
     mean = mean_remaining_lmti(samples.remaining_lmti, samples.actuator_count, probabilities) \
         if aggregate == "mean" else {}
     return TrajectoryResult(
         mechanism=mechanism.name, path=path, indices=samples, level=float(level), tolerance=tolerance,
         cases=tuple(cases), worst=_worst(cases, faults), margins=_margins(samples, s, cases, mean),
-        events=tuple(sorted(events, key=lambda e: (e.start, e.kind))), working_modes=working_modes(mechanism),
+        events=tuple(sorted(events, key=lambda e: (e.start, e.kind))), working_modes=along.working_modes(),
         aggregate=aggregate, mean=mean,
         weights=weights if aggregate == "mean" else {}, evaluations=evaluations[0])
 
@@ -452,8 +455,8 @@ def _margins(samples: Indices, s: NDArray, cases: list[FaultCase], mean: dict) -
     return margins
 
 
-def _events(mechanism: Mechanism, path: Path, samples: Indices, unreachable: NDArray,
-            analysis: AnalysisOptions) -> tuple[PathEvent, ...]:
+def _events(along: SerialPath | GraphPath, path: Path, samples: Indices, unreachable: NDArray
+            ) -> tuple[PathEvent, ...]:
     """A :class:`PathEvent` per stretch where the path is unreachable, with why at its first sample."""
     events = []
     s = path.arc_length
@@ -463,12 +466,6 @@ def _events(mechanism: Mechanism, path: Path, samples: Indices, unreachable: NDA
         if not inside.size:
             continue
         first, last = int(inside[0]), int(inside[-1])
-        kind = "closure" if np.any(status[first] == ChainStatus.MISSES_CLOSURE) else "joint limit"
-        try:
-            solve_one(mechanism, path.poses[first], limits=analysis.limits)
-            reason = "unreachable"
-        except UnreachablePose as error:
-            reason = str(error)
+        kind, reason = along.unreachable(path.poses[first], status[first])
         events.append(PathEvent(kind, float(start), float(stop), (first, last), reason))
     return tuple(events)
-

@@ -1,0 +1,144 @@
+"""What a path needs of a mechanism, for serial legs and for legs with loops inside them alike.
+
+:func:`~screwkit.studies.trajectory.trajectory` asks a mechanism for five things: every index at a batch of poses
+(with the joint values a branch change is seen on, at the samples), the same indices alone (each round of the
+refinement), those joint values alone (the branch search), why a pose is unreachable, and the working mode its
+closures keep. :class:`SerialPath` answers for a :class:`~screwkit.model.Mechanism` (closures chain by chain:
+closed forms, damped Newton), :class:`GraphPath` for a :class:`~screwkit.io.GraphMechanism` (every closure of the
+graph solved at once, each pose by continuation from the file's configuration,
+:meth:`~screwkit.io.GraphMechanism.solve`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
+from screwkit.closure.solve import ChainStatus
+from screwkit.indices.results import Indices
+from screwkit.io.graph import GraphMechanism
+from screwkit.model import Mechanism
+from screwkit.studies.branches import ChainJoints, chain_joints
+from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.poses import (
+    check_graph_analysis,
+    graph_indices_at_poses,
+    indices_and_joint_values,
+    indices_at_poses,
+)
+
+__all__ = ["SerialPath", "GraphPath", "path_mechanism"]
+
+
+@dataclass(frozen=True)
+class SerialPath:
+    """A mechanism of serial legs along a path: its closures keep each chain's working mode pose by pose."""
+
+    mechanism: Mechanism
+    analysis: AnalysisOptions
+    keywords: dict
+
+    @property
+    def chains(self) -> tuple[ChainJoints, ...]:
+        return chain_joints(self.mechanism)
+
+    def samples(self, poses: NDArray) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
+        """Every index (with detail) at ``poses``, and per chain its tree joints' values."""
+        return indices_and_joint_values(self.mechanism, poses, tree_only=True, **self.keywords)
+
+    def indices(self, poses: NDArray) -> Indices:
+        return indices_at_poses(self.mechanism, poses, **self.keywords)
+
+    def joint_values(self, poses: NDArray) -> list[NDArray[np.float64]]:
+        """Per chain, its tree joints' values at ``poses`` (NaN where it does not close)."""
+        values = solve(self.mechanism, poses, limits=self.analysis.limits).joint_values
+        return [v[..., :len(chain.joints)] for v, chain in zip(values, self.chains)]
+
+    def unreachable(self, pose: NDArray, status: NDArray) -> tuple[str, str]:
+        """``(kind, reason)`` of an unreachable pose: ``"closure"`` or ``"joint limit"``, and the closure's words."""
+        kind = "closure" if np.any(status == ChainStatus.MISSES_CLOSURE) else "joint limit"
+        try:
+            solve_one(self.mechanism, pose, limits=self.analysis.limits)
+            return kind, "unreachable"
+        except UnreachablePose as error:
+            return kind, str(error)
+
+    def working_modes(self) -> dict[str, str]:
+        return working_modes(self.mechanism)
+
+
+@dataclass(frozen=True)
+class GraphPath:
+    """A mechanism whose legs have loops inside them along a path: every pose closed by continuation from the
+    file's configuration, so the working mode is the one that continuation reaches; a branch change between two
+    samples is seen on the legs' revolute and prismatic joints (their ball joints turn with them)."""
+
+    graph: GraphMechanism
+    analysis: AnalysisOptions
+    keywords: dict
+
+    @property
+    def chains(self) -> tuple[ChainJoints, ...]:
+        model = self.graph.tree.model
+        kinds = self.graph.kinematics.kinds
+        return tuple(ChainJoints(leg.name, tuple(model.names[j] for j in self._joints(leg)),
+                                 tuple(kinds[j] == "prismatic" for j in self._joints(leg))) for leg in self.graph.legs)
+
+    def _joints(self, leg) -> tuple[int, ...]:
+        kinds = self.graph.kinematics.kinds
+        return tuple(j for j in leg.joints if kinds[j] in ("revolute", "unbounded", "prismatic"))
+
+    def _values(self, q: NDArray) -> list[NDArray[np.float64]]:
+        """Per leg, its revolute and prismatic joints' values (rad, m) in configurations ``q`` (..., nq)."""
+        kinematics = self.graph.kinematics
+        values = []
+        for leg in self.graph.legs:
+            columns = []
+            for joint in self._joints(leg):
+                at = kinematics.idx_q[joint]
+                columns.append(np.arctan2(q[..., at + 1], q[..., at]) if kinematics.kinds[joint] == "unbounded"
+                               else q[..., at])
+            values.append(np.stack(columns, axis=-1) if columns else np.zeros(q.shape[:-1] + (0,)))
+        return values
+
+    def samples(self, poses: NDArray) -> tuple[Indices, list[NDArray[np.float64]]]:
+        indices, q = graph_indices_at_poses(self.graph, poses, configurations=True, **self.keywords)
+        return indices, self._values(q)
+
+    def indices(self, poses: NDArray) -> Indices:
+        return graph_indices_at_poses(self.graph, poses, **self.keywords)
+
+    def joint_values(self, poses: NDArray) -> list[NDArray[np.float64]]:
+        q, reached = self.graph.solve(poses, limits=self.analysis.limits)
+        return self._values(np.where(reached[:, None], q, np.nan))
+
+    def unreachable(self, pose: NDArray, status: NDArray) -> tuple[str, str]:
+        """A pose the continuation closes once the joint limits are left aside is beyond a limit; else no closed
+        configuration reaches it."""
+        names = ", ".join(f"{name} {np.rad2deg(value):.6g} deg" if angular else f"{name} {value:.6g} m"
+                          for name, value, angular in zip(self.graph.task_coordinates, pose, self.graph.angular))
+        if self.analysis.limits and self.graph.solve(pose[None], limits=False)[1][0]:
+            return "joint limit", (f"{self.graph.tree.source}: at {names} a joint is beyond its limits in the "
+                                   "configuration reached from the file's by continuation")
+        return "closure", (f"{self.graph.tree.source}: no closed configuration reached from the file's by "
+                           f"continuation puts the output frame at {names}")
+
+    def working_modes(self) -> dict[str, str]:
+        mode = ("the one reached from the file's configuration by moving the platform straight to each pose "
+                "(continuation)")
+        return {leg.name: mode for leg in self.graph.legs}
+
+
+def path_mechanism(mechanism: Any, analysis: AnalysisOptions, keywords: dict) -> SerialPath | GraphPath:
+    """The :class:`SerialPath` or :class:`GraphPath` of ``mechanism``, with the index keywords of ``analysis``
+    (``keywords``: detail, threads, ...); a ValueError when a graph is asked for what it does not have (closed
+    forms, link faults)."""
+    if isinstance(mechanism, GraphMechanism):
+        check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
+        graph_keywords = {k: v for k, v in keywords.items() if k not in ("closed_forms", "fault_type")}
+        return GraphPath(mechanism, analysis, graph_keywords)
+    return SerialPath(mechanism, analysis, keywords)
