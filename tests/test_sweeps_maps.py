@@ -144,7 +144,9 @@ def test_spatial_map_over_an_orientation_set():
 @pytest.fixture(scope="module")
 def cluster():
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    # on loopback, the scheduler's web server on a free port (its default, 8787, may be another test's)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address="127.0.0.1:0") as cluster:
         with distributed.Client(cluster, set_as_default=False) as client:  # no default client: run_tasks needs none
             yield client
 
