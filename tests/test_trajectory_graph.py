@@ -157,3 +157,25 @@ def test_the_command_follows_a_path_of_the_rod_level_delta_as_written(tmp_path):
     one_line_error(screwkit("trajectory", "delta_rods_4", path, "--actuators"), "loops inside them", "--actuators")
     one_line_error(screwkit("trajectory", "delta_rods_4", "--line", "0", "0", "-0.75", "0", "0", "-0.7",
                             "--closed-forms"), "no closed forms")
+
+
+def test_the_bundled_rod_level_delta_loses_control_where_its_r_u_u_model_does():
+    """``delta_rods_4`` (a graph, closed by continuation) and ``delta_4`` (serial R-U-U legs, closed forms) have
+    the same ITI, LMTI and F_O1 at every pose: along a pick-and-place cycle, each failure's lost stretches agree to
+    the two tolerances and its minimum to 1e-9, although every number comes from another model and solver."""
+    from screwkit.io import graph_mechanism, read_closed_tree
+    from screwkit.io.loader import bundled_path, load
+    from screwkit.studies.paths import through_path
+
+    delta = load("delta_4")
+    corners = np.array([[0.2, 0.1, -0.65], [0.2, 0.1, -0.85], [0.2, 0.1, -0.65],
+                        [-0.2, -0.15, -0.65], [-0.2, -0.15, -0.85], [-0.2, -0.15, -0.65]])
+    cycle = through_path(delta, corners, 41)
+    serial = trajectory(delta, cycle, level=0.5)
+    rods = trajectory(graph_mechanism(read_closed_tree(bundled_path("delta_rods_4"))), cycle.poses, level=0.5)
+    assert not rods.events and sum(len(case.lost) for case in serial.cases) >= 4
+    for a, b in zip(serial.cases, rods.cases):
+        assert a.failed[0].split(":")[0][-1] == b.failed[0].split(":")[0][-1]  # leg_k and arm_k
+        assert a.lost.shape == b.lost.shape
+        np.testing.assert_allclose(b.lost, a.lost, atol=serial.tolerance + rods.tolerance)
+        assert abs(a.minimum - b.minimum) < 1e-9
