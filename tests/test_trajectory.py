@@ -60,10 +60,10 @@ def _dense_lost(values: np.ndarray, s: np.ndarray, level: float) -> np.ndarray:
 
 
 def test_the_lost_stretches_agree_with_a_dense_sampling(five_path):
-    """400,000 samples of the same path, batched: every stretch each failure leaves below the level, and every
-    singular point, within the refinement's tolerance plus the dense step."""
+    """1,000,000 samples of the same path (the issue's brute force), batched: every stretch each failure leaves
+    below the level, and every singular point, within the refinement's tolerance plus the dense step."""
     five, result = five_path
-    dense_s = np.linspace(0.0, result.path.length, 400_001)
+    dense_s = np.linspace(0.0, result.path.length, 1_000_001)
     dense = indices_at_poses(five, result.path.at(dense_s), detail=True)
     step = dense_s[1]
     lost_somewhere = 0
