@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "cross",
     "wrap_angle",
     "skew_matrix",
     "rotation_about_axis",
@@ -152,8 +153,9 @@ def _dot(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     return np.einsum("...i,...i->...", a, b)
 
 
-def _cross(a: NDArray, b: NDArray) -> NDArray[np.float64]:
-    """Cross products over the last axis, broadcast, component by component (faster than np.cross on batches)."""
+def cross(a: NDArray, b: NDArray) -> NDArray[np.float64]:
+    """Cross products over the last axis, broadcast, component by component: the numbers of ``np.cross`` (the same
+    products and differences), several times faster on batches of 3-vectors."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     return np.stack(np.broadcast_arrays(a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), -1)
@@ -188,7 +190,7 @@ def rotation_angle_to_align(axis: ArrayLike, start: ArrayLike, goal: ArrayLike) 
     start_perpendicular = start - _dot(start, axis)[..., None] * axis
     goal_perpendicular = goal - _dot(goal, axis)[..., None] * axis
     # a . (u' x v') = (a x u') . v'
-    return np.arctan2(_dot(_cross(axis, start_perpendicular), goal_perpendicular),
+    return np.arctan2(_dot(cross(axis, start_perpendicular), goal_perpendicular),
                       _dot(start_perpendicular, goal_perpendicular))
 
 
@@ -213,7 +215,7 @@ def two_axis_pointing(
     gap : ndarray, shape (...,)
         Negative where ``goal`` cannot be reached (how far ``gamma^2`` is below -1e-12), else 0.
     """
-    cross_axes = _cross(np.asarray(first_axis, dtype=float), np.asarray(second_axis, dtype=float))
+    cross_axes = cross(np.asarray(first_axis, dtype=float), np.asarray(second_axis, dtype=float))
     axes_cosine = _dot(first_axis, second_axis)
     denominator = axes_cosine**2 - 1.0
     second_start = _dot(second_axis, start)

@@ -46,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure.task_space import choose_task_axes
+from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -381,7 +382,7 @@ def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple
         tree.model.frames[frame_id].placement)
     offset = (frame[:3, 3] - state.centre[0]) / state.scale
     omega = motion[:, :3]
-    rates = np.concatenate([motion[:, 3:] + np.cross(omega, offset),
+    rates = np.concatenate([motion[:, 3:] + cross(omega, offset),
                             (rpy_rates_inverse(rpy_of(frame[None, :3, :3]))[0] @ omega.T).T], axis=1).T
     if tree.task_coordinates:
         unknown = [name for name in tree.task_coordinates if name not in SPATIAL_TASK_COORDINATES]

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
 __all__ = ["TreeKinematics", "solve_poses", "rpy_of", "rpy_rates_inverse", "STAGE_LENGTH", "MAX_ITERATIONS",
@@ -182,14 +183,14 @@ class TreeKinematics:
             start, kind = self.idx_v[joint], self.kinds[joint]
             if kind in ("revolute", "unbounded"):
                 omega = rotation @ self.axes[joint]
-                out[:, start, :3], out[:, start, 3:] = omega, np.cross(origin, omega)
+                out[:, start, :3], out[:, start, 3:] = omega, cross(origin, omega)
             elif kind == "prismatic":
                 out[:, start, 3:] = rotation @ self.axes[joint]
             else:
                 turn = start + (3 if kind == "free" else 0)
                 for k in range(3):
                     omega = rotation[:, :, k]
-                    out[:, turn + k, :3], out[:, turn + k, 3:] = omega, np.cross(origin, omega)
+                    out[:, turn + k, :3], out[:, turn + k, 3:] = omega, cross(origin, omega)
                     if kind == "free":
                         out[:, start + k, 3:] = omega
         return out
@@ -276,7 +277,7 @@ class _Residual:
                     if not columns.size:
                         continue
                     omega, v = twists[:, columns, :3], twists[:, columns, 3:]
-                    at_point = v + np.cross(omega, point[:, None, :] / self.scale)
+                    at_point = v + cross(omega, point[:, None, :] / self.scale)
                     matrix[:, top:top + 3, columns] += sign * np.swapaxes(at_point, 1, 2)
                     if closure.kind == "6d":
                         matrix[:, top + 3:top + 6, columns] += sign * np.swapaxes(omega, 1, 2)
@@ -290,7 +291,7 @@ class _Residual:
             if jacobian:
                 columns = self.columns(self.frame_joint)
                 omega, v = twists[:, columns, :3], twists[:, columns, 3:]
-                rates = np.concatenate([np.swapaxes(v + np.cross(omega, frame[:, None, :3, 3] / self.scale), 1, 2),
+                rates = np.concatenate([np.swapaxes(v + cross(omega, frame[:, None, :3, 3] / self.scale), 1, 2),
                                         rpy_rates_inverse(pose[:, 3:]) @ np.swapaxes(omega, 1, 2)], axis=1)
                 matrix[:, top:, columns] = rates[:, list(self.task_axes)]
         return np.concatenate(rows, axis=1), matrix

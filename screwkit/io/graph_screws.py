@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
@@ -121,7 +122,7 @@ class _State:
         twists = kinematics.twists(transforms)
         centre = transforms[:, platform, :3, 3]
         omega = twists[..., :3]
-        working = np.concatenate([omega, (twists[..., 3:] + np.cross(omega, centre[:, None, :])) / scale], axis=-1)
+        working = np.concatenate([omega, (twists[..., 3:] + cross(omega, centre[:, None, :])) / scale], axis=-1)
         return cls(tree.model, kinematics, platform, transforms, working, centre, scale)
 
 
@@ -175,7 +176,7 @@ def equivalent_chains(legs, screws: list[LegScrews], state: _State, rows: NDArra
     for leg, leg_screw in zip(legs, screws):
         dims = int(leg_screw.locked_dims[rows[0]])
         working = np.concatenate([leg_screw.own[rows][:, None, :], leg_screw.locked[rows][:, :dims]], axis=1)
-        world = np.concatenate([working[..., :3], working[..., 3:] * scale + np.cross(centre, working[..., :3])],
+        world = np.concatenate([working[..., :3], working[..., 3:] * scale + cross(centre, working[..., :3])],
                                axis=-1)
         points = np.concatenate([leg_screw.actuator_point[rows][:, None, :],
                                  np.repeat(leg_screw.oti_point[rows][:, None, :], dims, axis=1)], axis=1)
