@@ -93,6 +93,9 @@ def test_trajectory_validates(tmp_path):
                                      "--aggregate", "mean"])
     assert report["events"] and "f_o_mean1" in report["margins"]
     assert "missing.csv: no such file" in validate("trajectory", ["planar_5rrr", tmp_path / "missing.csv"])["error"]
+    graph = validate("trajectory", ["delta_rods_4", "--line", "0", "0", "-0.75", "0", "0", "-0.3", "--samples", "6",
+                                    "--aggregate", "mean"])  # legs with loops inside them, leaving the workspace
+    assert graph["events"][0]["kind"] == "closure" and "f_o_mean1" in graph["margins"]
 
 
 def test_every_command_with_json_has_a_schema():
