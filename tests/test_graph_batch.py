@@ -149,6 +149,21 @@ def test_batched_indices_in_millimetres_in_another_frame_and_with_the_legs_reord
     np.testing.assert_allclose(result.f_o[1], reference.f_o[1], atol=TOLERANCE)
 
 
+def test_a_pose_is_closed_the_same_alone_and_in_any_batch(tmp_path):
+    """Each pose takes as many continuation stages as its own move needs (not the batch's longest): a pose solved
+    alone and in a batch of poses near and far gives the same configuration, bit for bit."""
+    graph = open_delta(tmp_path)
+    moves = np.random.default_rng(12).uniform(-0.12, 0.12, (24, 3)) * np.geomspace(0.05, 1.0, 24)[:, None]
+    poses = graph.task_pose() + moves
+    together, reached = graph.solve(poses)
+    assert reached.all()
+    for k in (0, 5, 23):
+        alone, _ = graph.solve(poses[k:k + 1])
+        np.testing.assert_array_equal(alone[0], together[k])
+    reordered, _ = graph.solve(poses[::-1])
+    np.testing.assert_array_equal(reordered[::-1], together)
+
+
 def test_unreachable_poses_are_nan_and_bad_poses_are_refused(tmp_path):
     graph = open_delta(tmp_path)
     home = graph.task_pose()

@@ -45,7 +45,7 @@ mode's basin for the next stage (each moves the platform by :data:`STAGE_LENGTH`
 Newton steps of a tight closure."""
 FINAL_TOLERANCE = 1e-14
 """Residual to which the last stage closes a pose (Newton's last steps are cheap and take the configuration to
-rounding, so that one pose solved alone and in a batch agree to it); a pose counts as reached below
+rounding); a pose counts as reached below
 :data:`~screwkit.io.closed_tree.ASSEMBLY_TOLERANCE` times ten, or the residual the file's own configuration
 keeps."""
 
@@ -354,13 +354,17 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
     move[:, 3:] = (move[:, 3:] + np.pi) % (2 * np.pi) - np.pi
     held = list(task_axes)
     span = np.abs(move[:, held]) / np.where(np.arange(6)[held] < 3, scale, 1.0) if held else np.zeros((count, 0))
-    stages = max(int(np.ceil(np.max(span, initial=0.0) / STAGE_LENGTH)), 1)
+    # each pose its own stages, as many as its own move needs: the same steps alone as in any batch
+    stages = np.maximum(np.ceil(np.max(span, axis=1, initial=0.0) / STAGE_LENGTH), 1).astype(np.int64)
     q = np.repeat(start, count, axis=0)
-    for stage in range(1, stages + 1):
-        last = stage == stages
-        q, norm = _least_squares(residual, kinematics, q, origin + move * (stage / stages),
-                                 MAX_ITERATIONS if last else MAX_ITERATIONS // 4,
-                                 FINAL_TOLERANCE if last else STAGE_TOLERANCE)
+    norm = np.zeros(count)
+    for stage in range(1, int(np.max(stages, initial=1)) + 1):
+        for rows, iterations, tolerance in ((np.flatnonzero(stages > stage), MAX_ITERATIONS // 4, STAGE_TOLERANCE),
+                                            (np.flatnonzero(stages == stage), MAX_ITERATIONS, FINAL_TOLERANCE)):
+            if rows.size:
+                q[rows], norm[rows] = _least_squares(residual, kinematics, q[rows],
+                                                     origin + move[rows] * (stage / stages[rows])[:, None],
+                                                     iterations, tolerance)
     floor = float(np.linalg.norm(residual(start, np.concatenate([origin])[None], jacobian=False)[0]))
     reached = norm < max(ASSEMBLY_TOLERANCE * 10, 2 * floor)
     if limits:
