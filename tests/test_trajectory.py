@@ -10,7 +10,7 @@ from itertools import product
 import numpy as np
 import pytest
 
-from helpers import assert_indices_close, bundled, in_millimetres, one_line_error, screwkit
+from helpers import assert_indices_close, bundled, in_millimetres, moved_in_the_world, one_line_error, screwkit
 from screwkit.closure import actuator_values, solve
 from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
@@ -180,6 +180,45 @@ def test_a_mechanism_in_millimetres_has_the_same_stretches_scaled():
     assert big.worst == small.worst
     for name, margin in small.margins.items():
         assert big.margins[name].value == pytest.approx(margin.value, abs=1e-9), name
+
+
+def test_the_stretches_are_the_same_in_another_world_frame_and_with_the_legs_listed_otherwise(five_path):
+    """The 5-RRR placed in another world frame (its task coordinates stay the base's), and its file with the
+    chains listed in another order and renamed: every failure, found by the names of the failed actuators, loses
+    control on the same stretches, singular at the same points; the same worst failures and margins."""
+    from test_relabelling import listed_otherwise
+
+    five, reference = five_path
+    text = bundled_path("planar_5rrr").read_text()
+    moved = load_text(moved_in_the_world(text, (0.4, -1.3, 0.7), (0.3, -0.5, 2.0)), "planar_5rrr_moved.urdf")
+    listed, renamed = listed_otherwise(text, np.random.default_rng(4), rename=True)
+    relabelled = load_text(listed, "planar_5rrr_listed_otherwise.urdf")
+    assert relabelled.actuator_names != five.actuator_names
+
+    def by_failed(result, names=None):
+        names = names or {}
+
+        def original(actuator):
+            chain, _, joint = actuator.partition(":")
+            return f"{names.get(chain, chain)}:{joint}"
+
+        cases = {frozenset(map(original, case.failed)): case for case in result.cases}
+        worst = {j: {frozenset(map(original, ties)) for ties in sets} for j, sets in result.worst.items()}
+        return cases, worst
+
+    expected, expected_worst = by_failed(reference)
+    for mechanism, names in ((moved, None), (relabelled, renamed)):
+        assert not mechanism.base_is_world or mechanism is relabelled
+        result = trajectory(mechanism, line_path(mechanism, START, STOP, 41), level=LEVEL)
+        cases, worst = by_failed(result, names)
+        assert cases.keys() == expected.keys() and worst == expected_worst
+        for failed, case in cases.items():
+            np.testing.assert_allclose(case.lost, expected[failed].lost, rtol=0, atol=2 * reference.tolerance)
+            np.testing.assert_allclose(case.singular_at, expected[failed].singular_at, rtol=0,
+                                       atol=2 * reference.tolerance)
+            assert case.minimum == pytest.approx(expected[failed].minimum, abs=1e-9)
+        for name, margin in reference.margins.items():
+            assert result.margins[name].value == pytest.approx(margin.value, abs=1e-9), name
 
 
 def test_the_average_case_is_the_weighted_mean_over_the_failures(five_path):
