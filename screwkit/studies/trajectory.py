@@ -314,8 +314,8 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
         guesses = np.where(inside[:, None], np.stack([parabola_vertex(s[around[:, 1:4]], values[:, 1:4]),
                                                       kink_vertex(s[around[:, [0, 1, 3, 4]]],
                                                                   values[:, [0, 1, 3, 4]])], axis=1), np.nan)
-    ends = (rows == 0) | (rows == len(s) - 1)  # a dip at an end of the path: there, or near it
-    guesses[ends, 0] = s[rows[ends]]
+    at_end = (rows == 0) | (rows == len(s) - 1)  # a dip at an end of the path: there, or near it
+    guesses[at_end, 0] = s[rows[at_end]]
     before, after = np.maximum(rows - 1, 0), np.minimum(rows + 1, len(s) - 1)
     minima_at, minima = bracketed_minima(evaluate, s[before], s[after], series, tolerance, guesses)
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
