@@ -57,13 +57,15 @@ def _rotation(axis: NDArray, angle: NDArray) -> NDArray:
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
-def _quaternion_matrix(quaternion: NDArray) -> NDArray:
-    """Rotations (n, 3, 3) of unit quaternions (n, 4) in Pinocchio's order (x, y, z, w)."""
+def _quaternion_matrix(quaternion: NDArray, out: NDArray | None = None) -> NDArray:
+    """Rotations (n, 3, 3) of unit quaternions (n, 4) in Pinocchio's order (x, y, z, w), into ``out`` if given (a
+    view: written entry by entry, without stacking)."""
     x, y, z, w = np.moveaxis(quaternion / np.linalg.norm(quaternion, axis=-1, keepdims=True), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
+    out = np.empty(quaternion.shape[:-1] + (3, 3)) if out is None else out
+    out[..., 0, 0], out[..., 0, 1], out[..., 0, 2] = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
+    out[..., 1, 0], out[..., 1, 1], out[..., 1, 2] = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
+    out[..., 2, 0], out[..., 2, 1], out[..., 2, 2] = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
+    return out
 
 
 def _quaternion_step(quaternion: NDArray, omega: NDArray) -> NDArray:
@@ -167,9 +169,9 @@ class TreeKinematics:
                 motion[:, :3, :3] = np.eye(3)
                 motion[:, :3, 3] = q[:, start, None] * axis
             elif kind == "ball":
-                motion[:, :3, :3] = _quaternion_matrix(q[:, start:start + 4])
+                _quaternion_matrix(q[:, start:start + 4], out=motion[:, :3, :3])
             else:  # free
-                motion[:, :3, :3] = _quaternion_matrix(q[:, start + 3:start + 7])
+                _quaternion_matrix(q[:, start + 3:start + 7], out=motion[:, :3, :3])
                 motion[:, :3, 3] = q[:, start:start + 3]
             out[:, joint] = out[:, self.parents[joint]] @ local @ motion
         return out
@@ -246,9 +248,20 @@ class _Residual:
 
     def columns(self, joint: int) -> NDArray[np.int64]:
         """Velocity coordinates that move ``joint``'s body (none for the base)."""
+        return self._path(joint)[0]
+
+    def runs(self, joint: int) -> tuple[tuple[slice, slice], ...]:
+        """The columns of :meth:`columns` as runs of consecutive coordinates: ``(in the Jacobian, in the columns)``,
+        so that the Jacobian is written through views, not through a fancy index (the same numbers, faster)."""
+        return self._path(joint)[1]
+
+    def _path(self, joint: int):
         if joint not in self.paths:
-            self.paths[joint] = np.flatnonzero(self.kinematics.supports(self.model, joint)) if joint else np.zeros(
+            columns = np.flatnonzero(self.kinematics.supports(self.model, joint)) if joint else np.zeros(
                 0, dtype=np.int64)
+            cuts = [0, *(np.flatnonzero(np.diff(columns) != 1) + 1).tolist(), columns.size] if columns.size else []
+            runs = tuple((slice(int(columns[a]), int(columns[b - 1]) + 1), slice(a, b)) for a, b in zip(cuts, cuts[1:]))
+            self.paths[joint] = (columns, runs)
         return self.paths[joint]
 
     def frame(self, transforms: NDArray) -> NDArray:
@@ -277,10 +290,12 @@ class _Residual:
                     if not columns.size:
                         continue
                     omega, v = twists[:, columns, :3], twists[:, columns, 3:]
-                    at_point = v + cross(omega, point[:, None, :] / self.scale)
-                    matrix[:, top:top + 3, columns] += sign * np.swapaxes(at_point, 1, 2)
-                    if closure.kind == "6d":
-                        matrix[:, top + 3:top + 6, columns] += sign * np.swapaxes(omega, 1, 2)
+                    at_point = sign * np.swapaxes(v + cross(omega, point[:, None, :] / self.scale), 1, 2)
+                    turning = sign * np.swapaxes(omega, 1, 2) if closure.kind == "6d" else None
+                    for into, part in self.runs(joint):
+                        matrix[:, top:top + 3, into] += at_point[:, :, part]
+                        if turning is not None:
+                            matrix[:, top + 3:top + 6, into] += turning[:, :, part]
             top += 6 if closure.kind == "6d" else 3
         if self.task_axes:
             frame = self.frame(transforms)
@@ -293,7 +308,9 @@ class _Residual:
                 omega, v = twists[:, columns, :3], twists[:, columns, 3:]
                 rates = np.concatenate([np.swapaxes(v + cross(omega, frame[:, None, :3, 3] / self.scale), 1, 2),
                                         rpy_rates_inverse(pose[:, 3:]) @ np.swapaxes(omega, 1, 2)], axis=1)
-                matrix[:, top:, columns] = rates[:, list(self.task_axes)]
+                rates = rates[:, list(self.task_axes)]
+                for into, part in self.runs(self.frame_joint):
+                    matrix[:, top:, into] = rates[:, :, part]
         return np.concatenate(rows, axis=1), matrix
 
 
