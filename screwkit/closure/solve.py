@@ -24,6 +24,7 @@ from screwkit.closure.task_space import complete_poses, constraining_chains, mot
 from screwkit.closure.threads import for_each_block
 from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import NEWTON_TOLERANCE
+from screwkit.common.units import spelled_pose
 from screwkit.model.mechanism import Mechanism, require_mechanism
 
 __all__ = [
@@ -375,10 +376,8 @@ def solve_one(mechanism: Mechanism, pose: ArrayLike, **options) -> Solution:
         raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}.")
     solution = solve(mechanism, pose, **options)
     if not solution.reachable:
-        shown = np.where(mechanism.angular, np.rad2deg(pose), pose)
-        spelled = ", ".join(f"{name}={value:.6g}{' deg' if angular else ''}"
-                            for name, value, angular in zip(mechanism.task_coordinates, shown, mechanism.angular))
-        raise UnreachablePose(f"Pose ({spelled}) is unreachable for mechanism {mechanism.name!r}: "
+        raise UnreachablePose(f"Pose ({spelled_pose(mechanism.task_coordinates, pose)}) is unreachable for "
+                              f"mechanism {mechanism.name!r}: "
                               f"{unreachable_reason(mechanism, solution)}.")
     return solution
 

@@ -55,6 +55,16 @@ def unit_of(coordinate: str, *, degrees: bool = True) -> str:
     return "m"
 
 
+def spelled_pose(coordinates, pose) -> str:
+    """A pose (m, rad) as a report shows it: each task coordinate's name and value, angles in degrees.
+
+    >>> spelled_pose(("x", "y", "phi"), (0.25, -0.5, math.pi / 4))
+    'x=0.25, y=-0.5, phi=45 deg'
+    """
+    return ", ".join(f"{name}={math.degrees(value):.6g} deg" if is_angular(name) else f"{name}={value:.6g}"
+                     for name, value in zip(coordinates, pose))
+
+
 def metres_per(unit: str) -> float:
     """The length of one ``unit`` in metres; a ValueError lists the known units.
 

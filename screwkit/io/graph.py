@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure.task_space import choose_task_axes
 from screwkit.common.rotations import cross
+from screwkit.common.units import is_angular, unit_of
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -69,7 +70,6 @@ from screwkit.screw.chain_screws import ChainScrews
 __all__ = ["GraphLeg", "GraphMechanism", "LegScrews", "graph_legs", "graph_mechanism", "leg_screws",
            "equivalent_chains", "dimension_groups", "IN_LOOP_TOLERANCE"]
 
-ANGLES = ("roll", "pitch", "yaw")
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
 which the joint moves inside a loop of the leg (its twist is not a motion of the leg)."""
@@ -109,7 +109,7 @@ class GraphMechanism:
     @property
     def angular(self) -> NDArray[np.bool_]:
         """Which task coordinates are angles."""
-        return np.array([name in ANGLES for name in self.task_coordinates], dtype=bool)
+        return np.array([is_angular(name) for name in self.task_coordinates], dtype=bool)
 
     @property
     def length_scale(self) -> float:
@@ -154,7 +154,7 @@ class GraphMechanism:
         except (TypeError, ValueError) as error:
             raise ValueError(f"Expected numeric poses for mechanism {self.name!r}: {error}") from None
         if poses.ndim == 0 or poses.shape[-1] != self.n_task or not np.all(np.isfinite(poses)):
-            units = ", ".join(f"{name} ({'deg' if degrees and name in ANGLES else 'rad' if name in ANGLES else 'm'})"
+            units = ", ".join(f"{name} ({unit_of(name, degrees=degrees)})"
                               for name in self.task_coordinates)
             raise ValueError(f"Expected finite poses of shape (..., {self.n_task}) ({units}) for mechanism "
                              f"{self.name!r}, got shape {poses.shape}.")

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.solve import ChainStatus
+from screwkit.common.units import spelled_pose
 from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism
@@ -119,13 +120,12 @@ class GraphPath:
     def unreachable(self, pose: NDArray, status: NDArray) -> tuple[str, str]:
         """A pose the continuation closes once the joint limits are left aside is beyond a limit; else no closed
         configuration reaches it."""
-        names = ", ".join(f"{name} {np.rad2deg(value):.6g} deg" if angular else f"{name} {value:.6g} m"
-                          for name, value, angular in zip(self.graph.task_coordinates, pose, self.graph.angular))
+        names = spelled_pose(self.graph.task_coordinates, pose)
         if self.analysis.limits and self.graph.solve(pose[None], limits=False)[1][0]:
-            return "joint limit", (f"{self.graph.tree.source}: at {names} a joint is beyond its limits in the "
+            return "joint limit", (f"{self.graph.tree.source}: at ({names}) a joint is beyond its limits in the "
                                    "configuration reached from the file's by continuation")
         return "closure", (f"{self.graph.tree.source}: no closed configuration reached from the file's by "
-                           f"continuation puts the output frame at {names}")
+                           f"continuation puts the output frame at ({names})")
 
     def working_modes(self) -> dict[str, str]:
         mode = ("the one reached from the file's configuration by moving the platform straight to each pose "
