@@ -10,7 +10,7 @@ from itertools import product
 import numpy as np
 import pytest
 
-from helpers import assert_indices_close, bundled, in_millimetres, moved_in_the_world, one_line_error, screwkit
+from helpers import assert_indices_close, bundled, in_unit, moved_in_the_world, one_line_error, screwkit
 from screwkit.closure import actuator_values, solve
 from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
@@ -162,21 +162,24 @@ def test_a_fast_but_smooth_turn_near_the_base_joint_is_no_branch_change(five_pat
     assert set(five_path[1].working_modes) == {f"chain_{i}" for i in range(1, 6)}
 
 
-def test_a_mechanism_in_millimetres_has_the_same_stretches_scaled():
-    """The 5-RRR scaled by 1000 (its file in mm read as m) with the path and the threshold scaled: the same
-    stretches, singular points and margins, arc lengths times 1000 (default tolerance scales with it)."""
+@pytest.mark.parametrize("factor", [1000.0, 1e-3])
+def test_a_scaled_mechanism_has_the_same_stretches_scaled(factor):
+    """The 5-RRR with every length times 1000 (its file in mm read as m) or times 1e-3, with the path and the
+    threshold scaled: the same stretches, singular points and margins, arc lengths times the factor (the
+    default tolerance scales with it)."""
     five = bundled("planar_5rrr")
-    large = load_text(in_millimetres(bundled_path("planar_5rrr").read_text()), "planar_5rrr_mm.urdf")
-    scale = np.array([1000.0, 1000.0, 1.0])
+    large = load_text(in_unit(bundled_path("planar_5rrr").read_text(), "m", factor), "planar_5rrr_scaled.urdf")
+    scale = np.array([factor, factor, 1.0])
     small = trajectory(five, line_path(five, START, STOP, 41), level=LEVEL)
     big = trajectory(large, line_path(large, START * scale, STOP * scale, 41), level=LEVEL,
-                     analysis=AnalysisOptions(threshold=1000 * SINGULARITY_THRESHOLD))
-    assert big.tolerance == pytest.approx(1000 * small.tolerance, rel=1e-12)
-    assert big.path.length == pytest.approx(1000 * small.path.length, rel=1e-12)
+                     analysis=AnalysisOptions(threshold=factor * SINGULARITY_THRESHOLD))
+    assert big.tolerance == pytest.approx(factor * small.tolerance, rel=1e-12)
+    assert big.path.length == pytest.approx(factor * small.path.length, rel=1e-12)
     for one, other in zip(small.cases, big.cases):
         assert one.failed == other.failed
-        np.testing.assert_allclose(other.lost, 1000 * one.lost, rtol=0, atol=big.tolerance)
-        np.testing.assert_allclose(other.singular_at, 1000 * np.array(one.singular_at), rtol=0, atol=big.tolerance)
+        np.testing.assert_allclose(other.lost, factor * one.lost, rtol=0, atol=big.tolerance)
+        np.testing.assert_allclose(other.singular_at, factor * np.array(one.singular_at), rtol=0,
+                                   atol=big.tolerance)
     assert big.worst == small.worst
     for name, margin in small.margins.items():
         assert big.margins[name].value == pytest.approx(margin.value, abs=1e-9), name
