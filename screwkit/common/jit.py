@@ -10,18 +10,29 @@ stamp the digest of every source a kernel is compiled from
 (:func:`~screwkit.common.compiling.kernel_sources_digest`), so any change to any of them compiles every kernel anew;
 :func:`~screwkit.common.compiling.kernel_is_cached` reads the same digest in the index, so the first run after such a
 change says it compiles, as a first run does.
+
+Loading a cached kernel, numba first refreshes its whole CPU target: it imports every lowering registry it has
+(arrays, linear algebra, random generators, typed containers, cffi's parser and, through the BLAS check,
+``scipy.linalg``), about half a second of CPU, more than the rest of ``screwkit analyze``. Machine code read back
+from the cache needs none of that: only the runtime's symbols (numba's NRT, for the arrays a kernel allocates)
+and the hash secrets (for hashing) that the refresh also registers. :func:`install_lean_loads` makes a cache load
+register just those; a kernel that must be compiled still refreshes the target first, as numba's compiler always
+does. Set ``SCREWKIT_LEAN_KERNEL_LOADS=0`` for numba's own loading.
 """
 
 from __future__ import annotations
 
 import functools
+import os
 from pathlib import Path
 
 from numba import njit as numba_njit
 
 from screwkit.common.compiling import kernel_sources, kernel_sources_digest, numba_cache
 
-__all__ = ["njit", "install_locators"]
+__all__ = ["njit", "install_locators", "install_lean_loads"]
+
+LEAN_NUMBA = ((0, 60), (0, 69))  # the numba versions (from, before) whose cache loading install_lean_loads knows
 
 
 @functools.cache
@@ -69,7 +80,38 @@ def install_locators() -> bool:
     return True
 
 
+def install_lean_loads() -> bool:
+    """Make numba's cache loads register the runtime's symbols instead of refreshing the whole target (once);
+    False, and numba's own loads, where ``SCREWKIT_LEAN_KERNEL_LOADS`` is ``0`` or for a numba version or layout
+    this was not written for."""
+    import numba
+    from numba.core import caching
+
+    if os.environ.get("SCREWKIT_LEAN_KERNEL_LOADS", "1") == "0":
+        return False
+    version = tuple(int(part) for part in numba.__version__.split(".")[:2] if part.isdigit())
+    cache = getattr(caching, "Cache", None)
+    if not LEAN_NUMBA[0] <= version < LEAN_NUMBA[1] or cache is None or not all(
+            hasattr(cache, name) for name in ("load_overload", "_load_overload", "_guard_against_spurious_io_errors")):
+        return False
+    if getattr(cache.load_overload, "screwkit_lean", False):
+        return True
+
+    def load_overload(self, sig, target_context):
+        from numba.core.runtime import nrt
+        from numba.cpython import hashing  # noqa: F401  (registers the hash secrets' symbols)
+
+        nrt.rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+    load_overload.screwkit_lean = True
+    cache.load_overload = load_overload
+    return True
+
+
 install_locators()
+install_lean_loads()
 
 
 def njit(*args, **options):
