@@ -30,7 +30,8 @@ from screwkit.cli import app
 try:
     app(["analyze", "planar_5rrr", "--json"], standalone_mode=False)
 finally:
-    print(json.dumps(sorted(m for m in sys.modules if m.startswith(("numba.np", "scipy", "screwkit.indices.compiled.")))))
+    named = ("numba.np", "scipy", "screwkit.indices.compiled.")
+    print(json.dumps(sorted(m for m in sys.modules if m.startswith(named))))
 """
 
 

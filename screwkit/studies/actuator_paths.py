@@ -122,9 +122,9 @@ def _header(name: str) -> set[str]:
     cannot be read: :func:`~screwkit.studies.paths.read_columns` says why)."""
     try:
         if name.lower().endswith(".nc"):
-            from scipy.io import netcdf_file
+            from screwkit.studies.netcdf import netcdf_file
 
-            with netcdf_file(name, "r", mmap=False) as handle:
+            with netcdf_file()(name, "r", mmap=False) as handle:
                 return set(handle.variables)
         with open(name, encoding="utf-8") as handle:
             return {cell.strip() for cell in handle.readline().split(",")}

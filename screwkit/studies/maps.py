@@ -32,7 +32,7 @@ from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.files import atomic_write
 from screwkit.studies.graph_source import GraphSource, cached_graph, graph_source
-from screwkit.studies.netcdf import netcdf_attribute
+from screwkit.studies.netcdf import netcdf_attribute, netcdf_file
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.tasks import Execution, run_tasks
@@ -160,12 +160,10 @@ class GridMap:
 
     def write_netcdf(self, path) -> None:
         """Write a netCDF-3 file (``scipy.io.netcdf_file``) atomically; ``xarray.open_dataset`` reads it."""
-        from scipy.io import netcdf_file
-
         (x_name, _), (y_name, _) = self.coordinates.items()
 
         def write(temporary):
-            with netcdf_file(temporary, "w", version=2) as handle:
+            with netcdf_file()(temporary, "w", version=2) as handle:
                 for name, (values, unit) in self.coordinates.items():
                     handle.createDimension(name, values.size)
                     variable = handle.createVariable(name, "d", (name,))

@@ -17,14 +17,42 @@ so that ``xarray.open_dataset`` reads back exactly what :meth:`PlainDataset.to_d
 
 from __future__ import annotations
 
+import functools
+import importlib.util
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from screwkit.studies.files import atomic_write, output_suffix
 
-__all__ = ["PlainDataset", "netcdf_attribute"]
+__all__ = ["PlainDataset", "netcdf_attribute", "netcdf_file"]
+
+
+@functools.cache
+def netcdf_file() -> type:
+    """``scipy.io.netcdf_file``, without importing ``scipy.io``.
+
+    ``scipy.io`` imports its MATLAB reader and, through it, ``scipy.sparse`` and scipy's array-API layer: 0.12 s of
+    every command that writes a netCDF file, for a module (``scipy/io/_netcdf.py``) that needs only numpy and the
+    standard library. That module is loaded alone from scipy's folder; ``scipy.io``'s own class where it is not
+    there or does not load alone (a later scipy that gives it imports of its own package)."""
+    found = importlib.util.find_spec("scipy")
+    folders = list(found.submodule_search_locations or []) if found is not None else []
+    source = Path(folders[0], "io", "_netcdf.py") if folders else None
+    if source is not None and source.is_file():
+        try:
+            alone = importlib.util.spec_from_file_location("screwkit.studies._scipy_netcdf", source)
+            module = importlib.util.module_from_spec(alone)
+            alone.loader.exec_module(module)
+            return module.netcdf_file
+        except (ImportError, AttributeError, SyntaxError):
+            pass
+    from scipy.io import netcdf_file as scipy_netcdf_file
+
+    return scipy_netcdf_file
+
 
 
 @dataclass
@@ -98,22 +126,25 @@ _WRITER = None
 
 
 def _netcdf_writer():
-    """``scipy.io.netcdf_file``, writing each variable's values from the array given, in blocks of
+    """:func:`netcdf_file`, writing each variable's values from the array given, in blocks of
     :data:`STREAM_BLOCK` converted to the file's big-endian order, instead of from a big-endian copy of the whole
     array made when it is given and copied again to bytes when written (a path's 76 MB file took three times its
     size in memory): the same bytes. scipy's own writer (``streams`` False) where its writing of a variable's data
     is not the one this replaces."""
     global _WRITER
-    if _WRITER is not None:
-        return _WRITER
-    from scipy.io import netcdf_file
+    if _WRITER is None:
+        _WRITER = streaming(netcdf_file())
+    return _WRITER
 
+
+def streaming(base: type) -> type:
+    """``base`` (a ``netcdf_file`` class) writing each variable's values in blocks (:func:`_netcdf_writer`);
+    ``base`` itself if it has not the methods this replaces."""
     needed = ("_write_var_data", "_pack_begin", "_write_var_padding")
-    if not all(hasattr(netcdf_file, name) for name in needed):
-        _WRITER = netcdf_file
-        return _WRITER
+    if not all(hasattr(base, name) for name in needed):
+        return base
 
-    class StreamingNetCDF(netcdf_file):
+    class StreamingNetCDF(base):
         streams = True
 
         def __init__(self, *args, **kwargs):
@@ -133,8 +164,7 @@ def _netcdf_writer():
                 self.fp.write(flat[start:start + STREAM_BLOCK].astype(variable.data.dtype).tobytes())
             self._write_var_padding(variable, variable._vsize - flat.size * variable.data.itemsize)
 
-    _WRITER = StreamingNetCDF
-    return _WRITER
+    return StreamingNetCDF
 
 
 def netcdf_attribute(value):
