@@ -257,4 +257,4 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
                    "out of reach")
     one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes the output frame's x y z")
     converted = screwkit("convert", path, tmp_path / "out.urdf")
-    one_line_error(converted, "inside a leg", "`screwkit analyze`, `info`, `sweep`, `map` and `trajectory`")
+    one_line_error(converted, "inside a leg", "`screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view`")

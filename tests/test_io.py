@@ -370,7 +370,8 @@ def test_a_ball_joint_inside_a_leg_is_refused_by_name(tmp_path):
     path = tmp_path / "ball.xml"
     path.write_text(text)
     with pytest.raises(LegWithLoops, match=r"joint 'b_2' \(spherical\) inside a leg: not a serial chain of 1-DoF "
-                       r"joints; `screwkit analyze`, `info`, `sweep`, `map` and `trajectory`.*analyse it as a graph"):
+                       r"joints; `screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view`"
+                       r".*analyse it as a graph"):
         read_mechanism_file(path)
 
 

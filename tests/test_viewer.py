@@ -445,6 +445,118 @@ def test_a_long_timed_path_is_animated_at_frames_even_in_time(planar, tmp_path, 
     np.testing.assert_allclose(poses[:, 0], np.interp(at, times, 0.01 * times**2 - 0.5), atol=1e-12)
 
 
+# ----------------------------------------------------------------------------------------
+# Legs with loops inside them: rods between the joints of the closed tree
+# ----------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def graph():
+    from screwkit.io import graph_mechanism, read_closed_tree
+    from screwkit.io.loader import bundled_path
+
+    return graph_mechanism(read_closed_tree(bundled_path("delta_rods_4")))
+
+
+def pinocchio_points(graph, q):
+    """Pinocchio's own forward kinematics of the closed tree at q: each joint's origin, and each closure's two frame
+    origins (the independent reading the drawing is checked against)."""
+    import pinocchio
+
+    model = graph.tree.model
+    data = model.createData()
+    pinocchio.forwardKinematics(model, data, q)
+    pinocchio.updateFramePlacements(model, data)
+    origins = np.array([np.asarray(data.oMi[j].translation) for j in range(model.njoints)])
+    ends = {closure.name: [np.asarray((data.oMi[joint] * pinocchio.SE3(placement)).translation)
+                           for joint, placement in ((closure.joint_a, closure.placement_a),
+                                                    (closure.joint_b, closure.placement_b))]
+            for closure in graph.tree.closures}
+    return origins, ends, np.asarray(data.oMf[graph.frame_id].translation)
+
+
+def test_a_graph_is_drawn_as_rods_between_its_joints(graph, viewer):
+    """The rod-level Delta: every body a rod from its joint to each child joint and each closure frame on it, at
+    Pinocchio's forward kinematics of the closed configuration; the legs in their ITI's colour, the failed leg red
+    with a cross at its motor; the base and the platform in their own colours; no screw (a graph keeps none)."""
+    from screwkit.viewer.markers import node_label
+
+    pose = graph.home_pose + np.array([0.04, -0.03, 0.02])
+    scene = show(graph, pose, failed=["arm_2"], viewer=viewer)
+    assert scene.visualizer is None and scene.failed == (1,)
+    q, reached = graph.solve(pose[None])
+    origins, ends, output = pinocchio_points(graph, q[0])
+    np.testing.assert_allclose(output, pose, atol=1e-9)  # the drawn configuration is at the pose asked
+    names, parents = graph.tree.model.names, graph.tree.model.parents
+    links = {marker.path: marker for marker in scene.markers_of_kind("link")}
+    drawn = 0
+    for joint in range(1, len(parents)):
+        path = f"{ROOT_PATH}/links/{node_label(names[parents[joint]])}--{node_label(names[joint])}"
+        start, end = origins[parents[joint]], origins[joint]
+        if np.linalg.norm(end - start) < 1e-9:
+            assert path not in links
+            continue
+        drawn += 1
+        np.testing.assert_allclose(links[path].start, start, atol=1e-12)
+        np.testing.assert_allclose(links[path].end, end, atol=1e-12)
+    for closure in graph.tree.closures:
+        a, b = ends[closure.name]
+        assert np.linalg.norm(a - b) < 1e-8  # closed: the two ends of each rod's far joint meet
+        np.testing.assert_allclose(links[f"{ROOT_PATH}/links/{node_label(closure.name)}--a"].end, a, atol=1e-12)
+    assert drawn >= 8 and len(links) >= drawn + len(graph.tree.closures)
+    tree = scene_tree(scene.static_html())
+    for marker in list(links.values())[:5]:
+        matrix = tree[full_path(marker.path)]["transform"]
+        np.testing.assert_allclose(matrix[:3, 1], marker.end - marker.start, atol=1e-12)  # y scaled to the length
+        np.testing.assert_allclose(matrix[:3, 3], 0.5 * (marker.start + marker.end), atol=1e-12)
+    legs = {index: [m for m in links.values() if m.chain == index] for index in range(4)}
+    assert all(legs.values()) and all(m.failed for m in legs[1]) and not any(m.failed for m in legs[0])
+    bodies = {m.body for m in links.values() if m.chain is None}
+    assert "platform" in bodies and bodies <= {"platform", "base"}
+    platform_joint = list(names).index("platform_ball")
+    assert all(m.body == "platform" for m in links.values() if m.path.startswith(f"{ROOT_PATH}/links/rod_")
+               and m.path.endswith("--b"))  # the closures' platform side: on the platform's body
+    assert links[f"{ROOT_PATH}/links/rod_2a_end--b"].start.tolist() == origins[platform_joint].tolist()
+    expected = graph.at_pose(pose).indices().iti_actuators  # the indices of the mechanism moved to the pose alone
+    np.testing.assert_allclose(scene.chain_values[0, [0, 2, 3]], expected[[0, 2, 3]], atol=1e-9)
+    assert np.isnan(scene.chain_values[0, 1])
+    np.testing.assert_allclose(scene.chain_colors[1], FAILED_COLOR)
+    cross = scene.markers_of_kind("failed_actuator")
+    motor = list(names).index("motor_2")
+    assert len(cross) == 1 and np.allclose(cross[0].start, origins[motor], atol=1e-12)
+    assert not scene.markers_of_kind("actuation_wrench") and not scene.markers_of_kind("twist_axis")
+    assert resolve_actuators(graph, ["arm_2:motor_2"]) == resolve_actuators(graph, "motor_2") == (1,)
+    with pytest.raises(ValueError, match="no closed configuration"):
+        show(graph, graph.home_pose + np.array([0.0, 0.0, 5.0]), viewer=viewer)
+
+
+def test_a_graph_path_animation_follows_its_closed_configurations(graph, viewer):
+    """Keyframes of a rod follow Pinocchio's forward kinematics pose by pose, and each leg's colour track is the
+    colour of its index at each pose."""
+    poses = graph.home_pose + np.linspace([0.0, 0.0, 0.0], [0.08, 0.05, 0.03], 6)
+    scene = animate_sweep(graph, poses, failed=[3], viewer=viewer, frame_rate=5)
+    np.testing.assert_allclose(scene.poses, poses)
+    commands = [c for c in scene_commands(scene.static_html()) if c["type"] == "set_animation" and c["animations"]]
+    assert len(commands) == 1
+    clips = {item["path"]: item["clip"] for item in commands[0]["animations"]}
+    rod = f"{ROOT_PATH}/links/motor_1--ball_1b"
+    tracks = {track["name"]: track["keys"] for track in clips[full_path(rod)]["tracks"]}
+    q, _ = graph.solve(poses)
+    names = list(graph.tree.model.names)
+    for frame in range(len(poses)):
+        origins, _, output = pinocchio_points(graph, q[frame])
+        np.testing.assert_allclose(output, poses[frame], atol=1e-9)
+        middle_point = 0.5 * (origins[names.index("motor_1")] + origins[names.index("ball_1b")])
+        np.testing.assert_allclose(tracks[".position"][frame]["value"], middle_point, atol=1e-12)
+    colour = {t["name"]: t for t in clips[full_path(f"{rod}/<object>")]["tracks"]}[".material.color"]["keys"]
+    np.testing.assert_allclose([key["value"] for key in colour], colors_from_values(scene.chain_values[:, 0])[:, :3])
+    for frame in (0, 5):
+        expected = graph.at_pose(poses[frame]).indices().iti_actuators[0]
+        assert scene.chain_values[frame, 0] == pytest.approx(expected, abs=1e-9)
+    failed_leg = {full_path(m.path) for m in scene.frame_markers[0] if m.chain == 3 and m.kind == "link"}
+    assert failed_leg and all(m.failed for m in scene.frame_markers[0] if m.chain == 3)
+    assert not [p for p in failed_leg if f"{p}/<object>" in clips]  # the failed leg: red, its colour untracked
+    assert all(f"{full_path(m.path)}/<object>" in clips for m in scene.frame_markers[0] if m.chain == 0)
+
+
 def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):
     scene = show(planar, PLANAR_POSE, viewer=viewer)
     target = tmp_path / "scene.html"
@@ -527,6 +639,30 @@ def test_cli_view_animates_a_path_and_refuses_a_bad_path_file(tmp_path):
     ):
         one_line_error(screwkit("view", "planar_5rrr", *arguments, "--html", tmp_path / "never.html"), *needles)
     assert not (tmp_path / "never.html").exists()
+
+
+def test_cli_view_draws_and_animates_a_graph(tmp_path):
+    """`screwkit view` on the rod-level Delta (legs with loops inside them), still and along a path, as a user runs
+    it; each leg's value in the legend is its actuator's ITI as `screwkit analyze` reports it."""
+    still = tmp_path / "still.html"
+    outcome = screwkit("view", "delta_rods_4", "--failed", "arm_2", "--html", still)
+    assert outcome.returncode == 0, outcome.stderr
+    analysed = json.loads(screwkit("analyze", "delta_rods_4", "--json").stdout)
+    legend = dict(line.split()[:2] for line in outcome.stdout.splitlines()[1:5])
+    iti = analysed["iti_actuators"]
+    for leg in ("arm_1", "arm_3", "arm_4"):
+        assert float(legend[leg]) == pytest.approx(iti[f"{leg}:motor_{leg[-1]}"], abs=6e-5)
+    assert "failed: arm_2:motor_2" in outcome.stdout and "no screw drawn" in outcome.stdout
+    assert any(path.startswith(full_path(f"{ROOT_PATH}/links/")) for path in scene_tree(still.read_text()))
+    moving = tmp_path / "moving.html"
+    outcome = screwkit("view", "delta_rods_4", "--through", "0 0 -0.75", "0.1 0 -0.72", "0 0.1 -0.75", "--samples",
+                       "12", "--html", moving)
+    assert outcome.returncode == 0, outcome.stderr
+    animation = [c for c in scene_commands(moving.read_text()) if c["type"] == "set_animation" and c["animations"]]
+    keys = animation[0]["animations"][0]["clip"]["tracks"][0]["keys"]
+    assert len(keys) == 13  # 12 samples evenly spaced in arc length, plus the pose in the middle
+    one_line_error(screwkit("view", "delta_rods_4", "--pose", "0", "0", "5", "--html", tmp_path / "far.html"),
+                   "no closed configuration", "z=5")
 
 
 @pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
@@ -693,10 +829,12 @@ PATH_FRAME = 7  # probed keyframe of the path animation
 
 
 @pytest.fixture(scope="module")
-def screenshots(planar, hexapod, viewer, tmp_path_factory):
+def screenshots(planar, hexapod, graph, viewer, tmp_path_factory):
     folder = tmp_path_factory.mktemp("screenshots")
     export_html(show(planar, PLANAR_POSE, failed=[1], viewer=viewer), folder / "planar_5rrr.html")
     export_html(show(hexapod, SPATIAL_POSE, failed=[3], viewer=viewer), folder / "ups_hexapod_8.html")
+    export_html(show(graph, graph.home_pose + np.array([0.04, -0.03, 0.02]), failed=[1], viewer=viewer),
+                folder / "delta_rods_4.html")
     poses = np.column_stack([np.full(9, 0.05), np.full(9, -0.03), np.deg2rad(np.arange(-20.0, 21.0, 5.0))])
     sweep = animate_sweep(planar, poses, failed=[2], viewer=viewer, frame_rate=10)
     paths = {"platform": ["meshcat", ROOT_PATH, "mechanism", "visuals", "platform_0"],
@@ -715,7 +853,8 @@ def screenshots(planar, hexapod, viewer, tmp_path_factory):
     viewer[ROOT_PATH].delete()
     export_html(viewer, folder / "blank.html")
     pages = {name: folder / f"{name}.html"
-             for name in ("planar_5rrr", "ups_hexapod_8", "blank", "planar_5rrr_sweep", "planar_5rrr_path")}
+             for name in ("planar_5rrr", "ups_hexapod_8", "delta_rods_4", "blank", "planar_5rrr_sweep",
+                          "planar_5rrr_path")}
     return (render(pages, folder, dump_dom=("planar_5rrr_sweep", "planar_5rrr_path")), folder,
             {"sweep": sweep, "path": along})
 
@@ -731,7 +870,8 @@ def test_blank_page_fails_the_check(screenshots):
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "planar_5rrr_sweep", "planar_5rrr_path"])
+@pytest.mark.parametrize("name", ["planar_5rrr", "ups_hexapod_8", "delta_rods_4", "planar_5rrr_sweep",
+                                  "planar_5rrr_path"])
 def test_offline_page_renders_the_mechanism(screenshots, name):
     rendered, folder, _ = screenshots
     image, blank = rendered[name][0], rendered["blank"][0]

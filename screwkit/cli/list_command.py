@@ -25,4 +25,4 @@ def list_command(as_json: bool) -> None:
     for name in names:
         click.echo(name)
     for name in graphs:
-        click.echo(f"{name} (legs with loops inside them: analyze, info, sweep, map, trajectory)")
+        click.echo(f"{name} (legs with loops inside them: analyze, info, sweep, map, trajectory, view)")

@@ -26,6 +26,7 @@ from screwkit.cli.options import (
 )
 from screwkit.cli.trajectory import PathSource, circle_option, line_option, samples_option, through_option
 from screwkit.viewer import animate_sweep, export_html, show
+from screwkit.viewer.markers import actuator_pairs, chain_names
 
 __all__ = ["view"]
 
@@ -103,16 +104,19 @@ def _echo_legend(scene) -> None:
     extra = f" (first of {frames} frames, then the lowest over them)" if frames > 1 else ""
     click.echo(f"{mechanism.name}: chains coloured by the {what}{extra}; viridis 0 purple .. 1 yellow")
     names = mechanism.actuator_names
-    for index, chain in enumerate(mechanism.chains):
+    pairs = actuator_pairs(mechanism)
+    for index, chain in enumerate(chain_names(mechanism)):
         values = scene.chain_values[:, index]
-        failed = [names[i] for i in scene.failed if mechanism.actuators[i][0] == chain.name]
+        failed = [names[i] for i in scene.failed if pairs[i][0] == chain]
         note = f"  failed: {', '.join(failed)}" if failed else ""
         shown = "-" if np.isnan(values[0]) else f"{values[0]:.4f}"
         if frames > 1:
             shown += "  -" if np.all(np.isnan(values)) else f"  {np.nanmin(values):.4f}"
-        click.echo(f"  {chain.name:<24s} {shown}{note}")
+        click.echo(f"  {chain:<24s} {shown}{note}")
     best = scene.best_submechanisms[0]
-    if best is None:
+    if scene.visualizer is None:
+        click.echo("Legs with loops inside them: bodies drawn as rods between their joints; no screw drawn.")
+    elif best is None:
         click.echo("No working submechanism: no output twist drawn.")
     else:
         click.echo("Output twists of the best working submechanism: " + ", ".join(names[i] for i in best))
@@ -167,7 +171,7 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
     """
 
     check_outputs({"--html": (html_path, (".html", ".htm"))}, overwrite, quiet)
-    loaded = load_mechanism(mechanism, reading)
+    loaded = load_mechanism(mechanism, reading, graphs=True)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
     animated = _animated_poses(loaded, motion, target, quiet)

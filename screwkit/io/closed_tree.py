@@ -40,8 +40,8 @@ class LegWithLoops(ImportError_):
     configuration."""
 
 
-GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep`, `map` and `trajectory` (or screwkit.io.graph_mechanism) "
-              "analyse it as a graph; `convert` and the commands of serial legs do not")
+GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view` (or "
+              "screwkit.io.graph_mechanism) analyse it as a graph; `convert` and the commands of serial legs do not")
 """What a :class:`LegWithLoops` message adds."""
 
 

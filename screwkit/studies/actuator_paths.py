@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure import forward
 from screwkit.model import Mechanism
+from screwkit.studies.netcdf import netcdf_file
 from screwkit.studies.paths import Path, PathFileError, path_from_poses, read_columns
 
 __all__ = ["path_from_actuators", "read_actuator_path", "actuator_columns", "COARSE_SEGMENTS"]
@@ -122,8 +123,6 @@ def _header(name: str) -> set[str]:
     cannot be read: :func:`~screwkit.studies.paths.read_columns` says why)."""
     try:
         if name.lower().endswith(".nc"):
-            from screwkit.studies.netcdf import netcdf_file
-
             with netcdf_file()(name, "r", mmap=False) as handle:
                 return set(handle.variables)
         with open(name, encoding="utf-8") as handle:

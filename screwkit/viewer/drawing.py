@@ -140,12 +140,11 @@ def create_marker(viewer, marker: Marker, mechanism, chain_colors) -> None:
         for number, angle in enumerate((np.pi / 4, -np.pi / 4)):
             node[f"bar_{number}"].set_object(geometry.Box([size, 0.18 * size, 0.18 * size]), material)
             node[f"bar_{number}"].set_transform(transformations.rotation_matrix(angle, [0.0, 0.0, 1.0]))
-    elif marker.kind == "link":
-        color = FAILED_COLOR if marker.failed else tuple(chain_colors[marker.chain])
-        node.set_object(geometry.Cylinder(1.0, 2.0 * radius), lambert_material(color))
-    elif marker.kind == "joint":
-        color = FAILED_COLOR if marker.failed else tuple(chain_colors[marker.chain])
-        node.set_object(geometry.Sphere(3.0 * radius), lambert_material(color))
+    elif marker.kind in ("link", "joint"):
+        color = (FAILED_COLOR if marker.failed else BASE_COLOR if marker.body == "base"
+                 else PLATFORM_COLOR if marker.body == "platform" else tuple(chain_colors[marker.chain]))
+        shape = geometry.Cylinder(1.0, 2.0 * radius) if marker.kind == "link" else geometry.Sphere(3.0 * radius)
+        node.set_object(shape, lambert_material(color))
 
 
 def rotation_with_y_along(direction: NDArray) -> NDArray:
@@ -216,26 +215,28 @@ def clear_animation(viewer) -> None:
 
 def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_markers, frame_rate, loop,
             colours: dict[str, NDArray] | None = None, times: NDArray | None = None) -> None:
-    """One keyframe per frame: the links, and the markers (shown or hidden); with ``colours`` (per Meshcat path of a
-    drawn object, its RGB(A) colour at each frame, (frames, 3 or 4)), the material colour of each follows too.
+    """One keyframe per frame: the links (of ``visualizer``'s geometry: none when it is None), and the markers (shown
+    or hidden); with ``colours`` (per Meshcat path of a drawn object, its RGB(A) colour at each frame, (frames, 3 or
+    4)), the material colour of each follows too.
     Keyframe ``k`` is at ``k / frame_rate`` seconds, or with ``times`` (seconds, increasing, one per frame) at
     ``times[k] - times[0]``: Meshcat then plays the motion at its own pace, interpolating between keyframes."""
     import meshcat.animation
     import pinocchio
     from meshcat import transformations
 
-    model, data = visualizer.model, visualizer.data
-    visual_data = visualizer.visual_data
     animation = meshcat.animation.Animation(default_framerate=frame_rate)
     at = (np.arange(len(frames.configurations)) if times is None
           else (np.asarray(times, dtype=float) - times[0]) * frame_rate)  # keyframe numbers (Meshcat: frame / fps s)
+    geometries = [] if visualizer is None else visual_model.geometryObjects
     for frame, configuration in enumerate(frames.configurations):
-        pinocchio.forwardKinematics(model, data, configuration)
-        pinocchio.updateGeometryPlacements(model, data, visual_model, visual_data)
+        if visualizer is not None:
+            pinocchio.forwardKinematics(visualizer.model, visualizer.data, configuration)
+            pinocchio.updateGeometryPlacements(visualizer.model, visualizer.data, visual_model,
+                                               visualizer.visual_data)
         with animation.at_frame(viewer, int(at[frame]) if times is None else float(at[frame])) as keyframe:
-            for index, geometry in enumerate(visual_model.geometryObjects):
+            for index, geometry in enumerate(geometries):
                 node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
-                keyframe[node].set_transform(visual_data.oMg[index].homogeneous)
+                keyframe[node].set_transform(visualizer.visual_data.oMg[index].homogeneous)
                 scale = np.asarray(geometry.meshScale, dtype=float).ravel()
                 if not np.allclose(scale, 1.0):
                     keyframe[node].set_property("scale", "vector3", [float(s) for s in scale])

@@ -35,6 +35,8 @@ __all__ = [
     "solve_frames",
     "best_submechanism",
     "chain_index_values",
+    "chain_names",
+    "actuator_pairs",
     "markers_of_frame",
     "twist_markers",
 ]
@@ -130,7 +132,8 @@ def resolve_actuators(mechanism, actuators) -> tuple[int, ...]:
         return ()
     if isinstance(actuators, (int, np.integer, str)):
         actuators = [actuators]
-    names = [f"{chain}:{joint}" for chain, joint in mechanism.actuators]
+    pairs = actuator_pairs(mechanism)
+    names = [f"{chain}:{joint}" for chain, joint in pairs]
     chosen: set[int] = set()
     for actuator in actuators:
         if isinstance(actuator, (int, np.integer)) and not isinstance(actuator, bool):
@@ -145,7 +148,7 @@ def resolve_actuators(mechanism, actuators) -> tuple[int, ...]:
         if re.fullmatch(r"\d+", text):
             chosen.update(resolve_actuators(mechanism, [int(text)]))
             continue
-        hits = [i for i, (chain, joint) in enumerate(mechanism.actuators) if text in (names[i], joint, chain)]
+        hits = [i for i, (chain, joint) in enumerate(pairs) if text in (names[i], joint, chain)]
         if not hits:
             raise ValueError(f"Unknown actuator {actuator!r} for mechanism {mechanism.name!r}; actuators are "
                              f"0..{len(names) - 1}: {', '.join(names)} (a chain name selects all its actuators).")
@@ -176,6 +179,8 @@ class Marker:
         Drawn in :data:`FAILED_COLOR`.
     chain : int or None
         Chain index (link, joint and failure markers).
+    body : str or None
+        ``"base"`` or ``"platform"`` for a link or joint of those bodies (drawn in their colours), else None.
     """
 
     path: str
@@ -185,6 +190,7 @@ class Marker:
     end: NDArray[np.float64]
     failed: bool = False
     chain: int | None = None
+    body: str | None = None
 
     @property
     def direction(self) -> NDArray[np.float64]:
@@ -242,13 +248,26 @@ def best_submechanism(result, frame: int, failed: tuple[int, ...]) -> int | None
     return int(np.argmax(scores))
 
 
+def chain_names(mechanism) -> list[str]:
+    """The names of a mechanism's chains: a serial mechanism's chains, a graph's legs."""
+    legs = getattr(mechanism, "legs", None)
+    return [leg.name for leg in (legs if legs is not None else mechanism.chains)]
+
+
+def actuator_pairs(mechanism) -> list[tuple[str, str]]:
+    """``(chain, joint)`` of every actuator, in order: a serial mechanism's pairs, a graph's ``leg:joint`` split."""
+    return [tuple(actuator.split(":", 1)) if isinstance(actuator, str) else tuple(actuator)
+            for actuator in mechanism.actuators]
+
+
 def chain_index_values(mechanism, result, frame: int, failed: tuple[int, ...], color_by: str) -> NDArray:
-    chain_index = {chain.name: index for index, chain in enumerate(mechanism.chains)}
-    actuators_of = [[] for _ in mechanism.chains]
-    for actuator, (chain, _) in enumerate(mechanism.actuators):
+    names = chain_names(mechanism)
+    chain_index = {name: index for index, name in enumerate(names)}
+    actuators_of = [[] for _ in names]
+    for actuator, (chain, _) in enumerate(actuator_pairs(mechanism)):
         if actuator not in failed:
             actuators_of[chain_index[chain]].append(actuator)
-    values = np.full(len(mechanism.chains), np.nan)
+    values = np.full(len(names), np.nan)
     if color_by == "iti":
         iti = np.asarray(result.iti_actuators)[frame]
         for chain, members in enumerate(actuators_of):

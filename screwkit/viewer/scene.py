@@ -13,7 +13,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
-from screwkit.io.loader import load
+from screwkit.io.closed_tree import LegWithLoops
+from screwkit.io.graph import GraphMechanism
+from screwkit.io.loader import bundled_graph_names, bundled_path, load
 from screwkit.studies.files import atomic_text
 from screwkit.studies.paths import checked_times
 from screwkit.viewer.drawing import (
@@ -28,6 +30,7 @@ from screwkit.viewer.drawing import (
     load_visual_model,
     marker_matrix,
 )
+from screwkit.viewer.graph_drawing import graph_markers, solve_graph_frames
 from screwkit.viewer.markers import (
     FAILED_COLOR,
     MARKER_KINDS,
@@ -73,7 +76,9 @@ class Scene:
         Per frame, the best working submechanism (actuator indices) or None.
     frame_markers : tuple of tuple of Marker
         Per frame, the overlays drawn.
-    visualizer : pinocchio.visualize.MeshcatVisualizer
+    visualizer : pinocchio.visualize.MeshcatVisualizer or None
+        The visualizer of the mechanism's geometry (None for a mechanism whose legs have loops inside them, drawn
+        as rods and spheres).
     viewer : meshcat.Visualizer
     server : ViewerServer or None
         The server this scene started (None when drawn into a given viewer).
@@ -263,10 +268,17 @@ def export_html(target, path: str | os.PathLike) -> Path:
 
 
 def mechanism_of(mechanism):
-    if isinstance(mechanism, (str, os.PathLike)):
-
+    """A loaded mechanism, or one loaded from a bundled name or a path: a file whose legs have loops inside them as
+    a :class:`~screwkit.io.GraphMechanism` at the file's configuration."""
+    if not isinstance(mechanism, (str, os.PathLike)):
+        return mechanism
+    try:
         return load(mechanism)
-    return mechanism
+    except LegWithLoops:
+        from screwkit.io import graph_mechanism, read_closed_tree  # readers of other tools: for such a file only
+
+        name = os.fspath(mechanism)
+        return graph_mechanism(read_closed_tree(bundled_path(name) if name in bundled_graph_names() else name))
 
 
 def meshcat_viewer_of(target):
@@ -291,23 +303,20 @@ class _Animation:
     times: NDArray | None = None
 
 
-def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None) -> Scene:
-    """Draw :func:`show`'s one pose (``animation`` None: an unreachable pose is an error) or
-    :func:`animate_sweep`'s poses (the unreachable ones skipped)."""
-    import pinocchio
+@dataclass(frozen=True)
+class _Geometry:
+    """A serial mechanism's visual geometry (Pinocchio's), who owns each object, and what failed."""
 
-    import_meshcat()
-    from pinocchio.visualize import MeshcatVisualizer
+    visual_model: Any
+    owners: list
+    failed_joints: set
+    failed_chains: set
 
-    if color_by not in ("iti", "oti"):
-        raise ValueError(f"Expected `color_by` 'iti' or 'oti', got {color_by!r}.")
-    failed = resolve_actuators(mechanism, failed)
-    one_pose = animation is None
-    frames = solve_frames(mechanism, poses, threshold, one_pose)
-    count = frames.poses.shape[0]
-    result = frames.result
-    best = tuple(best_submechanism(result, frame, failed) for frame in range(count))
-    chain_values = np.stack([chain_index_values(mechanism, result, frame, failed, color_by) for frame in range(count)])
+
+def _serial_drawing(mechanism, poses, failed, threshold, strict: bool):
+    """Frames, markers and geometry of a mechanism of serial legs."""
+    frames = solve_frames(mechanism, poses, threshold, strict)
+    best = tuple(best_submechanism(frames.result, frame, failed) for frame in range(frames.poses.shape[0]))
     visual_model = load_visual_model(mechanism)
     owners, bare = geometry_owners(mechanism, visual_model)
     failed_joints, failed_chains = failed_joint_ids(mechanism, failed)
@@ -318,9 +327,59 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
         joint_id = model.getJointId(tree_joints[position])
         bare_links.append((chain, position, chain in failed_chains or joint_id in failed_joints))
     markers = tuple(tuple(markers_of_frame(mechanism, frames, frame, failed, best[frame], bare_links))
-                    for frame in range(count))
+                    for frame in range(frames.poses.shape[0]))
+    return frames, best, markers, _Geometry(visual_model, owners, failed_joints, failed_chains)
+
+
+def _graph_drawing(mechanism, poses, failed, threshold, strict: bool):
+    """Frames and markers of a mechanism whose legs have loops inside them (no geometry: rods and spheres)."""
+    frames = solve_graph_frames(mechanism, poses, threshold, strict)
+    best = tuple(best_submechanism(frames.result, frame, failed) for frame in range(frames.poses.shape[0]))
+    return frames, best, graph_markers(mechanism, frames, failed), None
+
+
+def _show_geometry(meshcat_viewer, mechanism, geometry: _Geometry, chain_colors, chain_of_node: dict):
+    """Pinocchio's visualizer of the serial mechanism's geometry in its colours (``chain_of_node`` gets the nodes
+    an animation recolours)."""
+    import pinocchio
+    from pinocchio.visualize import MeshcatVisualizer
+
+    visualizer = MeshcatVisualizer(mechanism.pinocchio_model, None, geometry.visual_model)
+    visualizer.initViewer(viewer=meshcat_viewer)
+    visualizer.loadViewerModel(rootNodeName=f"{ROOT_PATH}/mechanism")
+    for shape, owner in zip(geometry.visual_model.geometryObjects, geometry.owners):
+        node = visualizer.getViewerNodeName(shape, pinocchio.GeometryType.VISUAL)
+        if owner == "base":
+            color = BASE_COLOR
+        elif owner == "platform":
+            color = PLATFORM_COLOR
+        elif owner in geometry.failed_chains or shape.parentJoint in geometry.failed_joints:
+            color = FAILED_COLOR
+        else:
+            color = tuple(chain_colors[owner])
+            chain_of_node[node] = owner
+        meshcat_viewer[node].set_property("color", [float(c) for c in color])
+    return visualizer
+
+
+def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None) -> Scene:
+    """Draw :func:`show`'s one pose (``animation`` None: an unreachable pose is an error) or
+    :func:`animate_sweep`'s poses (the unreachable ones skipped); a mechanism whose legs have loops inside them as
+    rods and spheres (:mod:`screwkit.viewer.graph_drawing`)."""
+    import_meshcat()
+
+    if color_by not in ("iti", "oti"):
+        raise ValueError(f"Expected `color_by` 'iti' or 'oti', got {color_by!r}.")
+    failed = resolve_actuators(mechanism, failed)
+    one_pose = animation is None
+    is_graph = isinstance(mechanism, GraphMechanism)
+    frames, best, markers, geometry = (_graph_drawing if is_graph else _serial_drawing)(
+        mechanism, poses, failed, threshold, one_pose)
+    count = frames.poses.shape[0]
+    result = frames.result
+    chain_values = np.stack([chain_index_values(mechanism, result, frame, failed, color_by) for frame in range(count)])
     chain_colors = colors_from_values(chain_values[0])
-    for chain in failed_chains:
+    for chain in (set(failed) if is_graph else geometry.failed_chains):  # a graph's leg has one actuator
         chain_colors[chain] = FAILED_COLOR
 
     server = None
@@ -333,30 +392,18 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
         meshcat_viewer[ROOT_PATH].delete()
         if getattr(meshcat_viewer.window, "screwkit_animated", False):
             clear_animation(meshcat_viewer)
-        visualizer = MeshcatVisualizer(model, None, visual_model)
-        visualizer.initViewer(viewer=meshcat_viewer)
-        visualizer.loadViewerModel(rootNodeName=f"{ROOT_PATH}/mechanism")
         chain_of_node = {}  # drawn in its chain's colour: the colour an animation changes frame by frame
-        for geometry, owner in zip(visual_model.geometryObjects, owners):
-            node = visualizer.getViewerNodeName(geometry, pinocchio.GeometryType.VISUAL)
-            if owner == "base":
-                color = BASE_COLOR
-            elif owner == "platform":
-                color = PLATFORM_COLOR
-            elif owner in failed_chains or geometry.parentJoint in failed_joints:
-                color = FAILED_COLOR
-            else:
-                color = tuple(chain_colors[owner])
-                chain_of_node[node] = owner
-            meshcat_viewer[node].set_property("color", [float(c) for c in color])
-        visualizer.display(frames.configurations[0])
+        visualizer = None
+        if geometry is not None:
+            visualizer = _show_geometry(meshcat_viewer, mechanism, geometry, chain_colors, chain_of_node)
+            visualizer.display(frames.configurations[0])
         all_markers = {}
         for frame_markers in markers:
             for marker in frame_markers:
                 all_markers.setdefault(marker.path, marker)
         for marker in all_markers.values():
             create_marker(meshcat_viewer, marker, mechanism, chain_colors)
-            if marker.kind in ("link", "joint") and not marker.failed:
+            if marker.kind in ("link", "joint") and not marker.failed and marker.chain is not None:
                 chain_of_node[marker.path] = marker.chain
         for marker in markers[0]:
             meshcat_viewer[marker.path].set_transform(marker_matrix(marker))
@@ -365,7 +412,8 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
         display_offset = frame_view(meshcat_viewer, mechanism, frames)
         if animation is not None:
             frame_colors = colors_from_values(chain_values)  # (frames, chains, 4)
-            animate(meshcat_viewer, visualizer, visual_model, frames, markers, all_markers, animation.frame_rate,
+            animate(meshcat_viewer, visualizer, None if geometry is None else geometry.visual_model, frames, markers,
+                    all_markers, animation.frame_rate,
                     animation.loop, {node: frame_colors[:, chain] for node, chain in chain_of_node.items()},
                     None if animation.times is None else animation.times[frames.kept])
     except BaseException:
