@@ -165,7 +165,7 @@ def test_list_names_the_bundled_robots():
     assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr",
                                      "prs_3_ups", "rss_hexapod_8", "schoenflies_5", "ups_hexapod_8", "ups_stewart_6",
                                      "delta_rods_4", "(legs", "with", "loops", "inside", "them:", "analyze,", "info,",
-                                     "sweep,", "map,", "trajectory)"]
+                                     "sweep,", "map,", "trajectory,", "view)"]
 
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):
