@@ -151,7 +151,10 @@ def _blank(count: int, value) -> NDArray:
 
 
 def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
-    """Copy one chunk's per-configuration results (batch-first) into the batch arrays at ``index``."""
+    """Copy one chunk's per-configuration results (batch-first) into the batch arrays at ``index`` (sorted, without
+    repeats: a slice when it is a run, as when every pose of the chunk is reachable, a copy without indexing)."""
+    if index.size and int(index[-1]) - int(index[0]) + 1 == index.size:
+        index = slice(int(index[0]), int(index[-1]) + 1)
     applicable = _ARRAYS if result.constraint_count else tuple(n for n in _ARRAYS if not n.startswith("cti"))
     pieces = {name: getattr(result, name) for name in applicable}
     pieces.update({(name, j): value for name in _DICTS for j, value in getattr(result, name).items()
