@@ -109,3 +109,32 @@ def test_a_kernel_compiles_and_runs_after_lean_loads():
         assert result.returncode == 0, result.stderr
     difference, positive = result.stdout.split()
     assert float(difference) < 1e-12 and int(positive) == 7
+
+
+def test_another_target_is_loaded_by_numbas_own_loading():
+    """A context that is not numba's CPU target (CUDA's, in a process that uses both) is refreshed and loaded as
+    numba does it."""
+    import contextlib
+
+    from numba.core import caching
+    from numba.core.cpu import CPUContext
+
+    from screwkit.common.jit import install_lean_loads
+
+    assert install_lean_loads()
+    calls = []
+
+    class Target:  # not a CPUContext
+        def refresh(self):
+            calls.append("refresh")
+
+    class Cache:
+        def _guard_against_spurious_io_errors(self):
+            return contextlib.nullcontext()
+
+        def _load_overload(self, sig, target_context):
+            calls.append("load")
+            return "loaded"
+
+    assert not isinstance(Target(), CPUContext)
+    assert caching.Cache.load_overload(Cache(), None, Target()) == "loaded" and calls == ["refresh", "load"]

@@ -97,10 +97,17 @@ def install_lean_loads() -> bool:
     if getattr(cache.load_overload, "screwkit_lean", False):
         return True
 
+    numbas_own = cache.load_overload
+
     def load_overload(self, sig, target_context):
+        from numba.core.cpu import CPUContext
         from numba.core.runtime import nrt
         from numba.cpython import hashing  # noqa: F401  (registers the hash secrets' symbols)
 
+        if not isinstance(target_context, CPUContext):  # another target (CUDA) in the same process: numba's own
+            return numbas_own(self, sig, target_context)
+        # numba's extension entry points are not initialised here (50 ms of scanning installed packages): screwkit's
+        # kernels use no extension, and numba initialises them before any call it must compile
         nrt.rtsys.initialize(target_context)
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
