@@ -138,3 +138,22 @@ def test_another_target_is_loaded_by_numbas_own_loading():
 
     assert not isinstance(Target(), CPUContext)
     assert caching.Cache.load_overload(Cache(), None, Target()) == "loaded" and calls == ["refresh", "load"]
+
+
+def test_the_numba_versions_installed_are_those_lean_loads_know():
+    """pyproject.toml's bounds on numba are the versions install_lean_loads was written for, and this numba is one."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    import numba
+
+    from screwkit.common.jit import LEAN_NUMBA
+
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
+    numba_requirement = next(r for r in project["project"]["dependencies"] if r.startswith("numba"))
+    bounds = re.fullmatch(r"numba>=(\d+)\.(\d+),<(\d+)\.(\d+)", numba_requirement)
+    assert bounds, numba_requirement
+    low, high = (tuple(int(g) for g in bounds.groups()[i:i + 2]) for i in (0, 2))
+    assert (low, high) == LEAN_NUMBA
+    assert low <= tuple(int(part) for part in numba.__version__.split(".")[:2]) < high

@@ -32,7 +32,10 @@ from screwkit.common.compiling import kernel_sources, kernel_sources_digest, num
 
 __all__ = ["njit", "install_locators", "install_lean_loads"]
 
-LEAN_NUMBA = ((0, 60), (0, 69))  # the numba versions (from, before) whose cache loading install_lean_loads knows
+LEAN_NUMBA = ((0, 60), (0, 69))
+"""The numba versions (from, before) whose cache loading :func:`install_lean_loads` knows (run on 0.68.1; the code
+it replaces, ``Cache.load_overload``, and the runtime set-up it keeps read the same in 0.60.0): pyproject.toml's
+bounds."""
 
 
 @functools.cache
