@@ -54,7 +54,6 @@ def netcdf_file() -> type:
     return scipy_netcdf_file
 
 
-
 @dataclass
 class PlainDataset:
     """What an ``xarray.Dataset`` holds, as plain arrays.
