@@ -71,7 +71,8 @@ def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) ->
         if strict:
             pose = poses[int(np.flatnonzero(~reachable)[0])]
             raise ValueError(f"{graph.tree.source}: no closed configuration reached from the file's by continuation "
-                             f"puts the output frame at ({spelled_pose(graph.task_coordinates, pose)}).")
+                             f"puts the output frame at ({spelled_pose(graph.task_coordinates, pose)}) (out of reach, "
+                             "or a joint beyond its limits).")
         if not kept.size:
             raise ValueError(f"None of the {poses.shape[0]} poses is reachable for mechanism {graph.name!r}.")
         poses = poses[kept]  # each pose is closed alone as in any batch: the same configurations again
