@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure.task_space import choose_task_axes
 from screwkit.common.rotations import cross
-from screwkit.common.units import is_angular, unit_of
+from screwkit.common.units import is_angular, spelled_pose, unit_of
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -190,6 +190,16 @@ class GraphMechanism:
         targets[:, list(self.task_axes)] = poses
         return solve_poses(self.tree, self.q, self.scale, self.frame_id, targets, self.task_axes, limits=limits,
                            kinematics=self.kinematics)
+
+    def unreachable(self, pose, *, limits: bool = True) -> tuple[str, str]:
+        """``(kind, reason)`` of task coordinates ``pose`` (m, rad) that :meth:`solve` does not reach: ``"joint
+        limit"`` when the continuation reaches them once the joint limits are left aside, else ``"closure"``."""
+        names = spelled_pose(self.task_coordinates, pose)
+        if limits and self.solve(np.asarray(pose, dtype=float)[None], limits=False)[1][0]:
+            return "joint limit", (f"{self.tree.source}: at ({names}) a joint is beyond its limits in the "
+                                   "configuration reached from the file's by continuation")
+        return "closure", (f"{self.tree.source}: no closed configuration reached from the file's by continuation "
+                           f"puts the output frame at ({names})")
 
     def at_pose(self, position, rpy=None, *, limits: bool = True) -> GraphMechanism:
         """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default

@@ -19,7 +19,6 @@ from numpy.typing import NDArray
 
 from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.solve import ChainStatus
-from screwkit.common.units import spelled_pose
 from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism
@@ -118,14 +117,8 @@ class GraphPath:
         return self._values(np.where(reached[:, None], q, np.nan))
 
     def unreachable(self, pose: NDArray, status: NDArray) -> tuple[str, str]:
-        """A pose the continuation closes once the joint limits are left aside is beyond a limit; else no closed
-        configuration reaches it."""
-        names = spelled_pose(self.graph.task_coordinates, pose)
-        if self.analysis.limits and self.graph.solve(pose[None], limits=False)[1][0]:
-            return "joint limit", (f"{self.graph.tree.source}: at ({names}) a joint is beyond its limits in the "
-                                   "configuration reached from the file's by continuation")
-        return "closure", (f"{self.graph.tree.source}: no closed configuration reached from the file's by "
-                           f"continuation puts the output frame at ({names})")
+        """:meth:`~screwkit.io.GraphMechanism.unreachable` (``status`` is not needed: the graph is closed whole)."""
+        return self.graph.unreachable(pose, limits=self.analysis.limits)
 
     def working_modes(self) -> dict[str, str]:
         mode = ("the one reached from the file's configuration by moving the platform straight to each pose "

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.units import spelled_pose
 from screwkit.viewer.markers import ROOT_PATH, Frames, Marker, node_label
 
 __all__ = ["Rod", "graph_rods", "solve_graph_frames", "graph_markers"]
@@ -69,10 +68,7 @@ def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) ->
     kept = np.flatnonzero(reachable)
     if kept.size < reachable.size:
         if strict:
-            pose = poses[int(np.flatnonzero(~reachable)[0])]
-            raise ValueError(f"{graph.tree.source}: no closed configuration reached from the file's by continuation "
-                             f"puts the output frame at ({spelled_pose(graph.task_coordinates, pose)}) (out of reach, "
-                             "or a joint beyond its limits).")
+            raise ValueError(graph.unreachable(poses[int(np.flatnonzero(~reachable)[0])])[1] + ".")
         if not kept.size:
             raise ValueError(f"None of the {poses.shape[0]} poses is reachable for mechanism {graph.name!r}.")
         poses = poses[kept]  # each pose is closed alone as in any batch: the same configurations again
@@ -83,10 +79,10 @@ def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) ->
                   centres=graph.frame_pose(q)[:, :3], result=result, kept=kept)
 
 
-def _rod_ends(graph, rods: list[Rod], configurations: NDArray) -> NDArray[np.float64]:
-    """(frames, rods, 2, 3): the two ends of every rod, world frame."""
-    transforms = graph.kinematics.transforms(configurations)
-    ends = np.empty((configurations.shape[0], len(rods), 2, 3))
+def _rod_ends(rods: list[Rod], transforms: NDArray) -> NDArray[np.float64]:
+    """(frames, rods, 2, 3): the two ends of every rod, world frame, from the joints' world placements
+    ``transforms`` (frames, joints, 4, 4)."""
+    ends = np.empty((transforms.shape[0], len(rods), 2, 3))
     for index, rod in enumerate(rods):
         frame = transforms[:, rod.start]
         ends[:, index, 0] = frame[:, :3, 3]
@@ -99,10 +95,11 @@ def graph_markers(graph, frames: Frames, failed: tuple[int, ...]) -> tuple[tuple
     """Per frame, the rods and joint spheres of every body and a cross at each failed actuator's joint (see the
     module docstring); a rod shorter than 1e-9 length scales (two joints at one point) is left out."""
     rods = graph_rods(graph)
-    ends = _rod_ends(graph, rods, frames.configurations)
+    transforms = graph.kinematics.transforms(frames.configurations)
+    ends = _rod_ends(rods, transforms)
     names = graph.tree.model.names
     owners = _owners(graph)
-    origins = graph.kinematics.transforms(frames.configurations)[:, :, :3, 3]
+    origins = transforms[:, :, :3, 3]
     shortest = 1e-9 * float(graph.length_scale)
 
     def marker(path: str, kind: str, start: NDArray, end: NDArray, owner: int | str) -> Marker:
