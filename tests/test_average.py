@@ -148,3 +148,154 @@ def test_the_commands_offer_the_mean(tmp_path):
                    "--probabilities: Expected one failure probability in [0, 1] per actuator (5), got [0.1, 0.2].")
     one_line_error(screwkit("sweep", "planar_5rrr", "--phi", "0:60:30", "--aggregate", "mean", "--probabilities",
                             "a", "b"), "Expected numbers after --probabilities, got 'a b'.")
+
+
+def brute_force_rotation_mean(design, faults, probabilities, phi_step=30.0):
+    """The minimum over a full rotation at the centre of the mean over the sets of ``faults`` failed actuators of
+    the LMTI of the mechanism made of the chains left alone (a free-swinging planar R-R-R chain constrains nothing,
+    so the failed chains are simply left out), each set weighted by its failure pattern's probability."""
+    from screwkit.indices.analysis import analyze
+    from screwkit.screw.planar import planar_joint_points, rrr_chain_screws
+
+    phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step))
+    base, elbows, distal, reachable = planar_joint_points(design, np.column_stack([0 * phi, 0 * phi, phi]))
+    assert reachable.all()
+    a = design.chain_count
+    p = np.full(a, 0.5) if probabilities is None else np.asarray(probabilities)
+    total, weight = 0.0, 0.0
+    for failed in combinations(range(a), faults):
+        kept = [i for i in range(a) if i not in failed]
+        chance = np.prod([p[i] if i in failed else 1 - p[i] for i in range(a)])
+        total = total + chance * analyze(rrr_chain_screws(base[:, kept], elbows[:, kept], distal[:, kept])).lmti
+        weight += chance
+    return float(np.min(total / weight))
+
+
+@pytest.mark.parametrize("probabilities", [None, PROBABILITIES])
+def test_the_permutation_search_scores_the_mean(probabilities):
+    """design-search permutations with the average case: each design's score is the brute-force minimum over the
+    rotation of the mean over the failures, through the closed forms and the generic path alike."""
+    from screwkit.studies.design.permutations import planar_design, rotation_score, slot_design
+
+    design = planar_design(bundled("planar_5rrr"))
+    for permutation, mode in (((0, 3, 1, 4, 2), 1), ((0, 4, 3, 2, 1), 1), ((2, 0, 1, 4, 3), -1)):
+        candidate = slot_design(design, permutation, mode)
+        for faults in (1, 2):
+            wanted = brute_force_rotation_mean(candidate, faults, probabilities)
+            for closed_forms in (False, True):
+                got = rotation_score(candidate, phi_step_degrees=30.0, faults=faults, closed_forms=closed_forms,
+                                     aggregate="mean", probabilities=probabilities)
+                assert got == pytest.approx(wanted, abs=1e-12)
+                assert got >= rotation_score(candidate, phi_step_degrees=30.0, faults=faults,
+                                             closed_forms=closed_forms) - 1e-12  # the mean is above the worst
+    with pytest.raises(ValueError, match="weight the mean"):
+        rotation_score(design, probabilities=PROBABILITIES)
+
+
+def test_a_design_region_of_the_mean_is_the_brute_force_region():
+    """A design search's region of f_o_mean<j>: its area and worst value from the mean over the failures at every
+    pose of the map (expected_mean, pose by pose), the minimum over the orientations, for the planar family's
+    design through the closed forms and the generic path."""
+    from screwkit.studies.design.families import family
+    from screwkit.studies.design.objectives import disc_region, region_metrics
+
+    chosen = family("planar_rrr", 5)
+    mechanism = chosen.mechanism({})
+    for closed_forms in (True, False):
+        region = disc_region(0.2, 0.1, 120.0, index="f_o_mean1", level=0.75, closed_forms=closed_forms,
+                             probabilities=PROBABILITIES)
+        metrics = region_metrics(mechanism, region)
+        (_, xs), (_, ys) = region.grid
+        (_, phis), = region.over
+        minima = []
+        for row, y in enumerate(ys):
+            for column, x in enumerate(xs):
+                if region.mask[row, column]:
+                    minima.append(min(expected_mean(mechanism, [x, y, phi], 1, PROBABILITIES) for phi in phis))
+        minima = np.array(minima)
+        assert 0 < np.sum(minima >= 0.75) < minima.size  # the level cuts the disc
+        assert metrics["area"] == pytest.approx(np.sum(minima >= 0.75) * 0.1**2, abs=1e-15)
+        assert metrics["worst"] == pytest.approx(minima.min(), abs=1e-12)
+        assert metrics["mean"] == pytest.approx(minima.mean(), abs=1e-12)
+    with pytest.raises(ValueError, match="give the region an index f_o_mean<j>"):
+        disc_region(0.2, 0.1, 120.0, probabilities=PROBABILITIES)
+
+
+def test_the_design_search_commands_offer_the_mean(tmp_path):
+    """design-search family and permutations with --index f_o_mean<j> and --probabilities, as subprocesses: the
+    family's best design reproduced by a fresh `screwkit map` of its file with the options it prints, the
+    permutations' scores by the brute force; bad values refused in one line before any work."""
+    from screwkit.studies.design.permutations import planar_design
+
+    probabilities = [str(p) for p in PROBABILITIES]
+    region = ["--radius", "0.2", "--step", "0.1", "--phi-step", "120", "--level", "0.75"]
+    done = screwkit("design-search", "family", "planar_rrr", "--index", "f_o_mean1", "--probabilities",
+                    *probabilities, *region, "--budget", "4", "--json", "--urdf", tmp_path / "best.urdf")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["region"].startswith("f_o_mean1 >= 0.75")
+    (command,) = report["map_commands"]
+    assert command.endswith("--aggregate mean --probabilities " + " ".join(repr(p) for p in PROBABILITIES))
+    options = command.split()[3:]
+    mapped = screwkit("map", tmp_path / "best.urdf", *options, "--out", tmp_path / "best.nc")
+    assert mapped.returncode == 0, mapped.stderr
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "best.nc", engine="scipy") as best_map:
+        disc = np.isfinite(best_map["reachable_fraction"].values)  # the disc's points (NaN outside it)
+        values = np.nan_to_num(best_map["f_o_mean1"].values[disc], nan=0.0)  # an unreachable point counts 0
+    best = report["best"][0]["metrics"]
+    assert best["area"] == pytest.approx(np.sum(values >= 0.75) * 0.1**2, abs=1e-15)
+    assert best["worst"] == pytest.approx(values.min(), abs=1e-12) and best["mean"] == pytest.approx(values.mean())
+
+    design = planar_design(bundled("planar_5rrr"))
+    done = screwkit("design-search", "permutations", "planar_5rrr", "--phi-step", "30", "--index", "f_o_mean2",
+                    "--probabilities", *probabilities, "--json")
+    assert done.returncode == 0, done.stderr
+    ranking = json.loads(done.stdout)
+    assert ranking["index"] == "f_o_mean2" and ranking["probabilities"] == list(PROBABILITIES)
+    mine = next(row for row in ranking["designs"] if row["permutation"] == [0, 3, 1, 4, 2] and row["working_mode"] == 1)
+    assert mine["score"] == pytest.approx(brute_force_rotation_mean(design, 2, PROBABILITIES), abs=1e-12)
+
+    study = tmp_path / "study.yaml"
+    study.write_text("family: planar_rrr\nindex: f_o_mean1\nprobabilities: [0.1, 0.2]\nbudget: 4\n")
+    for arguments, message in [
+        (("family", "planar_rrr", "--index", "f_o_mean1", "--probabilities", "0.1", "0.2", "--budget", "4"),
+         "--probabilities: Expected one failure probability in [0, 1] per actuator (5), got [0.1, 0.2]."),
+        (("family", "--study", study),
+         "--probabilities: Expected one failure probability in [0, 1] per actuator (5), got [0.1, 0.2]."),
+        (("family", "planar_rrr", "--probabilities", *probabilities, "--budget", "4"),
+         "--probabilities weight the mean over the sets of failed actuators: give --index f_o_mean<j>"),
+        (("family", "planar_rrr", "--index", "f_o_mean1", "--probabilities", "a", "--budget", "4"),
+         "Expected numbers after --probabilities, got 'a'."),
+        (("family", "ups_hexapod", "--index", "f_o_mean3", "--budget", "4"),
+         "--index f_o_mean3: the designs have 8 actuators for 6 DoF, so at most 2 may fail (j in 1..2), not 3."),
+        (("family", "planar_rrr", "--index", "f_o3", "--budget", "4"),
+         "--index f_o3: the designs have 5 actuators for 3 DoF, so at most 2 may fail (j in 1..2), not 3."),
+        (("permutations", "planar_5rrr", "--index", "f_o_mean3"),
+         "--index f_o_mean3: planar_5rrr has 5 actuators for 3 DoF, so at most 2 may fail (j in 1..2), not 3."),
+        (("permutations", "planar_5rrr", "--index", "f_io1"), "Expected --index f_o<j> or f_o_mean<j> (j >= 1)"),
+        (("permutations", "planar_5rrr", "--probabilities", *probabilities),
+         "--probabilities weight the mean over the sets of failed actuators: give --index f_o_mean<j>"),
+        (("permutations", "planar_5rrr", "--index", "f_o_mean1", "--probabilities", "0.1", "2", "0", "0", "0"),
+         "--probabilities: Expected one failure probability in [0, 1] per actuator (5)"),
+    ]:
+        one_line_error(screwkit("design-search", *arguments), message)
+
+
+def test_a_search_state_belongs_to_its_failure_probabilities():
+    """A search's state file is keyed by what its evaluations depend on: other failure probabilities, another
+    state; the same ones, or none, the same key as before."""
+    from screwkit.studies.design.families import family
+    from screwkit.studies.design.objectives import disc_region
+    from screwkit.studies.design.optimise import Study
+
+    chosen = family("planar_rrr", 5)
+
+    def key(**region):
+        return Study(chosen, disc_region(0.2, 0.1, 120.0, **region), ("area",), budget=4).fingerprint()
+
+    weighted = key(index="f_o_mean1", probabilities=PROBABILITIES)
+    assert weighted == key(index="f_o_mean1", probabilities=list(PROBABILITIES))
+    assert weighted != key(index="f_o_mean1", probabilities=PROBABILITIES[::-1]) != key(index="f_o_mean1")
+    assert key(index="f_o_mean1") != key() == key(index="f_o1")

@@ -84,6 +84,9 @@ def test_list_verify_convert_and_design_search_validate(files, tmp_path):
     assert validate("verify", ["five_bar", "--samples", "50"])["largest_deviation"] < 1e-9
     validate("convert", [files / "five_bar.xml", tmp_path / "five_bar.urdf"])
     validate("design-search", ["permutations", "planar_5rrr", "--phi-step", "60", "--quiet"])
+    ranked = validate("design-search", ["permutations", "planar_5rrr", "--phi-step", "60", "--quiet", "--index",
+                                        "f_o_mean2", "--probabilities", "0.1", "0.2", "0.1", "0.1", "0.3"])
+    assert ranked["index"] == "f_o_mean2" and ranked["probabilities"] == [0.1, 0.2, 0.1, 0.1, 0.3]
     validate("design-search", ["family", "planar_rrr", "--budget", "4", "--quiet", "--step", "0.2", "--phi-step", "30"])
 
 

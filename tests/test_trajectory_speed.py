@@ -157,3 +157,29 @@ def test_strings_are_encoded_as_numpy_encodes_them(texts):
     encoded = netcdf._utf8(values)
     assert encoded.dtype == expected.dtype and encoded.shape == values.shape
     np.testing.assert_array_equal(encoded, expected)
+
+
+def test_rows_no_chunk_wrote_hold_nan_minus_one_and_false():
+    """The batch arrays filled chunk by chunk: a chunk of unreachable poses only, chunks with some and chunks with
+    none give every pose the indices it has alone, NaN (-1, False) where unreachable."""
+    five = bundled("planar_5rrr")
+    rng = np.random.default_rng(2)
+    home = np.asarray(five.home_pose, dtype=float)
+    near = home + rng.uniform(-1, 1, (30, 3)) * np.array([0.05, 0.05, 0.3])
+    far = near + np.array([5.0, 0.0, 0.0])  # five metres off: no leg reaches
+    batch = np.concatenate([far[:7], near[:7], np.where((np.arange(16) % 3 == 0)[:, None], far[7:23], near[7:23])])
+    result = poses.indices_at_poses(five, batch, detail=True, chunk_size=7)
+    reachable = np.asarray(result.reachable)
+    assert not reachable[:7].any() and reachable[7:14].all() and 0 < reachable[14:].sum() < 16
+    alone = [poses.indices_at_poses(five, pose[None], detail=True) for pose in batch[reachable]]
+    for field in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "mutual_interference"):
+        values = np.asarray(getattr(result, field))
+        expected = np.stack([np.asarray(getattr(one, field))[0] for one in alone])
+        np.testing.assert_allclose(values[reachable], expected, rtol=0, atol=1e-13)
+        blank = values[~reachable]
+        assert np.all(~blank) if blank.dtype == bool else np.all(np.isnan(blank))
+    for j in result.faults:
+        np.testing.assert_allclose(result.f_o[j][reachable], [one.f_o[j][0] for one in alone], rtol=0, atol=1e-13)
+        assert np.all(np.isnan(result.f_o[j][~reachable])) and np.all(np.isnan(result.remaining_lmti[j][~reachable]))
+        assert np.all(result.worst_fault_indices[j][~reachable] == -1)
+        assert np.all(result.worst_fault_indices[j][reachable] >= 0)

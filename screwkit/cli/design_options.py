@@ -17,6 +17,7 @@ from click.core import ParameterSource
 
 from screwkit.cli.map_command import grid_spec
 from screwkit.cli.options import (
+    GreedyOption,
     check_colour_scale,
     check_outputs,
     colour_scale_options,
@@ -26,13 +27,14 @@ from screwkit.cli.options import (
     overwrite_option,
     quiet_option,
 )
+from screwkit.indices.average import MEAN_NAME, failure_weights
 from screwkit.studies.design.families import Family
 from screwkit.studies.design.objectives import METRICS, default_region
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 
 __all__ = ["SearchOptions", "RegionOptions", "DesignOutputs", "Report", "search_options", "region_options",
            "design_outputs_options", "report_options", "study_option", "STUDY_KEYS", "read_study",
-           "parse_assignments", "parse_bounds", "region_of", "check_phi_step"]
+           "parse_assignments", "parse_bounds", "region_of", "check_region_against", "check_phi_step"]
 
 
 # -- records -----------------------------------------------------------------------------------------
@@ -77,6 +79,7 @@ class RegionOptions:
     layers: str | None = None
     index: str | None = None
     level: float | None = None
+    probabilities: str | None = None
 
     @property
     def spatial(self) -> bool:
@@ -123,9 +126,10 @@ def check_phi_step(phi_step: float | None) -> None:
         raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
 
 
-def _region(radius, step, phi_step, grids, overs, layers, region_index, level) -> RegionOptions:
+def _region(radius, step, phi_step, grids, overs, layers, region_index, level, probabilities=None) -> RegionOptions:
     check_phi_step(phi_step)
-    return RegionOptions(radius, step, phi_step, tuple(grids), tuple(overs), layers, region_index, level)
+    return RegionOptions(radius, step, phi_step, tuple(grids), tuple(overs), layers, region_index, level,
+                         probabilities)
 
 
 search_options = option_group(
@@ -165,10 +169,16 @@ region_options = option_group(
                  help="Spatial region: the orientation set, stop excluded, as screwkit map --over (repeatable)."),
     click.option("--layers", metavar="COORDINATE:START:STOP:STEP",
                  help="Spatial region: stack maps along a third coordinate (stop excluded) for a volume."),
-    click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|...",
-                 help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1)."),
+    click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|f_o_mean1|...",
+                 help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1; "
+                      "f_o_mean<j>: the mean over the sets of j failed actuators instead of the worst, screwkit's "
+                      "extension of Eq. 12)."),
     click.option("--level", type=float, default=None,
-                 help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar)."))
+                 help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar)."),
+    click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
+                 help="With --index f_o_mean<j>: each actuator's failure probability (in the order `screwkit info` "
+                      "lists the actuators of a design), weighting the mean by the probability of each set of "
+                      "failures."))
 """The region options, as ``region``, a :class:`RegionOptions`."""
 
 
@@ -205,9 +215,10 @@ report_options = option_group(
 STUDY_KEYS = {"family": "family_name", "legs": "legs", "objectives": "objectives", "constraints": "constraints",
               "free": "free", "set": "assignments", "start": "starts", "bounds": "bounds", "budget": "budget",
               "seed": "seed", "popsize": "popsize", "radius": "radius", "step": "step", "phi_step": "phi_step",
-              "grid": "grids", "over": "overs", "layers": "layers", "index": "region_index", "level": "level"}
+              "grid": "grids", "over": "overs", "layers": "layers", "index": "region_index", "level": "level",
+              "probabilities": "probabilities"}
 """Keys of a study file and the option each stands for (``set``, ``start``: name -> value; ``bounds``:
-name -> [lower, upper]; ``objectives``, ``constraints``, ``free``, ``grid``, ``over``: lists)."""
+name -> [lower, upper]; ``objectives``, ``constraints``, ``free``, ``grid``, ``over``, ``probabilities``: lists)."""
 
 
 def read_study(path: str) -> dict:
@@ -234,6 +245,8 @@ def read_study(path: str) -> dict:
                           for name, v in value.items())
         elif key in ("objectives", "constraints", "free", "grid", "over"):
             value = tuple(str(v) for v in (value if isinstance(value, (list, tuple)) else [value]))
+        elif key == "probabilities":  # as --probabilities gives them: joined by spaces
+            value = " ".join(str(v) for v in (value if isinstance(value, (list, tuple)) else [value]))
         out[STUDY_KEYS[key]] = value
     return out
 
@@ -258,7 +271,7 @@ def study_option(function):
         "--study", "study_path", type=click.Path(dir_okay=False),
         help="A study file (.yaml or .json) whose keys stand for this command's options (family, legs, objectives, "
              "constraints, free, set, start, bounds, budget, seed, popsize, radius, step, phi_step, grid, over, "
-             "layers, index, level); options given on the command line win.")(command)
+             "layers, index, level, probabilities); options given on the command line win.")(command)
 
 
 # -- parsing against a family --------------------------------------------------------------------------
@@ -299,10 +312,43 @@ def _spec(mechanism, text: str, option: str) -> tuple[str, tuple[float, float, f
     return name, (start, stop, step)
 
 
+def _probabilities(options: RegionOptions) -> tuple[float, ...] | None:
+    """``--probabilities`` as numbers, given with an ``f_o_mean<j>`` region index (its count is checked against a
+    design's actuators by :func:`check_region_against`)."""
+    if options.probabilities is None:
+        return None
+    try:
+        values = tuple(float(p) for p in options.probabilities.split())
+    except ValueError:
+        raise fail(f"Expected numbers after --probabilities, got {options.probabilities!r}.") from None
+    if not values:
+        raise fail("Expected a failure probability per actuator after --probabilities.")
+    index = options.index or "f_o1"
+    if index.rstrip("0123456789") != MEAN_NAME:
+        raise fail(f"--probabilities weight the mean over the sets of failed actuators: give --index {MEAN_NAME}<j> "
+                   f"(the region's index is {index}).")
+    return values
+
+
+def check_region_against(region, mechanism) -> None:
+    """The region's index and failure probabilities against the actuators of ``mechanism`` (a design of the family
+    searched; every design has as many): the j of an index per fault at most a - n, one probability in [0, 1] per
+    actuator. One line before any work."""
+    actuators, dof = len(mechanism.actuator_names), mechanism.dof
+    if region.failures is not None and region.failures > actuators - dof:
+        raise fail(f"--index {region.index}: the designs have {actuators} actuators for {dof} DoF, so at most "
+                   f"{actuators - dof} may fail (j in 1..{actuators - dof}), not {region.faults}.")
+    if region.probabilities is not None:
+        try:
+            failure_weights(actuators, 1, region.probabilities)
+        except ValueError as error:
+            raise fail(f"--probabilities: {error}") from None
+
+
 def region_of(family: Family, start_mechanism, options: RegionOptions):
     """The search's region: the family's default, changed by the region options (a spatial region's
     coordinates are checked against ``start_mechanism``, the start design)."""
-    changes = {"index": options.index, "level": options.level}
+    changes = {"index": options.index, "level": options.level, "probabilities": _probabilities(options)}
     if options.radius is not None or options.step is not None or options.phi_step is not None:
         if not family.planar:
             raise fail("--radius, --step and --phi-step map a planar family's disc; give --grid and --over.")

@@ -14,6 +14,7 @@ from screwkit.cli.design_options import (
     Report,
     SearchOptions,
     check_phi_step,
+    check_region_against,
     design_outputs_options,
     parse_assignments,
     parse_bounds,
@@ -25,6 +26,7 @@ from screwkit.cli.design_options import (
 )
 from screwkit.cli.family_search import run_search
 from screwkit.cli.options import (
+    GreedyOption,
     connected,
     echo_error,
     execution_options,
@@ -33,6 +35,7 @@ from screwkit.cli.options import (
     mechanism_argument,
     reading_options,
 )
+from screwkit.indices.average import MEAN_NAME, failure_weights
 from screwkit.studies.design.families import FAMILIES, Family, family
 from screwkit.studies.design.optimise import Constraint, Study
 from screwkit.studies.design.permutations import (
@@ -109,6 +112,13 @@ def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, reg
     except ValueError as error:
         raise fail(f"The start design: {error}") from None
     where = region_of(chosen, start_mechanism, region)
+    if start_mechanism is None:  # a planar family's start: only to check the region against its actuators
+        try:
+            start_mechanism = chosen.mechanism({**fixed, **initial})
+        except ValueError:
+            start_mechanism = None  # (a start that does not build scores 0, as any such design)
+    if start_mechanism is not None:
+        check_region_against(where, start_mechanism)
     free = options.free or [name for name in chosen.free if name not in fixed]
     try:
         study = Study(chosen, where, tuple(options.objectives) or ("area",), free=tuple(free) or None, fixed=fixed,
@@ -198,25 +208,64 @@ def optimise(mechanism, search, region, outputs, execution, reading, report) -> 
 @click.option("--phi-step", type=float, default=1.0, show_default=True,
               help="Step of the full rotation at the centre the designs are scored over (deg).")
 @click.option("--closed-forms", is_flag=True, help="Score with the paper's planar closed forms.")
+@click.option("--index", "score_index", default="f_o1", show_default=True, metavar="f_o<j>|f_o_mean<j>",
+              help="The index whose minimum over the rotation scores a design: F_Oj, the worst over the sets of j "
+                   "failed actuators (the paper), or f_o_mean<j>, their mean (screwkit's extension of Eq. 12).")
+@click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
+              help="With --index f_o_mean<j>: each chain's actuator failure probability (in the order `screwkit "
+                   "info` lists the actuators), weighting the mean by the probability of each set of failures.")
 @execution_options()
 @reading_options
 @report_options
-def permutations(mechanism, phi_step, closed_forms, execution, reading, report: Report) -> None:
+def permutations(mechanism, phi_step, closed_forms, score_index, probabilities, execution, reading,
+                 report: Report) -> None:
     """Rank every assignment of platform slots to the chains of MECHANISM (a planar n-RRR), in both working
-    modes: the paper's design selection, each scored by the minimum F_O1 over a full rotation at the centre."""
+    modes: the paper's design selection, each scored by the minimum F_O1 over a full rotation at the centre
+    (--index: F_Oj, or its mean over the sets of failed actuators)."""
     check_phi_step(phi_step)
+    aggregate, faults = _score_index(score_index)
     loaded, template = _planar_design(mechanism, reading)
+    weights = _score_probabilities(probabilities, aggregate, score_index, template.chain_count)
+    if faults > template.chain_count - 3:
+        raise fail(f"--index {score_index}: {loaded.name} has {template.chain_count} actuators for 3 DoF, so at "
+                   f"most {template.chain_count - 3} may fail (j in 1..{template.chain_count - 3}), not {faults}.")
     current = tuple(int(s) for s in slots_of(template))
     with connected(execution) as execution:  # the handshake before any work
         try:
             ranked = permutation_search(template, phi_step_degrees=phi_step, closed_forms=closed_forms,
-                                        execution=execution)
+                                        execution=execution, faults=faults, aggregate=aggregate,
+                                        probabilities=weights)
         except ClusterError as error:
             raise fail(str(error)) from None
-    _print_ranking(loaded, template, current, phi_step, ranked, report)
+    _print_ranking(loaded, template, current, phi_step, ranked, report, score_index, weights)
 
 
-def _print_ranking(loaded, template, current, phi_step, ranked, report: Report) -> None:
+def _score_index(text: str) -> tuple[str, int]:
+    """``--index`` of the permutations: (aggregate, j) of ``f_o<j>`` or ``f_o_mean<j>``."""
+    stem, digits = text.rstrip("0123456789"), text[len(text.rstrip("0123456789")):]
+    if stem not in ("f_o", MEAN_NAME) or not digits or digits.startswith("0"):
+        raise fail(f"Expected --index f_o<j> or {MEAN_NAME}<j> (j >= 1), got {text!r}.")
+    return ("mean" if stem == MEAN_NAME else "min"), int(digits)
+
+
+def _score_probabilities(text: str | None, aggregate: str, index: str, actuators: int):
+    """``--probabilities`` as numbers, one in [0, 1] per actuator, given with a mean index (one line if not)."""
+    if text is None:
+        return None
+    if aggregate != "mean":
+        raise fail(f"--probabilities weight the mean over the sets of failed actuators: give --index "
+                   f"{MEAN_NAME}<j> (the index is {index}).")
+    try:
+        values = tuple(float(p) for p in text.split())
+        failure_weights(actuators, 1, values)
+    except ValueError as error:
+        raise fail(f"--probabilities: {error}" if "probabilit" in str(error)
+                   else f"Expected numbers after --probabilities, got {text!r}.") from None
+    return values
+
+
+def _print_ranking(loaded, template, current, phi_step, ranked, report: Report, index: str = "f_o1",
+                   probabilities=None) -> None:
     best = ranked[0].score
     rows = [{"permutation": list(d.permutation), "working_mode": d.working_mode, "score": d.score,
              "rank": 1 + sum(round(o.score, 9) > round(d.score, 9) for o in ranked if np.isfinite(o.score)),
@@ -225,10 +274,12 @@ def _print_ranking(loaded, template, current, phi_step, ranked, report: Report) 
     mine = next(r for r in rows if tuple(r["permutation"]) == current and r["working_mode"] == mode)
     if report.as_json:
         click.echo(json.dumps({"mechanism": loaded.name, "current": list(current), "phi_step_deg": phi_step,
+                               "index": index, "probabilities": None if probabilities is None else list(probabilities),
                                "designs": rows}))
         return
-    click.echo(f"{loaded.name}: {len(ranked)} designs (slot permutations x 2 working modes); score = min F_O1 "
-               f"over a full rotation at the centre, {phi_step:g} deg steps")
+    weighted = "" if probabilities is None else f" (failure probabilities {' '.join(f'{p:g}' for p in probabilities)})"
+    click.echo(f"{loaded.name}: {len(ranked)} designs (slot permutations x 2 working modes); score = min "
+               f"{index}{weighted} over a full rotation at the centre, {phi_step:g} deg steps")
     click.echo(f"{'rank':>4s}  {'permutation':<18s} {'mode':>4s}  {'score':>7s}")
     for row in rows[:report.top]:
         mark = "  <- this file's design" if row is mine else ""

@@ -2,9 +2,9 @@
 
 A :class:`Region` is a map as ``screwkit map`` computes it (two grid coordinates, optionally
 stacked along a third in layers, the minimum of every index over an orientation set at each grid
-point), an index (``f_o1``, ``f_io1``, ...) and a level: the fault-tolerant region is where the
-minimum of that index over the orientation set is at least the level. :func:`region_metrics`
-evaluates a mechanism on it and returns every metric of :data:`METRICS`; each is reproduced by a
+point), an index (``f_o1``, ``f_io1``, ..., or the average case ``f_o_mean1``, ...) and a level: the
+fault-tolerant region is where the minimum of that index over the orientation set is at least the level.
+:func:`region_metrics` evaluates a mechanism on it and returns every metric of :data:`METRICS`; each is reproduced by a
 fresh ``screwkit map`` of the candidate's file with :meth:`Region.map_arguments` (one per layer).
 """
 
@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
+from screwkit.indices.average import MEAN_NAME, averaging
 from screwkit.indices.registry import column_record
 from screwkit.model import Mechanism
 from screwkit.studies.maps import MapBlock, disc_grid, map_block, orientation_set, range_values
@@ -69,12 +70,16 @@ class Region:
         A third coordinate stacking maps (volume); values in m.
     index : str
         ``f_o1``, ``f_io1``, ``f_o2``, ... (the index whose minimum over the orientation set is
-        compared with ``level``).
+        compared with ``level``), or ``f_o_mean1``, ``f_o_mean2``, ...: the average case of Eq. 12 over the
+        sets of failed actuators (:mod:`screwkit.indices.average`, screwkit's extension).
     level : float
     closed_forms : bool
         Evaluate with the paper's planar closed forms (planar families).
     map_options : tuple of str
         ``screwkit map`` options that compute the same map (without the layer's ``--at``).
+    probabilities : tuple of float, optional
+        With an ``f_o_mean<j>`` index: each actuator's failure probability, weighting the mean
+        (:func:`~screwkit.indices.average.failure_weights`); equal weights without.
     """
 
     grid: tuple
@@ -86,11 +91,35 @@ class Region:
     closed_forms: bool = False
     threshold: float = SINGULARITY_THRESHOLD
     map_options: tuple[str, ...] = ()
+    probabilities: tuple[float, ...] | None = None
 
     def __post_init__(self):
-        column_record(self.index)  # any registered index (screwkit.indices.registry), with j if per fault
+        if self.probabilities is not None:
+            if not self.average:
+                raise ValueError(f"Failure probabilities weight the mean over the sets of failed actuators: give "
+                                 f"the region an index {MEAN_NAME}<j>, not {self.index!r}.")
+            object.__setattr__(self, "probabilities", tuple(float(p) for p in self.probabilities))
+        self._record()  # any registered index (screwkit.indices.registry), with j if per fault
         if not math.isfinite(self.level):
             raise ValueError(f"Expected a finite region level, got {self.level}.")
+
+    @property
+    def average(self) -> bool:
+        """Whether the region's index is the average case of Eq. 12 (``f_o_mean<j>``)."""
+        return self.index.rstrip("0123456789") == MEAN_NAME
+
+    def _record(self):
+        """The index's registry record and its j (the average case registered for the look-up)."""
+        if not self.average:
+            return column_record(self.index)
+        with averaging(self.probabilities):
+            return column_record(self.index)
+
+    @property
+    def analysis(self) -> AnalysisOptions:
+        """What the region's maps compute at every pose: the j of its index, the mean too for ``f_o_mean<j>``."""
+        return AnalysisOptions(threshold=self.threshold, faults=(self.faults,), closed_forms=self.closed_forms,
+                               aggregate="mean" if self.average else "min", probabilities=self.probabilities)
 
     @property
     def cell(self) -> float:
@@ -124,7 +153,12 @@ class Region:
     @property
     def faults(self) -> int:
         """The number of faults the region's index needs (1 for one without j: the map computes F_O1 anyway)."""
-        return column_record(self.index)[1] or 1
+        return self.failures or 1
+
+    @property
+    def failures(self) -> int | None:
+        """The j of the region's index (``f_o2``: 2), None for an index without one (``lmti``)."""
+        return self._record()[1]
 
     @property
     def orientations(self) -> str:
@@ -143,15 +177,20 @@ class Region:
 
     def map_arguments(self, mechanism: Mechanism) -> list[list[str]]:
         """The ``screwkit map`` options computing the same map, one list per layer."""
+        options = list(self.map_options)
+        if self.average:
+            options += ["--aggregate", "mean"]
+            if self.probabilities is not None:
+                options += ["--probabilities", *(repr(p) for p in self.probabilities)]
         if not self.layers:
-            return [list(self.map_options)]
+            return [options]
         name, values = self.layers
         home = mechanism.home_pose
         out = []
         for value in values:
             at = [value if coordinate == name else home[i] for i, coordinate in enumerate(mechanism.task_coordinates)]
             shown = [math.degrees(v) if is_angular(c) else v for c, v in zip(mechanism.task_coordinates, at)]
-            out.append([*self.map_options, "--at", *(repr(float(v)) for v in shown)])
+            out.append([*options, "--at", *(repr(float(v)) for v in shown)])
         return out
 
 
@@ -165,14 +204,15 @@ def _span(name: str, values: NDArray) -> str:
 
 
 def disc_region(radius: float, step: float, phi_step_degrees: float, *, index: str = "f_o1", level: float = 0.4,
-                closed_forms: bool = True, centre=(0.0, 0.0)) -> Region:
-    """The paper's Fig. 5 region of a planar mechanism: a disc about ``centre``, phi over a full turn."""
+                closed_forms: bool = True, centre=(0.0, 0.0), probabilities=None) -> Region:
+    """The paper's Fig. 5 region of a planar mechanism: a disc about ``centre``, phi over a full turn
+    (``probabilities``: :attr:`Region.probabilities`)."""
     x_values, y_values, mask = disc_grid(radius, step, centre)
     phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
     options = ("--radius", repr(float(radius)), "--step", repr(float(step)), "--phi-step",
                repr(float(phi_step_degrees))) + (("--closed-forms",) if closed_forms else ())
     return Region((("x", x_values), ("y", y_values)), (("phi", phi),), index, level, mask, None, closed_forms,
-                  map_options=options)
+                  map_options=options, probabilities=probabilities)
 
 
 def _range(name: str, spec, include_stop: bool) -> tuple[NDArray, str]:
@@ -189,10 +229,11 @@ def _range(name: str, spec, include_stop: bool) -> tuple[NDArray, str]:
 
 
 def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: str = "f_o1",
-                level: float = 0.4) -> Region:
+                level: float = 0.4, probabilities=None) -> Region:
     """A spatial region, each coordinate as ``(start, stop, step)`` in m or deg, as ``screwkit map``
     reads them: the two ``grid`` coordinates include their stop, the ``over`` (orientation set)
-    coordinates and ``layers`` (name, (start, stop, step)) exclude it."""
+    coordinates and ``layers`` (name, (start, stop, step)) exclude it (``probabilities``:
+    :attr:`Region.probabilities`)."""
     if len(grid) != 2:
         raise ValueError(f"Expected a region grid of exactly two coordinates, got {list(grid)}.")
     options, axes, orientations = [], [], []
@@ -209,12 +250,13 @@ def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: s
         if is_angular(name):
             raise ValueError(f"Expected a length coordinate for the region's layers, got {name!r}.")
         layers = (name, _range(name, spec, False)[0])
-    return Region(tuple(axes), tuple(orientations), index, level, None, layers, False, map_options=tuple(options))
+    return Region(tuple(axes), tuple(orientations), index, level, None, layers, False, map_options=tuple(options),
+                  probabilities=probabilities)
 
 
 def default_region(family, **changes) -> Region:
     """The family's default region (:attr:`~screwkit.studies.design.families.Family.region`) with ``changes``
-    (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``)."""
+    (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``, ``probabilities``)."""
     spec = {**family.region, **{k: v for k, v in changes.items() if v is not None}}
     if changes.get("grid") is not None:
         spec.pop("disc", None)
@@ -224,10 +266,11 @@ def default_region(family, **changes) -> Region:
             raise ValueError("A disc region has no layers.")
         radius, step, phi_step = spec["disc"]
         return disc_region(radius, step, phi_step, index=index, level=level,
-                           closed_forms=spec.get("closed_forms", True))
+                           closed_forms=spec.get("closed_forms", True), probabilities=spec.get("probabilities"))
     if "grid" not in spec:
         raise ValueError(f"Family {family.name!r} has no default region: give its grid.")
-    return grid_region(spec["grid"], spec.get("over", {}), layers=spec.get("layers"), index=index, level=level)
+    return grid_region(spec["grid"], spec.get("over", {}), layers=spec.get("layers"), index=index, level=level,
+                       probabilities=spec.get("probabilities"))
 
 
 def inscribed_radius(inside: NDArray[np.bool_], spacing) -> float:
@@ -254,7 +297,7 @@ def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
     over_axes = tuple(names.index(name) for name, _ in region.over)
     over_values = orientation_set(dict(region.over))
     layer_values = region.layers[1] if region.layers else [None]
-    analysis = AnalysisOptions(threshold=region.threshold, faults=(region.faults,), closed_forms=region.closed_forms)
+    analysis = region.analysis
     out: dict[str, NDArray] = {}
     for k, value in enumerate(layer_values):
         at = mechanism.home_pose.copy()

@@ -198,6 +198,8 @@ class Study:
                      [(n, v.tolist()) for n, v in region.grid], [(n, v.tolist()) for n, v in region.over],
                      None if region.mask is None else region.mask.tolist(),
                      None if not region.layers else (region.layers[0], region.layers[1].tolist())]
+        if region.probabilities is not None:  # (appended only when given: the fingerprints of earlier states hold)
+            described.append(list(region.probabilities))
         return hashlib.sha256(json.dumps(described).encode()).hexdigest()[:16]
 
 

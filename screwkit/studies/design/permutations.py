@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from screwkit.closure import solve
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.analysis import analyze
+from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.closed_forms import planar_indices
 from screwkit.model import Mechanism
 from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
@@ -83,18 +84,30 @@ def slot_design(design: PlanarDesign, permutation, working_mode: int | None = No
 
 
 def rotation_score(design: PlanarDesign, centre=(0.0, 0.0), phi_step_degrees: float = 1.0, *,
-                   faults: int = 1, threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False) -> float:
-    """Minimum of F_Oj over a full platform rotation at ``centre`` (NaN if some angle is unreachable)."""
+                   faults: int = 1, threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False,
+                   aggregate: str = "min", probabilities=None) -> float:
+    """Minimum of F_Oj over a full platform rotation at ``centre`` (NaN if some angle is unreachable).
+
+    ``aggregate="mean"``: of the average case instead, the (``probabilities``-weighted) mean over the sets of ``j``
+    failed actuators of the LMTI left (:mod:`screwkit.indices.average`, screwkit's extension of Eq. 12)."""
+    if aggregate not in AGGREGATES:
+        raise ValueError(f"Expected `aggregate` in {', '.join(AGGREGATES)}, got {aggregate!r}.")
+    if probabilities is not None and aggregate != "mean":
+        raise ValueError("Failure probabilities weight the mean: give them with aggregate='mean'.")
     phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
     poses = np.column_stack([np.full_like(phi, centre[0]), np.full_like(phi, centre[1]), phi])
     base, elbows, distal, reachable = planar_joint_points(design, poses)
     if not np.all(reachable):
         return float("nan")
+    mean = aggregate == "mean"
     if closed_forms:
-        values = planar_indices(base, elbows, distal, threshold=threshold, faults=(faults,), threads=1)["f_o"][faults]
+        found = planar_indices(base, elbows, distal, threshold=threshold, faults=(faults,), threads=1)
+        worst, left = found["f_o"][faults], found["remaining_lmti"][faults]
     else:
-        values = analyze(rrr_chain_screws(base, elbows, distal), threshold=threshold, faults=faults,
-                         detail=False, threads=1).f_o[faults]
+        found = analyze(rrr_chain_screws(base, elbows, distal), threshold=threshold, faults=faults, detail=mean,
+                        threads=1)
+        worst, left = found.f_o[faults], found.remaining_lmti.get(faults)
+    values = mean_remaining_lmti({faults: left}, design.chain_count, probabilities)[faults] if mean else worst
     return float(values.min())
 
 
@@ -107,15 +120,19 @@ class DesignScore:
     score: float
 
 
-def _score_task(design, permutation, mode, phi_step, faults, threshold, closed_forms):
+def _score_task(design, permutation, mode, phi_step, faults, threshold, closed_forms, aggregate="min",
+                probabilities=None):
     return rotation_score(slot_design(design, permutation, mode), phi_step_degrees=phi_step, faults=faults,
-                          threshold=threshold, closed_forms=closed_forms)
+                          threshold=threshold, closed_forms=closed_forms, aggregate=aggregate,
+                          probabilities=probabilities)
 
 
 def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, faults: int = 1,
                        threshold: float = SINGULARITY_THRESHOLD, closed_forms: bool = False,
-                       execution: Execution | None = None) -> list[DesignScore]:
-    """Every slot permutation in both working modes, ranked by the minimum of F_O1 over a full rotation.
+                       execution: Execution | None = None, aggregate: str = "min",
+                       probabilities=None) -> list[DesignScore]:
+    """Every slot permutation in both working modes, ranked by the minimum of F_Oj over a full rotation (of its
+    mean over the sets of failed actuators with ``aggregate="mean"``: :func:`rotation_score`).
 
     As the paper's Sec. 4: base and platform joints on regular polygons, identical arms,
     the n! assignments of platform slots to chains, each scored at the workspace centre
@@ -131,7 +148,11 @@ def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, f
     """
     n = design.chain_count
     candidates = [(p, mode) for mode in (1, -1) for p in permutations(range(n))]
-    arguments = [(design, p, mode, phi_step_degrees, faults, threshold, closed_forms) for p, mode in candidates]
+    if probabilities is not None:  # (checked once, not in every task)
+        failure_weights(n, faults, probabilities)
+        probabilities = tuple(float(p) for p in probabilities)
+    arguments = [(design, p, mode, phi_step_degrees, faults, threshold, closed_forms, aggregate, probabilities)
+                 for p, mode in candidates]
     scores = run_tasks(_score_task, arguments, execution, label="designs")
     ranked = [DesignScore(tuple(int(i) for i in p), mode, float(s)) for (p, mode), s in zip(candidates, scores)]
     # Scores equal to 1e-9 are ties (rotated or mirrored copies differ only by rounding);
