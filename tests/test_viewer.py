@@ -473,10 +473,32 @@ def pinocchio_points(graph, q):
     return origins, ends, np.asarray(data.oMf[graph.frame_id].translation)
 
 
+def _hull(flat) -> list[int]:
+    """The vertices of the convex hull of planar points, counter-clockwise (Andrew's monotone chain: an independent
+    reading of what the drawing takes from qhull)."""
+    order = sorted(range(len(flat)), key=lambda i: (flat[i][0], flat[i][1]))
+
+    def turn(o, a, b):
+        return (flat[a][0] - flat[o][0]) * (flat[b][1] - flat[o][1]) - (flat[a][1] - flat[o][1]) * (flat[b][0]
+                                                                                                     - flat[o][0])
+
+    lower, upper = [], []
+    for i in order:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], i) <= 1e-15:
+            lower.pop()
+        lower.append(i)
+    for i in reversed(order):
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], i) <= 1e-15:
+            upper.pop()
+        upper.append(i)
+    return lower[:-1] + upper[:-1]
+
+
 def test_a_graph_is_drawn_as_rods_between_its_joints(graph, viewer):
-    """The rod-level Delta: every body a rod from its joint to each child joint and each closure frame on it, at
-    Pinocchio's forward kinematics of the closed configuration; the legs in their ITI's colour, the failed leg red
-    with a cross at its motor; the base and the platform in their own colours; no screw (a graph keeps none)."""
+    """The rod-level Delta: every body of a leg a rod from its joint to each child joint and each closure frame on
+    it, the base and the platform each the outline of the points where the legs hold it, at Pinocchio's forward
+    kinematics of the closed configuration; the legs in their ITI's colour, the failed leg red with a cross at its
+    motor; the base and the platform in their own colours; no screw (a graph keeps none)."""
     from screwkit.viewer.markers import node_label
 
     pose = graph.home_pose + np.array([0.04, -0.03, 0.02])
@@ -487,8 +509,13 @@ def test_a_graph_is_drawn_as_rods_between_its_joints(graph, viewer):
     np.testing.assert_allclose(output, pose, atol=1e-9)  # the drawn configuration is at the pose asked
     names, parents = graph.tree.model.names, graph.tree.model.parents
     links = {marker.path: marker for marker in scene.markers_of_kind("link")}
+    plates = {0: "base", graph.platform: "platform"}
+    held = {plate: [] if plate == 0 else [origins[plate]] for plate in plates}  # where the legs hold each plate
     drawn = 0
     for joint in range(1, len(parents)):
+        if parents[joint] in plates:
+            held[parents[joint]].append(origins[joint])  # revolute and ball joints: their origins do not move
+            continue
         path = f"{ROOT_PATH}/links/{node_label(names[parents[joint]])}--{node_label(names[joint])}"
         start, end = origins[parents[joint]], origins[joint]
         if np.linalg.norm(end - start) < 1e-9:
@@ -501,7 +528,27 @@ def test_a_graph_is_drawn_as_rods_between_its_joints(graph, viewer):
         a, b = ends[closure.name]
         assert np.linalg.norm(a - b) < 1e-8  # closed: the two ends of each rod's far joint meet
         np.testing.assert_allclose(links[f"{ROOT_PATH}/links/{node_label(closure.name)}--a"].end, a, atol=1e-12)
-    assert drawn >= 8 and len(links) >= drawn + len(graph.tree.closures)
+        held[closure.joint_b].append(b)  # the rods' far ends: on the platform
+    for plate, body in plates.items():
+        points = np.array(held[plate])
+        pieces = [m for m in links.values() if m.body == body and "--outline_" in m.path]
+        # independently: the convex hull of the held points in their mean plane, the others spokes from the centre
+        centre = points.mean(axis=0)
+        plane = np.linalg.svd(points - centre)[2][:2]
+        flat = (points - centre) @ plane.T
+        on_hull = _hull(flat)
+        inside = [i for i in range(len(points)) if i not in on_hull]
+        assert len(pieces) == len(on_hull) + len(inside)
+        edges = [(m.start, m.end) for m in pieces]
+        for a, b in zip(on_hull, on_hull[1:] + on_hull[:1]):  # the hull's edges, in one sense or the other
+            assert sum(np.allclose(start, points[a], atol=1e-12) and np.allclose(end, points[b], atol=1e-12)
+                       or np.allclose(start, points[b], atol=1e-12) and np.allclose(end, points[a], atol=1e-12)
+                       for start, end in edges) == 1
+        for i in inside:
+            assert any(np.allclose(start, centre, atol=1e-12) and np.allclose(end, points[i], atol=1e-12)
+                       for start, end in edges)
+        assert len(on_hull) >= 3
+    assert drawn >= 4 and not any(m.path.endswith(("universe--motor_1", "--b")) for m in links.values())
     tree = scene_tree(scene.static_html())
     for marker in list(links.values())[:5]:
         matrix = tree[full_path(marker.path)]["transform"]
@@ -511,10 +558,6 @@ def test_a_graph_is_drawn_as_rods_between_its_joints(graph, viewer):
     assert all(legs.values()) and all(m.failed for m in legs[1]) and not any(m.failed for m in legs[0])
     bodies = {m.body for m in links.values() if m.chain is None}
     assert "platform" in bodies and bodies <= {"platform", "base"}
-    platform_joint = list(names).index("platform_ball")
-    assert all(m.body == "platform" for m in links.values() if m.path.startswith(f"{ROOT_PATH}/links/rod_")
-               and m.path.endswith("--b"))  # the closures' platform side: on the platform's body
-    assert links[f"{ROOT_PATH}/links/rod_2a_end--b"].start.tolist() == origins[platform_joint].tolist()
     expected = graph.at_pose(pose).indices().iti_actuators  # the indices of the mechanism moved to the pose alone
     np.testing.assert_allclose(scene.chain_values[0, [0, 2, 3]], expected[[0, 2, 3]], atol=1e-9)
     assert np.isnan(scene.chain_values[0, 1])
@@ -913,3 +956,27 @@ def test_browser_plays_the_path_animation_with_the_chain_colours(screenshots):
                                atol=1e-6)  # the colour of its index at that pose, not of the first frame
     assert np.abs(along.chain_values[PATH_FRAME, 3] - along.chain_values[0, 3]) > 0.2
     np.testing.assert_allclose(probed["chain_3"]["colour"], FAILED_COLOR[:3], atol=1e-6)  # the failed chain: red
+
+
+def test_a_plate_outline_is_its_hull_with_spokes_to_the_points_inside():
+    """A plate held at the corners of a tilted square, at a point inside it and at a repeated corner: the four
+    edges of the square and one spoke from the centre of the five distinct points; points on a line: a polyline
+    along them; one point: nothing."""
+    from screwkit.viewer.graph_drawing import _outline
+
+    tilt = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(0.4), -np.sin(0.4)], [0.0, np.sin(0.4), np.cos(0.4)]])
+    corners = [tilt @ np.array(c) + [0.3, -0.2, 0.5] for c in ([1, 1, 0], [-1, 1, 0], [-1, -1, 0], [1, -1, 0])]
+    inner = tilt @ np.array([0.2, 0.1, 0.0]) + [0.3, -0.2, 0.5]
+    rods = _outline(0, "base", [corners[2], inner, corners[0], corners[3], corners[1], corners[0].copy()], 1.0)
+    assert all(rod.owner == "base" and rod.start == 0 and not rod.sphere for rod in rods)
+    pieces = {(tuple(np.round(rod.start_point, 12)), tuple(np.round(rod.point, 12))) for rod in rods}
+    centre = np.mean(corners + [inner], axis=0)
+    square = {frozenset({tuple(np.round(corners[k], 12)), tuple(np.round(corners[(k + 1) % 4], 12))})
+              for k in range(4)}
+    assert len(rods) == 5 and {frozenset(p) for p in pieces} - {frozenset({tuple(np.round(centre, 12)),
+                                                                           tuple(np.round(inner, 12))})} == square
+    line = [np.array([x, 2 * x, 0.0]) for x in (0.3, -0.1, 0.7, 0.1)]
+    along = _outline(5, "platform", line, 1.0)
+    assert sorted(tuple(sorted((rod.start_point[0], rod.point[0]))) for rod in along) == [(-0.1, 0.1), (0.1, 0.3),
+                                                                                          (0.3, 0.7)]
+    assert _outline(0, "base", [corners[0], corners[0] + 1e-12], 1.0) == []

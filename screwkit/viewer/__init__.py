@@ -28,8 +28,9 @@ points) and overlays the screws the indices are made of:
   colours skip submechanisms that use a failed actuator.
 
 A mechanism whose legs have loops inside them (:class:`screwkit.io.GraphMechanism`) has no visual geometry
-here: its bodies are drawn as rods between the joints and closure frames that hold them, its legs coloured in
-the same way, without screws (its indices keep none; :mod:`screwkit.viewer.graph_drawing`).
+here: its legs' bodies are drawn as rods between the joints and closure frames that hold them, its base and
+platform as the outlines of the points where the legs hold them, its legs coloured in the same way, without screws
+(its indices keep none; :mod:`screwkit.viewer.graph_drawing`).
 
 :func:`animate_sweep` turns a batch of poses into a Meshcat animation (one keyframe per
 reachable pose), :func:`export_html` writes the scene as one offline HTML page (the viewer's

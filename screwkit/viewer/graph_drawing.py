@@ -1,11 +1,14 @@
 """What a scene draws of a mechanism whose legs have loops inside them (:class:`screwkit.io.GraphMechanism`).
 
-Such a mechanism is drawn from its kinematic tree and its closures, not from visual geometry: every body as a rod
-from the origin of the joint that carries it to each point where another joint or a closure holds it, and a sphere
-at each of those points. The legs are coloured by their index as serial chains are (each leg of a graph has one
-actuator), the base and the platform in their own colours, a failed actuator's leg transparent red with a red cross
-at its joint. A graph's indices keep neither its actuation wrenches nor its output twists, so no screw is drawn.
-No Meshcat and no Pinocchio here.
+Such a mechanism is drawn from its kinematic tree and its closures, not from visual geometry: every body of a leg as
+a rod from the origin of the joint that carries it to each point where another joint or a closure holds it, and a
+sphere at each of those points. The base and the platform are plates: each is drawn as the outline of the points
+where the legs hold it (the joints it carries and the closure frames on it, with the platform's own joint): their
+convex hull in their mean plane, and a spoke from their centre to each point inside it; not as spokes from the
+body's frame, whose origin a CAD export may put far from the mechanism. The legs are coloured by their index as
+serial chains are (each leg of a graph has one actuator), the base and the platform in their own colours, a failed
+actuator's leg transparent red with a red cross at its joint. A graph's indices keep neither its actuation wrenches
+nor its output twists, so no screw is drawn. No Meshcat and no Pinocchio here.
 """
 
 from __future__ import annotations
@@ -22,15 +25,18 @@ __all__ = ["Rod", "graph_rods", "solve_graph_frames", "graph_markers"]
 
 @dataclass(frozen=True)
 class Rod:
-    """A straight piece of a body: from the origin of joint ``start`` to the origin of joint ``end``, or, with
-    ``point``, to that point of joint ``start``'s frame (a closure frame on the body). ``owner``: the leg's index,
-    ``"base"`` or ``"platform"``."""
+    """A straight piece of a body: from the origin of joint ``start`` (or, with ``start_point``, that point of its
+    frame) to the origin of joint ``end``, or, with ``point``, to that point of joint ``start``'s frame (a closure
+    frame on the body). ``owner``: the leg's index, ``"base"`` or ``"platform"``. ``sphere``: whether a sphere marks
+    its end (a piece of an outline has none: its ends are marked as the joints and closure frames they are)."""
 
     label: str
     owner: int | str
     start: int
     end: int | None = None
     point: NDArray[np.float64] | None = None
+    start_point: NDArray[np.float64] | None = None
+    sphere: bool = True
 
 
 def _owners(graph) -> dict[int, int | str]:
@@ -43,18 +49,69 @@ def _owners(graph) -> dict[int, int | str]:
 
 
 def graph_rods(graph) -> list[Rod]:
-    """The rods of every body: from its joint to each child joint, and to each closure frame on it."""
+    """The rods of every body of a leg (from its joint to each child joint and to each closure frame on it), and
+    the outlines of the base and the platform (:func:`_outline`)."""
     names = graph.tree.model.names
-    parents = graph.kinematics.parents
+    kinematics = graph.kinematics
+    parents = kinematics.parents
     owners = _owners(graph)
+    plates = (0, graph.platform)
     rods = [Rod(f"{node_label(names[parents[joint]])}--{node_label(names[joint])}",
-                owners.get(parents[joint], "base"), parents[joint], end=joint) for joint in range(1, len(parents))]
+                owners.get(parents[joint], "base"), parents[joint], end=joint)
+            for joint in range(1, len(parents)) if parents[joint] not in plates]
+    vertices: dict[int, list[NDArray]] = {plate: [] for plate in plates}
+    if kinematics.kinds[graph.platform] != "free":  # the joint carrying the platform holds it there
+        vertices[graph.platform].append(np.zeros(3))
+    for joint in range(1, len(parents)):
+        plate = parents[joint]
+        if plate not in plates or kinematics.kinds[joint] == "free":  # (a floating body is held nowhere)
+            continue
+        held = kinematics.placements[joint][:3, 3]
+        vertices[plate].append(held)
+        # from where the plate holds the joint to the joint's origin: nothing for a revolute or ball joint, the
+        # travel for a prismatic one; its sphere marks the joint
+        rods.append(Rod(f"{node_label(names[plate])}--{node_label(names[joint])}", owners.get(plate, "base"), plate,
+                        end=joint, start_point=held))
     for closure in graph.tree.closures:
         for side, joint, placement in (("a", closure.joint_a, closure.placement_a),
                                        ("b", closure.joint_b, closure.placement_b)):
-            rods.append(Rod(f"{node_label(closure.name)}--{side}", owners.get(joint, "base"), joint,
-                            point=np.asarray(placement, dtype=float)[:3, 3]))
+            at = np.asarray(placement, dtype=float)[:3, 3]
+            if joint in plates:  # a point of the outline: its sphere alone
+                vertices[joint].append(at)
+                rods.append(Rod(f"{node_label(closure.name)}--{side}", owners[joint], joint, point=at,
+                                start_point=at))
+            else:
+                rods.append(Rod(f"{node_label(closure.name)}--{side}", owners.get(joint, "base"), joint, point=at))
+    for plate in plates:
+        rods += _outline(plate, owners[plate], vertices[plate], graph.length_scale)
     return rods
+
+
+def _outline(plate: int, owner: str, points: list[NDArray], length: float) -> list[Rod]:
+    """The outline of a plate through ``points`` (its frame): their convex hull in their mean plane, with a spoke
+    from their centre to each point inside it (such as the platform's joint), a polyline along them when they lie
+    on a line, nothing for fewer than two distinct points."""
+    unique: list[NDArray] = []
+    for point in points:
+        if all(np.linalg.norm(point - other) > 1e-9 * length for other in unique):
+            unique.append(np.asarray(point, dtype=float))
+    if len(unique) < 2:
+        return []
+    stacked = np.array(unique)
+    centre = stacked.mean(axis=0)
+    _, singular, directions = np.linalg.svd(stacked - centre)
+    flat = (stacked - centre) @ directions[:2].T
+    if len(unique) > 2 and singular[1] > 1e-6 * singular[0]:
+        from scipy.spatial import ConvexHull  # the viewer's drawing of a graph only
+
+        order = ConvexHull(flat).vertices  # counter-clockwise in the mean plane
+        pieces = [(stacked[a], stacked[b]) for a, b in zip(order, np.roll(order, -1))]
+        pieces += [(centre, stacked[i]) for i in range(len(unique)) if i not in set(order.tolist())]
+    else:
+        order = np.argsort(flat[:, 0], kind="stable")
+        pieces = [(stacked[a], stacked[b]) for a, b in zip(order[:-1], order[1:])]
+    return [Rod(f"{owner}--outline_{index}", owner, plate, point=end, start_point=start, sphere=False)
+            for index, (start, end) in enumerate(pieces)]
 
 
 def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) -> Frames:
@@ -85,7 +142,8 @@ def _rod_ends(rods: list[Rod], transforms: NDArray) -> NDArray[np.float64]:
     ends = np.empty((transforms.shape[0], len(rods), 2, 3))
     for index, rod in enumerate(rods):
         frame = transforms[:, rod.start]
-        ends[:, index, 0] = frame[:, :3, 3]
+        ends[:, index, 0] = frame[:, :3, 3] if rod.start_point is None else frame[:, :3, :3] @ rod.start_point + \
+            frame[:, :3, 3]
         ends[:, index, 1] = (transforms[:, rod.end, :3, 3] if rod.point is None
                              else frame[:, :3, :3] @ rod.point + frame[:, :3, 3])
     return ends
@@ -114,6 +172,8 @@ def graph_markers(graph, frames: Frames, failed: tuple[int, ...]) -> tuple[tuple
             start, end = ends[frame, index]
             if np.linalg.norm(end - start) >= shortest:
                 markers.append(marker(f"{ROOT_PATH}/links/{rod.label}", "link", start, end, rod.owner))
+            if not rod.sphere:
+                continue
             # a sphere where the rod ends: a joint (its own body's colour) or a closure frame (the rod's)
             label, owner = (names[rod.end], owners.get(rod.end, "base")) if rod.point is None else (rod.label,
                                                                                                  rod.owner)
