@@ -353,9 +353,11 @@ def test_a_task_given_up_by_the_scheduler_gives_one_line_and_no_file(tmp_path_fa
 
 FAMILY_SEARCH = ("design-search", "family", "ups_hexapod", "--grid", "x:-0.1:0.1:0.05", "--grid", "y:-0.1:0.1:0.05",
                  "--over", "yaw:-20:40:20", "--free", "platform_radius", "--free", "height", "--objective", "mean",
-                 "--budget", "64", "--popsize", "4", "--json", "--quiet")
+                 "--budget", "64", "--popsize", "4", "--index", "f_o_mean1", "--probabilities", "0.1", "0.05", "0.2",
+                 "0.1", "0.1", "0.3", "0.1", "0.05", "--json", "--quiet")
 """A family search of up to 65 hexapod designs in 9 batches (the start, then 8 populations of 8; the mean index
-varies continuously, so the search does not stop early on a converged population)."""
+varies continuously, so the search does not stop early on a converged population), on the average case weighted by
+failure probabilities (registered in each worker that evaluates a design)."""
 
 
 def test_a_family_search_on_two_workers_equals_the_local_search_and_survives_a_killed_worker(tmp_path_factory,
