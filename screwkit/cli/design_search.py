@@ -257,10 +257,12 @@ def _score_probabilities(text: str | None, aggregate: str, index: str, actuators
                    f"{MEAN_NAME}<j> (the index is {index}).")
     try:
         values = tuple(float(p) for p in text.split())
+    except ValueError:
+        raise fail(f"Expected numbers after --probabilities, got {text!r}.") from None
+    try:
         failure_weights(actuators, 1, values)
     except ValueError as error:
-        raise fail(f"--probabilities: {error}" if "probabilit" in str(error)
-                   else f"Expected numbers after --probabilities, got {text!r}.") from None
+        raise fail(f"--probabilities: {error}") from None
     return values
 
 

@@ -142,8 +142,8 @@ def _rod_ends(rods: list[Rod], transforms: NDArray) -> NDArray[np.float64]:
     ends = np.empty((transforms.shape[0], len(rods), 2, 3))
     for index, rod in enumerate(rods):
         frame = transforms[:, rod.start]
-        ends[:, index, 0] = frame[:, :3, 3] if rod.start_point is None else frame[:, :3, :3] @ rod.start_point + \
-            frame[:, :3, 3]
+        ends[:, index, 0] = (frame[:, :3, 3] if rod.start_point is None
+                             else frame[:, :3, :3] @ rod.start_point + frame[:, :3, 3])
         ends[:, index, 1] = (transforms[:, rod.end, :3, 3] if rod.point is None
                              else frame[:, :3, :3] @ rod.point + frame[:, :3, 3])
     return ends

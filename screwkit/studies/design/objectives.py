@@ -4,8 +4,8 @@ A :class:`Region` is a map as ``screwkit map`` computes it (two grid coordinates
 stacked along a third in layers, the minimum of every index over an orientation set at each grid
 point), an index (``f_o1``, ``f_io1``, ..., or the average case ``f_o_mean1``, ...) and a level: the
 fault-tolerant region is where the minimum of that index over the orientation set is at least the level.
-:func:`region_metrics` evaluates a mechanism on it and returns every metric of :data:`METRICS`; each is reproduced by a
-fresh ``screwkit map`` of the candidate's file with :meth:`Region.map_arguments` (one per layer).
+:func:`region_metrics` evaluates a mechanism on it and returns every metric of :data:`METRICS`; each is
+reproduced by a fresh ``screwkit map`` of the candidate's file with :meth:`Region.map_arguments` (one per layer).
 """
 
 from __future__ import annotations
