@@ -299,3 +299,10 @@ def test_a_search_state_belongs_to_its_failure_probabilities():
     assert weighted == key(index="f_o_mean1", probabilities=list(PROBABILITIES))
     assert weighted != key(index="f_o_mean1", probabilities=PROBABILITIES[::-1]) != key(index="f_o_mean1")
     assert key(index="f_o_mean1") != key() == key(index="f_o1")
+
+
+def test_a_column_of_the_mean_is_named_so_and_nothing_else_is():
+    from screwkit.indices.average import is_mean_column
+
+    assert all(is_mean_column(name) for name in ("f_o_mean1", "f_o_mean2", "f_o_mean12"))
+    assert not any(is_mean_column(name) for name in ("f_o_mean", "f_o1", "f_io1", "lmti", "xf_o_mean1", "f_o_meanx"))

@@ -27,7 +27,7 @@ from screwkit.cli.options import (
     overwrite_option,
     quiet_option,
 )
-from screwkit.indices.average import MEAN_NAME, failure_weights
+from screwkit.indices.average import MEAN_NAME, failure_weights, is_mean_column
 from screwkit.studies.design.families import Family
 from screwkit.studies.design.objectives import METRICS, default_region
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
@@ -324,7 +324,7 @@ def _probabilities(options: RegionOptions) -> tuple[float, ...] | None:
     if not values:
         raise fail("Expected a failure probability per actuator after --probabilities.")
     index = options.index or "f_o1"
-    if index.rstrip("0123456789") != MEAN_NAME:
+    if not is_mean_column(index):
         raise fail(f"--probabilities weight the mean over the sets of failed actuators: give --index {MEAN_NAME}<j> "
                    f"(the region's index is {index}).")
     return values

@@ -35,7 +35,8 @@ from screwkit.cli.options import (
     mechanism_argument,
     reading_options,
 )
-from screwkit.indices.average import MEAN_NAME, failure_weights
+from screwkit.indices.average import MEAN_NAME, failure_weights, is_mean_column
+from screwkit.indices.registry import column_record
 from screwkit.studies.design.families import FAMILIES, Family, family
 from screwkit.studies.design.optimise import Constraint, Study
 from screwkit.studies.design.permutations import (
@@ -242,10 +243,14 @@ def permutations(mechanism, phi_step, closed_forms, score_index, probabilities, 
 
 def _score_index(text: str) -> tuple[str, int]:
     """``--index`` of the permutations: (aggregate, j) of ``f_o<j>`` or ``f_o_mean<j>``."""
-    stem, digits = text.rstrip("0123456789"), text[len(text.rstrip("0123456789")):]
-    if stem not in ("f_o", MEAN_NAME) or not digits or digits.startswith("0"):
+    mean = is_mean_column(text)
+    try:
+        record, faults = column_record("f_o" + text[len(MEAN_NAME):] if mean else text)
+    except ValueError:
+        record, faults = None, None
+    if record is None or record.name != "f_o" or faults is None:
         raise fail(f"Expected --index f_o<j> or {MEAN_NAME}<j> (j >= 1), got {text!r}.")
-    return ("mean" if stem == MEAN_NAME else "min"), int(digits)
+    return ("mean" if mean else "min"), faults
 
 
 def _score_probabilities(text: str | None, aggregate: str, index: str, actuators: int):

@@ -27,12 +27,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.indices.registry import IndexRecord, shared
 
-__all__ = ["AGGREGATES", "failure_weights", "mean_remaining_lmti", "mean_record", "averaging", "MEAN_NAME"]
+__all__ = ["AGGREGATES", "failure_weights", "mean_remaining_lmti", "mean_record", "averaging", "MEAN_NAME",
+           "is_mean_column"]
 
 AGGREGATES = ("min", "mean")
 """How the sets of ``j`` failures are combined: the paper's worst case (Eq. 12), or also their (weighted) mean."""
 MEAN_NAME = "f_o_mean"
 """The registry name (and column stem) of the mean: ``f_o_mean1``, ``f_o_mean2``, ..."""
+
+
+def is_mean_column(column: str) -> bool:
+    """Whether ``column`` names the average case (``f_o_mean1``, ``f_o_mean2``, ...): the registry knows it only
+    while a study has it registered (:func:`averaging`), so that a study choosing it by name asks here first."""
+    stem = column.rstrip("0123456789")
+    return stem == MEAN_NAME and stem != column
 
 
 def failure_weights(actuator_count: int, faults: int, probabilities: ArrayLike | None = None

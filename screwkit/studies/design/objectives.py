@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
-from screwkit.indices.average import MEAN_NAME, averaging
+from screwkit.indices.average import MEAN_NAME, averaging, is_mean_column
 from screwkit.indices.registry import column_record
 from screwkit.model import Mechanism
 from screwkit.studies.maps import MapBlock, disc_grid, map_block, orientation_set, range_values
@@ -106,7 +106,7 @@ class Region:
     @property
     def average(self) -> bool:
         """Whether the region's index is the average case of Eq. 12 (``f_o_mean<j>``)."""
-        return self.index.rstrip("0123456789") == MEAN_NAME
+        return is_mean_column(self.index)
 
     def _record(self):
         """The index's registry record and its j (the average case registered for the look-up)."""
