@@ -518,3 +518,17 @@ def test_a_volume_search_gives_one_map_command_per_layer(tmp_path):
     areas = [remapped_area(tmp_path, urdf, command, "f_o1", 0.5, 0.01) for command in summary["map_commands"]]
     assert sum(areas) * 0.1 == pytest.approx(summary["best"][0]["metrics"]["volume"], abs=1e-9)
     assert summary["best"][0]["metrics"]["volume"] >= summary["start"]["metrics"]["volume"] > 0
+
+
+@pytest.mark.parametrize("objectives, budget", [(("area",), 0), (("area",), 4), (("area",), 50),
+                                                (("area", "footprint"), 10), (("area", "footprint"), 30)])
+def test_a_search_announces_the_evaluations_it_makes(objectives, budget):
+    """The designs a search plans (its budget in the optimiser's whole generations: differential evolution rounds
+    down, NSGA-II up, at least one; the start alone for a budget of 0) are the designs it evaluates here, where
+    neither optimiser meets a design twice nor converges before the budget."""
+    planar = family("planar_rrr", 5)
+    study = Study(planar, disc_region(0.2, 0.1, 90.0), objectives, budget=budget, seed=3)
+    assert study.generation == 24
+    result = run_study(study, execution=QUIET)
+    assert len(result.evaluations) == study.planned_evaluations
+    assert study.planned_evaluations == {0: 1, 4: 24, 50: 48, 10: 24, 30: 48}[budget]

@@ -90,8 +90,14 @@ def run_search(study: Study, state: str | None, execution: Execution, outputs: D
     if outputs.front_figure and len(study.objectives) < 2:
         raise fail("--front-figure needs two or more --objective.")
     if not report.quiet:
-        echo_error(f"{family.name} ({family.legs} legs): {study.budget} evaluations of {', '.join(study.free)}; "
-                   f"region {region.describe()}")
+        planned = study.planned_evaluations
+        if not study.budget:
+            searched = f"the start design alone ({', '.join(study.free)} not varied, --budget 0)"
+        else:
+            rounded = (f" (--budget {study.budget} in whole generations of {study.generation})"
+                       if planned != study.budget else "")
+            searched = f"up to {planned} evaluations{rounded} of {', '.join(study.free)}"
+        echo_error(f"{family.name} ({family.legs} legs): {searched}; region {region.describe()}")
     try:
         result = run_study(study, execution=execution, state=state, notify=None if report.quiet else echo_error)
     except (StateError, ClusterError) as error:

@@ -170,6 +170,22 @@ class Study:
                              f"orientations x layers), more than {MAX_CONFIGURATIONS_PER_DESIGN:,}: use larger steps.")
 
     @property
+    def generation(self) -> int:
+        """Designs per generation of the optimiser: ``popsize`` x the varied parameters (NSGA-II: at least 4)."""
+        size = self.popsize * len(self.free)
+        return size if len(self.objectives) == 1 else max(4, size)
+
+    @property
+    def planned_evaluations(self) -> int:
+        """The designs the search asks for at most: the start alone for a budget of 0, else the budget in whole
+        generations (:attr:`generation`), at least one (differential evolution rounds down, NSGA-II up; either
+        asks for fewer when it converges early or meets a design twice)."""
+        if self.budget == 0:
+            return 1
+        whole = self.budget // self.generation if len(self.objectives) == 1 else -(-self.budget // self.generation)
+        return self.generation * max(1, whole)
+
+    @property
     def limits(self) -> NDArray[np.float64]:
         """(d, 2) bounds of the free parameters."""
         return np.array([self.bounds.get(name, (self.family.parameter(name).lower, self.family.parameter(name).upper))
