@@ -1,17 +1,16 @@
 """Design search over a parametric family: one objective (differential evolution) or several (NSGA-II).
 
-:class:`Study` names a family, the parameters it varies (the others fixed), the region whose
-metrics are scored (:mod:`screwkit.studies.design.objectives`), one or more objectives, constraints, an
-evaluation budget and a seed. :func:`run_study` searches it:
+:class:`Study` names a family, the parameters it varies (the others fixed), the region whose metrics are scored
+(:mod:`screwkit.studies.design.objectives`), objectives, constraints, a budget and a seed. :func:`run_study`:
 
 * one objective: ``scipy.optimize.differential_evolution`` (the starting design seeds the
   population, integer parameters through ``integrality``, deferred updating so that a generation is
   one batch of independent evaluations);
 * several: pymoo's NSGA-II, the Pareto front taken over every evaluation of the run.
 
-Every generation is evaluated as one batch, in local worker processes (one per core) or as tasks
-of a Dask cluster (:func:`screwkit.studies.tasks.run_tasks`); a candidate's metrics depend on its
-parameters alone, so the run is the same wherever it is evaluated. With a ``state`` file, each
+Every generation is evaluated as one batch, in local worker processes (one per core) or as tasks of a Dask cluster
+(:func:`screwkit.studies.tasks.run_tasks`); a candidate's metrics depend on its parameters alone, so the run is the
+same wherever it is evaluated. With a ``state`` file, each
 batch's metrics are appended to it as they come; a run started again with the same study and
 state replays the evaluations it finds there instead of recomputing them (the optimisers are
 seeded, so they ask for the same candidates), which resumes an interrupted run where it stopped.
@@ -19,9 +18,8 @@ A batch is appended whole or not at all: a write that fails (disk full, quota) i
 records before it; a last record cut off by a run killed while writing it is dropped when the
 state is read again (and computed again), and an empty state file starts a new search.
 
-The local worker processes end with the process that started them, however it ends (SIGKILL, the
-out-of-memory killer): each asks the kernel for a signal when its parent dies, or (where that
-cannot be asked) watches its parent.
+The local worker processes end with the process that started them, however it ends (SIGKILL, the out-of-memory
+killer): each asks the kernel for a signal when its parent dies, or (where that cannot be asked) watches its parent.
 """
 
 from __future__ import annotations
@@ -172,18 +170,14 @@ class Study:
     @property
     def generation(self) -> int:
         """Designs per generation of the optimiser: ``popsize`` x the varied parameters (NSGA-II: at least 4)."""
-        size = self.popsize * len(self.free)
-        return size if len(self.objectives) == 1 else max(4, size)
+        return self.popsize * len(self.free) if len(self.objectives) == 1 else max(4, self.popsize * len(self.free))
 
     @property
     def planned_evaluations(self) -> int:
         """The designs the search asks for at most: the start alone for a budget of 0, else the budget in whole
-        generations (:attr:`generation`), at least one (differential evolution rounds down, NSGA-II up; either
-        asks for fewer when it converges early or meets a design twice)."""
-        if self.budget == 0:
-            return 1
+        generations, at least one (differential evolution rounds down, NSGA-II up; fewer if either converges)."""
         whole = self.budget // self.generation if len(self.objectives) == 1 else -(-self.budget // self.generation)
-        return self.generation * max(1, whole)
+        return 1 if self.budget == 0 else self.generation * max(1, whole)
 
     @property
     def limits(self) -> NDArray[np.float64]:
@@ -214,8 +208,7 @@ class Study:
                      [(n, v.tolist()) for n, v in region.grid], [(n, v.tolist()) for n, v in region.over],
                      None if region.mask is None else region.mask.tolist(),
                      None if not region.layers else (region.layers[0], region.layers[1].tolist())]
-        if region.probabilities is not None:  # (appended only when given: the fingerprints of earlier states hold)
-            described.append(list(region.probabilities))
+        described += [list(region.probabilities)] if region.probabilities is not None else []  # (earlier keys hold)
         return hashlib.sha256(json.dumps(described).encode()).hexdigest()[:16]
 
 
@@ -452,8 +445,7 @@ def _single(study: Study, evaluate: Callable) -> None:
 
     limits = study.limits
     integrality = np.array([study.family.parameter(name).integer for name in study.free])
-    dimension = len(study.free)
-    generations = max(0, study.budget // (study.popsize * dimension) - 1)  # after the first population
+    generations = max(0, study.budget // study.generation - 1)  # after the first population
 
     raised: list[Exception] = []
 
@@ -485,7 +477,7 @@ def _multiple(study: Study, evaluate: Callable) -> None:
     from pymoo.optimize import minimize
 
     limits = study.limits
-    size = max(4, study.popsize * len(study.free))
+    size = study.generation
 
     class Search(Problem):
         def __init__(self):
