@@ -20,21 +20,24 @@ from screwkit.cli.options import (
     GreedyOption,
     check_colour_scale,
     check_outputs,
+    check_probabilities,
     colour_scale_options,
     fail,
     json_option,
     option_group,
     overwrite_option,
+    parse_probabilities,
     quiet_option,
 )
-from screwkit.indices.average import MEAN_NAME, failure_weights, is_mean_column
+from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.studies.design.families import Family
 from screwkit.studies.design.objectives import METRICS, default_region
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 
 __all__ = ["SearchOptions", "RegionOptions", "DesignOutputs", "Report", "search_options", "region_options",
            "design_outputs_options", "report_options", "study_option", "STUDY_KEYS", "read_study",
-           "parse_assignments", "parse_bounds", "region_of", "check_region_against", "check_phi_step"]
+           "parse_assignments", "parse_bounds", "region_of", "check_region_against", "check_weighting_a_mean",
+           "check_failures", "check_phi_step"]
 
 
 # -- records -----------------------------------------------------------------------------------------
@@ -315,34 +318,37 @@ def _spec(mechanism, text: str, option: str) -> tuple[str, tuple[float, float, f
 def _probabilities(options: RegionOptions) -> tuple[float, ...] | None:
     """``--probabilities`` as numbers, given with an ``f_o_mean<j>`` region index (its count is checked against a
     design's actuators by :func:`check_region_against`)."""
-    if options.probabilities is None:
+    values = parse_probabilities(options.probabilities)
+    if values is None:
         return None
-    try:
-        values = tuple(float(p) for p in options.probabilities.split())
-    except ValueError:
-        raise fail(f"Expected numbers after --probabilities, got {options.probabilities!r}.") from None
     if not values:
         raise fail("Expected a failure probability per actuator after --probabilities.")
-    index = options.index or "f_o1"
+    check_weighting_a_mean(options.index or "f_o1")
+    return values
+
+
+def check_weighting_a_mean(index: str) -> None:
+    """``--probabilities`` weight the mean: a one-line error unless ``index`` is ``f_o_mean<j>``."""
     if not is_mean_column(index):
         raise fail(f"--probabilities weight the mean over the sets of failed actuators: give --index {MEAN_NAME}<j> "
-                   f"(the region's index is {index}).")
-    return values
+                   f"(the index is {index}).")
+
+
+def check_failures(index: str, faults: int | None, actuators: int, dof: int, holder: str) -> None:
+    """At most a - n actuators may fail: a one-line error naming ``index`` and ``holder`` (what has the ``actuators``)
+    when its ``faults`` are more."""
+    if faults is not None and faults > actuators - dof:
+        raise fail(f"--index {index}: {holder} {actuators} actuators for {dof} DoF, so at most {actuators - dof} may "
+                   f"fail (j in 1..{actuators - dof}), not {faults}.")
 
 
 def check_region_against(region, mechanism) -> None:
     """The region's index and failure probabilities against the actuators of ``mechanism`` (a design of the family
     searched; every design has as many): the j of an index per fault at most a - n, one probability in [0, 1] per
     actuator. One line before any work."""
-    actuators, dof = len(mechanism.actuator_names), mechanism.dof
-    if region.failures is not None and region.failures > actuators - dof:
-        raise fail(f"--index {region.index}: the designs have {actuators} actuators for {dof} DoF, so at most "
-                   f"{actuators - dof} may fail (j in 1..{actuators - dof}), not {region.faults}.")
-    if region.probabilities is not None:
-        try:
-            failure_weights(actuators, 1, region.probabilities)
-        except ValueError as error:
-            raise fail(f"--probabilities: {error}") from None
+    actuators = len(mechanism.actuator_names)
+    check_failures(region.index, region.failures, actuators, mechanism.dof, "the designs have")
+    check_probabilities(region.probabilities, actuators)
 
 
 def region_of(family: Family, start_mechanism, options: RegionOptions):

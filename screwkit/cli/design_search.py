@@ -13,8 +13,10 @@ from screwkit.cli.design_options import (
     RegionOptions,
     Report,
     SearchOptions,
+    check_failures,
     check_phi_step,
     check_region_against,
+    check_weighting_a_mean,
     design_outputs_options,
     parse_assignments,
     parse_bounds,
@@ -27,15 +29,17 @@ from screwkit.cli.design_options import (
 from screwkit.cli.family_search import run_search
 from screwkit.cli.options import (
     GreedyOption,
+    check_probabilities,
     connected,
     echo_error,
     execution_options,
     fail,
     load_mechanism,
     mechanism_argument,
+    parse_probabilities,
     reading_options,
 )
-from screwkit.indices.average import MEAN_NAME, failure_weights, is_mean_column
+from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.indices.registry import column_record
 from screwkit.studies.design.families import FAMILIES, Family, family
 from screwkit.studies.design.optimise import Constraint, Study
@@ -226,10 +230,11 @@ def permutations(mechanism, phi_step, closed_forms, score_index, probabilities, 
     check_phi_step(phi_step)
     aggregate, faults = _score_index(score_index)
     loaded, template = _planar_design(mechanism, reading)
-    weights = _score_probabilities(probabilities, aggregate, score_index, template.chain_count)
-    if faults > template.chain_count - 3:
-        raise fail(f"--index {score_index}: {loaded.name} has {template.chain_count} actuators for 3 DoF, so at "
-                   f"most {template.chain_count - 3} may fail (j in 1..{template.chain_count - 3}), not {faults}.")
+    weights = parse_probabilities(probabilities)
+    if weights is not None:
+        check_weighting_a_mean(score_index)
+        check_probabilities(weights, template.chain_count)
+    check_failures(score_index, faults, template.chain_count, 3, f"{loaded.name} has")
     current = tuple(int(s) for s in slots_of(template))
     with connected(execution) as execution:  # the handshake before any work
         try:
@@ -251,24 +256,6 @@ def _score_index(text: str) -> tuple[str, int]:
     if record is None or record.name != "f_o" or faults is None:
         raise fail(f"Expected --index f_o<j> or {MEAN_NAME}<j> (j >= 1), got {text!r}.")
     return ("mean" if mean else "min"), faults
-
-
-def _score_probabilities(text: str | None, aggregate: str, index: str, actuators: int):
-    """``--probabilities`` as numbers, one in [0, 1] per actuator, given with a mean index (one line if not)."""
-    if text is None:
-        return None
-    if aggregate != "mean":
-        raise fail(f"--probabilities weight the mean over the sets of failed actuators: give --index "
-                   f"{MEAN_NAME}<j> (the index is {index}).")
-    try:
-        values = tuple(float(p) for p in text.split())
-    except ValueError:
-        raise fail(f"Expected numbers after --probabilities, got {text!r}.") from None
-    try:
-        failure_weights(actuators, 1, values)
-    except ValueError as error:
-        raise fail(f"--probabilities: {error}") from None
-    return values
 
 
 def _print_ranking(loaded, template, current, phi_step, ranked, report: Report, index: str = "f_o1",

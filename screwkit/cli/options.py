@@ -36,6 +36,8 @@ from screwkit.studies.tasks import CONNECT_TIMEOUT, ClusterError, Execution, con
 
 __all__ = [
     "check_average",
+    "check_probabilities",
+    "parse_probabilities",
     "GreedyOption",
     "ScrewkitGroup",
     "mechanism_argument",
@@ -268,10 +270,7 @@ def _analysis(threshold: float, fault_type: str, ignore_limits: bool, closed_for
               aggregate: str = "min", probabilities: str | None = None) -> AnalysisOptions:
     if probabilities is not None and aggregate != "mean":
         raise fail("--probabilities weight the mean: give --aggregate mean with them.")
-    try:
-        weights = None if probabilities is None else tuple(float(p) for p in probabilities.split())
-    except ValueError:
-        raise fail(f"Expected numbers after --probabilities, got {probabilities!r}.") from None
+    weights = parse_probabilities(probabilities)
     return AnalysisOptions(threshold=threshold, fault_type=fault_type, closed_forms=closed_forms,
                            limits=not ignore_limits, aggregate=aggregate, probabilities=weights)
 
@@ -296,13 +295,26 @@ def analysis_options(*, closed_forms: bool = True, average: bool = False) -> Cal
                         ignore_limits_option, *((aggregate_option, probabilities_option) if average else ()))
 
 
-def check_average(analysis: AnalysisOptions, mechanism) -> None:
-    """One failure probability per actuator of ``mechanism`` (a one-line error before any work)."""
-    if analysis.probabilities is not None:
+def parse_probabilities(text: str | None) -> tuple[float, ...] | None:
+    """``--probabilities`` as the numbers they are (a one-line error if some is not); None if not given."""
+    try:
+        return None if text is None else tuple(float(p) for p in text.split())
+    except ValueError:
+        raise fail(f"Expected numbers after --probabilities, got {text!r}.") from None
+
+
+def check_probabilities(probabilities, actuators: int) -> None:
+    """One failure probability in [0, 1] per actuator, if given (a one-line error before any work)."""
+    if probabilities is not None:
         try:
-            failure_weights(len(mechanism.actuator_names), 1, analysis.probabilities)
+            failure_weights(actuators, 1, probabilities)
         except ValueError as error:
             raise fail(f"--probabilities: {error}") from None
+
+
+def check_average(analysis: AnalysisOptions, mechanism) -> None:
+    """One failure probability per actuator of ``mechanism`` (a one-line error before any work)."""
+    check_probabilities(analysis.probabilities, len(mechanism.actuator_names))
 
 
 def _execution(scheduler: str | None, connect_timeout: float, task_size: int | None = None) -> Execution:
