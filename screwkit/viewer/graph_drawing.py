@@ -76,12 +76,11 @@ def graph_rods(graph) -> list[Rod]:
         for side, joint, placement in (("a", closure.joint_a, closure.placement_a),
                                        ("b", closure.joint_b, closure.placement_b)):
             at = np.asarray(placement, dtype=float)[:3, 3]
-            if joint in plates:  # a point of the outline: its sphere alone
+            on_plate = joint in plates  # a point of the outline: its sphere alone (a rod of no length)
+            if on_plate:
                 vertices[joint].append(at)
-                rods.append(Rod(f"{node_label(closure.name)}--{side}", owners[joint], joint, point=at,
-                                start_point=at))
-            else:
-                rods.append(Rod(f"{node_label(closure.name)}--{side}", owners.get(joint, "base"), joint, point=at))
+            rods.append(Rod(f"{node_label(closure.name)}--{side}", owners.get(joint, "base"), joint, point=at,
+                            start_point=at if on_plate else None))
     for plate in plates:
         rods += _outline(plate, owners[plate], vertices[plate], graph.length_scale)
     return rods
@@ -106,7 +105,7 @@ def _outline(plate: int, owner: str, points: list[NDArray], length: float) -> li
 
         order = ConvexHull(flat).vertices  # counter-clockwise in the mean plane
         pieces = [(stacked[a], stacked[b]) for a, b in zip(order, np.roll(order, -1))]
-        pieces += [(centre, stacked[i]) for i in range(len(unique)) if i not in set(order.tolist())]
+        pieces += [(centre, stacked[i]) for i in np.setdiff1d(np.arange(len(unique)), order)]
     else:
         order = np.argsort(flat[:, 0], kind="stable")
         pieces = [(stacked[a], stacked[b]) for a, b in zip(order[:-1], order[1:])]
