@@ -394,6 +394,8 @@ def test_the_flat_form_of_earlier_releases_still_runs_with_a_note(tmp_path):
     study.write_text("family: planar_rrr\nradius: 0.3\nstep: 0.1\nphi_step: 30\nbudget: 0\n")
     flat = screwkit("design-search", "--study", study, "--json", "--quiet")
     assert flat.returncode == 0 and json.loads(flat.stdout)["evaluations"] == 1, flat.stderr
+    printed = screwkit("design-search", "--study", study, "--quiet")  # one evaluation, said in the singular
+    assert printed.returncode == 0 and "legs), 1 evaluation (1 computed, 0 from the state file)" in printed.stdout
 
 
 def test_the_design_page_names_every_family_parameter_and_metric():

@@ -3,7 +3,8 @@
 Permuting the legs (chains) of a mechanism, the actuators within a leg, or renaming the legs changes no
 index -- ITI, LMTI, every F_Oj and F_IOj, the CTI and every F_Cj, the instantaneous DOF -- and the
 per-actuator and per-set values, the worst faults (with their ties) and the limiting actuators follow the
-names. Checked at two levels:
+names; so do the average-case F_Oj (equal weights, and weighted by failure probabilities that follow the
+actuators' names). Checked at two levels:
 
 * the core (:func:`screwkit.indices.analysis.analyze` on chain screws), where the chains are analysed in the
   order given: every bundled mechanism and random designs of every family (planar n-RRR, UPS and RSS
@@ -28,6 +29,7 @@ import pytest
 from helpers import random_reachable_poses, screwkit
 from screwkit.closure import chain_screws, solve
 from screwkit.indices.analysis import analyze
+from screwkit.indices.average import mean_remaining_lmti
 from screwkit.io.loader import bundled_names, bundled_path, load, load_text
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.studies.design.families import family
@@ -40,6 +42,11 @@ vector behind them are summed in the order of the actuators, and for the two-arm
 6 x 6 wrench matrices that rounding moves a non-limiting actuator's OTI by up to 3.2e-12 (measured over the
 cases below); each submechanism's OTI, its lowest, moves by at most 1.7e-14."""
 COUNT = 24
+
+
+def failure_probability(actuator: str) -> float:
+    """A failure probability in [0.05, 0.95] that belongs to the actuator's name (so it follows any relabelling)."""
+    return 0.05 + 0.9 * (sum(actuator.encode()) % 101) / 100
 
 
 def by_name(result, renamed: dict[str, str] | None = None) -> dict:
@@ -63,8 +70,12 @@ def by_name(result, renamed: dict[str, str] | None = None) -> dict:
             values[("oti_k", key, names[k])] = result.oti_actuators[..., s, slot]
         if result.cti_submechanisms is not None:
             values[("cti", key)] = result.cti_submechanisms[..., s]
+    probabilities = [failure_probability(actuator) for actuator in names]
     for j in result.faults:
         values[("f_o", j)], values[("f_io", j)] = result.f_o[j], result.f_io[j]
+        left = {j: result.remaining_lmti[j]}
+        values[("f_o_mean", j)] = mean_remaining_lmti(left, len(names))[j]
+        values[("f_o_mean weighted", j)] = mean_remaining_lmti(left, len(names), probabilities)[j]
         values[("f_c", j)] = result.f_c[j]
         for failed, column in zip(result.failed_sets(j), np.moveaxis(result.remaining_lmti[j], -1, 0)):
             values[("left", j, frozenset(names[k] for k in failed))] = column

@@ -130,7 +130,8 @@ def _print(summary: dict, study: Study, top: int) -> None:
         scores = ", ".join(f"{name} = {_shown(record['metrics'][name])}" for name in study.objectives)
         return f"{values} -> {scores}"
 
-    click.echo(f"{summary['family']} ({summary['legs']} legs), {summary['evaluations']} evaluations "
+    count = summary["evaluations"]
+    click.echo(f"{summary['family']} ({summary['legs']} legs), {count} evaluation{'' if count == 1 else 's'} "
                f"({summary['computed']} computed, {summary['replayed']} from the state file), seed {summary['seed']}")
     click.echo(f"  start: {line(summary['start'])}")
     if len(study.objectives) == 1:
