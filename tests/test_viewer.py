@@ -25,6 +25,7 @@ import pytest
 
 from helpers import one_line_error, screwkit
 from screwkit.closure import chain_screws, solve_one
+from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 from screwkit.studies.paths import line_path, path_from_poses
@@ -598,6 +599,27 @@ def test_a_graph_path_animation_follows_its_closed_configurations(graph, viewer)
     assert failed_leg and all(m.failed for m in scene.frame_markers[0] if m.chain == 3)
     assert not [p for p in failed_leg if f"{p}/<object>" in clips]  # the failed leg: red, its colour untracked
     assert all(f"{full_path(m.path)}/<object>" in clips for m in scene.frame_markers[0] if m.chain == 0)
+
+
+def test_a_graph_s_unreachable_poses_are_left_out_as_if_never_asked(graph):
+    """The frames of a batch with unreachable poses are the reachable ones' rows of it: every index and
+    configuration equal to a batch of the reachable poses alone, analysed afresh."""
+    from screwkit.studies.poses import graph_indices_at_poses
+    from screwkit.viewer.graph_drawing import solve_graph_frames
+
+    poses = graph.home_pose + np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 5.0], [0.05, 0.02, 0.01], [3.0, 0.0, 0.0],
+                                        [0.02, -0.04, 0.03]])
+    frames = solve_graph_frames(graph, poses, SINGULARITY_THRESHOLD, strict=False)
+    np.testing.assert_array_equal(frames.kept, [0, 2, 4])
+    alone, q = graph_indices_at_poses(graph, poses[[0, 2, 4]], detail=True, configurations=True)
+    np.testing.assert_array_equal(frames.poses, poses[[0, 2, 4]])
+    np.testing.assert_array_equal(frames.configurations, q)
+    assert frames.result.batch_shape == (3,) and bool(np.all(frames.result.reachable))
+    for name in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "cti"):
+        np.testing.assert_array_equal(getattr(frames.result, name), getattr(alone, name), err_msg=name)
+    for j in alone.faults:
+        for name in ("f_o", "f_io", "remaining_lmti"):
+            np.testing.assert_array_equal(getattr(frames.result, name)[j], getattr(alone, name)[j], err_msg=name)
 
 
 def test_export_html_is_atomic_and_offline(planar, viewer, tmp_path):

@@ -127,8 +127,9 @@ def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) ->
             raise ValueError(graph.unreachable(poses[int(np.flatnonzero(~reachable)[0])])[1] + ".")
         if not kept.size:
             raise ValueError(f"None of the {poses.shape[0]} poses is reachable for mechanism {graph.name!r}.")
-        poses = poses[kept]  # each pose is closed alone as in any batch: the same configurations again
-        result, q = graph_indices_at_poses(graph, poses, detail=True, threshold=threshold, configurations=True)
+        # each pose is closed and analysed alone (as in any batch): the reachable ones' rows are what a batch of
+        # them alone would give, so they are taken, not solved again
+        poses, result, q = poses[kept], result.at((kept,)), q[kept]
     transforms = graph.kinematics.transforms(q)
     return Frames(poses=np.asarray(poses), configurations=q,
                   chain_points=[transforms[:, list(leg.joints), :3, 3] for leg in graph.legs],
