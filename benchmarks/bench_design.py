@@ -1,6 +1,6 @@
 """Evaluations per second of ``screwkit design-search family`` for each bundled family, whole processes.
 
-Usage: python benchmarks/bench_design.py [--budget 192] [--runs 3] [--against /path/to/other/checkout]
+Usage: python benchmarks/bench_design.py [--budget 192] [--runs 3] [--against /path/to/other/checkout] [--json FILE]
 
 For each family, the command runs with ``--budget 0`` (start-up, the start's evaluation, the
 worker processes) and with ``--budget N`` on the family's default region, in turn, ``--runs``
@@ -69,7 +69,9 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--families", nargs="+", default=FAMILIES, choices=FAMILIES)
     parser.add_argument("--against", help="another checkout's folder, run alternately with this one")
+    parser.add_argument("--json", type=pathlib.Path, help="also write the rates (and their ratios) to this file")
     arguments = parser.parse_args()
+    found = {}
     codes = {"this": None} if arguments.against is None else {"this": None, "other": arguments.against}
     print(f"{'family':12s} {'code':5s} {'budget 0 (s)':>13s} {'budget N (s)':>13s} {'designs':>8s} {'designs/s':>10s}")
     for family in arguments.families:
@@ -88,6 +90,9 @@ def main() -> None:
             print(f"{family:12s} {name:5s} {line}")
         if len(codes) == 2:
             print(f"{family:12s} this / other: {rates['this'] / rates['other']:.2f}", flush=True)
+        found[family] = {**rates, **({"ratio": rates["this"] / rates["other"]} if len(codes) == 2 else {})}
+    if arguments.json:
+        arguments.json.write_text(json.dumps(found))
 
 
 if __name__ == "__main__":

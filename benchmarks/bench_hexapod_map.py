@@ -1,6 +1,6 @@
 """The hexapod map command against the straightforward numpy script, side by side, as whole processes.
 
-Usage: python benchmarks/bench_hexapod_map.py [--step 0.005] [--half 0.1] [--yaw-step 1] [--repeat 3]
+Usage: python benchmarks/bench_hexapod_map.py [--step 0.005] [--half 0.1] [--yaw-step 1] [--repeat 3] [--json FILE]
 
 Runs, in turn, ``screwkit map ups_hexapod_8 --grid x:-H:H:S --grid y:-H:H:S --over yaw:0:360:D
 --ignore-limits`` and ``python benchmarks/reference_hexapod_map.py --step S --half H --yaw-step D``
@@ -15,6 +15,7 @@ The defaults are the 41 x 41 grid and full turn at 1 deg: 605,160 configurations
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
@@ -100,6 +101,7 @@ def main() -> None:
     parser.add_argument("--half", type=float, default=0.1)
     parser.add_argument("--yaw-step", type=float, default=1.0)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--json", type=Path, help="also write the measures of issue 28's targets to this file")
     args = parser.parse_args()
     runs, fixed, difference = measured_maps(
         commands, (args.step, args.half, args.yaw_step), (args.half, args.half, 120.0), args.repeat,
@@ -113,13 +115,18 @@ def main() -> None:
     for name in ("command", "script"):
         wall, cpu, peak = (statistics.median(values) for values in zip(*runs[name]))
         print(f"{name:10s} {wall:8.2f} {cpu:8.2f} {peak:9.0f}   {fixed[name][0]:.2f} s, {fixed[name][2]:.0f} MiB")
-    print_ratios(runs)
+    ratios = print_ratios(runs)
     peak = {name: statistics.median(run[2] for run in runs[name]) for name in runs}
     allowed = peak["script"] + fixed["command"][2] - fixed["script"][2]
     print(f"peak memory: command {peak['command']:.0f} MiB; the script's {peak['script']:.0f} MiB plus the difference "
           f"in fixed cost ({fixed['command'][2]:.0f} - {fixed['script'][2]:.0f} MiB) allows {allowed:.0f} MiB: "
           f"{'within' if peak['command'] <= allowed else 'over'}")
     print(f"largest difference between the two maps (LMTI, F_O1, F_O2): {difference:.1e}")
+    if args.json:
+        args.json.write_text(json.dumps({
+            "configurations": points * points * yaws, "ratio_wall": statistics.median(ratios["wall"]),
+            "ratio_cpu": statistics.median(ratios["CPU"]), "memory_ratio": peak["command"] / peak["script"],
+            "difference": difference}))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Microseconds per configuration of ``indices_at_poses`` on lower-mobility mechanisms against the 8-leg hexapod.
 
-Usage: python benchmarks/bench_lower_mobility.py [--count 20000] [--repeat 3]
+Usage: python benchmarks/bench_lower_mobility.py [--count 20000] [--repeat 3] [--json FILE]
 
 For ``ups_hexapod_8``, ``prs_3_ups``, ``delta_4`` and ``schoenflies_5``, in one process: ``--count`` random
 reachable poses about the reference assembly (seeded: +-0.05 length scales, +-0.1 rad), each mechanism's whole
@@ -13,7 +13,9 @@ public API is used, so the same script measures an older checkout (``PYTHONPATH=
 from __future__ import annotations
 
 import argparse
+import json
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -48,6 +50,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=20_000)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--json", type=Path, help="also write the ratios to the hexapod to this file")
     args = parser.parse_args()
     mechanisms = {name: load(name) for name in MECHANISMS}
     poses = {name: random_reachable_poses(mechanism, args.count) for name, mechanism in mechanisms.items()}
@@ -69,6 +72,9 @@ def main() -> None:
         solving = closure[name] * per[name]
         print(f"{name:15s} {mechanism.dof:2d} {solving:8.1f} {total - solving:7.1f} {total:7.1f}  "
               f"{total / hexapod:.2f}")
+    if args.json:
+        args.json.write_text(json.dumps({name: {"microseconds": whole[name] * per[name],
+                                                "ratio": whole[name] * per[name] / hexapod} for name in MECHANISMS}))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """The paper's Fig. 5 map command against the straightforward numpy script, side by side, as whole processes.
 
-Usage: python benchmarks/bench_planar_map.py [--radius 0.6] [--step 0.02] [--phi-step 1] [--repeat 3]
+Usage: python benchmarks/bench_planar_map.py [--radius 0.6] [--step 0.02] [--phi-step 1] [--repeat 3] [--json FILE]
 
 Runs, in turn, ``screwkit map planar_5rrr --radius R --step S --phi-step D`` and
 ``python benchmarks/reference_planar_map.py --radius R --step S --phi-step D`` (``--repeat`` pairs, after
@@ -16,6 +16,7 @@ The defaults are the paper's map: 2,821 grid points x 360 orientations, 1,015,56
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import sys
@@ -63,6 +64,7 @@ def main() -> None:
     parser.add_argument("--step", type=float, default=0.02)
     parser.add_argument("--phi-step", type=float, default=1.0)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--json", type=Path, help="also write the measures of issue 28's targets to this file")
     args = parser.parse_args()
     load_before = os.getloadavg()
     runs, fixed, (names, missing, difference, same_nan, points) = measured_maps(
@@ -93,6 +95,11 @@ def main() -> None:
     print(f"  command <= {TARGET_RATIO} of the script's wall time: {statistics.median(ratios['wall']):.3f} "
           f"(CPU {statistics.median(ratios['CPU']):.3f}): {met(statistics.median(ratios['wall']), TARGET_RATIO)}")
     print(f"  peak memory <= {TARGET_MEMORY} x the script's: {memory:.2f} x: {met(memory, TARGET_MEMORY)}")
+    if args.json:
+        args.json.write_text(json.dumps({
+            "configurations": points * orientations, "command_wall_s": medians["command"][0],
+            "script_wall_s": medians["script"][0], "ratio_wall": statistics.median(ratios["wall"]),
+            "ratio_cpu": statistics.median(ratios["CPU"]), "memory_ratio": memory, "difference": difference}))
 
 
 if __name__ == "__main__":
