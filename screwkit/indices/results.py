@@ -239,8 +239,9 @@ class Indices:
                 return found[0]
         raise ValueError(f"Unknown actuator {name!r}; the actuators are {', '.join(self.actuators)}.")
 
-    def at(self, index: int | tuple[int, ...]) -> Indices:
-        """The indices of one configuration of the batch (its scalar fields become Python floats)."""
+    def at(self, index: int | tuple) -> Indices:
+        """The indices of one configuration of the batch (its scalar fields become Python floats); with a tuple of
+        integer arrays (numpy indexing, one per batch dimension), of those configurations, as a batch."""
         index = index if isinstance(index, tuple) else (index,)
         if len(index) != len(self.batch_shape):
             raise ValueError(f"Expected an index with {len(self.batch_shape)} entries for the batch shape "
