@@ -6,6 +6,8 @@ takes; its integration moves each frame along the twists (finite differences); t
 rod-level Delta are those of :meth:`GraphMechanism.at_pose` pose by pose (<= 1e-12) and the textbook pressure
 angles over a grid (<= 1e-9); the same in millimetres, in another world frame and with the legs listed in another
 order; unreachable poses are NaN, and a Stewart platform opened through the graph moves in all six coordinates.
+A position beyond the frame's reach (bounded by its tree path, checked against Pinocchio's forward kinematics and
+met by a straight arm) is unreachable without a continuation towards it, with the answer the continuation gives.
 """
 
 from __future__ import annotations
@@ -17,8 +19,10 @@ from test_gallery import GALLERY
 from test_graph_legs import AZIMUTHS, POSES, textbook
 
 from helpers import one_line_error, random_rotation, screwkit
+from screwkit.io import graph_kinematics
+from screwkit.io.closed_tree import homogeneous
 from screwkit.io.graph import graph_mechanism
-from screwkit.io.graph_kinematics import TreeKinematics
+from screwkit.io.graph_kinematics import TreeKinematics, reach_bound
 from screwkit.io.mjcf import read_mjcf
 from screwkit.studies.graph_source import cached_graph, graph_source
 from screwkit.studies.maps import index_map
@@ -175,6 +179,84 @@ def test_unreachable_poses_are_nan_and_bad_poses_are_refused(tmp_path):
         graph_indices_at_poses(graph, np.zeros((2, 6)))
     with pytest.raises(ValueError, match="Expected finite poses"):
         graph_indices_at_poses(graph, np.array([[np.nan, 0.0, 0.0]]))
+
+
+def test_the_reach_bound_is_never_exceeded_and_a_straight_arm_meets_it(tmp_path):
+    """No configuration puts the rod-level Delta's output frame farther from the world origin than the bound
+    (Pinocchio's forward kinematics at random configurations, closures aside); a straight arm of two revolute
+    joints and a slider at the end of its travel is exactly as far as the bound (the links' lengths plus the
+    travel); a slider without limits, or any travel with the limits aside, or a free joint: no bound."""
+    import pinocchio as pin
+
+    graph = open_delta(tmp_path)
+    model, frame = graph.tree.model, graph.tree.model.frames[graph.frame_id]
+    bound = reach_bound(graph.kinematics, int(frame.parentJoint), homogeneous(frame.placement))
+    data = model.createData()
+    farthest = 0.0
+    for q in random_configurations(model, 400, np.random.default_rng(4)):
+        pin.framesForwardKinematics(model, data, q)
+        farthest = max(farthest, float(np.linalg.norm(data.oMf[graph.frame_id].translation)))
+    assert 0.5 * bound < farthest <= bound
+    arm = """<robot name="arm"><link name="base"/><link name="a"/><link name="b"/><link name="c"/><link name="tip"/>
+      <joint name="shoulder" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0.1 0 0"/>
+        <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="elbow" type="continuous"><parent link="a"/><child link="b"/><origin xyz="0.3 0.4 0"/>
+        <axis xyz="0 0 1"/></joint>
+      <joint name="slide" type="prismatic"><parent link="b"/><child link="c"/><origin xyz="0.2 0 0"/>
+        <axis xyz="1 0 0"/><limit lower="-0.1" upper="0.25" effort="1" velocity="1"/></joint>
+      <joint name="tool" type="fixed"><parent link="c"/><child link="tip"/><origin xyz="0 0 0.05"/></joint></robot>"""
+    for root, expected in ((None, 0.1 + 0.5 + 0.2 + 0.25 + 0.05), (pin.JointModelFreeFlyer(), np.inf)):
+        model = pin.buildModelFromXML(arm, root) if root is not None else pin.buildModelFromXML(arm)
+        tip = model.getFrameId("tip")
+        kinematics = TreeKinematics.of(model)
+        joint, placement = int(model.frames[tip].parentJoint), homogeneous(model.frames[tip].placement)
+        assert reach_bound(kinematics, joint, placement) == pytest.approx(expected, rel=1e-12)
+        assert reach_bound(kinematics, joint, placement, limits=False) == np.inf
+    model = pin.buildModelFromXML(arm)
+    data, q = model.createData(), pin.neutral(model)
+    # straight: the shoulder turns the 0.3 x 0.4 link onto x, the elbow turns back, the slider at its far end
+    turn = np.arctan2(0.4, 0.3)
+    q[model.idx_qs[model.getJointId("shoulder")]] = -turn
+    elbow = model.idx_qs[model.getJointId("elbow")]
+    q[elbow:elbow + 2] = np.cos(turn), np.sin(turn)
+    q[model.idx_qs[model.getJointId("slide")]] = 0.25
+    pin.framesForwardKinematics(model, data, q)
+    distance = np.linalg.norm(data.oMf[model.getFrameId("tip")].translation)
+    horizontal = 0.1 + 0.5 + 0.2 + 0.25
+    assert distance == pytest.approx(np.hypot(horizontal, 0.05), abs=1e-12)  # the tool offset turns no further
+    assert distance <= reach_bound(TreeKinematics.of(model), int(model.frames[model.getFrameId("tip")].parentJoint),
+                                   homogeneous(model.frames[model.getFrameId("tip")].placement))
+
+
+def test_a_position_beyond_reach_is_not_followed_and_unreached_as_the_continuation_finds(tmp_path, monkeypatch):
+    """A target beyond the bound never enters the continuation (a path in millimetres read as metres took minutes
+    there: 2 minutes for 75 m); just beyond it, the continuation followed all the way finds it unreached too."""
+    graph = open_delta(tmp_path)
+    home = graph.task_pose()
+    asked = []
+    solve = graph_kinematics._least_squares
+
+    def recorded(residual, kinematics, q, target, iterations, tolerance):
+        asked.append(np.abs(target[:, 2]).max())
+        return solve(residual, kinematics, q, target, iterations, tolerance)
+
+    monkeypatch.setattr(graph_kinematics, "_least_squares", recorded)
+    frame = graph.tree.model.frames[graph.frame_id]
+    bound = reach_bound(graph.kinematics, int(frame.parentJoint), homogeneous(frame.placement))
+    far, near = home + [0.0, 0.0, -75.0], home + [0.0, 0.0, -0.6]
+    assert bound < np.linalg.norm(near) < 1.5 * bound
+    q, reached = graph.solve(np.array([home, far, near]))
+    assert reached.tolist() == [True, False, False] and max(asked) < 1.5 * bound
+    np.testing.assert_array_equal(q[1], graph.q)  # left at the start
+    monkeypatch.setattr(graph_kinematics, "beyond_reach", lambda *arguments, **options: np.zeros(1, dtype=bool))
+    assert graph.solve(near[None])[1].tolist() == [False]  # followed all the way: unreached as well
+    assert f"never farther than {bound:.4g} m from the world origin" in graph.unreachable(far)[1]
+
+
+def test_the_command_refuses_a_pose_beyond_reach_in_one_line():
+    one_line_error(screwkit("analyze", "delta_rods_4", "--pose", "0 0 -750"), "delta_rods_4",
+                   "[0.0, 0.0, -750.0] m", "out of reach: the output frame is never farther than 1.416 m from the "
+                   "world origin")
 
 
 def test_a_stewart_platform_through_the_graph_moves_in_six_coordinates():

@@ -61,7 +61,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
-from screwkit.io.graph_kinematics import TreeKinematics, rpy_of, rpy_rates_inverse, solve_poses
+from screwkit.io.graph_kinematics import TreeKinematics, reach_bound, rpy_of, rpy_rates_inverse, solve_poses
 from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
 from screwkit.io.star import output_frame
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
@@ -195,6 +195,12 @@ class GraphMechanism:
         """``(kind, reason)`` of task coordinates ``pose`` (m, rad) that :meth:`solve` does not reach: ``"joint
         limit"`` when the continuation reaches them once the joint limits are left aside, else ``"closure"``."""
         names = spelled_pose(self.task_coordinates, pose)
+        frame = self.tree.model.frames[self.frame_id]
+        bound = reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=False)
+        held = [k for k, axis in enumerate(self.task_axes) if axis < 3]
+        if held and np.linalg.norm(np.asarray(pose, dtype=float)[held]) > bound * (1.0 + 1e-9):
+            return "closure", (f"{self.tree.source}: no closed configuration puts the output frame at ({names}): it "
+                               f"is never farther than {bound:.4g} m from the world origin")
         if limits and self.solve(np.asarray(pose, dtype=float)[None], limits=False)[1][0]:
             return "joint limit", (f"{self.tree.source}: at ({names}) a joint is beyond its limits in the "
                                    "configuration reached from the file's by continuation")
@@ -216,10 +222,15 @@ class GraphMechanism:
         q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
                                  limits=limits, kinematics=self.kinematics)
         if not reached[0]:
+            frame = self.tree.model.frames[self.frame_id]
+            bound = reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=limits)
+            why = (f"out of reach: the output frame is never farther than {bound:.4g} m from the world origin"
+                   if np.linalg.norm(position) > bound * (1.0 + 1e-9)
+                   else "out of reach, a rotation the legs do not allow, or a joint beyond its limits")
             raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
                              f"output frame at {np.round(position, 9).tolist()} m"
                              + ("" if rpy is None else f", rpy {np.round(np.degrees(rpy), 9).tolist()} deg")
-                             + " (out of reach, a rotation the legs do not allow, or a joint beyond its limits).")
+                             + f" ({why}).")
         return graph_mechanism(self.tree, q=q[0], scale=self.scale)
 
     def indices(self, **options):

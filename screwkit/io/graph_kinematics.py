@@ -32,8 +32,8 @@ from numpy.typing import NDArray
 from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
-__all__ = ["TreeKinematics", "solve_poses", "rpy_of", "rpy_rates_inverse", "STAGE_LENGTH", "MAX_ITERATIONS",
-           "STAGE_TOLERANCE", "FINAL_TOLERANCE"]
+__all__ = ["TreeKinematics", "solve_poses", "reach_bound", "rpy_of", "rpy_rates_inverse", "STAGE_LENGTH",
+           "MAX_ITERATIONS", "STAGE_TOLERANCE", "FINAL_TOLERANCE"]
 
 STAGE_LENGTH = 0.05
 """Largest move of a continuation stage: task coordinates in units of the length scale, and radians."""
@@ -344,6 +344,39 @@ def _least_squares(residual: _Residual, kinematics: TreeKinematics, q: NDArray, 
     return q, norm
 
 
+def reach_bound(kinematics: TreeKinematics, joint: int, placement: NDArray, *, limits: bool = True) -> float:
+    """An upper bound (m) on the distance from the world origin of a frame (``placement`` 4x4 in ``joint``) over every
+    configuration of the tree, its closures aside: the lengths of the joint placements on its path from the root, and
+    of its own, add up (a revolute or ball joint turns about its origin and moves nothing there), plus each prismatic
+    joint's largest travel within its limits (``limits`` False: any travel). Infinite when a free joint, or a
+    prismatic joint without limits, is on the path."""
+    total = float(np.linalg.norm(placement[:3, 3]))
+    while joint > 0:
+        total += float(np.linalg.norm(kinematics.placements[joint][:3, 3]))
+        kind = kinematics.kinds[joint]
+        if kind == "free":
+            return np.inf
+        if kind == "prismatic":
+            travel = (kinematics.lower[kinematics.idx_v[joint]], kinematics.upper[kinematics.idx_v[joint]])
+            if not limits or not np.all(np.isfinite(travel)):
+                return np.inf
+            total += float(np.max(np.abs(travel)))
+        joint = kinematics.parents[joint]
+    return total
+
+
+def beyond_reach(kinematics: TreeKinematics, joint: int, placement: NDArray, targets: NDArray,
+                 task_axes: tuple[int, ...], scale: float, *, limits: bool = True) -> NDArray[np.bool_]:
+    """Which ``targets`` (n, 6) hold a position the frame can never reach: farther from the world origin, in the held
+    position coordinates, than :func:`reach_bound` (with the tolerance of a reached pose to spare)."""
+    held = [axis for axis in task_axes if axis < 3]
+    bound = reach_bound(kinematics, joint, placement, limits=limits)
+    if not held or not np.isfinite(bound):
+        return np.zeros(targets.shape[0], dtype=bool)
+    distance = np.linalg.norm(targets[:, held], axis=1)
+    return distance > bound * (1.0 + 1e-9) + 10.0 * ASSEMBLY_TOLERANCE * scale
+
+
 def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int, targets: NDArray,
                 task_axes: tuple[int, ...], *, limits: bool = True, kinematics: TreeKinematics | None = None):
     """Closed configurations (n, nq) putting the output frame's task coordinates at ``targets`` (n, 6: x, y, z in m
@@ -375,6 +408,11 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
     stages = np.maximum(np.ceil(np.max(span, axis=1, initial=0.0) / STAGE_LENGTH), 1).astype(np.int64)
     q = np.repeat(start, count, axis=0)
     norm = np.zeros(count)
+    # a position no configuration reaches (a path in millimetres read as metres: thousands of stages, minutes) is
+    # not followed at all: it stays at the start, unreached
+    beyond = beyond_reach(kinematics, int(frame.parentJoint), placement, targets, tuple(task_axes), scale,
+                          limits=limits)
+    stages[beyond], norm[beyond] = 0, np.inf
     for stage in range(1, int(np.max(stages, initial=1)) + 1):
         for rows, iterations, tolerance in ((np.flatnonzero(stages > stage), MAX_ITERATIONS // 4, STAGE_TOLERANCE),
                                             (np.flatnonzero(stages == stage), MAX_ITERATIONS, FINAL_TOLERANCE)):
