@@ -241,8 +241,7 @@ def test_a_position_beyond_reach_is_not_followed_and_unreached_as_the_continuati
         return solve(residual, kinematics, q, target, iterations, tolerance)
 
     monkeypatch.setattr(graph_kinematics, "_least_squares", recorded)
-    frame = graph.tree.model.frames[graph.frame_id]
-    bound = reach_bound(graph.kinematics, int(frame.parentJoint), homogeneous(frame.placement))
+    bound = graph.reach()
     far, near = home + [0.0, 0.0, -75.0], home + [0.0, 0.0, -0.6]
     assert bound < np.linalg.norm(near) < 1.5 * bound
     q, reached = graph.solve(np.array([home, far, near]))

@@ -191,12 +191,17 @@ class GraphMechanism:
         return solve_poses(self.tree, self.q, self.scale, self.frame_id, targets, self.task_axes, limits=limits,
                            kinematics=self.kinematics)
 
+    def reach(self, *, limits: bool = True) -> float:
+        """The farthest the output frame can be from the world origin (m), an upper bound
+        (:func:`screwkit.io.graph_kinematics.reach_bound`); infinite through a free joint or a slider without limits."""
+        frame = self.tree.model.frames[self.frame_id]
+        return reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=limits)
+
     def unreachable(self, pose, *, limits: bool = True) -> tuple[str, str]:
         """``(kind, reason)`` of task coordinates ``pose`` (m, rad) that :meth:`solve` does not reach: ``"joint
         limit"`` when the continuation reaches them once the joint limits are left aside, else ``"closure"``."""
         names = spelled_pose(self.task_coordinates, pose)
-        frame = self.tree.model.frames[self.frame_id]
-        bound = reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=False)
+        bound = self.reach(limits=False)
         held = [k for k, axis in enumerate(self.task_axes) if axis < 3]
         if held and np.linalg.norm(np.asarray(pose, dtype=float)[held]) > bound * (1.0 + 1e-9):
             return "closure", (f"{self.tree.source}: no closed configuration puts the output frame at ({names}): it "
@@ -222,8 +227,7 @@ class GraphMechanism:
         q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
                                  limits=limits, kinematics=self.kinematics)
         if not reached[0]:
-            frame = self.tree.model.frames[self.frame_id]
-            bound = reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=limits)
+            bound = self.reach(limits=limits)
             why = (f"out of reach: the output frame is never farther than {bound:.4g} m from the world origin"
                    if np.linalg.norm(position) > bound * (1.0 + 1e-9)
                    else "out of reach, a rotation the legs do not allow, or a joint beyond its limits")
