@@ -269,6 +269,33 @@ def test_a_path_leaving_the_workspace_reports_where():
         assert case.lost[-1, 1] == pytest.approx(1.5) and case.lost[-1, 0] <= event.start + result.tolerance
 
 
+def test_a_path_entering_the_workspace_or_out_of_it_throughout_reports_where():
+    """The same path run backwards (from out of reach into the workspace) has its closure event where the forward
+    one has it, mirrored; a path out of reach throughout is one event over its whole length, with why. Both were
+    reported as nothing: the stretches were taken from the reach series' values, whose NaN counts as true."""
+    five = bundled("planar_5rrr")
+    forward = path_from_poses(five, np.column_stack([np.zeros(16), np.linspace(0.0, 1.5, 16), np.zeros(16)]))
+    backward = path_from_poses(five, forward.poses[::-1])
+    (ahead,), (back,) = trajectory(five, forward).events, trajectory(five, backward).events
+    assert back.kind == "closure" and "misses closure" in back.reason and back.start == 0.0
+    assert back.stop == pytest.approx(1.5 - ahead.start, abs=2 * forward_tolerance(five))
+    assert back.samples[0] == 0 and back.samples[1] == 15 - ahead.samples[0]
+    away = path_from_poses(five, np.column_stack([np.linspace(100.0, 200.0, 5), np.zeros(5), np.zeros(5)]))
+    result = trajectory(five, away)
+    (event,) = result.events
+    assert (event.start, event.stop, event.samples) == (0.0, pytest.approx(100.0), (0, 4))
+    assert "is unreachable for mechanism 'planar_5rrr'" in event.reason and "(x=100, y=0" in event.reason
+    for case in result.cases:
+        assert case.lost.tolist() == [[0.0, pytest.approx(100.0)]] and case.first_loss == 0.0
+
+
+def forward_tolerance(mechanism) -> float:
+    """The default tolerance of a path's crossings for ``mechanism`` (m of arc length)."""
+    from screwkit.studies.trajectory import RELATIVE_TOLERANCE
+
+    return RELATIVE_TOLERANCE * mechanism.length_scale
+
+
 def test_a_hexapod_path_runs_and_agrees_with_its_samples():
     hexapod = bundled("ups_hexapod_8")
     home = hexapod.home_pose

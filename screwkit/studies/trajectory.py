@@ -341,9 +341,9 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
                                float(lost[0, 0]) if len(lost) else None,
                                float(v[lowest]) if finite.any() else np.nan, float(at[lowest]),
                                tuple(float(z) for z in np.sort(zeros))))
-    reach_at, reach_state = points[reach_series]
-    _, unreachable = _stretches(reach_at, reach_state, {i: crossing[(kk, i)] for kk, i in brackets
-                                                        if kk == reach_series})
+    reach_at = points[reach_series][0]  # its state, not its values (NaN where unreachable: NaN is true)
+    _, unreachable = _stretches(reach_at, states[reach_series], {i: crossing[(kk, i)] for kk, i in brackets
+                                                                 if kk == reach_series})
     chains = along.chains
     changes = branch_changes(chains, mechanism.length_scale, s, joint_values,
                              lambda at: along.joint_values(path.at(at)), tolerance)
