@@ -366,15 +366,15 @@ def reach_bound(kinematics: TreeKinematics, joint: int, placement: NDArray, *, l
 
 
 def beyond_reach(kinematics: TreeKinematics, joint: int, placement: NDArray, targets: NDArray,
-                 task_axes: tuple[int, ...], scale: float, *, limits: bool = True) -> NDArray[np.bool_]:
+                 task_axes: tuple[int, ...], spare: float, *, limits: bool = True) -> NDArray[np.bool_]:
     """Which ``targets`` (n, 6) hold a position the frame can never reach: farther from the world origin, in the held
-    position coordinates, than :func:`reach_bound` (with the tolerance of a reached pose to spare)."""
+    position coordinates, than :func:`reach_bound` plus ``spare`` (m: the residual a reached pose may keep)."""
     held = [axis for axis in task_axes if axis < 3]
     bound = reach_bound(kinematics, joint, placement, limits=limits)
     if not held or not np.isfinite(bound):
         return np.zeros(targets.shape[0], dtype=bool)
     distance = np.linalg.norm(targets[:, held], axis=1)
-    return distance > bound * (1.0 + 1e-9) + 10.0 * ASSEMBLY_TOLERANCE * scale
+    return distance > bound * (1.0 + 1e-9) + spare
 
 
 def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int, targets: NDArray,
@@ -408,10 +408,13 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
     stages = np.maximum(np.ceil(np.max(span, axis=1, initial=0.0) / STAGE_LENGTH), 1).astype(np.int64)
     q = np.repeat(start, count, axis=0)
     norm = np.zeros(count)
+    floor = float(np.linalg.norm(residual(start, np.concatenate([origin])[None], jacobian=False)[0]))
+    reach_tolerance = max(ASSEMBLY_TOLERANCE * 10, 2 * floor)  # a pose is reached below this residual
     # a position no configuration reaches (a path in millimetres read as metres: thousands of stages, minutes) is
-    # not followed at all: it stays at the start, unreached
-    beyond = beyond_reach(kinematics, int(frame.parentJoint), placement, targets, tuple(task_axes), scale,
-                          limits=limits)
+    # not followed at all: it stays at the start, unreached (its position's gap alone, in length scales, is more
+    # than a reached pose's whole residual)
+    beyond = beyond_reach(kinematics, int(frame.parentJoint), placement, targets, tuple(task_axes),
+                          reach_tolerance * scale, limits=limits)
     stages[beyond], norm[beyond] = 0, np.inf
     for stage in range(1, int(np.max(stages, initial=1)) + 1):
         for rows, iterations, tolerance in ((np.flatnonzero(stages > stage), MAX_ITERATIONS // 4, STAGE_TOLERANCE),
@@ -420,8 +423,7 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
                 q[rows], norm[rows] = _least_squares(residual, kinematics, q[rows],
                                                      origin + move[rows] * (stage / stages[rows])[:, None],
                                                      iterations, tolerance)
-    floor = float(np.linalg.norm(residual(start, np.concatenate([origin])[None], jacobian=False)[0]))
-    reached = norm < max(ASSEMBLY_TOLERANCE * 10, 2 * floor)
+    reached = norm < reach_tolerance
     if limits:
         values = np.zeros((count, kinematics.nv))
         for joint, kind in enumerate(kinematics.kinds):
