@@ -61,7 +61,14 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
-from screwkit.io.graph_kinematics import TreeKinematics, reach_bound, rpy_of, rpy_rates_inverse, solve_poses
+from screwkit.io.graph_kinematics import (
+    TreeKinematics,
+    beyond_reach,
+    reach_bound,
+    rpy_of,
+    rpy_rates_inverse,
+    solve_poses,
+)
 from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
 from screwkit.io.star import output_frame
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
@@ -197,15 +204,22 @@ class GraphMechanism:
         frame = self.tree.model.frames[self.frame_id]
         return reach_bound(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), limits=limits)
 
+    def _beyond_reach(self, target: NDArray, task_axes: tuple[int, ...], limits: bool) -> bool:
+        """Whether the frame pose ``target`` (6,) holds, in ``task_axes``, a position beyond :meth:`reach`
+        (:func:`screwkit.io.graph_kinematics.beyond_reach`, nothing spared): for the reason a refusal gives."""
+        frame = self.tree.model.frames[self.frame_id]
+        return bool(beyond_reach(self.kinematics, int(frame.parentJoint), homogeneous(frame.placement), target[None],
+                                 task_axes, 0.0, limits=limits)[0])
+
     def unreachable(self, pose, *, limits: bool = True) -> tuple[str, str]:
         """``(kind, reason)`` of task coordinates ``pose`` (m, rad) that :meth:`solve` does not reach: ``"joint
         limit"`` when the continuation reaches them once the joint limits are left aside, else ``"closure"``."""
         names = spelled_pose(self.task_coordinates, pose)
-        bound = self.reach(limits=False)
-        held = [k for k, axis in enumerate(self.task_axes) if axis < 3]
-        if held and np.linalg.norm(np.asarray(pose, dtype=float)[held]) > bound * (1.0 + 1e-9):
+        target = self.frame_pose()
+        target[list(self.task_axes)] = pose
+        if self._beyond_reach(target, self.task_axes, limits=False):
             return "closure", (f"{self.tree.source}: no closed configuration puts the output frame at ({names}): it "
-                               f"is never farther than {bound:.4g} m from the world origin")
+                               f"is never farther than {self.reach(limits=False):.4g} m from the world origin")
         if limits and self.solve(np.asarray(pose, dtype=float)[None], limits=False)[1][0]:
             return "joint limit", (f"{self.tree.source}: at ({names}) a joint is beyond its limits in the "
                                    "configuration reached from the file's by continuation")
@@ -227,9 +241,8 @@ class GraphMechanism:
         q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
                                  limits=limits, kinematics=self.kinematics)
         if not reached[0]:
-            bound = self.reach(limits=limits)
-            why = (f"out of reach: the output frame is never farther than {bound:.4g} m from the world origin"
-                   if np.linalg.norm(position) > bound * (1.0 + 1e-9)
+            why = (f"out of reach: the output frame is never farther than {self.reach(limits=limits):.4g} m from the "
+                   "world origin" if self._beyond_reach(target, tuple(range(6)), limits)
                    else "out of reach, a rotation the legs do not allow, or a joint beyond its limits")
             raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
                              f"output frame at {np.round(position, 9).tolist()} m"
