@@ -252,6 +252,26 @@ def test_a_position_beyond_reach_is_not_followed_and_unreached_as_the_continuati
     assert f"never farther than {bound:.4g} m from the world origin" in graph.unreachable(far)[1]
 
 
+def test_what_is_beyond_reach_is_the_same_in_millimetres_in_another_frame_and_with_the_legs_reordered(tmp_path):
+    """The bound is measured from the world origin, so moving, scaling or relabelling the file changes which poses
+    it refuses without a continuation; what is reached does not change: poses near home, just out of reach, far out
+    (refused at once) and 10,000 length scales away, the same answers in every copy, and the bound scales with it."""
+    graph = open_delta(tmp_path)
+    moves = np.array([[0.0, 0.0, 0.0], [0.02, -0.01, 0.03], [0.0, 0.0, -0.6], [0.9, 0.0, 0.0], [0.0, 0.0, -75.0],
+                      [4e3, 0.0, 0.0]])
+    reference = graph.solve(graph.task_pose() + moves)[1]
+    assert reference.tolist() == [True, True, False, False, False, False]
+    rotation = random_rotation(np.random.default_rng(13))
+    for scale, turn, shift in ((1e-3, rotation, np.array([0.01, 0.0, -0.02])), (1e3, np.eye(3), np.zeros(3)),
+                               (1.0, rotation, np.array([0.3, -1.2, 2.0]))):
+        moved = open_delta(tmp_path, transform=(scale, turn, shift), name="moved.xml")
+        assert moved.solve(moved.task_pose() + scale * moves @ turn.T)[1].tolist() == reference.tolist()
+        if not shift.any():
+            assert moved.reach() == pytest.approx(scale * graph.reach(), rel=1e-12)
+    relabelled = open_delta(tmp_path, azimuths=AZIMUTHS[[2, 0, 3, 1]], name="relabelled.xml")
+    assert relabelled.solve(relabelled.task_pose() + moves)[1].tolist() == reference.tolist()
+
+
 def test_the_command_refuses_a_pose_beyond_reach_in_one_line():
     one_line_error(screwkit("analyze", "delta_rods_4", "--pose", "0 0 -750"), "delta_rods_4",
                    "[0.0, 0.0, -750.0] m", "out of reach: the output frame is never farther than 1.416 m from the "
