@@ -289,6 +289,35 @@ def test_a_path_entering_the_workspace_or_out_of_it_throughout_reports_where():
         assert case.lost.tolist() == [[0.0, pytest.approx(100.0)]] and case.first_loss == 0.0
 
 
+@pytest.mark.parametrize("name, poses", [
+    ("planar_5rrr", [(0.95, 0.0, 0.0), (1.2, 0.0, 0.0)]),  # out of reach from 0.148 m: a leg cannot close
+    ("planar_4rpr", [(0.0, 0.0, 0.0), (-0.6, -0.7, 0.0), (0.0, 0.05, 0.0)]),  # a slider beyond its limit
+])
+def test_the_edge_of_an_unreachable_stretch_is_no_singular_point(name, poses):
+    """Several failures' LMTI left is lowest where the path leaves the workspace (or a joint's limits), well above
+    zero there (a dense sampling): none of them is singular there, and the worst failure is the one with the lowest
+    minimum on the dense sampling. The side of such a minimum out of reach used to count as an infinite rise,
+    which made every failure with its minimum at an edge 'singular' and the worst of the path."""
+    mechanism = bundled(name)
+    path = through_path(mechanism, np.array([(x, y, np.deg2rad(phi)) for x, y, phi in poses]), 21)
+    result = trajectory(mechanism, path)
+    edges = [edge for event in result.events for edge in (event.start, event.stop)]
+    assert edges and all(event.kind in ("closure", "joint limit") for event in result.events)
+    dense_s = np.linspace(0.0, path.length, 20_001)
+    dense = indices_at_poses(mechanism, path.at(dense_s), detail=True)
+    lowest, at_an_edge = {}, 0
+    for case in result.cases:
+        failed = tuple(result.indices.actuators.index(n) for n in case.failed)
+        values = dense.remaining_lmti[case.faults][:, result.indices.failed_sets(case.faults).index(failed)]
+        if np.nanmin(values) > 0.05:
+            assert not case.singular_at, (case.label, case.singular_at, np.nanmin(values))
+        at_an_edge += min(abs(case.at - edge) for edge in edges) <= 2 * result.tolerance
+        if case.faults == 1:
+            lowest[case.failed] = np.nanmin(values)
+    assert at_an_edge >= 2
+    assert result.worst[1] == (min(lowest, key=lowest.get),)
+
+
 def forward_tolerance(mechanism) -> float:
     """The default tolerance of a path's crossings for ``mechanism`` (m of arc length)."""
     from screwkit.studies.trajectory import RELATIVE_TOLERANCE

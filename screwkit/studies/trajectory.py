@@ -373,14 +373,17 @@ def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, ser
                   tolerance: float) -> NDArray[np.bool_]:
     """Which refined minima are zeros of their series: the value found is at most its rise one ``tolerance``
     either side (a V-shaped dip whose two sides, extended, meet within the tolerance at zero), whereas a smooth
-    minimum above zero rises only by the square of the tolerance there. One batched evaluation."""
+    minimum above zero rises only by the square of the tolerance there. One batched evaluation.
+
+    A side out of reach (the edge of an unreachable or joint-limit stretch) tells nothing of the dip: the rise is
+    the other side's alone, and a minimum with neither side reachable is no zero."""
     if minima_at.size == 0:
         return np.zeros(0, dtype=bool)
     sides = np.clip(np.concatenate([minima_at - tolerance, minima_at + tolerance]), 0.0, path.length)
     found = evaluate(sides, np.concatenate([series, series]))
-    found = np.where(np.isnan(found), np.inf, found)
-    rise = np.maximum(found[:minima.size], found[minima.size:]) - minima
-    return np.isfinite(minima) & (minima <= rise)
+    with np.errstate(invalid="ignore"):
+        rise = np.fmax(found[:minima.size], found[minima.size:]) - minima  # NaN only where both sides are
+        return np.isfinite(minima) & (minima <= rise)
 
 
 def _local_minima_of_blocks(blocks: list[NDArray]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
