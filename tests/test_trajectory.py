@@ -318,6 +318,33 @@ def test_the_edge_of_an_unreachable_stretch_is_no_singular_point(name, poses):
     assert result.worst[1] == (min(lowest, key=lowest.get),)
 
 
+def test_a_stretch_out_of_reach_between_two_reachable_samples_found_by_the_searches_is_reported():
+    """The 4-RPR on a straight path whose four samples are all reachable, while leg 1's slider passes its lower limit
+    between the second and the third (0.245 m to 0.354 m, a dense sampling says). The minimum searches between those
+    samples evaluate poses there; such a pose out of reach used to be dropped, leaving no event and every failure
+    controllable across the stretch. It is now reported with the samples either side, its edges located to the
+    tolerance, and it is lost for every failure, as on a path of 61 samples."""
+    rpr = bundled("planar_4rpr")
+    start, stop = np.array([-0.3793, -0.9035, 0.0]), np.array([-0.8035, -0.4793, 0.0])
+    coarse = trajectory(rpr, line_path(rpr, start, stop, 4))
+    assert np.asarray(coarse.indices.reachable).all()
+    dense_s = np.linspace(0.0, coarse.path.length, 200_001)
+    out = np.flatnonzero(~indices_at_poses(rpr, coarse.path.at(dense_s)).reachable)
+    assert out.size and np.all(np.diff(out) == 1)  # one stretch
+    (event,) = coarse.events
+    assert event.kind == "joint limit" and "leg_1_joint_slider" in event.reason and event.samples == (1, 2)
+    step = dense_s[1]
+    assert abs(event.start - dense_s[out[0]]) <= coarse.tolerance + step
+    assert abs(event.stop - dense_s[out[-1]]) <= coarse.tolerance + step
+    fine = trajectory(rpr, line_path(rpr, start, stop, 61))
+    (expected,) = fine.events
+    assert (event.start, event.stop) == (pytest.approx(expected.start, abs=2 * coarse.tolerance),
+                                         pytest.approx(expected.stop, abs=2 * coarse.tolerance))
+    for case in coarse.cases:
+        lost = case.lost
+        assert np.any((lost[:, 0] <= event.start + coarse.tolerance) & (lost[:, 1] >= event.stop - coarse.tolerance))
+
+
 def forward_tolerance(mechanism) -> float:
     """The default tolerance of a path's crossings for ``mechanism`` (m of arc length)."""
     from screwkit.studies.trajectory import RELATIVE_TOLERANCE

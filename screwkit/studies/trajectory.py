@@ -63,6 +63,10 @@ RELATIVE_TOLERANCE = 1e-6
 """Default refinement tolerance, in units of the mechanism's length scale (so a scaled mechanism has its
 tolerance scaled with it)."""
 
+_HIDDEN_ROUNDS = 4
+"""Rounds of locating stretches out of reach that lie between two reachable samples (each round's searches may
+find another); each further round is taken only when the one before found one."""
+
 
 @dataclass(frozen=True)
 class FaultCase:
@@ -116,7 +120,8 @@ class PathEvent:
     """Where the path cannot be followed in the working mode: ``kind`` is ``"closure"`` (a chain cannot close),
     ``"joint limit"`` or ``"branch"`` (a chain's joint values jump: it changes working mode); ``start``/``stop``
     the stretch of arc length (m, located to the tolerance), ``samples`` its first and last sample (for a branch
-    change, the samples either side), ``reason`` the chains and joints concerned."""
+    change, or a stretch out of reach between two samples, the samples either side), ``reason`` the chains and
+    joints concerned."""
 
     kind: str
     start: float
@@ -292,9 +297,13 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
         rows[at] = np.where(np.asarray(result.reachable), 1.0, np.nan)
         return rows.T
 
+    probed = []  # every pose evaluated between samples: (positions, their series (m, K + 1))
+
     def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
         evaluations[0] += positions.size
-        return table(along.indices(path.at(positions)))[np.arange(positions.size), series]
+        found = table(along.indices(path.at(positions)))
+        probed.append((positions, found))
+        return found[np.arange(positions.size), series]
 
     # the series at the samples, as views of the indices' own arrays (a column each; no copy of them all)
     blocks = [remaining_lmti(samples, j) for j in faults]
@@ -320,15 +329,22 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     minima_at, minima = bracketed_minima(evaluate, s[before], s[after], series, tolerance, guesses)
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
     points = _series_points(s, columns, rows, series, minima_at, minima)
-    states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
-              for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
-    brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
-    where = np.array([k for k, _ in brackets], dtype=np.int64)
-    ends = np.array([(points[k][0][i], points[k][0][i + 1], points[k][1][i], points[k][1][i + 1])
-                     for k, i in brackets]).reshape(-1, 4).T
-    guess = np.where(where == reach_series, np.nan, linear_crossing(*ends, level))
-    low, high = bisected_crossings(evaluate, ends[0], ends[1], where, above, tolerance, guess)
-    crossing = {(k, i): (lo + hi) / 2 for (k, i), lo, hi in zip(brackets, low, high)}
+    reachable_samples, kept = np.asarray(samples.reachable, dtype=bool), 0
+    for _ in range(_HIDDEN_ROUNDS):  # again while the searches find, between two reachable samples, a pose out of reach
+        states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
+                  for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
+        brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
+        where = np.array([k for k, _ in brackets], dtype=np.int64)
+        ends = np.array([(points[k][0][i], points[k][0][i + 1], points[k][1][i], points[k][1][i + 1])
+                         for k, i in brackets]).reshape(-1, 4).T
+        guess = np.where(where == reach_series, np.nan, linear_crossing(*ends, level))
+        low, high = bisected_crossings(evaluate, ends[0], ends[1], where, above, tolerance, guess)
+        crossing = {(k, i): (lo + hi) / 2 for (k, i), lo, hi in zip(brackets, low, high)}
+        hidden = _hidden_gaps(s, reachable_samples, probed[kept:])
+        kept = len(probed)
+        if hidden is None:
+            break
+        points = [_merged(at, v, hidden[0], hidden[1][:, k]) for k, (at, v) in enumerate(points)]
 
     cases = []
     for k, (j, failed) in enumerate(failed_sets):
@@ -384,6 +400,29 @@ def singular_dips(evaluate, path: Path, minima_at: NDArray, minima: NDArray, ser
     with np.errstate(invalid="ignore"):
         rise = np.fmax(found[:minima.size], found[minima.size:]) - minima  # NaN only where both sides are
         return np.isfinite(minima) & (minima <= rise)
+
+
+def _hidden_gaps(s: NDArray, reachable: NDArray, probed: list) -> tuple[NDArray, NDArray] | None:
+    """The poses the searches evaluated between two reachable samples that have one out of reach among them
+    (with every other pose evaluated between the same two samples, so that each edge lies between two of them):
+    ``(positions, series (m, K + 1))``, or None. Such a stretch out of reach is shorter than the samples' spacing;
+    once one of its poses is known, its edges are located as any other."""
+    if not probed:
+        return None
+    at = np.concatenate([positions for positions, _ in probed])
+    values = np.concatenate([found for _, found in probed])
+    after = np.searchsorted(s, at, side="right")  # the sample after each pose
+    between = (after > 0) & (after < len(s)) & (at > s[np.maximum(after - 1, 0)])
+    between &= reachable[np.maximum(after - 1, 0)] & reachable[np.minimum(after, len(s) - 1)]
+    gaps = np.unique(after[between & np.isnan(values[:, -1])])
+    chosen = between & np.isin(after, gaps)
+    return (at[chosen], values[chosen]) if gaps.size else None
+
+
+def _merged(at: NDArray, v: NDArray, more_at: NDArray, more: NDArray) -> tuple[NDArray, NDArray]:
+    """A series' points with more points inserted in order (after those at the same arc length)."""
+    order = np.argsort(np.concatenate([at, more_at]), kind="stable")
+    return np.concatenate([at, more_at])[order], np.concatenate([v, more])[order]
 
 
 def _local_minima_of_blocks(blocks: list[NDArray]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -466,9 +505,12 @@ def _events(along: SerialPath | GraphPath, path: Path, samples: Indices, unreach
     status = np.asarray(samples.chain_status)
     for start, stop in unreachable:
         inside = np.flatnonzero((s >= start) & (s <= stop) & ~np.asarray(samples.reachable))
-        if not inside.size:
-            continue
-        first, last = int(inside[0]), int(inside[-1])
-        kind, reason = along.unreachable(path.poses[first], status[first])
+        if inside.size:
+            first, last = int(inside[0]), int(inside[-1])
+            kind, reason = along.unreachable(path.poses[first], status[first])
+        else:  # between two samples (found by the searches): the samples either side, why at its middle
+            last = int(np.searchsorted(s, (start + stop) / 2))
+            first, middle = last - 1, path.at(np.array([(start + stop) / 2]))
+            kind, reason = along.unreachable(middle[0], np.asarray(along.indices(middle).chain_status)[0])
         events.append(PathEvent(kind, float(start), float(stop), (first, last), reason))
     return tuple(events)
