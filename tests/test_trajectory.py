@@ -147,6 +147,28 @@ def test_a_branch_change_between_two_samples_is_reported_where_it_happens(name, 
     assert jump == pytest.approx(180.0, abs=0.01)
 
 
+@pytest.mark.parametrize("moved", [False, True])
+def test_a_branch_change_at_a_sample_is_reported_as_between_samples(moved):
+    """The 5-RRR from x = 0.6 to 1.0 m: its chain 1 changes working mode at x = 0.9 (platform joint on base joint),
+    at 0.3 m. With 10 samples that is between two samples; with 9 it is a sample, where the closed form's joint
+    values are not determined (the chain closes only to rounding there, or closes, as rounding has it in another
+    world frame). The change is reported either way, located to the tolerance between the samples either side;
+    it used to be dropped when the sample between did not close (the screen skips a step to a sample that does
+    not close), so that the answer depended on the sampling and on the world frame."""
+    text = bundled_path("planar_5rrr").read_text()
+    if moved:
+        text = moved_in_the_world(text, (0.3, -0.2, 0.5), (0.4, -0.3, 1.1))
+    five = load_text(text, "planar_5rrr.urdf")
+    start, stop = np.array([0.6, 0.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    for samples, between in ((10, (6, 7)), (9, (5, 7))):
+        result = trajectory(five, line_path(five, start, stop, samples))
+        (change,) = [event for event in result.events if event.kind == "branch"]
+        assert "chain 'chain_1' changes working mode: joint 'chain_1_joint_b' jumps" in change.reason
+        assert change.start - 2 * result.tolerance <= 0.3 <= change.stop + 2 * result.tolerance
+        assert change.samples in (between, (6, 7))  # the sample on it closed (by rounding) or not
+        assert all(event.stop - event.start <= result.tolerance for event in result.events)
+
+
 def test_a_fast_but_smooth_turn_near_the_base_joint_is_no_branch_change(five_path):
     """The same 5-RRR path 0.03 m beside b_1: between samples 1 and 2 the actuated joint turns by most of half a
     turn (the screen suspects the segment), but smoothly: the bisection sees the step shrink, and nothing is

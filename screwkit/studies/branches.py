@@ -122,6 +122,22 @@ def suspect_segments(steps: NDArray, lengths: NDArray) -> NDArray[np.bool_]:
     return np.isfinite(miss) & (miss > _row_max(np.abs(predicted)) + STEP_FLOOR)
 
 
+def _bridged(chain: ChainJoints, values: NDArray, arc_length: NDArray) -> list[int]:
+    """The samples where the chain alone does not close between two where it does (a pose exactly where its joint
+    values are not determined: its end on its base joint's axis, the middle of a branch change), whose step
+    across, from the sample before to the one after, is suspect against the segments either side."""
+    finite = np.all(np.isfinite(values), axis=-1)
+    lone = np.flatnonzero(~finite[1:-1] & finite[:-2] & finite[2:]) + 1
+    bridged = []
+    for i in lone:
+        around = np.array([k for k in (i - 2, i - 1, i + 1, i + 2) if 0 <= k < len(finite)])
+        steps = joint_steps(chain, values[around[:-1]], values[around[1:]])
+        across = int(np.flatnonzero(around == i - 1)[0])  # the segment from i - 1 to i + 1
+        if suspect_segments(steps, np.diff(arc_length[around]))[across]:
+            bridged.append(int(i))
+    return bridged
+
+
 def _row_max(values: NDArray) -> NDArray[np.float64]:
     """The maximum of each row (NaN if any is NaN), a column at a time."""
     if values.shape[-1] == 0:
@@ -151,19 +167,20 @@ def branch_changes(chains: Sequence[ChainJoints], length_scale: float, arc_lengt
     """
     tree = _scaled(chains, length_scale, joint_values)
     lengths = np.diff(arc_length)
-    brackets = []  # (chain, segment)
+    brackets = []  # (chain, first sample, last sample)
     for chain, values in enumerate(tree):
         if values.shape[-1] == 0:
             continue
         steps = joint_steps(chains[chain], values[:-1], values[1:])
-        brackets += [(chain, int(i)) for i in np.flatnonzero(suspect_segments(steps, lengths))]
+        brackets += [(chain, int(i), int(i) + 1) for i in np.flatnonzero(suspect_segments(steps, lengths))]
+        brackets += [(chain, i - 1, i + 1) for i in _bridged(chains[chain], values, arc_length)]
     if not brackets:
         return []
-    of = np.array([c for c, _ in brackets])
-    segments = np.array([i for _, i in brackets])
-    low, high = arc_length[segments].astype(float), arc_length[segments + 1].astype(float)
-    left = [tree[c][i] for c, i in brackets]
-    right = [tree[c][i + 1] for c, i in brackets]
+    of = np.array([c for c, _, _ in brackets])
+    segments = np.array([(i, k) for _, i, k in brackets])
+    low, high = arc_length[segments[:, 0]].astype(float), arc_length[segments[:, 1]].astype(float)
+    left = [tree[c][i] for c, i, _ in brackets]
+    right = [tree[c][k] for c, _, k in brackets]
     first = np.array([np.max(np.abs(joint_steps(chains[c], a, b))) for c, a, b in zip(of, left, right)])
     found: list[BranchChange] = []
     jumps: list[int] = []
@@ -176,7 +193,7 @@ def branch_changes(chains: Sequence[ChainJoints], length_scale: float, arc_lengt
             c = of[k]
             value = at_middle[c][row]
             if not np.all(np.isfinite(value)):
-                found.append(BranchChange("closure", int(c), (int(segments[k]), int(segments[k]) + 1),
+                found.append(BranchChange("closure", int(c), (int(segments[k, 0]), int(segments[k, 1])),
                                           float(middle[row]), float(middle[row])))
                 continue
             before = np.max(np.abs(joint_steps(chains[c], left[k], value)))
@@ -193,14 +210,14 @@ def branch_changes(chains: Sequence[ChainJoints], length_scale: float, arc_lengt
             elif largest >= JUMP_SHARE * first[k]:
                 jumps.append(k)
         active = np.array(keep, dtype=np.int64)
-    found += _jumps(chains, length_scale, [(int(of[k]), int(segments[k]), low[k], high[k]) for k in jumps],
-                    solve_at, tolerance, arc_length[-1])
+    found += _jumps(chains, length_scale, [(int(of[k]), tuple(int(i) for i in segments[k]), low[k], high[k])
+                                           for k in jumps], solve_at, tolerance, arc_length[-1])
     return sorted(found, key=lambda change: (change.start, change.chain))
 
 
 def _jumps(chains: Sequence[ChainJoints], length_scale: float, located: list, solve_at: Callable, tolerance: float,
            length: float) -> list[BranchChange]:
-    """The :class:`BranchChange` of each located jump ``(chain, segment, low, high)``: the joint that jumps the
+    """The :class:`BranchChange` of each located jump ``(chain, samples, low, high)``: the joint that jumps the
     most, with its values (rad or m) one ``tolerance`` either side of the bracket (at its ends the pose may be
     the singular one, where the branch is undefined); one batched solve."""
     if not located:
@@ -208,11 +225,11 @@ def _jumps(chains: Sequence[ChainJoints], length_scale: float, located: list, so
     ends = np.array([[low - tolerance, high + tolerance] for _, _, low, high in located]).clip(0.0, length)
     values = _scaled(chains, length_scale, solve_at(ends.reshape(-1)))
     changes = []
-    for row, (chain, segment, low, high) in enumerate(located):
+    for row, (chain, samples, low, high) in enumerate(located):
         left, right = values[chain][2 * row], values[chain][2 * row + 1]
         joint = int(np.argmax(np.abs(joint_steps(chains[chain], left, right))))
         scale = length_scale if chains[chain].prismatic[joint] else 1.0
-        changes.append(BranchChange("branch", chain, (segment, segment + 1), float(low), float(high), joint,
+        changes.append(BranchChange("branch", chain, samples, float(low), float(high), joint,
                                     float(left[joint] * scale), float(right[joint] * scale)))
     return changes
 
