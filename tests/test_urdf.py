@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -166,3 +168,112 @@ def test_bundled_files_load_in_pinocchio_and_yourdfpy(name):
     assert set(robot.joint_map) == set(description.joints)
     assert set(robot.link_map) == set(description.links)
     assert description.loops and description.transmissions
+
+
+NO_LOOP = MINIMAL.format(loops="")
+
+
+def with_arm(joint_type="continuous", inside="", extra="") -> str:
+    """The toy robot with its arm joint of ``joint_type``, ``inside`` added to the joint, ``extra`` to the robot."""
+    document = NO_LOOP.replace('name="arm_joint" type="continuous"', f'name="arm_joint" type="{joint_type}"')
+    document = document.replace('<axis xyz="0 0 2"/>', f'<axis xyz="0 0 2"/>{inside}')
+    return document.replace("</robot>", f"{extra}</robot>")
+
+
+ARM_LIMIT = "<joint name='arm_joint'><limit>"
+
+
+@pytest.mark.parametrize(
+    ("document", "element", "problem"),
+    [
+        (with_arm("revolute"), ARM_LIMIT, "the element is missing: URDF requires <limit effort='...' velocity='...'/> "
+                                          "on a revolute joint"),
+        (with_arm("prismatic"), ARM_LIMIT, "the element is missing: URDF requires <limit effort='...' velocity='...'/> "
+                                           "on a prismatic joint"),
+        (with_arm("revolute", '<limit lower="-3" upper="3"/>'), ARM_LIMIT,
+         "the attributes 'effort' and 'velocity' are missing"),
+        (with_arm("revolute", '<limit lower="-3" upper="3" velocity="1"/>'), ARM_LIMIT,
+         "the attribute 'effort' is missing"),
+        (with_arm("prismatic", '<limit lower="-3" upper="3" effort="1"/>'), ARM_LIMIT,
+         "the attribute 'velocity' is missing"),
+        (with_arm("continuous", '<limit effort="1"/>'), ARM_LIMIT, "the attribute 'velocity' is missing"),
+        (with_arm("revolute", '<limit effort="nan" velocity="1"/>'), ARM_LIMIT,
+         "expected a finite number in 'effort', got 'nan'"),
+        (with_arm("revolute", '<limit effort="1" velocity="-2"/>'), ARM_LIMIT,
+         "expected a number of at least 0 in 'velocity', got '-2'"),
+        (with_arm("continuous", '<limit effort="1" velocity="1" lower="low"/>'), ARM_LIMIT,
+         "expected a finite number in 'lower', got 'low'"),
+        (with_arm("revolute", '<limit effort="1" velocity="1"/><mimic joint="platform_joint" multiplier="2"/>'),
+         "<joint name='arm_joint'><mimic joint='platform_joint'>", "coupled (mimic) joints are not modelled"),
+        (with_arm(extra='<named_pose name="p" x="0" y="0" phi="1e6"/>'), "<named_pose name='p'>",
+         "expected angles of at most 628.319 rad (100 turns) either way, got phi = 1e6"),
+        (with_arm(extra='<named_pose name="q" x="0" y="0" phi="-629"/>'), "<named_pose name='q'>",
+         "expected angles of at most 628.319 rad (100 turns) either way, got phi = -629"),
+    ],
+)
+def test_limits_mimic_repeated_units_and_huge_named_angles_are_refused_naming_the_element(document, element, problem):
+    with pytest.raises(ValueError) as error:
+        parse_urdf(document, "bad.urdf")
+    message = str(error.value)
+    assert message.startswith(f"bad.urdf: {element}: {problem}"), message
+    assert "\n" not in message
+
+
+def test_repeated_units_must_agree():
+    """A repeated <units> that says the same is harmless; one that disagrees is refused (not the last one winning)."""
+    assert parse_urdf(with_arm(extra='<units length="mm"/><units length="mm"/>'), "mm.urdf").length_unit == "mm"
+    for extra, element, before in (('<units length="mm"/><units length="m"/>', "<units length='m'>", "mm"),
+                                   ('<units length="m"/><units length="in"/>', "<units length='in'>", "m")):
+        with pytest.raises(ValueError) as error:
+            parse_urdf(with_arm(extra=extra), "units.urdf")
+        message = str(error.value)
+        assert message == (f"units.urdf: {element}: a second <units> element disagrees with <units length='{before}'> "
+                           "before it; keep one."), message
+        with pytest.raises(ValueError, match="disagrees"):  # even when the caller gives the unit
+            parse_urdf(with_arm(extra=extra), "units.urdf", length_unit="mm")
+
+
+LIMITS = ("", "<limit/>", '<limit effort="1"/>', '<limit velocity="1"/>', '<limit effort="1" velocity="1"/>',
+          '<limit lower="-1" upper="1" effort="1" velocity="1"/>', '<limit upper="1" effort="0" velocity="0"/>',
+          '<limit effort="x" velocity="1"/>', '<limit effort="1" velocity="inf"/>',
+          '<limit effort="1e400" velocity="1"/>', '<limit effort="-1" velocity="1"/>',
+          '<limit effort="1" velocity="-1"/>', '<limit effort="1" velocity="1" lower="a"/>',
+          '<limit effort="1" velocity="1" upper="nan"/>')
+"""<limit> elements urdfdom and Pinocchio read or refuse (effort and velocity required, lower and upper optional)."""
+
+
+@pytest.mark.parametrize("joint_type", ["revolute", "prismatic", "continuous", "fixed"])
+def test_joint_limits_are_refused_exactly_when_pinocchio_refuses_them(joint_type):
+    """The XML pass refuses what urdfdom and Pinocchio refuse (before they print to stderr), and nothing more."""
+    import pinocchio
+
+    for limit in LIMITS:
+        document = with_arm(joint_type, limit)
+        try:
+            pinocchio.buildModelFromXML(document)
+            pinocchio_refuses = False
+        except Exception:
+            pinocchio_refuses = True
+        try:
+            parse_urdf(document, "limits.urdf")
+            screwkit_refuses = False
+        except ValueError as error:
+            screwkit_refuses = True
+            assert str(error).startswith("limits.urdf: <joint name='arm_joint'><limit>: "), str(error)
+        assert screwkit_refuses == pinocchio_refuses, (joint_type, limit)
+
+
+def test_revolute_joint_without_limit_is_refused_before_urdfdom_prints_anything(tmp_path):
+    from helpers import one_line_error, screwkit
+
+    text = bundled_path("planar_5rrr").read_text()
+    joint = '<joint name="chain_1_joint_c" type="continuous">'
+    assert joint in text
+    path = tmp_path / "revolute_nolimit.urdf"
+    path.write_text(text.replace(joint, joint.replace("continuous", "revolute")))
+    expected = f"{path}: <joint name='chain_1_joint_c'><limit>: the element is missing: URDF requires <limit "
+    line = one_line_error(screwkit("analyze", path), expected)
+    assert "joint.cpp" not in line and "Pinocchio" not in line
+    result = screwkit("analyze", path, "--json")  # the error as JSON on stdout, nothing on stderr
+    assert (result.returncode, result.stderr) == (1, "")
+    assert json.loads(result.stdout)["error"].startswith(expected)

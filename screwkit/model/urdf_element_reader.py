@@ -13,6 +13,7 @@ import xml.etree.ElementTree as ElementTree
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.units import MAX_ANGLE_TURNS, angle_limit, is_angular
 from screwkit.model.chain import LOOP_JOINT_DOFS
 from screwkit.model.urdf_description import (
     AXIS_JOINT_TYPES,
@@ -36,15 +37,6 @@ MAX_TREE_DEPTH = 200
 """Most joints between the root link and any link; Pinocchio's URDF parser recurses once per
 level and crashes the process on a stack overflow at a few hundred levels in a thread with a
 small stack (about 230 with 512 KiB, 3,800 with 8 MiB), so deeper trees are refused."""
-
-
-def _lenient_number(element: ElementTree.Element | None, attribute: str) -> float:
-    """A number that screwkit does not use itself (an effort limit): inf when absent or unreadable."""
-    try:
-        value = float(element.get(attribute))
-    except (AttributeError, TypeError, ValueError):
-        return np.inf
-    return value if np.isfinite(value) else np.inf
 
 
 class ElementReader:
@@ -100,7 +92,7 @@ class ElementReader:
             tag = f"<named_pose name='{name}'>"
             if name in named_poses:
                 raise self.fail(tag, "the pose name is used twice.")
-            named_poses[name] = {key: self.number(element, tag, key) for key in element.keys() if key != "name"}
+            named_poses[name] = self.named_pose(element, tag)
         task_coordinates = None
         for element in root.findall("task_coordinates"):
             task_coordinates = tuple(self.required_attribute(element, "<task_coordinates>", "names").split())
@@ -243,14 +235,21 @@ class ElementReader:
         parent, _ = self.link_reference(element, tag, "parent", links)
         child, _ = self.link_reference(element, tag, "child", links)
         axis = self.axis(element, tag, "axis", required=False, meaningful=joint_type in AXIS_JOINT_TYPES)
-        limits = (-np.inf, np.inf)
+        limits, drive_limits = (-np.inf, np.inf), (np.inf, np.inf)
         limit = element.find("limit")
-        if joint_type in ("revolute", "prismatic") and limit is not None:
-            lower = self.number(limit, f"{tag}<limit>", "lower") if limit.get("lower") is not None else -np.inf
-            upper = self.number(limit, f"{tag}<limit>", "upper") if limit.get("upper") is not None else np.inf
-            if lower > upper:
-                raise self.fail(f"{tag}<limit>", f"the lower limit {lower:g} is above the upper limit {upper:g}.")
-            limits = (lower, upper)
+        if limit is not None:
+            limits, drive_limits = self.limit(limit, f"{tag}<limit>", joint_type)
+        elif joint_type in ("revolute", "prismatic"):
+            hint = "; a revolute joint without limits is of type 'continuous'" if joint_type == "revolute" else ""
+            raise self.fail(f"{tag}<limit>",
+                            "the element is missing: URDF requires <limit effort='...' velocity='...'/> "
+                            f"on a {joint_type} joint (lower and upper optional){hint}.")
+        mimic = element.find("mimic")
+        if mimic is not None:
+            mimicked = (mimic.get("joint") or "").strip()
+            raise self.fail(f"{tag}<mimic joint='{mimicked}'>" if mimicked else f"{tag}<mimic>",
+                            "coupled (mimic) joints are not modelled; remove the <mimic> element to analyse the joints "
+                            "as independent.")
         return JointElement(
             name=name,
             type=joint_type,
@@ -259,8 +258,46 @@ class ElementReader:
             origin=self.origin(element, tag),
             axis=np.array([1.0, 0.0, 0.0]) if axis is None else axis,
             limits=limits,
-            drive_limits=(_lenient_number(limit, "effort"), _lenient_number(limit, "velocity")),
+            drive_limits=drive_limits,
         )
+
+    def limit(self, limit: ElementTree.Element, tag: str,
+              joint_type: str) -> tuple[tuple[float, float], tuple[float, float]]:
+        """A joint's ``<limit>``: its position limits (unlimited but on revolute and prismatic joints) and its effort
+        and velocity. As urdfdom (Pinocchio's URDF parser) on every joint type: effort and velocity are required,
+        lower and upper optional, every number finite; as Pinocchio: effort and velocity not negative on the joints
+        it gives them to."""
+        missing = [attribute for attribute in ("effort", "velocity") if not (limit.get(attribute) or "").strip()]
+        if missing:
+            spelled = " and ".join(f"'{attribute}'" for attribute in missing)
+            raise self.fail(tag, f"the attribute{'s' if len(missing) > 1 else ''} {spelled} "
+                                 f"{'are' if len(missing) > 1 else 'is'} missing: URDF requires effort and velocity on "
+                                 "every <limit> (lower and upper are optional).")
+        effort, velocity = self.number(limit, tag, "effort"), self.number(limit, tag, "velocity")
+        lower = self.number(limit, tag, "lower") if limit.get("lower") is not None else -np.inf
+        upper = self.number(limit, tag, "upper") if limit.get("upper") is not None else np.inf
+        if joint_type in ("revolute", "prismatic", "continuous"):
+            for attribute, value in (("effort", effort), ("velocity", velocity)):
+                if value < 0:
+                    raise self.fail(tag, f"expected a number of at least 0 in '{attribute}', got "
+                                         f"{limit.get(attribute).strip()!r} (the largest {attribute} of the joint).")
+        if joint_type not in ("revolute", "prismatic"):
+            return (-np.inf, np.inf), (effort, velocity)
+        if lower > upper:
+            raise self.fail(tag, f"the lower limit {lower:g} is above the upper limit {upper:g}.")
+        return (lower, upper), (effort, velocity)
+
+    def named_pose(self, element: ElementTree.Element, tag: str) -> dict[str, float]:
+        """A ``<named_pose>``'s coordinates: finite numbers, angles within
+        :data:`~screwkit.common.units.MAX_ANGLE_TURNS` turns either way (the coordinates themselves are checked
+        against the mechanism's when it is loaded)."""
+        values = {key: self.number(element, tag, key) for key in element.keys() if key != "name"}
+        largest = angle_limit(degrees=False)
+        for key, value in values.items():
+            if is_angular(key) and abs(value) > largest:
+                raise self.fail(tag, f"expected angles of at most {largest:g} rad ({MAX_ANGLE_TURNS} turns) either "
+                                     f"way, got {key} = {element.get(key).strip()} rad.")
+        return values
 
     def read_loop(self, element: ElementTree.Element, links: set[str]) -> LoopElement:
         """A ``<loop>``: its type, predecessor and successor links with their origins, and axes."""

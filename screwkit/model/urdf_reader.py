@@ -7,7 +7,7 @@ convention (see ``docs/urdf-convention.md``):
 * ``<transmission>`` elements that mark the actuated joints,
 * the optional ``<reference_configuration>`` element (screwkit extension),
 * the optional ``<named_pose>`` elements and ``<units length="mm"/>`` (screwkit extensions),
-* the tree ``<joint>`` elements (names, types, links, origins, axes, limits) and the tree's
+* the tree ``<joint>`` elements (names, types, links, origins, axes, limits; a ``<mimic>`` is refused) and the tree's
   shape: one root link, one parent per link, no cycle.
 
 Lengths: a file written in another unit (``<units length="mm"/>`` or the ``length_unit``
@@ -127,13 +127,19 @@ def parse_urdf(document: str | bytes, source: str = "<string>", *, length_unit: 
 
 
 def _length_unit(root: ElementTree.Element, source: str, given: str | None) -> str:
-    """The document's length unit: ``given``, else ``<units length=...>``, else metres."""
+    """The document's length unit: ``given``, else ``<units length=...>``, else metres (repeated ``<units>`` must
+    agree)."""
     declared = None
     for element in root.findall("units"):
-        declared = (element.get("length") or "").strip()
-        if declared not in LENGTH_UNITS:
-            raise file_error(source, f"<units length='{declared}'>",
+        length = (element.get("length") or "").strip()
+        if length not in LENGTH_UNITS:
+            raise file_error(source, f"<units length='{length}'>",
                              f"unknown length unit; expected one of {', '.join(LENGTH_UNITS)}.")
+        if declared is not None and length != declared:
+            raise file_error(source, f"<units length='{length}'>",
+                             f"a second <units> element disagrees with <units length='{declared}'> before it; "
+                             "keep one.")
+        declared = length
     unit = given if given is not None else (declared or "m")
     if unit not in LENGTH_UNITS:
         raise ValueError(f"Unknown length unit {unit!r}; expected one of {', '.join(LENGTH_UNITS)}.")
