@@ -359,9 +359,18 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
         value = float(solution.joint_values[c][index][joint])
         lower, upper = chain.joint_limits[joint]
         unit = "m" if chain.prismatic[joint] else "rad"
-        parts.append(f"chain {chain.name!r}: joint {chain.joint_names[joint]!r} at {value:.6g} {unit} is outside "
-                     f"its limits [{lower:.6g}, {upper:.6g}]")
+        bound = lower if value < lower else upper
+        parts.append(f"chain {chain.name!r}: joint {chain.joint_names[joint]!r} at {_distinct(value, bound)} {unit} is "
+                     f"outside its limits [{lower:.6g}, {upper:.6g}]")
     return "; ".join(parts)
+
+
+def _distinct(value: float, bound: float) -> str:
+    """``value`` to 6 significant digits, or as many more as tell it from ``bound`` (a joint just past its limit)."""
+    for digits in range(6, 18):
+        if f"{value:.{digits}g}" != f"{bound:.{digits}g}":
+            return f"{value:.{digits}g}"
+    return repr(float(value))
 
 
 def solve_one(mechanism: Mechanism, pose: ArrayLike, **options) -> Solution:
