@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 
-from helpers import assert_indices_close, random_rotation, screwkit
+from helpers import assert_indices_close, one_line_error, random_rotation, screwkit
 from screwkit.io import ImportError_, LegWithLoops, read_gepetto, read_mechanism_file
 from screwkit.io.closed_tree import assemble, joint_kind
 from screwkit.io.loader import bundled_path, load
@@ -158,6 +159,19 @@ def test_a_gepetto_style_urdf_and_yaml_with_open_loops_is_assembled(tmp_path):
     assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
 
 
+def test_a_gepetto_joint_with_a_zero_axis_is_refused_naming_the_file(tmp_path):
+    """Pinocchio reads a URDF revolute joint about the zero vector: refused naming the file and the joint (numpy
+    warnings and "SVD did not converge" before)."""
+    urdf, yaml = five_bar_gepetto()
+    (tmp_path / "robot.urdf").write_text(re.sub(r'(<joint name="free2".*?<axis xyz=")0 0 1', r"\g<1>0 0 0", urdf,
+                                                count=1))
+    (tmp_path / "robot.yaml").write_text(yaml)
+    with pytest.raises(ValueError) as refused:
+        read_mechanism_file(tmp_path / "robot.urdf")
+    assert str(refused.value) == (f"{tmp_path / 'robot.urdf'} + robot.yaml: <joint name='free2'>: the axis is the "
+                                  "zero vector.")
+
+
 def test_a_planar_gepetto_five_bar_is_written_planar_and_non_redundant_gives_zero_fault_tolerance(tmp_path):
     urdf, yaml = five_bar_gepetto(legs=2)
     (tmp_path / "robot.urdf").write_text(urdf)
@@ -198,6 +212,91 @@ def test_a_number_mujoco_cannot_read_is_refused_naming_the_element(tmp_path, old
     path.write_text(text_)
     with pytest.raises(ValueError, match=f"bad.xml: {re.escape(element)}.*expected \\d finite number"):
         load(path)
+
+
+A_1 = '<joint name="a_1" type="hinge" axis="0.0 0.0 1.0"/>'
+FLAT = '<compiler angle="radian"/><default><default class="flat"><joint axis="0 0 0"/></default></default>'
+
+
+@pytest.mark.parametrize("old, new, element, problem", [
+    ('name="b_2"', 'name="b_1"', "<joint name='b_1'>", "the joint name is used twice."),
+    ('name="distal_2"', 'name="distal_1"', "<body name='distal_1'>", "the body name is used twice."),
+    ('name="base"', 'name="world"', "<body name='world'>",
+     "the body name is used twice (MuJoCo's world body is named 'world')."),
+    ('<site name="effector"', '<site name="effector"/><site name="effector"', "<site name='effector'>",
+     "the site name is used twice."),
+    ('name="loop_3"', 'name="loop_2"', "<connect name='loop_2'>", "the equality name is used twice."),
+    ('name="m_2"', 'name="m_1"', "<motor name='m_1'>", "the actuator name is used twice."),
+    (A_1, '<joint name="a_1" type="hinge" axis="0 0 0"/>', "<joint name='a_1'>",
+     "the axis is the zero vector (axis='0 0 0')."),
+    (A_1, '<joint name="a_1" type="slide" axis="0 1e-8 0"/>', "<joint name='a_1'>",
+     "the axis is the zero vector (axis='0 1e-8 0'; MuJoCo refuses lengths up to 1e-07)."),
+    (A_1, '<joint name="a_1" type="hinge" class="flat"/>', "<joint name='a_1'>",
+     "the axis is the zero vector (axis='0 0 0')."),
+    (A_1, '<joint name="a_1" type="hinge" axis="0 0 1" range="0.1 -0.1" limited="true"/>', "<joint name='a_1'>",
+     "range='0.1 -0.1' on a limited joint: the lower limit must be below the upper."),
+    ('<compiler angle="radian"/>', '<compiler angle="radian"/><default><joint limited="true"/></default>',
+     "<joint name='a_1'>", "range='0 0' on a limited joint: the lower limit must be below the upper."),
+    ('<compiler angle="radian"/>', '<compiler angle="radian" autolimits="false"/><default><joint range="-1 1"/>'
+     '</default>', "<joint name='a_1'>", "range='-1 1' without limited='true' or 'false', under <compiler "
+     "autolimits='false'>: limited or not?"),
+    (A_1, '<joint name="a_1" type="ball" range="0.5 1"/>', "<joint name='a_1'>",
+     "range='0.5 1' on a limited ball joint: the first number must be 0 (the second is the largest angle)."),
+])
+def test_a_joint_name_or_range_mujoco_refuses_is_refused_naming_the_element(tmp_path, old, new, element, problem):
+    """Names repeated in one of MuJoCo's namespaces (Pinocchio would merge two joints into one: wrong indices), a
+    zero axis (a hinge about nothing), a limited joint's range that is no interval: MuJoCo refuses the file, so
+    does screwkit, in one line naming the element."""
+    import mujoco
+
+    text_ = five_bar_mjcf().replace(old, new, 1).replace('<compiler angle="radian"/>',
+                                                        FLAT if "flat" in new else '<compiler angle="radian"/>')
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text_)
+    path = tmp_path / "bad.xml"
+    path.write_text(text_)
+    with pytest.raises(ValueError) as refused:
+        load(path)
+    assert str(refused.value) == f"{path}: {element}: {problem}"
+
+
+def test_a_range_mujoco_does_not_apply_is_not_read_as_limits(tmp_path):
+    """``limited="false"`` (and, with autolimits, a range that is no interval) leaves a joint free in MuJoCo;
+    Pinocchio would read the range as limits (here the reference assembly outside them: refused)."""
+    import mujoco
+
+    for attributes in ('range="0.001 1" limited="false"', 'range="1 0.001"'):
+        path = tmp_path / "free.xml"
+        path.write_text(five_bar_mjcf().replace(A_1, f'<joint name="a_1" type="hinge" axis="0 0 1" {attributes}/>'))
+        assert not mujoco.MjModel.from_xml_path(str(path)).jnt_limited.any()
+        converted, report = read_mechanism_file(path)
+        assert any("range not applied" in note and "a_1" in note for note in report.notes), report.notes
+        assert re.search(r'<joint name="a_1" type="continuous"', converted), converted
+        points = poses_near_home()
+        assert_textbook(indices_at_poses(load(path), points, detail=True), points)
+
+
+@pytest.mark.parametrize("old, new, element, problem", [
+    ('name="r_xb_rod1"', 'name="r_xb1"', "<joint name='r_xb1'>", "the joint name is used twice."),
+    ('axis="0.576369848528 -0.817188960833 0"', 'axis="0 0 0"', "<joint name='r_xb1'>", "the axis is the zero "
+     "vector"),
+    ('axis="-0.250022039445 -0.176342525304 0.952046371539" range="-0.1 0.1"', 'axis="0 0 0" range="-0.1 0.1"',
+     "<joint name='s1'>", "the axis is the zero vector"),
+    ('range="-0.1 0.1"', 'range="0.1 -0.1"', "<joint name='s1'>", "range='0.1 -0.1' on a limited joint"),
+])
+def test_the_command_refuses_a_cad_export_mujoco_refuses_in_one_line(tmp_path, old, new, element, problem):
+    """The published Stewart platform's CAD export with one joint renamed to another's name (screwkit read it with
+    one joint dropped: LMTI 0.4035 instead of 0.4233), a zero axis (numpy warnings, then "SVD did not converge"),
+    an inverted range on a limited slide (the limit ignored)."""
+    import mujoco
+
+    source = (Path(__file__).resolve().parent / "data" / "gallery" / "stewart_cad.xml").read_text()
+    assert old in source
+    path = tmp_path / "stewart_cad.xml"
+    path.write_text(source.replace(old, new, 1))
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_path(str(path))
+    one_line_error(screwkit("analyze", path), f"{path}: {element}: {problem}")
 
 
 def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_for(tmp_path):

@@ -151,6 +151,8 @@ def joint_kind(model, joint: int) -> tuple[str, NDArray | None]:
                          ("JointModelPrismatic", "prismatic")):
         if name.startswith(prefix):
             axis = np.asarray(joint_model.extract().axis, dtype=float)
+            if not np.linalg.norm(axis) > 0.0:  # refused where the source is known (assemble); a net here
+                raise ImportError_(f"<joint name='{model.names[joint]}'>: the axis is the zero vector.")
             return kind, axis / np.linalg.norm(axis)
     for prefix, kind in (("JointModelRUB", "revolute"), ("JointModelR", "revolute"), ("JointModelP", "prismatic")):
         if name.startswith(prefix) and name[-1] in "XYZ" and len(name) == len(prefix) + 1:
@@ -216,7 +218,11 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
     scale = _length_scale(model, data)
     prismatic = np.zeros(model.nv, dtype=bool)
     for joint in range(1, model.njoints):
-        if joint_kind(model, joint)[0] == "prismatic":
+        try:
+            kind = joint_kind(model, joint)[0]
+        except ImportError_ as error:  # a zero axis (a Gepetto URDF read by Pinocchio): the file named
+            raise ImportError_(f"{tree.source}: {error}") from None
+        if kind == "prismatic":
             prismatic[model.joints[joint].idx_v] = True
     unit = np.where(prismatic, scale, 1.0)
 

@@ -16,6 +16,10 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
   cameras, lights, sensors, tendons, contacts (a mechanism's bodies, joints, sites, inertias and closures are
   all that is read).
 
+What MuJoCo refuses of what is read is refused, naming the element: numbers that are not (or not as many as the
+attribute holds), a name twice in one namespace, a hinge or slide axis of zero length, a limited joint's range
+that is no interval. A range MuJoCo does not apply (``limited="false"``...) is dropped: Pinocchio would apply it.
+
 :func:`closure_placements` then gives each equality the frames MuJoCo constrains, from the bodies and sites
 of the tree Pinocchio built: a ``weld`` with a ``relpose`` holds body2 at that pose in body1's frame (without
 one, the pose they have at ``qpos0``); a ``connect`` holds body1's ``anchor`` on body2 at the point where it
@@ -45,6 +49,11 @@ NUMBER_COUNTS = {"pos": (3,), "quat": (4,), "axis": (3,), "euler": (3,), "axisan
                  "gear": (1, 2, 3, 4, 5, 6)}
 """How many numbers each attribute that places a body, a joint or a closure holds (MuJoCo refuses the file
 otherwise; a reader that took the numbers it could would place the mechanism somewhere else)."""
+NAMESPACES = {"body": "body", "joint": "joint", "freejoint": "joint", "site": "site"}
+SECTION_NAMESPACES = {"equality": "equality", "actuator": "actuator", "keyframe": "key"}
+"""MuJoCo's namespaces that screwkit reads: a name twice in one is refused (by MuJoCo too)."""
+MIN_AXIS = 1e-7
+"""Length of a hinge or slide axis up to which MuJoCo refuses it ("axis too small")."""
 
 
 class MjcfError(ValueError):
@@ -91,26 +100,40 @@ def _merged(root: ElementTree.Element, tag: str) -> ElementTree.Element | None:
     return found[0] if found else None
 
 
-def _class_joint_types(root: ElementTree.Element) -> dict[str, str]:
-    """The joint type each default class gives (inherited from enclosing classes; MuJoCo's default: hinge)."""
-    types: dict[str, str] = {}
+def _class_joints(root: ElementTree.Element) -> dict[str, dict[str, str]]:
+    """The joint attributes each default class gives (inherited from enclosing classes; MuJoCo's default: hinge)."""
+    classes: dict[str, dict[str, str]] = {}
 
-    def visit(default: ElementTree.Element, inherited: str) -> None:
-        name = default.get("class", "main")
+    def visit(default: ElementTree.Element, inherited: dict[str, str]) -> None:
         joint = default.find("joint")
-        kind = joint.get("type", inherited) if joint is not None else inherited
-        types[name] = kind
+        attributes = {**inherited, **(joint.attrib if joint is not None else {})}
+        classes[default.get("class", "main")] = attributes
         for child in default.findall("default"):
-            visit(child, kind)
+            visit(child, attributes)
 
     for top in root.findall("default"):
-        visit(top, "hinge")
-    return types
+        visit(top, {"type": "hinge"})
+    return classes
+
+
+def _joints(root: ElementTree.Element):
+    """Every ``<joint>`` of the tree and its attributes, class defaults (``class``, ``childclass``) included."""
+    classes = _class_joints(root)
+
+    def visit(element: ElementTree.Element, childclass: str):
+        childclass = element.get("childclass", childclass)
+        for child in element:
+            if child.tag == "joint":
+                yield child, {**classes.get(child.get("class") or childclass, {"type": "hinge"}), **child.attrib}
+            yield from visit(child, childclass)
+
+    for world in root.findall("worldbody"):
+        yield from visit(world, "main")
 
 
 def _to_radians(root: ElementTree.Element) -> int:
     """Every angle of a file in degrees, in radians; returns how many attributes changed."""
-    classes = _class_joint_types(root)
+    classes = {name: attributes["type"] for name, attributes in _class_joints(root).items()}
     changed = 0
 
     def scale(element: ElementTree.Element, attribute: str, which=slice(None)) -> None:
@@ -166,6 +189,66 @@ def _check_numbers(root: ElementTree.Element, path: Path) -> None:
                                 "number(s).")
 
 
+def _check_names(root: ElementTree.Element, path: Path) -> None:
+    """No name twice in one of MuJoCo's namespaces that screwkit reads (MuJoCo refuses the file; Pinocchio would
+    merge two joints into one, or take either of two bodies, sites, closures or keyframes)."""
+    seen: dict[str, set[str]] = {"body": {"world"}}  # MuJoCo's world body
+
+    def claim(element: ElementTree.Element, space: str) -> None:
+        name = element.get("name")
+        if not name:
+            return
+        if name in seen.setdefault(space, set()):
+            world = " (MuJoCo's world body is named 'world')" if (space, name) == ("body", "world") else ""
+            raise MjcfError(f"{path}: <{element.tag} name='{name}'>: the {space} name is used twice{world}.")
+        seen[space].add(name)
+
+    for world in root.findall("worldbody"):
+        for element in world.iter():
+            if element.tag in NAMESPACES:
+                claim(element, NAMESPACES[element.tag])
+    for section, space in SECTION_NAMESPACES.items():
+        for parent in root.findall(section):
+            for element in parent:
+                claim(element, space)
+
+
+def _check_joints(root: ElementTree.Element, path: Path, autolimits: bool) -> list[str]:
+    """The joints' axes and ranges, refused where MuJoCo refuses them; a range MuJoCo does not apply
+    (``limited="false"``; with autolimits, one that is no interval) is dropped, since Pinocchio would apply it.
+    Returns the joints whose range was dropped."""
+    dropped = []
+    for joint, attributes in _joints(root):
+        name = joint.get("name")
+        tag = f"<joint name='{name}'>" if name else "<joint>"
+        kind = attributes.get("type", "hinge")
+        if kind not in ("hinge", "slide", "ball"):
+            continue
+        axis = attributes.get("axis", "0 0 1")
+        length = math.hypot(*(float(word) for word in axis.split()))
+        if kind != "ball" and length <= MIN_AXIS:
+            small = "" if length == 0.0 else f"; MuJoCo refuses lengths up to {MIN_AXIS:g}"
+            raise MjcfError(f"{path}: {tag}: the axis is the zero vector (axis='{axis}'{small}).")
+        limited, text = attributes.get("limited", "auto"), attributes.get("range", "0 0")
+        low, high = (float(word) for word in text.split())
+        if limited not in ("true", "false", "auto"):
+            raise MjcfError(f"{path}: {tag}: limited='{limited}': expected true, false or auto.")
+        if limited == "auto" and not autolimits and (low, high) != (0.0, 0.0):
+            raise MjcfError(f"{path}: {tag}: range='{text}' without limited='true' or 'false', under <compiler "
+                            "autolimits='false'>: limited or not?")
+        applied = limited == "true" or (limited == "auto" and autolimits and low < high)
+        if applied and kind == "ball" and low != 0.0:
+            raise MjcfError(f"{path}: {tag}: range='{text}' on a limited ball joint: the first number must be 0 "
+                            "(the second is the largest angle).")
+        if applied and kind != "ball" and low >= high:
+            raise MjcfError(f"{path}: {tag}: range='{text}' on a limited joint: the lower limit must be below the "
+                            "upper.")
+        if not applied and (low, high) != (0.0, 0.0):
+            joint.set("range", "0 0")  # Pinocchio reads lower == upper: no limits (screwkit.io.star)
+            dropped.append(name or "?")
+    return dropped
+
+
 def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     """The text of an MJCF file as Pinocchio should read it, what was changed, and its element tree."""
     path = Path(path)
@@ -187,6 +270,11 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
             if child.tag in NOT_KINEMATICS:
                 parent.remove(child)
     _check_numbers(root, path)
+    _check_names(root, path)
+    dropped = _check_joints(root, path, compiler.get("autolimits", "true") == "true")
+    if dropped:
+        notes.append(f"range not applied, as MuJoCo does not (limited='false', or not an interval): "
+                     f"{', '.join(dropped)}")
     if compiler.get("angle", "degree") == "degree":
         count = _to_radians(root)
         if count:
@@ -210,11 +298,14 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
             notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
                          "held in one, 'screwkit_world', at the origin")
     equality = _merged(root, "equality")
-    unnamed = 0
+    unnamed, taken = 0, {element.get("name") for element in ([] if equality is None else equality)}
     for element in ([] if equality is None else list(equality)):
         if element.tag in ("connect", "weld") and not element.get("name"):
             unnamed += 1
-            element.set("name", f"{element.tag}_{unnamed}")
+            name = f"{element.tag}_{unnamed}"
+            while name in taken:  # a closure of the file has that name
+                name = f"{name}_"
+            element.set("name", name)
     if unnamed:
         notes.append(f"{unnamed} unnamed closure(s) named in file order (connect_1, weld_1, ...)")
     _merged(root, "actuator")
