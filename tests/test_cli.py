@@ -104,13 +104,25 @@ def test_mechanism_placed_and_tilted_in_space_gives_the_same_indices(tmp_path, r
     (("analyze", "planar_9rrr"), "Unknown bundled mechanism 'planar_9rrr'; bundled are: coop_arms, delta_4"),
     (("analyze", "planar_5rrr", "--pose", "0", "0"),
      "Expected --pose with 3 values (x (m), y (m), phi (deg)) or a named pose (home, paper_fig_2a)"),
-    (("analyze", "planar_5rrr", "--pose", "0", "nan", "0"), "Expected finite values in `poses`, got nan"),
+    (("analyze", "planar_5rrr", "--pose", "0", "nan", "0"), "Expected finite values in --pose, got nan for y."),
+    (("analyze", "planar_5rrr", "--actuators", "1e20", "0", "0", "0", "0"),  # was the pose of 0 deg, 1e20 rounded
+     "Expected angles of at most 36000 deg (100 turns) either way in --actuators (chain_1:chain_1_joint_b), got "
+     "1e+20 deg."),
+    (("analyze", "planar_5rrr", "--actuators", "0", "0", "-1e300", "0", "0"),
+     "either way in --actuators (chain_3:chain_3_joint_b), got -1e+300 deg."),
+    (("analyze", "planar_5rrr", "--actuators", "inf", "0", "0", "0", "0"),
+     "Expected finite values after --actuators, got inf for chain_1:chain_1_joint_b."),
+    (("analyze", "planar_5rrr", "--actuators", "0", "nan", "0", "0", "0"),
+     "Expected finite values after --actuators, got nan for chain_2:chain_2_joint_b."),
     (("analyze", "planar_5rrr", "--pose", "0", "x", "0"), "Expected numbers or a named pose after --pose, got '0 x 0'"),
     (("analyze", "planar_5rrr", "--pose", "paper_fig_9"), "Unknown pose 'paper_fig_9' of mechanism 'planar_5rrr'"),
     (("analyze", "planar_5rrr", "--pose", "5", "0", "0"),  # the chain that misses the most first
      "is unreachable for mechanism 'planar_5rrr': chain 'chain_3' misses closure by 3.86066 m; chain 'chain_4'"),
     (("sweep", "planar_5rrr", "--phi", "0:360"), "Expected --phi as START:STOP:STEP"),
     (("map", "planar_5rrr", "--radius", "0.3"), "A planar map takes --radius and --step"),
+    (("map", "planar_5rrr", "--radius", "0.1"), "A planar map takes --radius and --step (and --phi-step): --step is "
+                                                "missing."),
+    (("map", "planar_5rrr", "--step", "0.1"), "(and --phi-step): --radius is missing."),
     (("map", "planar_5rrr", "--radius", "0.3", "--step", "0.1", "--phi-step", "400"), "Expected 0 < --phi-step <= 360"),
 ])
 def test_bad_input_is_one_line(arguments, message):

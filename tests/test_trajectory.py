@@ -19,7 +19,15 @@ from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.actuator_paths import path_from_actuators, read_actuator_path
 from screwkit.studies.branches import chain_joints, joint_steps, suspect_segments
 from screwkit.studies.options import AnalysisOptions
-from screwkit.studies.paths import PathFileError, circle_path, line_path, path_from_poses, read_path, through_path
+from screwkit.studies.paths import (
+    PathFileError,
+    checked_tolerance,
+    circle_path,
+    line_path,
+    path_from_poses,
+    read_path,
+    through_path,
+)
 from screwkit.studies.trajectory import failure_weights, trajectory
 
 FIG_4 = np.array([0.0, 0.0, 0.0])
@@ -466,6 +474,33 @@ def test_generated_paths():
         path_from_poses(five, np.zeros((3, 3)))
 
 
+def test_a_path_of_rounding_or_overflowing_length_is_refused():
+    """A circle of two samples is a 'path' of 2.4e-17 m (sin 2 pi rounded); ends 1e308 m apart, an infinite arc
+    length: both were run (the second with overflow warnings, 'UNREACHABLE from inf m to inf m')."""
+    five = bundled("planar_5rrr")
+    with pytest.raises(ValueError, match=r"every pose of the path is the same to rounding \(a length of 2.45e-17 m"):
+        circle_path(five, five.home_pose, 0.1, 2)
+    with np.errstate(all="raise"):  # refused without a warning of the arithmetic
+        for start, stop in (([0, 0, 0], [1e308, 0, 0]), ([-1e308, 0, 0], [1e308, 0, 0])):
+            with pytest.raises(ValueError, match=r"Expected a path of finite length, got poses so far apart"):
+                line_path(five, start, stop, 201)
+    assert line_path(five, [0.1, 0, 0], [0.1 + 1e-12, 0, 0], 2).length == pytest.approx(1e-12, rel=1e-3)
+
+
+def test_the_tolerance_is_one_the_refinement_can_honour():
+    """1e-15 m on a 1.87 m path is below the rounding of its arc length (a singular point was lost), 10 m above the
+    path's length (false singular points); a path shorter than the default tolerance gets a thousandth of it."""
+    five = bundled("planar_5rrr")
+    path = line_path(five, START, STOP, 3)
+    for tolerance, shown in ((1e-15, "1e-15"), (path.length, f"{path.length:g}"), (10.0, "10"), (np.nan, "nan")):
+        with pytest.raises(ValueError, match=rf"Expected `tolerance` from 1.43e-14 m \(the rounding of the arc "
+                                             rf"length\) to below the path's length, 1.86672 m, got {shown}.$"):
+            trajectory(five, path, tolerance=tolerance)
+    assert checked_tolerance(path, 1.43e-14) == 1.43e-14
+    short = trajectory(five, line_path(five, [0, 0, 0], [1e-7, 0, 0], 3))
+    assert short.tolerance == pytest.approx(1e-10, rel=1e-12)
+
+
 BAD_FILES = {
     "missing.csv": (None, "missing.csv: no such file."),
     "columns.csv": ("x,y,theta\n0,0,0\n0.1,0,0\n", "no column 'phi'; a path of 'planar_5rrr' has columns x, y, phi"),
@@ -473,14 +508,36 @@ BAD_FILES = {
     "one.csv": ("x,y,phi\n0,0,0\n", "1 sample(s); a path needs at least 2."),
     "times.csv": ("t,x,y,phi\n0,0,0,0\n0,0.1,0,0\n", "Expected finite, increasing times along the path."),
     "path.txt": ("x,y,phi\n0,0,0\n", "a path file must end in .csv or .nc, got '.txt'."),
+    "doubled.csv": ("x,y,phi,x\n-0.1,0,0,5\n0.1,0.05,10,6\n",
+                    "column 'x' is in the header 2 times (columns 1, 4); give each column once."),
+    "turns.csv": ("x,y,phi\n0,0,0\n0,0,40000\n",
+                  "Expected angles of at most 36000 deg (100 turns) either way in column 'phi' (sample 1), got "
+                  "40000 deg."),
+    "still.csv": ("x,y,phi\n0.1,0,0\n0.10000000000000002,0,0\n", "every pose of the path is the same to rounding"),
+    "huge.csv": ("x,y,phi\n0,0,0\n1e200,0,0\n", "Expected a path of finite length, got poses so far apart"),
+    "lengths.nc": ({"x": ("a", [0.0, 0.1, 0.2]), "y": ("b", [0.0, 0.01, 0.02, 0.03]), "phi": ("a", [0.0, 1.0, 2.0])},
+                   "variables of different lengths ('x' 3, 'y' 4, 'phi' 3 samples); a path has one value of each"),
+    "units.nc": ({"x": ("s", [0.0, 0.1]), "y": ("s", [0.0, 0.0], {"units": "furlong"}), "phi": ("s", [0.0, 1.0])},
+                 "variable 'y' has units 'furlong'; expected a length unit (m, dm, cm, mm, um, km, in, ft), or no"),
+    "grad.nc": ({"x": ("s", [0.0, 0.1]), "y": ("s", [0.0, 0.0]), "phi": ("s", [0.0, 1.0], {"units": "grad"})},
+                "variable 'phi' has units 'grad'; expected deg or rad (an angle; or degrees, radians), or no units."),
 }
+
+
+def _write_path_file(folder, name: str, contents) -> None:
+    """A path file of BAD_FILES: the text of a CSV file, or the variables of a netCDF file."""
+    if isinstance(contents, dict):
+        import xarray as xr
+
+        xr.Dataset(contents).to_netcdf(folder / name, engine="scipy")
+    elif contents is not None:
+        (folder / name).write_text(contents)
 
 
 @pytest.mark.parametrize("name", BAD_FILES)
 def test_a_bad_path_file_is_one_line_naming_it(tmp_path, name):
     text, message = BAD_FILES[name]
-    if text is not None:
-        (tmp_path / name).write_text(text)
+    _write_path_file(tmp_path, name, text)
     with pytest.raises(PathFileError) as error:
         read_path(bundled("planar_5rrr"), tmp_path / name)
     assert str(error.value).startswith(str(tmp_path / name)) and message in str(error.value)
@@ -496,14 +553,66 @@ def test_a_path_file_reads_in_degrees_with_times(tmp_path):
     np.testing.assert_allclose(path.time_at([path.length / 2]), [1.0])
 
 
-@pytest.mark.parametrize("name", ["missing.csv", "columns.csv", "nan.csv", "one.csv"])
+def test_a_path_file_in_the_units_it_names_or_with_a_byte_order_mark_is_the_plain_csv(tmp_path):
+    """A netCDF variable in radians was read as degrees, one in mm as metres; an Excel CSV's byte-order mark made
+    its first column unknown."""
+    import xarray as xr
+
+    five = bundled("planar_5rrr")
+    (tmp_path / "plain.csv").write_text("t,x,y,phi\n0,-0.1,0,0\n2,0.1,0.05,10\n")
+    expected = read_path(five, tmp_path / "plain.csv")
+    (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.csv").read_bytes())
+    for x, y, phi, t in ((("m", [-0.1, 0.1]), ("metres", [0.0, 0.05]), ("radians", [0.0, np.deg2rad(10)]), "s"),
+                         (("mm", [-100.0, 100.0]), ("cm", [0.0, 5.0]), ("Degrees", [0.0, 10.0]), "seconds"),
+                         (("", [-0.1, 0.1]), ("", [0.0, 0.05]), ("rad", [0.0, np.deg2rad(10)]), "")):
+        variables = {name: ("s", values, {"units": unit} if unit else {}) for name, (unit, values) in
+                     zip(("x", "y", "phi"), (x, y, phi))}
+        xr.Dataset(variables, coords={"t": ("s", [0.0, 2.0], {"units": t} if t else {})}).to_netcdf(
+            tmp_path / f"{x[0] or 'none'}.nc", engine="scipy")
+        read = read_path(five, tmp_path / f"{x[0] or 'none'}.nc")
+        np.testing.assert_allclose(read.poses, expected.poses, rtol=1e-15, atol=1e-17)
+        np.testing.assert_array_equal(read.times, expected.times)
+    np.testing.assert_array_equal(read_path(five, tmp_path / "bom.csv").poses, expected.poses)
+    for name in ("mm.nc", "bom.csv"):
+        done = screwkit("trajectory", "planar_5rrr", tmp_path / name, "--json", "--level", "0.99")
+        assert done.returncode == 0, done.stderr
+        assert json.loads(done.stdout)["length_m"] == pytest.approx(expected.length, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["missing.csv", "columns.csv", "nan.csv", "one.csv", "doubled.csv", "turns.csv",
+                                  "still.csv", "huge.csv", "lengths.nc", "units.nc", "grad.nc"])
 def test_the_command_refuses_a_bad_path_file_in_one_line(tmp_path, name):
     text, message = BAD_FILES[name]
-    if text is not None:
-        (tmp_path / name).write_text(text)
+    _write_path_file(tmp_path, name, text)
     one_line_error(screwkit("trajectory", "planar_5rrr", tmp_path / name, "--out", tmp_path / "out.nc"),
                    str(tmp_path / name), message)
     assert not (tmp_path / "out.nc").exists()
+    if name == "lengths.nc":  # with --json, the same line as JSON on stdout
+        done = screwkit("trajectory", "planar_5rrr", tmp_path / name, "--json")
+        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+        assert message in json.loads(done.stdout)["error"]
+
+
+LINE = ("--line", "-0.3", "-0.2", "-45", "0.3", "0.2", "45", "--samples", "41")
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (("--circle", "home", "0.1", "--samples", "2"),
+     "every pose of the path is the same to rounding (a length of 2.45e-17"),
+    (("--line", "0", "0", "0", "1e308", "0", "0"), "Expected a path of finite length, got poses so far apart"),
+    (("--line", "0", "0", "0", "nan", "0", "0"), "Expected finite values in --line's second pose, got nan for x."),
+    (("--through", "0", "0", "0", "0.1", "0", "0", "0.1", "inf", "0"),
+     "Expected finite values in --through's pose 3, got inf for y."),
+    (("--circle", "0", "0", "nan", "0.1"), "Expected finite values in --circle's centre, got nan for phi."),
+    (("--circle", "0", "0", "0"), "Expected --circle with the centre's 3 task coordinates (x (m), y (m), phi (deg)) "
+                                  "then the radius (m), 4 numbers, got 3 (no radius): 0 0 0."),
+    (("--circle", "home", "nan"), "Expected --circle's radius > 0 (m), got nan."),
+    ((*LINE, "--tolerance", "1e-15"), "Expected --tolerance from 1.43e-14 m (the rounding of the arc length) to below "
+                                      "the path's length, 1.86672 m, got 1e-15."),
+    ((*LINE, "--tolerance", "10"), "to below the path's length, 1.86672 m, got 10."),
+])
+def test_the_command_refuses_a_path_or_tolerance_it_cannot_use_in_one_line(arguments, message):
+    one_line_error(screwkit("trajectory", "planar_5rrr", *arguments), message)
 
 
 def test_the_command_writes_the_path_its_summary_and_figure(tmp_path):
@@ -580,6 +689,27 @@ def test_a_path_in_actuator_values_is_the_path_of_the_poses_they_drive(tmp_path)
     values[7, 2] += 1.0  # chain 3 one degree off at sample 7: no pose gives all five
     with pytest.raises(ValueError, match="^sample 7: no pose near the previous sample's gives the actuator values"):
         path_from_actuators(five, np.deg2rad(values))
+    untimed = "\n".join(line.split(",", 1)[1] for line in file.read_text().splitlines())  # chain_1 first
+    (tmp_path / "bom.csv").write_text("\ufeff" + untimed, encoding="utf-8")  # Excel's byte-order mark, skipped
+    np.testing.assert_array_equal(read_actuator_path(five, tmp_path / "bom.csv").poses, driven.poses)
+
+
+def test_actuator_values_of_more_than_a_hundred_turns_are_refused(tmp_path):
+    """1e20 deg was taken for the angle it rounds to (a double cannot tell one turn of it from the next)."""
+    five = bundled("planar_5rrr")
+    values = np.zeros((3, 5))
+    values[1, 2] = 1e20
+    with pytest.raises(ValueError, match=r"at most 628.319 rad \(100 turns\) either way in actuator values "
+                                         r"\(chain_3:chain_3_joint_b, sample 1\), got 1e\+20 rad.$"):
+        path_from_actuators(five, values)
+    np.savetxt(tmp_path / "far.csv", values, delimiter=",", header="chain_1,chain_2,chain_3,chain_4,chain_5",
+               comments="")
+    message = ("Expected angles of at most 36000 deg (100 turns) either way in column 'chain_3' (sample 1), got "
+               "1e+20 deg.")
+    with pytest.raises(PathFileError, match=r"far.csv: Expected angles"):
+        read_actuator_path(five, tmp_path / "far.csv")
+    one_line_error(screwkit("trajectory", "planar_5rrr", tmp_path / "far.csv", "--actuators"),
+                   f"{tmp_path / 'far.csv'}: {message}")
 
 
 def test_the_command_takes_a_path_through_poses_or_in_actuator_values(tmp_path):

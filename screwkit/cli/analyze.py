@@ -129,6 +129,11 @@ def pose_from_actuators(mechanism, text: str, start):
         raise fail(f"Expected --actuators with {len(names)} values (one per actuator: {', '.join(names)}), "
                    f"got {len(values)}.")
     positions = mechanism.actuator_positions()
+    for name, value, (c, k) in zip(names, values, positions):  # as --pose: finite, angles within 100 turns
+        if not np.isfinite(value):
+            raise fail(f"Expected finite values after --actuators, got {value} for {name}.")
+        if not mechanism.chains[c].prismatic[k] and abs(value) > angle_limit(degrees=True):
+            raise fail(str(angle_beyond_limit(f"--actuators ({name})", value, degrees=True)))
     values = [value if mechanism.chains[c].prismatic[k] else float(np.deg2rad(value))
               for value, (c, k) in zip(values, positions)]
     solution = forward(mechanism, values, start)

@@ -61,8 +61,11 @@ class MapArea:
     def check(self) -> None:
         """The options that go together, before the mechanism is loaded."""
         if self.planar:
-            if self.radius is None or self.step is None or self.grids or self.overs:
+            if self.grids or self.overs:
                 raise fail("A planar map takes --radius and --step (and --phi-step), not --grid/--over.")
+            if self.radius is None or self.step is None:
+                raise fail(f"A planar map takes --radius and --step (and --phi-step): "
+                           f"{'--radius' if self.radius is None else '--step'} is missing.")
             if not 0 < self.phi_step <= 360:
                 raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {self.phi_step:g}.")
         elif len(self.grids) != 2:

@@ -451,6 +451,9 @@ def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarra
         named = f" or a named pose ({', '.join(mechanism.named_poses)})" if mechanism.named_poses else ""
         raise fail(f"Expected {option} with {mechanism.n_task} values ({units}){named} for mechanism "
                    f"{mechanism.name!r}, got {len(numbers)}: {text}.")
+    for word, number, name in zip(words, numbers, mechanism.task_coordinates):  # named as given on the line
+        if not np.isfinite(number):
+            raise fail(f"Expected finite values in {option}, got {word} for {name}.")
     try:
         return mechanism.poses_from_degrees(numbers)
     except ValueError as error:

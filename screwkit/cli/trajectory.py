@@ -28,7 +28,7 @@ from screwkit.cli.options import (
 from screwkit.model import Mechanism
 from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import wide_table, write_dataset
-from screwkit.studies.paths import PathFileError, circle_path, line_path, read_path, through_path
+from screwkit.studies.paths import PathFileError, checked_tolerance, circle_path, line_path, read_path, through_path
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
 __all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions", "line_option",
@@ -37,16 +37,19 @@ __all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "Fault
 DEFAULT_SAMPLES = 201
 
 
-def _poses(mechanism, words: list[str], count: int, option: str) -> list[np.ndarray]:
-    """``count`` poses from words: named poses, or ``count`` times every task coordinate (m, deg)."""
+def _poses(mechanism, words: list[str], count: int, option: str, label: str | None = None) -> list[np.ndarray]:
+    """``count`` poses from words: named poses, or ``count`` times every task coordinate (m, deg); ``label``, what a
+    single pose is called in a message (``option``'s first pose, second pose, ... by default)."""
+    ordinals = ("first pose", "second pose") if count == 2 else [f"pose {i + 1}" for i in range(count)]
+    labels = [label or option] if count == 1 else [f"{option}'s {ordinal}" for ordinal in ordinals]
     if len(words) == count and not any(_number(word) for word in words):
-        return [parse_pose(mechanism, word, option) for word in words]
+        return [parse_pose(mechanism, word, label) for word, label in zip(words, labels)]
     n = mechanism.n_task
     if len(words) != count * n or not all(_number(word) for word in words):
         units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
         raise fail(f"Expected {option} with {count} named pose(s) or {count} x {n} numbers ({units}) for "
                    f"{mechanism.name!r}, got {' '.join(words) or 'nothing'}.")
-    return [parse_pose(mechanism, " ".join(words[i * n:(i + 1) * n]), option) for i in range(count)]
+    return [parse_pose(mechanism, " ".join(words[i * n:(i + 1) * n]), labels[i]) for i in range(count)]
 
 
 def _number(word: str) -> bool:
@@ -71,8 +74,18 @@ def generated_path(mechanism, source: PathSource):
         if len(words) < 2 or not _number(words[-1]):
             raise fail(f"Expected --circle CENTRE RADIUS (a named pose or every task coordinate, then the radius in "
                        f"m), got {source.circle!r}.")
-        (centre,) = _poses(mechanism, words[:-1], 1, "--circle")
-        return circle_path(mechanism, centre, float(words[-1]), samples)
+        n = mechanism.n_task
+        if all(_number(word) for word in words) and len(words) != n + 1:
+            units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates,
+                                                                            mechanism.angular))
+            raise fail(f"Expected --circle with the centre's {n} task coordinates ({units}) then the radius (m), "
+                       f"{n + 1} numbers, got {len(words)}{' (no radius)' if len(words) == n else ''}: "
+                       f"{source.circle}.")
+        (centre,) = _poses(mechanism, words[:-1], 1, "--circle", "--circle's centre")
+        radius = float(words[-1])
+        if not (np.isfinite(radius) and radius > 0):
+            raise fail(f"Expected --circle's radius > 0 (m), got {words[-1]}.")
+        return circle_path(mechanism, centre, radius, samples)
     except ValueError as error:
         raise fail(str(error)) from None
 
@@ -196,8 +209,9 @@ fault_options = option_group(
                  help="The LMTI the actuators left after a failure must keep for the platform to count as "
                       "controllable."),
     click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
-                 help="How closely crossings of the level and singular points are located, in m of arc length "
-                      "(default 1e-6 times the mechanism's length scale)."))
+                 help="How closely crossings of the level and singular points are located, in m of arc length, "
+                      "from 64 units in the last place of the path's arc length to below its length (default 1e-6 "
+                      "times the mechanism's length scale, at most a thousandth of a shorter path)."))
 
 
 @click.command("trajectory")
@@ -228,6 +242,8 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     check_average(analysis, loaded)
     path = source.read(loaded)
     try:
+        if faults.tolerance is not None:  # what the refinement can honour on this path, named as given
+            checked_tolerance(path, faults.tolerance, "--tolerance")
         result = run_trajectory(loaded, path, analysis=analysis, aggregate=analysis.aggregate,
                                 probabilities=analysis.probabilities, **keywords)
     except ValueError as error:

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure import forward
+from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.model import Mechanism
 from screwkit.studies.netcdf import netcdf_file
 from screwkit.studies.paths import Path, PathFileError, path_from_poses, read_columns
@@ -60,6 +61,11 @@ def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLik
     if not np.all(np.isfinite(values)):
         raise ValueError(f"Expected finite actuator values, got {values[~np.isfinite(values)][0]} at sample "
                          f"{int(np.flatnonzero(~np.all(np.isfinite(values), axis=1))[0])}.")
+    beyond = np.argwhere(_angular(mechanism) & (np.abs(values) > angle_limit(degrees=False)))
+    if beyond.size:  # 1e20 rad cannot tell one turn from the next
+        sample, k = (int(i) for i in beyond[0])
+        raise angle_beyond_limit(f"actuator values ({mechanism.actuator_names[k]}, sample {sample})",
+                                 float(values[sample, k]), degrees=False)
     n = values.shape[0]
     poses = np.full((n, mechanism.n_task), np.nan)
     start = mechanism.home_pose if start is None else mechanism.check_poses(start)
@@ -125,7 +131,7 @@ def _header(name: str) -> set[str]:
         if name.lower().endswith(".nc"):
             with netcdf_file()(name, "r", mmap=False) as handle:
                 return set(handle.variables)
-        with open(name, encoding="utf-8") as handle:
+        with open(name, encoding="utf-8-sig") as handle:
             return {cell.strip() for cell in handle.readline().split(",")}
     except Exception:  # whatever a file that is not one raises: read_columns says what is wrong with it
         return set()

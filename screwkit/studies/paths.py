@@ -15,9 +15,10 @@ every arc length scaled by ``k``. :meth:`Path.at` gives the pose at any arc leng
 piecewise-linear path, which is where the refinement of :mod:`screwkit.studies.trajectory` evaluates.
 
 :func:`line_path`, :func:`circle_path` and :func:`through_path` (piecewise linear through given poses)
-generate paths; :func:`read_path` reads a CSV or netCDF file (angles in degrees unless a netCDF variable says
-``units: rad``) and says in one line what is wrong with it (:func:`read_columns`, which also reads the actuator
-values of :mod:`~screwkit.studies.actuator_paths`).
+generate paths; :func:`read_path` reads a CSV or netCDF file (angles in degrees and lengths in metres unless a
+netCDF variable's ``units`` says otherwise) and says in one line what is wrong with it (:func:`read_columns`, which
+also reads the actuator values of :mod:`~screwkit.studies.actuator_paths`). :func:`checked_tolerance` is the range of
+refinement tolerances a path can honour.
 """
 
 from __future__ import annotations
@@ -32,15 +33,27 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.common.units import is_angular
+from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.model import Mechanism
 from screwkit.studies.files import open_netcdf
 
 __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
-           "PathFileError", "TIME_COLUMN", "checked_times"]
+           "PathFileError", "TIME_COLUMN", "checked_times", "checked_tolerance", "ANGLE_UNITS", "TIME_UNITS"]
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
+
+ANGLE_UNITS = {"deg": math.pi / 180, "degree": math.pi / 180, "degrees": math.pi / 180,
+               "rad": 1.0, "radian": 1.0, "radians": 1.0}
+"""The ``units`` a netCDF path variable of an angle may have (any case), as radians per unit; none is deg."""
+
+TIME_UNITS = {"s": 1.0, "sec": 1.0, "second": 1.0, "seconds": 1.0}
+"""The ``units`` the :data:`TIME_COLUMN` variable of a netCDF path may have; none is s."""
+
+ROUNDING_ULPS = 64
+"""Units in the last place of a path's size (its poses', or the mechanism's length scale if larger) within which
+its length counts as zero (rounding, as of a circle of two samples), and of its arc length below which no
+refinement tolerance can be honoured."""
 
 
 class PathFileError(ValueError):
@@ -95,18 +108,49 @@ class Path:
 
 
 def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | None = None) -> Path:
-    """A :class:`Path` through ``poses`` (n, n_task; m, rad), checked: at least two samples, finite,
-    a length above zero, ``times`` (n,) increasing when given."""
+    """A :class:`Path` through ``poses`` (n, n_task; m, rad), checked: at least two samples, finite, a finite
+    length above the rounding of the poses and of the length scale (:data:`ROUNDING_ULPS`), ``times`` (n,)
+    increasing when given."""
     poses = mechanism.check_poses(poses)
     if poses.ndim != 2 or poses.shape[0] < 2:
         raise ValueError(f"Expected a path of at least 2 poses with shape (n, {mechanism.n_task}), got "
                          f"{poses.shape}.")
     weights = np.where(mechanism.angular, mechanism.length_scale, 1.0)
-    steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)
-    arc_length = np.concatenate([[0.0], np.cumsum(steps)])
+    with np.errstate(over="ignore", invalid="ignore"):  # a length that overflows is refused below
+        steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)
+        arc_length = np.concatenate([[0.0], np.cumsum(steps)])
+    size = max(float(np.max(np.abs(poses * weights))), float(mechanism.length_scale))
+    if not np.isfinite(arc_length[-1]):
+        raise _overflow(size)
     if not arc_length[-1] > 0:
         raise ValueError("Expected a path that moves: every pose of the path is the same.")
+    if arc_length[-1] <= ROUNDING_ULPS * np.spacing(size):
+        raise ValueError(f"Expected a path that moves: every pose of the path is the same to rounding (a length of "
+                         f"{arc_length[-1]:.3g} m, at a size of {size:.3g} m: its poses' or the mechanism's length "
+                         "scale).")
     return Path(poses, arc_length, float(mechanism.length_scale), checked_times(times, poses.shape[0]))
+
+
+def _overflow(size: float) -> ValueError:
+    return ValueError(f"Expected a path of finite length, got poses so far apart (up to {size:.3g} m) that its length "
+                      "overflows.")
+
+
+def checked_tolerance(path: Path, tolerance: float, name: str = "`tolerance`") -> float:
+    """``tolerance`` (m of arc length) as a float, if the refinement along ``path`` can honour it: at least
+    :data:`ROUNDING_ULPS` units in the last place of its arc length (rounded up to 3 digits), below its length;
+    else a ValueError naming ``name`` and that range."""
+    low = ROUNDING_ULPS * float(np.spacing(path.length))
+    digit = 10.0 ** (math.floor(math.log10(low)) - 2)
+    low = math.ceil(low / digit) * digit  # as the message shows it
+    try:
+        tolerance = float(tolerance)
+    except (TypeError, ValueError):
+        raise ValueError(f"Expected {name} to be a number (m of arc length), got {tolerance!r}.") from None
+    if not (np.isfinite(tolerance) and low <= tolerance < path.length):
+        raise ValueError(f"Expected {name} from {low:.3g} m (the rounding of the arc length) to below the path's "
+                         f"length, {path.length:.6g} m, got {tolerance:g}.")
+    return tolerance
 
 
 def checked_times(times: ArrayLike | None, count: int) -> NDArray[np.float64] | None:
@@ -128,7 +172,11 @@ def line_path(mechanism: Mechanism, start: ArrayLike, stop: ArrayLike, samples: 
         raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
     start, stop = mechanism.check_poses(start), mechanism.check_poses(stop)
     fractions = np.linspace(0.0, 1.0, samples)[:, None]
-    return path_from_poses(mechanism, start + fractions * (stop - start))
+    with np.errstate(over="ignore", invalid="ignore"):  # ends so far apart that their difference overflows
+        poses = start + fractions * (stop - start)
+    if not np.all(np.isfinite(poses)):
+        raise _overflow(float(np.max(np.abs([start, stop]))))
+    return path_from_poses(mechanism, poses)
 
 
 def circle_path(mechanism: Mechanism, centre: ArrayLike, radius: float, samples: int) -> Path:
@@ -164,15 +212,15 @@ def through_path(mechanism: Mechanism, poses: ArrayLike, samples: int) -> Path:
 
 def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
     """A path from a CSV or netCDF file: a column (variable) per task coordinate of ``mechanism`` (m, and deg
-    for angles; a netCDF variable with ``units: rad`` in rad) and an optional :data:`TIME_COLUMN` (s).
+    for angles; a netCDF variable in the ``units`` it names) and an optional :data:`TIME_COLUMN` (s).
 
     Other columns are ignored (so the output of ``screwkit trajectory --out`` reads back as a path).
 
     Raises
     ------
     PathFileError
-        One line naming the file: missing, a folder, an unknown suffix, unreadable, a column missing,
-        a value that is not a finite number, fewer than two samples, times not increasing.
+        One line naming the file: what :func:`read_columns` refuses, a path that does not move or whose length
+        overflows, times not increasing.
     """
     name = os.fspath(path)
     wanted = mechanism.task_coordinates
@@ -185,15 +233,17 @@ def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
 
 
 def read_columns(name: str, wanted, angular, expected: str) -> tuple[NDArray[np.float64], NDArray | None]:
-    """The columns ``wanted`` of a CSV or netCDF path file (n, k), angles (``angular``) read in deg (rad for a
-    netCDF variable with ``units: rad``) and returned in rad, and the :data:`TIME_COLUMN` if there is one.
-    ``expected`` says what a path has (for the message on a missing column).
+    """The columns ``wanted`` of a CSV or netCDF path file (n, k), angles (``angular``) read in deg and lengths
+    in m (a netCDF variable in its ``units``: :data:`ANGLE_UNITS`, :data:`~screwkit.common.units.LENGTH_UNITS`) and
+    returned in rad and m, and the :data:`TIME_COLUMN` (s) if there is one. ``expected`` says what a path has (for
+    the message on a missing column).
 
     Raises
     ------
     PathFileError
-        One line naming the file: missing, a folder, an unknown suffix, unreadable, a column missing, a value
-        that is not a finite number, fewer than two samples.
+        One line naming the file: missing, a folder, an unknown suffix, unreadable, a column missing or named
+        twice, variables of different lengths, units unknown, a value that is not a finite number, an angle beyond
+        :func:`~screwkit.common.units.angle_limit`, fewer than two samples.
     """
     if os.path.isdir(name):
         raise PathFileError(f"{name}: is a folder, not a path file (.csv or .nc).")
@@ -207,15 +257,49 @@ def read_columns(name: str, wanted, angular, expected: str) -> tuple[NDArray[np.
     if missing:
         raise PathFileError(f"{name}: no column {', '.join(repr(m) for m in missing)}; {expected} and optionally "
                             f"{TIME_COLUMN!r} (s), got {', '.join(columns) or 'none'}.")
-    for column in (*wanted, TIME_COLUMN):
-        if column in columns and columns[column][2]:
+    used = [column for column in (*wanted, TIME_COLUMN) if column in columns]
+    lengths = {column: columns[column][0].size for column in used}
+    if len(set(lengths.values())) > 1:
+        raise PathFileError(f"{name}: variables of different lengths ("
+                            + ", ".join(f"{column!r} {size}" for column, size in lengths.items())
+                            + " samples); a path has one value of each per sample.")
+    factors = [_unit_factor(name, column, columns[column][1], bool(a)) for column, a in zip(wanted, angular)]
+    for column in used:
+        if columns[column][2]:
             raise PathFileError(f"{name}: {columns[column][2]}")
-    values = np.column_stack([columns[c][0] for c in wanted])
+    values = np.column_stack([columns[c][0] for c in wanted]) * factors
     if values.shape[0] < 2:
         raise PathFileError(f"{name}: {values.shape[0]} sample(s); a path needs at least 2.")
-    in_degrees = [bool(a) and columns[c][1] != "rad" for c, a in zip(wanted, angular)]
-    values[:, in_degrees] = np.deg2rad(values[:, in_degrees])
-    return values, (columns[TIME_COLUMN][0] if TIME_COLUMN in columns else None)
+    for k, (column, a) in enumerate(zip(wanted, angular)):
+        beyond = np.flatnonzero(np.abs(values[:, k]) > angle_limit(degrees=False)) if a else ()
+        if len(beyond):
+            degrees = factors[k] != 1.0
+            error = angle_beyond_limit(f"{'variable' if suffix == '.nc' else 'column'} {column!r} (sample "
+                                       f"{beyond[0]})", values[beyond[0], k] / factors[k], degrees=degrees)
+            raise PathFileError(f"{name}: {error}")
+    if TIME_COLUMN not in columns:
+        return values, None
+    return values, columns[TIME_COLUMN][0] * _unit_factor(name, TIME_COLUMN, columns[TIME_COLUMN][1], None)
+
+
+_METRES = {"meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0}
+
+
+def _unit_factor(name: str, column: str, unit: str, angular: bool | None) -> float:
+    """What a value of a netCDF variable with ``units`` ``unit`` is in rad (``angular``), m, or s (``angular``
+    None, the time); none is deg, m or s. A PathFileError naming the variable for units of something else."""
+    spelled = unit.strip()
+    if angular is None:
+        factor, expected = (TIME_UNITS.get(spelled.lower()) if spelled else 1.0), "s (a time)"
+    elif angular:
+        factor = ANGLE_UNITS.get(spelled.lower()) if spelled else math.pi / 180
+        expected = "deg or rad (an angle; or degrees, radians)"
+    else:
+        factor = {**LENGTH_UNITS, **_METRES}.get(spelled) if spelled else 1.0
+        expected = f"a length unit ({', '.join(LENGTH_UNITS)})"
+    if factor is None:
+        raise PathFileError(f"{name}: variable {column!r} has units {unit!r}; expected {expected}, or no units.")
+    return factor
 
 
 def _read_csv(name: str, wanted) -> dict[str, tuple[NDArray[np.float64] | None, str, str]]:
@@ -239,14 +323,14 @@ def _read_plain_csv(name: str, wanted) -> dict[str, tuple[NDArray[np.float64], s
         with open(name, "rb") as raw:
             if b"\r" in raw.read():
                 return None
-        with open(name, newline="", encoding="utf-8") as handle:
+        with open(name, newline="", encoding="utf-8-sig") as handle:  # a byte-order mark (Excel) skipped
             header, skipped = None, 0
             for row in csv.reader(handle):
                 skipped += 1
                 if any(cell.strip() for cell in row):
                     header = [cell.strip() for cell in row]
                     break
-            if header is None:
+            if header is None or _doubled(header, wanted):
                 return None
             positions = {column: position for position, column in enumerate(header) if column in wanted}
             handle.seek(0)
@@ -266,7 +350,7 @@ def _read_plain_csv(name: str, wanted) -> dict[str, tuple[NDArray[np.float64], s
 def _read_csv_text(name: str, wanted) -> dict[str, tuple[NDArray[np.float64] | None, str, str]]:
     """:func:`_read_csv` on the file's whole text, cell by cell where numpy's parser cannot read it."""
     try:
-        with open(name, newline="", encoding="utf-8") as handle:
+        with open(name, newline="", encoding="utf-8-sig") as handle:  # a byte-order mark (Excel) skipped
             text = handle.read()
         rows = csv.reader(io.StringIO(text))
         header, skipped = None, 0
@@ -279,6 +363,11 @@ def _read_csv_text(name: str, wanted) -> dict[str, tuple[NDArray[np.float64] | N
         raise PathFileError(f"{name}: cannot be read as a CSV file ({error}).") from None
     if header is None:
         raise PathFileError(f"{name}: is empty; expected a header row of column names and a row per sample.")
+    doubled = _doubled(header, wanted)
+    if doubled:
+        where = [str(position + 1) for position, column in enumerate(header) if column == doubled]
+        raise PathFileError(f"{name}: column {doubled!r} is in the header {len(where)} times (columns "
+                            f"{', '.join(where)}); give each column once.")
     positions = {column: position for position, column in enumerate(header) if column in wanted}
     columns: dict[str, tuple[NDArray[np.float64] | None, str, str]] = dict.fromkeys(header, (None, "", ""))
     try:
@@ -292,6 +381,11 @@ def _read_csv_text(name: str, wanted) -> dict[str, tuple[NDArray[np.float64] | N
     except ValueError:
         pass
     return _read_csv_cells(name, text, positions, columns)
+
+
+def _doubled(header: list[str], wanted) -> str | None:
+    """The first column of ``wanted`` that ``header`` names more than once, or None."""
+    return next((column for column in header if column in wanted and header.count(column) > 1), None)
 
 
 def _read_csv_cells(name: str, text: str, positions: dict[str, int], columns: dict) -> dict:

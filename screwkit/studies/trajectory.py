@@ -45,7 +45,7 @@ from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.path_mechanisms import GraphPath, SerialPath, path_mechanism
-from screwkit.studies.paths import Path, path_from_poses
+from screwkit.studies.paths import Path, checked_tolerance, path_from_poses
 from screwkit.studies.refinement import (
     bisected_crossings,
     bracketed_minima,
@@ -275,9 +275,9 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
         raise ValueError(f"Expected `aggregate` in {', '.join(AGGREGATES)}, got {aggregate!r}.")
     if not np.isfinite(level) or not 0 < level <= 1:
         raise ValueError(f"Expected a level in (0, 1], got {level!r}.")
-    tolerance = RELATIVE_TOLERANCE * mechanism.length_scale if tolerance is None else float(tolerance)
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"Expected a tolerance > 0 (m of arc length), got {tolerance!r}.")
+    if tolerance is None:  # the default; at most a thousandth of a path shorter than a thousandth of the scale
+        tolerance = RELATIVE_TOLERANCE * min(mechanism.length_scale, 1e3 * path.length)
+    tolerance = checked_tolerance(path, tolerance)  # from a few ulps of the arc length to below the path's length
 
     along = path_mechanism(mechanism, analysis, dict(analysis.keywords(), detail=True, threads=threads))
     samples, joint_values = along.samples(path.poses)
