@@ -299,6 +299,27 @@ def test_the_command_refuses_a_cad_export_mujoco_refuses_in_one_line(tmp_path, o
     one_line_error(screwkit("analyze", path), f"{path}: {element}: {problem}")
 
 
+def test_two_actuators_on_one_joint_are_one_actuated_joint_as_mujoco_has_them(tmp_path):
+    """A servo written as a position and a velocity actuator on one slide: MuJoCo has two actuators and one joint
+    they drive; screwkit reads one actuated joint, says so in the report, and gives the file's indices."""
+    import mujoco
+
+    source = (Path(__file__).resolve().parent / "data" / "gallery" / "stewart_cad.xml").read_text()
+    plain, doubled = tmp_path / "plain.xml", tmp_path / "doubled.xml"
+    plain.write_text(source)
+    doubled.write_text(source.replace('<position name="act1" joint="s1" kp="10000"/>',
+                                      '<position name="act1" joint="s1" kp="10000"/><velocity name="act1_v" '
+                                      'joint="s1" kv="100"/>', 1))
+    model = mujoco.MjModel.from_xml_path(str(doubled))
+    assert model.nu == 7 and len(set(model.actuator_trnid[:, 0])) == 6
+    _, report = read_mechanism_file(doubled)
+    assert any("joint 's1' is driven by more than one <actuator>" in note for note in report.notes), report
+    mechanism = load(doubled)
+    assert len(mechanism.actuator_names) == 6
+    home = load(plain).home_pose
+    assert_indices_close(indices_at_pose(load(plain), home), indices_at_pose(mechanism, home), TOLERANCE)
+
+
 def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_for(tmp_path):
     """No frame named as an output: the body where most closures meet is the platform, said in the report; with
     one closure both of its bodies tie, and the file is refused with the option that names the platform."""

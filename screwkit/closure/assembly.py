@@ -236,7 +236,7 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
         raise mechanism.description.fail(
             f"<robot name='{mechanism.name}'>",
             f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
-            f"{needed} are needed (mark actuated joints with <transmission>).")
+            f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF).")
     return replace(mechanism, dof=dof)
 
 

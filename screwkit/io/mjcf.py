@@ -39,7 +39,10 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
             if joint is None:
                 raise ImportError_(f"{source}: <actuator><{element.tag} name={element.get('name')!r}> drives no "
                                    "joint (tendon and site transmissions are not supported).")
-            if joint not in motors:
+            if joint in motors:
+                notes.append(f"joint {joint!r} is driven by more than one <actuator> (a servo's position and velocity "
+                             "terms, say): one actuated joint")
+            else:
                 motors.append(joint)
     if not motors:
         raise ImportError_(f"{source}: no <actuator> drives a joint: nothing is actuated.")
