@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import screwkit
+from helpers import one_line_error, screwkit
 from screwkit.io.loader import bundled_path, load
 from screwkit.screw.planar import PlanarDesign
 from screwkit.studies import indices_at_poses
@@ -534,3 +534,171 @@ def test_a_search_announces_the_evaluations_it_makes(objectives, budget):
     result = run_study(study, execution=QUIET)
     assert len(result.evaluations) == study.planned_evaluations
     assert study.planned_evaluations == {0: 1, 4: 24, 50: 48, 10: 24, 30: 48}[budget]
+
+
+# -- designs that cannot be built, seeds, integer parameters, evaluations lost --------------------------------
+
+UNREACHABLE = {"base_radius": 2.0}
+"""planar_rrr on a base of radius 2 m: arms of 0.5 m cannot reach the platform at the home pose."""
+
+
+def test_a_design_that_cannot_be_built_is_never_the_best():
+    """It keeps its real size (footprint, link_length: the smallest of the family) and its error, but it is
+    infeasible: no objective picks it, the size ones included."""
+    chosen = family("planar_rrr")
+    for objectives in (("link_length",), ("footprint",), ("area", "link_length")):
+        study = Study(chosen, disc_region(0.3, 0.1, 30.0), objectives, fixed=UNREACHABLE,
+                      initial={"upper": 0.5, "lower": 0.5}, budget=12, popsize=2)
+        result = run_study(study, execution=QUIET)
+        failed = [r for r in result.evaluations if "error" in r["metrics"]]
+        assert failed and "cannot reach its platform joint" in failed[0]["metrics"]["error"]
+        assert not any(r["feasible"] for r in failed)
+        assert result.best and all("error" not in r["metrics"] for r in result.best)
+        assert all(r["feasible"] for r in result.evaluations if "error" not in r["metrics"])
+
+
+def test_a_search_keeps_its_designs_that_cannot_be_built_out_of_its_files(tmp_path):
+    common = ("design-search", "family", "planar_rrr", "--set", "base_radius=2", "--start", "upper=0.5", "--start",
+              "lower=0.5", *SMALL_DISC)
+    urdf, table, figure = tmp_path / "best.urdf", tmp_path / "all.csv", tmp_path / "maps.png"
+    result = screwkit(*common, "--objective", "link_length", "--budget", "6", "--popsize", "2", "--urdf", urdf,
+                      "--table", table, "--figure", figure, "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert "cannot reach its platform joint" in summary["start"]["metrics"]["error"]
+    assert "error" not in summary["best"][0]["metrics"]
+    assert load(str(urdf)).name and figure.stat().st_size > 10_000
+    rows = np.genfromtxt(table, delimiter=",", names=True)
+    assert rows["feasible"][0] == 0 and rows["best"][0] == 0 and rows["feasible"].sum() >= 1
+    state = tmp_path / "state.jsonl"
+    none = screwkit(*common, "--budget", "0", "--state", state, "--urdf", tmp_path / "none.urdf", "--table",
+                    tmp_path / "none.csv", "--figure", tmp_path / "none.png")
+    line = one_line_error(none, "No design evaluated can be built", "leg 1 cannot reach its platform joint",
+                          after=("planar_rrr (5 legs): ",))
+    assert "the state file" not in line or str(state) in line
+    assert sorted(os.listdir(tmp_path)) == sorted(["best.urdf", "all.csv", "maps.png", "state.jsonl"])
+    assert len(state.read_text().splitlines()) == 2  # the header and the start's record, kept
+
+
+def test_a_start_on_the_edge_of_narrowed_bounds_is_searched():
+    """The start (upper = 1 m clipped to 0.8) sits on a bound that differential evolution's rescaling would move
+    just outside its unit interval."""
+    study = Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), bounds={"upper": (0.6, 0.8)}, budget=6,
+                  popsize=2)
+    result = run_study(study, execution=QUIET)
+    assert result.start["values"]["upper"] == 0.8 and len(result.evaluations) > 1
+    assert all(0.6 <= r["values"]["upper"] <= 0.8 for r in result.evaluations)
+
+
+def test_a_seed_out_of_range_is_refused_before_any_work(tmp_path):
+    for seed in ("-1", str(2**32)):
+        one_line_error(screwkit("design-search", "family", "planar_rrr", *SMALL_DISC, "--budget", "6", "--popsize",
+                                "2", "--seed", seed, "--state", tmp_path / "state.jsonl"), "seed", seed)
+        assert not (tmp_path / "state.jsonl").exists()
+    study = tmp_path / "study.yaml"
+    for seed in ("-1", str(2**32), "0.5", "abc"):
+        study.write_text(f"family: planar_rrr\nradius: 0.3\nstep: 0.1\nphi_step: 30\nbudget: 6\npopsize: 2\n"
+                         f"seed: {seed}\n")
+        one_line_error(screwkit("design-search", "family", "--study", study), "seed", seed)
+    assert screwkit("design-search", "family", "planar_rrr", *SMALL_DISC, "--budget", "0", "--seed",
+                    str(2**32 - 1)).returncode == 0
+    with pytest.raises(ValueError, match="seed"):
+        Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), seed=-1)
+
+
+def test_a_design_of_integer_parameters_is_evaluated_once(tmp_path):
+    """NSGA-II varies the integer parameters continuously: the designs it asks that round to the same one are one
+    evaluation, and a state file of earlier releases (keyed by the unrounded values) resumes."""
+    study = Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), ("area", "link_length"),
+                  free=("mirrored", "upper"), budget=24, popsize=4)
+    state = tmp_path / "state.jsonl"
+    result = run_study(study, state=state, execution=QUIET)
+    designs = [(r["values"]["mirrored"], r["values"]["upper"]) for r in result.evaluations]
+    assert len(set(designs)) == len(designs) == result.computed
+    lines = state.read_text().splitlines()
+    assert len(lines) == 1 + result.computed
+    older = [lines[0]]  # the keys an earlier release wrote: the vector as asked, mirrored unrounded
+    for line in lines[1:]:
+        record = json.loads(line)
+        vector = np.frombuffer(bytes.fromhex(record["key"]), dtype=np.float64).copy()
+        vector[0] += 0.25 if vector[0] < 1 else -0.25
+        older.append(json.dumps({"key": vector.tobytes().hex(), "metrics": record["metrics"]}))
+    state.write_text("\n".join(older) + "\n")
+    resumed = run_study(study, state=state, execution=QUIET)
+    assert resumed.computed == 0 and resumed.replayed == result.computed
+    assert comparable(resumed.evaluations) == comparable(result.evaluations)
+
+
+def test_nothing_varied_by_default_that_is_fixed(tmp_path):
+    """--set of every parameter the family varies by default: the others vary (none was asked to vary)."""
+    result = screwkit("design-search", "family", "planar_rrr", "--set", "platform_radius=0.1", "--set", "upper=1",
+                      "--set", "lower=1", *SMALL_DISC, "--budget", "0", "--json")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["free"] == ["base_radius", "slots", "mirrored"]
+    assert summary["start"]["values"]["upper"] == 1.0 and summary["start"]["values"]["platform_radius"] == 0.1
+
+
+def test_a_scheduler_lost_mid_search_says_what_the_state_keeps(tmp_path, monkeypatch):
+    """The state file holds every generation evaluated before the scheduler was lost: the line says so."""
+    from screwkit.studies.design import evaluations
+    from screwkit.studies.tasks import ClusterError
+
+    calls = []
+
+    def lost_after_the_start(function, arguments, execution=None, **options):
+        calls.append(len(arguments))
+        if len(calls) > 1:
+            raise ClusterError("Lost the Dask scheduler at tcp://127.0.0.1:1 mid-run (CancelledError); "
+                               "nothing was written.")
+        return [function(*a) for a in arguments]
+
+    monkeypatch.setattr(evaluations, "run_tasks", lost_after_the_start)
+    study = Study(family("planar_rrr"), disc_region(0.3, 0.1, 30.0), budget=12, popsize=4)
+    remote = Execution(scheduler="tcp://127.0.0.1:1", progress=False)
+    state = tmp_path / "state.jsonl"
+    with pytest.raises(ClusterError) as raised:
+        run_study(study, state=state, execution=remote)
+    message = str(raised.value)
+    assert message.startswith("Lost the Dask scheduler at tcp://127.0.0.1:1 mid-run (CancelledError)")
+    assert "nothing was written" not in message and f"the state file {state} keeps 1 design" in message
+    calls.clear()
+    with pytest.raises(ClusterError, match="nothing was written"):  # without a state file, it is true
+        run_study(study, execution=remote)
+    assert run_study(replace(study, budget=0), state=state, execution=QUIET).replayed == 1
+
+
+def test_an_evaluation_process_killed_gives_one_line_and_the_state_resumes(tmp_path):
+    """kill -9 of a local evaluation process (as the out-of-memory killer does): one line, exit status 1, and the
+    state file keeps the designs evaluated before, which a run with it replays."""
+    import psutil  # (a dependency of dask.distributed)
+    arguments = ("design-search", "family", "planar_rrr", "--step", "0.03", "--phi-step", "2", "--budget", "120",
+                 "--popsize", "4", "--state", str(tmp_path / "state.jsonl"))
+    state = tmp_path / "state.jsonl"
+    command = subprocess.Popen([sys.executable, "-W", "error", "-m", "screwkit.cli", *arguments],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline, victim = time.monotonic() + 240, None
+        while victim is None and time.monotonic() < deadline:
+            assert command.poll() is None, "the search ended before a process could be killed"
+            if state.exists() and len(state.read_text().splitlines()) >= 2:
+                workers = [p for p in psutil.Process(command.pid).children(recursive=True)
+                           if "spawn_main" in " ".join(p.cmdline())]
+                victim = workers[0] if workers else None
+            time.sleep(0.05)
+        assert victim is not None, "no evaluation process started"
+        victim.send_signal(signal.SIGKILL)
+        stdout, stderr = command.communicate(timeout=120)
+    finally:
+        if command.poll() is None:
+            os.killpg(command.pid, signal.SIGKILL)
+            command.wait(timeout=30)
+    kept = len(state.read_text().splitlines()) - 1
+    assert kept >= 1
+    line = one_line_error(subprocess.CompletedProcess(command.args, command.returncode, stdout, stderr),
+                          "An evaluation process died", f"the state file {state} keeps {kept} design",
+                          after=("planar_rrr (5 legs): ",))
+    assert "resume" in line
+    resumed = screwkit(*arguments[:7], "--budget", "0", "--state", state, "--json")
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads(resumed.stdout)["replayed"] == 1 and json.loads(resumed.stdout)["computed"] == 0

@@ -10,6 +10,7 @@ where the designs are evaluated is :func:`screwkit.cli.options.execution_options
 from __future__ import annotations
 
 import functools
+import re
 from dataclasses import dataclass
 
 import click
@@ -31,13 +32,20 @@ from screwkit.cli.options import (
 )
 from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.studies.design.families import Family
-from screwkit.studies.design.objectives import METRICS, default_region
+from screwkit.studies.design.objectives import (
+    MAX_CONFIGURATIONS_PER_DESIGN,
+    METRICS,
+    check_region_size,
+    default_region,
+    turn_count,
+)
+from screwkit.studies.design.optimise import MAX_SEED
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 
 __all__ = ["SearchOptions", "RegionOptions", "DesignOutputs", "Report", "search_options", "region_options",
            "design_outputs_options", "report_options", "study_option", "STUDY_KEYS", "read_study",
            "parse_assignments", "parse_bounds", "region_of", "check_region_against", "check_weighting_a_mean",
-           "check_failures", "check_phi_step"]
+           "check_failures", "check_phi_step", "SEED_RANGE"]
 
 
 # -- records -----------------------------------------------------------------------------------------
@@ -124,15 +132,31 @@ class Report:
 
 # -- option groups -------------------------------------------------------------------------------------
 
+SEED_RANGE = click.IntRange(0, MAX_SEED)
+"""The seeds of a search, from ``--seed`` or a study file (those of numpy's and scipy's generators)."""
+
+
 def check_phi_step(phi_step: float | None) -> None:
-    if phi_step is not None and not 0 < phi_step <= 360:
+    """``--phi-step`` in (0, 360] deg, giving at most 10^8 angles of the full turn (refused before any array is
+    built)."""
+    if phi_step is None:
+        return
+    if not 0 < phi_step <= 360:
         raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
+    turns = turn_count(phi_step)
+    if turns is not None and turns > MAX_CONFIGURATIONS_PER_DESIGN:
+        raise fail(f"--phi-step {phi_step:g} makes {turns:,} angles of the full turn per design, more than 10^8: "
+                   "use a larger step.")
 
 
 def _region(radius, step, phi_step, grids, overs, layers, region_index, level, probabilities=None) -> RegionOptions:
     check_phi_step(phi_step)
-    return RegionOptions(radius, step, phi_step, tuple(grids), tuple(overs), layers, region_index, level,
-                         probabilities)
+    layers = (layers,) if isinstance(layers, str) else tuple(layers or ())
+    if len(layers) > 1:
+        raise fail(f"Expected one --layers (the coordinate the maps are stacked along), got {len(layers)}: "
+                   + " ".join(f"--layers {text}" for text in layers) + ".")
+    return RegionOptions(radius, step, phi_step, tuple(grids), tuple(overs), layers[0] if layers else None,
+                         region_index, level, probabilities)
 
 
 search_options = option_group(
@@ -152,7 +176,8 @@ search_options = option_group(
     click.option("--maxiter", type=click.IntRange(min=1),
                  help="One objective: generations of differential evolution (sets the budget to popsize x "
                       "parameters x (maxiter + 1))."),
-    click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search (same seed, same run)."),
+    click.option("--seed", type=SEED_RANGE, default=0, show_default=True,
+                 help="Seed of the search (same seed, same run)."),
     click.option("--popsize", type=click.IntRange(min=2), default=8, show_default=True,
                  help="Population size per varied parameter (count)."),
     click.option("--state", type=click.Path(dir_okay=False),
@@ -170,8 +195,9 @@ region_options = option_group(
                  help="Spatial region: a map coordinate, stop included (twice), as screwkit map --grid."),
     click.option("--over", "overs", multiple=True, metavar="COORDINATE:START:STOP:STEP",
                  help="Spatial region: the orientation set, stop excluded, as screwkit map --over (repeatable)."),
-    click.option("--layers", metavar="COORDINATE:START:STOP:STEP",
-                 help="Spatial region: stack maps along a third coordinate (stop excluded) for a volume."),
+    click.option("--layers", multiple=True, metavar="COORDINATE:START:STOP:STEP",
+                 help="Spatial region: stack maps along a third coordinate for a volume, the stop excluded as "
+                      "screwkit map --over (once)."),
     click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|f_o_mean1|...",
                  help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1; "
                       "f_o_mean<j>: the mean over the sets of j failed actuators instead of the worst, screwkit's "
@@ -224,8 +250,16 @@ STUDY_KEYS = {"family": "family_name", "legs": "legs", "objectives": "objectives
 name -> [lower, upper]; ``objectives``, ``constraints``, ``free``, ``grid``, ``over``, ``probabilities``: lists)."""
 
 
-def read_study(path: str) -> dict:
-    """A study file (YAML or JSON) as option values: {option destination: value as the option gives it}."""
+_LISTS = ("objectives", "constraints", "free", "grid", "over", "probabilities")
+"""Study keys whose value is a list (or one item of it)."""
+
+
+def read_study(path: str, parameters: dict[str, click.Parameter] | None = None) -> dict:
+    """A study file (YAML or JSON) as option values: {option destination: value as the option gives it}.
+
+    With ``parameters`` (the command's, by destination), each value goes through its option's conversion and
+    range check, as the same text on the command line would (``seed``: 0 to 2**32 - 1); a value refused is one
+    line naming the file and the key."""
     import yaml
 
     try:
@@ -246,26 +280,66 @@ def read_study(path: str) -> dict:
                 raise fail(f"Expected {key!r} in the study file {path} to map parameter names to values.")
             value = tuple(f"{name}={':'.join(map(str, v)) if isinstance(v, (list, tuple)) else v}"
                           for name, v in value.items())
-        elif key in ("objectives", "constraints", "free", "grid", "over"):
+        elif parameters is not None and STUDY_KEYS[key] in parameters:
+            value = _converted(path, key, value, parameters[STUDY_KEYS[key]])
+        elif key in _LISTS:
             value = tuple(str(v) for v in (value if isinstance(value, (list, tuple)) else [value]))
-        elif key == "probabilities":  # as --probabilities gives them: joined by spaces
-            value = " ".join(str(v) for v in (value if isinstance(value, (list, tuple)) else [value]))
+        if key == "probabilities":  # as --probabilities gives them: joined by spaces
+            value = " ".join(str(v) for v in value)
         out[STUDY_KEYS[key]] = value
     return out
+
+
+def _converted(path: str, key: str, value, parameter: click.Parameter):
+    """A study value as its option reads the same text: a tuple of items for a list key, else the one value."""
+    kind = SEED_RANGE if key == "seed" else parameter.type
+    if key in _LISTS:
+        items = list(value) if isinstance(value, (list, tuple)) else [value]
+    elif isinstance(value, (list, tuple, dict)):
+        raise fail(f"{path}: {key}: expected one value, got {value!r}.")
+    else:
+        items = [value]
+    converted = []
+    for item in items:
+        try:
+            if item is None or isinstance(item, (list, tuple, dict)):
+                raise click.BadParameter("not a value")
+            converted.append(kind.convert(str(item), parameter, click.get_current_context(silent=True)))
+        except click.BadParameter:
+            raise fail(f"{path}: {key}: expected {_expected(kind, parameter)}, got {item!r}.") from None
+    return tuple(converted) if key in _LISTS or parameter.multiple else converted[0]
+
+
+def _expected(kind: click.ParamType, parameter: click.Parameter) -> str:
+    """What an option of type ``kind`` takes, in words: ``an integer >= 0``, ``one of area, volume, ...``."""
+    if isinstance(kind, click.Choice):
+        return f"one of {', '.join(map(str, kind.choices))}"
+    if isinstance(kind, (click.types.IntParamType, click.types.FloatParamType)):
+        words = "an integer" if isinstance(kind, click.types.IntParamType) else "a number"
+        low, high = getattr(kind, "min", None), getattr(kind, "max", None)
+        if low is not None and high is not None:
+            return f"{words} in {low}..{high}"
+        if low is not None:
+            return f"{words} {'>' if kind.min_open else '>='} {low}"
+        if high is not None:
+            return f"{words} {'<' if kind.max_open else '<='} {high}"
+        return words
+    return parameter.metavar or "a text"
 
 
 def study_option(function):
     """``--study FILE``: its keys stand for the options not given on the command line.
 
     Put it first (right below the command's decorator), so that the study's values are in place
-    before the option groups make their records.
+    before the option groups make their records. Each value is converted and checked as its option's.
     """
 
     @functools.wraps(function)
     def command(*args, study_path=None, **values):
         if study_path:
             context = click.get_current_context()
-            for name, value in read_study(study_path).items():
+            parameters = {parameter.name: parameter for parameter in context.command.params}
+            for name, value in read_study(study_path, parameters).items():
                 if context.get_parameter_source(name) in (ParameterSource.DEFAULT, None):
                     values[name] = value
         return function(*args, **values)
@@ -310,9 +384,66 @@ def parse_bounds(family: Family, texts) -> dict[str, tuple[float, float]]:
 
 
 def _spec(mechanism, text: str, option: str) -> tuple[str, tuple[float, float, float]]:
-    name, _ = grid_spec(mechanism, text, option, True)  # the checks and messages of screwkit map
+    """``COORDINATE:START:STOP:STEP`` checked as ``screwkit map`` checks it (the same function): ``--grid`` includes
+    its stop, ``--over`` and ``--layers`` exclude it."""
+    name, _ = grid_spec(mechanism, text, option, option == "--grid")
     start, stop, step = (float(part) for part in text.split(":")[1:])
     return name, (start, stop, step)
+
+
+def _numbers(text: str):
+    """``COORDINATE:START:STOP:STEP`` -> (coordinate, (start, stop, step)) unchecked, to count a region before
+    building it; None if it is not four parts (:func:`_spec` then says why)."""
+    name, _, rest = text.partition(":")
+    try:
+        start, stop, step = (float(part) for part in rest.split(":"))
+    except ValueError:
+        return None
+    return name, (start, stop, step)
+
+
+def _once(texts, option: str) -> None:
+    """Each coordinate given once among ``texts`` of ``option``."""
+    seen = {}
+    for text in texts:
+        name = text.partition(":")[0]
+        if name in seen:
+            if option == "--grid":  # the message of screwkit map
+                raise fail(f"Expected two different coordinates in --grid, got {' '.join(texts)}.")
+            raise fail(f"{option} {name} given twice ({seen[name]}, {text}): give each coordinate once.")
+        seen[name] = text
+
+
+def _check_size(family: Family, changes: dict, options: RegionOptions) -> None:
+    """The region's poses per design counted from the options' numbers, before any of their values is listed."""
+    rough = dict(changes)
+    specs = {"grid": options.grids if len(options.grids) == 2 else (), "over": options.overs,
+             "layers": (options.layers,) if options.layers else ()}
+    for key, texts in specs.items():
+        parsed = [_numbers(text) for text in texts]
+        if any(p is None for p in parsed):
+            return
+        if parsed:
+            rough[key] = parsed[0] if key == "layers" else dict(parsed)
+    try:
+        check_region_size(family, **rough)
+    except ValueError as error:
+        raise fail(str(error)) from None
+
+
+def _check_metrics(region, search: SearchOptions | None) -> None:
+    """The objectives and constraints of ``search`` against what ``region`` defines: one that is NaN for every design
+    (``inscribed`` on a grid mixing a length and an angle) refused before any work."""
+    if search is None:
+        return
+    undefined = region.undefined_metrics
+    for name in search.objectives or ("area",):
+        if name in undefined:
+            raise fail(f"The objective {name} {undefined[name]}.")
+    for text in search.constraints:
+        name = re.split(r"[<>=]", text, maxsplit=1)[0].strip()
+        if name in undefined:
+            raise fail(f"The constraint {text} is never met: {name} {undefined[name]}.")
 
 
 def _probabilities(options: RegionOptions) -> tuple[float, ...] | None:
@@ -351,9 +482,10 @@ def check_region_against(region, mechanism) -> None:
     check_probabilities(region.probabilities, actuators)
 
 
-def region_of(family: Family, start_mechanism, options: RegionOptions):
+def region_of(family: Family, start_mechanism, options: RegionOptions, search: SearchOptions | None = None):
     """The search's region: the family's default, changed by the region options (a spatial region's
-    coordinates are checked against ``start_mechanism``, the start design)."""
+    coordinates are checked against ``start_mechanism``, the start design); ``search``'s objectives and constraints
+    checked against it."""
     changes = {"index": options.index, "level": options.level, "probabilities": _probabilities(options)}
     if options.radius is not None or options.step is not None or options.phi_step is not None:
         if not family.planar:
@@ -365,15 +497,20 @@ def region_of(family: Family, start_mechanism, options: RegionOptions):
     if options.spatial:  # each given part replaces the family's default, the others stay
         if family.planar:
             raise fail("A planar family's region is a disc (--radius, --step, --phi-step), not --grid/--over.")
+        if options.grids and len(options.grids) != 2:
+            raise fail("Expected exactly two --grid options (the region's map).")
+        _once(options.grids, "--grid")
+        _once(options.overs, "--over")
+        _check_size(family, changes, options)
         if options.grids:
-            if len(options.grids) != 2:
-                raise fail("Expected exactly two --grid options (the region's map).")
             changes["grid"] = dict(_spec(start_mechanism, g, "--grid") for g in options.grids)
         if options.overs:
             changes["over"] = dict(_spec(start_mechanism, o, "--over") for o in options.overs)
         if options.layers:
             changes["layers"] = _spec(start_mechanism, options.layers, "--layers")
     try:
-        return default_region(family, **changes)
+        region = default_region(family, **changes)
     except ValueError as error:
         raise fail(str(error)) from None
+    _check_metrics(region, search)
+    return region

@@ -105,7 +105,7 @@ def design_search() -> None:
 
 def _check(search_options: SearchOptions, outputs, report: Report) -> None:
     """What a search checks before any work: its options, and its outputs (no file written yet)."""
-    search_options.check()
+    search_options.check()  # (a seed is read by its option's type, from the command line or a study file)
     outputs.check(report.quiet, search_options.state)
 
 
@@ -116,7 +116,7 @@ def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, reg
         start_mechanism = chosen.mechanism({**fixed, **initial}) if region.spatial else None
     except ValueError as error:
         raise fail(f"The start design: {error}") from None
-    where = region_of(chosen, start_mechanism, region)
+    where = region_of(chosen, start_mechanism, region, options)
     if start_mechanism is None:  # a planar family's start: only to check the region against its actuators
         try:
             start_mechanism = chosen.mechanism({**fixed, **initial})
@@ -124,9 +124,9 @@ def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, reg
             start_mechanism = None  # (a start that does not build scores 0, as any such design)
     if start_mechanism is not None:
         check_region_against(where, start_mechanism)
-    free = options.free or [name for name in chosen.free if name not in fixed]
+    free = options.free or _varied(chosen, fixed)
     try:
-        study = Study(chosen, where, tuple(options.objectives) or ("area",), free=tuple(free) or None, fixed=fixed,
+        study = Study(chosen, where, tuple(options.objectives) or ("area",), free=tuple(free), fixed=fixed,
                       initial=initial, bounds=parse_bounds(chosen, options.bounds),
                       constraints=tuple(Constraint.parse(c) for c in options.constraints),
                       budget=options.evaluations(len(free)), seed=options.seed, popsize=options.popsize)
@@ -134,6 +134,13 @@ def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, reg
         raise fail(str(error)) from None
     with connected(execution) as execution:  # the handshake before any work
         run_search(study, options.state, execution, outputs, report, start_name)
+
+
+def _varied(chosen: Family, fixed: dict) -> list[str]:
+    """The parameters varied without --free: the family's that are not fixed (every one of them fixed: its other
+    parameters that are not)."""
+    return ([name for name in chosen.free if name not in fixed]
+            or [parameter.name for parameter in chosen.parameters if parameter.name not in fixed])
 
 
 @design_search.command("family", short_help="Search a parametric family: one objective or a Pareto front.")

@@ -14,7 +14,7 @@ from screwkit.cli.design_options import DesignOutputs, Report
 from screwkit.cli.options import echo_error, fail
 from screwkit.common.units import is_angular
 from screwkit.studies.design.objectives import METRICS, region_maps
-from screwkit.studies.design.optimise import StateError, Study, run_study
+from screwkit.studies.design.optimise import EvaluationError, StateError, Study, run_study
 from screwkit.studies.tasks import ClusterError, Execution
 
 __all__ = ["run_search"]
@@ -53,34 +53,45 @@ def _table(result):
     return dataset
 
 
+def _comparison(result, outputs: DesignOutputs, start_name: str):
+    """The figure of the start's and the best design's maps (a start that cannot be built: reachable nowhere)."""
+    from screwkit.plots import MapGrid, design_comparison_figure  # matplotlib: on use
+
+    study = result.study
+    region = study.region
+    layer = 0 if not region.layers else region.layers[1].size // 2  # with layers: the middle one
+    best = region_maps(study.family.mechanism(result.best[0]["values"]), region)[region.index][layer]
+    if "error" in result.start["metrics"]:
+        start, start_name = np.full_like(best, np.nan), f"{start_name} (cannot be built)"
+    else:
+        start = region_maps(study.family.mechanism(result.start["values"]), region)[region.index][layer]
+    step = float(region.steps[0])
+    units = {name: "rad" if is_angular(name) else "m" for name, _ in region.grid}
+    layout = MapGrid(step, coordinates=None if region.mask is not None else [values for _, values in region.grid],
+                     axes_labels=[f"{name} ({unit})" for name, unit in units.items()],
+                     area_unit=region.unit("area").replace("^2", "\u00b2"))
+    return design_comparison_figure(start, best, layout, region.level, start_name, vmin=outputs.vmin,
+                                    vmax=outputs.vmax, index=region.index, over=region.orientations)
+
+
 def _write_outputs(result, outputs: DesignOutputs, summary: dict, start_name: str) -> None:
-    from screwkit.plots import MapGrid, design_comparison_figure, pareto_figure, save_figure  # matplotlib: on use
+    """Every output made first, then written: a failure while making one writes none."""
+    from screwkit.plots import pareto_figure, save_figure  # matplotlib: on use
     from screwkit.studies.files import atomic_text, write_dataset  # netCDF writers: on use only
 
     study, best = result.study, result.best[0]
-    if outputs.urdf:
-        atomic_text(outputs.urdf, study.family.urdf(best["values"], f"{study.family.name}_{study.family.legs}_best"))
-        summary["files"].append(outputs.urdf)
-    if outputs.table:
-        write_dataset(_table(result), outputs.table)
-        summary["files"].append(outputs.table)
-    if outputs.figure:
-        region = study.region
-        layer = 0 if not region.layers else region.layers[1].size // 2  # with layers: the middle one
-        grids = [region_maps(study.family.mechanism(r["values"]), region)[region.index][layer]
-                 for r in (result.start, best)]
-        step = float(region.grid[0][1][1] - region.grid[0][1][0])
-        units = {name: "rad" if is_angular(name) else "m" for name, _ in region.grid}
-        layout = MapGrid(step, coordinates=None if region.mask is not None else [values for _, values in region.grid],
-                         axes_labels=[f"{name} ({unit})" for name, unit in units.items()],
-                         area_unit=region.unit("area").replace("^2", "\u00b2"))
-        figure = design_comparison_figure(*grids, layout, region.level, start_name, vmin=outputs.vmin,
-                                          vmax=outputs.vmax, index=region.index, over=region.orientations)
-        save_figure(figure, outputs.figure)
-        summary["files"].append(outputs.figure)
-    if outputs.front_figure:
-        save_figure(pareto_figure(result), outputs.front_figure)
-        summary["files"].append(outputs.front_figure)
+    urdf = study.family.urdf(best["values"], f"{study.family.name}_{study.family.legs}_best") if outputs.urdf else None
+    table = _table(result) if outputs.table else None
+    figure = _comparison(result, outputs, start_name) if outputs.figure else None
+    front = pareto_figure(result) if outputs.front_figure else None
+    writes = ((outputs.urdf, lambda path: atomic_text(path, urdf)),
+              (outputs.table, lambda path: write_dataset(table, path)),
+              (outputs.figure, lambda path: save_figure(figure, path)),
+              (outputs.front_figure, lambda path: save_figure(front, path)))
+    for path, write in writes:
+        if path:
+            write(path)
+            summary["files"].append(path)
 
 
 def run_search(study: Study, state: str | None, execution: Execution, outputs: DesignOutputs, report: Report,
@@ -100,12 +111,10 @@ def run_search(study: Study, state: str | None, execution: Execution, outputs: D
         echo_error(f"{family.name} ({family.legs} legs): {searched}; region {region.describe()}")
     try:
         result = run_study(study, execution=execution, state=state, notify=None if report.quiet else echo_error)
-    except (StateError, ClusterError) as error:
+    except (StateError, ClusterError, EvaluationError) as error:
         raise fail(str(error)) from None
     if not result.best:
-        start = result.start["metrics"]
-        raise fail(f"No evaluated design meets {', '.join(map(str, study.constraints))}; the start has "
-                   + ", ".join(f"{c.metric} = {start[c.metric]:g}" for c in study.constraints) + ".")
+        raise fail(_nothing_found(result))
     map_options = region.map_arguments(family.mechanism(result.best[0]["values"]))
     summary = {"family": family.name, "legs": family.legs, "objectives": list(study.objectives),
                "constraints": [str(c) for c in study.constraints], "free": list(study.free), "seed": study.seed,
@@ -124,11 +133,23 @@ def run_search(study: Study, state: str | None, execution: Execution, outputs: D
             echo_error(f"wrote {path}")
 
 
+def _nothing_found(result) -> str:
+    """Why a search has no best design: none of its designs can be built, or none meets the constraints."""
+    study, start = result.study, result.start["metrics"]
+    count = len(result.evaluations)
+    if all("error" in r["metrics"] for r in result.evaluations):
+        evaluated = "the start alone evaluated" if count == 1 else f"{count} evaluated"
+        return f"No design evaluated can be built ({evaluated}); the start: {start['error']}"
+    had = (f"cannot be built: {start['error']}" if "error" in start else "has " + ", ".join(
+        f"{c.metric} = {start[c.metric]:g}" for c in study.constraints) + ".")
+    return f"No evaluated design meets {', '.join(map(str, study.constraints))}; the start {had}"
+
+
 def _print(summary: dict, study: Study, top: int) -> None:
     def line(record):
         values = ", ".join(f"{name} = {record['values'][name]:.4g}" for name in study.free)
         scores = ", ".join(f"{name} = {_shown(record['metrics'][name])}" for name in study.objectives)
-        return f"{values} -> {scores}"
+        return f"{values} -> {scores}" + (" (cannot be built)" if "error" in record["metrics"] else "")
 
     count = summary["evaluations"]
     click.echo(f"{summary['family']} ({summary['legs']} legs), {count} evaluation{'' if count == 1 else 's'} "

@@ -24,8 +24,13 @@ from screwkit.model import Mechanism
 from screwkit.studies.maps import MapBlock, disc_grid, map_block, orientation_set, range_values
 from screwkit.studies.options import AnalysisOptions
 
-__all__ = ["METRICS", "MAXIMISED", "UNITS", "Region", "disc_region", "grid_region", "default_region", "region_maps",
-           "region_metrics", "inscribed_radius"]
+__all__ = ["METRICS", "MAXIMISED", "UNITS", "MAX_CONFIGURATIONS_PER_DESIGN", "Region", "disc_region", "grid_region",
+           "default_region", "region_size", "check_region_size", "turn_count", "region_maps", "region_metrics",
+           "inscribed_radius"]
+
+MAX_CONFIGURATIONS_PER_DESIGN = 10**8
+"""Poses a design may be evaluated at (grid points x orientations x layers); a larger region is refused from
+its counts, before any array is built."""
 
 METRICS = {
     "area": "area of the fault-tolerant region of the map (m^2 on a grid of two lengths, rad^2 on a grid of two "
@@ -80,6 +85,12 @@ class Region:
     probabilities : tuple of float, optional
         With an ``f_o_mean<j>`` index: each actuator's failure probability, weighting the mean
         (:func:`~screwkit.indices.average.failure_weights`); equal weights without.
+    steps : tuple of float, optional
+        The step of each grid coordinate (m, rad): the cell is their product, also on an axis of one value
+        (a disc of one point). Default: the spacing of the values (an axis of one value needs it).
+    layer_step : float, optional
+        The layers' step (m): each layer is that thick, however many layers there are. Default: the spacing
+        of the layers' values (a single layer needs it).
     """
 
     grid: tuple
@@ -92,8 +103,16 @@ class Region:
     threshold: float = SINGULARITY_THRESHOLD
     map_options: tuple[str, ...] = ()
     probabilities: tuple[float, ...] | None = None
+    steps: tuple[float, ...] | None = None
+    layer_step: float | None = None
 
     def __post_init__(self):
+        if self.steps is None:
+            object.__setattr__(self, "steps", tuple(_step(name, values) for name, values in self.grid))
+        if self.layers and self.layer_step is None:
+            object.__setattr__(self, "layer_step", _step(*self.layers))
+        if len(self.steps) != len(self.grid) or not all(math.isfinite(s) and s > 0 for s in self.steps):
+            raise ValueError(f"Expected a step > 0 per grid coordinate, got {self.steps}.")
         if self.probabilities is not None:
             if not self.average:
                 raise ValueError(f"Failure probabilities weight the mean over the sets of failed actuators: give "
@@ -124,7 +143,7 @@ class Region:
     @property
     def cell(self) -> float:
         """Area of one grid cell, in :meth:`unit` ``("area")`` (m^2, rad^2 or m rad)."""
-        return float(np.prod([_step(values) for _, values in self.grid]))
+        return float(np.prod(self.steps))
 
     @property
     def length_unit(self) -> str:
@@ -141,6 +160,20 @@ class Region:
         if metric in ("inscribed", "cylinder"):
             return self.length_unit or "mixed"
         return UNITS.get(metric, "index")
+
+    @property
+    def undefined_metrics(self) -> dict[str, str]:
+        """The metrics this region leaves undefined (NaN for every design), each with what it needs (a phrase
+        following the metric's name: ``volume needs a region with layers``)."""
+        out = {} if self.layers else {"volume": "needs a region with layers"}
+        names = ", ".join(name for name, _ in self.grid)
+        if not self.length_unit:
+            out.update(dict.fromkeys(("inscribed", "cylinder"), f"needs distances on the grid: give a grid of two "
+                                                                 f"lengths or two angles, not {names}"))
+        elif self.layers and self.length_unit != "m":
+            out.update(dict.fromkeys(("inscribed", "cylinder"), f"needs distances across the layers: give a grid "
+                                                                 f"of two lengths with layers, not {names}"))
+        return out
 
     @property
     def configurations(self) -> int:
@@ -165,7 +198,7 @@ class Region:
         """The orientation set in words."""
         words = []
         for name, values in self.over:
-            step = math.degrees(_step(values))
+            step = math.degrees(float(values[1] - values[0])) if values.size > 1 else 0.0
             full = is_angular(name) and values.size > 1 and abs(values.size * step - 360) < 1e-6
             words.append(f"a full turn of {name} ({step:g} deg steps)" if full else _span(name, values))
         return "; ".join(words) or "the home orientation"
@@ -194,8 +227,55 @@ class Region:
         return out
 
 
-def _step(values: NDArray) -> float:
-    return float(values[1] - values[0]) if values.size > 1 else 1.0
+def _step(name: str, values: NDArray) -> float:
+    """The spacing of evenly spaced ``values``; a single value has none: its step must be given."""
+    if values.size < 2:
+        raise ValueError(f"Expected the step of {name!r}, which has a single value in the region.")
+    return float(values[1] - values[0])
+
+
+def _count(spec, include_stop: bool) -> int | None:
+    """How many values ``(start, stop, step)`` gives (as :func:`~screwkit.studies.maps.range_values` counts them),
+    without listing them; None for a spec it refuses (its own message then says why)."""
+    try:
+        start, stop, step = (float(v) for v in spec)
+    except (TypeError, ValueError):
+        return None
+    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)) or not step > 0 or not stop > start:
+        return None
+    span = (stop - start) / step
+    return math.floor(span + 1e-6) + 1 if include_stop else math.ceil(span - 1e-6)
+
+
+def _disc_points(radius: float, step: float) -> int | None:
+    """Grid points of :func:`~screwkit.studies.maps.disc_grid`'s disc, counted row by row without the grid (a
+    close estimate for more than 10^7 rows); None for a radius or step it refuses."""
+    if not (math.isfinite(radius) and math.isfinite(step) and radius > 0 and step > 0):
+        return None
+    count = math.floor(radius / step + 1e-9)
+    if count >= 10**7:
+        return int(math.pi * (radius / step) ** 2)
+    offsets = step * np.arange(-count, count + 1, dtype=float)
+    half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
+    return int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
+
+
+def turn_count(phi_step_degrees: float) -> int | None:
+    """Angles of a full turn in ``phi_step_degrees`` steps (None for a step that is not > 0)."""
+    if not (math.isfinite(phi_step_degrees) and phi_step_degrees > 0):
+        return None
+    return max(1, math.ceil((360.0 - 1e-9) / phi_step_degrees))
+
+
+def _check_size(*counts: int | None) -> None:
+    """A region of more than :data:`MAX_CONFIGURATIONS_PER_DESIGN` poses refused from its ``counts`` (grid points,
+    orientations, layers; None: not known, a spec refused later with its own message)."""
+    if any(c is None for c in counts):
+        return
+    configurations = math.prod(counts)
+    if configurations > MAX_CONFIGURATIONS_PER_DESIGN:
+        raise ValueError(f"The region has {configurations:,} configurations per design (grid points x orientations "
+                         f"x layers), more than 10^8: use larger steps.")
 
 
 def _span(name: str, values: NDArray) -> str:
@@ -207,12 +287,13 @@ def disc_region(radius: float, step: float, phi_step_degrees: float, *, index: s
                 closed_forms: bool = True, centre=(0.0, 0.0), probabilities=None) -> Region:
     """The paper's Fig. 5 region of a planar mechanism: a disc about ``centre``, phi over a full turn
     (``probabilities``: :attr:`Region.probabilities`)."""
+    _check_size(_disc_points(radius, step), turn_count(phi_step_degrees))
     x_values, y_values, mask = disc_grid(radius, step, centre)
     phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
     options = ("--radius", repr(float(radius)), "--step", repr(float(step)), "--phi-step",
                repr(float(phi_step_degrees))) + (("--closed-forms",) if closed_forms else ())
     return Region((("x", x_values), ("y", y_values)), (("phi", phi),), index, level, mask, None, closed_forms,
-                  map_options=options, probabilities=probabilities)
+                  map_options=options, probabilities=probabilities, steps=(float(step), float(step)))
 
 
 def _range(name: str, spec, include_stop: bool) -> tuple[NDArray, str]:
@@ -228,6 +309,12 @@ def _range(name: str, spec, include_stop: bool) -> tuple[NDArray, str]:
     return (np.deg2rad(values) if is_angular(name) else values), f"{name}:{start!r}:{stop!r}:{step!r}"
 
 
+def _spec_step(name: str, spec) -> float:
+    """The step of a checked ``(start, stop, step)`` (m, rad)."""
+    step = float(spec[2])
+    return math.radians(step) if is_angular(name) else step
+
+
 def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: str = "f_o1",
                 level: float = 0.4, probabilities=None) -> Region:
     """A spatial region, each coordinate as ``(start, stop, step)`` in m or deg, as ``screwkit map``
@@ -236,6 +323,14 @@ def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: s
     :attr:`Region.probabilities`)."""
     if len(grid) != 2:
         raise ValueError(f"Expected a region grid of exactly two coordinates, got {list(grid)}.")
+    if set(grid) & set(over):  # the message of screwkit map
+        raise ValueError("A coordinate cannot be both on the grid and in the orientation set: "
+                         f"{set(grid) & set(over)}.")
+    if layers is not None and layers[0] in {*grid, *over}:
+        where = "on the grid" if layers[0] in grid else "in the orientation set"
+        raise ValueError(f"The layers' coordinate {layers[0]!r} is also {where}: a coordinate is on the grid, in the "
+                         "orientation set or in the layers, once.")
+    _check_size(*_grid_counts(grid, over, layers))
     options, axes, orientations = [], [], []
     for name, spec in grid.items():
         values, text = _range(name, spec, True)
@@ -245,21 +340,57 @@ def grid_region(grid: dict, over: dict, *, layers: tuple | None = None, index: s
         values, text = _range(name, spec, False)
         orientations.append((name, values))
         options += ["--over", text]
+    layer_step = None
     if layers is not None:
         name, spec = layers
         if is_angular(name):
             raise ValueError(f"Expected a length coordinate for the region's layers, got {name!r}.")
-        layers = (name, _range(name, spec, False)[0])
+        layers, layer_step = (name, _range(name, spec, False)[0]), _spec_step(name, spec)
     return Region(tuple(axes), tuple(orientations), index, level, None, layers, False, map_options=tuple(options),
-                  probabilities=probabilities)
+                  probabilities=probabilities, steps=tuple(_spec_step(name, spec) for name, spec in grid.items()),
+                  layer_step=layer_step)
+
+
+def _grid_counts(grid: dict, over: dict, layers) -> list[int | None]:
+    """Values of each grid coordinate, each orientation coordinate and the layers, counted from their specs."""
+    return [*(_count(spec, True) for spec in grid.values()), *(_count(spec, False) for spec in over.values()),
+            *(() if layers is None else (_count(layers[1], False),))]
+
+
+def _merged(family, changes: dict) -> dict:
+    spec = {**family.region, **{k: v for k, v in changes.items() if v is not None}}
+    if changes.get("grid") is not None:
+        spec.pop("disc", None)
+    return spec
+
+
+def region_size(family, **changes) -> int | None:
+    """Poses per design of :func:`default_region` ``(family, **changes)``, counted from the specs alone (no
+    array built); None when a spec is not valid (:func:`default_region` says why)."""
+    spec = _merged(family, changes)
+    try:
+        if "disc" in spec:
+            radius, step, phi_step = (float(v) for v in spec["disc"])
+            counts = [_disc_points(radius, step), turn_count(phi_step)]
+        else:
+            counts = _grid_counts(dict(spec.get("grid", {})), dict(spec.get("over", {})), spec.get("layers"))
+    except (TypeError, ValueError):
+        return None
+    return None if not counts or any(c is None for c in counts) else math.prod(counts)
+
+
+def check_region_size(family, **changes) -> None:
+    """:func:`region_size` of more than :data:`MAX_CONFIGURATIONS_PER_DESIGN` poses refused (ValueError)."""
+    _check_size(region_size(family, **changes))
 
 
 def default_region(family, **changes) -> Region:
     """The family's default region (:attr:`~screwkit.studies.design.families.Family.region`) with ``changes``
-    (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``, ``probabilities``)."""
-    spec = {**family.region, **{k: v for k, v in changes.items() if v is not None}}
-    if changes.get("grid") is not None:
-        spec.pop("disc", None)
+    (``disc``, ``grid``, ``over``, ``layers``, ``index``, ``level``, ``closed_forms``, ``probabilities``).
+
+    A region of more than :data:`MAX_CONFIGURATIONS_PER_DESIGN` poses is refused (ValueError) from its counts,
+    before any array is built."""
+    spec = _merged(family, changes)
     index, level = spec.get("index", "f_o1"), spec.get("level", 0.4)
     if "disc" in spec:
         if spec.get("layers"):
@@ -320,9 +451,9 @@ def region_metrics(mechanism: Mechanism, region: Region, size: dict[str, float] 
                            maps["iti"].shape)
     index = np.where(mask, np.nan_to_num(maps[region.index], nan=0.0), np.nan)
     inside = index >= region.level
-    layer_step = _step(region.layers[1]) if region.layers else None
+    layer_step = region.layer_step if region.layers else None
     area = float(np.sum(inside) * region.cell)
-    spacing = [_step(v) for _, v in region.grid][::-1]
+    spacing = list(region.steps)[::-1]
     if not region.length_unit or (layer_step and region.length_unit != "m"):  # distances across units: none
         radius = cylinder = math.nan
     else:

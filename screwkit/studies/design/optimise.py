@@ -16,10 +16,11 @@ state replays the evaluations it finds there instead of recomputing them (the op
 seeded, so they ask for the same candidates), which resumes an interrupted run where it stopped.
 A batch is appended whole or not at all: a write that fails (disk full, quota) is cut back to the
 records before it; a last record cut off by a run killed while writing it is dropped when the
-state is read again (and computed again), and an empty state file starts a new search.
+state is read again (and computed again), and an empty state file starts a new search. The evaluations, the state
+file and the worker processes are :mod:`screwkit.studies.design.evaluations`.
 
-The local worker processes end with the process that started them, however it ends (SIGKILL, the out-of-memory
-killer): each asks the kernel for a signal when its parent dies, or (where that cannot be asked) watches its parent.
+A design that cannot be built (an arm that cannot reach its platform joint at the home pose) is infeasible: never
+the best nor on the front, whatever the objectives (its size is real, its region metrics 0).
 """
 
 from __future__ import annotations
@@ -28,34 +29,28 @@ import hashlib
 import json
 import math
 import os
-import signal
-import sys
-import threading
-import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.studies.design.evaluations import EvaluationError, Evaluations, StateError, evaluate_candidate
 from screwkit.studies.design.families import Family
-from screwkit.studies.design.objectives import MAXIMISED, METRICS, Region, region_metrics
-from screwkit.studies.files import atomic_text
-from screwkit.studies.tasks import Execution, run_tasks
+from screwkit.studies.design.objectives import MAX_CONFIGURATIONS_PER_DESIGN, MAXIMISED, METRICS, Region
+from screwkit.studies.tasks import Execution
 
-__all__ = ["Constraint", "Study", "StudyResult", "run_study", "evaluate_candidate", "pareto_front", "StateError"]
+__all__ = ["Constraint", "Study", "StudyResult", "run_study", "evaluate_candidate", "pareto_front", "StateError",
+           "EvaluationError", "MAX_SEED"]
 
 INFEASIBLE = 1e6
 """Differential evolution's score of an infeasible candidate, plus its constraint violation (every
-feasible score is minus a metric, far smaller)."""
+feasible score is minus a metric, far smaller); a design that cannot be built adds it once more (it comes last)."""
+
+MAX_SEED = 2**32 - 1
+"""Largest seed (the optimisers' random generators take 32-bit seeds)."""
 
 
-MAX_CONFIGURATIONS_PER_DESIGN = 10**8
-"""Largest region a design is mapped on (about an hour of one core per design on the spatial path)."""
-
-
-class StateError(ValueError):
-    """A state file that belongs to another study, or cannot be read."""
 
 
 @dataclass(frozen=True)
@@ -114,7 +109,8 @@ class Study:
         whole number of them (one at least); NSGA-II stops at the first generation that reaches
         it. 0 evaluates the start only.
     seed : int
-        Seed of the optimiser: the same study and seed ask for the same designs in the same order.
+        Seed of the optimiser, in 0..:data:`MAX_SEED`: the same study and seed ask for the same designs in the
+        same order.
     popsize : int
         Population size per varied parameter.
     """
@@ -162,6 +158,9 @@ class Study:
             raise ValueError(f"No parameter of family {family.name!r} varies.")
         if self.budget < 0:
             raise ValueError(f"Expected a budget >= 0 evaluations, got {self.budget}.")
+        seed = self.seed
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= MAX_SEED:
+            raise ValueError(f"Expected a seed in 0..{MAX_SEED} (an integer), got {seed!r}.")
         configurations = self.region.configurations
         if configurations > MAX_CONFIGURATIONS_PER_DESIGN:
             raise ValueError(f"The region has {configurations:,} configurations per design (grid points x "
@@ -209,190 +208,9 @@ class Study:
                      None if region.mask is None else region.mask.tolist(),
                      None if not region.layers else (region.layers[0], region.layers[1].tolist())]
         described += [list(region.probabilities)] if region.probabilities is not None else []  # (earlier keys hold)
+        if any(values.size < 2 for _, values in region.grid) or (region.layers and region.layers[1].size < 2):
+            described += [list(region.steps), region.layer_step]  # a lone value's cell, not seen in its values
         return hashlib.sha256(json.dumps(described).encode()).hexdigest()[:16]
-
-
-def evaluate_candidate(family: Family, values: dict, region: Region) -> dict[str, float]:
-    """Every metric of one candidate (a task: depends on its arguments alone).
-
-    A candidate whose file cannot be written (an arm too short to reach the home pose) or whose
-    home pose does not assemble scores 0 on every region metric."""
-    try:
-        mechanism = family.mechanism(values)
-    except ValueError as error:
-        return {**{name: 0.0 for name in METRICS}, **family.size(values), "error": str(error)}
-    return region_metrics(mechanism, region, family.size(values))
-
-
-def _end_with_parent(parent: int) -> None:
-    """Initializer of the local evaluation processes: end when ``parent`` ends, however it ends.
-
-    Linux sends the process SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere a
-    thread checks every half second that the parent is still there. Either way no evaluation process
-    (nor the resource tracker they keep alive) outlives a search that was killed."""
-    asked = False
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        try:
-            libc = ctypes.CDLL(None, use_errno=True)
-            asked = libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # 1: PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            pass
-    if not asked:
-        def watch() -> None:
-            while os.getppid() == parent:
-                time.sleep(0.5)
-            os._exit(1)
-
-        threading.Thread(target=watch, daemon=True).start()
-    if os.getppid() != parent:  # the parent died before the request was made
-        os._exit(1)
-
-
-class _Evaluations:
-    """The study's evaluations by free-parameter vector (exact bits), appended to the state file."""
-
-    def __init__(self, study: Study, state: str | os.PathLike | None, execution: Execution,
-                 notify: Callable[[str], None] | None = None):
-        self.study, self.state = study, state
-        self.execution = replace(execution, progress=False)  # the search's own bar counts the designs
-        self.notify = notify or (lambda message: None)
-        self.known: dict[str, dict] = {}
-        self.order: list[tuple[NDArray, dict]] = []  # every design asked, once, in the order asked
-        self.seen: set[str] = set()
-        self.replayed = 0
-        self.computed = 0
-        self.stored = 0  # records in the state file
-        if state is not None and os.path.exists(state) and os.path.getsize(state) > 0:
-            self._read(state)
-        elif state is not None:
-            if os.path.exists(state):
-                self.notify(f"the design-search state {state} is empty (0 bytes): a new search starts in it")
-            header = json.dumps({"screwkit_design_state": 1, "study": study.fingerprint(),
-                                 "family": study.family.name, "free": list(study.free)})
-            try:
-                atomic_text(state, header + "\n")
-            except OSError as error:
-                raise StateError(f"Cannot write the design-search state {state}: "
-                                 f"{error.strerror or error}.") from None
-        self.bar, self.pool = None, None
-        if sys.stderr.isatty() if execution.progress is None else execution.progress:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=study.budget, desc="designs", unit="design", leave=False)
-
-    def _read(self, state) -> None:
-        try:
-            with open(state, "rb") as file:
-                content = file.read()
-            complete, _, cut = content.rpartition(b"\n")  # the bytes after the last newline: a cut-off record
-            lines = complete.decode("utf-8").split("\n")
-            header = json.loads(lines[0])
-            records = [self._record(line, number) for number, line in enumerate(lines[1:], start=2)]
-        except (OSError, ValueError) as error:
-            raise StateError(f"Cannot read the design-search state {state}: {error}") from None
-        if not isinstance(header, dict) or "screwkit_design_state" not in header:
-            raise StateError(f"{state} is not a design-search state (its first line is not the header of one); "
-                             "give a new --state file.")
-        if header.get("study") != self.study.fingerprint():
-            raise StateError(f"The state {state} belongs to another study (family {header.get('family')!r}, "
-                             f"free {header.get('free')}); give a new --state file or the same study options.")
-        if cut:
-            try:
-                os.truncate(state, len(content) - len(cut))  # the next batch starts on a line of its own
-            except OSError as error:
-                raise StateError(f"Cannot drop the cut-off last record of the design-search state {state}: "
-                                 f"{error.strerror or error}.") from None
-            self.notify(f"dropped the cut-off last record of {state} (a run stopped while writing it); "
-                        "it is computed again")
-        for record in records:
-            self.known[record["key"]] = record["metrics"]
-        self.stored = len(records)
-
-    @staticmethod
-    def _record(line: str, number: int) -> dict:
-        """One record; from a line where an earlier version of screwkit appended a record to a cut-off one,
-        the record it ends with."""
-        try:
-            return json.loads(line)
-        except ValueError:
-            start = line.rfind('{"key"')
-            if start <= 0:
-                raise ValueError(f"line {number} is not a record") from None
-            return json.loads(line[start:])
-
-    def _append(self, records: list[tuple[str, dict]]) -> None:
-        """Append a batch of records whole, or (disk full, quota) not at all."""
-        data = "".join(json.dumps({"key": key, "metrics": metrics}) + "\n" for key, metrics in records).encode()
-        try:
-            descriptor = os.open(self.state, os.O_WRONLY | os.O_APPEND)
-        except OSError as error:
-            raise StateError(f"Cannot append to the design-search state {self.state}: "
-                             f"{error.strerror or error}.") from None
-        try:
-            size = os.fstat(descriptor).st_size
-            try:
-                written = 0
-                while written < len(data):
-                    written += os.write(descriptor, data[written:])
-                os.fsync(descriptor)
-            except OSError as error:
-                os.ftruncate(descriptor, size)
-                raise StateError(f"Cannot append to the design-search state {self.state}: "
-                                 f"{error.strerror or error}; it keeps the {self.stored} evaluations stored before, "
-                                 "and a run with it resumes from them.") from None
-        finally:
-            os.close(descriptor)
-        self.stored += len(records)
-
-    def __call__(self, vectors: NDArray) -> list[dict]:
-        keys = [np.asarray(v, dtype=np.float64).tobytes().hex() for v in vectors]
-        first = {}
-        for i, key in enumerate(keys):
-            first.setdefault(key, i)
-        new = [key for key in first if key not in self.seen]
-        missing = [key for key in new if key not in self.known]
-        self.replayed += len(new) - len(missing)
-        self.computed += len(missing)
-        if missing:
-            arguments = [(self.study.family, self.study.values(vectors[first[key]]), self.study.region)
-                         for key in missing]
-            results = self._run(arguments)
-            self.known.update(zip(missing, results))
-            if self.state is not None:
-                self._append(list(zip(missing, results)))
-        for key in new:
-            self.seen.add(key)
-            self.order.append((np.array(vectors[first[key]], dtype=float), self.known[key]))
-        if self.bar is not None:
-            self.bar.update(len(new))
-        return [self.known[key] for key in keys]
-
-    def _run(self, arguments: list[tuple]) -> list[dict]:
-        """Evaluate on the cluster, or locally in worker processes: a candidate's evaluation is mostly
-        Python (writing, parsing and assembling its file), which threads would run one at a time.
-        A family whose functions a new process cannot import (written in a notebook or a script
-        run as ``__main__``) is evaluated on local threads."""
-        family = self.study.family
-        importable = all(f.__module__ != "__main__" and "<locals>" not in f.__qualname__
-                         for f in (family.writer, family.measures))  # what a spawned process can import
-        if self.execution.scheduler is not None or len(arguments) < 2 or (os.cpu_count() or 1) < 2 or not importable:
-            return run_tasks(evaluate_candidate, arguments, self.execution)
-        if self.pool is None:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            # spawn: a forked copy of a process that already runs threads (numba, Dask) can deadlock
-            self.pool = ProcessPoolExecutor(os.cpu_count(), mp_context=multiprocessing.get_context("spawn"),
-                                            initializer=_end_with_parent, initargs=(os.getpid(),))
-        return list(self.pool.map(evaluate_candidate, *zip(*arguments)))
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-        if self.pool is not None:
-            self.pool.shutdown(cancel_futures=True)
 
 
 @dataclass
@@ -421,10 +239,24 @@ class StudyResult:
 
 
 def _score(study: Study, metrics: dict) -> tuple[NDArray, float]:
-    """(objectives as minimised values, total constraint violation)."""
+    """(objectives as minimised values, total constraint violation: :data:`INFEASIBLE` more for a design that cannot
+    be built)."""
     objectives = np.array([-metrics[name] if MAXIMISED[name] else metrics[name] for name in study.objectives])
-    violation = sum(c.violation(metrics) for c in study.constraints)
+    violation = sum(c.violation(metrics) for c in study.constraints) + (INFEASIBLE if "error" in metrics else 0.0)
     return objectives, float(violation)
+
+
+def _inside(study: Study) -> NDArray[np.float64]:
+    """The start as differential evolution is given it: within the bounds as scipy rescales them to [0, 1] (a start
+    on a narrowed bound, 0.6 of 0.6:0.8, lands 1e-16 outside; it moves by that much, a few ulps)."""
+    limits, start = study.limits, study.start.copy()
+    middle, scale = 0.5 * (limits[:, 0] + limits[:, 1]), 1 / np.fabs(limits[:, 0] - limits[:, 1])  # (as scipy's)
+    for i in range(start.size):
+        while (start[i] - middle[i]) * scale[i] + 0.5 < 0:
+            start[i] = np.nextafter(start[i], np.inf)
+        while (start[i] - middle[i]) * scale[i] + 0.5 > 1:
+            start[i] = np.nextafter(start[i], -np.inf)
+    return start
 
 
 def pareto_front(scores: NDArray) -> NDArray[np.int64]:
@@ -462,7 +294,7 @@ def _single(study: Study, evaluate: Callable) -> None:
         return np.array(scores)
 
     try:
-        differential_evolution(fitness, bounds=limits, x0=study.start, maxiter=generations, popsize=study.popsize,
+        differential_evolution(fitness, bounds=limits, x0=_inside(study), maxiter=generations, popsize=study.popsize,
                                seed=study.seed, polish=False, tol=1e-6, integrality=integrality if integrality.any()
                                else None, vectorized=True, updating="deferred")
     except RuntimeError:
@@ -481,15 +313,15 @@ def _multiple(study: Study, evaluate: Callable) -> None:
 
     class Search(Problem):
         def __init__(self):
-            super().__init__(n_var=len(study.free), n_obj=len(study.objectives), n_ieq_constr=len(study.constraints),
-                             xl=limits[:, 0], xu=limits[:, 1])
+            super().__init__(n_var=len(study.free), n_obj=len(study.objectives),
+                             n_ieq_constr=len(study.constraints) + 1, xl=limits[:, 0], xu=limits[:, 1])
 
         def _evaluate(self, x, out, *args, **kwargs):
             metrics = evaluate(x)
             out["F"] = np.array([_score(study, m)[0] for m in metrics])
-            if study.constraints:  # pymoo: feasible where every G <= 0
-                out["G"] = np.array([[c.violation(m) if c.violation(m) > 0 else -1.0 for c in study.constraints]
-                                     for m in metrics])
+            # pymoo: feasible where every G <= 0; the last: the design can be built
+            out["G"] = np.array([[c.violation(m) if c.violation(m) > 0 else -1.0 for c in study.constraints]
+                                 + [1.0 if "error" in m else -1.0] for m in metrics])
 
     rng = np.random.default_rng(study.seed)
     sampling = limits[:, 0] + rng.random((size, len(study.free))) * (limits[:, 1] - limits[:, 0])
@@ -514,9 +346,10 @@ def run_study(study: Study, *, execution: Execution | None = None, state: str | 
 
     Raises
     ------
-    StateError, ClusterError, ValueError
+    StateError, ClusterError, EvaluationError, ValueError
+        ClusterError and EvaluationError (a local evaluation process died) say what the state file keeps.
     """
-    evaluations = _Evaluations(study, state, Execution() if execution is None else execution, notify)
+    evaluations = Evaluations(study, state, Execution() if execution is None else execution, notify)
     try:
         start_metrics = evaluations(study.start[None])[0]
         if study.budget > 0:
