@@ -91,6 +91,20 @@ def test_the_planar_family_at_its_defaults_is_table_2():
     assert legs == 5 and values == pytest.approx(family("planar_rrr").defaults(), abs=1e-12)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_design_is_a_member_of_its_family_whatever_the_order_of_its_legs(seed):
+    """The bundled 5-RRR with its legs listed in another order (a file whose chains are named otherwise) is the same
+    member of the family, with the same values: it was refused as "not a member" (chain 1's base joint elsewhere)."""
+    design = planar_design(load("planar_5rrr"))
+    order = np.random.default_rng(seed).permutation(design.chain_count)
+    while np.array_equal(order, np.arange(design.chain_count)):
+        order = np.roll(order, 1)
+    shuffled = PlanarDesign(design.base[order], design.platform[order], design.upper[order], design.lower[order],
+                            design.working_mode[order])
+    legs, values = family_values(shuffled)
+    assert legs == 5 and values == pytest.approx(family_values(design)[1], abs=1e-12)
+
+
 def ups_f_o1(base, platform, poses):
     """F_O1 of a UPS hexapod at (x, y, z, yaw) poses, from the leg lines alone: every 6-leg
     submechanism's output twists are the columns of its inverse wrench matrix."""

@@ -330,7 +330,9 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     singular = singular_dips(evaluate, path, minima_at, minima, series, tolerance)
     points = _series_points(s, columns, rows, series, minima_at, minima)
     reachable_samples, kept = np.asarray(samples.reachable, dtype=bool), 0
-    for _ in range(_HIDDEN_ROUNDS):  # again while the searches find, between two reachable samples, a pose out of reach
+    # again while the searches find a pose out of reach between two reachable samples, at most _HIDDEN_ROUNDS times
+    # (what the last round finds is left out: the points used below are those its crossings were located on)
+    for round_ in range(_HIDDEN_ROUNDS):
         states = [np.isfinite(v) if k == reach_series else np.nan_to_num(v, nan=-np.inf) >= level
                   for k, (_, v) in enumerate(points)]  # above(v, k) for one series at a time
         brackets = [(k, i) for k, state in enumerate(states) for i in np.flatnonzero(state[1:] != state[:-1])]
@@ -342,7 +344,7 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
         crossing = {(k, i): (lo + hi) / 2 for (k, i), lo, hi in zip(brackets, low, high)}
         hidden = _hidden_gaps(s, reachable_samples, probed[kept:])
         kept = len(probed)
-        if hidden is None:
+        if hidden is None or round_ == _HIDDEN_ROUNDS - 1:
             break
         points = [_merged(at, v, hidden[0], hidden[1][:, k]) for k, (at, v) in enumerate(points)]
 

@@ -209,8 +209,12 @@ def family_values(design: PlanarDesign) -> tuple[int, dict[str, float]]:
 
     Raises ValueError naming the first chain that does not fit the family (base joints on a circle
     at the angles 2 pi i / n, platform joints on a circle at slot angles, identical arms, one
-    working mode)."""
+    working mode), in the order of their base joints' angles whatever the order the file lists them in."""
     n = design.chain_count
+    turn = np.round(np.arctan2(design.base[:, 1], design.base[:, 0]) / (2 * np.pi / n)).astype(int) % n
+    order = np.argsort(turn, kind="stable")  # the family's chain i has its base joint at the angle 2 pi i / n
+    design = PlanarDesign(design.base[order], design.platform[order], design.upper[order], design.lower[order],
+                          design.working_mode[order])
     radius = float(np.mean(np.linalg.norm(design.base, axis=-1)))
     angles = 2 * np.pi * np.arange(n) / n
     expected = radius * np.column_stack([np.cos(angles), np.sin(angles)])
