@@ -32,13 +32,7 @@ from screwkit.cli.options import (
 )
 from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.studies.design.families import Family
-from screwkit.studies.design.objectives import (
-    MAX_CONFIGURATIONS_PER_DESIGN,
-    METRICS,
-    check_region_size,
-    default_region,
-    turn_count,
-)
+from screwkit.studies.design.objectives import METRICS, check_region_size, check_turn_count, default_region
 from screwkit.studies.design.optimise import MAX_SEED
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 
@@ -143,10 +137,10 @@ def check_phi_step(phi_step: float | None) -> None:
         return
     if not 0 < phi_step <= 360:
         raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {phi_step:g}.")
-    turns = turn_count(phi_step)
-    if turns is not None and turns > MAX_CONFIGURATIONS_PER_DESIGN:
-        raise fail(f"--phi-step {phi_step:g} makes {turns:,} angles of the full turn per design, more than 10^8: "
-                   "use a larger step.")
+    try:
+        check_turn_count(phi_step, "--phi-step")
+    except ValueError as error:
+        raise fail(str(error)) from None
 
 
 def _region(radius, step, phi_step, grids, overs, layers, region_index, level, probabilities=None) -> RegionOptions:

@@ -46,10 +46,15 @@ def _poses(mechanism, words: list[str], count: int, option: str, label: str | No
         return [parse_pose(mechanism, word, label) for word, label in zip(words, labels)]
     n = mechanism.n_task
     if len(words) != count * n or not all(_number(word) for word in words):
-        units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
+        units = _units(mechanism)
         raise fail(f"Expected {option} with {count} named pose(s) or {count} x {n} numbers ({units}) for "
                    f"{mechanism.name!r}, got {' '.join(words) or 'nothing'}.")
     return [parse_pose(mechanism, " ".join(words[i * n:(i + 1) * n]), labels[i]) for i in range(count)]
+
+
+def _units(mechanism) -> str:
+    """The task coordinates with the units a pose is given in on the command line: ``x (m), y (m), phi (deg)``."""
+    return ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
 
 
 def _number(word: str) -> bool:
@@ -76,8 +81,7 @@ def generated_path(mechanism, source: PathSource):
                        f"m), got {source.circle!r}.")
         n = mechanism.n_task
         if all(_number(word) for word in words) and len(words) != n + 1:
-            units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates,
-                                                                            mechanism.angular))
+            units = _units(mechanism)
             raise fail(f"Expected --circle with the centre's {n} task coordinates ({units}) then the radius (m), "
                        f"{n + 1} numbers, got {len(words)}{' (no radius)' if len(words) == n else ''}: "
                        f"{source.circle}.")
@@ -96,7 +100,7 @@ def _through(mechanism, words: list[str]) -> list[np.ndarray]:
     numbers = any(_number(word) for word in words)
     count = len(words) // n if numbers else len(words)
     if count < 2 or (numbers and len(words) % n):
-        units = ", ".join(f"{c} ({'deg' if a else 'm'})" for c, a in zip(mechanism.task_coordinates, mechanism.angular))
+        units = _units(mechanism)
         raise fail(f"Expected --through with at least 2 poses (named poses, or {n} numbers each: {units}) for "
                    f"{mechanism.name!r}, got {' '.join(words) or 'nothing'}.")
     return _poses(mechanism, words, count, "--through")

@@ -37,8 +37,8 @@ from screwkit.studies.options import AnalysisOptions
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.tasks import Execution, run_tasks
 
-__all__ = ["index_map", "planar_disc_map", "disc_grid", "range_values", "GridMap", "MapSize", "map_size", "disc_size",
-           "map_task", "map_block", "MapBlock", "orientation_set"]
+__all__ = ["index_map", "planar_disc_map", "disc_grid", "disc_point_count", "range_values", "range_count", "GridMap",
+           "MapSize", "map_size", "disc_size", "map_task", "map_block", "MapBlock", "orientation_set"]
 
 CONFIGURATIONS_PER_TASK = 131_072
 """Configurations (grid points times orientations) per task, at most (see :func:`task_size`)."""
@@ -450,7 +450,7 @@ def range_values(start: float, stop: float, step: float, *, include_stop: bool =
     if not (np.isfinite(start) and np.isfinite(stop) and np.isfinite(step)) or not step > 0 or not stop > start:
         raise ValueError("finite numbers, STEP > 0 and STOP > START")
     span = (stop - start) / step
-    count = int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
+    count = range_count(start, stop, step, include_stop=include_stop)
     if count > 10**8:
         raise ValueError(f"at most 10^8 values ({count:,} asked; use a larger step)")
     if include_stop and abs(span - round(span)) > 1e-6:
@@ -459,6 +459,23 @@ def range_values(start: float, stop: float, step: float, *, include_stop: bool =
                          f"= {span:.4g} steps; e.g. a stop of {start + whole * step:g}, or a step of "
                          f"{(stop - start) / whole:.6g} or {(stop - start) / (whole + 1):.6g})")
     return start + step * np.arange(count)
+
+
+def range_count(start: float, stop: float, step: float, *, include_stop: bool = False) -> int:
+    """How many values :func:`range_values` gives for a checked START, STOP and STEP, without listing them."""
+    span = (stop - start) / step
+    return int(np.floor(span + 1e-6)) + 1 if include_stop else int(np.ceil(span - 1e-6))
+
+
+def disc_point_count(radius: float, step: float) -> int:
+    """Grid points of :func:`disc_grid`'s disc for a checked radius and step, counted row by row without the grid
+    (beyond 10^7 rows, the disc's area in cells: close enough for a refusal)."""
+    count = int(math.floor(radius / step + 1e-9))
+    if count >= 10**7:
+        return int(math.pi * (radius / step) ** 2)
+    offsets = step * np.arange(-count, count + 1, dtype=float)
+    half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
+    return int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
 
 
 def disc_grid(radius: float, step: float, centre=(0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray[np.bool_]]:
@@ -478,12 +495,7 @@ def disc_size(mechanism: Mechanism, radius: float, step: float, phi_step_degrees
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"Expected `{name}` > 0, got {value}.")
     count = int(math.floor(radius / step + 1e-9))
-    offsets = step * np.arange(-count, count + 1, dtype=float) if count < 10**7 else None
-    if offsets is None:  # too many rows to list: the disc's area is close enough for a refusal
-        points = int(math.pi * (radius / step) ** 2)
-    else:
-        half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
-        points = int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
+    points = disc_point_count(radius, step)
     orientations = len(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees)) if phi_step_degrees >= 1e-6 else 10**12
     if "phi" not in mechanism.task_coordinates:  # a planar point output: no rotation to map over
         orientations = 1

@@ -422,9 +422,11 @@ def _hidden_gaps(s: NDArray, reachable: NDArray, probed: list) -> tuple[NDArray,
 
 
 def _merged(at: NDArray, v: NDArray, more_at: NDArray, more: NDArray) -> tuple[NDArray, NDArray]:
-    """A series' points with more points inserted in order (after those at the same arc length)."""
-    order = np.argsort(np.concatenate([at, more_at]), kind="stable")
-    return np.concatenate([at, more_at])[order], np.concatenate([v, more])[order]
+    """A series' points (``at`` in order, values ``v``) with more points inserted in order, each after the points
+    already at its arc length."""
+    order = np.argsort(more_at, kind="stable")
+    where = np.searchsorted(at, more_at[order], side="right")
+    return np.insert(at, where, more_at[order]), np.insert(v, where, more[order])
 
 
 def _local_minima_of_blocks(blocks: list[NDArray]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -447,10 +449,7 @@ def _series_points(s, columns, rows, series, minima_at, minima):
         if not mine.any():
             points.append((s, columns[k]))
             continue
-        order = np.argsort(minima_at[mine], kind="stable")
-        at, v = minima_at[mine][order], minima[mine][order]
-        where = np.searchsorted(s, at, side="right")  # after the samples at the same arc length, in order
-        points.append((np.insert(s, where, at), np.insert(columns[k], where, v)))
+        points.append(_merged(s, columns[k], minima_at[mine], minima[mine]))
     return points
 
 

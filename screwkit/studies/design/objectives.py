@@ -21,12 +21,20 @@ from screwkit.common.units import is_angular
 from screwkit.indices.average import MEAN_NAME, averaging, is_mean_column
 from screwkit.indices.registry import column_record
 from screwkit.model import Mechanism
-from screwkit.studies.maps import MapBlock, disc_grid, map_block, orientation_set, range_values
+from screwkit.studies.maps import (
+    MapBlock,
+    disc_grid,
+    disc_point_count,
+    map_block,
+    orientation_set,
+    range_count,
+    range_values,
+)
 from screwkit.studies.options import AnalysisOptions
 
 __all__ = ["METRICS", "MAXIMISED", "UNITS", "MAX_CONFIGURATIONS_PER_DESIGN", "Region", "disc_region", "grid_region",
-           "default_region", "region_size", "check_region_size", "turn_count", "region_maps", "region_metrics",
-           "inscribed_radius"]
+           "default_region", "region_size", "check_region_size", "turn_count", "check_turn_count", "region_maps",
+           "region_metrics", "inscribed_radius"]
 
 MAX_CONFIGURATIONS_PER_DESIGN = 10**8
 """Poses a design may be evaluated at (grid points x orientations x layers); a larger region is refused from
@@ -243,21 +251,14 @@ def _count(spec, include_stop: bool) -> int | None:
         return None
     if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)) or not step > 0 or not stop > start:
         return None
-    span = (stop - start) / step
-    return math.floor(span + 1e-6) + 1 if include_stop else math.ceil(span - 1e-6)
+    return range_count(start, stop, step, include_stop=include_stop)
 
 
 def _disc_points(radius: float, step: float) -> int | None:
-    """Grid points of :func:`~screwkit.studies.maps.disc_grid`'s disc, counted row by row without the grid (a
-    close estimate for more than 10^7 rows); None for a radius or step it refuses."""
+    """:func:`~screwkit.studies.maps.disc_point_count`; None for a radius or step it refuses."""
     if not (math.isfinite(radius) and math.isfinite(step) and radius > 0 and step > 0):
         return None
-    count = math.floor(radius / step + 1e-9)
-    if count >= 10**7:
-        return int(math.pi * (radius / step) ** 2)
-    offsets = step * np.arange(-count, count + 1, dtype=float)
-    half = np.sqrt(np.maximum(radius**2 * (1 + 1e-12) - offsets**2, 0.0))
-    return int(np.sum(2 * np.floor(half / step + 1e-9) + 1))
+    return disc_point_count(radius, step)
 
 
 def turn_count(phi_step_degrees: float) -> int | None:
@@ -265,6 +266,18 @@ def turn_count(phi_step_degrees: float) -> int | None:
     if not (math.isfinite(phi_step_degrees) and phi_step_degrees > 0):
         return None
     return max(1, math.ceil((360.0 - 1e-9) / phi_step_degrees))
+
+
+def check_turn_count(phi_step_degrees: float, name: str = "phi_step_degrees") -> int:
+    """:func:`turn_count`, refused (ValueError naming ``name``) for a step that is not > 0 or that makes more than
+    :data:`MAX_CONFIGURATIONS_PER_DESIGN` angles, before any angle is listed."""
+    turns = turn_count(phi_step_degrees)
+    if turns is None:
+        raise ValueError(f"Expected {name} > 0 (deg), got {phi_step_degrees!r}.")
+    if turns > MAX_CONFIGURATIONS_PER_DESIGN:
+        raise ValueError(f"{name} {phi_step_degrees:g} makes {turns:,} angles of the full turn per design, more than "
+                         "10^8: use a larger step.")
+    return turns
 
 
 def _check_size(*counts: int | None) -> None:

@@ -26,7 +26,7 @@ from screwkit.indices.closed_forms import planar_indices
 from screwkit.model import Mechanism
 from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
 from screwkit.studies.design.families import permutation_rank
-from screwkit.studies.design.objectives import MAX_CONFIGURATIONS_PER_DESIGN, turn_count
+from screwkit.studies.design.objectives import check_turn_count
 from screwkit.studies.poses import planar_points
 from screwkit.studies.tasks import Execution, run_tasks
 
@@ -147,10 +147,7 @@ def permutation_search(design: PlanarDesign, *, phi_step_degrees: float = 1.0, f
     list of DesignScore
         Best first (NaN scores, i.e. not fully rotatable, last).
     """
-    turn = turn_count(phi_step_degrees)
-    if turn is None or turn > MAX_CONFIGURATIONS_PER_DESIGN:  # counted before any angle is listed
-        raise ValueError(f"Expected a phi step giving at most 10^8 angles of the full turn per design, got "
-                         f"{phi_step_degrees!r} deg.")
+    check_turn_count(phi_step_degrees)  # counted before any angle is listed
     n = design.chain_count
     candidates = [(p, mode) for mode in (1, -1) for p in permutations(range(n))]
     if probabilities is not None:  # (checked once, not in every task)
