@@ -139,3 +139,46 @@ def delta_sdf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None, plugin
                       for i in range(1, len(base) + 1)) if plugin else ""
     return (f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="delta_rods">'
             + "".join(links + joints + ends) + plugins + "</model></sdf>\n")
+
+
+def hexapod_sdf(platform_joint: str = "universal", base_offset=(0.0, 0.0, 0.0)) -> str:
+    """The bundled 8-leg U-P-S hexapod (robots/ups_hexapod_8.urdf: its joint centres, read from that file) written in
+    SDFormat with its legs turned over, S-P-U: a ball joint at the base, the actuated slide, and at the platform a
+    ``universal`` (or ``revolute`` pair: ``platform_joint="revolute"``) joint closing the loop, at the centre of the
+    URDF's spherical joint. The base link's frame is drawn at ``base_offset`` (m; no joint moves with it). Such a
+    leg transmits the force along its slide as the U-P-S leg does: the same indices."""
+    from xml.etree import ElementTree
+
+    from screwkit.io.loader import bundled_path
+
+    root = ElementTree.parse(bundled_path("ups_hexapod_8")).getroot()
+    joints = {joint.get("name"): joint for joint in root.findall("joint")}
+    loops = {loop.get("name"): loop for loop in root.findall("loop")}
+    legs = sorted({name.split("_joint")[0] for name in joints if name.startswith("leg_")},
+                  key=lambda name: int(name.split("_")[1]))
+    placed = joints["platform_joint"].find("origin")
+    lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}>\n<model name="spu_hexapod">',
+             f'<link name="base"><pose>{text(base_offset)} 0 0 0</pose></link>',
+             '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
+             f'<link name="platform"><pose>{placed.get("xyz")} {placed.get("rpy")}</pose></link>']
+    for leg in legs:
+        origin = joints[f"{leg}_joint_u1"].find("origin")
+        length = float(loops[f"{leg}_joint_s"].find("predecessor/origin").get("xyz").split()[0])
+        lines.append(f'<link name="{leg}_cyl"><pose>{origin.get("xyz")} {origin.get("rpy")}</pose></link>'
+                     f'<link name="{leg}_pis"><pose>{origin.get("xyz")} {origin.get("rpy")}</pose></link>')
+        lines.append(f'<joint name="{leg}_s" type="ball"><parent>base</parent><child>{leg}_cyl</child>'
+                     f'<pose relative_to="{leg}_cyl"/></joint>')
+        lines.append(f'<joint name="{leg}_slider" type="prismatic"><parent>{leg}_cyl</parent><child>{leg}_pis</child>'
+                     '<axis><xyz>1 0 0</xyz></axis><screwkit:actuated/></joint>')
+        at = f'<pose relative_to="{leg}_pis">{length} 0 0 0 0 0</pose>'
+        if platform_joint == "universal":
+            lines.append(f'<joint name="{leg}_u" type="universal"><parent>{leg}_pis</parent><child>platform</child>'
+                         f'{at}<axis><xyz>0 1 0</xyz></axis><axis2><xyz>0 0 1</xyz></axis2></joint>')
+        else:  # the universal joint as two revolute joints about crossing axes, through a cross link
+            lines.append(f'<link name="{leg}_cross"><pose relative_to="{leg}_pis">{length} 0 0 0 0 0</pose></link>'
+                         f'<joint name="{leg}_u1" type="revolute"><parent>{leg}_pis</parent><child>{leg}_cross</child>'
+                         '<axis><xyz>0 1 0</xyz></axis></joint>'
+                         f'<joint name="{leg}_u2" type="revolute"><parent>{leg}_cross</parent><child>platform</child>'
+                         f'{at}<axis><xyz>0 0 1</xyz></axis></joint>')
+    lines.append("</model>\n</sdf>")
+    return "\n".join(lines)

@@ -174,11 +174,16 @@ def test_unreachable_poses_are_nan_and_bad_poses_are_refused(tmp_path):
     result = graph_indices_at_poses(graph, np.array([home, home + [0.0, 0.0, -5.0], home + [0.01, 0.0, 0.0]]))
     assert result.reachable.tolist() == [True, False, True]
     assert np.isnan(result.lmti[1]) and np.isfinite(result.lmti[[0, 2]]).all()
-    with pytest.raises(ValueError, match=r"Expected finite poses of shape \(\.\.\., 3\) "
-                                         r"\(x \(m\), y \(m\), z \(m\)\) for mechanism 'delta'"):
+    with pytest.raises(ValueError, match=r"Expected `poses` with shape \(\.\.\., 3\) for mechanism 'delta' "
+                                         r"\(x, y, z\), got \(2, 6\)"):
         graph_indices_at_poses(graph, np.zeros((2, 6)))
-    with pytest.raises(ValueError, match="Expected finite poses"):
+    with pytest.raises(ValueError, match=r"Expected finite values in `poses`, got nan at index \(0, 0\)"):
         graph_indices_at_poses(graph, np.array([[np.nan, 0.0, 0.0]]))
+    reach = 1e6 * graph.length_scale  # as a mechanism's poses are checked: positions within a million scales
+    with pytest.raises(ValueError, match=r"Expected positions within 1e\+06 length scales .* of the home pose of "
+                                         r"mechanism 'delta' in `poses` \(z, sample 1\), got -1e\+300 m"):
+        graph_indices_at_poses(graph, np.array([home, home + [0.0, 0.0, -1e300]]))
+    assert graph_indices_at_poses(graph, [home + [0.0, 0.0, -0.99 * reach]]).reachable.tolist() == [False]
 
 
 def test_the_reach_bound_is_never_exceeded_and_a_straight_arm_meets_it(tmp_path):

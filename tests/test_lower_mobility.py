@@ -622,3 +622,62 @@ def test_poses_whose_dependent_coordinates_do_not_close_are_unreachable_without_
         assert alone.reachable[0]
         for values, single in zip(batch.joint_values, alone.joint_values):
             np.testing.assert_allclose(values[row], single[0], rtol=0, atol=1e-12)
+
+
+def test_a_mechanism_of_one_dof_has_the_indices_of_its_closed_form():
+    """Mobility one: a platform on a passive slide along x, driven by three planar R-P-R legs at angles t_k. Each
+    leg's actuation wrench is a force along it, the output twist a translation along x: OTI_k = |cos t_k|, ITI_k = 1,
+    LMTI = max_k |cos t_k|, F_O1 = the least of the two largest, F_O2 = the smallest (Eqs. 6-12). It raised
+    "cannot reshape array of size 0" (the empty set of n - 1 = 0 locked actuators)."""
+    from screwkit.indices.analysis import analyze
+    from screwkit.screw.chain_screws import ChainScrews
+    from screwkit.screw.planar import rpr_chain_screws
+
+    rng = np.random.default_rng(11)
+    angles = rng.uniform(0.0, np.pi, (5, 3))
+    platform = rng.uniform(-0.2, 0.2, (5, 1, 2)) * np.ones((1, 3, 1))
+    legs = rpr_chain_screws(platform - 0.8 * np.stack([np.cos(angles), np.sin(angles)], axis=-1), platform)
+    slide = ChainScrews(np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], (5, 1, 1)),
+                        np.concatenate([platform[:, :1], np.zeros((5, 1, 1))], axis=-1), (), name="guide",
+                        joint_names=("slide",))
+    result = analyze([*legs, slide])
+    cosines = np.sort(np.abs(np.cos(angles)), axis=-1)
+    assert result.dof == 1
+    np.testing.assert_allclose(result.iti_actuators, 1.0, atol=1e-12)
+    np.testing.assert_allclose(result.lmti, cosines[:, 2], atol=1e-12)
+    np.testing.assert_allclose(result.f_o[1], cosines[:, 1], atol=1e-12)
+    np.testing.assert_allclose(result.f_o[2], cosines[:, 0], atol=1e-12)
+
+
+ONE_DOF_MJCF = (
+    '<mujoco model="welded_five_bar"><compiler angle="radian"/><worldbody><body name="base">'
+    '<body name="proximal_1" pos="-0.1 0 0"><joint name="a_1" type="hinge" axis="0 0 1"/><geom type="sphere" '
+    'size="0.01"/><body name="distal_1" pos="-0.1273240921790808 0.15423545490830878 0"><joint name="b_1" '
+    'type="hinge" axis="0 0 1"/><geom type="sphere" size="0.01"/><site name="effector" '
+    'pos="0.2273240921790808 0.1957645450916912 0"/></body></body>'
+    '<body name="proximal_2" pos="0.1 0 0"><joint name="a_2" type="hinge" axis="0 0 1"/><geom type="sphere" '
+    'size="0.01"/><body name="distal_2" pos="0.1273240921790808 0.15423545490830878 0"><joint name="b_2" '
+    'type="hinge" axis="0 0 1"/><geom type="sphere" size="0.01"/></body></body>'
+    '<body name="proximal_3" pos="0.2 0.65 0"><joint name="a_3" type="hinge" axis="0 0 1"/><geom type="sphere" '
+    'size="0.01"/><body name="distal_3" pos="-0.2 0 0"><joint name="b_3" type="hinge" axis="0 0 1"/><geom '
+    'type="sphere" size="0.01"/></body></body></body></worldbody><equality><weld name="loop_2" body1="distal_2" '
+    'body2="distal_1"/><connect name="loop_3" body1="distal_3" body2="distal_1" anchor="0 -0.3 0"/></equality>'
+    '<actuator><motor name="m_1" joint="a_1"/><motor name="m_2" joint="a_2"/><motor name="m_3" joint="a_3"/>'
+    '</actuator></mujoco>')
+
+
+def test_a_file_of_one_dof_is_analysed_and_swept_on_the_command_line(tmp_path):
+    """A five-bar whose first two legs are welded where the third meets them: one DOF, three actuators. `analyze`
+    and `sweep` said "cannot reshape array of size 0 into shape (0)"; now the indices, each LMTI the largest of
+    its actuators' min(ITI, OTI) (Eq. 11 over submechanisms of one actuator)."""
+    path = tmp_path / "welded.xml"
+    path.write_text(ONE_DOF_MJCF)
+    analysed = screwkit("analyze", path, "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    report = json.loads(analysed.stdout)
+    assert report["dof"] == 1 and set(report["f_o"]) == {"1", "2"}
+    iti = np.array(list(report["iti_actuators"].values()))
+    assert 0 < report["lmti"] <= 1 and report["lmti"] <= iti.max() + 1e-12
+    swept = screwkit("sweep", path, "--sweep", "phi:-2:3:1")
+    assert swept.returncode == 0, swept.stderr
+    assert len(swept.stdout.splitlines()) == 6

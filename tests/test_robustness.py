@@ -449,8 +449,8 @@ def test_a_grid_step_that_does_not_divide_its_range_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("arguments, needle", [
-    (("analyze", "planar_5rrr", "--pose", "0", "0", "1e308"), "in `poses` (phi), got 1e+308 deg"),
-    (("analyze", "ups_hexapod_8", "--pose", "0", "0", "1", "0", "0", "-1e20"), "in `poses` (yaw), got -1e+20 deg"),
+    (("analyze", "planar_5rrr", "--pose", "0", "0", "1e308"), "in --pose (phi), got 1e+308 deg"),
+    (("analyze", "ups_hexapod_8", "--pose", "0", "0", "1", "0", "0", "-1e20"), "in --pose (yaw), got -1e+20 deg"),
     (("sweep", "planar_5rrr", "--phi", "0:1e20:1e19"), "in --phi, got 1e+20 deg"),
     (("map", "ups_hexapod_8", "--grid", "x:-0.02:0.02:0.02", "--grid", "y:-0.02:0.02:0.02", "--over",
       "yaw:0:1e20:1e19"), "in --over yaw:0:1e20:1e19, got 1e+20 deg"),
@@ -460,6 +460,40 @@ def test_angles_beyond_a_hundred_turns_are_refused(arguments, needle):
     1e20 deg from the next)."""
     one_line_error(screwkit(*arguments), "Expected angles of at most 36000 deg (100 turns) either way", needle,
                    after=("screwkit: compiling ",))
+
+
+@pytest.mark.parametrize("arguments, needle", [
+    (("analyze", "planar_5rrr", "--pose", "1e300", "0", "0"), "in --pose (x), got 1e+300 m"),
+    (("analyze", "planar_4rpr", "--pose", "0", "1e160", "0"), "in --pose (y), got 1e+160 m"),
+    (("analyze", "ups_hexapod_8", "--pose", "0", "0", "-1e300", "0", "0", "0"), "in --pose (z), got -1e+300 m"),
+    (("sweep", "planar_5rrr", "--at", "1e300 0 0", "--phi", "0:90:45"), "in --at (x), got 1e+300 m"),
+])
+def test_positions_beyond_a_million_length_scales_are_refused(arguments, needle):
+    """Such poses overflowed the closures' squares: the 4-RPR's slider was "at -1.20416 m" at y = 1e160 m, the
+    hexapod's legs missed their closures "by nan m", with numpy's overflow warnings on stderr."""
+    one_line_error(screwkit(*arguments), "Expected positions within 1e+06 length scales", needle,
+                   after=("screwkit: compiling ",))
+
+
+def test_the_position_bound_follows_the_mechanism_not_its_unit_or_world_frame(tmp_path):
+    """A million length scales from the home pose: the same poses refused and analysed for the file in metres, in
+    millimetres and moved far in the world frame; a pose within the bound is unreachable, not refused."""
+    from helpers import in_millimetres, moved_in_the_world
+    from screwkit.io.loader import bundled_path
+
+    metres = load("planar_5rrr")
+    reach = 1e6 * metres.length_scale
+    text = bundled_path("planar_5rrr").read_text()
+    (tmp_path / "mm.urdf").write_text(in_millimetres(text, declare=True))
+    (tmp_path / "moved.urdf").write_text(moved_in_the_world(text, [3e3, -2e3, 0.0], [0.0, 0.0, 0.7]))
+    files = [load(tmp_path / "mm.urdf"), load(tmp_path / "moved.urdf")]
+    for mechanism in [metres, *files]:
+        assert mechanism.length_scale == pytest.approx(metres.length_scale, rel=1e-12)
+        home = mechanism.home_pose
+        with pytest.raises(ValueError, match=r"Expected positions within 1e\+06 length scales"):
+            indices_at_poses(mechanism, [home + [1.01 * reach, 0.0, 0.0]])
+        assert not indices_at_poses(mechanism, [home + [0.99 * reach, 0.0, 0.0]]).reachable[0]
+        assert indices_at_poses(mechanism, [home]).reachable[0]
 
 
 def test_an_angle_of_a_hundred_turns_is_the_angle_itself():
@@ -510,3 +544,35 @@ def test_a_map_states_its_size_before_it_starts_when_stderr_is_not_a_terminal():
     assert first == f"planar_5rrr: mapping {size.configurations:,} configurations ({size.grid_points:,} grid points " \
                     f"x 360 orientations)\n"
     assert still_working
+
+
+def test_range_values_are_the_decimals_written():
+    """START + k STEP in doubles drifts from the decimal written (-0.2 + 3 x 0.1 = 0.10000000000000003): the values
+    are the doubles nearest START + k STEP computed in decimals, as Python reads those decimals typed."""
+    from decimal import Decimal
+
+    from screwkit.cli.options import parse_range
+
+    for text, include in (("-0.2:0.2:0.1", True), ("0:1:0.1", True), ("0.05:0.6:0.05", False),
+                          ("-1.3:2.6:0.013", False), ("1e-3:5e-2:1e-3", False), ("100000:100010:2.5", True)):
+        values = parse_range(text, "--grid", include_stop=include)
+        start, _, step = (Decimal(part) for part in text.split(":"))
+        assert values.tolist() == [float(start + k * step) for k in range(len(values))], text
+    degrees = parse_range("0:360:0.36", "--over", angular=True)
+    assert np.array_equal(degrees, np.deg2rad([float(Decimal("0.36") * k) for k in range(1000)]))
+
+
+def test_a_swept_coordinate_reads_back_as_written_and_is_the_pose_typed():
+    """The CSV's x column is -0.2, -0.1, 0.0, 0.1 (not 0.10000000000000003), and its row at 0.1 is `analyze --pose`
+    at 0.1."""
+    swept = screwkit("sweep", "planar_5rrr", "--sweep", "x:-0.2:0.2:0.1")
+    assert swept.returncode == 0, swept.stderr
+    lines = swept.stdout.splitlines()
+    header = lines[0].split(",")
+    assert [line.split(",")[0] for line in lines[1:]] == ["-0.2", "-0.1", "0.0", "0.1"]
+    row = dict(zip(header, lines[-1].split(",")))
+    alone = screwkit("analyze", "planar_5rrr", "--pose", f"0.1 {row['y']} {row['phi']}", "--json")
+    assert alone.returncode == 0, alone.stderr
+    report = json.loads(alone.stdout)
+    assert float(row["lmti"]) == pytest.approx(report["lmti"], abs=1e-12)
+    assert float(row["iti"]) == pytest.approx(report["iti"], abs=1e-12)

@@ -15,7 +15,7 @@ import json
 import numpy as np
 import pytest
 from delta_rods import delta_rods_mjcf
-from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses
+from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses, hexapod_sdf
 from test_graph_legs import POSES, assert_delta_textbook, textbook
 from test_io import HOME, assert_textbook, poses_near_home
 from test_lower_mobility import five_bar_expected
@@ -294,3 +294,22 @@ def test_analyze_of_an_sdformat_five_bar_on_a_turntable_names_lock_and_locked_gi
     report, expected = json.loads(completed.stdout), five_bar_expected(HOME)
     assert report["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
     assert report["f_o"]["1"] == pytest.approx(expected["f_o1"], abs=TOLERANCE)
+
+
+@pytest.mark.parametrize(("platform_joint", "base_offset"), [
+    ("universal", (0.0, 0.0, 0.0)), ("universal", (3.0, 0.0, 0.0)), ("revolute", (0.0, -2.0, 0.5))])
+def test_a_hexapod_whose_loops_close_by_hinges_has_the_indices_of_its_legs_wherever_its_base_frame_is_drawn(
+        tmp_path, platform_joint, base_offset):
+    """An S-P-U hexapod's loops close at the platform by universal (or two revolute) joints, each made a hinge of two
+    points on its axis. The leg's OTI point is the joint, not the middle of those two points, whose distance is
+    the model's size: it was, and the LMTI was 0.66 (0.43 with the base link's frame drawn 3 m away) for the
+    0.8738 of the same legs as U-P-S (the bundled file, read through its own serial chains)."""
+    from screwkit.studies import indices_at_pose
+
+    bundled = load("ups_hexapod_8")
+    reference = indices_at_pose(bundled, bundled.home_pose)
+    found = graph_mechanism(read_closed_tree(write(tmp_path, hexapod_sdf(platform_joint, base_offset)))).indices()
+    assert found.lmti == pytest.approx(reference.lmti, abs=1e-9)
+    for j in reference.faults:
+        assert found.f_o[j] == pytest.approx(reference.f_o[j], abs=1e-9)
+    np.testing.assert_allclose(sorted(found.iti_actuators), sorted(reference.iti_actuators), atol=1e-9)

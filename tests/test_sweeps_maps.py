@@ -260,3 +260,32 @@ def test_default_task_and_chunk_sizes_balance_the_cores_and_bound_the_memory(fiv
     np.testing.assert_allclose(whole.lmti, pieces.lmti, rtol=0, atol=1e-13)
     with pytest.raises(ValueError, match="chunk_size"):
         indices_at_poses(five, poses, chunk_size=0)
+
+
+def test_chunks_out_of_reach_before_between_and_among_reachable_ones_give_no_result_there(five):
+    """Each batch array is written once per row (unfilled until the chunks write it): poses out of reach in the
+    first chunks, in a whole chunk between reachable ones and among reachable poses hold NaN, -1 and False, and
+    every other row the indices of the poses computed one at a time."""
+    from screwkit.studies.poses import indices_at_poses
+
+    good = np.column_stack([np.zeros(9), np.linspace(-0.15, 0.15, 9), np.linspace(0.0, 2.0, 9)])
+    far = np.array([5.0, 5.0, 0.0])
+    poses = np.array([far, far, far, far, good[0], far, good[1], good[2], far, far, far, good[3], good[4], good[5],
+                      far, good[6], good[7], good[8], far])
+    out = np.all(poses == far, axis=-1)
+    chunked = indices_at_poses(five, poses, detail=True, chunk_size=3, threads=1)
+    assert np.array_equal(np.asarray(chunked.reachable), ~out)
+    for j in chunked.faults:
+        assert np.all(np.isnan(chunked.f_o[j][out])) and np.all(np.isnan(chunked.remaining_lmti[j][out]))
+        assert np.all(chunked.worst_fault_indices[j][out] == -1)
+    for name in ("iti", "lmti", "iti_actuators", "oti_submechanisms"):
+        assert np.all(np.isnan(getattr(chunked, name)[out])), name
+    assert not np.any(np.asarray(chunked.mutual_interference)[out])
+    alone = [indices_at_poses(five, pose[None], detail=True) for pose in poses[~out]]
+    for name in ("iti", "lmti", "iti_actuators", "oti_submechanisms"):
+        np.testing.assert_allclose(getattr(chunked, name)[~out], np.concatenate([getattr(a, name) for a in alone]),
+                                   rtol=0, atol=1e-13, err_msg=name)
+    for j in chunked.faults:
+        np.testing.assert_allclose(chunked.f_o[j][~out], np.concatenate([a.f_o[j] for a in alone]), rtol=0, atol=1e-13)
+        assert np.array_equal(chunked.worst_fault_indices[j][~out],
+                              np.concatenate([a.worst_fault_indices[j] for a in alone]))

@@ -480,9 +480,10 @@ def test_a_path_of_rounding_or_overflowing_length_is_refused():
     five = bundled("planar_5rrr")
     with pytest.raises(ValueError, match=r"every pose of the path is the same to rounding \(a length of 2.45e-17 m"):
         circle_path(five, five.home_pose, 0.1, 2)
-    with np.errstate(all="raise"):  # refused without a warning of the arithmetic
+    with np.errstate(all="raise"):  # refused without a warning of the arithmetic, as beyond the mechanism's reach
         for start, stop in (([0, 0, 0], [1e308, 0, 0]), ([-1e308, 0, 0], [1e308, 0, 0])):
-            with pytest.raises(ValueError, match=r"Expected a path of finite length, got poses so far apart"):
+            with pytest.raises(ValueError, match=r"Expected positions within 1e\+06 length scales \(1.09614e\+06 m\) "
+                                                 r"of the home pose of mechanism 'planar_5rrr' in `poses` \(x\)"):
                 line_path(five, start, stop, 201)
     assert line_path(five, [0.1, 0, 0], [0.1 + 1e-12, 0, 0], 2).length == pytest.approx(1e-12, rel=1e-3)
 
@@ -514,7 +515,8 @@ BAD_FILES = {
                   "Expected angles of at most 36000 deg (100 turns) either way in column 'phi' (sample 1), got "
                   "40000 deg."),
     "still.csv": ("x,y,phi\n0.1,0,0\n0.10000000000000002,0,0\n", "every pose of the path is the same to rounding"),
-    "huge.csv": ("x,y,phi\n0,0,0\n1e200,0,0\n", "Expected a path of finite length, got poses so far apart"),
+    "huge.csv": ("x,y,phi\n0,0,0\n1e200,0,0\n", "Expected positions within 1e+06 length scales (1.09614e+06 m) of the "
+                 "home pose of mechanism 'planar_5rrr' in the file (x, sample 1), got 1e+200 m."),
     "lengths.nc": ({"x": ("a", [0.0, 0.1, 0.2]), "y": ("b", [0.0, 0.01, 0.02, 0.03]), "phi": ("a", [0.0, 1.0, 2.0])},
                    "variables of different lengths ('x' 3, 'y' 4, 'phi' 3 samples); a path has one value of each"),
     "units.nc": ({"x": ("s", [0.0, 0.1]), "y": ("s", [0.0, 0.0], {"units": "furlong"}), "phi": ("s", [0.0, 1.0])},
@@ -599,7 +601,8 @@ LINE = ("--line", "-0.3", "-0.2", "-45", "0.3", "0.2", "45", "--samples", "41")
 @pytest.mark.parametrize("arguments, message", [
     (("--circle", "home", "0.1", "--samples", "2"),
      "every pose of the path is the same to rounding (a length of 2.45e-17"),
-    (("--line", "0", "0", "0", "1e308", "0", "0"), "Expected a path of finite length, got poses so far apart"),
+    (("--line", "0", "0", "0", "1e308", "0", "0"), "home pose of mechanism 'planar_5rrr' in --line's second pose (x), "
+                                                   "got 1e+308 m."),
     (("--line", "0", "0", "0", "nan", "0", "0"), "Expected finite values in --line's second pose, got nan for x."),
     (("--through", "0", "0", "0", "0.1", "0", "0", "0.1", "inf", "0"),
      "Expected finite values in --through's pose 3, got inf for y."),

@@ -27,6 +27,7 @@ from screwkit.common.compiling import (
     silence,
     stage_kernels,
 )
+from screwkit.common.decimals import decimal_range
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import LENGTH_UNITS, angle_beyond_limit, angle_limit, is_angular
 from screwkit.indices.average import AGGREGATES, failure_weights
@@ -455,7 +456,7 @@ def parse_pose(mechanism, text: str | None, option: str = "--pose") -> np.ndarra
         if not np.isfinite(number):
             raise fail(f"Expected finite values in {option}, got {word} for {name}.")
     try:
-        return mechanism.poses_from_degrees(numbers)
+        return mechanism.poses_from_degrees(numbers, where=option)
     except ValueError as error:
         raise fail(str(error)) from None
 
@@ -480,6 +481,8 @@ def parse_range(text: str, option: str, *, include_stop: bool = False, angular: 
         values = range_values(start, stop, step, include_stop=include_stop)
     except ValueError as error:
         raise fail(f"Expected {option} with {error}, got {text!r}.") from None
+    exact = decimal_range(parts[0], parts[2], len(values))
+    values = values if exact is None else exact
     return np.deg2rad(values) if angular else values
 
 

@@ -33,10 +33,10 @@ def set_plan(a: int, n: int, fault_list: tuple[int, ...]) -> dict:
     locked_index = {subset: index for index, subset in enumerate(locked)}
     set_children, fault_rows = reductions(a, n, submechanisms, fault_list)
     return dict(
-        submechanisms=np.array(submechanisms, dtype=np.int64).reshape(-1, n),
-        locked_sets=np.array(locked, dtype=np.int64).reshape(-1, n - 1),
+        submechanisms=np.array(submechanisms, dtype=np.int64).reshape(len(submechanisms), n),
+        locked_sets=np.array(locked, dtype=np.int64).reshape(len(locked), n - 1),  # n = 1: one empty set
         locked_of=np.array([[locked_index[tuple(i for i in sub if i != k)] for k in sub] for sub in submechanisms],
-                           dtype=np.int64).reshape(-1, n),
+                           dtype=np.int64).reshape(len(submechanisms), n),
         failed_sets={j: np.array([sorted(set(range(a)) - set(e)) for e in fault_sets(a, n, j)],
                                  dtype=np.int64).reshape(-1, j) for j in fault_list},
         set_children=set_children, fault_rows=fault_rows,

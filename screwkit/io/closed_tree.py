@@ -55,6 +55,10 @@ class Closure:
     joint_b: int
     placement_b: NDArray[np.float64]
     kind: str
+    axis_point: bool = False
+    """A second point on a hinge's axis (a hinge closed by two "3d" closures, the first at the joint): it makes the
+    hinge, but is not where the leg meets the body (:func:`screwkit.io.graph_screws` leaves it out of a leg's ITI
+    and OTI points, which would otherwise move with the arbitrary distance between the two points)."""
 
 
 @dataclass

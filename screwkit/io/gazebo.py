@@ -98,7 +98,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             on_parent = homogeneous(parent.placement) @ parent_from_world @ world_child @ placement
             on_child = homogeneous(child.placement) @ placement
             closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
-                                    on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d"))
+                                    on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
+                                    axis_point=number == 1))
     transmitted = [joint.text.strip() for transmission in root.findall("transmission")
                    for joint in transmission.findall("joint") if joint.text and joint.text.strip()]
     transmitted += [joint.get("name") for transmission in root.findall("transmission")

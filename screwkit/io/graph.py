@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure.task_space import choose_task_axes
 from screwkit.common.rotations import cross
-from screwkit.common.units import is_angular, spelled_pose, unit_of
+from screwkit.common.units import is_angular, spelled_pose
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -71,7 +71,7 @@ from screwkit.io.graph_kinematics import (
 )
 from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
 from screwkit.io.star import output_frame
-from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
+from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
 
 __all__ = ["GraphLeg", "GraphMechanism", "LegScrews", "graph_legs", "graph_mechanism", "leg_screws",
@@ -154,22 +154,14 @@ class GraphMechanism:
     def named_pose(self, name: str) -> NDArray[np.float64]:
         raise ValueError(f"Unknown pose {name!r} of mechanism {self.name!r}: a closed-loop graph has no named poses.")
 
-    def check_poses(self, poses, *, degrees: bool = False) -> NDArray[np.float64]:
-        """Poses as a float array (..., n_task) of finite values, or a ValueError naming the coordinates."""
-        try:
-            poses = np.asarray(poses, dtype=float)
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"Expected numeric poses for mechanism {self.name!r}: {error}") from None
-        if poses.ndim == 0 or poses.shape[-1] != self.n_task or not np.all(np.isfinite(poses)):
-            units = ", ".join(f"{name} ({unit_of(name, degrees=degrees)})"
-                              for name in self.task_coordinates)
-            raise ValueError(f"Expected finite poses of shape (..., {self.n_task}) ({units}) for mechanism "
-                             f"{self.name!r}, got shape {poses.shape}.")
-        return poses
+    def check_poses(self, poses, *, degrees: bool = False, where: str = "`poses`") -> NDArray[np.float64]:
+        """Poses as a float array (..., n_task), checked as a mechanism's are
+        (:func:`~screwkit.model.mechanism.checked_task_poses`)."""
+        return checked_task_poses(self, poses, degrees=degrees, where=where)
 
-    def poses_from_degrees(self, values) -> NDArray[np.float64]:
-        """Task coordinates with angles in degrees -> radians (checked)."""
-        poses = self.check_poses(values, degrees=True).copy()
+    def poses_from_degrees(self, values, where: str = "`poses`") -> NDArray[np.float64]:
+        """Task coordinates with angles in degrees -> radians (checked; ``where``: what held them)."""
+        poses = self.check_poses(values, degrees=True, where=where).copy()
         angular = self.angular
         poses[..., angular] = np.deg2rad(poses[..., angular])
         return poses

@@ -93,10 +93,13 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
 
 
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
-    """World points (n, 3) where the leg's joints (to its children) and closures meet ``body``."""
+    """World points (n, 3) where the leg's joints (to its children) and closures meet ``body`` (a hinge closed by
+    two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`)."""
     model = state.model
     points = [state.transforms[:, j, :3, 3] for j in leg.joints if model.parents[j] == body]
     for closure in leg.closures:
+        if closure.axis_point:
+            continue
         for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
             if joint == body:
                 points.append((state.transforms[:, joint] @ placement)[:, :3, 3])

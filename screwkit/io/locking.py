@@ -45,7 +45,8 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     for closure in tree.closures:
         joint_a, placement_a = carried(closure.joint_a, closure.placement_a)
         joint_b, placement_b = carried(closure.joint_b, closure.placement_b)
-        closures.append(Closure(closure.name, joint_a, placement_a, joint_b, placement_b, closure.kind))
+        closures.append(Closure(closure.name, joint_a, placement_a, joint_b, placement_b, closure.kind,
+                                closure.axis_point))
     kept = [joint for joint in range(1, model.njoints) if joint not in locked]
     q = np.concatenate([tree.q_reference[model.joints[j].idx_q:model.joints[j].idx_q + model.joints[j].nq]
                         for j in kept]) if kept else np.zeros(0)

@@ -191,15 +191,15 @@ def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str]
         parent = builder.add_joint(parent, joint.name, "prismatic", builder.axis_in_joint(joint, 0), world,
                                    joint.axes[0].limits)
 
-    def closure(name: str, at: NDArray, kind: str) -> Closure:
+    def closure(name: str, at: NDArray, kind: str, axis_point: bool = False) -> Closure:
         return Closure(name, parent, inverse(builder.joint_world[parent]) @ at, child,
-                       inverse(builder.joint_world[child]) @ at, kind)
+                       inverse(builder.joint_world[child]) @ at, kind, axis_point)
 
     if joint.kind in ("ball", "fixed", "prismatic"):
         return [closure(joint.name, world, "3d" if joint.kind == "ball" else "6d")]
     second = world.copy()  # a hinge: two points on its axis, made the hinge through them by the conversion
     second[:3, 3] += scale * world[:3, :3] @ builder.axis_in_joint(joint, 0)
-    return [closure(f"{joint.name}_a", world, "3d"), closure(f"{joint.name}_b", second, "3d")]
+    return [closure(f"{joint.name}_a", world, "3d"), closure(f"{joint.name}_b", second, "3d", axis_point=True)]
 
 
 def _ends(sdf: SdfModel) -> dict[str, tuple[str, str]]:

@@ -143,7 +143,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     on_platform_a, on_platform_b = platform in a_path, platform in b_path
     if on_platform_a and not on_platform_b:
         closure = Closure(closure.name, closure.joint_b, closure.placement_b, closure.joint_a, closure.placement_a,
-                          closure.kind)
+                          closure.kind, closure.axis_point)
         a_path, b_path = b_path, a_path
     elif on_platform_a:
         raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side.")

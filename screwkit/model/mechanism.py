@@ -249,32 +249,12 @@ class Mechanism:
 
     # -- poses ---------------------------------------------------------------------------
 
-    def check_poses(self, poses: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
+    def check_poses(self, poses: ArrayLike, *, degrees: bool = False, where: str = "`poses`") -> NDArray[np.float64]:
         """Poses as a float array (..., n_task) of finite real values, angles within
-        :func:`~screwkit.common.units.angle_limit` (in degrees if ``degrees``), or a ValueError saying what arrived."""
-        try:
-            given = np.asarray(poses)
-            if given.dtype.kind in "bc":  # float() would take True as 1 and drop an imaginary part
-                kind = "boolean" if given.dtype.kind == "b" else "complex"
-                raise ValueError(f"expected real numbers (m, {'deg' if degrees else 'rad'}), got {kind} values "
-                                 f"({given.dtype})")
-            poses = given.astype(float)
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"Expected numeric `poses` for mechanism {self.name!r}: {error}") from None
-        if poses.ndim == 0 or poses.shape[-1] != self.n_task:
-            raise ValueError(
-                f"Expected `poses` with shape (..., {self.n_task}) for mechanism {self.name!r} "
-                f"({', '.join(self.task_coordinates)}), got {poses.shape}."
-            )
-        if not np.all(np.isfinite(poses)):
-            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(poses))[0])
-            raise ValueError(f"Expected finite values in `poses`, got {poses[bad]} at index {bad}.")
-        angles = poses[..., self.angular]
-        beyond = np.abs(angles) > angle_limit(degrees=degrees)
-        if np.any(beyond):
-            name = np.array(self.task_coordinates)[self.angular][np.argwhere(beyond)[0][-1]]
-            raise angle_beyond_limit(f"`poses` ({name})", float(angles[beyond][0]), degrees=degrees)
-        return poses
+        :func:`~screwkit.common.units.angle_limit` (in degrees if ``degrees``) and positions within
+        :data:`MAX_REACH_SCALES` length scales of the home pose, or a ValueError naming ``where`` they came from and
+        what arrived (:func:`checked_task_poses`)."""
+        return checked_task_poses(self, poses, degrees=degrees, where=where)
 
     def named_pose(self, name: str) -> NDArray[np.float64]:
         """A documented pose by name (m, rad); a ValueError lists the names."""
@@ -283,9 +263,9 @@ class Mechanism:
                              f"{', '.join(self.named_poses)}.")
         return np.array(self.named_poses[name], dtype=float)
 
-    def poses_from_degrees(self, values: ArrayLike) -> NDArray[np.float64]:
-        """Task coordinates with angles in degrees -> radians (checked)."""
-        poses = self.check_poses(values, degrees=True).copy()
+    def poses_from_degrees(self, values: ArrayLike, where: str = "`poses`") -> NDArray[np.float64]:
+        """Task coordinates with angles in degrees -> radians (checked; ``where``: what held them)."""
+        poses = self.check_poses(values, degrees=True, where=where).copy()
         poses[..., self.angular] = np.deg2rad(poses[..., self.angular])
         return poses
 
@@ -351,3 +331,52 @@ def require_mechanism(mechanism: Any, function: str) -> None:
                         f"mechanism = screwkit.io.loader.load({mechanism!r}).")
     raise TypeError(f"{function} expects a Mechanism (from screwkit.io.loader.load), got {type(mechanism).__name__} "
                     f"{mechanism!r:.60}.")
+
+
+MAX_REACH_SCALES = 1e6
+"""Farthest a pose's position may be from the mechanism's home pose, in its length scales (a million: 500 km for a
+5-RRR of 0.5 m). No robot reaches so far, whereas beyond about 1e150 m the closures' squares overflow and their
+answers (a slide's length, a miss by NaN m) would mean nothing; such a pose is refused as an angle beyond
+:data:`~screwkit.common.units.MAX_ANGLE_TURNS` is. The bound follows the mechanism, not the world frame or the
+length unit of its file."""
+
+
+def checked_task_poses(mechanism, poses: ArrayLike, *, degrees: bool = False, where: str = "`poses`"
+                       ) -> NDArray[np.float64]:
+    """``mechanism``'s poses (..., n_task) as a float array of finite real values, angles within
+    :func:`~screwkit.common.units.angle_limit` (in degrees if ``degrees``) and positions within
+    :data:`MAX_REACH_SCALES` length scales of its home pose, or a ValueError naming ``where`` they came from (an
+    argument, an option) and what arrived. For :class:`Mechanism` and the closed-loop graphs alike."""
+    name, n_task, coordinates = mechanism.name, mechanism.n_task, tuple(mechanism.task_coordinates)
+    try:
+        given = np.asarray(poses)
+        if given.dtype.kind in "bc":  # float() would take True as 1 and drop an imaginary part
+            kind = "boolean" if given.dtype.kind == "b" else "complex"
+            raise ValueError(f"expected real numbers (m, {'deg' if degrees else 'rad'}), got {kind} values "
+                             f"({given.dtype})")
+        poses = given.astype(float)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"Expected numeric {where} for mechanism {name!r}: {error}") from None
+    if poses.ndim == 0 or poses.shape[-1] != n_task:
+        raise ValueError(f"Expected {where} with shape (..., {n_task}) for mechanism {name!r} "
+                         f"({', '.join(coordinates)}), got {poses.shape}.")
+    if not np.all(np.isfinite(poses)):
+        bad = tuple(int(i) for i in np.argwhere(~np.isfinite(poses))[0])
+        raise ValueError(f"Expected finite values in {where}, got {poses[bad]} at index {bad}.")
+    angular = np.array([is_angular(coordinate) for coordinate in coordinates], dtype=bool)
+    angles = poses[..., angular]
+    beyond = np.abs(angles) > angle_limit(degrees=degrees)
+    if np.any(beyond):
+        coordinate = np.array(coordinates)[angular][np.argwhere(beyond)[0][-1]]
+        raise angle_beyond_limit(f"{where} ({coordinate})", float(angles[beyond][0]), degrees=degrees)
+    reach = MAX_REACH_SCALES * float(mechanism.length_scale)
+    offsets = poses[..., ~angular] - np.asarray(mechanism.home_pose, dtype=float)[~angular]
+    far = np.abs(offsets) > reach
+    if np.any(far):
+        at = tuple(int(i) for i in np.argwhere(far)[0])
+        coordinate = np.array(coordinates)[~angular][at[-1]]
+        sample = "" if len(at) == 1 else f", sample {at[0]}" if len(at) == 2 else f", index {at[:-1]}"
+        raise ValueError(f"Expected positions within {MAX_REACH_SCALES:g} length scales ({reach:g} m) of the home "
+                         f"pose of mechanism {name!r} in {where} ({coordinate}{sample}), got "
+                         f"{poses[..., ~angular][at]:g} m.")
+    return poses

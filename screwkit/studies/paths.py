@@ -107,21 +107,20 @@ class Path:
         return np.interp(arc_length, self.arc_length, self.times)
 
 
-def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | None = None) -> Path:
-    """A :class:`Path` through ``poses`` (n, n_task; m, rad), checked: at least two samples, finite, a finite
-    length above the rounding of the poses and of the length scale (:data:`ROUNDING_ULPS`), ``times`` (n,)
-    increasing when given."""
-    poses = mechanism.check_poses(poses)
+def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | None = None,
+                    where: str = "`poses`") -> Path:
+    """A :class:`Path` through ``poses`` (n, n_task; m, rad), checked: at least two samples, finite and within the
+    mechanism's reach of angles and positions (:meth:`~screwkit.model.Mechanism.check_poses`, naming ``where`` they
+    came from), a length above the rounding of the poses and of the length scale (:data:`ROUNDING_ULPS`),
+    ``times`` (n,) increasing when given."""
+    poses = mechanism.check_poses(poses, where=where)
     if poses.ndim != 2 or poses.shape[0] < 2:
         raise ValueError(f"Expected a path of at least 2 poses with shape (n, {mechanism.n_task}), got "
                          f"{poses.shape}.")
     weights = np.where(mechanism.angular, mechanism.length_scale, 1.0)
-    with np.errstate(over="ignore", invalid="ignore"):  # a length that overflows is refused below
-        steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)
-        arc_length = np.concatenate([[0.0], np.cumsum(steps)])
+    steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)  # finite: the poses are within reach
+    arc_length = np.concatenate([[0.0], np.cumsum(steps)])
     size = max(float(np.max(np.abs(poses * weights))), float(mechanism.length_scale))
-    if not np.isfinite(arc_length[-1]):
-        raise _overflow(size)
     if not arc_length[-1] > 0:
         raise ValueError("Expected a path that moves: every pose of the path is the same.")
     if arc_length[-1] <= ROUNDING_ULPS * np.spacing(size):
@@ -129,11 +128,6 @@ def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | N
                          f"{arc_length[-1]:.3g} m, at a size of {size:.3g} m: its poses' or the mechanism's length "
                          "scale).")
     return Path(poses, arc_length, float(mechanism.length_scale), checked_times(times, poses.shape[0]))
-
-
-def _overflow(size: float) -> ValueError:
-    return ValueError(f"Expected a path of finite length, got poses so far apart (up to {size:.3g} m) that its length "
-                      "overflows.")
 
 
 def checked_tolerance(path: Path, tolerance: float, name: str = "`tolerance`") -> float:
@@ -172,11 +166,7 @@ def line_path(mechanism: Mechanism, start: ArrayLike, stop: ArrayLike, samples: 
         raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
     start, stop = mechanism.check_poses(start), mechanism.check_poses(stop)
     fractions = np.linspace(0.0, 1.0, samples)[:, None]
-    with np.errstate(over="ignore", invalid="ignore"):  # ends so far apart that their difference overflows
-        poses = start + fractions * (stop - start)
-    if not np.all(np.isfinite(poses)):
-        raise _overflow(float(np.max(np.abs([start, stop]))))
-    return path_from_poses(mechanism, poses)
+    return path_from_poses(mechanism, start + fractions * (stop - start))
 
 
 def circle_path(mechanism: Mechanism, centre: ArrayLike, radius: float, samples: int) -> Path:
@@ -219,15 +209,15 @@ def read_path(mechanism: Mechanism, path: str | os.PathLike) -> Path:
     Raises
     ------
     PathFileError
-        One line naming the file: what :func:`read_columns` refuses, a path that does not move or whose length
-        overflows, times not increasing.
+        One line naming the file: what :func:`read_columns` refuses, a pose beyond the mechanism's reach, a path
+        that does not move, times not increasing.
     """
     name = os.fspath(path)
     wanted = mechanism.task_coordinates
     poses, times = read_columns(name, wanted, [is_angular(c) for c in wanted],
                                 f"a path of {mechanism.name!r} has columns {', '.join(wanted)} (m, deg)")
     try:
-        return path_from_poses(mechanism, poses, times)
+        return path_from_poses(mechanism, poses, times, where="the file")
     except ValueError as error:
         raise PathFileError(f"{name}: {error}") from None
 

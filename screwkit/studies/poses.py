@@ -29,6 +29,7 @@ from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
 from screwkit.indices.results import Indices
 from screwkit.model import Mechanism, require_mechanism
+from screwkit.studies.batch_arrays import ARRAYS, DICTS, fill_unreachable, scatter
 
 if TYPE_CHECKING:  # the graph reader is imported when a graph is analysed (it is no part of the other paths)
     from screwkit.io.graph import GraphMechanism
@@ -136,35 +137,6 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
          "remaining_lmti": closed["remaining_lmti"]},
         threshold=threshold, submechanisms=closed["submechanisms"], task_coordinates=mechanism.task_coordinates,
         mechanism=mechanism.name)
-
-
-_ARRAYS = ("iti", "lmti", "mutual_interference", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms",
-           "instantaneous_dof", "constraint_singular")
-_DICTS = ("f_o", "f_io", "worst_fault_indices", "f_c", "remaining_lmti", "derived")
-
-
-def _blank(count: int, value) -> NDArray:
-    """An array for a whole batch like one chunk's ``value``: NaN, -1 or False until filled (unreachable)."""
-    value = np.asarray(value)
-    fill = False if value.dtype == bool else -1 if np.issubdtype(value.dtype, np.integer) else np.nan
-    return np.full((count,) + value.shape[1:], fill, dtype=value.dtype)
-
-
-def _scatter(arrays: dict, count: int, index: NDArray, result: Indices) -> None:
-    """Copy one chunk's per-configuration results (batch-first) into the batch arrays at ``index`` (sorted, without
-    repeats: a slice when it is a run, as when every pose of the chunk is reachable, a copy without indexing)."""
-    if index.size and int(index[-1]) - int(index[0]) + 1 == index.size:
-        index = slice(int(index[0]), int(index[-1]) + 1)
-    applicable = _ARRAYS if result.constraint_count else tuple(n for n in _ARRAYS if not n.startswith("cti"))
-    pieces = {name: getattr(result, name) for name in applicable}
-    pieces.update({(name, j): value for name in _DICTS for j, value in getattr(result, name).items()
-                   if result.constraint_count or name != "f_c"})
-    for key, value in pieces.items():
-        if value is None:
-            continue
-        if key not in arrays:
-            arrays[key] = _blank(count, value)
-        arrays[key][index] = value
 
 
 CHUNK_WORK = 1 << 21
@@ -287,7 +259,7 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     meta: Indices | None = None
     kept_joints = [chain.geometry.n_tree_joints if keep_joint_values == "tree" else chain.geometry.n_dofs
                    for chain in mechanism.chains]
-    joint_values = [np.full((count, joints), np.nan) for joints in kept_joints] if keep_joint_values else None
+    joint_values = [np.empty((count, joints)) for joints in kept_joints] if keep_joint_values else None  # every chunk
 
     def chunk(part: slice):
         """The closures of one chunk and the indices of its reachable poses (None if it has none)."""
@@ -312,10 +284,11 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
                     kept[part] = values[..., :joints]
             if result is not None:
                 meta = result
-                _scatter(arrays, count, index, result)
+                scatter(arrays, count, index, result)
             if progress is not None:
                 progress(part.stop - part.start)
 
+    fill_unreachable(arrays)
     described = _Described(mechanism.actuator_names, mechanism.dof, mechanism.task_coordinates, mechanism.name,
                            mechanism.pose_coordinates)
     result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
@@ -429,8 +402,8 @@ def _batch_indices(arrays: dict, meta: Indices | None, gathered: _Gathered, desc
              "full_poses": full_poses.reshape(batch + (full_poses.shape[-1],))},
             threshold=threshold, task_coordinates=task_coordinates, mechanism=mechanism_name,
             pose_coordinates=pose_coordinates, derive=False)
-    fields = {name: shaped(name) for name in _ARRAYS}
-    fields.update({name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in _DICTS})
+    fields = {name: shaped(name) for name in ARRAYS}
+    fields.update({name: {j: shaped((name, j)) for j in getattr(meta, name)} for name in DICTS})
     if not meta.constraint_count:
         fields.update(not_applicable)
     fields.update(poses=poses, reachable=reachable.reshape(batch),
@@ -525,11 +498,12 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
                 result = analyze(chains, iti_points=iti, oti_points=oti, detail=detail, threshold=threshold,
                                  faults=faults, threads=threads, dof=n_task)
                 meta = result
-                _scatter(arrays, count, index[rows] + start, result)
+                scatter(arrays, count, index[rows] + start, result)
         if progress is not None:
             progress(part.stop - part.start)
     chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
     names = tuple(f"{leg.name}:{model.names[leg.actuators[0]]}" for leg in graph.legs)
+    fill_unreachable(arrays)
     described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
     result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
                             faults=faults, detail=detail, threshold=threshold)
