@@ -172,6 +172,8 @@ def test_a_disc_of_one_point_from_the_command(tmp_path):
     ("family: [planar_rrr]", "family: expected one value, got ['planar_rrr']"),
     ("objectives: [area, size]", "objectives: expected one of"),
     ("layers: ['z:0:1:0.1']", "layers: expected one value"),
+    ("index: 5", "index: expected f_o1|f_io1|f_o_mean1|..., got 5"),
+    ("index: f_oo1", "index: expected f_o1|f_io1|f_o_mean1|..., got 'f_oo1'"),
 ])
 def test_a_study_value_is_checked_as_its_option(tmp_path, line, message):
     study = tmp_path / "st.yaml"
@@ -187,8 +189,13 @@ def test_a_study_value_is_checked_as_its_option(tmp_path, line, message):
 
 def test_a_study_value_is_refused_in_one_line_from_the_command(tmp_path):
     study = tmp_path / "st.yaml"
-    study.write_text("family: delta\nindex: 5\nseed: -3\n")
+    study.write_text("family: delta\nseed: -3\n")
     one_line_error(screwkit("design-search", "family", "--study", study, "--budget", "0"), f"{study}: seed: ")
+    study.write_text("family: delta\nindex: 5\n")  # it was refused after the search started, naming no file
+    one_line_error(screwkit("design-search", "family", "--study", study, "--budget", "0"),
+                   f"{study}: index: expected f_o1|f_io1|f_o_mean1|..., got 5.")
+    one_line_error(screwkit("design-search", "family", "delta", "--index", "5", "--budget", "0"),
+                   "Invalid value for '--index': Unknown index '5'")
     study.write_text("family: planar_rrr\nbudget: abc\n")
     one_line_error(screwkit("design-search", "family", "--study", study),
                    f"{study}: budget: expected an integer >= 0, got 'abc'")

@@ -32,7 +32,13 @@ from screwkit.cli.options import (
 )
 from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.studies.design.families import Family
-from screwkit.studies.design.objectives import METRICS, check_region_size, check_turn_count, default_region
+from screwkit.studies.design.objectives import (
+    METRICS,
+    check_region_size,
+    check_turn_count,
+    default_region,
+    region_index_record,
+)
 from screwkit.studies.design.optimise import MAX_SEED
 from screwkit.studies.files import DATA_SUFFIXES, FIGURE_SUFFIXES
 
@@ -143,6 +149,20 @@ def check_phi_step(phi_step: float | None) -> None:
         raise fail(str(error)) from None
 
 
+class IndexName(click.ParamType):
+    """``--index``: a region's index by column name, checked as the region will check it (a study file's ``index``
+    too, so that its refusal names the file and the key)."""
+
+    name = "index"
+
+    def convert(self, value, param, ctx):
+        try:
+            region_index_record(str(value).strip())
+        except ValueError as error:
+            self.fail(str(error), param, ctx)
+        return str(value).strip()
+
+
 def _region(radius, step, phi_step, grids, overs, layers, region_index, level, probabilities=None) -> RegionOptions:
     check_phi_step(phi_step)
     layers = (layers,) if isinstance(layers, str) else tuple(layers or ())
@@ -192,7 +212,7 @@ region_options = option_group(
     click.option("--layers", multiple=True, metavar="COORDINATE:START:STOP:STEP",
                  help="Spatial region: stack maps along a third coordinate for a volume, the stop excluded as "
                       "screwkit map --over (once)."),
-    click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|f_o_mean1|...",
+    click.option("--index", "region_index", default=None, metavar="f_o1|f_io1|f_o_mean1|...", type=IndexName(),
                  help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1; "
                       "f_o_mean<j>: the mean over the sets of j failed actuators instead of the worst, screwkit's "
                       "extension of Eq. 12)."),

@@ -67,6 +67,15 @@ MAXIMISED = {"area": True, "volume": True, "inscribed": True, "cylinder": True, 
 """The sense in which each metric is better: larger (True) or smaller (False)."""
 
 
+
+def region_index_record(index: str, probabilities=None):
+    """The registry record and j of a region's index (``f_o1``, ``f_io2``, ``f_o_mean1``, ...; any registered
+    index); a ValueError naming the indices when there is none such."""
+    if not is_mean_column(index):
+        return column_record(index)
+    with averaging(probabilities):
+        return column_record(index)
+
 @dataclass(frozen=True)
 class Region:
     """A map and the fault-tolerant level on it.
@@ -137,10 +146,7 @@ class Region:
 
     def _record(self):
         """The index's registry record and its j (the average case registered for the look-up)."""
-        if not self.average:
-            return column_record(self.index)
-        with averaging(self.probabilities):
-            return column_record(self.index)
+        return region_index_record(self.index, self.probabilities)
 
     @property
     def analysis(self) -> AnalysisOptions:
