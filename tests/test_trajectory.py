@@ -252,6 +252,30 @@ def test_the_stretches_are_the_same_in_another_world_frame_and_with_the_legs_lis
             assert case.minimum == pytest.approx(expected[failed].minimum, abs=1e-9)
         for name, margin in reference.margins.items():
             assert result.margins[name].value == pytest.approx(margin.value, abs=1e-9), name
+            at = result.margins[name].arc_length
+            assert at == pytest.approx(margin.arc_length, abs=2 * reference.tolerance), name
+
+
+@pytest.mark.parametrize("name", ["planar_4rpr", "ups_hexapod_8"])
+def test_a_margin_tied_along_the_path_is_at_its_first_sample_in_any_unit_and_world_frame(name):
+    """An ITI of 1 all along (rounding apart) had its margin at sample 6 of the 4-RPR's path, at sample 0 with the
+    file in another world frame (26 and 5 for the hexapod): where rounding fell. Now at the first sample of the
+    ties, in metres, in millimetres and moved."""
+    text = bundled_path(name).read_text()
+    files = (bundled(name), load_text(in_unit(text, "mm", 1000.0, declare=True), f"{name}_mm.urdf"),
+             load_text(moved_in_the_world(text, (1.0, 2.0, 0.0), (0.0, 0.0, 0.5)), f"{name}_moved.urdf"))
+    margins = []
+    for mechanism in files:
+        start, stop = mechanism.home_pose.copy(), mechanism.home_pose.copy()
+        start[:2] -= [0.2, 0.1] if mechanism.is_planar else [0.0, 0.0]
+        stop[0] += 0.2 if mechanism.is_planar else 0.1
+        stop[-1] += 0.3 if mechanism.is_planar else 0.5
+        margins.append(trajectory(mechanism, line_path(mechanism, start, stop, 41)).margins)
+    for column, margin in margins[0].items():
+        for other in margins[1:]:
+            assert other[column].value == pytest.approx(margin.value, abs=1e-9), column
+            assert other[column].sample == margin.sample, column
+    assert margins[0]["iti"].sample == 0 and margins[0]["iti"].value == pytest.approx(1.0, abs=1e-12)
 
 
 def test_the_average_case_is_the_weighted_mean_over_the_failures(five_path):

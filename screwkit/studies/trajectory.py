@@ -479,7 +479,9 @@ def _worst(cases: list[FaultCase], faults) -> dict[int, tuple[tuple[str, ...], .
 
 
 def _margins(samples: Indices, s: NDArray, cases: list[FaultCase], mean: dict) -> dict[str, Margin]:
-    """The minimum of every index column along the path; F_Oj's over the refined minima too."""
+    """The minimum of every index column along the path, at its first sample within :data:`WORST_FAULT_TIE` of it
+    (values equal but for rounding, such as an ITI of 1 all along, would otherwise put it where rounding falls,
+    which moves with the file's unit and world frame); F_Oj's over the refined minima too."""
     columns = dict(index_columns(samples))
     columns.update({f"f_o_mean{j}": values for j, values in mean.items()})
     margins = {}
@@ -487,8 +489,9 @@ def _margins(samples: Indices, s: NDArray, cases: list[FaultCase], mean: dict) -
         values = np.asarray(values, dtype=float)
         if not np.any(np.isfinite(values)):
             continue  # not applicable (a CTI without constraint wrenches) or nothing reachable
-        index = int(np.nanargmin(values))
-        margins[name] = Margin(float(values[index]), float(s[index]), index)
+        lowest = float(np.nanmin(values))
+        index = int(np.flatnonzero(values <= lowest + WORST_FAULT_TIE)[0])
+        margins[name] = Margin(lowest, float(s[index]), index)
     for j in samples.faults:
         refined = [c for c in cases if c.faults == j and np.isfinite(c.minimum)]
         if refined and f"f_o{j}" in margins:
