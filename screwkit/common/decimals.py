@@ -49,10 +49,11 @@ def degrees_as_written(radians: ArrayLike) -> NDArray[np.float64]:
     ``np.rad2deg`` of it: an angle typed as 30 deg (and so computed at ``np.deg2rad(30)``) reads back as 30.0, not
     29.999999999999996, and is exactly the angle computed.
 
-    >>> degrees_as_written(np.deg2rad([30.0, 0.36, 59.99])).tolist()
-    [30.0, 0.36, 59.99]
+    >>> degrees_as_written(np.deg2rad([30.0, 0.36, 59.99])).tolist(), float(degrees_as_written(np.deg2rad(30.0)))
+    ([30.0, 0.36, 59.99], 30.0)
     """
-    radians = np.asarray(radians, dtype=float)
+    given = np.asarray(radians, dtype=float)
+    radians = given.ravel()
     degrees = np.rad2deg(radians)
     pending = np.isfinite(degrees)
     for places in range(18):
@@ -63,4 +64,4 @@ def degrees_as_written(radians: ArrayLike) -> NDArray[np.float64]:
         back = np.flatnonzero(pending)[np.deg2rad(candidates) == radians[pending]]
         degrees[back] = candidates[np.deg2rad(candidates) == radians[pending]]
         pending[back] = False
-    return degrees
+    return degrees.reshape(given.shape)

@@ -10,8 +10,11 @@ the model's links, joints and ``<frame>`` elements with SDFormat's pose semantic
 * **the tree**: a breadth-first spanning tree of the joint graph from the base, the joints taken in file order
   (so loops close where the legs meet, farthest from the base), built as a Pinocchio model at zero joint values
   (SDFormat's reference): revolute and continuous joints as revolute ones about their axis, prismatic,
-  ball (spherical), fixed (the link welded to its parent body), universal and revolute2 as two revolute joints
-  ``<name>_axis`` (parent side) and ``<name>_axis2``;
+  fixed (the link welded to its parent body), universal and revolute2 as two revolute joints ``<name>_axis``
+  (parent side) and ``<name>_axis2``, ball as three revolute joints ``<name>_x``, ``<name>_y``, ``<name>_z`` about
+  its frame's axes through its centre (as ``docs/urdf-convention.md`` writes a spherical joint inside a leg: a leg
+  stays a serial chain of 1-DoF joints, so a U-P-S leg carrying the platform converts; the three span every
+  rotation unless the middle one turns a quarter turn from the file's configuration);
 * **the loops**: every other joint closes a loop, as :mod:`screwkit.io.gazebo` closes ``<gazebo><joint>``
   elements: a ball joint one point both links keep (``3d``), a fixed one the whole frame (``6d``), a revolute or
   continuous one two points on its axis (``<name>_a``, ``<name>_b``; the conversion makes them the hinge through
@@ -65,23 +68,46 @@ def actuated_joints(sdf: SdfModel) -> list[str]:
 
 
 def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
-    """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node)."""
+    """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node).
+
+    Links welded by fixed joints are one body: reached together (the fixed joints in the tree), so a chain of welded
+    links does not lengthen a leg and move the loop's closing joint into it (onto a fixed joint inside the leg)."""
     base = WORLD if any(WORLD in pair for pair in ends.values()) else sdf.canonical
-    visited, queue, tree, loops, used = {base}, [base], [], [], set()
+    visited, queue, tree, loops, used = set(), [], [], [], set()
+
+    def step(node: str, joint: SdfJoint) -> str | None:
+        """The other end of a joint not taken yet from ``node`` (None: taken, or a loop joint now)."""
+        parent, child = ends[joint.name]
+        if joint.name in used or node not in (parent, child):
+            return None
+        used.add(joint.name)
+        other = child if node == parent else parent
+        if other in visited:
+            loops.append(joint)
+            return None
+        tree.append((joint, node, other))
+        return other
+
+    def reach(node: str) -> None:
+        """A node and every link welded to it, queued."""
+        stack = [node]
+        visited.add(node)
+        while stack:
+            current = stack.pop()
+            queue.append(current)
+            for joint in sdf.joints:
+                other = step(current, joint) if joint.kind == "fixed" else None
+                if other is not None:
+                    visited.add(other)
+                    stack.append(other)
+
+    reach(base)
     while queue:
         node = queue.pop(0)
         for joint in sdf.joints:
-            parent, child = ends[joint.name]
-            if joint.name in used or node not in (parent, child):
-                continue
-            used.add(joint.name)
-            other = child if node == parent else parent
-            if other in visited:
-                loops.append(joint)
-            else:
-                visited.add(other)
-                queue.append(other)
-                tree.append((joint, node, other))
+            other = step(node, joint)
+            if other is not None:
+                reach(other)
     loose = [link for link in sdf.links if link not in visited]
     if loose:
         fixed = "the world" if base == WORLD else f"the canonical link {base!r}"
@@ -124,14 +150,13 @@ class _TreeBuilder:
 
     def add_joint(self, parent: int, name: str, kind: str, axis: NDArray, world: NDArray,
                   limits: tuple[float, float] | None = None) -> int:
-        """A 1-DoF (revolute, prismatic) or ball joint on Pinocchio joint ``parent``, its frame at ``world``."""
+        """A 1-DoF joint (revolute, prismatic) on Pinocchio joint ``parent``, its frame at ``world``."""
         pin = self.pin
         models = {"revolute": pin.JointModelRevoluteUnaligned, "prismatic": pin.JointModelPrismaticUnaligned}
-        joint_model = pin.JointModelSpherical() if kind == "ball" else models[kind](np.asarray(axis, dtype=float))
-        index = self.model.addJoint(parent, joint_model, self._se3(parent, world), name)
+        index = self.model.addJoint(parent, models[kind](np.asarray(axis, dtype=float)), self._se3(parent, world),
+                                    name)
         self.joint_world[index] = world
-        if kind != "ball":
-            self.limits[index] = limits if limits is not None else (-np.inf, np.inf)
+        self.limits[index] = limits if limits is not None else (-np.inf, np.inf)
         return index
 
     def tree_joint(self, joint: SdfJoint, parent_node: str, child_node: str) -> None:
@@ -146,17 +171,18 @@ class _TreeBuilder:
                 child_node, parent, self._se3(parent, self.poses[child_node]), frame))
             return
         reverse = child_node != attached_link(self.sdf, joint.child)
-        steps = [(joint.name, "ball" if joint.kind == "ball" else "prismatic" if joint.kind == "prismatic"
-                  else "revolute", 0)]
+        steps = [(joint.name, "prismatic" if joint.kind == "prismatic" else "revolute", self.axis_in_joint(joint, 0),
+                  joint.axes[0].limits)]
         if joint.kind in TWO_AXES:
-            steps = [(f"{joint.name}_axis", "revolute", 0), (f"{joint.name}_axis2", "revolute", 1)]
-            steps = steps[::-1] if reverse else steps
+            steps = [(f"{joint.name}_axis", "revolute", self.axis_in_joint(joint, 0), joint.axes[0].limits),
+                     (f"{joint.name}_axis2", "revolute", self.axis_in_joint(joint, 1), joint.axes[1].limits)]
+        elif joint.kind == "ball":  # three hinges through its centre, about its frame's axes (the module docstring)
+            steps = [(f"{joint.name}_{axis}", "revolute", np.eye(3)[k], None) for k, axis in enumerate("xyz")]
         index = parent
-        for name, kind, number in steps:
-            limits = joint.axes[number].limits
+        for name, kind, axis, limits in steps[::-1] if reverse else steps:
             if limits is not None and reverse:
                 limits = (-limits[1], -limits[0])
-            index = self.add_joint(index, name, kind, self.axis_in_joint(joint, number), world, limits)
+            index = self.add_joint(index, name, kind, axis, world, limits)
             parent_frame = self.model.addJointFrame(index, parent_frame)
         self.placed[child_node] = (index, self.model.addBodyFrame(
             child_node, index, self._se3(index, self.poses[child_node]), parent_frame))

@@ -14,7 +14,11 @@ What :mod:`screwkit.io.sdformat` builds a closed tree from, and what :mod:`screw
 
 :func:`world_poses` gives every frame's pose in the world at zero joint values, as SDFormat's own semantic pose
 resolution does. Constructs this reading does not follow are refused with the file and element named: nested
-models, ``<include>``, several models, a ``placement_frame``, unknown frames and cycles of ``relative_to``.
+models, ``<include>`` (wherever it is), several models, a ``placement_frame``, unknown frames and cycles of
+``relative_to``; so are an unnamed model, link, joint or frame and a ``degrees`` that is not a bool or is on a
+quaternion (SDFormat refuses them), a zero quaternion (no rotation), an axis ``<limit>`` whose lower bound is above
+the upper (no range) or equal to it (a joint Gazebo holds still: write it ``fixed``). A ``continuous`` joint's
+limits are ignored, as SDFormat says ("omit if joint is continuous").
 """
 
 from __future__ import annotations
@@ -50,6 +54,15 @@ def numbers(text: str | None, count: int, default: str, where: str, tag: str) ->
     return values
 
 
+def _flag(node, attribute: str, where: str) -> bool:
+    """An SDFormat bool attribute (``true``, ``false``, ``1``, ``0``, any case; absent: false)."""
+    text = node.get(attribute, "false").strip().lower()
+    if text not in ("true", "false", "1", "0"):
+        raise ImportError_(f"{where}: <{node.tag} {attribute}={node.get(attribute)!r}>: expected true or false (or 1 "
+                           "or 0).")
+    return text in ("true", "1")
+
+
 def parse_pose(node, where: str) -> tuple[NDArray[np.float64], str]:
     """A ``<pose>`` element (or None: the identity) as a 4x4 matrix, and its ``relative_to`` ("" if not given)."""
     matrix = np.eye(4)
@@ -59,16 +72,23 @@ def parse_pose(node, where: str) -> tuple[NDArray[np.float64], str]:
     if node.get("rotation_format", "euler_rpy") not in ("euler_rpy", "quat_xyzw"):
         raise ImportError_(f"{where}: <pose rotation_format={node.get('rotation_format')!r}> (expected euler_rpy or "
                            "quat_xyzw).")
+    degrees = _flag(node, "degrees", where)
+    if quaternion and degrees:
+        raise ImportError_(f"{where}: <pose rotation_format='quat_xyzw' degrees={node.get('degrees')!r}>: degrees "
+                           "apply to roll, pitch and yaw, not to a quaternion (SDFormat refuses it).")
     values = numbers(node.text, 7 if quaternion else 6, "0 0 0 0 0 0 1" if quaternion else "0 0 0 0 0 0", where,
                      "pose")
     matrix[:3, 3] = values[:3]
     if quaternion:
-        x, y, z, w = values[3:] / np.linalg.norm(values[3:])
+        norm = float(np.linalg.norm(values[3:]))
+        if not 1e-12 < norm < np.inf:
+            raise ImportError_(f"{where}: <pose rotation_format='quat_xyzw'> {node.text.strip()!r}: the quaternion "
+                               "x y z w is " + ("zero" if norm <= 1e-12 else "too large") + ": no rotation.")
+        x, y, z, w = values[3:] / norm
         matrix[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
                           [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                           [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
     else:
-        degrees = node.get("degrees", "false").strip().lower() in ("true", "1")
         matrix[:3, :3] = rotation_from_rpy(np.radians(values[3:]) if degrees else values[3:])
     return matrix, node.get("relative_to", "").strip()
 
@@ -105,14 +125,32 @@ def _axis(element, tag: str, where: str, legacy: bool) -> SdfAxis:
     expressed = xyz_node.get("expressed_in", "").strip() if xyz_node is not None else ""
     if legacy and node is not None and node.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1"):
         expressed = expressed or MODEL_FRAME
-    limits = None
-    if node is not None and node.find("limit") is not None:
-        lower = node.find("limit").findtext("lower", "").strip() or str(-UNLIMITED)
-        upper = node.find("limit").findtext("upper", "").strip() or str(UNLIMITED)
-        bounds = numbers(f"{lower} {upper}", 2, "", where, f"{tag}><limit")
-        if abs(bounds[0]) < UNLIMITED and abs(bounds[1]) < UNLIMITED and bounds[0] < bounds[1]:
-            limits = (float(bounds[0]), float(bounds[1]))
-    return SdfAxis(xyz / np.linalg.norm(xyz), expressed, limits)
+    for inner in node.iter() if node is not None else ():
+        if "degrees" in inner.attrib:
+            raise ImportError_(f"{where}: <{tag}>...<{inner.tag} degrees=...>: SDFormat has no degrees there (only "
+                               "on <pose>): limits are in radians.")
+    return SdfAxis(xyz / np.linalg.norm(xyz), expressed, _limits(element, tag, where))
+
+
+def _limits(element, tag: str, where: str) -> tuple[float, float] | None:
+    """An axis's ``<limit>``: None when it has none, the joint is continuous (SDFormat ignores a continuous joint's
+    limits: "omit if joint is continuous") or ball or fixed, or its bounds are SDFormat's defaults (no limit);
+    refused when the lower bound is not below the upper."""
+    node = element.find(f"{tag}/limit")
+    if node is None or element.get("type", "") in ("continuous", "ball", "fixed"):
+        return None
+    lower = node.findtext("lower", "").strip() or str(-UNLIMITED)
+    upper = node.findtext("upper", "").strip() or str(UNLIMITED)
+    bounds = numbers(f"{lower} {upper}", 2, "", where, f"{tag}><limit")
+    if bounds[0] > bounds[1]:
+        raise ImportError_(f"{where}: <{tag}><limit> lower {bounds[0]:g} > upper {bounds[1]:g}: the lower limit must "
+                           "be below the upper.")
+    if bounds[0] == bounds[1]:
+        raise ImportError_(f"{where}: <{tag}><limit> lower = upper = {bounds[0]:g}: the joint cannot move (Gazebo "
+                           "holds it at that value); write a fixed joint, or limits with lower below upper.")
+    if abs(bounds[0]) < UNLIMITED and abs(bounds[1]) < UNLIMITED:
+        return float(bounds[0]), float(bounds[1])
+    return None
 
 
 def parse_joint(element, where: str, legacy: bool = False) -> SdfJoint:
@@ -151,15 +189,19 @@ class SdfModel:
 def _the_model(path: Path, root) -> object:
     if root.tag != "sdf":
         raise ImportError_(f"{path}: the root element is <{root.tag}>, not <sdf>: not an SDFormat file.")
-    for scope in [root] + root.findall("world"):
-        for include in scope.findall("include"):
-            raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
-                               "not read; write the model in the file.")
+    parents = {child: parent for parent in root.iter() for child in parent}
+    for include in root.iter("include"):  # wherever it is: in <sdf>, a <world>, a <model>, a nested one
+        scope = parents[include]
+        named = f" name='{scope.get('name')}'" if scope.get("name") is not None else ""
+        raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
+                           f"not read (this one in <{scope.tag}{named}>); write the model in the file.")
     models = root.findall("model") + root.findall("world/model")
     if len(models) != 1:
         names = ", ".join(repr(model.get("name")) for model in models)
         raise ImportError_(f"{path}: {len(models)} <model> elements ({names or 'none'}); screwkit reads one model.")
     model = models[0]
+    if not (model.get("name") or "").strip():
+        raise ImportError_(f"{path}: <model> has no name (SDFormat requires one).")
     for nested in model.iter("model"):
         if nested is not model:
             raise ImportError_(f"{path}: <model name='{model.get('name')}'><model name='{nested.get('name')}'>: "
@@ -181,6 +223,7 @@ def read_model(path: Path) -> SdfModel:
     legacy = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2]
                    if part.isdigit()) < (1, 7)
     label = f"{path}: <model name='{element.get('name')}'>"
+    _check_names(element, label)
     links = [link.get("name", "") for link in element.findall("link")]
     if not links:
         raise ImportError_(f"{label}: no <link>.")
@@ -208,6 +251,16 @@ def read_model(path: Path) -> SdfModel:
     if model.canonical not in links:
         raise ImportError_(f"{label}: canonical_link {model.canonical!r} is not one of its links.")
     return model
+
+
+def _check_names(element, label: str) -> None:
+    """Every link, joint and frame of the model named (SDFormat requires the name), else refused by position."""
+    for tag in ("link", "joint", "frame"):
+        for number, child in enumerate(element.findall(tag), start=1):
+            if not (child.get("name") or "").strip():
+                suffix = "th" if 10 <= number % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(number % 10, "th")
+                raise ImportError_(f"{label}: its {number}{suffix} <{tag}> has no name (SDFormat requires one: a "
+                                   f"{tag} is a frame, named to be placed and joined).")
 
 
 def _declare(model: SdfModel, name: str, relative_to: str, pose: NDArray, where: str) -> None:
