@@ -1,7 +1,9 @@
 """MuJoCo MJCF files: prepared as MuJoCo reads them, the tree read by Pinocchio's own parser.
 
 :func:`screwkit.io.mjcf_text.prepared_mjcf` resolves ``<include>``s, wraps several world bodies in one,
-names unnamed closures and converts degrees (MuJoCo's default unit) to radians, saying what it did;
+names unnamed closures, converts degrees (MuJoCo's default unit) to radians, writes every orientation as a
+quaternion and lifts the children of ``<frame>`` elements, saying what it did, and refuses an active joint,
+tendon or flex coupling (``<equality><joint>``...: screwkit does not model couplings);
 ``buildModelAndConstraintsFromMJCF`` then builds the tree. Every ``<equality><connect>`` is a ``3d`` closure
 (a ball joint) and every ``<weld>`` a ``6d`` one, their frames placed as MuJoCo places them
 (:func:`~screwkit.io.mjcf_text.closure_placements`: a weld's ``relpose``, a connect's ``anchor``, or sites).
@@ -52,6 +54,12 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
         try:
             model, _, _ = pin.buildModelAndConstraintsFromMJCF(str(prepared))
         except Exception as error:  # noqa: BLE001 - Pinocchio's parser raises anything (IndexError, ...): one line
+            if "Keyframe size" in str(error):  # MuJoCo pads a short qpos with qpos0, Pinocchio refuses it
+                keys = ", ".join(f"'{key.get('name', '?')}' {len((key.get('qpos') or '').split())}"
+                                 for keyframe in root.findall("keyframe") for key in keyframe.findall("key"))
+                raise ImportError_(f"{source}: <keyframe><key> qpos: one number per joint coordinate expected "
+                                   f"(MuJoCo fills a short one from qpos0, Pinocchio does not); numbers given: {keys}."
+                                   ) from None
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
     references = {item.key(): np.array(item.data()) for item in model.referenceConfigurations}
     qpos0 = np.asarray(references.get("qpos0", pin.neutral(model)), dtype=float)

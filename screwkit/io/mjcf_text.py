@@ -9,7 +9,11 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
   one body at the origin (Pinocchio reads only the first);
 * unnamed ``<connect>``/``<weld>`` elements are named (Pinocchio merges unnamed ones);
 * angles in degrees (``<compiler angle="degree">``, MuJoCo's default) become radians: hinge and ball joints'
-  ``range``, ``ref`` and ``springref``, and every ``euler`` and ``axisangle`` (class defaults included);
+  ``range``, ``ref`` and ``springref``;
+* every ``euler``, ``axisangle``, ``xyaxes`` and ``zaxis`` becomes the ``quat`` MuJoCo computes from it
+  (``<compiler angle>`` and ``eulerseq`` honoured, axes normalised), and every ``<frame>``'s children are
+  lifted to its parent, the frame's pose composed into theirs (:mod:`screwkit.io.mjcf_pose`);
+* several ``<compiler>`` elements are read as one (MuJoCo applies them all);
 * several top-level ``<default>``, ``<equality>``, ``<actuator>`` sections are merged (MuJoCo merges them;
   Pinocchio reads the first);
 * what kinematics does not need and Pinocchio cannot always read is left out: geoms, assets, plugins,
@@ -18,7 +22,10 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
 
 What MuJoCo refuses of what is read is refused, naming the element: numbers that are not (or not as many as the
 attribute holds), a name twice in one namespace, a hinge or slide axis of zero length, a limited joint's range
-that is no interval. A range MuJoCo does not apply (``limited="false"``...) is dropped: Pinocchio would apply it.
+that is no interval, a keyframe's ``qpos`` that is not numbers. A range MuJoCo does not apply
+(``limited="false"``...) is dropped: Pinocchio would apply it. An equality that is not a closure (a ``joint``,
+``tendon`` or ``flex`` coupling) changes the mobility, which screwkit does not model: refused, unless it is
+inactive (then left out, and said).
 
 :func:`closure_placements` then gives each equality the frames MuJoCo constrains, from the bodies and sites
 of the tree Pinocchio built: a ``weld`` with a ``relpose`` holds body2 at that pose in body1's frame (without
@@ -35,12 +42,22 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.io.mjcf_pose import (
+    MIN_AXIS,
+    MjcfError,
+    class_attributes,
+    defaults_written,
+    describe,
+    euler_sequence,
+    frames_flattened,
+    orientations_as_quaternions,
+)
+
 __all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError"]
 
 MAX_INCLUDE_DEPTH = 20
 """Deepest chain of ``<include>``s followed (a file including itself is refused before that)."""
 ANGLE_ATTRIBUTES = ("range", "ref", "springref")
-ORIENTED = ("body", "geom", "site", "frame", "camera", "light", "inertial")
 NOT_KINEMATICS = ("geom", "asset", "plugin", "extension", "camera", "light", "sensor", "tendon", "contact", "visual")
 PLACEMENT_ATTRIBUTES = ("pos", "quat", "axisangle", "euler", "xyaxes", "zaxis")
 """How a body is placed in its parent (MJCF): on the one body under ``<worldbody>``, they move the whole robot."""
@@ -52,12 +69,11 @@ otherwise; a reader that took the numbers it could would place the mechanism som
 NAMESPACES = {"body": "body", "joint": "joint", "freejoint": "joint", "site": "site"}
 SECTION_NAMESPACES = {"equality": "equality", "actuator": "actuator", "keyframe": "key"}
 """MuJoCo's namespaces that screwkit reads: a name twice in one is refused (by MuJoCo too)."""
-MIN_AXIS = 1e-7
-"""Length of a hinge or slide axis up to which MuJoCo refuses it ("axis too small")."""
-
-
-class MjcfError(ValueError):
-    """An MJCF file that cannot be prepared (the message names the file and the element)."""
+COUPLINGS = {"joint": "a joint coupling", "tendon": "a tendon coupling", "flex": "a flex's edge lengths",
+             "flexstrain": "a flex's strain"}
+"""Equalities that are not closures: each constrains the mechanism's joints (changes its mobility)."""
+IDENTIFYING = ("joint1", "joint2", "tendon1", "tendon2", "flex")
+"""The attributes that say what a coupling couples, in messages."""
 
 
 def _parse(path: Path) -> ElementTree.Element:
@@ -102,18 +118,7 @@ def _merged(root: ElementTree.Element, tag: str) -> ElementTree.Element | None:
 
 def _class_joints(root: ElementTree.Element) -> dict[str, dict[str, str]]:
     """The joint attributes each default class gives (inherited from enclosing classes; MuJoCo's default: hinge)."""
-    classes: dict[str, dict[str, str]] = {}
-
-    def visit(default: ElementTree.Element, inherited: dict[str, str]) -> None:
-        joint = default.find("joint")
-        attributes = {**inherited, **(joint.attrib if joint is not None else {})}
-        classes[default.get("class", "main")] = attributes
-        for child in default.findall("default"):
-            visit(child, attributes)
-
-    for top in root.findall("default"):
-        visit(top, {"type": "hinge"})
-    return classes
+    return class_attributes(root, "joint", {"type": "hinge"})
 
 
 def _joints(root: ElementTree.Element):
@@ -132,11 +137,12 @@ def _joints(root: ElementTree.Element):
 
 
 def _to_radians(root: ElementTree.Element) -> int:
-    """Every angle of a file in degrees, in radians; returns how many attributes changed."""
+    """Every joint angle of a file in degrees, in radians; returns how many attributes changed (orientations
+    are quaternions by then)."""
     classes = {name: attributes["type"] for name, attributes in _class_joints(root).items()}
     changed = 0
 
-    def scale(element: ElementTree.Element, attribute: str, which=slice(None)) -> None:
+    def scale(element: ElementTree.Element, attribute: str) -> None:
         nonlocal changed
         words = (element.get(attribute) or "").split()
         if not words:
@@ -145,9 +151,7 @@ def _to_radians(root: ElementTree.Element) -> int:
             values = [float(word) for word in words]
         except ValueError:
             return
-        indices = range(len(values))[which]
-        values = [math.radians(v) if i in indices else v for i, v in enumerate(values)]
-        element.set(attribute, " ".join(repr(v) for v in values))
+        element.set(attribute, " ".join(repr(math.radians(v)) for v in values))
         changed += 1
 
     def joint_type(element: ElementTree.Element, childclass: str) -> str:
@@ -161,9 +165,6 @@ def _to_radians(root: ElementTree.Element) -> int:
             if child.tag == "joint" and joint_type(child, childclass) in ("hinge", "ball"):
                 for attribute in ANGLE_ATTRIBUTES:
                     scale(child, attribute)
-            if child.tag in ORIENTED:
-                scale(child, "euler")
-                scale(child, "axisangle", slice(3, 4))
             visit(child, childclass, in_default or child.tag == "default")
 
     visit(root, "main", False)
@@ -187,6 +188,45 @@ def _check_numbers(root: ElementTree.Element, path: Path) -> None:
                 name = f" name='{element.get('name')}'" if element.get("name") else ""
                 raise MjcfError(f"{path}: <{element.tag}{name}> {attribute}={text!r}: expected {expected} finite "
                                 "number(s).")
+
+
+def _check_keys(root: ElementTree.Element, path: Path) -> None:
+    """Every keyframe's ``qpos`` is finite numbers (MuJoCo refuses a word, Pinocchio misreads a NaN)."""
+    for keyframe in root.findall("keyframe"):
+        for key in keyframe.findall("key"):
+            for word in (key.get("qpos") or "").split():
+                try:
+                    finite = math.isfinite(float(word))
+                except ValueError:
+                    finite = False
+                if not finite:
+                    raise MjcfError(f"{path}: <keyframe>{describe(key)} qpos={key.get('qpos')!r}: {word!r} is not a "
+                                    "finite number.")
+
+
+def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element | None, path: Path) -> list[str]:
+    """The equalities, as MuJoCo reads them: ``active`` from the element or its class; an active coupling of
+    joints is refused (screwkit does not model it), an inactive one left out. Returns what was left out."""
+    classes = class_attributes(root, "equality")
+    ignored = []
+    for element in ([] if equality is None else list(equality)):
+        named = " ".join(f"{key}='{element.get(key)}'" for key in ("name", *IDENTIFYING) if element.get(key))
+        where = f"{path}: <equality><{element.tag}{' ' + named if named else ''}>"
+        if element.tag not in ("connect", "weld", *COUPLINGS):
+            removed = " (MuJoCo 2's distance constraint, since removed)" if element.tag == "distance" else ""
+            raise MjcfError(f"{where}: not an equality MuJoCo reads{removed}: MuJoCo refuses the file.")
+        active = element.get("active", classes.get(element.get("class") or "main", {}).get("active", "true"))
+        if active not in ("true", "false"):
+            raise MjcfError(f"{where}: active='{active}': expected true or false.")
+        element.set("active", active)
+        if element.tag in COUPLINGS and active == "true":
+            raise MjcfError(f"{where}: {COUPLINGS[element.tag]} changes the mechanism's mobility and screwkit "
+                            "does not model it; remove the element (or set active='false') to analyse the joints "
+                            "as independent.")
+        if element.tag in COUPLINGS:
+            ignored.append(f"<{element.tag}{' ' + repr(element.get('name')) if element.get('name') else ''}>")
+            equality.remove(element)
+    return ignored
 
 
 def _check_names(root: ElementTree.Element, path: Path) -> None:
@@ -258,28 +298,46 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
         raise MjcfError(f"{path}: the root element is <{root.tag}>, not <mujoco>{hint}.")
     _resolve_includes(root, path.parent, (path.resolve(),))
     notes = []
+    compilers = root.findall("compiler")
     compiler = _merged(root, "compiler")
     if compiler is None:
         compiler = ElementTree.Element("compiler")
         root.insert(0, compiler)
+    for later in compilers[1:]:  # MuJoCo applies every <compiler>'s attributes
+        compiler.attrib.update(later.attrib)
     for attribute in ("meshdir", "texturedir", "assetdir"):
         compiler.attrib.pop(attribute, None)  # no mesh is read
+    angle = compiler.get("angle", "degree")
+    if angle not in ("degree", "radian"):
+        raise MjcfError(f"{path}: <compiler angle='{angle}'>: expected degree or radian.")
+    sequence = euler_sequence(compiler, path)
     _merged(root, "default")
+    equality = _merged(root, "equality")
+    ignored = _check_equalities(root, equality, path)  # before the tendons go: <equality><tendon> is one
+    if ignored:
+        notes.append(f"inactive equality coupling(s) left out, as MuJoCo leaves them out: {', '.join(ignored)}")
     for parent in list(root.iter()):
         for child in list(parent):
             if child.tag in NOT_KINEMATICS:
                 parent.remove(child)
     _check_numbers(root, path)
+    _check_keys(root, path)
     _check_names(root, path)
+    in_degrees = orientations_as_quaternions(root, angle == "degree", sequence, path)
+    defaults_written(root)
+    frames = frames_flattened(root)
+    if frames:
+        notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
     dropped = _check_joints(root, path, compiler.get("autolimits", "true") == "true")
     if dropped:
         notes.append(f"range not applied, as MuJoCo does not (limited='false', or not an interval): "
                      f"{', '.join(dropped)}")
-    if compiler.get("angle", "degree") == "degree":
-        count = _to_radians(root)
+    if angle == "degree":
+        count = _to_radians(root) + in_degrees
         if count:
             notes.append(f"angles in degrees (MuJoCo's default unit) read as such: {count} attribute(s) converted")
-        compiler.set("angle", "radian")
+    compiler.set("angle", "radian")
+    compiler.set("eulerseq", "xyz")  # no euler is left
     world = _merged(root, "worldbody")
     bodies = [] if world is None else world.findall("body")
     if not bodies:
@@ -297,7 +355,6 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
         if len(bodies) > 1:
             notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
                          "held in one, 'screwkit_world', at the origin")
-    equality = _merged(root, "equality")
     unnamed, taken = 0, {element.get("name") for element in ([] if equality is None else equality)}
     for element in ([] if equality is None else list(equality)):
         if element.tag in ("connect", "weld") and not element.get("name"):

@@ -1,0 +1,334 @@
+"""MJCF orientations, ``<frame>`` elements, equality couplings and keyframes, read as MuJoCo reads them.
+
+Every placement is checked against MuJoCo's own reading of the same file (the ``mujoco`` package: every body and
+site at ``qpos0`` and at a random configuration, to 1e-9), every index against a file screwkit already reads
+right that describes the same robot (the five-bar of ``tests/test_io.py``, the gallery's Stewart platform).
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+from test_io import five_bar_mjcf, poses_near_home
+
+from helpers import assert_indices_close, one_line_error, screwkit
+from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.io.mjcf import read_mjcf
+from screwkit.studies.poses import indices_at_pose, indices_at_poses
+
+STEWART = Path(__file__).resolve().parent / "data" / "gallery" / "stewart_cad.xml"
+TOLERANCE = 1e-9
+INERTIA = '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+CHAIN = """<mujoco model="chain">{compiler}
+<default><joint axis="0 1 0"/><site pos="0.01 0.02 0.03" {site_default}/>
+ <default class="c2"><joint axis="1 0 0" pos="0 0.1 0"/><site pos="0.2 0 0"/></default></default>
+<worldbody>
+ <body name="b0" pos="0.1 0.2 0.3" {o0}>""" + INERTIA + """
+  <joint name="j0" type="hinge" axis="0 0 1"/><site name="s0"/>
+  <body name="b1" pos="0.3 0 0" {o1}>""" + INERTIA + """
+   <joint name="j1" type="slide" pos="0.05 0 0"/><site name="s1" {o2}/>
+   <body name="b2" pos="0 0.2 0.1" childclass="c2" {o3}>""" + INERTIA + """
+     <joint name="j2" type="hinge"/><site name="s2" pos="0.1 0.1 0"/><site name="s3"/>
+   </body>
+  </body>
+ </body>
+</worldbody>
+<actuator><motor joint="j0"/><motor joint="j1"/><motor joint="j2"/></actuator>
+</mujoco>"""
+"""A serial chain whose bodies and sites are turned by ``o0``... (class defaults and ``childclass`` too)."""
+
+
+def chain(compiler="", site_default="", **orientations) -> str:
+    values = {key: orientations.get(key, "") for key in ("o0", "o1", "o2", "o3")}
+    return CHAIN.format(compiler=compiler, site_default=site_default, **values)
+
+
+def written(tmp_path: Path, text: str, name: str = "robot.xml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def assert_placed_as_mujoco(path: Path, seed: int = 0) -> int:
+    """Every body and site of MuJoCo's reading of ``path`` is where screwkit's tree has it, at ``qpos0`` and at a
+    random configuration (hinges and slides); returns how many were compared."""
+    mj_model = mujoco.MjModel.from_xml_path(str(path))
+    mj_data = mujoco.MjData(mj_model)
+    tree = read_mjcf(path)
+    model, data = tree.model, tree.model.createData()
+    rng = np.random.default_rng(seed)
+    compared = 0
+    for qpos in (mj_model.qpos0.copy(), mj_model.qpos0 + rng.uniform(-1.0, 1.0, mj_model.nq)):
+        mj_data.qpos[:] = qpos
+        mujoco.mj_kinematics(mj_model, mj_data)
+        q = pin.neutral(model)
+        for k in range(mj_model.njnt):
+            assert int(mj_model.jnt_type[k]) in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+            name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, k)
+            q[model.joints[model.getJointId(name)].idx_q] = qpos[mj_model.jnt_qposadr[k]]
+        pin.framesForwardKinematics(model, data, q)
+        kinds = ((mujoco.mjtObj.mjOBJ_BODY, range(1, mj_model.nbody), mj_data.xpos, mj_data.xmat, pin.FrameType.BODY),
+                 (mujoco.mjtObj.mjOBJ_SITE, range(mj_model.nsite), mj_data.site_xpos, mj_data.site_xmat,
+                  pin.FrameType.OP_FRAME))
+        for kind, indices, positions, matrices, frame_type in kinds:
+            for k in indices:
+                name = mujoco.mj_id2name(mj_model, kind, k)
+                assert model.existFrame(name, frame_type), f"{path.name}: {name} is missing"
+                placement = data.oMf[model.getFrameId(name, frame_type)]
+                np.testing.assert_allclose(placement.translation, positions[k], atol=TOLERANCE, rtol=0,
+                                           err_msg=f"{path.name}: {name}")
+                np.testing.assert_allclose(placement.rotation, matrices[k].reshape(3, 3), atol=TOLERANCE, rtol=0,
+                                           err_msg=f"{path.name}: {name}")
+                compared += 1
+    return compared
+
+
+# -- 1. <compiler eulerseq>: fixed (uppercase) and moving (lowercase) axes -------------------------------------
+
+
+def test_every_euler_sequence_turns_bodies_and_sites_as_mujoco_turns_them(tmp_path):
+    """All 216 sequences MuJoCo accepts (x, y, z: moving axes; X, Y, Z: fixed axes; mixed), in degrees and
+    radians, on bodies, a site and a class default."""
+    for index, letters in enumerate(itertools.product("xyzXYZ", repeat=3)):
+        sequence, unit = "".join(letters), ("degree", "radian")[index % 2]
+        scale = 180 / np.pi if unit == "degree" else 1.0
+        angles = [" ".join(repr(scale * v) for v in row) for row in ((0.3, 0.2, 0.25), (-0.7, 0.4, 1.1),
+                                                                      (0.5, -0.9, 0.2), (1.3, 0.1, -0.6))]
+        text = chain(compiler=f'<compiler angle="{unit}" eulerseq="{sequence}"/>', site_default=f'euler="{angles[3]}"',
+                     o0=f'euler="{angles[0]}"', o1=f'euler="{angles[1]}"', o2=f'euler="{angles[2]}"')
+        assert assert_placed_as_mujoco(written(tmp_path, text, f"{sequence}_{unit}.xml")) == 2 * (3 + 4)
+
+
+def test_several_compiler_elements_are_read_as_one_as_mujoco_does(tmp_path):
+    text = chain(compiler='<compiler angle="radian"/><compiler eulerseq="ZYX"/>', o0='euler="0.3 0.2 0.25"',
+                 o3='euler="-0.5 1 0.2"')
+    assert_placed_as_mujoco(written(tmp_path, text))
+
+
+def test_a_stewart_platform_turned_in_fixed_axes_has_the_indices_of_the_same_turn_as_a_quaternion(tmp_path):
+    """The gallery's Stewart platform, one leg's base turned by ``euler`` under ``eulerseq="XYZ"``, and the same
+    turn written as the quaternion MuJoCo computes: one robot for MuJoCo, the same indices for screwkit."""
+    original = STEWART.read_text()
+    text = original.replace('<compiler angle="radian"', '<compiler angle="radian" eulerseq="XYZ"').replace(
+        '<body name="X2bottom" pos="0.128557521937 0.153208888624 0"',
+        '<body name="X2bottom" pos="0.128557521937 0.153208888624 0" euler="0.3 0.2 0.25"')
+    assert text.count('euler="0.3 0.2 0.25"') == 1
+    euler = written(tmp_path, text, "euler.xml")
+    mj_model = mujoco.MjModel.from_xml_path(str(euler))
+    quat = mj_model.body_quat[mujoco.mj_name2id(mj_model, mujoco.mjtObj.mjOBJ_BODY, "X2bottom")]
+    quat_text = " ".join(repr(float(v)) for v in quat)
+    quaternion = written(tmp_path, text.replace('euler="0.3 0.2 0.25"', f'quat="{quat_text}"'), "quat.xml")
+    assert_placed_as_mujoco(euler)
+    first, second = load(quaternion), load(euler)
+    assert_indices_close(indices_at_pose(first, first.home_pose), indices_at_pose(second, second.home_pose), 1e-9)
+
+
+def test_an_euler_sequence_mujoco_refuses_is_refused_naming_the_compiler(tmp_path):
+    for sequence in ("xyw", "xy", "xyzx"):
+        text = chain(compiler=f'<compiler angle="radian" eulerseq="{sequence}"/>', o0='euler="0.3 0.2 0.25"')
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)
+        with pytest.raises(ImportError_, match=f"robot.xml: <compiler eulerseq='{sequence}'>: expected three"):
+            read_mjcf(written(tmp_path, text))
+
+
+# -- 4. axisangle, xyaxes, zaxis: axes of any length, normalised as MuJoCo does ------------------------------
+
+
+@pytest.mark.parametrize("compiler, orientations", [
+    ('<compiler angle="radian"/>', {"o1": 'axisangle="1 1 0 0.7"', "o3": 'axisangle="0 0 2 0.4"'}),
+    ("", {"o0": 'axisangle="0 3 4 40"', "o2": 'axisangle="-2 0 0 -75"'}),
+    ('<compiler angle="radian"/>', {"o0": 'xyaxes="2 0 0.3 0.5 3 0"', "o2": 'zaxis="0 0 -5"',
+                                    "o3": 'zaxis="1e-8 0 -2"', "o1": 'zaxis="0.3 -0.2 2"'}),
+    ('<compiler angle="radian"/>', {"o0": 'xyaxes="1 0 0.1 0 -1 0"', "o1": 'xyaxes="-1 0 0 0 1 0.2"',
+                                    "o2": 'xyaxes="-1 0.1 0 0 -1 0"', "o3": 'zaxis="0 0 -1"'}),
+])
+def test_an_axis_of_any_length_turns_as_mujoco_turns_it(tmp_path, compiler, orientations):
+    assert_placed_as_mujoco(written(tmp_path, chain(compiler=compiler, **orientations)))
+
+
+def test_a_five_bar_leg_turned_about_a_long_axis_has_the_indices_of_a_unit_one(tmp_path):
+    """Pinocchio alone turns by the axis's length times the angle: the leg was elsewhere (or unreadable)."""
+    text = five_bar_mjcf()
+    base = re.search(r'<body name="proximal_3" pos="([^"]+)"', text).group(1)
+    unit = written(tmp_path, text.replace(f'name="proximal_3" pos="{base}"',
+                                          f'name="proximal_3" pos="{base}" axisangle="0 0 1 0.4"'), "unit.xml")
+    long = written(tmp_path, text.replace(f'name="proximal_3" pos="{base}"',
+                                          f'name="proximal_3" pos="{base}" axisangle="0 0 2.5 0.4"'), "long.xml")
+    assert_placed_as_mujoco(long)
+    points = poses_near_home()
+    first, second = (indices_at_poses(load(path), points, detail=True) for path in (unit, long))
+    assert_indices_close(first, second, 1e-9)
+
+
+@pytest.mark.parametrize("orientation, problem", [
+    ('axisangle="0 0 0 0.4"', "axisangle's axis is the zero vector"),
+    ('axisangle="0 1e-9 0 0.4"', "axisangle's axis is the zero vector"),
+    ('zaxis="0 0 0"', "zaxis is the zero vector"),
+    ('xyaxes="1 0 0 2 0 0"', "y axis orthogonal to its x axis is the zero vector"),
+    ('quat="0 0 0 0"', "the zero quaternion"),
+    ('quat="1 0 0 0" euler="0 0 1"', "quat and euler: one orientation only"),
+])
+def test_an_orientation_mujoco_refuses_is_refused_naming_the_element(tmp_path, orientation, problem):
+    text = five_bar_mjcf().replace('<body name="proximal_3"', f'<body name="proximal_3" {orientation}')
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
+    expected = re.escape("robot.xml: <body name='proximal_3'>: ") + f".*{re.escape(problem)}"
+    with pytest.raises(ImportError_, match=expected):
+        read_mjcf(written(tmp_path, text))
+
+
+def test_the_command_refuses_a_zero_axisangle_axis_in_one_line(tmp_path):
+    text = five_bar_mjcf().replace('<body name="proximal_3"', '<body name="proximal_3" axisangle="0 0 0 0.4"')
+    one_line_error(screwkit("analyze", written(tmp_path, text)), "robot.xml", "<body name='proximal_3'>",
+                   "axisangle", "zero vector")
+
+
+# -- 3. <frame>: children lifted to the frame's parent, the frame's pose composed --------------------------------
+
+
+FRAMES = """<mujoco model="frames"><compiler angle="degree" eulerseq="zYx"/>
+<default><joint axis="0 1 0"/>
+ <default class="c"><joint axis="1 0 0" pos="0 0 0.2"/><site pos="0.3 0 0" euler="0 0 45"/></default></default>
+<worldbody>
+ <frame name="outer" pos="0.1 0 0.2" euler="10 20 30">
+ <body name="b0" pos="0.1 0.2 0.3" xyaxes="0 1 0 -1 0 0">""" + INERTIA + """
+  <frame pos="0.05 0 0" axisangle="1 1 0 30" childclass="c">
+   <site name="s_class"/><site name="s_own" pos="0 0.1 0" quat="0 1 0 0"/>
+   <frame pos="0 0 0.1" zaxis="1 0 0"><site name="s_nested" pos="0.1 0 0"/>
+    <body name="b1" pos="0.3 0 0">""" + INERTIA + """<joint name="j1" type="hinge"/><site name="s1"/></body>
+   </frame>
+   <joint name="j0b" type="hinge"/>
+  </frame>
+  <body name="b2" pos="0 0.2 0.1">""" + INERTIA + """
+   <frame euler="0 90 0" pos="0.1 0 0"><joint name="j2" type="hinge" pos="0 0.1 0"/></frame>
+   <site name="s2" pos="0.1 0.1 0"/>
+  </body>
+ </body>
+ </frame>
+</worldbody>
+<actuator><motor joint="j0b"/><motor joint="j1"/><motor joint="j2"/></actuator>
+</mujoco>"""
+"""Frames in the world, in a body, nested, with a childclass (a site's and a joint's defaults), holding bodies,
+sites and joints (one a body, as Pinocchio reads them), turned every way MJCF turns them."""
+
+
+def test_frames_place_bodies_sites_and_joints_as_mujoco_does(tmp_path):
+    path = written(tmp_path, FRAMES)
+    assert assert_placed_as_mujoco(path, seed=1) == 2 * (3 + 5)
+    assert_placed_as_mujoco(path, seed=2)
+    site = re.search(r'<site name="effector" [^>]+/>', five_bar_mjcf()).group(0)
+    _, report = read_mechanism_file(written(tmp_path, five_bar_mjcf().replace(site, f"<frame>{site}</frame>"),
+                                            "five_bar_frame.xml"))
+    assert any("1 <frame> element(s)" in note for note in report.notes), report.notes
+
+
+def test_a_five_bar_written_with_frames_has_the_indices_of_the_plain_one(tmp_path):
+    """The output site and a whole leg inside frames (a shift the frame's children take back): the robot of the
+    plain file, its output site found by name."""
+    text = five_bar_mjcf()
+    site = re.search(r'<site name="effector" pos="([^"]+)"/>', text)
+    x, y, z = (float(word) for word in site.group(1).split())
+    half = float(np.sqrt(0.5))  # the site turned back by the quarter turn of its frame
+    text = text.replace(site.group(0), f'<frame pos="0.01 0 0" euler="0 0 {np.pi / 2!r}"><site name="effector" '
+                                       f'pos="{y!r} {-(x - 0.01)!r} {z!r}" quat="{half!r} 0 0 {-half!r}"/></frame>')
+    leg = re.search(r'<body name="proximal_3" pos="([^"]+)">', text)
+    px, py, pz = (float(word) for word in leg.group(1).split())
+    start, end = leg.start(), text.index("</body></body>", leg.start()) + len("</body></body>")
+    body = text[start:end].replace(leg.group(0), f'<body name="proximal_3" pos="{px - 0.05} {py} {pz}">')
+    text = text[:start] + f'<frame pos="0.05 0 0">{body}</frame>' + text[end:]
+    plain, framed = written(tmp_path, five_bar_mjcf(), "plain.xml"), written(tmp_path, text, "framed.xml")
+    assert_placed_as_mujoco(framed)
+    points = poses_near_home()
+    first = indices_at_poses(load(plain, output="effector", output_type="frame"), points, detail=True)
+    second = indices_at_poses(load(framed, output="effector", output_type="frame"), points, detail=True)
+    assert_indices_close(first, second, 1e-9)
+
+
+# -- 2. equalities that are not closures: couplings refused, inactive ones left out ----------------------------
+
+
+COUPLINGS = {
+    "joint": ('<joint name="couple" joint1="b_3" joint2="a_3" polycoef="0 1 0 0 0"/>', "",
+              "<equality><joint name='couple' joint1='b_3' joint2='a_3'>: a joint coupling"),
+    "tendon": ('<tendon tendon1="t"/>', '<tendon><fixed name="t"><joint joint="a_3" coef="1"/>'
+               '<joint joint="b_3" coef="1"/></fixed></tendon>', "<equality><tendon tendon1='t'>: a tendon coupling"),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(COUPLINGS))
+def test_an_active_coupling_is_refused_naming_the_element(tmp_path, kind):
+    """MuJoCo reads a coupling (it changes the mechanism's mobility); screwkit does not model one: refused, not
+    left out without a word."""
+    element, tendons, message = COUPLINGS[kind]
+    text = five_bar_mjcf().replace("</equality>", element + "</equality>" + tendons)
+    assert mujoco.MjModel.from_xml_string(text).neq == 3
+    with pytest.raises(ImportError_, match=re.escape(f"robot.xml: {message}") + ".*screwkit does not model it"):
+        read_mjcf(written(tmp_path, text))
+
+
+def test_the_command_refuses_a_joint_coupling_in_one_line(tmp_path):
+    text = five_bar_mjcf().replace("</equality>", COUPLINGS["joint"][0] + "</equality>")
+    one_line_error(screwkit("analyze", written(tmp_path, text)), "robot.xml", "<equality><joint name='couple'",
+                   "does not model it")
+
+
+def test_a_distance_equality_mujoco_refuses_is_refused_naming_it(tmp_path):
+    text = five_bar_mjcf().replace("</equality>", '<distance geom1="g1" geom2="g2" distance="0.1"/></equality>')
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(ImportError_, match=re.escape("robot.xml: <equality><distance>: not an equality MuJoCo reads")):
+        read_mjcf(written(tmp_path, text))
+
+
+@pytest.mark.parametrize("kind", sorted(COUPLINGS))
+def test_an_inactive_coupling_is_left_out_and_said_with_the_indices_of_the_file_without_it(tmp_path, kind):
+    element, tendons, _ = COUPLINGS[kind]
+    text = five_bar_mjcf().replace("</equality>", element.replace("/>", ' active="false"/>') + "</equality>" + tendons)
+    mj_model = mujoco.MjModel.from_xml_string(text)
+    assert list(mj_model.eq_active0) == [True, True, False]
+    path = written(tmp_path, text)
+    _, report = read_mechanism_file(path)
+    assert any("inactive equality coupling(s) left out" in note and f"<{kind}" in note for note in report.notes)
+    points = poses_near_home()
+    first = indices_at_poses(load(written(tmp_path, five_bar_mjcf(), "plain.xml")), points, detail=True)
+    assert_indices_close(first, indices_at_poses(load(path), points, detail=True))
+
+
+def test_a_closure_made_inactive_by_its_class_is_left_out_as_mujoco_leaves_it_out(tmp_path):
+    text = five_bar_mjcf().replace("<worldbody>", '<default><default class="off"><equality active="false"/>'
+                                                  '</default></default><worldbody>')
+    text = text.replace('<connect name="loop_3"', '<connect name="loop_3" class="off"')
+    mj_model = mujoco.MjModel.from_xml_string(text)
+    active = [mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_EQUALITY, k) for k in range(mj_model.neq)
+              if mj_model.eq_active0[k]]
+    assert active == ["loop_2"]
+    assert [closure.name for closure in read_mjcf(written(tmp_path, text)).closures] == active
+
+
+# -- 5. keyframes --------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", ["nan", "a", "inf"])
+def test_a_keyframe_value_that_is_not_a_finite_number_is_refused_naming_the_key(tmp_path, value):
+    text = five_bar_mjcf().replace("</mujoco>", f'<keyframe><key name="home" qpos="0 0 0 0 {value} 0"/></keyframe>'
+                                                "</mujoco>")
+    if value == "a":
+        with pytest.raises(ValueError, match="bad format"):
+            mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(ImportError_, match=re.escape(f"robot.xml: <keyframe><key name='home'> qpos='0 0 0 0 {value} "
+                                                     f"0': '{value}' is not a finite number")):
+        read_mjcf(written(tmp_path, text))
+
+
+def test_a_keyframe_of_the_wrong_size_says_so_naming_the_key(tmp_path):
+    text = five_bar_mjcf().replace("</mujoco>", '<keyframe><key name="home" qpos="0 0"/></keyframe></mujoco>')
+    with pytest.raises(ImportError_, match=re.escape("one number per joint coordinate expected") + ".*'home' 2"):
+        read_mjcf(written(tmp_path, text))
