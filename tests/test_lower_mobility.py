@@ -681,3 +681,49 @@ def test_a_file_of_one_dof_is_analysed_and_swept_on_the_command_line(tmp_path):
     swept = screwkit("sweep", path, "--sweep", "phi:-2:3:1")
     assert swept.returncode == 0, swept.stderr
     assert len(swept.stdout.splitlines()) == 6
+
+
+def _ups_leg(base, top, name):
+    """A U-P-S leg's screws from ``base`` to ``top``: universal at the base (two hinges across the leg), the slide
+    along it (actuated), a ball at the top (three hinges): its actuation wrench is a force along the leg."""
+    from screwkit.screw.chain_screws import ChainScrews
+
+    along = (top - base) / np.linalg.norm(top - base)
+    across = np.cross(along, [1.0, 0.0, 0.0] if abs(along[0]) < 0.9 else [0.0, 1.0, 0.0])
+    across /= np.linalg.norm(across)
+    axes = [across, np.cross(along, across), None, *np.eye(3)]
+    points = [base, base, top, top, top, top]
+    twists = [np.concatenate([np.zeros(3), along]) if axis is None else np.concatenate([axis, np.cross(p, axis)])
+              for axis, p in zip(axes, points)]
+    return ChainScrews(np.array(twists), np.array(points), (2,), name=name,
+                       joint_names=("u1", "u2", "slide", "s1", "s2", "s3"))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_an_actuator_whose_force_does_no_work_on_the_platform_s_motion_leaves_the_others_free(seed):
+    """A platform on a passive slide along x (mobility one), three U-P-S legs, the first two across x: their
+    forces do no work on the slide, so locking them leaves it free, and the third is no mutual-interference
+    actuator (Sec. 3), F_O1 = F_O2 = 0 exactly; LMTI = the third leg's |cos| with x (0.8). Rows of rounding noise
+    measured against their own norms made their submechanisms count as independent: the third leg was flagged in
+    most placements and F_O1 came out 1e-17. The plain-numpy reference gives the same."""
+    from screwkit.indices.analysis import analyze
+    from screwkit.screw.chain_screws import ChainScrews
+    from screwkit.screw.reference import reference_indices
+
+    rng = np.random.default_rng(seed)
+    directions = np.array([[0.0, 1.0, 0.3], [0.0, 0.8, 0.6], [0.8, 0.0, 0.6]])
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    tops = rng.uniform(-0.2, 0.2, (3, 3))
+    legs = [_ups_leg(top - 0.9 * u, top, f"leg_{k}") for k, (u, top) in enumerate(zip(directions, tops))]
+    slide = ChainScrews(np.array([[0.0, 0.0, 0.0, 1.0, 0.0, 0.0]]), np.zeros((1, 3)), (), name="guide",
+                        joint_names=("slide",))
+    result = analyze([*legs, slide], threads=1)
+    assert result.dof == 1
+    assert list(result.mutual_interference) == [True, True, False]
+    assert result.lmti == pytest.approx(0.8, abs=1e-12)
+    assert result.f_o[1] == 0.0 and result.f_o[2] == 0.0
+    chains = [*legs, slide]
+    reference = reference_indices([c.twists for c in chains], [c.points for c in chains],
+                                  [c.actuated for c in chains], 1)
+    assert list(reference["mutual_interference"]) == [True, True, False]
+    assert reference["lmti"] == pytest.approx(0.8, abs=1e-12) and reference["f_o"][1] == 0.0

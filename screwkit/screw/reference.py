@@ -85,9 +85,11 @@ def input_transmission(wrench: NDArray, twist: NDArray, point: NDArray, threshol
 
 def output_twists(wrenches: NDArray, basis: NDArray) -> NDArray | None:
     """The output twist of each of ``n`` actuators (Eq. 8): the motion (in the space ``basis`` (n, 6)) with the
-    other ``n - 1`` locked, reciprocal to their wrenches; None when the wrenches are dependent."""
+    other ``n - 1`` locked, reciprocal to their wrenches; None when the wrenches are dependent: |det| at most
+    :data:`RANK_TOLERANCE` times the product of the wrenches' norms, which bounds it (not of the rows' norms: a
+    wrench that does no work on the motion space has a row of rounding noise, independent of itself)."""
     matrix = reciprocal_product(wrenches[:, None, :], basis[None, :, :])  # (n, n): A_k o M_q
-    if abs(np.linalg.det(matrix)) <= RANK_TOLERANCE * np.prod(np.linalg.norm(matrix, axis=1)):
+    if abs(np.linalg.det(matrix)) <= RANK_TOLERANCE * np.prod(np.linalg.norm(wrenches, axis=1)):
         return None
     return np.array([np.linalg.svd(np.delete(matrix, k, axis=0))[2][-1] @ basis for k in range(len(wrenches))])
 

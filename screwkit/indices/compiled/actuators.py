@@ -140,10 +140,17 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def wrench_matrix_rows(wrench_lanes, motion_lanes, width, wrench_matrix, row_norms):
-    """Each actuator's row of the wrench matrix in motion coordinates, A_k o M_q, and its norm, lane by lane."""
+    """Each actuator's row of the wrench matrix in motion coordinates, A_k o M_q, and the norm of its wrench A_k
+    (working coordinates), lane by lane: the scale a submechanism's determinant is measured against
+    (:func:`~screwkit.indices.compiled.outputs.submechanism_determinants`). Not the row's own norm: a wrench that
+    does no work on the motion space has a row of rounding noise, which measured against itself would count as
+    independent."""
     for act in range(wrench_lanes.shape[0]):
         for r in range(width):
             row_norms[act, r] = 0.0
+        for c in range(6):
+            for r in range(width):
+                row_norms[act, r] += wrench_lanes[act, c, r] * wrench_lanes[act, c, r]
         for q in range(motion_lanes.shape[0]):
             for r in range(width):
                 value = (wrench_lanes[act, 0, r] * motion_lanes[q, 3, r]
@@ -153,7 +160,6 @@ def wrench_matrix_rows(wrench_lanes, motion_lanes, width, wrench_matrix, row_nor
                          + wrench_lanes[act, 4, r] * motion_lanes[q, 1, r]
                          + wrench_lanes[act, 5, r] * motion_lanes[q, 2, r])
                 wrench_matrix[act, q, r] = value
-                row_norms[act, r] += value * value
         for r in range(width):
             row_norms[act, r] = np.sqrt(row_norms[act, r])
 

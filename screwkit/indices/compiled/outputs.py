@@ -177,7 +177,9 @@ def locked_stage(locked_sets, locked_depth, wedge_table, wedge_start, wrench_mat
 def submechanism_determinants(submechanisms, locked_of, wrench_matrix, output, row_norms, rank_tolerance, width,
                              determinant, volume, independent):
     """det W of every submechanism s (its first row against its first locked set's cofactors), and whether its wrenches
-    are independent: |det W| above ``rank_tolerance`` times the product of its rows' norms."""
+    are independent: |det W| above ``rank_tolerance`` times the product of its wrenches' norms (``row_norms``:
+    :func:`~screwkit.indices.compiled.actuators.wrench_matrix_rows`), which bounds it (the motion basis is
+    orthonormal), so that a wrench doing no work on the motion space makes its submechanisms dependent."""
     for s in range(submechanisms.shape[0]):
         n = submechanisms.shape[1]
         first = locked_of[s, 0]
