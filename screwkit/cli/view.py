@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
+import math
 import signal
+import threading
 import time
 from dataclasses import dataclass
 
@@ -33,7 +36,8 @@ __all__ = ["view"]
 
 MAX_FRAMES = 500
 """A path of more samples is animated at this many (one keyframe each), evenly spaced in time when it has a time
-column, else in arc length."""
+column, else in arc length; a ``--sweep-phi`` of more angles at this many, evenly spaced from its first angle to
+its last."""
 
 
 @dataclass(frozen=True)
@@ -54,6 +58,8 @@ def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, lin
     if len(given) > 1:
         raise fail(f"Expected at most one of --sweep-phi, --path, --line, --circle and --through, got "
                    f"{', '.join(given)}.")
+    if not (math.isfinite(frame_rate) and frame_rate > 0):  # (click's range lets nan and inf through)
+        raise fail(f"Expected --frame-rate a finite number > 0 (keyframes per second), got {frame_rate:g}.")
     source = None
     if given and given[0] != "--sweep-phi":
         source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples)
@@ -68,16 +74,28 @@ class Colouring:
     color_by: str
     threshold: float
 
+    def __post_init__(self):
+        if not self.threshold >= 0:  # (as `analyze` takes it: inf allowed)
+            raise fail(f"Expected --threshold >= 0 (a length, m), got {self.threshold:g}.")
 
-def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool):
+
+def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool, resampled: list | None = None):
     """The poses of ``--sweep-phi`` or of the path (at most :data:`MAX_FRAMES`) and their times (a path's time
-    column, else None), or None (one pose)."""
+    column, else None), or None (one pose); ``resampled`` gets True when they are not the path's own samples."""
     if motion.sweep_phi is not None:
         if not mechanism.is_planar:
             raise fail(f"--sweep-phi sweeps a planar mechanism; {mechanism.name!r} is spatial.")
+        coordinates = list(getattr(mechanism, "task_coordinates", ()))
+        if "phi" not in coordinates:
+            raise fail(f"--sweep-phi sweeps phi; {mechanism.name!r} has {', '.join(coordinates)}.")
         angles = parse_range(motion.sweep_phi, "--sweep-phi", angular=True)
+        if angles.size > MAX_FRAMES:
+            if not quiet:
+                echo_error(f"--sweep-phi gives {angles.size} angles: animating {MAX_FRAMES} evenly spaced from the "
+                           "first to the last.")
+            angles = np.linspace(angles[0], angles[-1], MAX_FRAMES)
         poses = np.repeat(target[None], angles.size, axis=0)
-        poses[:, 2] = angles
+        poses[:, coordinates.index("phi")] = angles
         return poses, None
     if motion.path is None:
         return None
@@ -86,6 +104,8 @@ def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool):
         echo_error(f"Animated at the path's own times: {path.times[-1] - path.times[0]:g} s.")
     if path.samples <= MAX_FRAMES:
         return path.poses, path.times
+    if resampled is not None:
+        resampled.append(True)
     if path.times is None:
         if not quiet:
             echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in arc length.")
@@ -94,6 +114,40 @@ def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool):
         echo_error(f"{path.samples} samples: animating {MAX_FRAMES} evenly spaced in time.")
     times = np.linspace(path.times[0], path.times[-1], MAX_FRAMES)
     return path.at(np.interp(times, path.times, path.arc_length)), times
+
+
+def _runs(indices: np.ndarray) -> list[tuple[int, int]]:
+    """Consecutive runs ``(first, last)`` of sorted indices."""
+    breaks = np.flatnonzero(np.diff(indices) > 1)
+    return list(zip(indices[np.r_[0, breaks + 1]].tolist(), indices[np.r_[breaks, indices.size - 1]].tolist()))
+
+
+def _echo_skipped(scene, poses: np.ndarray, times, what: str) -> None:
+    """One line on stderr naming the unreachable poses an animation skipped, as stretches of ``what`` (samples,
+    frames of a resampled path, or angles of ``--sweep-phi``), with their times or angles."""
+    asked = poses.shape[0]
+    missing = np.setdiff1d(np.arange(asked), scene.kept)
+    if not missing.size:
+        return
+    sweep = what == "angles"
+    parts = []
+    for first, last in _runs(missing):
+        where = f"{first}" if first == last else f"{first}-{last}"
+        if sweep:
+            phi = np.degrees(poses[[first, last], list(scene.mechanism.task_coordinates).index("phi")])
+            where += f" (phi {phi[0]:g} deg)" if first == last else f" (phi {phi[0]:g}..{phi[1]:g} deg)"
+        elif times is not None:
+            where += f" (t {times[first]:g} s)" if first == last else f" (t {times[first]:g}..{times[last]:g} s)"
+        parts.append(where)
+    one = what[:-1]
+    inside = np.any((missing > scene.kept[0]) & (missing < scene.kept[-1]))
+    how = ["moves straight across a skipped stretch"] if inside else []
+    if scene.kept[0] > 0:
+        how.append(f"waits at {one} {scene.kept[0]} (the first reachable) from the start until its time")
+    if scene.kept[-1] < asked - 1:
+        how.append(f"ends at {one} {scene.kept[-1]} (the last reachable)")
+    echo_error(f"UNREACHABLE {what}, skipped: {', '.join(parts)} ({missing.size} of {asked}); the animation keeps "
+               f"the {what}' times: it {', '.join(how)}.")
 
 
 def _echo_legend(scene) -> None:
@@ -122,10 +176,46 @@ def _echo_legend(scene) -> None:
         click.echo("Output twists of the best working submechanism: " + ", ".join(names[i] for i in best))
 
 
-def _interrupt(signum, frame) -> None:
-    """SIGTERM as Ctrl+C: without it, the process would end without stopping its Meshcat server, which would go on
-    serving with no parent."""
-    raise KeyboardInterrupt
+class Stopped(BaseException):
+    """SIGTERM or SIGHUP received (a `kill`, a service manager, the terminal closed): raised where the command is,
+    like Ctrl+C's KeyboardInterrupt, so that the Meshcat server is stopped on the way out (not an ``Exception``:
+    nothing on the way catches it)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.name = signal.Signals(signum).name
+
+
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
+"""Signals that end ``view`` as Ctrl+C does, from its start: the Meshcat server is started while drawing."""
+
+
+def _stop(signum, frame) -> None:
+    """The first SIGTERM/SIGHUP raises :class:`Stopped`; later ones are ignored while the server is stopped (the
+    server's own watchdog ends it if the process dies anyway)."""
+    for number in STOP_SIGNALS:
+        signal.signal(number, signal.SIG_IGN)
+    raise Stopped(signum)
+
+
+@contextlib.contextmanager
+def _stopped_by_signals():
+    """SIGTERM and SIGHUP raise :class:`Stopped` inside the block (in the main thread only), as before after it."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {number: signal.signal(number, _stop) for number in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _say(message: str) -> None:
+    """A note on stderr that may find no terminal (SIGHUP: it was closed)."""
+    with contextlib.suppress(OSError):
+        echo_error(message)
 
 
 @click.command("view")
@@ -171,10 +261,28 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
     """
 
     check_outputs({"--html": (html_path, (".html", ".htm"))}, overwrite, quiet)
+    serving = []  # [True] from the moment the URL is shown
+    with _stopped_by_signals():  # from the start: the Meshcat server is started while drawing
+        try:
+            _view(mechanism, pose, failed, html_path, motion, colouring, reading, open_browser, quiet, serving)
+        except (KeyboardInterrupt, Stopped) as stop:  # the scene's server was stopped on the way here
+            if serving:
+                _say("Stopped.")
+                return
+            what = "no HTML written" if html_path is not None else "nothing served"
+            name = stop.name if isinstance(stop, Stopped) else "SIGINT"
+            raise fail(f"Stopped by {name} before the view was ready; {what}.") from None
+
+
+def _view(mechanism, pose, failed, html_path, motion: Motion, colouring: Colouring, reading, open_browser,
+          quiet, serving: list) -> None:
+    """The command once its outputs are checked: returns once the HTML is written; serves until the server stops
+    (an error) or a signal ends it (``serving`` gets True once the URL is shown)."""
     loaded = load_mechanism(mechanism, reading, graphs=True)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
-    animated = _animated_poses(loaded, motion, target, quiet)
+    resampled = []
+    animated = _animated_poses(loaded, motion, target, quiet, resampled)
     try:
         if animated is not None:
             poses, times = animated
@@ -184,7 +292,9 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
             scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by)
     except (ValueError, RuntimeError) as error:
         raise fail(str(error)) from None
-    with scene:
+    with scene:  # whatever ends the command from here (an error, Ctrl+C, SIGTERM, SIGHUP) stops the server
+        if animated is not None:  # (a warning: said even with --quiet)
+            _echo_skipped(scene, *animated, "angles" if motion.sweep_phi else "frames" if resampled else "samples")
         _echo_legend(scene)
         if html_path is not None:
             try:
@@ -194,14 +304,10 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
             if not quiet:
                 echo_error(f"wrote {written}")
             return
-        try:  # from the moment the URL is shown, Ctrl+C stops the server and exits cleanly
-            signal.signal(signal.SIGTERM, _interrupt)  # a `kill`, a service manager: as Ctrl+C
-            echo_error(f"Serving at {scene.url} (127.0.0.1 only); press Ctrl+C to stop.")
-            if open_browser:
-                scene.viewer.open()
-            while scene.server.running:
-                time.sleep(0.5)
-        except KeyboardInterrupt:
-            echo_error("Stopped.")
-            return
+        echo_error(f"Serving at {scene.url} (127.0.0.1 only); press Ctrl+C to stop.")
+        serving.append(True)
+        if open_browser:
+            scene.viewer.open()
+        while scene.server.running:
+            time.sleep(0.5)
         raise fail(f"The Meshcat server stopped unexpectedly (exit code {scene.server.process.returncode}).")

@@ -20,20 +20,109 @@ from screwkit.plots.style import (
     wrap_text,
 )
 
-__all__ = ["trajectory_figure"]
+__all__ = ["trajectory_figure", "time_ticks", "trajectory_from_dataset"]
 
 LOST_COLOR = "#D55E00"
 """Stretches where a failure leaves the platform below the level (Okabe-Ito vermilion)."""
+
+
+def trajectory_from_dataset(dataset):
+    """What :func:`trajectory_figure` draws, read back from the dataset of ``screwkit trajectory --out FILE.nc``
+    (:meth:`~screwkit.studies.trajectory.TrajectoryResult.to_dataset`): the indices over ``sample`` with the
+    ``arc_length`` (and ``t``) coordinates, and the JSON ``summary`` attribute (fault cases, worst failures,
+    margins, events). Nothing is computed: the figure is the one ``trajectory --figure`` drew.
+
+    Raises
+    ------
+    ValueError, KeyError
+        The dataset lacks what the figure needs.
+    """
+    import json
+    import re
+    from types import SimpleNamespace
+
+    from screwkit.studies.trajectory import FaultCase, Margin, PathEvent  # the studies: for a file read back only
+
+    summary = json.loads(dataset.attrs["summary"])
+
+    def series(name: str) -> np.ndarray:
+        return np.asarray(dataset[name].values, dtype=float)
+
+    def number(value) -> float:
+        return np.nan if value is None else float(value)
+
+    faults = sorted(int(name[3:]) for name in dataset.data_vars if re.fullmatch(r"f_o\d+", str(name)))
+    indices = SimpleNamespace(faults=faults, iti=series("iti"), lmti=series("lmti"),
+                              f_o={j: series(f"f_o{j}") for j in faults}, f_io={j: series(f"f_io{j}") for j in faults})
+    s = np.asarray(dataset["arc_length"].values, dtype=float)
+    path = SimpleNamespace(arc_length=s, times=np.asarray(dataset["t"].values, dtype=float) if "t" in dataset else None,
+                           samples=int(summary["samples"]), length=float(summary["length_m"]),
+                           length_scale=float(summary["length_scale_m"]))
+    cases = tuple(FaultCase(int(c["j"]), tuple(c["failed"]), np.asarray(c["controllable_m"], float).reshape(-1, 2),
+                            np.asarray(c["lost_m"], float).reshape(-1, 2), c["first_loss_m"], number(c["minimum"]),
+                            number(c["at_m"]), tuple(c["singular_at_m"])) for c in summary["faults"])
+    margins = {name: Margin(number(m["value"]), number(m["arc_length_m"]), m["sample"])
+               for name, m in summary["margins"].items()}
+    events = tuple(PathEvent(e["kind"], float(e["start_m"]), float(e["stop_m"]), tuple(e["samples"]), e["reason"])
+                   for e in summary["events"])
+    return SimpleNamespace(mechanism=summary["mechanism"], path=path, indices=indices, level=float(summary["level"]),
+                           cases=cases, worst={int(j): tuple(tuple(t) for t in ties)
+                                               for j, ties in summary["worst"].items()},
+                           margins=margins, events=events,
+                           mean={j: series(f"f_o_mean{j}") for j in faults if f"f_o_mean{j}" in dataset})
 
 
 def _short(name: str) -> str:
     return name.rsplit(":", 1)[-1]
 
 
+def time_ticks(s, times, *, spacing: float = 0.06) -> tuple[list[float], list[str]]:
+    """Ticks of the time axis over arc length: positions (m of arc length) and labels (s).
+
+    Round times within the path's own times (none before its first or after its last), each at the arc length
+    where the path is at that time (linear between samples, as the path's times run between its samples). Where
+    the platform dwells (consecutive samples at one arc length, so one position for a span of times), that
+    position gets one tick labelled with the span, ``"t1–t2"`` (arrival–departure), and no round time inside the
+    span is drawn; times are increasing, so no time lies at two arc lengths. A round-time tick closer than
+    ``spacing`` (a fraction of the path's length) to a tick already placed (dwells first, then in time order) is
+    left out, so labels do not overlap.
+    """
+    from matplotlib.ticker import MaxNLocator
+
+    s, times = np.asarray(s, dtype=float), np.asarray(times, dtype=float)
+    gap = spacing * max(float(s[-1] - s[0]), 1e-300)
+    ticks: list[tuple[float, str]] = []
+    dwells = []
+    for k in np.flatnonzero(np.diff(s) <= 0):
+        if dwells and dwells[-1][1] == times[k]:
+            dwells[-1][1] = times[k + 1]
+        else:
+            dwells.append([times[k], times[k + 1], s[k]])
+    for start, stop, at in dwells:
+        ticks.append((float(at), f"{_time(start)}–{_time(stop)}"))
+    candidates = MaxNLocator(nbins=8, steps=[1, 2, 2.5, 5, 10]).tick_values(times[0], times[-1])
+    span = max(float(times[-1] - times[0]), 1e-300)
+    for t in candidates:
+        if not times[0] - 1e-9 * span <= t <= times[-1] + 1e-9 * span:
+            continue
+        if any(start <= t <= stop for start, stop, _ in dwells):
+            continue
+        at = float(np.interp(t, times, s))
+        if all(abs(at - other) >= gap for other, _ in ticks):
+            ticks.append((at, _time(t)))
+    ticks.sort(key=lambda tick: tick[0])
+    return [at for at, _ in ticks], [label for _, label in ticks]
+
+
+def _time(t: float) -> str:
+    return f"{float(np.round(t, 9)):g}"
+
+
 def trajectory_figure(result):
     """Indices along the path and, for every number of faults j, the stretches each failure leaves uncontrollable.
 
-    Panels, against arc length (m; the time of the samples on a top axis when the path has times):
+    Panels, against arc length (m; when the path has times, a top axis marks the arc length where the path is at
+    round times within its own, see :func:`time_ticks`):
 
     - (a) ITI, LMTI and, for every j, F_Oj (bold) and F_IOj (dashed), the level as a dotted line, unreachable
       stretches shaded grey;
@@ -78,8 +167,9 @@ def trajectory_figure(result):
     ax.set_title("(a) indices along the path" + ("; unreachable stretches shaded grey" if result.events else ""),
                  fontsize=TITLE_SIZE, loc="left")
     if result.path.times is not None:
-        top = ax.secondary_xaxis("top", functions=(lambda x: np.interp(x, s, result.path.times),
-                                                   lambda t: np.interp(t, result.path.times, s)))
+        top = ax.secondary_xaxis("top", functions=(lambda x: x, lambda x: x))  # arc length, labelled with times
+        positions, labels = time_ticks(s, result.path.times)
+        top.set_xticks(positions, labels)
         top.set_xlabel("t (s)")
     worst_names = []
     for row, j in enumerate(faults, start=1):

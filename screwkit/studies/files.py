@@ -257,9 +257,11 @@ def open_netcdf(path: str, error: type[Exception] = ValueError):
 
 
 def read_result(path) -> tuple[str, object]:
-    """A map or a sweep read back from the netCDF file :func:`write_dataset` wrote: ``("map" | "sweep", dataset)``.
+    """A map, a sweep or a trajectory read back from the netCDF file :func:`write_dataset` wrote:
+    ``("map" | "sweep" | "trajectory", dataset)``.
 
-    A map's indices lie over two grid coordinates, a sweep's along one.
+    A map's indices lie over two grid coordinates, a sweep's along one; a trajectory's along ``sample``, with the
+    ``arc_length`` coordinate and the JSON ``summary`` attribute (``screwkit trajectory --out``).
 
     Raises
     ------
@@ -276,6 +278,13 @@ def read_result(path) -> tuple[str, object]:
                          "FILE.nc).")
     dataset = open_netcdf(path)
     dimensions = dataset["iti"].ndim if "iti" in dataset.data_vars else 0
+    if dimensions == 1 and dataset["iti"].dims == ("sample",) and "arc_length" in dataset.coords \
+            and "summary" in dataset.attrs:  # indices along a path: screwkit trajectory --out FILE.nc
+        return "trajectory", dataset
+    if dimensions == 1 and dataset["iti"].dims == ("sample",):  # samples of a path, not a swept coordinate
+        raise ValueError(f"{path}: holds indices along a path (over 'sample') without the arc length and summary "
+                         "that `screwkit trajectory --out` writes; draw its figure with `screwkit trajectory ... "
+                         "--figure FILE`.")
     if "lmti" not in dataset.data_vars or dimensions not in (1, 2):
         raise ValueError(f"{path}: not a map or a sweep of screwkit (expected 'iti' and 'lmti' over one or two "
                          f"coordinates, got variables {', '.join(sorted(map(str, dataset.data_vars))) or 'none'}).")

@@ -184,15 +184,21 @@ def frame_view(viewer, mechanism, frames: Frames) -> NDArray[np.float64]:
 
     Meshcat 0.3 orbits about the viewer's origin and cannot move that target, so the scene
     (``/meshcat``) and the ground grid and axes are shifted together by ``-centre``: the
-    picture is the mechanism's world, centred where the camera looks.
+    picture is the mechanism's world, centred where the camera looks. A planar mechanism's centre is on its
+    platform's plane, and the camera looks at that plane from the same side and angle, wherever and however
+    tilted its world frame puts the plane.
     """
     points = np.concatenate([points[0].reshape(-1, 3) for points in frames.chain_points] + [frames.centres[:1]])
-    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
-    if mechanism.is_planar:
-        centre[2] = 0.0
+    rotation = np.asarray(getattr(mechanism, "rotation_world_base", np.eye(3)), dtype=float)
+    origin = np.asarray(getattr(mechanism, "translation_world_base", np.zeros(3)), dtype=float)
+    in_base = (points - origin) @ rotation  # the bounding box in the base frame: it moves with the mechanism
+    centre = rotation @ (0.5 * (in_base.min(axis=0) + in_base.max(axis=0))) + origin
+    if mechanism.is_planar:  # onto the platform's plane (its base frame's x-y plane, wherever the world puts it)
+        normal = rotation[:, 2]
+        centre = centre - normal * float(np.dot(centre - frames.centres[0], normal))
     reach = max(float(np.max(np.linalg.norm(points - centre, axis=-1))), 0.5 * float(mechanism.length_scale), 1e-3)
-    if mechanism.is_planar:
-        direction, distance = np.array([0.3, -0.75, 1.0]), 1.9 * reach
+    if mechanism.is_planar:  # the same view of the plane however the world frame tilts it
+        direction, distance = rotation @ np.array([0.3, -0.75, 1.0]), 1.9 * reach
     else:
         direction, distance = np.array([1.0, -1.4, 0.7]), 2.4 * reach
     shift = np.eye(4)
@@ -218,15 +224,18 @@ def animate(viewer, visualizer, visual_model, frames: Frames, markers, all_marke
     """One keyframe per frame: the links (of ``visualizer``'s geometry: none when it is None), and the markers (shown
     or hidden); with ``colours`` (per Meshcat path of a drawn object, its RGB(A) colour at each frame, (frames, 3 or
     4)), the material colour of each follows too.
-    Keyframe ``k`` is at ``k / frame_rate`` seconds, or with ``times`` (seconds, increasing, one per frame) at
-    ``times[k] - times[0]``: Meshcat then plays the motion at its own pace, interpolating between keyframes."""
+    The keyframe of frame ``k``, drawn for pose ``frames.kept[k]`` of those asked for, is at ``frames.kept[k] /
+    frame_rate`` seconds, or with ``times`` (seconds, increasing, one per pose asked for) at
+    ``times[frames.kept[k]] - times[0]``: Meshcat then plays the motion at its own pace, interpolating between
+    keyframes, and unreachable poses left out keep their time."""
     import meshcat.animation
     import pinocchio
     from meshcat import transformations
 
     animation = meshcat.animation.Animation(default_framerate=frame_rate)
-    at = (np.arange(len(frames.configurations)) if times is None
-          else (np.asarray(times, dtype=float) - times[0]) * frame_rate)  # keyframe numbers (Meshcat: frame / fps s)
+    kept = np.arange(len(frames.configurations)) if frames.kept is None else np.asarray(frames.kept)
+    at = (kept if times is None  # keyframe numbers (Meshcat: frame / fps s)
+          else (np.asarray(times, dtype=float)[kept] - float(times[0])) * frame_rate)
     geometries = [] if visualizer is None else visual_model.geometryObjects
     for frame, configuration in enumerate(frames.configurations):
         if visualizer is not None:

@@ -357,10 +357,8 @@ def twist_markers(mechanism, slot: int, actuator: int, twist: NDArray, centre: N
         if np.linalg.norm(nearest - centre) < 50.0 * length:
             markers = [Marker(f"{base}/axis", "twist_axis", actuator, nearest - length * direction,
                               nearest + length * direction)]
-            if mechanism.is_planar:
-                in_plane = axis_point + direction * (centre[2] - axis_point[2]) / direction[2] \
-                    if abs(direction[2]) > 1e-12 else nearest
-                markers.append(Marker(f"{base}/centre", "instantaneous_centre", actuator, in_plane, in_plane.copy()))
+            if mechanism.is_planar:  # the axis is normal to the platform plane: it meets it at `nearest`
+                markers.append(Marker(f"{base}/centre", "instantaneous_centre", actuator, nearest, nearest.copy()))
             return markers
     direction = centre_velocity / max(np.linalg.norm(centre_velocity), 1e-300)
     return [Marker(f"{base}/translation", "translation", actuator, centre.copy(), centre + 0.6 * length * direction)]

@@ -91,6 +91,9 @@ class Scene:
     times : ndarray, shape (frames,), or None
         Seconds at which each animated pose is reached when the animation follows the poses' own times (a path
         with a time column, or ``times``); None otherwise.
+    kept : ndarray of int, shape (frames,)
+        Which of the poses asked for are drawn (the reachable ones, in order): an animation skips the others and
+        keeps the time base of all of them (see :func:`animate_sweep`).
     """
 
     mechanism: Any
@@ -108,6 +111,7 @@ class Scene:
     frame_rate: float | None = None
     display_offset: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
     times: NDArray[np.float64] | None = None
+    kept: NDArray[np.int64] = field(default_factory=lambda: np.zeros(1, dtype=int))
 
     @property
     def pose(self) -> NDArray[np.float64]:
@@ -198,11 +202,16 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
 
     The first reachable pose is drawn as by :func:`show` (chain colours from its indices);
     a Meshcat animation then moves the links, the wrench lines, the twist axes and the
-    instantaneous centres through the reachable poses (unreachable ones are skipped), one
-    keyframe per pose, and turns the colour of every working chain to that of its index at
-    the pose (``scene.chain_values``; a failed chain stays red). Markers that do not exist
-    in a frame (a centre at infinity, a twist of a frame without a working submechanism) are
+    instantaneous centres through the reachable poses, one keyframe per pose, and turns the
+    colour of every working chain to that of its index at the pose (``scene.chain_values``;
+    a failed chain stays red). Markers that do not exist in a frame (a centre at infinity, a
+    twist of a frame without a working submechanism) are
     hidden in it.
+
+    Unreachable poses are skipped (``scene.kept`` names the drawn ones) with their time: the keyframe of pose
+    ``k`` stays at ``k / frame_rate`` (or ``times[k] - times[0]``) seconds, pose 0's time being the clip's start
+    even when pose 0 is unreachable, so the platform moves straight across a skipped stretch in the time the path
+    takes over it, and before the first reachable pose it waits there.
 
     Parameters
     ----------
@@ -415,7 +424,7 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
             animate(meshcat_viewer, visualizer, None if geometry is None else geometry.visual_model, frames, markers,
                     all_markers, animation.frame_rate,
                     animation.loop, {node: frame_colors[:, chain] for node, chain in chain_of_node.items()},
-                    None if animation.times is None else animation.times[frames.kept])
+                    animation.times)
     except BaseException:
         if server is not None:
             with contextlib.suppress(Exception):
@@ -429,7 +438,8 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
                       None if b is None else tuple(result.submechanisms[b]) for b in best),
                   frame_markers=markers, visualizer=visualizer, viewer=meshcat_viewer, server=server,
                   frame_rate=None if one_pose else animation.frame_rate, display_offset=display_offset,
-                  times=None if one_pose or animation.times is None else animation.times[frames.kept])
+                  times=None if one_pose or animation.times is None else animation.times[frames.kept],
+                  kept=np.asarray(frames.kept, dtype=int))
     if open_browser:
         meshcat_viewer.open()
     return scene

@@ -3,7 +3,8 @@
 ``meshcat.Visualizer()`` would start ``meshcat.servers.zmqserver``, whose tornado web server
 listens on every interface (``Application.listen(port)`` without an address); the server here
 is started with ``listen`` bound to :data:`LOOPBACK_HOST`. Stop it with
-:meth:`ViewerServer.stop`; it is also stopped when the Python process exits.
+:meth:`ViewerServer.stop`; it is also stopped when the Python process exits, and it stops itself
+when its parent process is gone however that ended (a watchdog in the server, see :data:`_SERVER_CODE`).
 """
 
 from __future__ import annotations
@@ -29,9 +30,18 @@ BACKGROUND_COLORS = ((0.98, 0.98, 0.98), (0.80, 0.82, 0.85))
 
 
 _SERVER_CODE = r"""
-import os, sys
-import tornado.web
+import os, select, sys, threading, time
 host = sys.argv[1]
+parent = os.getppid()
+def _watch_parent():
+    # Ends the server when its parent is gone, however it ended (even SIGKILL): the parent holds the only write
+    # end of this process's stdin, so its end reads as end-of-file; and the parent id changes on re-parenting.
+    while True:
+        readable = select.select([0], [], [], 0.5)[0]
+        if (readable and not os.read(0, 4096)) or os.getppid() != parent:
+            os._exit(0)
+threading.Thread(target=_watch_parent, daemon=True).start()
+import tornado.web
 _listen = tornado.web.Application.listen
 def _listen_on_host(self, port, address=None, **kwargs):
     return _listen(self, port, host, **kwargs)
@@ -46,7 +56,9 @@ os.dup2(quiet, 2)
 bridge.run()
 """
 """Started as ``python -c``: meshcat's ZeroMQ/websocket bridge with tornado's ``listen``
-forced onto ``host`` (meshcat passes no address, which means every interface)."""
+forced onto ``host`` (meshcat passes no address, which means every interface), and a watchdog thread that
+ends the server as soon as its parent is gone (its stdin, a pipe only the parent holds, reaches end-of-file, or
+its parent process id changes): a parent killed by any signal, even SIGKILL, leaves no server behind."""
 
 
 class ViewerServer:
@@ -90,7 +102,7 @@ class ViewerServer:
             The server exited or did not report its URLs in time (the message quotes its output).
         """
         with tempfile.TemporaryFile() as errors:
-            process = subprocess.Popen([sys.executable, "-c", _SERVER_CODE, host], stdin=subprocess.DEVNULL,
+            process = subprocess.Popen([sys.executable, "-c", _SERVER_CODE, host], stdin=subprocess.PIPE,
                                        stdout=subprocess.PIPE, stderr=errors, start_new_session=True)
             urls: dict[str, str] = {}
             problem = None
@@ -151,8 +163,10 @@ def stop_process(process: subprocess.Popen) -> None:
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
-    if process.stdout is not None and not process.stdout.closed:
-        process.stdout.close()
+    for stream in (process.stdout, process.stdin):
+        if stream is not None and not stream.closed:
+            with contextlib.suppress(OSError):
+                stream.close()
 
 
 def start_viewer(server: ViewerServer | None = None, *, timeout: float = 30.0):
