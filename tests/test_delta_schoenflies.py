@@ -321,8 +321,8 @@ def test_schoenflies_5_output_twists_match_finite_differences_of_the_closure(pos
         np.testing.assert_allclose(moved.full_poses[:, 3:5], 0.0, atol=1e-12)
         for position in range(len(sub)):
             twist = platform_twist(sch, moved.full_poses[2 * position], moved.full_poses[2 * position + 1], step)
-            expected = result.output_twists[s, position]
-            cosine = abs(twist @ expected) / np.linalg.norm(twist) / np.linalg.norm(expected)
+            expected = result.output_twists[s, position]  # signed: the motion with its actuator moving forward
+            cosine = (twist @ expected) / np.linalg.norm(twist) / np.linalg.norm(expected)
             assert cosine > 1 - 1e-6, (s, position, cosine)
 
 

@@ -82,8 +82,9 @@ class Indices:
     actuation_wrenches : ndarray (..., a, 6) or None
         Unit actuation wrenches ``(f, m)`` in the world frame.
     output_twists : ndarray (..., S, n, 6) or None
-        Output twists ``(omega, v)`` of each actuator of each submechanism, world frame
-        (only their screw axes are meaningful: they are scaled as adjugate columns).
+        Output twists ``(omega, v)`` of each actuator of each submechanism, world frame: their screw axes, signed so
+        that the actuator's wrench does positive work on its twist (the motion when it drives and the others
+        hold); their size is that of adjugate columns, not meaningful.
     poses : ndarray (..., n_task) or None
         The platform poses (m, rad), when the indices were computed from poses.
     reachable : ndarray (...) of bool

@@ -241,15 +241,23 @@ def actuator_otis(submechanisms, locked_of, output_twist, omega_squares, point_l
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def world_output_twists(locked_of, output_twist, first_index, width, centres, lengths, twist_out):
-    """Submechanism s's output twists back in world units and origin (v_0 = L v' - omega x c) into ``twist_out``."""
+def world_output_twists(submechanisms, locked_of, wrench_matrix, output, output_twist, first_index, width, centres,
+                        lengths, twist_out):
+    """Submechanism s's output twists back in world units and origin (v_0 = L v' - omega x c) into ``twist_out``,
+    each signed so that its actuator's wrench does positive work on it (A_k o T_k = W_k . y > 0: the motion of the
+    platform when that actuator drives and the others hold, whatever the sign the motion basis was found with)."""
     for s in range(locked_of.shape[0]):
         for position in range(locked_of.shape[1]):
             locked = locked_of[s, position]
+            act = submechanisms[s, position]
             for r in range(width):
                 index = first_index + r
+                power = 0.0
+                for q in range(output.shape[1]):
+                    power += wrench_matrix[act, q, r] * output[locked, q, r]
+                sign = -1.0 if power < 0.0 else 1.0
                 for k in range(6):
-                    total = output_twist[locked, k, r]
+                    total = sign * output_twist[locked, k, r]
                     twist_out[index, s, position, k] = total if k < 3 else total * lengths[r]
                 x0, x1, x2 = cross(twist_out[index, s, position, 0], twist_out[index, s, position, 1],
                                    twist_out[index, s, position, 2], centres[0, r], centres[1, r], centres[2, r])
@@ -284,7 +292,8 @@ def submechanism_stage(submechanisms, locked_of, wrench_matrix, output, row_norm
         actuator_otis(submechanisms, locked_of, output_twist, omega_squares, point_lanes, pitch_lanes, has_force,
                       thresholds, determinant, independent, first_index, width, oti_out)
     if twist_out.shape[0] > 0:
-        world_output_twists(locked_of, output_twist, first_index, width, centres, lengths, twist_out)
+        world_output_twists(submechanisms, locked_of, wrench_matrix, output, output_twist, first_index, width, centres,
+                            lengths, twist_out)
     submechanism_otis(determinant, independent, longest_sq, width, lmti_lanes)
     if oti_sub_out.shape[0] > 0:
         for s in range(submechanisms.shape[0]):
