@@ -132,3 +132,25 @@ def test_plot_refuses_index_values_outside_0_1(tmp_path):
     unreachable["iti"].values[1] = np.nan  # NaN: unreachable, drawn
     unreachable.to_netcdf(tmp_path / "nan.nc", engine="scipy")
     assert screwkit("plot", tmp_path / "nan.nc", "--figure", tmp_path / "nan.png").returncode == 0
+
+
+def test_a_reachable_sample_between_two_out_of_reach_is_drawn():
+    """The 5-RRR along x from 0 to 1.2 m in 13 samples reaches 1.0 m between two samples out of reach (0.9, 1.1 m):
+    a line alone drew nothing there; now every index of panel (a) has a dot at that sample, at its value."""
+    from screwkit.io.loader import load
+    from screwkit.plots.trajectory import trajectory_figure
+    from screwkit.studies.paths import line_path
+    from screwkit.studies.trajectory import trajectory
+
+    five = load("planar_5rrr")
+    result = trajectory(five, line_path(five, [0.0, 0.0, 0.0], [1.2, 0.0, 0.0], 13))
+    reachable = np.asarray(result.indices.reachable)
+    assert reachable[[8, 10]].all() and not reachable[[9, 11, 12]].any()
+    figure = trajectory_figure(result)
+    dots = [line for line in figure.axes[0].lines if line.get_marker() == "."]
+    at = result.path.arc_length[10]
+    drawn = {round(float(y), 12) for line in dots for x, y in zip(line.get_xdata(), line.get_ydata()) if x == at}
+    expected = [result.indices.iti[10], result.indices.lmti[10], *(result.indices.f_o[j][10] for j in (1, 2)),
+                *(result.indices.f_io[j][10] for j in (1, 2))]
+    assert {round(float(v), 12) for v in expected} <= drawn
+    assert all(x == at for line in dots for x in line.get_xdata())  # no dot where a line is drawn

@@ -118,6 +118,21 @@ def _time(t: float) -> str:
     return f"{float(np.round(t, 9)):g}"
 
 
+def _series(ax, s, values, **style) -> None:
+    """One index along the path: its line, and a dot at each reachable sample between two out of reach (or at an
+    end of the path next to one), which a line alone does not draw."""
+    values = np.asarray(values, dtype=float)
+    ax.plot(s, values, **style)
+    finite = np.isfinite(values)
+    neighbours = np.zeros(len(values), dtype=bool)
+    neighbours[1:] |= finite[:-1]
+    neighbours[:-1] |= finite[1:]
+    lone = finite & ~neighbours
+    if lone.any() and len(values) > 1:
+        dot = {key: value for key, value in style.items() if key in ("color", "zorder")}
+        ax.plot(s[lone], values[lone], linestyle="none", marker=".", markersize=5, **dot)
+
+
 def trajectory_figure(result):
     """Indices along the path and, for every number of faults j, the stretches each failure leaves uncontrollable.
 
@@ -148,16 +163,16 @@ def trajectory_figure(result):
     axes = np.atleast_1d(axes)
     ax = axes[0]
     colours = plt.get_cmap(COLORMAP)(np.linspace(0.15, 0.85, max(len(faults), 1)))
-    ax.plot(s, samples.iti, label=f"ITI (min {np.nanmin(samples.iti):.3f})", color="0.45", linewidth=1.2)
-    ax.plot(s, samples.lmti, label=f"LMTI (min {np.nanmin(samples.lmti):.3f})", color="0.2", linewidth=1.2,
+    _series(ax, s, samples.iti, label=f"ITI (min {np.nanmin(samples.iti):.3f})", color="0.45", linewidth=1.2)
+    _series(ax, s, samples.lmti, label=f"LMTI (min {np.nanmin(samples.lmti):.3f})", color="0.2", linewidth=1.2,
             linestyle="--")
     for colour, j in zip(colours, faults):
         margin = result.margins.get(f"f_o{j}")
         shown = f" (min {margin.value:.3f})" if margin else ""
-        ax.plot(s, samples.f_o[j], label=f"$F_{{O{j}}}${shown}", **{**BOLD, "color": colour})
-        ax.plot(s, samples.f_io[j], label=f"$F_{{IO{j}}}$", **{**F_IO_STYLE, "color": colour, "linewidth": 1.0})
+        _series(ax, s, samples.f_o[j], label=f"$F_{{O{j}}}${shown}", **{**BOLD, "color": colour})
+        _series(ax, s, samples.f_io[j], label=f"$F_{{IO{j}}}$", **{**F_IO_STYLE, "color": colour, "linewidth": 1.0})
         if j in result.mean:
-            ax.plot(s, result.mean[j], label=f"$F_{{O{j}}}$ mean", color=colour, linewidth=1.0, linestyle=":")
+            _series(ax, s, result.mean[j], label=f"$F_{{O{j}}}$ mean", color=colour, linewidth=1.0, linestyle=":")
     ax.axhline(result.level, **{**MANY, "linestyle": ":", "color": "black"}, label=f"level {result.level:g}")
     for event in result.events:
         ax.axvspan(event.start, event.stop, color=UNREACHABLE_COLOR, zorder=0)
