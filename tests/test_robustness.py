@@ -315,7 +315,8 @@ def test_plot_draws_a_saved_map_or_sweep_again_as_it_was_drawn(tmp_path):
         ((tmp_path / "missing.nc", "--figure", tmp_path / "x.png"), "missing.nc: no such file"),
         ((tmp_path, "--figure", tmp_path / "x.png"), "is a folder; expected the netCDF file (.nc)"),
         ((tmp_path / "m.png", "--figure", tmp_path / "x.png"), "expected the netCDF file (.nc) of a map or a sweep"),
-        ((tmp_path / "fake.nc", "--figure", tmp_path / "x.png"), "cannot be read as a netCDF file"),
+        ((tmp_path / "fake.nc", "--figure", tmp_path / "x.png"),
+         "fake.nc: cannot be read as a netCDF file (it is not a valid NetCDF 3 file)."),  # not "(Error: .../fake.nc"
         ((tmp_path / "s.nc", "--figure", tmp_path / "x.png", "--vmin", "0"), "holds a sweep"),
         ((tmp_path / "m.nc", "--figure", tmp_path / "x.png", "--vmin", "1", "--vmax", "0"), "--vmin < --vmax"),
         ((tmp_path / "m.nc", "--figure", tmp_path / "m.png"), "the file exists; pass --overwrite"),

@@ -253,6 +253,7 @@ def open_netcdf(path: str, error: type[Exception] = ValueError):
             return dataset.load()
     except Exception as failure:  # whatever the netCDF reader makes of a file that is not one
         reason = str(failure).splitlines()[0] if str(failure) else type(failure).__name__
+        reason = reason.removeprefix("Error: ").replace(f"{path} ", "it ", 1)  # (scipy's words name it again)
         raise error(f"{path}: cannot be read as a netCDF file ({reason}).") from None
 
 
