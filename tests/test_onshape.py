@@ -203,3 +203,26 @@ def test_the_task_coordinates_a_source_urdf_declares_are_kept(tmp_path):
     path.write_text(five_bar_onshape().replace("</robot>", '<task_coordinates names="x phi"/></robot>'))
     with pytest.raises(ValueError, match="<task_coordinates>"):
         load(path)
+
+
+def test_the_actuators_a_transmission_names_are_the_actuators(tmp_path):
+    """A URDF's <transmission> elements say which joints are driven: the elbows here, not the base joints the reader
+    would guess (it guessed them although the file said otherwise); a transmission naming no 1-DoF joint of the
+    tree is refused naming it."""
+    elbows = "".join(f'<transmission name="t{i}"><type>transmission_interface/SimpleTransmission</type>'
+                     f'<joint name="passive{i}"><hardwareInterface>hardware_interface/EffortJointInterface'
+                     f'</hardwareInterface></joint><actuator name="m{i}"/></transmission>' for i in (1, 2, 3))
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_onshape().replace("</robot>", elbows + "</robot>"))
+    converted, report = read_mechanism_file(path)
+    assert report.motors == ["passive1", "passive2", "passive3"]
+    assert "actuators guessed" not in "\n".join(report.lines())
+    mechanism = load(path)
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["passive1", "passive2", "passive3"]
+    (tmp_path / "plain.urdf").write_text(five_bar_onshape())
+    base_driven = load(tmp_path / "plain.urdf")
+    elbow, base = (indices_at_poses(m, HOME, detail=True) for m in (mechanism, base_driven))
+    assert not np.allclose(elbow.iti_actuators, base.iti_actuators)  # another set of actuators, other numbers
+    path.write_text(five_bar_onshape().replace("</robot>", elbows.replace("passive3", "nowhere") + "</robot>"))
+    with pytest.raises(ImportError_, match=r"<transmission> names joint\(s\) nowhere, not 1-DoF joints of the tree"):
+        read_mechanism_file(path)

@@ -30,7 +30,15 @@ from pathlib import Path
 
 import numpy as np
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, declared_task_coordinates, homogeneous, inverse
+from screwkit.io.closed_tree import (
+    ClosedTree,
+    Closure,
+    ImportError_,
+    declared_task_coordinates,
+    homogeneous,
+    inverse,
+    transmitted_joints,
+)
 from screwkit.io.onshape import guessed_motors
 from screwkit.io.sdformat_text import parse_joint
 
@@ -59,7 +67,6 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     """The closed tree of a URDF whose loops are ``<gazebo><joint>`` elements."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    root = ElementTree.fromstring(urdf.read_bytes())
     try:
         model = pin.buildModelFromUrdf(str(urdf))
     except (RuntimeError, ValueError) as error:
@@ -100,11 +107,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
                                     on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
                                     axis_point=number == 1))
-    transmitted = [joint.text.strip() for transmission in root.findall("transmission")
-                   for joint in transmission.findall("joint") if joint.text and joint.text.strip()]
-    transmitted += [joint.get("name") for transmission in root.findall("transmission")
-                    for joint in transmission.findall("joint") if joint.get("name")]
-    motors = list(dict.fromkeys(transmitted)) or guessed_motors(model, closures)
+    transmitted = transmitted_joints(urdf.read_bytes())
+    motors = transmitted or guessed_motors(model, closures)
     unknown = [motor for motor in motors if motor not in list(model.names)]
     if unknown:
         raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree.")

@@ -31,6 +31,7 @@ from screwkit.io.closed_tree import (
     homogeneous,
     joint_kind,
     path_to,
+    transmitted_joints,
 )
 
 __all__ = ["CLOSING", "closing_pairs", "read_onshape"]
@@ -78,7 +79,13 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
         a, b = frames[first], frames[second]
         closures.append(Closure(f"closing_{key}", int(a.parentJoint), homogeneous(a.placement),
                                 int(b.parentJoint), homogeneous(b.placement), "3d"))
-    motors = guessed_motors(model, closures)
+    transmitted = transmitted_joints(urdf.read_bytes())
+    unknown = [name for name in transmitted if not model.existJointName(name)
+               or model.joints[model.getJointId(name)].nv != 1]
+    if unknown:
+        raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not 1-DoF joints of the "
+                           "tree.")
+    motors = transmitted or guessed_motors(model, closures)
     if not motors:
         raise ImportError_(f"{urdf}: no 1-DoF joint leaves the base on the way to a closure: nothing to actuate "
                            "(a robot.yaml beside the file can list the actuated joints as name_mot).")
@@ -88,8 +95,9 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
     tree.notes.append(f"closing_ pairs read as ball joints (a URDF does not say the mate's type): "
                       f"{', '.join(c.name for c in closures)}; a robot.yaml beside the file (type: 3d or 6d) says "
                       "otherwise")
-    tree.notes.append(f"actuators guessed from the branches leaving the base (a URDF does not say which joints are "
-                      f"driven): {', '.join(motors)}; a robot.yaml beside the file (name_mot) says otherwise")
+    if not transmitted:
+        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
+                          f"{', '.join(motors)}; a robot.yaml beside the file (name_mot) says otherwise")
     return tree
 
 
