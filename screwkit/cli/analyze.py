@@ -187,7 +187,7 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         click.echo(json.dumps(report))
     else:
         print_report(report)
-    for number, line in enumerate(loaded.import_report):  # what was inferred, so that a wrong guess is seen
+    for number, line in enumerate([] if as_json else loaded.import_report):  # (with --json: its "converted")
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
 
 

@@ -68,8 +68,18 @@ class MapArea:
                            f"{'--radius' if self.radius is None else '--step'} is missing.")
             if not 0 < self.phi_step <= 360:
                 raise fail(f"Expected 0 < --phi-step <= 360 (deg), got {self.phi_step:g}.")
-        elif len(self.grids) != 2:
+            if self.at is not None:
+                raise fail("--at fixes the other coordinates of a --grid map; a planar map (--radius, --step) is a "
+                           "disc about the home pose over every phi: leave out --at, or give --grid x:... --grid "
+                           "y:... --over phi:0:360:STEP with --at.")
+            return
+        if len(self.grids) != 2:
             raise fail("Expected --radius/--step (planar) or exactly two --grid options.")
+        context = click.get_current_context(silent=True)
+        if context is not None and context.get_parameter_source("phi_step") in (
+                click.core.ParameterSource.COMMANDLINE, click.core.ParameterSource.ENVIRONMENT):
+            raise fail("--phi-step is the phi step of a planar map (--radius, --step); with --grid, give the "
+                       f"orientation set as --over phi:0:360:{self.phi_step:g}.")
 
 
 map_area_options = option_group(
@@ -102,6 +112,11 @@ def _map(loaded, area: MapArea, analysis, execution, proceed: bool, quiet: bool)
             if len(grid) != 2:
                 raise fail(f"Expected two different coordinates in --grid, got {' '.join(area.grids)}.")
             over = dict(grid_spec(loaded, o, "--over", False) for o in area.overs)
+            if len(over) != len(area.overs):
+                named = [o.partition(":")[0] for o in area.overs]
+                repeated = next(name for name in named if named.count(name) > 1)
+                raise fail(f"Expected each coordinate at most once in --over (the orientation set is the product of "
+                           f"their ranges), got {repeated} {named.count(repeated)} times: {' '.join(area.overs)}.")
             at_pose = fixed_pose(loaded, area.at)
             size = map_size(loaded, grid, over)
         size.check(proceed=proceed)
@@ -146,6 +161,9 @@ def map_command(mechanism, area: MapArea, outputs: Outputs, analysis, execution,
     """
 
     outputs.check(quiet)
+    if outputs.figure is None and (outputs.vmin is not None or outputs.vmax is not None):
+        raise fail("--vmin and --vmax are the ends of the colour scale of --figure, and there is none: give --figure "
+                   "with them.")
     area.check()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
     check_average(analysis, loaded)

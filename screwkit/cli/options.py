@@ -19,6 +19,7 @@ from typing import Callable
 import click
 import numpy as np
 
+from screwkit.cli.option_checks import execution_record, finite_threshold
 from screwkit.cli.reading import Reading, lock_option, output_frame_option, output_type_option, reading_record
 from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import (
@@ -200,7 +201,7 @@ def reading_options(function: Callable) -> Callable:
 
 def threshold_option(function: Callable) -> Callable:
     return click.option("--threshold", type=float, default=SINGULARITY_THRESHOLD, show_default=True,
-                        help="Singularity threshold p on the moment arm (m).")(function)
+                        callback=finite_threshold, help="Singularity threshold p on the moment arm (m).")(function)
 
 
 def fault_option(function: Callable) -> Callable:
@@ -319,8 +320,7 @@ def check_average(analysis: AnalysisOptions, mechanism) -> None:
 
 
 def _execution(scheduler: str | None, connect_timeout: float, task_size: int | None = None) -> Execution:
-    return Execution(scheduler=scheduler, connect_timeout=connect_timeout, configurations_per_task=task_size,
-                     progress=False if _quiet() else None)
+    return execution_record(scheduler, connect_timeout, task_size, quiet=_quiet())  # checked: one line otherwise
 
 
 def execution_options(*, task_size: bool = False) -> Callable:
@@ -329,16 +329,16 @@ def execution_options(*, task_size: bool = False) -> Callable:
     :func:`connected` connects to its scheduler."""
     options = [
         click.option("--scheduler", metavar="ADDRESS",
-                     help="Address of a running dask.distributed scheduler, e.g. tcp://host:8786 "
-                          "(default: local threads)."),
-        click.option("--connect-timeout", type=click.FloatRange(min=0, min_open=True), default=CONNECT_TIMEOUT,
-                     show_default=True, help="Seconds to wait for the --scheduler to answer."),
+                     help="Address of a running dask.distributed scheduler, tcp://HOST:PORT or tls://HOST:PORT, e.g. "
+                          "tcp://host:8786 (default: local threads)."),
+        click.option("--connect-timeout", type=float, default=CONNECT_TIMEOUT, show_default=True,
+                     help="Seconds to wait for the --scheduler to answer (at most 86,400: a day)."),
     ]
     if task_size:
         options.append(click.option(
             "--task-size", type=click.IntRange(min=1),
             help="Configurations (grid points x orientations) per task (default: at most 131,072 and at least "
-                 "16,384, and 4 tasks per core of this machine where the map is large enough)."))
+                 "16,384, and 16 tasks per core of this machine where the map is large enough)."))
     return option_group("execution", _execution, *options)
 
 

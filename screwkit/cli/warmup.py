@@ -16,6 +16,7 @@ from screwkit.common.compiling import (
     SPACE_KERNEL,
     compile_ahead,
     kernel_is_cached,
+    silence,
 )
 
 __all__ = ["warmup"]
@@ -36,6 +37,11 @@ def warmup() -> None:
 
     start = time.perf_counter()
     cached = {module: kernel_is_cached(module) for module in KERNELS}
+    missing = [KERNELS[module][0] for module in KERNELS if not cached[module]]
+    if missing:  # said here, for the notices of the kernels compiled below would point at this very command
+        click.echo(f"screwkit warmup: compiling {len(missing)} of {len(KERNELS)} kernels, not in numba's cache yet "
+                   f"({', '.join(missing)}; first run only, a minute or two)", err=True)
+    silence()
     compile_ahead(*INDEX_KERNELS, NULL_KERNEL, GRAM_KERNEL, SPACE_KERNEL, CONSTRAINT_KERNEL, CLOSED_FORM_KERNEL)
     five, hexapod = load("planar_5rrr"), load("ups_hexapod_8")
     steps = {  # the kernels compiled here first, while the child processes compile the index kernels

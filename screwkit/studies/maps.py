@@ -25,11 +25,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.common.units import is_angular, unit_of
+from screwkit.common.units import unit_of
 from screwkit.indices.registry import index_columns
 from screwkit.io.graph import GraphMechanism
 from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
+from screwkit.studies.coordinates import map_axis, pose_text, shown_values
 from screwkit.studies.files import atomic_write
 from screwkit.studies.graph_source import GraphSource, cached_graph, graph_source
 from screwkit.studies.netcdf import netcdf_attribute, netcdf_file
@@ -88,8 +89,8 @@ class MapSize:
     @property
     def description(self) -> str:
         """``N configurations (P grid points x K orientations)``."""
-        return (f"{self.configurations:,} configurations ({self.grid_points:,} grid points x "
-                f"{self.orientations:,} orientations)")
+        return (f"{_count(self.configurations, 'configuration')} ({_count(self.grid_points, 'grid point')} x "
+                f"{_count(self.orientations, 'orientation')})")
 
     def check(self, *, max_configurations: int = MAX_CONFIGURATIONS, proceed: bool = False,
               available_bytes: int | None = None) -> None:
@@ -103,6 +104,10 @@ class MapSize:
             raise ValueError(f"The map has {summary}, more than {max_configurations:,}; it would run for a long time "
                              f"and its result needs {_bytes(self.memory_bytes)}: use a coarser grid, or pass --yes "
                              "to proceed.")
+
+
+def _count(count: int, noun: str) -> str:
+    return f"{count:,} {noun}{'' if count == 1 else 's'}"
 
 
 def _bytes(count: int) -> str:
@@ -385,7 +390,9 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
     if set(grid) & set(over):
         raise ValueError("A coordinate cannot be both on the grid and in the orientation set: "
                          f"{set(grid) & set(over)}.")
-    (x_name, x_values), (y_name, y_values) = ((k, np.asarray(v, dtype=float)) for k, v in grid.items())
+    grid = {name: map_axis(values, f"`grid[{name!r}]`") for name, values in grid.items()}
+    over = {name: map_axis(values, f"`over[{name!r}]`") for name, values in over.items()}
+    (x_name, x_values), (y_name, y_values) = grid.items()
     shape = (y_values.size, x_values.size)
     if mask is not None:
         mask = np.asarray(mask, dtype=bool)
@@ -415,11 +422,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         for key in keys:
             view = variables[key][rows, columns]
             view[block_mask] = result[key]
-    angular = {name: is_angular(name) for name in names}
-
-    def shown(name, values):
-        return np.rad2deg(values) if angular[name] else values
-
+    shown = shown_values
     grid_map = GridMap(
         coordinates={x_name: (shown(x_name, x_values), unit_of(x_name)),
                      y_name: (shown(y_name, y_values), unit_of(y_name))},
@@ -433,7 +436,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
                 f"{name}: {len(np.unique(over_values[:, i]))} values from {shown(name, over_values[:, i].min()):g} "
                 f"to {shown(name, over_values[:, i].max()):g} {unit_of(name)}" for i, name in enumerate(over))
             or "the fixed pose only",
-            fixed_pose=", ".join(f"{n}={shown(n, v):g}" for n, v in zip(names, at) if n not in grid and n not in over),
+            fixed_pose=pose_text(names, at, mechanism.length_scale, leave_out=[*grid, *over]),
             joint_limits="respected" if analysis.limits else "ignored", fault_type=analysis.fault_type,
             configurations=int(size.configurations)))
     return grid_map.to_dataset() if as_dataset else grid_map
@@ -496,7 +499,8 @@ def disc_size(mechanism: Mechanism, radius: float, step: float, phi_step_degrees
             raise ValueError(f"Expected `{name}` > 0, got {value}.")
     count = int(math.floor(radius / step + 1e-9))
     points = disc_point_count(radius, step)
-    orientations = len(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees)) if phi_step_degrees >= 1e-6 else 10**12
+    orientations = (len(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees)) if phi_step_degrees >= 1e-6 else
+                    int(math.ceil(360.0 / phi_step_degrees - 1e-9)))  # (counted, not listed: 3.6e11 for 1e-9)
     if "phi" not in mechanism.task_coordinates:  # a planar point output: no rotation to map over
         orientations = 1
     a = len(mechanism.actuators)

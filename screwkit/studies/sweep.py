@@ -19,6 +19,7 @@ from screwkit.common.units import is_angular
 from screwkit.indices.results import set_label
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
+from screwkit.studies.coordinates import pose_text, shown_values
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 
 __all__ = ["sweep"]
@@ -57,7 +58,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         ``iti``, ``iti_actuator``, ``oti_submechanism``, ``lmti``, ``lmti_remaining{j}``,
         ``f_o{j}``, ``f_io{j}``, ``worst_fault{j}``, ``mutual_interference``, ``reachable``
         (those of :meth:`screwkit.indices.results.Indices.to_dataset` along the swept coordinate,
-        and the LMTI of every set left after j faults).
+        and the LMTI of every set left after j faults). Attribute ``fixed_pose``: the other coordinates (m, deg).
     """
 
     graph = isinstance(mechanism, GraphMechanism)
@@ -81,7 +82,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         result = indices_at_poses(mechanism, poses, detail=True, threshold=threshold, faults=faults,
                                   closed_forms=closed_forms, limits=limits, fault_type=fault_type)
     angular = is_angular(coordinate)
-    shown = np.rad2deg(values) if angular else values
+    shown = shown_values(coordinate, values)  # degrees as written: 30, not 29.999999999999996
     dataset = result.to_dataset(dims=(coordinate,),
                                 coords={coordinate: (coordinate, shown, {"units": "deg" if angular else "m"})})
     a = result.actuator_count
@@ -94,6 +95,6 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
             dataset[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
                                              {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
     dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
-                         fixed_pose=", ".join(f"{n}={v:g}" for n, v in zip(mechanism.task_coordinates, at)),
+                         fixed_pose=pose_text(mechanism.task_coordinates, at, mechanism.length_scale, [coordinate]),
                          method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
     return dataset

@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import logging
+import math
 import os
 import socket
 import sys
@@ -24,10 +25,17 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
-__all__ = ["run_tasks", "connect", "disconnect", "ClusterError", "CONNECT_TIMEOUT", "Execution"]
+__all__ = ["run_tasks", "connect", "disconnect", "ClusterError", "CONNECT_TIMEOUT", "MAX_CONNECT_TIMEOUT", "Execution",
+           "check_connect_timeout", "check_address", "SUPPORTED_ADDRESSES"]
 
 CONNECT_TIMEOUT = 3.0
 """Seconds to wait for a Dask scheduler to answer (and to give its handshake) before giving up."""
+MAX_CONNECT_TIMEOUT = 86_400.0
+"""The longest ``connect_timeout`` taken: a day. A scheduler still starting (a job queue granting its node) is
+waited for within hours at most; a longer wait is a mistyped value. Far larger ones cannot be waited at all: a
+socket's timeout of 10^10 s overflows (``OverflowError: timestamp out of range``), and NaN would never be reached."""
+SUPPORTED_ADDRESSES = "tcp://HOST:PORT or tls://HOST:PORT (a port from 1 to 65535)"
+"""The scheduler addresses :func:`connect` takes: those of a scheduler in another process, reached over TCP."""
 
 
 @dataclass(frozen=True)
@@ -114,6 +122,39 @@ def _first_line(error: BaseException) -> str:
     return f"{type(error).__name__}: {text.splitlines()[0]}" if text else type(error).__name__
 
 
+def check_connect_timeout(seconds, name: str = "`connect_timeout`") -> float:
+    """``seconds`` as a float if it is a number of seconds to wait, 0 < seconds <= :data:`MAX_CONNECT_TIMEOUT`;
+    else a ValueError naming ``name``."""
+    try:
+        value = float(seconds)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not (math.isfinite(value) and 0 < value <= MAX_CONNECT_TIMEOUT):
+        given = f"{value:g}" if isinstance(seconds, (int, float)) else repr(seconds)
+        raise ValueError(f"Expected {name} in seconds, more than 0 and at most {MAX_CONNECT_TIMEOUT:,.0f} (a day), "
+                         f"got {given}.")
+    return value
+
+
+def check_address(scheduler) -> tuple[str, str, int]:
+    """(scheme, host, port) of a scheduler address :func:`connect` can use (:data:`SUPPORTED_ADDRESSES`; without
+    a scheme, tcp); else a ValueError saying what is wrong and what is supported."""
+    from distributed.comm import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(scheduler)
+        if scheme not in ("tcp", "tls"):
+            raise ValueError(f"{scheme}:// is not supported")
+        host, port = parse_host_port(location)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"Cannot use the Dask scheduler address {scheduler!r}: {error}; expected "
+                         f"{SUPPORTED_ADDRESSES}.") from None
+    if not 1 <= int(port) <= 65535:
+        raise ValueError(f"Cannot use the Dask scheduler address {scheduler!r}: port {port} is not from 1 to 65535; "
+                         f"expected {SUPPORTED_ADDRESSES}.")
+    return scheme, host, int(port)
+
+
 def _reach(host: str, port: int, deadline: float) -> None:
     """Open (and close) a TCP connection to host:port, trying again until ``deadline`` while nothing listens."""
     pause = 0.01
@@ -132,7 +173,7 @@ def _handshake(address: str, connection_args: dict, seconds: float) -> None:
     """Dask's handshake with ``address`` within ``seconds``, in an event loop of its own (distributed's
     ``connect`` waits for the handshake without a time limit once a connection is open)."""
     import asyncio
-    import concurrent.futures
+    import threading
 
     from distributed.comm import connect as open_comm
 
@@ -140,8 +181,30 @@ def _handshake(address: str, connection_args: dict, seconds: float) -> None:
         comm = await asyncio.wait_for(open_comm(address, timeout=seconds, **connection_args), seconds)
         await comm.close()
 
-    with concurrent.futures.ThreadPoolExecutor(1) as thread:  # a loop of its own, whatever runs in this thread
-        thread.submit(asyncio.run, exchange()).result()
+    # A loop of its own, whatever runs in this thread, in a daemon thread: Ctrl+C (KeyboardInterrupt here) ends the
+    # wait at once, where the exit of a ThreadPoolExecutor's block waited for its thread, up to the whole timeout.
+    loop = asyncio.new_event_loop()
+    task = loop.create_task(exchange())
+    outcome: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            loop.run_until_complete(task)
+        except BaseException as error:  # (re-raised in the calling thread)
+            outcome.append(error)
+        finally:
+            loop.close()
+
+    thread = threading.Thread(target=run, name="screwkit-handshake", daemon=True)
+    thread.start()
+    try:
+        thread.join()
+    except BaseException:
+        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile: nothing left to cancel
+            loop.call_soon_threadsafe(task.cancel)
+        raise
+    if outcome:
+        raise outcome[0]
 
 
 def connect(scheduler: str, connect_timeout: float = CONNECT_TIMEOUT):
@@ -154,37 +217,38 @@ def connect(scheduler: str, connect_timeout: float = CONNECT_TIMEOUT):
     Raises
     ------
     ClusterError
-        One line naming the address and what was found there.
+        One line naming the address and what was found there (or what is wrong with it: only
+        :data:`SUPPORTED_ADDRESSES` are taken).
+    ValueError
+        ``connect_timeout`` is not a number of seconds, 0 < connect_timeout <= :data:`MAX_CONNECT_TIMEOUT`.
     """
     from distributed import Client
-    from distributed.comm import parse_address, parse_host_port
     from distributed.security import Security
 
+    connect_timeout = check_connect_timeout(connect_timeout)
     try:
-        scheme, location = parse_address(scheduler)
-        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
-    except (TypeError, ValueError) as error:
-        raise ClusterError(f"Cannot use the Dask scheduler address {scheduler!r}: {error}") from None
+        scheme, host, port = check_address(scheduler)
+    except ValueError as error:
+        raise ClusterError(str(error)) from None
     connection_args = Security().get_connection_args("client")
     if scheme == "tls" and connection_args.get("ssl_context") is None:
         raise ClusterError(f"Cannot connect to the Dask scheduler at {scheduler}: a tls:// address needs TLS "
                            "settings (distributed.comm.tls.ca-file, .client.cert and .client.key in Dask's "
                            "configuration, e.g. DASK_DISTRIBUTED__COMM__TLS__CA_FILE), and none are set.")
     deadline = time.monotonic() + connect_timeout
-    if host is not None:
-        try:
-            _reach(host, port, deadline)
-        except OSError as error:
-            raise ClusterError(f"Cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
-                               f"({_first_line(error)}).") from None
-        try:
-            _handshake(scheduler, connection_args, max(0.01, deadline - time.monotonic()))
-        except TimeoutError:
-            raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: no Dask handshake "
-                               f"within {connect_timeout:g} s (a web server, or the dashboard's port?).") from None
-        except Exception as error:  # what a server of another protocol says (read as Dask's frames), or its hang-up
-            raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: its answer is not "
-                               f"Dask's handshake ({_first_line(error)[:160]}).") from None
+    try:
+        _reach(host, port, deadline)
+    except OSError as error:
+        raise ClusterError(f"Cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
+                           f"({_first_line(error)}).") from None
+    try:
+        _handshake(scheduler, connection_args, max(0.01, deadline - time.monotonic()))
+    except TimeoutError:
+        raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: no Dask handshake "
+                           f"within {connect_timeout:g} s (a web server, or the dashboard's port?).") from None
+    except Exception as error:  # what a server of another protocol says (read as Dask's frames), or its hang-up
+        raise ClusterError(f"The address {scheduler} answers but is not a Dask scheduler: its answer is not "
+                           f"Dask's handshake ({_first_line(error)[:160]}).") from None
     try:
         return Client(scheduler, set_as_default=False, timeout=connect_timeout)
     except (OSError, TimeoutError) as error:

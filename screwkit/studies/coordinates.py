@@ -1,0 +1,56 @@
+"""Task coordinates as the studies' files and titles show them, and the checks of a map's axes.
+
+Angles are shown in degrees as written (:func:`~screwkit.common.decimals.degrees_as_written`: 30 deg, not
+29.999999999999996, so that ``dataset.sel(yaw=30)`` finds it). A fixed pose is shown with its round-off noise
+as 0: a pose read through a tilted or moved base frame comes back with coordinates such as roll = -2.4e-15 deg
+or x = -1.2e-16 m for 0, which ``%g`` prints as they are.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.common.decimals import degrees_as_written
+from screwkit.common.units import is_angular
+
+__all__ = ["shown_values", "pose_text", "map_axis", "NOISE"]
+
+NOISE = 1e-12
+"""A fixed coordinate smaller than this (in degrees for angles; times the mechanism's length scale for lengths)
+is shown as 0. Round-off of a pose through a base frame is a few units of 1e-16 of the scale (an ulp of the
+coordinates it was computed from: 2.4e-15 deg, 1.2e-16 m on a metre-sized hexapod), a thousandth of this; the
+solvers close loops to about 1e-12 of the scale, so no coordinate set or solved is known more finely than this."""
+
+
+def shown_values(name: str, values: ArrayLike) -> NDArray[np.float64]:
+    """A coordinate's values as shown: degrees as written for an angle (values in radians), metres as they are."""
+    return degrees_as_written(values) if is_angular(name) else np.asarray(values, dtype=float)
+
+
+def pose_text(names: Iterable[str], pose: ArrayLike, length_scale: float, leave_out: Iterable[str] = ()) -> str:
+    """``x=0.1, y=0, pitch=5``: the coordinates of ``pose`` (m, rad) other than ``leave_out``, in m and deg, ``%g``,
+    round-off noise (below :data:`NOISE`) and -0 shown as 0."""
+    left_out = set(leave_out)
+    parts = []
+    for name, value in zip(names, np.asarray(pose, dtype=float)):
+        if name in left_out:
+            continue
+        shown = float(shown_values(name, value))
+        if abs(shown) < NOISE * (1.0 if is_angular(name) else float(length_scale)):
+            shown = 0.0
+        parts.append(f"{name}={shown + 0.0:g}")
+    return ", ".join(parts)
+
+
+def map_axis(values: ArrayLike, what: str) -> NDArray[np.float64]:
+    """A map's axis (``grid``'s or ``over``'s values) as a 1-D array of at least one finite value; else a ValueError
+    naming ``what``."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim != 1 or array.size == 0:
+        raise ValueError(f"Expected {what} as a 1-D sequence of at least one value, got shape {array.shape}.")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"Expected finite values in {what}.")
+    return array
