@@ -157,6 +157,20 @@ def test_round_off_of_a_pose_is_not_shown_in_the_fixed_pose(tmp_path):
             assert float(text) == pytest.approx(expected, rel=1e-5, abs=1e-12), (name, text, value)
 
 
+def test_round_off_of_a_pose_is_not_shown_by_info(tmp_path):
+    """`info --json` of the same tilted hexapod gave its home pose as roll = 1.06e-15 deg, x = -1.13e-18 m: now 0,
+    the other coordinates the home pose (m, deg)."""
+    path = tilted_hexapod(tmp_path)
+    mechanism = load(str(path))
+    described = screwkit("info", path, "--json")
+    assert described.returncode == 0, described.stderr
+    home = json.loads(described.stdout)["named_poses"]["home"]
+    for name, value in zip(mechanism.task_coordinates, mechanism.home_pose):
+        value = np.rad2deg(value) if name in ("roll", "pitch", "yaw") else value
+        expected = 0.0 if abs(value) < 1e-12 * mechanism.length_scale else value
+        assert home[name] == pytest.approx(expected, rel=1e-12, abs=0.0), (name, home[name])
+
+
 # -- 4. Ctrl+C while a handshake is awaited -----------------------------------------------------------------------
 
 def test_ctrl_c_aborts_at_once_while_a_silent_listener_is_awaited(tmp_path):

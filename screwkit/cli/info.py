@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 
 import click
-import numpy as np
 
 from screwkit.cli.options import (
     ignore_limits_option,
@@ -15,9 +14,10 @@ from screwkit.cli.options import (
     reading_options,
 )
 from screwkit.closure import working_modes
-from screwkit.common.units import is_angular, unit_of
+from screwkit.common.units import unit_of
 from screwkit.io import GraphMechanism
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
+from screwkit.studies.coordinates import shown_number
 
 __all__ = ["info", "mechanism_info", "graph_info"]
 
@@ -54,8 +54,8 @@ def mechanism_info(mechanism) -> dict:
     if isinstance(mechanism, GraphMechanism):
         return graph_info(mechanism)
 
-    def shown(pose):
-        return {name: float(np.rad2deg(value) if is_angular(name) else value) + 0.0
+    def shown(pose):  # in m and deg as written, without round-off noise (a pose through a tilted base frame)
+        return {name: shown_number(name, value, mechanism.length_scale)
                 for name, value in zip(mechanism.task_coordinates, pose)}
 
     modes = working_modes(mechanism)

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.decimals import degrees_as_written
 from screwkit.common.units import is_angular
 
-__all__ = ["shown_values", "pose_text", "map_axis", "NOISE"]
+__all__ = ["shown_values", "shown_number", "pose_text", "map_axis", "NOISE"]
 
 NOISE = 1e-12
 """A fixed coordinate smaller than this (in degrees for angles; times the mechanism's length scale for lengths)
@@ -30,6 +30,15 @@ def shown_values(name: str, values: ArrayLike) -> NDArray[np.float64]:
     return degrees_as_written(values) if is_angular(name) else np.asarray(values, dtype=float)
 
 
+def shown_number(name: str, value: float, length_scale: float) -> float:
+    """One coordinate of a pose (m, rad) as shown: in m or deg as written, round-off noise (below :data:`NOISE`)
+    and -0 as 0."""
+    shown = float(shown_values(name, value))
+    if abs(shown) < NOISE * (1.0 if is_angular(name) else float(length_scale)):
+        shown = 0.0
+    return shown + 0.0
+
+
 def pose_text(names: Iterable[str], pose: ArrayLike, length_scale: float, leave_out: Iterable[str] = ()) -> str:
     """``x=0.1, y=0, pitch=5``: the coordinates of ``pose`` (m, rad) other than ``leave_out``, in m and deg, ``%g``,
     round-off noise (below :data:`NOISE`) and -0 shown as 0."""
@@ -38,10 +47,7 @@ def pose_text(names: Iterable[str], pose: ArrayLike, length_scale: float, leave_
     for name, value in zip(names, np.asarray(pose, dtype=float)):
         if name in left_out:
             continue
-        shown = float(shown_values(name, value))
-        if abs(shown) < NOISE * (1.0 if is_angular(name) else float(length_scale)):
-            shown = 0.0
-        parts.append(f"{name}={shown + 0.0:g}")
+        parts.append(f"{name}={shown_number(name, value, length_scale):g}")
     return ", ".join(parts)
 
 
