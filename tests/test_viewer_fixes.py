@@ -206,6 +206,27 @@ def test_view_refuses_a_sweep_of_phi_without_phi_and_non_finite_options(tmp_path
     assert not page.exists()
 
 
+@pytest.mark.parametrize("arguments, needle", [
+    (("--samples", "5"), "--samples is the number of samples of a --line, --circle or --through path"),
+    (("--frame-rate", "5"), "--frame-rate is the pace of an animation (--sweep-phi or a path)"),
+    (("--open",), "--open opens the served viewer, and --html writes a file instead of serving"),
+    (("--pose", "0.1 0 0", "--line", "0 0 0 0.1 0 0"), "--pose is the pose of one view"),
+])
+def test_view_refuses_options_it_would_ignore(tmp_path, arguments, needle):
+    """Each was accepted and ignored without a word; the same options where they mean something still draw."""
+    page = tmp_path / "never.html"
+    one_line_error(screwkit("view", "planar_5rrr", *arguments, "--html", page), needle)
+    assert not page.exists()
+
+
+def test_view_takes_those_options_where_they_mean_something(tmp_path):
+    page = tmp_path / "drawn.html"
+    for arguments in (("--line", "0 0 0 0.1 0 0", "--samples", "5", "--frame-rate", "5"),
+                      ("--sweep-phi", "0:90:45", "--frame-rate", "5", "--pose", "0.1 0 0")):
+        drawn = screwkit("view", "planar_5rrr", *arguments, "--html", page, "--overwrite")
+        assert drawn.returncode == 0 and page.is_file(), drawn.stderr
+
+
 def _platform_keys(page: Path):
     from screwkit.viewer.markers import ROOT_PATH
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import click
 import numpy as np
 
+from screwkit.cli.option_checks import given as option_given
 from screwkit.cli.options import (
     GreedyOption,
     check_outputs,
@@ -60,6 +61,12 @@ def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, lin
                    f"{', '.join(given)}.")
     if not (math.isfinite(frame_rate) and frame_rate > 0):  # (click's range lets nan and inf through)
         raise fail(f"Expected --frame-rate a finite number > 0 (keyframes per second), got {frame_rate:g}.")
+    if option_given("samples") and not (line or circle or through):
+        raise fail("--samples is the number of samples of a --line, --circle or --through path, and there is none: "
+                   "give one of them, or leave --samples out.")
+    if option_given("frame_rate") and not given:
+        raise fail("--frame-rate is the pace of an animation (--sweep-phi or a path), and there is none: give one, "
+                   "or leave --frame-rate out.")
     source = None
     if given and given[0] != "--sweep-phi":
         source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples)
@@ -261,6 +268,12 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
     """
 
     check_outputs({"--html": (html_path, (".html", ".htm"))}, overwrite, quiet)
+    if open_browser and html_path is not None:
+        raise fail("--open opens the served viewer, and --html writes a file instead of serving: open the file, or "
+                   "leave --html out.")
+    if pose is not None and motion.path is not None:
+        raise fail("--pose is the pose of one view (or the x y of --sweep-phi), and a path gives its own poses: leave "
+                   "--pose out.")
     serving = []  # [True] from the moment the URL is shown
     with _stopped_by_signals():  # from the start: the Meshcat server is started while drawing
         try:
