@@ -245,6 +245,9 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
     assert "4 actuators, 3 DOF (1 redundant), at the file's configuration" in completed.stdout
     assert f"LMTI (Eq. 11, all actuators)        {expected['lmti']:.4f}" in completed.stdout
     assert "analysed as a graph" in completed.stderr and "Traceback" not in completed.stderr
+    at_file = screwkit("analyze", path, "--json")  # its pose is the output frame's there ({} before)
+    assert at_file.returncode == 0, at_file.stderr
+    assert json.loads(at_file.stdout)["pose"] == pytest.approx(dict(zip("xyz", frame_position(graph))), abs=1e-12)
     target = frame_position(graph) + np.subtract(POSES[1], POSES[0])
     posed = screwkit("analyze", path, "--pose", *[repr(float(v)) for v in target], "--json")
     assert posed.returncode == 0, posed.stderr

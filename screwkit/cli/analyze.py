@@ -23,6 +23,7 @@ from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
 from screwkit.model import Mechanism
 from screwkit.studies import indices_at_pose
+from screwkit.studies.coordinates import shown_number
 
 __all__ = ["analyze", "print_report"]
 
@@ -219,9 +220,13 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
         result = graph.indices(threshold=analysis.threshold, fault_type=analysis.fault_type)
     except ValueError as error:
         raise fail(str(error)) from None
+    at_file = not shown  # the file's configuration: its output frame's task coordinates in the JSON, as given ones are
+    if at_file:
+        shown = {name: shown_number(name, value, graph.length_scale)
+                 for name, value in zip(graph.task_coordinates, graph.task_pose())}
     report = {**result.to_dict(), "mechanism": graph.name, "pose": shown, "converted": graph.report.lines()}
     if as_json:
         click.echo(json.dumps(report))
     else:
-        print_report(report)
+        print_report({**report, "pose": {}} if at_file else report)  # "at the file's configuration"
         click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)
