@@ -141,12 +141,10 @@ def delta_sdf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None, plugin
             + "".join(links + joints + ends) + plugins + "</model></sdf>\n")
 
 
-def hexapod_sdf(platform_joint: str = "universal", base_offset=(0.0, 0.0, 0.0)) -> str:
-    """The bundled 8-leg U-P-S hexapod (robots/ups_hexapod_8.urdf: its joint centres, read from that file) written in
-    SDFormat with its legs turned over, S-P-U: a ball joint at the base, the actuated slide, and at the platform a
-    ``universal`` (or ``revolute`` pair: ``platform_joint="revolute"``) joint closing the loop, at the centre of the
-    URDF's spherical joint. The base link's frame is drawn at ``base_offset`` (m; no joint moves with it). Such a
-    leg transmits the force along its slide as the U-P-S leg does: the same indices."""
+def hexapod_legs() -> tuple[str, list[tuple[str, str, tuple[str, str, str], str]]]:
+    """The bundled 8-leg U-P-S hexapod's geometry as robots/ups_hexapod_8.urdf writes it: the platform joint's pose
+    (``"x y z r p y"``) and per leg, in leg order, its name, its base joint's pose, the axes of its universal joint
+    and slide (``xyz`` texts) and the slide's length to the spherical joint (the loop's offset along the slide)."""
     from xml.etree import ElementTree
 
     from screwkit.io.loader import bundled_path
@@ -154,18 +152,33 @@ def hexapod_sdf(platform_joint: str = "universal", base_offset=(0.0, 0.0, 0.0)) 
     root = ElementTree.parse(bundled_path("ups_hexapod_8")).getroot()
     joints = {joint.get("name"): joint for joint in root.findall("joint")}
     loops = {loop.get("name"): loop for loop in root.findall("loop")}
-    legs = sorted({name.split("_joint")[0] for name in joints if name.startswith("leg_")},
-                  key=lambda name: int(name.split("_")[1]))
-    placed = joints["platform_joint"].find("origin")
+    names = sorted({name.split("_joint")[0] for name in joints if name.startswith("leg_")},
+                   key=lambda name: int(name.split("_")[1]))
+
+    def pose(element) -> str:
+        origin = element.find("origin")
+        return f'{origin.get("xyz")} {origin.get("rpy")}'
+
+    legs = [(leg, pose(joints[f"{leg}_joint_u1"]),
+             tuple(joints[f"{leg}_joint_{part}"].find("axis").get("xyz") for part in ("u1", "u2", "slider")),
+             loops[f"{leg}_joint_s"].find("predecessor/origin").get("xyz").split()[0]) for leg in names]
+    return pose(joints["platform_joint"]), legs
+
+
+def hexapod_sdf(platform_joint: str = "universal", base_offset=(0.0, 0.0, 0.0)) -> str:
+    """The bundled 8-leg U-P-S hexapod (robots/ups_hexapod_8.urdf: its joint centres, read from that file) written in
+    SDFormat with its legs turned over, S-P-U: a ball joint at the base, the actuated slide, and at the platform a
+    ``universal`` (or ``revolute`` pair: ``platform_joint="revolute"``) joint closing the loop, at the centre of the
+    URDF's spherical joint. The base link's frame is drawn at ``base_offset`` (m; no joint moves with it). Such a
+    leg transmits the force along its slide as the U-P-S leg does: the same indices."""
+    platform, legs = hexapod_legs()
     lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}>\n<model name="spu_hexapod">',
              f'<link name="base"><pose>{text(base_offset)} 0 0 0</pose></link>',
              '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
-             f'<link name="platform"><pose>{placed.get("xyz")} {placed.get("rpy")}</pose></link>']
-    for leg in legs:
-        origin = joints[f"{leg}_joint_u1"].find("origin")
-        length = float(loops[f"{leg}_joint_s"].find("predecessor/origin").get("xyz").split()[0])
-        lines.append(f'<link name="{leg}_cyl"><pose>{origin.get("xyz")} {origin.get("rpy")}</pose></link>'
-                     f'<link name="{leg}_pis"><pose>{origin.get("xyz")} {origin.get("rpy")}</pose></link>')
+             f'<link name="platform"><pose>{platform}</pose></link>']
+    for leg, base_pose, _, length in legs:
+        lines.append(f'<link name="{leg}_cyl"><pose>{base_pose}</pose></link>'
+                     f'<link name="{leg}_pis"><pose>{base_pose}</pose></link>')
         lines.append(f'<joint name="{leg}_s" type="ball"><parent>base</parent><child>{leg}_cyl</child>'
                      f'<pose relative_to="{leg}_cyl"/></joint>')
         lines.append(f'<joint name="{leg}_slider" type="prismatic"><parent>{leg}_cyl</parent><child>{leg}_pis</child>'

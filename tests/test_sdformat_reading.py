@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 import pytest
-from sdformat_models import NAMESPACE, five_bar_sdf
+from sdformat_models import NAMESPACE, five_bar_sdf, hexapod_legs
 
 from helpers import one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy
@@ -189,28 +189,20 @@ def test_an_unnamed_element_is_refused_by_its_position(tmp_path, edit, needles):
 def ups_hexapod_sdf(reversed_ball: bool = False) -> str:
     """The bundled U-P-S hexapod (robots/ups_hexapod_8.urdf) in SDFormat: per leg a universal joint at the base, the
     actuated slide, a ball joint at the platform (``reversed_ball``: written platform to piston)."""
-    root = ElementTree.parse(bundled_path("ups_hexapod_8")).getroot()
-    joints = {joint.get("name"): joint for joint in root.findall("joint")}
-    loops = {loop.get("name"): loop for loop in root.findall("loop")}
-    legs = sorted({name.split("_joint")[0] for name in joints if name.startswith("leg_")},
-                  key=lambda name: int(name.split("_")[1]))
-    placed = joints["platform_joint"].find("origin")
+    platform, legs = hexapod_legs()
     lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}>\n<model name="ups">',
              '<link name="base"/><joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
-             f'<link name="platform"><pose>{placed.get("xyz")} {placed.get("rpy")}</pose></link>']
-    for leg in legs:
-        origin = joints[f"{leg}_joint_u1"].find("origin")
-        axes = [joints[f"{leg}_joint_{name}"].find("axis").get("xyz") for name in ("u1", "u2", "slider")]
-        length = loops[f"{leg}_joint_s"].find("predecessor/origin").get("xyz")
+             f'<link name="platform"><pose>{platform}</pose></link>']
+    for leg, base_pose, axes, length in legs:
         ends = ("platform", f"{leg}_pis") if reversed_ball else (f"{leg}_pis", "platform")
-        lines.append(f'<link name="{leg}_cyl"><pose>{origin.get("xyz")} {origin.get("rpy")}</pose></link>'
+        lines.append(f'<link name="{leg}_cyl"><pose>{base_pose}</pose></link>'
                      f'<link name="{leg}_pis"><pose relative_to="{leg}_cyl"/></link>'
                      f'<joint name="{leg}_u" type="universal"><parent>base</parent><child>{leg}_cyl</child>'
                      f'<axis><xyz>{axes[0]}</xyz></axis><axis2><xyz>{axes[1]}</xyz></axis2></joint>'
                      f'<joint name="{leg}_slider" type="prismatic"><parent>{leg}_cyl</parent><child>{leg}_pis</child>'
                      f'<axis><xyz>{axes[2]}</xyz></axis><screwkit:actuated/></joint>'
                      f'<joint name="{leg}_s" type="ball"><parent>{ends[0]}</parent><child>{ends[1]}</child>'
-                     f'<pose relative_to="{leg}_pis">{length} 0 0 0</pose></joint>')
+                     f'<pose relative_to="{leg}_pis">{length} 0 0 0 0 0</pose></joint>')
     lines.append("</model>\n</sdf>")
     return "\n".join(lines)
 
