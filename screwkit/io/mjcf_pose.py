@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MjcfError", "MIN_AXIS", "describe", "class_attributes", "euler_sequence", "quaternion_product",
-           "orientations_as_quaternions", "defaults_written", "frames_flattened"]
+           "rotation_matrix", "orientations_as_quaternions", "defaults_written", "frames_flattened"]
 
 MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
@@ -80,6 +80,7 @@ def quaternion_product(a: NDArray, b: NDArray) -> NDArray:
 
 
 def rotation_matrix(quaternion: NDArray) -> NDArray:
+    """The rotation matrix of a quaternion (w, x, y, z), normalised first (MJCF's ``quat`` need not be unit)."""
     w, x, y, z = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],

@@ -51,6 +51,7 @@ from screwkit.io.mjcf_pose import (
     euler_sequence,
     frames_flattened,
     orientations_as_quaternions,
+    rotation_matrix,
 )
 
 __all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError"]
@@ -373,14 +374,6 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
 # -- MuJoCo's closure geometry -------------------------------------------------------------------------
 
 
-def _quaternion_matrix(w: float, x: float, y: float, z: float) -> NDArray:
-    norm = math.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / norm, x / norm, y / norm, z / norm
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def _numbers(element: ElementTree.Element, attribute: str, count: int, default) -> list[float]:
     words = (element.get(attribute) or "").split()
     if not words:
@@ -419,7 +412,7 @@ def closure_placements(element: ElementTree.Element, model, data, frame_of) -> t
     relpose = _numbers(element, "relpose", 7, ())
     if relpose and any(relpose[3:]):  # body2's pose in body1's frame
         relative = np.eye(4)
-        relative[:3, :3] = _quaternion_matrix(*relpose[3:])
+        relative[:3, :3] = rotation_matrix(relpose[3:])
         relative[:3, 3] = relpose[:3]
     else:  # the pose they have at qpos0
         relative = np.linalg.inv(world_1) @ world_2
