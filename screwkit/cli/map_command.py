@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import click
 
+from screwkit.cli.option_checks import given
 from screwkit.cli.options import (
     GreedyOption,
     Outputs,
@@ -75,9 +76,7 @@ class MapArea:
             return
         if len(self.grids) != 2:
             raise fail("Expected --radius/--step (planar) or exactly two --grid options.")
-        context = click.get_current_context(silent=True)
-        if context is not None and context.get_parameter_source("phi_step") in (
-                click.core.ParameterSource.COMMANDLINE, click.core.ParameterSource.ENVIRONMENT):
+        if given("phi_step"):
             raise fail("--phi-step is the phi step of a planar map (--radius, --step); with --grid, give the "
                        f"orientation set as --over phi:0:360:{self.phi_step:g}.")
 
