@@ -29,7 +29,15 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from helpers import assert_indices_close, bundled, in_millimetres, moved_in_the_world, screwkit
+from helpers import (
+    assert_indices_close,
+    bundled,
+    in_millimetres,
+    moved,
+    moved_in_the_world,
+    random_rotation,
+    screwkit,
+)
 from screwkit.closure import solve_one
 from screwkit.io.loader import bundled_path, load, load_text
 from screwkit.studies.poses import indices_at_poses
@@ -727,3 +735,26 @@ def test_an_actuator_whose_force_does_no_work_on_the_platform_s_motion_leaves_th
                                   [c.actuated for c in chains], 1)
     assert list(reference["mutual_interference"]) == [True, True, False]
     assert reference["lmti"] == pytest.approx(0.8, abs=1e-12) and reference["f_o"][1] == 0.0
+    # the same in another world frame, at lengths x 1e-3 and x 1e3, and with the legs listed in reverse
+    rotation, translation = random_rotation(rng), rng.uniform(-2.0, 2.0, 3)
+    for variant, flags in ((moved(chains, rotation, translation), [True, True, False]),
+                           (_scaled(chains, 1e-3), [True, True, False]), (_scaled(chains, 1e3), [True, True, False]),
+                           ([*legs[::-1], slide], [False, True, True])):
+        other = analyze(variant, threads=1)
+        assert list(other.mutual_interference) == flags
+        assert other.lmti == pytest.approx(0.8, abs=1e-12) and other.f_o[1] == 0.0 and other.f_o[2] == 0.0
+
+
+def _scaled(chains, factor: float):
+    """Chain screws of the mechanism with every length times ``factor`` (points, and the moments of revolute twists;
+    a slide's unit direction stays)."""
+    from screwkit.screw.chain_screws import ChainScrews
+
+    scaled = []
+    for c in chains:
+        twists = np.array(c.twists, dtype=float)
+        revolute = np.linalg.norm(twists[..., :3], axis=-1) > 0
+        twists[revolute, 3:] *= factor
+        scaled.append(ChainScrews(twists, np.asarray(c.points) * factor, c.actuated, c.name,
+                                  joint_names=c.joint_names))
+    return scaled
