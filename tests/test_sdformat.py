@@ -313,3 +313,70 @@ def test_a_hexapod_whose_loops_close_by_hinges_has_the_indices_of_its_legs_where
     for j in reference.faults:
         assert found.f_o[j] == pytest.approx(reference.f_o[j], abs=1e-9)
     np.testing.assert_allclose(sorted(found.iti_actuators), sorted(reference.iti_actuators), atol=1e-9)
+
+
+CRANK, SPAN = 0.3, 0.2
+"""The parallelogram four-bar: cranks of CRANK m from pins SPAN m apart on the ground, hanging down at zero."""
+
+
+def parallelogram_sdf(crank_first: str) -> str:
+    """Cranks ``AB`` and ``DC`` hanging from A = (0, 0) and D = (SPAN, 0), the coupler ``BC`` (its frame at B)
+    pinned to both; every joint native, ``crank_first`` ("A" or "D") the crank whose joints the file lists first
+    (which decides where a breadth-first tree closes the loop: at C or at B)."""
+    links = ('<link name="crank_AB"/><link name="crank_DC"><pose>0.2 0 0 0 0 0</pose></link>'
+             '<link name="coupler"><pose>0 -0.3 0 0 0 0</pose></link>')
+    axis = "<axis><xyz>0 0 1</xyz></axis>"
+    crank_a = (f'<joint name="A" type="revolute"><parent>world</parent><child>crank_AB</child>{axis}</joint>'
+               f'<joint name="B" type="revolute"><pose relative_to="coupler">0 0 0 0 0 0</pose><parent>crank_AB'
+               f'</parent><child>coupler</child>{axis}</joint>')
+    crank_d = (f'<joint name="D" type="revolute"><parent>world</parent><child>crank_DC</child>{axis}</joint>'
+               f'<joint name="C" type="revolute"><pose relative_to="coupler">0.2 0 0 0 0 0</pose><parent>crank_DC'
+               f'</parent><child>coupler</child>{axis}</joint>')
+    joints = crank_a + crank_d if crank_first == "A" else crank_d + crank_a
+    return f'<sdf version="1.7"><model name="parallelogram">{links}{joints}</model></sdf>'
+
+
+def test_a_parallelogram_whose_loop_the_file_does_not_cut_has_the_same_indices_whichever_crank_is_listed_first(
+        tmp_path):
+    """SDFormat does not say where a loop is cut; the breadth-first tree cut the parallelogram at the coupler's
+    second pin in file order, and the output point was that pin: listing the other crank first moved the output
+    from C to B (the same 19.47 deg configuration at x = 0.3 or 0.1) and swapped the cranks' ITIs (0.9428 and 1).
+    Now the output is the coupler's frame, whichever crank comes first, and its indices are the closed forms: the
+    coupler translates on the circle x = CRANK sin t, and the constraint keeping it from turning, a force along a
+    crank, has power coefficient cos t with the twist freed by releasing that crank (the coupler turning about the
+    other crank's pin, its velocity at the pin across the horizontal coupler)."""
+    angles = np.radians([0.0, 12.0, 19.47122063449069, -30.0, 40.0])
+    results = {}
+    for first in ("A", "D"):
+        path = write(tmp_path, parallelogram_sdf(first), f"parallelogram_{first}.sdf")
+        for t in angles:
+            x = repr(float(CRANK * np.sin(t)))
+            analysed = screwkit("analyze", path, "--output", "coupler", "--pose", x, "--json")
+            assert analysed.returncode == 0, analysed.stderr
+            results[first, t] = json.loads(analysed.stdout)
+            assert results[first, t]["cti"] == pytest.approx(np.cos(t), abs=TOLERANCE)
+            assert results[first, t]["f_c"]["1"] == pytest.approx(np.cos(t), abs=TOLERANCE)
+        shown = screwkit("info", path, "--output", "coupler")
+        assert shown.returncode == 0, shown.stderr
+        cut = {"A": "C", "D": "B"}[first]
+        assert f"output the platform's frame: the loop closed at '{cut}_a' could as well be closed at another joint" \
+               in shown.stdout and "output frame 'coupler' on body 'coupler'" in shown.stdout
+        point = screwkit("info", path, "--output", "coupler", "--output-type", "point")  # asked for: the pin cut
+        assert point.returncode == 0 and f"the point where the chains meet on body 'coupler' (closure '{cut}_a')" \
+            in point.stdout, point.stderr
+    for t in angles:
+        one, other = results["A", t], results["D", t]
+        assert one["pose"] == pytest.approx(other["pose"], abs=1e-12)
+        for key in ("iti", "lmti", "cti"):
+            assert one[key] == pytest.approx(other[key], abs=TOLERANCE), key
+        assert one["f_o"]["1"] == pytest.approx(other["f_o"]["1"], abs=TOLERANCE)
+
+
+@pytest.mark.parametrize("degrees", [5.0, 12.0, 15.0, 30.0])
+def test_the_parallelogram_s_actuator_values_give_the_pose_the_geometry_gives(tmp_path, degrees):
+    """--actuators 15 15 was refused ("no closed pose ... near the start pose") between about 11 and 17 deg: the
+    forward kinematics asked the closure for 1e-13 where the coupler's completed pose holds to about 2e-13."""
+    path = write(tmp_path, parallelogram_sdf("A"), "parallelogram.sdf")
+    analysed = screwkit("analyze", path, "--output", "coupler", "--actuators", f"{degrees!r} {degrees!r}", "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    assert json.loads(analysed.stdout)["pose"]["x"] == pytest.approx(CRANK * np.sin(np.radians(degrees)), abs=1e-12)

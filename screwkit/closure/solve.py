@@ -197,14 +197,21 @@ def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray
     lower, upper = limits[:, 0], limits[:, 1]
     slack = 1e-12 * (1.0 + np.maximum(np.abs(np.where(np.isfinite(lower), lower, 0.0)),
                                       np.abs(np.where(np.isfinite(upper), upper, 0.0))))
-    inside = (values >= lower - slack) & (values <= upper + slack)
-    revolute = ~np.asarray(prismatic, dtype=bool)
+    lowest, highest = lower - slack, upper + slack
+    # NaN compares false: a chain that did not close is reported as such, not as a limit
+    outside = values < lowest
+    outside |= values > highest
+    rows = np.flatnonzero(outside.any(axis=-1))
+    first = np.full(values.shape[:-1], -1, dtype=np.int64)
+    if not rows.size:
+        return first
+    revolute = ~np.asarray(prismatic, dtype=bool)  # the rows with a value outside: revolutes a turn either way
+    some, still = values[rows], outside[rows]
     for turn in (2.0 * np.pi, -2.0 * np.pi):
-        shifted = values + turn
-        inside |= revolute & (shifted >= lower - slack) & (shifted <= upper + slack)
-    inside |= np.isnan(values)  # a chain that did not close is reported as such, not as a limit
-    outside = ~inside
-    return np.where(outside.any(axis=-1), np.argmax(outside, axis=-1), -1)
+        shifted = some + turn
+        still &= ~(revolute & (shifted >= lowest) & (shifted <= highest))
+    first[rows] = np.where(still.any(axis=-1), np.argmax(still, axis=-1), -1)
+    return first
 
 
 def solve(
@@ -484,7 +491,7 @@ def forward(
     for _ in range(max_iterations):
         if active.size == 0:
             break
-        solution = solve(mechanism, poses[active], initial=previous, tolerance=1e-13, limits=False)
+        solution = solve(mechanism, poses[active], initial=previous, limits=False)
         values = np.stack([solution.joint_values[chain][..., joint] for chain, joint in selected], -1)
         error = values - targets[active]
         error[:, angular] = wrap_angle(error[:, angular])
@@ -515,7 +522,7 @@ def forward(
         update *= np.minimum(1.0, 0.2 / np.maximum(largest, 1e-300))[:, None]
         usable = np.all(np.isfinite(update), axis=-1)
         poses[active[usable]] += update[usable]
-    solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), tolerance=1e-13, limits=limits)
+    solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), limits=limits)
     converged = converged.reshape(batch)
     return Solution(
         poses=solution.poses,

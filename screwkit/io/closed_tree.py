@@ -76,6 +76,9 @@ class ClosedTree:
     notes: list[str] = field(default_factory=list)  # what reading the file changed (said in the report)
     task_coordinates: tuple[str, ...] | None = None  # a URDF source's <task_coordinates names="...">, kept
     locked: tuple[str, ...] = ()  # joints held at their values in the file (screwkit.io.locking)
+    cut_by_order: tuple[str, ...] = ()
+    """Closures of loops the file could as well have closed at another joint, where the reader chose by the file's
+    order (SDFormat's breadth-first tree tied): no point output is taken at them unless asked."""
 
 
 def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:

@@ -68,12 +68,16 @@ def actuated_joints(sdf: SdfModel) -> list[str]:
 
 
 def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
-    """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node).
+    """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node, and
+    (loop joint, tree joint) pairs whose roles the file's order chose among equals).
 
     Links welded by fixed joints are one body: reached together (the fixed joints in the tree), so a chain of welded
-    links does not lengthen a leg and move the loop's closing joint into it (onto a fixed joint inside the leg)."""
+    links does not lengthen a leg and move the loop's closing joint into it (onto a fixed joint inside the leg).
+    A loop joint from a link at depth d to one at depth d + 1 could as well be in the tree, and the tree joint
+    that reached the deeper link (from another link at depth d) close the loop instead: the breadth-first tree is
+    tied there and the file's order decides (a parallelogram's two rods reaching its coupler)."""
     base = WORLD if any(WORLD in pair for pair in ends.values()) else sdf.canonical
-    visited, queue, tree, loops, used = set(), [], [], [], set()
+    visited, queue, tree, loops, used, depth, reached_by, tied = set(), [], [], [], set(), {}, {}, []
 
     def step(node: str, joint: SdfJoint) -> str | None:
         """The other end of a joint not taken yet from ``node`` (None: taken, or a loop joint now)."""
@@ -84,14 +88,19 @@ def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
         other = child if node == parent else parent
         if other in visited:
             loops.append(joint)
+            if joint.kind != "fixed" and depth[other] == depth[node] + 1:
+                tied.append((joint.name, reached_by[other]))
             return None
         tree.append((joint, node, other))
+        welded = joint.kind == "fixed"  # one body with ``node``: its depth and the joint that reached it
+        depth[other], reached_by[other] = depth[node] + (not welded), reached_by.get(node) if welded else joint.name
         return other
 
     def reach(node: str) -> None:
         """A node and every link welded to it, queued."""
         stack = [node]
         visited.add(node)
+        depth.setdefault(node, 0)
         while stack:
             current = stack.pop()
             queue.append(current)
@@ -113,7 +122,7 @@ def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
         fixed = "the world" if base == WORLD else f"the canonical link {base!r}"
         raise ImportError_(f"{sdf.source}: <link name='{loose[0]}'> is joined to nothing on the way to {fixed} (links "
                            f"joined to nothing fixed: {', '.join(loose)}).")
-    return tree, loops, base
+    return tree, loops, base, tied
 
 
 class _TreeBuilder:
@@ -252,7 +261,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     sdf = read_model(Path(path))
     poses = world_poses(sdf)
     ends = _ends(sdf)
-    tree_joints, loops, base = _spanning_tree(sdf, ends)
+    tree_joints, loops, base, tied = _spanning_tree(sdf, ends)
     builder = _TreeBuilder(sdf, poses)
     notes = []
     if base != WORLD:
@@ -263,7 +272,11 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     builder.frames()
     origins = np.array([poses[link][:3, 3] for link in sdf.links])
     scale = float(np.max(np.linalg.norm(origins - origins.mean(axis=0), axis=1), initial=0.0)) or 1.0
-    closures = [c for joint in loops for c in _loop_closures(builder, joint, ends[joint.name], scale)]
+    closing = {joint.name: _loop_closures(builder, joint, ends[joint.name], scale) for joint in loops}
+    closures = [closure for made in closing.values() for closure in made]
+    # where the tree joint the order put in the tree is elsewhere than the loop joint, the cut moves with the order
+    cut_by_order = tuple(closure.name for name, other in tied for closure in closing[name]
+                         if np.linalg.norm(poses[name][:3, 3] - poses[other][:3, 3]) > 1e-9 * scale)
     model = builder.finish()
     stated = actuated_joints(sdf)
     for name in stated:
@@ -278,4 +291,5 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
         notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/> and no joint "
                      f"controller plugin): {', '.join(motors)}")
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
-                      "SDFormat (joints closing loops)", notes)
+                      "SDFormat (joints closing loops)", notes,
+                      cut_by_order=cut_by_order)

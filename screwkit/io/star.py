@@ -447,7 +447,12 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.planar = normal is not None
     output_world = homogeneous(data.oMf[frame_index])
     idle = _idle_about_the_meeting_point(legs, normal)
-    point = tree.output_type == "point" or (tree.output_type is None and meet and idle)
+    chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
+    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen)
+    if tree.output_type is None and meet and idle and chosen:  # the meeting point would follow the file's order
+        report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
+                            "another joint (the file does not say where its legs end), which would move the point "
+                            "where the chains meet; --output-type point takes the point there")
     if point and not meet:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
                            "point; they do not.")
