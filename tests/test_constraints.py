@@ -91,6 +91,25 @@ def test_4_prs_home_is_a_constraint_singularity(prs_4):
     assert "CONSTRAINT SINGULARITY: 3 instantaneous DOF at this pose, mobility 2" in completed.stdout
 
 
+def test_the_4_prs_constraint_singularity_has_no_fault_index_under_link_failures_either(prs_4):
+    """Under link failures the home pose gave F_O1 0.948 and F_C1 0.8845 beside LMTI 0 and CTI 0 (the 3-PRS a
+    removed leg leaves holds its platform there): the intact mechanism does not hold its platform, so every fault
+    index is zero and the worst faults the first sets, as under free-swinging failures; a tilted pose in the same
+    batch keeps its own values."""
+    mechanism, _ = prs_4
+    poses = mechanism.home_pose + np.array([[0.0, 0.0], [0.0, np.deg2rad(5.0)]])
+    swinging = indices_at_poses(mechanism, poses, detail=True)
+    link = indices_at_poses(mechanism, poses, fault_type="link", detail=True)
+    assert list(link.constraint_singular) == [True, False]
+    for j in link.faults:
+        assert link.f_o[j][0] == 0.0 and link.f_c[j][0] == 0.0 and np.all(link.remaining_lmti[j][0] == 0.0)
+        assert list(link.worst_fault_indices[j][0]) == list(swinging.worst_fault_indices[j][0])
+    alone = indices_at_poses(mechanism, poses[1:], fault_type="link")
+    for j in link.faults:
+        assert link.f_o[j][1] == alone.f_o[j][0] and link.f_c[j][1] == alone.f_c[j][0]
+    assert link.f_o[1][1] > 0.9  # a 3-PRS left: held (two faults leave two actuators for its three DOF)
+
+
 @pytest.mark.parametrize("tilt_degrees", [3.0, 8.0, -12.0])
 def test_4_prs_cti_matches_the_explicit_geometry(prs_4, tilt_degrees):
     mechanism, _ = prs_4

@@ -318,6 +318,13 @@ def analyze(
                                    threads=threads, output_point=output_point, planar=planar),
                    "idle_count": 0 if idle is None else idle.shape[-2]}
         link = link_fault_indices(given_chains, plan.actuators, plan.faults, batch_shape, analyze, options)
+        if constraint_plan.count:  # a constraint singularity of the intact mechanism: no fault index (as for FSJF)
+            singular = batch_first(merged["constraint_singular"]).astype(bool)
+            for j in plan.faults:
+                for name in ("f_o", "f_c", "lmti"):
+                    link[name][j] = np.where(singular[..., None] if name == "lmti" else singular, 0.0,
+                                             link[name][j])
+                link["worst"][j] = np.where(singular[..., None], plan.failed_sets[j][0], link["worst"][j])
         f_o, worst = link["f_o"], link["worst"]
         remaining = link["lmti"] if detail else {}
         f_c = link["f_c"] if constraint_plan.count else f_c
