@@ -12,6 +12,8 @@ met by a straight arm) is unreachable without a continuation towards it, with th
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from delta_rods import delta_rods_mjcf
@@ -315,6 +317,24 @@ def test_a_sweep_of_a_graph_gives_the_textbook_pressure_angles_along_it(tmp_path
         np.testing.assert_allclose(dataset["iti_actuator"].values[k], expected["iti"], atol=TOLERANCE)
     with pytest.raises(ValueError, match="no closed forms, no link faults"):
         sweep(graph, home, "z", heights, closed_forms=True)
+
+
+def test_link_faults_of_a_graph_are_refused_naming_what_it_has_in_the_api_and_on_the_command_line(tmp_path):
+    """``analyze FILE --fault link`` said "`iti_points` and `oti_points` apply to free-swinging faults only", options
+    the user never gave; ``graph.indices(fault_type="link")`` said the same."""
+    graph = open_delta(tmp_path)
+    message = "a mechanism whose legs have loops inside them is analysed by the generic screw path with " \
+              "free-swinging faults (no closed forms, no link faults)"
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        graph.indices(fault_type="link")
+    path = tmp_path / "delta.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], AZIMUTHS))
+    for extra in ((), ("--pose", "0.02 -0.03 -0.45"), ("--json",)):
+        refused = screwkit("analyze", path, "--fault", "link", *extra)
+        if extra == ("--json",):
+            assert refused.returncode == 1 and message in json.loads(refused.stdout)["error"], refused.stdout
+        else:
+            one_line_error(refused, message)
 
 
 def test_the_command_line_sweeps_a_rod_level_delta_as_written(tmp_path):

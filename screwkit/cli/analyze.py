@@ -198,6 +198,10 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     if by_actuators:
         raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by the output frame only: leave out "
                    "--actuators (give --pose x y z [roll pitch yaw]).")
+    try:
+        graph.check_study(fault_type=analysis.fault_type)
+    except ValueError as error:
+        raise fail(str(error)) from None
     shown = {}
     if pose is not None:
         try:

@@ -242,10 +242,17 @@ class GraphMechanism:
                              + f" ({why}).")
         return graph_mechanism(self.tree, q=q[0], scale=self.scale)
 
+    def check_study(self, *, closed_forms: bool = False, fault_type: str = "free-swinging") -> None:
+        """A ValueError when a study asks these legs for what they do not have: closed forms, link faults."""
+        if closed_forms or fault_type != "free-swinging":
+            raise ValueError(f"{self.name}: a mechanism whose legs have loops inside them is analysed by the generic "
+                             "screw path with free-swinging faults (no closed forms, no link faults).")
+
     def indices(self, **options):
         """Every index at this configuration (:func:`screwkit.indices.analysis.analyze`'s options)."""
         from screwkit.indices.analysis import analyze  # the index layer, above io: only when indices are asked
 
+        self.check_study(fault_type=options.get("fault_type", "free-swinging"))
         options.setdefault("detail", True)
         options.setdefault("dof", len(self.task_axes))
         result = analyze(self.chains, iti_points=self.iti_points, oti_points=self.oti_points, **options)

@@ -450,9 +450,7 @@ Jacobians take about 10 kB a pose for a rod-level Delta)."""
 
 def check_graph_analysis(graph: GraphMechanism, closed_forms: bool = False, fault_type: str = "free-swinging") -> None:
     """A ValueError when a study asks a closed-loop graph for what it does not have."""
-    if closed_forms or fault_type != "free-swinging":
-        raise ValueError(f"{graph.name}: a mechanism whose legs have loops inside them is analysed by the generic "
-                         "screw path with free-swinging faults (no closed forms, no link faults).")
+    graph.check_study(closed_forms=closed_forms, fault_type=fault_type)
 
 
 def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,
