@@ -172,6 +172,16 @@ def test_verify_compares_with_the_closed_forms():
     assert screwkit("verify", "planar_4rpr", "--samples", "300").returncode == 0
 
 
+def test_verify_refuses_a_spatial_mechanism_before_compiling_anything(tmp_path):
+    """It started compiling three kernels (about 18 s on a first run, and said so in two lines) before refusing."""
+    import os
+
+    cache = tmp_path / "empty_cache"
+    refused = screwkit("verify", "ups_hexapod_8", env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)))
+    one_line_error(refused, "verify compares with the planar closed forms; 'ups_hexapod_8' is spatial.")
+    assert not cache.exists() or not any(cache.rglob("*.nbi"))
+
+
 def test_list_names_the_bundled_robots():
     result = screwkit("list")
     assert result.stdout.split() == ["coop_arms", "delta_4", "five_bar", "five_bar_3", "planar_4rpr", "planar_5rrr",

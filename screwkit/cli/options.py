@@ -26,7 +26,6 @@ from screwkit.common.compiling import (
     INDEX_KERNELS,
     compile_ahead,
     silence,
-    stage_kernels,
 )
 from screwkit.common.decimals import decimal_range
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
@@ -422,11 +421,9 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     if ignored and not (context and context.params.get("quiet")):
         echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
-        from screwkit.studies.kernels import constraint_kernels  # the closures and indices: commands computing them
+        from screwkit.studies.kernels import mechanism_kernels  # the closures and indices: commands computing them
 
-        compile_ahead(*stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated],
-                                     mechanism.dof),
-                     *(constraint_kernels(mechanism) if batches else ()))
+        compile_ahead(*mechanism_kernels(mechanism, batches=batches))
     return mechanism
 
 

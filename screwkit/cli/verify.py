@@ -16,6 +16,9 @@ from screwkit.cli.options import (
     reading_options,
 )
 from screwkit.closure import solve
+from screwkit.common.compiling import INDEX_KERNELS, compile_ahead
+from screwkit.indices.stages import SPACES_COMPILED_FROM
+from screwkit.studies.kernels import mechanism_kernels
 from screwkit.studies.poses import analyze_solution, closed_form_indices, planar_points
 
 __all__ = ["verify"]
@@ -34,9 +37,10 @@ def verify(mechanism: str, samples: int, seed: int, reading, as_json: bool) -> N
     Exit status 1 when some index differs by more than 1e-9.
     """
 
-    loaded = load_mechanism(mechanism, reading)
+    loaded = load_mechanism(mechanism, reading, indices=False)  # nothing compiled before the refusal below
     if not loaded.is_planar:
         raise fail(f"verify compares with the planar closed forms; {loaded.name!r} is spatial.")
+    compile_ahead(*INDEX_KERNELS, *mechanism_kernels(loaded, batches=samples >= SPACES_COMPILED_FROM))
     rng = np.random.default_rng(seed)
     home = loaded.home_pose
     spread = np.where(loaded.angular, np.pi, 0.5 * loaded.length_scale)  # a turn, or half the length scale

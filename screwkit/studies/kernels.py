@@ -6,13 +6,21 @@ from __future__ import annotations
 import numpy as np
 
 from screwkit.closure import chain_screws, solve
-from screwkit.common.compiling import CONSTRAINT_KERNEL, SPACE_KERNEL
+from screwkit.common.compiling import CONSTRAINT_KERNEL, SPACE_KERNEL, stage_kernels
 from screwkit.indices.analysis import constraint_structure
 from screwkit.indices.stages import square_subsystems
 from screwkit.model import Mechanism
 from screwkit.studies.poses import output_points
 
-__all__ = ["constraint_kernels"]
+__all__ = ["constraint_kernels", "mechanism_kernels"]
+
+
+def mechanism_kernels(mechanism: Mechanism, *, batches: bool = True) -> tuple[str, ...]:
+    """The kernels beyond the index kernels that this mechanism's indices need: those of its actuated chains'
+    joint counts (:func:`~screwkit.common.compiling.stage_kernels`) and, for ``batches`` of many poses,
+    :func:`constraint_kernels`."""
+    return (stage_kernels([chain.geometry.n_dofs for chain in mechanism.chains if chain.actuated], mechanism.dof)
+            + (constraint_kernels(mechanism) if batches else ()))
 
 
 def constraint_kernels(mechanism: Mechanism) -> tuple[str, ...]:
