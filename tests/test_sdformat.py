@@ -284,6 +284,19 @@ def test_a_five_bar_on_a_turntable_with_the_table_locked_is_the_five_bar_in_any_
         graph_mechanism(read_closed_tree(path, lock=("table",)))  # the effector turns freely on its pin: no frame
 
 
+def test_a_platform_no_actuator_holds_is_refused_naming_the_actuators_and_whether_they_were_guessed(tmp_path):
+    """A published SDFormat robot whose motors the file does not mark (Cassie's cassie_v2.sdf) was refused as "moves
+    with every actuator locked" without saying which joints were taken as actuators: here the turntable alone, the
+    one branch leaving the base."""
+    guessed = write(tmp_path, five_bar_sdf(marker="", stage=True), "guessed.sdf")
+    with pytest.raises(ImportError_, match=r"or motors the file does not name; actuators table, guessed from the "
+                                           r"branches leaving the base\)"):
+        graph_mechanism(read_closed_tree(guessed))
+    marked = write(tmp_path, five_bar_sdf(stage=True), "marked.sdf")
+    with pytest.raises(ImportError_, match=r"actuators mot1, mot2, mot3\): its frame is no output"):
+        graph_mechanism(read_closed_tree(marked, lock=("table",)))
+
+
 def test_analyze_of_an_sdformat_five_bar_on_a_turntable_names_lock_and_locked_gives_the_pressure_angles(tmp_path):
     """The command line, as a subprocess, on the millimetre copy: without ``--lock`` one line naming the option;
     with it the textbook LMTI and F_O1 at the file's pose."""

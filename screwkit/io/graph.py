@@ -364,10 +364,13 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
                            f"frame of their platform {body!r} only.")
     idle = _motion_space(screws, locked=True)
     if len(idle):
+        guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
+                        if note.startswith("actuators guessed")), "")
         raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
                            "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
-                           "meet): its frame is no output of this mechanism; analysable through serial legs as a "
-                           "point output, not through the graph.")
+                           f"meet, or motors the file does not name; actuators {', '.join(tree.motors)}"
+                           f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; "
+                           "analysable through serial legs as a point output, not through the graph.")
 
 
 def _check_actuators(tree: ClosedTree, legs) -> None:
