@@ -469,6 +469,51 @@ def test_forward_kinematics_recovers_the_pose_from_three_locked_actuators():
     np.testing.assert_allclose(recovered.poses, poses, atol=1e-10)
 
 
+def test_forward_kinematics_of_the_delta_reaches_a_pose_where_newton_stalls_at_the_closure_s_accuracy():
+    """From z = -0.7856 m the actuator mismatch of the Delta's pose z = -0.7928 m stalled at 1.04e-11 rad for 30
+    steps, just above the 1e-11 asked, and the pose (exactly found) was refused: a path of actuator values that
+    screwkit's own inverse kinematics gave failed at its 493rd sample."""
+    mechanism_ = mechanism("delta_4")
+    target = np.array([0.0, 0.0, -0.7928])
+    values = actuator_values(mechanism_, solve(mechanism_, target[None]).joint_values)
+    recovered = forward(mechanism_, values, np.array([[0.0, 0.0, -0.7856]]))
+    assert recovered.reachable.all()
+    np.testing.assert_allclose(recovered.poses[0], target, atol=1e-10)
+
+
+@pytest.mark.parametrize("name", ["planar_5rrr", "planar_4rpr"])
+def test_redundant_actuator_values_rounded_to_nine_digits_give_their_least_squares_pose(name):
+    """Rounded values of a redundantly actuated mechanism cannot all be met at once: they were refused as values
+    that "disagree with each other". Within ``agreement`` (1e-5) the pose is their least-squares fit, near the pose
+    they were computed at; values that do disagree (one off by 1e-3) are still refused."""
+    mechanism_ = mechanism(name)
+    poses = mechanism_.home_pose + np.array([[0.01, -0.02, 0.1], [-0.03, 0.01, -0.2], [0.0, 0.0, 0.3]])
+    exact = actuator_values(mechanism_, solve(mechanism_, poses).joint_values)
+    rounded = np.array([[float(f"{value:.9g}") for value in row] for row in exact])
+    assert np.max(np.abs(rounded - exact)) > 1e-11  # the rounding is more than the tolerance
+    recovered = forward(mechanism_, rounded, mechanism_.home_pose)
+    assert recovered.reachable.all()
+    np.testing.assert_allclose(recovered.poses, poses, atol=1e-7)
+    wrong = rounded.copy()
+    wrong[:, 0] += 1e-3
+    assert not forward(mechanism_, wrong, mechanism_.home_pose).reachable.any()
+
+
+@pytest.mark.parametrize("actuators, message", [
+    ([0, 1], "Expected at least 3 distinct actuators held (the DOF of 'planar_5rrr'; fewer leave the pose "
+             "undetermined), got chain_1:chain_1_joint_b, chain_2:chain_2_joint_b."),
+    ([0, 0, 1], "Expected at least 3 distinct actuators held"),
+    (["nope"], "Unknown actuator 'nope'; actuators are chain_1:chain_1_joint_b, "),
+])
+def test_forward_kinematics_refuses_actuators_that_do_not_determine_the_pose(actuators, message):
+    """Two held actuators of the 3-DOF 5-RRR gave some pose, marked reachable, that depended on the start; a
+    repeated actuator counted twice; an unknown name said "not enough values to unpack (expected 2, got 1)"."""
+    mechanism_ = mechanism("planar_5rrr")
+    with pytest.raises(ValueError) as raised:
+        forward(mechanism_, np.zeros(len(actuators)), mechanism_.home_pose, actuators=actuators)
+    assert str(raised.value).startswith(message)
+
+
 def test_forward_kinematics_of_the_hexapod_with_named_actuators():
     mechanism_ = mechanism("ups_hexapod_8")
     pose = mechanism_.home_pose + [0.05, -0.03, 0.04, 0.1, -0.05, 0.2]

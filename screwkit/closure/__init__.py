@@ -13,17 +13,18 @@ Modules: :mod:`~screwkit.closure.chain_kinematics` (one chain's forward kinemati
 twists), :mod:`~screwkit.closure.newton`, :mod:`~screwkit.closure.analytic` (closed-form
 chain solvers; the spatial ones, and the joint screws, of large batches compiled in
 ``_closed_form_kernel``), :mod:`~screwkit.closure.assembly` (the reference assembly and working modes),
-:mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.configuration_screws`, :mod:`~screwkit.closure.threads`.
+:mod:`~screwkit.closure.solve`, :mod:`~screwkit.closure.forward_kinematics`,
+:mod:`~screwkit.closure.configuration_screws`, :mod:`~screwkit.closure.threads`.
 """
 
 from screwkit.closure.assembly import working_modes
 from screwkit.closure.configuration_screws import chain_screws, joint_screws
+from screwkit.closure.forward_kinematics import forward
 from screwkit.closure.solve import (
     Solution,
     UnreachablePose,
     actuator_values,
     closure_residuals,
-    forward,
     solve,
     solve_one,
     unreachable_reason,

@@ -18,11 +18,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure.analytic import KernelKind
-from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics, chain_jacobian
+from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.newton import pose_error, solve_newton_chain
-from screwkit.closure.task_space import complete_poses, constraining_chains, motion_space_at, pose_rates
+from screwkit.closure.task_space import complete_poses, constraining_chains
 from screwkit.closure.threads import for_each_block
-from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import NEWTON_TOLERANCE
 from screwkit.common.units import spelled_pose
 from screwkit.model.mechanism import Mechanism, require_mechanism
@@ -33,7 +32,6 @@ __all__ = [
     "ChainStatus",
     "solve",
     "solve_one",
-    "forward",
     "actuator_values",
     "closure_residuals",
     "unreachable_reason",
@@ -421,120 +419,3 @@ def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.fl
         error = pose_error(target_rotation, target_translation, frames.end_rotation, frames.end_translation)
         residuals.append(np.linalg.norm(error, axis=-1))
     return np.stack(residuals, -1)
-
-
-def _task_to_pose_rates(mechanism: Mechanism, full_poses: NDArray, joint_values) -> NDArray[np.float64]:
-    """d(pose coordinates)/d(task coordinates) (N, n_pose, n_task) on the closure: the identity at full
-    mobility, else the dependent rates that keep the platform in its motion space."""
-    count = full_poses.shape[0]
-    if not mechanism.dependent_indices:
-        return np.broadcast_to(np.eye(mechanism.n_pose), (count, mechanism.n_pose, mechanism.n_pose))
-    _, basis = motion_space_at(mechanism, full_poses, joint_values)
-    space = basis[..., :mechanism.dof]  # pose-coordinate rates, lengths in units of the length scale
-    scale = np.where(mechanism.pose_angular, 1.0, mechanism.length_scale)
-    space = space * scale[:, None]  # back to metres
-    task = space[:, list(mechanism.task_indices)]  # (N, n_task, dof)
-    return space @ np.linalg.pinv(task)
-
-
-def forward(
-    mechanism: Mechanism,
-    actuator_values: ArrayLike,
-    initial_pose: ArrayLike,
-    *,
-    actuators: Sequence[int | str | tuple[str, str]] | None = None,
-    tolerance: float = 1e-11,
-    max_iterations: int = 30,
-    limits: bool = False,
-) -> Solution:
-    """Platform poses for given actuator values (forward kinematics of the closed mechanism).
-
-    Only the listed ``actuators`` are held at ``actuator_values``; all others move freely
-    (they act as passive joints). With as many listed actuators as DOF this is the forward
-    kinematics of a non-redundant submechanism. Newton steps on the pose: the rates of the
-    listed actuators per task-coordinate rate come from each chain's analytic Jacobian
-    (:func:`~screwkit.closure.chain_kinematics.chain_jacobian`), ``dq = J^+ dT``, at the
-    current closed configuration; the working mode is the one reachable from ``initial_pose``.
-
-    Parameters
-    ----------
-    actuator_values : array_like, shape (..., k)
-        Values of the listed actuators (rad or m).
-    initial_pose : array_like, shape (..., n_task)
-        Start pose.
-    actuators : sequence, optional
-        Indices into :attr:`~Mechanism.actuators`, ``chain:joint`` names or ``(chain, joint)``
-        pairs; default all.
-    tolerance : float
-        Convergence on the largest actuator mismatch (rad, or length scales for a slide).
-    limits : bool
-        Whether joint limits make a pose unreachable (default: no, as in the pure geometry).
-
-    Returns
-    -------
-    Solution
-        At the poses found; ``reachable`` is False where Newton did not converge.
-    """
-    require_mechanism(mechanism, "forward")
-    selected = mechanism.actuator_positions(actuators)
-    targets = np.asarray(actuator_values, dtype=float)
-    if targets.shape[-1:] != (len(selected),):
-        raise ValueError(f"Expected `actuator_values` with shape (..., {len(selected)}), got {targets.shape}.")
-    poses = mechanism.check_poses(initial_pose)
-    batch = np.broadcast_shapes(targets.shape[:-1], poses.shape[:-1])
-    targets = np.broadcast_to(targets, batch + (len(selected),)).reshape(-1, len(selected))
-    poses = np.array(np.broadcast_to(poses, batch + (mechanism.n_task,)).reshape(-1, mechanism.n_task))
-    angular = np.array([not mechanism.chains[chain].prismatic[joint] for chain, joint in selected])
-    converged = np.zeros(poses.shape[0], dtype=bool)
-    active = np.arange(poses.shape[0])
-    previous = None
-    for _ in range(max_iterations):
-        if active.size == 0:
-            break
-        solution = solve(mechanism, poses[active], initial=previous, limits=False)
-        values = np.stack([solution.joint_values[chain][..., joint] for chain, joint in selected], -1)
-        error = values - targets[active]
-        error[:, angular] = wrap_angle(error[:, angular])
-        done = np.all(np.abs(error) / np.where(angular, 1.0, mechanism.length_scale) < tolerance, axis=-1)
-        converged[active[done]] = True
-        keep = ~done & np.all(np.isfinite(error), axis=-1)
-        previous = [chain_values[keep] for chain_values in solution.joint_values]
-        active, error = active[keep], error[keep]
-        if active.size == 0:
-            break
-        full = solution.full_poses[keep]
-        rates = pose_rates(mechanism, full) @ _task_to_pose_rates(mechanism, full, previous)  # (N, 6, n_task)
-        rotation, translation = mechanism.transforms_from_poses(full)
-        jacobian = np.empty((active.size, len(selected), mechanism.n_task))
-        for row, (chain_index, joint) in enumerate(selected):
-            chain = mechanism.chains[chain_index]
-            frames = chain_forward_kinematics(chain.geometry, previous[chain_index])
-            _, end = mechanism.loop_targets(chain_index, rotation, translation)
-            # velocity of the loop frame's origin: v_end = v_origin + omega x (end - origin)
-            arm = end - translation
-            loop_rates = rates.copy()
-            loop_rates[:, 3:] += np.swapaxes(np.cross(np.swapaxes(rates[:, :3], 1, 2), arm[:, None, :]), 1, 2)
-            joint_rates = np.linalg.pinv(chain_jacobian(chain.geometry, frames)) @ loop_rates
-            jacobian[:, row] = joint_rates[:, joint]
-        update = -(np.linalg.pinv(jacobian) @ error[..., None])[..., 0]
-        # steps of at most 0.2 rad and 0.2 length scales (task coordinates mix angles and lengths)
-        largest = np.max(np.abs(update) / np.where(mechanism.angular, 1.0, mechanism.length_scale), axis=-1)
-        update *= np.minimum(1.0, 0.2 / np.maximum(largest, 1e-300))[:, None]
-        usable = np.all(np.isfinite(update), axis=-1)
-        poses[active[usable]] += update[usable]
-    solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), limits=limits)
-    converged = converged.reshape(batch)
-    return Solution(
-        poses=solution.poses,
-        full_poses=solution.full_poses,
-        reachable=solution.reachable & converged,
-        chain_reachable=solution.chain_reachable & converged[..., None],
-        status=np.where(converged[..., None], solution.status,
-                        np.maximum(solution.status, MISSES_CLOSURE)).astype(np.int8),
-        residuals=solution.residuals,
-        limit_joints=solution.limit_joints,
-        joint_axes=solution.joint_axes,
-        joint_points=solution.joint_points,
-        value_sources=solution.joint_values,
-    )
-

@@ -314,7 +314,10 @@ class Mechanism:
                     raise ValueError(f"Expected actuator indices in 0..{len(self.actuators) - 1}, got {actuator}.")
                 chain_name, joint_name = self.actuators[actuator]
             else:
-                chain_name, joint_name = actuator.split(":", 1) if isinstance(actuator, str) else actuator
+                try:
+                    chain_name, joint_name = actuator.split(":", 1) if isinstance(actuator, str) else actuator
+                except (TypeError, ValueError):  # not a chain:joint name nor a (chain, joint) pair
+                    chain_name, joint_name = None, None
                 if (chain_name, joint_name) not in self.actuators:
                     raise ValueError(f"Unknown actuator {actuator!r}; actuators are {', '.join(self.actuator_names)}.")
             chain_index = chain_names.index(chain_name)
