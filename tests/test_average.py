@@ -306,3 +306,29 @@ def test_a_column_of_the_mean_is_named_so_and_nothing_else_is():
 
     assert all(is_mean_column(name) for name in ("f_o_mean1", "f_o_mean2", "f_o_mean12"))
     assert not any(is_mean_column(name) for name in ("f_o_mean", "f_o1", "f_io1", "lmti", "xf_o_mean1", "f_o_meanx"))
+
+
+def test_the_mean_under_link_faults_weights_the_reduced_mechanisms_left(tmp_path):
+    """``--fault link --aggregate mean --probabilities`` failed in analyze and sweep whatever was given ("one
+    failure probability per actuator (3)" for four, "(4)" for three): the reduced mechanisms were averaged with the
+    whole mechanism's probabilities. The 3-PRS + UPS under link faults: losing a PRS leg frees a DOF (LMTI 0),
+    losing the UPS leg leaves the 3-PRS, analysed here as a mechanism of its own; the mean weights them by the
+    probability of each failure pattern."""
+    from screwkit.io.loader import load_text
+    from screwkit.robots.generate import PRS_UPS, prs_mechanism
+
+    whole = load_text(prs_mechanism("prs_3_ups_test", PRS_UPS, with_ups=True), "prs_3_ups_test")
+    three = load_text(prs_mechanism("prs_3_test", PRS_UPS, with_ups=False), "prs_3_test")
+    probabilities = (0.1, 0.2, 0.3, 0.4)
+    pose = whole.home_pose + np.array([0.005, np.radians(-10.0), np.radians(20.0)])
+    with averaging(probabilities):
+        mean = indices_at_pose(whole, pose, fault_type="link").index("f_o_mean")
+    chance = [p * np.prod([1 - q for i, q in enumerate(probabilities) if i != k]) for k, p in enumerate(probabilities)]
+    left = float(indices_at_pose(three, pose).lmti)
+    assert left > 0.5 and mean[1] == pytest.approx(chance[3] / sum(chance) * left, abs=1e-12)
+    analysed = screwkit("analyze", "prs_3_ups", "--pose", "0.2 -10 20", "--fault", "link", "--aggregate", "mean",
+                        "--probabilities", *map(str, probabilities), "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    swept = screwkit("sweep", "prs_3_ups", "--sweep", "z:0.19:0.21:0.01", "--fault", "link", "--aggregate", "mean",
+                     "--probabilities", *map(str, probabilities))
+    assert swept.returncode == 0 and "f_o_mean1" in swept.stdout, swept.stderr

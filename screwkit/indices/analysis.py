@@ -307,8 +307,9 @@ def analyze(
     f_c = ({j: batch_first(merged[f"f_c{j}"]) for j in plan.faults} if constraint_plan.count
            else dict.fromkeys(plan.faults, not_applicable))
     remaining = {j: batch_first(merged[f"remaining{j}"]) for j in plan.faults} if detail else {}
-    if a == plan.dof:  # no redundancy (a = n): one failed actuator leaves the platform
-        # uncontrolled, so no set of n working actuators remains: F_O1 = F_IO1 = 0 (every fault ties; the first named)
+    if a == plan.dof and not (faults is not None and np.size(faults) == 0):  # no redundancy (a = n), and fault
+        # indices not declined (faults=()): one failed actuator leaves the platform uncontrolled, so no set of n
+        # working actuators remains: F_O1 = F_IO1 = 0 (every fault ties; the first named)
         f_o = {1: np.zeros(batch_shape)}
         worst = {1: np.zeros(batch_shape + (1,), dtype=np.int64)}
         f_c = {1: np.zeros(batch_shape) if constraint_plan.count else not_applicable}
