@@ -323,6 +323,9 @@ def test_plot_draws_a_saved_map_or_sweep_again_as_it_was_drawn(tmp_path):
         ((tmp_path / "m.nc", "--figure", tmp_path / "x.jpg"), "must end in .png, .pdf, .svg"),
     ]:
         one_line_error(screwkit("plot", *arguments), message)
+    # named as given, relative: scipy names it absolutely ("(/tmp/.../it is not a valid ..." before)
+    one_line_error(screwkit("plot", "fake.nc", "--figure", "x.png", cwd=tmp_path),
+                   "Error: fake.nc: cannot be read as a netCDF file (it is not a valid NetCDF 3 file).")
     assert not (tmp_path / "x.png").exists()
 
 

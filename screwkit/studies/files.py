@@ -253,7 +253,11 @@ def open_netcdf(path: str, error: type[Exception] = ValueError):
             return dataset.load()
     except Exception as failure:  # whatever the netCDF reader makes of a file that is not one
         reason = str(failure).splitlines()[0] if str(failure) else type(failure).__name__
-        reason = reason.removeprefix("Error: ").replace(f"{path} ", "it ", 1)  # (scipy's words name it again)
+        reason = reason.removeprefix("Error: ")
+        for named in (os.path.abspath(path), str(path)):  # scipy's words name it again, absolutely or as given
+            if reason.startswith(f"{named} "):
+                reason = "it " + reason[len(named) + 1:]
+                break
         raise error(f"{path}: cannot be read as a netCDF file ({reason}).") from None
 
 
