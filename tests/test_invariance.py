@@ -503,3 +503,34 @@ def test_closure_and_forward_kinematics_of_a_scaled_copy(tmp_path, name, scale):
     np.testing.assert_array_equal(found.reachable, in_metres.reachable)  # what forward reaches from home
     assert found.reachable.sum() >= 4
     np.testing.assert_allclose(found.poses[found.reachable] / factor, poses[found.reachable], atol=1e-9)
+
+
+def test_a_stretched_leg_is_reached_in_every_unit_and_world_frame(tmp_path):
+    """At the boundary of a leg's reach the R-R-R closed form decided "reachable" by the sign of a square height
+    that rounding sets: five_bar_3 at (-0.2, 0.35) was unreachable in metres and in millimetres and reachable moved
+    in its world, (0.3, 0.3) the other way round, and maps of it differed at 2-4 of 441 points. The leg is
+    stretched there (its elbow on the line from its base joint to the platform joint: ITI 0, a singular
+    configuration); now reached in every unit and frame, with the same indices."""
+    from helpers import in_millimetres, moved_in_the_world
+    from screwkit.io.loader import bundled_path, load
+    from screwkit.studies import indices_at_poses
+
+    text = bundled_path("five_bar_3").read_text()
+    files = {"m": text, "mm": in_millimetres(text, declare=True),
+             "moved": moved_in_the_world(text, (0.3, -0.2, 0.5), (0.4, -0.3, 0.7)),
+             "in plane": moved_in_the_world(text, (0.25, -0.15, 0.0), (0.0, 0.0, 1.1))}
+    poses = np.array([[-0.2, 0.35], [0.3, 0.3], [0.30000000000000004, 0.3], [-0.2, 0.4], [0.2, 0.4]])
+    results = {}
+    for name, written in files.items():
+        path = tmp_path / f"five_bar_3_{name.replace(' ', '_')}.urdf"
+        path.write_text(written)
+        results[name] = indices_at_poses(load(path), poses, detail=True)
+    reference = results["m"]
+    assert reference.reachable.all() and np.all(reference.iti[:2] == 0.0)
+    stretched = np.isclose(reference.iti_actuators, 0.0, atol=1e-12)
+    assert stretched.any(axis=-1).all()  # at each pose a stretched leg, whose actuator's ITI is 0
+    for name, result in results.items():
+        assert result.reachable.all(), name
+        np.testing.assert_allclose(result.lmti, reference.lmti, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(result.f_o[1], reference.f_o[1], atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(result.iti_actuators, reference.iti_actuators, atol=1e-7, err_msg=name)

@@ -17,7 +17,7 @@ from screwkit.closure.analytic.results import ClosedFormResult, Rejection
 from screwkit.closure.chain_kinematics import ChainFrames, chain_forward_kinematics
 from screwkit.closure.threads import for_each_block
 from screwkit.common.rotations import wrap_angle
-from screwkit.common.tolerances import CLOSURE_TOLERANCE
+from screwkit.common.tolerances import BOUNDARY_ROUNDING, CLOSURE_TOLERANCE
 from screwkit.model.chain import ChainGeometry
 
 
@@ -167,7 +167,9 @@ class PlanarRevoluteChain(PlanarClosedForm):
             inverse = 1.0 / squared
             along = (0.5 * (first * first - second * second)) * inverse + 0.5  # along / distance
             height_squared = (first * first) * inverse - along * along  # (height / distance)^2
-        reachable = height_squared >= 0.0
+        # a stretched or folded leg (height 0) is reached whatever rounding makes of its height: beyond its reach by
+        # less than a 1e-12th of the distance, as the unit or the world frame the file is written in rounds it
+        reachable = height_squared >= -BOUNDARY_ROUNDING * np.maximum(1.0, (first * first) * inverse)
         height = np.sqrt(np.maximum(height_squared, 0.0))
         with np.errstate(invalid="ignore"):  # the end on the base joint (delta 0): NaN, an unreachable pose
             if branch > 0:
