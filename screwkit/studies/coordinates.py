@@ -40,14 +40,16 @@ def shown_number(name: str, value: float, length_scale: float) -> float:
 
 
 def pose_text(names: Iterable[str], pose: ArrayLike, length_scale: float, leave_out: Iterable[str] = ()) -> str:
-    """``x=0.1, y=0, pitch=5``: the coordinates of ``pose`` (m, rad) other than ``leave_out``, in m and deg, ``%g``,
-    round-off noise (below :data:`NOISE`) and -0 shown as 0."""
+    """``x=0.1, y=0, pitch=5``: the coordinates of ``pose`` (m, rad) other than ``leave_out``, in m and deg, each
+    the shortest decimal that reads back as the value shown (``z=0.2085665361461421``, not ``%g``'s ``0.208567``,
+    so that the pose the file states gives its numbers), round-off noise (below :data:`NOISE`) and -0 shown as 0."""
     left_out = set(leave_out)
     parts = []
     for name, value in zip(names, np.asarray(pose, dtype=float)):
         if name in left_out:
             continue
-        parts.append(f"{name}={shown_number(name, value, length_scale):g}")
+        text = repr(shown_number(name, value, length_scale))
+        parts.append(f"{name}={text.removesuffix('.0')}")
     return ", ".join(parts)
 
 
