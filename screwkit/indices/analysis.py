@@ -32,7 +32,7 @@ numbers of those coordinates. The one length is the singularity threshold *p*, c
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -133,7 +133,8 @@ def analyze(
     rigidly moved copy of it, so every tolerance below compares dimensionless numbers and no
     decision depends on the length unit, the scale or the world frame; the singularity
     threshold *p*, a length, is compared as :math:`p / L`. ``c`` and ``L`` belong to each
-    configuration: a batch gives what a loop over single configurations gives.
+    configuration: a batch gives what a loop over single configurations gives, to rounding (the chunks and the
+    other configurations of a batch can change the last digits, about 1e-15).
 
     **Actuation wrench** (Sec. 2): the wrench of chain ``i`` reciprocal to every other
     joint of the chain; it is defined modulo the chain's constraint wrenches. screwkit's
@@ -231,6 +232,10 @@ def analyze(
         Actuators named ``chain:joint`` from the chains' names and joint names. Actuation
         wrenches and output twists are in the world frame and the unit of the screws.
     """
+    if isinstance(chains, (ChainScrews, str)) or not isinstance(chains, Iterable):  # a Mechanism, one chain, a name
+        raise TypeError(f"Expected `chains` as a sequence of ChainScrews (screwkit.closure.chain_screws of a solved "
+                        f"mechanism; indices of a Mechanism at poses: screwkit.indices_at_poses), got "
+                        f"{type(chains).__name__}.")
     chains = list(chains)
     if not chains:
         raise ValueError("Expected at least one chain in `chains`, got none.")

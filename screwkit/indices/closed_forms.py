@@ -24,6 +24,8 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.chunks import map_chunks
 from screwkit.common.compiling import announce_compilation
 from screwkit.common.tolerances import RANK_TOLERANCE, SINGULARITY_THRESHOLD, WORST_FAULT_TIE
+from screwkit.common.validation import as_float_array, check_finite
+from screwkit.indices.stages import checked_faults, checked_threshold
 
 __all__ = [
     "det2",
@@ -194,8 +196,37 @@ def _planar_chunk(base, elbows, distal, directions, threshold, triples, fault_me
     return iti_chains, iti, oti_subs, f_o, worst, mutual, remaining
 
 
+def _planar_inputs(base, elbows, distal, directions):
+    """:func:`planar_indices`' points and directions checked (finite, shapes (..., k, 2) like ``distal``'s, unit
+    directions from nonzero ones): ``(distal, batch shape, k, base, elbows, directions)``, the unused ones None."""
+    distal = check_finite(as_float_array(distal, "distal"), "distal")
+    if distal.ndim < 2 or distal.shape[-1] != 2 or distal.shape[-2] < 3:
+        raise ValueError(f"Expected `distal` with shape (..., k, 2), k >= 3, got {distal.shape}.")
+
+    def like_distal(value, name):
+        array = check_finite(as_float_array(value, name), name)
+        try:
+            return np.broadcast_to(array, distal.shape)
+        except ValueError:
+            raise ValueError(f"Expected `{name}` with the shape of `distal`, {distal.shape}, got {array.shape}.") \
+                from None
+
+    if directions is not None:
+        directions = like_distal(directions, "directions")
+        length = np.linalg.norm(directions, axis=-1, keepdims=True)
+        if not np.all(length > 0):
+            where = tuple(int(i) for i in np.argwhere(length[..., 0] == 0)[0])
+            raise ValueError(f"Expected nonzero leg `directions`, got a zero vector at index {where}.")
+        return distal, distal.shape[:-2], distal.shape[-2], None, None, directions / length
+    if elbows is None:
+        raise ValueError("Expected `elbows` or `directions`, got neither.")
+    if base is None:
+        raise ValueError("Expected `base` with `elbows` (RRR chains), got None.")
+    return distal, distal.shape[:-2], distal.shape[-2], like_distal(base, "base"), like_distal(elbows, "elbows"), None
+
+
 def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
-                   threshold: float = SINGULARITY_THRESHOLD, faults: tuple[int, ...] | None = None,
+                   threshold: float = SINGULARITY_THRESHOLD, faults: int | tuple[int, ...] | None = None,
                    directions: ArrayLike | None = None,
                    chunk_size: int = 65536, threads: int | None = None, rank_tolerance: float = RANK_TOLERANCE) -> dict:
     r"""ITI, LMTI, F_Oj and F_IOj of a planar mechanism from its closed forms (Eqs. 35-38, 12, 14).
@@ -208,15 +239,16 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     Parameters
     ----------
     base, elbows, distal : array_like, shape (..., k, 2)
-        Points ``b_i, c_i, d_i``. ``elbows`` may be None for RPR chains: then
-        ``directions`` (the leg directions) must be given and the ITI is 1 (prismatic input
-        along its own force).
+        Points ``b_i, c_i, d_i`` (finite; ``base`` and ``elbows`` broadcast to the shape of ``distal``).
+        ``elbows`` may be None for RPR chains: then ``directions`` (the leg directions) must be given
+        and the ITI is 1 (prismatic input along its own force). An empty batch gives empty arrays.
     threshold : float
-        Singularity threshold *p* on :math:`\rho_{k\max}`.
-    faults : tuple of int, optional
+        Singularity threshold *p* on :math:`\rho_{k\max}` (finite, >= 0).
+    faults : int or tuple of int, optional
         Which ``j`` (default ``1..k-3``).
     directions : array_like, shape (..., k, 2), optional
-        The distal-link directions ``f_i`` (computed from ``elbows`` if omitted).
+        The distal-link directions ``f_i`` (computed from ``elbows`` if omitted), normalised here: only
+        their direction counts (a zero vector is refused). ``base`` and ``elbows`` are then not used.
     chunk_size : int
         Configurations per chunk (bounds memory).
     threads : int, optional
@@ -237,21 +269,14 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
         (tuple of triples), ``remaining_lmti`` (dict over j of (..., C(k, j)): the LMTI of every set left after j
         faults, Eq. 38, in combination order).
     """
-    distal = np.asarray(distal, dtype=float)
-    if distal.ndim < 2 or distal.shape[-1] != 2 or distal.shape[-2] < 3:
-        raise ValueError(f"Expected `distal` with shape (..., k, 2), k >= 3, got {distal.shape}.")
-    batch, count = distal.shape[:-2], distal.shape[-2]
-    if directions is None:
-        if elbows is None:
-            raise ValueError("Expected `elbows` or `directions`, got neither.")
-        elbows = np.broadcast_to(np.asarray(elbows, dtype=float), distal.shape)
-        base = np.broadcast_to(np.asarray(base, dtype=float), distal.shape)
-    else:
-        directions = np.broadcast_to(np.asarray(directions, dtype=float), distal.shape)
-    faults = tuple(range(1, count - 2)) if faults is None else tuple(faults)
-    for j in faults:
-        if not 1 <= j <= max(count - 3, 1):
-            raise ValueError(f"Expected the number of faults `j` in 1..{count - 3}, got {j}.")
+    distal, batch, count, base, elbows, directions = _planar_inputs(base, elbows, distal, directions)
+    threshold = checked_threshold(threshold)
+    if isinstance(rank_tolerance, (str, bytes, bool)) or not rank_tolerance > 0:
+        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance!r}.")
+    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
+        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+    faults = checked_faults(faults, count - 3)
+    faults = tuple(range(1, count - 2)) if faults is None else faults
     if count == 3:
         faults = ()  # no redundancy: F_O1 = 0 below
     triples = tuple(combinations(range(count), 3))
@@ -275,7 +300,11 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
                  for a in sources]
         return _planar_chunk(*chunk, threshold, triples, fault_members, rank_tolerance, without)
 
-    pieces = map_chunks(run, total, chunk_size, threads)
+    # an empty batch: one empty piece (no chunk), so that every array has its shape (0, ...)
+    pieces = map_chunks(run, total, chunk_size, threads) or [(
+        np.empty((0, count)), np.empty(0), np.empty((0, len(triples))), {j: np.empty(0) for j in faults},
+        {j: np.empty(0, dtype=np.int64) for j in faults}, np.empty((0, count), dtype=bool),
+        {j: np.empty((0, len(members))) for j, members in fault_members.items()})]
 
     def gather(arrays):  # chunk pieces (n, ...) -> (..., ...)
         joined = np.concatenate(arrays, axis=0)
@@ -324,10 +353,8 @@ def point_indices(base: ArrayLike, elbows: ArrayLike, distal: ArrayLike, faults:
     pairs = tuple(combinations(range(count), 2))
     oti = np.stack([np.abs(det2(forces[..., k, :], forces[..., l, :])) for k, l in pairs], axis=-1)
     oti = np.where(oti > rank_tolerance, oti, 0.0)
-    faults = tuple(range(1, count - 1)) if faults is None else tuple(faults)
-    for j in faults:
-        if not 1 <= j <= max(count - 2, 1):
-            raise ValueError(f"Expected the number of faults `j` in 1..{count - 2}, got {j}.")
+    faults = checked_faults(faults, count - 2)
+    faults = tuple(range(1, count - 1)) if faults is None else faults
     if count == 2:
         faults = ()  # no redundancy: F_O1 = 0 below
     f_o, worst, remaining = {}, {}, {}

@@ -39,6 +39,10 @@ def worst_fault_ties(indices, faults: int) -> tuple[tuple[str, ...], ...]:
     ``worst_faults`` first). Only the reported one without ``detail``; none where unreachable."""
     if indices.batch_shape:
         raise ValueError("worst_fault_ties is for one configuration; take .at(index) of a batch first.")
+    if isinstance(faults, (bool, np.bool_)) or not isinstance(faults, (int, np.integer)) \
+            or faults not in indices.worst_faults:
+        raise ValueError(f"Expected `faults` as one of the numbers of faults j computed, "
+                         f"{', '.join(map(str, indices.faults)) or 'none'}, got {faults!r}.")
     if not indices.reachable:
         return ()
     first = tuple(indices.worst_faults[faults])
@@ -196,9 +200,9 @@ def indices_variables(indices, dims: Sequence[str] | None = None,
     batch = indices.batch_shape
     if dims is None:
         dims = ("pose",) if len(batch) == 1 else tuple(f"pose_{i}" for i in range(len(batch)))
-    dims = tuple(dims)
-    if len(dims) != len(batch):
-        raise ValueError(f"Expected {len(batch)} names in `dims` for the batch shape {batch}, got {dims}.")
+    dims = (dims,) if isinstance(dims, str) else tuple(dims)  # one name: the dimension of a 1-D batch
+    if len(dims) != len(batch) or not all(isinstance(name, str) for name in dims):
+        raise ValueError(f"Expected {len(batch)} names (str) in `dims` for the batch shape {batch}, got {dims}.")
     variables = {"reachable": (dims, np.asarray(indices.reachable))}
     for record in INDICES.values():  # every index, one record each
         values = _values(indices, record) if applies(record, indices) else None
@@ -230,6 +234,10 @@ def indices_variables(indices, dims: Sequence[str] | None = None,
             values = np.rad2deg(values) if is_angular(name) else values
             if name not in dims:
                 all_coords[name] = (dims, values, {"units": "deg" if is_angular(name) else "m"})
+    taken = sorted(set(coords or {}) & (set(all_coords) | set(variables)))
+    if taken:  # it would replace a pose coordinate, the actuators, the submechanisms or an index, silently
+        raise ValueError(f"Expected `coords` named unlike the dataset's own coordinates and variables, got "
+                         f"{', '.join(map(repr, taken))} (taken: {', '.join(sorted(all_coords))}).")
     all_coords.update(coords or {})
     attrs: dict[str, Any] = dict(threshold_m=indices.threshold, dof=indices.dof, fault_type=indices.fault_type)
     if indices.mechanism:

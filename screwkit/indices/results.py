@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
 from itertools import combinations
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -226,6 +226,8 @@ class Indices:
     def actuator_index(self, actuator: int | str) -> int:
         """Index into :attr:`actuators` of an actuator given by index, ``chain:joint`` name,
         joint name or chain name (the chain's only actuator)."""
+        if isinstance(actuator, (bool, np.bool_)):
+            raise TypeError(f"Expected an actuator as an index or a name, got {actuator!r}.")
         if isinstance(actuator, (int, np.integer)):
             if not 0 <= actuator < self.actuator_count:
                 raise ValueError(f"Expected an actuator index in 0..{self.actuator_count - 1}, got {actuator}.")
@@ -243,10 +245,7 @@ class Indices:
     def at(self, index: int | tuple) -> Indices:
         """The indices of one configuration of the batch (its scalar fields become Python floats); with a tuple of
         integer arrays (numpy indexing, one per batch dimension), of those configurations, as a batch."""
-        index = index if isinstance(index, tuple) else (index,)
-        if len(index) != len(self.batch_shape):
-            raise ValueError(f"Expected an index with {len(self.batch_shape)} entries for the batch shape "
-                             f"{self.batch_shape}, got {index}.")
+        index = _checked_index(index, self.batch_shape)
 
         def pick(value):
             return None if value is None else np.asarray(value)[index]
@@ -262,6 +261,7 @@ class Indices:
         actuators: they cannot hold the platform (no submechanism, as the paper's LMTI of a mechanism that is not
         fully constrained). A float for one configuration, an array (...) for a batch.
         """
+        _check_actuator_set(actuator_set)
         if self.oti_submechanisms is None:
             raise ValueError("These indices were computed without detail; recompute with detail=True for lmti_of.")
         chosen = sorted({self.actuator_index(actuator) for actuator in actuator_set})
@@ -287,10 +287,13 @@ class Indices:
         return self.derived[name]
 
     def failed_sets(self, faults: int) -> tuple[tuple[int, ...], ...]:
-        """The failed actuators (indices) of each set left after ``faults`` faults, in the combination order of
-        the sets left (that of :attr:`remaining_lmti`)."""
+        """The failed actuators (indices) of each set left after ``faults`` faults (an int in ``1..a``), in the
+        combination order of the sets left (that of :attr:`remaining_lmti`)."""
         a = self.actuator_count
-        return tuple(tuple(sorted(set(range(a)) - set(left))) for left in combinations(range(a), a - faults))
+        if isinstance(faults, (bool, np.bool_)) or not isinstance(faults, (int, np.integer)) or not 1 <= faults <= a:
+            raise ValueError(f"Expected `faults` as an int j in 1..a = 1..{a} (a number of failed actuators), "
+                             f"got {faults!r}.")
+        return tuple(tuple(sorted(set(range(a)) - set(left))) for left in combinations(range(a), a - int(faults)))
 
     def worst_fault_ties(self, faults: int) -> tuple[tuple[str, ...], ...]:
         """Every worst case of ``faults`` faults at one configuration, by name (:func:`~screwkit.indices.exports.
@@ -321,11 +324,12 @@ class Indices:
 
         Parameters
         ----------
-        dims : sequence of str, optional
+        dims : str or sequence of str, optional
             Names of the batch dimensions (default ``pose`` for a 1-D batch, else
-            ``pose_0, pose_1, ...``).
+            ``pose_0, pose_1, ...``); one str names the dimension of a 1-D batch.
         coords : dict, optional
-            Extra coordinates, as xarray takes them (e.g. the values of a swept coordinate).
+            Extra coordinates, as xarray takes them (e.g. the values of a swept coordinate); a name
+            the dataset already has (a pose coordinate, ``actuator``, ``submechanism``, an index) is refused.
 
         Returns
         -------
@@ -336,6 +340,27 @@ class Indices:
             coordinates along the batch dimensions (m, deg).
         """
         return indices_to_dataset(self, dims, coords)
+
+
+def _checked_index(index, batch_shape: tuple[int, ...]) -> tuple:
+    """:meth:`Indices.at`'s index as a tuple, checked against the batch shape here (not by numpy on a field)."""
+    index = index if isinstance(index, tuple) else (index,)
+    if len(index) != len(batch_shape):
+        raise ValueError(f"Expected an index with {len(batch_shape)} entries for the batch shape {batch_shape}, "
+                         f"got {index}.")
+    try:
+        np.broadcast_to(np.empty((), dtype=bool), batch_shape)[index]
+    except (IndexError, TypeError, ValueError) as error:
+        raise ValueError(f"Expected `index` within the batch shape {batch_shape} (integers, or integer arrays), "
+                         f"got {index if len(index) > 1 else index[0]!r}: {error}.") from None
+    return index
+
+
+def _check_actuator_set(actuator_set) -> None:
+    """:meth:`Indices.lmti_of` takes a sequence of actuators: not one actuator, nor a name's characters."""
+    if isinstance(actuator_set, (str, bytes)) or not isinstance(actuator_set, Iterable):
+        raise TypeError(f"Expected `actuator_set` as a sequence of actuators (indices or names), got "
+                        f"{actuator_set!r}; a set of one is [{actuator_set!r}].")
 
 
 def _normalise(result: Indices) -> None:

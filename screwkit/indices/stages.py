@@ -7,6 +7,7 @@ Only numpy is imported here (numba when the kernels first run).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -31,7 +32,7 @@ from screwkit.screw.outputs import quotient_bases
 
 __all__ = ["Plan", "make_plan", "run_kernel", "ChunkSpaces", "analyze_chunk", "joints_of_all_chains",
            "constraint_plan_of", "constraint_chunk", "at_constraint_singularities", "CONSTRAINTS_COMPILED_FROM",
-           "square_subsystems", "compiled_constraint_stage"]
+           "square_subsystems", "compiled_constraint_stage", "checked_faults", "checked_threshold"]
 
 
 @dataclass
@@ -60,11 +61,40 @@ class Plan:
     idle_count: int = 0
 
 
+def checked_threshold(threshold, name: str = "threshold") -> float:
+    """The singularity threshold *p* as a float: a real number, finite and >= 0 (a length), else a one-line error."""
+    if isinstance(threshold, (str, bytes, bool, np.bool_)) or np.ndim(threshold) != 0 \
+            or np.asarray(threshold).dtype.kind not in "iuf":
+        raise TypeError(f"Expected `{name}` as a number >= 0 (a length), got {threshold!r}.")
+    value = float(threshold)
+    if not 0.0 <= value < np.inf:
+        raise ValueError(f"Expected `{name}` >= 0 and finite (a length), got {threshold!r}.")
+    return value
+
+
+def checked_faults(faults, most: int, span: str = "") -> tuple[int, ...] | None:
+    """The numbers of faults ``j`` that ``faults`` asks for (None: all; an int; a sequence of ints), distinct and
+    ascending, each in ``1..max(most, 1)`` (``span`` how that range is written in the message, ``1..{most}`` by
+    default). Bools, floats, strings and other non-integers are refused (a TypeError), not truncated."""
+    if faults is None:
+        return None
+    if isinstance(faults, Iterable) and not isinstance(faults, (str, bytes)):
+        values = tuple(faults.reshape(-1) if isinstance(faults, np.ndarray) else faults)
+    else:
+        values = (faults,)
+    for j in values:
+        if isinstance(j, (bool, np.bool_)) or not isinstance(j, (int, np.integer)):
+            raise TypeError(f"Expected `faults` as an int or a sequence of ints (numbers of faults j), got {faults!r}.")
+    for j in values:
+        if not 1 <= j <= max(most, 1):
+            raise ValueError(f"Expected the number of faults `j` in {span or f'1..{most}'}, got {j}.")
+    return tuple(sorted({int(j) for j in values}))
+
+
 def make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int = 0) -> Plan:
-    if not threshold >= 0:
-        raise ValueError(f"Expected `threshold` >= 0 (a length), got {threshold}.")
-    if not rank_tolerance > 0:
-        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance}.")
+    threshold = checked_threshold(threshold)
+    if isinstance(rank_tolerance, (str, bytes, bool)) or not rank_tolerance > 0:
+        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance!r}.")
     space = motion_space(chains, None if dof is None else dof + idle_count)
     n = space.dof - idle_count
     if idle_count:  # a point output: the motion space modulo the idle rotations, configuration by configuration
@@ -81,15 +111,11 @@ def make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int = 
                 f"Chain {chain.name!r} has {chain.n_joints} joint DoFs, fewer than the platform's DOF n = {n}: "
                 "it cannot follow the platform."
             )
-    if faults is None:
+    fault_list = checked_faults(faults, a - n, f"1..a-n = 1..{a - n}")
+    if fault_list is None:
         fault_list = tuple(range(1, a - n + 1))
-    else:
-        fault_list = tuple(sorted(set(int(j) for j in np.atleast_1d(faults))))
-        for j in fault_list:
-            if not 1 <= j <= max(a - n, 1):
-                raise ValueError(f"Expected the number of faults `j` in 1..a-n = 1..{a - n}, got {j}.")
-        if a == n:  # no redundancy: F_O1 = 0 (see analyze), no set of n actuators is left to reduce
-            fault_list = ()
+    elif a == n:  # no redundancy: F_O1 = 0 (see analyze), no set of n actuators is left to reduce
+        fault_list = ()
     complement = space.complement if space.constant_basis is not None else np.empty((0, 6))
     return Plan(
         actuators=actuators, dof=n, space=space, complement=complement,

@@ -28,6 +28,7 @@ from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
 from screwkit.indices.results import Indices
+from screwkit.indices.stages import checked_faults, checked_threshold
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.batch_arrays import ARRAYS, DICTS, fill_unreachable, scatter
 
@@ -123,9 +124,8 @@ def closed_form_indices(mechanism: Mechanism, solution, threshold: float = SINGU
             raise ValueError(f"The point-output closed forms are for R-R-R legs; {mechanism.name!r} has R-P-R legs.")
         closed, dof = point_indices(base, elbows, distal, faults=faults), 2
     elif prismatic:
-        direction = distal - base
         closed = planar_indices(base, None, distal, threshold=threshold, faults=faults, threads=threads,
-                                directions=direction / np.linalg.norm(direction, axis=-1, keepdims=True))
+                                directions=distal - base)  # the leg directions, normalised there
         dof = 3
     else:
         closed, dof = planar_indices(base, elbows, distal, threshold=threshold, faults=faults, threads=threads), 3
@@ -248,9 +248,10 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, mechanism.n_task)
     count = flat.shape[0]
+    _check_settings(faults, threshold, progress, len(mechanism.actuator_names), mechanism.dof)
     if chunk_size is None:
         chunk_size = poses_per_chunk(mechanism)
-    elif not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
+    elif not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
         raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
     reachable = np.zeros(count, dtype=bool)
     chain_status = np.zeros((count, len(mechanism.chains)), dtype=np.int8)
@@ -346,6 +347,14 @@ _SETTINGS = dict(detail=False, threshold=SINGULARITY_THRESHOLD, faults=None, chu
 """The keywords of :func:`indices_at_poses` and their defaults."""
 
 
+def _check_settings(faults, threshold, progress, actuators: int, dof: int) -> None:
+    """The settings of a batch checked before any work, whatever turns out reachable (as ``analyze`` checks them)."""
+    checked_faults(faults, actuators - dof, f"1..a-n = 1..{actuators - dof}")
+    checked_threshold(threshold)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"Expected `progress` as a callable taking the number of poses done, got {progress!r}.")
+
+
 
 
 @dataclass(frozen=True)
@@ -389,7 +398,8 @@ def _batch_indices(arrays: dict, meta: Indices | None, gathered: _Gathered, desc
 
     a = len(actuator_names)
     if meta is None:  # nothing reachable: the structure of the indices from the mechanism alone
-        faults_list = tuple(range(1, max(a - dof, 1) + 1)) if faults is None else tuple(np.atleast_1d(faults).tolist())
+        faults_list = checked_faults(faults, a - dof, f"1..a-n = 1..{a - dof}")
+        faults_list = tuple(range(1, max(a - dof, 1) + 1)) if faults_list is None else faults_list
         nothing = np.full(batch, np.nan)
         return Indices.from_arrays(
             actuator_names, dof,
@@ -397,6 +407,9 @@ def _batch_indices(arrays: dict, meta: Indices | None, gathered: _Gathered, desc
              "worst_fault_indices": {j: np.full(batch + (j,), -1, dtype=np.int64) for j in faults_list},
              "mutual_interference": np.zeros(batch + (a,), dtype=bool),
              "iti_actuators": np.full(batch + (a,), np.nan) if detail else None, "poses": poses,
+             # with detail, what a batch with a reachable pose has: NaN per submechanism and per set left
+             "oti_submechanisms": np.full(batch + (comb(a, dof),), np.nan) if detail else None,
+             "remaining_lmti": {j: np.full(batch + (comb(a, j),), np.nan) for j in faults_list} if detail else {},
              "reachable": reachable.reshape(batch),
              "chain_status": chain_status.reshape(batch + chain_status.shape[-1:]),
              "full_poses": full_poses.reshape(batch + (full_poses.shape[-1],))},
@@ -471,6 +484,9 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
 
     poses = graph.check_poses(poses)
     n_task = graph.n_task
+    _check_settings(faults, threshold, progress, len(graph.legs), n_task)
+    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
+        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]
