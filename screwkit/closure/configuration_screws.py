@@ -20,7 +20,7 @@ from screwkit.closure.chain_kinematics import (
     transform_axes_and_points,
     twists_from_axes_and_points,
 )
-from screwkit.closure.solve import Solution
+from screwkit.closure.solve import Solution, check_solution
 from screwkit.closure.threads import block_threads
 from screwkit.common.compiling import CLOSED_FORM_KERNEL, prepare_kernels
 from screwkit.model.mechanism import Mechanism
@@ -81,6 +81,7 @@ def chain_screws(
         ``solution.reachable``), or fill them with the reference assembly's screws (finite
         placeholders: mask the results with ``solution.reachable``).
     """
+    check_solution(mechanism, solution, "chain_screws")
     if frame not in ("world", "base"):
         raise ValueError(f"Expected `frame` 'world' or 'base', got {frame!r}.")
     if unreachable not in ("raise", "drop", "reference"):

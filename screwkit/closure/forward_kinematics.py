@@ -83,8 +83,12 @@ def forward(
     targets = np.asarray(actuator_values, dtype=float)
     if targets.shape[-1:] != (len(selected),):
         raise ValueError(f"Expected `actuator_values` with shape (..., {len(selected)}), got {targets.shape}.")
-    poses = mechanism.check_poses(initial_pose)
-    batch = np.broadcast_shapes(targets.shape[:-1], poses.shape[:-1])
+    poses = mechanism.check_poses(initial_pose, where="`initial_pose`")
+    try:
+        batch = np.broadcast_shapes(targets.shape[:-1], poses.shape[:-1])
+    except ValueError:
+        raise ValueError(f"Expected batches of `actuator_values` {targets.shape[:-1]} and `initial_pose` "
+                         f"{poses.shape[:-1]} that broadcast together (equal, or one of them a single one).") from None
     targets = np.broadcast_to(targets, batch + (len(selected),)).reshape(-1, len(selected))
     poses = np.array(np.broadcast_to(poses, batch + (mechanism.n_task,)).reshape(-1, mechanism.n_task))
     angular = np.array([not mechanism.chains[chain].prismatic[joint] for chain, joint in selected])

@@ -337,6 +337,13 @@ def solve(
 
 def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = ()) -> str:
     """Why the pose at ``index`` of a solution is unreachable, worst chain first (one line)."""
+    check_solution(mechanism, solution, "unreachable_reason")
+    batch = solution.batch_shape
+    index = tuple(index) if isinstance(index, (tuple, list)) else (index,)
+    if len(index) != len(batch) or not all(isinstance(i, (int, np.integer)) and not isinstance(i, bool) and -n <= i < n
+                                           for i, n in zip(index, batch)):
+        raise ValueError(f"Expected `index` of one pose of the solution's batch {batch} (a tuple of {len(batch)} "
+                         f"int), got {index!r}.")
     status = solution.status[index]
     residuals = solution.residuals[index]
     missing = [c for c in np.flatnonzero(status == MISSES_CLOSURE)]
@@ -399,9 +406,22 @@ def solve_one(mechanism: Mechanism, pose: ArrayLike, **options) -> Solution:
 def actuator_values(mechanism: Mechanism, joint_values: Sequence[ArrayLike]) -> NDArray[np.float64]:
     """Values (..., a) of all actuators, in :attr:`~Mechanism.actuators` order.
 
-    ``joint_values`` holds one array (..., m_i) per chain, e.g. ``solution.joint_values``.
+    ``joint_values`` holds one array (..., m_i) per chain, e.g. ``solution.joint_values`` (or the solution).
     """
-    joint_values = tuple(joint_values)
+    require_mechanism(mechanism, "actuator_values")
+    if isinstance(joint_values, Solution):
+        joint_values = check_solution(mechanism, joint_values, "actuator_values").joint_values
+    try:
+        joint_values = tuple(np.asarray(values, dtype=float) for values in joint_values)
+    except (TypeError, ValueError):
+        raise ValueError(f"Expected `joint_values` as one numeric array (..., m_i) per chain of {mechanism.name!r}, "
+                         f"got {joint_values!r:.60}.") from None
+    given = [values.shape[-1:] for values in joint_values]
+    wanted = [(chain.n_joints,) for chain in mechanism.chains]
+    if given != wanted or len({values.shape[:-1] for values in joint_values}) > 1:
+        raise ValueError(f"Expected `joint_values` of mechanism {mechanism.name!r}: {len(wanted)} arrays (..., m_i) "
+                         f"of one batch shape, m_i = {[m for m, in wanted]}, got shapes "
+                         f"{[values.shape for values in joint_values]}.")
     return np.stack([np.asarray(joint_values[chain])[..., joint]
                      for chain, joint in mechanism.actuator_positions(None)], -1)
 
@@ -411,6 +431,7 @@ def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.fl
 
     Returns an array (..., n_chains); NaN where the chain did not close.
     """
+    check_solution(mechanism, solution, "closure_residuals")
     rotation, translation = mechanism.transforms_from_poses(solution.full_poses)
     residuals = []
     for index, chain in enumerate(mechanism.chains):
@@ -419,3 +440,19 @@ def closure_residuals(mechanism: Mechanism, solution: Solution) -> NDArray[np.fl
         error = pose_error(target_rotation, target_translation, frames.end_rotation, frames.end_translation)
         residuals.append(np.linalg.norm(error, axis=-1))
     return np.stack(residuals, -1)
+
+
+def check_solution(mechanism: Mechanism, solution: Solution, function: str) -> Solution:
+    """``solution``, checked to be a :class:`Solution` of ``mechanism`` (its chains, their joints and its task
+    coordinates), or a one-line error saying what ``function`` got instead."""
+    require_mechanism(mechanism, function)
+    if not isinstance(solution, Solution):
+        raise TypeError(f"{function} expects a Solution (from screwkit.closure.solve or forward), got "
+                        f"{type(solution).__name__}.")
+    joints = [axes.shape[-2] for axes in solution.joint_axes]
+    if joints != [chain.n_joints for chain in mechanism.chains] or solution.poses.shape[-1] != mechanism.n_task:
+        raise ValueError(f"Expected a Solution of mechanism {mechanism.name!r} ({len(mechanism.chains)} chains of "
+                         f"{[chain.n_joints for chain in mechanism.chains]} joints, {mechanism.n_task} task "
+                         f"coordinates) in {function}, got one of {len(joints)} chains of {joints} joints, "
+                         f"{solution.poses.shape[-1]} task coordinates: solved for another mechanism.")
+    return solution

@@ -40,6 +40,7 @@ output is the platform frame.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from os import PathLike
 from pathlib import Path
 
 import numpy as np
@@ -439,6 +440,11 @@ def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple
 def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | None = None) -> GraphMechanism:
     """The closed tree assembled at the file's configuration (or at ``q``, a closed configuration, with the length
     scale ``scale``), its legs and their equivalent chains."""
+    if not isinstance(tree, ClosedTree):
+        got = (f"the name or path {str(tree)!r}: read it first, graph_mechanism(read_closed_tree(path)), a bundled "
+               "name's path from screwkit.io.loader.bundled_path(name)" if isinstance(tree, (str, PathLike))
+               else f"{type(tree).__name__}")
+        raise TypeError(f"graph_mechanism expects a ClosedTree (from screwkit.io.read_closed_tree), got {got}.")
     model = tree.model
     report = ImportReport(source=tree.source, file_format=tree.file_format)
     at_file = q is None or scale is None

@@ -174,6 +174,9 @@ def _content(path: Path, max_bytes: int) -> bytes | None:
 
 def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None, limits: bool = True) -> Mechanism:
     """Load a mechanism from the text of a URDF (``source`` names it in messages; ``limits``: as :func:`load`)."""
+    if not isinstance(text, (str, bytes, bytearray, memoryview)):
+        hint = ": a file or a bundled name is opened by screwkit.load(path)" if isinstance(text, os.PathLike) else ""
+        raise TypeError(f"load_text expects the text of a URDF (str or bytes), got {type(text).__name__}{hint}.")
     return mechanism_from_description(parse_urdf(text, source, length_unit=length_unit), limits=limits)
 
 

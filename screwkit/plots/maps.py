@@ -23,6 +23,7 @@ from screwkit.plots.style import (
     fixed_coordinates,
     index_label,
     pyplot,
+    require_dataset,
     wrap_text,
 )
 
@@ -98,6 +99,8 @@ def map_figure(dataset, variables=None, reference=None, *, vmin=None, vmax=None,
     plt = pyplot()
     low, high = colour_scale(vmin, vmax)
     dataset, reference = _as_dataset(dataset), _as_dataset(reference)
+    for data in (dataset, reference) if reference is not None else (dataset,):
+        require_dataset(data, "map_figure", "a map (the xarray.Dataset or GridMap of screwkit.studies.maps.index_map)")
     rows = [dataset] + ([reference] if reference is not None else [])
     if variables is None:
         variables = [v for v in ("iti", "lmti") if v in dataset.data_vars]

@@ -47,6 +47,15 @@ def pyplot():
     return plt
 
 
+def require_dataset(data, function: str, takes: str) -> None:
+    """A TypeError saying what ``function`` takes (``takes``) when ``data`` is no xarray Dataset (a file's path:
+    open it first)."""
+    if hasattr(data, "data_vars"):
+        return
+    opened = ": open the file first, xarray.open_dataset(path)" if isinstance(data, (str, os.PathLike)) else ""
+    raise TypeError(f"{function} expects {takes}, got {type(data).__name__} {data!r:.60}{opened}.")
+
+
 # --------------------------------------------------------------------------------------------
 # Names and units
 # --------------------------------------------------------------------------------------------

@@ -25,6 +25,7 @@ from screwkit.plots.style import (
     fixed_coordinates,
     index_label,
     pyplot,
+    require_dataset,
     wrap_text,
 )
 
@@ -162,6 +163,7 @@ def sweep_figure(dataset):
     ValueError
         If the dataset has no ``iti`` or ``lmti`` variable along one dimension.
     """
+    require_dataset(dataset, "sweep_figure", "a sweep (the xarray.Dataset of screwkit.studies.sweep.sweep)")
     plt = pyplot()
     for name in ("iti", "lmti"):
         if name not in dataset.data_vars or dataset[name].ndim != 1:

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.common.decimals import degrees_as_written
 from screwkit.common.units import is_angular
 
-__all__ = ["shown_values", "shown_number", "pose_text", "map_axis", "NOISE"]
+__all__ = ["shown_values", "shown_number", "pose_text", "map_axis", "one_pose", "planar_position", "NOISE"]
 
 NOISE = 1e-12
 """A fixed coordinate smaller than this (in degrees for angles; times the mechanism's length scale for lengths)
@@ -62,3 +62,24 @@ def map_axis(values: ArrayLike, what: str) -> NDArray[np.float64]:
     if not np.all(np.isfinite(array)):
         raise ValueError(f"Expected finite values in {what}.")
     return array
+
+
+def one_pose(mechanism, at: ArrayLike, where: str = "`at`") -> NDArray[np.float64]:
+    """``at`` checked as one pose (n_task,) of ``mechanism`` (:meth:`~screwkit.model.Mechanism.check_poses`), a
+    ValueError naming ``where`` for a batch of poses (a study fixes the other coordinates at one pose)."""
+    at = mechanism.check_poses(at, where=where)
+    if at.ndim != 1:
+        raise ValueError(f"Expected one pose as {where}, shape ({mechanism.n_task},), got {at.shape}.")
+    return at
+
+
+def planar_position(centre, where: str = "`centre`") -> NDArray[np.float64]:
+    """``centre`` checked as a position (x, y) in m: two finite numbers, or a ValueError naming ``where``."""
+    try:
+        given = np.asarray(centre)
+    except (TypeError, ValueError):  # ragged
+        given = np.full(0, np.nan)
+    position = given.astype(float) if given.dtype.kind in "iuf" else np.full(0, np.nan)  # no bool, str, complex
+    if position.shape != (2,) or not np.all(np.isfinite(position)):
+        raise ValueError(f"Expected {where} as a position (x, y): two finite numbers (m), got {centre!r:.60}.")
+    return position

@@ -30,11 +30,11 @@ from screwkit.indices.registry import index_columns
 from screwkit.io.graph import GraphMechanism
 from screwkit.io.loader import cached_mechanism
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.studies.coordinates import map_axis, pose_text, shown_values
+from screwkit.studies.coordinates import map_axis, one_pose, planar_position, pose_text, shown_values
 from screwkit.studies.files import atomic_write
 from screwkit.studies.graph_source import GraphSource, cached_graph, graph_source
 from screwkit.studies.netcdf import netcdf_attribute, netcdf_file
-from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.options import AnalysisOptions, checked_analysis
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.tasks import Execution, run_tasks
 
@@ -376,12 +376,15 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
         variables ``iti``, ``lmti``, ``f_o{j}``, ``f_io{j}`` (NaN where unreachable for some
         orientation of the set) and ``reachable_fraction``.
     """
-    analysis = AnalysisOptions() if analysis is None else analysis
+    analysis = checked_analysis(analysis, "index_map")
     if isinstance(mechanism, GraphMechanism):
         check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
     else:
         require_mechanism(mechanism, "index_map")
     names = mechanism.task_coordinates
+    for name, given in (("grid", grid), ("over", over)):
+        if not isinstance(given, dict):
+            raise TypeError(f"index_map expects `{name}` as a dict of task coordinates to values, got {given!r:.60}.")
     if len(grid) != 2:
         raise ValueError(f"Expected `grid` with exactly two task coordinates, got {list(grid)}.")
     for name in list(grid) + list(over):
@@ -402,7 +405,7 @@ def index_map(mechanism: Mechanism, grid: dict[str, ArrayLike], over: dict[str, 
     size = map_size(mechanism, grid, over, mask, analysis.faults)
     size.check(max_configurations=max_configurations, proceed=proceed)
     mask = np.ones(shape, dtype=bool) if mask is None else mask
-    at = mechanism.check_poses(mechanism.home_pose if at is None else at)
+    at = one_pose(mechanism, mechanism.home_pose if at is None else at)
     over_axes = tuple(names.index(name) for name in over)
     over_values = orientation_set(over)
     configurations_per_task = execution.configurations_per_task
@@ -489,6 +492,7 @@ def disc_grid(radius: float, step: float, centre=(0.0, 0.0)) -> tuple[NDArray, N
     count = int(math.floor(radius / step + 1e-9))
     offsets = step * np.arange(-count, count + 1)
     mask = offsets[None, :] ** 2 + offsets[:, None] ** 2 <= radius**2 * (1 + 1e-12)
+    centre = planar_position(centre)
     return centre[0] + offsets, centre[1] + offsets, mask
 
 
@@ -524,8 +528,7 @@ def planar_disc_map(mechanism: Mechanism, radius: float, step: float, phi_step_d
     disc_size(mechanism, radius, step, phi_step_degrees).check(
         proceed=proceed, max_configurations=keywords.get("max_configurations", MAX_CONFIGURATIONS))
     home = mechanism.home_pose
-    centre = home[:2] if centre is None else np.asarray(centre, dtype=float)
-    x_values, y_values, mask = disc_grid(radius, step, centre)
+    x_values, y_values, mask = disc_grid(radius, step, home[:2] if centre is None else centre)
     rotating = "phi" in mechanism.task_coordinates
     over = {"phi": np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))} if rotating else {}
     result = index_map(mechanism, {"x": x_values, "y": y_values}, over, home, mask=mask, proceed=proceed,

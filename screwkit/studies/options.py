@@ -17,7 +17,7 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.average import AGGREGATES, averaging
 from screwkit.indices.faults import FAULT_TYPES
 
-__all__ = ["AnalysisOptions"]
+__all__ = ["AnalysisOptions", "checked_analysis"]
 
 
 @dataclass(frozen=True)
@@ -74,3 +74,14 @@ class AnalysisOptions:
         """A context in which the indices asked for are registered: with ``aggregate="mean"``, the average case
         (:func:`screwkit.indices.average.averaging`); else nothing to do."""
         return averaging(self.probabilities) if self.aggregate == "mean" else nullcontext()
+
+
+def checked_analysis(analysis, function: str) -> AnalysisOptions:
+    """``analysis`` (None: the default :class:`AnalysisOptions`), or a TypeError saying what ``function`` takes."""
+    if analysis is None:
+        return AnalysisOptions()
+    if not isinstance(analysis, AnalysisOptions):
+        hint = f": pass AnalysisOptions(**{analysis!r:.60})" if isinstance(analysis, dict) else ""
+        raise TypeError(f"{function} expects `analysis` as a screwkit.studies.options.AnalysisOptions, got "
+                        f"{type(analysis).__name__}{hint}.")
+    return analysis

@@ -159,11 +159,16 @@ def checked_times(times: ArrayLike | None, count: int) -> NDArray[np.float64] | 
     return times
 
 
+def _check_samples(samples: int) -> None:
+    """A ValueError for ``samples`` that is not a whole number >= 2 (a float, a string, a bool: not a count)."""
+    if isinstance(samples, (bool, np.bool_)) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ValueError(f"Expected `samples`: at least 2 samples on a path, a whole number, got {samples!r}.")
+
+
 def line_path(mechanism: Mechanism, start: ArrayLike, stop: ArrayLike, samples: int) -> Path:
     """``samples`` poses evenly spaced on the straight segment from ``start`` to ``stop`` (task coordinates, m
     and rad), both included."""
-    if samples < 2:
-        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    _check_samples(samples)
     start, stop = mechanism.check_poses(start), mechanism.check_poses(stop)
     fractions = np.linspace(0.0, 1.0, samples)[:, None]
     return path_from_poses(mechanism, start + fractions * (stop - start))
@@ -173,8 +178,7 @@ def circle_path(mechanism: Mechanism, centre: ArrayLike, radius: float, samples:
     """``samples`` poses on the circle of ``radius`` (m) about ``centre`` (task coordinates) in the x-y plane of
     the task coordinates, the other coordinates fixed at the centre's; a full turn from ``+x``, counter-clockwise,
     the first pose repeated at the end."""
-    if samples < 2:
-        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    _check_samples(samples)
     names = mechanism.task_coordinates
     if "x" not in names or "y" not in names:
         raise ValueError(f"A circle lies in the x-y plane; {mechanism.name!r} has task coordinates "
@@ -193,8 +197,7 @@ def through_path(mechanism: Mechanism, poses: ArrayLike, samples: int) -> Path:
     """The piecewise-linear path through ``poses`` (k >= 2, (k, n_task); m, rad), straight in task coordinates
     between consecutive poses: ``samples`` points evenly spaced in arc length over the whole path, and every pose
     given (its corners are samples)."""
-    if samples < 2:
-        raise ValueError(f"Expected at least 2 samples on a path, got {samples}.")
+    _check_samples(samples)
     corners = path_from_poses(mechanism, poses)
     return path_from_poses(mechanism, corners.at(np.union1d(np.linspace(0.0, corners.length, samples),
                                                             corners.arc_length)))

@@ -19,7 +19,7 @@ from screwkit.common.units import is_angular
 from screwkit.indices.results import set_label
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
-from screwkit.studies.coordinates import pose_text, shown_values
+from screwkit.studies.coordinates import one_pose, pose_text, shown_values
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 
 __all__ = ["sweep"]
@@ -68,8 +68,16 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         require_mechanism(mechanism, "sweep")
     if coordinate not in mechanism.task_coordinates:
         raise ValueError(f"Expected `coordinate` in {mechanism.task_coordinates}, got {coordinate!r}.")
-    at = mechanism.check_poses(at)
-    values = np.asarray(values, dtype=float)
+    at = one_pose(mechanism, at)
+    try:  # (a string such as "0:360" is not numbers; nor are booleans)
+        given = np.asarray(values)
+        if given.dtype.kind not in "iuf":
+            raise TypeError
+    except (TypeError, ValueError):
+        raise ValueError(f"Expected `values` as numbers (k,) of {coordinate} (m or rad), got {values!r:.60}.") from None
+    values = given.astype(float)
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"Expected finite `values`, got {values[~np.isfinite(values)][0]}.")
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"Expected `values` with shape (k,), k >= 1, got {values.shape}.")
     axis = mechanism.task_coordinates.index(coordinate)
@@ -98,3 +106,4 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
                          fixed_pose=pose_text(mechanism.task_coordinates, at, mechanism.length_scale, [coordinate]),
                          method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
     return dataset
+

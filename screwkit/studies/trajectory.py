@@ -43,7 +43,7 @@ from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
-from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.options import AnalysisOptions, checked_analysis
 from screwkit.studies.path_mechanisms import GraphPath, SerialPath, path_mechanism
 from screwkit.studies.paths import Path, checked_tolerance, path_from_poses
 from screwkit.studies.refinement import (
@@ -270,11 +270,12 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     if not isinstance(mechanism, GraphMechanism):
         require_mechanism(mechanism, "trajectory")
     path = path if isinstance(path, Path) else path_from_poses(mechanism, path, times)
-    analysis = analysis or AnalysisOptions()
+    analysis = checked_analysis(analysis, "trajectory")
     if aggregate not in AGGREGATES:
         raise ValueError(f"Expected `aggregate` in {', '.join(AGGREGATES)}, got {aggregate!r}.")
-    if not np.isfinite(level) or not 0 < level <= 1:
-        raise ValueError(f"Expected a level in (0, 1], got {level!r}.")
+    if isinstance(level, (bool, np.bool_)) or not isinstance(level, (int, float, np.integer, np.floating)) \
+            or not 0 < level <= 1:  # (NaN too)
+        raise ValueError(f"Expected `level` in (0, 1] (an LMTI), got {type(level).__name__} {level!r}.")
     if tolerance is None:  # the default; at most a thousandth of a path shorter than a thousandth of the scale
         tolerance = RELATIVE_TOLERANCE * min(mechanism.length_scale, 1e3 * path.length)
     tolerance = checked_tolerance(path, tolerance)  # from a few ulps of the arc length to below the path's length

@@ -33,8 +33,8 @@ from screwkit.studies.maps import (
 from screwkit.studies.options import AnalysisOptions
 
 __all__ = ["METRICS", "MAXIMISED", "UNITS", "MAX_CONFIGURATIONS_PER_DESIGN", "Region", "disc_region", "grid_region",
-           "default_region", "region_size", "check_region_size", "turn_count", "check_turn_count", "region_maps",
-           "region_metrics", "inscribed_radius"]
+           "default_region", "region_size", "check_region_size", "turn_count", "check_turn_count", "check_disc",
+           "real_number", "region_maps", "region_metrics", "inscribed_radius"]
 
 MAX_CONFIGURATIONS_PER_DESIGN = 10**8
 """Poses a design may be evaluated at (grid points x orientations x layers); a larger region is refused from
@@ -274,15 +274,38 @@ def turn_count(phi_step_degrees: float) -> int | None:
     return max(1, math.ceil((360.0 - 1e-9) / phi_step_degrees))
 
 
-def check_turn_count(phi_step_degrees: float, name: str = "phi_step_degrees") -> int:
-    """:func:`turn_count`, refused (ValueError naming ``name``) for a step that is not > 0 or that makes more than
-    :data:`MAX_CONFIGURATIONS_PER_DESIGN` angles, before any angle is listed."""
+def check_turn_count(phi_step_degrees: float, name: str = "`phi_step_degrees`") -> int:
+    """:func:`turn_count`, refused (ValueError naming ``name``) for a step that is not in (0, 360] (a larger one
+    would score the single angle 0 as a full turn) or that makes more than :data:`MAX_CONFIGURATIONS_PER_DESIGN`
+    angles, before any angle is listed."""
+    phi_step_degrees = real_number(phi_step_degrees, name)
     turns = turn_count(phi_step_degrees)
-    if turns is None:
-        raise ValueError(f"Expected {name} > 0 (deg), got {phi_step_degrees!r}.")
+    if turns is None or phi_step_degrees > 360:
+        raise ValueError(f"Expected 0 < {name} <= 360 (deg), got {phi_step_degrees!r}.")
     if turns > MAX_CONFIGURATIONS_PER_DESIGN:
         raise ValueError(f"{name} {phi_step_degrees:g} makes {turns:,} angles of the full turn per design, more than "
                          "10^8: use a larger step.")
+    return turns
+
+
+def real_number(value, name: str) -> float:
+    """``value`` as a float, or a TypeError naming ``name`` for what is not a real number (a string, a bool, an
+    array)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"Expected {name} to be a number, got {type(value).__name__} {value!r:.60}.")
+    return float(value)
+
+
+def check_disc(radius: float, step: float, phi_step_degrees: float) -> int:
+    """The turns of a disc of ``radius`` and grid ``step`` (m) turned in ``phi_step_degrees`` steps, each refused
+    in one line naming it when it is not a finite number > 0 (and the step within a turn), or the disc when it
+    has more than :data:`MAX_CONFIGURATIONS_PER_DESIGN` configurations, before any grid is built."""
+    for name, value in (("radius", radius), ("step", step)):
+        value = real_number(value, f"`{name}`")
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"Expected `{name}` > 0 (m), got {value!r}.")
+    turns = check_turn_count(phi_step_degrees)
+    _check_size(_disc_points(float(radius), float(step)), turns)
     return turns
 
 

@@ -23,10 +23,11 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.indices.analysis import analyze
 from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.closed_forms import planar_indices
-from screwkit.model import Mechanism
+from screwkit.model import Mechanism, require_mechanism
 from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
+from screwkit.studies.coordinates import planar_position
 from screwkit.studies.design.families import permutation_rank
-from screwkit.studies.design.objectives import check_turn_count
+from screwkit.studies.design.objectives import check_disc, check_turn_count, real_number
 from screwkit.studies.poses import planar_points
 from screwkit.studies.tasks import Execution, run_tasks
 
@@ -40,6 +41,7 @@ def planar_design(mechanism: Mechanism) -> PlanarDesign:
     Base and platform joint points, arm lengths and working mode are read from the solved
     reference assembly (base frame), so any planar RRR URDF can be searched.
     """
+    require_mechanism(mechanism, "planar_design")
     if not mechanism.is_planar:
         raise ValueError(f"Design search needs a planar n-RRR; {mechanism.name!r} is spatial.")
     if mechanism.task_coordinates != ("x", "y", "phi"):
@@ -74,10 +76,21 @@ def slot_design(design: PlanarDesign, permutation, working_mode: int | None = No
     kept unless given (+1 or -1 for every chain).
     """
     n = design.chain_count
-    permutation = np.asarray(permutation, dtype=int)
-    if permutation.shape != (n,) or sorted(permutation.tolist()) != list(range(n)):
-        raise ValueError(f"Expected `permutation` to be a permutation of 0..{n - 1}, got {permutation.tolist()}.")
-    radius = float(np.mean(np.linalg.norm(design.platform, axis=-1))) if platform_radius is None else platform_radius
+    try:  # whole numbers only: 3.9 is no slot (not slot 3)
+        given = np.asarray(permutation, dtype=float)
+    except (TypeError, ValueError):
+        given = np.full(1, np.nan)
+    if given.shape != (n,) or not np.all(given == np.round(given)) or sorted(given.tolist()) != list(range(n)):
+        raise ValueError(f"Expected `permutation` to be a permutation of 0..{n - 1}, got {permutation!r:.80}.")
+    permutation = given.astype(int)
+    if working_mode is not None and working_mode not in (1, -1):
+        raise ValueError(f"Expected `working_mode` +1 or -1 (or None: kept), got {working_mode!r}.")
+    if platform_radius is None:
+        radius = float(np.mean(np.linalg.norm(design.platform, axis=-1)))
+    else:
+        radius = real_number(platform_radius, "`platform_radius`")
+        if not (np.isfinite(radius) and radius > 0):
+            raise ValueError(f"Expected `platform_radius` > 0 (m), got {platform_radius!r}.")
     angles = permutation * 2 * np.pi / n
     platform = radius * np.column_stack([np.cos(angles), np.sin(angles)])
     mode = design.working_mode if working_mode is None else np.full(n, float(working_mode))
@@ -95,8 +108,10 @@ def rotation_score(design: PlanarDesign, centre=(0.0, 0.0), phi_step_degrees: fl
         raise ValueError(f"Expected `aggregate` in {', '.join(AGGREGATES)}, got {aggregate!r}.")
     if probabilities is not None and aggregate != "mean":
         raise ValueError("Failure probabilities weight the mean: give them with aggregate='mean'.")
+    check_turn_count(phi_step_degrees)
+    x, y = planar_position(centre)
     phi = np.deg2rad(np.arange(0.0, 360.0 - 1e-9, phi_step_degrees))
-    poses = np.column_stack([np.full_like(phi, centre[0]), np.full_like(phi, centre[1]), phi])
+    poses = np.column_stack([np.full_like(phi, x), np.full_like(phi, y), phi])
     base, elbows, distal, reachable = planar_joint_points(design, poses)
     if not np.all(reachable):
         return float("nan")
@@ -182,6 +197,9 @@ def fault_tolerant_area(design: PlanarDesign, *, level: float = 0.4, radius: flo
     grid : ndarray (k, k)
         Minimum over the rotation at every grid point (NaN outside the disc or unreachable).
     """
+    check_disc(radius, step, phi_step_degrees)
+    if not 0 <= real_number(level, "`level`") <= 1:  # (NaN too) the indices are in [0, 1]
+        raise ValueError(f"Expected `level` in [0, 1] (an index value), got {level!r}.")
     count = int(np.floor(radius / step + 1e-9))
     offsets = step * np.arange(-count, count + 1)
     x, y = np.meshgrid(offsets, offsets)
