@@ -10,7 +10,7 @@ from screwkit.closure import chain_screws, solve
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.solve import _PoseCache
 from screwkit.common.rotations import rotation_from_rotation_vector
-from screwkit.io.loader import load
+from screwkit.io.loader import bundled_path, load
 
 BRANCHES = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
 
@@ -117,3 +117,68 @@ def test_compiled_closure_keeps_the_indices_in_other_units_scales_and_world_fram
                                        err_msg=f"{label} {key}")
         for j, value in reference.f_o.items():
             np.testing.assert_allclose(other.f_o[j], value, rtol=0, atol=1e-9, err_msg=f"{label} f_o{j}")
+
+
+def rod_stretched_height(mechanism) -> float:
+    """The platform height above the RSS hexapod's home pose where its first rod is stretched (its end as far from
+    the crank circle as the rod is long), found by bisection in 50-digit arithmetic on the crank-rod geometry of the
+    file (crank point, axis and arm, rod length): the boundary of the leg's reach as a vertical rise meets it."""
+    import mpmath
+
+    mpmath.mp.dps = 50
+    chain, home = mechanism.chains[0].closed_form, mechanism.home_pose
+
+    def attachment(z):
+        pose = home.copy()
+        pose[2] = z
+        return mechanism.loop_targets(0, *mechanism.transforms_from_poses(pose[None]))[1][0]
+
+    start, along_z = attachment(home[2]), attachment(home[2] + 1.0) - attachment(home[2])
+    c, n, v = (mpmath.matrix([float(x) for x in a]) for a in (chain.crank_point, chain.crank_axis, chain.crank_vector))
+    length = mpmath.mpf(float(chain.rod_length))
+
+    def dot(a, b):
+        return sum(a[i] * b[i] for i in range(3))
+
+    def excess(s):  # |constant| - amplitude of the crank angle's equation: > 0 out of reach
+        o = mpmath.matrix([float(x) for x in start]) + s * mpmath.matrix([float(x) for x in along_z]) - c
+        perpendicular = v - dot(v, n) * n
+        binormal = mpmath.matrix([n[1] * perpendicular[2] - n[2] * perpendicular[1],
+                                  n[2] * perpendicular[0] - n[0] * perpendicular[2],
+                                  n[0] * perpendicular[1] - n[1] * perpendicular[0]])
+        constant = (dot(o, o) + dot(v, v) - length**2) / 2 - dot(o, dot(v, n) * n)
+        return abs(constant) - mpmath.sqrt(dot(o, perpendicular) ** 2 + dot(o, binormal) ** 2)
+
+    low, high = mpmath.mpf(0), mpmath.mpf(1)
+    assert excess(low) < 0 < excess(high)
+    for _ in range(200):
+        middle = (low + high) / 2
+        low, high = (low, middle) if excess(middle) > 0 else (middle, high)
+    return float(home[2] + low)
+
+
+def test_a_stretched_rod_is_reached_in_every_unit_and_world_frame_by_numpy_and_the_kernel(tmp_path):
+    """At the boundary of an R-U-S leg's reach the closed forms decided "reachable" by the sign of a difference that
+    rounding sets: of nine heights one ulp apart about the stretched rod, the first two were out of reach and the
+    next seven within. Now each is reached (the rod stretched: the ITI of its crank 0), by numpy and by the kernel,
+    in metres, millimetres and another world frame; a height 1e-9 of the scale beyond stays out of reach."""
+    mechanism = load("rss_hexapod_8")
+    z = [rod_stretched_height(mechanism) - 4 * np.spacing(1.6)]
+    for _ in range(16):
+        z.append(np.nextafter(z[-1], 2.0))
+    beyond = z[-1] + 1e-9 * mechanism.length_scale
+    written = bundled_path("rss_hexapod_8").read_text()
+    variants = {"m": written, "mm": in_millimetres(written, declare=True),
+                "moved": moved_in_the_world(written, (0.4, -0.3, 0.2), (0.3, -0.2, 0.6))}
+    for name, text in variants.items():
+        path = tmp_path / f"rss_{name}.urdf"
+        path.write_text(text)
+        variant = load(path)
+        poses = np.repeat(variant.home_pose[None], len(z) + 1, 0)
+        poses[:, 2] = variant.home_pose[2] - mechanism.home_pose[2] + np.array([*z, beyond])
+        small = solve(variant, poses)  # numpy below COMPILED_FROM poses
+        large = solve(variant, np.tile(poses, (COMPILED_FROM // len(poses) + 1, 1)))  # the kernel
+        for solution in (small, large):
+            reached = np.asarray(solution.reachable).reshape(-1, len(poses))
+            assert reached[:, :-1].all(), (name, reached)
+            assert not reached[:, -1].any(), name

@@ -79,9 +79,10 @@ file, and the tolerance of recognising a chain's closed-form type (axes parallel
 coincident, axes along z), so that a file written to 6 decimals keeps its closed forms."""
 
 BOUNDARY_ROUNDING = 1e-12
-"""Dimensionless: how far (relative to the distance) a closed-form chain's end may lie beyond the boundary of its
-reach and still be reached, stretched or folded: there its square height is decided by rounding, which the unit and
-the world frame of the file change (a pose of a map at the boundary was reachable in metres and not in millimetres)."""
+"""Dimensionless: how far a closed-form chain's end may lie beyond the boundary of its reach (relative to the
+squared distances of the R-R-R leg's or the R-U-S leg's equation) and still be reached, stretched or folded: there
+the sign that decides is set by rounding, which the unit and the world frame of the file change (a pose of a map at
+the boundary was reachable in metres and not in millimetres)."""
 
 NEWTON_TOLERANCE = 1e-11
 """Radians and length scales: a chain solved by damped Newton is closed when its loop error norm

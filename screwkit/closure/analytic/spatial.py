@@ -25,7 +25,7 @@ from screwkit.common.rotations import (
     two_axis_pointing,
     wrap_angle,
 )
-from screwkit.common.tolerances import CLOSURE_TOLERANCE
+from screwkit.common.tolerances import BOUNDARY_ROUNDING, CLOSURE_TOLERANCE
 from screwkit.model.chain import ChainGeometry
 
 
@@ -272,7 +272,9 @@ class CrankRodChain(SpatialClosedForm):
             np.sum(offset * offset, -1) + self.crank_vector @ self.crank_vector - self.rod_length**2
         ) - offset @ along
         amplitude = np.hypot(cosine_coefficient, sine_coefficient)
-        gap = np.maximum(np.abs(constant) - amplitude, 0.0) / np.linalg.norm(perpendicular)
+        excess = np.abs(constant) - amplitude  # a stretched or folded rod within rounding of its reach: reached
+        excess = np.where(excess > BOUNDARY_ROUNDING * np.maximum(np.abs(constant), amplitude), excess, 0.0)
+        gap = excess / np.linalg.norm(perpendicular)
         crank = np.arctan2(sine_coefficient, cosine_coefficient) + crank_sign * np.arccos(
             np.clip(constant / np.where(amplitude > 0.0, amplitude, 1.0), -1.0, 1.0)
         )

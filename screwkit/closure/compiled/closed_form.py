@@ -20,6 +20,7 @@ import numpy as np
 
 from screwkit.closure.compiled.frames import apply, leg_frames, log_map, matrix_at, mul, rotation_about
 from screwkit.common.jit import njit
+from screwkit.common.tolerances import BOUNDARY_ROUNDING
 
 __all__ = ["spatial_closed_form_kernel", "joint_screws_kernel"]
 
@@ -98,7 +99,10 @@ def _crank_rod(parameters, t0, t1, t2, crank_sign, universal_sign, values):
     constant = (0.5 * (_dot(o0, o1, o2, o0, o1, o2) + _dot(v0, v1, v2, v0, v1, v2) - rod_length * rod_length)
                 - _dot(o0, o1, o2, w0, w1, w2))
     amplitude = math.hypot(cosine_coefficient, sine_coefficient)
-    gap = max(abs(constant) - amplitude, 0.0) / math.sqrt(_dot(p0, p1, p2, p0, p1, p2))
+    excess = abs(constant) - amplitude  # within rounding of the rod's reach: reached (as CrankRodChain)
+    if excess <= BOUNDARY_ROUNDING * max(abs(constant), amplitude):
+        excess = 0.0
+    gap = excess / math.sqrt(_dot(p0, p1, p2, p0, p1, p2))
     ratio = constant / (amplitude if amplitude > 0.0 else 1.0)
     crank = (math.atan2(sine_coefficient, cosine_coefficient)
              + crank_sign * math.acos(min(1.0, max(-1.0, ratio))))
