@@ -353,3 +353,23 @@ def test_a_spherical_wrist_has_no_cti_and_says_why(tmp_path):
     completed = screwkit("analyze", path)
     assert completed.returncode == 0, completed.stderr
     assert "CTI  not applicable: every chain holds the same 3 constraint wrenches" in completed.stdout
+
+
+def test_a_stretched_delta_in_the_batch_leaves_the_cti_of_the_other_poses_as_they_are_alone():
+    """The constraint structure was planned from every sampled configuration, the Delta at the boundary of its
+    workspace (every arm stretched, a constraint wrench more per chain) included: added to a batch, it set the CTI
+    of every other pose to 0 (a sweep from the boundary printed cti 0 on every row). Now the plan reads the samples
+    where every chain has its largest rank; each pose keeps the CTI it has alone, and the CTI agrees with the
+    couple formula of docs/theory.md on the poses alone."""
+    from screwkit.io.loader import load
+
+    delta = load("delta_4")
+    home = delta.home_pose
+    poses = np.array([home, home + [0.0, 0.0, -0.2], home + [0.0, 0.0, -0.39017542510292885]])
+    alone = [float(indices_at_poses(delta, pose[None], limits=False).cti[0]) for pose in poses[:2]]
+    for pose, value in zip(poses[:2], alone):
+        twists = [chain.twists[0] for chain in chain_screws(delta, solve(delta, pose[None], limits=False))]
+        assert value == pytest.approx(delta_cti(twists), abs=1e-9)
+    batch = indices_at_poses(delta, poses, limits=False)
+    assert 0.4 < min(alone) and batch.cti[:2] == pytest.approx(alone, abs=1e-12)
+    assert batch.lmti[2] == 0.0  # every arm stretched: singular

@@ -176,9 +176,18 @@ def _subsystems(own: list[NDArray], rank: int) -> tuple[tuple[int, ...], ...]:
 
 def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
     """The constraint structure of a mechanism from its chains' twists at sample configurations
-    (working coordinates). Symmetric in the chains: permuting them permutes the plan."""
+    (working coordinates). Symmetric in the chains: permuting them permutes the plan.
+
+    Only the samples where every chain has its largest rank are read: a chain singular at one sample (a Delta arm
+    stretched at the boundary of the workspace) has a constraint wrench more there, and planned from it every
+    configuration of the batch had its constraint subsystems wrong (CTI 0 throughout a sweep that touched the
+    boundary)."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
-    counts = tuple(int(6 - np.max(_rank(twists, tolerance))) for twists in chain_twists)
+    ranks = [_rank(twists, tolerance) for twists in chain_twists]
+    regular = np.all([rank == np.max(rank) for rank in ranks], axis=0)
+    if regular.any():
+        chain_twists = [twists[regular] for twists in chain_twists]
+    counts = tuple(int(6 - np.max(rank)) for rank in ranks)
     wrenches = [chain_constraint_wrenches(twists, c) for twists, c in zip(chain_twists, counts)]
     if min(counts) > 0:
         total = sum(np.eye(6) - np.swapaxes(w, -1, -2) @ w for w in wrenches)
