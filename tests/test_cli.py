@@ -266,3 +266,14 @@ def test_a_first_run_says_it_is_compiling_within_a_second_and_warmup_reports_the
         assert sorted(announced) == sorted(compiled), lines  # every compilation was announced, once
         assert all(" cached, ready after " in line or " compiled, ready after " in line for line in reports), lines
     assert not compiled, lines
+
+
+def test_sweep_at_x_y_of_a_planar_point_output_without_phi():
+    """``sweep five_bar --at "0 0.35"`` (the help's "x y for a planar mechanism", the whole pose of this one) died
+    in a traceback reading a phi the five-bar does not have."""
+    swept = screwkit("sweep", "five_bar", "--at", "0 0.35", "--sweep", "x:-0.05:0.1:0.05")
+    assert swept.returncode == 0 and "Traceback" not in swept.stderr, swept.stderr
+    rows = swept.stdout.splitlines()
+    rows = rows[next(k for k, row in enumerate(rows) if row.startswith("x,reachable,")) + 1:]
+    assert [float(row.split(",")[0]) for row in rows] == [-0.05, 0.0, 0.05], swept.stdout
+    assert all(row.split(",")[1] == "True" for row in rows), swept.stdout

@@ -30,8 +30,9 @@ __all__ = ["sweep", "fixed_pose", "write_outputs"]
 
 
 def fixed_pose(mechanism, at: str | None) -> np.ndarray:
-    """``--at``: every task coordinate (m, deg), a named pose, or for a planar mechanism just x y."""
-    if at is not None and mechanism.is_planar and len(at.split()) == 2:
+    """``--at``: every task coordinate (m, deg), a named pose, or for a planar mechanism just x y (its phi, if it
+    has one, at the home pose's)."""
+    if at is not None and mechanism.is_planar and len(at.split()) == 2 and mechanism.n_task == 3:
         at = f"{at} {float(np.rad2deg(mechanism.home_pose[2]))!r}"
     return parse_pose(mechanism, at, "--at")
 
