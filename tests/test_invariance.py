@@ -509,8 +509,10 @@ def test_a_stretched_leg_is_reached_in_every_unit_and_world_frame(tmp_path):
     """At the boundary of a leg's reach the R-R-R closed form decided "reachable" by the sign of a square height
     that rounding sets: five_bar_3 at (-0.2, 0.35) was unreachable in metres and in millimetres and reachable moved
     in its world, (0.3, 0.3) the other way round, and maps of it differed at 2-4 of 441 points. The leg is
-    stretched there (its elbow on the line from its base joint to the platform joint: ITI 0, a singular
-    configuration); now reached in every unit and frame, with the same indices."""
+    stretched there (its elbow on the line from its base joint to the platform joint: ITI 0, an input singularity);
+    now reached in every unit and frame, with the same indices, which are the paper's closed forms (Eqs. 21-23:
+    the stretched leg's actuation wrench is the force along it; the generic path had it zero there, and so its
+    OTIs: F_O1 0 where the closed forms give 0.5843)."""
     from helpers import in_millimetres, moved_in_the_world
     from screwkit.io.loader import bundled_path, load
     from screwkit.studies import indices_at_poses
@@ -526,9 +528,12 @@ def test_a_stretched_leg_is_reached_in_every_unit_and_world_frame(tmp_path):
         path.write_text(written)
         results[name] = indices_at_poses(load(path), poses, detail=True)
     reference = results["m"]
-    assert reference.reachable.all() and np.all(reference.iti[:2] == 0.0)
     stretched = np.isclose(reference.iti_actuators, 0.0, atol=1e-12)
-    assert stretched.any(axis=-1).all()  # at each pose a stretched leg, whose actuator's ITI is 0
+    assert reference.reachable.all() and stretched.any(axis=-1).all()  # at each pose a stretched leg: ITI 0
+    closed = indices_at_poses(load(tmp_path / "five_bar_3_m.urdf"), poses, closed_forms=True)
+    np.testing.assert_allclose(reference.lmti, closed.lmti, atol=1e-12)
+    np.testing.assert_allclose(reference.f_o[1], closed.f_o[1], atol=1e-12)
+    assert closed.f_o[1][0] == pytest.approx(0.5843193180388375, abs=1e-12)
     for name, result in results.items():
         assert result.reachable.all(), name
         np.testing.assert_allclose(result.lmti, reference.lmti, atol=1e-12, err_msg=name)

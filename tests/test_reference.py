@@ -16,7 +16,7 @@ from helpers import random_reachable_poses
 from screwkit.closure import chain_screws, solve
 from screwkit.io.loader import bundled_names, load
 from screwkit.screw.reference import reference_indices
-from screwkit.studies.poses import analyze_solution, output_points
+from screwkit.studies.poses import analyze_solution, indices_at_poses, output_points
 
 TOLERANCE = 1e-10
 COUNT = 6
@@ -65,6 +65,24 @@ def test_the_compiled_pipeline_equals_the_reference_on_every_bundled_mechanism(n
     mechanism = load(name)
     poses = random_reachable_poses(mechanism, np.random.default_rng(len(name)), COUNT, spread=0.5)
     compare(mechanism, np.concatenate([mechanism.home_pose[None], poses]))
+
+
+@pytest.mark.parametrize("name, poses", [("five_bar", [[0.4, 0.0], [0.4 - 1e-12, 0.0]]),
+                                         ("five_bar_3", [[0.3, 0.3], [-0.2, 0.35], [0.2, 0.4]])])
+def test_at_a_stretched_leg_both_pipelines_give_the_paper_s_closed_forms(name, poses):
+    """At an input singularity (a leg stretched: its actuated joint's twist in the span of the others) the
+    minimum-norm wrench has no solution, and both pipelines made it zero, and with it every OTI of the sets holding
+    that actuator: five_bar at (0.4, 0) had LMTI 0 where the closed forms (Eqs. 21-23, the force along the distal
+    link) give 0.6285, and 0.6285 1e-12 inside. Now the wrench is the limit (in the span of the chain's twists and
+    the motion space, reciprocal to the other joints): the compiled kernel and the numpy reference agree with each
+    other and with the closed forms, and the value is continuous."""
+    mechanism = load(name)
+    poses = np.array(poses)
+    result = compare(mechanism, poses)
+    closed = indices_at_poses(mechanism, poses, closed_forms=True)
+    np.testing.assert_allclose(result.lmti, closed.lmti, atol=1e-9)
+    np.testing.assert_allclose(result.f_o[1], closed.f_o[1], atol=1e-9)
+    assert np.all(result.lmti > 0.4) and np.all(np.min(result.iti_actuators, axis=-1) < 1e-5)  # sqrt(1e-12) inside
 
 
 @pytest.mark.parametrize("index", range(8))

@@ -59,6 +59,13 @@ unit norm in working coordinates, so its diagonal is 1) is singular (an idle DoF
 of an S-S rod) when a pivot of its elimination is at or below this times its largest diagonal
 entry."""
 
+SINGULAR_SPAN = 1e-6
+"""Relative: at an input singularity (a chain whose Gram matrix, above, is singular and has no consistent
+solution), the actuation wrench is sought in the span of the chain's unit twists and the motion space; a direction
+whose remainder is at most this does not count. It is the square root of GRAM_PIVOT: the twists' own singular
+values below it are the ones the Gram elimination called singular (a leg stretched to within rounding has one of
+about 1e-8, the square root of rounding)."""
+
 PSEUDO_INVERSE_CONSISTENCY = 1e-9
 """Relative: a pseudo-inverse solution of a singular Gram system (above) is kept when its
 largest residual is at most this times ``max(1, largest entry of the solution)``; otherwise the

@@ -26,7 +26,13 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.tolerances import MOTION_SPACE_TOLERANCE, PSEUDO_INVERSE_CONSISTENCY, PURE_COUPLE, RANK_TOLERANCE
+from screwkit.common.tolerances import (
+    MOTION_SPACE_TOLERANCE,
+    PSEUDO_INVERSE_CONSISTENCY,
+    PURE_COUPLE,
+    RANK_TOLERANCE,
+    SINGULAR_SPAN,
+)
 from screwkit.screw.algebra import SWAP, power_coefficient, project_on_axis, reciprocal_product
 
 __all__ = ["working_frame", "motion_space", "actuation_wrench", "input_transmission", "output_twists",
@@ -57,24 +63,45 @@ def motion_space(twists: list[NDArray], dof: int) -> NDArray:
     return np.linalg.eigh(total)[1][:, :dof].T
 
 
-def actuation_wrench(chain: NDArray, points: NDArray, k: int) -> NDArray:
+def actuation_wrench(chain: NDArray, points: NDArray, k: int, basis: NDArray | None = None) -> NDArray:
     r"""The actuation wrench of joint ``k`` of a chain (working coordinates), moments about the origin.
 
     Reciprocal to every other joint of the chain and doing unit work on joint ``k``, the one of least norm in
     :math:`|f|^2 + |m_d|^2` with moments about the platform joint ``d``: :math:`x = J_d^+ e_k` (the chain's
-    twists about ``d`` as rows), :math:`w = \Delta x`. Scaled to a unit force (a unit moment for a couple);
-    zero when joint ``k``'s twist depends on the others (the chain cannot drive it).
+    twists about ``d`` as rows), :math:`w = \Delta x`. Scaled to a unit force (a unit moment for a couple).
+
+    When joint ``k``'s twist depends on the others (an input singularity: a leg stretched or folded), no wrench of
+    the chain's twist span does work on it alone; the actuation wrench is then the limit of the one above: of
+    least norm about ``d`` in the span of the chain's twists and the motion space ``basis`` (rows), reciprocal to
+    every other joint (a force along the stretched leg; it does no work on joint ``k``: ITI 0). Zero without a
+    ``basis`` or where that wrench is not unique.
     """
     about_d = np.concatenate([chain[:, :3], chain[:, 3:] + np.cross(chain[:, :3], points[-1])], axis=1)
     unit = about_d / np.linalg.norm(about_d, axis=1, keepdims=True)
     x = np.linalg.pinv(unit)[:, k]
     if np.max(np.abs(unit @ x - np.eye(len(chain))[k])) > PSEUDO_INVERSE_CONSISTENCY * max(1.0, np.max(np.abs(x))):
-        return np.zeros(6)
+        if basis is None:
+            return np.zeros(6)
+        x = _singular_wrench(unit, k, basis, points[-1])
+        if x is None:
+            return np.zeros(6)
     force, moment_d = x[3:], x[:3]  # the wrench (f, m_d) is the twist-space vector with its halves swapped
     moment = moment_d + np.cross(points[-1], force)  # about the origin (the centroid)
     if np.linalg.norm(force) <= PURE_COUPLE * np.linalg.norm(moment):
         return np.concatenate([np.zeros(3), moment / np.linalg.norm(moment)])
     return np.concatenate([force, moment]) / np.linalg.norm(force)
+
+
+def _singular_wrench(unit: NDArray, k: int, basis: NDArray, d: NDArray) -> NDArray | None:
+    """:func:`actuation_wrench` at an input singularity, as a twist-space vector about ``d`` (halves swapped)."""
+    shifted = np.concatenate([basis[:, :3], basis[:, 3:] + np.cross(basis[:, :3], d)], axis=1)
+    rows = np.concatenate([unit, shifted / np.linalg.norm(shifted, axis=1, keepdims=True)])
+    _, singular, right = np.linalg.svd(rows)
+    span = right[:np.sum(singular > SINGULAR_SPAN * singular[0])]  # orthonormal rows
+    passive = np.delete(unit, k, axis=0) @ span.T
+    _, values, vectors = np.linalg.svd(passive, full_matrices=True)
+    rank = np.sum(values > SINGULAR_SPAN * max(values[0], 1e-300)) if values.size else 0
+    return vectors[rank] @ span if len(span) - rank == 1 else None
 
 
 def input_transmission(wrench: NDArray, twist: NDArray, point: NDArray, threshold: float) -> float:
@@ -195,7 +222,7 @@ def reference_indices(twists: list[NDArray], points: list[NDArray], actuated: li
         kept = _span(idle)
         space = np.linalg.svd(space - space @ kept.T @ kept)[2][:dof]
     actuators = [(c, k) for c, ks in enumerate(actuated) for k in ks]
-    wrenches = np.array([actuation_wrench(work[c], at[c], k) for c, k in actuators])
+    wrenches = np.array([actuation_wrench(work[c], at[c], k, space) for c, k in actuators])
     p = threshold / length
     iti = [input_transmission(wrenches[a], work[c][k], at[c][min(k + 1, len(at[c]) - 1)], p)
            for a, (c, k) in enumerate(actuators)]

@@ -67,7 +67,7 @@ def run_kernels(plan, twists, points, basis, complement, iti_override, oti_overr
         if gram_kernel is not None:
             gram_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint, n,
                         tolerances.GRAM_PIVOT, tolerances.PSEUDO_INVERSE_CONSISTENCY, own["outside"], carry[0],
-                        carry[3], carry[4])
+                        carry[3], carry[4], basis_part, tolerances.SINGULAR_SPAN)
         output_kernel(twists[part], points[part], plan.chain_start, plan.actuator_chain, plan.actuator_joint,
                       basis_part, plan.submechanisms, plan.locked_sets, plan.locked_of, plan.set_children,
                       plan.fault_rows, plan.locked_depth, plan.wedge_table, plan.wedge_start, plan.rank_tolerance,

@@ -28,7 +28,7 @@ __all__ = ["gram_kernel"]
 # The one signature: joint screws and points in any layout (as the first kernel's), the rest C-contiguous.
 _SIGNATURE = (
     "void(float64[:, :, :], float64[:, :, :], int64[::1], int64[::1], int64[::1], int64, float64, float64, "
-    "boolean[::1], float64[:, :, :, ::1], float64[:, ::1], float64[:, :, ::1])"
+    "boolean[::1], float64[:, :, :, ::1], float64[:, ::1], float64[:, :, ::1], float64[:, :, ::1], float64)"
 )
 
 
@@ -117,12 +117,80 @@ def consistent_pseudo_solution(gram, m, column, rhs, solution, work, eigenvector
             solution[i] = 0.0
 
 
+@njit(cache=True, error_model="numpy")
+def _remainder(vector, basis, count) -> float:
+    """``vector`` less its components along basis[:count] (orthonormal rows; twice, for rounding), in place;
+    returns the norm of what is left."""
+    size = vector.shape[0]
+    for _ in range(2):
+        for q in range(count):
+            along = 0.0
+            for p in range(size):
+                along += vector[p] * basis[q, p]
+            for p in range(size):
+                vector[p] -= along * basis[q, p]
+    return np.sqrt(np.sum(vector * vector))
+
+
+@njit(cache=True, error_model="numpy")
+def singular_wrench(shifted_lanes, m, column, basis, row, r, platform, tolerance, twist):
+    """At an input singularity of the chain (joint ``column``'s twist depends on the others: a leg stretched or
+    folded), twist[:] = the twist-space vector (about d, halves to be swapped) of its actuation wrench, the limit
+    of the minimum-norm one: in the span of the chain's unit twists and the motion space basis[row] (about d),
+    reciprocal to every other joint (:func:`screwkit.screw.reference.actuation_wrench`). Returns whether it is
+    unique (else ``twist`` is not written). Rare: not inlined."""
+    vector, span = np.empty(6), np.empty((6, 6))
+    size = 0
+    for i in range(m + basis.shape[1]):  # an orthonormal basis of the span
+        if i < m:
+            for p in range(6):
+                vector[p] = shifted_lanes[i, p, r]
+        else:
+            w0, w1, w2 = basis[row, i - m, 0], basis[row, i - m, 1], basis[row, i - m, 2]
+            x0, x1, x2 = cross(w0, w1, w2, platform[0, r], platform[1, r], platform[2, r])
+            vector[0], vector[1], vector[2] = w0, w1, w2
+            vector[3] = basis[row, i - m, 3] + x0
+            vector[4] = basis[row, i - m, 4] + x1
+            vector[5] = basis[row, i - m, 5] + x2
+            vector /= max(np.sqrt(np.sum(vector * vector)), 1e-300)
+        norm = _remainder(vector, span, size)
+        if norm > tolerance and size < 6:
+            span[size] = vector / norm
+            size += 1
+    coordinates, taken = np.empty(size), np.empty((size, size))
+    kept = 0
+    for j in range(m):  # the other joints' coordinates in the span, orthonormalised
+        if j == column:
+            continue
+        for q in range(size):
+            coordinates[q] = np.sum(shifted_lanes[j, :, r] * span[q])
+        norm = _remainder(coordinates, taken, kept)
+        if norm > tolerance and kept < size:
+            taken[kept] = coordinates / norm
+            kept += 1
+    if size - kept != 1:
+        return False
+    best, null, candidate = 0.0, np.zeros(size), np.empty(size)
+    for e in range(size):  # the one direction of the span the other joints leave: the largest remainder
+        candidate[:] = 0.0
+        candidate[e] = 1.0
+        norm = _remainder(candidate, taken, kept)
+        if norm > best:
+            best, null = norm, candidate / norm
+    for p in range(6):
+        twist[p] = np.sum(null * span[:size, p])
+    return True
+
+
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def minimum_norm_wrenches(gram_lanes, shifted_lanes, m, column, first_index, width, outside, gram_pivot,
-                          pseudo_inverse_consistency, gram, work, eigenvectors, eigenvalues, rhs, solution, force):
+                          pseudo_inverse_consistency, gram, work, eigenvectors, eigenvalues, rhs, solution, force,
+                          basis, platform, span_tolerance):
     """force[:, r] += SWAP J' (J'^T J')^-1 e_column, the minimum-norm wrench about d (J' the unit twists
-    ``shifted_lanes``, J'^T J' ``gram_lanes``), configuration by configuration; the configurations flagged
-    ``outside`` are left alone (recomputed with their own motion space)."""
+    ``shifted_lanes``, J'^T J' ``gram_lanes``), configuration by configuration, or at an input singularity
+    (no consistent solution) :func:`singular_wrench`'s; the configurations flagged ``outside`` are left alone
+    (recomputed with their own motion space)."""
+    limit = np.empty(6)
     for r in range(width):
         if outside[first_index + r]:
             continue  # recomputed with its own motion space
@@ -135,6 +203,19 @@ def minimum_norm_wrenches(gram_lanes, shifted_lanes, m, column, first_index, wid
         if not regular:
             consistent_pseudo_solution(gram, m, column, rhs, solution, work, eigenvectors, eigenvalues,
                                        pseudo_inverse_consistency)
+            zero = True
+            for j in range(m):
+                zero = zero and solution[j] == 0.0
+            row = 0 if basis.shape[0] == 1 else first_index + r
+            if zero and singular_wrench(shifted_lanes, m, column, basis, row, r, platform, span_tolerance,
+                                        limit):
+                force[0, r] += limit[3]
+                force[1, r] += limit[4]
+                force[2, r] += limit[5]
+                force[3, r] += limit[0]
+                force[4, r] += limit[1]
+                force[5, r] += limit[2]
+                continue
         for j in range(m):  # the wrench about d: SWAP of the combination
             y = solution[j]
             force[0, r] += y * shifted_lanes[j, 3, r]
@@ -147,7 +228,8 @@ def minimum_norm_wrenches(gram_lanes, shifted_lanes, m, column, first_index, wid
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_joint, n, gram_pivot,
-                pseudo_inverse_consistency, outside, force_rows, length_rows, centre_rows):
+                pseudo_inverse_consistency, outside, force_rows, length_rows, centre_rows, basis,
+                span_tolerance):
     """Add the actuation wrench of every actuator whose chain has other than n joint DoFs to ``force_rows``.
 
     Parameters (N configurations, J joints in all, C chains, a actuators)
@@ -161,6 +243,8 @@ def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_jo
         space; left alone here).
     force_rows, length_rows, centre_rows : the first kernel's per-block wrenches (zero for these
         actuators), lengths L and centroids c (:func:`screwkit.indices.compiled.algebra.carry_arrays`).
+    basis (1 or N, n, 6), span_tolerance : the motion space (working coordinates, as the first kernel's) and
+        SINGULAR_SPAN, for the wrench at an input singularity (:func:`singular_wrench`).
 
     Per block and actuator of such a chain: :func:`chain_unit_twist_lanes`, :func:`gram_matrix_lanes`,
     :func:`minimum_norm_wrenches`.
@@ -187,4 +271,4 @@ def gram_kernel(all_twists, all_points, chain_start, actuator_chain, actuator_jo
             gram_matrix_lanes(shifted_lanes, m, width, lane0, gram_lanes)
             minimum_norm_wrenches(gram_lanes, shifted_lanes, m, actuator_joint[act], first_index, width, outside,
                                   gram_pivot, pseudo_inverse_consistency, gram, work, eigenvectors, eigenvalues, rhs,
-                                  solution, force_rows[block, act])
+                                  solution, force_rows[block, act], basis, platform, span_tolerance)
