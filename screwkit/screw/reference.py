@@ -33,7 +33,7 @@ from screwkit.common.tolerances import (
     RANK_TOLERANCE,
     SINGULAR_SPAN,
 )
-from screwkit.screw.algebra import SWAP, power_coefficient, project_on_axis, reciprocal_product
+from screwkit.screw.algebra import SWAP, power_coefficient, project_on_axis, reciprocal_product, shift_twist
 
 __all__ = ["working_frame", "motion_space", "actuation_wrench", "input_transmission", "output_twists",
            "output_transmission", "fault_tolerance", "constraint_transmission", "reference_indices"]
@@ -76,7 +76,7 @@ def actuation_wrench(chain: NDArray, points: NDArray, k: int, basis: NDArray | N
     every other joint (a force along the stretched leg; it does no work on joint ``k``: ITI 0). Zero without a
     ``basis`` or where that wrench is not unique.
     """
-    about_d = np.concatenate([chain[:, :3], chain[:, 3:] + np.cross(chain[:, :3], points[-1])], axis=1)
+    about_d = shift_twist(chain, points[-1])
     unit = about_d / np.linalg.norm(about_d, axis=1, keepdims=True)
     x = np.linalg.pinv(unit)[:, k]
     if np.max(np.abs(unit @ x - np.eye(len(chain))[k])) > PSEUDO_INVERSE_CONSISTENCY * max(1.0, np.max(np.abs(x))):
@@ -94,10 +94,7 @@ def actuation_wrench(chain: NDArray, points: NDArray, k: int, basis: NDArray | N
 
 def _singular_wrench(unit: NDArray, k: int, basis: NDArray, d: NDArray) -> NDArray | None:
     """:func:`actuation_wrench` at an input singularity, as a twist-space vector about ``d`` (halves swapped)."""
-    shifted = np.concatenate([basis[:, :3], basis[:, 3:] + np.cross(basis[:, :3], d)], axis=1)
-    rows = np.concatenate([unit, shifted / np.linalg.norm(shifted, axis=1, keepdims=True)])
-    _, singular, right = np.linalg.svd(rows)
-    span = right[:np.sum(singular > SINGULAR_SPAN * singular[0])]  # orthonormal rows
+    span = _span(np.concatenate([unit, shift_twist(basis, d)]), SINGULAR_SPAN)
     passive = np.delete(unit, k, axis=0) @ span.T
     _, values, vectors = np.linalg.svd(passive, full_matrices=True)
     rank = np.sum(values > SINGULAR_SPAN * max(values[0], 1e-300)) if values.size else 0
