@@ -48,6 +48,7 @@ from screwkit.indices.stages import (
     ChunkSpaces,
     analyze_chunk,
     at_constraint_singularities,
+    checked_chunk_size,
     constraint_chunk,
     constraint_plan_of,
     joints_of_all_chains,
@@ -257,8 +258,7 @@ def analyze(
                 f"Expected every chain to share the batch shape {batch_shape}, "
                 f"chain {chain.name!r} has {chain.batch_shape}."
             )
-    if not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
-        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+    checked_chunk_size(chunk_size)
     if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"Expected `threads` >= 1, got {threads!r}.")
     count = int(np.prod(batch_shape, dtype=np.int64))

@@ -25,7 +25,7 @@ from screwkit.common.chunks import map_chunks
 from screwkit.common.compiling import announce_compilation
 from screwkit.common.tolerances import RANK_TOLERANCE, SINGULARITY_THRESHOLD, WORST_FAULT_TIE
 from screwkit.common.validation import as_float_array, check_finite
-from screwkit.indices.stages import checked_faults, checked_threshold
+from screwkit.indices.stages import checked_chunk_size, checked_faults, checked_rank_tolerance, checked_threshold
 
 __all__ = [
     "det2",
@@ -271,10 +271,8 @@ def planar_indices(base: ArrayLike, elbows: ArrayLike | None, distal: ArrayLike,
     """
     distal, batch, count, base, elbows, directions = _planar_inputs(base, elbows, distal, directions)
     threshold = checked_threshold(threshold)
-    if isinstance(rank_tolerance, (str, bytes, bool)) or not rank_tolerance > 0:
-        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance!r}.")
-    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
-        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+    checked_rank_tolerance(rank_tolerance)
+    checked_chunk_size(chunk_size)
     faults = checked_faults(faults, count - 3)
     faults = tuple(range(1, count - 2)) if faults is None else faults
     if count == 3:

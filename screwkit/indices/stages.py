@@ -32,7 +32,8 @@ from screwkit.screw.outputs import quotient_bases
 
 __all__ = ["Plan", "make_plan", "run_kernel", "ChunkSpaces", "analyze_chunk", "joints_of_all_chains",
            "constraint_plan_of", "constraint_chunk", "at_constraint_singularities", "CONSTRAINTS_COMPILED_FROM",
-           "square_subsystems", "compiled_constraint_stage", "checked_faults", "checked_threshold"]
+           "square_subsystems", "compiled_constraint_stage", "checked_faults", "checked_threshold",
+           "checked_rank_tolerance", "checked_chunk_size"]
 
 
 @dataclass
@@ -72,6 +73,18 @@ def checked_threshold(threshold, name: str = "threshold") -> float:
     return value
 
 
+def checked_rank_tolerance(rank_tolerance) -> None:
+    """A ValueError unless ``rank_tolerance`` is a number > 0."""
+    if isinstance(rank_tolerance, (str, bytes, bool)) or not rank_tolerance > 0:
+        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance!r}.")
+
+
+def checked_chunk_size(chunk_size) -> None:
+    """A ValueError unless ``chunk_size`` is a whole number >= 1 (a bool is not one)."""
+    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
+        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+
+
 def checked_faults(faults, most: int, span: str = "") -> tuple[int, ...] | None:
     """The numbers of faults ``j`` that ``faults`` asks for (None: all; an int; a sequence of ints), distinct and
     ascending, each in ``1..max(most, 1)`` (``span`` how that range is written in the message, ``1..{most}`` by
@@ -93,8 +106,7 @@ def checked_faults(faults, most: int, span: str = "") -> tuple[int, ...] | None:
 
 def make_plan(chains, dof, faults, threshold, rank_tolerance, idle_count: int = 0) -> Plan:
     threshold = checked_threshold(threshold)
-    if isinstance(rank_tolerance, (str, bytes, bool)) or not rank_tolerance > 0:
-        raise ValueError(f"Expected `rank_tolerance` > 0, got {rank_tolerance!r}.")
+    checked_rank_tolerance(rank_tolerance)
     space = motion_space(chains, None if dof is None else dof + idle_count)
     n = space.dof - idle_count
     if idle_count:  # a point output: the motion space modulo the idle rotations, configuration by configuration

@@ -28,7 +28,7 @@ from screwkit.indices.analysis import analyze
 from screwkit.indices.closed_forms import planar_indices, point_indices
 from screwkit.indices.faults import FAULT_TYPES
 from screwkit.indices.results import Indices
-from screwkit.indices.stages import checked_faults, checked_threshold
+from screwkit.indices.stages import checked_chunk_size, checked_faults, checked_threshold
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.batch_arrays import ARRAYS, DICTS, fill_unreachable, scatter
 
@@ -248,11 +248,9 @@ def _indices_in_chunks(mechanism: Mechanism, poses: ArrayLike, settings: dict, k
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, mechanism.n_task)
     count = flat.shape[0]
-    _check_settings(faults, threshold, progress, len(mechanism.actuator_names), mechanism.dof)
+    _check_settings(faults, threshold, progress, chunk_size, len(mechanism.actuator_names), mechanism.dof)
     if chunk_size is None:
         chunk_size = poses_per_chunk(mechanism)
-    elif not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
-        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
     reachable = np.zeros(count, dtype=bool)
     chain_status = np.zeros((count, len(mechanism.chains)), dtype=np.int8)
     full_poses = np.empty((count, mechanism.n_pose))
@@ -347,12 +345,15 @@ _SETTINGS = dict(detail=False, threshold=SINGULARITY_THRESHOLD, faults=None, chu
 """The keywords of :func:`indices_at_poses` and their defaults."""
 
 
-def _check_settings(faults, threshold, progress, actuators: int, dof: int) -> None:
-    """The settings of a batch checked before any work, whatever turns out reachable (as ``analyze`` checks them)."""
+def _check_settings(faults, threshold, progress, chunk_size, actuators: int, dof: int) -> None:
+    """The settings of a batch checked before any work, whatever turns out reachable (as ``analyze`` checks them);
+    ``chunk_size`` None is the default."""
     checked_faults(faults, actuators - dof, f"1..a-n = 1..{actuators - dof}")
     checked_threshold(threshold)
     if progress is not None and not callable(progress):
         raise TypeError(f"Expected `progress` as a callable taking the number of poses done, got {progress!r}.")
+    if chunk_size is not None:
+        checked_chunk_size(chunk_size)
 
 
 
@@ -484,9 +485,7 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
 
     poses = graph.check_poses(poses)
     n_task = graph.n_task
-    _check_settings(faults, threshold, progress, len(graph.legs), n_task)
-    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
-        raise ValueError(f"Expected `chunk_size` >= 1, got {chunk_size!r}.")
+    _check_settings(faults, threshold, progress, chunk_size, len(graph.legs), n_task)
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]
