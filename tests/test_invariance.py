@@ -513,20 +513,21 @@ def test_a_stretched_leg_is_reached_in_every_unit_and_world_frame(tmp_path):
     now reached in every unit and frame, with the same indices, which are the paper's closed forms (Eqs. 21-23:
     the stretched leg's actuation wrench is the force along it; the generic path had it zero there, and so its
     OTIs: F_O1 0 where the closed forms give 0.5843)."""
-    from helpers import in_millimetres, moved_in_the_world
+    from helpers import in_millimetres, in_unit, moved_in_the_world
     from screwkit.io.loader import bundled_path, load
     from screwkit.studies import indices_at_poses
 
     text = bundled_path("five_bar_3").read_text()
-    files = {"m": text, "mm": in_millimetres(text, declare=True),
-             "moved": moved_in_the_world(text, (0.3, -0.2, 0.5), (0.4, -0.3, 0.7)),
-             "in plane": moved_in_the_world(text, (0.25, -0.15, 0.0), (0.0, 0.0, 1.1))}
+    files = {"m": (text, 1.0), "mm": (in_millimetres(text, declare=True), 1.0),
+             "moved": (moved_in_the_world(text, (0.3, -0.2, 0.5), (0.4, -0.3, 0.7)), 1.0),
+             "in plane": (moved_in_the_world(text, (0.25, -0.15, 0.0), (0.0, 0.0, 1.1)), 1.0),
+             "x1e-3": (in_unit(text, "m", 1e-3), 1e-3), "x1e3": (in_unit(text, "m", 1e3), 1e3)}
     poses = np.array([[-0.2, 0.35], [0.3, 0.3], [0.30000000000000004, 0.3], [-0.2, 0.4], [0.2, 0.4]])
     results = {}
-    for name, written in files.items():
+    for name, (written, scale) in files.items():  # a scaled copy: its poses scaled with it
         path = tmp_path / f"five_bar_3_{name.replace(' ', '_')}.urdf"
         path.write_text(written)
-        results[name] = indices_at_poses(load(path), poses, detail=True)
+        results[name] = indices_at_poses(load(path), poses * scale, detail=True)
     reference = results["m"]
     stretched = np.isclose(reference.iti_actuators, 0.0, atol=1e-12)
     assert reference.reachable.all() and stretched.any(axis=-1).all()  # at each pose a stretched leg: ITI 0

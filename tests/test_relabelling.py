@@ -175,6 +175,21 @@ def test_every_index_follows_the_names_under_any_order_of_legs_and_actuators(nam
         assert_same_by_name(reference, by_name(other, names))
 
 
+def test_at_a_stretched_leg_every_index_follows_the_names_under_any_order_of_legs_and_actuators():
+    """At an input singularity (a five_bar_3 leg stretched) the actuation wrench is the limit of the least-norm one
+    (found in the span of the chain's twists and the motion space); every index, worst fault and flag still
+    follows the legs listed in another order and renamed."""
+    mechanism = load("five_bar_3")
+    solution = solve(mechanism, np.array([[0.3, 0.3], [-0.2, 0.35], [0.2, 0.4], [-0.2, 0.4]]))
+    chains = list(chain_screws(mechanism, solution))
+    reference = by_name(analyze_chains(mechanism, solution, chains))
+    assert np.all(reference["lmti"] > 0.9)  # not the zero the stretched leg's wrench gave before
+    rng = np.random.default_rng(3)
+    for trial in range(4):
+        permuted, _, names = relabelled(chains, rng, rename=trial > 0)
+        assert_same_by_name(reference, by_name(analyze_chains(mechanism, solution, permuted), names))
+
+
 def test_the_delta_cti_is_the_same_whichever_leg_is_listed_first():
     """The case that was order-dependent: a 4-leg Delta whose four constraint couples have rank three."""
     from screwkit.model.delta_writer import delta_urdf
