@@ -503,7 +503,7 @@ def test_a_urdf_named_xml_and_output_options_on_a_screwkit_file_are_refused_in_o
     own = tmp_path / "five.urdf"
     own.write_text(bundled_path("five_bar_3").read_text())
     result = screwkit("convert", own, tmp_path / "out.urdf", "--output", "effector")
-    assert result.returncode == 1 and "apply to MJCF files and URDF + robot.yaml" in result.stderr
+    assert result.returncode == 1 and "apply to files of other tools (MJCF, SDFormat" in result.stderr
     assert result.stderr.count("\n") == 1
 
 

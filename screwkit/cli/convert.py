@@ -7,7 +7,8 @@ from pathlib import Path
 
 import click
 
-from screwkit.cli.options import fail, ignore_limits_option, json_option, lock_option, overwrite_option, quiet_option
+from screwkit.cli.options import fail, ignore_limits_option, json_option, overwrite_option, quiet_option
+from screwkit.cli.reading import actuate_option, lock_option
 from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
 from screwkit.io.loader import load, load_text
@@ -26,12 +27,13 @@ __all__ = ["convert"]
               help="A point output (where the chains meet) or the output frame; default: the point when every "
                    "closure meets the platform at one point, else the frame.")
 @lock_option
+@actuate_option
 @ignore_limits_option
 @overwrite_option
 @quiet_option
 @json_option
-def convert(source: Path, out: Path, output_frame, output_type, lock, ignore_limits: bool, overwrite: bool,
-            quiet: bool, as_json: bool) -> None:
+def convert(source: Path, out: Path, output_frame, output_type, lock, actuate, ignore_limits: bool,
+            overwrite: bool, quiet: bool, as_json: bool) -> None:
     """Write SOURCE (an MJCF or SDFormat file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
     URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
     already in the convention whose joint values leave loops open is written back with them closed. With
@@ -48,11 +50,13 @@ def convert(source: Path, out: Path, output_frame, output_type, lock, ignore_lim
         raise fail(str(error)) from None
     try:
         if is_foreign(source):
-            text, report = read_mechanism_file(source, output=output_frame, output_type=output_type, lock=tuple(lock))
+            text, report = read_mechanism_file(source, output=output_frame, output_type=output_type, lock=tuple(lock),
+                                               actuate=tuple(actuate))
         else:  # screwkit's own convention: the loops the file leaves open, closed and written back
-            if output_frame is not None or output_type is not None or lock:
-                raise fail(f"{source}: --output, --output-type and --lock apply to MJCF files and URDF + robot.yaml; "
-                           "this file is in screwkit's convention (its output is its platform).")
+            if output_frame is not None or output_type is not None or lock or actuate:
+                raise fail(f"{source}: --output, --output-type, --lock and --actuate apply to files of other tools "
+                           "(MJCF, SDFormat, URDF + robot.yaml, onshape-to-robot URDFs); this file is in screwkit's "
+                           "convention (its output is its platform, its <transmission>s name its actuators).")
             own = load(source, limits=not ignore_limits)
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",

@@ -20,7 +20,7 @@ import click
 import numpy as np
 
 from screwkit.cli.option_checks import execution_record, finite_threshold
-from screwkit.cli.reading import Reading, lock_option, output_frame_option, output_type_option, reading_record
+from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
 from screwkit.closure.assembly import LIMITS_IGNORED
 from screwkit.common.compiling import (
     INDEX_KERNELS,
@@ -191,11 +191,10 @@ def length_unit_option(function: Callable) -> Callable:
 
 
 def reading_options(function: Callable) -> Callable:
-    """``--length-unit``, ``--output FRAME``, ``--output-type``, ``--lock JOINT``: how MECHANISM is read, as
+    """``--length-unit``, ``--output FRAME``, ``--output-type``, ``--lock``, ``--actuate``: how MECHANISM is read, as
     ``reading``, a :class:`Reading` (the options :func:`screwkit.io.read_mechanism_file` and ``screwkit convert``
     take)."""
-    return option_group("reading", reading_record, length_unit_option, output_frame_option, output_type_option,
-                        lock_option)(function)
+    return option_group("reading", reading_record, length_unit_option, *FILE_OPTIONS)(function)
 
 
 def threshold_option(function: Callable) -> Callable:
@@ -398,7 +397,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     length_unit = reading.length_unit
     try:
         mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
-                         output_type=reading.output_type, lock=reading.lock)
+                         output_type=reading.output_type, lock=reading.lock, actuate=reading.actuate)
     except ValueError as error:
         from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree  # readers of other tools: when used
 
@@ -409,7 +408,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         try:
             source = bundled_path(name) if name in bundled_graph_names() else name
             return graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
-                                                    lock=reading.lock))
+                                                    lock=reading.lock, actuate=reading.actuate))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     context = click.get_current_context(silent=True)

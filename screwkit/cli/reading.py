@@ -7,31 +7,43 @@ from typing import Callable
 
 import click
 
-__all__ = ["Reading", "reading_record", "lock_option", "output_frame_option", "output_type_option", "LOCK_HELP"]
+__all__ = ["Reading", "reading_record", "lock_option", "actuate_option", "output_frame_option", "output_type_option",
+           "LOCK_HELP", "ACTUATE_HELP", "FILE_OPTIONS"]
 
 
 @dataclass(frozen=True)
 class Reading:
     """How MECHANISM's file is read: its length unit, and for a file of another tool the frame whose body is the
     platform and whether the output is a point or that frame (``--length-unit``, ``--output``, ``--output-type``),
-    and the joints held at their values in the file (``--lock``)."""
+    the joints held at their values in the file (``--lock``) and the actuated joints named instead of the file's
+    (``--actuate``)."""
 
     length_unit: str | None = None
     output: str | None = None
     output_type: str | None = None
     lock: tuple[str, ...] = ()
+    actuate: tuple[str, ...] = ()
 
 
-def reading_record(length_unit: str | None, output_frame: str | None, output_type: str | None, lock) -> Reading:
-    return Reading(length_unit, output_frame, output_type, tuple(lock or ()))
+def reading_record(length_unit: str | None, output_frame: str | None, output_type: str | None, lock,
+                   actuate=()) -> Reading:
+    return Reading(length_unit, output_frame, output_type, tuple(lock or ()), tuple(actuate or ()))
 
 
 LOCK_HELP = ("For a file of another tool: hold this joint at its value in the file (repeatable): a serial stage "
              "before the parallel part, such as a turntable every leg stands on.")
 
 
+ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the actuators are the joints named, in "
+                "this order, instead of those the file marks or screwkit guesses.")
+
+
 def lock_option(function: Callable) -> Callable:
     return click.option("--lock", multiple=True, metavar="JOINT", help=LOCK_HELP)(function)
+
+
+def actuate_option(function: Callable) -> Callable:
+    return click.option("--actuate", multiple=True, metavar="JOINT", help=ACTUATE_HELP)(function)
 
 
 def output_frame_option(function: Callable) -> Callable:
@@ -46,3 +58,7 @@ def output_type_option(function: Callable) -> Callable:
                         help="For a file of another tool: a point output (where the chains meet) or the output "
                              "frame; default: the point when every closure meets the platform at one point and its "
                              "rotations about it are idle, else the frame.")(function)
+
+
+FILE_OPTIONS = (output_frame_option, output_type_option, lock_option, actuate_option)
+"""The options of a file of another tool, in the order every command that reads MECHANISM shows them."""

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file
     from screwkit.io.gazebo import read_gazebo
     from screwkit.io.gepetto import read_gepetto
     from screwkit.io.graph import GraphMechanism, graph_mechanism
-    from screwkit.io.locking import lock_joints
+    from screwkit.io.locking import actuate_joints, lock_joints
     from screwkit.io.mjcf import read_mjcf
     from screwkit.io.onshape import read_onshape
     from screwkit.io.sdformat import read_sdformat
@@ -35,7 +35,8 @@ if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "lock_joints", "with_reference_configuration"]
+           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "lock_joints", "actuate_joints",
+           "with_reference_configuration"]
 
 _READERS = {
     **dict.fromkeys(("ClosedTree", "Closure", "ImportError_", "ImportReport", "LegWithLoops"),
@@ -43,7 +44,7 @@ _READERS = {
     **dict.fromkeys(("GraphMechanism", "graph_mechanism"), "screwkit.io.graph"),
     "read_gazebo": "screwkit.io.gazebo", "read_gepetto": "screwkit.io.gepetto", "read_mjcf": "screwkit.io.mjcf",
     "read_onshape": "screwkit.io.onshape", "convert_tree": "screwkit.io.star", "lock_joints": "screwkit.io.locking",
-    "read_sdformat": "screwkit.io.sdformat",
+    "actuate_joints": "screwkit.io.locking", "read_sdformat": "screwkit.io.sdformat",
 }
 """Where each name of the readers of other tools lives: imported when first used (PEP 562), since loading a file
 in screwkit's convention (and every bundled mechanism) needs none of them (about 20 ms, YAML and XML readers)."""
@@ -74,12 +75,20 @@ def is_foreign(path: Path) -> bool:
 
 
 def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None,
-                     lock: tuple[str, ...] = ()) -> ClosedTree:
+                     lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> ClosedTree:
     """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
-    ``lock``: as :func:`read_mechanism_file`)."""
-    from screwkit.io.locking import lock_joints  # the readers: only for a file of another tool
+    ``lock``, ``actuate``: as :func:`read_mechanism_file`)."""
+    from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
+    from screwkit.io.locking import actuate_joints, lock_joints  # (idem)
 
-    return lock_joints(_read_tree(Path(path), output, output_type), lock)
+    tree = _read_tree(Path(path), output, output_type)
+    if tree.unactuated and not actuate:
+        raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints.")
+    tree = actuate_joints(lock_joints(tree, lock), actuate)
+    if not tree.motors:
+        raise ImportError_(f"{tree.source}: nothing to actuate: the file names no actuated joint and no 1-DoF joint "
+                           "leaves the base on the way to a closure (--actuate JOINT names them).")
+    return tree
 
 
 def _read_tree(path: Path, output: str | None, output_type: str | None) -> ClosedTree:
@@ -108,18 +117,20 @@ def _read_tree(path: Path, output: str | None, output_type: str | None) -> Close
 
 
 def read_mechanism_file(path: Path, *, output: str | None = None, output_type: str | None = None,
-                        lock: tuple[str, ...] = ()) -> tuple[str, ImportReport]:
+                        lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> tuple[str, ImportReport]:
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
     ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says); ``lock``: joints held at their
-    values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part). A leg
+    values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part);
+    ``actuate``: the actuated joints, in that order, instead of the file's or the guessed ones
+    (:func:`screwkit.io.locking.actuate_joints`). A leg
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).
     """
     from screwkit.io.star import convert_tree  # the conversion: only for a file of another tool
 
-    return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock))
+    return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate))
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

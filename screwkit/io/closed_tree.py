@@ -76,6 +76,11 @@ class ClosedTree:
     notes: list[str] = field(default_factory=list)  # what reading the file changed (said in the report)
     task_coordinates: tuple[str, ...] | None = None  # a URDF source's <task_coordinates names="...">, kept
     locked: tuple[str, ...] = ()  # joints held at their values in the file (screwkit.io.locking)
+    actuated: tuple[str, ...] = ()  # the actuators as the user named them (--actuate), not the file (idem)
+    unactuated: str = ""  # why the file's own actuators cannot be taken: refused unless --actuate names them
+    split: dict[str, str] = field(default_factory=dict)
+    """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
+    it is, for messages (none is an actuator)."""
     cut_by_order: tuple[str, ...] = ()
     """Closures of loops the file could as well have closed at another joint, where the reader chose by the file's
     order (SDFormat's breadth-first tree tied): no point output is taken at them unless asked."""

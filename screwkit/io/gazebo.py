@@ -117,5 +117,5 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
                           urdf.read_bytes()))
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
-                          f"{', '.join(motors)}")
+                          f"{', '.join(motors)}; --actuate JOINT says otherwise")
     return tree

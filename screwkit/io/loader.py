@@ -94,7 +94,7 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
          max_bytes: int = MAX_FILE_BYTES, limits: bool = True, output: str | None = None,
-         output_type: str | None = None, lock: tuple[str, ...] = ()) -> Mechanism:
+         output_type: str | None = None, lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> Mechanism:
     """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
 
     Parameters
@@ -121,6 +121,9 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     lock : tuple of str
         For a file of another tool: joints held at their values in the file (``--lock``; a serial stage before the
         parallel part, :func:`screwkit.io.locking.lock_joints`).
+    actuate : tuple of str
+        For a file of another tool: the actuated joints, in this order, instead of those the file marks or that
+        are guessed (``--actuate``; :func:`screwkit.io.locking.actuate_joints`).
 
     Raises
     ------
@@ -139,7 +142,7 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
         if path.suffix == ".xml":  # a bundled graph: as its file (refused with LegWithLoops, for graph_mechanism)
-            read_mechanism_file(path, output=output, output_type=output_type, lock=lock)
+            read_mechanism_file(path, output=output, output_type=output_type, lock=lock, actuate=actuate)
     else:
         path = Path(text)
         if path.is_dir():
@@ -151,13 +154,15 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         if is_foreign(path):  # MJCF, SDFormat, or a URDF of another tool (robot.yaml, closing_ frames, Gazebo joints)
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
-            converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock)
+            converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
+                                                    actuate=actuate)
             mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
-    if output is not None or output_type is not None or lock:
-        raise ValueError(f"{path}: an output frame or type, or locked joints, apply to files of other tools (MJCF, "
-                         "SDFormat, URDF + robot.yaml, onshape-to-robot URDFs); this file is in screwkit's convention "
-                         "(its output is its platform).")
+    if output is not None or output_type is not None or lock or actuate:
+        raise ValueError(f"{path}: an output frame or type, locked joints or actuated joints named apart from the "
+                         "file apply to files of other tools (MJCF, SDFormat, URDF + robot.yaml, onshape-to-robot "
+                         "URDFs); this file is in screwkit's convention (its output is its platform, its "
+                         "<transmission>s name its actuators).")
     return load_cached(_content(path, max_bytes), ("file", str(path), length_unit, limits, max_bytes),
                        lambda: mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes),
                                                           limits=limits))

@@ -1,4 +1,5 @@
-"""Locking joints of a closed tree: a serial stage before the parallel part held at the file's value."""
+"""Locking and driving joints of a closed tree: a serial stage before the parallel part held at the file's value
+(``--lock``), and the actuated joints named by the user instead of the file (``--actuate``)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ from numpy.typing import NDArray
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints"]
+__all__ = ["lock_joints", "actuate_joints", "joint_names"]
+
+GUESSED = "actuators guessed"
+"""How a reader's note on guessed actuators begins."""
 
 
 def lock_joints(tree: ClosedTree, names) -> ClosedTree:
@@ -22,7 +26,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     base (:func:`screwkit.io.onshape.guessed_motors`) are guessed again on the locked tree."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    names = tuple(names or ())
+    names = joint_names(names, "lock", tree.source)
     if not names:
         return tree
     model = tree.model
@@ -53,7 +57,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     notes = [f"joints {', '.join(names)} locked at their values in the file (--lock): the legs analysed on the body "
              "they turn"]
     motors = [motor for motor in tree.motors if motor not in names]
-    guessed = [k for k, note in enumerate(tree.notes) if note.startswith("actuators guessed")]
+    guessed = [k for k, note in enumerate(tree.notes) if note.startswith(GUESSED)]
     other = [note for k, note in enumerate(tree.notes) if k not in guessed]
     if guessed and len(motors) < len(tree.motors):
         motors = guessed_motors(reduced, closures)
@@ -63,3 +67,50 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
         other += [tree.notes[k] for k in guessed]
     return replace(tree, model=reduced, closures=closures, motors=motors, q_reference=q, notes=other + notes,
                    locked=tree.locked + names)
+
+
+def joint_names(names, option: str, source: str) -> tuple[str, ...]:
+    """``names`` (joint names, or one name as a string) as a tuple; a name given twice or not a non-empty string is
+    refused naming the file ``source`` and ``--option``."""
+    names = (names,) if isinstance(names, str) else tuple(names or ())
+    for name in names:
+        if not isinstance(name, str) or not name:
+            raise ImportError_(f"{source}: --{option}: expected joint names, got {name!r}.")
+        if names.count(name) > 1:
+            raise ImportError_(f"{source}: --{option} {name}: given twice.")
+    return names
+
+
+def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
+    """The tree with the joints ``names`` as its actuators, in that order (``--actuate``), instead of those the file
+    marks (transmissions, MJCF actuators, ``<screwkit:actuated/>``, controller plugins, ``name_mot``) or that were
+    guessed from the branches leaving the base. Each must be a 1-DoF joint (revolute or prismatic) of the tree as
+    read, so not one held by ``--lock``; the report says the actuators were given, and which the file had."""
+    names = joint_names(names, "actuate", tree.source)
+    if not names:
+        return tree
+    model = tree.model
+    for name in names:
+        if name in tree.locked:
+            raise ImportError_(f"{tree.source}: --actuate {name}: the joint is held by --lock {name}.")
+        if name in tree.split:
+            raise ImportError_(f"{tree.source}: --actuate {name}: {tree.split[name]}; an actuator is a 1-DoF joint "
+                               "(revolute or prismatic).")
+        if not model.existJointName(name) or model.getJointId(name) == 0:
+            welded = model.existFrame(name) and str(model.frames[model.getFrameId(name)].type) == "FIXED_JOINT"
+            joints = [str(n) for n in list(model.names)[1:]
+                      if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split]
+            closing = any(closure.name in (name, f"{name}_a") for closure in tree.closures)
+            what = ("a fixed joint, which cannot drive anything" if welded else "the joint closing a loop, where the "
+                    "loop is cut (a joint of the tree can be driven)" if closing else "no joint of that name")
+            raise ImportError_(f"{tree.source}: --actuate {name}: {what}; its 1-DoF joints are {', '.join(joints)}.")
+        joint = model.joints[model.getJointId(name)]
+        if joint.nv != 1:
+            raise ImportError_(f"{tree.source}: --actuate {name}: a joint of {joint.nv} DoF ({joint.shortname()}); "
+                               "an actuator is a 1-DoF joint (revolute or prismatic).")
+    had = [note for note in tree.notes if note.startswith(GUESSED)]
+    notes = [note for note in tree.notes if not note.startswith(GUESSED)]
+    file = (f"could not be taken ({tree.unactuated.removeprefix(tree.source + ': ')})" if tree.unactuated else
+            f"{'were guessed' if had else 'are'}: {', '.join(tree.motors) or 'none'}")
+    notes.append(f"actuators as given (--actuate): {', '.join(names)}; the file's {file}")
+    return replace(tree, motors=list(names), notes=notes, actuated=names)

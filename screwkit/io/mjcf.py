@@ -34,20 +34,21 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
         text, notes, root = prepared_mjcf(Path(path))
     except MjcfError as error:
         raise ImportError_(str(error)) from None
-    motors = []
+    motors, unactuated = [], ""
     for actuators in root.findall("actuator"):
         for element in actuators:
             joint = element.get("joint")
             if joint is None:
-                raise ImportError_(f"{source}: <actuator><{element.tag} name={element.get('name')!r}> drives no "
-                                   "joint (tendon and site transmissions are not supported).")
+                unactuated = unactuated or (f"{source}: <actuator><{element.tag} name={element.get('name')!r}> drives "
+                                            "no joint (tendon and site transmissions are not supported)")
+                continue
             if joint in motors:
                 notes.append(f"joint {joint!r} is driven by more than one <actuator> (a servo's position and velocity "
                              "terms, say): one actuated joint")
             else:
                 motors.append(joint)
     if not motors:
-        raise ImportError_(f"{source}: no <actuator> drives a joint: nothing is actuated.")
+        unactuated = unactuated or f"{source}: no <actuator> drives a joint: nothing is actuated"
     with tempfile.TemporaryDirectory(prefix="screwkit-mjcf-") as folder:
         prepared = Path(folder) / Path(path).name
         prepared.write_text(text, encoding="utf-8")
@@ -90,4 +91,4 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                     "3d" if element.tag == "connect" else "6d"))
     q = references.get("home", qpos0)
     return ClosedTree(source, model, closures, motors, np.asarray(q, dtype=float), output, output_type, "MJCF",
-                      notes)
+                      notes, unactuated=unactuated)

@@ -85,10 +85,7 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
     if unknown:
         raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not 1-DoF joints of the "
                            "tree.")
-    motors = transmitted or guessed_motors(model, closures)
-    if not motors:
-        raise ImportError_(f"{urdf}: no 1-DoF joint leaves the base on the way to a closure: nothing to actuate "
-                           "(a robot.yaml beside the file can list the actuated joints as name_mot).")
+    motors = transmitted or guessed_motors(model, closures)  # none: refused once --actuate had its say
     tree = ClosedTree(str(urdf), model, closures, motors, pin.neutral(model), output, output_type,
                       "onshape-to-robot URDF (closing_ frame pairs)",
                       task_coordinates=declared_task_coordinates(urdf.read_bytes()))
@@ -97,7 +94,8 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
                       "otherwise")
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
-                          f"{', '.join(motors)}; a robot.yaml beside the file (name_mot) says otherwise")
+                          f"{', '.join(motors)}; --actuate JOINT or a robot.yaml beside the file (name_mot) says "
+                          "otherwise")
     return tree
 
 

@@ -136,6 +136,7 @@ class _TreeBuilder:
         self.model.name = sdf.name
         self.joint_world = {0: np.eye(4)}  # each Pinocchio joint's frame in the world at zero joint values
         self.placed = {WORLD: (0, 0)}  # node -> (Pinocchio joint, frame): where each link is attached
+        self.split: dict[str, str] = {}  # a hinge of a ball or universal joint -> that joint (ClosedTree.split)
         self.limits: dict[int, tuple[float, float]] = {}
 
     def _se3(self, joint: int, world: NDArray):
@@ -187,6 +188,9 @@ class _TreeBuilder:
                      (f"{joint.name}_axis2", "revolute", self.axis_in_joint(joint, 1), joint.axes[1].limits)]
         elif joint.kind == "ball":  # three hinges through its centre, about its frame's axes (the module docstring)
             steps = [(f"{joint.name}_{axis}", "revolute", np.eye(3)[k], None) for k, axis in enumerate("xyz")]
+        if len(steps) > 1:
+            self.split.update({name: f"one hinge of {joint.kind} joint {joint.name!r}" for name, *_ in steps})
+            self.split[joint.name] = f"a {joint.kind} joint ({len(steps)} DoF)"
         index = parent
         for name, kind, axis, limits in steps[::-1] if reverse else steps:
             if limits is not None and reverse:
@@ -289,7 +293,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     motors = stated or guessed_motors(model, closures)
     if not stated:
         notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/> and no joint "
-                     f"controller plugin): {', '.join(motors)}")
+                     f"controller plugin): {', '.join(motors)}; --actuate JOINT says otherwise")
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
                       "SDFormat (joints closing loops)", notes,
-                      cut_by_order=cut_by_order)
+                      cut_by_order=cut_by_order, split=builder.split)

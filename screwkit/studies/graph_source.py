@@ -15,14 +15,15 @@ __all__ = ["GraphSource", "graph_source", "cached_graph"]
 @dataclass(frozen=True)
 class GraphSource:
     """What a task needs to rebuild a closed-loop graph (:class:`~screwkit.io.GraphMechanism`): its file, read where
-    the task runs (a Dask worker on another machine needs it at the same path), the reading's output choice, and
-    the file's digest (a task refuses a file changed since the map began)."""
+    the task runs (a Dask worker on another machine needs it at the same path), the reading's output choice, its
+    locked and actuated joints, and the file's digest (a task refuses a file changed since the map began)."""
 
     path: str
     output: str | None
     output_type: str | None
     digest: str
     lock: tuple[str, ...] = ()
+    actuate: tuple[str, ...] = ()
 
 
 @functools.lru_cache(maxsize=4)
@@ -35,10 +36,11 @@ def cached_graph(source: GraphSource) -> GraphMechanism:
     if hashlib.sha256(data).hexdigest() != source.digest:
         raise ValueError(f"{source.path}: the file changed while the map was computed.")
     return graph_mechanism(read_closed_tree(Path(source.path), output=source.output, output_type=source.output_type,
-                                            lock=source.lock))
+                                            lock=source.lock, actuate=source.actuate))
 
 
 def graph_source(graph: GraphMechanism) -> GraphSource:
     """What a task elsewhere needs to rebuild ``graph`` as read (:func:`cached_graph`)."""
     digest = hashlib.sha256(Path(graph.tree.source).read_bytes()).hexdigest()
-    return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest, graph.tree.locked)
+    return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest, graph.tree.locked,
+                       graph.tree.actuated)
