@@ -63,6 +63,26 @@ def test_fault_tolerant_area_refuses_what_would_give_a_plausible_zero(keywords, 
         fault_tolerant_area(paper_5rrr(), **keywords)
 
 
+@pytest.mark.parametrize("level, error, message", [
+    (1.5, ValueError, r"Expected a region level in \[0, 1\] \(a value of f_o1\), got 1.5"),
+    (-0.1, ValueError, r"Expected a region level in \[0, 1\] \(a value of f_o1\), got -0.1"),
+    (float("nan"), ValueError, r"Expected a region level in \[0, 1\] \(a value of f_o1\), got nan"),
+    ("0.4", TypeError, r"Expected region level to be a number, got str '0.4'"),
+])
+def test_a_design_region_refuses_a_level_no_index_value_can_be(level, error, message):
+    """Before: a level above 1 scored every design 0 (no index reaches it) and one below 0 counted every reachable
+    point, F_O1 = 0 included, as fault tolerant; the search then ran its whole budget on that. An index registered
+    without bounds (tests/test_registry.py's toy margin, which is negative) takes any finite level."""
+    from screwkit.studies.design.objectives import disc_region, grid_region
+
+    with pytest.raises(error, match=message):
+        disc_region(0.2, 0.1, 60.0, level=level)
+    with pytest.raises(error, match=message):
+        grid_region({"x": (-0.1, 0.1, 0.1), "y": (-0.1, 0.1, 0.1)}, {"yaw": (0, 30, 10)}, level=level)
+    assert disc_region(0.2, 0.1, 60.0, level=1).level == 1 and disc_region(0.2, 0.1, 60.0, level=0).level == 0
+    assert disc_region(0.2, 0.1, 60.0, index="iti", level=0.5).level == 0.5
+
+
 @pytest.mark.parametrize("keywords", [{"level": "0.4"}, {"step": "0.1"}, {"phi_step_degrees": "30"}])
 def test_fault_tolerant_area_refuses_numbers_as_text(keywords):
     with pytest.raises(TypeError, match="to be a number, got str"):

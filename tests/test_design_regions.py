@@ -51,7 +51,7 @@ def test_a_disc_of_one_point_has_the_cell_of_its_step():
     holds no point beyond the map reaches the next grid point, one step away."""
     chosen = family("planar_rrr")
     for step in (0.05, 0.07):
-        region = disc_region(0.04, step, 90.0, level=-1.0)  # every point fault tolerant
+        region = disc_region(0.04, step, 90.0, level=0.0)  # every reachable point fault tolerant (F_O1 >= 0)
         assert region.configurations == 4
         metrics = region_metrics(chosen.mechanism(), region, chosen.size())
         assert metrics["area"] == pytest.approx(step**2, rel=1e-12)
@@ -64,7 +64,7 @@ def test_one_layer_is_as_thick_as_its_step():
     of a single layer reaches beyond the map one layer step away."""
     chosen = family("delta")
     region = grid_region({"x": (-0.1, 0.1, 0.1), "y": (-0.1, 0.1, 0.1)}, {}, layers=("z", (-0.75, -0.7, 0.05)),
-                         level=-1.0)
+                         level=0.0)
     assert region.layers[1].size == 1
     metrics = region_metrics(chosen.mechanism(), region, chosen.size())
     assert metrics["area"] == pytest.approx(9 * 0.1**2, rel=1e-12)
@@ -148,7 +148,7 @@ def test_over_and_layers_exclude_their_stop_as_the_map_over_does(tmp_path):
 
 def test_a_disc_of_one_point_from_the_command(tmp_path):
     result = screwkit("design-search", "family", "planar_rrr", "--budget", "0", "--json", "--quiet", "--radius",
-                      "0.04", "--step", "0.05", "--level", "-1")
+                      "0.04", "--step", "0.05", "--level", "0")
     assert result.returncode == 0, result.stderr
     metrics = json.loads(result.stdout)["start"]["metrics"]
     assert metrics["area"] == pytest.approx(0.05**2, rel=1e-12) and metrics["inscribed"] == pytest.approx(0.05)
@@ -168,6 +168,7 @@ def test_a_disc_of_one_point_from_the_command(tmp_path):
     ("seed: 4294967296", "seed: expected an integer"),
     ("radius: abc", "radius: expected a number, got 'abc'"),
     ("level: [1]", "level: expected one value, got [1]"),
+    ("level: 1.5", "level: expected a number in 0..1, got 1.5"),
     ("legs: two", "legs: expected an integer >= 1, got 'two'"),
     ("family: [planar_rrr]", "family: expected one value, got ['planar_rrr']"),
     ("objectives: [area, size]", "objectives: expected one of"),

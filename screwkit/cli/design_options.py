@@ -216,7 +216,7 @@ region_options = option_group(
                  help="Index whose minimum over the orientation set makes a point fault tolerant (default f_o1; "
                       "f_o_mean<j>: the mean over the sets of j failed actuators instead of the worst, screwkit's "
                       "extension of Eq. 12)."),
-    click.option("--level", type=float, default=None,
+    click.option("--level", type=click.FloatRange(min=0, max=1), default=None,
                  help="The index level that makes a point fault tolerant (default: the family's, 0.4 planar)."),
     click.option("--probabilities", cls=GreedyOption, metavar="P1 P2 ...",
                  help="With --index f_o_mean<j>: each actuator's failure probability (in the order `screwkit info` "

@@ -86,7 +86,8 @@ def mean_record(probabilities: tuple[float, ...] | None = None) -> IndexRecord:
     return IndexRecord(
         MEAN_NAME, "F_Omean", "screwkit's extension of Eq. 12",
         f"output fault-tolerance index, average case: the {weighted}mean LMTI after j faults", per_fault=True,
-        compute=lambda result: mean_remaining_lmti(result.remaining_lmti, result.actuator_count, probabilities))
+        compute=lambda result: mean_remaining_lmti(result.remaining_lmti, result.actuator_count, probabilities),
+        bounds=(0.0, 1.0))
 
 
 @contextmanager

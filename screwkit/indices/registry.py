@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import threading
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable, Iterator
 
 __all__ = ["IndexRecord", "INDICES", "register", "unregister", "registered", "shared", "index_columns",
@@ -45,6 +45,9 @@ class IndexRecord:
     compute : callable or None
         For an index derived from the others: ``compute(result)`` gives its values (a dict by ``j`` with
         ``per_fault``) from a result computed with detail. None for the indices the compiled kernels give.
+    bounds : (float, float) or None
+        The range of its values, where it has one (the paper's indices and screwkit's extensions: [0, 1]); a
+        design region's level outside it is refused.
     """
 
     name: str
@@ -55,6 +58,7 @@ class IndexRecord:
     constraints: bool = False
     reduce: str = "min"
     compute: Callable[[Any], Any] | None = None
+    bounds: tuple[float, float] | None = None
 
     def column(self, faults: int | None = None) -> str:
         """The column name: the name, followed by ``j`` for a per-fault index."""
@@ -182,5 +186,5 @@ for _record in (
     IndexRecord("f_c", "F_C", "screwkit's extension of Eq. 12", "the worst CTI after j faults", per_fault=True,
                 constraints=True),
 ):
-    register(_record)
+    register(replace(_record, bounds=(0.0, 1.0)))
 del _record

@@ -135,9 +135,11 @@ class Region:
                 raise ValueError(f"Failure probabilities weight the mean over the sets of failed actuators: give "
                                  f"the region an index {MEAN_NAME}<j>, not {self.index!r}.")
             object.__setattr__(self, "probabilities", tuple(float(p) for p in self.probabilities))
-        self._record()  # any registered index (screwkit.indices.registry), with j if per fault
-        if not math.isfinite(self.level):
-            raise ValueError(f"Expected a finite region level, got {self.level}.")
+        record, _ = self._record()  # any registered index (screwkit.indices.registry), with j if per fault
+        low, high = record.bounds or (-math.inf, math.inf)
+        if not low <= real_number(self.level, "region level") <= high:  # (NaN too)
+            raise ValueError(f"Expected a region level in [{low:g}, {high:g}] (a value of {self.index}), got "
+                             f"{self.level}.")
 
     @property
     def average(self) -> bool:
