@@ -18,8 +18,10 @@ the model's links, joints and ``<frame>`` elements with SDFormat's pose semantic
 * **the loops**: every other joint closes a loop, as :mod:`screwkit.io.gazebo` closes ``<gazebo><joint>``
   elements: a ball joint one point both links keep (``3d``), a fixed one the whole frame (``6d``), a revolute or
   continuous one two points on its axis (``<name>_a``, ``<name>_b``; the conversion makes them the hinge through
-  them); a universal one its first revolute joint in the tree and the second as such a hinge; a prismatic one
-  the slide in the tree on a body welded (``6d``) to the child;
+  them, the first of them where the joint is); a universal one its first revolute joint in the tree and the second
+  as such a hinge; a prismatic one the slide in the tree on a body welded (``6d``) to the child. Where the parent
+  link is where more loops close than the child (the platform), the universal's second revolute joint and the
+  prismatic slide hang from the child instead, so that every loop closes on the platform;
 * **the actuated joints**: those with a ``<screwkit:actuated/>`` child (a custom element, its namespace declared on
   ``<sdf>``, e.g. ``xmlns:screwkit="https://screwkit.org/sdformat"``: SDFormat keeps such elements, Gazebo
   ignores them), and those a joint-controller ``<plugin>`` of the model drives (a plugin whose ``filename`` or
@@ -32,6 +34,7 @@ Types other than these (``screw``, ``gearbox``) are refused by name.
 from __future__ import annotations
 
 import re
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -216,19 +219,31 @@ class _TreeBuilder:
         return self.model
 
 
-def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str], scale: float) -> list[Closure]:
-    """The closures of a joint outside the spanning tree (the module docstring says which)."""
+def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str], scale: float,
+                   on_child: bool = False) -> list[Closure]:
+    """The closures of a joint outside the spanning tree (the module docstring says which). ``on_child``: a
+    universal or prismatic loop joint's tree part hangs from its child link, not its parent (the parent is where
+    more loops close, the platform: a body hung from it would put the closure beyond the platform)."""
     world = builder.poses[joint.name]
     (parent, _), (child, _) = builder.placed[ends[0]], builder.placed[ends[1]]
-    if joint.kind in TWO_AXES:  # the first revolute joint in the tree, on the parent side; the second a hinge
-        parent = builder.add_joint(parent, f"{joint.name}_axis", "revolute", builder.axis_in_joint(joint, 0), world,
-                                   joint.axes[0].limits)
-        joint = SdfJoint(f"{joint.name}_axis2", "revolute", joint.parent, joint.child, joint.pose, joint.relative_to,
-                         joint.axes[1:], joint.where)
-        builder.poses[joint.name] = world
-    elif joint.kind == "prismatic":  # the slide in the tree, on a body welded to the child
-        parent = builder.add_joint(parent, joint.name, "prismatic", builder.axis_in_joint(joint, 0), world,
-                                   joint.axes[0].limits)
+    if joint.kind in TWO_AXES or joint.kind == "prismatic":
+        # universal: one hinge in the tree (the first on the parent side, or the second on the child side), the
+        # other a hinge closure; prismatic: the slide in the tree, on a body welded to the other link
+        tree_axis = 1 if on_child and joint.kind in TWO_AXES else 0
+        names = (f"{joint.name}_axis", f"{joint.name}_axis2") if joint.kind in TWO_AXES else (joint.name,)
+        kind, limits = ("prismatic" if joint.kind == "prismatic" else "revolute"), joint.axes[tree_axis].limits
+        axis = builder.axis_in_joint(joint, tree_axis)
+        if on_child:  # the same motion seen from the child: its value's sign changed
+            limits = None if limits is None else (-limits[1], -limits[0])
+            child = builder.add_joint(child, names[tree_axis], kind, axis, world, limits)
+        else:
+            parent = builder.add_joint(parent, names[tree_axis], kind, axis, world, limits)
+        if joint.kind in TWO_AXES:
+            builder.split.update({name: f"one hinge of {joint.kind} joint {joint.name!r}" for name in names})
+            builder.split[joint.name] = f"a {joint.kind} joint (2 DoF)"
+            joint = SdfJoint(names[1 - tree_axis], "revolute", joint.parent, joint.child, joint.pose,
+                             joint.relative_to, (joint.axes[1 - tree_axis],), joint.where)
+            builder.poses[joint.name] = world
 
     def closure(name: str, at: NDArray, kind: str, axis_point: bool = False) -> Closure:
         return Closure(name, parent, inverse(builder.joint_world[parent]) @ at, child,
@@ -276,7 +291,10 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     builder.frames()
     origins = np.array([poses[link][:3, 3] for link in sdf.links])
     scale = float(np.max(np.linalg.norm(origins - origins.mean(axis=0), axis=1), initial=0.0)) or 1.0
-    closing = {joint.name: _loop_closures(builder, joint, ends[joint.name], scale) for joint in loops}
+    touches = Counter(end for joint in loops for end in ends[joint.name])  # the platform: where most loops close
+    closing = {joint.name: _loop_closures(builder, joint, ends[joint.name], scale,
+                                          touches[ends[joint.name][0]] > touches[ends[joint.name][1]])
+               for joint in loops}
     closures = [closure for made in closing.values() for closure in made]
     # where the tree joint the order put in the tree is elsewhere than the loop joint, the cut moves with the order
     cut_by_order = tuple(closure.name for name, other in tied for closure in closing[name]
@@ -292,8 +310,11 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                                   "not a joint of the model."))
     motors = stated or guessed_motors(model, closures)
     if not stated:
-        notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/> and no joint "
-                     f"controller plugin): {', '.join(motors)}; --actuate JOINT says otherwise")
+        silent = any(CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
+                     for plugin in sdf.element.findall("plugin"))  # a controller whose joints its own code names
+        plugins = "its joint controller plugin names no <joint_name>" if silent else "no joint controller plugin"
+        notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/>, {plugins}): "
+                     f"{', '.join(motors)}; --actuate JOINT says otherwise")
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
                       "SDFormat (joints closing loops)", notes,
                       cut_by_order=cut_by_order, split=builder.split)

@@ -8,7 +8,8 @@ What :mod:`screwkit.io.sdformat` builds a closed tree from, and what :mod:`screw
   model frame ``__model__`` for a link, the child link for a joint, the ``attached_to`` frame for a ``<frame>``
   (itself ``__model__`` by default); the model's own ``<pose>`` places the model in the world;
 * a joint's ``<axis><xyz>`` (and ``<axis2>``) is written in the joint frame, or in the frame its ``expressed_in``
-  names (``__model__`` when a file of SDFormat 1.6 or earlier says ``<use_parent_model_frame>true``);
+  names (``__model__`` when a file of SDFormat 1.5 or 1.6 says ``<use_parent_model_frame>true``, and always in a
+  file of SDFormat 1.4 or earlier, whose axes libsdformat reads in the model frame);
 * a joint's ``<parent>`` may be ``world``; a link, joint or frame name is a frame, and ``__model__`` is attached
   to the canonical link (the model's ``canonical_link``, else its first link).
 
@@ -116,14 +117,15 @@ class SdfJoint:
     where: str
 
 
-def _axis(element, tag: str, where: str, legacy: bool) -> SdfAxis:
+def _axis(element, tag: str, where: str, version: tuple[int, ...]) -> SdfAxis:
     node = element.find(tag)
     xyz_node = node.find("xyz") if node is not None else None
     xyz = numbers(xyz_node.text if xyz_node is not None else None, 3, "0 0 1", where, f"{tag}><xyz")
     if np.linalg.norm(xyz) < 1e-12:
         raise ImportError_(f"{where}: <{tag}><xyz> is zero.")
     expressed = xyz_node.get("expressed_in", "").strip() if xyz_node is not None else ""
-    if legacy and node is not None and node.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1"):
+    stated = node is not None and node.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1")
+    if version < (1, 5) or (version < (1, 7) and stated):  # 1.4: always (libsdformat's 1_4.convert adds it)
         expressed = expressed or MODEL_FRAME
     for inner in node.iter() if node is not None else ():
         if "degrees" in inner.attrib:
@@ -153,9 +155,10 @@ def _limits(element, tag: str, where: str) -> tuple[float, float] | None:
     return None
 
 
-def parse_joint(element, where: str, legacy: bool = False) -> SdfJoint:
-    """An SDFormat ``<joint>`` element as written (``where``: the file and element, for messages; ``legacy``: a
-    file of SDFormat 1.6 or earlier, whose ``<use_parent_model_frame>`` is read)."""
+def parse_joint(element, where: str, version: tuple[int, ...] = (1, 7)) -> SdfJoint:
+    """An SDFormat ``<joint>`` element as written (``where``: the file and element, for messages; ``version``: the
+    file's SDFormat version: 1.5 and 1.6 read ``<use_parent_model_frame>``, 1.4 and earlier write every axis in the
+    model frame)."""
     name = element.get("name", "")
     ends = []
     for tag in ("parent", "child"):
@@ -165,7 +168,7 @@ def parse_joint(element, where: str, legacy: bool = False) -> SdfJoint:
             raise ImportError_(f"{where}: no <{tag}>.")
         ends.append(end)
     pose, relative = parse_pose(element.find("pose"), where)
-    axes = tuple(_axis(element, tag, where, legacy) for tag in ("axis", "axis2"))
+    axes = tuple(_axis(element, tag, where, version) for tag in ("axis", "axis2"))
     return SdfJoint(name, element.get("type", ""), ends[0], ends[1], pose, relative, axes, where)
 
 
@@ -220,8 +223,7 @@ def read_model(path: Path) -> SdfModel:
     except ElementTree.ParseError as error:
         raise ImportError_(f"{path}: not well-formed XML ({error}).") from None
     element = _the_model(path, root)
-    legacy = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2]
-                   if part.isdigit()) < (1, 7)
+    version = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2] if part.isdigit())
     label = f"{path}: <model name='{element.get('name')}'>"
     _check_names(element, label)
     links = [link.get("name", "") for link in element.findall("link")]
@@ -239,7 +241,7 @@ def read_model(path: Path) -> SdfModel:
         pose, relative = parse_pose(link.find("pose"), where)
         _declare(model, link.get("name", ""), relative or MODEL_FRAME, pose, where)
     for joint in element.findall("joint"):
-        parsed = parse_joint(joint, f"{path}: <joint name='{joint.get('name')}'>", legacy)
+        parsed = parse_joint(joint, f"{path}: <joint name='{joint.get('name')}'>", version)
         model.joints.append(parsed)
         _declare(model, parsed.name, parsed.relative_to or parsed.child, parsed.pose, parsed.where)
     for frame in element.findall("frame"):

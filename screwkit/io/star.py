@@ -211,7 +211,8 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
             continue
         axis = spread[np.argmax(np.linalg.norm(spread, axis=1))]
         axis = axis / np.linalg.norm(axis)
-        centre = np.mean(points, axis=0)
+        joint_points = [point for point, closure in zip(points, balls) if not closure.axis_point]
+        centre = np.mean(joint_points or points, axis=0)  # a point only on the hinge's line is not where it is
         frame = np.eye(4)
         frame[:3, :3] = _frame_with_z(axis)
         frame[:3, 3] = centre
