@@ -19,13 +19,16 @@ What is checked against what:
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 from delta_rods import delta_rods_mjcf
 from sdformat_models import delta_sdf, five_bar_sdf
+from test_gazebo import five_bar_gazebo
 from test_graph_legs import POSES, assert_delta_textbook, textbook
-from test_io import assert_textbook, five_bar_mjcf, poses_near_home
+from test_io import assert_textbook, five_bar_gepetto, five_bar_mjcf, poses_near_home
+from test_onshape import five_bar_onshape
 
 from helpers import one_line_error, screwkit
 from screwkit.io import ImportError_, graph_mechanism, read_closed_tree, read_mechanism_file
@@ -124,12 +127,14 @@ def test_an_mjcf_actuator_through_a_tendon_is_refused_unless_the_actuators_are_n
                for note in report.notes), report.notes
 
 
+DRIVABLE = r"; the joints that can be driven \(revolute or prismatic\) are table, mot1, mot2, mot3, free1, free2, " \
+    r"free3, loop_1\.$"
+
 MISTAKES = [
-    (("nope",), r"--actuate nope: no joint of that name; its 1-DoF joints are table, mot1, mot2, mot3, free1, free2, "
-                r"free3, loop_1\.$"),
-    (("loop_2",), r"--actuate loop_2: the joint closing a loop, where the loop is cut \(a joint of the tree can be "
-                  r"driven\); its 1-DoF joints are table, "),
-    (("anchor",), r"--actuate anchor: a fixed joint, which cannot drive anything"),
+    (("nope",), r"--actuate nope: no joint of that name" + DRIVABLE),
+    (("loop_2",), r"--actuate loop_2: it closes a loop, which screwkit cuts there \(a joint of the tree can be "
+                  r"driven\)" + DRIVABLE),
+    (("anchor",), r"--actuate anchor: a fixed joint, which cannot drive anything" + DRIVABLE),
     (("mot1", "mot1"), r"robot\.sdf: --actuate mot1: given twice"),
     (("",), r"robot\.sdf: --actuate: expected joint names, got ''"),
 ]
@@ -144,27 +149,33 @@ def test_a_joint_that_cannot_be_actuated_is_refused_naming_it(tmp_path, names, m
 
 def test_a_locked_joint_and_a_ball_joint_are_refused(tmp_path):
     path = write(tmp_path, five_bar_sdf(marker="", stage=True))
-    with pytest.raises(ImportError_, match=r"robot\.sdf: --actuate table: the joint is held by --lock table"):
+    with pytest.raises(ImportError_, match=r"robot\.sdf: --actuate table: the joint is held by --lock table; the "
+                                           r"joints that can be driven \(revolute or prismatic\) are mot1, "):
         read_closed_tree(path, lock=("table",), actuate=("table", "mot1"))
     delta = write(tmp_path, delta_sdf(POSES[0]), "delta.sdf")
-    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate ball_2a: a ball joint \(3 DoF\); an actuator is a "
-                                           r"1-DoF joint"):
+    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate ball_2a: a ball joint \(3 DoF\), not a 1-DoF joint; "
+                                           r"the joints that can be driven \(revolute or prismatic\) are motor_1"):
         read_closed_tree(delta, actuate=("ball_2a",))
-    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate ball_2a_y: one hinge of ball joint 'ball_2a'; an "
-                                           r"actuator is a 1-DoF joint"):
+    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate ball_2a_y: one hinge of ball joint 'ball_2a', not a "
+                                           r"1-DoF joint"):
         read_closed_tree(delta, actuate=("motor_1", "ball_2a_y"))
-    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate nope: no joint of that name; its 1-DoF joints are "
-                                           r"motor_1, motor_2, motor_3, motor_4\.$"):
+    with pytest.raises(ImportError_, match=r"delta\.sdf: --actuate nope: no joint of that name; the joints that can "
+                                           r"be driven \(revolute or prismatic\) are motor_1, motor_2, motor_3, "
+                                           r"motor_4\.$"):
         read_closed_tree(delta, actuate=("nope",))
     mjcf = write(tmp_path, delta_rods_mjcf(POSES[0]), "delta.xml")  # MJCF: Pinocchio's own spherical joint
     with pytest.raises(ImportError_, match=r"delta\.xml: --actuate ball_2a: a joint of 3 DoF \(JointModelSpherical"
-                                           r"\); an actuator is a 1-DoF joint"):
+                                           r"\), not a 1-DoF joint; the joints that can be driven"):
         read_closed_tree(mjcf, actuate=("ball_2a",))
 
 
 def test_a_string_is_one_name_and_a_file_in_screwkits_convention_refuses_the_option(tmp_path):
     path = write(tmp_path, five_bar_sdf(marker=""))
     assert read_closed_tree(path, actuate="mot2").motors == ["mot2"]
+    for wrong, shown in ((5, "int 5"), (b"mot1", "bytes b'mot1'")):
+        with pytest.raises(ImportError_, match=rf"robot\.sdf: --actuate: expected joint names \(strings\), got "
+                                               rf"{shown}"):
+            read_closed_tree(path, actuate=wrong)
     with pytest.raises(ValueError, match=r"five_bar_3\.urdf: an output frame or type, locked joints or actuated "
                                          r"joints named apart from the file apply to files of other tools"):
         load("five_bar_3", actuate=("motor_1",))
@@ -194,3 +205,61 @@ def test_the_command_line_drives_the_joints_named(tmp_path):
                    "name")
     one_line_error(screwkit("analyze", "five_bar_3", "--actuate", "motor_1"), "five_bar_3.urdf: an output frame or "
                    "type, locked joints or actuated joints")
+
+
+def _gepetto_without_name_mot(tmp_path):
+    urdf, yaml = five_bar_gepetto()
+    (tmp_path / "robot.urdf").write_text(urdf)
+    (tmp_path / "robot.yaml").write_text("\n".join(line for line in yaml.splitlines() if "name_mot" not in line))
+    return tmp_path / "robot.urdf", ("mot1", "mot2", "mot3")
+
+
+def _onshape_naming_no_joint(tmp_path):
+    bad = ('<transmission name="t"><type>transmission_interface/SimpleTransmission</type><joint name="gripper"/>'
+           "</transmission>")
+    path = write(tmp_path, five_bar_onshape().replace("</robot>", bad + "</robot>"), "robot.urdf")
+    return path, ("motor1", "motor2", "motor3")
+
+
+def _gazebo_naming_a_loop_joint(tmp_path):
+    bad = ('<transmission name="t"><type>transmission_interface/SimpleTransmission</type><joint name="loop_2"/>'
+           "</transmission>")
+    path = write(tmp_path, five_bar_gazebo(transmissions=False).replace("</robot>", bad + "</robot>"), "robot.urdf")
+    return path, ("mot1", "mot2", "mot3")
+
+
+def _sdformat_marking_a_ball(tmp_path):
+    text = delta_sdf(POSES[0], plugin=False).replace('type="ball"><parent>arm_2</parent>',
+                                                     f'type="ball">{MARKER}<parent>arm_2</parent>', 1)
+    return write(tmp_path, text, "delta.sdf"), ("motor_1", "motor_2", "motor_3", "motor_4")
+
+
+@pytest.mark.parametrize("make, message", [
+    (_gepetto_without_name_mot, r"robot\.yaml: name_mot must list the actuated joints"),
+    (_onshape_naming_no_joint, r"<transmission> names joint\(s\) gripper, not 1-DoF joints of the tree"),
+    (_gazebo_naming_a_loop_joint, r"<transmission> names joint\(s\) loop_2, not in the tree"),
+    (_sdformat_marking_a_ball, r"joint 'ball_2a' is marked actuated but is a ball joint, not a 1-DoF one"),
+])
+def test_a_file_whose_own_marking_is_wrong_is_refused_as_written_and_opens_with_its_actuators_named(tmp_path, make,
+                                                                                                      message):
+    """Each reader refused the file's wrong or missing marking before --actuate could replace it."""
+    path, named = make(tmp_path)
+    with pytest.raises(ImportError_, match=message + r"; --actuate JOINT names the actuated joints\.$"):
+        read_closed_tree(path)
+    tree = read_closed_tree(path, actuate=named)
+    assert tree.motors == list(named)
+    assert any(note.startswith("actuators as given (--actuate)") and "the file's could not be taken" in note
+               for note in tree.notes), tree.notes
+    if path.suffix == ".sdf":  # the rod-level Delta: a graph, its textbook
+        assert_delta_textbook(graph_mechanism(tree).indices(), textbook(POSES[0]))
+    else:
+        points = poses_near_home()
+        assert_textbook(indices_at_poses(load(path, actuate=named), points, detail=True), points)
+
+
+def test_a_refusal_after_reading_names_the_option_that_named_the_joint():
+    """A joint named that is on no leg (the published five-bar's closing frame): the message said "actuated joint",
+    as if the file had marked it."""
+    published = Path(__file__).parent / "data/gallery/published/example_parallel_robots/5bar_linkage/robot.urdf"
+    with pytest.raises(ImportError_, match=r"robot\.yaml: --actuate closedloop1_B is on no leg"):
+        read_mechanism_file(published, actuate=("closedloop1_B", "mot1"))

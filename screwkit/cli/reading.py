@@ -34,8 +34,8 @@ LOCK_HELP = ("For a file of another tool: hold this joint at its value in the fi
              "before the parallel part, such as a turntable every leg stands on.")
 
 
-ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the actuators are the joints named, in "
-                "this order, instead of those the file marks or screwkit guesses.")
+ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the actuators are the joints named "
+                "instead of those the file marks or screwkit guesses (listed, as ever, in the legs' order).")
 
 
 def lock_option(function: Callable) -> Callable:

@@ -236,7 +236,8 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
         raise mechanism.description.fail(
             f"<robot name='{mechanism.name}'>",
             f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
-            f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF).")
+            f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF; or name "
+            "them with --actuate JOINT in a file of another tool).")
     return replace(mechanism, dof=dof)
 
 

@@ -81,6 +81,10 @@ class ClosedTree:
     split: dict[str, str] = field(default_factory=dict)
     """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
     it is, for messages (none is an actuator)."""
+
+    def motor_label(self, name: str) -> str:
+        """How a message names the actuated joint ``name``: by the option that named it, else as the file's."""
+        return f"--actuate {name}" if name in self.actuated else f"actuated joint {name!r}"
     cut_by_order: tuple[str, ...] = ()
     """Closures of loops the file could as well have closed at another joint, where the reader chose by the file's
     order (SDFormat's breadth-first tree tied): no point output is taken at them unless asked."""

@@ -110,11 +110,10 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     transmitted = transmitted_joints(urdf.read_bytes())
     motors = transmitted or guessed_motors(model, closures)
     unknown = [motor for motor in motors if motor not in list(model.names)]
-    if unknown:
-        raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree.")
-    tree = ClosedTree(str(urdf), model, closures, motors, q, output, output_type,
+    unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
+    tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, q, output, output_type,
                       "URDF + Gazebo joints (<gazebo><joint>)", task_coordinates=declared_task_coordinates(
-                          urdf.read_bytes()))
+                          urdf.read_bytes()), unactuated=unactuated)  # refused unless --actuate (read_closed_tree)
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
                           f"{', '.join(motors)}; --actuate JOINT says otherwise")

@@ -46,8 +46,8 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
         raise ImportError_(f"{yaml_path}: joint_name/joint_type (joint types changed at loading) are not supported: "
                            "write those joints in the URDF.")
     pairs, kinds, motors = spec.get("closed_loop") or [], spec.get("type") or [], spec.get("name_mot")
-    if not isinstance(motors, list) or not motors:
-        raise ImportError_(f"{yaml_path}: name_mot must list the actuated joints.")
+    unactuated = "" if isinstance(motors, list) and motors else f"{yaml_path}: name_mot must list the actuated joints"
+    motors = motors if not unactuated else []  # refused unless --actuate names them (screwkit.io.read_closed_tree)
     if len(kinds) != len(pairs):
         raise ImportError_(f"{yaml_path}: {len(pairs)} closed_loop pair(s) but {len(kinds)} type(s).")
     try:
@@ -70,4 +70,5 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
         closures.append(Closure(f"{pair[0]}-{pair[1]}", sides[0][0], sides[0][1], sides[1][0], sides[1][1],
                                 str(kind).lower()))
     return ClosedTree(source, model, closures, [str(m) for m in motors], pin.neutral(model), output, output_type,
-                      "URDF + Gepetto robot.yaml", task_coordinates=declared_task_coordinates(urdf.read_bytes()))
+                      "URDF + Gepetto robot.yaml", task_coordinates=declared_task_coordinates(urdf.read_bytes()),
+                      unactuated=unactuated)

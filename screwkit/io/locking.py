@@ -72,7 +72,14 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
 def joint_names(names, option: str, source: str) -> tuple[str, ...]:
     """``names`` (joint names, or one name as a string) as a tuple; a name given twice or not a non-empty string is
     refused naming the file ``source`` and ``--option``."""
-    names = (names,) if isinstance(names, str) else tuple(names or ())
+    if isinstance(names, str):
+        names = (names,)
+    elif names is None:
+        names = ()
+    elif isinstance(names, (bytes, bytearray)) or not hasattr(names, "__iter__"):
+        raise ImportError_(f"{source}: --{option}: expected joint names (strings), got {type(names).__name__} "
+                           f"{names!r:.60}.")
+    names = tuple(names)
     for name in names:
         if not isinstance(name, str) or not name:
             raise ImportError_(f"{source}: --{option}: expected joint names, got {name!r}.")
@@ -82,32 +89,34 @@ def joint_names(names, option: str, source: str) -> tuple[str, ...]:
 
 
 def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
-    """The tree with the joints ``names`` as its actuators, in that order (``--actuate``), instead of those the file
-    marks (transmissions, MJCF actuators, ``<screwkit:actuated/>``, controller plugins, ``name_mot``) or that were
-    guessed from the branches leaving the base. Each must be a 1-DoF joint (revolute or prismatic) of the tree as
-    read, so not one held by ``--lock``; the report says the actuators were given, and which the file had."""
+    """The tree with the joints ``names`` as its actuators (``--actuate``), instead of those the file marks
+    (transmissions, MJCF actuators, ``<screwkit:actuated/>``, controller plugins, ``name_mot``) or that were guessed
+    from the branches leaving the base; the mechanism lists its actuators in its legs' order, whatever the order
+    given. Each must be a 1-DoF joint (revolute or prismatic) of the tree as read, so not one held by ``--lock``; the
+    report says the actuators were given, and which the file had."""
     names = joint_names(names, "actuate", tree.source)
     if not names:
         return tree
     model = tree.model
+    drivable = ", ".join(str(n) for n in list(model.names)[1:]
+                         if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
     for name in names:
+        what = None
         if name in tree.locked:
-            raise ImportError_(f"{tree.source}: --actuate {name}: the joint is held by --lock {name}.")
-        if name in tree.split:
-            raise ImportError_(f"{tree.source}: --actuate {name}: {tree.split[name]}; an actuator is a 1-DoF joint "
-                               "(revolute or prismatic).")
-        if not model.existJointName(name) or model.getJointId(name) == 0:
+            what = f"the joint is held by --lock {name}"
+        elif name in tree.split:
+            what = f"{tree.split[name]}, not a 1-DoF joint"
+        elif not model.existJointName(name) or model.getJointId(name) == 0:
             welded = model.existFrame(name) and str(model.frames[model.getFrameId(name)].type) == "FIXED_JOINT"
-            joints = [str(n) for n in list(model.names)[1:]
-                      if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split]
             closing = any(closure.name in (name, f"{name}_a") for closure in tree.closures)
-            what = ("a fixed joint, which cannot drive anything" if welded else "the joint closing a loop, where the "
-                    "loop is cut (a joint of the tree can be driven)" if closing else "no joint of that name")
-            raise ImportError_(f"{tree.source}: --actuate {name}: {what}; its 1-DoF joints are {', '.join(joints)}.")
-        joint = model.joints[model.getJointId(name)]
-        if joint.nv != 1:
-            raise ImportError_(f"{tree.source}: --actuate {name}: a joint of {joint.nv} DoF ({joint.shortname()}); "
-                               "an actuator is a 1-DoF joint (revolute or prismatic).")
+            what = ("a fixed joint, which cannot drive anything" if welded else "it closes a loop, which screwkit "
+                    "cuts there (a joint of the tree can be driven)" if closing else "no joint of that name")
+        elif model.joints[model.getJointId(name)].nv != 1:
+            joint = model.joints[model.getJointId(name)]
+            what = f"a joint of {joint.nv} DoF ({joint.shortname()}), not a 1-DoF joint"
+        if what is not None:
+            raise ImportError_(f"{tree.source}: --actuate {name}: {what}; the joints that can be driven (revolute or "
+                               f"prismatic) are {drivable}.")
     had = [note for note in tree.notes if note.startswith(GUESSED)]
     notes = [note for note in tree.notes if not note.startswith(GUESSED)]
     file = (f"could not be taken ({tree.unactuated.removeprefix(tree.source + ': ')})" if tree.unactuated else

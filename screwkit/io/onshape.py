@@ -82,13 +82,12 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
     transmitted = transmitted_joints(urdf.read_bytes())
     unknown = [name for name in transmitted if not model.existJointName(name)
                or model.joints[model.getJointId(name)].nv != 1]
-    if unknown:
-        raise ImportError_(f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not 1-DoF joints of the "
-                           "tree.")
-    motors = transmitted or guessed_motors(model, closures)  # none: refused once --actuate had its say
+    unactuated = (f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not 1-DoF joints of the tree"
+                  if unknown else "")  # refused unless --actuate names the actuators (read_closed_tree)
+    motors = [] if unknown else transmitted or guessed_motors(model, closures)  # none: refused, idem
     tree = ClosedTree(str(urdf), model, closures, motors, pin.neutral(model), output, output_type,
                       "onshape-to-robot URDF (closing_ frame pairs)",
-                      task_coordinates=declared_task_coordinates(urdf.read_bytes()))
+                      task_coordinates=declared_task_coordinates(urdf.read_bytes()), unactuated=unactuated)
     tree.notes.append(f"closing_ pairs read as ball joints (a URDF does not say the mate's type): "
                       f"{', '.join(c.name for c in closures)}; a robot.yaml beside the file (type: 3d or 6d) says "
                       "otherwise")

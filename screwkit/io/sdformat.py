@@ -300,15 +300,14 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     cut_by_order = tuple(closure.name for name, other in tied for closure in closing[name]
                          if np.linalg.norm(poses[name][:3, 3] - poses[other][:3, 3]) > 1e-9 * scale)
     model = builder.finish()
-    stated = actuated_joints(sdf)
-    for name in stated:
+    stated, unactuated = actuated_joints(sdf), ""
+    for name in stated:  # a marker on what cannot drive: refused unless --actuate names them (read_closed_tree)
         where = next((joint.where for joint in sdf.joints if joint.name == name), f"{sdf.source}: <plugin>")
-        if not model.existJointName(name) or model.joints[model.getJointId(name)].nv != 1:
+        if not unactuated and (not model.existJointName(name) or model.joints[model.getJointId(name)].nv != 1):
             kinds = {joint.name: joint.kind for joint in sdf.joints}
-            raise ImportError_(f"{where}: joint {name!r} is marked actuated but is "
-                               + (f"a {kinds[name]} joint, not a 1-DoF one." if name in kinds else
-                                  "not a joint of the model."))
-    motors = stated or guessed_motors(model, closures)
+            unactuated = f"{where}: joint {name!r} is marked actuated but is " + (
+                f"a {kinds[name]} joint, not a 1-DoF one" if name in kinds else "not a joint of the model")
+    motors = [] if unactuated else stated or guessed_motors(model, closures)
     if not stated:
         silent = any(CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
                      for plugin in sdf.element.findall("plugin"))  # a controller whose joints its own code names
@@ -317,4 +316,4 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                      f"{', '.join(motors)}; --actuate JOINT says otherwise")
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
                       "SDFormat (joints closing loops)", notes,
-                      cut_by_order=cut_by_order, split=builder.split)
+                      cut_by_order=cut_by_order, split=builder.split, unactuated=unactuated)

@@ -420,16 +420,16 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     motor_ids = {}
     for name in tree.motors:
         if not model.existJointName(name):
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} is not a joint of the tree.")
+            raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is not a joint of the tree.")
         joint = model.getJointId(name)
         if joint not in owner:
             through = [c.name for c in couplings if joint in path_to(model, c.joint_a) + path_to(model, c.joint_b)]
             if through:
-                raise ImportError_(f"{tree.source}: actuated joint {name!r} drives through closure {through[0]!r}, "
+                raise ImportError_(f"{tree.source}: {tree.motor_label(name)} drives through closure {through[0]!r}, "
                                    "which ends on another leg's link, not on the platform (a closed-loop "
                                    "transmission): screwkit writes compound legs whose actuators lie on a path from "
                                    "the base to the platform.")
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} is on no leg (a leg is a tree path from the "
+            raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is on no leg (a leg is a tree path from the "
                                "base to the platform or to a closure).")
         motor_ids[joint] = name
     normal = _planar_normal(tree, data, legs)
