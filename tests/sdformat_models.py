@@ -197,7 +197,8 @@ def hexapod_sdf(platform_joint: str = "universal", base_offset=(0.0, 0.0, 0.0)) 
     return "\n".join(lines)
 
 
-def ups_sdf(version: str = "1.9", from_platform: bool = True, reverse: bool = False) -> str:
+def ups_sdf(version: str = "1.9", from_platform: bool = True, reverse: bool = False, scale: float = 1.0,
+            limits: float | None = None) -> str:
     """The bundled 8-leg U-P-S hexapod written as published Gazebo Stewart platforms write theirs: per leg a
     universal joint at the base as two revolute joints (through a yoke link), the actuated slide, and the spherical
     joint at the platform as a pitch hinge on the piston plus a ``revolute2`` joint, written from the platform to the
@@ -205,30 +206,37 @@ def ups_sdf(version: str = "1.9", from_platform: bool = True, reverse: bool = Fa
     link's frame is at its joint's centre, turned along its leg. ``version`` "1.9": axes in the joint frames; "1.4":
     no ``relative_to``, every axis in the model frame (SDFormat 1.4, whose axes libsdformat reads in the model frame).
     ``reverse``: the legs written in reverse order. The joint centres and leg lines are the bundled file's, so the
-    indices are those of ``ups_hexapod_8``."""
+    indices are those of ``ups_hexapod_8``. ``scale``: every length times it (a file in millimetres: 1000);
+    ``limits``: each slide's limits +-``limits`` (m, times ``scale`` too)."""
     from screwkit.common.rotations import rotation_from_rpy
 
     platform, legs = hexapod_legs()
+    platform = " ".join([*(repr(float(v) * scale) for v in platform.split()[:3]), *platform.split()[3:]])
     lines = [f'<?xml version="1.0"?>\n<sdf version="{version}" {NAMESPACE}>\n<model name="ups_stewart">',
              '<link name="base"/>', '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child>'
              '</joint>', f'<link name="platform"><pose>{platform}</pose></link>']
     for leg, base_pose, (first, second, slide), length in (legs[::-1] if reverse else legs):
         values = np.array(base_pose.split(), dtype=float)
+        values[:3] *= scale
+        base_pose = text(values)
         turn = rotation_from_rpy(values[3:])
-        top = values[:3] + turn @ np.array([float(length), 0.0, 0.0])
+        top = values[:3] + turn @ np.array([scale * float(length), 0.0, 0.0])
 
-        def axis(local: str, tag: str = "axis", turn=turn) -> str:
+        def axis(local: str, tag: str = "axis", turn=turn, bounds: str = "") -> str:
             vector = np.array(local.split(), dtype=float)
-            return f"<{tag}><xyz>{text(turn @ vector if version == '1.4' else vector)}</xyz></{tag}>"
+            return f"<{tag}><xyz>{text(turn @ vector if version == '1.4' else vector)}</xyz>{bounds}</{tag}>"
 
         at = f"{text(top)} {text(values[3:])}"
+        bounds = "" if limits is None else (f"<limit><lower>{-limits * scale!r}</lower><upper>{limits * scale!r}"
+                                            "</upper></limit>")
         lines.append(f'<link name="{leg}_yoke"><pose>{base_pose}</pose></link><link name="{leg}_cyl"><pose>'
                      f'{base_pose}</pose></link><link name="{leg}_pis"><pose>{at}</pose></link><link name="{leg}_top">'
                      f'<pose>{at}</pose></link>')
         lines.append(f'<joint name="{leg}_b1" type="revolute"><parent>base</parent><child>{leg}_yoke</child>'
                      f'{axis(first)}</joint><joint name="{leg}_b2" type="revolute"><parent>{leg}_yoke</parent><child>'
                      f'{leg}_cyl</child>{axis(second)}</joint><joint name="{leg}_slider" type="prismatic"><parent>'
-                     f'{leg}_cyl</parent><child>{leg}_pis</child>{axis(slide)}<screwkit:actuated/></joint>'
+                     f'{leg}_cyl</parent><child>{leg}_pis</child>{axis(slide, bounds=bounds)}<screwkit:actuated/>'
+                     '</joint>'
                      f'<joint name="{leg}_pitch" type="revolute"><parent>{leg}_pis</parent><child>{leg}_top</child>'
                      f'{axis("0 1 0")}</joint>')
         ends = ("platform", f"{leg}_top") if from_platform else (f"{leg}_top", "platform")

@@ -29,7 +29,8 @@ def graph_info(graph: GraphMechanism) -> dict:
     mode = ("the one reached from the file's configuration by moving the platform straight to the pose "
             "(continuation)")
     return {
-        "mechanism": graph.name, "file": str(graph.tree.source), "length_unit": "m", "dof": graph.dof,
+        "mechanism": graph.name, "file": str(graph.tree.source), "length_unit": graph.tree.length_unit or "m",
+        "dof": graph.dof,
         "task_coordinates": [{"name": name, "unit": unit_of(name)} for name in graph.task_coordinates],
         "task_coordinates_source": "declared" if graph.tree.task_coordinates else "inferred",
         "dependent_coordinates": [{"name": name, "unit": unit_of(name)} for name in SPATIAL_TASK_COORDINATES

@@ -403,12 +403,11 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
 
         if not isinstance(error, LegWithLoops) or not graphs:
             raise fail(str(error)) from None
-        if length_unit not in (None, "m"):
-            raise fail(f"{name}: --length-unit is not applied to legs with loops inside them.") from None
         try:
             source = bundled_path(name) if name in bundled_graph_names() else name
             return graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
-                                                    lock=reading.lock, actuate=reading.actuate))
+                                                    lock=reading.lock, actuate=reading.actuate,
+                                                    length_unit=length_unit))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     context = click.get_current_context(silent=True)

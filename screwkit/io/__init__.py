@@ -75,13 +75,17 @@ def is_foreign(path: Path) -> bool:
 
 
 def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None,
-                     lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> ClosedTree:
+                     lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
+                     length_unit: str | None = None) -> ClosedTree:
     """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
-    ``lock``, ``actuate``: as :func:`read_mechanism_file`)."""
+    ``lock``, ``actuate``: as :func:`read_mechanism_file`; ``length_unit``: the unit the file is written in, its
+    lengths then brought to metres, :func:`screwkit.io.tree_units.in_metres`; a file read through
+    :func:`read_mechanism_file` is scaled as its converted text is loaded instead)."""
     from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
     from screwkit.io.locking import actuate_joints, lock_joints  # (idem)
+    from screwkit.io.tree_units import in_metres  # (idem)
 
-    tree = _read_tree(Path(path), output, output_type)
+    tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
     if tree.unactuated and not actuate:
         raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints.")
     tree = actuate_joints(lock_joints(tree, lock), actuate)

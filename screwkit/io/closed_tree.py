@@ -78,6 +78,7 @@ class ClosedTree:
     locked: tuple[str, ...] = ()  # joints held at their values in the file (screwkit.io.locking)
     actuated: tuple[str, ...] = ()  # the actuators as the user named them (--actuate), not the file (idem)
     unactuated: str = ""  # why the file's own actuators cannot be taken: refused unless --actuate names them
+    length_unit: str | None = None  # the unit the file was written in, its lengths now in m (screwkit.io.tree_units)
     split: dict[str, str] = field(default_factory=dict)
     """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
     it is, for messages (none is an actuator)."""

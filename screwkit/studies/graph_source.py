@@ -16,7 +16,8 @@ __all__ = ["GraphSource", "graph_source", "cached_graph"]
 class GraphSource:
     """What a task needs to rebuild a closed-loop graph (:class:`~screwkit.io.GraphMechanism`): its file, read where
     the task runs (a Dask worker on another machine needs it at the same path), the reading's output choice, its
-    locked and actuated joints, and the file's digest (a task refuses a file changed since the map began)."""
+    locked and actuated joints, its length unit, and the file's digest (a task refuses a file changed since the map
+    began)."""
 
     path: str
     output: str | None
@@ -24,6 +25,7 @@ class GraphSource:
     digest: str
     lock: tuple[str, ...] = ()
     actuate: tuple[str, ...] = ()
+    length_unit: str | None = None
 
 
 @functools.lru_cache(maxsize=4)
@@ -36,11 +38,11 @@ def cached_graph(source: GraphSource) -> GraphMechanism:
     if hashlib.sha256(data).hexdigest() != source.digest:
         raise ValueError(f"{source.path}: the file changed while the map was computed.")
     return graph_mechanism(read_closed_tree(Path(source.path), output=source.output, output_type=source.output_type,
-                                            lock=source.lock, actuate=source.actuate))
+                                            lock=source.lock, actuate=source.actuate, length_unit=source.length_unit))
 
 
 def graph_source(graph: GraphMechanism) -> GraphSource:
     """What a task elsewhere needs to rebuild ``graph`` as read (:func:`cached_graph`)."""
     digest = hashlib.sha256(Path(graph.tree.source).read_bytes()).hexdigest()
     return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest, graph.tree.locked,
-                       graph.tree.actuated)
+                       graph.tree.actuated, graph.tree.length_unit)
