@@ -232,11 +232,12 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
         tree.model, data, c)]}
 
 
-def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
+def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
     """A configuration closing every closure, near the file's reference one; and the length scale.
 
     Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
-    joint type; a damped step is the least change when the closures leave joints free),
+    joint type; a damped step is the least change when the closures leave joints free; the joints ``held``, by
+    id, keep their values),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
     the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
     turn); the Jacobian by central differences.
@@ -272,6 +273,10 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
 
     if not tree.closures:
         raise ImportError_(f"{tree.source}: no closure: nothing closes the tree into a parallel mechanism.")
+    free = np.ones(model.nv, dtype=bool)
+    for joint in held:
+        free[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv] = False
+    directions = np.eye(model.nv)[free]
     v = np.zeros(model.nv)
     error = residuals(v)
     damping = 1e-6
@@ -281,9 +286,9 @@ def assemble(tree: ClosedTree) -> tuple[NDArray, float]:
             break
         step = 1e-7
         jacobian = np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step)
-                                    for e in np.eye(model.nv)])
-        normal = jacobian.T @ jacobian + (damping + norm**2) * np.eye(model.nv)
-        change = -np.linalg.solve(normal, jacobian.T @ error)
+                                    for e in directions])
+        normal = jacobian.T @ jacobian + (damping + norm**2) * np.eye(len(directions))
+        change = -np.linalg.solve(normal, jacobian.T @ error) @ directions
         change *= min(1.0, 0.5 / max(float(np.max(np.abs(change))), 1e-300))
         candidate = residuals(v + change)
         if np.linalg.norm(candidate) < norm:

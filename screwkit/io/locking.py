@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, assemble, homogeneous, joint_value, path_to
 from screwkit.io.onshape import guessed_motors
 
 __all__ = ["lock_joints", "actuate_joints", "joint_names"]
@@ -22,7 +22,9 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     model: each locked joint's body merged into its parent's), its closures and actuators carried over.
 
     For a serial stage before the parallel part -- a turntable under a Stewart head, every leg passing through it
-    -- the legs are then analysed on the body the stage turns. Actuators guessed from the branches leaving the
+    -- the legs are then analysed on the body the stage turns. A passive joint inside a loop (a knee that a
+    four-bar turns, which a file may write open) is held where the loops close with the other locked joints and
+    the actuators held, and the report says so. Actuators guessed from the branches leaving the
     base (:func:`screwkit.io.onshape.guessed_motors`) are guessed again on the locked tree."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -35,9 +37,10 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
             raise ImportError_(f"{tree.source}: --lock {name}: no joint of that name; joints are "
                                + ", ".join(str(n) for n in list(model.names)[1:]) + ".")
     locked = [model.getJointId(name) for name in names]
+    held, moved = _values_closing_the_loops(tree, locked)
     data = model.createData()
-    pin.forwardKinematics(model, data, tree.q_reference)
-    reduced = pin.buildReducedModel(model, locked, tree.q_reference)
+    pin.forwardKinematics(model, data, held)
+    reduced = pin.buildReducedModel(model, locked, held)
 
     def carried(joint: int, placement: NDArray) -> tuple[int, NDArray]:
         while joint in locked:  # the frame rides on the body the locked joint's body is merged into
@@ -55,7 +58,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     q = np.concatenate([tree.q_reference[model.joints[j].idx_q:model.joints[j].idx_q + model.joints[j].nq]
                         for j in kept]) if kept else np.zeros(0)
     notes = [f"joints {', '.join(names)} locked at their values in the file (--lock): the legs analysed on the body "
-             "they turn"]
+             "they turn"] + moved
     motors = [motor for motor in tree.motors if motor not in names]
     guessed = [k for k, note in enumerate(tree.notes) if note.startswith(GUESSED)]
     other = [note for k, note in enumerate(tree.notes) if k not in guessed]
@@ -67,6 +70,30 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
         other += [tree.notes[k] for k in guessed]
     return replace(tree, model=reduced, closures=closures, motors=motors, q_reference=q, notes=other + notes,
                    locked=tree.locked + names)
+
+
+def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDArray, list[str]]:
+    """The file's configuration, each locked joint at its value in the file, but a locked passive joint inside a loop
+    (a knee that a four-bar turns) at the value that closes the loops with the other locked joints and the actuators
+    held there: a file may write such a joint open. With the notes saying which moved."""
+    model, held = tree.model, np.array(tree.q_reference, dtype=float)
+    cycles = set()  # the joints of every closure's loop: its two tree paths, less what they share
+    for closure in tree.closures:
+        cycles |= set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b))
+    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
+    inside = [joint for joint in locked if joint in cycles and joint not in motors]
+    if not inside:
+        return held, []
+    closed, _ = assemble(replace(tree, notes=[]), held=[j for j in locked if j not in inside] + sorted(motors))
+    moved = []
+    for joint in inside:
+        span = slice(model.joints[joint].idx_q, model.joints[joint].idx_q + model.joints[joint].nq)
+        before = joint_value(model, joint, held) if model.joints[joint].nv == 1 else None
+        held[span] = closed[span]
+        if before is not None and abs(joint_value(model, joint, held) - before) > 1e-9:
+            moved.append(f"joint {model.names[joint]} (passive, inside a loop) locked at "
+                         f"{joint_value(model, joint, held):.9g}, where the loops close (the file writes {before:.9g})")
+    return held, moved
 
 
 def joint_names(names, option: str, source: str) -> tuple[str, ...]:

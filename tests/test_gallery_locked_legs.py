@@ -1,0 +1,161 @@
+"""Gepetto's walking-robot legs (example-parallel-robots, BSD-3-Clause, ``tests/data/gallery/published``): the
+parallel ankle under a serial leg, analysed with the leg held by ``--lock``.
+
+``digit_like`` (a hip of three motors, a knee motor driving the shin through a four-bar, and a two-rod ankle) and
+``cassie_like`` (the same with a one-rod plantar four-bar) write their knee four-bar open: the passive ``free_knee``
+is 0 in the file, where its loop misses by 5-6 cm. screwkit's own messages lead a user to lock the hip and knee
+motors and then ``free_knee``; locked at the file's 0 the loop could never close, and the file was refused. A
+locked passive joint inside a loop is now held where the loops close with the other locked joints and the motors
+held (:func:`screwkit.io.locking.lock_joints`).
+
+Checked with Pinocchio and scipy alone: every loop of the file closed by scipy's least squares with the locked
+motors at the file's 0 and the ankle's motors at the values screwkit reports gives ``free_knee`` where screwkit
+holds it, and at that configuration the ankle's indices from the rod lines: the actuation wrench of a crank-rod leg
+is the force along its rod through the rod's ball centres, ITI = |f . v_crank| / |v_crank| at the crank's ball, and
+OTI = |f . v| / |v| at the rod's platform ball, v from the foot twist reciprocal to the other rod's force in the
+foot's motion space (its two hinges for digit's ankle, its hinge for cassie's).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+from scipy.optimize import least_squares
+from test_gallery_published import GEPETTO
+
+from helpers import screwkit
+from screwkit.io import read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+TOLERANCE = 1e-9
+DIGIT_LOCKS = ("motor_hip_x", "motor_hip_y", "motor_hip_z", "motor_knee", "free_knee")
+CASSIE_LOCKS = ("motor_hip1", "motor_hip2", "motor_tigh", "motor_knee", "free_knee")
+
+
+def closed_by_scipy(path, held: dict[str, float]) -> tuple[object, object, np.ndarray]:
+    """The file's tree (Pinocchio's own reading) with every loop of its robot.yaml closed by scipy's least squares
+    over the joints not ``held`` (those at the given values), from the file's zero configuration."""
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
+    pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
+    names = [str(name) for name in list(model.names)[1:]]
+    free = [name for name in names if name not in held]
+    index = {name: model.joints[model.getJointId(name)].idx_q for name in names}
+
+    def configuration(x):
+        q = pin.neutral(model)
+        for name, value in held.items():
+            q[index[name]] = value
+        for name, value in zip(free, x):
+            q[index[name]] = value
+        return q
+
+    def residuals(x):
+        pin.framesForwardKinematics(model, data, configuration(x))
+        return np.concatenate([pin.log6(data.oMf[a].inverse() * data.oMf[b]).vector for a, b in pairs])
+
+    solved = least_squares(residuals, np.zeros(len(free)), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    assert np.abs(residuals(solved.x)).max() < 1e-10  # every loop closed
+    q = configuration(solved.x)
+    pin.forwardKinematics(model, data, q)
+    return model, data, q
+
+
+def point_and_axis(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+    joint = model.getJointId(name)
+    axis = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}.get(
+        model.joints[joint].shortname())
+    axis = np.array(axis, dtype=float) if axis is not None else np.asarray(model.joints[joint].extract().axis)
+    return data.oMi[joint].translation.copy(), data.oMi[joint].rotation @ axis
+
+
+def analysed(path, locks):
+    """screwkit's indices at the file's home pose with ``locks`` held, its actuators' values (rad) and the value it
+    holds free_knee at (from the import report)."""
+    mechanism = load(path, lock=locks)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    values = {name.split(":")[-1]: value for name, value in result.joint_values.items()}
+    motors = {name.split(":")[-1]: values[name.split(":")[-1]] for name in result.actuators}
+    _, report = read_mechanism_file(path, lock=locks)
+    note = next(note for note in report.notes if note.startswith("joint free_knee (passive, inside a loop) locked"))
+    return result, motors, float(note.split(" locked at ")[1].split(",")[0])
+
+
+def rod_force(model, data, crank_ball: str, platform_ball: str):
+    crank, _ = point_and_axis(model, data, crank_ball)
+    end, _ = point_and_axis(model, data, platform_ball)
+    return (end - crank) / np.linalg.norm(end - crank), crank, end
+
+
+def test_digit_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
+    path = GEPETTO / "digit_like" / "robot.urdf"
+    result, motors, knee = analysed(path, DIGIT_LOCKS)
+    assert sorted(motors) == ["motor_shin1", "motor_shin2"] and result.dof == 2
+    held = {name: 0.0 for name in DIGIT_LOCKS[:4]} | motors
+    model, data, q = closed_by_scipy(path, held)
+    assert q[model.joints[model.getJointId("free_knee")].idx_q] == pytest.approx(knee, abs=1e-8)
+    assert knee == pytest.approx(0.7163546, abs=1e-6)  # (what the file writes: 0)
+    legs = {"motor_shin1": ("crank_toe_b_2/2_rev0", "foot_part_toe_b_1/2_2_rev0"),
+            "motor_shin2": ("crank_2_toe_b_2/2_2_rev0", "foot_part_toe_b_1/2_rev0")}
+    forces, itis = {}, []
+    for motor in sorted(motors):
+        force, crank, end = rod_force(model, data, *legs[motor])
+        origin, axis = point_and_axis(model, data, motor)
+        velocity = np.cross(axis, crank - origin)
+        itis.append(abs(force @ velocity) / np.linalg.norm(velocity))
+        forces[motor] = (force, crank, end)
+    hinges = [point_and_axis(model, data, name) for name in ("free_foot1", "free_foot2")]
+    space = np.array([np.concatenate([axis, np.cross(point, axis)]) for point, axis in hinges]).T  # (omega, v at 0)
+
+    def power(force, at, twist):
+        return force @ (twist[3:] + np.cross(twist[:3], at))
+
+    otis = []
+    for motor in sorted(motors):
+        force, crank, end = forces[motor]
+        other, other_at, _ = next(value for key, value in forces.items() if key != motor)
+        twist = space @ np.array([-power(other, other_at, space[:, 1]), power(other, other_at, space[:, 0])])
+        velocity = twist[3:] + np.cross(twist[:3], end)
+        otis.append(abs(force @ velocity) / np.linalg.norm(velocity))
+    order = [name.split(":")[-1] for name in result.actuators]
+    assert order == sorted(motors)
+    np.testing.assert_allclose(result.iti_actuators, itis, atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, min(otis), atol=TOLERANCE)
+
+
+def test_cassie_s_plantar_four_bar_with_its_leg_locked_has_the_rod_line_indices():
+    path = GEPETTO / "cassie_like" / "robot.urdf"
+    result, motors, knee = analysed(path, CASSIE_LOCKS)
+    assert list(motors) == ["motor_ankle"] and result.dof == 1
+    model, data, q = closed_by_scipy(path, {name: 0.0 for name in CASSIE_LOCKS[:4]} | motors)
+    assert q[model.joints[model.getJointId("free_knee")].idx_q] == pytest.approx(knee, abs=1e-8)
+    force, crank, end = rod_force(model, data, "servo_gauche_half_planta_rode_rev0", "foot_2_half_planta_rode_2_rev0")
+    origin, axis = point_and_axis(model, data, "motor_ankle")
+    foot, hinge = point_and_axis(model, data, "free_ankle")
+    at_crank, at_foot = np.cross(axis, crank - origin), np.cross(hinge, end - foot)
+    np.testing.assert_allclose(result.iti_actuators, [abs(force @ at_crank) / np.linalg.norm(at_crank)],
+                               atol=TOLERANCE)
+    np.testing.assert_allclose(result.lmti, abs(force @ at_foot) / np.linalg.norm(at_foot), atol=TOLERANCE)
+
+
+def test_the_command_line_follows_its_own_lock_suggestions_to_the_ankle(tmp_path):
+    """Each refusal names the next joint to lock; with all five the ankle is analysed, and the report says where
+    free_knee is held."""
+    path = GEPETTO / "digit_like" / "robot.urdf"
+    locks = []
+    for name in DIGIT_LOCKS:
+        refused = screwkit("info", path, *[part for lock in locks for part in ("--lock", lock)])
+        assert refused.returncode == 1 and f"--lock {name} analyses the legs" in refused.stderr, refused.stderr
+        locks.append(name)
+    done = screwkit("analyze", path, *[part for lock in locks for part in ("--lock", lock)], "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["dof"] == 2
+    info = screwkit("info", path, *[part for lock in locks for part in ("--lock", lock)])
+    assert "joint free_knee (passive, inside a loop) locked at 0.716354" in info.stdout
