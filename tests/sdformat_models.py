@@ -247,3 +247,46 @@ def ups_sdf(version: str = "1.9", from_platform: bool = True, reverse: bool = Fa
                      f'{pose}{axis("0 0 1")}{axis("1 0 0", "axis2")}</joint>')
     lines.append("</model>\n</sdf>")
     return "\n".join(lines)
+
+
+RRP_CENTRE = np.array([0.05, 0.02])
+"""The 3-RRP's platform point (m) in the file's configuration."""
+
+
+def rrp_legs() -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """Per leg of :func:`rrp_sdf` (planar, m): its base pin B, its slide's point A on the platform, its elbow E and
+    the slide's direction u (from E to A), in the file's configuration."""
+    legs = []
+    for k in range(3):
+        turn = np.radians(90 + 120 * k)
+        base = np.array([np.cos(turn), np.sin(turn)])
+        slide = RRP_CENTRE + 0.3 * np.array([np.cos(turn + 0.7), np.sin(turn + 0.7)])
+        elbow = base + 0.45 * np.array([np.cos(turn + 2.6), np.sin(turn + 2.6)])
+        legs.append((base, slide, elbow, (slide - elbow) / np.linalg.norm(slide - elbow)))
+    return legs
+
+
+def rrp_sdf(from_platform=(), limits=None, order=(0, 1, 2)) -> str:
+    """A planar 3-RRP (per leg: base -R- link 1 -R- link 2 -P, actuated, onto the platform), every axis in
+    ``__model__``. The legs in ``from_platform`` write their slide from the platform to link 2, along the opposite
+    axis: the same joint, the same value (SDFormat's value is the child's displacement along the axis) and limits
+    (``limits``: (lower, upper) m). ``order``: the order the legs are written in."""
+    lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="rrp">', '<link name="base"/>',
+             '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
+             f'<link name="platform"><pose>{text((*RRP_CENTRE, 0.0))} 0 0 0</pose></link>',
+             '<frame name="effector" attached_to="platform"/>']
+    bounds = "" if limits is None else f"<limit><lower>{limits[0]!r}</lower><upper>{limits[1]!r}</upper></limit>"
+    legs = rrp_legs()
+    for k in order:
+        base, slide, elbow, direction = legs[k]
+        lines.append(f'<link name="l1_{k}"><pose>{text((*base, 0.0))} 0 0 0</pose></link><link name="l2_{k}"><pose>'
+                     f'{text((*elbow, 0.0))} 0 0 0</pose></link>'
+                     f'<joint name="r1_{k}" type="revolute"><parent>base</parent><child>l1_{k}</child><axis><xyz>0 0 1'
+                     f'</xyz></axis></joint><joint name="r2_{k}" type="revolute"><parent>l1_{k}</parent><child>l2_{k}'
+                     '</child><axis><xyz>0 0 1</xyz></axis></joint>')
+        ends, sign = (("platform", f"l2_{k}"), -1.0) if k in from_platform else ((f"l2_{k}", "platform"), 1.0)
+        lines.append(f'<joint name="p_{k}" type="prismatic"><parent>{ends[0]}</parent><child>{ends[1]}</child>'
+                     f'<pose relative_to="__model__">{text((*slide, 0.0))} 0 0 0</pose><axis><xyz expressed_in='
+                     f'"__model__">{text((*(sign * direction), 0.0))}</xyz>{bounds}</axis><screwkit:actuated/></joint>')
+    lines.append("</model></sdf>")
+    return "\n".join(lines)

@@ -174,7 +174,7 @@ class _TreeBuilder:
 
     def tree_joint(self, joint: SdfJoint, parent_node: str, child_node: str) -> None:
         """A joint of the spanning tree from ``parent_node`` to ``child_node`` (reversed if those are the SDFormat
-        child and parent: the same motion, its value's sign changed)."""
+        child and parent: the same motion about or along the opposite axis, so its value and limits are the file's)."""
         parent, parent_frame = self.placed[parent_node]
         world = self.poses[joint.name]
         if joint.kind == "fixed":
@@ -196,9 +196,9 @@ class _TreeBuilder:
             self.split[joint.name] = f"a {joint.kind} joint ({len(steps)} DoF)"
         index = parent
         for name, kind, axis, limits in steps[::-1] if reverse else steps:
-            if limits is not None and reverse:
-                limits = (-limits[1], -limits[0])
-            index = self.add_joint(index, name, kind, axis, world, limits)
+            # reversed: the parent's motion seen from the child, about (along) the opposite axis, so that each value
+            # and its limits are the file's
+            index = self.add_joint(index, name, kind, -axis if reverse else axis, world, limits)
             parent_frame = self.model.addJointFrame(index, parent_frame)
         self.placed[child_node] = (index, self.model.addBodyFrame(
             child_node, index, self._se3(index, self.poses[child_node]), parent_frame))
@@ -233,9 +233,8 @@ def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str]
         names = (f"{joint.name}_axis", f"{joint.name}_axis2") if joint.kind in TWO_AXES else (joint.name,)
         kind, limits = ("prismatic" if joint.kind == "prismatic" else "revolute"), joint.axes[tree_axis].limits
         axis = builder.axis_in_joint(joint, tree_axis)
-        if on_child:  # the same motion seen from the child: its value's sign changed
-            limits = None if limits is None else (-limits[1], -limits[0])
-            child = builder.add_joint(child, names[tree_axis], kind, axis, world, limits)
+        if on_child:  # the same motion seen from the child, about (along) the opposite axis: the file's value
+            child = builder.add_joint(child, names[tree_axis], kind, -axis, world, limits)
         else:
             parent = builder.add_joint(parent, names[tree_axis], kind, axis, world, limits)
         if joint.kind in TWO_AXES:
