@@ -25,6 +25,7 @@ import pinocchio as pin
 import pytest
 import yaml
 from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
 from test_gallery_published import GEPETTO
 
 from helpers import screwkit
@@ -159,3 +160,28 @@ def test_the_command_line_follows_its_own_lock_suggestions_to_the_ankle(tmp_path
     assert json.loads(done.stdout)["dof"] == 2
     info = screwkit("info", path, *[part for lock in locks for part in ("--lock", lock)])
     assert "joint free_knee (passive, inside a loop) locked at 0.716354" in info.stdout
+
+
+def test_a_lock_on_a_file_whose_loop_closes_with_the_locked_joint_where_written_keeps_it_there(tmp_path):
+    """Gepetto's five-bar with mot1's crank turned 2.5 rad in the file (written open, 1.9 m apart): the loop closes
+    with free1 held at the file's 0 and the motors moved, so --lock free1 holds it there, as before the rule above
+    (which first held the motors too, where no free1 closes it, and refused the file)."""
+    source = GEPETTO / "5bar_linkage"
+    text = (source / "robot.urdf").read_text()
+    head = '<joint name="mot1" type="revolute">'
+    start = text.index('rpy="', text.index(head)) + len('rpy="')
+    end = text.index('"', start)
+    turned = Rotation.from_euler("xyz", np.array(text[start:end].split(), dtype=float)) * Rotation.from_euler(
+        "z", 2.5)
+    path = tmp_path / "robot.urdf"
+    path.write_text(text[:start] + " ".join(repr(float(v)) for v in turned.as_euler("xyz")) + text[end:])
+    (tmp_path / "robot.yaml").write_text((source / "robot.yaml").read_text())
+    mechanism = load(path, lock=("free1",))
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert mechanism.dof == 1 and result.iti > 0.5
+    _, report = read_mechanism_file(path, lock=("free1",))
+    assert not any("inside a loop) locked at" in note for note in report.notes)  # free1 kept at the file's 0
+    model, data, q = closed_by_scipy(path, {"free1": 0.0, **{
+        name.split(":")[-1]: value for name, value in result.joint_values.items() if name.split(":")[-1] in
+        ("mot1", "mot2")}})
+    assert q[model.joints[model.getJointId("free1")].idx_q] == 0.0  # and the loop closes there (scipy, above)

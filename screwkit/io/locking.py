@@ -23,9 +23,9 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
 
     For a serial stage before the parallel part -- a turntable under a Stewart head, every leg passing through it
     -- the legs are then analysed on the body the stage turns. A passive joint inside a loop (a knee that a
-    four-bar turns, which a file may write open) is held where the loops close with the other locked joints and
-    the actuators held, and the report says so. Actuators guessed from the branches leaving the
-    base (:func:`screwkit.io.onshape.guessed_motors`) are guessed again on the locked tree."""
+    four-bar turns) whose value in the file leaves the loops open however the other joints move is held where
+    they close with the other locked joints held, and the report says so. Actuators guessed from the branches
+    leaving the base (:func:`screwkit.io.onshape.guessed_motors`) are guessed again on the locked tree."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     names = joint_names(names, "lock", tree.source)
@@ -73,18 +73,31 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
 
 
 def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDArray, list[str]]:
-    """The file's configuration, each locked joint at its value in the file, but a locked passive joint inside a loop
-    (a knee that a four-bar turns) at the value that closes the loops with the other locked joints and the actuators
-    held there: a file may write such a joint open. With the notes saying which moved."""
+    """The file's configuration, each locked joint at its value in the file when the loops close with every locked
+    joint there (the other joints moved); else each locked passive joint inside a loop (a knee that a four-bar
+    turns: a file may write it open) at the value where the loops close with the other locked joints held. With
+    the notes saying which moved."""
     model, held = tree.model, np.array(tree.q_reference, dtype=float)
+    quiet = replace(tree, notes=[])  # (the assembly's own notes are said when it runs again, on the locked tree)
+    try:
+        assemble(quiet, held=locked)
+        return held, []  # the file's values close: as written
+    except ImportError_ as error:
+        refusal = error
     cycles = set()  # the joints of every closure's loop: its two tree paths, less what they share
     for closure in tree.closures:
         cycles |= set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b))
     motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
     inside = [joint for joint in locked if joint in cycles and joint not in motors]
     if not inside:
-        return held, []
-    closed, _ = assemble(replace(tree, notes=[]), held=[j for j in locked if j not in inside] + sorted(motors))
+        raise ImportError_(f"{refusal} (with --lock {', --lock '.join(model.names[j] for j in locked)} held at the "
+                           "file's values)") from None
+    try:
+        closed, _ = assemble(quiet, held=[joint for joint in locked if joint not in inside])
+    except ImportError_ as error:
+        raise ImportError_(f"{error} (with --lock {', --lock '.join(model.names[j] for j in locked)}: the passive "
+                           f"{', '.join(model.names[j] for j in inside)} free to close the loops, the others held at "
+                           "the file's values)") from None
     moved = []
     for joint in inside:
         span = slice(model.joints[joint].idx_q, model.joints[joint].idx_q + model.joints[joint].nq)
