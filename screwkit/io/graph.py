@@ -351,9 +351,13 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
         if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
+            below = [model.names[j] for j in path_to(model, actuator)[:-1] if j in leg.joints]  # carrying it
+            one = len(below) == 1
+            hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
+                    f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else "")
             raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
                                "twist is not a motion the leg allows: the leg has no serial input); analysable when "
-                               "the actuated joint joins the base to the rest of its leg.")
+                               f"the actuated joint joins the base to the rest of its leg{hint}.")
 
 
 def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
