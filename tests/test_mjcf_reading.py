@@ -332,3 +332,41 @@ def test_a_keyframe_of_the_wrong_size_says_so_naming_the_key(tmp_path):
     text = five_bar_mjcf().replace("</mujoco>", '<keyframe><key name="home" qpos="0 0"/></keyframe></mujoco>')
     with pytest.raises(ImportError_, match=re.escape("one number per joint coordinate expected") + ".*'home' 2"):
         read_mjcf(written(tmp_path, text))
+
+
+def _schema_attributes(tag: str) -> set[str]:
+    """The attributes MuJoCo's own XML schema (``mujoco.mj_printSchema``) allows on ``<equality><tag>``: the words
+    after ``tag (*)`` on its line and on the continuation lines below it (indented to the attributes' column)."""
+    lines = mujoco.mj_printSchema(False, False).splitlines()
+    equality = next(k for k, line in enumerate(lines) if line.split()[:1] == ["equality"])
+    first = next(k for k in range(equality + 1, len(lines)) if lines[k].split()[:1] == [tag])
+    column = len(lines[first]) - len(lines[first].lstrip()) + len(tag) + 4  # "tag (*)" ends before the attributes
+    words = lines[first].split()[2:]
+    for line in lines[first + 1:]:
+        if len(line) - len(line.lstrip()) < column:
+            break
+        words += line.split()
+    return set(words)
+
+
+@pytest.mark.parametrize("tag", ["connect", "weld"])
+def test_the_closure_attributes_screwkit_reads_are_those_of_mujoco_s_schema(tag):
+    from screwkit.io.mjcf_text import CLOSURE_ATTRIBUTES
+
+    assert CLOSURE_ATTRIBUTES[tag] == _schema_attributes(tag)
+
+
+def test_an_attribute_mujoco_refuses_on_a_closure_is_refused_rather_than_ignored(tmp_path):
+    """A relpose on a <connect> (only a <weld> has one): MuJoCo refuses the file; screwkit read it, ignoring the
+    pose the author may have meant."""
+    text = five_bar_mjcf()
+    assert text.count("<connect") >= 1
+    text = text.replace("<connect", '<connect relpose="0 0 0 1 0 0 0"', 1)
+    with pytest.raises(ValueError, match="unrecognized attribute: 'relpose'"):
+        mujoco.MjModel.from_xml_string(text)
+    path = tmp_path / "five_bar.xml"
+    path.write_text(text)
+    with pytest.raises(ImportError_, match=r"five_bar\.xml: <equality><connect[^>]*>: relpose='0 0 0 1 0 0 0': not an "
+                                           r"attribute of <connect> \(it has active, anchor, body1, body2, class, "
+                                           r"name, site1, site2, solimp, solref\): MuJoCo refuses the file\."):
+        read_mechanism_file(path)

@@ -54,7 +54,7 @@ from screwkit.io.mjcf_pose import (
     rotation_matrix,
 )
 
-__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError"]
+__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError", "CLOSURE_ATTRIBUTES"]
 
 MAX_INCLUDE_DEPTH = 20
 """Deepest chain of ``<include>``s followed (a file including itself is refused before that)."""
@@ -75,6 +75,11 @@ COUPLINGS = {"joint": "a joint coupling", "tendon": "a tendon coupling", "flex":
 """Equalities that are not closures: each constrains the mechanism's joints (changes its mobility)."""
 IDENTIFYING = ("joint1", "joint2", "tendon1", "tendon2", "flex")
 """The attributes that say what a coupling couples, in messages."""
+_COMMON = ("name", "class", "active", "solref", "solimp")
+CLOSURE_ATTRIBUTES = {"connect": {*_COMMON, "body1", "body2", "anchor", "site1", "site2"},
+                      "weld": {*_COMMON, "body1", "body2", "relpose", "anchor", "site1", "site2", "torquescale"}}
+"""The attributes MuJoCo's schema allows on the closures screwkit reads; it refuses a file with any other (a
+``relpose`` on a ``<connect>``, which only a ``<weld>`` has), and so does screwkit rather than ignore it."""
 
 
 def _parse(path: Path) -> ElementTree.Element:
@@ -216,6 +221,10 @@ def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element |
         if element.tag not in ("connect", "weld", *COUPLINGS):
             removed = " (MuJoCo 2's distance constraint, since removed)" if element.tag == "distance" else ""
             raise MjcfError(f"{where}: not an equality MuJoCo reads{removed}: MuJoCo refuses the file.")
+        unknown = sorted(set(element.attrib) - CLOSURE_ATTRIBUTES.get(element.tag, set(element.attrib)))
+        if unknown:
+            raise MjcfError(f"{where}: {unknown[0]}={element.get(unknown[0])!r}: not an attribute of <{element.tag}> "
+                            f"(it has {', '.join(sorted(CLOSURE_ATTRIBUTES[element.tag]))}): MuJoCo refuses the file.")
         active = element.get("active", classes.get(element.get("class") or "main", {}).get("active", "true"))
         if active not in ("true", "false"):
             raise MjcfError(f"{where}: active='{active}': expected true or false.")
