@@ -52,12 +52,10 @@ def convert(source: Path, out: Path, output_frame, output_type, lock, actuate, i
         if is_foreign(source):
             text, report = read_mechanism_file(source, output=output_frame, output_type=output_type, lock=tuple(lock),
                                                actuate=tuple(actuate))
-        else:  # screwkit's own convention: the loops the file leaves open, closed and written back
-            if output_frame is not None or output_type is not None or lock or actuate:
-                raise fail(f"{source}: --output, --output-type, --lock and --actuate apply to files of other tools "
-                           "(MJCF, SDFormat, URDF + robot.yaml, onshape-to-robot URDFs); this file is in screwkit's "
-                           "convention (its output is its platform, its <transmission>s name its actuators).")
-            own = load(source, limits=not ignore_limits)
+        else:  # screwkit's own convention: the loops the file leaves open, closed and written back (the options of
+            # files of other tools refused by the loader, as on every command)
+            own = load(source, limits=not ignore_limits, output=output_frame, output_type=output_type,
+                       lock=tuple(lock), actuate=tuple(actuate))
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))

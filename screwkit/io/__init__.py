@@ -127,7 +127,7 @@ def read_mechanism_file(path: Path, *, output: str | None = None, output_type: s
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
     ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says); ``lock``: joints held at their
     values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part);
-    ``actuate``: the actuated joints, in that order, instead of the file's or the guessed ones
+    ``actuate``: the actuated joints, instead of the file's or the guessed ones
     (:func:`screwkit.io.locking.actuate_joints`). A leg
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).

@@ -142,6 +142,11 @@ class _TreeBuilder:
         self.split: dict[str, str] = {}  # a hinge of a ball or universal joint -> that joint (ClosedTree.split)
         self.limits: dict[int, tuple[float, float]] = {}
 
+    def hinges(self, joint: SdfJoint, names) -> None:
+        """Record the hinges ``names`` a ball or universal joint is written as (:attr:`ClosedTree.split`)."""
+        self.split.update({name: f"one hinge of {joint.kind} joint {joint.name!r}" for name in names})
+        self.split[joint.name] = f"a {joint.kind} joint ({len(names)} DoF)"
+
     def _se3(self, joint: int, world: NDArray):
         matrix = inverse(self.joint_world[joint]) @ world
         return self.pin.SE3(matrix[:3, :3].copy(), matrix[:3, 3].copy())
@@ -192,8 +197,7 @@ class _TreeBuilder:
         elif joint.kind == "ball":  # three hinges through its centre, about its frame's axes (the module docstring)
             steps = [(f"{joint.name}_{axis}", "revolute", np.eye(3)[k], None) for k, axis in enumerate("xyz")]
         if len(steps) > 1:
-            self.split.update({name: f"one hinge of {joint.kind} joint {joint.name!r}" for name, *_ in steps})
-            self.split[joint.name] = f"a {joint.kind} joint ({len(steps)} DoF)"
+            self.hinges(joint, [name for name, *_ in steps])
         index = parent
         for name, kind, axis, limits in steps[::-1] if reverse else steps:
             # reversed: the parent's motion seen from the child, about (along) the opposite axis, so that each value
@@ -238,8 +242,7 @@ def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str]
         else:
             parent = builder.add_joint(parent, names[tree_axis], kind, axis, world, limits)
         if joint.kind in TWO_AXES:
-            builder.split.update({name: f"one hinge of {joint.kind} joint {joint.name!r}" for name in names})
-            builder.split[joint.name] = f"a {joint.kind} joint (2 DoF)"
+            builder.hinges(joint, names)
             joint = SdfJoint(names[1 - tree_axis], "revolute", joint.parent, joint.child, joint.pose,
                              joint.relative_to, (joint.axes[1 - tree_axis],), joint.where)
             builder.poses[joint.name] = world
