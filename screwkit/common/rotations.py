@@ -16,6 +16,7 @@ __all__ = [
     "wrap_angle",
     "skew_matrix",
     "rotation_about_axis",
+    "rotation_with_z_along",
     "rotation_from_rotation_vector",
     "rotation_vector_from_rotation",
     "rotation_from_rpy",
@@ -60,6 +61,15 @@ def rotation_about_axis(axis: ArrayLike, angles: ArrayLike) -> NDArray[np.float6
     sine = np.sin(angles)[..., None, None]
     versine = (1.0 - np.cos(angles))[..., None, None]
     return _IDENTITY + sine * skew + versine * skew_squared
+
+
+def rotation_with_z_along(axis: NDArray) -> NDArray[np.float64]:
+    """A rotation whose third column is ``axis`` (unit); its first column is perpendicular to x (or to y when the
+    axis is near x)."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    first = np.cross(helper, axis)
+    first /= np.linalg.norm(first)
+    return np.column_stack([first, np.cross(axis, first), axis])
 
 
 def rotation_from_rotation_vector(rotation_vectors: ArrayLike) -> NDArray[np.float64]:
@@ -131,20 +141,27 @@ def rotation_from_rpy(rpy: ArrayLike) -> NDArray[np.float64]:
 def rpy_from_rotation(rotations: ArrayLike) -> NDArray[np.float64]:
     """Roll, pitch, yaw (..., 3) of rotation matrices, inverse of :func:`rotation_from_rpy`.
 
-    Pitch is in [-pi/2, pi/2]; at pitch = +-pi/2 (gimbal lock) roll is set to zero.
+    Pitch is in [-pi/2, pi/2]; at pitch = +-pi/2 (gimbal lock, to 1e-14) roll is zero. Rebuilt by
+    :func:`rotation_from_rpy`, the angles give the matrix back to rounding also near the lock: the pitch comes from
+    ``atan2`` (``arcsin`` of an entry near 1 loses half the digits, 1.5e-8 rad), and within 1e-3 rad of the lock
+    the roll is what the matrix leaves once the yaw and pitch are taken off, so an error of the yaw there (the angle
+    of two tiny entries) is taken up by the roll, about nearly the same axis.
 
     >>> rpy_from_rotation(rotation_from_rpy([0.1, -0.2, 0.3])).round(12)
     array([ 0.1, -0.2,  0.3])
     """
     rotations = np.asarray(rotations, dtype=float)
-    pitch = np.arcsin(np.clip(-rotations[..., 2, 0], -1.0, 1.0))
-    locked = np.abs(rotations[..., 2, 0]) > 1.0 - 1e-12
-    roll = np.where(locked, 0.0, np.arctan2(rotations[..., 2, 1], rotations[..., 2, 2]))
+    across = np.hypot(rotations[..., 0, 0], rotations[..., 1, 0])  # cos(pitch)
+    pitch = np.arctan2(-rotations[..., 2, 0], across)
+    locked = across < 1e-14
     yaw = np.where(
         locked,
         np.arctan2(-rotations[..., 0, 1], rotations[..., 1, 1]),
         np.arctan2(rotations[..., 1, 0], rotations[..., 0, 0]),
     )
+    rest = np.swapaxes(rotation_from_rpy(np.stack([np.zeros_like(yaw), pitch, yaw], -1)), -1, -2) @ rotations
+    roll = np.where(across > 1e-3, np.arctan2(rotations[..., 2, 1], rotations[..., 2, 2]),
+                    np.arctan2(rest[..., 2, 1], rest[..., 2, 2]))  # rest: Rx(roll)
     return np.stack([roll, pitch, yaw], -1)
 
 

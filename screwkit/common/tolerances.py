@@ -91,6 +91,15 @@ squared distances of the R-R-R leg's or the R-U-S leg's equation) and still be r
 the sign that decides is set by rounding, which the unit and the world frame of the file change (a pose of a map at
 the boundary was reachable in metres and not in millimetres)."""
 
+FILE_ROUNDING = 1e-5
+"""Relative (lengths in units of the mechanism's length scale, radians): how far a file of another tool may miss the
+mechanism its author drew because its numbers are written rounded (CAD exporters and Gazebo write 6 decimals: a
+micrometre on links of decimetres, a microradian on an axis). Redundant closures that its rounding leaves apart
+by at most this are closed as well as they can be (:mod:`screwkit.io.closed_tree`); an overconstrained loop that its
+rounding makes rigid (a parallelogram of hinges whose axes are parallel to 6 decimals) moves as drawn when the
+singular value of its closure Jacobian that locks it is at most this (:mod:`screwkit.io.compound`). It is used where
+a file is read, once, never on the configurations of a study."""
+
 NEWTON_TOLERANCE = 1e-11
 """Radians and length scales: a chain solved by damped Newton is closed when its loop error norm
 (rotation in rad, translation divided by the mechanism's length scale) is below this."""

@@ -18,13 +18,15 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.tolerances import FILE_ROUNDING
+
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
-INCONSISTENCY_TOLERANCE = 1e-5
+INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
@@ -159,11 +161,8 @@ class ImportReport:
 
 
 def homogeneous(placement) -> NDArray[np.float64]:
-    """A Pinocchio placement (SE3) as a 4x4 matrix."""
-    matrix = np.eye(4)
-    matrix[:3, :3] = np.asarray(placement.rotation)
-    matrix[:3, 3] = np.asarray(placement.translation)
-    return matrix
+    """A Pinocchio placement (SE3) as a 4x4 matrix (a new array)."""
+    return np.array(placement.homogeneous, dtype=float)
 
 
 def inverse(matrix: NDArray) -> NDArray:
@@ -240,7 +239,9 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
     id, keep their values),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
     the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
-    turn); the Jacobian by central differences.
+    turn); the Jacobian by central differences. Once the residual is within the file's rounding
+    (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three, and rounded
+    redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -279,10 +280,11 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
     directions = np.eye(model.nv)[free]
     v = np.zeros(model.nv)
     error = residuals(v)
-    damping = 1e-6
+    damping, within = 1e-6, 0
     for _ in range(500):
         norm = float(np.linalg.norm(error))
-        if norm < ASSEMBLY_TOLERANCE or damping > 1e8:
+        within += norm < INCONSISTENCY_TOLERANCE  # closures that close need 2-3 steps from there; rounded ones creep
+        if norm < ASSEMBLY_TOLERANCE or damping > 1e8 or within > 20:
             break
         step = 1e-7
         jacobian = np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step)

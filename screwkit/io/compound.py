@@ -45,6 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import skew_matrix
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, assemble, joint_kind, path_to
 
 __all__ = ["NotReducible", "compound_groups", "platform_twists", "Reduction", "equivalent_constraint", "closed_samples",
@@ -53,15 +54,22 @@ __all__ = ["NotReducible", "compound_groups", "platform_twists", "Reduction", "e
            "CONSTANT_TOLERANCE"]
 
 TWIST_RANK_TOLERANCE = 1e-9
-"""Singular values of a closure Jacobian (working coordinates), relative to the largest, counted as zero."""
+"""Singular values of a closure Jacobian (working coordinates), relative to the largest, counted as zero where
+closures are solved at the configurations of a study (:mod:`screwkit.io.graph`)."""
 
-SUBSPACE_TOLERANCE = 1e-6
+SUBSPACE_TOLERANCE = 10 * FILE_ROUNDING
 """Singular values (of unit twists in working coordinates) below which two twist spaces count as sharing a
-direction, or a leg as allowing no rotation about one: what a leg allows has parts of order one, while
-closures solved to 1e-10 leave parts of about 1e-8."""
+direction, a leg as allowing no rotation about one, or a null-space direction as not moving the platform. What a
+leg allows has parts of order one. A twist system read through a closure Jacobian whose rounding (at most
+:data:`~screwkit.common.tolerances.FILE_ROUNDING`) was taken as zero is off by that over the smallest singular value
+kept, 0.1 or more in a leg away from its singularities (0.18-0.27 on the published spatial Delta, whose rounding,
+3.5e-7, moves its twist systems by about 2e-6); closures solved to 1e-10 leave about 1e-8. A four-bar whose
+opposite sides differ by more than this (relative) is not a parallelogram."""
 
-CONSTANT_TOLERANCE = 1e-6
-"""Largest change of the projector on R_g between closed configurations for R_g to count as constant."""
+CONSTANT_TOLERANCE = SUBSPACE_TOLERANCE
+"""Largest change of the projector on R_g between closed configurations for R_g to count as constant: a rotation
+that turns with a forearm changes it by about the 0.2 rad the samples move; rounding, as much as it moves a twist
+system (above)."""
 
 
 class NotReducible(ValueError):
@@ -104,15 +112,18 @@ def compound_groups(model, legs: list[list[int]], couplings: list) -> list[tuple
 
 
 def platform_twists(model, data, joints: list[int], closures: list, platform: int, spine: bool, centre: NDArray,
-                    scale: float) -> NDArray[np.float64]:
-    """Orthonormal rows (k, 6) spanning the platform twists a set of joints allows with its closures closed.
+                    scale: float) -> tuple[NDArray[np.float64], float]:
+    """Orthonormal rows (k, 6) spanning the platform twists a set of joints allows with its closures closed, and the
+    largest singular value of the closure Jacobian (relative) taken as the file's rounding (0.0 when none).
 
     Twists in working coordinates ``(omega, v_centre / scale)``. Unknowns: the rates of ``joints``
     and the platform twist T. Each closure adds the relative velocity of its two frames (6 rows for
     ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves with
     T plus the joints of ``joints`` beyond the platform, unless ``spine`` (the platform's own path
     is among ``joints``): then T is tied to the platform body's twist. Needs
-    ``pinocchio.computeJointJacobians`` at the configuration.
+    ``pinocchio.computeJointJacobians`` at the configuration. Singular values at or below
+    :data:`~screwkit.common.tolerances.FILE_ROUNDING` times the largest (at least 1) count as zero: an
+    overconstrained loop whose axes or lengths are rounded (a parallelogram of hinges) moves as drawn.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -139,10 +150,12 @@ def platform_twists(model, data, joints: list[int], closures: list, platform: in
         blocks.append(np.hstack([working(platform)[:, columns], -np.eye(6)]))
     matrix = np.vstack(blocks) if blocks else np.zeros((0, len(columns) + 6))
     _, singular, right = np.linalg.svd(matrix, full_matrices=True)
-    rank = int(np.sum(singular > TWIST_RANK_TOLERANCE * max(float(singular[0]) if singular.size else 0.0, 1.0)))
+    largest = max(float(singular[0]) if singular.size else 0.0, 1.0)
+    rank = int(np.sum(singular > FILE_ROUNDING * largest))
+    rounding = singular[rank:][singular[rank:] > TWIST_RANK_TOLERANCE * largest]
     twists = right[rank:, -6:]  # the T part of the null space
     left, values, rows = np.linalg.svd(twists, full_matrices=False)
-    return rows[:int(np.sum(values > TWIST_RANK_TOLERANCE))]
+    return rows[:int(np.sum(values > SUBSPACE_TOLERANCE))], float(rounding.max() / largest) if rounding.size else 0.0
 
 
 def _dimension(rows: NDArray) -> int:
@@ -229,6 +242,68 @@ def closed_samples(tree: ClosedTree, q: NDArray, scale: float, count: int = 4) -
     return samples
 
 
+def _hinges(model, data, joints: list[int], closures: list[Closure]) -> list[tuple[frozenset, NDArray, NDArray]]:
+    """The hinges among ``joints`` and ``closures`` at the configuration in ``data``: (the two bodies it joins, by the
+    joint each hangs from; a point of its axis; its unit axis), world. A hinge closure is two ball closures between
+    the same two bodies (the point is the one not marked ``axis_point``)."""
+    hinges = []
+    for joint in joints:
+        kind, axis = joint_kind(model, joint)
+        if kind == "revolute":
+            hinges.append((frozenset({model.parents[joint], joint}), np.asarray(data.oMi[joint].translation),
+                           np.asarray(data.oMi[joint].rotation) @ axis))
+    pairs: dict[frozenset, list[Closure]] = {}
+    for closure in closures:
+        if closure.kind == "3d":
+            pairs.setdefault(frozenset({closure.joint_a, closure.joint_b}), []).append(closure)
+    for bodies, pair in pairs.items():
+        if len(pair) == 2 and len(bodies) == 2:
+            points = [(np.asarray(data.oMi[c.joint_a].homogeneous) @ c.placement_a)[:3, 3] for c in pair]
+            axis = points[1] - points[0]
+            point = points[1] if pair[0].axis_point else points[0]
+            hinges.append((bodies, point, axis / max(float(np.linalg.norm(axis)), 1e-300)))
+    return hinges
+
+
+def parallelogram_midlines(model, data, joints: list[int], closures: list[Closure], path: list[int],
+                           motors: set[int], scale: float) -> dict[int, NDArray]:
+    """World offsets that move the actuated path's rods that are one side of a parallelogram of hinges onto its
+    midline: {joint id: offset} for both hinges of each such rod.
+
+    A rod of the path is the body between two consecutive passive hinges j1 (from body X) and j2 (to body Y); it is
+    one side of a parallelogram when hinges of the leg join X to another body R' and R' to Y, parallel to j1 and j2,
+    offset from them by one vector D (perpendicular to the axes; to FILE_ROUNDING of the length scale). The leg then
+    transmits the force along the parallelogram's midline, not along the rod the spanning tree happens to run
+    through: the path's actuation wrench (orthogonal to the path's own constraint wrenches, :mod:`docs/theory`)
+    would follow the rod, and change with the file's choice of tree. The rod moved by D / 2 (a virtual rod, the
+    platform's motion unchanged) gives the leg's.
+    """
+    hinges = _hinges(model, data, joints, closures)
+    offsets: dict[int, NDArray] = {}
+    for j1, j2 in zip(path, path[1:]):
+        if model.parents[j2] != j1 or model.parents[j1] == 0 or {j1, j2} & motors:
+            continue
+        if joint_kind(model, j1)[0] != "revolute" or joint_kind(model, j2)[0] != "revolute":
+            continue
+        first, second = ((np.asarray(data.oMi[j].translation), np.asarray(data.oMi[j].rotation) @ joint_kind(
+            model, j)[1]) for j in (j1, j2))
+        x, y = model.parents[j1], j2
+        for bodies_1, point_1, axis_1 in hinges:
+            if x not in bodies_1 or j1 in bodies_1 or np.linalg.norm(np.cross(axis_1, first[1])) > FILE_ROUNDING:
+                continue
+            other = next(iter(bodies_1 - {x}))
+            offset = point_1 - first[0]
+            offset = offset - (offset @ first[1]) * first[1]
+            for bodies_2, point_2, axis_2 in hinges:
+                gap = point_2 - second[0]
+                gap = gap - (gap @ second[1]) * second[1]
+                if (bodies_2 == frozenset({other, y}) and np.linalg.norm(np.cross(axis_2, second[1])) <= FILE_ROUNDING
+                        and np.linalg.norm(gap - offset) <= FILE_ROUNDING * scale
+                        and np.linalg.norm(offset) > FILE_ROUNDING * scale):
+                    offsets[j1] = offsets[j2] = offset / 2
+    return offsets
+
+
 def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, couplings: list[Closure],
                    motors: set[int], platform: int, normal: NDArray | None,
                    report: ImportReport) -> list[tuple[str, Reduction, NDArray]]:
@@ -264,19 +339,28 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
             raise ImportError_(f"{tree.source}: {label} has {len(actuated)} actuated legs "
                                f"({', '.join(model.names[legs[i].joints[0]] for i in actuated)}): screwkit writes a "
                                "compound leg with one actuator.")
-        closures = list(group_couplings) + [legs[i].source for i in members if legs[i].source is not None]
+        closures = list(group_couplings) + [closure for i in members for closure in legs[i].sources]
         spine = 0 in members
         joints = joints_of(closures, members, spine)
         if actuated:
             kept = legs[actuated[0]]
-            path_closures = [kept.source] if kept.source is not None else []
+            path_closures = list(kept.sources)
             path_joints = joints_of(path_closures, actuated, actuated[0] == 0)
-        systems, paths = [], []
+            if normal is None:
+                kept.offsets = parallelogram_midlines(model, states[0], joints_of(closures, members, True), closures,
+                                                      kept.joints, motors, scale)
+                if kept.offsets.get(kept.joints[-1]) is not None:  # the loop frame stays where it is
+                    kept.predecessor = kept.predecessor.copy()
+                    kept.predecessor[:3, 3] -= np.asarray(states[0].oMi[kept.joints[-1]].rotation).T @ kept.offsets[
+                        kept.joints[-1]]
+        systems, paths, rounding = [], [], 0.0
         for state in states:
             centre = np.asarray(state.oMi[platform].translation)
-            systems.append(platform_twists(model, state, joints, closures, platform, spine, centre, scale))
+            system, absorbed = platform_twists(model, state, joints, closures, platform, spine, centre, scale)
+            systems.append(system)
             paths.append(platform_twists(model, state, path_joints, path_closures, platform, actuated[0] == 0, centre,
-                                         scale) if actuated else np.eye(6))
+                                         scale)[0] if actuated else np.eye(6))
+            rounding = max(rounding, absorbed)
         try:
             reduction = equivalent_constraint(systems, paths, normal)
         except NotReducible as error:
@@ -296,6 +380,9 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
                f"{name}" if reduction.needed else
                f"nothing written for its passive {'legs ' + replaced + ' and ' if passive else ''}branches: they "
                "constrain nothing the actuated path does not"))
+        if rounding:
+            report.notes.append(f"{label}: its loops move only to within the file's rounding (a singular value of "
+                                f"{rounding:.2g} of its closure Jacobian, relative, taken as zero): read as drawn")
         if reduction.needed:
             equivalents.append((name, reduction, first.successor_world[:3, 3].copy()))
     legs[:] = [leg for index, leg in enumerate(legs) if index not in removed]

@@ -475,6 +475,11 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     motion = _motion_space(screws)
     task_axes = _task_axes(tree, state, frame_id, motion)
+    if not task_axes:
+        raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move: analysed as a graph, "
+                           "its legs allow no twist in common at the file's configuration (a loop inside a leg "
+                           "that the file's numbers make rigid reads so, e.g. a parallelogram of hinges parallel "
+                           "only to the file's rounding: the graph reads a file as written).")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.motors = [model.names[leg.actuators[0]] for leg in legs]

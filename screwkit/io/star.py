@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.rotations import rotation_about_axis, rpy_from_rotation
+from screwkit.common.rotations import rotation_about_axis, rotation_with_z_along, rpy_from_rotation
 from screwkit.io.closed_tree import (
     GRAPH_HINT,
     ClosedTree,
@@ -59,6 +59,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
+from screwkit.io.rounding import drawn_axes
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -133,7 +134,9 @@ class _Leg:
     loop_dofs: list[tuple[str, NDArray, NDArray]]  # world (kind, axis, point) of the loop DoFs at the assembly
     closure: str
     locked: list[int] = field(default_factory=list)
-    source: Closure | None = None  # the closure onto the platform (None: the platform body's own path)
+    offsets: dict = field(default_factory=dict)  # world offsets of joints moved onto a parallelogram's midline
+    sources: tuple[Closure, ...] = ()  # the closures onto the platform that make its loop joint (none: the platform
+    # body's own path; two ball closures on one hinge's axis, or three or more of a weld)
 
 
 def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
@@ -157,9 +160,9 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                                "screwkit supports.")
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
-        return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, source=closure)
+        return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
     if not after:
-        return _Leg(a_path, "fixed", closure.placement_a, frame_a, None, [], closure.name, source=closure)
+        return _Leg(a_path, "fixed", closure.placement_a, frame_a, None, [], closure.name, sources=(closure,))
     # the platform-side loop frame: the first joint beyond the platform at zero motion
     first = after[0]
     zero = homogeneous(data.oMi[model.parents[first]]) @ homogeneous(model.jointPlacements[first])
@@ -168,14 +171,14 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         kind, axis = kinds[0]
         world_axis = zero[:3, :3] @ axis
         return _Leg(a_path, kind, predecessor, zero, axis, [(kind, world_axis, zero[:3, 3])], closure.name,
-                    source=closure)
+                    sources=(closure,))
     concurrent = all(np.linalg.norm(np.asarray(model.jointPlacements[j].translation)) < 1e-9 * scale
                      for j in after[1:])
     if (len(after) == 3 and concurrent and all(k[0] == "revolute" for k in kinds)) or \
             (len(after) == 1 and kinds[0][0] == "spherical"):
         centre = zero[:3, 3]
         axes = [("revolute", zero[:3, k], centre) for k in range(3)]
-        return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name, source=closure)
+        return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name, sources=(closure,))
     raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
@@ -205,7 +208,7 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
             legs.append(first)
             continue
         if rank >= 2:
-            first.loop, first.loop_dofs, first.axis = "fixed", [], None
+            first.loop, first.loop_dofs, first.axis, first.sources = "fixed", [], None, tuple(balls)
             report.notes.append(f"ball closures {names} join the same two bodies at points not on one line: a weld")
             legs.append(first)
             continue
@@ -214,21 +217,13 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
         joint_points = [point for point, closure in zip(points, balls) if not closure.axis_point]
         centre = np.mean(joint_points or points, axis=0)  # a point only on the hinge's line is not where it is
         frame = np.eye(4)
-        frame[:3, :3] = _frame_with_z(axis)
+        frame[:3, :3] = rotation_with_z_along(axis)
         frame[:3, 3] = centre
-        leg_end = homogeneous(data.oMi[first.source.joint_a])
+        leg_end = homogeneous(data.oMi[first.sources[0].joint_a])
         legs.append(_Leg(first.joints, "revolute", inverse(leg_end) @ frame, frame, np.array([0.0, 0.0, 1.0]),
-                         [("revolute", axis, centre)], first.closure, source=first.source))
+                         [("revolute", axis, centre)], first.closure, sources=tuple(balls)))
         report.notes.append(f"ball closures {names} join the same two bodies on one line: the hinge through them")
     return legs
-
-
-def _frame_with_z(axis: NDArray) -> NDArray:
-    """A rotation whose third column is ``axis`` (unit)."""
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    first = np.cross(helper, axis)
-    first /= np.linalg.norm(first)
-    return np.column_stack([first, np.cross(axis, first), axis])
 
 
 def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
@@ -440,6 +435,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
+    axes, equivalents = drawn_axes(model, data, legs, equivalents, report)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):
@@ -494,6 +490,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             placement = homogeneous(model.jointPlacements[joint])
             if position == 0:
                 placement = inverse(world_base) @ placement
+            shift = leg.offsets.get(joint, np.zeros(3)) - leg.offsets.get(model.parents[joint], np.zeros(3))
+            placement[:3, 3] += np.asarray(data.oMi[model.parents[joint]].rotation).T @ shift
             link = f"{model.names[joint]}_link"
             if joint in leg.locked:
                 writer.link(link)
@@ -502,6 +500,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 report.locked.append(model.names[joint])
             else:
                 kind, axis = joint_kind(model, joint)
+                axis = axes.get(joint, axis)
                 lower = model.lowerPositionLimit[model.joints[joint].idx_q]
                 upper = model.upperPositionLimit[model.joints[joint].idx_q]
                 limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \

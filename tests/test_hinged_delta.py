@@ -1,0 +1,136 @@
+"""A spatial Delta whose forearms are parallelograms of hinges, in SDFormat as Gazebo writes it (tests/hinged_delta.py).
+
+Published models of this robot are written to 6 decimals. Three readings were wrong:
+
+* the rounding (hinge axes 1e-7 to 1e-5 rad apart where they are drawn parallel) made every parallelogram rigid, and
+  the file was refused ("the actuated path and the leg's translations and rotations share 4 twists, the leg has
+  3"); read with the rounding taken as zero, the legs' hinges to the platform (written through rounded
+  roll-pitch-yaw) were not parallel to their motor axes, and the Delta had one DOF;
+* a leg joined to the platform by a hinge (two ball closures) counted only one of them in its twist system: the
+  leg seemed to allow every rotation, and its parallelogram's constraint was left out;
+* a leg's actuation wrench followed the rod the spanning tree runs through, not the parallelogram's midline: the
+  ITI was up to 8e-4 off the pressure angle, and changed sign of error with the other rod.
+
+Every index is checked against the textbook pressure angles of the geometry (tests/hinged_delta.py), computed with
+numpy from the points alone.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hinged_delta import geometry, hinged_delta_sdf, textbook
+
+from helpers import random_rotation, screwkit
+from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.loader import load
+from screwkit.io.rounding import parallel_axes
+from screwkit.studies import indices_at_pose
+
+TOLERANCE = 1e-9
+ROUNDED = 1e-5  # a file written to 6 decimals, against the geometry it rounds
+POSES = [((0.01, -0.02, -0.42), (35.0, 28.0, 40.0, 32.0)), ((-0.05, 0.03, -0.38), (22.0, 41.0, 30.0, 18.0))]
+MOVED = (random_rotation(np.random.default_rng(11)), np.array([0.3, -0.2, 0.7]))
+
+
+def indices(tmp_path, **options):
+    path = tmp_path / "hinged_delta.sdf"
+    path.write_text(hinged_delta_sdf(**options))
+    mechanism = load(path)
+    return mechanism, indices_at_pose(mechanism, mechanism.home_pose)
+
+
+def assert_textbook(mechanism, result, expected: dict, tolerance: float) -> None:
+    assert mechanism.dof == 3 and len(mechanism.actuators) == 4, (mechanism.dof, mechanism.actuators)
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=tolerance)
+    found = dict(zip(result.submechanisms, result.oti_submechanisms))
+    for members, value in expected["oti"].items():
+        np.testing.assert_allclose(found[members], value, atol=tolerance, err_msg=str(members))
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=tolerance)
+
+
+@pytest.mark.parametrize("pose", POSES)
+@pytest.mark.parametrize(("platform_leg", "half_width", "transform"), [
+    (0, 0.025, None), (2, 0.025, None), (0, -0.025, None), (3, -0.025, MOVED)])
+def test_a_hinged_delta_has_the_textbook_pressure_angles_whichever_rod_and_leg_the_tree_runs_through(
+        tmp_path, pose, platform_leg, half_width, transform):
+    centre, arms = pose
+    mechanism, result = indices(tmp_path, centre=centre, arm_angles=arms, platform_leg=platform_leg,
+                                half_width=half_width, transform=transform)
+    assert_textbook(mechanism, result, textbook(geometry(centre, arms)), TOLERANCE)
+    notes = mechanism.import_report
+    legs = [note for note in notes if "twist system of dimension 4 (rotations about" in note]
+    assert len(legs) == 4, notes  # each leg: the translations and the rotation about its motor axis
+    assert not [note for note in notes if "rounding" in note], notes  # an exact file is read as written
+
+
+@pytest.mark.parametrize(("platform_leg", "half_width", "transform"), [(0, 0.025, None), (2, -0.025, MOVED)])
+def test_the_same_delta_written_to_six_decimals_opens_with_three_dof_and_the_indices_of_what_it_rounds(
+        tmp_path, platform_leg, half_width, transform):
+    centre, arms = POSES[0]
+    mechanism, result = indices(tmp_path, centre=centre, arm_angles=arms, platform_leg=platform_leg,
+                                half_width=half_width, transform=transform, digits=6)
+    assert_textbook(mechanism, result, textbook(geometry(centre, arms)), ROUNDED)
+    notes = mechanism.import_report
+    assert any("its loops move only to within the file's rounding" in note for note in notes), notes
+    assert any("joint axes that agree to the file's rounding written parallel" in note for note in notes), notes
+
+
+def test_a_trapezoid_is_not_read_as_a_parallelogram_and_is_refused_by_name(tmp_path):
+    """The second rod's lower hinge 1 mm further out (4 % of the cross-piece): a four-bar whose coupler turns, far
+    beyond rounding."""
+    path = tmp_path / "trapezoid.sdf"
+    path.write_text(hinged_delta_sdf(widen=1e-3, digits=6))
+    with pytest.raises(ImportError_, match=r"trapezoid.sdf: the compound leg joined by closure 'bottom_1b_a', "
+                                           r"'bottom_1b_b' cannot be written as serial chains"):
+        read_mechanism_file(path)
+
+
+def test_the_graph_reading_agrees_on_the_exact_file_and_refuses_the_rounded_one_by_name(tmp_path):
+    """The graph derivation (the leg's wrench system from its closure Jacobian, not the serial path and equivalent
+    chain) gives the same textbook values; it reads a file exactly, so the rounded one cannot move, and says so in
+    one line instead of failing inside the index computation."""
+    path = tmp_path / "exact.sdf"
+    path.write_text(hinged_delta_sdf(platform_leg=1, half_width=-0.025))
+    graph = graph_mechanism(read_closed_tree(path))
+    assert_textbook(graph, graph.indices(), textbook(geometry(*POSES[0])), TOLERANCE)
+    path = tmp_path / "rounded.sdf"
+    path.write_text(hinged_delta_sdf(digits=6))
+    with pytest.raises(ImportError_, match=r"rounded.sdf: the platform 'platform' cannot move: analysed as a graph"):
+        graph_mechanism(read_closed_tree(path))
+
+
+def test_analyze_opens_the_rounded_file_on_the_command_line(tmp_path):
+    path = tmp_path / "delta.sdf"
+    path.write_text(hinged_delta_sdf(digits=6, platform_leg=1))
+    run = screwkit("analyze", path, "--json")
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout)
+    expected = textbook(geometry(*POSES[0]))
+    assert found["dof"] == 3
+    np.testing.assert_allclose(list(found["iti_actuators"].values()), expected["iti"], atol=ROUNDED)
+    np.testing.assert_allclose([found["lmti"], found["f_o"]["1"]], [expected["lmti"], expected["f_o1"]], atol=ROUNDED)
+
+
+def test_parallel_axes_makes_nearly_parallel_directions_parallel_in_any_order_keeping_each_sense():
+    rng = np.random.default_rng(4)
+    axis = np.array([0.6, -0.48, 0.64])
+    tilt = np.cross(axis, [0.0, 0.0, 1.0])
+    near = [axis, -axis + 3e-6 * tilt, axis - 2e-6 * tilt, 2.0 * axis + 1e-6 * np.cross(axis, tilt)]
+    far = [axis + 0.01 * tilt, np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])]
+    directions = np.array(near + far)
+    turned, turn = parallel_axes(directions)
+    units = directions / np.linalg.norm(directions, axis=1, keepdims=True)
+    common = turned[0]
+    assert np.max(np.linalg.norm(np.cross(turned[:4], common), axis=1)) < 1e-15
+    assert np.all(np.sum(turned[:4] * units[:4], axis=1) > 0.999)  # each keeps its own sense
+    np.testing.assert_array_equal(turned[4:], units[4:])  # too far apart, or already exactly (anti)parallel
+    moved = np.arcsin(np.minimum(np.linalg.norm(np.cross(units[:4], common), axis=1), 1.0))
+    assert turn == pytest.approx(np.max(moved), rel=1e-6) and 1e-6 < turn < 1e-5
+    order = rng.permutation(len(directions))
+    again, turn_again = parallel_axes(directions[order])
+    np.testing.assert_allclose(again, turned[order], atol=1e-15)
+    assert turn_again == pytest.approx(turn, rel=1e-9)
