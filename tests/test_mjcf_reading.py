@@ -370,3 +370,32 @@ def test_an_attribute_mujoco_refuses_on_a_closure_is_refused_rather_than_ignored
                                            r"attribute of <connect> \(it has active, anchor, body1, body2, class, "
                                            r"name, site1, site2, solimp, solref\): MuJoCo refuses the file\."):
         read_mechanism_file(path)
+
+
+SINGULAR_FIVE_BAR = """<mujoco model="five_bar"><worldbody>
+ <body name="left_1" pos="-0.2 0 0"><joint name="left_motor" type="hinge" axis="0 0 1"/>""" + INERTIA + """
+  <body name="left_2" pos="0.3 0 0"><joint name="left_elbow" type="hinge" axis="0 0 1"/>""" + INERTIA + """</body>
+ </body>
+ <body name="right_1" pos="0.2 0 0"><joint name="right_motor" type="hinge" axis="0 0 1"/>""" + INERTIA + """
+  <body name="right_2" pos="-0.3 0 0"><joint name="right_elbow" type="hinge" axis="0 0 1"/>""" + INERTIA + """</body>
+ </body>
+ <body name="effector" pos="0 0 0"><freejoint/>""" + INERTIA + """</body>
+</worldbody>
+<equality><connect body1="left_2" body2="effector" anchor="0.3 0 0"/>
+ <connect body1="right_2" body2="effector" anchor="-0.3 0 0"/></equality>
+<actuator><motor joint="left_motor"/><motor joint="right_motor"/></actuator></mujoco>
+"""
+
+
+def test_a_five_bar_written_with_every_link_on_one_line_is_refused_as_a_singular_configuration(tmp_path):
+    """As a published MuJoCo five-bar writes it: every link along x at qpos0, so the loops close with the links on
+    one line. Locking a motor there takes no motion away, but it does at closed configurations nearby: the message
+    says the file is written at a singularity, not that motors are missing (and suggests no --lock)."""
+    path = tmp_path / "five_bar.xml"
+    path.write_text(SINGULAR_FIVE_BAR)
+    message = one_line_error(screwkit("info", path))
+    assert re.search(r"five_bar.xml: locking actuated joint '(left|right)_motor' leaves the platform of leg "
+                     r"'(left|right)_1' as free as before at the file's joint values, and takes a motion away at "
+                     r"closed configurations near them: the file is written at a singular configuration", message), \
+        message
+    assert "--lock" not in message

@@ -61,7 +61,7 @@ from screwkit.io.closed_tree import (
     joint_value,
     path_to,
 )
-from screwkit.io.compound import TWIST_RANK_TOLERANCE
+from screwkit.io.compound import TWIST_RANK_TOLERANCE, closed_samples
 from screwkit.io.graph_kinematics import (
     TreeKinematics,
     beyond_reach,
@@ -337,15 +337,23 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     return sorted(legs, key=lambda leg: leg.name)
 
 
-def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews]) -> None:
+def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None:
     """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
-    motion away (else the actuator moves inside a loop of the leg)."""
+    motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
+    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it)."""
     model = tree.model
-    for leg, screw in zip(legs, screws):  # one actuator each (_check_actuators)
+    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each (_check_actuators)
         actuator = leg.actuators[0]
         name = model.names[actuator]
         carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
         if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
+            around = nearby()[index]
+            if np.any(around.locked_dims < around.allowed_dims):
+                raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
+                                   f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
+                                   "away at closed configurations near them: the file is written at a singular "
+                                   "configuration of the leg (its links on one line, stretched or folded); give "
+                                   "joint values away from it (a keyframe, the joints' initial values).")
             raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
                                f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
@@ -469,7 +477,12 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
     if at_file:
-        _check_legs(tree, legs, screws)
+        def nearby():  # closed configurations near the file's, only when a leg's check needs them
+            samples = closed_samples(tree, q, scale, count=3)
+            return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else [
+                replace(screw, locked_dims=screw.allowed_dims) for screw in screws]
+
+        _check_legs(tree, legs, screws, nearby)
         _check_output(tree, screws, report.platform_body)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
