@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import itertools
 import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
@@ -286,3 +287,23 @@ def leg_line_otis(starts, ends) -> np.ndarray:
         velocity = twist[3:] + np.cross(twist[:3], ends[k])
         otis.append(abs(directions[k] @ velocity) / np.linalg.norm(velocity))
     return np.array(otis)
+
+
+def translational_pressure_angles(rods, tangents) -> dict:
+    """Indices of a translational parallel robot whose legs transmit forces along unit ``rods`` (n, 3) and whose
+    actuators move the rods' upper ends along unit ``tangents`` (n, 3): ITI_i = |u_i . t_i|, OTI of every 3-subset
+    (the least over its legs of |u_k . v_k| / |v_k|, v_k = u_i x u_j the translation the other two forces allow), LMTI
+    the largest OTI and F_O1 the least, over the failed leg, of the largest OTI without it (numpy alone)."""
+    rods, tangents = np.asarray(rods, dtype=float), np.asarray(tangents, dtype=float)
+    oti = {}
+    for members in itertools.combinations(range(len(rods)), 3):
+        values = []
+        for k in members:
+            j, m = [i for i in members if i != k]
+            v = np.cross(rods[j], rods[m])
+            values.append(abs(rods[k] @ v) / np.linalg.norm(v))
+        oti[members] = min(values)
+    legs = range(len(rods))
+    f_o1 = min(max(v for members, v in oti.items() if failed not in members) for failed in legs) \
+        if len(rods) > 3 else 0.0
+    return {"iti": np.abs(np.sum(rods * tangents, axis=1)), "oti": oti, "lmti": max(oti.values()), "f_o1": f_o1}

@@ -15,10 +15,10 @@ the elbow's velocity direction, OTI_k = |u_k . v_k|, v_k the translation recipro
 
 from __future__ import annotations
 
-from itertools import combinations
-
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from helpers import translational_pressure_angles
 
 BASE, ARM, PLATFORM, HALF_WIDTH = 0.09, 0.2, 0.04, 0.025
 AZIMUTHS = np.radians([-90.0, 30.0, 150.0, 60.0])
@@ -39,21 +39,9 @@ def geometry(centre, arm_angles, azimuths=AZIMUTHS) -> dict[str, np.ndarray]:
 
 def textbook(points: dict) -> dict:
     """ITI per leg, OTI of every 3-subset, LMTI and F_O1 (pressure angles of the geometry's rods)."""
-    rods, axes = points["rods"], points["axes"]
     arms = points["elbows"] - points["base"]
-    iti = np.abs(np.sum(rods * np.cross(axes, arms), axis=1)) / np.linalg.norm(arms, axis=1)
-    oti = {}
-    for members in combinations(range(len(rods)), 3):
-        values = []
-        for k in members:
-            j, m = [i for i in members if i != k]
-            v = np.cross(rods[j], rods[m])
-            values.append(abs(rods[k] @ v) / np.linalg.norm(v))
-        oti[members] = min(values)
-    legs = range(len(rods))
-    f_o1 = min(max(v for members, v in oti.items() if failed not in members) for failed in legs) \
-        if len(rods) > 3 else 0.0
-    return {"iti": iti, "oti": oti, "lmti": max(oti.values()), "f_o1": f_o1}
+    tangents = np.cross(points["axes"], arms) / np.linalg.norm(arms, axis=1, keepdims=True)
+    return translational_pressure_angles(points["rods"], tangents)
 
 
 def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 32.0), azimuths=AZIMUTHS,

@@ -13,14 +13,20 @@ every bundled mechanism the equivalent chain of the graph derivation gives the p
 from __future__ import annotations
 
 import json
-from itertools import combinations
 
 import numpy as np
 import pytest
 from delta_rods import ARM, ROD, delta_geometry, delta_rods_mjcf
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, mujoco_state, screwkit_residuals
 
-from helpers import assert_indices_close, bundled_chain_screws, one_line_error, random_rotation, screwkit
+from helpers import (
+    assert_indices_close,
+    bundled_chain_screws,
+    one_line_error,
+    random_rotation,
+    screwkit,
+    translational_pressure_angles,
+)
 from screwkit.indices.analysis import analyze
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import bundled_names, load
@@ -38,19 +44,7 @@ def textbook(centre, azimuths=AZIMUTHS) -> dict:
     base, axes, elbows, attach = delta_geometry(centre, azimuths)
     rods = (attach - elbows) / ROD
     tangents = np.cross(axes, elbows - base) / ARM
-    iti = np.abs(np.sum(rods * tangents, axis=1))
-    oti = {}
-    for members in combinations(range(len(base)), 3):
-        values = []
-        for k in members:
-            j, m = [i for i in members if i != k]
-            v = np.cross(rods[j], rods[m])
-            values.append(abs(rods[k] @ v) / np.linalg.norm(v))
-        oti[members] = min(values)
-    legs = range(len(base))
-    lmti = max(oti.values())
-    f_o1 = min(max(v for members, v in oti.items() if failed not in members) for failed in legs)
-    return {"iti": iti, "oti": oti, "lmti": lmti, "f_o1": f_o1, "rods": rods, "axes": axes, "elbows": elbows}
+    return {**translational_pressure_angles(rods, tangents), "rods": rods, "axes": axes, "elbows": elbows}
 
 
 def assert_delta_textbook(result, expected: dict) -> None:
