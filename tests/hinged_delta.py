@@ -46,12 +46,13 @@ def textbook(points: dict) -> dict:
 
 def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 32.0), azimuths=AZIMUTHS,
                      platform_leg: int = 0, digits: int | None = None, transform=None, half_width: float = HALF_WIDTH,
-                     widen: float = 0.0) -> str:
+                     widen: float = 0.0, elbow_shift: float = 0.0) -> str:
     """The SDFormat text (see the module docstring); ``transform`` (rotation, translation) moves the whole robot.
 
     The first rod of each leg is at +``half_width`` along a (a negative value mirrors the rods: the tree then runs
     through the other one); ``widen`` moves the second rod's lower hinge that much further out along a, so that
-    the rods make a trapezoid, not a parallelogram.
+    the rods make a trapezoid, not a parallelogram; ``elbow_shift`` draws each elbow hinge that far along its own
+    axis (the same mechanism).
     """
     points = geometry(centre, arm_angles, azimuths)
     rotation, shift = (np.eye(3), np.zeros(3)) if transform is None else transform
@@ -101,7 +102,7 @@ def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 
         link(f"rod_{leg}b", e - half_width * a, turn)
         link(f"lower_{leg}", p, turn)
         joint(f"motor_{leg}", "base", f"arm_{leg}", b, a, True)
-        joint(f"elbow_{leg}", f"arm_{leg}", f"cross_{leg}", e, a, True)
+        joint(f"elbow_{leg}", f"arm_{leg}", f"cross_{leg}", e + elbow_shift * a, a, True)
         joint(f"top_{leg}a", f"cross_{leg}", f"rod_{leg}a", e + half_width * a, n, True)
         joint(f"top_{leg}b", f"cross_{leg}", f"rod_{leg}b", e - half_width * a, n, True)
         joint(f"bottom_{leg}a", f"rod_{leg}a", f"lower_{leg}", p + half_width * a, n, True)

@@ -143,7 +143,7 @@ def rpy_from_rotation(rotations: ArrayLike) -> NDArray[np.float64]:
 
     Pitch is in [-pi/2, pi/2]; at pitch = +-pi/2 (gimbal lock, to 1e-14) roll is zero. Rebuilt by
     :func:`rotation_from_rpy`, the angles give the matrix back to rounding also near the lock: the pitch comes from
-    ``atan2`` (``arcsin`` of an entry near 1 loses half the digits, 1.5e-8 rad), and within 1e-3 rad of the lock
+    ``atan2`` (``arcsin`` of an entry near 1 loses half the digits, 1.5e-8 rad), and within 0.1 rad of the lock
     the roll is what the matrix leaves once the yaw and pitch are taken off, so an error of the yaw there (the angle
     of two tiny entries) is taken up by the roll, about nearly the same axis.
 
@@ -160,7 +160,7 @@ def rpy_from_rotation(rotations: ArrayLike) -> NDArray[np.float64]:
         np.arctan2(rotations[..., 1, 0], rotations[..., 0, 0]),
     )
     rest = np.swapaxes(rotation_from_rpy(np.stack([np.zeros_like(yaw), pitch, yaw], -1)), -1, -2) @ rotations
-    roll = np.where(across > 1e-3, np.arctan2(rotations[..., 2, 1], rotations[..., 2, 2]),
+    roll = np.where(across > 0.1, np.arctan2(rotations[..., 2, 1], rotations[..., 2, 2]),
                     np.arctan2(rest[..., 2, 1], rest[..., 2, 2]))  # rest: Rx(roll)
     return np.stack([roll, pitch, yaw], -1)
 

@@ -272,11 +272,12 @@ def parallelogram_midlines(model, data, joints: list[int], closures: list[Closur
 
     A rod of the path is the body between two consecutive passive hinges j1 (from body X) and j2 (to body Y); it is
     one side of a parallelogram when hinges of the leg join X to another body R' and R' to Y, parallel to j1 and j2,
-    offset from them by one vector D (perpendicular to the axes; to FILE_ROUNDING of the length scale). The leg then
-    transmits the force along the parallelogram's midline, not along the rod the spanning tree happens to run
-    through: the path's actuation wrench (orthogonal to the path's own constraint wrenches, :mod:`docs/theory`)
-    would follow the rod, and change with the file's choice of tree. The rod moved by D / 2 (a virtual rod, the
-    platform's motion unchanged) gives the leg's.
+    offset from them by one vector D (perpendicular to the axes; to :data:`SUBSPACE_TOLERANCE` of the length scale,
+    beyond what :func:`equivalent_constraint` accepts as a parallelogram). The leg then transmits the force along
+    the parallelogram's midline, not along the rod the spanning tree happens to run through: the path's actuation
+    wrench (orthogonal to the path's own constraint wrenches, :mod:`docs/theory`) would follow the rod, and change
+    with the file's choice of tree. Each of j1 and j2 moved halfway to its twin (a virtual rod, the platform's motion
+    unchanged) gives the leg's.
     """
     hinges = _hinges(model, data, joints, closures)
     offsets: dict[int, NDArray] = {}
@@ -298,9 +299,9 @@ def parallelogram_midlines(model, data, joints: list[int], closures: list[Closur
                 gap = point_2 - second[0]
                 gap = gap - (gap @ second[1]) * second[1]
                 if (bodies_2 == frozenset({other, y}) and np.linalg.norm(np.cross(axis_2, second[1])) <= FILE_ROUNDING
-                        and np.linalg.norm(gap - offset) <= FILE_ROUNDING * scale
-                        and np.linalg.norm(offset) > FILE_ROUNDING * scale):
-                    offsets[j1] = offsets[j2] = offset / 2
+                        and np.linalg.norm(gap - offset) <= SUBSPACE_TOLERANCE * scale
+                        and np.linalg.norm(offset) > SUBSPACE_TOLERANCE * scale):
+                    offsets[j1], offsets[j2] = offset / 2, gap / 2
     return offsets
 
 

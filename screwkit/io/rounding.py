@@ -7,8 +7,16 @@ that parallel axes give are lost (the published spatial Delta with hinged parall
 differ by 4e-6 rad, reads with one DOF instead of three). :func:`parallel_axes` gives each group of directions
 within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of each other (up to sign, linked pairwise) one direction:
 the normalised sum of its members turned to one sense, which does not depend on the order in which they are listed,
-and keeps each joint's own sense. Directions that already agree to 1e-12 are left as they are, so an exact file is
-written unchanged. It runs once, where a file of another tool is converted (:mod:`screwkit.io.star`).
+and keeps each joint's own sense. Directions that already agree to 1e-12 are left as they are; an exact file is
+written unchanged unless two of its axes happen to lie within 1e-5 rad of each other at the file's configuration
+(then they are made parallel, and its indices move by about that much, 1e-7).
+
+Where a hinge is drawn along its axis is not the mechanism either: :func:`iti_hinge_offsets` slides the hinge after
+each actuator (the ITI's characteristic point, :mod:`screwkit.indices.analysis`) along its axis to where the next
+hinge's axis meets it, so that the point lies on the leg's actuation wrench wherever the file draws the hinge (a
+Delta's elbow drawn off its parallelogram's midline gave an ITI off the pressure angle, by 3e-3 at some poses).
+
+Both run once, where a file of another tool is converted (:mod:`screwkit.io.star`).
 """
 
 from __future__ import annotations
@@ -21,7 +29,7 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import joint_kind
 
-__all__ = ["parallel_axes", "drawn_axes", "EXACT"]
+__all__ = ["parallel_axes", "drawn_axes", "iti_hinge_offsets", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree: a group of them is left as written."""
@@ -62,13 +70,45 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def drawn_axes(model, data, legs: list, equivalents: list, report) -> tuple[dict[int, NDArray], list]:
-    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied.
+def iti_hinge_offsets(model, data, leg, motors, scale: float) -> None:
+    """Slide the hinge after ``leg``'s actuator along its axis to the foot of the common perpendicular with the next
+    hinge's axis, when the two axes meet (to FILE_ROUNDING of the length ``scale``) and are not parallel; the world
+    offset goes into ``leg.offsets`` (on top of a parallelogram's midline shift), its children keep their places."""
+    joints = list(leg.joints)
+    actuated = [position for position, joint in enumerate(joints) if joint in motors]
+    if len(actuated) != 1 or actuated[0] + 2 >= len(joints):
+        return
+    first, second = joints[actuated[0] + 1], joints[actuated[0] + 2]
+    lines = []
+    for joint in (first, second):
+        kind, axis = joint_kind(model, joint)
+        if kind != "revolute" or joint in leg.locked:
+            return
+        lines.append((np.asarray(data.oMi[joint].translation) + leg.offsets.get(joint, np.zeros(3)),
+                      np.asarray(data.oMi[joint].rotation) @ axis))
+    (point, axis), (other, direction) = lines
+    normal = np.cross(axis, direction)
+    if np.linalg.norm(normal) < 1e-3:  # parallel hinges: no point where they meet
+        return
+    normal /= np.linalg.norm(normal)
+    if abs((other - point) @ normal) > FILE_ROUNDING * scale:  # skew axes
+        return
+    along = np.cross(other - point, direction) @ normal / (np.cross(axis, direction) @ normal)
+    if abs(along) > FILE_ROUNDING * scale:
+        leg.offsets = {**leg.offsets, first: leg.offsets.get(first, np.zeros(3)) + along * axis}
 
-    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes are set in place.
-    Returns each 1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations
-    turned; the import ``report`` notes the largest turn.
+
+def drawn_axes(model, data, legs: list, equivalents: list, report, motors, scale: float
+               ) -> tuple[dict[int, NDArray], list]:
+    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and each
+    leg's hinge after its actuator (``motors``, joint ids) slid by :func:`iti_hinge_offsets`.
+
+    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes and offsets are set in
+    place. Returns each 1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their
+    rotations turned; the import ``report`` notes the largest turn.
     """
+    for leg in legs:
+        iti_hinge_offsets(model, data, leg, motors, scale)
     owners, directions = [], []
     for leg in legs:
         for joint in leg.joints:

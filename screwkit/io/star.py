@@ -435,7 +435,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
-    axes, equivalents = drawn_axes(model, data, legs, equivalents, report)
+    axes, equivalents = drawn_axes(model, data, legs, equivalents, report, set(motor_ids), scale)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):
