@@ -134,7 +134,7 @@ class _Leg:
     loop_dofs: list[tuple[str, NDArray, NDArray]]  # world (kind, axis, point) of the loop DoFs at the assembly
     closure: str
     locked: list[int] = field(default_factory=list)
-    offsets: dict = field(default_factory=dict)  # world offsets of joints moved onto a parallelogram's midline
+    offsets: dict = field(default_factory=dict)  # world offsets of moved hinges: midlines, the ITI hinge (rounding)
     sources: tuple[Closure, ...] = ()  # the closures onto the platform that make its loop joint (none: the platform
     # body's own path; two ball closures on one hinge's axis, or three or more of a weld)
 
