@@ -71,9 +71,10 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
 
 
 def iti_hinge_offsets(model, data, leg, motors, scale: float) -> None:
-    """Slide the hinge after ``leg``'s actuator along its axis to the foot of the common perpendicular with the next
-    hinge's axis, when the two axes meet (to FILE_ROUNDING of the length ``scale``) and are not parallel; the world
-    offset goes into ``leg.offsets`` (on top of a parallelogram's midline shift), its children keep their places."""
+    """Slide the hinge after ``leg``'s actuator along its axis to the next hinge's point when that point lies on its
+    axis (to FILE_ROUNDING of the length ``scale``) and the two axes are not parallel: a universal joint, a Delta's
+    elbow and its parallelogram's hinge, drawn with their origins apart. The world offset goes into ``leg.offsets``
+    (on top of a parallelogram's midline shift); its children keep their places."""
     joints = list(leg.joints)
     actuated = [position for position, joint in enumerate(joints) if joint in motors]
     if len(actuated) != 1 or actuated[0] + 2 >= len(joints):
@@ -87,14 +88,9 @@ def iti_hinge_offsets(model, data, leg, motors, scale: float) -> None:
         lines.append((np.asarray(data.oMi[joint].translation) + leg.offsets.get(joint, np.zeros(3)),
                       np.asarray(data.oMi[joint].rotation) @ axis))
     (point, axis), (other, direction) = lines
-    normal = np.cross(axis, direction)
-    if np.linalg.norm(normal) < 1e-3:  # parallel hinges: no point where they meet
-        return
-    normal /= np.linalg.norm(normal)
-    if abs((other - point) @ normal) > FILE_ROUNDING * scale:  # skew axes
-        return
-    along = np.cross(other - point, direction) @ normal / (np.cross(axis, direction) @ normal)
-    if abs(along) > FILE_ROUNDING * scale:
+    along = (other - point) @ axis
+    if (np.linalg.norm(np.cross(axis, direction)) >= 1e-3 and abs(along) > FILE_ROUNDING * scale
+            and np.linalg.norm(other - point - along * axis) <= FILE_ROUNDING * scale):
         leg.offsets = {**leg.offsets, first: leg.offsets.get(first, np.zeros(3)) + along * axis}
 
 
