@@ -24,9 +24,12 @@ import json
 import numpy as np
 import pytest
 from hinged_delta import geometry, hinged_delta_sdf, textbook
+from test_gallery import assert_same_bodies, mujoco_residuals, mujoco_state
+from test_io import mjcf_of_tree
 
 from helpers import random_rotation, screwkit
 from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
+from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
 from screwkit.io.rounding import parallel_axes
@@ -96,6 +99,25 @@ def test_a_parallelogram_off_by_micrometres_gives_the_same_indices_whichever_rod
     np.testing.assert_allclose(found[0].iti_actuators, found[1].iti_actuators, atol=TOLERANCE if digits is None
                                else ROUNDED)
     np.testing.assert_allclose(found[0].iti_actuators, textbook(geometry(centre, arms))["iti"], atol=ROUNDED)
+
+
+@pytest.mark.parametrize("platform_leg", [0, 2])
+def test_the_same_delta_in_mjcf_as_mujoco_reads_it_has_the_textbook_pressure_angles(tmp_path, platform_leg):
+    """The tree written in MJCF (every loop hinge two ``<connect>``s on its axis, as CAD exporters write them for
+    MuJoCo): MuJoCo reads it closed with every body where screwkit puts it, and the indices are the textbook's."""
+    source = tmp_path / "hinged_delta.sdf"
+    source.write_text(hinged_delta_sdf(platform_leg=platform_leg))
+    tree = read_closed_tree(source)
+    q, _ = assemble(tree)
+    path = tmp_path / "hinged_delta.xml"
+    path.write_text(mjcf_of_tree(tree, q, "platform"))
+    mj_model, mj_data = mujoco_state(path)
+    assert max(np.max(np.abs(r)) for r in mujoco_residuals(mj_model, mj_data).values()) < TOLERANCE
+    mjcf = read_closed_tree(path)
+    assert_same_bodies(mjcf, mj_model, mj_data, mjcf.q_reference)
+    mechanism = load(path)
+    assert_textbook(mechanism, indices_at_pose(mechanism, mechanism.home_pose), textbook(geometry(*POSES[0])),
+                    TOLERANCE)
 
 
 def test_a_trapezoid_is_not_read_as_a_parallelogram_and_is_refused_by_name(tmp_path):
