@@ -22,7 +22,7 @@ from screwkit.common.tolerances import FILE_ROUNDING
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
-           "closure_gaps", "assemble"]
+           "closure_gaps", "assemble", "ball_line"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -214,6 +214,22 @@ def _length_scale(model, data) -> float:
     points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
     spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
     return float(spread) if spread > 0.0 else 1.0
+
+
+def ball_line(points, closures: list[Closure], scale: float) -> tuple[int, NDArray | None, NDArray]:
+    """Ball closures joining the same two bodies, at world ``points`` (one per closure): the rank of their spread
+    (0 one point, 1 a hinge through them, 2 or more a weld; to 1e-9 of the length ``scale``), the unit direction of
+    the largest spread (None for one point), and the hinge's point: the mean of the points not marked
+    :attr:`Closure.axis_point` (a point only on the hinge's line is not where it is), else of all."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    spread = points - points[0]
+    rank = int(np.linalg.matrix_rank(spread, tol=1e-9 * scale)) if len(points) > 1 else 0
+    axis = None
+    if rank:
+        axis = spread[np.argmax(np.linalg.norm(spread, axis=1))]
+        axis = axis / np.linalg.norm(axis)
+    joint_points = [point for point, closure in zip(points, closures) if not closure.axis_point]
+    return rank, axis, np.mean(joint_points or points, axis=0)
 
 
 def _frames(model, data, closure: Closure) -> tuple[NDArray, NDArray]:

@@ -46,7 +46,16 @@ from numpy.typing import NDArray
 
 from screwkit.common.rotations import skew_matrix
 from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, assemble, joint_kind, path_to
+from screwkit.io.closed_tree import (
+    ClosedTree,
+    Closure,
+    ImportError_,
+    ImportReport,
+    assemble,
+    ball_line,
+    joint_kind,
+    path_to,
+)
 
 __all__ = ["NotReducible", "compound_groups", "platform_twists", "Reduction", "equivalent_constraint", "closed_samples",
            "compound_legs",
@@ -242,26 +251,27 @@ def closed_samples(tree: ClosedTree, q: NDArray, scale: float, count: int = 4) -
     return samples
 
 
-def _hinges(model, data, joints: list[int], closures: list[Closure]) -> list[tuple[frozenset, NDArray, NDArray]]:
+def _hinges(model, data, joints: list[int], closures: list[Closure],
+            scale: float) -> list[tuple[frozenset, NDArray, NDArray]]:
     """The hinges among ``joints`` and ``closures`` at the configuration in ``data``: (the two bodies it joins, by the
-    joint each hangs from; a point of its axis; its unit axis), world. A hinge closure is two ball closures between
-    the same two bodies (the point is the one not marked ``axis_point``)."""
+    joint each hangs from; a point of its axis; its unit axis), world. A hinge closure is ball closures between the
+    same two bodies on one line (:func:`~screwkit.io.closed_tree.ball_line`, as the serial legs read them)."""
     hinges = []
     for joint in joints:
         kind, axis = joint_kind(model, joint)
         if kind == "revolute":
             hinges.append((frozenset({model.parents[joint], joint}), np.asarray(data.oMi[joint].translation),
                            np.asarray(data.oMi[joint].rotation) @ axis))
-    pairs: dict[frozenset, list[Closure]] = {}
+    pairs: dict[frozenset, list[Closure]] = {}  # ball closures by the two bodies they join
     for closure in closures:
         if closure.kind == "3d":
             pairs.setdefault(frozenset({closure.joint_a, closure.joint_b}), []).append(closure)
-    for bodies, pair in pairs.items():
-        if len(pair) == 2 and len(bodies) == 2:
-            points = [(np.asarray(data.oMi[c.joint_a].homogeneous) @ c.placement_a)[:3, 3] for c in pair]
-            axis = points[1] - points[0]
-            point = points[1] if pair[0].axis_point else points[0]
-            hinges.append((bodies, point, axis / max(float(np.linalg.norm(axis)), 1e-300)))
+    for bodies, balls in pairs.items():
+        if len(bodies) == 2:
+            rank, axis, point = ball_line([(np.asarray(data.oMi[c.joint_a].homogeneous) @ c.placement_a)[:3, 3]
+                                           for c in balls], balls, scale)
+            if rank == 1:
+                hinges.append((bodies, point, axis))
     return hinges
 
 
@@ -279,7 +289,7 @@ def parallelogram_midlines(model, data, joints: list[int], closures: list[Closur
     with the file's choice of tree. Each of j1 and j2 moved halfway to its twin (a virtual rod, the platform's motion
     unchanged) gives the leg's.
     """
-    hinges = _hinges(model, data, joints, closures)
+    hinges = _hinges(model, data, joints, closures, scale)
     offsets: dict[int, NDArray] = {}
     for j1, j2 in zip(path, path[1:]):
         if model.parents[j2] != j1 or model.parents[j1] == 0 or {j1, j2} & motors:

@@ -51,6 +51,7 @@ from screwkit.io.closed_tree import (
     ImportReport,
     LegWithLoops,
     assemble,
+    ball_line,
     closure_gaps,
     homogeneous,
     inverse,
@@ -201,8 +202,7 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
             continue
         first = _loop_of(tree, data, balls[0], platform, scale)
         points = [_loop_of(tree, data, c, platform, scale).successor_world[:3, 3] for c in balls]
-        spread = np.array(points) - points[0]
-        rank = np.linalg.matrix_rank(spread, tol=1e-9 * scale) if len(points) > 1 else 0
+        rank, axis, centre = ball_line(points, balls, scale)
         names = ", ".join(repr(c.name) for c in balls)
         if rank == 0:
             legs.append(first)
@@ -212,10 +212,6 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
             report.notes.append(f"ball closures {names} join the same two bodies at points not on one line: a weld")
             legs.append(first)
             continue
-        axis = spread[np.argmax(np.linalg.norm(spread, axis=1))]
-        axis = axis / np.linalg.norm(axis)
-        joint_points = [point for point, closure in zip(points, balls) if not closure.axis_point]
-        centre = np.mean(joint_points or points, axis=0)  # a point only on the hinge's line is not where it is
         frame = np.eye(4)
         frame[:3, :3] = rotation_with_z_along(axis)
         frame[:3, 3] = centre
