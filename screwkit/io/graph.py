@@ -340,15 +340,15 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
 def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None:
     """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
     motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
-    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it)."""
+    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
     model = tree.model
     for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each (_check_actuators)
         actuator = leg.actuators[0]
         name = model.names[actuator]
         carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
         if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
-            around = nearby()[index]
-            if np.any(around.locked_dims < around.allowed_dims):
+            around = nearby()
+            if around and np.any(around[index].locked_dims < around[index].allowed_dims):
                 raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
                                    f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
                                    "away at closed configurations near them: the file is written at a singular "
@@ -479,8 +479,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     if at_file:
         def nearby():  # closed configurations near the file's, only when a leg's check needs them
             samples = closed_samples(tree, q, scale, count=3)
-            return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else [
-                replace(screw, locked_dims=screw.allowed_dims) for screw in screws]
+            return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else []
 
         _check_legs(tree, legs, screws, nearby)
         _check_output(tree, screws, report.platform_body)
