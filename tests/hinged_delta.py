@@ -46,13 +46,13 @@ def textbook(points: dict) -> dict:
 
 def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 32.0), azimuths=AZIMUTHS,
                      platform_leg: int = 0, digits: int | None = None, transform=None, half_width: float = HALF_WIDTH,
-                     widen: float = 0.0, elbow_shift: float = 0.0) -> str:
+                     widen: float = 0.0, elbow_shift: float = 0.0, unit: float = 1.0) -> str:
     """The SDFormat text (see the module docstring); ``transform`` (rotation, translation) moves the whole robot.
 
     The first rod of each leg is at +``half_width`` along a (a negative value mirrors the rods: the tree then runs
     through the other one); ``widen`` moves the second rod's lower hinge that much further out along a, so that
     the rods make a trapezoid, not a parallelogram; ``elbow_shift`` draws each elbow hinge that far along its own
-    axis (the same mechanism).
+    axis (the same mechanism); ``unit``: every length written times it (1000: the file in millimetres).
     """
     points = geometry(centre, arm_angles, azimuths)
     rotation, shift = (np.eye(3), np.zeros(3)) if transform is None else transform
@@ -75,7 +75,7 @@ def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 
         frame[:3, 3] = rotation @ point + shift
         frames[name] = frame
         rpy = Rotation.from_matrix(frame[:3, :3]).as_euler("xyz")
-        links.append(f"<link name='{name}'><pose frame=''>{numbers(frame[:3, 3])} {numbers(rpy)}</pose>"
+        links.append(f"<link name='{name}'><pose frame=''>{numbers(unit * frame[:3, 3])} {numbers(rpy)}</pose>"
                      "<inertial><mass>0.1</mass></inertial></link>")
 
     def joint(name: str, parent: str, child: str, point, axis, in_model: bool) -> None:
@@ -84,7 +84,7 @@ def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 
         world_axis = rotation @ axis
         written = world_axis if in_model else frame[:3, :3].T @ world_axis
         joints.append(f"<joint name='{name}' type='revolute'><parent>{parent}</parent><child>{child}</child>"
-                      f"<pose frame=''>{numbers(local_point)} 0 0 0</pose><axis><xyz>{numbers(written)}</xyz>"
+                      f"<pose frame=''>{numbers(unit * local_point)} 0 0 0</pose><axis><xyz>{numbers(written)}</xyz>"
                       f"<use_parent_model_frame>{1 if in_model else 0}</use_parent_model_frame>"
                       "<limit><lower>-3</lower><upper>3</upper></limit></axis></joint>")
 

@@ -23,7 +23,7 @@ import json
 
 import numpy as np
 import pytest
-from hinged_delta import geometry, hinged_delta_sdf, textbook
+from hinged_delta import AZIMUTHS, geometry, hinged_delta_sdf, textbook
 from test_gallery import assert_same_bodies, mujoco_residuals, mujoco_state
 from test_io import mjcf_of_tree
 
@@ -73,6 +73,39 @@ def test_a_hinged_delta_has_the_textbook_pressure_angles_whichever_rod_and_leg_t
     legs = [note for note in notes if "twist system of dimension 4 (rotations about" in note]
     assert len(legs) == 4, notes  # each leg: the translations and the rotation about its motor axis
     assert not [note for note in notes if "rounding" in note], notes  # an exact file is read as written
+
+
+@pytest.mark.parametrize(("unit", "name"), [(1000.0, "mm"), (1e-3, "km")])
+def test_the_same_delta_in_another_length_unit_has_the_same_indices(tmp_path, unit, name):
+    """Every length times 1000 (millimetres) or 1e-3 (kilometres), read with ``length_unit``: the metre file's
+    indices, each leg's with its leg."""
+    centre, arms = POSES[1]
+    _, metres = indices(tmp_path, centre=centre, arm_angles=arms, platform_leg=2)
+    path = tmp_path / f"hinged_delta_{name}.sdf"
+    path.write_text(hinged_delta_sdf(centre=centre, arm_angles=arms, platform_leg=2, unit=unit))
+    mechanism = load(path, length_unit=name)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert_textbook(mechanism, result, textbook(geometry(centre, arms)), TOLERANCE)
+    np.testing.assert_allclose(result.iti_actuators, metres.iti_actuators, atol=TOLERANCE)
+    np.testing.assert_allclose(result.oti_submechanisms, metres.oti_submechanisms, atol=TOLERANCE)
+
+
+def test_legs_listed_in_another_order_carry_their_indices_and_the_worst_fault_with_them(tmp_path):
+    """The legs written in the order 3, 1, 4, 2 (so motor_k names another leg): each leg's ITI, every OTI and the
+    worst single fault follow the leg, and the LMTI and F_O1 do not change."""
+    centre, arms = POSES[0]
+    order = [2, 0, 3, 1]
+    _, first = indices(tmp_path, centre=centre, arm_angles=arms)
+    _, second = indices(tmp_path, centre=centre, arm_angles=[arms[k] for k in order],
+                        azimuths=AZIMUTHS[order])
+    np.testing.assert_allclose(second.iti_actuators, np.asarray(first.iti_actuators)[order], atol=TOLERANCE)
+    found = dict(zip(second.submechanisms, second.oti_submechanisms))
+    for members, value in zip(first.submechanisms, first.oti_submechanisms):
+        renamed = tuple(sorted(order.index(k) for k in members))
+        np.testing.assert_allclose(found[renamed], value, atol=TOLERANCE, err_msg=str(members))
+    np.testing.assert_allclose([second.lmti, second.f_o[1]], [first.lmti, first.f_o[1]], atol=TOLERANCE)
+    worst = [int(name.split(":")[0].split("_")[1]) - 1 for name in first.worst_faults[1]]
+    assert second.worst_faults[1] == tuple(f"motor_{order.index(k) + 1}:motor_{order.index(k) + 1}" for k in worst)
 
 
 @pytest.mark.parametrize(("platform_leg", "half_width", "transform"), [(0, 0.025, None), (2, -0.025, MOVED)])
