@@ -31,6 +31,7 @@ from screwkit.indices.analysis import analyze
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import bundled_names, load
 from screwkit.io.mjcf import read_mjcf
+from screwkit.screw import algebra as screws
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.studies import indices_at_pose
 
@@ -138,8 +139,10 @@ def test_a_stewart_platform_through_the_graph_has_the_indices_of_its_serial_legs
 @pytest.mark.parametrize("name", bundled_names())
 def test_the_equivalent_chain_of_the_graph_derivation_gives_the_per_chain_wrenches(name):
     """For a serial leg the graph derivation's equivalent chain -- the actuated joints' twists and a basis of the
-    twists the leg allows with them locked, from the null space of the leg's closure Jacobian [J | -I] -- carries
-    the same points and gives the same actuation wrenches and indices as the chain's own joints (<= 1e-12)."""
+    twists the leg allows with them locked, from the null space of the leg's closure Jacobian [J | -I] -- gives
+    the same actuation wrenches as the chain's own joints, and the same indices about the same characteristic
+    points (<= 1e-12): the basis carries no joint axes, so those points are given, as the graph derivation gives
+    its own, each where the wrench axis comes nearest to its joint's axis in the serial chain."""
     chains, poses = bundled_chain_screws(name, 6)
     equivalent = []
     for chain in chains:
@@ -165,7 +168,18 @@ def test_the_equivalent_chain_of_the_graph_derivation_gives_the_per_chain_wrench
         points = output_points(mechanism, solve(mechanism, poses).full_poses)
         options = dict(output_point=points, dof=mechanism.dof,
                        planar=mechanism.rotation_world_base[:, 2] if mechanism.is_planar else False)
-    reference, result = analyze(chains, **options), analyze(equivalent, **options)
+    reference = analyze(chains, **options)
+    if mechanism.output_point is None:
+        wrenches = reference.actuation_wrenches
+        given = {"iti_points": [], "oti_points": []}
+        for chain in chains:
+            for k in chain.actuated:
+                wrench = wrenches[:, len(given["oti_points"])]
+                for name, joint in (("iti_points", min(k + 1, chain.n_joints - 1)), ("oti_points", -1)):
+                    line = screws.joint_lines(chain.twists, chain.points, joint)
+                    given[name].append(screws.nearest_on_axis(wrench, chain.points[:, joint], line))
+        options.update({name: np.stack(points, axis=1) for name, points in given.items()})
+    result = analyze(equivalent, **options)
     assert_indices_close(reference, result, 1e-12)
     np.testing.assert_allclose(result.actuation_wrenches, reference.actuation_wrenches, atol=1e-12)
 

@@ -397,7 +397,8 @@ def test_each_configuration_has_its_own_working_coordinates(name, move):
 
 def test_output_twists_and_oti_in_world_units():
     """Output twists come back in world units: the public power coefficient of a world wrench on a
-    world twist, with the threshold and the characteristic length in the same unit, gives the OTI."""
+    world twist, about the point of the wrench's axis nearest to the platform joint's axis, with the threshold and
+    the characteristic length in the same unit, gives the OTI."""
     chains = skew_rsr(count=10, seed=5)
     for scale in (1e-3, 1.0, 1e3):
         current = scaled(chains, scale)
@@ -409,7 +410,8 @@ def test_output_twists_and_oti_in_world_units():
             for s, sub in enumerate(result.submechanisms):
                 for position, k in enumerate(sub):
                     wrench = result.actuation_wrenches[index, k]
-                    point = screws.project_on_axis(wrench, current[k].points[index, -1])
+                    line = screws.joint_lines(current[k].twists[index], current[k].points[index], -1)
+                    point = screws.nearest_on_axis(wrench, current[k].points[index, -1], line, length[index])
                     value = screws.power_coefficient(wrench, result.output_twists[index, s, position], point,
                                                      THRESHOLD * scale, length=length[index])
                     assert result.oti_actuators[index, s, position] == pytest.approx(float(value), abs=1e-9)

@@ -53,6 +53,22 @@ PURE_COUPLE = 1e-10
 times ``|m|`` (the moment about the centroid; :func:`screwkit.screw.algebra.power_coefficient` takes
 it about the characteristic point with its ``length`` argument as ``L``)."""
 
+AXIS_PARALLEL = 1e-12
+"""Relative: a joint's axis is parallel to a wrench's axis when the squared sine of the angle between them is at
+or below this; the characteristic point on the wrench axis (the point nearest to the joint's axis) is then the
+projection of the joint's point instead (:func:`screwkit.screw.algebra.nearest_on_axis`)."""
+
+ZERO_PITCH = 1e-9
+"""Relative: a wrench is a force (zero pitch) when its pitch is at most this times the characteristic length ``L``
+(working coordinates). Only a force is sure to cross the axis of a revolute it is reciprocal to; the characteristic
+point of a wrench with a pitch (a serial arm's) is the joint's drawn point projected on its axis
+(:func:`screwkit.screw.algebra.nearest_on_axis`)."""
+
+SAME_POINT = 1e-9
+"""Relative: two neighbouring joints of a chain are drawn at the same point when their points are at most this
+apart (working coordinates); with axes that are not parallel they are a universal or a ball joint, whose
+characteristic point is that point, not a line (:func:`screwkit.screw.algebra.joint_lines`)."""
+
 GRAM_PIVOT = 1e-12
 """Relative: the Gram matrix of a chain's joint twists (about the platform joint, each scaled to
 unit norm in working coordinates, so its diagonal is 1) is singular (an idle DoF, e.g. the spin

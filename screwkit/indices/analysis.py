@@ -157,9 +157,13 @@ def analyze(
     (a unit moment for a pure couple: :math:`|f| \le` ``PURE_COUPLE`` :math:`|m_c| / L`) and
     signed so that they do positive work on their own joint.
 
-    **Characteristic points**: for the ITI the point of the first joint after the actuator,
-    for the OTI the chain's platform-joint point, each projected on the wrench axis
-    (overridable with ``iti_points`` / ``oti_points``, used as given).
+    **Characteristic points**: for the ITI the first joint after the actuator, for the OTI the
+    chain's platform joint. On a force, where its axis comes nearest to the joint's axis
+    (:func:`~screwkit.screw.algebra.nearest_on_axis`: where it crosses a revolute, wherever along
+    its axis the joint is drawn); the joint's point projected on the wrench axis for a wrench with
+    a pitch, a prismatic joint, a universal or ball joint written as revolutes
+    (:func:`~screwkit.screw.algebra.joint_lines`) and an axis parallel to the force's (overridable
+    with ``iti_points`` / ``oti_points``, used as given).
 
     **Output twists** (Eq. 8): for a submechanism ``N`` with wrench matrix
     :math:`W_N = [A_k \circ M_q]` in motion coordinates (``M`` an orthonormal basis of the

@@ -11,12 +11,11 @@ and keeps each joint's own sense. Directions that already agree to 1e-12 are lef
 written unchanged unless two of its axes happen to lie within 1e-5 rad of each other at the file's configuration
 (then they are made parallel, and its indices move by about that much, 1e-7).
 
-Where a hinge is drawn along its axis is not the mechanism either: :func:`iti_hinge_offsets` slides the hinge after
-each actuator (the ITI's characteristic point, :mod:`screwkit.indices.analysis`) along its axis to where the next
-hinge's axis meets it, so that the point lies on the leg's actuation wrench wherever the file draws the hinge (a
-Delta's elbow drawn off its parallelogram's midline gave an ITI off the pressure angle, by 3e-3 at some poses).
+Where a hinge is drawn along its axis is not the mechanism either; the indices take no account of it (the
+characteristic points lie where the wrench's axis comes nearest to the joint's axis:
+:func:`screwkit.screw.algebra.nearest_on_axis`), so nothing here moves a hinge.
 
-Both run once, where a file of another tool is converted (:mod:`screwkit.io.star`).
+This runs once, where a file of another tool is converted (:mod:`screwkit.io.star`).
 """
 
 from __future__ import annotations
@@ -29,7 +28,7 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import joint_kind
 
-__all__ = ["parallel_axes", "drawn_axes", "iti_hinge_offsets", "EXACT"]
+__all__ = ["parallel_axes", "drawn_axes", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree: a group of them is left as written."""
@@ -70,41 +69,13 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def iti_hinge_offsets(model, data, leg, motors, scale: float) -> None:
-    """Slide the hinge after ``leg``'s actuator along its axis to the next hinge's point when that point lies on its
-    axis (to FILE_ROUNDING of the length ``scale``) and the two axes are not parallel: a universal joint, a Delta's
-    elbow and its parallelogram's hinge, drawn with their origins apart. The world offset goes into ``leg.offsets``
-    (on top of a parallelogram's midline shift); its children keep their places."""
-    joints = list(leg.joints)
-    actuated = [position for position, joint in enumerate(joints) if joint in motors]
-    if len(actuated) != 1 or actuated[0] + 2 >= len(joints):
-        return
-    first, second = joints[actuated[0] + 1], joints[actuated[0] + 2]
-    lines = []
-    for joint in (first, second):
-        kind, axis = joint_kind(model, joint)
-        if kind != "revolute" or joint in leg.locked:
-            return
-        lines.append((np.asarray(data.oMi[joint].translation) + leg.offsets.get(joint, np.zeros(3)),
-                      np.asarray(data.oMi[joint].rotation) @ axis))
-    (point, axis), (other, direction) = lines
-    along = (other - point) @ axis
-    if (np.linalg.norm(np.cross(axis, direction)) >= 1e-3 and abs(along) > FILE_ROUNDING * scale
-            and np.linalg.norm(other - point - along * axis) <= FILE_ROUNDING * scale):
-        leg.offsets = {**leg.offsets, first: leg.offsets.get(first, np.zeros(3)) + along * axis}
+def drawn_axes(model, data, legs: list, equivalents: list, report) -> tuple[dict[int, NDArray], list]:
+    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied.
 
-
-def drawn_axes(model, data, legs: list, equivalents: list, report, motors, scale: float
-               ) -> tuple[dict[int, NDArray], list]:
-    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and each
-    leg's hinge after its actuator (``motors``, joint ids) slid by :func:`iti_hinge_offsets`.
-
-    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes and offsets are set in
-    place. Returns each 1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their
-    rotations turned; the import ``report`` notes the largest turn.
+    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes are set in place.
+    Returns each 1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations
+    turned; the import ``report`` notes the largest turn.
     """
-    for leg in legs:
-        iti_hinge_offsets(model, data, leg, motors, scale)
     owners, directions = [], []
     for leg in legs:
         for joint in leg.joints:

@@ -135,7 +135,7 @@ class _Leg:
     loop_dofs: list[tuple[str, NDArray, NDArray]]  # world (kind, axis, point) of the loop DoFs at the assembly
     closure: str
     locked: list[int] = field(default_factory=list)
-    offsets: dict = field(default_factory=dict)  # world offsets of moved hinges: midlines, the ITI hinge (rounding)
+    offsets: dict = field(default_factory=dict)  # world offsets of hinges moved onto a parallelogram's midline
     sources: tuple[Closure, ...] = ()  # the closures onto the platform that make its loop joint (none: the platform
     # body's own path; two ball closures on one hinge's axis, or three or more of a weld)
 
@@ -431,7 +431,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
-    axes, equivalents = drawn_axes(model, data, legs, equivalents, report, set(motor_ids), scale)
+    axes, equivalents = drawn_axes(model, data, legs, equivalents, report)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):

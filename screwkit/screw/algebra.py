@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.common.tolerances import PURE_COUPLE, SINGULARITY_THRESHOLD
+from screwkit.common.tolerances import AXIS_PARALLEL, PURE_COUPLE, SAME_POINT, SINGULARITY_THRESHOLD, ZERO_PITCH
 from screwkit.common.validation import as_float_array, check_finite, check_shape
 
 __all__ = [
@@ -26,6 +26,8 @@ __all__ = [
     "pitch",
     "axis_point",
     "project_on_axis",
+    "nearest_on_axis",
+    "joint_lines",
     "shift_twist",
     "shift_wrench",
     "adjoint",
@@ -138,6 +140,81 @@ def project_on_axis(screw: ArrayLike, point: ArrayLike) -> NDArray[np.float64]:
     foot = np.cross(direction, screw[..., 3:]) / safe
     along = np.einsum("...i,...i->...", point - foot, direction)[..., None] / safe
     return np.where(norm_sq > 0, foot + along * direction, point)
+
+
+def nearest_on_axis(screw: ArrayLike, point: ArrayLike, direction: ArrayLike, length: float = 1.0
+                    ) -> NDArray[np.float64]:
+    """A joint's characteristic point on a force, independent of where along its axis the joint is drawn: the point
+    of the axis of ``screw`` nearest to the line through ``point`` along ``direction``.
+
+    For a revolute joint (``direction`` its axis) and a force reciprocal to it, the point where the force's line
+    crosses the joint's axis. The projection of ``point`` (:func:`project_on_axis`) when the screw is not a force
+    (its pitch above :data:`~screwkit.common.tolerances.ZERO_PITCH` times ``length``, or no axis), the lines are
+    parallel (squared sine at or below :data:`~screwkit.common.tolerances.AXIS_PARALLEL`) or ``direction`` is zero
+    (a prismatic joint: its point is the one drawn).
+
+    Parameters
+    ----------
+    screw : array_like, shape (..., 6)
+    point, direction : array_like, shape (..., 3)
+    length : float
+        The characteristic length the pitch is measured against (1 in working coordinates).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+    """
+    screw = _screws(screw, "screw")
+    point = _points(point, "point")
+    direction = _points(direction, "direction")
+    projected = project_on_axis(screw, point)
+    force = screw[..., :3]
+    force_sq = np.einsum("...i,...i->...", force, force)[..., None]
+    direction_sq = np.einsum("...i,...i->...", direction, direction)[..., None]
+    unit_force = force / np.sqrt(np.where(force_sq > 0, force_sq, 1.0))
+    unit = direction / np.sqrt(np.where(direction_sq > 0, direction_sq, 1.0))
+    cosine = np.einsum("...i,...i->...", unit_force, unit)[..., None]
+    sine_sq = 1.0 - cosine * cosine
+    crossing = np.where(sine_sq > AXIS_PARALLEL, sine_sq, 1.0)
+    # projected + t f is nearest to point + s u: t = (f.u)(u.(projected - point)) / (1 - (f.u)^2)
+    along = cosine * np.einsum("...i,...i->...", unit, projected - point)[..., None] / crossing
+    dot = np.einsum("...i,...i->...", force, screw[..., 3:])[..., None]
+    force_like = np.abs(dot) <= ZERO_PITCH * length * force_sq
+    use = (force_sq > 0) & force_like & (direction_sq > 0) & (sine_sq > AXIS_PARALLEL)
+    return np.where(use, projected + along * unit_force, projected)
+
+
+def joint_lines(twists: ArrayLike, points: ArrayLike, joint: int) -> NDArray[np.float64]:
+    """The direction along which joint ``joint`` of a chain may be drawn anywhere: its axis, for
+    :func:`nearest_on_axis`; zero for a prismatic joint and for a joint drawn at the same point as a neighbour in
+    the chain with another axis (a universal or ball joint written as revolutes, whose point is that point).
+
+    Parameters
+    ----------
+    twists : array_like, shape (..., m, 6)
+    points : array_like, shape (..., m, 3)
+        The chain's joint twists and points in working coordinates (the same point: at most
+        :data:`~screwkit.common.tolerances.SAME_POINT` apart; another axis: squared sine above
+        :data:`~screwkit.common.tolerances.AXIS_PARALLEL`).
+    joint : int
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+    """
+    twists, points = np.asarray(twists, dtype=float), np.asarray(points, dtype=float)
+    count = twists.shape[-2]
+    joint = joint % count
+    axis = twists[..., joint, :3]
+    point = np.ones(axis.shape[:-1], dtype=bool)
+    for other in (joint - 1, joint + 1):
+        if 0 <= other < count:
+            neighbour = twists[..., other, :3]
+            gap = np.linalg.norm(points[..., other, :] - points[..., joint, :], axis=-1)
+            sine_sq = np.sum(np.cross(axis, neighbour) ** 2, axis=-1)
+            crossing = sine_sq > AXIS_PARALLEL * np.sum(axis * axis, -1) * np.sum(neighbour * neighbour, -1)
+            point &= ~((gap <= SAME_POINT) & crossing)
+    return np.where(point[..., None], axis, 0.0)
 
 
 def _shift(screw: NDArray, point: NDArray) -> NDArray[np.float64]:

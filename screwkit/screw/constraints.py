@@ -54,6 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common import tolerances
+from screwkit.screw.algebra import joint_lines, nearest_on_axis
 from screwkit.screw.motion import chain_decompositions
 
 __all__ = ["ConstraintPlan", "plan_constraints", "constraint_indices", "chain_constraint_wrenches"]
@@ -224,16 +225,6 @@ def _coefficient(wrench: NDArray, twist: NDArray, point: NDArray, threshold: NDA
     return np.where(singular, 0.0, np.minimum(value, 1.0))
 
 
-def _project_on_axis(wrench: NDArray, point: NDArray) -> NDArray:
-    """The point of a wrench's axis nearest ``point`` (``point`` itself for a couple)."""
-    force, moment = wrench[..., :3], wrench[..., 3:]
-    norm_sq = np.sum(force * force, -1, keepdims=True)
-    safe = np.where(norm_sq > 0, norm_sq, 1.0)
-    foot = np.cross(force, moment) / safe
-    along = np.sum((point - foot) * force, -1, keepdims=True) / safe
-    return np.where(norm_sq > 0, foot + along * force, point)
-
-
 def _released_pairs(own: NDArray, freed: NDArray, valid: NDArray | None = None):
     """Principal pairs of a chain's own constraint wrenches (..., c, 6) and the twists (..., 6, d) their release
     frees: wrenches ``U^T C`` and twists ``F V`` from the singular vectors of the pairing
@@ -258,7 +249,8 @@ def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], memb
                    points: list[NDArray], threshold: NDArray) -> NDArray:
     """:math:`CTI_{N,L}` (N, S) of every actuator set (their unit wrenches ``actuation``, (N, S, n, 6)) and one
     subsystem ``members``: the lowest power coefficient of a released constraint wrench on the twist it frees.
-    ``shared`` (N, c0, 6), ``own`` per chain (N, c_i, 6), ``points`` per chain (N, 3), ``threshold`` (N,)."""
+    ``shared`` (N, c0, 6), ``own`` per chain (N, c_i, 6), ``points`` per chain (N, 6: the platform joint's point and its
+    :func:`~screwkit.screw.algebra.joint_lines` direction), ``threshold`` (N,)."""
     sets = actuation.shape[1]
     blocks = [np.broadcast_to(own[i][:, None], own[i].shape[:1] + (sets,) + own[i].shape[1:]) for i in members]
     common = np.broadcast_to(shared[:, None], shared.shape[:1] + (sets,) + shared.shape[1:])
@@ -289,7 +281,7 @@ def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], memb
             freed_of.append(_SWAP @ np.swapaxes(right[..., -size:, :], -1, -2))
     for index, block, freed, valid in zip(members, blocks, freed_of, valid_of):
         wrenches, twists, exists = _released_pairs(block, freed, valid)
-        centres = _project_on_axis(wrenches, points[index][:, None, None, :])
+        centres = nearest_on_axis(wrenches, points[index][:, None, None, :3], points[index][:, None, None, 3:])
         kappa = _coefficient(wrenches, twists, centres, threshold[:, None, None])
         values = np.minimum(values, np.where(exists, kappa, np.inf).min(axis=-1))
     return np.where(regular & np.isfinite(values), values, 0.0)
@@ -317,7 +309,8 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
     decompositions : list, optional
         :func:`screwkit.screw.motion.chain_decompositions` of ``chain_twists`` when already computed.
     stage : callable, optional
-        What computes, from every chain's constraint wrenches (N, K, 6), their platform joints (N, C, 3),
+        What computes, from every chain's constraint wrenches (N, K, 6), their platform joints (N, C, 6: point and
+        :func:`~screwkit.screw.algebra.joint_lines` direction),
         ``wrenches`` and ``threshold``, the instantaneous DOF (N,) and :math:`CTI_N` of every actuator set (N, S)
         before constraint singularities are zeroed, in place of the numpy code below (the compiled kernel of
         :mod:`screwkit.indices.compiled.constraints`, for large chunks); only asked when the CTI applies.
@@ -336,7 +329,9 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
     constraints = [chain_constraint_wrenches(t, c, d)
                    for t, c, d in zip(chain_twists, plan.chain_counts, decompositions)]
     stacked = np.concatenate(constraints, axis=-2) if constraints else np.zeros((count, 0, 6))
-    points = [chain[:, -1] for chain in chain_points]  # each chain's platform joint
+    # each chain's platform joint: its point and the axis along which that point is arbitrary (joint_lines)
+    points = [np.concatenate([chain[:, -1], joint_lines(twists, chain, -1)], axis=-1)
+              for twists, chain in zip(chain_twists, chain_points)]
     if stage is not None and plan.count:
         instantaneous, per_set = stage(stacked, np.stack(points, axis=1), wrenches, threshold)
     else:

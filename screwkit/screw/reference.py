@@ -33,7 +33,14 @@ from screwkit.common.tolerances import (
     RANK_TOLERANCE,
     SINGULAR_SPAN,
 )
-from screwkit.screw.algebra import SWAP, power_coefficient, project_on_axis, reciprocal_product, shift_twist
+from screwkit.screw.algebra import (
+    SWAP,
+    joint_lines,
+    nearest_on_axis,
+    power_coefficient,
+    reciprocal_product,
+    shift_twist,
+)
 
 __all__ = ["working_frame", "motion_space", "actuation_wrench", "input_transmission", "output_twists",
            "output_transmission", "fault_tolerance", "constraint_transmission", "reference_indices"]
@@ -101,10 +108,12 @@ def _singular_wrench(unit: NDArray, k: int, basis: NDArray, d: NDArray) -> NDArr
     return vectors[rank] @ span if len(span) - rank == 1 else None
 
 
-def input_transmission(wrench: NDArray, twist: NDArray, point: NDArray, threshold: float) -> float:
-    """ITI of one actuator (Eq. 6): the power coefficient on its joint's twist, the wrench rotated about the
-    first joint after the actuator (``point``) projected on its axis."""
-    return float(power_coefficient(wrench, twist, project_on_axis(wrench, point), threshold))
+def input_transmission(wrench: NDArray, twist: NDArray, after: NDArray, point: NDArray, threshold: float) -> float:
+    """ITI of one actuator (Eq. 6): the power coefficient on its joint's ``twist``, the wrench rotated about the
+    first joint after the actuator, drawn at ``point`` with the axis direction ``after`` (:func:`joint_lines`): on
+    a force, the point of its axis nearest to that joint's axis (where it crosses it), wherever along its axis the
+    joint is drawn (:func:`nearest_on_axis`)."""
+    return float(power_coefficient(wrench, twist, nearest_on_axis(wrench, point, after), threshold))
 
 
 def output_twists(wrenches: NDArray, basis: NDArray) -> NDArray | None:
@@ -118,9 +127,10 @@ def output_twists(wrenches: NDArray, basis: NDArray) -> NDArray | None:
     return np.array([np.linalg.svd(np.delete(matrix, k, axis=0))[2][-1] @ basis for k in range(len(wrenches))])
 
 
-def output_transmission(wrench: NDArray, twist: NDArray, point: NDArray, threshold: float) -> float:
-    """OTI of one actuator of a submechanism (Eq. 8), the wrench rotated about its platform joint."""
-    return float(power_coefficient(wrench, twist, project_on_axis(wrench, point), threshold))
+def output_transmission(wrench: NDArray, twist: NDArray, platform: NDArray, point: NDArray, threshold: float) -> float:
+    """OTI of one actuator of a submechanism (Eq. 8), the wrench rotated about its platform joint (axis direction
+    ``platform``, :func:`joint_lines`, drawn at ``point``), the point taken as for the ITI."""
+    return float(power_coefficient(wrench, twist, nearest_on_axis(wrench, point, platform), threshold))
 
 
 def fault_tolerance(oti_sets: dict, actuators: int, dof: int) -> dict:
@@ -182,8 +192,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
                 left, singular, right = np.linalg.svd(reciprocal_product(own[i][:, None], freed[None]),
                                                       full_matrices=False)
                 for wrench, twist in zip(left.T @ own[i], right @ freed):
-                    kappas.append(float(power_coefficient(wrench, twist, project_on_axis(wrench, points[i][-1]),
-                                                          threshold)))
+                    centre = nearest_on_axis(wrench, points[i][-1], joint_lines(twists[i], points[i], -1))
+                    kappas.append(float(power_coefficient(wrench, twist, centre, threshold)))
             best = max(best, min(kappas))
         result[tuple(members)] = best
     return result, instantaneous
@@ -221,7 +231,8 @@ def reference_indices(twists: list[NDArray], points: list[NDArray], actuated: li
     actuators = [(c, k) for c, ks in enumerate(actuated) for k in ks]
     wrenches = np.array([actuation_wrench(work[c], at[c], k, space) for c, k in actuators])
     p = threshold / length
-    iti = [input_transmission(wrenches[a], work[c][k], at[c][min(k + 1, len(at[c]) - 1)], p)
+    after = [min(k + 1, len(at[c]) - 1) for c, k in actuators]
+    iti = [input_transmission(wrenches[a], work[c][k], joint_lines(work[c], at[c], after[a]), at[c][after[a]], p)
            for a, (c, k) in enumerate(actuators)]
     sets = list(combinations(range(len(actuators)), dof))
     cti, instantaneous = constraint_transmission(work, at, wrenches, sets, dof + len(idle), p)
@@ -231,7 +242,8 @@ def reference_indices(twists: list[NDArray], points: list[NDArray], actuated: li
     for members in sets:
         outputs = None if singular else output_twists(wrenches[list(members)], space)
         oti[members] = [0.0] * dof if outputs is None else \
-            [output_transmission(wrenches[a], t, at[actuators[a][0]][-1], p) for a, t in zip(members, outputs)]
+            [output_transmission(wrenches[a], t, joint_lines(work[c], at[c], -1), at[c][-1], p)
+             for a, t in zip(members, outputs) for c in [actuators[a][0]]]
     faults = fault_tolerance({m: min(v) for m, v in oti.items()}, len(actuators), dof)
     if singular:  # held with actuator a free: the other actuators and every constraint wrench span all six
         every = np.concatenate([_complement(_span(t)) @ SWAP for t in work])

@@ -20,6 +20,7 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.common.tolerances import AXIS_PARALLEL, SAME_POINT, ZERO_PITCH
 from screwkit.indices.compiled.algebra import BLOCK, arm_square, cross, power_coefficient, working_point, working_twist
 
 __all__ = ["actuator_scratch", "actuator_stage"]
@@ -27,20 +28,41 @@ __all__ = ["actuator_scratch", "actuator_stage"]
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def actuator_scratch(a, n):
-    """The per-actuator lanes the later stages read, allocated once per call: each actuator's joint twist and points
-    (a, 12, BLOCK), unit wrench (a, 6, BLOCK), OTI characteristic point (a, 3, BLOCK), pitch
-    (0 for a couple), whether it has a force (else a couple), ITI, row of W in motion coordinates (a, n, BLOCK) and
-    that row's norm."""
-    return (np.empty((a, 12, BLOCK)), np.empty((a, 6, BLOCK)), np.empty((a, 3, BLOCK)), np.empty((a, BLOCK)),
+    """The per-actuator lanes the later stages read, allocated once per call: each actuator's joint twist, points and
+    the axes along which those points are arbitrary (a, 18, BLOCK), unit wrench (a, 6, BLOCK), OTI characteristic
+    point (a, 3, BLOCK), pitch (0 for a couple), whether it has a force (else a couple), ITI, row of W in motion
+    coordinates (a, n, BLOCK) and that row's norm."""
+    return (np.empty((a, 18, BLOCK)), np.empty((a, 6, BLOCK)), np.empty((a, 3, BLOCK)), np.empty((a, BLOCK)),
             np.zeros((a, BLOCK), dtype=np.bool_), np.zeros((a, BLOCK)), np.zeros((a, n, BLOCK)),
             np.zeros((a, BLOCK)))
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def joint_line(all_twists, all_points, index, joint, first, last, inverse):
+    """Joint ``joint``'s axis direction (as :func:`screwkit.screw.reference.joint_line`): zero for a prismatic joint
+    and for one drawn at the same point as a neighbour (``first`` to ``last``, its chain) with another axis."""
+    w0, w1, w2 = all_twists[index, joint, 0], all_twists[index, joint, 1], all_twists[index, joint, 2]
+    for other in (joint - 1, joint + 1):
+        if other < first or other > last:
+            continue
+        g0 = (all_points[index, other, 0] - all_points[index, joint, 0]) * inverse
+        g1 = (all_points[index, other, 1] - all_points[index, joint, 1]) * inverse
+        g2 = (all_points[index, other, 2] - all_points[index, joint, 2]) * inverse
+        if g0 * g0 + g1 * g1 + g2 * g2 <= SAME_POINT * SAME_POINT:
+            u0, u1, u2 = all_twists[index, other, 0], all_twists[index, other, 1], all_twists[index, other, 2]
+            x0, x1, x2 = cross(w0, w1, w2, u0, u1, u2)
+            if x0 * x0 + x1 * x1 + x2 * x2 > AXIS_PARALLEL * (w0 * w0 + w1 * w1 + w2 * w2) * (u0 * u0 + u1 * u1
+                                                                                                + u2 * u2):
+                return 0.0, 0.0, 0.0
+    return w0, w1, w2
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def actuator_joint_lanes(all_twists, all_points, chain_start, actuator_chain, actuator_joint, first_index, width,
                          centres, inverse_lengths, joint_lanes):
     """Each actuator's joint twist (rows 0-5 of ``joint_lanes[act]``), the point of the joint after it (6-8) and its
-    chain's platform joint d (9-11), lane by lane, in working coordinates (as the first stage computed them)."""
+    chain's platform joint d (9-11), lane by lane, in working coordinates (as the first stage computed them), and
+    the axes of those two joints along which their points are arbitrary (12-14, 15-17: :func:`joint_line`)."""
     for act in range(actuator_chain.shape[0]):
         start = chain_start[actuator_chain[act]]
         own = start + actuator_joint[act]
@@ -55,15 +77,32 @@ def actuator_joint_lanes(all_twists, all_points, chain_start, actuator_chain, ac
                 all_points, first_index + r, after, c0, c1, c2, inverse)
             joint_lanes[act, 9, r], joint_lanes[act, 10, r], joint_lanes[act, 11, r] = working_point(
                 all_points, first_index + r, last, c0, c1, c2, inverse)
+            joint_lanes[act, 12, r], joint_lanes[act, 13, r], joint_lanes[act, 14, r] = joint_line(
+                all_twists, all_points, first_index + r, after, start, last, inverse)
+            joint_lanes[act, 15, r], joint_lanes[act, 16, r], joint_lanes[act, 17, r] = joint_line(
+                all_twists, all_points, first_index + r, last, start, last, inverse)
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def on_wrench_axis(p0, p1, p2, f0, f1, f2, axis0, axis1, axis2, forceful):
-    """p projected on the axis of a unit-force wrench (through ``axis``, f x m); p itself for a couple."""
-    if forceful:
-        along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
-        return axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
-    return p0, p1, p2
+def on_wrench_axis(joint_lanes, act, r, row, f0, f1, f2, axis0, axis1, axis2, pitch, forceful):
+    """The characteristic point of the joint whose point and axis are ``joint_lanes[act, row:row + 3, r]`` and
+    ``[row + 6:row + 9]`` on the axis of a unit-force wrench (through ``axis``, f x m; ``pitch`` in working
+    coordinates), as :func:`screwkit.screw.algebra.nearest_on_axis`: for a force, the point of its axis nearest to
+    the joint's axis; the point's projection for a pitch, a parallel or a zero axis; p itself for a couple."""
+    p0, p1, p2 = joint_lanes[act, row, r], joint_lanes[act, row + 1, r], joint_lanes[act, row + 2, r]
+    if not forceful:
+        return p0, p1, p2
+    along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+    q0, q1, q2 = axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
+    u0, u1, u2 = joint_lanes[act, row + 6, r], joint_lanes[act, row + 7, r], joint_lanes[act, row + 8, r]
+    direction_sq = u0 * u0 + u1 * u1 + u2 * u2
+    if direction_sq > 0.0 and abs(pitch) <= ZERO_PITCH:
+        cosine = (f0 * u0 + f1 * u1 + f2 * u2) / np.sqrt(direction_sq)
+        sine_sq = 1.0 - cosine * cosine
+        if sine_sq > AXIS_PARALLEL:
+            shift = cosine * (u0 * (q0 - p0) + u1 * (q1 - p1) + u2 * (q2 - p2)) / (np.sqrt(direction_sq) * sine_sq)
+            return q0 + shift * f0, q1 + shift * f1, q2 + shift * f2
+    return q0, q1, q2
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -81,7 +120,8 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
     characteristic point, lane by lane.
 
     The characteristic points are the caller's (``iti_override``, ``oti_override``), else the joint after the
-    actuated one (ITI) and the platform joint d (OTI), each projected on the wrench axis.
+    actuated one (ITI) and the platform joint d (OTI), each where the wrench axis comes nearest to the joint's axis
+    (:func:`on_wrench_axis`).
     """
     for act in range(forces.shape[0]):
         for r in range(width):
@@ -115,13 +155,12 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
             has_force[act, r] = forceful
             pitch = f0 * m0 + f1 * m1 + f2 * m2 if forceful else 0.0
             pitch_lanes[act, r] = pitch
-            # Characteristic points: projections on the wrench axis (unit force).
+            # Characteristic points on the wrench axis (unit force).
             axis0, axis1, axis2 = cross(f0, f1, f2, m0, m1, m2)
             if iti_override.shape[0] > 0:
                 p0, p1, p2 = given_point(iti_override, first_index + r, act, centres, r, inverse_lengths[r])
             else:
-                p0, p1, p2 = on_wrench_axis(joint_lanes[act, 6, r], joint_lanes[act, 7, r], joint_lanes[act, 8, r],
-                                            f0, f1, f2, axis0, axis1, axis2, forceful)
+                p0, p1, p2 = on_wrench_axis(joint_lanes, act, r, 6, f0, f1, f2, axis0, axis1, axis2, pitch, forceful)
             # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
             w0, w1, w2 = joint_lanes[act, 0, r], joint_lanes[act, 1, r], joint_lanes[act, 2, r]
             omega = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
@@ -132,7 +171,7 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
             if oti_override.shape[0] > 0:
                 p0, p1, p2 = given_point(oti_override, first_index + r, act, centres, r, inverse_lengths[r])
             else:
-                p0, p1, p2 = on_wrench_axis(d0, d1, d2, f0, f1, f2, axis0, axis1, axis2, forceful)
+                p0, p1, p2 = on_wrench_axis(joint_lanes, act, r, 9, f0, f1, f2, axis0, axis1, axis2, pitch, forceful)
             point_lanes[act, 0, r] = p0
             point_lanes[act, 1, r] = p1
             point_lanes[act, 2, r] = p2

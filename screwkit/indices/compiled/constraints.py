@@ -30,6 +30,7 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.common.tolerances import AXIS_PARALLEL, ZERO_PITCH
 from screwkit.indices.compiled.jacobi import NULL_COLUMN, singular_vectors, symmetric_eigen, unit_columns
 
 __all__ = ["constraint_kernel"]
@@ -299,8 +300,9 @@ def released_pairs(own, chain, size, freed, rank_tolerance, pairing, wrenches, t
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_couple):
     """Power coefficient of the unit constraint wrench ``wrenches[pair]`` on the twist ``twists[pair]`` (as
-    ``_coefficient``), its characteristic point, the chain's platform joint ``points[index, chain]``, projected on
-    the wrench's axis (as ``_project_on_axis``; a couple: |m . omega| / |m||omega|)."""
+    ``_coefficient``), its characteristic point the point of the wrench's axis nearest to the chain's platform joint
+    ``points[index, chain, :3]`` or, for a force and when the joint has one, its axis ``points[index, chain, 3:]``
+    (:func:`screwkit.screw.algebra.nearest_on_axis`; a couple: |m . omega| / |m||omega|)."""
     f0, f1, f2 = wrenches[pair, 0], wrenches[pair, 1], wrenches[pair, 2]
     m0, m1, m2 = wrenches[pair, 3], wrenches[pair, 4], wrenches[pair, 5]
     w0, w1, w2 = twists[pair, 0], twists[pair, 1], twists[pair, 2]
@@ -308,10 +310,19 @@ def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_co
     numerator = abs(f0 * v0 + f1 * v1 + f2 * v2 + m0 * w0 + m1 * w1 + m2 * w2)
     norm_sq = f0 * f0 + f1 * f1 + f2 * f2
     p0, p1, p2 = points[index, chain, 0], points[index, chain, 1], points[index, chain, 2]
-    if norm_sq > 0.0:  # the point of the axis nearest the chain's platform joint
+    if norm_sq > 0.0:  # the point of the axis nearest the chain's platform joint (its axis, when it has one)
         c0, c1, c2 = (f1 * m2 - f2 * m1) / norm_sq, (f2 * m0 - f0 * m2) / norm_sq, (f0 * m1 - f1 * m0) / norm_sq
         along = ((p0 - c0) * f0 + (p1 - c1) * f1 + (p2 - c2) * f2) / norm_sq
-        p0, p1, p2 = c0 + along * f0, c1 + along * f1, c2 + along * f2
+        q0, q1, q2 = c0 + along * f0, c1 + along * f1, c2 + along * f2
+        u0, u1, u2 = points[index, chain, 3], points[index, chain, 4], points[index, chain, 5]
+        direction_sq = u0 * u0 + u1 * u1 + u2 * u2
+        if direction_sq > 0.0 and abs(f0 * m0 + f1 * m1 + f2 * m2) <= ZERO_PITCH * norm_sq:
+            cosine_sq = (f0 * u0 + f1 * u1 + f2 * u2) ** 2 / (norm_sq * direction_sq)
+            if 1.0 - cosine_sq > AXIS_PARALLEL:  # as screwkit.screw.algebra.nearest_on_axis
+                shift = ((f0 * u0 + f1 * u1 + f2 * u2) * (u0 * (q0 - p0) + u1 * (q1 - p1) + u2 * (q2 - p2))
+                         / (norm_sq * direction_sq * (1.0 - cosine_sq)))
+                q0, q1, q2 = q0 + shift * f0, q1 + shift * f1, q2 + shift * f2
+        p0, p1, p2 = q0, q1, q2
     force_norm = np.sqrt(norm_sq)
     moment_norm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
     omega_norm = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
@@ -377,7 +388,8 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
         :func:`screwkit.screw.constraints.chain_constraint_wrenches`), chains in consecutive rows.
     wrench_start (C + 1,) : the first row of each chain's constraint wrenches, and K.
     own_counts (C,), common : the constraint plan's own wrenches per chain and common wrenches.
-    points (N, C, 3) : each chain's platform joint in working coordinates.
+    points (N, C, 6) : each chain's platform joint in working coordinates and the direction along which it may be
+        drawn anywhere (:func:`screwkit.screw.algebra.joint_lines`; zero for a point).
     wrenches (N, a, 6) : unit actuation wrenches in working coordinates.
     submechanisms (S, n) : the actuator sets; members (L, C) : 1 for the chains of each subsystem.
     threshold (N,) : the singularity threshold in working coordinates (p / L).

@@ -1,0 +1,137 @@
+"""The indices do not depend on where along its axis a revolute joint is drawn.
+
+A file may put a revolute joint's origin anywhere on its axis (a CAD export at the middle of a bearing, a Delta's
+elbow off its parallelogram's midline): the mechanism is the same. The characteristic points of the ITI, the OTI
+and the CTI are taken where the wrench's axis comes nearest to the joint's axis (``docs/theory.md``, "The
+characteristic points"). Here every revolute's drawn point is moved along its axis, by a different amount in every
+configuration, and every index must stay; and the points are checked against an independent construction: the
+common perpendicular of the two lines from a least-squares solve, the power coefficient from the public algebra.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_invariance import skew_rsr
+
+from helpers import assert_indices_close, bundled_chain_screws
+from screwkit.indices.analysis import analyze
+from screwkit.indices.stages import CONSTRAINTS_COMPILED_FROM
+from screwkit.screw import algebra as screws
+from screwkit.screw.chain_screws import ChainScrews
+
+THRESHOLD = 1e-6
+COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups")
+"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis (the two others are the exceptions
+``docs/theory.md`` names: a prismatic joint after an actuator, a force parallel to the joint after it; and the
+skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint force whose moment
+about the platform joint changes with the joint's drawn place, and so does their representative)."""
+
+
+def moved_along_axes(chains, chain: int, joint: int, rng, scale: float):
+    """The chains with joint ``joint`` of chain ``chain`` drawn elsewhere on its axis, by up to half of ``scale``
+    either way, a different amount in each configuration."""
+    current = chains[chain]
+    axis = current.twists[..., joint, :3]
+    shift = rng.uniform(-0.5, 0.5, axis.shape[:-1] + (1,)) * scale
+    points = current.points.copy()
+    points[..., joint, :] += shift * axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    moved = list(chains)
+    moved[chain] = ChainScrews(current.twists, points, current.actuated, current.name, current.joint_names)
+    return moved
+
+
+def revolutes(chains):
+    """(chain, joint) of every revolute joint (a twist with a rotation)."""
+    return [(c, j) for c, chain in enumerate(chains) for j in range(chain.n_joints)
+            if np.all(np.linalg.norm(chain.twists[..., j, :3], axis=-1) > 0.5)]
+
+
+def size(chains) -> float:
+    points = np.concatenate([chain.points.reshape(-1, 3) for chain in chains])
+    return float(np.max(np.ptp(points, axis=0)))
+
+
+@pytest.mark.parametrize("name", COVERED)
+def test_every_index_is_the_same_wherever_a_revolute_is_drawn_along_its_axis(name):
+    """One joint at a time, so that the joints of a universal or ball joint written as revolutes come apart too
+    (each then a line of its own); ITIs, OTIs, LMTI, F_Oj, F_IOj and the CTI to 1e-12."""
+    chains = bundled_chain_screws(name, 40)[0]
+    rng = np.random.default_rng(sum(map(ord, name)))
+    reference = analyze(chains, threshold=THRESHOLD)
+    for chain, joint in revolutes(chains):
+        moved = analyze(moved_along_axes(chains, chain, joint, rng, size(chains)), threshold=THRESHOLD)
+        assert_indices_close(reference, moved, 1e-12)
+
+
+def test_the_compiled_constraint_kernel_takes_the_same_points():
+    """A chunk large enough for the compiled CTI (the Delta's R-U-U legs hold constraint couples)."""
+    chains = bundled_chain_screws("delta_4", CONSTRAINTS_COMPILED_FROM + 40)[0]
+    rng = np.random.default_rng(4)
+    reference = analyze(chains, threshold=THRESHOLD)
+    assert np.all(np.isfinite(reference.cti))
+    for chain, joint in revolutes(chains)[:5]:
+        moved = analyze(moved_along_axes(chains, chain, joint, rng, size(chains)), threshold=THRESHOLD)
+        assert_indices_close(reference, moved, 1e-12)
+
+
+def nearest_point(wrench, point, axis):
+    """The point of the wrench's axis nearest to the line through ``point`` along ``axis``: least squares on the two
+    lines' parameters (a construction of its own, not the package's formula)."""
+    force = wrench[:3] / np.linalg.norm(wrench[:3])
+    foot = np.cross(wrench[:3], wrench[3:]) / np.dot(wrench[:3], wrench[:3])
+    (t, _), *_ = np.linalg.lstsq(np.column_stack([force, -axis]), point - foot, rcond=None)
+    return foot + t * force
+
+
+def test_the_points_are_where_each_force_crosses_its_joint_axis():
+    """A 4-RSR with skew axes: the actuation wrenches are forces reciprocal to the S and to the platform's R, so
+    they cross the R's axis; the ITI about the S's centre and the OTI about that crossing, from the public power
+    coefficient, are the indices (the crossing is one: the lines meet to 1e-9 of the platform's size)."""
+    chains = skew_rsr(count=10, seed=2)
+    result = analyze(chains, threshold=THRESHOLD, keep_twists=True)
+    length = size(chains)
+    checked = 0
+    for index in range(10):
+        for s, members in enumerate(result.submechanisms):
+            for position, k in enumerate(members):
+                chain = chains[k]
+                wrench = result.actuation_wrenches[index, k]
+                assert abs(screws.pitch(wrench)) < 1e-9 * length
+                axis = chain.twists[index, -1, :3]
+                crossing = nearest_point(wrench, chain.points[index, -1], axis)
+                offset = crossing - chain.points[index, -1]
+                assert np.linalg.norm(np.cross(offset, axis)) < 1e-9 * length  # on the R's axis too
+                expected = screws.power_coefficient(wrench, result.output_twists[index, s, position], crossing,
+                                                    THRESHOLD)
+                assert result.oti_actuators[index, s, position] == pytest.approx(float(expected), abs=1e-9)
+                checked += 1
+        for k, chain in enumerate(chains):
+            wrench = result.actuation_wrenches[index, k]
+            centre = screws.project_on_axis(wrench, chain.points[index, 1])  # the S's joints share its centre
+            expected = screws.power_coefficient(wrench, chain.twists[index, 0], centre, THRESHOLD)
+            assert result.iti_actuators[index, k] == pytest.approx(float(expected), abs=1e-9)
+    assert checked
+
+
+def test_the_drawn_point_is_kept_where_the_line_does_not_decide():
+    """A prismatic joint (no axis), a ball's revolutes at one point, an axis parallel to the wrench and a wrench with
+    a pitch (whose axis need not meet the joint's): the drawn point projected on the wrench axis."""
+    force = np.array([0.0, 0.0, 1.0, 0.3, -0.2, 0.0])  # a force along z through (0.2, 0.3, .) (f x m)
+    point = np.array([1.0, 0.3, 0.5])
+    projected = screws.project_on_axis(force, point)
+    for direction in ([0.0, 0.0, 0.0], [0.0, 0.0, 2.0]):
+        np.testing.assert_allclose(screws.nearest_on_axis(force, point, direction), projected, atol=1e-15)
+    crossing = screws.nearest_on_axis(force, point, [1.0, 0.0, 1.0])  # the line through point along x + z
+    np.testing.assert_allclose(crossing, [0.2, 0.3, -0.3], atol=1e-12)  # (1, 0.3, 0.5) - 0.8 (1, 0, 1)
+    screw = force + [0.0, 0.0, 0.0, 0.0, 0.0, 0.05]  # the same axis, pitch 0.05
+    np.testing.assert_allclose(screws.nearest_on_axis(screw, point, [1.0, 0.0, 1.0]), projected, atol=1e-15)
+    np.testing.assert_allclose(screws.nearest_on_axis(screw, point, [1.0, 0.0, 1.0], length=1e8), crossing,
+                               atol=1e-12)  # a pitch of 5e-10 lengths: a force
+    twists = np.array([[1.0, 0, 0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0], [0, 0, 1.0, 0, 0, 0]])
+    ball = np.zeros((3, 3))
+    assert not np.any(screws.joint_lines(twists, ball, 1))
+    apart = ball + [[0, 0, 0], [0, 0, 0], [0, 0, 1.0]]
+    np.testing.assert_allclose(screws.joint_lines(twists, apart, -1), [0, 0, 1.0])  # on its own line
+    prismatic = np.array([[0, 0, 0, 1.0, 0, 0]])
+    assert not np.any(screws.joint_lines(prismatic, np.zeros((1, 3)), 0))
