@@ -10,15 +10,20 @@ common perpendicular of the two lines from a least-squares solve, the power coef
 
 from __future__ import annotations
 
+from pathlib import Path
+from xml.etree import ElementTree
+
 import numpy as np
 import pytest
 from test_invariance import skew_rsr
 
-from helpers import assert_indices_close, bundled_chain_screws
+from helpers import assert_indices_close, bundled_chain_screws, random_reachable_poses
 from screwkit.indices.analysis import analyze
 from screwkit.indices.stages import CONSTRAINTS_COMPILED_FROM
+from screwkit.io.loader import load
 from screwkit.screw import algebra as screws
 from screwkit.screw.chain_screws import ChainScrews
+from screwkit.studies import indices_at_poses
 
 THRESHOLD = 1e-6
 COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups")
@@ -73,6 +78,68 @@ def test_the_compiled_constraint_kernel_takes_the_same_points():
     for chain, joint in revolutes(chains)[:5]:
         moved = analyze(moved_along_axes(chains, chain, joint, rng, size(chains)), threshold=THRESHOLD)
         assert_indices_close(reference, moved, 1e-12)
+
+
+def numbers(text: str) -> np.ndarray:
+    return np.array([float(value) for value in text.split()])
+
+
+def urdf_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's rpy: Rz(yaw) Ry(pitch) Rx(roll), about fixed axes."""
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    return (np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+            @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]]))
+
+
+def written(values) -> str:
+    return " ".join(repr(float(value)) for value in values)
+
+
+def origins_in(root, link: str):
+    """Every ``<origin>`` expressed in ``link``'s frame: its child joints' and the loops' ends on it."""
+    for joint in root.iter("joint"):
+        parent = joint.find("parent")
+        if parent is not None and parent.get("link") == link and joint.find("origin") is not None:
+            yield joint.find("origin")
+    for loop in root.iter("loop"):
+        for end in ("predecessor", "successor"):
+            element = loop.find(end)
+            if element is not None and element.get("link") == link:
+                yield element.find("origin")
+
+
+def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
+    """The URDF with every tree revolute's origin moved along its own axis (by up to ``span`` either way, each its
+    own amount) and the origins in its child link's frame moved back, so that every body stays where it was: the
+    same mechanism, drawn otherwise (written here with ElementTree, not with screwkit's reader)."""
+    root = ElementTree.fromstring(text)
+    for joint in root.iter("joint"):
+        if joint.get("type") not in ("revolute", "continuous"):
+            continue
+        origin = joint.find("origin")
+        axis = numbers(joint.find("axis").get("xyz"))
+        shift = rng.uniform(-span, span) * axis / np.linalg.norm(axis)
+        rotation = urdf_rotation(*numbers(origin.get("rpy", "0 0 0")))
+        origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
+        for inner in origins_in(root, joint.find("child").get("link")):
+            inner.set("xyz", written(numbers(inner.get("xyz", "0 0 0")) - shift))
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8"))
+def test_a_file_whose_revolutes_are_drawn_elsewhere_on_their_axes_gives_the_same_indices(name, tmp_path):
+    """What a user meets: the bundled URDF with every revolute's origin moved along its axis (up to a tenth of the
+    mechanism's size), read and analysed at random reachable poses, gives the indices of the file as bundled."""
+    source = Path(__file__).resolve().parents[1] / "robots" / f"{name}.urdf"
+    mechanism = load(source)
+    rng = np.random.default_rng(sum(map(ord, name)))
+    moved = tmp_path / f"{name}.urdf"
+    moved.write_text(revolutes_drawn_elsewhere(source.read_text(), rng, 0.1 * mechanism.length_scale))
+    assert moved.read_text() != source.read_text()
+    poses = random_reachable_poses(mechanism, rng, 30)
+    reference = indices_at_poses(mechanism, poses, detail=True)
+    other = indices_at_poses(load(moved), poses, detail=True)
+    assert_indices_close(reference, other, 1e-9)
 
 
 def nearest_point(wrench, point, axis):
