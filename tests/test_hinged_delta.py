@@ -63,8 +63,9 @@ def assert_textbook(mechanism, result, expected: dict, tolerance: float) -> None
     (1, 0.025, None, 0.01), (2, -0.025, MOVED, -0.02)])
 def test_a_hinged_delta_has_the_textbook_pressure_angles_whichever_rod_and_leg_the_tree_runs_through(
         tmp_path, pose, platform_leg, half_width, transform, elbow_shift):
-    """Also with each elbow hinge drawn 1 or 2 cm along its own axis: the ITI's point slides along it to where the
-    parallelogram's hinge meets it (drawn off it, the ITI was off the pressure angle)."""
+    """Also with each elbow hinge drawn 1 or 2 cm along its own axis: the ITI's point is where the leg's force
+    crosses the hinge's axis, wherever the hinge is drawn on it (the projection of the drawn point was off the
+    pressure angle)."""
     centre, arms = pose
     mechanism, result = indices(tmp_path, centre=centre, arm_angles=arms, platform_leg=platform_leg,
                                 half_width=half_width, transform=transform, elbow_shift=elbow_shift)
