@@ -110,9 +110,19 @@ def origins_in(root, link: str):
 
 def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
     """The URDF with every tree revolute's origin moved along its own axis (by up to ``span`` either way, each its
-    own amount) and the origins in its child link's frame moved back, so that every body stays where it was: the
-    same mechanism, drawn otherwise (written here with ElementTree, not with screwkit's reader)."""
+    own amount) and the origins in its child link's frame moved back, so that every body stays where it was, and
+    every revolute loop joint's two ends moved along its axis together: the same mechanism, drawn otherwise (written
+    here with ElementTree, not with screwkit's reader)."""
     root = ElementTree.fromstring(text)
+    for loop in root.iter("loop"):
+        if loop.get("type") != "revolute":
+            continue
+        axis = numbers(loop.find("axis").get("xyz"))
+        shift = rng.uniform(-span, span) * axis / np.linalg.norm(axis)
+        for end in ("predecessor", "successor"):  # both frames of the joint, which coincide as drawn
+            origin = loop.find(end).find("origin")
+            rotation = urdf_rotation(*numbers(origin.get("rpy", "0 0 0")))
+            origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
     for joint in root.iter("joint"):
         if joint.get("type") not in ("revolute", "continuous"):
             continue
@@ -126,7 +136,7 @@ def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
     return ElementTree.tostring(root, encoding="unicode")
 
 
-@pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8"))
+@pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8", "planar_5rrr"))
 def test_a_file_whose_revolutes_are_drawn_elsewhere_on_their_axes_gives_the_same_indices(name, tmp_path):
     """What a user meets: the bundled URDF with every revolute's origin moved along its axis (up to a tenth of the
     mechanism's size), read and analysed at random reachable poses, gives the indices of the file as bundled."""
