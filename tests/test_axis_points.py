@@ -1,11 +1,12 @@
 """The indices do not depend on where along its axis a revolute joint is drawn.
 
 A file may put a revolute joint's origin anywhere on its axis (a CAD export at the middle of a bearing, a Delta's
-elbow off its parallelogram's midline): the mechanism is the same. The characteristic points of the ITI, the OTI
-and the CTI are taken where the wrench's axis comes nearest to the joint's axis (``docs/theory.md``, "The
-characteristic points"). Here every revolute's drawn point is moved along its axis, by a different amount in every
-configuration, and every index must stay; and the points are checked against an independent construction: the
-common perpendicular of the two lines from a least-squares solve, the power coefficient from the public algebra.
+elbow off its parallelogram's midline): the mechanism is the same. On a force, the characteristic points of the
+ITI, the OTI and the CTI are taken where its axis comes nearest to the joint's axis (``docs/theory.md``, "The
+characteristic points"). Here revolutes' drawn points are moved along their axes, in the screws (a different amount
+in every configuration) and in the files, and every index must stay; and the points are checked against an
+independent construction: the common perpendicular of the two lines from a least-squares solve, the power
+coefficient from the public algebra.
 """
 
 from __future__ import annotations
@@ -27,10 +28,10 @@ from screwkit.studies import indices_at_poses
 
 THRESHOLD = 1e-6
 COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups")
-"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis (the two others are the exceptions
-``docs/theory.md`` names: a prismatic joint after an actuator, a force parallel to the joint after it; and the
-skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint force whose moment
-about the platform joint changes with the joint's drawn place, and so does their representative)."""
+"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis. The two others are the exceptions
+``docs/theory.md`` names: a prismatic joint after an actuator; wrenches with a pitch and a force parallel to the joint
+after it. The skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint force
+whose moment about the platform joint changes with the joint's drawn place, and so does their representative."""
 
 
 def moved_along_axes(chains, chain: int, joint: int, rng, scale: float):
