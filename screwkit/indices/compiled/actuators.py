@@ -21,7 +21,15 @@ import numpy as np
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
 from screwkit.common.tolerances import AXIS_PARALLEL, SAME_POINT, ZERO_PITCH
-from screwkit.indices.compiled.algebra import BLOCK, arm_square, cross, power_coefficient, working_point, working_twist
+from screwkit.indices.compiled.algebra import (
+    BLOCK,
+    arm_square,
+    cross,
+    crossing_point,
+    power_coefficient,
+    working_point,
+    working_twist,
+)
 
 __all__ = ["actuator_scratch", "actuator_stage"]
 
@@ -94,15 +102,10 @@ def on_wrench_axis(joint_lanes, act, r, row, f0, f1, f2, axis0, axis1, axis2, pi
         return p0, p1, p2
     along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
     q0, q1, q2 = axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
-    u0, u1, u2 = joint_lanes[act, row + 6, r], joint_lanes[act, row + 7, r], joint_lanes[act, row + 8, r]
-    direction_sq = u0 * u0 + u1 * u1 + u2 * u2
-    if direction_sq > 0.0 and abs(pitch) <= ZERO_PITCH:
-        cosine = (f0 * u0 + f1 * u1 + f2 * u2) / np.sqrt(direction_sq)
-        sine_sq = 1.0 - cosine * cosine
-        if sine_sq > AXIS_PARALLEL:
-            shift = cosine * (u0 * (q0 - p0) + u1 * (q1 - p1) + u2 * (q2 - p2)) / (np.sqrt(direction_sq) * sine_sq)
-            return q0 + shift * f0, q1 + shift * f1, q2 + shift * f2
-    return q0, q1, q2
+    if abs(pitch) > ZERO_PITCH:
+        return q0, q1, q2
+    return crossing_point(p0, p1, p2, q0, q1, q2, f0, f1, f2, 1.0, joint_lanes[act, row + 6, r],
+                          joint_lanes[act, row + 7, r], joint_lanes[act, row + 8, r])
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")

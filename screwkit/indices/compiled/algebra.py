@@ -23,8 +23,9 @@ that no decision depends on the length unit, the scale of the mechanism or the w
 singularity threshold *p*, a length, is compared as p / L. ``c`` and ``L`` are computed per
 configuration, exactly as :func:`screwkit.screw.motion.working_coordinates` does for the
 motion-space bases it passes in; outputs go back to world units and frame. The tolerances come
-in as arguments (named in :mod:`screwkit.common.tolerances`): numba's disk cache would not notice a
-changed constant of another module.
+in as arguments (named in :mod:`screwkit.common.tolerances`); those of the characteristic points
+(``AXIS_PARALLEL``, ``ZERO_PITCH``, ``SAME_POINT``) are read as constants of that module, which the kernels' cache
+stamp covers (:mod:`screwkit.common.jit`).
 """
 
 from __future__ import annotations
@@ -33,11 +34,13 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
+from screwkit.common.tolerances import AXIS_PARALLEL
 from screwkit.indices.compiled.jacobi import rotate_symmetric
 
 __all__ = ["BLOCK", "KERNEL_BATCH", "CARRY_SIGNATURE", "LEADING_PIVOT_RATIO", "PSEUDO_INVERSE_RCOND",
-           "add_swapped_combination", "carry_arrays", "cross", "motion_lanes_of", "null_vector", "null_vectors_lanes",
-           "pseudo_inverse", "power_coefficient", "shifted_basis_lanes", "solve", "working_point", "working_twist"]
+           "add_swapped_combination", "carry_arrays", "cross", "crossing_point", "motion_lanes_of", "null_vector",
+           "null_vectors_lanes", "pseudo_inverse", "power_coefficient", "shifted_basis_lanes", "solve", "working_point",
+           "working_twist"]
 
 BLOCK = 64  # configurations gathered batch-first at a time
 KERNEL_BATCH = 32 * BLOCK
@@ -48,6 +51,21 @@ for them (:func:`carry_arrays`, about 2 kB per configuration of an 8-leg hexapod
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
 def cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH)
+def crossing_point(p0, p1, p2, q0, q1, q2, f0, f1, f2, force_sq, u0, u1, u2):
+    """The point of a force's axis nearest to the line through p along u (as
+    :func:`screwkit.screw.algebra.nearest_on_axis`): q, p's projection on the axis of the force f (|f|^2
+    ``force_sq``), moved along f; q itself when u is zero or parallel to f."""
+    direction_sq = u0 * u0 + u1 * u1 + u2 * u2
+    if direction_sq > 0.0:
+        dot = f0 * u0 + f1 * u1 + f2 * u2
+        sine_sq = 1.0 - dot * dot / (force_sq * direction_sq)
+        if sine_sq > AXIS_PARALLEL:
+            shift = dot * (u0 * (q0 - p0) + u1 * (q1 - p1) + u2 * (q2 - p2)) / (force_sq * direction_sq * sine_sq)
+            return q0 + shift * f0, q1 + shift * f1, q2 + shift * f2
+    return q0, q1, q2
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)

@@ -30,7 +30,8 @@ import numpy as np
 
 from screwkit.common.fastmath import FASTMATH
 from screwkit.common.jit import njit
-from screwkit.common.tolerances import AXIS_PARALLEL, ZERO_PITCH
+from screwkit.common.tolerances import ZERO_PITCH
+from screwkit.indices.compiled.algebra import crossing_point
 from screwkit.indices.compiled.jacobi import NULL_COLUMN, singular_vectors, symmetric_eigen, unit_columns
 
 __all__ = ["constraint_kernel"]
@@ -314,14 +315,9 @@ def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_co
         c0, c1, c2 = (f1 * m2 - f2 * m1) / norm_sq, (f2 * m0 - f0 * m2) / norm_sq, (f0 * m1 - f1 * m0) / norm_sq
         along = ((p0 - c0) * f0 + (p1 - c1) * f1 + (p2 - c2) * f2) / norm_sq
         q0, q1, q2 = c0 + along * f0, c1 + along * f1, c2 + along * f2
-        u0, u1, u2 = points[index, chain, 3], points[index, chain, 4], points[index, chain, 5]
-        direction_sq = u0 * u0 + u1 * u1 + u2 * u2
-        if direction_sq > 0.0 and abs(f0 * m0 + f1 * m1 + f2 * m2) <= ZERO_PITCH * norm_sq:
-            cosine_sq = (f0 * u0 + f1 * u1 + f2 * u2) ** 2 / (norm_sq * direction_sq)
-            if 1.0 - cosine_sq > AXIS_PARALLEL:  # as screwkit.screw.algebra.nearest_on_axis
-                shift = ((f0 * u0 + f1 * u1 + f2 * u2) * (u0 * (q0 - p0) + u1 * (q1 - p1) + u2 * (q2 - p2))
-                         / (norm_sq * direction_sq * (1.0 - cosine_sq)))
-                q0, q1, q2 = q0 + shift * f0, q1 + shift * f1, q2 + shift * f2
+        if abs(f0 * m0 + f1 * m1 + f2 * m2) <= ZERO_PITCH * norm_sq:  # a force: where it crosses the joint's axis
+            q0, q1, q2 = crossing_point(p0, p1, p2, q0, q1, q2, f0, f1, f2, norm_sq, points[index, chain, 3],
+                                        points[index, chain, 4], points[index, chain, 5])
         p0, p1, p2 = q0, q1, q2
     force_norm = np.sqrt(norm_sq)
     moment_norm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
