@@ -17,6 +17,7 @@ from xml.etree import ElementTree
 import numpy as np
 import pytest
 from test_invariance import skew_rsr
+from test_lower_mobility import rpy_matrix
 
 from helpers import assert_indices_close, bundled_chain_screws, random_reachable_poses
 from screwkit.indices.analysis import analyze
@@ -85,13 +86,6 @@ def numbers(text: str) -> np.ndarray:
     return np.array([float(value) for value in text.split()])
 
 
-def urdf_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """URDF's rpy: Rz(yaw) Ry(pitch) Rx(roll), about fixed axes."""
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
-    return (np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-            @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]]))
-
-
 def written(values) -> str:
     return " ".join(repr(float(value)) for value in values)
 
@@ -122,7 +116,7 @@ def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
         shift = rng.uniform(-span, span) * axis / np.linalg.norm(axis)
         for end in ("predecessor", "successor"):  # both frames of the joint, which coincide as drawn
             origin = loop.find(end).find("origin")
-            rotation = urdf_rotation(*numbers(origin.get("rpy", "0 0 0")))
+            rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
             origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
     for joint in root.iter("joint"):
         if joint.get("type") not in ("revolute", "continuous"):
@@ -130,7 +124,7 @@ def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
         origin = joint.find("origin")
         axis = numbers(joint.find("axis").get("xyz"))
         shift = rng.uniform(-span, span) * axis / np.linalg.norm(axis)
-        rotation = urdf_rotation(*numbers(origin.get("rpy", "0 0 0")))
+        rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
         origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
         for inner in origins_in(root, joint.find("child").get("link")):
             inner.set("xyz", written(numbers(inner.get("xyz", "0 0 0")) - shift))

@@ -53,6 +53,7 @@ from screwkit.io.closed_tree import (
     ImportReport,
     assemble,
     ball_line,
+    homogeneous,
     joint_kind,
     path_to,
 )
@@ -268,7 +269,7 @@ def _hinges(model, data, joints: list[int], closures: list[Closure],
             pairs.setdefault(frozenset({closure.joint_a, closure.joint_b}), []).append(closure)
     for bodies, balls in pairs.items():
         if len(bodies) == 2:
-            rank, axis, point = ball_line([(np.asarray(data.oMi[c.joint_a].homogeneous) @ c.placement_a)[:3, 3]
+            rank, axis, point = ball_line([(homogeneous(data.oMi[c.joint_a]) @ c.placement_a)[:3, 3]
                                            for c in balls], balls, scale)
             if rank == 1:
                 hinges.append((bodies, point, axis))
