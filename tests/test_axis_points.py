@@ -29,10 +29,12 @@ from screwkit.studies import indices_at_poses
 
 THRESHOLD = 1e-6
 COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups")
-"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis. The two others are the exceptions
-``docs/theory.md`` names: a prismatic joint after an actuator; wrenches with a pitch and a force parallel to the joint
-after it. The skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint force
-whose moment about the platform joint changes with the joint's drawn place, and so does their representative."""
+"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis in their screws. The two others are the
+exceptions ``docs/theory.md`` names: a prismatic joint after an actuator; wrenches with a pitch and a force parallel to
+the joint after it. The skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint
+force whose moment about the platform joint changes with the joint's drawn place, and so does their representative.
+Read from a file, ``coop_arms`` and the skew 4-RSR are covered too: the loader draws every revolute at a canonical
+point (``test_canonical_points.py``)."""
 
 
 def moved_along_axes(chains, chain: int, joint: int, rng, scale: float):

@@ -163,7 +163,10 @@ def analyze(
     its axis the joint is drawn); the joint's point projected on the wrench axis for a wrench with
     a pitch, a prismatic joint, a universal or ball joint written as revolutes
     (:func:`~screwkit.screw.algebra.joint_lines`) and an axis parallel to the force's (overridable
-    with ``iti_points`` / ``oti_points``, used as given).
+    with ``iti_points`` / ``oti_points``, used as given). The chains' points are taken as given; the
+    loader draws every revolute of a file at a point its geometry decides
+    (:mod:`screwkit.model.canonical`), so that ``L``, the representative and these points do not
+    depend on where along its axis the file draws it.
 
     **Output twists** (Eq. 8): for a submechanism ``N`` with wrench matrix
     :math:`W_N = [A_k \circ M_q]` in motion coordinates (``M`` an orthonormal basis of the

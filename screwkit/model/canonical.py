@@ -1,0 +1,176 @@
+r"""Canonical points of revolute joints: a chain's geometry made independent of where along its axis a file
+draws each revolute joint.
+
+A revolute joint is a line; a file draws its frame at some point of that line, and any other point draws the same
+mechanism. The indices read joint points in three places: the working length ``L`` and centroid (every joint
+point), the characteristic points of the ITI and OTI (for a force, the point of its axis nearest to the joint's
+axis, which does not depend on the drawn point; for a wrench with a pitch and the other exceptions of
+:func:`screwkit.screw.algebra.nearest_on_axis`, the drawn point projected), and the representative of an actuation
+wrench defined modulo constraint wrenches (least norm about the chain's platform joint). So that none of them
+depends on how the file is written, :func:`canonical_geometry` moves each revolute joint, once when the chain is
+read, to a point of its axis that the geometry alone decides, as Denavit and Hartenberg place their frames:
+
+* each joint of a chain is a **slide** (prismatic: no point), a **point** or a **line** (any other revolute). The
+  points are the revolutes of a universal or ball joint, where their axes meet: first those drawn at the same point
+  as a neighbour in the chain with another axis (a universal or ball joint written as revolutes, a loop joint's
+  universal or spherical DoFs, whose axes are only frame axes), which stay there; then revolutes drawn elsewhere
+  whose axes meet a neighbour's (not parallel, at most :data:`~screwkit.common.tolerances.MEETING` apart), which go
+  to the meeting point (the mean of two, for an axis that meets both its neighbours');
+* a line takes the foot, on its axis, of the common perpendicular with each neighbour in the chain (the joint
+  before it and the one after it) that is a line whose axis is not nearly parallel to its own (squared sine above
+  :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), and the foot of the perpendicular from each neighbour that is a
+  point; the midpoint of the two feet when both neighbours give one (so that the rule reads a chain the same way
+  from either end);
+* a line whose line neighbours are all (nearly) parallel to it, as in a run of parallel axes, takes the foot of the
+  perpendicular from the points its neighbours took, passed along the run;
+* a line that nothing decides (a planar chain: every axis parallel and no point) keeps its drawn point, as does every
+  slide.
+
+The points depend on the lines alone (and on which revolutes a file draws together), so a chain drawn at its
+canonical points is its own canonical drawing.
+
+Two consecutive joints of a chain are fixed in the link between them, so every foot is a constant of the design,
+the same at every configuration: the points are found once, at zero joint values, and the chain's constant
+placements rewritten so that each moved joint's frame sits there (its child placements compensated). The chain
+moves exactly as before, every joint value is unchanged, and the Pinocchio tree (drawn by the viewer) is not
+touched. A slide between two joints breaks the link they would share, so it decides nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, PARALLEL_FOOT
+from screwkit.model.chain import ChainGeometry
+
+__all__ = ["joint_lines_at_zero", "canonical_offsets", "canonical_geometry"]
+
+
+def joint_lines_at_zero(geometry: ChainGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit axis and drawn point of every DoF of a chain at zero joint values, base frame: shapes (m, 3), (m, 3)."""
+    rotation, translation = np.eye(3), np.zeros(3)
+    axes, points = [], []
+    for index in range(geometry.n_tree_joints):
+        translation = translation + rotation @ geometry.joint_translations[index]
+        rotation = rotation @ geometry.joint_rotations[index]
+        axes.append(rotation @ geometry.joint_axes[index])
+        points.append(translation)
+    translation = translation + rotation @ geometry.leg_loop_translation
+    rotation = rotation @ geometry.leg_loop_rotation
+    if geometry.loop_type == "spherical":
+        loop_axes = list(rotation.T)
+    else:
+        loop_axes = [rotation @ axis for axis in geometry.loop_axes[:len(geometry.dof_prismatic) - len(axes)]]
+    axes += loop_axes
+    points += [translation] * len(loop_axes)
+    axes = np.array(axes, dtype=float).reshape(-1, 3)
+    return axes / np.linalg.norm(axes, axis=1, keepdims=True), np.array(points, dtype=float).reshape(-1, 3)
+
+
+def _line_gap(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: NDArray) -> float:
+    """Distance between two lines (unit axes that are not parallel)."""
+    normal = np.cross(axis, other_axis)
+    return abs((other_point - point) @ normal) / np.linalg.norm(normal)
+
+
+def _foot_on_line(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: NDArray) -> NDArray:
+    """The foot on the line (``point``, ``axis``) of its common perpendicular with the line (``other_point``,
+    ``other_axis``), unit axes that are not parallel."""
+    gap = point - other_point
+    cosine = axis @ other_axis
+    along = (cosine * (other_axis @ gap) - axis @ gap) / (1.0 - cosine * cosine)
+    return point + along * axis
+
+
+def _foot_of(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
+    """The foot on the line (``point``, ``axis``) of the perpendicular from ``other``."""
+    return point + ((other - point) @ axis) * axis
+
+
+def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray) -> list[NDArray | None]:
+    """The point of each revolute DoF that is part of a joint at a point (None for the others): a universal or
+    ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` apart relative to the chain's
+    extent). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
+    spherical DoFs, whose axes are only frame axes) are taken first; then revolutes drawn elsewhere whose axes meet
+    a neighbour's, at the mean of their meeting points."""
+    extent = max(float(np.ptp(points, axis=0).max()) if len(points) else 0.0, np.finfo(float).tiny)
+    count = len(prismatic)
+    pairs = [(joint, joint + 1) for joint in range(count - 1) if not (prismatic[joint] or prismatic[joint + 1])
+             and np.sum(np.cross(axes[joint], axes[joint + 1]) ** 2) > AXIS_PARALLEL]
+    found: list[NDArray | None] = [None] * count
+    for joint, other in pairs:
+        if np.linalg.norm(points[other] - points[joint]) <= MEETING * extent:
+            found[joint], found[other] = points[joint], points[other]
+    meets: list[list[NDArray]] = [[] for _ in range(count)]
+    for joint, other in pairs:
+        if found[joint] is None and found[other] is None and (
+                _line_gap(points[joint], axes[joint], points[other], axes[other]) <= MEETING * extent):
+            meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
+                             + _foot_on_line(points[other], axes[other], points[joint], axes[joint]))
+            meets[joint].append(meeting)
+            meets[other].append(meeting)
+    return [_foot_of(points[joint], axes[joint], np.mean(meets[joint], axis=0)) if meets[joint] else point
+            for joint, point in enumerate(found)]
+
+
+def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
+    """How far along its axis (base-frame units, signed along the joint's axis) each DoF of a chain moves to its
+    canonical point (see the module docstring); zero for slides and undecided lines. Shape (m,)."""
+    axes, points = joint_lines_at_zero(geometry)
+    prismatic = geometry.dof_prismatic
+    count = len(prismatic)
+    canonical = _points(prismatic, axes, points)
+    is_point = [found is not None for found in canonical]
+    lines = [joint for joint in range(count) if not prismatic[joint] and not is_point[joint]]
+    for joint in lines:
+        feet = []
+        for other in (joint - 1, joint + 1):
+            if not 0 <= other < count or prismatic[other]:
+                continue
+            if is_point[other]:
+                feet.append(_foot_of(points[joint], axes[joint], canonical[other]))
+            elif np.sum(np.cross(axes[joint], axes[other]) ** 2) > PARALLEL_FOOT:
+                feet.append(_foot_on_line(points[joint], axes[joint], points[other], axes[other]))
+        if feet:
+            canonical[joint] = np.mean(feet, axis=0)
+    for _ in range(count):  # along runs of parallel axes, from the joints already decided
+        passed = {}
+        for joint in lines:
+            sources = [canonical[other] for other in (joint - 1, joint + 1)
+                       if canonical[joint] is None and other in lines and canonical[other] is not None]
+            if sources:
+                passed[joint] = np.mean([_foot_of(points[joint], axes[joint], source) for source in sources], axis=0)
+        if not passed:
+            break
+        for joint, point in passed.items():
+            canonical[joint] = point
+    return np.array([0.0 if point is None else float((point - points[joint]) @ axes[joint])
+                     for joint, point in enumerate(canonical)])
+
+
+def canonical_geometry(geometry: ChainGeometry) -> ChainGeometry:
+    """The chain's geometry with every revolute joint's frame moved along its axis to its canonical point
+    (:func:`canonical_offsets`), the placements after it compensated: the same chain, drawn canonically."""
+    offsets = canonical_offsets(geometry)
+    if not np.any(offsets):
+        return geometry
+    tree = geometry.n_tree_joints
+    translations = np.array(geometry.joint_translations, dtype=float)
+    leg_translation = np.array(geometry.leg_loop_translation, dtype=float)
+    platform_translation = np.array(geometry.platform_loop_translation, dtype=float)
+    for joint in range(tree):
+        shift = offsets[joint] * geometry.joint_axes[joint]  # in the joint's own frame, fixed by its motion
+        translations[joint] += geometry.joint_rotations[joint] @ shift
+        if joint + 1 < tree:
+            translations[joint + 1] -= shift
+        else:
+            leg_translation -= shift
+    if geometry.loop_type in ("revolute", "continuous") and offsets[tree:].size:
+        shift = offsets[tree] * geometry.loop_axes[0]
+        leg_translation += geometry.leg_loop_rotation @ shift
+        platform_translation += geometry.platform_loop_rotation @ shift
+    return replace(geometry, joint_translations=translations, leg_loop_translation=leg_translation,
+                   platform_loop_translation=platform_translation)

@@ -1,0 +1,184 @@
+"""Revolute joints read at canonical points: no index depends on where along its axis a file draws a revolute.
+
+On a force the ITI's and OTI's points do not depend on the drawn point (``test_axis_points.py``). Three other
+readings of joint points did: the working length and centroid, the characteristic points of wrenches with a pitch
+(a serial arm's), and the representative of an actuation wrench defined modulo a constraint force (least norm about
+the platform joint). The loader now moves each revolute to a point its geometry decides
+(:mod:`screwkit.model.canonical`). Checked here against constructions of the tests' own: the feet of common
+perpendiculars from least squares, the chain's motion against Pinocchio's, and files rewritten with ElementTree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_axis_points import revolutes_drawn_elsewhere
+from test_invariance import SkewRSR
+
+from helpers import assert_indices_close, random_reachable_poses
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
+from screwkit.io.loader import bundled_names, load
+from screwkit.model.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
+from screwkit.studies import indices_at_poses
+
+ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+
+
+def xyz(vector) -> str:
+    return " ".join(repr(float(value)) for value in vector)
+
+
+def skew_rsr_urdf(design: SkewRSR) -> str:
+    """A URDF of the skew 4-RSR of ``test_invariance`` (written here, not by screwkit): each leg a base revolute on
+    its skew axis, a ball written as three revolutes at the elbow, and the platform revolute as the chain's loop;
+    the legs' constraint forces miss the platform joints, so the representative of each actuation wrench depends on
+    the platform joint's point."""
+    links = ["base_link", "platform"]
+    parts = ['<joint name="platform_joint" type="floating"><parent link="base_link"/><child link="platform"/>'
+             f'<origin xyz="{xyz(design.height)}"/></joint>']
+    for leg in range(4):
+        names = [f"leg_{leg}_{part}" for part in ("crank", "ball_1", "ball_2", "rod")]
+        links += names
+        parts.append(f'<joint name="leg_{leg}_base" type="revolute"><parent link="base_link"/>'
+                     f'<child link="{names[0]}"/><origin xyz="{xyz(design.base[leg])}"/>'
+                     f'<axis xyz="{xyz(design.base_axis[leg])}"/>'
+                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+        for step, axis in enumerate(np.eye(3)):
+            origin = design.crank[leg] if step == 0 else np.zeros(3)
+            parts.append(f'<joint name="leg_{leg}_ball_{step}" type="continuous"><parent link="{names[step]}"/>'
+                         f'<child link="{names[step + 1]}"/><origin xyz="{xyz(origin)}"/>'
+                         f'<axis xyz="{xyz(axis)}"/></joint>')
+        parts.append(f'<loop name="leg_{leg}_hinge" type="revolute" chain="leg_{leg}">'
+                     f'<predecessor link="{names[3]}"><origin xyz="{xyz(-design.link[leg])}"/></predecessor>'
+                     f'<successor link="platform"><origin xyz="{xyz(design.platform_point[leg])}"/></successor>'
+                     f'<axis xyz="{xyz(design.platform_axis[leg])}"/></loop>')
+        parts.append(f'<transmission name="leg_{leg}_drive"><type>transmission_interface/SimpleTransmission</type>'
+                     f'<joint name="leg_{leg}_base"><hardwareInterface>hardware_interface/EffortJointInterface'
+                     f'</hardwareInterface></joint><actuator name="leg_{leg}_motor"/></transmission>')
+    body = "".join(f'<link name="{link}"/>' for link in links) + "".join(parts)
+    return f'<?xml version="1.0"?><robot name="skew_4rsr">{body}</robot>'
+
+
+@pytest.fixture(scope="module")
+def skew_file(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("skew") / "skew_4rsr.urdf"
+    path.write_text(skew_rsr_urdf(SkewRSR(np.random.default_rng(3))))
+    return path
+
+
+def foot_of_perpendicular(point, axis, other):
+    """The point of the line (``point``, ``axis``) nearest to ``other``, by least squares."""
+    along = np.linalg.lstsq(axis[:, None], other - point, rcond=None)[0][0]
+    return point + along * axis
+
+
+def meeting_point(point, axis, other_point, other_axis):
+    """The point where two lines meet, by least squares on ``point + s axis = other_point + t other_axis``."""
+    (along, _), *_ = np.linalg.lstsq(np.column_stack([axis, -other_axis]), other_point - point, rcond=None)
+    return point + along * axis
+
+
+@pytest.mark.parametrize("name", ("skew_4rsr", "coop_arms", "delta_4", "rss_hexapod_8"))
+def test_a_file_whose_revolutes_are_drawn_elsewhere_gives_the_same_indices(name, skew_file, tmp_path):
+    """Every revolute's origin moved along its axis in the file (each by its own amount, up to a tenth of the
+    mechanism's size, a ball's three revolutes apart), read and analysed at random reachable poses: every index of
+    the file as written, the representative-dependent LMTI and F_Oj of the skew 4-RSR and the pitched wrenches of the
+    cooperating arms included."""
+    source = skew_file if name == "skew_4rsr" else ROBOTS / f"{name}.urdf"
+    mechanism = load(source)
+    rng = np.random.default_rng(sum(map(ord, name)))
+    poses = random_reachable_poses(mechanism, rng, 30)
+    reference = indices_at_poses(mechanism, poses, detail=True)
+    for attempt in range(2):
+        moved = tmp_path / f"{name}_{attempt}.urdf"
+        moved.write_text(revolutes_drawn_elsewhere(source.read_text(), rng, 0.1 * mechanism.length_scale))
+        assert_indices_close(reference, indices_at_poses(load(moved), poses, detail=True), 1e-9)
+
+
+@pytest.mark.parametrize("redrawn", (False, True))
+def test_the_skew_legs_revolutes_sit_at_the_feet_from_the_ball(skew_file, tmp_path, redrawn):
+    """Each leg's base and platform revolutes: the foot of the perpendicular from the ball's centre (its three
+    revolutes meet there), as the design draws them and with every revolute drawn elsewhere on its axis."""
+    if redrawn:
+        moved = tmp_path / "redrawn.urdf"
+        moved.write_text(revolutes_drawn_elsewhere(skew_file.read_text(), np.random.default_rng(2), 0.3))
+        skew_file = moved
+    mechanism = load(skew_file)
+    design = SkewRSR(np.random.default_rng(3))
+    for leg, chain in enumerate(mechanism.chains):
+        axes, points = joint_lines_at_zero(chain.geometry)
+        elbow = design.base[leg] + design.crank[leg]
+        np.testing.assert_allclose(points[1:4], np.broadcast_to(elbow, (3, 3)), atol=1e-12)
+        np.testing.assert_allclose(points[0], foot_of_perpendicular(design.base[leg], design.base_axis[leg], elbow),
+                                   atol=1e-12)
+        platform = design.height + design.platform_point[leg]
+        np.testing.assert_allclose(points[4], foot_of_perpendicular(platform, design.platform_axis[leg], elbow),
+                                   atol=1e-12)
+
+
+def test_the_cooperating_arms_revolutes_sit_where_their_axes_meet_or_pass_nearest():
+    """The UR5 arms of ``coop_arms``: shoulder pan and lift meet (both there), consecutive wrist axes meet (wrist 2
+    between its two meeting points), and the elbow, parallel to both its neighbours, at the mean of the feet of the
+    perpendiculars from the shoulder's and the first wrist's meeting points."""
+    for chain in load("coop_arms").chains:
+        axes, points = joint_lines_at_zero(chain.geometry)
+        pan, lift, elbow, wrist_1, wrist_2, wrist_3 = range(6)
+        shoulder = meeting_point(points[pan], axes[pan], points[lift], axes[lift])
+        first = meeting_point(points[wrist_1], axes[wrist_1], points[wrist_2], axes[wrist_2])
+        second = meeting_point(points[wrist_2], axes[wrist_2], points[wrist_3], axes[wrist_3])
+        for joint, expected in ((pan, shoulder), (lift, shoulder), (wrist_1, first),
+                                (wrist_2, 0.5 * (first + second)), (wrist_3, second)):
+            np.testing.assert_allclose(points[joint], expected, atol=1e-12)
+        between = [foot_of_perpendicular(points[elbow], axes[elbow], meeting) for meeting in (shoulder, first)]
+        np.testing.assert_allclose(points[elbow], np.mean(between, axis=0), atol=1e-12)
+        assert np.linalg.norm(between[0] - between[1]) > 0.05  # the mean is a choice, and is tested as one
+
+
+def every_chain(skew_path):
+    for name in bundled_names():
+        yield from ((name, chain) for chain in load(name).chains)
+    yield from (("skew_4rsr", chain) for chain in load(skew_path).chains)
+
+
+def test_a_canonical_chain_is_its_own_canonical_drawing(skew_file):
+    """Read again, a chain drawn at its canonical points stays there (the points depend on the lines alone)."""
+    for name, chain in every_chain(skew_file):
+        np.testing.assert_allclose(canonical_offsets(chain.geometry), 0.0, atol=1e-12, err_msg=name)
+
+
+def test_the_canonical_chain_moves_as_the_drawn_one(skew_file):
+    """The rewritten placements: at random joint values, the same axes and loop frames, and each joint's point
+    moved along its own axis by a constant (the forward kinematics of the chain as drawn, by :func:`_drawn`)."""
+    rng = np.random.default_rng(8)
+    for name, chain in every_chain(skew_file):
+        drawn = _drawn(chain.geometry, rng)
+        canonical = canonical_geometry(drawn)
+        offsets = canonical_offsets(drawn)
+        values = rng.uniform(-np.pi, np.pi, (50, chain.n_joints))
+        before = chain_forward_kinematics(drawn, values, compiled=False)
+        after = chain_forward_kinematics(canonical, values, compiled=False)
+        for field in ("axes", "leg_rotation", "end_rotation", "end_translation"):
+            np.testing.assert_allclose(getattr(after, field), getattr(before, field), atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(after.points, before.points + offsets[:, None] * before.axes, atol=1e-12,
+                                   err_msg=name)
+        loop_point = before.leg_translation + offsets[-1] * before.axes[..., -1, :] * (chain.loop_type == "revolute")
+        np.testing.assert_allclose(after.leg_translation, loop_point, atol=1e-12, err_msg=name)
+
+
+def _drawn(geometry, rng):
+    """The chain with every tree revolute drawn elsewhere on its axis (placements after it compensated, by hand)."""
+    translations = np.array(geometry.joint_translations, dtype=float)
+    leg = np.array(geometry.leg_loop_translation, dtype=float)
+    for joint in range(geometry.n_tree_joints):
+        if geometry.joint_prismatic[joint]:
+            continue
+        shift = rng.uniform(-0.2, 0.2) * geometry.joint_axes[joint]
+        translations[joint] += geometry.joint_rotations[joint] @ shift
+        if joint + 1 < geometry.n_tree_joints:
+            translations[joint + 1] -= shift
+        else:
+            leg -= shift
+    return replace(geometry, joint_translations=translations, leg_loop_translation=leg)
