@@ -16,11 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from test_axis_points import revolutes_drawn_elsewhere
+from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
 from helpers import assert_indices_close, random_reachable_poses
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
-from screwkit.io.loader import bundled_names, load
+from screwkit.io.loader import bundled_names, load, load_text
 from screwkit.model.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
 from screwkit.studies import indices_at_poses
 
@@ -182,3 +183,14 @@ def _drawn(geometry, rng):
         else:
             leg -= shift
     return replace(geometry, joint_translations=translations, leg_loop_translation=leg)
+
+
+def test_a_spherical_chain_keeps_its_drawn_points():
+    """Every axis of a spherical wrist's leg passes through its centre, where the rule would put every joint (and the
+    working length to zero): its legs keep the points the file draws, on each axis at the wrist's radius."""
+    mechanism = load_text(spherical_wrist_urdf(radius=0.1), "wrist.urdf")
+    centre = np.array([0.0, 0.0, 0.3])
+    for chain in mechanism.chains:
+        axes, points = joint_lines_at_zero(chain.geometry)
+        np.testing.assert_allclose(points, centre + 0.1 * axes, atol=1e-12)
+        np.testing.assert_allclose(canonical_offsets(chain.geometry), 0.0, atol=0.0)

@@ -24,7 +24,9 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
 * a line whose line neighbours are all (nearly) parallel to it, as in a run of parallel axes, takes the foot of the
   perpendicular from the points its neighbours took, passed along the run;
 * a line that nothing decides (a planar chain: every axis parallel and no point) keeps its drawn point, as does every
-  slide.
+  slide;
+* a chain whose every axis passes through one point (a spherical wrist's leg) keeps its drawn points: its canonical
+  points would all be that point, and a spherical mechanism's working length would vanish with them.
 
 The points depend on the lines alone (and on which revolutes a file draws together), so a chain drawn at its
 canonical points is its own canonical drawing.
@@ -147,6 +149,10 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
             break
         for joint, point in passed.items():
             canonical[joint] = point
+    placed = [point for point in canonical if point is not None]
+    extent = float(np.ptp(points, axis=0).max()) if count else 0.0
+    if len(placed) == count and count > 1 and np.ptp(placed, axis=0).max() <= MEETING * extent:
+        return np.zeros(count)  # a spherical chain, every axis through one point: drawn as the file draws it
     return np.array([0.0 if point is None else float((point - points[joint]) @ axes[joint])
                      for joint, point in enumerate(canonical)])
 
