@@ -97,25 +97,26 @@ def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray) -> list
     ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` apart relative to the chain's
     extent). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
     spherical DoFs, whose axes are only frame axes) are taken first; then revolutes drawn elsewhere whose axes meet
-    a neighbour's, at the mean of their meeting points."""
+    a neighbour's. Each takes the mean of its meeting points (the midpoint of the feet of the two axes' common
+    perpendicular), on its own axis."""
     extent = max(float(np.ptp(points, axis=0).max()) if len(points) else 0.0, np.finfo(float).tiny)
     count = len(prismatic)
     pairs = [(joint, joint + 1) for joint in range(count - 1) if not (prismatic[joint] or prismatic[joint + 1])
              and np.sum(np.cross(axes[joint], axes[joint + 1]) ** 2) > AXIS_PARALLEL]
-    found: list[NDArray | None] = [None] * count
-    for joint, other in pairs:
-        if np.linalg.norm(points[other] - points[joint]) <= MEETING * extent:
-            found[joint], found[other] = points[joint], points[other]
+    together = [np.linalg.norm(points[other] - points[joint]) <= MEETING * extent for joint, other in pairs]
     meets: list[list[NDArray]] = [[] for _ in range(count)]
-    for joint, other in pairs:
-        if found[joint] is None and found[other] is None and (
-                _line_gap(points[joint], axes[joint], points[other], axes[other]) <= MEETING * extent):
+    for drawn_together in (True, False):
+        taken = [bool(found) for found in meets]
+        for (joint, other), close in zip(pairs, together):
+            if drawn_together != close or taken[joint] or taken[other] or (
+                    _line_gap(points[joint], axes[joint], points[other], axes[other]) > MEETING * extent):
+                continue
             meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
                              + _foot_on_line(points[other], axes[other], points[joint], axes[joint]))
             meets[joint].append(meeting)
             meets[other].append(meeting)
-    return [_foot_of(points[joint], axes[joint], np.mean(meets[joint], axis=0)) if meets[joint] else point
-            for joint, point in enumerate(found)]
+    return [_foot_of(points[joint], axes[joint], np.mean(found, axis=0)) if found else None
+            for joint, found in enumerate(meets)]
 
 
 def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
