@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
@@ -194,3 +195,20 @@ def test_a_spherical_chain_keeps_its_drawn_points():
         axes, points = joint_lines_at_zero(chain.geometry)
         np.testing.assert_allclose(points, centre + 0.1 * axes, atol=1e-12)
         np.testing.assert_allclose(canonical_offsets(chain.geometry), 0.0, atol=0.0)
+
+
+def test_nearly_parallel_axes_in_one_plane_do_not_meet_far_away(tmp_path):
+    """The UR5 elbows tilted by 2e-6 rad in the plane of their parallel neighbours: the lines meet some 1e5 m away,
+    which is no joint of the arm; the points stay on the arm and every pose of the untilted file still closes."""
+    root = ElementTree.fromstring((ROBOTS / "coop_arms.urdf").read_text())
+    for joint in root.iter("joint"):
+        if joint.get("name").endswith("elbow_joint") and joint.get("type"):  # not a transmission's <joint>
+            assert joint.find("axis").get("xyz").split() == ["0", "1", "0"]
+            joint.find("axis").set("xyz", f"0 {float(np.cos(2e-6))!r} {float(np.sin(2e-6))!r}")
+    tilted = tmp_path / "tilted.urdf"
+    tilted.write_text(ElementTree.tostring(root, encoding="unicode"))
+    mechanism, other = load("coop_arms"), load(tilted)
+    reach = max(np.linalg.norm(joint_lines_at_zero(chain.geometry)[1], axis=1).max() for chain in other.chains)
+    assert reach < 1.5 * mechanism.length_scale
+    poses = random_reachable_poses(mechanism, np.random.default_rng(5), 20)
+    assert indices_at_poses(other, poses).reachable.all()

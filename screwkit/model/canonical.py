@@ -97,18 +97,20 @@ def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray) -> list
     ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` apart relative to the chain's
     extent). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
     spherical DoFs, whose axes are only frame axes) are taken first; then revolutes drawn elsewhere whose axes meet
-    a neighbour's. Each takes the mean of its meeting points (the midpoint of the feet of the two axes' common
-    perpendicular), on its own axis."""
+    a neighbour's at a clear angle (squared sine above :data:`PARALLEL_FOOT`). Each takes the mean of its meeting
+    points (the midpoint of the feet of the two axes' common perpendicular), on its own axis."""
     extent = max(float(np.ptp(points, axis=0).max()) if len(points) else 0.0, np.finfo(float).tiny)
     count = len(prismatic)
     pairs = [(joint, joint + 1) for joint in range(count - 1) if not (prismatic[joint] or prismatic[joint + 1])
              and np.sum(np.cross(axes[joint], axes[joint + 1]) ** 2) > AXIS_PARALLEL]
     together = [np.linalg.norm(points[other] - points[joint]) <= MEETING * extent for joint, other in pairs]
+    # axes drawn apart meet only at a clear angle: nearly parallel lines in one plane would meet far away
+    clear = [np.sum(np.cross(axes[joint], axes[other]) ** 2) > PARALLEL_FOOT for joint, other in pairs]
     meets: list[list[NDArray]] = [[] for _ in range(count)]
     for drawn_together in (True, False):
         taken = [bool(found) for found in meets]
-        for (joint, other), close in zip(pairs, together):
-            if drawn_together != close or taken[joint] or taken[other] or (
+        for (joint, other), close, at_an_angle in zip(pairs, together, clear):
+            if drawn_together != close or taken[joint] or taken[other] or not (close or at_an_angle) or (
                     _line_gap(points[joint], axes[joint], points[other], axes[other]) > MEETING * extent):
                 continue
             meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
