@@ -14,8 +14,9 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
   points are the revolutes of a universal or ball joint, where their axes meet: first those drawn at the same point
   as a neighbour in the chain with another axis (a universal or ball joint written as revolutes, a loop joint's
   universal or spherical DoFs, whose axes are only frame axes), which stay there; then revolutes drawn elsewhere
-  whose axes meet a neighbour's (not parallel, at most :data:`~screwkit.common.tolerances.MEETING` apart), which go
-  to the meeting point (the mean of two, for an axis that meets both its neighbours');
+  whose axes meet a neighbour's (at most :data:`~screwkit.common.tolerances.MEETING` apart, at an angle whose
+  squared sine is above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), which go to the meeting point (the mean
+  of two, for an axis that meets both its neighbours');
 * a line takes the foot, on its axis, of the common perpendicular with each neighbour in the chain (the joint
   before it and the one after it) that is a line whose axis is not nearly parallel to its own (squared sine above
   :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), and the foot of the perpendicular from each neighbour that is a
