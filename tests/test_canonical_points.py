@@ -4,7 +4,7 @@ On a force the ITI's and OTI's points do not depend on the drawn point (``test_a
 readings of joint points did: the working length and centroid, the characteristic points of wrenches with a pitch
 (a serial arm's), and the representative of an actuation wrench defined modulo a constraint force (least norm about
 the platform joint). The loader now moves each revolute to a point its geometry decides
-(:mod:`screwkit.model.canonical`). Checked here against constructions of the tests' own: the feet of common
+(:mod:`screwkit.closure.canonical`). Checked here against constructions of the tests' own: the feet of common
 perpendiculars from least squares, the chain's motion against Pinocchio's, and files rewritten with ElementTree.
 """
 
@@ -21,9 +21,9 @@ from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
 from helpers import assert_indices_close, random_reachable_poses
+from screwkit.closure.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import bundled_names, load, load_text
-from screwkit.model.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
 from screwkit.studies import indices_at_poses
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"

@@ -282,7 +282,7 @@ def test_joint_screws_match_pinocchio_jacobians_and_placements(name):
 
 def _assert_on_axis_by_a_constant(screws, sample, index, drawn, moved, key):
     """The chain's point of a joint is the point Pinocchio draws, moved along the joint's axis to its canonical point
-    (:mod:`screwkit.model.canonical`) by the same signed distance in every configuration (a constant of the design);
+    (:mod:`screwkit.closure.canonical`) by the same signed distance in every configuration (a constant of the design);
     a prismatic joint is not moved."""
     point, twist = screws.points[sample, index], screws.twists[sample, index]
     axis = twist[:3] if np.linalg.norm(twist[:3]) > 0.5 else np.zeros(3)

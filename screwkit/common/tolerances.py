@@ -71,14 +71,14 @@ characteristic point is that point, not a line (:func:`screwkit.screw.algebra.jo
 
 MEETING = 1e-5
 """Relative to a chain's extent: two neighbouring revolutes of a chain whose axes are not parallel and pass at most
-this far apart meet, a universal or ball joint (:mod:`screwkit.model.canonical`); loose enough for a file whose
+this far apart meet, a universal or ball joint (:mod:`screwkit.closure.canonical`); loose enough for a file whose
 lengths are rounded to six decimals."""
 
 PARALLEL_FOOT = 1e-2
 """Squared sine: two neighbouring revolute axes of a chain are too near parallel (within 5.7 degrees) for the foot of
 their common perpendicular to place a joint (it would lie up to ten times their offset away, and at infinity for
 parallel axes); the joint's canonical point then comes along the run of parallel axes
-(:mod:`screwkit.model.canonical`). A constant of a design: consecutive joints share a link."""
+(:mod:`screwkit.closure.canonical`). A constant of a design: consecutive joints share a link."""
 
 GRAM_PIVOT = 1e-12
 """Relative: the Gram matrix of a chain's joint twists (about the platform joint, each scaled to

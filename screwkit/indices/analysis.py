@@ -165,7 +165,7 @@ def analyze(
     (:func:`~screwkit.screw.algebra.joint_lines`) and an axis parallel to the force's (overridable
     with ``iti_points`` / ``oti_points``, used as given). The chains' points are taken as given; the
     loader draws every revolute of a file at a point its geometry decides
-    (:mod:`screwkit.model.canonical`), so that ``L``, the representative and these points do not
+    (:mod:`screwkit.closure.canonical`), so that ``L``, the representative and these points do not
     depend on where along its axis the file draws it.
 
     **Output twists** (Eq. 8): for a submechanism ``N`` with wrench matrix

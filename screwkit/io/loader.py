@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.closure.assembly import assemble, task_space
+from screwkit.closure.canonical import canonical_geometry
 from screwkit.io import is_foreign, read_mechanism_file
 from screwkit.io.model_cache import load_cached
 from screwkit.model.builder import read_chains, read_platform
@@ -77,7 +78,9 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
     if model is None:
         model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
     platform = read_platform(description, model, name)
-    chains = read_chains(description, model, platform)
+    # every revolute drawn where the chain's geometry puts it, not where the file does (screwkit.closure.canonical)
+    chains = tuple(replace(chain, geometry=canonical_geometry(chain.geometry))
+                   for chain in read_chains(description, model, platform))
     draft = Mechanism(
         name=name, path=description.source, description=description, pinocchio_model=model,
         is_planar=platform.is_planar, pose_coordinates=platform.pose_coordinates, base_link=platform.base_link,

@@ -15,7 +15,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.model.canonical import canonical_geometry
 from screwkit.model.chain import LOOP_JOINT_DOFS, Chain, ChainGeometry
 from screwkit.model.mechanism import PLANAR_TASK_COORDINATES, SPATIAL_TASK_COORDINATES
 from screwkit.model.pinocchio_bridge import (
@@ -183,7 +182,7 @@ def read_chains(description: UrdfDescription, model, platform: Platform) -> tupl
         platform_rotation, platform_translation = placement_arrays(platform_inverse * frames[platform_link].placement)
         platform_translation = platform_translation + platform_rotation @ platform_origin.translation
         platform_rotation = platform_rotation @ platform_origin.rotation
-        geometry = canonical_geometry(ChainGeometry(  # revolutes where the geometry puts them, not the file
+        geometry = ChainGeometry(
             name=loop.chain,
             joint_rotations=np.array(rotations).reshape(-1, 3, 3),
             joint_translations=np.array(translations).reshape(-1, 3),
@@ -195,7 +194,7 @@ def read_chains(description: UrdfDescription, model, platform: Platform) -> tupl
             loop_axes=np.array(axes).reshape(-1, 3),
             platform_loop_rotation=platform_rotation,
             platform_loop_translation=platform_translation,
-        ))
+        )
         if loop.chain in names:
             raise description.fail(tag, f"the chain name {loop.chain!r} is used twice.")
         names.add(loop.chain)

@@ -46,6 +46,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, PARALLEL_FOOT
 from screwkit.model.chain import ChainGeometry
 
@@ -54,23 +55,9 @@ __all__ = ["joint_lines_at_zero", "canonical_offsets", "canonical_geometry"]
 
 def joint_lines_at_zero(geometry: ChainGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit axis and drawn point of every DoF of a chain at zero joint values, base frame: shapes (m, 3), (m, 3)."""
-    rotation, translation = np.eye(3), np.zeros(3)
-    axes, points = [], []
-    for index in range(geometry.n_tree_joints):
-        translation = translation + rotation @ geometry.joint_translations[index]
-        rotation = rotation @ geometry.joint_rotations[index]
-        axes.append(rotation @ geometry.joint_axes[index])
-        points.append(translation)
-    translation = translation + rotation @ geometry.leg_loop_translation
-    rotation = rotation @ geometry.leg_loop_rotation
-    if geometry.loop_type == "spherical":
-        loop_axes = list(rotation.T)
-    else:
-        loop_axes = [rotation @ axis for axis in geometry.loop_axes[:len(geometry.dof_prismatic) - len(axes)]]
-    axes += loop_axes
-    points += [translation] * len(loop_axes)
-    axes = np.array(axes, dtype=float).reshape(-1, 3)
-    return axes / np.linalg.norm(axes, axis=1, keepdims=True), np.array(points, dtype=float).reshape(-1, 3)
+    frames = chain_forward_kinematics(geometry, np.zeros(geometry.n_dofs), compiled=False)
+    axes = frames.axes.reshape(-1, 3)
+    return axes / np.linalg.norm(axes, axis=1, keepdims=True), frames.points.reshape(-1, 3)
 
 
 def _line_gap(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: NDArray) -> float:
@@ -93,14 +80,14 @@ def _foot_of(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
     return point + ((other - point) @ axis) * axis
 
 
-def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray) -> list[NDArray | None]:
+def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent: float) -> list[NDArray | None]:
     """The point of each revolute DoF that is part of a joint at a point (None for the others): a universal or
-    ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` apart relative to the chain's
-    extent). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
+    ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` times the chain's ``extent``
+    apart). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
     spherical DoFs, whose axes are only frame axes) are taken first; then revolutes drawn elsewhere whose axes meet
     a neighbour's at a clear angle (squared sine above :data:`PARALLEL_FOOT`). Each takes the mean of its meeting
     points (the midpoint of the feet of the two axes' common perpendicular), on its own axis."""
-    extent = max(float(np.ptp(points, axis=0).max()) if len(points) else 0.0, np.finfo(float).tiny)
+    extent = max(extent, np.finfo(float).tiny)
     count = len(prismatic)
     pairs = [(joint, joint + 1) for joint in range(count - 1) if not (prismatic[joint] or prismatic[joint + 1])
              and np.sum(np.cross(axes[joint], axes[joint + 1]) ** 2) > AXIS_PARALLEL]
@@ -128,7 +115,8 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
     axes, points = joint_lines_at_zero(geometry)
     prismatic = geometry.dof_prismatic
     count = len(prismatic)
-    canonical = _points(prismatic, axes, points)
+    extent = float(np.ptp(points, axis=0).max()) if count else 0.0  # the chain's size as drawn
+    canonical = _points(prismatic, axes, points, extent)
     is_point = [found is not None for found in canonical]
     lines = [joint for joint in range(count) if not prismatic[joint] and not is_point[joint]]
     for joint in lines:
@@ -154,7 +142,6 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
         for joint, point in passed.items():
             canonical[joint] = point
     placed = [point for point in canonical if point is not None]
-    extent = float(np.ptp(points, axis=0).max()) if count else 0.0
     if len(placed) == count and count > 1 and np.ptp(placed, axis=0).max() <= MEETING * extent:
         return np.zeros(count)  # a spherical chain, every axis through one point: drawn as the file draws it
     return np.array([0.0 if point is None else float((point - points[joint]) @ axes[joint])
