@@ -20,7 +20,7 @@ from test_axis_points import revolutes_drawn_elsewhere
 from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
-from helpers import assert_indices_close, random_reachable_poses
+from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses
 from screwkit.closure.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import bundled_names, load, load_text
@@ -60,7 +60,7 @@ def skew_rsr_urdf(design: SkewRSR) -> str:
         parts.append(f'<transmission name="leg_{leg}_drive"><type>transmission_interface/SimpleTransmission</type>'
                      f'<joint name="leg_{leg}_base"><hardwareInterface>hardware_interface/EffortJointInterface'
                      f'</hardwareInterface></joint><actuator name="leg_{leg}_motor"/></transmission>')
-    body = "".join(f'<link name="{link}"/>' for link in links) + "".join(parts)
+    body = "".join(f'<link name="{link}"></link>' for link in links) + "".join(parts)
     return f'<?xml version="1.0"?><robot name="skew_4rsr">{body}</robot>'
 
 
@@ -212,3 +212,28 @@ def test_nearly_parallel_axes_in_one_plane_do_not_meet_far_away(tmp_path):
     assert reach < 1.5 * mechanism.length_scale
     poses = random_reachable_poses(mechanism, np.random.default_rng(5), 20)
     assert indices_at_poses(other, poses).reachable.all()
+
+
+@pytest.mark.parametrize("name", ("skew_4rsr", "coop_arms"))
+@pytest.mark.parametrize("change", ("x1e-3", "x1e3", "world"))
+def test_a_redrawn_file_scaled_or_moved_in_the_world_gives_the_same_indices(name, change, skew_file, tmp_path):
+    """The file with its revolutes drawn elsewhere on their axes, then its lengths times 1e-3 or 1e3 (poses scaled
+    with them) or the whole mechanism in another world frame: the indices of the file as written."""
+    source = skew_file if name == "skew_4rsr" else ROBOTS / f"{name}.urdf"
+    mechanism = load(source)
+    rng = np.random.default_rng(sum(map(ord, name + change)))
+    poses = random_reachable_poses(mechanism, rng, 20)
+    factor = {"x1e-3": 1e-3, "x1e3": 1e3, "world": 1.0}[change]
+    text = source.read_text()
+    if change == "world":
+        text = moved_in_the_world(text, rng.uniform(-2.0, 2.0, 3), rng.uniform(-np.pi, np.pi, 3))
+        assert "world_to_base" in text
+    text = revolutes_drawn_elsewhere(text, rng, 0.2 * mechanism.length_scale)
+    if change != "world":
+        text = in_unit(text, "m", factor)
+    changed = tmp_path / f"{name}_{change}.urdf"
+    changed.write_text(text)
+    other = load(changed)
+    scaled = poses * np.where(mechanism.angular, 1.0, factor)
+    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, scaled, detail=True),
+                         1e-9)
