@@ -121,16 +121,29 @@ def revolutes_drawn_elsewhere(text: str, rng, span: float) -> str:
             rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
             origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
     for joint in root.iter("joint"):
-        if joint.get("type") not in ("revolute", "continuous"):
-            continue
-        origin = joint.find("origin")
-        axis = numbers(joint.find("axis").get("xyz"))
-        shift = rng.uniform(-span, span) * axis / np.linalg.norm(axis)
-        rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
-        origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
-        for inner in origins_in(root, joint.find("child").get("link")):
-            inner.set("xyz", written(numbers(inner.get("xyz", "0 0 0")) - shift))
+        if joint.get("type") in ("revolute", "continuous"):
+            _move_along_axis(root, joint, rng.uniform(-span, span))
     return ElementTree.tostring(root, encoding="unicode")
+
+
+def revolutes_moved(text: str, distances: dict[str, float]) -> str:
+    """The URDF with each named tree revolute's origin moved along its own axis by the given distance (signed along
+    the axis as written), the origins in its child link's frame moved back: the same mechanism, drawn otherwise."""
+    root = ElementTree.fromstring(text)
+    joints = {joint.get("name"): joint for joint in root.findall("joint")}
+    for name, distance in distances.items():
+        _move_along_axis(root, joints[name], distance)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def _move_along_axis(root, joint, distance: float) -> None:
+    origin = joint.find("origin")
+    axis = numbers(joint.find("axis").get("xyz"))
+    shift = distance * axis / np.linalg.norm(axis)
+    rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
+    origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))
+    for inner in origins_in(root, joint.find("child").get("link")):
+        inner.set("xyz", written(numbers(inner.get("xyz", "0 0 0")) - shift))
 
 
 @pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8", "planar_5rrr"))

@@ -16,12 +16,12 @@ from xml.etree import ElementTree
 
 import numpy as np
 import pytest
-from test_axis_points import revolutes_drawn_elsewhere
+from test_axis_points import revolutes_drawn_elsewhere, revolutes_moved
 from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
 from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses
-from screwkit.closure.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero
+from screwkit.closure.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero, offsets_along_axes
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import bundled_names, load, load_text
 from screwkit.studies import indices_at_poses
@@ -137,6 +137,91 @@ def test_the_cooperating_arms_revolutes_sit_where_their_axes_meet_or_pass_neares
         between = [foot_of_perpendicular(points[elbow], axes[elbow], meeting) for meeting in (shoulder, first)]
         np.testing.assert_allclose(points[elbow], np.mean(between, axis=0), atol=1e-12)
         assert np.linalg.norm(between[0] - between[1]) > 0.05  # the mean is a choice, and is tested as one
+
+
+WRIST_MEETINGS = {"first": {"wrist_1_joint": 0.093}, "second": {"wrist_2_joint": 0.09465},
+                  "both": {"wrist_1_joint": 0.093, "wrist_2_joint": 0.09465}}
+
+
+@pytest.mark.parametrize("moved", WRIST_MEETINGS)
+def test_an_arm_whose_wrist_frames_sit_where_the_next_axis_meets_reads_as_bundled(moved, tmp_path):
+    """Denavit and Hartenberg draw a frame where its axis meets the next one. The UR5 arms of ``coop_arms`` with the
+    first wrist joint drawn where its axis meets the second's (0.093 m along it, the offset the file gives the
+    second), the second where its axis meets the third's (0.09465 m), or both: the same points and indices as the
+    file as bundled. The second wrist axis meets both its neighbours', at two points: a tie, whose mean it takes
+    however the file draws it (before the meetings were ranked, an index moved by up to 0.094)."""
+    distances = {f"{side}_{joint}": distance for side in ("left", "right")
+                 for joint, distance in WRIST_MEETINGS[moved].items()}
+    text = (ROBOTS / "coop_arms.urdf").read_text()
+    redrawn = tmp_path / "coop_arms_dh.urdf"
+    redrawn.write_text(revolutes_moved(text, distances))
+    mechanism, other = load("coop_arms"), load(redrawn)
+    for chain, other_chain in zip(mechanism.chains, other.chains):
+        np.testing.assert_allclose(joint_lines_at_zero(other_chain.geometry)[1], joint_lines_at_zero(chain.geometry)[1],
+                                   rtol=0, atol=1e-12)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(11), 30)
+    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
+                         1e-9)
+
+
+def test_a_universal_joint_drawn_apart_keeps_its_centre_and_the_crank_its_foot(tmp_path):
+    """``rss_hexapod_8`` with each leg's first universal-joint revolute drawn 5 cm along its axis away from the
+    second: its axis still meets the second's at the joint's centre at a right angle, and the crank's far away (1.18
+    m) at a shallow one. The right angle ranks first, so the universal joint's revolutes stay at its centre, the
+    crank at the foot of the perpendicular from it, and the length scale is the bundled one (1.55 instead of 1.40
+    before the meetings were ranked)."""
+    distances = {f"leg_{leg}_joint_u1": 0.05 * (-1) ** leg for leg in range(1, 9)}
+    redrawn = tmp_path / "rss_u_apart.urdf"
+    redrawn.write_text(revolutes_moved((ROBOTS / "rss_hexapod_8.urdf").read_text(), distances))
+    mechanism, other = load("rss_hexapod_8"), load(redrawn)
+    assert other.length_scale == pytest.approx(mechanism.length_scale, rel=1e-12)
+    for chain, other_chain in zip(mechanism.chains, other.chains):
+        axes, points = joint_lines_at_zero(other_chain.geometry)
+        np.testing.assert_allclose(points, joint_lines_at_zero(chain.geometry)[1], rtol=0, atol=1e-12)
+        crank, first, second = range(3)
+        centre = meeting_point(points[first], axes[first], points[second], axes[second])
+        np.testing.assert_allclose(points[[first, second]], [centre, centre], atol=1e-12)
+        np.testing.assert_allclose(points[crank], foot_of_perpendicular(points[crank], axes[crank], centre),
+                                   atol=1e-12)
+
+
+def test_meetings_are_ranked_by_the_axes_through_them_then_by_their_angle():
+    """A chain crank - universal - ball, drawn anywhere along its axes: the crank's axis meets the universal joint's
+    first axis 5 m away at a shallow angle (squared sine 1/26), and the universal joint's second axis meets the
+    ball's first frame axis at a right angle, at neither centre. However it is drawn, the ball's revolutes sit at its
+    centre (three axes pass there), the universal joint's at its own (a right angle beats the shallow crossing and
+    ties with the one the ball took), the crank at the foot of the perpendicular from that centre."""
+    universal, ball = np.zeros(3), np.array([1.0, 0.0, 1.0])
+    crank_axis = np.array([0.0, 1.0, 5.0]) / np.sqrt(26.0)  # through (0, 0, -5) on the universal joint's first axis
+    axes = np.array([crank_axis, [0, 0, 1], [1, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0]], dtype=float)
+    on_axes = np.array([[0.0, 1.0, 0.0], universal, universal, ball, ball, ball])
+    expected = np.array([foot_of_perpendicular(on_axes[0], crank_axis, universal), universal, universal, ball, ball,
+                         ball])
+    rng = np.random.default_rng(4)
+    for draw in range(6):
+        points = on_axes + (rng.uniform(-2.0, 2.0, 6) if draw else np.zeros(6))[:, None] * axes
+        offsets = offsets_along_axes((False,) * 6, axes, points)
+        np.testing.assert_allclose(points + offsets[:, None] * axes, expected, atol=1e-12)
+
+
+def test_a_loop_balls_frame_axes_meet_nothing():
+    """An R-U-S leg whose spherical loop joint's first frame axis lies along the rod, through the universal joint's
+    centre (as ``rss_hexapod_8`` draws it): that axis meets the universal joint's second at a right angle, at a
+    point three axes pass through, as many as through the ball's centre. A loop joint's axes are only its frame's,
+    so its DoFs sit at its centre before any meeting is ranked, and the universal joint's revolutes at theirs."""
+    universal, ball = np.zeros(3), np.array([0.0, 0.6, 0.8])
+    rod = ball / np.linalg.norm(ball)
+    axes = np.array([[0.0, 0.6, 0.8 + 0.5], [0, 0, 1], [1, 0, 0], rod, [1, 0, 0], np.cross(rod, [1, 0, 0])])
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    on_axes = np.array([[0.3, 0.0, 0.0], universal, universal, ball, ball, ball])
+    expected = np.array([foot_of_perpendicular(on_axes[0], axes[0], universal), universal, universal, ball, ball,
+                         ball])
+    rng = np.random.default_rng(6)
+    for draw in range(6):
+        points = on_axes + (rng.uniform(-2.0, 2.0, 6) if draw else np.zeros(6))[:, None] * axes
+        points[3:] = ball  # a loop joint is drawn at its centre
+        offsets = offsets_along_axes((False,) * 6, axes, points, declared=3)
+        np.testing.assert_allclose(points + offsets[:, None] * axes, expected, atol=1e-12)
 
 
 def every_chain(skew_path):

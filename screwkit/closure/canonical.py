@@ -11,12 +11,11 @@ depends on how the file is written, :func:`canonical_geometry` moves each revolu
 read, to a point of its axis that the geometry alone decides, as Denavit and Hartenberg place their frames:
 
 * each joint of a chain is a **slide** (prismatic: no point), a **point** or a **line** (any other revolute). The
-  points are the revolutes of a universal or ball joint, where their axes meet: first those drawn at the same point
-  as a neighbour in the chain with another axis (a universal or ball joint written as revolutes, a loop joint's
-  universal or spherical DoFs, whose axes are only frame axes), which stay there; then revolutes drawn elsewhere
-  whose axes meet a neighbour's (at most :data:`~screwkit.common.tolerances.MEETING` apart, at an angle whose
-  squared sine is above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), which go to the meeting point (the mean
-  of two, for an axis that meets both its neighbours');
+  points are the revolutes of a universal or ball joint, where their axes meet a neighbour's (at most
+  :data:`~screwkit.common.tolerances.MEETING` apart; drawn apart, at an angle whose squared sine is above
+  :data:`~screwkit.common.tolerances.PARALLEL_FOOT` too). The meetings are taken in order of how many of the chain's
+  axes pass through them, then of how clear their angle is; one is kept unless either axis has kept one of a higher
+  rank, and an axis that keeps two (a tie) takes their mean (:func:`_points`);
 * a line takes the foot, on its axis, of the common perpendicular with each neighbour in the chain (the joint
   before it and the one after it) that is a line whose axis is not nearly parallel to its own (squared sine above
   :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), and the foot of the perpendicular from each neighbour that is a
@@ -29,8 +28,8 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
 * a chain whose every axis passes through one point (a spherical wrist's leg) keeps its drawn points: its canonical
   points would all be that point, and a spherical mechanism's working length would vanish with them.
 
-The points depend on the lines alone (and on which revolutes a file draws together), so a chain drawn at its
-canonical points is its own canonical drawing.
+The points depend on the lines alone (and, for nearly parallel axes, on whether a file draws them together), so a
+chain drawn at its canonical points is its own canonical drawing.
 
 Two consecutive joints of a chain are fixed in the link between them, so every foot is a constant of the design,
 the same at every configuration: the points are found once, at zero joint values, and the chain's constant
@@ -47,10 +46,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
-from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, PARALLEL_FOOT
-from screwkit.model.chain import ChainGeometry
+from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, MEETING_TIE, PARALLEL_FOOT
+from screwkit.model.chain import LOOP_JOINT_DOFS, ChainGeometry
 
-__all__ = ["joint_lines_at_zero", "canonical_offsets", "canonical_geometry"]
+__all__ = ["joint_lines_at_zero", "canonical_offsets", "offsets_along_axes", "canonical_geometry"]
 
 
 def joint_lines_at_zero(geometry: ChainGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -80,43 +79,71 @@ def _foot_of(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
     return point + ((other - point) @ axis) * axis
 
 
-def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent: float) -> list[NDArray | None]:
+def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent: float, declared: int = 0
+            ) -> list[NDArray | None]:
     """The point of each revolute DoF that is part of a joint at a point (None for the others): a universal or
     ball joint, whose revolutes' axes meet (not parallel, at most :data:`MEETING` times the chain's ``extent``
-    apart). Revolutes drawn at that point (the file's universal and ball joints, and a loop's universal and
-    spherical DoFs, whose axes are only frame axes) are taken first; then revolutes drawn elsewhere whose axes meet
-    a neighbour's at a clear angle (squared sine above :data:`PARALLEL_FOOT`). Each takes the mean of its meeting
-    points (the midpoint of the feet of the two axes' common perpendicular), on its own axis."""
+    apart; drawn apart, at a clear angle too: squared sine above :data:`PARALLEL_FOOT`).
+
+    An axis may meet both its neighbours', at two points (a UR wrist's second axis, or a universal joint's first
+    axis and a crank's, met far away at a shallow angle). The meetings are then taken in order of how many of the
+    chain's axes pass through them, then of how clear their angle is (squared sine), each joint keeping the
+    meetings of the first rank it is met in: a ball's centre before anything else, a universal joint's right angle
+    before a shallow crossing, and an axis met by both neighbours at equal rank (to :data:`MEETING_TIE`) takes the
+    mean of the two points, which the feet of the common perpendiculars give too when the axes pass near each other
+    instead. Nothing of this depends on where the file draws the joints. The last ``declared`` DoFs (a universal or
+    spherical loop joint) are a joint at a point by declaration, at their drawn centre, before any meeting: their
+    axes are only the axes of the loop's frame, whose meetings with a neighbour's mean nothing."""
     extent = max(extent, np.finfo(float).tiny)
-    count = len(prismatic)
-    pairs = [(joint, joint + 1) for joint in range(count - 1) if not (prismatic[joint] or prismatic[joint + 1])
-             and np.sum(np.cross(axes[joint], axes[joint + 1]) ** 2) > AXIS_PARALLEL]
-    together = [np.linalg.norm(points[other] - points[joint]) <= MEETING * extent for joint, other in pairs]
-    # axes drawn apart meet only at a clear angle: nearly parallel lines in one plane would meet far away
-    clear = [np.sum(np.cross(axes[joint], axes[other]) ** 2) > PARALLEL_FOOT for joint, other in pairs]
-    meets: list[list[NDArray]] = [[] for _ in range(count)]
-    for drawn_together in (True, False):
-        taken = [bool(found) for found in meets]
-        for (joint, other), close, at_an_angle in zip(pairs, together, clear):
-            if drawn_together != close or taken[joint] or taken[other] or not (close or at_an_angle) or (
-                    _line_gap(points[joint], axes[joint], points[other], axes[other]) > MEETING * extent):
-                continue
-            meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
-                             + _foot_on_line(points[other], axes[other], points[joint], axes[joint]))
-            meets[joint].append(meeting)
-            meets[other].append(meeting)
-    return [_foot_of(points[joint], axes[joint], np.mean(found, axis=0)) if found else None
-            for joint, found in enumerate(meets)]
+    reach = MEETING * extent
+    revolutes = [joint for joint, slide in enumerate(prismatic[:len(prismatic) - declared]) if not slide]
+    found = []  # (axes through the meeting, squared sine, joint, its neighbour, meeting point)
+    for joint, other in zip(revolutes, revolutes[1:]):
+        sine2 = float(np.sum(np.cross(axes[joint], axes[other]) ** 2))
+        if other != joint + 1 or sine2 <= AXIS_PARALLEL:
+            continue
+        together = np.linalg.norm(points[other] - points[joint]) <= reach
+        # axes drawn apart meet only at a clear angle: nearly parallel lines in one plane would meet far away
+        if not (together or sine2 > PARALLEL_FOOT) or _line_gap(points[joint], axes[joint], points[other],
+                                                                 axes[other]) > reach:
+            continue
+        meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
+                         + _foot_on_line(points[other], axes[other], points[joint], axes[joint]))
+        through = sum(np.linalg.norm(np.cross(meeting - points[line], axes[line])) <= reach for line in revolutes)
+        found.append((through, sine2, joint, other, meeting))
+    found.sort(key=lambda meeting: (-meeting[0], -meeting[1]))
+    meets: list[list[NDArray]] = [[] for _ in prismatic]
+    for joint in range(len(prismatic) - declared, len(prismatic)):
+        meets[joint].append(points[joint])
+    start = 0
+    while start < len(found):
+        through, clearest = found[start][:2]
+        rank = [meeting for meeting in found[start:] if meeting[0] == through and clearest - meeting[1] <= MEETING_TIE]
+        met = {joint for joint, joint_meets in enumerate(meets) if joint_meets}
+        for _, _, joint, other, meeting in rank:
+            if joint not in met and other not in met:
+                meets[joint].append(meeting)
+                meets[other].append(meeting)
+        start += len(rank)
+    return [_foot_of(points[joint], axes[joint], np.mean(joint_meets, axis=0)) if joint_meets else None
+            for joint, joint_meets in enumerate(meets)]
 
 
 def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
     """How far along its axis (base-frame units, signed along the joint's axis) each DoF of a chain moves to its
     canonical point (see the module docstring); zero for slides and undecided lines. Shape (m,)."""
-    axes, points = joint_lines_at_zero(geometry)
-    prismatic = geometry.dof_prismatic
+    declared = LOOP_JOINT_DOFS[geometry.loop_type] if geometry.loop_type in ("universal", "spherical") else 0
+    return offsets_along_axes(geometry.dof_prismatic, *joint_lines_at_zero(geometry), declared=declared)
+
+
+def offsets_along_axes(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0
+                       ) -> NDArray[np.float64]:
+    """:func:`canonical_offsets` of a chain's joints given as lines: which are slides, unit axes (m, 3) and drawn
+    points (m, 3), consecutive in the chain, the last ``declared`` of them the DoFs of a loop joint at a point (a
+    universal or spherical loop joint, whose axes are only its frame's). Shape (m,)."""
     count = len(prismatic)
     extent = float(np.ptp(points, axis=0).max()) if count else 0.0  # the chain's size as drawn
-    canonical = _points(prismatic, axes, points, extent)
+    canonical = _points(prismatic, axes, points, extent, declared)
     is_point = [found is not None for found in canonical]
     lines = [joint for joint in range(count) if not prismatic[joint] and not is_point[joint]]
     for joint in lines:
