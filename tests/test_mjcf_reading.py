@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 import re
 from pathlib import Path
+from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
@@ -17,7 +18,7 @@ import pinocchio as pin
 import pytest
 from test_io import five_bar_mjcf, poses_near_home
 
-from helpers import assert_indices_close, one_line_error, screwkit
+from helpers import assert_indices_close, one_line_error, random_reachable_poses, screwkit
 from screwkit.io import ImportError_, read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
@@ -228,6 +229,51 @@ def test_frames_place_bodies_sites_and_joints_as_mujoco_does(tmp_path):
     _, report = read_mechanism_file(written(tmp_path, five_bar_mjcf().replace(site, f"<frame>{site}</frame>"),
                                             "five_bar_frame.xml"))
     assert any("1 <frame> element(s)" in note for note in report.notes), report.notes
+
+
+OFFSET_SITES = """<mujoco model="offset_sites"><worldbody>
+ <body name="arm" pos="0.3 0 0" quat="0.9 0.1 0.3 0.2">""" + INERTIA + """
+  <joint name="hinge" type="hinge" axis="0.6 0.8 0" pos="0.06 0.08 0.01"/><site name="on_arm" pos="0.1 0 0"/>
+  <body name="hand" pos="0.05 0 0" quat="0.7071068 0 0 0.7071068">""" + INERTIA + """
+   <site name="tool" pos="0.1 0.2 0.3" quat="0.9238795 0 0.3826834 0"/>
+   <body name="finger" pos="0 0.1 0">""" + INERTIA + """<site name="tip" pos="0.02 0 0"/></body>
+  </body>
+ </body></worldbody><actuator><motor joint="hinge"/></actuator></mujoco>"""
+"""A hinge drawn away from its body's origin, and sites of bodies without a joint of their own under it."""
+
+
+def hinges_drawn_elsewhere(text: str, rng, span: float) -> str:
+    """The MJCF with every hinge's ``pos`` moved along its own axis (each by its own amount, up to ``span``): the
+    same mechanism, as MuJoCo reads it (a hinge is a line; its body and the body's children do not move)."""
+    root = ElementTree.fromstring(text)
+    for joint in root.iter("joint"):
+        if joint.get("type", "hinge") == "hinge" and joint.get("axis"):
+            axis = np.array([float(word) for word in joint.get("axis").split()])
+            pos = np.array([float(word) for word in joint.get("pos", "0 0 0").split()])
+            joint.set("pos", " ".join(repr(float(value)) for value in pos + rng.uniform(-span, span) * axis
+                                      / np.linalg.norm(axis)))
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def test_sites_under_a_hinge_drawn_off_its_bodys_origin_are_placed_as_mujoco_places_them(tmp_path):
+    """Pinocchio's parser leaves the hinge's ``pos`` out of the sites of jointless bodies under it; screwkit places
+    every site on its body's frame, where MuJoCo has it, at ``qpos0`` and at a random configuration."""
+    assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 3)
+
+
+def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_the_same_robot(tmp_path):
+    """The CAD Stewart platform with every hinge's ``pos`` moved along its axis (up to 5 cm): its output site
+    ``tool`` sits under the last hinge of a leg. Bodies and sites where MuJoCo has them, the same home pose, and the
+    indices of the file as written at random poses (before, the output site followed the last hinge's drawn point,
+    1.9 cm away here, so every pose named another placement of the platform)."""
+    moved = written(tmp_path, hinges_drawn_elsewhere(STEWART.read_text(), np.random.default_rng(1), 0.05),
+                    "stewart_moved.xml")
+    assert assert_placed_as_mujoco(moved) == assert_placed_as_mujoco(STEWART)
+    mechanism, other = load(STEWART), load(moved)
+    np.testing.assert_allclose(other.home_pose, mechanism.home_pose, rtol=0, atol=1e-12)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(2), 20)
+    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
+                         1e-9)
 
 
 def test_a_five_bar_written_with_frames_has_the_indices_of_the_plain_one(tmp_path):

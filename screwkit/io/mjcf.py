@@ -20,9 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
+from screwkit.io.mjcf_pose import local_pose, rotation_matrix
 from screwkit.io.mjcf_text import MjcfError, closure_placements, prepared_mjcf
 
-__all__ = ["read_mjcf"]
+__all__ = ["read_mjcf", "sites_placed"]
 
 
 def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -62,6 +63,7 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                    f"(MuJoCo fills a short one from qpos0, Pinocchio does not); numbers given: {keys}."
                                    ) from None
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
+    sites_placed(model, root)
     references = {item.key(): np.array(item.data()) for item in model.referenceConfigurations}
     qpos0 = np.asarray(references.get("qpos0", pin.neutral(model)), dtype=float)
     data = model.createData()
@@ -92,3 +94,25 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
     q = references.get("home", qpos0)
     return ClosedTree(source, model, closures, motors, np.asarray(q, dtype=float), output, output_type, "MJCF",
                       notes, unactuated=unactuated)
+
+
+def sites_placed(model, root) -> None:
+    """Each named site's frame placed on its body's frame by the site's own ``pos`` and ``quat``, as MuJoCo places
+    it. Pinocchio 4.1's parser leaves out the offset of a body's joint (its ``pos``) for the sites of a body without
+    a joint of its own under it, so such a site would sit off by that offset (a platform's output site, or a
+    closure's, under a hinge drawn away from its body's origin)."""
+    import pinocchio as pin
+
+    for body in root.iter("body"):
+        for site in body.findall("site"):
+            name = site.get("name")
+            if name is None or not model.existFrame(name, pin.FrameType.OP_FRAME):
+                continue
+            index = model.getFrameId(name, pin.FrameType.OP_FRAME)
+            frame = model.frames[index]
+            parent = model.frames[frame.parentFrame]
+            if parent.name != body.get("name") or parent.type != pin.FrameType.BODY:
+                continue  # not the frame of the site's body: left as Pinocchio places it
+            position, quaternion = local_pose(site)
+            frame.placement = parent.placement * pin.SE3(rotation_matrix(quaternion), position)
+            model.frames[index] = frame

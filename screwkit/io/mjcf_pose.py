@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MjcfError", "MIN_AXIS", "describe", "class_attributes", "euler_sequence", "quaternion_product",
-           "rotation_matrix", "orientations_as_quaternions", "defaults_written", "frames_flattened"]
+           "rotation_matrix", "orientations_as_quaternions", "local_pose", "defaults_written", "frames_flattened"]
 
 MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
@@ -161,7 +161,10 @@ def orientations_as_quaternions(root: ElementTree.Element, degree: bool, sequenc
     return in_degrees
 
 
-def _pose(element: ElementTree.Element) -> tuple[NDArray, NDArray]:
+def local_pose(element: ElementTree.Element) -> tuple[NDArray, NDArray]:
+    """An element's ``pos`` and ``quat`` (w, x, y, z) in its parent's frame, MuJoCo's defaults where absent (once
+    :func:`orientations_as_quaternions` has written every orientation as a quaternion)."""
+
     def numbers(attribute: str, default: tuple) -> NDArray:
         text = element.get(attribute)
         return np.array([float(word) for word in text.split()] if text else default, dtype=float)
@@ -202,14 +205,14 @@ def frames_flattened(root: ElementTree.Element) -> int:
         """The children of ``frame`` (frames inside it already lifted) placed in the frame's parent's frame."""
         nonlocal count
         inner_class = frame.get("childclass", outer_class)
-        position, quaternion = _pose(frame)
+        position, quaternion = local_pose(frame)
         rotation = rotation_matrix(quaternion)
         for child in frame:
             if child.tag == "joint":
                 axis = np.array([float(word) for word in child.get("axis", "0 0 1").split()])
                 child.set("axis", _text(rotation @ axis))
             if child.tag in ORIENTED or child.tag == "joint":
-                pos, quat = _pose(child)
+                pos, quat = local_pose(child)
                 child.set("pos", _text(position + rotation @ pos))
                 if child.tag != "joint":
                     child.set("quat", _text(quaternion_product(quaternion, quat)))
