@@ -149,7 +149,7 @@ def test_an_arm_whose_wrist_frames_sit_where_the_next_axis_meets_reads_as_bundle
     first wrist joint drawn where its axis meets the second's (0.093 m along it, the offset the file gives the
     second), the second where its axis meets the third's (0.09465 m), or both: the same points and indices as the
     file as bundled. The second wrist axis meets both its neighbours', at two points: a tie, whose mean it takes
-    however the file draws it (before the meetings were ranked, an index moved by up to 0.094)."""
+    however the file draws it (before the meetings were ranked, an OTI moved by up to 0.17)."""
     distances = {f"{side}_{joint}": distance for side in ("left", "right")
                  for joint, distance in WRIST_MEETINGS[moved].items()}
     text = (ROBOTS / "coop_arms.urdf").read_text()
@@ -202,6 +202,69 @@ def test_meetings_are_ranked_by_the_axes_through_them_then_by_their_angle():
         points = on_axes + (rng.uniform(-2.0, 2.0, 6) if draw else np.zeros(6))[:, None] * axes
         offsets = offsets_along_axes((False,) * 6, axes, points)
         np.testing.assert_allclose(points + offsets[:, None] * axes, expected, atol=1e-12)
+
+
+def canonical_however_drawn(axes, on_axes, seed: int, declared: int = 0) -> np.ndarray:
+    """The canonical points of a chain of revolutes (unit ``axes``, one point of each axis ``on_axes``), found from six
+    drawings (the given points, then each moved along its axis by up to 2 either way), which must all agree; the last
+    ``declared`` are a loop joint's DoFs, drawn at their centre."""
+    rng, found = np.random.default_rng(seed), []
+    for draw in range(6):
+        points = on_axes + (rng.uniform(-2.0, 2.0, len(axes)) if draw else np.zeros(len(axes)))[:, None] * axes
+        if declared:
+            points[-declared:] = on_axes[-declared:]
+        offsets = offsets_along_axes((False,) * len(axes), axes, points, declared=declared)
+        found.append(points + offsets[:, None] * axes)
+    for other in found[1:]:
+        np.testing.assert_allclose(other, found[0], atol=1e-12)
+    return found[0]
+
+
+def unit_rows(rows) -> np.ndarray:
+    rows = np.asarray(rows, dtype=float)
+    return rows / np.linalg.norm(rows, axis=1, keepdims=True)
+
+
+def test_a_ball_whose_axes_meet_at_unequal_angles_stays_one_point():
+    """A universal joint, then a ball written as three revolutes whose pairs meet at different angles (squared sines
+    0.5 and 0.8), the universal joint's second axis meeting the ball's first elsewhere at a right angle: the ball's
+    pairs are one joint at one point whatever their angles, so its revolutes sit at its centre and the universal
+    joint's at its own."""
+    universal, ball = np.zeros(3), np.array([1.0, 0.0, 1.0])
+    axes = unit_rows([[0, 0, 1], [1, 0, 0], [0, 0, 1], [1, 0, 1], [np.sqrt(0.2), np.sqrt(0.8), 0]])
+    found = canonical_however_drawn(axes, np.array([universal, universal, ball, ball, ball]), seed=8)
+    np.testing.assert_allclose(found, [universal, universal, ball, ball, ball], atol=1e-12)
+
+
+def test_a_meeting_more_axes_pass_through_comes_before_a_clearer_one():
+    """A ball whose second and third axes meet at a shallow angle (squared sine 0.05), the third meeting the next
+    revolute's elsewhere at a right angle: three axes pass through the ball's centre, two through the other meeting,
+    so the third revolute stays in the ball and the next one takes the foot of the perpendicular from its centre."""
+    ball = np.zeros(3)
+    third = np.array([np.sqrt(0.05), 0.0, np.sqrt(0.95)])
+    after_point = 0.7 * third  # on the third axis, where the next revolute's axis crosses it
+    after_axis = np.cross(third, [0.0, 1.0, 0.0])
+    axes = unit_rows([[1, 0, 0], [0, 0, 1], third, after_axis])
+    on_axes = np.array([ball, ball, ball, after_point + 0.4 * after_axis / np.linalg.norm(after_axis)])
+    found = canonical_however_drawn(axes, on_axes, seed=9)
+    np.testing.assert_allclose(found[:3], [ball, ball, ball], atol=1e-12)
+    np.testing.assert_allclose(found[3], foot_of_perpendicular(on_axes[3], axes[3], ball), atol=1e-12)
+
+
+@pytest.mark.parametrize("unrelated", (1.0, 0.9999))
+def test_an_axis_met_by_both_neighbours_at_nearly_equal_angles_takes_the_mean(unrelated):
+    """A wrist axis (z) meeting the axis before it at squared sine 0.99994 and the one after at 0.99987, within the
+    tie of 1e-4 (as axes written to a few decimals give): the mean of its two meeting points, whatever the angle of
+    an unrelated pair earlier in the chain (squared sine 1 or 0.9999)."""
+    first, second, base = np.array([0.0, 0.0, 0.2]), np.array([0.0, 0.0, 0.5]), np.array([0.5, 0.0, -1.0])
+    axes = np.array([[np.sqrt(unrelated), np.sqrt(1.0 - unrelated), 0.0],  # meets the next one at base
+                     [0.0, 1.0, 0.0],  # through base, skew to the next one
+                     [np.sqrt(0.99994), 0.0, np.sqrt(1.0 - 0.99994)],  # meets the wrist axis at first
+                     [0.0, 0.0, 1.0],  # the wrist axis
+                     [0.0, np.sqrt(0.99987), np.sqrt(1.0 - 0.99987)]])  # meets the wrist axis at second
+    found = canonical_however_drawn(axes, np.array([base, base, first, first, second]), seed=10)
+    np.testing.assert_allclose(found[3], 0.5 * (first + second), atol=1e-12)
+    np.testing.assert_allclose(found[[0, 1, 2, 4]], [base, base, first, second], atol=1e-12)
 
 
 def test_a_loop_balls_frame_axes_meet_nothing():

@@ -87,13 +87,14 @@ def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent:
 
     An axis may meet both its neighbours', at two points (a UR wrist's second axis, or a universal joint's first
     axis and a crank's, met far away at a shallow angle). The meetings are then taken in order of how many of the
-    chain's axes pass through them, then of how clear their angle is (squared sine), each joint keeping the
-    meetings of the first rank it is met in: a ball's centre before anything else, a universal joint's right angle
-    before a shallow crossing, and an axis met by both neighbours at equal rank (to :data:`MEETING_TIE`) takes the
-    mean of the two points, which the feet of the common perpendiculars give too when the axes pass near each other
-    instead. Nothing of this depends on where the file draws the joints. The last ``declared`` DoFs (a universal or
-    spherical loop joint) are a joint at a point by declaration, at their drawn centre, before any meeting: their
-    axes are only the axes of the loop's frame, whose meetings with a neighbour's mean nothing."""
+    chain's axes pass through them, then of how clear their angle is (squared sine); a meeting is kept when each of
+    its two joints has kept none yet, or one at the same point (a ball's pairs, at whatever angles), or one of the
+    same rank (the same number of axes, squared sines within :data:`MEETING_TIE`): a ball's centre before anything
+    else, a universal joint's right angle before a shallow crossing, and an axis met by both neighbours at equal
+    rank takes the mean of the two points, which the feet of the common perpendiculars give too when the axes pass
+    near each other instead. Nothing of this depends on where the file draws the joints. The last ``declared`` DoFs
+    (a universal or spherical loop joint) are a joint at a point by declaration, at their drawn centre, before any
+    meeting: their axes are only the axes of the loop's frame, whose meetings with a neighbour's mean nothing."""
     extent = max(extent, np.finfo(float).tiny)
     reach = MEETING * extent
     revolutes = [joint for joint, slide in enumerate(prismatic[:len(prismatic) - declared]) if not slide]
@@ -113,18 +114,21 @@ def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent:
         found.append((through, sine2, joint, other, meeting))
     found.sort(key=lambda meeting: (-meeting[0], -meeting[1]))
     meets: list[list[NDArray]] = [[] for _ in prismatic]
+    best: list[tuple[float, float]] = [(np.inf, np.inf)] * len(prismatic)  # rank of each joint's first meeting
     for joint in range(len(prismatic) - declared, len(prismatic)):
         meets[joint].append(points[joint])
-    start = 0
-    while start < len(found):
-        through, clearest = found[start][:2]
-        rank = [meeting for meeting in found[start:] if meeting[0] == through and clearest - meeting[1] <= MEETING_TIE]
-        met = {joint for joint, joint_meets in enumerate(meets) if joint_meets}
-        for _, _, joint, other, meeting in rank:
-            if joint not in met and other not in met:
-                meets[joint].append(meeting)
-                meets[other].append(meeting)
-        start += len(rank)
+
+    def may_keep(joint: int, through: int, sine2: float, meeting: NDArray) -> bool:
+        """Whether ``joint`` keeps a meeting: its first, one at the point it already holds (a ball's pairs, at
+        whatever angles), or one of the same rank as its first (a tie: the mean)."""
+        return (not meets[joint] or all(np.linalg.norm(meeting - held) <= reach for held in meets[joint])
+                or (through == best[joint][0] and best[joint][1] - sine2 <= MEETING_TIE))
+
+    for through, sine2, joint, other, meeting in found:
+        if may_keep(joint, through, sine2, meeting) and may_keep(other, through, sine2, meeting):
+            for member in (joint, other):
+                best[member] = best[member] if meets[member] else (through, sine2)
+                meets[member].append(meeting)
     return [_foot_of(points[joint], axes[joint], np.mean(joint_meets, axis=0)) if joint_meets else None
             for joint, joint_meets in enumerate(meets)]
 

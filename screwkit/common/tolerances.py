@@ -81,10 +81,10 @@ parallel axes); the joint's canonical point then comes along the run of parallel
 (:mod:`screwkit.closure.canonical`). A constant of a design: consecutive joints share a link."""
 
 MEETING_TIE = 1e-4
-"""Squared sine: an axis that meets both its neighbours' at two points (:data:`MEETING`) meets them at equally clear
-angles when the squared sines of the two angles differ by at most this (0.6 degrees about a right angle), and takes
-the mean of the two points; otherwise the clearer meeting (:mod:`screwkit.closure.canonical`). Loose enough for
-axes written to six decimals."""
+"""Squared sine: an axis that meets both its neighbours' at two points (:data:`MEETING`) through which as many of the
+chain's axes pass meets them at equally clear angles when the squared sines of the two angles differ by at most this
+(0.6 degrees about a right angle), and takes the mean of the two points; otherwise the meeting more axes pass
+through, then the clearer one (:mod:`screwkit.closure.canonical`). Loose enough for axes written to six decimals."""
 
 GRAM_PIVOT = 1e-12
 """Relative: the Gram matrix of a chain's joint twists (about the platform joint, each scaled to
