@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from test_io import five_bar_mjcf, poses_near_home
+from test_io import assert_textbook, five_bar_mjcf, poses_near_home
 
 from helpers import assert_indices_close, one_line_error, random_reachable_poses, screwkit
 from screwkit.io import ImportError_, read_mechanism_file
@@ -274,6 +274,22 @@ def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_th
     poses = random_reachable_poses(mechanism, np.random.default_rng(2), 20)
     assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
                          1e-9)
+
+
+def test_a_five_bar_whose_pins_and_closures_are_drawn_along_the_pins_is_the_planar_five_bar(tmp_path):
+    """A leg's distal hinge drawn 0.1 m along its pin and a closure's anchor lifted 0.05 m along it (a CAD export
+    places each pin at its own layer): the chains still meet on the pins' common line, so the mechanism is the planar
+    five-bar with its output point and the textbook pressure angles (before, the closures no longer met at one
+    point, and the platform's idle rotation made the output a frame)."""
+    text = five_bar_mjcf().replace('<joint name="b_1" type="hinge"', '<joint name="b_1" type="hinge" pos="0 0 0.1"')
+    anchor = re.search(r'<connect name="loop_2" [^>]*anchor="([^"]+)"', text)
+    x, y, _ = (float(word) for word in anchor.group(1).split())
+    text = text.replace(anchor.group(0), anchor.group(0).replace(anchor.group(1), f"{x!r} {y!r} 0.05"))
+    assert text.count('pos="0 0 0.1"') == 1 and text != five_bar_mjcf()
+    mechanism = load(written(tmp_path, text, "lifted.xml"))
+    assert mechanism.is_planar and mechanism.task_coordinates == ("x", "y")
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
 
 
 def test_a_five_bar_written_with_frames_has_the_indices_of_the_plain_one(tmp_path):

@@ -11,6 +11,7 @@ frame, legs reversed and motors renamed; the rod-level Delta's (tests/test_graph
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -221,12 +222,29 @@ def test_map_verify_and_sweep_of_a_serial_leg_sdformat_file_and_a_graph_sweep(tm
     assert swept.returncode == 0 and "swept z over 2 values (2 reachable)" in swept.stderr, swept.stderr
 
 
-def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles():
+STACKED_PINS = {"wrist_1": 0.1, "elbow_2": -0.05, "wrist_3": 0.07, "motor_3": 0.2}
+"""Joints of tests/data/sdformat/five_bar.sdf drawn elsewhere along their pins (z, metres)."""
+
+
+@pytest.mark.parametrize("stacked", (False, True))
+def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles(tmp_path, stacked):
     """tests/data/sdformat/five_bar.sdf, written by hand (link frames at the joints, unturned): ITI_i the sine of
-    the angle between leg i's proximal and distal links, the OTI of a pair the sine between their distal links."""
+    the angle between leg i's proximal and distal links, the OTI of a pair the sine between their distal links.
+    Also with joints drawn elsewhere along their pins (a coaxial wrist drawn stacked, as a CAD export places each
+    pin at its own layer): the same planar five-bar with its output point (before, the wrists no longer met at one
+    point, and the platform's idle rotation made the output a frame with every LMTI zero)."""
     from pathlib import Path
 
     from screwkit.studies import indices_at_pose
+
+    path = Path(__file__).parent / "data" / "sdformat" / "five_bar.sdf"
+    if stacked:
+        text = path.read_text()
+        for joint, height in STACKED_PINS.items():
+            opening = re.search(rf'<joint name="{joint}" type="revolute">.*?</child>', text).group(0)
+            text = text.replace(opening, f"{opening}<pose>0 0 {height} 0 0 0</pose>")
+        path = tmp_path / "five_bar_stacked.sdf"
+        path.write_text(text)
 
     bases = np.array([[-0.1, 0.0], [0.1, 0.0], [0.2, 0.65]])
     elbows = np.array([[-0.25, 0.15], [0.25, 0.15], [0.35, 0.4]])
@@ -235,8 +253,8 @@ def test_the_five_bar_of_docs_other_formats_opens_with_its_pressure_angles():
     def sine(u, v):
         return abs(u[0] * v[1] - u[1] * v[0]) / np.linalg.norm(u) / np.linalg.norm(v)
 
-    mechanism = load(Path(__file__).parent / "data" / "sdformat" / "five_bar.sdf")
-    assert mechanism.is_planar and mechanism.dof == 2
+    mechanism = load(path)
+    assert mechanism.is_planar and mechanism.dof == 2 and mechanism.task_coordinates == ("x", "y")
     result = indices_at_pose(mechanism, mechanism.home_pose)
     distal = point - elbows
     np.testing.assert_allclose(result.iti_actuators, [sine(e - b, d) for b, e, d in zip(bases, elbows, distal)],

@@ -275,6 +275,21 @@ def _ends(sdf: SdfModel) -> dict[str, tuple[str, str]]:
     return ends
 
 
+def _one_hinge(builder, sdf, poses: dict, name: str, other: str, scale: float) -> bool:
+    """Whether two joints tied to one link are one joint: drawn at one point, or revolutes on one line (a coaxial
+    wrist drawn stacked along its pin)."""
+    gap = poses[name][:3, 3] - poses[other][:3, 3]
+    if np.linalg.norm(gap) <= 1e-9 * scale:
+        return True
+    joints = {joint.name: joint for joint in sdf.joints}
+    if any(joints[each].kind not in ("revolute", "continuous") for each in (name, other)):
+        return False
+    axis, other_axis = (poses[each][:3, :3] @ builder.axis_in_joint(joints[each], 0) for each in (name, other))
+    axis, other_axis = axis / np.linalg.norm(axis), other_axis / np.linalg.norm(other_axis)
+    return bool(np.linalg.norm(np.cross(axis, other_axis)) <= 1e-9
+                and np.linalg.norm(gap - (gap @ axis) * axis) <= 1e-9 * scale)
+
+
 def read_sdformat(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
     """The closed tree of an SDFormat file's model (its loops closed by native joints; the module docstring)."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
@@ -299,8 +314,9 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                for joint in loops}
     closures = [closure for made in closing.values() for closure in made]
     # where the tree joint the order put in the tree is elsewhere than the loop joint, the cut moves with the order
+    # (not along the common axis of two coaxial pins: closed at either, it is the same hinge)
     cut_by_order = tuple(closure.name for name, other in tied for closure in closing[name]
-                         if np.linalg.norm(poses[name][:3, 3] - poses[other][:3, 3]) > 1e-9 * scale)
+                         if not _one_hinge(builder, sdf, poses, name, other, scale))
     model = builder.finish()
     stated, unactuated = actuated_joints(sdf), ""
     for name in stated:  # a marker on what cannot drive: refused unless --actuate names them (read_closed_tree)

@@ -22,8 +22,9 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
    with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
    assembled values, from its end backwards, until they are independent: the span of the leg's
    twists, so the platform's motion and every index, is unchanged; the report names them.
-5. **Output.** When every closure onto the platform meets it at one point and joins it by every
-   rotation about that point (ball joints; pins about the plane's normal in a planar mechanism),
+5. **Output.** When every closure onto the platform meets it at one point (in a plane: on one line along the
+   normal, wherever along their pins they are drawn) and joins it by every rotation about that point (ball
+   joints; pins about the plane's normal in a planar mechanism),
    the platform's rotations about the point are idle and the output is the point (a five-bar's
    distal joint, where pressure angles are measured); otherwise the output frame, whatever points
    the closures reference (welds at the platform body's origin make a 6-DOF platform, not a point).
@@ -427,7 +428,10 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     if normal is not None:
         _planar_loops(legs, normal)
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
-    meet = all(np.linalg.norm(c - centres[0]) < 1e-9 * scale for c in centres)
+    # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
+    gaps = [c - centres[0] if normal is None else (c - centres[0]) - ((c - centres[0]) @ normal) * normal
+            for c in centres]
+    meet = all(np.linalg.norm(gap) < 1e-9 * scale for gap in gaps)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
