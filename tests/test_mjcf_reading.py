@@ -81,6 +81,8 @@ def assert_placed_as_mujoco(path: Path, seed: int = 0) -> int:
         for kind, indices, positions, matrices, frame_type in kinds:
             for k in indices:
                 name = mujoco.mj_id2name(mj_model, kind, k)
+                if not name:
+                    continue  # an unnamed body: Pinocchio names it itself
                 assert model.existFrame(name, frame_type), f"{path.name}: {name} is missing"
                 placement = data.oMf[model.getFrameId(name, frame_type)]
                 np.testing.assert_allclose(placement.translation, positions[k], atol=TOLERANCE, rtol=0,
@@ -237,9 +239,13 @@ OFFSET_SITES = """<mujoco model="offset_sites"><worldbody>
   <body name="hand" pos="0.05 0 0" quat="0.7071068 0 0 0.7071068">""" + INERTIA + """
    <site name="tool" pos="0.1 0.2 0.3" quat="0.9238795 0 0.3826834 0"/>
    <body name="finger" pos="0 0.1 0">""" + INERTIA + """<site name="tip" pos="0.02 0 0"/></body>
+   <body pos="0 -0.1 0" euler="0.1 0.2 0.3">""" + INERTIA + """<site name="in_unnamed" pos="0.1 0.2 0.3"/></body>
+   <site name="segment" type="capsule" size="0.01" fromto="0 0 0 0.1 0.2 0.3"/>
+   <site name="down" type="capsule" size="0.01" fromto="0 0 0.3 0 0 0"/>
   </body>
  </body></worldbody><actuator><motor joint="hinge"/></actuator></mujoco>"""
-"""A hinge drawn away from its body's origin, and sites of bodies without a joint of their own under it."""
+"""A hinge drawn away from its body's origin, and sites of bodies without a joint of their own under it (one of them
+unnamed, two given by ``fromto``)."""
 
 
 def hinges_drawn_elsewhere(text: str, rng, span: float) -> str:
@@ -256,9 +262,10 @@ def hinges_drawn_elsewhere(text: str, rng, span: float) -> str:
 
 
 def test_sites_under_a_hinge_drawn_off_its_bodys_origin_are_placed_as_mujoco_places_them(tmp_path):
-    """Pinocchio's parser leaves the hinge's ``pos`` out of the sites of jointless bodies under it; screwkit places
-    every site on its body's frame, where MuJoCo has it, at ``qpos0`` and at a random configuration."""
-    assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 3)
+    """Pinocchio's parser leaves the hinge's ``pos`` out of the sites of jointless bodies under it (named or not)
+    and reads no ``fromto``; screwkit places every named site on its body's frame, where MuJoCo has it, at ``qpos0``
+    and at a random configuration."""
+    assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 6)
 
 
 def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_the_same_robot(tmp_path):

@@ -97,10 +97,10 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
 
 
 def sites_placed(model, root) -> None:
-    """Each named site's frame placed on its body's frame by the site's own ``pos`` and ``quat``, as MuJoCo places
-    it. Pinocchio 4.1's parser leaves out the offset of a body's joint (its ``pos``) for the sites of a body without
-    a joint of its own under it, so such a site would sit off by that offset (a platform's output site, or a
-    closure's, under a hinge drawn away from its body's origin)."""
+    """Each named site's frame placed on its body's frame by the site's own ``pos`` and ``quat`` (or ``fromto``), as
+    MuJoCo places it. Pinocchio 4.1's parser leaves out the offset of a body's joint (its ``pos``) for the sites of
+    a body without a joint of its own under it, so such a site would sit off by that offset (a platform's output
+    site, or a closure's, under a hinge drawn away from its body's origin), and reads no ``fromto``."""
     import pinocchio as pin
 
     for body in root.iter("body"):
@@ -111,8 +111,25 @@ def sites_placed(model, root) -> None:
             index = model.getFrameId(name, pin.FrameType.OP_FRAME)
             frame = model.frames[index]
             parent = model.frames[frame.parentFrame]
-            if parent.name != body.get("name") or parent.type != pin.FrameType.BODY:
-                continue  # not the frame of the site's body: left as Pinocchio places it
-            position, quaternion = local_pose(site)
-            frame.placement = parent.placement * pin.SE3(rotation_matrix(quaternion), position)
+            if parent.type != pin.FrameType.BODY or body.get("name") not in (None, parent.name):
+                continue  # not the frame of the site's body (Pinocchio names an unnamed body itself)
+            position, rotation = _site_pose(site)
+            frame.placement = parent.placement * pin.SE3(rotation, position)
             model.frames[index] = frame
+
+
+def _site_pose(site) -> tuple:
+    """A site's position and rotation matrix in its body: its ``fromto`` segment's midpoint, its z axis from the
+    segment's end to its start (the shortest turn from z, as MuJoCo turns it), else its ``pos`` and ``quat``."""
+    if site.get("fromto") is None:
+        position, quaternion = local_pose(site)
+        return position, rotation_matrix(quaternion)
+    ends = np.array([float(word) for word in site.get("fromto").split()]).reshape(2, 3)
+    along = ends[0] - ends[1]
+    along = along / np.linalg.norm(along)
+    axis, cosine = np.cross([0.0, 0.0, 1.0], along), float(along[2])
+    if np.linalg.norm(axis) < 1e-14:  # along z or against it (MuJoCo turns by pi about x)
+        return ends.mean(axis=0), np.eye(3) if cosine > 0 else np.diag([1.0, -1.0, -1.0])
+    axis = axis / np.linalg.norm(axis)
+    half = 0.5 * np.arccos(np.clip(cosine, -1.0, 1.0))
+    return ends.mean(axis=0), rotation_matrix(np.concatenate([[np.cos(half)], np.sin(half) * axis]))
