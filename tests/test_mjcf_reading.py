@@ -233,7 +233,7 @@ def test_frames_place_bodies_sites_and_joints_as_mujoco_does(tmp_path):
     assert any("1 <frame> element(s)" in note for note in report.notes), report.notes
 
 
-OFFSET_SITES = """<mujoco model="offset_sites"><worldbody>
+OFFSET_SITES = """<mujoco model="offset_sites"><worldbody><site name="ground" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2"/>
  <body name="arm" pos="0.3 0 0" quat="0.9 0.1 0.3 0.2">""" + INERTIA + """
   <joint name="hinge" type="hinge" axis="0.6 0.8 0" pos="0.06 0.08 0.01"/><site name="on_arm" pos="0.1 0 0"/>
   <body name="hand" pos="0.05 0 0" quat="0.7071068 0 0 0.7071068">""" + INERTIA + """
@@ -245,7 +245,7 @@ OFFSET_SITES = """<mujoco model="offset_sites"><worldbody>
   </body>
  </body></worldbody><actuator><motor joint="hinge"/></actuator></mujoco>"""
 """A hinge drawn away from its body's origin, and sites of bodies without a joint of their own under it (one of them
-unnamed, two given by ``fromto``)."""
+unnamed, two given by ``fromto``), and a site of the world itself."""
 
 
 def hinges_drawn_elsewhere(text: str, rng, span: float) -> str:
@@ -262,10 +262,10 @@ def hinges_drawn_elsewhere(text: str, rng, span: float) -> str:
 
 
 def test_sites_under_a_hinge_drawn_off_its_bodys_origin_are_placed_as_mujoco_places_them(tmp_path):
-    """Pinocchio's parser leaves the hinge's ``pos`` out of the sites of jointless bodies under it (named or not)
-    and reads no ``fromto``; screwkit places every named site on its body's frame, where MuJoCo has it, at ``qpos0``
-    and at a random configuration."""
-    assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 6)
+    """Pinocchio's parser leaves the hinge's ``pos`` out of the sites of jointless bodies under it (named or not),
+    reads no ``fromto`` and makes no frame of a site of the world; screwkit places every named site on its body's
+    frame, where MuJoCo has it, at ``qpos0`` and at a random configuration."""
+    assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 7)
 
 
 def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_the_same_robot(tmp_path):

@@ -100,8 +100,16 @@ def sites_placed(model, root) -> None:
     """Each named site's frame placed on its body's frame by the site's own ``pos`` and ``quat`` (or ``fromto``), as
     MuJoCo places it. Pinocchio 4.1's parser leaves out the offset of a body's joint (its ``pos``) for the sites of
     a body without a joint of its own under it, so such a site would sit off by that offset (a platform's output
-    site, or a closure's, under a hinge drawn away from its body's origin), and reads no ``fromto``."""
+    site, or a closure's, under a hinge drawn away from its body's origin), reads no ``fromto``, and makes no frame
+    of a site of ``<worldbody>`` itself (a closure's anchor on the ground), which is added on the world's frame."""
     import pinocchio as pin
+
+    for world in root.findall("worldbody"):
+        for site in world.findall("site"):
+            name = site.get("name")
+            if name is not None and not model.existFrame(name, pin.FrameType.OP_FRAME):
+                position, rotation = _site_pose(site)
+                model.addFrame(pin.Frame(name, 0, 0, pin.SE3(rotation, position), pin.FrameType.OP_FRAME))
 
     for body in root.iter("body"):
         for site in body.findall("site"):
