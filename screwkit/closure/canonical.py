@@ -14,8 +14,9 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
   points are the revolutes of a universal or ball joint, where their axes meet a neighbour's (at most
   :data:`~screwkit.common.tolerances.MEETING` apart; drawn apart, at an angle whose squared sine is above
   :data:`~screwkit.common.tolerances.PARALLEL_FOOT` too). The meetings are taken in order of how many of the chain's
-  axes pass through them, then of how clear their angle is; one is kept unless either axis has kept one of a higher
-  rank, and an axis that keeps two (a tie) takes their mean (:func:`_points`);
+  axes pass through them, then of how clear their angle is; one is kept unless either axis has already kept one of a
+  higher rank at another point, and an axis that keeps two (a tie) takes their mean (:func:`_points`); a universal
+  or spherical loop joint's DoFs sit at its centre before any of this;
 * a line takes the foot, on its axis, of the common perpendicular with each neighbour in the chain (the joint
   before it and the one after it) that is a line whose axis is not nearly parallel to its own (squared sine above
   :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), and the foot of the perpendicular from each neighbour that is a
