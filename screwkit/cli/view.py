@@ -274,7 +274,7 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
     if pose is not None and motion.path is not None:
         raise fail("--pose is the pose of one view (or the x y of --sweep-phi), and a path gives its own poses: leave "
                    "--pose out.")
-    serving = []  # [True] from the moment the URL is shown
+    serving = []  # [True] from the moment the URL is about to be shown
     with _stopped_by_signals():  # from the start: the Meshcat server is started while drawing
         try:
             _view(mechanism, pose, failed, html_path, motion, colouring, reading, open_browser, quiet, serving)
@@ -290,7 +290,7 @@ def view(mechanism: str, pose, failed, html_path, motion: Motion, colouring: Col
 def _view(mechanism, pose, failed, html_path, motion: Motion, colouring: Colouring, reading, open_browser,
           quiet, serving: list) -> None:
     """The command once its outputs are checked: returns once the HTML is written; serves until the server stops
-    (an error) or a signal ends it (``serving`` gets True once the URL is shown)."""
+    (an error) or a signal ends it (``serving`` gets True just before the URL is shown)."""
     loaded = load_mechanism(mechanism, reading, graphs=True)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
@@ -317,8 +317,8 @@ def _view(mechanism, pose, failed, html_path, motion: Motion, colouring: Colouri
             if not quiet:
                 echo_error(f"wrote {written}")
             return
+        serving.append(True)  # before the line: a signal sent once it is read finds the view served
         echo_error(f"Serving at {scene.url} (127.0.0.1 only); press Ctrl+C to stop.")
-        serving.append(True)
         if open_browser:
             scene.viewer.open()
         while scene.server.running:
