@@ -268,6 +268,19 @@ def test_sites_under_a_hinge_drawn_off_its_bodys_origin_are_placed_as_mujoco_pla
     assert assert_placed_as_mujoco(written(tmp_path, OFFSET_SITES)) == 2 * (3 + 7)
 
 
+def test_a_site_whose_fromto_has_no_length_is_refused_naming_it_as_mujoco_refuses_it(tmp_path):
+    """A site's ``fromto`` gives its orientation only through its segment: one of no length is refused, by MuJoCo
+    and in one line by the command, naming the site."""
+    text = OFFSET_SITES.replace('fromto="0 0 0 0.1 0.2 0.3"', 'fromto="0.1 0.2 0.3 0.1 0.2 0.3"')
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
+    path = written(tmp_path, text)
+    with pytest.raises(ImportError_, match=re.escape("robot.xml: <site name='segment'>: the fromto segment is the "
+                                                     "zero vector")):
+        read_mjcf(path)
+    one_line_error(screwkit("analyze", path), "robot.xml", "<site name='segment'>", "fromto", "zero vector")
+
+
 def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_the_same_robot(tmp_path):
     """The CAD Stewart platform with every hinge's ``pos`` moved along its axis (up to 5 cm): its output site
     ``tool`` sits under the last hinge of a leg. Bodies and sites where MuJoCo has them, the same home pose, and the

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
-from screwkit.io.mjcf_pose import local_pose, rotation_matrix
+from screwkit.io.mjcf_pose import rotation_matrix, site_pose
 from screwkit.io.mjcf_text import MjcfError, closure_placements, prepared_mjcf
 
 __all__ = ["read_mjcf", "sites_placed"]
@@ -63,7 +63,10 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                    f"(MuJoCo fills a short one from qpos0, Pinocchio does not); numbers given: {keys}."
                                    ) from None
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
-    sites_placed(model, root)
+    try:
+        sites_placed(model, root)
+    except MjcfError as error:
+        raise ImportError_(f"{source}: {error}") from None
     references = {item.key(): np.array(item.data()) for item in model.referenceConfigurations}
     qpos0 = np.asarray(references.get("qpos0", pin.neutral(model)), dtype=float)
     data = model.createData()
@@ -108,8 +111,9 @@ def sites_placed(model, root) -> None:
         for site in world.findall("site"):
             name = site.get("name")
             if name is not None and not model.existFrame(name, pin.FrameType.OP_FRAME):
-                position, rotation = _site_pose(site)
-                model.addFrame(pin.Frame(name, 0, 0, pin.SE3(rotation, position), pin.FrameType.OP_FRAME))
+                position, quaternion = site_pose(site)
+                model.addFrame(pin.Frame(name, 0, 0, pin.SE3(rotation_matrix(quaternion), position),
+                                         pin.FrameType.OP_FRAME))
 
     for body in root.iter("body"):
         for site in body.findall("site"):
@@ -121,23 +125,6 @@ def sites_placed(model, root) -> None:
             parent = model.frames[frame.parentFrame]
             if parent.type != pin.FrameType.BODY or body.get("name") not in (None, parent.name):
                 continue  # not the frame of the site's body (Pinocchio names an unnamed body itself)
-            position, rotation = _site_pose(site)
-            frame.placement = parent.placement * pin.SE3(rotation, position)
+            position, quaternion = site_pose(site)
+            frame.placement = parent.placement * pin.SE3(rotation_matrix(quaternion), position)
             model.frames[index] = frame
-
-
-def _site_pose(site) -> tuple:
-    """A site's position and rotation matrix in its body: its ``fromto`` segment's midpoint, its z axis from the
-    segment's end to its start (the shortest turn from z, as MuJoCo turns it), else its ``pos`` and ``quat``."""
-    if site.get("fromto") is None:
-        position, quaternion = local_pose(site)
-        return position, rotation_matrix(quaternion)
-    ends = np.array([float(word) for word in site.get("fromto").split()]).reshape(2, 3)
-    along = ends[0] - ends[1]
-    along = along / np.linalg.norm(along)
-    axis, cosine = np.cross([0.0, 0.0, 1.0], along), float(along[2])
-    if np.linalg.norm(axis) < 1e-14:  # along z or against it (MuJoCo turns by pi about x)
-        return ends.mean(axis=0), np.eye(3) if cosine > 0 else np.diag([1.0, -1.0, -1.0])
-    axis = axis / np.linalg.norm(axis)
-    half = 0.5 * np.arccos(np.clip(cosine, -1.0, 1.0))
-    return ends.mean(axis=0), rotation_matrix(np.concatenate([[np.cos(half)], np.sin(half) * axis]))

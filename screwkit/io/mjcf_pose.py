@@ -23,7 +23,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["MjcfError", "MIN_AXIS", "describe", "class_attributes", "euler_sequence", "quaternion_product",
-           "rotation_matrix", "orientations_as_quaternions", "local_pose", "defaults_written", "frames_flattened"]
+           "rotation_matrix", "orientations_as_quaternions", "local_pose", "site_pose", "defaults_written",
+           "frames_flattened"]
 
 MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
@@ -170,6 +171,16 @@ def local_pose(element: ElementTree.Element) -> tuple[NDArray, NDArray]:
         return np.array([float(word) for word in text.split()] if text else default, dtype=float)
 
     return numbers("pos", (0.0, 0.0, 0.0)), numbers("quat", (1.0, 0.0, 0.0, 0.0))
+
+
+def site_pose(site: ElementTree.Element) -> tuple[NDArray, NDArray]:
+    """A site's ``pos`` and ``quat`` in its body, as MuJoCo places it: for a ``fromto``, the segment's midpoint and
+    the smallest turn taking z from the segment's end to its start (as a ``zaxis``); else :func:`local_pose`."""
+    if site.get("fromto") is None:
+        return local_pose(site)
+    ends = np.array([float(word) for word in site.get("fromto").split()]).reshape(2, 3)
+    along = _unit(ends[0] - ends[1], "fromto segment", describe(site))
+    return ends.mean(axis=0), _alternative_quaternion("zaxis", along, False, "xyz", describe(site))
 
 
 def _text(values: NDArray) -> str:
