@@ -300,6 +300,11 @@ def _idle_about_the_meeting_point(legs: list[_Leg], normal: NDArray | None) -> b
     return True
 
 
+def _in_plane(vector: NDArray, normal: NDArray | None) -> NDArray:
+    """``vector`` without its component along the plane's ``normal`` (all of it in space: no normal)."""
+    return vector if normal is None else vector - (vector @ normal) * normal
+
+
 def _origin(matrix: NDArray) -> dict:
     return dict(zip(("xyz", "rpy"), _pose(matrix)))
 
@@ -429,9 +434,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         _planar_loops(legs, normal)
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
-    gaps = [c - centres[0] if normal is None else (c - centres[0]) - ((c - centres[0]) @ normal) * normal
-            for c in centres]
-    meet = all(np.linalg.norm(gap) < 1e-9 * scale for gap in gaps)
+    meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < 1e-9 * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
@@ -454,9 +457,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
                            "point; they do not.")
     if point:
-        offset = output_world[:3, 3] - centres[0]
-        if normal is not None:  # the distance in the plane of motion
-            offset = offset - (offset @ normal) * normal
+        offset = _in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
         report.output = (f"the point where the chains meet on body {body!r} (closure {tree.closures[0].name!r}), "
                          f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
                          f"frame {frame.name!r}")
