@@ -16,9 +16,10 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from test_io import assert_textbook, five_bar_mjcf, poses_near_home
+from test_io import HOME, assert_textbook, five_bar_mjcf, poses_near_home
+from test_lower_mobility import five_bar_expected
 
-from helpers import assert_indices_close, one_line_error, random_reachable_poses, screwkit
+from helpers import assert_indices_close, one_line_error, random_reachable_poses, random_rotation, screwkit
 from screwkit.io import ImportError_, read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
@@ -296,20 +297,30 @@ def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_th
                          1e-9)
 
 
-def test_a_five_bar_whose_pins_and_closures_are_drawn_along_the_pins_is_the_planar_five_bar(tmp_path):
-    """A leg's distal hinge drawn 0.1 m along its pin and a closure's anchor lifted 0.05 m along it (a CAD export
-    places each pin at its own layer): the chains still meet on the pins' common line, so the mechanism is the planar
-    five-bar with its output point and the textbook pressure angles (before, the closures no longer met at one
-    point, and the platform's idle rotation made the output a frame)."""
-    text = five_bar_mjcf().replace('<joint name="b_1" type="hinge"', '<joint name="b_1" type="hinge" pos="0 0 0.1"')
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_a_five_bar_whose_pins_and_closures_are_drawn_along_the_pins_is_the_planar_five_bar(tmp_path, scale):
+    """A leg's distal hinge drawn 0.1 length units along its pin and a closure's anchor lifted 0.05 along it (a CAD
+    export places each pin at its own layer), in another unit and world frame: the chains still meet on the pins'
+    common line, so the mechanism is the planar five-bar with its output point and the textbook pressure angles
+    (before, the closures no longer met at one point, and the platform's idle rotation made the output a frame)."""
+    rotation = np.eye(3) if scale == 1.0 else random_rotation(np.random.default_rng(int(scale * 1000) % 97))
+    plain = five_bar_mjcf(rotation, scale)
+    pin_axis = rotation @ np.array([0.0, 0.0, 1.0])
+    lifted = " ".join(repr(float(value)) for value in 0.1 * scale * pin_axis)
+    text = plain.replace('<joint name="b_1" type="hinge"', f'<joint name="b_1" type="hinge" pos="{lifted}"')
     anchor = re.search(r'<connect name="loop_2" [^>]*anchor="([^"]+)"', text)
-    x, y, _ = (float(word) for word in anchor.group(1).split())
-    text = text.replace(anchor.group(0), anchor.group(0).replace(anchor.group(1), f"{x!r} {y!r} 0.05"))
-    assert text.count('pos="0 0 0.1"') == 1 and text != five_bar_mjcf()
+    moved = np.array([float(word) for word in anchor.group(1).split()]) + 0.05 * scale * pin_axis
+    text = text.replace(anchor.group(0), anchor.group(0).replace(anchor.group(1), " ".join(map(repr, moved.tolist()))))
+    assert text.count(f'pos="{lifted}"') == 1 and text != plain
     mechanism = load(written(tmp_path, text, "lifted.xml"))
     assert mechanism.is_planar and mechanism.task_coordinates == ("x", "y")
-    points = poses_near_home()
-    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    expected = five_bar_expected(HOME)
+    np.testing.assert_allclose(result.iti_actuators, expected["iti_actuators"], atol=TOLERANCE)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=TOLERANCE)
+    if scale == 1.0:
+        points = poses_near_home()
+        assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
 
 
 def test_a_five_bar_written_with_frames_has_the_indices_of_the_plain_one(tmp_path):
