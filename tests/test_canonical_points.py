@@ -21,7 +21,13 @@ from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
 from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses
-from screwkit.closure.canonical import canonical_geometry, canonical_offsets, joint_lines_at_zero, offsets_along_axes
+from screwkit.closure.canonical import (
+    canonical_geometry,
+    canonical_offsets,
+    chain_extent,
+    joint_lines_at_zero,
+    offsets_along_axes,
+)
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.io.loader import bundled_names, load, load_text
 from screwkit.studies import indices_at_poses
@@ -276,6 +282,46 @@ def test_a_loop_balls_frame_axes_meet_nothing():
     expected = np.array([foot_of_perpendicular(on_axes[0], axes[0], universal), universal, universal, ball, ball,
                          ball])
     np.testing.assert_allclose(canonical_however_drawn(axes, on_axes, seed=6, declared=3), expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("scale", (1e-3, 1.0, 1e3))
+@pytest.mark.parametrize("gap, meets", ((2e-5, False), (5e-6, True)))
+def test_whether_two_axes_meet_does_not_depend_on_where_another_joint_is_drawn(gap, meets, scale):
+    """Three revolutes at right angles: the first two axes pass ``gap`` apart (of a chain 1 long), the last two meet.
+    Two axes meet within 1e-5 of the chain's size; that size is the lines' own, so drawing the first joint far along
+    its axis (up to 100 chain lengths) decides nothing: 2e-5 apart they do not meet and the middle revolute sits where
+    it meets the last, 5e-6 apart they meet and it takes the mean of its two meetings; in any unit."""
+    axes = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    on_axes = scale * np.array([[0.0, 0.0, 0.0], [0.0, gap, 0.0], [1.0, gap, 0.0]])
+    middle = scale * np.array([0.5 if meets else 1.0, gap, 0.0])
+    for along in (0.0, 3.0, -10.0, 100.0):
+        for moved in (0, 2):
+            points = on_axes.copy()
+            points[moved] += scale * along * axes[moved]
+            found = points + offsets_along_axes((False,) * 3, axes, points)[:, None] * axes
+            np.testing.assert_allclose(found, [on_axes[0], middle, on_axes[2]], atol=1e-12 * scale,
+                                       err_msg=f"joint {moved} drawn {along} along its axis")
+
+
+def test_a_chains_extent_is_its_lines_own():
+    """:func:`chain_extent` of random chains (revolutes at random angles, some parallel, a slide, a ball's pairs) is
+    the same however each revolute is drawn along its axis, and scales with the chain; a chain whose axes all pass
+    through one point has no extent of its lines and is measured as drawn."""
+    rng = np.random.default_rng(17)
+    for _ in range(200):
+        count = int(rng.integers(2, 8))
+        axes = unit_rows(rng.normal(size=(count, 3)))
+        if count > 3:
+            axes[2] = axes[1]  # a parallel pair
+        on_axes = rng.normal(size=(count, 3))
+        prismatic = (False, False) + tuple(bool(flag) for flag in rng.random(count - 2) < 0.2)  # two revolutes or more
+        extent = chain_extent(prismatic, axes, on_axes)
+        redrawn = on_axes + rng.uniform(-50.0, 50.0, count)[:, None] * axes * ~np.array(prismatic)[:, None]
+        assert chain_extent(prismatic, axes, redrawn) == pytest.approx(extent, rel=1e-9)
+        assert chain_extent(prismatic, axes, 1e3 * on_axes) == pytest.approx(1e3 * extent, rel=1e-12)
+    axes = unit_rows(rng.normal(size=(4, 3)))
+    drawn = 0.1 * axes  # every axis through the origin, each drawn at 0.1 along it
+    assert chain_extent((False,) * 4, axes, drawn) == pytest.approx(float(np.ptp(drawn, axis=0).max()), rel=1e-12)
 
 
 def every_chain(skew_path):

@@ -12,7 +12,8 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
 
 * each joint of a chain is a **slide** (prismatic: no point), a **point** or a **line** (any other revolute). The
   points are the revolutes of a universal or ball joint, where their axes meet a neighbour's (at most
-  :data:`~screwkit.common.tolerances.MEETING` apart; drawn apart, at an angle whose squared sine is above
+  :data:`~screwkit.common.tolerances.MEETING` times the chain's size apart, a size its lines decide:
+  :func:`chain_extent`; drawn apart, at an angle whose squared sine is above
   :data:`~screwkit.common.tolerances.PARALLEL_FOOT` too). The meetings are taken in order of how many of the chain's
   axes pass through them, then of how clear their angle is; one is kept unless either axis has already kept one of a
   higher rank at another point, and an axis that keeps two (a tie) takes their mean (:func:`_points`); a universal
@@ -50,7 +51,7 @@ from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, MEETING_TIE, PARALLEL_FOOT
 from screwkit.model.chain import LOOP_JOINT_DOFS, ChainGeometry
 
-__all__ = ["joint_lines_at_zero", "canonical_offsets", "offsets_along_axes", "canonical_geometry"]
+__all__ = ["joint_lines_at_zero", "chain_extent", "canonical_offsets", "offsets_along_axes", "canonical_geometry"]
 
 
 def joint_lines_at_zero(geometry: ChainGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -141,13 +142,40 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
     return offsets_along_axes(geometry.dof_prismatic, *joint_lines_at_zero(geometry), declared=declared)
 
 
+def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0) -> float:
+    """The size of a chain that its lines alone decide, the scale of :data:`MEETING`: the spread of the feet of the
+    common perpendiculars of every two revolute axes at a clear angle (squared sine above :data:`PARALLEL_FOOT`) and
+    of the centre of a loop joint at a point (the last ``declared`` DoFs), or the largest distance between two
+    revolute axes when that is larger. Where the file draws a joint along its axis changes none of it; a chain whose
+    every axis passes through one point has none (a spherical chain), and is measured as drawn (the spread of its
+    drawn points), as is a chain whose lines are all that close to one point at that scale."""
+    count = len(prismatic)
+    revolutes = [joint for joint, slide in enumerate(prismatic[:count - declared]) if not slide]
+    anchors = [points[joint] for joint in range(count - declared, count)]
+    gaps = [0.0]
+    for index, joint in enumerate(revolutes):
+        for other in revolutes[index + 1:]:
+            sine2 = float(np.sum(np.cross(axes[joint], axes[other]) ** 2))
+            if sine2 <= AXIS_PARALLEL:  # parallel: the distance between the lines
+                gaps.append(float(np.linalg.norm(np.cross(points[other] - points[joint], axes[joint]))))
+                continue
+            gaps.append(_line_gap(points[joint], axes[joint], points[other], axes[other]))
+            if sine2 > PARALLEL_FOOT:
+                anchors += [_foot_on_line(points[joint], axes[joint], points[other], axes[other]),
+                            _foot_on_line(points[other], axes[other], points[joint], axes[joint])]
+    spread = float(np.ptp(anchors, axis=0).max()) if len(anchors) > 1 else 0.0
+    drawn = float(np.ptp(points, axis=0).max()) if count else 0.0
+    lines = max(spread, max(gaps))
+    return lines if lines > MEETING * drawn else drawn
+
+
 def offsets_along_axes(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0
                        ) -> NDArray[np.float64]:
     """:func:`canonical_offsets` of a chain's joints given as lines: which are slides, unit axes (m, 3) and drawn
     points (m, 3), consecutive in the chain, the last ``declared`` of them the DoFs of a loop joint at a point (a
     universal or spherical loop joint, whose axes are only its frame's). Shape (m,)."""
     count = len(prismatic)
-    extent = float(np.ptp(points, axis=0).max()) if count else 0.0  # the chain's size as drawn
+    extent = chain_extent(prismatic, axes, points, declared)
     canonical = _points(prismatic, axes, points, extent, declared)
     is_point = [found is not None for found in canonical]
     lines = [joint for joint in range(count) if not prismatic[joint] and not is_point[joint]]

@@ -70,9 +70,9 @@ apart (working coordinates); with axes that are not parallel they are a universa
 characteristic point is that point, not a line (:func:`screwkit.screw.algebra.joint_lines`)."""
 
 MEETING = 1e-5
-"""Relative to a chain's extent: two neighbouring revolutes of a chain whose axes are not parallel and pass at most
-this far apart meet, a universal or ball joint (:mod:`screwkit.closure.canonical`); loose enough for a file whose
-lengths are rounded to six decimals."""
+"""Relative to a chain's extent (its lines' own, :func:`screwkit.closure.canonical.chain_extent`): two neighbouring
+revolutes of a chain whose axes are not parallel and pass at most this far apart meet, a universal or ball joint
+(:mod:`screwkit.closure.canonical`); loose enough for a file whose lengths are rounded to six decimals."""
 
 PARALLEL_FOOT = 1e-2
 """Squared sine: two neighbouring revolute axes of a chain are too near parallel (within 5.7 degrees) for the foot of
