@@ -60,7 +60,7 @@ def written(tmp_path: Path, text: str, name: str = "robot.xml") -> Path:
 
 def assert_placed_as_mujoco(path: Path, seed: int = 0) -> int:
     """Every body and site of MuJoCo's reading of ``path`` is where screwkit's tree has it, at ``qpos0`` and at a
-    random configuration (hinges and slides); returns how many were compared."""
+    random configuration (hinges, slides, ball and free joints); returns how many were compared."""
     mj_model = mujoco.MjModel.from_xml_path(str(path))
     mj_data = mujoco.MjData(mj_model)
     tree = read_mjcf(path)
@@ -68,13 +68,20 @@ def assert_placed_as_mujoco(path: Path, seed: int = 0) -> int:
     rng = np.random.default_rng(seed)
     compared = 0
     for qpos in (mj_model.qpos0.copy(), mj_model.qpos0 + rng.uniform(-1.0, 1.0, mj_model.nq)):
-        mj_data.qpos[:] = qpos
-        mujoco.mj_kinematics(mj_model, mj_data)
         q = pin.neutral(model)
         for k in range(mj_model.njnt):
-            assert int(mj_model.jnt_type[k]) in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
-            name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, k)
-            q[model.joints[model.getJointId(name)].idx_q] = qpos[mj_model.jnt_qposadr[k]]
+            kind, start = int(mj_model.jnt_type[k]), int(mj_model.jnt_qposadr[k])
+            position = model.joints[model.getJointId(mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, k))].idx_q
+            if kind in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+                q[position] = qpos[start]
+                continue
+            linear = 3 if kind == int(mujoco.mjtJoint.mjJNT_FREE) else 0  # a free joint: position, then quaternion
+            turn = slice(start + linear, start + linear + 4)
+            quaternion = qpos[turn] / np.linalg.norm(qpos[turn])
+            qpos[turn] = quaternion
+            q[position:position + linear + 4] = [*qpos[start:start + linear], *quaternion[1:], quaternion[0]]
+        mj_data.qpos[:] = qpos
+        mujoco.mj_kinematics(mj_model, mj_data)
         pin.framesForwardKinematics(model, data, q)
         kinds = ((mujoco.mjtObj.mjOBJ_BODY, range(1, mj_model.nbody), mj_data.xpos, mj_data.xmat, pin.FrameType.BODY),
                  (mujoco.mjtObj.mjOBJ_SITE, range(mj_model.nsite), mj_data.site_xpos, mj_data.site_xmat,

@@ -8,8 +8,9 @@ tendon or flex coupling (``<equality><joint>``...: screwkit does not model coupl
 (a ball joint) and every ``<weld>`` a ``6d`` one, their frames placed as MuJoCo places them
 (:func:`~screwkit.io.mjcf_text.closure_placements`: a weld's ``relpose``, a connect's ``anchor``, or sites).
 The joints driven by ``<actuator>`` elements (``motor``, ``position``, ``velocity``, ``general``..., by their
-``joint`` attribute) are the actuated joints. Reference joint values are ``qpos0`` (the joints' ``ref``), or
-the keyframe named ``home`` when there is one.
+``joint`` attribute) are the actuated joints. A free body's joint is placed at the world's origin, its
+coordinates being its pose in the world (MuJoCo's reading; Pinocchio 4.1 offsets a turned free body).
+Reference joint values are ``qpos0`` (the joints' ``ref``), or the keyframe named ``home`` when there is one.
 """
 
 from __future__ import annotations
@@ -63,6 +64,9 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                    f"(MuJoCo fills a short one from qpos0, Pinocchio does not); numbers given: {keys}."
                                    ) from None
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
+    for joint in range(1, model.njoints):  # a free body's coordinates are its pose in the world (MuJoCo's)
+        if model.joints[joint].shortname() == "JointModelFreeFlyer" and model.parents[joint] == 0:
+            model.jointPlacements[joint] = pin.SE3.Identity()  # Pinocchio 4.1 offsets a turned one by (I - R) p
     try:
         sites_placed(model, root)
     except MjcfError as error:

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 __all__ = ["MjcfError", "MIN_AXIS", "describe", "class_attributes", "euler_sequence", "quaternion_product",
            "rotation_matrix", "orientations_as_quaternions", "local_pose", "site_pose", "defaults_written",
-           "frames_flattened"]
+           "frames_flattened", "joints_one_per_body"]
 
 MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
@@ -187,9 +187,12 @@ def _text(values: NDArray) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-def defaults_written(root: ElementTree.Element) -> None:
-    """Every site's and joint's pose (``pos`` and ``quat``, ``pos`` and ``axis``) written on it when its class
-    gives it (Pinocchio does not read a site's class defaults; a frame's children are then composed from them)."""
+def defaults_written(root: ElementTree.Element, path: Path | str = "") -> None:
+    """Every site's and joint's pose (``pos`` and ``quat`` or ``fromto``, ``pos`` and ``axis``) written on it when its
+    class gives it (Pinocchio does not read a site's class defaults; a frame's children are then composed from
+    them). A site with a ``fromto``, its own or its class's, is placed by it alone, as MuJoCo places it (its
+    orientation left out); MuJoCo refuses one that also has a ``pos`` from anywhere, or that is not a capsule,
+    cylinder, box or ellipsoid, and so does this."""
     defaults = {tag: class_attributes(root, tag) for tag in ("site", "joint")}
     wanted = {"site": ("pos", "quat"), "joint": ("pos", "axis")}
 
@@ -197,13 +200,30 @@ def defaults_written(root: ElementTree.Element) -> None:
         for child in element:
             if child.tag in wanted:
                 given = defaults[child.tag].get(child.get("class") or childclass, {})
-                for attribute in wanted[child.tag]:
-                    if child.get(attribute) is None and given.get(attribute) is not None:
-                        child.set(attribute, given[attribute])
+                if child.tag == "site" and (child.get("fromto") or given.get("fromto")) is not None:
+                    _fromto_site(child, given, path)
+                else:
+                    for attribute in wanted[child.tag]:
+                        if child.get(attribute) is None and given.get(attribute) is not None:
+                            child.set(attribute, given[attribute])
             visit(child, child.get("childclass", childclass) if child.tag in ("body", "frame") else childclass)
 
     for world in root.findall("worldbody"):
         visit(world, "main")
+
+
+def _fromto_site(site: ElementTree.Element, given: dict[str, str], path: Path | str) -> None:
+    """A site placed by a ``fromto`` (its own, else its class's), written on it alone, or refused as MuJoCo refuses
+    it."""
+    where = f"{path}: {describe(site)}" if path else describe(site)
+    if (site.get("pos") or given.get("pos")) is not None:
+        raise MjcfError(f"{where}: both pos and fromto, from the site or its class (MuJoCo refuses it).")
+    kind = site.get("type") or given.get("type", "sphere")
+    if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
+        raise MjcfError(f"{where}: a fromto on a site of type '{kind}': MuJoCo takes one on a capsule, cylinder, box "
+                        "or ellipsoid only (and refuses the file).")
+    site.set("fromto", site.get("fromto") or given["fromto"])
+    site.attrib.pop("quat", None)  # MuJoCo places such a site by its segment alone
 
 
 def frames_flattened(root: ElementTree.Element) -> int:
@@ -222,6 +242,11 @@ def frames_flattened(root: ElementTree.Element) -> int:
             if child.tag == "joint":
                 axis = np.array([float(word) for word in child.get("axis", "0 0 1").split()])
                 child.set("axis", _text(rotation @ axis))
+            if child.tag == "site" and child.get("fromto") is not None:  # its pose in the frame, then composed
+                pos, quat = site_pose(child)
+                del child.attrib["fromto"]
+                child.set("pos", _text(pos))
+                child.set("quat", _text(quat))
             if child.tag in ORIENTED or child.tag == "joint":
                 pos, quat = local_pose(child)
                 child.set("pos", _text(position + rotation @ pos))
@@ -248,3 +273,44 @@ def frames_flattened(root: ElementTree.Element) -> int:
     for world in root.findall("worldbody"):
         visit(world, "main")
     return count
+
+
+def joints_one_per_body(root: ElementTree.Element) -> list[str]:
+    """Every body with several joints written as nested bodies with one joint each, at its frame, the last one keeping
+    the body's name and everything else it holds; returns those bodies' names. MuJoCo turns a body by its joints in
+    the order written, each about its own axis through its own ``pos`` in the body's frame as turned by the joints
+    before it, which is the motion of these nested bodies; Pinocchio 4.1 makes one composite joint of them, which
+    moves the body otherwise and no longer has the joints' names. Run after :func:`frames_flattened`."""
+    taken = {element.get("name") for element in root.iter("body")}
+    split = []
+    for body in list(root.iter("body")):
+        joints = [child for child in body if child.tag in ("joint", "freejoint")]
+        if len(joints) < 2:
+            continue
+        attributes = dict(body.attrib)
+        name = attributes.get("name") or f"body_{len(split) + 1}"
+        split.append(name)
+        kept = [child for child in body if child.tag not in ("joint", "freejoint")]
+        for child in list(body):
+            body.remove(child)
+        outer = body
+        for index, joint in enumerate(joints):
+            if index == len(joints) - 1:  # the body itself, at the frame the joints before it turned
+                inner = ElementTree.SubElement(outer, "body", {key: value for key, value in attributes.items()
+                                                               if key not in ("pos", "quat", "mocap")})
+                inner.append(joint)
+                inner.extend(kept)
+                break
+            inner = outer if index == 0 else ElementTree.SubElement(outer, "body")
+            shell = f"{name}__{joint.get('name') or index}"
+            while shell in taken:
+                shell += "_"
+            taken.add(shell)
+            inner.set("name", shell)
+            if attributes.get("childclass") is not None:
+                inner.set("childclass", attributes["childclass"])
+            # an inertia of its own: Pinocchio asks one of every body when <compiler inertiafromgeom="false">
+            ElementTree.SubElement(inner, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+            inner.append(joint)
+            outer = inner
+    return split

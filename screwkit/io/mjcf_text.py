@@ -3,8 +3,8 @@
 Pinocchio's ``buildModelAndConstraintsFromMJCF`` reads the kinematic tree, but not everything a published
 MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML first, saying what it did:
 
-* ``<include file=...>`` elements are replaced by the included file's content (paths relative to the
-  including file, as MuJoCo resolves them);
+* ``<include file=...>`` elements are replaced by the included file's content (paths relative to the main
+  file's folder, a nested include's too, as MuJoCo resolves them);
 * several bodies under ``<worldbody>`` (a robot beside a camera rig, two halves of a mechanism) are wrapped in
   one body at the origin (Pinocchio reads only the first);
 * unnamed ``<connect>``/``<weld>`` elements are named (Pinocchio merges unnamed ones);
@@ -12,10 +12,13 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
   ``range``, ``ref`` and ``springref``;
 * every ``euler``, ``axisangle``, ``xyaxes`` and ``zaxis`` becomes the ``quat`` MuJoCo computes from it
   (``<compiler angle>`` and ``eulerseq`` honoured, axes normalised), and every ``<frame>``'s children are
-  lifted to its parent, the frame's pose composed into theirs (:mod:`screwkit.io.mjcf_pose`);
+  lifted to its parent, the frame's pose composed into theirs (:mod:`screwkit.io.mjcf_pose`); a site's
+  ``fromto`` from its class is written on it; a body with several joints becomes nested bodies with one joint
+  each (:func:`~screwkit.io.mjcf_pose.joints_one_per_body`; Pinocchio would make one composite joint of them);
 * several ``<compiler>`` elements are read as one (MuJoCo applies them all);
 * several top-level ``<default>``, ``<equality>``, ``<actuator>`` sections are merged (MuJoCo merges them;
-  Pinocchio reads the first);
+  Pinocchio reads the first): the top class's element defaults take every section's attributes, a later one's
+  winning;
 * what kinematics does not need and Pinocchio cannot always read is left out: geoms, assets, plugins,
   cameras, lights, sensors, tendons, contacts (a mechanism's bodies, joints, sites, inertias and closures are
   all that is read).
@@ -50,6 +53,7 @@ from screwkit.io.mjcf_pose import (
     describe,
     euler_sequence,
     frames_flattened,
+    joints_one_per_body,
     orientations_as_quaternions,
     rotation_matrix,
 )
@@ -63,8 +67,8 @@ NOT_KINEMATICS = ("geom", "asset", "plugin", "extension", "camera", "light", "se
 PLACEMENT_ATTRIBUTES = ("pos", "quat", "axisangle", "euler", "xyaxes", "zaxis")
 """How a body is placed in its parent (MJCF): on the one body under ``<worldbody>``, they move the whole robot."""
 NUMBER_COUNTS = {"pos": (3,), "quat": (4,), "axis": (3,), "euler": (3,), "axisangle": (4,), "xyaxes": (6,),
-                 "zaxis": (3,), "anchor": (3,), "relpose": (7,), "range": (2,), "ref": (1,), "springref": (1,),
-                 "gear": (1, 2, 3, 4, 5, 6)}
+                 "zaxis": (3,), "fromto": (6,), "anchor": (3,), "relpose": (7,), "range": (2,), "ref": (1,),
+                 "springref": (1,), "gear": (1, 2, 3, 4, 5, 6)}
 """How many numbers each attribute that places a body, a joint or a closure holds (MuJoCo refuses the file
 otherwise; a reader that took the numbers it could would place the mechanism somewhere else)."""
 NAMESPACES = {"body": "body", "joint": "joint", "freejoint": "joint", "site": "site"}
@@ -106,7 +110,7 @@ def _resolve_includes(element: ElementTree.Element, folder: Path, stack: tuple[P
         included = _parse(path)
         if included.tag != "mujoco":
             raise MjcfError(f"{path}: an included file's root must be <mujoco>, got <{included.tag}>.")
-        _resolve_includes(included, path.parent, stack + (path,))
+        _resolve_includes(included, folder, stack + (path,))  # nested ones too: the main file's folder
         element.remove(child)
         for offset, grandchild in enumerate(list(included)):
             element.insert(position + offset, grandchild)
@@ -120,6 +124,41 @@ def _merged(root: ElementTree.Element, tag: str) -> ElementTree.Element | None:
             found[0].append(child)
         root.remove(extra)
     return found[0] if found else None
+
+
+def _defaults_merged(root: ElementTree.Element, path: Path) -> None:
+    """Several top-level ``<default>`` sections read as MuJoCo reads them: one top class, ``main``, whose element
+    defaults take every section's attributes (a later one's winning) and which holds every section's classes;
+    refused as MuJoCo refuses them: a top section of another class, a class name twice, an element twice in one
+    class. The top class is named ``main`` in the text (Pinocchio knows it by that name only then)."""
+    tops = root.findall("default")
+    for top in tops:
+        if top.get("class", "main") != "main":
+            raise MjcfError(f"{path}: top-level <default class='{top.get('class')}'>: the top class is 'main' and "
+                            "cannot be renamed (MuJoCo refuses it); nest the class in a <default>.")
+    seen: set[str] = set()
+    for default in (nested for top in tops for nested in top.iter("default")):
+        name = default.get("class", "main")
+        if name in seen and default not in tops:
+            raise MjcfError(f"{path}: <default class='{name}'>: a class name given twice (MuJoCo refuses it).")
+        seen.add(name)
+        tags = [child.tag for child in default if child.tag != "default"]
+        for tag in {tag for tag in tags if tags.count(tag) > 1}:
+            raise MjcfError(f"{path}: <default class='{name}'> holds more than one <{tag}> (MuJoCo refuses it).")
+    if not tops:
+        if any("main" in (element.get("class"), element.get("childclass")) for element in root.iter()):
+            root.insert(1, ElementTree.Element("default", {"class": "main"}))
+        return
+    first = tops[0]
+    for later in tops[1:]:
+        for child in list(later):
+            own = first.find(child.tag) if child.tag != "default" else None
+            if own is None:
+                first.append(child)
+            else:
+                own.attrib.update(child.attrib)
+        root.remove(later)
+    first.set("class", "main")
 
 
 def _class_joints(root: ElementTree.Element) -> dict[str, dict[str, str]]:
@@ -263,6 +302,29 @@ def _check_names(root: ElementTree.Element, path: Path) -> None:
                 claim(element, space)
 
 
+def _placed_in(element: ElementTree.Element, tag: str):
+    """The ``tag`` children of ``element``, those of its ``<frame>`` children (at any depth) included."""
+    for child in element:
+        if child.tag == tag:
+            yield child
+        if child.tag == "frame":
+            yield from _placed_in(child, tag)
+
+
+def _check_free_bodies(root: ElementTree.Element, path: Path) -> None:
+    """A free joint or a mocap body only where MuJoCo takes them: on a body of ``<worldbody>`` itself."""
+    free = {id(joint) for joint, attributes in _joints(root) if attributes.get("type") == "free"}
+    for world in root.findall("worldbody"):
+        top = set(_placed_in(world, "body"))
+        for body in world.iter("body"):
+            joints = [*_placed_in(body, "joint"), *_placed_in(body, "freejoint")]
+            found = (("a free joint", any(j.tag == "freejoint" or id(j) in free for j in joints)),
+                     ("a mocap body", body.get("mocap") == "true"))
+            for what in (what for what, present in found if present and body not in top):
+                raise MjcfError(f"{path}: {describe(body)}: {what} inside another body; MuJoCo takes it only on a "
+                                "body of <worldbody> (and refuses the file).")
+
+
 def _check_joints(root: ElementTree.Element, path: Path, autolimits: bool) -> list[str]:
     """The joints' axes and ranges, refused where MuJoCo refuses them; a range MuJoCo does not apply
     (``limited="false"``; with autolimits, one that is no interval) is dropped, since Pinocchio would apply it.
@@ -321,7 +383,10 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     if angle not in ("degree", "radian"):
         raise MjcfError(f"{path}: <compiler angle='{angle}'>: expected degree or radian.")
     sequence = euler_sequence(compiler, path)
-    _merged(root, "default")
+    if compiler.get("coordinate", "local") != "local":
+        raise MjcfError(f"{path}: <compiler coordinate='{compiler.get('coordinate')}'>: global coordinates are no "
+                        "longer read by MuJoCo (since 2.3.3; it refuses the file): write it in local coordinates.")
+    _defaults_merged(root, path)
     equality = _merged(root, "equality")
     ignored = _check_equalities(root, equality, path)  # before the tendons go: <equality><tendon> is one
     if ignored:
@@ -333,11 +398,16 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     _check_numbers(root, path)
     _check_keys(root, path)
     _check_names(root, path)
+    _check_free_bodies(root, path)
     in_degrees = orientations_as_quaternions(root, angle == "degree", sequence, path)
-    defaults_written(root)
+    defaults_written(root, path)
     frames = frames_flattened(root)
     if frames:
         notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
+    split = joints_one_per_body(root)
+    if split:
+        notes.append(f"bodies with several joints ({', '.join(split)}) read as MuJoCo composes them: nested bodies "
+                     "with one joint each, the body's name on the last")
     dropped = _check_joints(root, path, compiler.get("autolimits", "true") == "true")
     if dropped:
         notes.append(f"range not applied, as MuJoCo does not (limited='false', or not an interval): "

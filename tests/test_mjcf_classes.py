@@ -1,0 +1,235 @@
+"""MJCF class defaults, several default sections, sites given by ``fromto``, bodies with several joints, free bodies
+and nested includes, read as MuJoCo reads them.
+
+Every placement is checked against MuJoCo's own reading of the same file (``assert_placed_as_mujoco``: every body and
+site at ``qpos0`` and at a random configuration), every index against the same robot written plainly (the five-bar's
+closed-form pressure angles, the gallery's Stewart platform), every refusal against MuJoCo's refusal of the file.
+"""
+
+from __future__ import annotations
+
+import re
+from xml.etree import ElementTree
+
+import mujoco
+import numpy as np
+import pytest
+from test_io import HOME, five_bar_mjcf
+from test_lower_mobility import five_bar_expected
+from test_mjcf_reading import INERTIA, STEWART, assert_placed_as_mujoco, written
+
+from helpers import assert_indices_close, one_line_error, random_reachable_poses, random_rotation, screwkit
+from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.io.mjcf import read_mjcf
+from screwkit.studies.poses import indices_at_pose, indices_at_poses
+
+SECTIONS = """<mujoco model="sections"><compiler angle="radian"/>
+<default><site euler="0 0 1" pos="0 0 1"/><joint pos="0 0.02 0"/><default class="a"><site pos="0.1 0 0"/></default>
+</default>
+<default><site pos="0 0.1 0"/><joint axis="0.6 0 0.8"/><default class="b"><joint pos="0.03 0 0"/></default></default>
+<worldbody><body name="b0" pos="0.1 0 0">""" + INERTIA + """<joint name="j0"/><site name="s0"/>
+ <body name="b1" pos="0.3 0 0" childclass="b">""" + INERTIA + """<joint name="j1"/><site name="sa" class="a"/>
+  <site name="sb"/></body></body></worldbody><actuator><motor joint="j0"/><motor joint="j1"/></actuator></mujoco>"""
+"""Two top-level default sections, each with attributes of the top class (one of them in both) and a class."""
+
+
+def test_several_default_sections_are_one_top_class_as_mujoco_reads_them(tmp_path):
+    """MuJoCo reads every top-level ``<default>`` as the top class, a later section's attributes winning, and its
+    classes inherit them all; screwkit read only the first section's (Pinocchio's reading): bodies and sites off by
+    up to the length of the chain."""
+    assert assert_placed_as_mujoco(written(tmp_path, SECTIONS)) == 2 * (2 + 3)
+
+
+def test_a_five_bar_whose_hinge_axes_come_from_a_second_default_section_has_the_textbook_angles(tmp_path):
+    """The five-bar turned in space, its hinges given no axis and the pins' axis given in a second default section
+    (as a file that includes a defaults file has it): the textbook pressure angles near home (before, every hinge
+    turned about z: an ITI of 0.961 for 0.9998)."""
+    rotation = random_rotation(np.random.default_rng(5))
+    text = five_bar_mjcf(rotation)
+    axis = re.search(r' axis="([^"]+)"', text).group(1)
+    text = text.replace(f' axis="{axis}"', "").replace(
+        '<compiler angle="radian"/>', f'<compiler angle="radian"/><default><joint damping="0.1"/></default>'
+                                      f'<default><joint axis="{axis}"/></default>')
+    assert "axis" not in text.split("</default>")[-1]
+    path = written(tmp_path, text, "sections.xml")
+    assert_placed_as_mujoco(path)
+    mechanism = load(path)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    expected = five_bar_expected(HOME)
+    np.testing.assert_allclose(result.iti_actuators, expected["iti_actuators"], atol=1e-9)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=1e-9)
+
+
+FROMTO = """<mujoco model="fromto"><compiler angle="radian"/>
+<default><default class="rod"><site type="capsule" size="0.01" fromto="0.1 0.2 0.3 0.3 0 0.1"/></default></default>
+<worldbody><body name="b0" pos="0.1 0 0" quat="0.9 0.1 0.3 0.2">""" + INERTIA + """<joint name="j0" axis="0 0 1"/>
+ <site name="by_class" class="rod"/><site name="own_turn_ignored" class="rod" quat="0 1 0 0"/>
+ <frame pos="0.05 0.1 0" euler="0.3 0.2 0.1"><site name="in_frame" class="rod"/>
+  <site name="own_in_frame" type="box" size="0.01 0.01 0.01" fromto="0 0 0 0 0.2 0.1"/></frame>
+ <body name="b1" pos="0.3 0 0" childclass="rod">""" + INERTIA + """<joint name="j1" axis="0 1 0"/>
+  <site name="by_child"/></body></body></worldbody>
+<actuator><motor joint="j0"/><motor joint="j1"/></actuator></mujoco>"""
+"""Sites placed by a ``fromto`` from a class (by ``class`` and by ``childclass``), one with an orientation of its own
+that the segment overrides, and two inside a turned frame."""
+
+
+def test_sites_given_by_a_fromto_of_their_class_or_in_a_frame_are_placed_as_mujoco_places_them(tmp_path):
+    """Before, a class's ``fromto`` was not read (the site sat at its body's origin) and a site with a ``fromto``
+    inside a ``<frame>`` was refused by Pinocchio ('both pos and fromto')."""
+    assert assert_placed_as_mujoco(written(tmp_path, FROMTO)) == 2 * (2 + 5)
+
+
+def test_a_stewart_platform_whose_output_site_comes_from_a_class_fromto_is_the_same_robot(tmp_path):
+    """The CAD Stewart platform's output site ``tool`` given by a class's ``fromto``: a short segment along the
+    platform's z, centred where the file has the site, which turns the site by nothing (MuJoCo turns a site's z to
+    point from the segment's end to its start). The same home pose and indices as the file (before, ``tool`` sat
+    0.118 m away, at the platform body's origin)."""
+    site = re.search(r'<site name="tool" pos="([^"]+)"/>', STEWART.read_text())
+    x, y, z = (float(word) for word in site.group(1).split())
+    segment = f"{x!r} {y!r} {z + 0.01!r} {x!r} {y!r} {z - 0.01!r}"
+    text = STEWART.read_text().replace(site.group(0), '<site name="tool" class="tip"/>').replace(
+        '<default class="spin">', f'<default class="tip"><site type="capsule" size="0.005" fromto="{segment}"/>'
+                                  '</default><default class="spin">')
+    path = written(tmp_path, text, "stewart_class_fromto.xml")
+    assert assert_placed_as_mujoco(path) == assert_placed_as_mujoco(STEWART)
+    mechanism, other = load(STEWART), load(path)
+    np.testing.assert_allclose(other.home_pose, mechanism.home_pose, rtol=0, atol=1e-12)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(3), 12)
+    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
+                         1e-9)
+
+
+def merged_joints(text: str) -> str:
+    """The MJCF with every body of one joint and no site whose only child body has one joint and sits at its origin
+    unturned merged into that child (which keeps its name and takes the body's place and joint, first): a universal
+    joint written as two hinges in one body, a cylindrical joint as a slide and a hinge. The same robot for MuJoCo."""
+    root = ElementTree.fromstring(text)
+    parents = {child: parent for parent in root.iter() for child in parent}
+    for body in list(root.iter("body")):
+        children = body.findall("body")
+        joints = body.findall("joint")
+        if len(children) != 1 or len(joints) != 1 or body.findall("site") or body not in parents:
+            continue
+        inner = children[0]
+        if len(inner.findall("joint")) != 1 or inner.get("quat") or inner.get("pos", "0 0 0") != "0 0 0":
+            continue
+        inner.insert(0, joints[0])
+        inner.set("pos", body.get("pos", "0 0 0"))
+        parent = parents[body]
+        parent.insert(list(parent).index(body), inner)
+        parent.remove(body)
+        parents[inner] = parent
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def test_a_stewart_platform_written_with_several_joints_per_body_is_the_same_robot(tmp_path):
+    """The CAD Stewart platform with each universal joint written as two hinges in one body and each piston as a
+    slide and a hinge in one (MuJoCo turns a body by its joints in order, each in the frame the joints before it
+    turned). Pinocchio makes one composite joint of each, which moved the bodies elsewhere at any configuration but
+    the file's; screwkit writes them as nested bodies: the bodies where MuJoCo has them, the same indices."""
+    text = merged_joints(STEWART.read_text())
+    assert len(re.findall(r"<body ", text)) == 38 - 18
+    path = written(tmp_path, text, "stewart_merged.xml")
+    assert assert_placed_as_mujoco(path) == 2 * (20 + 1)  # 20 bodies (and the world), the output site
+    mechanism, other = load(STEWART), load(path)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(4), 12)
+    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
+                         1e-9)
+    _, report = read_mechanism_file(path)
+    assert any("bodies with several joints (cylinder1, piston1, UJ1," in note for note in report.notes), report.notes
+
+
+JOINTS = """<mujoco model="joints"><compiler angle="radian"/><worldbody>
+ <body name="arm" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2">""" + INERTIA + """
+  <joint name="h" axis="0.6 0.8 0" pos="0.05 0 0"/><joint name="s" type="slide" axis="0 0 1" pos="0 0.1 0"/>
+  <joint name="b" type="ball" pos="0.02 0.03 0"/><site name="on_arm" pos="0.1 0 0"/>
+  <body name="hand" pos="0.2 0 0">""" + INERTIA + """<joint name="h2" axis="1 0 0"/><site name="tip" pos="0 0.1 0"/>
+  </body></body>
+ <body name="free" pos="0.4 0.5 0.6" euler="0 0.4 1.2">""" + INERTIA + """<freejoint name="f"/>
+  <site name="on_free" pos="0.1 0 0"/></body></worldbody>
+<actuator><motor joint="h"/><motor joint="h2"/></actuator></mujoco>"""
+"""A body turned by a hinge, a slide and a ball joint, each about its own point, and a free body turned and moved."""
+
+
+def test_bodies_with_several_joints_and_a_turned_free_body_are_placed_as_mujoco_places_them(tmp_path):
+    """Before, the three joints of ``arm`` were one composite joint (bodies off at any other configuration) and the
+    free body sat (I - R) p away from where MuJoCo has it."""
+    assert assert_placed_as_mujoco(written(tmp_path, JOINTS)) == 2 * (3 + 3)
+
+
+def test_nested_includes_are_found_from_the_main_files_folder_as_mujoco_finds_them(tmp_path):
+    """A file included by an included file is looked for in the main file's folder (MuJoCo's rule), not beside the
+    file that includes it; a decoy beside that one is not read."""
+    (tmp_path / "sub").mkdir()
+    written(tmp_path, f'<mujoco><body name="tip" pos="0.1 0 0">{INERTIA}<site name="found"/></body></mujoco>',
+            "tip.xml")
+    written(tmp_path / "sub", f'<mujoco><body name="tip" pos="0 0.3 0">{INERTIA}<site name="decoy"/></body>'
+            "</mujoco>", "tip.xml")
+    written(tmp_path / "sub", f'<mujoco><body name="leg" pos="0.2 0 0">{INERTIA}<joint name="j1"/>'
+            '<include file="tip.xml"/></body></mujoco>', "leg.xml")
+    main = written(tmp_path, f'<mujoco><worldbody><body name="base">{INERTIA}<joint name="j0"/>'
+                   '<include file="sub/leg.xml"/></body></worldbody><actuator><motor joint="j0"/></actuator></mujoco>',
+                   "main.xml")
+    assert assert_placed_as_mujoco(main) == 2 * (3 + 1)
+    assert read_mjcf(main).model.existFrame("found")
+
+
+@pytest.mark.parametrize("old, new, problem", [
+    ('<joint name="j1"/><site name="sa" class="a"/>', '<joint name="j1" class="main"/><site name="sa" class="main"/>',
+     None),
+    ('<default><site euler', '<default class="main"><site euler', None),
+])
+def test_the_top_class_named_main_is_read_as_mujoco_reads_it(tmp_path, old, new, problem):
+    """MuJoCo names the top class ``main``; a file may name it on an element or on the top ``<default>``
+    (Pinocchio refused both: 'unordered_map::at')."""
+    assert old in SECTIONS
+    assert assert_placed_as_mujoco(written(tmp_path, SECTIONS.replace(old, new, 1))) == 2 * (2 + 3)
+
+
+REFUSED = {
+    "a pos and a class fromto": ('<site name="by_class" class="rod"/>',
+                                 '<site name="by_class" class="rod" pos="0 0 1"/>',
+                                 "<site name='by_class'>: both pos and fromto"),
+    "a fromto on a sphere": ('type="capsule" size="0.01" fromto', 'size="0.01" fromto',
+                             "<site name='by_class'>: a fromto on a site of type 'sphere'"),
+    "a fromto of five numbers": ('fromto="0 0 0 0 0.2 0.1"', 'fromto="0 0 0 0 0.2"',
+                                 "<site name='own_in_frame'> fromto='0 0 0 0 0.2': expected 6 finite number(s)"),
+    "a renamed top class": ("<default><default class=", '<default class="top"><default class=',
+                            "top-level <default class='top'>: the top class is 'main'"),
+    "a class name twice": ('<default class="rod">', '<default class="rod"/><default class="rod">',
+                           "<default class='rod'>: a class name given twice"),
+    "two sites in one class": ('<site type="capsule"', '<site group="1"/><site type="capsule"',
+                               "<default class='rod'> holds more than one <site>"),
+    "a free joint inside a body": ('<joint name="j1" axis="0 1 0"/>', '<freejoint name="j1"/>',
+                                   "<body name='b1'>: a free joint inside another body"),
+    "a mocap body inside a body": ('<body name="b1" pos="0.3 0 0"', '<body name="b1" mocap="true" pos="0.3 0 0"',
+                                   "<body name='b1'>: a mocap body inside another body"),
+    "global coordinates": ('<compiler angle="radian"/>', '<compiler angle="radian" coordinate="global"/>',
+                           "<compiler coordinate='global'>: global coordinates are no longer read by MuJoCo"),
+}
+
+
+@pytest.mark.parametrize("case", list(REFUSED))
+def test_what_mujoco_refuses_is_refused_naming_the_element(tmp_path, case):
+    """Each of these files MuJoCo refuses; screwkit did not (it read a NaN placement, another site, a body placed in
+    the world's frame as if in its parent's, or raised from deep in numpy): it now refuses them, naming the element,
+    in one line from the command."""
+    old, new, message = REFUSED[case]
+    assert old in FROMTO
+    text = FROMTO.replace(old, new, 1)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
+    path = written(tmp_path, text)
+    with pytest.raises(ImportError_, match=re.escape(message)):
+        read_mjcf(path)
+    if case in ("a fromto of five numbers", "a free joint inside a body"):
+        one_line_error(screwkit("analyze", path), "robot.xml", message.split(":")[0])
+
+
+def test_a_fromto_with_a_nan_is_refused_in_one_line(tmp_path):
+    """MuJoCo only warns of a NaN in a file, and places the site nowhere (NaN); screwkit read a closure's site there
+    and printed indices beside a NaN gap. It refuses it, naming the site."""
+    path = written(tmp_path, FROMTO.replace('fromto="0 0 0 0 0.2 0.1"', 'fromto="0 0 0 0 nan 0.1"'))
+    one_line_error(screwkit("analyze", path), "robot.xml", "<site name='own_in_frame'> fromto='0 0 0 0 nan 0.1'",
+                   "expected 6 finite number(s)")
