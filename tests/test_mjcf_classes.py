@@ -205,6 +205,10 @@ REFUSED = {
                                    "<body name='b1'>: a free joint inside another body"),
     "a mocap body inside a body": ('<body name="b1" pos="0.3 0 0"', '<body name="b1" mocap="true" pos="0.3 0 0"',
                                    "<body name='b1'>: a mocap body inside another body"),
+    "an unknown class": ('<site name="by_class" class="rod"/>', '<site name="by_class" class="rods"/>',
+                         "<site name='by_class'>: class='rods' names no default class"),
+    "an unknown childclass": ('childclass="rod"', 'childclass="nope"',
+                              "<body name='b1'>: childclass='nope' names no default class"),
     "global coordinates": ('<compiler angle="radian"/>', '<compiler angle="radian" coordinate="global"/>',
                            "<compiler coordinate='global'>: global coordinates are no longer read by MuJoCo"),
 }

@@ -145,6 +145,11 @@ def _defaults_merged(root: ElementTree.Element, path: Path) -> None:
         tags = [child.tag for child in default if child.tag != "default"]
         for tag in {tag for tag in tags if tags.count(tag) > 1}:
             raise MjcfError(f"{path}: <default class='{name}'> holds more than one <{tag}> (MuJoCo refuses it).")
+    for element in root.iter():
+        for attribute in ("class", "childclass") if element.tag != "default" else ():
+            if element.get(attribute) not in (None, *seen, "main"):
+                raise MjcfError(f"{path}: {describe(element)}: {attribute}='{element.get(attribute)}' names no default "
+                                "class of the file (MuJoCo refuses it).")
     if not tops:
         if any("main" in (element.get("class"), element.get("childclass")) for element in root.iter()):
             root.insert(1, ElementTree.Element("default", {"class": "main"}))
