@@ -136,6 +136,53 @@ def test_a_rod_level_delta_in_sdformat_has_the_textbook_pressure_angles_through_
     assert_delta_textbook(result, expected)
 
 
+def balls_as_three_hinges(text: str, names, reverse: bool = False) -> str:
+    """The SDFormat text with each ball joint of ``names`` written as three revolute joints about perpendicular axes
+    through its centre, joined by two links of no mass (as files converted from URDF write a ball); ``reverse``:
+    every joint listed in the opposite order. The same mechanism."""
+    for name in names:
+        joint = re.search(rf'<joint name="{name}" type="ball"><parent>(\w+)</parent><child>(\w+)</child>(<pose[^>]*>'
+                          r'[^<]*</pose>)</joint>', text)
+        parent, child, pose = joint.groups()
+        pose = pose if "relative_to" in pose else pose.replace("<pose>", f'<pose relative_to="{child}">')
+        links = f'<link name="{name}_l1">{pose}</link><link name="{name}_l2">{pose}</link>'
+        hinges = (f'<joint name="{name}_r1" type="revolute"><parent>{parent}</parent><child>{name}_l1</child>'
+                  '<axis><xyz>1 0 0</xyz></axis></joint>'
+                  f'<joint name="{name}_r2" type="revolute"><parent>{name}_l1</parent><child>{name}_l2</child>'
+                  '<axis><xyz>0 1 0</xyz></axis></joint>'
+                  f'<joint name="{name}_r3" type="revolute"><parent>{name}_l2</parent><child>{child}</child>'
+                  f'<pose relative_to="{name}_l2">0 0 0 0 0 0</pose><axis><xyz>0 0 1</xyz></axis></joint>')
+        text = text.replace(joint.group(0), hinges).replace("<link ", links + "<link ", 1)
+    if reverse:
+        joints = re.findall(r"<joint .*?</joint>", text)
+        for joint in joints:
+            text = text.replace(joint, "", 1)
+        text = text.replace("<plugin", "".join(reversed(joints)) + "<plugin", 1)
+    return text
+
+
+@pytest.mark.parametrize("names, reverse", [(["end_1b"], False), (["end_1a"], True), (["end_1a", "end_2b"], False),
+                                            (["end_1a", "end_2b"], True), (["end_4b"], False)])
+def test_a_delta_whose_platform_balls_are_written_as_three_hinges_opens_in_any_order(tmp_path, names, reverse):
+    """A platform ball joint of the rod-level Delta written as three revolute joints through two massless links:
+    the spanning tree reached those links through the platform before their own rod (depending on the order the
+    file lists its joints and on the rod), and the loop closed inside the leg, beyond the platform, which every
+    command refused. The platform's joints are now taken last: the textbook pressure angles, whatever the order."""
+    centre = POSES[0]
+    text = balls_as_three_hinges(delta_sdf(centre), names, reverse)
+    assert text.count('type="ball"') == 16 - len(names)
+    path = write(tmp_path, text)
+    with pytest.raises(LegWithLoops, match=r"inside a leg"):  # the commands then analyse it as a graph
+        read_mechanism_file(path)
+    result = graph_mechanism(read_closed_tree(path)).indices()
+    assert result.dof == 3
+    assert_delta_textbook(result, textbook(centre))
+    if names == ["end_1b"]:  # and the command, as users run it
+        command = screwkit("analyze", path, "--json")
+        assert command.returncode == 0, command.stderr
+        assert json.loads(command.stdout)["lmti"] == pytest.approx(float(result.lmti), abs=1e-12)
+
+
 def test_motors_marked_in_the_file_and_the_marker_on_a_joint_that_cannot_drive(tmp_path):
     tree = read_closed_tree(write(tmp_path, delta_sdf(plugin=False)))
     assert tree.motors == ["motor_1", "motor_2", "motor_3", "motor_4"] and tree.notes == []
@@ -144,6 +191,14 @@ def test_motors_marked_in_the_file_and_the_marker_on_a_joint_that_cannot_drive(t
     with pytest.raises(ImportError_, match=r"robot.sdf: <joint name='ball_2a'>: joint 'ball_2a' is marked actuated "
                                            r"but is a ball joint"):
         read_closed_tree(write(tmp_path, text))
+
+
+def effector_first(text: str) -> str:
+    """The five-bar without its joint to the world and with the effector listed first: the effector is then the
+    canonical link, fixed as the base, and a motor closes a loop of the tree grown from it."""
+    effector = re.search(r'<link name="effector">.*?</link>', text).group(0)
+    text = text.replace('<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>', "")
+    return text.replace(effector, "").replace('<link name="base"/>', effector + '<link name="base"/>')
 
 
 BAD = [
@@ -167,6 +222,13 @@ BAD = [
     (lambda t: t.replace("<parent>world</parent><child>base</child>", "<parent>world</parent><child>base</child>")
      .replace("<child>proximal_1</child>", "<child>base</child>"),
      r"<joint name='mot1'>: <parent> and <child> are on the same link 'base'"),
+    (lambda t: t.replace('<pose relative_to="proximal_2">', '<pose relative_to="world">'),  # not in a model's scope
+     r"<link name='distal_2'>: its pose is relative_to 'world', a frame outside the model's scope"),
+    (lambda t: t.replace('expressed_in="__model__"', 'expressed_in="world"'),
+     r"<joint name='loop_2'>: <axis><xyz expressed_in='world'>: not a frame of the model"),
+    (effector_first,
+     r"<joint name='mot2'>: joint 'mot2' is marked actuated but closes a loop of the tree grown from the canonical "
+     r"link 'effector'"),
 ]
 
 

@@ -9,12 +9,13 @@ the model's links, joints and ``<frame>`` elements with SDFormat's pose semantic
   ``canonical_link``, else its first) is fixed in the world, and the report says so;
 * **the tree**: a breadth-first spanning tree of the joint graph from the base, the joints taken in file order
   (so loops close where the legs meet, farthest from the base), built as a Pinocchio model at zero joint values
-  (SDFormat's reference): revolute and continuous joints as revolute ones about their axis, prismatic,
-  fixed (the link welded to its parent body), universal and revolute2 as two revolute joints ``<name>_axis``
-  (parent side) and ``<name>_axis2``, ball as three revolute joints ``<name>_x``, ``<name>_y``, ``<name>_z`` about
-  its frame's axes through its centre (as ``docs/urdf-convention.md`` writes a spherical joint inside a leg: a leg
-  stays a serial chain of 1-DoF joints, so a U-P-S leg carrying the platform converts; the three span every
-  rotation unless the middle one turns a quarter turn from the file's configuration);
+  (SDFormat's reference), grown again with the platform's joints taken last when it would hang from the
+  platform links where a loop closes too (the last links of a leg); revolute and continuous joints as revolute
+  ones about their axis, prismatic, fixed (the link welded to its parent body), universal and revolute2 as two
+  revolute joints ``<name>_axis`` (parent side) and ``<name>_axis2``, ball as three revolute joints ``<name>_x``,
+  ``<name>_y``, ``<name>_z`` about its frame's axes through its centre (as ``docs/urdf-convention.md`` writes a
+  spherical joint inside a leg: a leg stays a serial chain of 1-DoF joints, so a U-P-S leg carrying the platform
+  converts; the three span every rotation unless the middle one turns a quarter turn from the file's configuration);
 * **the loops**: every other joint closes a loop, as :mod:`screwkit.io.gazebo` closes ``<gazebo><joint>``
   elements: a ball joint one point both links keep (``3d``), a fixed one the whole frame (``6d``), a revolute or
   continuous one two points on its axis (``<name>_a``, ``<name>_b``; the conversion makes them the hinge through
@@ -70,9 +71,10 @@ def actuated_joints(sdf: SdfModel) -> list[str]:
     return list(dict.fromkeys(marked + driven))
 
 
-def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
+def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]], last: str | None = None):
     """(tree joints as (joint, tree parent, tree child) in breadth-first order, loop joints, the base node, and
-    (loop joint, tree joint) pairs whose roles the file's order chose among equals).
+    (loop joint, tree joint) pairs whose roles the file's order chose among equals). ``last``: a link (the platform)
+    whose joints are taken only once no other link is left to take them from (what hangs from it alone, a gripper).
 
     Links welded by fixed joints are one body: reached together (the fixed joints in the tree), so a chain of welded
     links does not lengthen a leg and move the loop's closing joint into it (onto a fixed joint inside the leg).
@@ -114,8 +116,12 @@ def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]]):
                     stack.append(other)
 
     reach(base)
-    while queue:
-        node = queue.pop(0)
+    deferred: list[str] = []
+    while queue or deferred:
+        node = queue.pop(0) if queue else deferred.pop(0)
+        if node == last and queue:
+            deferred.append(node)
+            continue
         for joint in sdf.joints:
             other = step(node, joint)
             if other is not None:
@@ -156,7 +162,7 @@ class _TreeBuilder:
         axis = joint.axes[number]
         if not axis.expressed_in or axis.expressed_in == joint.name:
             return axis.xyz
-        if axis.expressed_in not in self.poses:
+        if axis.expressed_in not in self.poses or axis.expressed_in == WORLD:  # 'world': outside the model's scope
             raise ImportError_(f"{joint.where}: <axis><xyz expressed_in={axis.expressed_in!r}>: not a frame of the "
                                "model.")
         return self.poses[joint.name][:3, :3].T @ self.poses[axis.expressed_in][:3, :3] @ axis.xyz
@@ -258,6 +264,22 @@ def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str]
     return [closure(f"{joint.name}_a", world, "3d"), closure(f"{joint.name}_b", second, "3d", axis_point=True)]
 
 
+def _hung_from_platform(tree_joints, loops, ends: dict[str, tuple[str, str]]) -> str | None:
+    """The platform (the link where most loops close) when the tree hangs from it links where a loop closes too: the
+    last links of a leg (a ball joint written as three revolute joints through two massless links), reached through
+    the platform before their own leg reached them, which would close that leg's loop inside it; else None."""
+    touches = Counter(end for joint in loops for end in ends[joint.name])
+    if not touches:
+        return None
+    platform = max(touches, key=lambda link: touches[link])  # the first of the most touched, in the loops' order
+    below, hung = {platform}, set()
+    for _, parent, child in tree_joints:
+        if parent in below:
+            below.add(child)
+            hung.add(child)
+    return platform if any(end in hung for joint in loops for end in ends[joint.name]) else None
+
+
 def _ends(sdf: SdfModel) -> dict[str, tuple[str, str]]:
     ends = {}
     for joint in sdf.joints:
@@ -298,6 +320,9 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     poses = world_poses(sdf)
     ends = _ends(sdf)
     tree_joints, loops, base, tied = _spanning_tree(sdf, ends)
+    platform = _hung_from_platform(tree_joints, loops, ends)
+    if platform is not None:  # a leg's last links reached through the platform: reach them from their leg
+        tree_joints, loops, base, tied = _spanning_tree(sdf, ends, last=platform)
     builder = _TreeBuilder(sdf, poses)
     notes = []
     if base != WORLD:
@@ -323,8 +348,12 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
         where = next((joint.where for joint in sdf.joints if joint.name == name), f"{sdf.source}: <plugin>")
         if not unactuated and (not model.existJointName(name) or model.joints[model.getJointId(name)].nv != 1):
             kinds = {joint.name: joint.kind for joint in sdf.joints}
-            unactuated = f"{where}: joint {name!r} is marked actuated but is " + (
-                f"a {kinds[name]} joint, not a 1-DoF one" if name in kinds else "not a joint of the model")
+            fixed = ("the world" if base == WORLD else f"the canonical link {base!r}, fixed as the base since no "
+                     "joint is to the world (a joint from the world, or <model canonical_link=...>, names the base)")
+            unactuated = f"{where}: joint {name!r} is marked actuated but " + (
+                "is not a joint of the model" if name not in kinds else
+                f"is a {kinds[name]} joint, not a 1-DoF one" if kinds[name] not in (*HINGES, "prismatic") else
+                f"closes a loop of the tree grown from {fixed}")
     motors = [] if unactuated else stated or guessed_motors(model, closures)
     if not stated:
         silent = any(CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))

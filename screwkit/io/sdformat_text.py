@@ -278,11 +278,16 @@ def _declare(model: SdfModel, name: str, relative_to: str, pose: NDArray, where:
 def world_poses(model: SdfModel) -> dict[str, NDArray[np.float64]]:
     """Every frame's pose (4x4) in the world at zero joint values: links, joints, frames, ``__model__``."""
     resolved: dict[str, NDArray] = {WORLD: np.eye(4)}
+    children_of_world = {joint.name for joint in model.joints if joint.child == WORLD}  # refused later, and said why
 
     def resolve(name: str, seen: tuple[str, ...]) -> NDArray:
         if name in resolved:
             return resolved[name]
         relative, pose = model.poses[name]
+        if relative == WORLD and name != MODEL_FRAME and name not in children_of_world:
+            raise ImportError_(f"{model.where[name]}: its pose is relative_to 'world', a frame outside the model's "
+                               "scope (SDFormat names only frames of the same scope: the model's '__model__', a link, "
+                               "a joint or a <frame>; the model's own <pose> places it in the world).")
         if relative not in model.poses and relative != WORLD:
             raise ImportError_(f"{model.where[name]}: its pose is relative_to {relative!r}, not a frame of the model.")
         if relative in seen + (name,):
