@@ -64,10 +64,14 @@ ZERO_PITCH = 1e-9
 point of a wrench with a pitch (a serial arm's) is the joint's drawn point projected on its axis
 (:func:`screwkit.screw.algebra.nearest_on_axis`)."""
 
-SAME_POINT = 1e-9
+SAME_POINT = 1e-5
 """Relative: two neighbouring joints of a chain are drawn at the same point when their points are at most this
 apart (working coordinates); with axes that are not parallel they are a universal or a ball joint, whose
-characteristic point is that point, not a line (:func:`screwkit.screw.algebra.joint_lines`)."""
+characteristic point is that point, not a line (:func:`screwkit.screw.algebra.joint_lines`). As loose as
+:data:`MEETING`: the revolutes of a ball whose axes a file rounds so that they miss by a little meet, and their
+canonical points (each on its own axis) are then that little apart; read as three lines, a force along one of
+them would cross it wherever the rounding puts the crossing (an ITI of 0.978 for 0.858 on a published Stewart
+head drawn another way)."""
 
 MEETING = 1e-5
 """Relative to a chain's extent (its lines' own, :func:`screwkit.closure.canonical.chain_extent`): two neighbouring
