@@ -35,9 +35,9 @@ SECTIONS = """<mujoco model="sections"><compiler angle="radian"/>
 
 
 def test_several_default_sections_are_one_top_class_as_mujoco_reads_them(tmp_path):
-    """MuJoCo reads every top-level ``<default>`` as the top class, a later section's attributes winning, and its
-    classes inherit them all; screwkit read only the first section's (Pinocchio's reading): bodies and sites off by
-    up to the length of the chain."""
+    """MuJoCo reads every top-level ``<default>`` as the top class, a later section's attributes winning, and a
+    class inherits the top class as it stands when its section is read; screwkit read only the first section's
+    (Pinocchio's reading): bodies and sites off by up to the length of the chain."""
     assert assert_placed_as_mujoco(written(tmp_path, SECTIONS)) == 2 * (2 + 3)
 
 
@@ -187,6 +187,42 @@ def test_the_top_class_named_main_is_read_as_mujoco_reads_it(tmp_path, old, new,
     assert assert_placed_as_mujoco(written(tmp_path, SECTIONS.replace(old, new, 1))) == 2 * (2 + 3)
 
 
+CLASSES_AND_BODIES = """<mujoco model="classes"><compiler angle="degree"/>
+<default><default class="early"><site size="0.01"/></default></default>
+<default><joint pos="0 0.03 0" axis="1 0 0"/><site pos="0 0.2 0"/>
+ <default class="k"><joint type="slide" axis="0 1 0" pos="0.01 0 0" ref="10"/></default></default>
+<worldbody>
+ <body name="arm" pos="0.1 0.2 0.3" childclass="k">""" + INERTIA + """<joint name="h" class="main" axis="0 0 1"/>
+  <joint name="early" class="early"/><site name="on_arm" class="early"/><site name="own" class="main"/>
+  <body name="hand" pos="0.2 0 0">""" + INERTIA + """<joint name="slide"/><site name="tip" pos="0 0.1 0"/>
+   <body pos="0.1 0.1 0" quat="0.9 0.1 0.3 0.2">""" + INERTIA + """<joint name="u1" class="main" pos="0.05 0 0"/>
+    <joint name="u2" class="main" axis="0 1 0"/><site name="in_unnamed" pos="0.1 0 0"/>
+    <body name="last" pos="0.2 0 0">""" + INERTIA + """<joint name="end" class="main"/><site name="end_tip"/></body>
+   </body></body></body>
+ <body name="free" pos="0.4 0.5 0.6" euler="0 20 70">""" + INERTIA + """<joint name="f" type="free" pos="0.1 0.2 0.3"/>
+  <site name="on_free" pos="0.1 0 0"/></body>
+</worldbody><actuator><motor joint="h"/><motor joint="slide"/></actuator></mujoco>"""
+"""A joint and a site of the top class in a body whose ``childclass`` is a slide with a ``ref`` (in degrees: a
+slide's ``ref`` is a length), a class read before a later section changed the top class, an unnamed body with two
+hinges inside another, and a free joint with a ``pos`` on a turned body."""
+
+
+def test_classes_unnamed_bodies_and_a_free_joint_s_pos_are_read_as_mujoco_reads_them(tmp_path):
+    """Each of these was read otherwise (the second read of this change): Pinocchio took the body's childclass for a
+    joint of ``class="main"`` (a slide for a hinge), a class of an earlier section took the later section's top
+    class (MuJoCo copies the top class as it stands when it reads a class), Pinocchio dropped an unnamed body
+    inside another with its joints and sites, offset a free body by its joint's ``pos``, and a slide's ``ref`` from a
+    class was converted from degrees as an angle. Every body and site where MuJoCo has it, and the reference
+    configuration MuJoCo's ``qpos0``."""
+    path = written(tmp_path, CLASSES_AND_BODIES)
+    assert assert_placed_as_mujoco(path) == 2 * (4 + 6)  # the named bodies and every site
+    mj_model, tree = mujoco.MjModel.from_xml_path(str(path)), read_mjcf(path)
+    for name in ("h", "early", "slide", "u1", "u2", "end"):
+        joint = mujoco.mj_name2id(mj_model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        position = tree.model.joints[tree.model.getJointId(name)].idx_q
+        assert tree.q_reference[position] == pytest.approx(mj_model.qpos0[mj_model.jnt_qposadr[joint]], abs=1e-12)
+
+
 REFUSED = {
     "a pos and a class fromto": ('<site name="by_class" class="rod"/>',
                                  '<site name="by_class" class="rod" pos="0 0 1"/>',
@@ -209,6 +245,14 @@ REFUSED = {
                          "<site name='by_class'>: class='rods' names no default class"),
     "an unknown childclass": ('childclass="rod"', 'childclass="nope"',
                               "<body name='b1'>: childclass='nope' names no default class"),
+    "a ball then a hinge in one body": ('<joint name="j1" axis="0 1 0"/>',
+                                        '<joint name="b" type="ball"/><joint name="j1" axis="0 1 0"/>',
+                                        "<body name='b1'>: a ball joint followed by a rotation in one body"),
+    "a free joint and a hinge in one body": ('<body name="b0" pos="0.1 0 0" quat="0.9 0.1 0.3 0.2">' + INERTIA
+                                             + '<joint name="j0" axis="0 0 1"/>',
+                                             '<body name="b0" pos="0.1 0 0" quat="0.9 0.1 0.3 0.2">' + INERTIA
+                                             + '<freejoint/><joint name="j0" axis="0 0 1"/>',
+                                             "<body name='b0'>: a free joint and other joints in one body"),
     "global coordinates": ('<compiler angle="radian"/>', '<compiler angle="radian" coordinate="global"/>',
                            "<compiler coordinate='global'>: global coordinates are no longer read by MuJoCo"),
 }

@@ -54,6 +54,11 @@ from screwkit.model.chain import LOOP_JOINT_DOFS, ChainGeometry
 __all__ = ["joint_lines_at_zero", "chain_extent", "canonical_offsets", "offsets_along_axes", "canonical_geometry"]
 
 
+CLEAR_FEET = 0.25
+"""Squared sine (30 degrees): two axes whose common perpendicular's feet measure a chain's size; at a shallower angle
+the feet lie far along the axes (more than twice their distance apart), outside the chain."""
+
+
 def joint_lines_at_zero(geometry: ChainGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit axis and drawn point of every DoF of a chain at zero joint values, base frame: shapes (m, 3), (m, 3)."""
     frames = chain_forward_kinematics(geometry, np.zeros(geometry.n_dofs), compiled=False)
@@ -144,7 +149,7 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
 
 def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0) -> float:
     """The size of a chain that its lines alone decide, the scale of :data:`MEETING`: the spread of the feet of the
-    common perpendiculars of every two revolute axes at a clear angle (squared sine above :data:`PARALLEL_FOOT`) and
+    common perpendiculars of every two revolute axes at a clear angle (squared sine above :data:`CLEAR_FEET`) and
     of the centre of a loop joint at a point (the last ``declared`` DoFs), or the largest distance between two
     revolute axes when that is larger. Where the file draws a joint along its axis changes none of it; a chain whose
     every axis passes through one point has none (a spherical chain), and is measured as drawn (the spread of its
@@ -160,7 +165,7 @@ def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, de
                 gaps.append(float(np.linalg.norm(np.cross(points[other] - points[joint], axes[joint]))))
                 continue
             gaps.append(_line_gap(points[joint], axes[joint], points[other], axes[other]))
-            if sine2 > PARALLEL_FOOT:
+            if sine2 > CLEAR_FEET:
                 anchors += [_foot_on_line(points[joint], axes[joint], points[other], axes[other]),
                             _foot_on_line(points[other], axes[other], points[joint], axes[joint])]
     spread = float(np.ptp(anchors, axis=0).max()) if len(anchors) > 1 else 0.0

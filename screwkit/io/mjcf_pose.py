@@ -30,6 +30,11 @@ MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
 ALTERNATIVES = ("axisangle", "euler", "xyaxes", "zaxis")
 """The ways MJCF gives an orientation other than ``quat``."""
+BUILT_IN = {("joint", "type"): "hinge", ("joint", "axis"): "0 0 1", ("joint", "pos"): "0 0 0",
+            ("joint", "ref"): "0", ("joint", "springref"): "0", ("joint", "range"): "0 0",
+            ("joint", "limited"): "auto", ("site", "pos"): "0 0 0", ("site", "quat"): "1 0 0 0",
+            ("site", "type"): "sphere", ("equality", "active"): "true"}
+"""MuJoCo's own defaults of the attributes screwkit reads."""
 ORIENTED = ("body", "geom", "site", "frame", "camera", "light", "inertial")
 """The elements that have a pose of their own (in ``<worldbody>`` or as class defaults)."""
 CLASSED = ("joint", "site", "geom", "camera", "light")
@@ -188,13 +193,15 @@ def _text(values: NDArray) -> str:
 
 
 def defaults_written(root: ElementTree.Element, path: Path | str = "") -> None:
-    """Every site's and joint's pose (``pos`` and ``quat`` or ``fromto``, ``pos`` and ``axis``) written on it when its
-    class gives it (Pinocchio does not read a site's class defaults; a frame's children are then composed from
-    them). A site with a ``fromto``, its own or its class's, is placed by it alone, as MuJoCo places it (its
-    orientation left out); MuJoCo refuses one that also has a ``pos`` from anywhere, or that is not a capsule,
-    cylinder, box or ellipsoid, and so does this."""
+    """Every site's pose (``pos`` and ``quat``, or its ``fromto``) and every joint's ``type``, ``pos``, ``axis``,
+    ``ref``, ``springref`` and ``range`` written on it, from its class or MuJoCo's own defaults (Pinocchio reads no
+    site's class, and takes an attribute a joint's class leaves unset from the body's ``childclass``; a frame's children
+    are then composed from them; a joint's angles are converted from degrees by its own type, a slide's ``ref``
+    from a class being a length whatever the class's joint type). A site with a ``fromto``, its own or its class's,
+    is placed by it alone, as MuJoCo places it (its orientation left out); MuJoCo refuses one that also has a
+    ``pos`` from anywhere, or that is not a capsule, cylinder, box or ellipsoid, and so does this."""
     defaults = {tag: class_attributes(root, tag) for tag in ("site", "joint")}
-    wanted = {"site": ("pos", "quat"), "joint": ("pos", "axis")}
+    wanted = {"site": ("pos", "quat"), "joint": ("type", "pos", "axis", "ref", "springref", "range")}
 
     def visit(element: ElementTree.Element, childclass: str) -> None:
         for child in element:
@@ -203,9 +210,10 @@ def defaults_written(root: ElementTree.Element, path: Path | str = "") -> None:
                 if child.tag == "site" and (child.get("fromto") or given.get("fromto")) is not None:
                     _fromto_site(child, given, path)
                 else:
-                    for attribute in wanted[child.tag]:
-                        if child.get(attribute) is None and given.get(attribute) is not None:
-                            child.set(attribute, given[attribute])
+                    for attribute in wanted[child.tag]:  # every one written: Pinocchio would take a childclass's
+                        kind = child.get("type", "hinge")
+                        if child.get(attribute) is None and (kind in ("hinge", "slide") or "ref" not in attribute):
+                            child.set(attribute, given.get(attribute, BUILT_IN[child.tag, attribute]))
             visit(child, child.get("childclass", childclass) if child.tag in ("body", "frame") else childclass)
 
     for world in root.findall("worldbody"):

@@ -15,6 +15,8 @@ MJCF file holds the way MuJoCo does. :func:`prepared_mjcf` rewrites the XML firs
   lifted to its parent, the frame's pose composed into theirs (:mod:`screwkit.io.mjcf_pose`); a site's
   ``fromto`` from its class is written on it; a body with several joints becomes nested bodies with one joint
   each (:func:`~screwkit.io.mjcf_pose.joints_one_per_body`; Pinocchio would make one composite joint of them);
+* default sections, classes, unnamed bodies and the joints of one body as MuJoCo reads them
+  (:mod:`screwkit.io.mjcf_classes`);
 * several ``<compiler>`` elements are read as one (MuJoCo applies them all);
 * several top-level ``<default>``, ``<equality>``, ``<actuator>`` sections are merged (MuJoCo merges them;
   Pinocchio reads the first): the top class's element defaults take every section's attributes, a later one's
@@ -45,6 +47,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.io.mjcf_classes import bodies_named, check_body_joints, defaults_merged, top_class_renamed
 from screwkit.io.mjcf_pose import (
     MIN_AXIS,
     MjcfError,
@@ -124,46 +127,6 @@ def _merged(root: ElementTree.Element, tag: str) -> ElementTree.Element | None:
             found[0].append(child)
         root.remove(extra)
     return found[0] if found else None
-
-
-def _defaults_merged(root: ElementTree.Element, path: Path) -> None:
-    """Several top-level ``<default>`` sections read as MuJoCo reads them: one top class, ``main``, whose element
-    defaults take every section's attributes (a later one's winning) and which holds every section's classes;
-    refused as MuJoCo refuses them: a top section of another class, a class name twice, an element twice in one
-    class. The top class is named ``main`` in the text (Pinocchio knows it by that name only then)."""
-    tops = root.findall("default")
-    for top in tops:
-        if top.get("class", "main") != "main":
-            raise MjcfError(f"{path}: top-level <default class='{top.get('class')}'>: the top class is 'main' and "
-                            "cannot be renamed (MuJoCo refuses it); nest the class in a <default>.")
-    seen: set[str] = set()
-    for default in (nested for top in tops for nested in top.iter("default")):
-        name = default.get("class", "main")
-        if name in seen and default not in tops:
-            raise MjcfError(f"{path}: <default class='{name}'>: a class name given twice (MuJoCo refuses it).")
-        seen.add(name)
-        tags = [child.tag for child in default if child.tag != "default"]
-        for tag in {tag for tag in tags if tags.count(tag) > 1}:
-            raise MjcfError(f"{path}: <default class='{name}'> holds more than one <{tag}> (MuJoCo refuses it).")
-    for element in root.iter():
-        for attribute in ("class", "childclass") if element.tag != "default" else ():
-            if element.get(attribute) not in (None, *seen, "main"):
-                raise MjcfError(f"{path}: {describe(element)}: {attribute}='{element.get(attribute)}' names no default "
-                                "class of the file (MuJoCo refuses it).")
-    if not tops:
-        if any("main" in (element.get("class"), element.get("childclass")) for element in root.iter()):
-            root.insert(1, ElementTree.Element("default", {"class": "main"}))
-        return
-    first = tops[0]
-    for later in tops[1:]:
-        for child in list(later):
-            own = first.find(child.tag) if child.tag != "default" else None
-            if own is None:
-                first.append(child)
-            else:
-                own.attrib.update(child.attrib)
-        root.remove(later)
-    first.set("class", "main")
 
 
 def _class_joints(root: ElementTree.Element) -> dict[str, dict[str, str]]:
@@ -391,7 +354,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     if compiler.get("coordinate", "local") != "local":
         raise MjcfError(f"{path}: <compiler coordinate='{compiler.get('coordinate')}'>: global coordinates are no "
                         "longer read by MuJoCo (since 2.3.3; it refuses the file): write it in local coordinates.")
-    _defaults_merged(root, path)
+    defaults_merged(root, path)
     equality = _merged(root, "equality")
     ignored = _check_equalities(root, equality, path)  # before the tendons go: <equality><tendon> is one
     if ignored:
@@ -409,6 +372,8 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     frames = frames_flattened(root)
     if frames:
         notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
+    bodies_named(root)  # Pinocchio merges unnamed bodies inside others, and drops their joints
+    check_body_joints(root, path, {id(joint): attributes for joint, attributes in _joints(root)})
     split = joints_one_per_body(root)
     if split:
         notes.append(f"bodies with several joints ({', '.join(split)}) read as MuJoCo composes them: nested bodies "
@@ -451,6 +416,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     if unnamed:
         notes.append(f"{unnamed} unnamed closure(s) named in file order (connect_1, weld_1, ...)")
     _merged(root, "actuator")
+    top_class_renamed(root)
     text = ElementTree.tostring(root, encoding="unicode")
     return text, notes, root
 

@@ -1,0 +1,136 @@
+"""MJCF default classes, bodies and their joints, as MuJoCo reads them, before Pinocchio reads the file.
+
+Used by :func:`screwkit.io.mjcf_text.prepared_mjcf`:
+
+* :func:`defaults_merged` reads several top-level ``<default>`` sections as MuJoCo does: each reopens the top class
+  ``main``, a later one's attributes winning, and a class keeps ``main`` as it stood when its section was read;
+* :func:`bodies_named` names every unnamed body (Pinocchio 4.1 merges unnamed bodies inside others and drops their
+  joints);
+* :func:`check_body_joints` refuses the joints of one body MuJoCo refuses, and places a free joint at its body's
+  origin, where MuJoCo has it whatever its ``pos``;
+* :func:`top_class_renamed` gives the top class a name of its own in the text Pinocchio reads (Pinocchio applies a
+  body's ``childclass`` to an element of ``class="main"``).
+
+Only the standard library.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+from screwkit.io.mjcf_pose import ALTERNATIVES, BUILT_IN, MjcfError, describe
+
+__all__ = ["defaults_merged", "bodies_named", "check_body_joints", "top_class_renamed", "TOP_CLASS"]
+
+TOP_CLASS = "screwkit_main"
+"""The top class's name in the text Pinocchio reads."""
+ORIENTATIONS = ("quat", *ALTERNATIVES)
+
+
+def _frozen(first: ElementTree.Element, tag: str, changed: dict[str, str]) -> None:
+    """The classes of ``first`` keep the top class's ``tag`` attributes as they stand, before ``changed`` changes
+    them (MuJoCo copies the top class into a class when it reads the class)."""
+    own = first.find(tag)
+    standing = dict(own.attrib) if own is not None else {}
+    for cls in first.findall("default"):
+        element = cls.find(tag)
+        if element is None:
+            element = ElementTree.Element(tag)
+            cls.insert(0, element)
+        for key in changed:
+            if key in ORIENTATIONS:
+                if not any(element.get(other) is not None for other in ORIENTATIONS):
+                    given = [other for other in ORIENTATIONS if other in standing]
+                    element.set(given[0] if given else "quat", standing[given[0]] if given else "1 0 0 0")
+            elif element.get(key) is None and (key in standing or (tag, key) in BUILT_IN):
+                element.set(key, standing.get(key, BUILT_IN.get((tag, key), "")))
+        if not element.attrib and not len(element):
+            cls.remove(element)
+
+
+def defaults_merged(root: ElementTree.Element, path: Path) -> None:
+    """Several top-level ``<default>`` sections read as MuJoCo reads them: one top class, ``main``, whose element
+    defaults take every section's attributes (a later one's winning) and which holds every section's classes, each
+    class keeping ``main`` as it stood when its section was read; refused as MuJoCo refuses them: a top section of
+    another class, a class name twice, an element twice in one class, a class or childclass no class is called."""
+    tops = root.findall("default")
+    for top in tops:
+        if top.get("class", "main") != "main":
+            raise MjcfError(f"{path}: top-level <default class='{top.get('class')}'>: the top class is 'main' and "
+                            "cannot be renamed (MuJoCo refuses it); nest the class in a <default>.")
+    seen: set[str] = set()
+    for default in (nested for top in tops for nested in top.iter("default")):
+        name = default.get("class", "main")
+        if name in seen and default not in tops:
+            raise MjcfError(f"{path}: <default class='{name}'>: a class name given twice (MuJoCo refuses it).")
+        seen.add(name)
+        tags = [child.tag for child in default if child.tag != "default"]
+        for tag in {tag for tag in tags if tags.count(tag) > 1}:
+            raise MjcfError(f"{path}: <default class='{name}'> holds more than one <{tag}> (MuJoCo refuses it).")
+    for element in root.iter():
+        for attribute in ("class", "childclass") if element.tag != "default" else ():
+            if element.get(attribute) not in (None, *seen, "main"):
+                raise MjcfError(f"{path}: {describe(element)}: {attribute}='{element.get(attribute)}' names no default "
+                                "class of the file (MuJoCo refuses it).")
+    if not tops:
+        if any("main" in (element.get("class"), element.get("childclass")) for element in root.iter()):
+            root.insert(1, ElementTree.Element("default", {"class": "main"}))
+        return
+    first = tops[0]
+    for later in tops[1:]:
+        for child in list(later):
+            own = first.find(child.tag) if child.tag != "default" else None
+            if child.tag != "default":
+                _frozen(first, child.tag, child.attrib)
+            if own is None:
+                first.append(child)
+            else:
+                own.attrib.update(child.attrib)
+        root.remove(later)
+    first.set("class", "main")
+
+
+def bodies_named(root: ElementTree.Element) -> int:
+    """Every unnamed body given a name of its own (``body_1``, ...); returns how many."""
+    taken = {body.get("name") for body in root.iter("body")}
+    count = 0
+    for body in root.iter("body"):
+        if body.get("name") is None:
+            count += 1
+            name = f"body_{count}"
+            while name in taken:
+                name += "_"
+            taken.add(name)
+            body.set("name", name)
+    return count
+
+
+def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int, dict[str, str]]) -> None:
+    """The joints of each body, refused where MuJoCo refuses them: a free joint with others (more than six DoFs) or a
+    ball joint followed by a hinge or a ball (a rotation after a rotation of every axis); a free joint's ``pos``
+    dropped (MuJoCo places a free body by its coordinates alone). ``resolved``: each joint's attributes, its class's
+    included, by ``id``."""
+    for body in root.iter("body"):
+        joints = [child for child in body if child.tag in ("joint", "freejoint")]
+        kinds = ["free" if joint.tag == "freejoint" else resolved.get(id(joint), {}).get("type", "hinge")
+                 for joint in joints]
+        for joint, kind in zip(joints, kinds):
+            if kind == "free":
+                joint.attrib.pop("pos", None)
+        if "free" in kinds and len(joints) > 1:
+            raise MjcfError(f"{path}: {describe(body)}: a free joint and other joints in one body (more than six "
+                            "DoFs; MuJoCo refuses it).")
+        if "ball" in kinds[:-1] and any(kind in ("hinge", "ball") for kind in kinds[kinds.index("ball") + 1:]):
+            raise MjcfError(f"{path}: {describe(body)}: a ball joint followed by a rotation in one body (MuJoCo "
+                            "refuses it).")
+
+
+def top_class_renamed(root: ElementTree.Element) -> None:
+    """The top class named :data:`TOP_CLASS` in the text, and every ``class`` or ``childclass`` naming it."""
+    for element in root.iter():
+        if element.tag == "default" and element in root.findall("default"):
+            element.set("class", TOP_CLASS)
+        for attribute in ("class", "childclass"):
+            if element.tag != "default" and element.get(attribute) == "main":
+                element.set(attribute, TOP_CLASS)
