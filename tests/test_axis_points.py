@@ -96,8 +96,8 @@ def origins_in(root, link: str):
     """Every ``<origin>`` expressed in ``link``'s frame: its child joints' and the loops' ends on it."""
     for joint in root.iter("joint"):
         parent = joint.find("parent")
-        if parent is not None and parent.get("link") == link and joint.find("origin") is not None:
-            yield joint.find("origin")
+        if parent is not None and parent.get("link") == link:
+            yield joint.find("origin") if joint.find("origin") is not None else ElementTree.SubElement(joint, "origin")
     for loop in root.iter("loop"):
         for end in ("predecessor", "successor"):
             element = loop.find(end)
@@ -137,8 +137,8 @@ def revolutes_moved(text: str, distances: dict[str, float]) -> str:
 
 
 def _move_along_axis(root, joint, distance: float) -> None:
-    origin = joint.find("origin")
-    axis = numbers(joint.find("axis").get("xyz"))
+    origin = joint.find("origin") if joint.find("origin") is not None else ElementTree.SubElement(joint, "origin")
+    axis = numbers(joint.find("axis").get("xyz") if joint.find("axis") is not None else "1 0 0")  # URDF's default
     shift = distance * axis / np.linalg.norm(axis)
     rotation = rpy_matrix(*numbers(origin.get("rpy", "0 0 0")))
     origin.set("xyz", written(numbers(origin.get("xyz", "0 0 0")) + rotation @ shift))

@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from test_axis_points import revolutes_moved
+from test_axis_points import revolutes_drawn_elsewhere, revolutes_moved
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, screwkit_residuals
 
 from helpers import leg_line_otis, one_line_error, screwkit
@@ -456,3 +456,20 @@ def test_a_file_whose_joint_values_do_not_close_assembles_the_same_in_another_wo
     here, there = (indices_at_pose(m := load(path), m.home_pose) for path in (source, folder / "robot.urdf"))
     np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, atol=1e-9)
     np.testing.assert_allclose([there.lmti, there.iti], [here.lmti, here.iti], atol=1e-9)
+
+
+def test_the_6_sps_leg_with_its_ball_revolutes_drawn_apart_on_their_axes_is_the_same_robot(tmp_path):
+    """Gepetto's ``wl16_like`` with every revolute drawn elsewhere on its axis (up to 5 cm), the balls' three
+    revolutes among them: the ball that ends each leg beyond the platform is still one point, where its three axes
+    meet (it was refused: 'three revolute joints through one point' was read from where the file draws them), and
+    at the file's pose the indices are the file's, the ITI the slider's 1 (a rod force through both ball centres)."""
+    source = GEPETTO / "wl16_like" / "robot.urdf"
+    folder = tmp_path / "wl16_like"
+    folder.mkdir()
+    (folder / "robot.urdf").write_text(revolutes_drawn_elsewhere(source.read_text(), np.random.default_rng(4), 0.05))
+    (folder / "robot.yaml").write_text((source.parent / "robot.yaml").read_text())
+    original, other = load(source), load(folder / "robot.urdf")
+    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, original.home_pose)
+    np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(there.iti_actuators, 1.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)

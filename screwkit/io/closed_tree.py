@@ -18,11 +18,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.tolerances import FILE_ROUNDING
+from screwkit.common.tolerances import FILE_ROUNDING, MEETING
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
-           "closure_gaps", "assemble", "ball_line"]
+           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -214,6 +214,39 @@ def _length_scale(model, data) -> float:
     points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
     spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
     return float(spread) if spread > 0.0 else 1.0
+
+
+def at_point(frame: NDArray, point: NDArray, parent: NDArray | None = None) -> NDArray[np.float64]:
+    """A 4x4 frame (in ``parent``'s, the world's when None) moved, unturned, so that its origin is the world
+    ``point``."""
+    world = frame if parent is None else parent @ frame
+    moved = np.eye(4)
+    moved[:3, 3] = world[:3, :3].T @ (np.asarray(point, dtype=float) - world[:3, 3])
+    return frame @ moved
+
+
+def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArray, scale: float) -> NDArray | None:
+    r"""The centre of a ball joint ending a leg beyond the platform, or None: one spherical joint, or three revolute
+    ``joints`` in a row (their :func:`joint_kind`\ s ``kinds``; ``first`` the first one's frame, 4x4, world, at zero
+    motion) whose axis lines pass within :data:`MEETING` of the length ``scale`` of one point, wherever along them
+    the file draws each joint, and span every rotation (no two parallel, not in one plane: the absolute determinant
+    of the unit axes above 0.1); the centre is the point nearest to the three lines."""
+    if len(joints) == 1 and kinds[0][0] == "spherical":
+        return np.asarray(first, dtype=float)[:3, 3]
+    if len(joints) != 3 or any(kind[0] != "revolute" for kind in kinds):
+        return None
+    placements, axes = [homogeneous(model.jointPlacements[j]) for j in joints[1:]], [kind[1] for kind in kinds]
+    frames = [np.asarray(first, dtype=float)]
+    for placement in placements:
+        frames.append(frames[-1] @ np.asarray(placement, dtype=float))
+    units = np.array([frame[:3, :3] @ axis / np.linalg.norm(axis) for frame, axis in zip(frames, axes)])
+    points = np.array([frame[:3, 3] for frame in frames])
+    if abs(np.linalg.det(units)) <= 0.1:
+        return None
+    normals = np.eye(3)[None] - units[:, :, None] * units[:, None, :]  # projections off each line
+    centre = np.linalg.solve(normals.sum(axis=0), np.einsum("kij,kj->i", normals, points))
+    gaps = np.linalg.norm(np.einsum("kij,kj->ki", normals, centre - points), axis=1)
+    return centre if np.all(gaps <= MEETING * scale) else None
 
 
 def ball_line(points, closures: list[Closure], scale: float) -> tuple[int, NDArray | None, NDArray]:

@@ -52,7 +52,9 @@ from screwkit.io.closed_tree import (
     ImportReport,
     LegWithLoops,
     assemble,
+    at_point,
     ball_line,
+    ball_of_revolutes,
     closure_gaps,
     homogeneous,
     inverse,
@@ -174,12 +176,10 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         world_axis = zero[:3, :3] @ axis
         return _Leg(a_path, kind, predecessor, zero, axis, [(kind, world_axis, zero[:3, 3])], closure.name,
                     sources=(closure,))
-    concurrent = all(np.linalg.norm(np.asarray(model.jointPlacements[j].translation)) < 1e-9 * scale
-                     for j in after[1:])
-    if (len(after) == 3 and concurrent and all(k[0] == "revolute" for k in kinds)) or \
-            (len(after) == 1 and kinds[0][0] == "spherical"):
-        centre = zero[:3, 3]
-        axes = [("revolute", zero[:3, k], centre) for k in range(3)]
+    ball = ball_of_revolutes(model, after, kinds, zero, scale)
+    if ball is not None:  # both loop frames at the ball's centre, wherever the file draws its revolutes
+        zero, predecessor = at_point(zero, ball), at_point(predecessor, ball, homogeneous(data.oMi[closure.joint_a]))
+        axes = [("revolute", zero[:3, k], ball) for k in range(3)]
         return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name, sources=(closure,))
     raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
