@@ -19,6 +19,7 @@ licences in its ``SOURCES.md``).
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -472,4 +473,27 @@ def test_the_6_sps_leg_with_its_ball_revolutes_drawn_apart_on_their_axes_is_the_
     here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, original.home_pose)
     np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
     np.testing.assert_allclose(there.iti_actuators, 1.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("axes", [("0 0 1", "0 1 0", "0 0 1"), ("1 0 0", "0 1 0", "1 1 0.1")],
+                         ids=["z-y-z at its singular pose", "nearly in one plane"])
+def test_a_leg_ending_on_any_three_revolutes_that_meet_is_a_ball(tmp_path, axes):
+    """``wl16_like`` with one foot ball's revolutes turned to other axes through the same point: a Z-Y-Z one drawn
+    at its singular pose (the first and third axes parallel) and one whose axes are nearly in one plane. Both are a
+    ball beyond the platform (every rotation about the point, as the file's), so the indices are the file's (a
+    determinant test refused both)."""
+    source = GEPETTO / "wl16_like" / "robot.urdf"
+    text = source.read_text()
+    for k, axis in enumerate(axes):
+        text = re.sub(rf'(<joint name="foot_part_axis_1_4_rev{k}" type="revolute">.*?<axis xyz=")[^"]*(")',
+                      rf"\g<1>{axis}\2", text, count=1, flags=re.S)
+    assert text.count(f'<axis xyz="{axes[2]}"') >= 1 and text != source.read_text()
+    folder = tmp_path / "wl16_like"
+    folder.mkdir()
+    (folder / "robot.urdf").write_text(text)
+    (folder / "robot.yaml").write_text((source.parent / "robot.yaml").read_text())
+    original, other = load(source), load(folder / "robot.urdf")
+    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, original.home_pose)
+    np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
     np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)

@@ -223,6 +223,41 @@ def test_classes_unnamed_bodies_and_a_free_joint_s_pos_are_read_as_mujoco_reads_
         assert tree.q_reference[position] == pytest.approx(mj_model.qpos0[mj_model.jnt_qposadr[joint]], abs=1e-12)
 
 
+LIMITS = """<mujoco model="limits"><compiler angle="degree"/>
+<default><joint axis="0 1 0" limited="true" range="-30 30"/><default class="early"><joint damping="1"/></default>
+ <default class="hg"><joint ref="20" springref="10"/><default class="bl"><joint type="ball" range="0 45"/></default>
+ </default></default>
+<default><default class="late"><joint damping="2"/></default><joint axis="1 0 0"/>
+ <default class="sl"><joint type="slide" axis="0 0 1" range="-0.1 0.2"/></default></default>
+<worldbody><body name="b1">""" + INERTIA + """<joint name="early" class="early"/>
+ <body name="b2" pos="0.3 0 0">""" + INERTIA + """<joint name="late" class="late"/>
+  <body name="b3" pos="0.3 0 0" childclass="hg">""" + INERTIA + """<joint name="hinge_ref" ref="10"/>
+   <body name="b4" pos="0.2 0 0">""" + INERTIA + """<joint name="ball" class="bl"/>
+    <body name="b5" pos="0.2 0 0">""" + INERTIA + """<joint name="slide" class="sl" ref="0.05"/>
+     <site name="tip" pos="0.1 0.1 0"/></body></body></body></body></body></worldbody>
+<keyframe><key name="home" qpos="0.1 0.2 0.3 1 0 0 0 0.06"/></keyframe>
+<actuator><motor joint="early"/><motor joint="slide"/></actuator></mujoco>"""
+"""A later default section whose class comes before its own joint defaults (the class takes them: MuJoCo reads a
+section's element defaults first), a ball joint of a class under one with a ``ref``, limits from classes in degrees
+on joints with a ``ref`` of their own."""
+
+
+def test_limits_refs_and_a_later_section_s_classes_are_read_as_mujoco_reads_them(tmp_path):
+    """The third read of this change: a later section's class took the top class as it stood before the section's
+    own joint defaults (bodies 0.84 m off), Pinocchio shifts a joint's limits by its ``ref`` (a hinge MuJoCo limits
+    to [0.4, 0.6] and starts at 0.5 was refused as outside [-0.1, 0.1]), and refused a ball joint whose class
+    inherits a ``ref``. Every body and site where MuJoCo has it, and every hinge's and slide's limits MuJoCo's."""
+    path = written(tmp_path, LIMITS)
+    assert assert_placed_as_mujoco(path) == 2 * (5 + 1)
+    mj_model, model = mujoco.MjModel.from_xml_path(str(path)), read_mjcf(path).model
+    for joint in range(mj_model.njnt):
+        if int(mj_model.jnt_type[joint]) in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+            name = mujoco.mj_id2name(mj_model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+            index = model.joints[model.getJointId(name)].idx_q
+            np.testing.assert_allclose([model.lowerPositionLimit[index], model.upperPositionLimit[index]],
+                                       mj_model.jnt_range[joint], rtol=0, atol=1e-12, err_msg=name)
+
+
 REFUSED = {
     "a pos and a class fromto": ('<site name="by_class" class="rod"/>',
                                  '<site name="by_class" class="rod" pos="0 0 1"/>',

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.tolerances import FILE_ROUNDING, MEETING
+from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
@@ -229,8 +229,9 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
     r"""The centre of a ball joint ending a leg beyond the platform, or None: one spherical joint, or three revolute
     ``joints`` in a row (their :func:`joint_kind`\ s ``kinds``; ``first`` the first one's frame, 4x4, world, at zero
     motion) whose axis lines pass within :data:`MEETING` of the length ``scale`` of one point, wherever along them
-    the file draws each joint, and span every rotation (no two parallel, not in one plane: the absolute determinant
-    of the unit axes above 0.1); the centre is the point nearest to the three lines."""
+    the file draws each joint, no two in a row nearly parallel (squared sine above :data:`PARALLEL_FOOT`; the first
+    and the third may be, a Z-Y-Z wrist drawn at its singular pose); the centre is the point nearest to the three
+    lines."""
     if len(joints) == 1 and kinds[0][0] == "spherical":
         return np.asarray(first, dtype=float)[:3, 3]
     if len(joints) != 3 or any(kind[0] != "revolute" for kind in kinds):
@@ -241,8 +242,8 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
         frames.append(frames[-1] @ np.asarray(placement, dtype=float))
     units = np.array([frame[:3, :3] @ axis / np.linalg.norm(axis) for frame, axis in zip(frames, axes)])
     points = np.array([frame[:3, 3] for frame in frames])
-    if abs(np.linalg.det(units)) <= 0.1:
-        return None
+    if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(2)):
+        return None  # two in a row on (nearly) one direction turn about one axis: no ball
     normals = np.eye(3)[None] - units[:, :, None] * units[:, None, :]  # projections off each line
     centre = np.linalg.solve(normals.sum(axis=0), np.einsum("kij,kj->i", normals, points))
     gaps = np.linalg.norm(np.einsum("kij,kj->ki", normals, centre - points), axis=1)

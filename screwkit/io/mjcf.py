@@ -22,7 +22,7 @@ import numpy as np
 
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
 from screwkit.io.mjcf_pose import rotation_matrix, site_pose
-from screwkit.io.mjcf_text import MjcfError, closure_placements, prepared_mjcf
+from screwkit.io.mjcf_text import MjcfError, closure_placements, joint_ranges, prepared_mjcf
 
 __all__ = ["read_mjcf", "sites_placed"]
 
@@ -64,6 +64,12 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                    f"(MuJoCo fills a short one from qpos0, Pinocchio does not); numbers given: {keys}."
                                    ) from None
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
+    lower, upper = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
+    for name, limits in joint_ranges(root).items():  # MuJoCo's: Pinocchio shifts them by a ref
+        if model.existJointName(name) and model.joints[model.getJointId(name)].nq == 1:
+            lower[model.joints[model.getJointId(name)].idx_q], upper[model.joints[model.getJointId(name)].idx_q] = (
+                limits or (-np.inf, np.inf))
+    model.lowerPositionLimit, model.upperPositionLimit = lower, upper
     for joint in range(1, model.njoints):  # a free body's coordinates are its pose in the world (MuJoCo's)
         if model.joints[joint].shortname() == "JointModelFreeFlyer" and model.parents[joint] == 0:
             model.jointPlacements[joint] = pin.SE3.Identity()  # Pinocchio 4.1 offsets a turned one by (I - R) p

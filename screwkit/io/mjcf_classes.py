@@ -9,7 +9,7 @@ Used by :func:`screwkit.io.mjcf_text.prepared_mjcf`:
 * :func:`check_body_joints` refuses the joints of one body MuJoCo refuses, and places a free joint at its body's
   origin, where MuJoCo has it whatever its ``pos``;
 * :func:`top_class_renamed` gives the top class a name of its own in the text Pinocchio reads (Pinocchio applies a
-  body's ``childclass`` to an element of ``class="main"``).
+  body's ``childclass`` to an element of ``class="main"``), and leaves the classes' joint ``ref`` out.
 
 Only the standard library.
 """
@@ -78,8 +78,8 @@ def defaults_merged(root: ElementTree.Element, path: Path) -> None:
             root.insert(1, ElementTree.Element("default", {"class": "main"}))
         return
     first = tops[0]
-    for later in tops[1:]:
-        for child in list(later):
+    for later in tops[1:]:  # its own element defaults first, as MuJoCo reads a section, then its classes
+        for child in sorted(later, key=lambda element: element.tag == "default"):
             own = first.find(child.tag) if child.tag != "default" else None
             if child.tag != "default":
                 _frozen(first, child.tag, child.attrib)
@@ -127,7 +127,12 @@ def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int,
 
 
 def top_class_renamed(root: ElementTree.Element) -> None:
-    """The top class named :data:`TOP_CLASS` in the text, and every ``class`` or ``childclass`` naming it."""
+    """The top class named :data:`TOP_CLASS` in the text, and every ``class`` or ``childclass`` naming it; the classes'
+    joint ``ref`` and ``springref`` left out (written on every hinge and slide by then, and refused by Pinocchio on a
+    ball joint of such a class, which MuJoCo reads)."""
+    for joint in (element for default in root.iter("default") for element in default.findall("joint")):
+        for attribute in ("ref", "springref"):
+            joint.attrib.pop(attribute, None)
     for element in root.iter():
         if element.tag == "default" and element in root.findall("default"):
             element.set("class", TOP_CLASS)

@@ -211,9 +211,11 @@ def defaults_written(root: ElementTree.Element, path: Path | str = "") -> None:
                     _fromto_site(child, given, path)
                 else:
                     for attribute in wanted[child.tag]:  # every one written: Pinocchio would take a childclass's
-                        kind = child.get("type", "hinge")
-                        if child.get(attribute) is None and (kind in ("hinge", "slide") or "ref" not in attribute):
-                            child.set(attribute, given.get(attribute, BUILT_IN[child.tag, attribute]))
+                        default = None if attribute == "range" else BUILT_IN.get((child.tag, attribute))
+                        if "ref" in attribute and child.get("type", "hinge") not in ("hinge", "slide"):
+                            continue  # a ref on a 1-DoF joint only (Pinocchio refuses one on a ball)
+                        if child.get(attribute) is None and given.get(attribute, default) is not None:
+                            child.set(attribute, given.get(attribute, default))  # no range: Pinocchio's infinite
             visit(child, child.get("childclass", childclass) if child.tag in ("body", "frame") else childclass)
 
     for world in root.findall("worldbody"):

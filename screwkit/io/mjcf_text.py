@@ -61,7 +61,8 @@ from screwkit.io.mjcf_pose import (
     rotation_matrix,
 )
 
-__all__ = ["prepared_mjcf", "closure_placements", "MAX_INCLUDE_DEPTH", "MjcfError", "CLOSURE_ATTRIBUTES"]
+__all__ = ["prepared_mjcf", "closure_placements", "joint_ranges", "MAX_INCLUDE_DEPTH", "MjcfError",
+           "CLOSURE_ATTRIBUTES"]
 
 MAX_INCLUDE_DEPTH = 20
 """Deepest chain of ``<include>``s followed (a file including itself is refused before that)."""
@@ -147,6 +148,18 @@ def _joints(root: ElementTree.Element):
 
     for world in root.findall("worldbody"):
         yield from visit(world, "main")
+
+
+def joint_ranges(root: ElementTree.Element) -> dict[str, tuple[float, float] | None]:
+    """Each named hinge's and slide's limits as MuJoCo applies them, once the file is prepared (radians; None: not
+    limited). Pinocchio 4.1 shifts a joint's limits by its ``ref`` (and by a class's instead of its own), although
+    its joint values are MuJoCo's: :func:`screwkit.io.mjcf.read_mjcf` writes these instead."""
+    ranges: dict[str, tuple[float, float] | None] = {}
+    for joint, attributes in _joints(root):
+        if joint.get("name") and attributes.get("type", "hinge") in ("hinge", "slide"):
+            low, high = (float(word) for word in attributes.get("range", "0 0").split())
+            ranges[joint.get("name")] = (low, high) if low < high else None
+    return ranges
 
 
 def _to_radians(root: ElementTree.Element) -> int:
