@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from test_io import HOME, five_bar_mjcf
 from test_lower_mobility import five_bar_expected
-from test_mjcf_reading import INERTIA, STEWART, assert_placed_as_mujoco, written
+from test_mjcf_reading import INERTIA, STEWART, assert_placed_as_mujoco, assert_the_stewart_platform, written
 
-from helpers import assert_indices_close, one_line_error, random_reachable_poses, random_rotation, screwkit
+from helpers import one_line_error, random_rotation, screwkit
 from screwkit.io import ImportError_, read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
-from screwkit.studies.poses import indices_at_pose, indices_at_poses
+from screwkit.studies.poses import indices_at_pose
 
 SECTIONS = """<mujoco model="sections"><compiler angle="radian"/>
 <default><site euler="0 0 1" pos="0 0 1"/><joint pos="0 0.02 0"/><default class="a"><site pos="0.1 0 0"/></default>
@@ -93,11 +93,7 @@ def test_a_stewart_platform_whose_output_site_comes_from_a_class_fromto_is_the_s
                                   '</default><default class="spin">')
     path = written(tmp_path, text, "stewart_class_fromto.xml")
     assert assert_placed_as_mujoco(path) == assert_placed_as_mujoco(STEWART)
-    mechanism, other = load(STEWART), load(path)
-    np.testing.assert_allclose(other.home_pose, mechanism.home_pose, rtol=0, atol=1e-12)
-    poses = random_reachable_poses(mechanism, np.random.default_rng(3), 12)
-    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
-                         1e-9)
+    assert_the_stewart_platform(path, seed=3, count=12)
 
 
 def merged_joints(text: str) -> str:
@@ -132,10 +128,7 @@ def test_a_stewart_platform_written_with_several_joints_per_body_is_the_same_rob
     assert len(re.findall(r"<body ", text)) == 38 - 18
     path = written(tmp_path, text, "stewart_merged.xml")
     assert assert_placed_as_mujoco(path) == 2 * (20 + 1)  # 20 bodies (and the world), the output site
-    mechanism, other = load(STEWART), load(path)
-    poses = random_reachable_poses(mechanism, np.random.default_rng(4), 12)
-    assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
-                         1e-9)
+    assert_the_stewart_platform(path, seed=4, count=12)
     _, report = read_mechanism_file(path)
     assert any("bodies with several joints (cylinder1, piston1, UJ1," in note for note in report.notes), report.notes
 

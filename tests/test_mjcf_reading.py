@@ -297,9 +297,15 @@ def test_a_stewart_platform_whose_hinges_are_drawn_elsewhere_on_their_axes_is_th
     moved = written(tmp_path, hinges_drawn_elsewhere(STEWART.read_text(), np.random.default_rng(1), 0.05),
                     "stewart_moved.xml")
     assert assert_placed_as_mujoco(moved) == assert_placed_as_mujoco(STEWART)
-    mechanism, other = load(STEWART), load(moved)
+    assert_the_stewart_platform(moved, seed=2, count=20)
+
+
+def assert_the_stewart_platform(path: Path, seed: int, count: int) -> None:
+    """``path`` is the gallery's CAD Stewart platform written otherwise: the same home pose and the same indices at
+    ``count`` random reachable poses."""
+    mechanism, other = load(STEWART), load(path)
     np.testing.assert_allclose(other.home_pose, mechanism.home_pose, rtol=0, atol=1e-12)
-    poses = random_reachable_poses(mechanism, np.random.default_rng(2), 20)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(seed), count)
     assert_indices_close(indices_at_poses(mechanism, poses, detail=True), indices_at_poses(other, poses, detail=True),
                          1e-9)
 

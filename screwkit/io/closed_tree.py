@@ -236,11 +236,10 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
         return np.asarray(first, dtype=float)[:3, 3]
     if len(joints) != 3 or any(kind[0] != "revolute" for kind in kinds):
         return None
-    placements, axes = [homogeneous(model.jointPlacements[j]) for j in joints[1:]], [kind[1] for kind in kinds]
     frames = [np.asarray(first, dtype=float)]
-    for placement in placements:
-        frames.append(frames[-1] @ np.asarray(placement, dtype=float))
-    units = np.array([frame[:3, :3] @ axis / np.linalg.norm(axis) for frame, axis in zip(frames, axes)])
+    for joint in joints[1:]:  # each at zero motion of the ones before
+        frames.append(frames[-1] @ homogeneous(model.jointPlacements[joint]))
+    units = np.array([frame[:3, :3] @ kind[1] / np.linalg.norm(kind[1]) for frame, kind in zip(frames, kinds)])
     points = np.array([frame[:3, 3] for frame in frames])
     if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(2)):
         return None  # two in a row on (nearly) one direction turn about one axis: no ball

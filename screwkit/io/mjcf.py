@@ -66,9 +66,9 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
             raise ImportError_(f"{source}: Pinocchio cannot read it ({type(error).__name__}: {error}).") from None
     lower, upper = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
     for name, limits in joint_ranges(root).items():  # MuJoCo's: Pinocchio shifts them by a ref
-        if model.existJointName(name) and model.joints[model.getJointId(name)].nq == 1:
-            lower[model.joints[model.getJointId(name)].idx_q], upper[model.joints[model.getJointId(name)].idx_q] = (
-                limits or (-np.inf, np.inf))
+        joint = model.joints[model.getJointId(name)] if model.existJointName(name) else None
+        if joint is not None and joint.nq == 1:
+            lower[joint.idx_q], upper[joint.idx_q] = limits or (-np.inf, np.inf)
     model.lowerPositionLimit, model.upperPositionLimit = lower, upper
     for joint in range(1, model.njoints):  # a free body's coordinates are its pose in the world (MuJoCo's)
         if model.joints[joint].shortname() == "JointModelFreeFlyer" and model.parents[joint] == 0:

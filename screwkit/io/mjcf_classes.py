@@ -6,8 +6,9 @@ Used by :func:`screwkit.io.mjcf_text.prepared_mjcf`:
   ``main``, a later one's attributes winning, and a class keeps ``main`` as it stood when its section was read;
 * :func:`bodies_named` names every unnamed body (Pinocchio 4.1 merges unnamed bodies inside others and drops their
   joints);
-* :func:`check_body_joints` refuses the joints of one body MuJoCo refuses, and places a free joint at its body's
-  origin, where MuJoCo has it whatever its ``pos``;
+* :func:`check_body_joints` refuses the joints of one body MuJoCo refuses (a free joint or mocap body inside another
+  body, a free joint with others, a ball followed by a rotation), and places a free joint at its body's origin,
+  where MuJoCo has it whatever its ``pos``;
 * :func:`top_class_renamed` gives the top class a name of its own in the text Pinocchio reads (Pinocchio applies a
   body's ``childclass`` to an element of ``class="main"``), and leaves the classes' joint ``ref`` out.
 
@@ -19,7 +20,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from screwkit.io.mjcf_pose import ALTERNATIVES, BUILT_IN, MjcfError, describe
+from screwkit.io.mjcf_pose import ALTERNATIVES, BUILT_IN, MjcfError, describe, unused_name
 
 __all__ = ["defaults_merged", "bodies_named", "check_body_joints", "top_class_renamed", "TOP_CLASS"]
 
@@ -98,23 +99,26 @@ def bodies_named(root: ElementTree.Element) -> int:
     for body in root.iter("body"):
         if body.get("name") is None:
             count += 1
-            name = f"body_{count}"
-            while name in taken:
-                name += "_"
-            taken.add(name)
-            body.set("name", name)
+            body.set("name", unused_name(f"body_{count}", taken))
     return count
 
 
 def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int, dict[str, str]]) -> None:
-    """The joints of each body, refused where MuJoCo refuses them: a free joint with others (more than six DoFs) or a
-    ball joint followed by a hinge or a ball (a rotation after a rotation of every axis); a free joint's ``pos``
-    dropped (MuJoCo places a free body by its coordinates alone). ``resolved``: each joint's attributes, its class's
-    included, by ``id``."""
-    for body in root.iter("body"):
+    """The joints of each body, refused where MuJoCo refuses them: a free joint or a mocap body inside another body
+    (MuJoCo takes them on a body of ``<worldbody>`` only), a free joint with others (more than six DoFs), a ball
+    joint followed by a hinge or a ball (a rotation after a rotation of every axis); a free joint's ``pos`` dropped
+    (MuJoCo places a free body by its coordinates alone). ``resolved``: each joint's attributes, its class's
+    included, by ``id``. Run once the frames are flattened (:func:`~screwkit.io.mjcf_pose.frames_flattened`: every
+    joint is then its body's child, every body of the world the world's)."""
+    top = {body for world in root.findall("worldbody") for body in world.findall("body")}
+    for body in (body for world in root.findall("worldbody") for body in world.iter("body")):
         joints = [child for child in body if child.tag in ("joint", "freejoint")]
         kinds = ["free" if joint.tag == "freejoint" else resolved.get(id(joint), {}).get("type", "hinge")
                  for joint in joints]
+        nested = (("a free joint", "free" in kinds), ("a mocap body", body.get("mocap") == "true"))
+        for what in (what for what, present in nested if present and body not in top):
+            raise MjcfError(f"{path}: {describe(body)}: {what} inside another body; MuJoCo takes it only on a body "
+                            "of <worldbody> (and refuses the file).")
         for joint, kind in zip(joints, kinds):
             if kind == "free":
                 joint.attrib.pop("pos", None)

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 __all__ = ["MjcfError", "MIN_AXIS", "describe", "class_attributes", "euler_sequence", "quaternion_product",
            "rotation_matrix", "orientations_as_quaternions", "local_pose", "site_pose", "defaults_written",
-           "frames_flattened", "joints_one_per_body"]
+           "frames_flattened", "joints_one_per_body", "unused_name"]
 
 MIN_AXIS = 1e-7
 """Length of an axis (a hinge's, an ``axisangle``'s, a ``zaxis``, an ``xyaxes``'s) up to which MuJoCo refuses it."""
@@ -188,6 +188,14 @@ def site_pose(site: ElementTree.Element) -> tuple[NDArray, NDArray]:
     return ends.mean(axis=0), _alternative_quaternion("zaxis", along, False, "xyz", describe(site))
 
 
+def unused_name(name: str, taken: set) -> str:
+    """``name``, with underscores added until it is not in ``taken``, which it joins."""
+    while name in taken:
+        name += "_"
+    taken.add(name)
+    return name
+
+
 def _text(values: NDArray) -> str:
     return " ".join(repr(float(v)) for v in values)
 
@@ -290,7 +298,8 @@ def joints_one_per_body(root: ElementTree.Element) -> list[str]:
     the body's name and everything else it holds; returns those bodies' names. MuJoCo turns a body by its joints in
     the order written, each about its own axis through its own ``pos`` in the body's frame as turned by the joints
     before it, which is the motion of these nested bodies; Pinocchio 4.1 makes one composite joint of them, which
-    moves the body otherwise and no longer has the joints' names. Run after :func:`frames_flattened`."""
+    moves the body otherwise and no longer has the joints' names. Run after :func:`frames_flattened`, every body
+    named (:func:`screwkit.io.mjcf_classes.bodies_named`)."""
     taken = {element.get("name") for element in root.iter("body")}
     split = []
     for body in list(root.iter("body")):
@@ -298,8 +307,7 @@ def joints_one_per_body(root: ElementTree.Element) -> list[str]:
         if len(joints) < 2:
             continue
         attributes = dict(body.attrib)
-        name = attributes.get("name") or f"body_{len(split) + 1}"
-        split.append(name)
+        split.append(attributes["name"])
         kept = [child for child in body if child.tag not in ("joint", "freejoint")]
         for child in list(body):
             body.remove(child)
@@ -312,11 +320,7 @@ def joints_one_per_body(root: ElementTree.Element) -> list[str]:
                 inner.extend(kept)
                 break
             inner = outer if index == 0 else ElementTree.SubElement(outer, "body")
-            shell = f"{name}__{joint.get('name') or index}"
-            while shell in taken:
-                shell += "_"
-            taken.add(shell)
-            inner.set("name", shell)
+            inner.set("name", unused_name(f"{attributes['name']}__{joint.get('name') or index}", taken))
             if attributes.get("childclass") is not None:
                 inner.set("childclass", attributes["childclass"])
             # an inertia of its own: Pinocchio asks one of every body when <compiler inertiafromgeom="false">

@@ -283,29 +283,6 @@ def _check_names(root: ElementTree.Element, path: Path) -> None:
                 claim(element, space)
 
 
-def _placed_in(element: ElementTree.Element, tag: str):
-    """The ``tag`` children of ``element``, those of its ``<frame>`` children (at any depth) included."""
-    for child in element:
-        if child.tag == tag:
-            yield child
-        if child.tag == "frame":
-            yield from _placed_in(child, tag)
-
-
-def _check_free_bodies(root: ElementTree.Element, path: Path) -> None:
-    """A free joint or a mocap body only where MuJoCo takes them: on a body of ``<worldbody>`` itself."""
-    free = {id(joint) for joint, attributes in _joints(root) if attributes.get("type") == "free"}
-    for world in root.findall("worldbody"):
-        top = set(_placed_in(world, "body"))
-        for body in world.iter("body"):
-            joints = [*_placed_in(body, "joint"), *_placed_in(body, "freejoint")]
-            found = (("a free joint", any(j.tag == "freejoint" or id(j) in free for j in joints)),
-                     ("a mocap body", body.get("mocap") == "true"))
-            for what in (what for what, present in found if present and body not in top):
-                raise MjcfError(f"{path}: {describe(body)}: {what} inside another body; MuJoCo takes it only on a "
-                                "body of <worldbody> (and refuses the file).")
-
-
 def _check_joints(root: ElementTree.Element, path: Path, autolimits: bool) -> list[str]:
     """The joints' axes and ranges, refused where MuJoCo refuses them; a range MuJoCo does not apply
     (``limited="false"``; with autolimits, one that is no interval) is dropped, since Pinocchio would apply it.
@@ -379,14 +356,13 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     _check_numbers(root, path)
     _check_keys(root, path)
     _check_names(root, path)
-    _check_free_bodies(root, path)
     in_degrees = orientations_as_quaternions(root, angle == "degree", sequence, path)
     defaults_written(root, path)
     frames = frames_flattened(root)
     if frames:
         notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
-    bodies_named(root)  # Pinocchio merges unnamed bodies inside others, and drops their joints
     check_body_joints(root, path, {id(joint): attributes for joint, attributes in _joints(root)})
+    bodies_named(root)  # Pinocchio merges unnamed bodies inside others, and drops their joints
     split = joints_one_per_body(root)
     if split:
         notes.append(f"bodies with several joints ({', '.join(split)}) read as MuJoCo composes them: nested bodies "
