@@ -20,7 +20,7 @@ from test_axis_points import revolutes_drawn_elsewhere, revolutes_moved
 from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
-from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses
+from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses, random_rotation
 from screwkit.closure.canonical import (
     canonical_geometry,
     canonical_offsets,
@@ -305,7 +305,8 @@ def test_whether_two_axes_meet_does_not_depend_on_where_another_joint_is_drawn(g
 
 def test_a_chains_extent_is_its_lines_own():
     """:func:`chain_extent` of random chains (revolutes at random angles, some parallel, a slide, a ball's pairs) is
-    the same however each revolute is drawn along its axis, and scales with the chain; two axes at a shallow angle
+    the same however each revolute is drawn along its axis and in any world frame (a bounding box along the world's
+    axes was not), and scales with the chain; two axes at a shallow angle
     do not stretch it to where their common perpendicular's feet lie; a chain whose axes all pass through one point
     has no extent of its lines and is measured as drawn."""
     rng = np.random.default_rng(17)
@@ -319,13 +320,19 @@ def test_a_chains_extent_is_its_lines_own():
         extent = chain_extent(prismatic, axes, on_axes)
         redrawn = on_axes + rng.uniform(-50.0, 50.0, count)[:, None] * axes * ~np.array(prismatic)[:, None]
         assert chain_extent(prismatic, axes, redrawn) == pytest.approx(extent, rel=1e-9)
-        assert chain_extent(prismatic, axes, 1e3 * on_axes) == pytest.approx(1e3 * extent, rel=1e-12)
+        for factor in (1e-3, 1e3):
+            assert chain_extent(prismatic, axes, factor * on_axes) == pytest.approx(factor * extent, rel=1e-12)
+        turn, shift = random_rotation(rng), rng.uniform(-5.0, 5.0, 3)  # another world frame
+        assert chain_extent(prismatic, axes @ turn.T, on_axes @ turn.T + shift) == pytest.approx(extent, rel=1e-9)
     shallow = np.radians(6.3)  # axes 0 and 2 at a shallow angle, 1.4 apart: their feet lie 9 along the axes
     axes = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [np.sin(shallow), 0.0, np.cos(shallow)]])
-    assert chain_extent((False,) * 3, axes, np.array([[0.0, 0, 0], [0, 1e-5, 0], [1, 1, 0]])) == pytest.approx(1.0)
+    # the feet of the clear pairs: the origin (axes 0 and 1) and (1, 1e-5, 0), (1, 1, 0) (axes 1 and 2): sqrt(2)
+    assert chain_extent((False,) * 3, axes, np.array([[0.0, 0, 0], [0, 1e-5, 0], [1, 1, 0]])) == pytest.approx(
+        np.sqrt(2.0))
     axes = unit_rows(rng.normal(size=(4, 3)))
     drawn = 0.1 * axes  # every axis through the origin, each drawn at 0.1 along it
-    assert chain_extent((False,) * 4, axes, drawn) == pytest.approx(float(np.ptp(drawn, axis=0).max()), rel=1e-12)
+    largest = max(np.linalg.norm(a - b) for a in drawn for b in drawn)  # the drawn points' diameter
+    assert chain_extent((False,) * 4, axes, drawn) == pytest.approx(largest, rel=1e-12)
 
 
 def every_chain(skew_path):

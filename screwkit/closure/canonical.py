@@ -147,6 +147,13 @@ def canonical_offsets(geometry: ChainGeometry) -> NDArray[np.float64]:
     return offsets_along_axes(geometry.dof_prismatic, *joint_lines_at_zero(geometry), declared=declared)
 
 
+def _diameter(points) -> float:
+    """The largest distance between two of ``points`` (0 for fewer than two): the same in any world frame, unlike
+    the extent of their bounding box along the world's axes."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    return float(np.max(np.linalg.norm(points[:, None] - points[None], axis=-1))) if len(points) > 1 else 0.0
+
+
 def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0) -> float:
     """The size of a chain that its lines alone decide, the scale of :data:`MEETING`: the spread of the feet of the
     common perpendiculars of every two revolute axes at a clear angle (squared sine above :data:`CLEAR_FEET`) and
@@ -168,8 +175,7 @@ def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, de
             if sine2 > CLEAR_FEET:
                 anchors += [_foot_on_line(points[joint], axes[joint], points[other], axes[other]),
                             _foot_on_line(points[other], axes[other], points[joint], axes[joint])]
-    spread = float(np.ptp(anchors, axis=0).max()) if len(anchors) > 1 else 0.0
-    drawn = float(np.ptp(points, axis=0).max()) if count else 0.0
+    spread, drawn = _diameter(anchors), _diameter(points)
     lines = max(spread, max(gaps))
     return lines if lines > MEETING * drawn else drawn
 
@@ -207,7 +213,7 @@ def offsets_along_axes(prismatic: tuple[bool, ...], axes: NDArray, points: NDArr
         for joint, point in passed.items():
             canonical[joint] = point
     placed = [point for point in canonical if point is not None]
-    if len(placed) == count and count > 1 and np.ptp(placed, axis=0).max() <= MEETING * extent:
+    if len(placed) == count and count > 1 and _diameter(placed) <= MEETING * extent:
         return np.zeros(count)  # a spherical chain, every axis through one point: drawn as the file draws it
     return np.array([0.0 if point is None else float((point - points[joint]) @ axes[joint])
                      for joint, point in enumerate(canonical)])
