@@ -30,7 +30,7 @@ import pytest
 from test_axis_points import revolutes_drawn_elsewhere, revolutes_moved
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, screwkit_residuals
 
-from helpers import leg_line_otis, one_line_error, screwkit
+from helpers import in_unit, leg_line_otis, one_line_error, screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
@@ -459,20 +459,46 @@ def test_a_file_whose_joint_values_do_not_close_assembles_the_same_in_another_wo
     np.testing.assert_allclose([there.lmti, there.iti], [here.lmti, here.iti], atol=1e-9)
 
 
-def test_the_6_sps_leg_with_its_ball_revolutes_drawn_apart_on_their_axes_is_the_same_robot(tmp_path):
-    """Gepetto's ``wl16_like`` with every revolute drawn elsewhere on its axis (up to 5 cm), the balls' three
-    revolutes among them: the ball that ends each leg beyond the platform is still one point, where its three axes
-    meet (it was refused: 'three revolute joints through one point' was read from where the file draws them), and
-    at the file's pose the indices are the file's, the ITI the slider's 1 (a rod force through both ball centres)."""
-    source = GEPETTO / "wl16_like" / "robot.urdf"
-    folder = tmp_path / "wl16_like"
+def wl16_written(folder: Path, text: str) -> Path:
+    """``text`` as a copy of Gepetto's ``wl16_like`` (its robot.yaml beside it) in ``folder``."""
     folder.mkdir()
-    (folder / "robot.urdf").write_text(revolutes_drawn_elsewhere(source.read_text(), np.random.default_rng(4), 0.05))
-    (folder / "robot.yaml").write_text((source.parent / "robot.yaml").read_text())
-    original, other = load(source), load(folder / "robot.urdf")
-    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, original.home_pose)
+    (folder / "robot.urdf").write_text(text)
+    (folder / "robot.yaml").write_text((GEPETTO / "wl16_like" / "robot.yaml").read_text())
+    return folder / "robot.urdf"
+
+
+@pytest.mark.parametrize("factor", [1.0, 1e-3, 1e3])
+def test_the_6_sps_leg_with_its_ball_revolutes_drawn_apart_on_their_axes_is_the_same_robot(tmp_path, factor):
+    """Gepetto's ``wl16_like`` with every revolute drawn elsewhere on its axis (up to 5 cm), the balls' three
+    revolutes among them, in metres, millimetres and kilometres: the ball that ends each leg beyond the platform is
+    still one point, where its three axes meet (it was refused: 'three revolute joints through one point' was read
+    from where the file draws them), and at the file's pose the indices are the file's, the ITI the slider's 1 (a rod
+    force through both ball centres)."""
+    source = GEPETTO / "wl16_like" / "robot.urdf"
+    redrawn = revolutes_drawn_elsewhere(source.read_text(), np.random.default_rng(4), 0.05)
+    other = load(wl16_written(tmp_path / "wl16_like", in_unit(redrawn, "m", factor)))
+    original = load(source)
+    pose = original.home_pose * np.array([factor] * 3 + [1.0] * 3)
+    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, pose)
     np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
     np.testing.assert_allclose(there.iti_actuators, 1.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)
+
+
+def test_the_6_sps_leg_drawn_apart_on_its_axes_in_another_world_frame_is_the_same_robot(tmp_path):
+    """The same redrawn ``wl16_like`` hung in another world frame: its balls beyond the platform are found at the
+    same points of the robot, and its indices at its home pose are the unmoved redrawn file's at its own."""
+    source = GEPETTO / "wl16_like" / "robot.urdf"
+    redrawn = revolutes_drawn_elsewhere(source.read_text(), np.random.default_rng(4), 0.05)
+    base = "base_link" if '<link name="base_link">' in redrawn else ET.fromstring(redrawn).find("link").get("name")
+    placement = '<origin xyz="2.0 0.5 -3.0" rpy="0.4 -0.3 1.1"/>'
+    moved = redrawn.replace(f'<link name="{base}">', '<link name="new_world"/><joint name="new_world_to_base" '
+                            f'type="fixed"><parent link="new_world"/><child link="{base}"/>{placement}</joint>'
+                            f'<link name="{base}">', 1)
+    assert moved != redrawn
+    unmoved, other = (load(wl16_written(tmp_path / name, text)) for name, text in (("a", redrawn), ("b", moved)))
+    here, there = indices_at_pose(unmoved, unmoved.home_pose), indices_at_pose(other, other.home_pose)
+    np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
     np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)
 
 
