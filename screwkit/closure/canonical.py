@@ -155,12 +155,13 @@ def _diameter(points) -> float:
 
 
 def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, declared: int = 0) -> float:
-    """The size of a chain that its lines alone decide, the scale of :data:`MEETING`: the spread of the feet of the
-    common perpendiculars of every two revolute axes at a clear angle (squared sine above :data:`CLEAR_FEET`) and
-    of the centre of a loop joint at a point (the last ``declared`` DoFs), or the largest distance between two
-    revolute axes when that is larger. Where the file draws a joint along its axis changes none of it; a chain whose
-    every axis passes through one point has none (a spherical chain), and is measured as drawn (the spread of its
-    drawn points), as is a chain whose lines are all that close to one point at that scale."""
+    """The size of a chain that its lines alone decide, the scale of :data:`MEETING`: the largest distance between
+    the feet of the common perpendiculars of every two revolute axes at a clear angle (squared sine above
+    :data:`CLEAR_FEET`) and the centre of a loop joint at a point (the last ``declared`` DoFs), or the largest
+    distance between two revolute axes when that is larger. Where the file draws a joint along its axis, and the
+    world frame, change none of it; a chain whose every axis passes through one point has none (a spherical chain),
+    and is measured as drawn (the largest distance between its drawn points), as is a chain whose lines are all
+    that close to one point at that scale."""
     count = len(prismatic)
     revolutes = [joint for joint, slide in enumerate(prismatic[:count - declared]) if not slide]
     anchors = [points[joint] for joint in range(count - declared, count)]
