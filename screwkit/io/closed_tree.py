@@ -4,10 +4,10 @@ Other tools describe a closed-loop mechanism as a **tree** (a Pinocchio model bu
 or an MJCF file) plus **closures**: pairs of frames that must coincide in position (``3d``: a ball
 joint) or entirely (``6d``: a weld). This module holds that description (:class:`ClosedTree`,
 :class:`Closure`), what an import reports (:class:`ImportReport`) and the **assembly**
-(:func:`assemble`): the closures are solved from the file's reference joint values
-(Levenberg-Marquardt on every joint: damped steps, so the configuration reached is usually the
-nearest closed one); the gaps closed and the largest joint change are reported, and a closure
-that cannot close is named with its gap. :func:`screwkit.io.star.convert_tree` writes a closed
+(:func:`assemble`): the closures are solved from the file's reference joint values (Levenberg-Marquardt on every
+joint, then along the closed configurations to the one nearest to the file's values, which the mechanism decides,
+not its drawing); the gaps closed and the largest joint change are reported, and a closure that cannot close is
+named with its gap. :func:`screwkit.io.star.convert_tree` writes a closed
 tree in screwkit's convention.
 """
 
@@ -26,6 +26,8 @@ __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport",
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
+LEVI_CIVITA = np.zeros((3, 3, 3))
+LEVI_CIVITA[[0, 1, 2], [1, 2, 0], [2, 0, 1]], LEVI_CIVITA[[0, 1, 2], [2, 0, 1], [1, 2, 0]] = 1.0, -1.0
 INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
@@ -208,12 +210,35 @@ def path_to(model, joint: int) -> list[int]:
     return path[::-1]
 
 
-def _length_scale(model, data) -> float:
-    """The root-mean-square distance of the joints from their centroid: the mechanism's own size, the same in any
-    world frame (the universe joint, at the world's origin, is not one of them)."""
-    points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
-    spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
-    return float(spread) if spread > 0.0 else 1.0
+def _length_scale(model, data, closures=()) -> float:
+    """The mechanism's own size at the configuration in ``data``: the root-mean-square distance of its revolute axis
+    lines and ball centres (spherical joints, ``3d`` closures) from the point nearest to them all (least squares),
+    which neither where the file draws a joint along its axis, nor its link frames, nor the world frame change; the
+    spread of the joints' drawn origins about their centroid when that is zero (every line through one point) or
+    there are none."""
+    projections, points = [], []  # each line's (or point's) projection off itself, and a point of it
+    for joint in range(1, model.njoints):
+        kind, axis = joint_kind(model, joint)
+        frame = homogeneous(data.oMi[joint])
+        if kind in ("revolute", "spherical"):
+            direction = frame[:3, :3] @ axis if kind == "revolute" else np.zeros(3)
+            projections.append(np.eye(3) - np.outer(direction, direction))
+            points.append(frame[:3, 3])
+    for closure in closures:
+        if closure.kind == "3d":
+            projections.append(np.eye(3))
+            points.append(_frames(model, data, closure)[0][:3, 3])
+    if points:
+        projections, points = np.array(projections), np.array(points)
+        offsets = np.einsum("kij,kj->ki", projections, points)
+        centre = np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=None)[0]
+        distances = np.einsum("kij,kj->ki", projections, points - centre)
+        spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
+        if spread > 1e-9 * float(np.max(np.abs(points - centre))):
+            return spread
+    drawn = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
+    spread = float(np.sqrt(np.mean(np.sum((drawn - drawn.mean(axis=0)) ** 2, axis=-1))))
+    return spread if spread > 0.0 else 1.0
 
 
 def at_point(frame: NDArray, point: NDArray, parent: NDArray | None = None) -> NDArray[np.float64]:
@@ -280,24 +305,64 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
         tree.model, data, c)]}
 
 
-def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
-    """A configuration closing every closure, near the file's reference one; and the length scale.
+def _jacobian(residuals, v: NDArray, directions: NDArray) -> NDArray[np.float64]:
+    """The residuals' derivatives along each of ``directions`` (rows) at ``v``, by central differences."""
+    step = 1e-7
+    return np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step) for e in directions])
+
+
+def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray) -> tuple[NDArray, NDArray]:
+    """From a closed ``v`` (its residuals ``error``; ``derivatives(v)`` their Jacobian along ``directions``), the
+    closed configuration nearest to the reference one (v = 0;
+    angles in rad, lengths in length scales, along ``directions`` only): the point of the linearised closed set
+    nearest to 0 (the pseudo-inverse of the closures' Jacobian, whose null space is where the closures stay closed,
+    whatever the residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it
+    does not close again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them
+    closed comes nearer): the least change of the joints, which the mechanism decides, not its drawing."""
+    floor = max(float(np.linalg.norm(error)), ASSEMBLY_TOLERANCE)
+    for _ in range(100):
+        x = directions @ v
+        jacobian = derivatives(v)
+        inverse_ = np.linalg.pinv(jacobian, rcond=1e-7)
+        step = inverse_ @ (jacobian @ x - error) - x
+        if np.linalg.norm(step) <= 1e-10 * max(1.0, float(np.linalg.norm(x))):
+            break
+        for fraction in 0.5 ** np.arange(8):
+            candidate = v + (fraction * step) @ directions
+            closed = residuals(candidate)
+            for _ in range(8):  # closed again along the same Jacobian (a chord step)
+                if np.linalg.norm(closed) <= floor:
+                    break
+                candidate = candidate - (inverse_ @ closed) @ directions
+                closed = residuals(candidate)
+            nearer = np.linalg.norm(directions @ candidate) <= np.linalg.norm(x) * (1.0 + 1e-12)  # to round-off
+            if np.linalg.norm(closed) <= floor and nearer:
+                break
+        else:
+            break
+        v, error = candidate, closed
+    return v, error
+
+
+def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, float]:
+    """The closed configuration nearest to the file's reference one, and the length scale.
 
     Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
-    joint type; a damped step is the least change when the closures leave joints free; the joints ``held``, by
-    id, keep their values),
+    joint type; the joints ``held``, by id, keep their values),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
     the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
     turn); the Jacobian by central differences. Once the residual is within the file's rounding
     (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three, and rounded
-    redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor.
+    redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor. Then, when
+    ``nearest``, the configuration is slid along the closed ones to the nearest (:func:`_nearest`): the damped
+    steps reach *a* closed configuration, which depends on how the residuals are weighed and so on where the file
+    draws its joints and frames; the nearest one does not.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
     data = model.createData()
     pin.forwardKinematics(model, data, tree.q_reference)
-    scale = _length_scale(model, data)
     prismatic = np.zeros(model.nv, dtype=bool)
     for joint in range(1, model.njoints):
         try:
@@ -306,6 +371,7 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
             raise ImportError_(f"{tree.source}: {error}") from None
         if kind == "prismatic":
             prismatic[model.joints[joint].idx_v] = True
+    scale = _length_scale(model, data, tree.closures)
     unit = np.where(prismatic, scale, 1.0)
 
     def configuration(v):
@@ -321,6 +387,22 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
                 rows.append((b[:3, :3] - a[:3, :3]).ravel())
         return np.concatenate(rows)
 
+    def derivatives(v):  # the residuals' Jacobian along the free directions, from Pinocchio's joint Jacobians
+        pin.computeJointJacobians(model, data, configuration(v))
+        rows = []
+        for closure in tree.closures:
+            motions = []
+            for joint, frame in zip((closure.joint_a, closure.joint_b), _frames(model, data, closure)):
+                jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+                offset = frame[:3, 3] - data.oMi[joint].translation
+                turning = np.einsum("ijl,jk,lc->ick", LEVI_CIVITA, jacobian[3:], frame[:3, :3])  # w x each column
+                motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), turning))
+            rows.append((motions[1][0] - motions[0][0]) / scale)
+            if closure.kind == "6d":
+                rows.append((motions[1][1] - motions[0][1]).reshape(9, -1))
+        chain = pin.dIntegrate(model, tree.q_reference, v * unit, pin.ARG1) * unit
+        return np.vstack(rows) @ chain @ directions.T
+
     if not tree.closures:
         raise ImportError_(f"{tree.source}: no closure: nothing closes the tree into a parallel mechanism.")
     free = np.ones(model.nv, dtype=bool)
@@ -335,9 +417,7 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
         within += norm < INCONSISTENCY_TOLERANCE  # closures that close need 2-3 steps from there; rounded ones creep
         if norm < ASSEMBLY_TOLERANCE or damping > 1e8 or within > 20:
             break
-        step = 1e-7
-        jacobian = np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step)
-                                    for e in directions])
+        jacobian = _jacobian(residuals, v, directions)
         normal = jacobian.T @ jacobian + (damping + norm**2) * np.eye(len(directions))
         change = -np.linalg.solve(normal, jacobian.T @ error) @ directions
         change *= min(1.0, 0.5 / max(float(np.max(np.abs(change))), 1e-300))
@@ -346,6 +426,8 @@ def assemble(tree: ClosedTree, held=()) -> tuple[NDArray, float]:
             v, error, damping = v + change, candidate, max(damping * 0.1, 1e-12)
         else:
             damping *= 10.0
+    if nearest and np.linalg.norm(error) < INCONSISTENCY_TOLERANCE:
+        v, error = _nearest(residuals, derivatives, v, error, directions)
     result = type("Result", (), {"x": v})
     q = configuration(result.x)
     final = error

@@ -244,7 +244,7 @@ def closed_samples(tree: ClosedTree, q: NDArray, scale: float, count: int = 4) -
     for _ in range(3 * count):
         start = pin.integrate(model, q, rng.uniform(-0.2, 0.2, model.nv) * unit)
         try:
-            samples.append(assemble(replace(tree, q_reference=start))[0])
+            samples.append(assemble(replace(tree, q_reference=start), nearest=False)[0])
         except ImportError_:
             continue
         if len(samples) == count:

@@ -369,8 +369,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     q, scale = assemble(tree)
     report.gaps_after = closure_gaps(tree, q)
     change = pin.difference(model, tree.q_reference, q)
-    report.notes.append(f"working mode: the closed configuration damped least squares reach from the file's joint "
-                        f"values (the largest joint change {float(np.max(np.abs(change), initial=0.0)):.3g} rad or m)")
+    report.notes.append(f"working mode: the closed configuration nearest to the file's joint values (the largest "
+                        f"joint change {float(np.max(np.abs(change), initial=0.0)):.3g} rad or m)")
     data = model.createData()
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)

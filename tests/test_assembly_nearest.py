@@ -1,0 +1,168 @@
+"""The configuration a file assembles into when its joint values leave its loops open.
+
+Gepetto's published ``robot_delta`` and ``wl16_like`` leave their closures open at the file's joint values (by up to
+0.37 m for the 6-SPS leg), and every configuration of a whole family closes them. screwkit takes the one nearest to
+the file's values (angles in rad, slides in length scales): a choice the mechanism makes, so the same whether the file
+draws a revolute elsewhere on its axis, turns a link's frame about its joint's axis, or is written in millimetres.
+The damped steps that reached *a* closed configuration before depended on all three (the Delta's home moved by up
+to 4 mm and its ITI by up to 0.095; the 6-SPS leg's LMTI was 0.038 or 0.121).
+
+Checked here against Pinocchio's own Jacobians (the change from the file's values is normal to the closed
+configurations: no motion that keeps the loops closed shortens it) and against closed configurations sampled around
+it (none is nearer).
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.spatial.transform import Rotation
+from test_axis_points import numbers, origins_in, revolutes_moved, written
+from test_gallery import screwkit_residuals
+from test_lower_mobility import rpy_matrix
+
+from helpers import in_unit
+from screwkit.io import read_closed_tree
+from screwkit.io.closed_tree import assemble, joint_kind
+from screwkit.io.compound import closed_samples
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+GEPETTO = Path(__file__).resolve().parent / "data" / "gallery" / "published" / "example_parallel_robots"
+OPEN_FILES = ("robot_delta", "wl16_like")
+
+
+def rpy_of(rotation) -> str:
+    """URDF's roll-pitch-yaw (R = Rz Ry Rx, fixed axes) of a rotation matrix, checked to give it back (at a pitch of
+    90 degrees any split of the other two does)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Gimbal lock", UserWarning)
+        angles = Rotation.from_matrix(rotation).as_euler("xyz")
+    np.testing.assert_allclose(rpy_matrix(*angles), rotation, atol=1e-12)
+    return written(angles)
+
+
+def closure_joints(name: str) -> set[str]:
+    """The joints whose frames robot.yaml welds (Gepetto's closures are joint frames: drawing one of those
+    elsewhere, or turning it, would change the mechanism)."""
+    return set(re.findall(r"closedloop\w+", (GEPETTO / name / "robot.yaml").read_text()))
+
+
+def revolutes(text: str, name: str) -> list:
+    """The tree revolutes of the URDF ``text`` but the closure frames (ElementTree elements)."""
+    return [joint for joint in ET.fromstring(text).iter("joint") if joint.get("type") in ("revolute", "continuous")
+            and joint.get("name") not in closure_joints(name)]
+
+
+def drawn_along_axes(text: str, name: str, rng) -> str:
+    """Every tree revolute but the closure frames drawn elsewhere on its axis (up to 5 cm either way)."""
+    return revolutes_moved(text, {joint.get("name"): rng.uniform(-0.05, 0.05) for joint in revolutes(text, name)})
+
+
+def frames_turned_about_axes(text: str, name: str, rng) -> str:
+    """The URDF with every tree revolute's child link frame (but the closure frames) turned about the joint's axis (each
+    by its own angle) and every origin written in that frame turned back: every body where it was at every joint
+    value, drawn in other frames (written here with ElementTree, not with screwkit's reader)."""
+    root = ET.fromstring(text)
+    turned = {joint.get("name") for joint in revolutes(text, name)}
+    for joint in root.iter("joint"):
+        if joint.get("name") not in turned:
+            continue
+        axis = numbers(joint.find("axis").get("xyz") if joint.find("axis") is not None else "1 0 0")
+        turn = Rotation.from_rotvec(rng.uniform(-np.pi, np.pi) * axis / np.linalg.norm(axis)).as_matrix()
+        origin = joint.find("origin") if joint.find("origin") is not None else ET.SubElement(joint, "origin")
+        origin.set("rpy", rpy_of(rpy_matrix(*numbers(origin.get("rpy", "0 0 0"))) @ turn))
+        for inner in origins_in(root, joint.find("child").get("link")):
+            inner.set("xyz", written(turn.T @ numbers(inner.get("xyz", "0 0 0"))))
+            inner.set("rpy", rpy_of(turn.T @ rpy_matrix(*numbers(inner.get("rpy", "0 0 0")))))
+    return ET.tostring(root, encoding="unicode")
+
+
+def copied(folder: Path, name: str, text: str) -> Path:
+    """``text`` as Gepetto's ``name`` (its robot.yaml beside it) in ``folder``."""
+    folder.mkdir()
+    (folder / "robot.urdf").write_text(text)
+    (folder / "robot.yaml").write_text((GEPETTO / name / "robot.yaml").read_text())
+    return folder / "robot.urdf"
+
+
+DRAWINGS = {
+    "revolutes elsewhere on their axes": lambda text, name, rng: (drawn_along_axes(text, name, rng), 1.0),
+    "link frames turned about their axes": lambda text, name, rng: (frames_turned_about_axes(text, name, rng), 1.0),
+    "both, in millimetres": lambda text, name, rng: (in_unit(frames_turned_about_axes(
+        drawn_along_axes(text, name, rng), name, rng), "mm", 1000.0), 1000.0),
+}
+
+
+@pytest.mark.parametrize("drawing", DRAWINGS)
+@pytest.mark.parametrize("name", OPEN_FILES)
+def test_a_file_that_does_not_close_assembles_into_the_same_configuration_however_it_is_drawn(tmp_path, name,
+                                                                                            drawing):
+    """The home pose's task coordinates (lengths in the file's unit; the platform's frame, where a drawing moves it,
+    moves along an axis that is not one of them) and the indices at each file's home pose."""
+    source = GEPETTO / name / "robot.urdf"
+    text, factor = DRAWINGS[drawing](source.read_text(), name, np.random.default_rng(7))
+    assert text != source.read_text()
+    original, other = load(source), load(copied(tmp_path / name, name, text))
+    lengths = np.array([factor if other.pose_coordinates[k] in "xyz" else 1.0 for k in other.task_indices])
+    np.testing.assert_allclose(other.home_pose, lengths * original.home_pose, rtol=0, atol=1e-8 * factor)
+    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, other.home_pose)
+    np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(there.oti_actuators, here.oti_actuators, rtol=0, atol=1e-7)
+    np.testing.assert_allclose([there.lmti, *there.f_o.values()], [here.lmti, *here.f_o.values()], rtol=0,
+                               atol=1e-7)
+
+
+def closure_jacobian(tree, q) -> np.ndarray:
+    """The closures' velocity constraints at q from Pinocchio's joint Jacobians: for each closure, the relative
+    velocity of its two frames' origin (and, for a weld, their relative angular velocity), world-aligned."""
+    model, data = tree.model, tree.model.createData()
+    pin.computeJointJacobians(model, data, q)
+    rows = []
+    for closure in tree.closures:
+        motions = []
+        for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
+            jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+            point = data.oMi[joint].homogeneous @ placement
+            offset = point[:3, 3] - data.oMi[joint].translation
+            linear = jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0)  # v + w x offset
+            motions.append((linear, jacobian[3:]))
+        rows.append(motions[1][0] - motions[0][0])
+        if closure.kind == "6d":
+            rows.append(motions[1][1] - motions[0][1])
+    return np.vstack(rows)
+
+
+@pytest.mark.parametrize("name", OPEN_FILES)
+def test_the_assembly_is_the_closed_configuration_nearest_to_the_file_s_values(name):
+    """The change x from the file's values (slides in length scales) closes every closure (Pinocchio's placements)
+    and has no part along a motion that keeps them closed (the null space of Pinocchio's closure Jacobian, carried
+    to the file's configuration): the first-order condition of the nearest. Closed configurations sampled within
+    0.2 rad or length scales of it are all farther."""
+    tree = read_closed_tree(GEPETTO / name / "robot.urdf")
+    q, scale = assemble(tree)
+    model = tree.model
+    gaps = screwkit_residuals(tree, q)
+    assert max(float(np.max(np.abs(gap))) for gap in gaps.values()) < 1e-12
+    unit = np.ones(model.nv)
+    for joint in range(1, model.njoints):
+        if joint_kind(model, joint)[0] == "prismatic":
+            unit[model.joints[joint].idx_v] = scale
+    change = pin.difference(model, tree.q_reference, q)
+    x = change / unit
+    assert np.linalg.norm(x) > 0.5  # far from closing: the nearest is a real choice
+    constraints = closure_jacobian(tree, q) @ pin.dIntegrate(model, tree.q_reference, change, pin.ARG1) * unit
+    _, singular, rows = np.linalg.svd(constraints)
+    rank = int(np.sum(singular > 1e-9 * singular[0]))
+    along_closed = rows[rank:] @ x
+    assert np.linalg.norm(along_closed) < 1e-7 * np.linalg.norm(x), np.linalg.norm(along_closed)
+    samples = closed_samples(tree, q, scale, count=4)
+    assert len(samples) == 4
+    distances = [np.linalg.norm(pin.difference(model, tree.q_reference, sample) / unit) for sample in samples]
+    assert min(distances) >= np.linalg.norm(x) - 1e-9, (distances, np.linalg.norm(x))
