@@ -29,7 +29,7 @@ from test_lower_mobility import rpy_matrix
 
 from helpers import in_unit
 from screwkit.io import read_closed_tree
-from screwkit.io.closed_tree import assemble, joint_kind
+from screwkit.io.closed_tree import ClosedTree, Closure, assemble, joint_kind
 from screwkit.io.compound import closed_samples
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -166,3 +166,42 @@ def test_the_assembly_is_the_closed_configuration_nearest_to_the_file_s_values(n
     assert len(samples) == 4
     distances = [np.linalg.norm(pin.difference(model, tree.q_reference, sample) / unit) for sample in samples]
     assert min(distances) >= np.linalg.norm(x) - 1e-9, (distances, np.linalg.norm(x))
+
+
+def arm_and_free_platform(length: float, target) -> ClosedTree:
+    """A revolute arm of ``length`` about z at the origin whose tip is joined by a ball to a free body, which the
+    file places at ``target`` (unturned): the loop is open unless the tip is there."""
+    model = pin.Model()
+    arm = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "arm")
+    model.appendBodyToJoint(arm, pin.Inertia.Random(), pin.SE3.Identity())
+    free = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "platform")
+    model.appendBodyToJoint(free, pin.Inertia.Random(), pin.SE3.Identity())
+    tip = np.eye(4)
+    tip[0, 3] = length
+    q = pin.neutral(model)
+    q[1:4] = target
+    return ClosedTree("arm_and_free_platform", model, [Closure("ball", arm, tip, free, np.eye(4), "3d")], ["arm"], q)
+
+
+@pytest.mark.parametrize("length", [1.0, 1e-3, 1e3])
+def test_a_free_body_s_translation_is_weighed_in_length_scales(length):
+    """A free joint's translation is a length, as a slide is: the nearest closed configuration of the arm and its
+    free platform (the platform 0.4 and 0.3 arm lengths off the tip) turns the arm by the angle that minimises
+    angle^2 + (platform's move / length scale)^2 (its orientation kept), found here by a bounded scalar search, the
+    same in any unit. Weighed in metres, a millimetre arm barely moved its platform and a kilometre one barely
+    turned."""
+    from scipy.optimize import minimize_scalar
+
+    tree = arm_and_free_platform(length, length * np.array([1.4, 0.3, 0.0]))
+    q, scale = assemble(tree)
+    assert scale == pytest.approx(length / 2, rel=1e-12)  # the z axis and the ball centre: each L/2 from the middle
+
+    def distance(angle):
+        tip = length * np.array([np.cos(angle), np.sin(angle), 0.0])
+        return angle**2 + np.sum((tip - tree.q_reference[1:4]) ** 2) / scale**2
+
+    expected = minimize_scalar(distance, bounds=(-1.0, 1.0), method="bounded", options={"xatol": 1e-12}).x
+    np.testing.assert_allclose(q[0], expected, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(q[1:4], length * np.array([np.cos(expected), np.sin(expected), 0.0]), rtol=0,
+                               atol=1e-8 * length)
+    np.testing.assert_allclose(q[4:], [0.0, 0.0, 0.0, 1.0], atol=1e-7)  # unturned (to the solve's tolerance)

@@ -22,10 +22,14 @@ from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
-           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point"]
+           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point", "LENGTH_COORDINATES"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
+LENGTH_COORDINATES = {"JointModelPX": 1, "JointModelPY": 1, "JointModelPZ": 1, "JointModelPrismaticUnaligned": 1,
+                      "JointModelTranslation": 3, "JointModelPlanar": 2, "JointModelFreeFlyer": 3}
+"""Pinocchio joint models whose first configuration coordinates (and velocity coordinates) are lengths, and how
+many."""
 LEVI_CIVITA = np.zeros((3, 3, 3))
 LEVI_CIVITA[[0, 1, 2], [1, 2, 0], [2, 0, 1]], LEVI_CIVITA[[0, 1, 2], [2, 0, 1], [1, 2, 0]] = 1.0, -1.0
 INCONSISTENCY_TOLERANCE = FILE_ROUNDING
@@ -363,16 +367,17 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     model = tree.model
     data = model.createData()
     pin.forwardKinematics(model, data, tree.q_reference)
-    prismatic = np.zeros(model.nv, dtype=bool)
+    lengths = np.zeros(model.nv, dtype=bool)  # the velocity coordinates that are lengths (slides, translations)
     for joint in range(1, model.njoints):
         try:
             kind = joint_kind(model, joint)[0]
         except ImportError_ as error:  # a zero axis (a Gepetto URDF read by Pinocchio): the file named
             raise ImportError_(f"{tree.source}: {error}") from None
-        if kind == "prismatic":
-            prismatic[model.joints[joint].idx_v] = True
+        start = model.joints[joint].idx_v
+        lengths[start:start + (1 if kind == "prismatic" else
+                               LENGTH_COORDINATES.get(model.joints[joint].shortname(), 0))] = True
     scale = _length_scale(model, data, tree.closures)
-    unit = np.where(prismatic, scale, 1.0)
+    unit = np.where(lengths, scale, 1.0)
 
     def configuration(v):
         return pin.integrate(model, tree.q_reference, v * unit)

@@ -15,13 +15,9 @@ from dataclasses import replace
 import numpy as np
 
 from screwkit.common.units import metres_per
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_
+from screwkit.io.closed_tree import LENGTH_COORDINATES, ClosedTree, Closure, ImportError_
 
 __all__ = ["in_metres", "LENGTH_COORDINATES"]
-
-LENGTH_COORDINATES = {"JointModelPX": 1, "JointModelPY": 1, "JointModelPZ": 1, "JointModelPrismaticUnaligned": 1,
-                      "JointModelTranslation": 3, "JointModelPlanar": 2, "JointModelFreeFlyer": 3}
-"""Pinocchio joint models whose first configuration coordinates are lengths, and how many."""
 _ANGULAR = ("JointModelR", "JointModelSpherical", "JointModelUniversal")
 
 
