@@ -229,13 +229,15 @@ def _length_scale(model, data, closures=()) -> float:
             projections.append(np.eye(3) - np.outer(direction, direction))
             points.append(frame[:3, 3])
     for closure in closures:
-        if closure.kind == "3d":
+        if closure.kind == "3d":  # the ball's centre: midway between its two frames (apart where the file is open)
             projections.append(np.eye(3))
-            points.append(_frames(model, data, closure)[0][:3, 3])
+            points.append(np.mean([frame[:3, 3] for frame in _frames(model, data, closure)], axis=0))
     if points:
         projections, points = np.array(projections), np.array(points)
-        offsets = np.einsum("kij,kj->ki", projections, points)
-        centre = np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=None)[0]
+        middle = points.mean(axis=0)  # the centre from the points' centroid: axes rounded off parallel (a planar
+        # mechanism's) leave the centre undecided along them, and it stays near the mechanism
+        offsets = np.einsum("kij,kj->ki", projections, points - middle)
+        centre = middle + np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=1e-6)[0]
         distances = np.einsum("kij,kj->ki", projections, points - centre)
         spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
         if spread > 1e-9 * float(np.max(np.abs(points - centre))):
@@ -323,7 +325,14 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
     whatever the residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it
     does not close again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them
     closed comes nearer): the least change of the joints, which the mechanism decides, not its drawing."""
-    floor = max(float(np.linalg.norm(error)), ASSEMBLY_TOLERANCE)
+    for _ in range(10):  # closed first to round-off (the damped steps stop at ASSEMBLY_TOLERANCE), so that a nearer
+        inverse_ = np.linalg.pinv(derivatives(v), rcond=1e-7)  # point is not one that is merely less closed
+        candidate = v - (inverse_ @ error) @ directions
+        closed = residuals(candidate)
+        if not np.linalg.norm(closed) < np.linalg.norm(error):
+            break
+        v, error = candidate, closed
+    floor = max(2.0 * float(np.linalg.norm(error)), 1e-14)
     for _ in range(100):
         x = directions @ v
         jacobian = derivatives(v)
