@@ -28,11 +28,14 @@ from screwkit.screw.chain_screws import ChainScrews
 from screwkit.studies import indices_at_poses
 
 THRESHOLD = 1e-6
-COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups")
-"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis in their screws. The two others are the
-exceptions ``docs/theory.md`` names: a prismatic joint after an actuator; wrenches with a pitch and a force parallel to
-the joint after it. The skew 4-RSR below is not covered either: its actuation wrenches are defined modulo a constraint
-force whose moment about the platform joint changes with the joint's drawn place, and so does their representative.
+COVERED = ("planar_5rrr", "planar_4rpr", "ups_hexapod_8", "ups_stewart_6", "rss_hexapod_8", "delta_4", "prs_3_ups",
+           "schoenflies_5")
+"""Bundled mechanisms whose every revolute may be drawn anywhere on its axis in their screws (``schoenflies_5`` since
+the ITI's point of an actuator followed by a slide is where the force crosses the next joint that turns, not the
+slide's drawn point). The other is the exception ``docs/theory.md`` names: wrenches with a pitch and a force
+parallel to the joint after it. The skew 4-RSR below is not covered either: its actuation wrenches are defined modulo
+a constraint force whose moment about the platform joint changes with the joint's drawn place, and so does their
+representative.
 Read from a file, ``coop_arms`` and the skew 4-RSR are covered too: the loader draws every revolute at a canonical
 point (``test_canonical_points.py``)."""
 
@@ -146,7 +149,8 @@ def _move_along_axis(root, joint, distance: float) -> None:
         inner.set("xyz", written(numbers(inner.get("xyz", "0 0 0")) - shift))
 
 
-@pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8", "planar_5rrr"))
+@pytest.mark.parametrize("name", ("delta_4", "rss_hexapod_8", "prs_3_ups", "ups_hexapod_8", "planar_5rrr",
+                                  "schoenflies_5"))
 def test_a_file_whose_revolutes_are_drawn_elsewhere_on_their_axes_gives_the_same_indices(name, tmp_path):
     """What a user meets: the bundled URDF with every revolute's origin moved along its axis (up to a tenth of the
     mechanism's size), read and analysed at random reachable poses, gives the indices of the file as bundled."""

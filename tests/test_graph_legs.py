@@ -33,6 +33,7 @@ from screwkit.io.loader import bundled_names, load
 from screwkit.io.mjcf import read_mjcf
 from screwkit.screw import algebra as screws
 from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.reference import joint_after
 from screwkit.studies import indices_at_pose
 
 TOLERANCE = 1e-9
@@ -175,7 +176,7 @@ def test_the_equivalent_chain_of_the_graph_derivation_gives_the_per_chain_wrench
         for chain in chains:
             for k in chain.actuated:
                 wrench = wrenches[:, len(given["oti_points"])]
-                for name, joint in (("iti_points", min(k + 1, chain.n_joints - 1)), ("oti_points", -1)):
+                for name, joint in (("iti_points", joint_after(chain.twists[0], k)), ("oti_points", -1)):
                     line = screws.joint_lines(chain.twists, chain.points, joint)
                     given[name].append(screws.nearest_on_axis(wrench, chain.points[:, joint], line))
         options.update({name: np.stack(points, axis=1) for name, points in given.items()})

@@ -42,7 +42,7 @@ from screwkit.screw.algebra import (
     shift_twist,
 )
 
-__all__ = ["working_frame", "motion_space", "actuation_wrench", "input_transmission", "output_twists",
+__all__ = ["working_frame", "motion_space", "actuation_wrench", "joint_after", "input_transmission", "output_twists",
            "output_transmission", "fault_tolerance", "constraint_transmission", "reference_indices"]
 
 
@@ -108,11 +108,22 @@ def _singular_wrench(unit: NDArray, k: int, basis: NDArray, d: NDArray) -> NDArr
     return vectors[rank] @ span if len(span) - rank == 1 else None
 
 
+def joint_after(twists: NDArray, joint: int) -> int:
+    """The joint whose point is the ITI's for the actuator ``joint`` of a chain (its unit twists (m, 6)): the first
+    joint after it that turns. A slide has no point (its twist is a direction), so a force acts on the actuated link
+    where it crosses the next joint that has an axis (a Schoenflies leg's slider carriage turns on the revolute
+    after it); the last joint when every joint after the actuator slides, the actuator when it is the last."""
+    for after in range(joint + 1, len(twists)):
+        if np.any(twists[after, :3] != 0.0):
+            return after
+    return len(twists) - 1
+
+
 def input_transmission(wrench: NDArray, twist: NDArray, after: NDArray, point: NDArray, threshold: float) -> float:
     """ITI of one actuator (Eq. 6): the power coefficient on its joint's ``twist``, the wrench rotated about the
-    first joint after the actuator, drawn at ``point`` with the axis direction ``after`` (:func:`joint_lines`): on
-    a force, the point of its axis nearest to that joint's axis (where it crosses it), wherever along its axis the
-    joint is drawn (:func:`nearest_on_axis`)."""
+    joint after the actuator (:func:`joint_after`), drawn at ``point`` with the axis direction ``after``
+    (:func:`joint_lines`): on a force, the point of its axis nearest to that joint's axis (where it crosses it),
+    wherever along its axis the joint is drawn (:func:`nearest_on_axis`)."""
     return float(power_coefficient(wrench, twist, nearest_on_axis(wrench, point, after), threshold))
 
 
@@ -231,7 +242,7 @@ def reference_indices(twists: list[NDArray], points: list[NDArray], actuated: li
     actuators = [(c, k) for c, ks in enumerate(actuated) for k in ks]
     wrenches = np.array([actuation_wrench(work[c], at[c], k, space) for c, k in actuators])
     p = threshold / length
-    after = [min(k + 1, len(at[c]) - 1) for c, k in actuators]
+    after = [joint_after(work[c], k) for c, k in actuators]
     iti = [input_transmission(wrenches[a], work[c][k], joint_lines(work[c], at[c], after[a]), at[c][after[a]], p)
            for a, (c, k) in enumerate(actuators)]
     sets = list(combinations(range(len(actuators)), dof))
