@@ -434,10 +434,10 @@ def test_convert_writes_reachy_mini_s_urdf_with_its_yaw_stage_locked(tmp_path):
                                             ("wl16_like", (2.0, 0.5, -3.0), (0.4, -0.3, 1.1))])
 def test_a_file_whose_joint_values_do_not_close_assembles_the_same_in_another_world_frame(tmp_path, name, xyz, rpy):
     """Both files' joint values leave their closures open (by up to 3 cm and 0.37 m): the assembly moves them to the
-    closed configuration nearest in its own units, slides in the mechanism's length scale. That scale is the
-    mechanism's size (the root-mean-square distance of its axis lines and ball centres from the point nearest to
-    them), not their distance from the world's origin, which it once included: moved to another world frame, the file
-    assembled elsewhere on the mechanism and its indices changed in the third decimal."""
+    closed configuration nearest to them. The length scale its gaps are measured in is the mechanism's size (the
+    joints' spread about their centroid), not their distance from the world's origin, which it once included: moved
+    to another world frame, the file assembled elsewhere on the mechanism and its indices changed in the third
+    decimal."""
     source = GEPETTO / name / "robot.urdf"
     text = source.read_text(encoding="utf-8")
     root = ET.fromstring(text)

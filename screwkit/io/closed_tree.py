@@ -214,12 +214,21 @@ def path_to(model, joint: int) -> list[int]:
     return path[::-1]
 
 
-def _length_scale(model, data, closures=()) -> float:
-    """The mechanism's own size at the configuration in ``data``: the root-mean-square distance of its revolute axis
-    lines and ball centres (spherical joints, ``3d`` closures) from the point nearest to them all (least squares),
-    which neither where the file draws a joint along its axis, nor its link frames, nor the world frame change; the
-    spread of the joints' drawn origins about their centroid when that is zero (every line through one point) or
-    there are none."""
+def _length_scale(model, data) -> float:
+    """The root-mean-square distance of the joints from their centroid: the mechanism's own size, the same in any
+    world frame (the universe joint, at the world's origin, is not one of them); what the closures' gaps and their
+    tolerances are measured in."""
+    points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
+    spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
+    return float(spread) if spread > 0.0 else 1.0
+
+
+def _lines_scale(model, data, closures=()) -> float:
+    """The length that weighs a slide against an angle in the nearest closed configuration, at the configuration in
+    ``data``: the root-mean-square distance of the revolute axis lines and ball centres (spherical joints, ``3d``
+    closures) from the point nearest to them all (least squares), which neither where the file draws a joint along
+    its axis, nor its link frames, nor the world frame change; the joints' spread (:func:`_length_scale`) when that
+    is zero (every line through one point) or there are none."""
     projections, points = [], []  # each line's (or point's) projection off itself, and a point of it
     for joint in range(1, model.njoints):
         kind, axis = joint_kind(model, joint)
@@ -240,11 +249,9 @@ def _length_scale(model, data, closures=()) -> float:
         centre = middle + np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=1e-6)[0]
         distances = np.einsum("kij,kj->ki", projections, points - centre)
         spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
-        if spread > 1e-9 * float(np.max(np.abs(points - centre))):
+        if spread > MEETING * float(np.max(np.abs(points - centre))):  # lines that meet to rounding: spherical
             return spread
-    drawn = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
-    spread = float(np.sqrt(np.mean(np.sum((drawn - drawn.mean(axis=0)) ** 2, axis=-1))))
-    return spread if spread > 0.0 else 1.0
+    return _length_scale(model, data)
 
 
 def at_point(frame: NDArray, point: NDArray, parent: NDArray | None = None) -> NDArray[np.float64]:
@@ -319,14 +326,16 @@ def _jacobian(residuals, v: NDArray, directions: NDArray) -> NDArray[np.float64]
 
 def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray) -> tuple[NDArray, NDArray]:
     """From a closed ``v`` (its residuals ``error``; ``derivatives(v)`` their Jacobian along ``directions``), the
-    closed configuration nearest to the reference one (v = 0;
-    angles in rad, lengths in length scales, along ``directions`` only): the point of the linearised closed set
-    nearest to 0 (the pseudo-inverse of the closures' Jacobian, whose null space is where the closures stay closed,
-    whatever the residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it
-    does not close again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them
-    closed comes nearer): the least change of the joints, which the mechanism decides, not its drawing."""
+    closed configuration nearest to the reference one (v = 0; angles in rad, lengths in units of
+    :func:`_lines_scale`, along ``directions`` only): the point of the linearised closed set nearest to 0 (the
+    pseudo-inverse of the closures' Jacobian, whose null space is where the closures stay closed, whatever the
+    residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it does not close
+    again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them closed comes
+    nearer): the least change of the joints, which the mechanism decides, not its drawing."""
     for _ in range(10):  # closed first to round-off (the damped steps stop at ASSEMBLY_TOLERANCE), so that a nearer
-        inverse_ = np.linalg.pinv(derivatives(v), rcond=1e-7)  # point is not one that is merely less closed
+        if np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file closed as written
+            break  # is left as written, to the bit (a rounded one's reading can turn on its last bits)
+        inverse_ = np.linalg.pinv(derivatives(v), rcond=1e-7)
         candidate = v - (inverse_ @ error) @ directions
         closed = residuals(candidate)
         if not np.linalg.norm(closed) < np.linalg.norm(error):
@@ -361,15 +370,18 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     """The closed configuration nearest to the file's reference one, and the length scale.
 
     Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
-    joint type; the joints ``held``, by id, keep their values),
+    joint type, lengths in units of :func:`_lines_scale`; the joints ``held``, by id, keep their values),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
     the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
     turn); the Jacobian by central differences. Once the residual is within the file's rounding
     (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three, and rounded
     redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor. Then, when
-    ``nearest``, the configuration is slid along the closed ones to the nearest (:func:`_nearest`): the damped
-    steps reach *a* closed configuration, which depends on how the residuals are weighed and so on where the file
-    draws its joints and frames; the nearest one does not.
+    ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
+    (:func:`_nearest`): the damped steps reach *a* closed configuration, which depends on how the residuals are
+    weighed and so on where the file draws its joints and frames; the nearest one does not. Closures that close
+    only to the file's rounding keep the damped steps' configuration: configurations closed to that rounding can
+    form a larger family than the closed ones (a spherical mechanism whose axes miss their centre by 1e-7 m), and
+    a slide along it went far from the file's values or left the floor.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -385,8 +397,8 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         start = model.joints[joint].idx_v
         lengths[start:start + (1 if kind == "prismatic" else
                                LENGTH_COORDINATES.get(model.joints[joint].shortname(), 0))] = True
-    scale = _length_scale(model, data, tree.closures)
-    unit = np.where(lengths, scale, 1.0)
+    scale = _length_scale(model, data)
+    unit = np.where(lengths, _lines_scale(model, data, tree.closures), 1.0)  # slides weighed against angles
 
     def configuration(v):
         return pin.integrate(model, tree.q_reference, v * unit)
@@ -440,8 +452,8 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             v, error, damping = v + change, candidate, max(damping * 0.1, 1e-12)
         else:
             damping *= 10.0
-    if nearest and np.linalg.norm(error) < INCONSISTENCY_TOLERANCE:
-        v, error = _nearest(residuals, derivatives, v, error, directions)
+    if nearest and np.linalg.norm(error) < ASSEMBLY_TOLERANCE:  # closures closed to rounding stay where they are:
+        v, error = _nearest(residuals, derivatives, v, error, directions)  # a slide would leave their floor
     result = type("Result", (), {"x": v})
     q = configuration(result.x)
     final = error
