@@ -600,3 +600,32 @@ def test_a_swept_coordinate_reads_back_as_written_and_is_the_pose_typed():
     report = json.loads(alone.stdout)
     assert float(row["lmti"]) == pytest.approx(report["lmti"], abs=1e-12)
     assert float(row["iti"]) == pytest.approx(report["iti"], abs=1e-12)
+
+
+RIGID_URDF = """<robot name="rigid">
+  <link name="base"/><link name="link1"/><link name="link2"/><link name="link3"/><link name="end_a"/>
+  <link name="end_b"/><link name="effector"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="link1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="link1"/><child link="link2"/><origin xyz="1 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="end_a_frame" type="fixed"><parent link="link2"/><child link="end_a"/><origin xyz="1 0 0"/></joint>
+  <joint name="effector_frame" type="fixed"><parent link="link2"/><child link="effector"/><origin xyz="0.5 0 0"/>
+  </joint>
+  <joint name="j3" type="revolute"><parent link="base"/><child link="link3"/><origin xyz="2 0.5 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="end_b_frame" type="fixed"><parent link="link3"/><child link="end_b"/><origin xyz="0 -0.5 0"/></joint>
+</robot>
+"""
+"""Two revolutes in a row from the base welded (a Gepetto 6d closure) to a third revolute's link: three planar
+joints and three planar constraints, a rigid triangle."""
+
+
+def test_a_file_whose_closures_leave_the_platform_no_motion_is_refused_as_rigid(tmp_path):
+    """The frame-output file's platform cannot move at all: one line that says so (it said that an output point
+    could not move, "every platform motion is a rotation about it", of a file with no point output)."""
+    (tmp_path / "robot.urdf").write_text(RIGID_URDF)
+    (tmp_path / "robot.yaml").write_text("closed_loop: [['end_a', 'end_b']]\ntype: ['6d']\nname_mot: ['j1']\n")
+    message = one_line_error(screwkit("analyze", tmp_path / "robot.urdf"), "robot.urdf",
+                             "the platform cannot move", "(DOF 0)")
+    assert "output point" not in message

@@ -304,9 +304,12 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
-    if mobility < 1:
+    if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")
+    if mobility < 1:  # rigid: its closures leave the platform no motion (as a CAD export's rounding can make them)
+        raise mechanism.description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move: its chains "
+                                         "leave it no motion at the reference assembly (DOF 0).")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
     candidates = [i for i, name in enumerate(names) if not (idle and name in ("phi", "roll", "pitch", "yaw"))]
     if declared is not None:
