@@ -249,7 +249,8 @@ def _lines_scale(model, data, closures=()) -> float:
         centre = middle + np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=1e-6)[0]
         distances = np.einsum("kij,kj->ki", projections, points - centre)
         spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
-        if spread > MEETING * float(np.max(np.abs(points - centre))):  # lines that meet to rounding: spherical
+        if spread > MEETING * float(np.max(np.linalg.norm(points - centre, axis=1))):  # else lines that meet to
+            # rounding: a spherical mechanism
             return spread
     return _length_scale(model, data)
 
