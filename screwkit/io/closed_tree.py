@@ -223,6 +223,17 @@ def _length_scale(model, data) -> float:
     return float(spread) if spread > 0.0 else 1.0
 
 
+def _nearest_to_lines(projections: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
+    """The point nearest to lines in the least-squares sense, each line given by its projection off itself
+    (``projections`` (k, 3, 3): I - u u^T, or I for a point) and a point of it (``points`` (k, 3)); and each line's
+    offset from it, perpendicular to the line (k, 3). Solved from the points' centroid: lines rounded off parallel (a
+    planar mechanism's) leave the point undecided along them, and it stays near the mechanism."""
+    middle = points.mean(axis=0)
+    offsets = np.einsum("kij,kj->ki", projections, points - middle)
+    centre = middle + np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=1e-6)[0]
+    return centre, np.einsum("kij,kj->ki", projections, points - centre)
+
+
 def _lines_scale(model, data, closures=()) -> float:
     """The length that weighs a slide against an angle in the nearest closed configuration, at the configuration in
     ``data``: the root-mean-square distance of the revolute axis lines and ball centres (spherical joints, ``3d``
@@ -243,11 +254,7 @@ def _lines_scale(model, data, closures=()) -> float:
             points.append(np.mean([frame[:3, 3] for frame in _frames(model, data, closure)], axis=0))
     if points:
         projections, points = np.array(projections), np.array(points)
-        middle = points.mean(axis=0)  # the centre from the points' centroid: axes rounded off parallel (a planar
-        # mechanism's) leave the centre undecided along them, and it stays near the mechanism
-        offsets = np.einsum("kij,kj->ki", projections, points - middle)
-        centre = middle + np.linalg.lstsq(projections.sum(axis=0), offsets.sum(axis=0), rcond=1e-6)[0]
-        distances = np.einsum("kij,kj->ki", projections, points - centre)
+        centre, distances = _nearest_to_lines(projections, points)
         spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
         if spread > MEETING * float(np.max(np.linalg.norm(points - centre, axis=1))):  # else lines that meet to
             # rounding: a spherical mechanism
@@ -282,10 +289,8 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
     points = np.array([frame[:3, 3] for frame in frames])
     if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(2)):
         return None  # two in a row on (nearly) one direction turn about one axis: no ball
-    normals = np.eye(3)[None] - units[:, :, None] * units[:, None, :]  # projections off each line
-    centre = np.linalg.solve(normals.sum(axis=0), np.einsum("kij,kj->i", normals, points))
-    gaps = np.linalg.norm(np.einsum("kij,kj->ki", normals, centre - points), axis=1)
-    return centre if np.all(gaps <= MEETING * scale) else None
+    centre, offsets = _nearest_to_lines(np.eye(3)[None] - units[:, :, None] * units[:, None, :], points)
+    return centre if np.all(np.linalg.norm(offsets, axis=1) <= MEETING * scale) else None
 
 
 def ball_line(points, closures: list[Closure], scale: float) -> tuple[int, NDArray | None, NDArray]:
