@@ -72,17 +72,19 @@ def actuator_joint_lanes(all_twists, all_points, chain_start, actuator_chain, ac
     first that turns, as :func:`screwkit.screw.reference.joint_after` takes it) and its chain's platform joint d
     (9-11), lane by lane, in working coordinates (as the first stage computed them), and the axes of those two joints
     along which their points are arbitrary (12-14, 15-17: :func:`joint_line`)."""
+    if width == 0:
+        return
     for act in range(actuator_chain.shape[0]):
         start = chain_start[actuator_chain[act]]
         own = start + actuator_joint[act]
         last = chain_start[actuator_chain[act] + 1] - 1
+        after = own  # a slide has no point: the next joint that turns (a slide's twist turns in no configuration)
+        for joint in range(own + 1, last + 1):
+            after = joint
+            if (all_twists[first_index, joint, 0] != 0.0 or all_twists[first_index, joint, 1] != 0.0
+                    or all_twists[first_index, joint, 2] != 0.0):
+                break
         for r in range(width):
-            after = own
-            for joint in range(own + 1, last + 1):  # a slide has no point: the next joint that turns
-                after = joint
-                if (all_twists[first_index + r, joint, 0] != 0.0 or all_twists[first_index + r, joint, 1] != 0.0
-                        or all_twists[first_index + r, joint, 2] != 0.0):
-                    break
             c0, c1, c2, inverse = centres[0, r], centres[1, r], centres[2, r], inverse_lengths[r]
             (joint_lanes[act, 0, r], joint_lanes[act, 1, r], joint_lanes[act, 2, r], joint_lanes[act, 3, r],
              joint_lanes[act, 4, r], joint_lanes[act, 5, r]) = working_twist(all_twists, first_index + r, own, c0, c1,
