@@ -313,3 +313,41 @@ def test_closures_that_close_only_to_the_file_s_rounding_are_not_slid(seed, roun
     assert np.max(np.abs(pin.difference(tree.model, tree.q_reference, q))) < 1e-2
     assert max(closure_gaps(tree, q).values()) < 3e-7
     assert any("at best" in note for note in tree.notes), tree.notes
+
+
+@pytest.mark.parametrize("name", OPEN_FILES)
+def test_a_file_that_does_not_close_assembles_the_same_with_its_joints_renamed_and_reordered(tmp_path, name):
+    """The same robot with every joint renamed so that their order reverses (Pinocchio orders a link's children by
+    their joint's name: the tree's velocity coordinates come out in another order) and its closures and motors
+    listed in reverse: the nearest closed configuration is the same (the home pose), and actuator by actuator (by
+    name, the new names read back) the same ITIs and OTIs, and the same LMTI."""
+    source = GEPETTO / name
+    text, yaml = (source / "robot.urdf").read_text(), (source / "robot.yaml").read_text()
+    names = sorted(joint.get("name") for joint in ET.fromstring(text).iter("joint"))
+    renamed = {joint: f"j{len(names) - k:03d}_{joint}" for k, joint in enumerate(names)}
+    root = ET.fromstring(text)
+    for joint in root.iter("joint"):
+        joint.set("name", renamed[joint.get("name")])
+    # (a closure names a joint's frame, or a link's, kept)
+    lists = {key: re.findall(r"'([^']+)'", re.search(rf"{key}: \[(.*)\]", yaml).group(1))
+             for key in ("type", "name_mot")}
+    pairs = re.findall(r"\['([^']+)', '([^']+)'\]", yaml.splitlines()[0])  # the closed_loop line
+    closures = [f"['{renamed.get(a, a)}', '{renamed.get(b, b)}']" for a, b in reversed(pairs)]
+    written = ("closed_loop: [" + ", ".join(closures) + "]\n"
+               + "type: [" + ", ".join(f"'{kind}'" for kind in reversed(lists["type"])) + "]\n"
+               + "name_mot: [" + ", ".join(f"'{renamed[motor]}'" for motor in reversed(lists["name_mot"])) + "]\n")
+    folder = tmp_path / name
+    folder.mkdir()
+    (folder / "robot.urdf").write_text(ET.tostring(root, encoding="unicode"))
+    (folder / "robot.yaml").write_text(written)
+    original, other = read_closed_tree(source / "robot.urdf"), read_closed_tree(folder / "robot.urdf")
+    assert [re.sub(r"j\d{3}_", "", n) for n in other.model.names] != list(original.model.names)  # another order
+    original, other = load(source / "robot.urdf"), load(folder / "robot.urdf")
+    np.testing.assert_allclose(other.home_pose, original.home_pose, rtol=0, atol=1e-8)
+    here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, other.home_pose)
+    for field in ("iti_actuators", "oti_actuators"):
+        by_name = {re.sub(r"j\d{3}_", "", actuator): value
+                   for actuator, value in zip(there.actuators, np.ravel(getattr(there, field)))}
+        np.testing.assert_allclose([by_name[actuator] for actuator in here.actuators], np.ravel(getattr(here, field)),
+                                   rtol=0, atol=1e-7, err_msg=field)
+    np.testing.assert_allclose(there.lmti, here.lmti, rtol=0, atol=1e-7)
