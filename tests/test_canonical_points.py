@@ -21,6 +21,7 @@ from test_constraints import spherical_wrist_urdf
 from test_invariance import SkewRSR
 
 from helpers import assert_indices_close, in_unit, moved_in_the_world, random_reachable_poses, random_rotation
+from screwkit.closure import solve
 from screwkit.closure.canonical import (
     canonical_geometry,
     canonical_offsets,
@@ -382,15 +383,27 @@ def _drawn(geometry, rng):
     return replace(geometry, joint_translations=translations, leg_loop_translation=leg)
 
 
-def test_a_spherical_chain_keeps_its_drawn_points():
+@pytest.mark.parametrize("radius", [0.1, 0.37])
+def test_a_spherical_chain_keeps_its_drawn_points_but_its_platform_joint_which_goes_to_the_centre(radius):
     """Every axis of a spherical wrist's leg passes through its centre, where the rule would put every joint (and the
-    working length to zero): its legs keep the points the file draws, on each axis at the wrist's radius."""
-    mechanism = load_text(spherical_wrist_urdf(radius=0.1), "wrist.urdf")
+    working length to zero): its legs keep the points the file draws, on each axis at the wrist's radius, but for the
+    platform joint, at the centre: there the actuation wrench is the couple normal to the two passive axes, so the
+    agile eye's ITI is the triple product of its axes, |u . (v x w)| / |v x w|, at every pose and every radius."""
+    mechanism = load_text(spherical_wrist_urdf(radius=radius), "wrist.urdf")
     centre = np.array([0.0, 0.0, 0.3])
     for chain in mechanism.chains:
         axes, points = joint_lines_at_zero(chain.geometry)
-        np.testing.assert_allclose(points, centre + 0.1 * axes, atol=1e-12)
-        np.testing.assert_allclose(canonical_offsets(chain.geometry), 0.0, atol=0.0)
+        np.testing.assert_allclose(points[:-1], centre + radius * axes[:-1], atol=1e-12)
+        np.testing.assert_allclose(points[-1], centre, atol=1e-12)
+        np.testing.assert_allclose(canonical_offsets(chain.geometry)[:-1], 0.0, atol=0.0)
+    poses = mechanism.home_pose + np.deg2rad([[0.0, 0.0, 0.0], [10.0, -5.0, 15.0], [-20.0, 10.0, -25.0]])
+    result, solution = indices_at_poses(mechanism, poses, detail=True), solve(mechanism, poses)
+    for (chain, joint), iti in zip(mechanism.actuator_positions(), result.iti_actuators.T):
+        axes = solution.joint_axes[chain]
+        normal = np.cross(axes[:, joint + 1], axes[:, joint + 2])
+        expected = np.abs(np.sum(axes[:, joint] * normal, axis=1)) / np.linalg.norm(normal, axis=1)
+        np.testing.assert_allclose(iti, expected, atol=1e-12)
+    np.testing.assert_allclose(result.iti_actuators[0], 1.0, atol=1e-12)  # home: each motor along its couple
 
 
 def test_nearly_parallel_axes_in_one_plane_do_not_meet_far_away(tmp_path):

@@ -27,8 +27,12 @@ read, to a point of its axis that the geometry alone decides, as Denavit and Har
   perpendicular from the points its neighbours took, passed along the run;
 * a line that nothing decides (a planar chain: every axis parallel and no point) keeps its drawn point, as does every
   slide;
-* a chain whose every axis passes through one point (a spherical wrist's leg) keeps its drawn points: its canonical
-  points would all be that point, and a spherical mechanism's working length would vanish with them.
+* a chain whose every axis passes through one point (a spherical wrist's leg) keeps its drawn points but for its
+  last joint (the platform joint), which goes to that point: all its canonical points would be that point, and a
+  spherical mechanism's working length would vanish with them; the platform joint is the point its actuation wrench
+  is taken about, and there the representative is the couple normal to the passive axes (a force through the
+  centre, which any drawn point would add, does no work on the chain's joints or on the platform's rotations about
+  it, but lowers the ITI's power coefficient).
 
 The points depend on the lines alone (and, for nearly parallel axes, on whether a file draws them together), so a
 chain drawn at its canonical points is its own canonical drawing.
@@ -215,7 +219,11 @@ def offsets_along_axes(prismatic: tuple[bool, ...], axes: NDArray, points: NDArr
             canonical[joint] = point
     placed = [point for point in canonical if point is not None]
     if len(placed) == count and count > 1 and _diameter(placed) <= MEETING * extent:
-        return np.zeros(count)  # a spherical chain, every axis through one point: drawn as the file draws it
+        # a spherical chain, every axis through one point: drawn as the file draws it but for its platform joint,
+        # which goes to the point (where its actuation wrench's representative is the couple)
+        offsets = np.zeros(count)
+        offsets[-1] = float((np.mean(placed, axis=0) - points[-1]) @ axes[-1])
+        return offsets
     return np.array([0.0 if point is None else float((point - points[joint]) @ axes[joint])
                      for joint, point in enumerate(canonical)])
 

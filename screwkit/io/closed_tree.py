@@ -22,7 +22,8 @@ from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
-           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point", "LENGTH_COORDINATES"]
+           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point", "LENGTH_COORDINATES",
+           "nearest_to_lines"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -223,7 +224,7 @@ def _length_scale(model, data) -> float:
     return float(spread) if spread > 0.0 else 1.0
 
 
-def _nearest_to_lines(projections: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
+def nearest_to_lines(projections: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
     """The point nearest to lines in the least-squares sense, each line given by its projection off itself
     (``projections`` (k, 3, 3): I - u u^T, or I for a point) and a point of it (``points`` (k, 3)); and each line's
     offset from it, perpendicular to the line (k, 3). Solved from the points' centroid: lines rounded off parallel (a
@@ -254,7 +255,7 @@ def _lines_scale(model, data, closures=()) -> float:
             points.append(np.mean([frame[:3, 3] for frame in _frames(model, data, closure)], axis=0))
     if points:
         projections, points = np.array(projections), np.array(points)
-        centre, distances = _nearest_to_lines(projections, points)
+        centre, distances = nearest_to_lines(projections, points)
         spread = float(np.sqrt(np.mean(np.sum(distances**2, axis=-1))))
         if spread > MEETING * float(np.max(np.linalg.norm(points - centre, axis=1))):  # else lines that meet to
             # rounding: a spherical mechanism
@@ -289,7 +290,7 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
     points = np.array([frame[:3, 3] for frame in frames])
     if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(2)):
         return None  # two in a row on (nearly) one direction turn about one axis: no ball
-    centre, offsets = _nearest_to_lines(np.eye(3)[None] - units[:, :, None] * units[:, None, :], points)
+    centre, offsets = nearest_to_lines(np.eye(3)[None] - units[:, :, None] * units[:, None, :], points)
     return centre if np.all(np.linalg.norm(offsets, axis=1) <= MEETING * scale) else None
 
 

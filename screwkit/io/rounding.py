@@ -11,9 +11,18 @@ and keeps each joint's own sense. Directions that already agree to 1e-12 are lef
 written unchanged unless two of its axes happen to lie within 1e-5 rad of each other at the file's configuration
 (then they are made parallel, and its indices move by about that much, 1e-7).
 
+Joint axes drawn through one point come out of the same rounding missing it by a few tenths of a micrometre (the
+nine axes of a spherical manipulator exported from CAD miss its centre by up to 3.4e-7 m on links of 5 cm). Read
+exactly, that file too is another mechanism: the constraint forces that pass through the centre no longer do, and the
+three rotations about it read as one DOF, or none. :func:`meeting_lines` moves each group of three or more axis lines
+that pass within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of the length scale of one point onto the point
+nearest to them all (least squares, which does not depend on their order), each line moved perpendicular to itself;
+pairs of lines are left as written (two lines always pass at some least distance; making it zero constrains no
+motion), and so are lines that meet to 1e-12 of the scale.
+
 Where a hinge is drawn along its axis is not the mechanism either; the indices take no account of it (the
 characteristic points lie where the wrench's axis comes nearest to the joint's axis:
-:func:`screwkit.screw.algebra.nearest_on_axis`), so nothing here moves a hinge.
+:func:`screwkit.screw.algebra.nearest_on_axis`), so nothing here moves a hinge along its axis.
 
 This runs once, where a file of another tool is converted (:mod:`screwkit.io.star`).
 """
@@ -25,13 +34,14 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io.closed_tree import joint_kind
+from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
+from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
-__all__ = ["parallel_axes", "drawn_axes", "EXACT"]
+__all__ = ["parallel_axes", "meeting_lines", "drawn_lines", "EXACT"]
 
 EXACT = 1e-12
-"""Directions whose cross product is at most this already agree: a group of them is left as written."""
+"""Directions whose cross product is at most this already agree, lines that pass within this of the length scale
+of their meeting point already meet: a group of them is left as written."""
 
 
 def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
@@ -69,12 +79,76 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def drawn_axes(model, data, legs: list, equivalents: list, report) -> tuple[dict[int, NDArray], list]:
-    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied.
+def meeting_lines(points: NDArray, units: NDArray, scale: float,
+                  tolerance: float = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
+    """Moves (n, 3), each perpendicular to its line, that make every group of three or more lines passing within
+    ``tolerance`` times ``scale`` of one point pass through it, and the largest move.
 
-    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes are set in place.
-    Returns each 1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations
-    turned; the import ``report`` notes the largest turn.
+    Lines: a point (n, 3) and a unit direction (n, 3) each. A group's point is where two of its lines come nearest
+    (no two nearly parallel: squared sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), with every line
+    that passes that near; two such points that share two lines are one (two lines meet once), and the group meets at
+    the point nearest to all its lines, which each must pass within the tolerance of. A line in two groups (the axis
+    of two wrists) is left as written, and so are those groups.
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    units = np.asarray(units, dtype=float).reshape(-1, 3)
+    count, reach = points.shape[0], tolerance * scale
+    moves = np.zeros((count, 3))
+    if count < 3:
+        return moves, 0.0
+    projections = np.eye(3)[None] - units[:, :, None] * units[:, None, :]
+    first, second = np.triu_indices(count, 1)
+    cosine = np.sum(units[first] * units[second], axis=1)
+    sine2 = 1.0 - cosine**2
+    clear = sine2 > PARALLEL_FOOT
+    first, second, cosine, sine2 = first[clear], second[clear], cosine[clear], sine2[clear]
+    between = points[first] - points[second]
+    along_first, along_second = np.sum(units[first] * between, axis=1), np.sum(units[second] * between, axis=1)
+    nearest_first = points[first] + ((cosine * along_second - along_first) / sine2)[:, None] * units[first]
+    nearest_second = points[second] + ((along_second - cosine * along_first) / sine2)[:, None] * units[second]
+    near = np.linalg.norm(nearest_first - nearest_second, axis=1) <= reach
+    candidates = (nearest_first[near] + nearest_second[near]) / 2
+    through = np.linalg.norm(np.einsum("kij,ckj->cki", projections, points[None] - candidates[:, None]),
+                             axis=-1) <= reach  # (candidate, line)
+    through = through[np.sum(through, axis=1) >= 3]
+    parent = list(range(through.shape[0]))
+
+    def find(index: int) -> int:
+        while parent[index] != index:
+            parent[index] = parent[parent[index]]
+            index = parent[index]
+        return index
+
+    shared = through.astype(int) @ through.T.astype(int)
+    for one, other in zip(*np.nonzero(np.triu(shared >= 2, k=1))):
+        parent[find(int(one))] = find(int(other))
+    groups: dict[int, NDArray] = {}
+    for index in range(through.shape[0]):
+        root = find(index)
+        groups[root] = groups.get(root, np.zeros(count, dtype=bool)) | through[index]
+    members = [np.flatnonzero(lines) for lines in groups.values()]
+    uses = np.bincount(np.concatenate(members), minlength=count) if members else np.zeros(count, dtype=int)
+    largest = 0.0
+    for lines in members:
+        if np.any(uses[lines] > 1):
+            continue
+        _, offsets = nearest_to_lines(projections[lines], points[lines])
+        distances = np.linalg.norm(offsets, axis=1)
+        if np.max(distances) > reach or np.max(distances) <= EXACT * scale:
+            continue
+        moves[lines] = -offsets
+        largest = max(largest, float(np.max(distances)))
+    return moves, largest
+
+
+def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report) -> tuple[dict[int, NDArray], list]:
+    """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and the
+    legs' revolute lines (joints and revolute loops) with :func:`meeting_lines` applied.
+
+    ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes, loop frames and
+    joint offsets are set in place (a leg's loop frame stays where it is when its last joint moves). Returns each
+    1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations turned; the
+    import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale.
     """
     owners, directions = [], []
     for leg in legs:
@@ -106,4 +180,42 @@ def drawn_axes(model, data, legs: list, equivalents: list, report) -> tuple[dict
             rotations[owner[0]][owner[1]] = direction
     equivalents = [(name, replace(reduction, rotations=rotation), point)
                    for (name, reduction, point), rotation in zip(equivalents, rotations)]
+    _meet(model, data, legs, local, scale, report)
     return local, equivalents
+
+
+def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, report) -> None:
+    """:func:`meeting_lines` on the legs' revolute joints (axes ``local``, in their own frames) and revolute loops:
+    a joint's move is added to its leg's offsets, a loop's moves its two frames."""
+    owners, points, units = [], [], []
+    for leg in legs:
+        for joint in leg.joints:
+            if joint not in leg.locked and joint_kind(model, joint)[0] == "revolute":
+                rotation = np.asarray(data.oMi[joint].rotation)
+                owners.append((leg, joint))
+                points.append(np.asarray(data.oMi[joint].translation) + leg.offsets.get(joint, np.zeros(3)))
+                units.append(rotation @ local[joint] / np.linalg.norm(local[joint]))
+        if leg.loop == "revolute":
+            owners.append((leg, None))
+            points.append(leg.loop_dofs[0][2])
+            units.append(leg.loop_dofs[0][1] / np.linalg.norm(leg.loop_dofs[0][1]))
+    moves, largest = meeting_lines(np.array(points).reshape(-1, 3), np.array(units).reshape(-1, 3), scale)
+    if not largest:
+        return
+    report.notes.append(f"joint axes that meet to the file's rounding written through one point (the largest move "
+                        f"{largest:.2g} m)")
+    for (leg, joint), move in zip(owners, moves):
+        if not np.any(move):
+            continue
+        end = np.asarray(data.oMi[leg.joints[-1]].rotation)  # the leg end's frame, where the loop frame is written
+        leg.predecessor = leg.predecessor.copy()
+        if joint is None:  # the loop's line: both its frames move with it
+            leg.successor_world = leg.successor_world.copy()
+            leg.successor_world[:3, 3] += move
+            leg.predecessor[:3, 3] += end.T @ move
+            leg.loop_dofs = [(leg.loop_dofs[0][0], leg.loop_dofs[0][1], leg.loop_dofs[0][2] + move)]
+            continue
+        leg.offsets = dict(leg.offsets)
+        leg.offsets[joint] = leg.offsets.get(joint, np.zeros(3)) + move
+        if joint == leg.joints[-1]:  # the loop frame stays where it is
+            leg.predecessor[:3, 3] -= end.T @ move

@@ -63,7 +63,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
-from screwkit.io.rounding import drawn_axes
+from screwkit.io.rounding import drawn_lines
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -438,7 +438,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
-    axes, equivalents = drawn_axes(model, data, legs, equivalents, report)
+    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):

@@ -1,0 +1,226 @@
+"""Axes that a file's rounding leaves missing the point they meet at meet again, and a spherical leg's actuation
+wrench is the couple normal to its passive axes.
+
+A spherical 3-RRR manipulator (every joint axis through one centre) exported from CAD comes with its axes missing
+the centre by a few tenths of a micrometre. Read exactly, its constraint forces no longer pass through one point, and
+the three rotations read as one DOF (or none): ``screwkit.io.rounding.meeting_lines`` makes them meet. The checks
+here are independent of the code under test: the mobility and indices of the same manipulator written exactly, the
+classical transmission index of a spherical leg (the triple product of its axes), and MuJoCo's own reading of the
+file (its bodies' places at the file's joint values).
+"""
+
+from __future__ import annotations
+
+import json
+from itertools import permutations
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import screwkit
+from screwkit.closure import solve
+from screwkit.io.loader import load
+from screwkit.io.rounding import meeting_lines
+from screwkit.studies import indices_at_poses
+
+CENTRE = np.array([0.0, 0.0, 0.3])
+RADIUS, BALL = 0.05, 0.03
+
+
+def _unit(vector) -> np.ndarray:
+    vector = np.asarray(vector, dtype=float)
+    return vector / np.linalg.norm(vector)
+
+
+def spm_axes() -> tuple[list, list, list]:
+    """Motor axes u, middle axes v = u x w and platform axes w of a 3-RRR spherical manipulator at its drawn
+    configuration (three legs 120 degrees apart, motors 55 degrees off the downward vertical)."""
+    beta = np.radians(55.0)
+    u = [np.array([np.sin(beta) * np.cos(a), np.sin(beta) * np.sin(a), -np.cos(beta)])
+         for a in np.radians([0, 120, 240])]
+    w = [np.array([np.sin(0.6) * np.cos(a + 0.3), np.sin(0.6) * np.sin(a + 0.3), np.cos(0.6)])
+         for a in np.radians([0, 120, 240])]
+    v = [_unit(np.cross(a, b)) for a, b in zip(u, w)]
+    return u, v, w
+
+
+def _xyz(vector) -> str:
+    return " ".join(repr(float(x)) for x in vector)
+
+
+def spm_mjcf(rounding: float = 0.0, seed: int = 0, drawn: float = 0.0) -> str:
+    """The manipulator in MJCF, every body unturned (axes in world directions): leg 2 carries the platform on its
+    third hinge, legs 1 and 3 end on a ``<connect>`` (a ball) at a point of their platform axis; motors on the three
+    base hinges. Each hinge axis passes off the centre by a random ``rounding`` (m, perpendicular to the axis), as a
+    CAD export rounds it; ``drawn``: each hinge drawn up to that far (m) along its axis (the same lines)."""
+    rng = np.random.default_rng(seed)
+    u, v, w = spm_axes()
+
+    def line(axis) -> np.ndarray:  # a point of the axis: off the centre by the rounding, along it by the drawing
+        off = rng.normal(size=3)
+        off -= (off @ axis) * axis
+        return CENTRE + RADIUS * axis + rounding * _unit(off) + drawn * rng.uniform(-1, 1) * axis
+
+    def hinge(name, point, axis, origin) -> str:
+        return f'<joint name="{name}" type="hinge" pos="{_xyz(point - origin)}" axis="{_xyz(axis)}"/>'
+
+    bodies = []
+    for i in range(3):
+        pu, pv = line(u[i]), line(v[i])
+        leg = (f'<body name="motor{i + 1}" pos="{_xyz(pu)}">{hinge(f"m{i + 1}", pu, u[i], pu)}'
+               f'<geom type="sphere" size="0.005"/>'
+               f'<body name="middle{i + 1}" pos="{_xyz(pv - pu)}">{hinge(f"p{i + 1}", pv, v[i], pv)}'
+               f'<geom type="sphere" size="0.005"/>')
+        if i == 1:
+            pw = line(w[i])
+            leg += (f'<body name="platform" pos="{_xyz(pw - pv)}">{hinge("q2", pw, w[i], pw)}'
+                    f'<geom type="sphere" size="0.01"/><site name="effector" pos="{_xyz(CENTRE - pw)}"/></body>')
+        leg += "</body></body>"
+        bodies.append(leg)
+    connects = [(i, CENTRE + BALL * w[i]) for i in (0, 2)]  # each ball's centre on the platform axis w_i
+    text = ('<mujoco model="spm"><worldbody>' + "".join(bodies) + "</worldbody><equality>"
+            + "".join(f'<connect name="ball{i + 1}" body1="middle{i + 1}" body2="platform" anchor="ANCHOR{i}"/>'
+                      for i, _ in connects)
+            + '</equality><actuator>' + "".join(f'<motor joint="m{i + 1}"/>' for i in range(3))
+            + "</actuator></mujoco>")
+    model = mujoco.MjModel.from_xml_string(text.replace("ANCHOR0", "0 0 0").replace("ANCHOR2", "0 0 0"))
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    for i, centre in connects:  # the anchor: the ball's centre in the middle body's frame, as MuJoCo places it
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"middle{i + 1}")
+        text = text.replace(f"ANCHOR{i}", _xyz(data.xmat[body].reshape(3, 3).T @ (centre - data.xpos[body])))
+    return text
+
+
+def written(tmp_path: Path, text: str, name: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_the_synthetic_file_is_the_manipulator_mujoco_reads():
+    """MuJoCo's own reading of the exact file: every hinge axis passes through the centre, the balls close at the
+    file's joint values, and the platform's site is the centre."""
+    model = mujoco.MjModel.from_xml_string(spm_mjcf())
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    for joint in range(model.njnt):
+        body = model.jnt_bodyid[joint]
+        point = data.xpos[body] + data.xmat[body].reshape(3, 3) @ model.jnt_pos[joint]
+        axis = data.xmat[body].reshape(3, 3) @ model.jnt_axis[joint]
+        assert np.linalg.norm(np.cross(point - CENTRE, axis)) < 1e-12
+    platform = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "platform")
+    for k in range(model.neq):
+        body = model.eq_obj1id[k]
+        ball = data.xpos[body] + data.xmat[body].reshape(3, 3) @ model.eq_data[k][:3]
+        own = data.xpos[platform] + data.xmat[platform].reshape(3, 3) @ model.eq_data[k][3:6]
+        assert np.linalg.norm(ball - own) < 1e-12
+    np.testing.assert_allclose(data.site_xpos[0], CENTRE, atol=1e-12)
+
+
+def poses_about(mechanism) -> np.ndarray:
+    return mechanism.home_pose + np.deg2rad([[0.0, 0.0, 0.0], [8.0, -5.0, 6.0], [-6.0, 4.0, -9.0]])
+
+
+@pytest.mark.parametrize("rounding, seed", [(1e-7, 0), (2e-7, 1), (3e-7, 2)])
+def test_a_manipulator_whose_axes_miss_their_centre_by_rounding_has_three_dof_and_the_exact_ones_indices(
+        tmp_path, rounding, seed):
+    """Axes off the centre by 0.1-0.3 um (as Rhoban's exported manipulator's, up to 0.34 um on links of 5 cm): three
+    rotations, as the exact file, and its indices to the rounding's order; the report says what was moved."""
+    exact = load(written(tmp_path, spm_mjcf(), "exact.xml"))
+    rounded = load(written(tmp_path, spm_mjcf(rounding, seed), "rounded.xml"))
+    assert exact.dof == rounded.dof == 3 and rounded.task_coordinates == exact.task_coordinates
+    assert any("written through one point" in note for note in rounded.import_report)
+    assert not any("written through one point" in note for note in exact.import_report)
+    poses = poses_about(exact)
+    first, second = indices_at_poses(exact, poses), indices_at_poses(rounded, poses)
+    assert first.reachable.all() and second.reachable.all()
+    for name in ("iti", "lmti"):
+        np.testing.assert_allclose(getattr(second, name), getattr(first, name), atol=1e-4)
+
+
+def triple_product(axes: np.ndarray) -> float:
+    """The transmission index of a spherical R-R-R leg's first joint: the cosine between its axis and the normal
+    to the two passive axes, |u . (v x w)| / |v x w| (the couple the passive joints let through)."""
+    normal = np.cross(axes[1], axes[2])
+    return float(abs(axes[0] @ normal) / np.linalg.norm(normal))
+
+
+@pytest.mark.parametrize("drawn", [0.0, 0.02])
+def test_the_spherical_leg_transmits_the_couple_normal_to_its_passive_axes_however_its_hinges_are_drawn(
+        tmp_path, drawn):
+    """Leg 2 (R-R-R, every axis through the centre, the platform on its third hinge): its ITI is the triple product
+    of its axes at each pose, with the hinges drawn at the radius or anywhere up to 2 cm along their axes; before,
+    the actuation wrench was a force through the last hinge's drawn point (0.25 for 0.95 on the exported file)."""
+    mechanism = load(written(tmp_path, spm_mjcf(drawn=drawn, seed=3), "spm.xml"))
+    leg = next(index for index, chain in enumerate(mechanism.chains) if chain.loop_type == "fixed")
+    poses = poses_about(mechanism)
+    solution = solve(mechanism, poses)
+    result = indices_at_poses(mechanism, poses, detail=True)
+    actuator = [index for index, (chain, _) in enumerate(mechanism.actuator_positions()) if chain == leg]
+    assert len(actuator) == 1
+    expected = [triple_product(solution.joint_axes[leg][pose]) for pose in range(len(poses))]
+    np.testing.assert_allclose(result.iti_actuators[:, actuator[0]], expected, atol=1e-9)
+
+
+def test_lines_meeting_to_rounding_are_moved_onto_one_point_in_any_order():
+    """Five lines through a point, each moved off it perpendicular to itself by up to 1e-6 of a unit length: moves
+    perpendicular to each line that make all five pass through one point, the same whatever the order of the lines;
+    two lines alone, or lines missing by more than the tolerance, are left as written."""
+    rng = np.random.default_rng(7)
+    units = np.array([_unit(rng.normal(size=3)) for _ in range(5)])
+    offsets = rng.normal(size=(5, 3)) * 1e-6
+    offsets -= np.sum(offsets * units, axis=1, keepdims=True) * units
+    points = np.array([1.0, 2.0, 3.0]) + offsets + rng.uniform(-1, 1, (5, 1)) * units
+    moves, largest = meeting_lines(points, units, 1.0)
+    np.testing.assert_allclose(np.sum(moves * units, axis=1), 0.0, atol=1e-15)
+    moved = points + moves
+    projections = np.eye(3)[None] - np.einsum("ki,kj->kij", units, units)
+    meet = np.linalg.solve(projections.sum(axis=0), np.einsum("kij,kj->i", projections, moved))
+    for point, unit in zip(moved, units):
+        assert np.linalg.norm(np.cross(point - meet, unit)) < 1e-13
+    assert largest == pytest.approx(np.max(np.linalg.norm(moves, axis=1)))
+    assert 0.0 < largest < 1e-5
+    for order in list(permutations(range(5)))[::17]:
+        again, _ = meeting_lines(points[list(order)], units[list(order)], 1.0)
+        np.testing.assert_allclose(again, moves[list(order)], atol=1e-15)
+    assert not np.any(meeting_lines(points[:2], units[:2], 1.0)[0])
+    assert not np.any(meeting_lines(points, units, 1e-3)[0])  # 1e-6 off on a length of 1e-3: not rounding
+
+
+@pytest.mark.parametrize("rounding", [0.0, 3e-7])
+def test_the_axes_written_meet_exactly(tmp_path, rounding):
+    """Every hinge axis of the loaded manipulator (the balls' own frame axes aside) passes through one point to
+    1e-12 of its length scale, rounded file or exact; the exact one is left as written (no note)."""
+    mechanism = load(written(tmp_path, spm_mjcf(rounding, seed=4), "spm.xml"))
+    solution = solve(mechanism, poses_about(mechanism))
+    for pose in range(3):
+        axes, points = [], []
+        for chain, chain_axes, chain_points in zip(mechanism.chains, solution.joint_axes, solution.joint_points):
+            count = chain.geometry.n_tree_joints  # a ball loop's DoFs are its frame's axes, not hinges
+            axes += list(chain_axes[pose][:count])
+            points += list(chain_points[pose][:count])
+        projections = np.eye(3)[None] - np.einsum("ki,kj->kij", axes, axes)
+        centre = np.linalg.lstsq(projections.sum(axis=0), np.einsum("kij,kj->i", projections, points), rcond=None)[0]
+        misses = np.linalg.norm(np.einsum("kij,kj->ki", projections, np.array(points) - centre), axis=1)
+        assert len(axes) == 7 and misses.max() < 1e-12 * mechanism.length_scale
+    moved = any("written through one point" in note for note in mechanism.import_report)
+    assert moved == (rounding > 0.0)
+
+
+def test_analyze_reads_the_rounded_manipulator_as_three_rotations_on_the_command_line(tmp_path):
+    """``screwkit analyze`` as a user runs it on the rounded file: three DOF, the motors' ITIs those of the exact
+    file to the rounding's order, and the report line that says the axes were moved."""
+    exact = load(written(tmp_path, spm_mjcf(), "exact.xml"))
+    expected = indices_at_poses(exact, exact.home_pose[None], detail=True)
+    path = written(tmp_path, spm_mjcf(3e-7, 5), "spm.xml")
+    run = screwkit("analyze", path, "--pose", *(repr(float(x)) for x in exact.home_pose), "--json")
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout)
+    assert found["dof"] == 3
+    np.testing.assert_allclose(list(found["iti_actuators"].values()), expected.iti_actuators[0], atol=1e-4)
+    text = screwkit("analyze", path)
+    assert text.returncode == 0 and "3 DOF (no redundancy)" in text.stdout
+    assert "joint axes that meet to the file's rounding written through one point" in text.stderr
