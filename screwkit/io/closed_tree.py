@@ -325,12 +325,6 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
         tree.model, data, c)]}
 
 
-def _jacobian(residuals, v: NDArray, directions: NDArray) -> NDArray[np.float64]:
-    """The residuals' derivatives along each of ``directions`` (rows) at ``v``, by central differences."""
-    step = 1e-7
-    return np.column_stack([(residuals(v + step * e) - residuals(v - step * e)) / (2 * step) for e in directions])
-
-
 def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray) -> tuple[NDArray, NDArray]:
     """From a closed ``v`` (its residuals ``error``; ``derivatives(v)`` their Jacobian along ``directions``), the
     closed configuration nearest to the reference one (v = 0; angles in rad, lengths in units of
@@ -380,7 +374,7 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     joint type, lengths in units of :func:`_lines_scale`; the joints ``held``, by id, keep their values),
     residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
     the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
-    turn); the Jacobian by central differences. Once the residual is within the file's rounding
+    turn); the Jacobian from Pinocchio's joint Jacobians. Once the residual is within the file's rounding
     (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three, and rounded
     redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor. Then, when
     ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
@@ -450,7 +444,7 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         within += norm < INCONSISTENCY_TOLERANCE  # closures that close need 2-3 steps from there; rounded ones creep
         if norm < ASSEMBLY_TOLERANCE or damping > 1e8 or within > 20:
             break
-        jacobian = _jacobian(residuals, v, directions)
+        jacobian = derivatives(v)
         normal = jacobian.T @ jacobian + (damping + norm**2) * np.eye(len(directions))
         change = -np.linalg.solve(normal, jacobian.T @ error) @ directions
         change *= min(1.0, 0.5 / max(float(np.max(np.abs(change))), 1e-300))
