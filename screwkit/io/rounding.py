@@ -16,9 +16,11 @@ nine axes of a spherical manipulator exported from CAD miss its centre by up to 
 exactly, that file too is another mechanism: the constraint forces that pass through the centre no longer do, and the
 three rotations about it read as one DOF, or none. :func:`meeting_lines` moves each group of three or more axis lines
 that pass within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of the length scale of one point onto the point
-nearest to them all (least squares, which does not depend on their order), each line moved perpendicular to itself;
-pairs of lines are left as written (two lines always pass at some least distance; making it zero constrains no
-motion), and so are lines that meet to 1e-12 of the scale.
+nearest to them all (least squares, which does not depend on their order), each line moved perpendicular to itself.
+Pairs of lines are left as written (two lines always pass at some least distance; making it zero constrains no
+motion), and so are groups whose lines all meet to 1e-12 of the scale already, and groups one of whose lines meets
+another line elsewhere (a universal joint on it, or a second group), which moving it would part: the report names
+those (Reachy Mini's symmetric head has two, by coincidence of its design).
 
 Where a hinge is drawn along its axis is not the mechanism either; the indices take no account of it (the
 characteristic points lie where the wrench's axis comes nearest to the joint's axis:
@@ -79,23 +81,25 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def meeting_lines(points: NDArray, units: NDArray, scale: float,
-                  tolerance: float = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
+def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: float = FILE_ROUNDING
+                  ) -> tuple[NDArray[np.float64], float, list[tuple[NDArray, int, int]]]:
     """Moves (n, 3), each perpendicular to its line, that make every group of three or more lines passing within
-    ``tolerance`` times ``scale`` of one point pass through it, and the largest move.
+    ``tolerance`` times ``scale`` of one point pass through it; the largest move; and the groups left as written.
 
     Lines: a point (n, 3) and a unit direction (n, 3) each. A group's point is where two of its lines come nearest
     (no two nearly parallel: squared sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), with every line
     that passes that near; two such points that share two lines are one (two lines meet once), and the group meets at
-    the point nearest to all its lines, which each must pass within the tolerance of. A line in two groups (the axis
-    of two wrists) is left as written, and so are those groups.
+    the point nearest to all its lines, which each must pass within the tolerance of. A group whose lines all pass
+    within :data:`EXACT` of the scale of that point is left as it is. So is a group one of whose lines also comes
+    that near another line elsewhere (a universal joint on it, or another group): moving it alone would part that
+    meeting; such groups are returned as (the group's lines, that line, the other line).
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     units = np.asarray(units, dtype=float).reshape(-1, 3)
     count, reach = points.shape[0], tolerance * scale
     moves = np.zeros((count, 3))
     if count < 3:
-        return moves, 0.0
+        return moves, 0.0, []
     projections = np.eye(3)[None] - units[:, :, None] * units[:, None, :]
     first, second = np.triu_indices(count, 1)
     cosine = np.sum(units[first] * units[second], axis=1)
@@ -107,10 +111,11 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float,
     nearest_first = points[first] + ((cosine * along_second - along_first) / sine2)[:, None] * units[first]
     nearest_second = points[second] + ((along_second - cosine * along_first) / sine2)[:, None] * units[second]
     near = np.linalg.norm(nearest_first - nearest_second, axis=1) <= reach
+    pairs = list(zip(first[near].tolist(), second[near].tolist()))  # lines that meet, at the group's point or not
     candidates = (nearest_first[near] + nearest_second[near]) / 2
     through = np.linalg.norm(np.einsum("kij,ckj->cki", projections, points[None] - candidates[:, None]),
                              axis=-1) <= reach  # (candidate, line)
-    through = through[np.sum(through, axis=1) >= 3]
+    through = np.unique(through[np.sum(through, axis=1) >= 3], axis=0)  # many lines through one point: one row
     parent = list(range(through.shape[0]))
 
     def find(index: int) -> int:
@@ -119,26 +124,30 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float,
             index = parent[index]
         return index
 
-    shared = through.astype(int) @ through.T.astype(int)
+    shared = through.astype(np.int32) @ through.T.astype(np.int32)
     for one, other in zip(*np.nonzero(np.triu(shared >= 2, k=1))):
         parent[find(int(one))] = find(int(other))
     groups: dict[int, NDArray] = {}
     for index in range(through.shape[0]):
         root = find(index)
         groups[root] = groups.get(root, np.zeros(count, dtype=bool)) | through[index]
-    members = [np.flatnonzero(lines) for lines in groups.values()]
-    uses = np.bincount(np.concatenate(members), minlength=count) if members else np.zeros(count, dtype=int)
-    largest = 0.0
-    for lines in members:
-        if np.any(uses[lines] > 1):
-            continue
+    largest, left = 0.0, []
+    for members in groups.values():
+        lines = np.flatnonzero(members)
         _, offsets = nearest_to_lines(projections[lines], points[lines])
         distances = np.linalg.norm(offsets, axis=1)
         if np.max(distances) > reach or np.max(distances) <= EXACT * scale:
             continue
+        elsewhere = [(one, other) if members[one] else (other, one) for one, other in pairs
+                     if members[one] != members[other]]
+        elsewhere += [(int(line), int(np.flatnonzero(another & ~members)[0])) for another in groups.values()
+                      if another is not members for line in np.flatnonzero(another & members)]  # two groups
+        if elsewhere:
+            left.append((lines, *elsewhere[0]))
+            continue
         moves[lines] = -offsets
         largest = max(largest, float(np.max(distances)))
-    return moves, largest
+    return moves, largest, left
 
 
 def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report) -> tuple[dict[int, NDArray], list]:
@@ -199,7 +208,11 @@ def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, repo
             owners.append((leg, None))
             points.append(leg.loop_dofs[0][2])
             units.append(leg.loop_dofs[0][1] / np.linalg.norm(leg.loop_dofs[0][1]))
-    moves, largest = meeting_lines(np.array(points).reshape(-1, 3), np.array(units).reshape(-1, 3), scale)
+    moves, largest, left = meeting_lines(np.array(points).reshape(-1, 3), np.array(units).reshape(-1, 3), scale)
+    names = [model.names[joint] if joint is not None else f"{leg.closure} (loop)" for leg, joint in owners]
+    for lines, line, other in left:
+        report.notes.append(f"joint axes {', '.join(names[k] for k in lines)} pass within the file's rounding of one "
+                            f"point and are left as written: {names[line]} also meets {names[other]} elsewhere")
     if not largest:
         return
     report.notes.append(f"joint axes that meet to the file's rounding written through one point (the largest move "
