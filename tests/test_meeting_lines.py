@@ -18,6 +18,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from helpers import screwkit
 from screwkit.closure import solve
@@ -50,18 +51,23 @@ def _xyz(vector) -> str:
     return " ".join(repr(float(x)) for x in vector)
 
 
-def spm_mjcf(rounding: float = 0.0, seed: int = 0, drawn: float = 0.0) -> str:
+def spm_mjcf(rounding: float = 0.0, seed: int = 0, drawn: float = 0.0, unit: float = 1.0, turn=None) -> str:
     """The manipulator in MJCF, every body unturned (axes in world directions): leg 2 carries the platform on its
     third hinge, legs 1 and 3 end on a ``<connect>`` (a ball) at a point of their platform axis; motors on the three
     base hinges. Each hinge axis passes off the centre by a random ``rounding`` (m, perpendicular to the axis), as a
-    CAD export rounds it; ``drawn``: each hinge drawn up to that far (m) along its axis (the same lines)."""
+    CAD export rounds it; ``drawn``: each hinge drawn up to that far (m) along its axis (the same lines). The whole
+    mechanism turned by ``turn`` (3 x 3) about the world's origin and written in units of 1 / ``unit`` m (1000: mm),
+    with the same rounding (scaled)."""
     rng = np.random.default_rng(seed)
-    u, v, w = spm_axes()
+    turn = np.eye(3) if turn is None else np.asarray(turn, dtype=float)
+    u, v, w = ([turn @ axis for axis in axes] for axes in spm_axes())
+    centre, radius, ball = unit * (turn @ CENTRE), unit * RADIUS, unit * BALL
+    rounding, drawn = unit * rounding, unit * drawn
 
     def line(axis) -> np.ndarray:  # a point of the axis: off the centre by the rounding, along it by the drawing
-        off = rng.normal(size=3)
+        off = turn @ rng.normal(size=3)  # turned with the mechanism: the same rounding in any world frame
         off -= (off @ axis) * axis
-        return CENTRE + RADIUS * axis + rounding * _unit(off) + drawn * rng.uniform(-1, 1) * axis
+        return centre + radius * axis + rounding * _unit(off) + drawn * rng.uniform(-1, 1) * axis
 
     def hinge(name, point, axis, origin) -> str:
         return f'<joint name="{name}" type="hinge" pos="{_xyz(point - origin)}" axis="{_xyz(axis)}"/>'
@@ -76,10 +82,10 @@ def spm_mjcf(rounding: float = 0.0, seed: int = 0, drawn: float = 0.0) -> str:
         if i == 1:
             pw = line(w[i])
             leg += (f'<body name="platform" pos="{_xyz(pw - pv)}">{hinge("q2", pw, w[i], pw)}'
-                    f'<geom type="sphere" size="0.01"/><site name="effector" pos="{_xyz(CENTRE - pw)}"/></body>')
+                    f'<geom type="sphere" size="0.01"/><site name="effector" pos="{_xyz(centre - pw)}"/></body>')
         leg += "</body></body>"
         bodies.append(leg)
-    connects = [(i, CENTRE + BALL * w[i]) for i in (0, 2)]  # each ball's centre on the platform axis w_i
+    connects = [(i, centre + ball * w[i]) for i in (0, 2)]  # each ball's centre on the platform axis w_i
     text = ('<mujoco model="spm"><worldbody>' + "".join(bodies) + "</worldbody><equality>"
             + "".join(f'<connect name="ball{i + 1}" body1="middle{i + 1}" body2="platform" anchor="ANCHOR{i}"/>'
                       for i, _ in connects)
@@ -88,9 +94,9 @@ def spm_mjcf(rounding: float = 0.0, seed: int = 0, drawn: float = 0.0) -> str:
     model = mujoco.MjModel.from_xml_string(text.replace("ANCHOR0", "0 0 0").replace("ANCHOR2", "0 0 0"))
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    for i, centre in connects:  # the anchor: the ball's centre in the middle body's frame, as MuJoCo places it
+    for i, point in connects:  # the anchor: the ball's centre in the middle body's frame, as MuJoCo places it
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"middle{i + 1}")
-        text = text.replace(f"ANCHOR{i}", _xyz(data.xmat[body].reshape(3, 3).T @ (centre - data.xpos[body])))
+        text = text.replace(f"ANCHOR{i}", _xyz(data.xmat[body].reshape(3, 3).T @ (point - data.xpos[body])))
     return text
 
 
@@ -302,3 +308,18 @@ def test_the_otis_are_those_of_the_output_twists_with_the_other_motors_locked(tm
                 velocity = np.cross(omega, forces[k][1])
                 expected = abs(forces[k][0] @ velocity) / np.linalg.norm(velocity)
             assert otis[0, k] == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("unit, turned", [(1e3, False), (1e-3, False), (1.0, True), (1e3, True)])
+def test_the_rounded_manipulator_in_another_unit_or_world_frame_reads_the_same(tmp_path, unit, turned):
+    """The rounded file in millimetres (or kilometres), or turned in the world: the axes met at the same rounding
+    relative to its size, three DOF, and the metre file's indices at home; in another unit at poses too."""
+    turn = Rotation.from_rotvec([0.4, -1.1, 0.7]).as_matrix() if turned else None
+    metres = load(written(tmp_path, spm_mjcf(3e-7, 8), "metres.xml"))
+    other = load(written(tmp_path, spm_mjcf(3e-7, 8, unit=unit, turn=turn), "other.xml"))
+    assert other.dof == 3 and any("written through one point" in note for note in other.import_report)
+    poses = poses_about(metres)[:1] if turned else poses_about(metres)
+    first = indices_at_poses(metres, poses, detail=True)
+    second = indices_at_poses(other, poses, detail=True)
+    for name in ("iti_actuators", "lmti", "cti"):
+        np.testing.assert_allclose(getattr(second, name), getattr(first, name), atol=1e-9)
