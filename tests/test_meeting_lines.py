@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 from helpers import screwkit
 from screwkit.closure import solve
 from screwkit.io.loader import load
-from screwkit.io.rounding import meeting_lines
+from screwkit.io.rounding import meeting_lines, turned_joint
 from screwkit.studies import indices_at_pose, indices_at_poses
 
 CENTRE = np.array([0.0, 0.0, 0.3])
@@ -323,3 +323,34 @@ def test_the_rounded_manipulator_in_another_unit_or_world_frame_reads_the_same(t
     second = indices_at_poses(other, poses, detail=True)
     for name in ("iti_actuators", "lmti", "cti"):
         np.testing.assert_allclose(getattr(second, name), getattr(first, name), atol=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["revolute", "prismatic"])
+def test_a_turned_axis_keeps_every_frame_where_the_assembly_put_it(kind):
+    """An axis made parallel to its neighbours' (``parallel_axes``) turns by up to 1e-5 rad; written with the joint's
+    placement unchanged, its frame at the assembly's joint value would turn (a revolute) or shift (a slide) by the
+    turn times that value, and open the loops the assembly closed (a spherical manipulator's own home then missed its
+    closure by 3.5e-11, beyond Newton's tolerance). The frame at that value is the file's, by scipy's rotations."""
+    rng = np.random.default_rng(12)
+    placement = np.eye(4)
+    placement[:3, :3] = Rotation.from_rotvec(rng.normal(size=3)).as_matrix()
+    placement[:3, 3] = rng.normal(size=3)
+    axis = _unit(rng.normal(size=3))
+    turned = _unit(axis + 3e-6 * rng.normal(size=3))
+    value = 0.7
+
+    def motion(direction):
+        moved = np.eye(4)
+        if kind == "revolute":
+            moved[:3, :3] = Rotation.from_rotvec(value * direction).as_matrix()
+        else:
+            moved[:3, 3] = value * direction
+        return moved
+
+    kept, written = turned_joint(placement, kind, axis, turned, value)
+    np.testing.assert_array_equal(written, turned)
+    np.testing.assert_allclose(kept @ motion(turned), placement @ motion(axis), atol=1e-15)
+    assert np.max(np.abs(placement @ motion(turned) - placement @ motion(axis))) > 1e-6  # unturned placement moves it
+    again, same = turned_joint(placement, kind, axis, axis, value)  # an axis not turned: the placement as written
+    assert again is placement and same is axis
+    assert turned_joint(placement, kind, axis, None, value) == (placement, axis)

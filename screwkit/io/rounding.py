@@ -9,7 +9,8 @@ within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of each other (up to si
 the normalised sum of its members turned to one sense, which does not depend on the order in which they are listed,
 and keeps each joint's own sense. Directions that already agree to 1e-12 are left as they are; an exact file is
 written unchanged unless two of its axes happen to lie within 1e-5 rad of each other at the file's configuration
-(then they are made parallel, and its indices move by about that much, 1e-7).
+(then they are made parallel, and its indices move by about that much, 1e-7). A turned joint's placement turns
+with it (:func:`turned_joint`), so that at the assembly every frame stays where it was and the loops stay closed.
 
 Joint axes drawn through one point come out of the same rounding missing it by a few tenths of a micrometre (the
 nine axes of a spherical manipulator exported from CAD miss its centre by up to 3.4e-7 m on links of 5 cm). Read
@@ -36,10 +37,11 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
 from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
-__all__ = ["parallel_axes", "meeting_lines", "drawn_lines", "EXACT"]
+__all__ = ["parallel_axes", "meeting_lines", "drawn_lines", "turned_joint", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree, lines that pass within this of the length scale
@@ -232,3 +234,24 @@ def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, repo
         leg.offsets[joint] = leg.offsets.get(joint, np.zeros(3)) + move
         if joint == leg.joints[-1]:  # the loop frame stays where it is
             leg.predecessor[:3, 3] -= end.T @ move
+
+
+def turned_joint(placement: NDArray, kind: str, axis: NDArray, turned: NDArray | None, value: float
+                 ) -> tuple[NDArray[np.float64], NDArray]:
+    """A joint's placement (4x4, in its parent's frame) and axis (its own frame) written with the axis ``turned``
+    by :func:`drawn_lines` (None: as the file has it), its placement turned with it so that at the joint's
+    ``value`` at the assembly its frame, and every frame after it, stays where it is (a turned axis alone moves
+    them by the turn times the joint's value, which opens the loops the assembly closed): the rotation
+    ``R(a, value) R(a', -value)`` after the placement's for a revolute, the offset ``(a - a') value`` for a slide."""
+    if turned is None:
+        return placement, axis
+    written = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    direction = np.asarray(turned, dtype=float) / np.linalg.norm(turned)
+    if np.linalg.norm(np.cross(written, direction)) <= EXACT:  # not turned (its own frame's axis, read back)
+        return placement, turned
+    kept = np.array(placement, dtype=float)
+    if kind == "revolute":
+        kept[:3, :3] = kept[:3, :3] @ rotation_about_axis(written, value) @ rotation_about_axis(direction, -value)
+    else:
+        kept[:3, 3] += kept[:3, :3] @ ((written - direction) * value)
+    return kept, turned

@@ -63,7 +63,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
-from screwkit.io.rounding import drawn_lines
+from screwkit.io.rounding import drawn_lines, turned_joint
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -501,7 +501,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 report.locked.append(model.names[joint])
             else:
                 kind, axis = joint_kind(model, joint)
-                axis = axes.get(joint, axis)
+                placement, axis = turned_joint(placement, kind, axis, axes.get(joint), joint_value(model, joint, q))
                 lower = model.lowerPositionLimit[model.joints[joint].idx_q]
                 upper = model.upperPositionLimit[model.joints[joint].idx_q]
                 limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
