@@ -12,7 +12,7 @@ file (its bodies' places at the file's joint values).
 from __future__ import annotations
 
 import json
-from itertools import permutations
+from itertools import combinations, permutations
 from pathlib import Path
 
 import mujoco
@@ -354,3 +354,37 @@ def test_a_turned_axis_keeps_every_frame_where_the_assembly_put_it(kind):
     again, same = turned_joint(placement, kind, axis, axis, value)  # an axis not turned: the placement as written
     assert again is placement and same is axis
     assert turned_joint(placement, kind, axis, None, value) == (placement, axis)
+
+
+def _miss(points, units, lines) -> float:
+    """The largest distance of ``lines`` from the point nearest to them all (least squares)."""
+    projections = np.eye(3)[None] - np.einsum("ki,kj->kij", units[lines], units[lines])
+    meet = np.linalg.lstsq(projections.sum(axis=0), np.einsum("kij,kj->i", projections, points[lines]), rcond=None)[0]
+    return float(np.max(np.linalg.norm(np.einsum("kij,kj->ki", projections, points[lines] - meet), axis=1)))
+
+
+def test_any_lines_near_one_point_are_grouped_without_failing_and_lines_far_off_do_not_block():
+    """Four to eight lines passing up to 1.3 tolerances from one or two points a few tolerances apart, 4000 times:
+    no failure (groups inside groups were one of them), and every moved group meets. A line meeting a group's line
+    exactly only far from the mechanism (10 scales away, in one plane by symmetry) is no universal joint there: the
+    group is still moved."""
+    rng = np.random.default_rng(0)
+    for _ in range(4000):
+        count = int(rng.integers(4, 9))
+        units = np.array([_unit(rng.normal(size=3)) for _ in range(count)])
+        offsets = rng.normal(size=(count, 3))
+        offsets -= np.sum(offsets * units, axis=1, keepdims=True) * units
+        offsets *= rng.uniform(0.0, 1.3e-5, (count, 1)) / np.linalg.norm(offsets, axis=1, keepdims=True)
+        centres = np.where(rng.random((count, 1)) < 0.4, rng.normal(size=3) * rng.uniform(0.0, 3e-5), 0.0)
+        points = centres + offsets + rng.uniform(-1.0, 1.0, (count, 1)) * units
+        moves, largest, left = meeting_lines(points, units, 1.0)
+        moved = np.flatnonzero(np.any(moves != 0.0, axis=1))
+        for line in moved:  # each moved line meets two other moved lines at one point (its group's)
+            assert any(_miss(points + moves, units, [line, one, other]) < 1e-12
+                       for one, other in combinations([k for k in moved if k != line], 2))
+        assert largest <= 1e-5 and all(len(lines) >= 3 for lines, _, _ in left)
+    units = np.array([[1.0, 0.0, 0.0], _unit([0.0, 1.0, 1.0]), _unit([0.0, 1.0, -1.0])])
+    points = np.array([[0.0, 2e-7, 0.0], [1e-7, 0.0, 0.0], [-1e-7, 0.0, 0.0]])
+    alone = meeting_lines(points, units, 1.0)
+    far = meeting_lines(np.vstack([points, [10.0, 0.0, 0.0]]), np.vstack([units, _unit([1.0, 1.0, 0.0])]), 1.0)
+    assert alone[1] > 1e-7 and far[1] == alone[1] and far[2] == []

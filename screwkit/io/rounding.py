@@ -20,8 +20,8 @@ that pass within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of the length
 nearest to them all (least squares, which does not depend on their order), each line moved perpendicular to itself.
 Pairs of lines are left as written (two lines always pass at some least distance; making it zero constrains no
 motion), and so are groups whose lines all meet to 1e-12 of the scale already, and groups one of whose lines meets
-another line elsewhere (a universal joint on it, or a second group), which moving it would part: the report names
-those (Reachy Mini's symmetric head has two, by coincidence of its design).
+another line exactly elsewhere (a universal joint on it) or belongs to a second group, which moving it would part:
+the report names those (Reachy Mini's symmetric head has two, by coincidence of its design).
 
 Where a hinge is drawn along its axis is not the mechanism either; the indices take no account of it (the
 characteristic points lie where the wrench's axis comes nearest to the joint's axis:
@@ -92,8 +92,9 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
     (no two nearly parallel: squared sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`), with every line
     that passes that near; two such points that share two lines are one (two lines meet once), and the group meets at
     the point nearest to all its lines, which each must pass within the tolerance of. A group whose lines all pass
-    within :data:`EXACT` of the scale of that point is left as it is. So is a group one of whose lines also comes
-    that near another line elsewhere (a universal joint on it, or another group): moving it alone would part that
+    within :data:`EXACT` of the scale of that point is left as it is. So is a group one of whose lines meets another
+    line exactly (to :data:`EXACT`) at a point of the mechanism (within three scales of the lines' drawn points'
+    centroid) other than the group's (a universal joint on it), or belongs to another group: moving it would part that
     meeting; such groups are returned as (the group's lines, that line, the other line).
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -112,37 +113,37 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
     along_first, along_second = np.sum(units[first] * between, axis=1), np.sum(units[second] * between, axis=1)
     nearest_first = points[first] + ((cosine * along_second - along_first) / sine2)[:, None] * units[first]
     nearest_second = points[second] + ((along_second - cosine * along_first) / sine2)[:, None] * units[second]
-    near = np.linalg.norm(nearest_first - nearest_second, axis=1) <= reach
-    pairs = list(zip(first[near].tolist(), second[near].tolist()))  # lines that meet, at the group's point or not
-    candidates = (nearest_first[near] + nearest_second[near]) / 2
-    through = np.linalg.norm(np.einsum("kij,ckj->cki", projections, points[None] - candidates[:, None]),
+    gaps = np.linalg.norm(nearest_first - nearest_second, axis=1)
+    meetings = (nearest_first + nearest_second) / 2
+    near = gaps <= reach
+    middle = points.mean(axis=0)
+    exact = (gaps <= EXACT * scale) & (np.linalg.norm(meetings - middle, axis=1) <= 3.0 * scale)  # on the mechanism
+    joined = [(int(one), int(other), meeting) for one, other, meeting in
+              zip(first[exact], second[exact], meetings[exact])]  # lines that meet exactly: a universal joint
+    through = np.linalg.norm(np.einsum("kij,ckj->cki", projections, points[None] - meetings[near][:, None]),
                              axis=-1) <= reach  # (candidate, line)
-    through = np.unique(through[np.sum(through, axis=1) >= 3], axis=0)  # many lines through one point: one row
-    parent = list(range(through.shape[0]))
-
-    def find(index: int) -> int:
-        while parent[index] != index:
-            parent[index] = parent[parent[index]]
-            index = parent[index]
-        return index
-
-    shared = through.astype(np.int32) @ through.T.astype(np.int32)
-    for one, other in zip(*np.nonzero(np.triu(shared >= 2, k=1))):
-        parent[find(int(one))] = find(int(other))
-    groups: dict[int, NDArray] = {}
-    for index in range(through.shape[0]):
-        root = find(index)
-        groups[root] = groups.get(root, np.zeros(count, dtype=bool)) | through[index]
+    groups = [row for row in np.unique(through[np.sum(through, axis=1) >= 3], axis=0)]  # many through one: one row
+    merged = True
+    while merged:  # points that share two lines are one (two lines meet once), also through a third point
+        merged = False
+        for one in range(len(groups)):
+            for other in range(one + 1, len(groups)):
+                if np.sum(groups[one] & groups[other]) >= 2:
+                    groups[one] = groups[one] | groups.pop(other)
+                    merged = True
+                    break
+            if merged:
+                break
     largest, left = 0.0, []
-    for members in groups.values():
+    for members in groups:
         lines = np.flatnonzero(members)
-        _, offsets = nearest_to_lines(projections[lines], points[lines])
+        centre, offsets = nearest_to_lines(projections[lines], points[lines])
         distances = np.linalg.norm(offsets, axis=1)
         if np.max(distances) > reach or np.max(distances) <= EXACT * scale:
             continue
-        elsewhere = [(one, other) if members[one] else (other, one) for one, other in pairs
-                     if members[one] != members[other]]
-        elsewhere += [(int(line), int(np.flatnonzero(another & ~members)[0])) for another in groups.values()
+        elsewhere = [(one, other) if members[one] else (other, one) for one, other, meeting in joined
+                     if members[one] != members[other] and np.linalg.norm(meeting - centre) > 2.0 * reach]
+        elsewhere += [(int(line), int(np.flatnonzero(another & ~members)[0])) for another in groups
                       if another is not members for line in np.flatnonzero(another & members)]  # two groups
         if elsewhere:
             left.append((lines, *elsewhere[0]))
