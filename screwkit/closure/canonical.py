@@ -55,7 +55,8 @@ from screwkit.closure.chain_kinematics import chain_forward_kinematics
 from screwkit.common.tolerances import AXIS_PARALLEL, MEETING, MEETING_TIE, PARALLEL_FOOT
 from screwkit.model.chain import LOOP_JOINT_DOFS, ChainGeometry
 
-__all__ = ["joint_lines_at_zero", "chain_extent", "canonical_offsets", "offsets_along_axes", "canonical_geometry"]
+__all__ = ["joint_lines_at_zero", "chain_extent", "canonical_offsets", "offsets_along_axes", "canonical_geometry",
+           "foot_on_line"]
 
 
 CLEAR_FEET = 0.25
@@ -76,13 +77,13 @@ def _line_gap(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: N
     return abs((other_point - point) @ normal) / np.linalg.norm(normal)
 
 
-def _foot_on_line(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: NDArray) -> NDArray:
+def foot_on_line(point: NDArray, axis: NDArray, other_point: NDArray, other_axis: NDArray) -> NDArray:
     """The foot on the line (``point``, ``axis``) of its common perpendicular with the line (``other_point``,
-    ``other_axis``), unit axes that are not parallel."""
+    ``other_axis``), unit axes that are not parallel; pairs of lines (..., 3) at once."""
     gap = point - other_point
-    cosine = axis @ other_axis
-    along = (cosine * (other_axis @ gap) - axis @ gap) / (1.0 - cosine * cosine)
-    return point + along * axis
+    cosine = np.sum(axis * other_axis, axis=-1)
+    along = (cosine * np.sum(other_axis * gap, axis=-1) - np.sum(axis * gap, axis=-1)) / (1.0 - cosine * cosine)
+    return point + along[..., None] * axis
 
 
 def _foot_of(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
@@ -119,8 +120,8 @@ def _points(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, extent:
         if not (together or sine2 > PARALLEL_FOOT) or _line_gap(points[joint], axes[joint], points[other],
                                                                  axes[other]) > reach:
             continue
-        meeting = 0.5 * (_foot_on_line(points[joint], axes[joint], points[other], axes[other])
-                         + _foot_on_line(points[other], axes[other], points[joint], axes[joint]))
+        meeting = 0.5 * (foot_on_line(points[joint], axes[joint], points[other], axes[other])
+                         + foot_on_line(points[other], axes[other], points[joint], axes[joint]))
         through = sum(np.linalg.norm(np.cross(meeting - points[line], axes[line])) <= reach for line in revolutes)
         found.append((through, sine2, joint, other, meeting))
     found.sort(key=lambda meeting: (-meeting[0], -meeting[1]))
@@ -178,8 +179,8 @@ def chain_extent(prismatic: tuple[bool, ...], axes: NDArray, points: NDArray, de
                 continue
             gaps.append(_line_gap(points[joint], axes[joint], points[other], axes[other]))
             if sine2 > CLEAR_FEET:
-                anchors += [_foot_on_line(points[joint], axes[joint], points[other], axes[other]),
-                            _foot_on_line(points[other], axes[other], points[joint], axes[joint])]
+                anchors += [foot_on_line(points[joint], axes[joint], points[other], axes[other]),
+                            foot_on_line(points[other], axes[other], points[joint], axes[joint])]
     spread, drawn = _diameter(anchors), _diameter(points)
     lines = max(spread, max(gaps))
     return lines if lines > MEETING * drawn else drawn
@@ -203,7 +204,7 @@ def offsets_along_axes(prismatic: tuple[bool, ...], axes: NDArray, points: NDArr
             if is_point[other]:
                 feet.append(_foot_of(points[joint], axes[joint], canonical[other]))
             elif np.sum(np.cross(axes[joint], axes[other]) ** 2) > PARALLEL_FOOT:
-                feet.append(_foot_on_line(points[joint], axes[joint], points[other], axes[other]))
+                feet.append(foot_on_line(points[joint], axes[joint], points[other], axes[other]))
         if feet:
             canonical[joint] = np.mean(feet, axis=0)
     for _ in range(count):  # along runs of parallel axes, from the joints already decided

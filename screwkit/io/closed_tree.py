@@ -455,13 +455,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             damping *= 10.0
     if nearest and np.linalg.norm(error) < ASSEMBLY_TOLERANCE:  # closures closed to rounding stay where they are:
         v, error = _nearest(residuals, derivatives, v, error, directions)  # a slide would leave their floor
-    result = type("Result", (), {"x": v})
-    q = configuration(result.x)
-    final = error
-    if np.max(np.abs(final)) >= ASSEMBLY_TOLERANCE:
+    q = configuration(v)
+    if np.max(np.abs(error)) >= ASSEMBLY_TOLERANCE:
         gaps = closure_gaps(tree, q)
         worst = max(gaps, key=gaps.get)
-        if np.max(np.abs(final)) < INCONSISTENCY_TOLERANCE:
+        if np.max(np.abs(error)) < INCONSISTENCY_TOLERANCE:
             tree.notes.append(f"the closures close to {gaps[worst]:.3g} m at best (closure {worst!r}): the file's "
                               "numbers disagree by that much (redundant closures written rounded)")
             return q, scale

@@ -37,6 +37,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closure.canonical import foot_on_line
 from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
 from screwkit.io.closed_tree import joint_kind, nearest_to_lines
@@ -105,14 +106,10 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
         return moves, 0.0, []
     projections = np.eye(3)[None] - units[:, :, None] * units[:, None, :]
     first, second = np.triu_indices(count, 1)
-    cosine = np.sum(units[first] * units[second], axis=1)
-    sine2 = 1.0 - cosine**2
-    clear = sine2 > PARALLEL_FOOT
-    first, second, cosine, sine2 = first[clear], second[clear], cosine[clear], sine2[clear]
-    between = points[first] - points[second]
-    along_first, along_second = np.sum(units[first] * between, axis=1), np.sum(units[second] * between, axis=1)
-    nearest_first = points[first] + ((cosine * along_second - along_first) / sine2)[:, None] * units[first]
-    nearest_second = points[second] + ((along_second - cosine * along_first) / sine2)[:, None] * units[second]
+    clear = np.sum(np.cross(units[first], units[second]) ** 2, axis=1) > PARALLEL_FOOT
+    first, second = first[clear], second[clear]
+    nearest_first = foot_on_line(points[first], units[first], points[second], units[second])
+    nearest_second = foot_on_line(points[second], units[second], points[first], units[first])
     gaps = np.linalg.norm(nearest_first - nearest_second, axis=1)
     meetings = (nearest_first + nearest_second) / 2
     near = gaps <= reach
