@@ -388,3 +388,42 @@ def test_any_lines_near_one_point_are_grouped_without_failing_and_lines_far_off_
     alone = meeting_lines(points, units, 1.0)
     far = meeting_lines(np.vstack([points, [10.0, 0.0, 0.0]]), np.vstack([units, _unit([1.0, 1.0, 0.0])]), 1.0)
     assert alone[1] > 1e-7 and far[1] == alone[1] and far[2] == []
+
+
+def relabelled(text: str) -> tuple[str, dict[str, str]]:
+    """The file with its legs, closures and motors listed in reverse order and every joint renamed; the names'
+    map (old -> new)."""
+    names = {old: f"joint_{chr(ord('z') - k)}" for k, old in enumerate(["m1", "p1", "m2", "p2", "q2", "m3", "p3"])}
+    for old, new in names.items():
+        text = text.replace(f'name="{old}"', f'name="{new}"').replace(f'joint="{old}"', f'joint="{new}"')
+    head, rest = text.split("<worldbody>")
+    world, tail = rest.split("</worldbody>")
+    legs = ['<body name="motor' + part for part in world.split('<body name="motor')[1:]]
+    equality, actuators = tail.split("<equality>")[1].split("</equality>")[0], tail.split("<actuator>")[1].split(
+        "</actuator>")[0]
+    reverse = lambda block, tag: "".join(f"<{tag}" + part for part in reversed(block.split(f"<{tag}")[1:]))  # noqa: E731
+    return (head + "<worldbody>" + "".join(reversed(legs)) + "</worldbody><equality>" + reverse(equality, "connect")
+            + "</equality><actuator>" + reverse(actuators, "motor") + "</actuator></mujoco>"), names
+
+
+def test_the_rounded_manipulator_relabelled_has_the_same_indices_actuator_by_actuator(tmp_path):
+    """Legs, closures and motors listed in reverse and every joint renamed (so the tree, the chains and the
+    actuators come in another order): three DOF, the same home, and each motor's ITI, the LMTI and the CTI of the
+    file as written; MuJoCo reads both as the same bodies' places."""
+    text = spm_mjcf(3e-7, 10)
+    other_text, names = relabelled(text)
+    for one in (text, other_text):
+        model = mujoco.MjModel.from_xml_string(one)
+        assert model.neq == 2 and model.nu == 3 and model.njnt == 7
+    first = load(written(tmp_path, text, "spm.xml"))
+    second = load(written(tmp_path, other_text, "relabelled.xml"))
+    assert second.dof == 3 and [a.split(":")[1] for a in second.actuator_names] != [
+        names[a.split(":")[1]] for a in first.actuator_names]  # another order indeed
+    np.testing.assert_allclose(second.home_pose, first.home_pose, atol=1e-9)
+    poses = poses_about(first)
+    one, two = indices_at_poses(first, poses, detail=True), indices_at_poses(second, poses, detail=True)
+    order = [[a.split(":")[1] for a in second.actuator_names].index(names[a.split(":")[1]])
+             for a in first.actuator_names]
+    np.testing.assert_allclose(two.iti_actuators[:, order], one.iti_actuators, atol=1e-9)
+    for name in ("lmti", "cti"):
+        np.testing.assert_allclose(getattr(two, name), getattr(one, name), atol=1e-9)
