@@ -14,6 +14,7 @@ it (none is nearer).
 
 from __future__ import annotations
 
+import json
 import re
 import warnings
 import xml.etree.ElementTree as ET
@@ -23,11 +24,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
-from test_axis_points import numbers, origins_in, revolutes_moved, written
+from test_axis_points import numbers, origins_in, revolutes_drawn_elsewhere, revolutes_moved, written
 from test_gallery import screwkit_residuals
 from test_lower_mobility import rpy_matrix
 
-from helpers import in_unit
+from helpers import in_unit, screwkit
 from screwkit.io import read_closed_tree
 from screwkit.io.closed_tree import ClosedTree, Closure, _lines_scale, assemble, closure_gaps, joint_kind
 from screwkit.io.compound import closed_samples
@@ -269,12 +270,16 @@ def test_the_length_scale_of_a_planar_mechanism_does_not_follow_the_rounding_of_
     assert _lines_scale(model, data) == pytest.approx(expected, rel=1e-9)
 
 
-def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.03) -> ClosedTree:
+def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.03, along=None,
+                          unit: float = 1.0) -> ClosedTree:
     """A 3-RRR spherical parallel manipulator about the origin (motor axes u_i 55 degrees off the downward vertical,
     platform axes w_i, middle axes v_i = u_i x w_i), read as an onshape-to-robot URDF of it is: leg 2 reaches the
     platform, legs 1 and 3 end on balls on their platform axes, 3 cm from the centre. Every axis is drawn through a
     point ``r`` along it moved off the centre by about ``rounding`` (m), and each ball's two frames apart by as much,
-    as a CAD export rounds them."""
+    as a CAD export rounds them. ``along``: each joint's frame drawn that much further along its axis (seven lengths,
+    the motor and middle joint of each leg, then the platform's: the same lines, the same mechanism); everything
+    written in units of 1 / ``unit`` m."""
+    shifts = iter(np.zeros(7) if along is None else along)
     beta = np.radians(55.0)
     turns = np.radians([0.0, 120.0, 240.0])
     u = [np.array([np.sin(beta) * np.cos(a), np.sin(beta) * np.sin(a), -np.cos(beta)]) for a in turns]
@@ -284,7 +289,7 @@ def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.
 
     def joint(parent, parent_world, axis, name):
         turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-        world = pin.SE3(turn, r * axis + rounding * rng.normal(size=3))
+        world = pin.SE3(turn, unit * ((r + next(shifts)) * axis + rounding * rng.normal(size=3)))
         index = model.addJoint(parent, pin.JointModelRZ(), parent_world.inverse() * world, name)
         model.appendBodyToJoint(index, pin.Inertia.Random(), pin.SE3.Identity())
         return index, world
@@ -293,26 +298,45 @@ def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.
     platform, platform_world = joint(*legs[1], w[1], "platform2")
     closures = []
     for i in (0, 2):
-        near, far = (pin.SE3(np.eye(3), rho * w[i] + rounding * rng.normal(size=3)) for _ in range(2))
+        near, far = (pin.SE3(np.eye(3), unit * (rho * w[i] + rounding * rng.normal(size=3))) for _ in range(2))
         closures.append(Closure(f"ball{i + 1}", legs[i][0], (legs[i][1].inverse() * near).homogeneous, platform,
                                 (platform_world.inverse() * far).homogeneous, "3d"))
     return ClosedTree("spm", model, closures, ["motor1", "motor2", "motor3"], pin.neutral(model))
 
 
 @pytest.mark.parametrize("seed, rounding", [(0, 1e-7), (1, 1e-7), (2, 3e-7)])
-def test_closures_that_close_only_to_the_file_s_rounding_are_not_slid(seed, rounding):
+def test_closures_that_close_only_to_the_file_s_rounding_stay_within_its_order_of_the_file_s_values(seed, rounding):
     """A spherical manipulator whose axes miss their centre by about 0.1-0.3 um: its balls, each on an axis through
     the centre, close only to that rounding (exactly, the mechanism would lock), and its file's values close them
-    to within two micrometres. The assembly leaves them as closed as the damped steps do, a few milliradians from the
-    file's values; sliding along the configurations closed to that rounding took one of these 0.28 um open, beyond
-    the file's rounding, and refused it (and a published export of such a manipulator 0.5 rad away)."""
+    to within two micrometres. The assembly closes them as well as they close, and moves the joints by the
+    rounding's order (its gap over the 3 cm ball radius, at most a few times 1e-5 rad), not along the floor: the
+    damped steps crept 3-5 mrad along it, and a slide along every direction closed to that rounding took one of
+    these 0.28 um open, beyond the file's rounding (and a published export of such a manipulator 0.5 rad away)."""
     tree = spherical_manipulator(rounding, np.random.default_rng(seed))
     gaps = closure_gaps(tree, tree.q_reference)
     assert 1e-8 < max(gaps.values()) < 2e-6
     q, _ = assemble(tree)
-    assert np.max(np.abs(pin.difference(tree.model, tree.q_reference, q))) < 1e-2
+    assert np.max(np.abs(pin.difference(tree.model, tree.q_reference, q))) < 3 * max(gaps.values()) / 0.03
     assert max(closure_gaps(tree, q).values()) < 3e-7
     assert any("at best" in note for note in tree.notes), tree.notes
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_closures_closed_to_rounding_assemble_the_same_however_drawn_listed_or_scaled(seed):
+    """The same rounded manipulator with its joint frames drawn up to 2 cm along their axes, its closures listed in
+    the other order, or written in millimetres: the same joint values (1e-9 rad; they are the same joints about the
+    same lines). Where the damped steps stopped on the floor depended on all of these (1e-3 rad apart)."""
+    rounding = 1e-7 if seed == 0 else 3e-7
+    reference, _ = assemble(spherical_manipulator(rounding, np.random.default_rng(seed)))
+    for draw in range(3):
+        along = np.random.default_rng(10 + draw).uniform(-0.02, 0.02, 7)
+        q, _ = assemble(spherical_manipulator(rounding, np.random.default_rng(seed), along=along))
+        np.testing.assert_allclose(q, reference, atol=1e-9, err_msg=f"drawn along the axes by {along}")
+    listed = spherical_manipulator(rounding, np.random.default_rng(seed))
+    listed.closures.reverse()
+    np.testing.assert_allclose(assemble(listed)[0], reference, atol=1e-9, err_msg="closures in the other order")
+    in_mm = spherical_manipulator(rounding, np.random.default_rng(seed), unit=1000.0)
+    np.testing.assert_allclose(assemble(in_mm)[0], reference, atol=1e-9, err_msg="in millimetres")
 
 
 @pytest.mark.parametrize("name", OPEN_FILES)
@@ -351,3 +375,64 @@ def test_a_file_that_does_not_close_assembles_the_same_with_its_joints_renamed_a
         np.testing.assert_allclose([by_name[actuator] for actuator in here.actuators], np.ravel(getattr(here, field)),
                                    rtol=0, atol=1e-7, err_msg=field)
     np.testing.assert_allclose(there.lmti, here.lmti, rtol=0, atol=1e-7)
+
+
+def spherical_manipulator_onshape(rounding: float, seed: int, unit: float = 1.0) -> str:
+    """:func:`spherical_manipulator` as onshape-to-robot writes it: a URDF of its seven joints (each link's frame its
+    joint's, z along the axis), its two balls as ``closing_ball<i>_1`` / ``_2`` frame pairs and an ``effector`` frame
+    at the centre, in units of 1 / ``unit`` m."""
+    tree = spherical_manipulator(rounding, np.random.default_rng(seed), unit=unit)
+    model, data = tree.model, tree.model.createData()
+    pin.forwardKinematics(model, data, tree.q_reference)
+
+    def origin(placement) -> str:
+        return f'<origin xyz="{written(placement.translation)}" rpy="{rpy_of(placement.rotation)}"/>'
+
+    def link(name: str) -> str:
+        return f'<link name="{name}"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" ' \
+               f'iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>'
+
+    out = ['<robot name="spm">', link("base")]
+    for joint in range(1, model.njoints):
+        name, parent = model.names[joint], model.parents[joint]
+        out += [link(f"{name}_link"), f'<joint name="{name}" type="revolute">{origin(model.jointPlacements[joint])}'
+                f'<parent link="{"base" if parent == 0 else model.names[parent] + "_link"}"/><child '
+                f'link="{name}_link"/><axis xyz="0 0 1"/><limit effort="1" velocity="20" lower="-3" upper="3"/>'
+                '</joint>']
+    frames = [(f"closing_{c.name}_{k + 1}", joint, pin.SE3(placement)) for c in tree.closures
+              for k, (joint, placement) in enumerate(((c.joint_a, c.placement_a), (c.joint_b, c.placement_b)))]
+    platform = model.getJointId("platform2")
+    frames.append(("effector", platform, data.oMi[platform].inverse() * pin.SE3.Identity()))
+    for name, joint, placement in frames:
+        out += [link(name), f'<joint name="{name}_frame" type="fixed">{origin(placement)}<parent '
+                f'link="{model.names[joint]}_link"/><child link="{name}"/></joint>']
+    return "\n".join(out + ["</robot>"]) + "\n"
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_analyze_reads_a_manipulator_closed_to_rounding_the_same_however_drawn_or_scaled(tmp_path, seed):
+    """``screwkit analyze`` as users run it, on the rounded manipulator exported as onshape-to-robot writes it, as
+    written, with its revolutes drawn up to 2 cm along their axes (two drawings), and in millimetres: three DOF,
+    the same home pose and indices to 1e-9 (where the damped steps stopped creeping along the floor put the home
+    poses up to 0.06 rad apart), and the report's line that the closures close only to the rounding."""
+    text = spherical_manipulator_onshape(1e-7, seed)  # axes off the centre within FILE_ROUNDING of its size
+    files = {"written": text, "in mm": spherical_manipulator_onshape(1e-7, seed, 1000.0)}
+    for draw in (1, 2):
+        files[f"drawn {draw}"] = revolutes_drawn_elsewhere(text, np.random.default_rng(draw), 0.02)
+    found = {}
+    for label, content in files.items():
+        path = tmp_path / label.replace(" ", "_") / "robot.urdf"
+        path.parent.mkdir()
+        path.write_text(content)
+        run = screwkit("analyze", path, "--json")
+        assert run.returncode == 0, (label, run.stderr)
+        found[label] = json.loads(run.stdout)
+        assert found[label]["dof"] == 3, label
+        assert any("at best" in line for line in found[label]["converted"]), (label, found[label]["converted"])
+    first = found["written"]
+    for label, other in found.items():
+        np.testing.assert_allclose(list(other["pose"].values()), list(first["pose"].values()), atol=1e-9,
+                                   err_msg=label)
+        np.testing.assert_allclose(list(other["iti_actuators"].values()), list(first["iti_actuators"].values()),
+                                   atol=1e-9, err_msg=label)
+        assert other["lmti"] == pytest.approx(first["lmti"], abs=1e-9), label

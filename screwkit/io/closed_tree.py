@@ -37,6 +37,13 @@ INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
+FLOOR_RCOND = float(np.sqrt(INCONSISTENCY_TOLERANCE))
+"""Singular value (relative to the largest) of the closures' Jacobian below which a direction only moves along the
+floor of closures that close to the file's rounding: along it the residual changes by the rounding's order over a
+radian or a length scale (a ball's radial gap on a sphere its axes all meet), so closing that gap would move the
+joints by O(1), not by the rounding. The geometric middle of the rounding and 1: the Jacobians met are 5 orders of
+magnitude apart there (1e-6 against 0.5-1 for Rhoban's exported spherical manipulator), and its home is the same
+from 1e-4 to 1e-1."""
 
 
 class ImportError_(ValueError):
@@ -325,28 +332,44 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
         tree.model, data, c)]}
 
 
-def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray) -> tuple[NDArray, NDArray]:
+def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray,
+             on_floor: bool = False) -> tuple[NDArray, NDArray]:
     """From a closed ``v`` (its residuals ``error``; ``derivatives(v)`` their Jacobian along ``directions``), the
     closed configuration nearest to the reference one (v = 0; angles in rad, lengths in units of
     :func:`_lines_scale`, along ``directions`` only): the point of the linearised closed set nearest to 0 (the
     pseudo-inverse of the closures' Jacobian, whose null space is where the closures stay closed, whatever the
     residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it does not close
     again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them closed comes
-    nearer): the least change of the joints, which the mechanism decides, not its drawing."""
+    nearer): the least change of the joints, which the mechanism decides, not its drawing. ``on_floor``: closures
+    that close only to the file's rounding. The directions that only move along their floor are then free (the
+    pseudo-inverse's ``rcond`` is :data:`FLOOR_RCOND`), and closed means that what the other directions can close
+    of the residual (its part in the Jacobian's range) is closed: the point nearest to the reference where every
+    closure is as closed as it can be, the same for residuals weighed otherwise (the file drawn otherwise)."""
+    rcond = FLOOR_RCOND if on_floor else 1e-7
+
+    def closable(jacobian, inverse_, residual) -> float:
+        """What of ``residual`` the steps close: all of it, or on a floor its part in the Jacobian's range."""
+        return float(np.linalg.norm(jacobian @ (inverse_ @ residual) if on_floor else residual))
+
     for _ in range(10):  # closed first to round-off (the damped steps stop at ASSEMBLY_TOLERANCE), so that a nearer
-        if np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file closed as written
-            break  # is left as written, to the bit (a rounded one's reading can turn on its last bits)
-        inverse_ = np.linalg.pinv(derivatives(v), rcond=1e-7)
+        if not on_floor and np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file
+            break  # closed as written is left as written, to the bit (a rounded one's reading can turn on last bits)
+        jacobian = derivatives(v)
+        inverse_ = np.linalg.pinv(jacobian, rcond=rcond)
+        if closable(jacobian, inverse_, error) <= 1e-14:
+            break
         candidate = v - (inverse_ @ error) @ directions
         closed = residuals(candidate)
-        if not np.linalg.norm(closed) < np.linalg.norm(error):
+        if not closable(jacobian, inverse_, closed) < closable(jacobian, inverse_, error):
             break
         v, error = candidate, closed
-    floor = max(2.0 * float(np.linalg.norm(error)), 1e-14)
+    jacobian = derivatives(v) if on_floor else None
+    floor = max(2.0 * (closable(jacobian, np.linalg.pinv(jacobian, rcond=rcond), error) if on_floor
+                       else float(np.linalg.norm(error))), 1e-14)
     for _ in range(100):
         x = directions @ v
         jacobian = derivatives(v)
-        inverse_ = np.linalg.pinv(jacobian, rcond=1e-7)
+        inverse_ = np.linalg.pinv(jacobian, rcond=rcond)
         step = inverse_ @ (jacobian @ x - error) - x
         if np.linalg.norm(step) <= 1e-10 * max(1.0, float(np.linalg.norm(x))):
             break
@@ -354,12 +377,12 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
             candidate = v + (fraction * step) @ directions
             closed = residuals(candidate)
             for _ in range(8):  # closed again along the same Jacobian (a chord step)
-                if np.linalg.norm(closed) <= floor:
+                if closable(jacobian, inverse_, closed) <= floor:
                     break
                 candidate = candidate - (inverse_ @ closed) @ directions
                 closed = residuals(candidate)
             nearer = np.linalg.norm(directions @ candidate) <= np.linalg.norm(x) * (1.0 + 1e-12)  # to round-off
-            if np.linalg.norm(closed) <= floor and nearer:
+            if closable(jacobian, inverse_, closed) <= floor and nearer:
                 break
         else:
             break
@@ -380,9 +403,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
     (:func:`_nearest`): the damped steps reach *a* closed configuration, which depends on how the residuals are
     weighed and so on where the file draws its joints and frames; the nearest one does not. Closures that close
-    only to the file's rounding keep the damped steps' configuration: configurations closed to that rounding can
-    form a larger family than the closed ones (a spherical mechanism whose axes miss their centre by 1e-7 m), and
-    a slide along it went far from the file's values or left the floor.
+    only to the file's rounding are slid the same way along their floor (``rcond`` :data:`FLOOR_RCOND`): the damped
+    steps creep along it (Rhoban's exported spherical manipulator, its balls rounded off their sphere: 0.02 rad in
+    20 steps for 2 % of the residual), and where they stop depended on the drawing; the floor's point nearest to
+    the file's values does not. Directions that close the floor's gap only at the rounding's rate are left alone
+    (a pseudo-inverse of all of them went far from the file's values or left the floor).
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -453,8 +478,8 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             v, error, damping = v + change, candidate, max(damping * 0.1, 1e-12)
         else:
             damping *= 10.0
-    if nearest and np.linalg.norm(error) < ASSEMBLY_TOLERANCE:  # closures closed to rounding stay where they are:
-        v, error = _nearest(residuals, derivatives, v, error, directions)  # a slide would leave their floor
+    if nearest and np.linalg.norm(error) < INCONSISTENCY_TOLERANCE:  # on a floor: along it only, back from the creep
+        v, error = _nearest(residuals, derivatives, v, error, directions, np.linalg.norm(error) >= ASSEMBLY_TOLERANCE)
     q = configuration(v)
     if np.max(np.abs(error)) >= ASSEMBLY_TOLERANCE:
         gaps = closure_gaps(tree, q)
