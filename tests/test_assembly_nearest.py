@@ -29,10 +29,12 @@ from test_gallery import screwkit_residuals
 from test_lower_mobility import rpy_matrix
 
 from helpers import in_unit, screwkit
+from screwkit.closure.assembly import DOF_AT_ROUNDING, DOF_MARGIN
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io import read_closed_tree
 from screwkit.io.closed_tree import ClosedTree, Closure, _lines_scale, assemble, closure_gaps, joint_kind
 from screwkit.io.compound import closed_samples
-from screwkit.io.loader import load
+from screwkit.io.loader import bundled_names, load
 from screwkit.studies import indices_at_pose
 
 GEPETTO = Path(__file__).resolve().parent / "data" / "gallery" / "published" / "example_parallel_robots"
@@ -436,3 +438,30 @@ def test_analyze_reads_a_manipulator_closed_to_rounding_the_same_however_drawn_o
         np.testing.assert_allclose(list(other["iti_actuators"].values()), list(first["iti_actuators"].values()),
                                    atol=1e-9, err_msg=label)
         assert other["lmti"] == pytest.approx(first["lmti"], abs=1e-9), label
+
+
+def test_a_dof_count_that_turns_on_the_file_s_rounding_is_said(tmp_path):
+    """The manipulator's axes off its centre by 3e-7 m at random (up to 1.3e-5 of its size, beyond the rounding that
+    reading idealises): its constraints are independent only to 1e-5, so it reads 2 DOF where the same manipulator
+    written exactly (checked here) has 3. ``screwkit analyze`` says so in one line and in its JSON; the manipulator
+    within the rounding, and every bundled mechanism, has no such note."""
+    paths = {}
+    for label, rounding, seed in (("exact", 0.0, 2), ("within", 1e-7, 0), ("beyond", 3e-7, 2)):
+        paths[label] = tmp_path / label / "robot.urdf"
+        paths[label].parent.mkdir()
+        paths[label].write_text(spherical_manipulator_onshape(rounding, seed))
+    assert load(paths["exact"]).dof == load(paths["within"]).dof == 3
+    beyond = load(paths["beyond"])
+    assert beyond.dof == 2
+    [note] = [note for note in beyond.assembly_notes if note.startswith(DOF_AT_ROUNDING)]
+    assert "2 DOF" in note and "may have 3 DOF" in note
+    value = float(re.search(r"only to ([0-9.e+-]+) \(relative\)", note).group(1))
+    assert FILE_ROUNDING / 10 < value < DOF_MARGIN
+    run = screwkit("analyze", paths["beyond"])
+    assert run.returncode == 0 and f"{paths['beyond']}: {DOF_AT_ROUNDING}2 DOF" in run.stderr, run.stderr
+    as_json = screwkit("analyze", paths["beyond"], "--json")
+    assert as_json.returncode == 0 and json.loads(as_json.stdout)["assembly"] == [note]
+    within = screwkit("analyze", paths["within"])
+    assert within.returncode == 0 and DOF_AT_ROUNDING not in within.stderr
+    for name in bundled_names():
+        assert not [note for note in load(name).assembly_notes if note.startswith(DOF_AT_ROUNDING)], name

@@ -9,7 +9,7 @@ import click
 
 from screwkit.cli.options import fail, ignore_limits_option, json_option, overwrite_option, quiet_option
 from screwkit.cli.reading import actuate_option, lock_option
-from screwkit.closure.assembly import LIMITS_IGNORED
+from screwkit.closure.assembly import NOT_OPEN_LOOPS
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
 from screwkit.io.loader import load, load_text
 from screwkit.studies.files import atomic_text, check_output
@@ -59,14 +59,15 @@ def convert(source: Path, out: Path, output_frame, output_type, lock, actuate, i
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))
-            report.notes = [f"assembled: {note}" for note in own.assembly_notes] or ["every loop closes as written"]
+            report.notes = [f"assembled: {note}" for note in own.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)
+                            ] or ["every loop closes as written"]  # (the others: below, from the file written)
         mechanism = load_text(text, str(source), limits=not ignore_limits)  # what is written must load
     except (ImportError_, ValueError) as error:
         raise fail(str(error)) from None
-    still_open = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
+    still_open = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]
     if still_open:
         raise fail(f"{out}: the converted file still leaves loops open: {'; '.join(still_open)}")
-    report.notes += [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
+    report.notes += [note for note in mechanism.assembly_notes if note.startswith(NOT_OPEN_LOOPS)]
     atomic_text(out, text)
     summary = {"source": str(source), "written": str(out), "format": report.file_format,
                "platform_body": report.platform_body, "output": report.output, "planar": report.planar,

@@ -21,7 +21,7 @@ import numpy as np
 
 from screwkit.cli.option_checks import execution_record, finite_threshold
 from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
-from screwkit.closure.assembly import LIMITS_IGNORED
+from screwkit.closure.assembly import NOT_OPEN_LOOPS
 from screwkit.common.compiling import (
     INDEX_KERNELS,
     compile_ahead,
@@ -411,8 +411,8 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
     context = click.get_current_context(silent=True)
-    opened = [note for note in mechanism.assembly_notes if not note.startswith(LIMITS_IGNORED)]
-    ignored = [note for note in mechanism.assembly_notes if note.startswith(LIMITS_IGNORED)]
+    opened = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]
+    ignored = [note for note in mechanism.assembly_notes if note.startswith(NOT_OPEN_LOOPS)]
     if opened and not (context and context.params.get("quiet")):
         # a file whose loops are open as written describes another mechanism than the one analysed: say so
         echo_error(f"{name}: loops open at the file's own joint values were closed at loading: " + "; ".join(opened))

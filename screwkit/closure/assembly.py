@@ -35,18 +35,29 @@ from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import (
     BRANCH_MATCH_TOLERANCE,
     CLOSURE_TOLERANCE,
+    FILE_ROUNDING,
     MOTION_SPACE_TOLERANCE,
     NEWTON_TOLERANCE,
 )
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["assemble", "mobility", "working_modes", "LIMITS_IGNORED"]
+__all__ = ["assemble", "mobility", "working_modes", "LIMITS_IGNORED", "DOF_AT_ROUNDING", "NOT_OPEN_LOOPS"]
 
 
 LIMITS_IGNORED = "limits ignored: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that is not an open loop starts: a
 reference assembly outside a joint's limits, read with ``limits=False``."""
+DOF_AT_ROUNDING = "DOF decided at the file's rounding: "
+"""How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that says the DOF count turns on
+a singular value of the order of a file's rounding (:func:`mobility_notes`)."""
+NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING)
+"""The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
+DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
+"""Relative: a singular value counted by :func:`mobility` (above :data:`MOTION_SPACE_TOLERANCE`) but at most this is
+of the order of a file's rounding rather than of its geometry: the geometric middle of :data:`FILE_ROUNDING` and 1.
+Every bundled and published mechanism read so far has its smallest at 0.01 or more; a spherical manipulator whose axes
+miss their centre by 1.3e-5 of its size (beyond what is idealised on reading) has one at 1e-5."""
 
 def _tidy(value: float) -> str:
     """A number for messages: 6 significant digits, round-off below 1e-12 shown as 0."""
@@ -175,21 +186,54 @@ def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
     Twists are taken about the centroid of the platform joints with lengths in units of the
     mechanism's length scale, so the count does not depend on the unit or the frame.
     """
+    return _mobility(mechanism, chains)[0]
+
+
+def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[tuple[str, float]]]:
+    """:func:`mobility`, and the smallest singular value it counted (relative to the largest, the stacked
+    complements' being orthonormal rows) of each chain's twists (named by the chain) and of the chains' stacked
+    complements (named ""), where there is one."""
     rows = task_rows(mechanism.is_planar)
     frames = [chain_forward_kinematics(chain.geometry, chain.reference_values) for chain in chains]
     centre = np.mean([f.points[-1] for f in frames], axis=0)
-    complements = []
+    complements, smallest = [], []
     for chain, chain_frames in zip(chains, frames):
         twists = twists_from_axes_and_points(chain_frames.axes, chain_frames.points - centre, chain.prismatic)
         twists = np.concatenate([twists[:, :3], twists[:, 3:] / mechanism.length_scale], axis=-1)[:, rows].T
         left, singular, _ = np.linalg.svd(twists)
-        rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * max(1.0, singular[0] if singular.size else 1.0)))
+        largest = max(1.0, singular[0] if singular.size else 1.0)
+        rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * largest))
         complements.append(left[:, rank:].T)
+        if rank:
+            smallest.append((chain.name, float(singular[rank - 1] / largest)))
     stacked = np.concatenate(complements, axis=0)
     if stacked.size == 0:
-        return len(rows)
+        return len(rows), smallest
     singular = np.linalg.svd(stacked, compute_uv=False)
-    return len(rows) - int(np.sum(singular > MOTION_SPACE_TOLERANCE))
+    rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE))
+    if rank:
+        smallest.append(("", float(singular[rank - 1])))
+    return len(rows) - rank, smallest
+
+
+def mobility_notes(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[str]]:
+    """:func:`mobility`, and a note (:data:`DOF_AT_ROUNDING`) for each count that turns on a singular value at most
+    :data:`DOF_MARGIN`: a chain whose joint screws are independent only to the order of a file's rounding (written
+    exactly, it may have one freedom fewer), or constraints of the chains independent of each other only so far
+    (written exactly, the platform may have one DOF more: axes meant to meet or to be parallel, written rounded)."""
+    dof, smallest = _mobility(mechanism, chains)
+    notes = []
+    for name, value in smallest:
+        if value > DOF_MARGIN:
+            continue
+        if name:
+            notes.append(f"{DOF_AT_ROUNDING}chain {name!r}: its joint screws are independent only to {value:.2g} "
+                         "(relative), the order of a file's rounding; written exactly, it may have one freedom fewer")
+        else:
+            notes.append(f"{DOF_AT_ROUNDING}{dof} DOF, with the chains' constraints independent of each other only "
+                         f"to {value:.2g} (relative), the order of a file's rounding; written exactly (axes meant to "
+                         f"meet or to be parallel written so), the platform may have {dof + 1} DOF")
+    return dof, notes
 
 
 def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
@@ -226,8 +270,8 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
             branch = chain.reference_sign
         solved.append(replace(chain, closed_form=solver, branch=branch, solver=solver.kind if solver else "newton",
                               solver_reason=reason))
-    mechanism = replace(mechanism, chains=tuple(solved))
-    dof = mobility(mechanism, mechanism.chains)
+    dof, notes = mobility_notes(mechanism, tuple(solved))
+    mechanism = replace(mechanism, chains=tuple(solved), assembly_notes=mechanism.assembly_notes + tuple(notes))
     actuators = mechanism.actuator_names
     needed = dof  # a point output: its DOF, the rotations about it need no actuator
     if mechanism.output_point is not None:
