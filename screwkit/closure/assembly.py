@@ -42,7 +42,8 @@ from screwkit.common.tolerances import (
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["assemble", "mobility", "working_modes", "LIMITS_IGNORED", "DOF_AT_ROUNDING", "NOT_OPEN_LOOPS"]
+__all__ = ["assemble", "mobility", "mobility_notes", "rounded_dof_note", "working_modes", "LIMITS_IGNORED",
+           "DOF_AT_ROUNDING", "DOF_MARGIN", "NOT_OPEN_LOOPS"]
 
 
 LIMITS_IGNORED = "limits ignored: "
@@ -189,10 +190,10 @@ def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
     return _mobility(mechanism, chains)[0]
 
 
-def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[tuple[str, float]]]:
-    """:func:`mobility`, and the smallest singular value it counted (relative to the largest, the stacked
-    complements' being orthonormal rows) of each chain's twists (named by the chain) and of the chains' stacked
-    complements (named ""), where there is one."""
+def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[tuple[str, NDArray]]]:
+    """:func:`mobility`, and the singular values it counted (relative to the largest, the stacked complements' being
+    orthonormal rows) of each chain's twists (named by the chain) and of the chains' stacked complements (named
+    "")."""
     rows = task_rows(mechanism.is_planar)
     frames = [chain_forward_kinematics(chain.geometry, chain.reference_values) for chain in chains]
     centre = np.mean([f.points[-1] for f in frames], axis=0)
@@ -204,36 +205,42 @@ def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, lis
         largest = max(1.0, singular[0] if singular.size else 1.0)
         rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * largest))
         complements.append(left[:, rank:].T)
-        if rank:
-            smallest.append((chain.name, float(singular[rank - 1] / largest)))
+        smallest.append((chain.name, singular[:rank] / largest))
     stacked = np.concatenate(complements, axis=0)
     if stacked.size == 0:
         return len(rows), smallest
     singular = np.linalg.svd(stacked, compute_uv=False)
     rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE))
-    if rank:
-        smallest.append(("", float(singular[rank - 1])))
+    smallest.append(("", singular[:rank]))
     return len(rows) - rank, smallest
 
 
 def mobility_notes(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[str]]:
-    """:func:`mobility`, and a note (:data:`DOF_AT_ROUNDING`) for each count that turns on a singular value at most
+    """:func:`mobility`, and a note (:data:`DOF_AT_ROUNDING`) for each count that turns on singular values at most
     :data:`DOF_MARGIN`: a chain whose joint screws are independent only to the order of a file's rounding (written
-    exactly, it may have one freedom fewer), or constraints of the chains independent of each other only so far
-    (written exactly, the platform may have one DOF more: axes meant to meet or to be parallel, written rounded)."""
-    dof, smallest = _mobility(mechanism, chains)
+    exactly, it may have fewer freedoms), or constraints of the chains independent of each other only so far
+    (written exactly, the platform may have more DOF: axes meant to meet or to be parallel, written rounded)."""
+    dof, counted = _mobility(mechanism, chains)
     notes = []
-    for name, value in smallest:
-        if value > DOF_MARGIN:
+    for name, values in counted:
+        small = values[values <= DOF_MARGIN]
+        if not small.size:
             continue
         if name:
-            notes.append(f"{DOF_AT_ROUNDING}chain {name!r}: its joint screws are independent only to {value:.2g} "
-                         "(relative), the order of a file's rounding; written exactly, it may have one freedom fewer")
+            notes.append(f"{DOF_AT_ROUNDING}chain {name!r}: its joint screws are independent only to "
+                         f"{small.min():.2g} (relative), the order of a file's rounding; written exactly, it may have "
+                         f"up to {small.size} freedom(s) fewer")
         else:
-            notes.append(f"{DOF_AT_ROUNDING}{dof} DOF, with the chains' constraints independent of each other only "
-                         f"to {value:.2g} (relative), the order of a file's rounding; written exactly (axes meant to "
-                         f"meet or to be parallel written so), the platform may have {dof + 1} DOF")
+            notes.append(rounded_dof_note(dof, small, "chains"))
     return dof, notes
+
+
+def rounded_dof_note(dof: int, small: NDArray, legs: str) -> str:
+    """The :data:`DOF_AT_ROUNDING` note of a platform whose ``legs``' constraints are independent of each other only
+    to the singular values ``small`` (each at most :data:`DOF_MARGIN`)."""
+    return (f"{DOF_AT_ROUNDING}{dof} DOF, with the {legs}' constraints independent of each other only to "
+            f"{np.min(small):.2g} (relative), the order of a file's rounding; written exactly (axes meant to meet or "
+            f"to be parallel written so), the platform may have up to {dof + len(small)} DOF")
 
 
 def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:

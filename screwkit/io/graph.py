@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closure.assembly import DOF_MARGIN, rounded_dof_note
 from screwkit.closure.task_space import choose_task_axes
 from screwkit.common.rotations import cross
 from screwkit.common.units import is_angular, spelled_pose
@@ -412,9 +413,10 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
                                "actuator drives one revolute or prismatic joint.")
 
 
-def _motion_space(screws: list[LegScrews], locked: bool = False) -> NDArray[np.float64]:
+def _motion_space(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:
     """Orthonormal rows (d, 6) spanning the platform twists every leg allows (working coordinates), at the first
-    configuration of a batch; ``locked``: with every actuator locked (the motions no actuator controls)."""
+    configuration of a batch; ``locked``: with every actuator locked (the motions no actuator controls);
+    ``counted``: a list that gets the singular values counted of the legs' stacked complements."""
     complements = []
     for screw in screws:
         rows = (screw.locked[0][:int(screw.locked_dims[0])] if locked else
@@ -425,7 +427,10 @@ def _motion_space(screws: list[LegScrews], locked: bool = False) -> NDArray[np.f
     if not len(stacked):
         return np.eye(6)
     _, values, right = np.linalg.svd(np.vstack([stacked, np.zeros((max(6 - len(stacked), 0), 6))]))
-    return right[int(np.sum(values > TWIST_RANK_TOLERANCE)):]
+    rank = int(np.sum(values > TWIST_RANK_TOLERANCE))
+    if counted is not None:
+        counted.extend(values[:rank])
+    return right[rank:]
 
 
 def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple[int, ...]:
@@ -485,7 +490,11 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
         _check_output(tree, screws, report.platform_body)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
-    motion = _motion_space(screws)
+    counted = []
+    motion = _motion_space(screws, counted=counted)
+    small = np.array(counted)[np.array(counted) <= DOF_MARGIN]
+    if small.size:  # as closure.assembly.mobility_notes says it of serial legs
+        report.notes.append(rounded_dof_note(len(motion), small, "legs"))
     task_axes = _task_axes(tree, state, frame_id, motion)
     if not task_axes:
         raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move: analysed as a graph, "
