@@ -37,13 +37,14 @@ INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
-FLOOR_RCOND = float(np.sqrt(INCONSISTENCY_TOLERANCE))
-"""Singular value (relative to the largest) of the closures' Jacobian below which a direction only moves along the
-floor of closures that close to the file's rounding: along it the residual changes by the rounding's order over a
-radian or a length scale (a ball's radial gap on a sphere its axes all meet), so closing that gap would move the
-joints by O(1), not by the rounding. The geometric middle of the rounding and 1: the Jacobians met are 5 orders of
-magnitude apart there (1e-6 against 0.5-1 for Rhoban's exported spherical manipulator), and its home is the same
-from 1e-4 to 1e-1."""
+FLOOR_MOVE = 0.1
+"""Joint change (rad, or length scales) beyond which closing a residual of the file's rounding is not what the
+rounding means. On closures that close only to that rounding, a direction of their Jacobian whose singular value is
+below the residual over this moves along the floor: closing the residual along it would turn the joints by more than
+this (a ball's radial gap on a sphere that every axis meets), and the assembly does not creep along it. Rhoban's
+exported spherical manipulator has two such directions, at 1.2e-6 and 5.5e-6 against a residual of 8.5e-6 (moves of
+1.5 rad and more); a 1 mm four-bar beside one of 0.5 m, or one 0.01 rad from its flat singular configuration, has
+its weakest closing direction at about 1e-3 (a move of 1e-4 rad for a residual of 1e-7), which is closed."""
 
 
 class ImportError_(ValueError):
@@ -341,11 +342,21 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
     residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it does not close
     again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them closed comes
     nearer): the least change of the joints, which the mechanism decides, not its drawing. ``on_floor``: closures
-    that close only to the file's rounding. The directions that only move along their floor are then free (the
-    pseudo-inverse's ``rcond`` is :data:`FLOOR_RCOND`), and closed means that what the other directions can close
-    of the residual (its part in the Jacobian's range) is closed: the point nearest to the reference where every
-    closure is as closed as it can be, the same for residuals weighed otherwise (the file drawn otherwise)."""
-    rcond = FLOOR_RCOND if on_floor else 1e-7
+    that close only to the file's rounding. The directions that only move along their floor (singular values below
+    the residual over :data:`FLOOR_MOVE`) are then free, and closed means that what the other directions can close
+    of the residual (its part in their range) is closed, judged on each candidate's own Jacobian: the point nearest
+    to the reference where every closure is as closed as it can be (the same for residuals weighed otherwise, to the
+    order of the floor times the change of weights)."""
+    cut = float(np.linalg.norm(error)) / FLOOR_MOVE
+
+    def inverse(jacobian) -> NDArray:
+        """The closures' pseudo-inverse: singular values at most 1e-7 of the largest dropped, on a floor also those
+        below ``cut``."""
+        if not on_floor:
+            return np.linalg.pinv(jacobian, rcond=1e-7)
+        left, singular, right = np.linalg.svd(jacobian, full_matrices=False)
+        keep = singular > max(cut, 1e-7 * (singular[0] if singular.size else 0.0))
+        return (right[keep].T / singular[keep]) @ left[:, keep].T
 
     def closable(jacobian, inverse_, residual) -> float:
         """What of ``residual`` the steps close: all of it, or on a floor its part in the Jacobian's range."""
@@ -355,7 +366,7 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
         if not on_floor and np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file
             break  # closed as written is left as written, to the bit (a rounded one's reading can turn on last bits)
         jacobian = derivatives(v)
-        inverse_ = np.linalg.pinv(jacobian, rcond=rcond)
+        inverse_ = inverse(jacobian)
         if closable(jacobian, inverse_, error) <= 1e-14:
             break
         candidate = v - (inverse_ @ error) @ directions
@@ -364,25 +375,40 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
             break
         v, error = candidate, closed
     jacobian = derivatives(v) if on_floor else None
-    floor = max(2.0 * (closable(jacobian, np.linalg.pinv(jacobian, rcond=rcond), error) if on_floor
+    floor = max(2.0 * (closable(jacobian, inverse(jacobian), error) if on_floor
                        else float(np.linalg.norm(error))), 1e-14)
+
+    def close_again(candidate, closed, jacobian, inverse_) -> tuple[NDArray, NDArray, bool]:
+        """``candidate`` closed again by chord steps on the Jacobian it was found with, then on a floor judged (and
+        closed) on its own Jacobian (the range that closes turns with the configuration); and whether it is closed."""
+        for _ in range(8):
+            if closable(jacobian, inverse_, closed) <= floor:
+                break
+            candidate = candidate - (inverse_ @ closed) @ directions
+            closed = residuals(candidate)
+        if not on_floor:
+            return candidate, closed, closable(jacobian, inverse_, closed) <= floor
+        for _ in range(4):
+            own = derivatives(candidate)
+            own_inverse = inverse(own)
+            if closable(own, own_inverse, closed) <= floor:
+                return candidate, closed, True
+            candidate = candidate - (own_inverse @ closed) @ directions
+            closed = residuals(candidate)
+        return candidate, closed, False
+
     for _ in range(100):
         x = directions @ v
         jacobian = derivatives(v)
-        inverse_ = np.linalg.pinv(jacobian, rcond=rcond)
+        inverse_ = inverse(jacobian)
         step = inverse_ @ (jacobian @ x - error) - x
         if np.linalg.norm(step) <= 1e-10 * max(1.0, float(np.linalg.norm(x))):
             break
         for fraction in 0.5 ** np.arange(8):
-            candidate = v + (fraction * step) @ directions
-            closed = residuals(candidate)
-            for _ in range(8):  # closed again along the same Jacobian (a chord step)
-                if closable(jacobian, inverse_, closed) <= floor:
-                    break
-                candidate = candidate - (inverse_ @ closed) @ directions
-                closed = residuals(candidate)
+            trial = v + (fraction * step) @ directions
+            candidate, closed, closes = close_again(trial, residuals(trial), jacobian, inverse_)
             nearer = np.linalg.norm(directions @ candidate) <= np.linalg.norm(x) * (1.0 + 1e-12)  # to round-off
-            if closable(jacobian, inverse_, closed) <= floor and nearer:
+            if closes and nearer:
                 break
         else:
             break
@@ -403,11 +429,12 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
     (:func:`_nearest`): the damped steps reach *a* closed configuration, which depends on how the residuals are
     weighed and so on where the file draws its joints and frames; the nearest one does not. Closures that close
-    only to the file's rounding are slid the same way along their floor (``rcond`` :data:`FLOOR_RCOND`): the damped
-    steps creep along it (Rhoban's exported spherical manipulator, its balls rounded off their sphere: 0.02 rad in
-    20 steps for 2 % of the residual), and where they stop depended on the drawing; the floor's point nearest to
-    the file's values does not. Directions that close the floor's gap only at the rounding's rate are left alone
-    (a pseudo-inverse of all of them went far from the file's values or left the floor).
+    only to the file's rounding (their largest residual within it) are slid the same way along their floor
+    (:data:`FLOOR_MOVE`): the damped steps creep along it (Rhoban's exported spherical manipulator, its balls
+    rounded off their sphere: 0.02 rad in 20 steps for 2 % of the residual), and where they stop depended on the
+    drawing; the floor's point nearest to the file's values does not. Directions that close the floor's gap only by
+    turning the joints far are left alone (a pseudo-inverse of all of them went far from the file's values or left
+    the floor); a slide that would leave the residual beyond the rounding keeps the damped steps' configuration.
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -478,8 +505,12 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             v, error, damping = v + change, candidate, max(damping * 0.1, 1e-12)
         else:
             damping *= 10.0
-    if nearest and np.linalg.norm(error) < INCONSISTENCY_TOLERANCE:  # on a floor: along it only, back from the creep
-        v, error = _nearest(residuals, derivatives, v, error, directions, np.linalg.norm(error) >= ASSEMBLY_TOLERANCE)
+    if nearest and np.linalg.norm(error) < ASSEMBLY_TOLERANCE:
+        v, error = _nearest(residuals, derivatives, v, error, directions)
+    elif nearest and np.max(np.abs(error)) < INCONSISTENCY_TOLERANCE:  # on a floor: along it only, back from the creep
+        slid, slid_error = _nearest(residuals, derivatives, v, error, directions, on_floor=True)
+        if np.max(np.abs(slid_error)) < INCONSISTENCY_TOLERANCE:
+            v, error = slid, slid_error
     q = configuration(v)
     if np.max(np.abs(error)) >= ASSEMBLY_TOLERANCE:
         gaps = closure_gaps(tree, q)
