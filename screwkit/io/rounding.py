@@ -42,7 +42,7 @@ from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
 from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
-__all__ = ["parallel_axes", "meeting_lines", "drawn_lines", "turned_joint", "EXACT"]
+__all__ = ["parallel_axes", "plane_normal", "meeting_lines", "drawn_lines", "turned_joint", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree, lines that pass within this of the length scale
@@ -82,6 +82,27 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
         result[members] = senses[:, None] * direction
         turn = max(turn, float(np.max(np.linalg.norm(np.cross(units[members], direction), axis=1))))
     return result, turn
+
+
+def plane_normal(revolutes, prismatics) -> NDArray[np.float64] | None:
+    """The normal of the plane a mechanism moves in: the common direction of its ``revolutes`` axes when its
+    ``prismatics`` are perpendicular to it, else None. Parallel to 1e-9, the first revolute's direction as written;
+    else, all parallel to the file's rounding (one group of :func:`parallel_axes`, slides perpendicular to
+    :data:`FILE_ROUNDING`), the direction they are written along. A CAD export's five-bar, its axes parallel to 3e-7
+    rad, read as a spatial mechanism otherwise: other task coordinates, and a home it could not reach."""
+    if not len(revolutes):
+        return None
+    revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))
+    normal = revolutes[0]
+    if (np.all(np.linalg.norm(np.cross(revolutes, normal), axis=1) <= 1e-9)
+            and np.all(np.abs(prismatics @ normal) <= 1e-9)):
+        return normal
+    turned, _ = parallel_axes(revolutes)
+    normal = turned[0]
+    if (np.all(np.linalg.norm(np.cross(turned, normal), axis=1) <= 1e-9)
+            and np.all(np.abs(prismatics @ normal) <= FILE_ROUNDING * np.linalg.norm(prismatics, axis=1))):
+        return normal
+    return None
 
 
 def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: float = FILE_ROUNDING

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import rotation_about_axis, rotation_with_z_along, rpy_from_rotation
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import (
     GRAPH_HINT,
     ClosedTree,
@@ -63,7 +64,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
-from screwkit.io.rounding import drawn_lines, turned_joint
+from screwkit.io.rounding import drawn_lines, plane_normal, turned_joint
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -121,11 +122,11 @@ def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, sca
     return np.array(rows).reshape(-1, 6)
 
 
-def _independent(rows: NDArray) -> bool:
+def _independent(rows: NDArray, tolerance: float = INDEPENDENCE_TOLERANCE) -> bool:
     if rows.shape[0] == 0:
         return True
     singular = np.linalg.svd(rows, compute_uv=False)
-    return rows.shape[0] <= 6 and singular[-1] > INDEPENDENCE_TOLERANCE * singular[0]
+    return rows.shape[0] <= 6 and singular[-1] > tolerance * singular[0]
 
 
 @dataclass
@@ -224,7 +225,9 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
 
 
 def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
-    """Lock passive joints, from the leg end backwards, while the leg's joint twists are dependent."""
+    """Lock passive joints, from the leg end backwards, while the leg's joint twists are dependent to the file's
+    rounding (a hinge coaxial with the revolute loop that closes it to 3e-7 rad, as its axes are written parallel
+    and through one point afterwards: kept, the leg had a fourth joint in its plane and its home no closure)."""
     model = tree.model
 
     def rows(kept):
@@ -237,13 +240,13 @@ def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]
 
     kept = list(leg.joints)
     for joint in reversed(leg.joints):
-        if _independent(rows(kept)):
+        if _independent(rows(kept), FILE_ROUNDING):
             break
         if joint in motors:
             continue
         trial = [j for j in kept if j != joint]
-        if np.linalg.matrix_rank(rows(trial), tol=INDEPENDENCE_TOLERANCE) == \
-                np.linalg.matrix_rank(rows(kept), tol=INDEPENDENCE_TOLERANCE):
+        rank = np.linalg.matrix_rank(rows(kept), tol=FILE_ROUNDING)
+        if np.linalg.matrix_rank(rows(trial), tol=FILE_ROUNDING) == rank:
             kept = trial
             leg.locked.append(joint)
     if not _independent(rows(kept)):
@@ -252,9 +255,10 @@ def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]
 
 
 def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
-    """The common direction of every revolute axis when slides are perpendicular to it, else None. Ball loops
-    (a ``connect``) do not count: in a mechanism whose other joints all move in one plane, only their rotation
-    about the plane's normal moves (:func:`_planar_loops` writes them so)."""
+    """The common direction of every revolute axis when slides are perpendicular to it, to the file's rounding
+    (:func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count: in a mechanism
+    whose other joints all move in one plane, only their rotation about the plane's normal moves
+    (:func:`_planar_loops` writes them so)."""
     model = tree.model
     axes = []
     for leg in legs:
@@ -263,16 +267,8 @@ def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
             axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
         if leg.loop != "spherical":
             axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
-    revolute = [axis for kind, axis in axes if kind == "revolute"]
-    if not revolute:
-        return None
-    normal = revolute[0]
-    for kind, axis in axes:
-        if kind == "revolute" and np.linalg.norm(np.cross(axis, normal)) > 1e-9:
-            return None
-        if kind == "prismatic" and abs(axis @ normal) > 1e-9:
-            return None
-    return normal
+    return plane_normal([axis for kind, axis in axes if kind == "revolute"],
+                        [axis for kind, axis in axes if kind == "prismatic"])
 
 
 def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
@@ -434,7 +430,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         _planar_loops(legs, normal)
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
-    meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < 1e-9 * scale for c in centres)
+    meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         _lock_idle(tree, data, leg, scale, set(motor_ids))
