@@ -29,9 +29,10 @@ from test_gallery import screwkit_residuals
 from test_lower_mobility import rpy_matrix
 
 from helpers import in_unit, screwkit
+from screwkit.cli import options
 from screwkit.closure.assembly import DOF_AT_ROUNDING, DOF_MARGIN
 from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io import read_closed_tree
+from screwkit.io import LegWithLoops, read_closed_tree
 from screwkit.io.closed_tree import ClosedTree, Closure, _lines_scale, assemble, closure_gaps, joint_kind
 from screwkit.io.compound import closed_samples
 from screwkit.io.graph import graph_mechanism
@@ -465,8 +466,10 @@ def test_a_dof_count_that_turns_on_the_file_s_rounding_is_said(tmp_path):
     assert as_json.returncode == 0 and json.loads(as_json.stdout)["assembly"] == [note]
     within = screwkit("analyze", paths["within"])
     assert within.returncode == 0 and DOF_AT_ROUNDING not in within.stderr
-    for name in bundled_names():
-        assert not [note for note in load(name).assembly_notes if note.startswith(DOF_AT_ROUNDING)], name
+    for name in bundled_names():  # read in metres and as if written in mm (a slide's twist is 1 / the length scale)
+        for unit in ("m", "mm"):
+            notes = load(name, length_unit=unit).assembly_notes
+            assert not [note for note in notes if note.startswith(DOF_AT_ROUNDING)], (name, unit)
     # the graph derivation reads a file as written (no axes made to meet): its count is said alike
     exact, rounded = (graph_mechanism(read_closed_tree(paths[label])) for label in ("exact", "within"))
     assert exact.dof == 3 and not [note for note in exact.report.notes if note.startswith(DOF_AT_ROUNDING)]
@@ -531,3 +534,71 @@ def test_on_a_floor_a_small_or_nearly_singular_loop_is_still_closed(small, crank
             ((small_ball.joint_a, small_ball.placement_a), (small_ball.joint_b, small_ball.placement_b))]
     assert np.linalg.norm(ends[0] - ends[1]) < 1e-6 * small  # its own rounding: 1e-7 of its size
     assert closure_gaps(tree, found)["big_ball"] < 1e-6 and any("at best" in note for note in tree.notes)
+
+
+def test_every_command_says_a_graph_s_dof_count_that_turns_on_the_rounding(tmp_path, monkeypatch, capsys):
+    """The commands' loader prints a graph mechanism's note as it prints a serial one's (before, only ``info`` and
+    ``analyze --json``'s import report carried it). The manipulator within the rounding is routed to the graph
+    derivation here (its serial reading, patched, says its legs have loops), which reads it as written."""
+    path = tmp_path / "robot.urdf"
+    path.write_text(spherical_manipulator_onshape(1e-7, 0))
+
+    def legs_with_loops(*args, **kwargs):
+        raise LegWithLoops(f"{path}: routed to the graph derivation by the test")
+
+    monkeypatch.setattr(options, "load", legs_with_loops)
+    graph = options.load_mechanism(str(path), None, graphs=True, indices=False)
+    assert graph.dof == 1
+    printed = capsys.readouterr().err
+    assert f"{path}: {DOF_AT_ROUNDING}1 DOF" in printed and "may have up to 3 DOF" in printed, printed
+
+
+def tilted_four_bar(opened: float, tilt: float, along=(0.0, 0.0, 0.0)) -> ClosedTree:
+    """A 0.5 m planar four-bar (crank 0.2, coupler 0.5, rocker 0.45, ground 0.5) whose rocker axis is tilted by
+    ``tilt`` about the rocker's line at the crank angle 1.2: written so, it closes only there, at q = 0. The file's
+    joint values are its planar solution ``opened`` rad of crank further, where only an out-of-plane gap of about
+    tilt x rocker x opened is open; ``along``: the three joint frames drawn that far along their axes."""
+    a, b, c, d = 0.2, 0.5, 0.45, 0.5
+
+    def planar(crank):
+        elbow = a * np.array([np.cos(crank), np.sin(crank), 0.0])
+        to_rocker = np.array([d, 0.0, 0.0]) - elbow
+        length = np.linalg.norm(to_rocker)
+        unit, normal = to_rocker / length, np.array([-to_rocker[1], to_rocker[0], 0.0]) / length
+        foot = (b**2 - c**2 + length**2) / (2 * length)
+        return elbow, elbow + foot * unit + np.sqrt(b**2 - foot**2) * normal
+
+    def angle(vector):
+        return float(np.arctan2(vector[1], vector[0]))
+
+    ground, rocker_at, z = np.zeros(3), np.array([d, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    (elbow, point), (elbow_file, point_file) = planar(1.2), planar(1.2 + opened)
+    line = (point - rocker_at) / np.linalg.norm(point - rocker_at)
+    axis = np.cos(tilt) * z + np.sin(tilt) * np.cross(line, z)
+    at_ground, at_elbow = pin.SE3(np.eye(3), ground + along[0] * z), pin.SE3(np.eye(3), elbow + along[1] * z)
+    at_rocker = pin.SE3(pin.Quaternion.FromTwoVectors(z, axis).matrix(), rocker_at + along[2] * axis)
+    model = pin.Model()
+    crank = model.addJoint(0, pin.JointModelRZ(), at_ground, "crank")
+    coupler = model.addJoint(crank, pin.JointModelRZ(), at_ground.inverse() * at_elbow, "coupler")
+    rocker = model.addJoint(0, pin.JointModelRZ(), at_rocker, "rocker")
+    for joint in (crank, coupler, rocker):
+        model.appendBodyToJoint(joint, pin.Inertia.Random(), pin.SE3.Identity())
+    ball = pin.SE3(np.eye(3), point)
+    closure = Closure("ball", coupler, (at_elbow.inverse() * ball).homogeneous, rocker,
+                      (at_rocker.inverse() * ball).homogeneous, "3d")
+    values = [opened, (angle(point_file - elbow_file) - angle(elbow_file)) - (angle(point - elbow) - angle(elbow)),
+              angle(point_file - rocker_at) - angle(point - rocker_at)]
+    return ClosedTree("tilted", model, [closure], ["crank"], np.array(values))
+
+
+@pytest.mark.parametrize("opened", [0.003, 0.02, 0.05])
+def test_a_weak_closing_direction_within_the_floor_s_reach_is_closed_however_drawn(opened):
+    """The four-bar's tilted rocker (1e-5 rad) closes it only at q = 0, 0.003-0.05 rad of crank from the file's
+    values: closing that takes less than FLOOR_MOVE, so the assembly closes it there exactly, drawn as written or
+    with its frames 0.1-0.2 m along their axes. A full step that way bent the stiff loop open, and the assembly
+    stayed where the damped steps had crept (3e-4 to 2e-3 rad off, drawings that far apart)."""
+    for along in ((0.0, 0.0, 0.0), (0.1, -0.2, 0.15), (-0.15, 0.2, -0.1)):
+        tree = tilted_four_bar(opened, 1e-5, along)
+        q, _ = assemble(tree)
+        np.testing.assert_allclose(q, 0.0, atol=1e-9, err_msg=f"drawn {along}")
+        assert closure_gaps(tree, q)["ball"] < 1e-12

@@ -191,9 +191,10 @@ def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
 
 
 def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, list[tuple[str, NDArray]]]:
-    """:func:`mobility`, and the singular values it counted (relative to the largest, the stacked complements' being
-    orthonormal rows) of each chain's twists (named by the chain) and of the chains' stacked complements (named
-    "")."""
+    """:func:`mobility`, and the singular values it counted of each chain's twists (named by the chain; each twist
+    scaled to unit norm, relative to the largest: a slide's twist is otherwise one over the length scale, and a
+    chain of slides and hinges drawn small would read as nearly dependent) and of the chains' stacked complements
+    (named ""; orthonormal rows)."""
     rows = task_rows(mechanism.is_planar)
     frames = [chain_forward_kinematics(chain.geometry, chain.reference_values) for chain in chains]
     centre = np.mean([f.points[-1] for f in frames], axis=0)
@@ -205,7 +206,8 @@ def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, lis
         largest = max(1.0, singular[0] if singular.size else 1.0)
         rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * largest))
         complements.append(left[:, rank:].T)
-        smallest.append((chain.name, singular[:rank] / largest))
+        units = np.linalg.svd(twists / np.maximum(np.linalg.norm(twists, axis=0), 1e-300), compute_uv=False)
+        smallest.append((chain.name, units[:rank] / max(units[0] if units.size else 1.0, 1e-300)))
     stacked = np.concatenate(complements, axis=0)
     if stacked.size == 0:
         return len(rows), smallest
