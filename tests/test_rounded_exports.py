@@ -87,3 +87,18 @@ def test_gepetto_s_five_bar_written_to_six_decimals_reads_as_published(tmp_path)
     run = screwkit("analyze", path)
     assert run.returncode == 0, run.stderr
     assert "2 DOF" in run.stdout and "at x = " in run.stdout
+
+
+def test_a_joint_at_its_stop_beyond_it_by_the_rounding_is_read(tmp_path):
+    """The CAD Stewart platform's rod joints are limited to [0, 2 pi] and sit at 0. Written to 7 decimals (its
+    upper limit 6.2831853, its assembly putting one rod joint 3e-9 rad below 0) it was refused as outside its
+    limits; it reads as the exact file does (home within 1e-7, LMTI within 1e-6), and the report says which limits
+    moved and to where."""
+    source = Path(__file__).resolve().parent / "data" / "gallery" / "stewart_cad.xml"
+    exact = load(source)
+    path = rounded_copy(tmp_path, source, 7)
+    rounded = load(path)
+    assert rounded.dof == exact.dof == 6
+    np.testing.assert_allclose(rounded.home_pose, exact.home_pose, atol=1e-7)
+    assert abs(indices_at_pose(rounded, rounded.home_pose).lmti - indices_at_pose(exact, exact.home_pose).lmti) < 1e-6
+    assert any("limits moved out to" in note for note in rounded.import_report), rounded.import_report

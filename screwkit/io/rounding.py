@@ -42,7 +42,7 @@ from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
 from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
-__all__ = ["parallel_axes", "plane_normal", "meeting_lines", "drawn_lines", "turned_joint", "EXACT"]
+__all__ = ["parallel_axes", "plane_normal", "meeting_lines", "drawn_lines", "turned_joint", "held_limits", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree, lines that pass within this of the length scale
@@ -274,3 +274,19 @@ def turned_joint(placement: NDArray, kind: str, axis: NDArray, turned: NDArray |
     else:
         kept[:3, 3] += kept[:3, :3] @ ((written - direction) * value)
     return kept, turned
+
+
+def held_limits(model, joint: int, value: float, kind: str, scale: float, report) -> tuple[float, float]:
+    """The limits of a 1-DoF ``joint`` as written, or moved out to its assembled ``value`` where that value misses
+    them by at most the file's rounding (:data:`FILE_ROUNDING` rad, or times the length ``scale`` for a slide), said
+    in the import ``report``. A CAD export writes a full turn as [0, 6.28318] and a joint drawn at its stop 1e-9 to
+    3e-7 beyond it: read as written, the file's own configuration was refused as outside its limits."""
+    index = model.joints[joint].idx_q
+    lower, upper = float(model.lowerPositionLimit[index]), float(model.upperPositionLimit[index])
+    reach = FILE_ROUNDING * (scale if kind == "prismatic" else 1.0)
+    moved = lower - reach <= value < lower or upper < value <= upper + reach
+    if moved and np.isfinite(lower) and np.isfinite(upper) and lower < upper:  # (no range: a continuous joint)
+        lower, upper = min(lower, value), max(upper, value)
+        report.notes.append(f"joint {model.names[joint]!r}: its limits moved out to {value:.6g}, where the assembly "
+                            "puts it, beyond them by less than the file's rounding")
+    return lower, upper

@@ -64,7 +64,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
-from screwkit.io.rounding import drawn_lines, plane_normal, turned_joint
+from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -498,8 +498,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             else:
                 kind, axis = joint_kind(model, joint)
                 placement, axis = turned_joint(placement, kind, axis, axes.get(joint), joint_value(model, joint, q))
-                lower = model.lowerPositionLimit[model.joints[joint].idx_q]
-                upper = model.upperPositionLimit[model.joints[joint].idx_q]
+                lower, upper = held_limits(model, joint, joint_value(model, joint, q), kind, scale, report)
                 limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
                     and model.joints[joint].nq == 1 else None
                 joint_type = kind
