@@ -230,8 +230,9 @@ def mobility_notes(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int
             continue
         if name:
             notes.append(f"{DOF_AT_ROUNDING}chain {name!r}: its joint screws are independent only to "
-                         f"{small.min():.2g} (relative), the order of a file's rounding; written exactly, it may have "
-                         f"up to {small.size} freedom(s) fewer")
+                         f"{small.min():.2g} (relative), the order of a file's rounding (or the reference assembly is "
+                         f"that near a singularity of the chain); written exactly, it may have up to {small.size} "
+                         "freedom(s) fewer")
         else:
             notes.append(rounded_dof_note(dof, small, "chains"))
     return dof, notes
@@ -241,8 +242,9 @@ def rounded_dof_note(dof: int, small: NDArray, legs: str) -> str:
     """The :data:`DOF_AT_ROUNDING` note of a platform whose ``legs``' constraints are independent of each other only
     to the singular values ``small`` (each at most :data:`DOF_MARGIN`)."""
     return (f"{DOF_AT_ROUNDING}{dof} DOF, with the {legs}' constraints independent of each other only to "
-            f"{np.min(small):.2g} (relative), the order of a file's rounding; written exactly (axes meant to meet or "
-            f"to be parallel written so), the platform may have up to {dof + len(small)} DOF")
+            f"{np.min(small):.2g} (relative), the order of a file's rounding (or the reference assembly is that near "
+            f"a constraint singularity); written exactly (axes meant to meet or to be parallel written so), the "
+            f"platform may have up to {dof + len(small)} DOF")
 
 
 def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
