@@ -29,14 +29,10 @@ from test_gallery import screwkit_residuals
 from test_lower_mobility import rpy_matrix
 
 from helpers import in_unit, screwkit
-from screwkit.cli import options
-from screwkit.closure.assembly import DOF_AT_ROUNDING, DOF_MARGIN
-from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io import LegWithLoops, read_closed_tree
+from screwkit.io import read_closed_tree
 from screwkit.io.closed_tree import ClosedTree, Closure, _lines_scale, assemble, closure_gaps, joint_kind
 from screwkit.io.compound import closed_samples
-from screwkit.io.graph import graph_mechanism
-from screwkit.io.loader import bundled_names, load
+from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
 GEPETTO = Path(__file__).resolve().parent / "data" / "gallery" / "published" / "example_parallel_robots"
@@ -442,41 +438,6 @@ def test_analyze_reads_a_manipulator_closed_to_rounding_the_same_however_drawn_o
         assert other["lmti"] == pytest.approx(first["lmti"], abs=1e-9), label
 
 
-def test_a_dof_count_that_turns_on_the_file_s_rounding_is_said(tmp_path):
-    """The manipulator's axes off its centre by 3e-7 m at random (up to 1.3e-5 of its size, beyond the rounding that
-    reading idealises): its constraints are independent only to 1e-5, so it reads 2 DOF where the same manipulator
-    written exactly (checked here) has 3. ``screwkit analyze`` says so in one line and in its JSON; the manipulator
-    within the rounding, and every bundled mechanism, has no such note. The graph derivation, which reads the file
-    as written, reads 1 DOF of the manipulator within the rounding, and says so; of the exact one, 3 and nothing."""
-    paths = {}
-    for label, rounding, seed in (("exact", 0.0, 2), ("within", 1e-7, 0), ("beyond", 3e-7, 2)):
-        paths[label] = tmp_path / label / "robot.urdf"
-        paths[label].parent.mkdir()
-        paths[label].write_text(spherical_manipulator_onshape(rounding, seed))
-    assert load(paths["exact"]).dof == load(paths["within"]).dof == 3
-    beyond = load(paths["beyond"])
-    assert beyond.dof == 2
-    [note] = [note for note in beyond.assembly_notes if note.startswith(DOF_AT_ROUNDING)]
-    assert "2 DOF" in note and "may have up to 3 DOF" in note
-    value = float(re.search(r"only to ([0-9.e+-]+) \(relative\)", note).group(1))
-    assert FILE_ROUNDING / 10 < value < DOF_MARGIN
-    run = screwkit("analyze", paths["beyond"])
-    assert run.returncode == 0 and f"{paths['beyond']}: {DOF_AT_ROUNDING}2 DOF" in run.stderr, run.stderr
-    as_json = screwkit("analyze", paths["beyond"], "--json")
-    assert as_json.returncode == 0 and json.loads(as_json.stdout)["assembly"] == [note]
-    within = screwkit("analyze", paths["within"])
-    assert within.returncode == 0 and DOF_AT_ROUNDING not in within.stderr
-    for name in bundled_names():  # read in metres and as if written in mm (a slide's twist is 1 / the length scale)
-        for unit in ("m", "mm"):
-            notes = load(name, length_unit=unit).assembly_notes
-            assert not [note for note in notes if note.startswith(DOF_AT_ROUNDING)], (name, unit)
-    # the graph derivation reads a file as written (no axes made to meet): its count is said alike
-    exact, rounded = (graph_mechanism(read_closed_tree(paths[label])) for label in ("exact", "within"))
-    assert exact.dof == 3 and not [note for note in exact.report.notes if note.startswith(DOF_AT_ROUNDING)]
-    [note] = [note for note in rounded.report.notes if note.startswith(DOF_AT_ROUNDING)]
-    assert rounded.dof == 1 and "may have up to 3 DOF" in note, note
-
-
 def rounded_four_bar(model, closures, tag: str, origin, size: float, rng, rounding: float, crank: float = 1.2,
                      sides=(0.4, 1.0, 0.9, 1.0)) -> int:
     """A planar four-bar (crank a, coupler b, rocker c, ground d, times ``size``) added to ``model`` at ``origin``,
@@ -534,23 +495,6 @@ def test_on_a_floor_a_small_or_nearly_singular_loop_is_still_closed(small, crank
             ((small_ball.joint_a, small_ball.placement_a), (small_ball.joint_b, small_ball.placement_b))]
     assert np.linalg.norm(ends[0] - ends[1]) < 1e-6 * small  # its own rounding: 1e-7 of its size
     assert closure_gaps(tree, found)["big_ball"] < 1e-6 and any("at best" in note for note in tree.notes)
-
-
-def test_every_command_says_a_graph_s_dof_count_that_turns_on_the_rounding(tmp_path, monkeypatch, capsys):
-    """The commands' loader prints a graph mechanism's note as it prints a serial one's (before, only ``info`` and
-    ``analyze --json``'s import report carried it). The manipulator within the rounding is routed to the graph
-    derivation here (its serial reading, patched, says its legs have loops), which reads it as written."""
-    path = tmp_path / "robot.urdf"
-    path.write_text(spherical_manipulator_onshape(1e-7, 0))
-
-    def legs_with_loops(*args, **kwargs):
-        raise LegWithLoops(f"{path}: routed to the graph derivation by the test")
-
-    monkeypatch.setattr(options, "load", legs_with_loops)
-    graph = options.load_mechanism(str(path), None, graphs=True, indices=False)
-    assert graph.dof == 1
-    printed = capsys.readouterr().err
-    assert f"{path}: {DOF_AT_ROUNDING}1 DOF" in printed and "may have up to 3 DOF" in printed, printed
 
 
 def tilted_four_bar(opened: float, tilt: float, along=(0.0, 0.0, 0.0)) -> ClosedTree:
