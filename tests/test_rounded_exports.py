@@ -29,6 +29,7 @@ from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io import LegWithLoops, read_closed_tree, read_mechanism_file
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import bundled_names, load
+from screwkit.io.rounding import FULL_TURNS
 from screwkit.studies.poses import indices_at_pose, indices_at_poses
 
 GEPETTO_FIVE_BAR = (Path(__file__).resolve().parent / "data" / "gallery" / "published" / "example_parallel_robots"
@@ -97,20 +98,26 @@ def test_gepetto_s_five_bar_written_to_six_decimals_reads_as_published(tmp_path)
     assert "2 DOF" in run.stdout and "at x = " in run.stdout
 
 
-def test_a_joint_at_its_stop_beyond_it_by_the_rounding_is_read(tmp_path):
-    """The CAD Stewart platform's rod joints are limited to [0, 2 pi] and sit at 0. Written to 7 decimals (its
-    upper limit 6.2831853, its assembly putting one rod joint 3e-9 rad below 0) it was refused as outside its
-    limits; it reads as the exact file does (home within 1e-7, LMTI within 1e-6), and the report says which limits
-    moved and to where."""
+def test_a_full_turn_or_a_stop_missed_by_the_rounding_is_read(tmp_path):
+    """The CAD Stewart platform's rod joints are limited to [0, 6.283185] (a full turn to 3e-7 rad) and sit at 0;
+    written to 7 decimals, its assembly puts one 3e-9 rad below 0. That was refused as outside its limits. Now the
+    full turns read as continuous joints, and the file reads as the exact one does (home within 1e-7, LMTI within
+    1e-6). With the rods limited to [0, 3] instead, the limit that the assembly misses by 3e-9 is moved out to the
+    joint's value, and the report says which and to where."""
     source = Path(__file__).resolve().parent / "data" / "gallery" / "stewart_cad.xml"
     exact = load(source)
+    assert any(FULL_TURNS in note and "r_rod6" in note for note in exact.import_report)
     path = rounded_copy(tmp_path, source, 7)
     rounded = load(path)
     assert rounded.dof == exact.dof == 6
     np.testing.assert_allclose(rounded.home_pose, exact.home_pose, atol=1e-7)
     assert abs(indices_at_pose(rounded, rounded.home_pose).lmti - indices_at_pose(exact, exact.home_pose).lmti) < 1e-6
-    assert any("limits moved out to" in note for note in rounded.import_report), rounded.import_report
-
+    half = path.with_name("half_turn.xml")
+    half.write_text(path.read_text().replace('range="0 6.283185"', 'range="0 3.0"'))
+    stopped = load(half)
+    assert any("limits moved out to" in note for note in stopped.import_report), stopped.import_report
+    assert not any(FULL_TURNS in note for note in stopped.import_report)
+    np.testing.assert_allclose(stopped.home_pose, rounded.home_pose, atol=1e-12)
 
 GALLERY = Path(__file__).resolve().parent / "data"
 ROUNDED_FILES = ["gallery/published/example_parallel_robots/5bar_linkage/robot.urdf",

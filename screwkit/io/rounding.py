@@ -276,13 +276,25 @@ def turned_joint(placement: NDArray, kind: str, axis: NDArray, turned: NDArray |
     return kept, turned
 
 
+FULL_TURNS = "revolutes whose limits span a full turn to the file's rounding, read as continuous joints: "
+"""How the import report's note on :func:`held_limits`' full turns starts (the joints' names follow)."""
+
+
 def held_limits(model, joint: int, value: float, kind: str, scale: float, report) -> tuple[float, float]:
     """The limits of a 1-DoF ``joint`` as written, or moved out to its assembled ``value`` where that value misses
     them by at most the file's rounding (:data:`FILE_ROUNDING` rad, or times the length ``scale`` for a slide), said
-    in the import ``report``. A CAD export writes a full turn as [0, 6.28318] and a joint drawn at its stop 1e-9 to
-    3e-7 beyond it: read as written, the file's own configuration was refused as outside its limits."""
+    in the import ``report``; a revolute whose limits span a full turn to the rounding ([0, 6.283185], [-3.14159,
+    3.14159]) unlimited (-inf, inf): a continuous joint. A CAD export writes a joint drawn at its stop 1e-9 to 3e-7
+    beyond it: read as written, the file's own configuration was refused as outside its limits."""
     index = model.joints[joint].idx_q
     lower, upper = float(model.lowerPositionLimit[index]), float(model.upperPositionLimit[index])
+    if kind == "revolute" and upper - lower >= 2.0 * np.pi - FILE_ROUNDING and np.isfinite(upper - lower):
+        named = [k for k, note in enumerate(report.notes) if note.startswith(FULL_TURNS)]
+        if named:
+            report.notes[named[0]] += f", {model.names[joint]}"
+        else:
+            report.notes.append(f"{FULL_TURNS}{model.names[joint]}")
+        return -np.inf, np.inf  # (a sliver of 3e-7 rad left out of [0, 6.283185] reads as a limit otherwise)
     reach = FILE_ROUNDING * (scale if kind == "prismatic" else 1.0)
     moved = lower - reach <= value < lower or upper < value <= upper + reach
     if moved and np.isfinite(lower) and np.isfinite(upper) and lower < upper:  # (no range: a continuous joint)
