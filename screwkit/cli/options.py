@@ -410,18 +410,16 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
                                                      length_unit=length_unit))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
-        context = click.get_current_context(silent=True)
         rounded = [note for note in graph.report.notes if note.startswith(DOF_AT_ROUNDING)]
-        if rounded and not (context and context.params.get("quiet")):  # as a serial mechanism's, on every command
+        if rounded and not _quiet():  # as a serial mechanism's, on every command
             echo_error(f"{name}: " + "; ".join(rounded))
         return graph
-    context = click.get_current_context(silent=True)
     opened = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]
     ignored = [note for note in mechanism.assembly_notes if note.startswith(NOT_OPEN_LOOPS)]
-    if opened and not (context and context.params.get("quiet")):
+    if opened and not _quiet():
         # a file whose loops are open as written describes another mechanism than the one analysed: say so
         echo_error(f"{name}: loops open at the file's own joint values were closed at loading: " + "; ".join(opened))
-    if ignored and not (context and context.params.get("quiet")):
+    if ignored and not _quiet():
         echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         from screwkit.studies.kernels import mechanism_kernels  # the closures and indices: commands computing them

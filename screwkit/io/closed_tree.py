@@ -362,6 +362,15 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
         """What of ``residual`` the steps close: all of it, or on a floor its part in the Jacobian's range."""
         return float(np.linalg.norm(jacobian @ (inverse_ @ residual) if on_floor else residual))
 
+    def chords(candidate, closed, jacobian, inverse_, bound: float, steps: int = 8) -> tuple[NDArray, NDArray]:
+        """``candidate`` closed again by up to ``steps`` chord steps along ``jacobian``, until ``bound`` is met."""
+        for _ in range(steps):
+            if closable(jacobian, inverse_, closed) <= bound:
+                break
+            candidate = candidate - (inverse_ @ closed) @ directions
+            closed = residuals(candidate)
+        return candidate, closed
+
     for _ in range(10):  # closed first to round-off (the damped steps stop at ASSEMBLY_TOLERANCE), so that a nearer
         if not on_floor and np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file
             break  # closed as written is left as written, to the bit (a rounded one's reading can turn on last bits)
@@ -370,12 +379,8 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
         if closable(jacobian, inverse_, error) <= 1e-14:
             break
         candidate = v - (inverse_ @ error) @ directions
-        closed = residuals(candidate)
-        for _ in range(8 if on_floor else 0):  # chord steps: a weak direction's full step can bend a stiff loop open
-            if closable(jacobian, inverse_, closed) <= 1e-14:
-                break
-            candidate = candidate - (inverse_ @ closed) @ directions
-            closed = residuals(candidate)
+        candidate, closed = chords(candidate, residuals(candidate), jacobian, inverse_, 1e-14,
+                                   8 if on_floor else 0)  # a weak direction's full step can bend a stiff loop open
         if not closable(jacobian, inverse_, closed) < closable(jacobian, inverse_, error):
             break
         v, error = candidate, closed
@@ -386,11 +391,7 @@ def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDA
     def close_again(candidate, closed, jacobian, inverse_) -> tuple[NDArray, NDArray, bool]:
         """``candidate`` closed again by chord steps on the Jacobian it was found with, then on a floor judged (and
         closed) on its own Jacobian (the range that closes turns with the configuration); and whether it is closed."""
-        for _ in range(8):
-            if closable(jacobian, inverse_, closed) <= floor:
-                break
-            candidate = candidate - (inverse_ @ closed) @ directions
-            closed = residuals(candidate)
+        candidate, closed = chords(candidate, closed, jacobian, inverse_, floor)
         if not on_floor:
             return candidate, closed, closable(jacobian, inverse_, closed) <= floor
         for _ in range(4):

@@ -492,7 +492,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     counted = []
     motion = _motion_space(screws, counted=counted)
-    small = np.array(counted)[np.array(counted) <= DOF_MARGIN]
+    counted = np.array(counted)
+    small = counted[counted <= DOF_MARGIN]
     if small.size:  # as closure.assembly.mobility_notes says it of serial legs
         report.notes.append(rounded_dof_note(len(motion), small, "legs"))
     task_axes = _task_axes(tree, state, frame_id, motion)

@@ -93,16 +93,14 @@ def plane_normal(revolutes, prismatics) -> NDArray[np.float64] | None:
     if not len(revolutes):
         return None
     revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))
-    normal = revolutes[0]
-    if (np.all(np.linalg.norm(np.cross(revolutes, normal), axis=1) <= 1e-9)
-            and np.all(np.abs(prismatics @ normal) <= 1e-9)):
-        return normal
-    turned, _ = parallel_axes(revolutes)
-    normal = turned[0]
-    if (np.all(np.linalg.norm(np.cross(turned, normal), axis=1) <= 1e-9)
-            and np.all(np.abs(prismatics @ normal) <= FILE_ROUNDING * np.linalg.norm(prismatics, axis=1))):
-        return normal
-    return None
+
+    def normal_of(axes, slides: float) -> NDArray | None:  # the first axis, if every one is parallel to it
+        parallel = np.all(np.linalg.norm(np.cross(axes, axes[0]), axis=1) <= 1e-9)
+        return axes[0] if parallel and np.all(np.abs(prismatics @ axes[0]) <= slides) else None
+
+    exact = normal_of(revolutes, 1e-9)
+    return exact if exact is not None else normal_of(parallel_axes(revolutes)[0],
+                                                     FILE_ROUNDING * np.linalg.norm(prismatics, axis=1))
 
 
 def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: float = FILE_ROUNDING

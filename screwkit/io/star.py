@@ -497,8 +497,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 report.locked.append(model.names[joint])
             else:
                 kind, axis = joint_kind(model, joint)
-                placement, axis = turned_joint(placement, kind, axis, axes.get(joint), joint_value(model, joint, q))
-                lower, upper = held_limits(model, joint, joint_value(model, joint, q), kind, scale, report)
+                value = joint_value(model, joint, q)
+                placement, axis = turned_joint(placement, kind, axis, axes.get(joint), value)
+                lower, upper = held_limits(model, joint, value, kind, scale, report)
                 limit = (lower, upper, 0, 0) if np.isfinite(lower) and np.isfinite(upper) and lower < upper \
                     and model.joints[joint].nq == 1 else None
                 joint_type = kind
@@ -508,7 +509,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 writer.link(link)
                 writer.joint(model.names[joint], joint_type, parent, link, axis=tuple(axis), limit=limit,
                              **_origin(placement))
-                reference[model.names[joint]] = joint_value(model, joint, q)
+                reference[model.names[joint]] = value
             parent, end = link, link
         name = model.names[leg.joints[0]]
         successor = inverse(platform_world) @ leg.successor_world
