@@ -271,15 +271,16 @@ def test_the_length_scale_of_a_planar_mechanism_does_not_follow_the_rounding_of_
 
 
 def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.03, along=None,
-                          unit: float = 1.0) -> ClosedTree:
+                          unit: float = 1.0, world=None) -> ClosedTree:
     """A 3-RRR spherical parallel manipulator about the origin (motor axes u_i 55 degrees off the downward vertical,
     platform axes w_i, middle axes v_i = u_i x w_i), read as an onshape-to-robot URDF of it is: leg 2 reaches the
     platform, legs 1 and 3 end on balls on their platform axes, 3 cm from the centre. Every axis is drawn through a
     point ``r`` along it moved off the centre by about ``rounding`` (m), and each ball's two frames apart by as much,
     as a CAD export rounds them. ``along``: each joint's frame drawn that much further along its axis (seven lengths,
     the motor and middle joint of each leg, then the platform's: the same lines, the same mechanism); everything
-    written in units of 1 / ``unit`` m."""
+    written in units of 1 / ``unit`` m, and placed by ``world`` (a pin.SE3, default the identity)."""
     shifts = iter(np.zeros(7) if along is None else along)
+    world = pin.SE3.Identity() if world is None else world
     beta = np.radians(55.0)
     turns = np.radians([0.0, 120.0, 240.0])
     u = [np.array([np.sin(beta) * np.cos(a), np.sin(beta) * np.sin(a), -np.cos(beta)]) for a in turns]
@@ -289,16 +290,16 @@ def spherical_manipulator(rounding: float, rng, r: float = 0.05, rho: float = 0.
 
     def joint(parent, parent_world, axis, name):
         turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-        world = pin.SE3(turn, unit * ((r + next(shifts)) * axis + rounding * rng.normal(size=3)))
-        index = model.addJoint(parent, pin.JointModelRZ(), parent_world.inverse() * world, name)
+        placed = world * pin.SE3(turn, unit * ((r + next(shifts)) * axis + rounding * rng.normal(size=3)))
+        index = model.addJoint(parent, pin.JointModelRZ(), parent_world.inverse() * placed, name)
         model.appendBodyToJoint(index, pin.Inertia.Random(), pin.SE3.Identity())
-        return index, world
+        return index, placed
 
     legs = [joint(*joint(0, pin.SE3.Identity(), u[i], f"motor{i + 1}"), v[i], f"middle{i + 1}") for i in range(3)]
     platform, platform_world = joint(*legs[1], w[1], "platform2")
     closures = []
     for i in (0, 2):
-        near, far = (pin.SE3(np.eye(3), unit * (rho * w[i] + rounding * rng.normal(size=3))) for _ in range(2))
+        near, far = (world * pin.SE3(np.eye(3), unit * (rho * w[i] + rounding * rng.normal(size=3))) for _ in range(2))
         closures.append(Closure(f"ball{i + 1}", legs[i][0], (legs[i][1].inverse() * near).homogeneous, platform,
                                 (platform_world.inverse() * far).homogeneous, "3d"))
     return ClosedTree("spm", model, closures, ["motor1", "motor2", "motor3"], pin.neutral(model))
@@ -321,11 +322,16 @@ def test_closures_that_close_only_to_the_file_s_rounding_stay_within_its_order_o
     assert any("at best" in note for note in tree.notes), tree.notes
 
 
+TURNED_WORLD = pin.SE3(pin.rpy.rpyToMatrix(0.7, -1.1, 2.3), np.array([0.4, -1.3, 2.1]))
+"""A world frame the rounded manipulator is placed in, turned and moved."""
+
+
 @pytest.mark.parametrize("seed", [0, 2, 4, 5])
 def test_closures_closed_to_rounding_assemble_the_same_however_drawn_listed_or_scaled(seed):
     """The same rounded manipulator with its joint frames drawn up to 2 cm along their axes, its closures listed in
-    the other order, or written in millimetres: the same joint values (1e-9 rad; they are the same joints about the
-    same lines). Where the damped steps stopped on the floor depended on all of these (1e-3 rad apart)."""
+    the other order, written in millimetres or in kilometres, or turned and moved in the world: the same joint
+    values (1e-9 rad; they are the same joints about the same lines). Where the damped steps stopped on the floor
+    depended on these (1e-3 rad apart)."""
     rounding = 1e-7 if seed == 0 else 3e-7  # seeds 4 and 5: the first step undoes the whole creep (4e-3 rad)
     reference, _ = assemble(spherical_manipulator(rounding, np.random.default_rng(seed)))
     for draw in range(3):
@@ -335,8 +341,11 @@ def test_closures_closed_to_rounding_assemble_the_same_however_drawn_listed_or_s
     listed = spherical_manipulator(rounding, np.random.default_rng(seed))
     listed.closures.reverse()
     np.testing.assert_allclose(assemble(listed)[0], reference, atol=1e-9, err_msg="closures in the other order")
-    in_mm = spherical_manipulator(rounding, np.random.default_rng(seed), unit=1000.0)
-    np.testing.assert_allclose(assemble(in_mm)[0], reference, atol=1e-9, err_msg="in millimetres")
+    for unit in (1e3, 1e-3):  # written in mm, and in km
+        scaled = spherical_manipulator(rounding, np.random.default_rng(seed), unit=unit)
+        np.testing.assert_allclose(assemble(scaled)[0], reference, atol=1e-9, err_msg=f"lengths x {unit}")
+    turned = spherical_manipulator(rounding, np.random.default_rng(seed), world=TURNED_WORLD)
+    np.testing.assert_allclose(assemble(turned)[0], reference, atol=1e-9, err_msg="in a turned and moved world")
 
 
 @pytest.mark.parametrize("name", OPEN_FILES)
@@ -377,11 +386,12 @@ def test_a_file_that_does_not_close_assembles_the_same_with_its_joints_renamed_a
     np.testing.assert_allclose(there.lmti, here.lmti, rtol=0, atol=1e-7)
 
 
-def spherical_manipulator_onshape(rounding: float, seed: int, unit: float = 1.0) -> str:
+def spherical_manipulator_onshape(rounding: float, seed: int, unit: float = 1.0, world=None) -> str:
     """:func:`spherical_manipulator` as onshape-to-robot writes it: a URDF of its seven joints (each link's frame its
     joint's, z along the axis), its two balls as ``closing_ball<i>_1`` / ``_2`` frame pairs and an ``effector`` frame
-    at the centre, in units of 1 / ``unit`` m."""
-    tree = spherical_manipulator(rounding, np.random.default_rng(seed), unit=unit)
+    at the centre, in units of 1 / ``unit`` m, placed by ``world`` (a pin.SE3)."""
+    world = pin.SE3.Identity() if world is None else world
+    tree = spherical_manipulator(rounding, np.random.default_rng(seed), unit=unit, world=world)
     model, data = tree.model, tree.model.createData()
     pin.forwardKinematics(model, data, tree.q_reference)
 
@@ -402,7 +412,7 @@ def spherical_manipulator_onshape(rounding: float, seed: int, unit: float = 1.0)
     frames = [(f"closing_{c.name}_{k + 1}", joint, pin.SE3(placement)) for c in tree.closures
               for k, (joint, placement) in enumerate(((c.joint_a, c.placement_a), (c.joint_b, c.placement_b)))]
     platform = model.getJointId("platform2")
-    frames.append(("effector", platform, data.oMi[platform].inverse() * pin.SE3.Identity()))
+    frames.append(("effector", platform, data.oMi[platform].inverse() * world))
     for name, joint, placement in frames:
         out += [link(name), f'<joint name="{name}_frame" type="fixed">{origin(placement)}<parent '
                 f'link="{model.names[joint]}_link"/><child link="{name}"/></joint>']

@@ -16,6 +16,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from test_assembly_nearest import spherical_manipulator_onshape
 from test_io import poses_near_home
@@ -193,3 +194,36 @@ def test_every_command_says_a_graph_s_dof_count_that_turns_on_the_rounding(tmp_p
     printed = capsys.readouterr().err
     assert f"{path}: {DOF_AT_ROUNDING}1 DOF" in printed and "may have up to 3 DOF" in printed, printed
 
+
+
+def relabelled_urdf(text: str) -> str:
+    """The URDF with its links and joints listed in reverse order (so Pinocchio's tree, the chains and the actuators
+    come in another order) and its motors renamed."""
+    lines = text.splitlines()
+    head, body, tail = lines[:2], lines[2:-1], lines[-1:]  # <robot>, the base link; </robot>
+    return re.sub(r"\bmotor(\d)\b", r"drive_\1", "\n".join(head + body[::-1] + tail)) + "\n"
+
+
+def test_the_dof_note_is_the_same_in_any_unit_world_or_order(tmp_path):
+    """The manipulator beyond the rounding, written with its lengths x 1e-3 and x 1e3, turned and moved in the world,
+    or with its legs listed in reverse and its motors renamed: the same 2 DOF and the same note, word for word (its
+    singular value is of unit twists and orthonormal complements, which no unit, frame or order changes)."""
+    turned = pin.SE3(pin.rpy.rpyToMatrix(0.7, -1.1, 2.3), np.array([0.4, -1.3, 2.1]))
+    texts = {"as written": spherical_manipulator_onshape(3e-7, 2),
+             "x 1e-3": spherical_manipulator_onshape(3e-7, 2, unit=1e-3),
+             "x 1e3": spherical_manipulator_onshape(3e-7, 2, unit=1e3),
+             "turned": spherical_manipulator_onshape(3e-7, 2, world=turned)}
+    texts["reversed"] = relabelled_urdf(texts["as written"])
+    assert 'name="drive_1"' in texts["reversed"] and 'name="motor1"' not in texts["reversed"]
+    notes = {}
+    for label, text in texts.items():
+        path = tmp_path / label.replace(" ", "_") / "robot.urdf"
+        path.parent.mkdir()
+        path.write_text(text)
+        mechanism = load(path)
+        assert mechanism.dof == 2, label
+        notes[label] = [note for note in mechanism.assembly_notes if note.startswith(DOF_AT_ROUNDING)]
+    assert [a.split(":")[1] for a in load(tmp_path / "reversed" / "robot.urdf").actuator_names] != ["motor1",
+                                                                                                "motor2", "motor3"]
+    for label, found in notes.items():
+        assert found == notes["as written"] and len(found) == 1, (label, found)

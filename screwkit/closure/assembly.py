@@ -58,7 +58,7 @@ DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
 """Relative: a singular value counted by :func:`mobility` (above :data:`MOTION_SPACE_TOLERANCE`) but at most this is
 of the order of a file's rounding rather than of its geometry: the geometric middle of :data:`FILE_ROUNDING` and 1.
 Every bundled and published mechanism read so far has its smallest at 0.01 or more; a spherical manipulator whose axes
-miss their centre by 1.3e-5 of its size (beyond what is idealised on reading) has one at 1e-5."""
+miss their centre by 1.3e-5 of its size (beyond what is idealised on reading) has one at 1.5e-5."""
 
 def _tidy(value: float) -> str:
     """A number for messages: 6 significant digits, round-off below 1e-12 shown as 0."""
@@ -184,8 +184,9 @@ def _matching_branch(mechanism: Mechanism, index: int, solver) -> tuple[int, ...
 def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
     """DOF of the platform at the reference assembly: the dimension of the intersection of the chains' twist spaces.
 
-    Twists are taken about the centroid of the platform joints with lengths in units of the
-    mechanism's length scale, so the count does not depend on the unit or the frame.
+    Twists are taken about the centroid of the platform joints with lengths in units of the chains' own size (the
+    root-mean-square distance of their joints from that centroid), so the count does not depend on the unit or the
+    frame; the mechanism's length scale, the distance from the base's origin, grew as the world frame moved away.
     """
     return _mobility(mechanism, chains)[0]
 
@@ -198,10 +199,12 @@ def _mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> tuple[int, lis
     rows = task_rows(mechanism.is_planar)
     frames = [chain_forward_kinematics(chain.geometry, chain.reference_values) for chain in chains]
     centre = np.mean([f.points[-1] for f in frames], axis=0)
+    offsets = np.concatenate([f.points - centre for f in frames])
+    size = float(np.sqrt(np.mean(np.sum(offsets**2, axis=1)))) or mechanism.length_scale  # (all at one point: any)
     complements, smallest = [], []
     for chain, chain_frames in zip(chains, frames):
         twists = twists_from_axes_and_points(chain_frames.axes, chain_frames.points - centre, chain.prismatic)
-        twists = np.concatenate([twists[:, :3], twists[:, 3:] / mechanism.length_scale], axis=-1)[:, rows].T
+        twists = np.concatenate([twists[:, :3], twists[:, 3:] / size], axis=-1)[:, rows].T
         left, singular, _ = np.linalg.svd(twists)
         largest = max(1.0, singular[0] if singular.size else 1.0)
         rank = int(np.sum(singular > MOTION_SPACE_TOLERANCE * largest))
