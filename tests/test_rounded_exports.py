@@ -21,7 +21,7 @@ import pytest
 from test_assembly_nearest import spherical_manipulator_onshape
 from test_io import poses_near_home
 from test_lower_mobility import five_bar_expected
-from test_onshape import five_bar_onshape
+from test_onshape import MOVED, assert_moved_textbook, five_bar_onshape
 
 from helpers import screwkit
 from screwkit.cli import options
@@ -227,3 +227,24 @@ def test_the_dof_note_is_the_same_in_any_unit_world_or_order(tmp_path):
                                                                                                 "motor2", "motor3"]
     for label, found in notes.items():
         assert found == notes["as written"] and len(found) == 1, (label, found)
+
+
+SMALL_FAR = pytest.mark.xfail(strict=True, reason=(
+    "a known defect: the mechanism's length scale is its farthest joint's distance from the base's origin, so a 1 mm "
+    "five-bar 0.23 m from it gets tolerances 340 times looser than its size; loops written rounded (redundant, "
+    "closing only to 3e-7 of the size) are then solved to that looser tolerance, and the ITIs move by up to 2.4e-5 "
+    "(4e-12 in metres at the origin, 1.5e-9 in kilometres)"))
+
+
+@pytest.mark.parametrize("transform", [pytest.param(MOVED[0], marks=SMALL_FAR), MOVED[1]])
+def test_the_rounded_five_bar_in_another_unit_and_frame_with_its_legs_reordered_reads_planar(tmp_path, transform):
+    """The onshape five-bar with its hinges tilted by 3e-7 rad, scaled by 1e-3 and 1e3, turned and shifted in the
+    world, its legs written in reverse and its motors renamed: planar, and at poses near its home the textbook
+    pressure angles, each following its own leg, and the worst single fault the leg the textbook names (to 1e-5)."""
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path = tmp_path / "robot.urdf"
+    path.write_text(tilted(five_bar_onshape(transform=transform, order=(2, 1, 0), motor=names.get), 3e-7, 1))
+    assert read_mechanism_file(path)[1].planar
+    mechanism = load(path)
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["drive_a", "drive_b", "drive_c"]
+    assert_moved_textbook(mechanism, transform, {name: leg for leg, name in names.items()}.get, tolerance=1e-5)
