@@ -320,16 +320,22 @@ def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
     return motion
 
 
-def _base_rotation(normal: NDArray | None) -> NDArray:
-    """World rotation of the written base frame: its z axis along a planar mechanism's normal."""
+def _base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
+    """World frame of the written base: z along a planar mechanism's normal; its origin the world's, or where a world
+    axis the normal is parallel to the file's rounding meets the plane through ``point``: the plane's x, y are then
+    the world's to second order in the rounding however far the plane is (turned about the origin, they were not)."""
+    frame = np.eye(4)
     if normal is None:
-        return np.eye(3)
+        return frame
     z = normal / np.linalg.norm(normal)
     x = np.array([1.0, 0.0, 0.0]) - z[0] * z
     if np.linalg.norm(x) < 1e-6:
         x = np.array([0.0, 1.0, 0.0]) - z[1] * z
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
+    x, axis = x / np.linalg.norm(x), int(np.argmax(np.abs(z)))
+    frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+    if np.linalg.norm(np.delete(z, axis)) <= FILE_ROUNDING:
+        frame[axis, 3] = float(z @ point) / z[axis]
+    return frame
 
 
 def _write_equivalent(writer: UrdfWriter, name: str, reduction: Reduction, attachment: NDArray, world_base: NDArray,
@@ -459,12 +465,10 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                          f"frame {frame.name!r}")
     else:
         report.output = f"frame {frame.name!r} on body {body!r}"
-    base_rotation = _base_rotation(normal)
-    world_base = np.eye(4)
-    world_base[:3, :3] = base_rotation
     platform_world = np.eye(4)
-    platform_world[:3, :3] = base_rotation if (point or normal is not None) else output_world[:3, :3]
     platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
+    world_base = _base_frame(normal, platform_world[:3, 3])
+    platform_world[:3, :3] = world_base[:3, :3] if (point or normal is not None) else output_world[:3, :3]
     writer = UrdfWriter(tree.source.rsplit("/", 1)[-1].split(".")[0] or "mechanism",
                         f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
     base = "base"
