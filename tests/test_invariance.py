@@ -18,15 +18,19 @@ planar mechanism from random joint points (any points close planar chains of som
 from __future__ import annotations
 
 import functools
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
-from helpers import assert_indices_close, bundled_chain_screws, random_rotation
+from helpers import assert_indices_close, bundled_chain_screws, in_unit, random_rotation
 from screwkit.indices.analysis import analyze
+from screwkit.io.loader import bundled_path, load
 from screwkit.screw import algebra as screws
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.planar import rrr_chain_screws
+from screwkit.studies.paths import path_from_poses
 
 SCALES = (1e-3, 1e-2, 1.0, 1e2, 1e3)
 THRESHOLD = 1e-6  # p at scale 1 (m); p = THRESHOLD * scale
@@ -542,3 +546,52 @@ def test_a_stretched_leg_is_reached_in_every_unit_and_world_frame(tmp_path):
         np.testing.assert_allclose(result.lmti, reference.lmti, atol=1e-12, err_msg=name)
         np.testing.assert_allclose(result.f_o[1], reference.f_o[1], atol=1e-12, err_msg=name)
         np.testing.assert_allclose(result.iti_actuators, reference.iti_actuators, atol=1e-7, err_msg=name)
+
+
+def drawn_elsewhere(text: str, rotation: np.ndarray, shift: np.ndarray) -> str:
+    """A URDF with every joint hanging from ``base_link`` (its chains' first joints and the platform's) turned by
+    ``rotation`` and moved by ``shift`` in the base link's frame: the same mechanism drawn elsewhere in its base frame,
+    as CAD files draw theirs; its chains renamed so that they are listed the other way round, its elements written in
+    reverse order."""
+    root = ElementTree.fromstring(text)
+    for joint in root.iter("joint"):
+        parent, origin = joint.find("parent"), joint.find("origin")
+        if parent is None or parent.get("link") != "base_link":
+            continue
+        xyz = rotation @ np.array(origin.get("xyz", "0 0 0").split(), float) + shift
+        turned = rotation @ Rotation.from_euler("xyz", np.array(origin.get("rpy", "0 0 0").split(), float)).as_matrix()
+        origin.set("xyz", " ".join(repr(float(v)) for v in xyz))
+        origin.set("rpy", " ".join(repr(float(v)) for v in Rotation.from_matrix(turned).as_euler("xyz")))
+    loops = [loop for loop in root.iter("loop")]
+    for rank, loop in enumerate(sorted(loops, key=lambda loop: loop.get("chain"), reverse=True)):
+        loop.set("chain", f"leg_{rank}")
+    root[:] = list(root)[::-1]
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize("name", ["prs_3_ups", "coop_arms", "schoenflies_5", "five_bar_3", "ups_hexapod_8"])
+def test_the_length_scale_is_the_mechanism_s_own_size(tmp_path, name):
+    """The length scale (what closures measure their gaps and tolerances in, and what weighs angles against lengths
+    along a path) follows the mechanism's unit only: drawn 2 m from its base link's origin and turned there (about the
+    vertical unless it moves in six DOF), its chains listed the other way round, it is the same to 1e-12, and a path
+    turning the platform has the same arc length; lengths x 1e3 make it x 1e3. It was the largest distance from the
+    base link's origin: 0.26 m for the 3-PRS + UPS drawn about it, 2.19 m drawn 2 m away."""
+    text = bundled_path(name).read_text(encoding="utf-8")
+    mechanism = load(bundled_path(name))
+    turn = np.array([0.4, -0.7, 0.3]) if mechanism.dof == 6 else np.array([0.0, 0.0, 0.3])  # keeping its coordinates
+    rotation = Rotation.from_rotvec(turn).as_matrix()
+    copies = {"drawn elsewhere": (drawn_elsewhere(text, rotation, np.array([0.9, -1.7, 0.4])), 1.0),
+              "x 1e3": (in_unit(text, "mm", 1e3), 1e3)}
+    for label, (copy, factor) in copies.items():
+        path = tmp_path / f"{label.replace(' ', '_')}.urdf"
+        path.write_text(copy, encoding="utf-8")
+        other = load(path)
+        assert other.length_scale == pytest.approx(factor * mechanism.length_scale, rel=1e-12), label
+        if factor == 1.0:
+            assert [c.joint_names[0] for c in other.chains] == [c.joint_names[0] for c in mechanism.chains][::-1]
+        angles = np.flatnonzero(other.angular)
+        if factor == 1.0 and angles.size:
+            for loaded in (mechanism, other):
+                turned = np.array([loaded.home_pose, loaded.home_pose])
+                turned[1, angles[0]] += 0.2
+                assert path_from_poses(loaded, turned).length == pytest.approx(0.2 * mechanism.length_scale, rel=1e-12)

@@ -67,8 +67,10 @@ def _tidy(value: float) -> str:
 
 
 def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
-    """The largest distance of a joint of the reference assembly, or the platform, from the base origin."""
-    points = [mechanism.home_translation[None]]
+    """The largest distance of a joint of the reference assembly, or the platform, from the centroid of the chains'
+    base joints: the mechanism's own size, the same in any world frame and in any order of its chains (the base
+    frame's origin, which files put anywhere, is not one of its points)."""
+    points, base = [mechanism.home_translation[None]], []
     for chain in chains:
         geometry = chain.geometry
         tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
@@ -76,7 +78,9 @@ def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
         frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
         points.append(frames.points)
         points.append(frames.leg_translation[None])
-    return max(float(np.max(np.linalg.norm(np.concatenate(points), axis=-1))), 1e-12)
+        base.append(frames.points[:1])
+    centre = np.mean(np.concatenate(base), axis=0)
+    return max(float(np.max(np.linalg.norm(np.concatenate(points) - centre, axis=-1))), 1e-12)
 
 
 def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_scale: float,
@@ -186,8 +190,7 @@ def mobility(mechanism: Mechanism, chains: tuple[Chain, ...]) -> int:
 
     Twists are taken about the centroid of the platform joints with lengths in units of the chains' own size (the
     root-mean-square distance of their joints from that centroid), so the count does not depend on the unit or the
-    frame; the mechanism's length scale, the distance from the base's origin, grew as the world frame moved away.
-    """
+    frame (the mechanism's length scale was once the distance from the base's origin, and grew with it)."""
     return _mobility(mechanism, chains)[0]
 
 

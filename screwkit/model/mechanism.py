@@ -78,8 +78,10 @@ class Mechanism:
         the chains' twist spaces).
     length_scale : float
         A characteristic length of the mechanism (m): the largest distance of a joint of the
-        reference assembly from the base frame origin (at least 1 mm). Used for step sizes of
-        continuation and for judging point coincidences relative to the mechanism's size.
+        reference assembly, or of the platform's origin, from the centroid of the chains' base joints
+        (the same wherever the file draws the mechanism in its base frame, and in any order of its
+        chains). Used for step sizes of continuation, closure tolerances, weighing angles against
+        lengths along a path, and judging point coincidences relative to the mechanism's size.
     named_poses : dict of str to ndarray
         Documented poses (task coordinates, m and rad): ``home`` (the reference assembly) and
         those of the file's ``<named_pose>`` elements.
