@@ -280,3 +280,40 @@ def test_the_rounded_cad_stewart_platform_is_where_mujoco_puts_it(tmp_path, deci
         np.testing.assert_allclose(data.site_xpos[site], pose[:3], atol=tolerance)
         np.testing.assert_allclose(data.site_xmat[site].reshape(3, 3),
                                    Rotation.from_euler("xyz", pose[3:]).as_matrix(), atol=tolerance)
+
+
+def mjcf_scaled(text: str, factor: float) -> str:
+    """An MJCF's lengths times ``factor``: body, geom and site positions, capsules' ends, welds' relative positions and
+    slides' ranges (all the CAD Stewart platform has)."""
+    def times(values) -> str:
+        return " ".join(repr(factor * float(v)) for v in values)
+
+    text = re.sub(r'\b(pos|fromto)="([^"]*)"', lambda m: f'{m.group(1)}="{times(m.group(2).split())}"', text)
+    text = re.sub(r'relpose="(\S+) (\S+) (\S+) ', lambda m: f'relpose="{times(m.groups())} ', text)
+    return re.sub(r'(type="slide" axis="[^"]*" )range="([^"]*)"', lambda m: f'{m.group(1)}range="'
+                  f'{times(m.group(2).split())}"', text)
+
+
+@pytest.mark.parametrize("factor", [1.0, 1e3, 1e-3])
+def test_a_slide_stop_missed_by_the_rounding_is_held_in_any_unit(tmp_path, factor):
+    """The CAD Stewart platform with one slider's lower stop written 1e-6 m (3e-6 of its length scale) above where
+    it sits: the stop is moved out to the slider's value and the report names it, in metres and with every length x
+    1e3 and x 1e-3, and the indices are the unedited file's. A stop 1e-4 m above (3e-4 of the length scale, beyond
+    the rounding) is refused in one line naming the file, the joint and its limits."""
+    text = mjcf_scaled((GALLERY / "gallery" / "stewart_cad.xml").read_text(), factor)
+    stops = {}
+    for offset in (1e-6, 1e-4):
+        stops[offset] = tmp_path / f"stop_{offset:g}.xml"
+        stops[offset].write_text(re.sub(r'(<joint name="s3" type="slide" axis="[^"]*" )range="[^"]*"',
+                                        lambda m, low=offset * factor: f'{m.group(1)}range="{low!r} {0.1 * factor!r}"',
+                                        text))
+    (tmp_path / "as_written.xml").write_text(text)
+    written, held = load(tmp_path / "as_written.xml"), load(stops[1e-6])
+    assert [note for note in held.import_report if "moved out to" in note and "'s3'" in note], held.import_report
+    assert not [note for note in written.import_report if "moved out to" in note]
+    first, second = indices_at_pose(written, written.home_pose), indices_at_pose(held, held.home_pose)
+    np.testing.assert_allclose(second.iti_actuators, first.iti_actuators, atol=1e-12)
+    with pytest.raises(ValueError) as refused:
+        load(stops[1e-4])
+    message = str(refused.value)
+    assert "\n" not in message and stops[1e-4].name in message and "'s3'" in message and "outside its limits" in message
