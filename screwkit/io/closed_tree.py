@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
+from screwkit.io.nearest import independent_blocks, nearest_closed
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
@@ -37,16 +38,6 @@ INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
-FLOOR_MOVE = 0.1
-"""Joint change (rad, or length scales) beyond which closing a residual of the file's rounding is not what the
-rounding means. On closures that close only to that rounding, a direction of their Jacobian whose singular value is
-below the residual over this moves along the floor: closing the residual along it would turn the joints by more than
-this (a ball's radial gap on a sphere that every axis meets), and the assembly does not creep along it. Rhoban's
-exported spherical manipulator has two such directions, at 1.2e-6 and 5.5e-6 against a residual of 8.5e-6 (moves of
-1.5 rad and more); a 1 mm four-bar beside one of 0.5 m, or one 0.01 rad from its flat singular configuration, has
-its weakest closing direction at about 1e-3 (a move of 1e-4 rad for a residual of 1e-7), which is closed."""
-
-
 class ImportError_(ValueError):
     """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
 
@@ -333,115 +324,25 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
         tree.model, data, c)]}
 
 
-def _nearest(residuals, derivatives, v: NDArray, error: NDArray, directions: NDArray,
-             on_floor: bool = False) -> tuple[NDArray, NDArray]:
-    """From a closed ``v`` (its residuals ``error``; ``derivatives(v)`` their Jacobian along ``directions``), the
-    closed configuration nearest to the reference one (v = 0; angles in rad, lengths in units of
-    :func:`_lines_scale`, along ``directions`` only): the point of the linearised closed set nearest to 0 (the
-    pseudo-inverse of the closures' Jacobian, whose null space is where the closures stay closed, whatever the
-    residuals' weights), closed again on that Jacobian, taken while it comes nearer (halved when it does not close
-    again or come nearer). At the end ``v`` is normal to the closed set (no change that keeps them closed comes
-    nearer): the least change of the joints, which the mechanism decides, not its drawing. ``on_floor``: closures
-    that close only to the file's rounding. The directions that only move along their floor (singular values below
-    the residual over :data:`FLOOR_MOVE`) are then free, and closed means that what the other directions can close
-    of the residual (its part in their range) is closed, judged on each candidate's own Jacobian: the point nearest
-    to the reference where every closure is as closed as it can be (the same for residuals weighed otherwise, to the
-    order of the floor times the change of weights)."""
-    cut = float(np.linalg.norm(error)) / FLOOR_MOVE
-
-    def inverse(jacobian) -> NDArray:
-        """The closures' pseudo-inverse: singular values at most 1e-7 of the largest dropped, on a floor also those
-        below ``cut``."""
-        if not on_floor:
-            return np.linalg.pinv(jacobian, rcond=1e-7)
-        left, singular, right = np.linalg.svd(jacobian, full_matrices=False)
-        keep = singular > max(cut, 1e-7 * (singular[0] if singular.size else 0.0))
-        return (right[keep].T / singular[keep]) @ left[:, keep].T
-
-    def closable(jacobian, inverse_, residual) -> float:
-        """What of ``residual`` the steps close: all of it, or on a floor its part in the Jacobian's range."""
-        return float(np.linalg.norm(jacobian @ (inverse_ @ residual) if on_floor else residual))
-
-    def chords(candidate, closed, jacobian, inverse_, bound: float, steps: int = 8) -> tuple[NDArray, NDArray]:
-        """``candidate`` closed again by up to ``steps`` chord steps along ``jacobian``, until ``bound`` is met."""
-        for _ in range(steps):
-            if closable(jacobian, inverse_, closed) <= bound:
-                break
-            candidate = candidate - (inverse_ @ closed) @ directions
-            closed = residuals(candidate)
-        return candidate, closed
-
-    for _ in range(10):  # closed first to round-off (the damped steps stop at ASSEMBLY_TOLERANCE), so that a nearer
-        if not on_floor and np.linalg.norm(error) <= 1e-14:  # point is not one that is merely less closed; a file
-            break  # closed as written is left as written, to the bit (a rounded one's reading can turn on last bits)
-        jacobian = derivatives(v)
-        inverse_ = inverse(jacobian)
-        if closable(jacobian, inverse_, error) <= 1e-14:
-            break
-        candidate = v - (inverse_ @ error) @ directions
-        candidate, closed = chords(candidate, residuals(candidate), jacobian, inverse_, 1e-14,
-                                   8 if on_floor else 0)  # a weak direction's full step can bend a stiff loop open
-        if not closable(jacobian, inverse_, closed) < closable(jacobian, inverse_, error):
-            break
-        v, error = candidate, closed
-    jacobian = derivatives(v) if on_floor else None
-    floor = max(2.0 * (closable(jacobian, inverse(jacobian), error) if on_floor
-                       else float(np.linalg.norm(error))), 1e-14)
-
-    def close_again(candidate, closed, jacobian, inverse_) -> tuple[NDArray, NDArray, bool]:
-        """``candidate`` closed again by chord steps on the Jacobian it was found with, then on a floor judged (and
-        closed) on its own Jacobian (the range that closes turns with the configuration); and whether it is closed."""
-        candidate, closed = chords(candidate, closed, jacobian, inverse_, floor)
-        if not on_floor:
-            return candidate, closed, closable(jacobian, inverse_, closed) <= floor
-        for _ in range(4):
-            own = derivatives(candidate)
-            own_inverse = inverse(own)
-            if closable(own, own_inverse, closed) <= floor:
-                return candidate, closed, True
-            candidate = candidate - (own_inverse @ closed) @ directions
-            closed = residuals(candidate)
-        return candidate, closed, False
-
-    for _ in range(100):
-        x = directions @ v
-        jacobian = derivatives(v)
-        inverse_ = inverse(jacobian)
-        step = inverse_ @ (jacobian @ x - error) - x
-        if np.linalg.norm(step) <= 1e-10 * max(1.0, float(np.linalg.norm(x))):
-            break
-        for fraction in 0.5 ** np.arange(8):
-            trial = v + (fraction * step) @ directions
-            candidate, closed, closes = close_again(trial, residuals(trial), jacobian, inverse_)
-            nearer = np.linalg.norm(directions @ candidate) <= np.linalg.norm(x) * (1.0 + 1e-12)  # to round-off
-            if closes and nearer:
-                break
-        else:
-            break
-        v, error = candidate, closed
-    return v, error
-
-
 def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, float]:
     """The closed configuration nearest to the file's reference one, and the length scale.
 
-    Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any
-    joint type, lengths in units of :func:`_lines_scale`; the joints ``held``, by id, keep their values),
-    residuals the closures' origin gaps in units of the length scale and, for ``6d`` closures,
-    the difference of their rotation matrices (smooth where a rotation vector jumps, at half a
-    turn); the Jacobian from Pinocchio's joint Jacobians. Once the residual is within the file's rounding
-    (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three, and rounded
-    redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor. Then, when
-    ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
-    (:func:`_nearest`): the damped steps reach *a* closed configuration, which depends on how the residuals are
-    weighed and so on where the file draws its joints and frames; the nearest one does not. Closures that close
-    only to the file's rounding (their largest residual within it) are slid the same way along their floor
-    (:data:`FLOOR_MOVE`): the damped steps creep along it (Rhoban's exported spherical manipulator, its balls
-    rounded off their sphere: 0.02 rad in 20 steps for 2 % of the residual), and where they stop depended on the
-    drawing; the floor's point nearest to the file's values does not. Directions that close the floor's gap only by
-    turning the joints far are left alone (a pseudo-inverse of all of them went far from the file's values or left
-    the floor). A file whose floor there is beyond the rounding is refused: the damped steps had crept 0.16 rad
-    from its values to bring it under (drawings 0.03 rad apart).
+    Levenberg-Marquardt on the joint velocities integrated from the reference configuration (any joint type, lengths in
+    units of :func:`_lines_scale`; the joints ``held``, by id, keep their values), residuals the closures' origin gaps
+    in units of the length scale and, for ``6d`` closures, the difference of their rotation matrices (smooth where a
+    rotation vector jumps, at half a turn); the Jacobian from Pinocchio's joint Jacobians. Once the residual is within
+    the file's rounding (:data:`INCONSISTENCY_TOLERANCE`), 20 more steps at most: closures that close take two or three,
+    and rounded redundant ones (a parallelogram of hinges written to 6 decimals) only creep along their floor. Then,
+    when ``nearest`` and the closures close, the configuration is slid along the closed ones to the nearest
+    (:func:`~screwkit.io.nearest.nearest_closed`): the damped steps reach *a* closed configuration, which depends on how
+    the residuals are weighed and so on where the file draws its joints and frames; the nearest one does not. Closures
+    that close only to the file's rounding (their largest residual within it) are slid the same way along their floor
+    (:data:`~screwkit.io.nearest.FLOOR_MOVE`): the damped steps creep along it (Rhoban's exported spherical manipulator,
+    its balls rounded off their sphere: 0.02 rad in 20 steps for 2 % of the residual), and where they stop depended on
+    the drawing; the floor's point nearest to the file's values does not. Directions that close the floor's gap only by
+    turning the joints far are left alone (a pseudo-inverse of all of them went far from the file's values or left the
+    floor). A file whose floor there is beyond the rounding is refused: the damped steps had crept 0.16 rad from its
+    values to bring it under (drawings 0.03 rad apart).
     """
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -513,9 +414,15 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         else:
             damping *= 10.0
     if nearest and np.linalg.norm(error) < ASSEMBLY_TOLERANCE:
-        v, error = _nearest(residuals, derivatives, v, error, directions)
+        v, error = nearest_closed(residuals, derivatives, v, error, directions)
     elif nearest and np.max(np.abs(error)) < INCONSISTENCY_TOLERANCE:  # on a floor: along it only, back from the creep
-        v, error = _nearest(residuals, derivatives, v, error, directions, on_floor=True)
+        direction = np.cumsum(free) - 1  # each free velocity coordinate's direction
+        columns = {joint: [direction[k] for k in range(model.joints[joint].idx_v, model.joints[joint].idx_v
+                                                       + model.joints[joint].nv) if free[k]]
+                   for joint in range(1, model.njoints)}
+        loops = [set(model.supports[c.joint_a]) ^ set(model.supports[c.joint_b]) for c in tree.closures]
+        blocks = independent_blocks([12 if c.kind == "6d" else 3 for c in tree.closures], loops, columns)
+        v, error = nearest_closed(residuals, derivatives, v, error, directions, on_floor=True, blocks=blocks)
     q = configuration(v)
     if np.max(np.abs(error)) >= ASSEMBLY_TOLERANCE:
         gaps = closure_gaps(tree, q)
