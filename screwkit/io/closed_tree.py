@@ -38,6 +38,8 @@ INCONSISTENCY_TOLERANCE = FILE_ROUNDING
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
+
+
 class ImportError_(ValueError):
     """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
 
