@@ -290,3 +290,45 @@ def rrp_sdf(from_platform=(), limits=None, order=(0, 1, 2)) -> str:
                      f'"__model__">{text((*(sign * direction), 0.0))}</xyz>{bounds}</axis><screwkit:actuated/></joint>')
     lines.append("</model></sdf>")
     return "\n".join(lines)
+
+
+def rss_sdf(tilt: float = 0.0, seed: int = 0, scale: float = 1.0, reverse: bool = False) -> str:
+    """The bundled 8-RSS hexapod (robots/rss_hexapod_8.urdf: its crank pivots and axes, crank ends and platform ball
+    centres at the reference assembly, read from that file) written in SDFormat as a published Gazebo Stewart platform
+    writes its RSS legs: an actuated crank, then a ball joint at the crank's end and one at the platform, each rod's
+    link frame at its lower ball with its x axis along the rod, off it by ``tilt`` rad (a file's rounding; ``seed``
+    picks the direction). Balls read as three hinges about their frames' axes, the lower one's x hinge is the rod's
+    idle spin (to ``tilt``). The link frames change no joint centre or axis: the indices are those of
+    ``rss_hexapod_8``. ``scale``: every length times it; ``reverse``: the legs written in reverse order."""
+    from scipy.spatial.transform import Rotation
+
+    from screwkit.closure.chain_kinematics import chain_forward_kinematics
+    from screwkit.io.loader import load
+
+    bundled, rng = load("rss_hexapod_8"), np.random.default_rng(seed)
+    platform = scale * np.asarray(bundled.home_translation, dtype=float)
+    lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}>\n<model name="rss_stewart">',
+             '<link name="base"/>', '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child>'
+             '</joint>', f'<link name="platform"><pose>{text(platform)} 0 0 0</pose></link>']
+    legs = list(enumerate(bundled.chains))
+    for k, chain in legs[::-1] if reverse else legs:
+        geometry = chain.geometry
+        tree = [bundled.description.reference_configuration.get(name, 0.0)
+                for name in chain.joint_names[: geometry.n_tree_joints]]
+        frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - len(tree))]))
+        pivot, elbow, ball = (scale * frames.points[k] for k in (0, 1, -1))
+        axis = frames.axes[0]
+        along = (ball - elbow) / np.linalg.norm(ball - elbow)
+        side = np.cross(along, rng.normal(size=3))
+        along = Rotation.from_rotvec(tilt * side / np.linalg.norm(side)).apply(along)
+        second = np.cross(along, axis) / np.linalg.norm(np.cross(along, axis))
+        turn = Rotation.from_matrix(np.column_stack([along, second, np.cross(along, second)])).as_euler("xyz")
+        lines.append(f'<link name="crank_{k}"><pose>{text(pivot)} 0 0 0</pose></link>'
+                     f'<link name="rod_{k}"><pose>{text(elbow)} {text(turn)}</pose></link>')
+        lines.append(f'<joint name="motor_{k}" type="revolute"><parent>base</parent><child>crank_{k}</child>'
+                     f'<axis><xyz>{text(axis)}</xyz></axis><screwkit:actuated/></joint>')
+        lines.append(f'<joint name="elbow_{k}" type="ball"><parent>crank_{k}</parent><child>rod_{k}</child></joint>')
+        lines.append(f'<joint name="top_{k}" type="ball"><parent>rod_{k}</parent><child>platform</child>'
+                     f'<pose relative_to="__model__">{text(ball)} 0 0 0</pose></joint>')
+    lines.append("</model>\n</sdf>")
+    return "\n".join(lines)

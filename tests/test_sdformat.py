@@ -16,7 +16,7 @@ import re
 import numpy as np
 import pytest
 from delta_rods import delta_rods_mjcf
-from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses, hexapod_sdf
+from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses, hexapod_sdf, rss_sdf
 from test_graph_legs import POSES, assert_delta_textbook, textbook
 from test_io import HOME, assert_textbook, poses_near_home
 from test_lower_mobility import five_bar_expected
@@ -475,3 +475,31 @@ def test_the_parallelogram_s_actuator_values_give_the_pose_the_geometry_gives(tm
     # to what the forward kinematics asks of the actuator values (1e-11 rad) through the crank: x = CRANK sin(t)
     assert json.loads(analysed.stdout)["pose"]["x"] == pytest.approx(CRANK * np.sin(np.radians(degrees)),
                                                                     abs=CRANK * 1e-11)
+
+
+@pytest.mark.parametrize("tilt, scale, reverse", [(0.0, 1.0, False), (4e-5, 1.0, False), (3e-4, 1.0, False),
+                                                  (4e-5, 1e-3, True), (3e-4, 1e3, True)])
+def test_an_rss_stewart_platform_locks_each_rod_s_spin_however_its_frames_are_turned(tmp_path, tilt, scale, reverse):
+    """The bundled 8-RSS hexapod in SDFormat with ball joints at both ends of its rods, each rod's frame along it to
+    ``tilt`` (a file's rounding; 0 exactly), in m, mm-like and km-like sizes, its legs listed either way: the hinge
+    locked as each rod's idle spin is its lower ball's x (the one along the rod; in the leg the platform hangs from, one
+    of its six ball hinges), its legs' joints are independent (no DOF note), and the indices at its home and at a pose
+    off it are ``rss_hexapod_8``'s (1e-9). The first hinge from the leg's end whose removal kept the rank at the
+    rounding used to be locked: the leg kept its spin and a hinge 4e-5 from it, and five of the eight chains read "DOF
+    decided at the file's rounding"."""
+    path = tmp_path / "rss.sdf"
+    path.write_text(rss_sdf(tilt, seed=1, scale=scale, reverse=reverse))
+    mechanism, bundled = load(path), load("rss_hexapod_8")
+    assert mechanism.dof == 6 and not mechanism.assembly_notes
+    locked = [note for note in mechanism.import_report if "idle joints locked" in note]
+    carrier = 7 if reverse else 0  # the platform hangs from the first leg written: its path holds both its balls
+    names = re.findall(r"\w+_\d_[xyz]", locked[0]) if len(locked) == 1 else []
+    assert len(names) == 8 and {f"elbow_{k}_x" for k in range(8) if k != carrier} <= set(names), locked
+    poses = bundled.home_pose + np.array([[0.0] * 6, [0.02, -0.03, 0.01, 0.05, -0.03, 0.04]])
+    expected = indices_at_poses(bundled, poses, detail=True)
+    names = [f"motor_{name.split(':')[0].removeprefix('leg_')}" for name in bundled.actuator_names]
+    order = [[name.split(":")[-1] for name in mechanism.actuator_names].index(f"motor_{int(n.split('_')[1]) - 1}")
+             for n in names]
+    found = indices_at_poses(mechanism, poses * np.where(mechanism.angular, 1.0, scale), detail=True)
+    np.testing.assert_allclose(found.iti_actuators[:, order], expected.iti_actuators, atol=1e-9)
+    np.testing.assert_allclose(found.lmti, expected.lmti, atol=1e-9)

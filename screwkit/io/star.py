@@ -225,30 +225,29 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
 
 
 def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
-    """Lock passive joints, from the leg end backwards, while the leg's joint twists are dependent to the file's
-    rounding (a hinge coaxial with the revolute loop that closes it to 3e-7 rad, as its axes are written parallel
-    and through one point afterwards: kept, the leg had a fourth joint in its plane and its home no closure)."""
+    """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
+    removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
+    loop that closes it to 3e-7 rad, kept, gave the leg a fourth joint in its plane and its home no closure; the first
+    hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it."""
     model = tree.model
 
     def rows(kept):
-        triples = []
-        for joint in kept:
-            kind, axis = joint_kind(model, joint)
-            placement = data.oMi[joint]
-            triples.append((kind, np.asarray(placement.rotation) @ axis, np.asarray(placement.translation)))
+        triples = [(kind, np.asarray(data.oMi[joint].rotation) @ axis, np.asarray(data.oMi[joint].translation))
+                   for joint in kept for kind, axis in [joint_kind(model, joint)]]
         return _twists(triples + leg.loop_dofs, leg.successor_world[:3, 3], scale)
 
     kept = list(leg.joints)
-    for joint in reversed(leg.joints):
-        if _independent(rows(kept), FILE_ROUNDING):
+    while not _independent(rows(kept), FILE_ROUNDING):
+        rank, best = np.linalg.matrix_rank(rows(kept), tol=FILE_ROUNDING), (0.0, None)
+        for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
+            trial = np.linalg.svd(rows([j for j in kept if j != joint]), compute_uv=False)
+            margin = trial[rank - 1] / trial[0] if trial.size >= rank else 0.0
+            if margin > FILE_ROUNDING and margin > best[0] * (1.0 + 1e-6):
+                best = (margin, joint)
+        if best[1] is None:
             break
-        if joint in motors:
-            continue
-        trial = [j for j in kept if j != joint]
-        rank = np.linalg.matrix_rank(rows(kept), tol=FILE_ROUNDING)
-        if np.linalg.matrix_rank(rows(trial), tol=FILE_ROUNDING) == rank:
-            kept = trial
-            leg.locked.append(joint)
+        kept.remove(best[1])
+        leg.locked.append(best[1])
     if not _independent(rows(kept)):
         raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
                            "its idle passive joints (its actuated joints are dependent at the assembly).")
