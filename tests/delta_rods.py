@@ -64,9 +64,11 @@ def quaternion(rotation) -> np.ndarray:
     return np.array([(rotation[j, i] - rotation[i, j]) / (4 * v[k]), *v])
 
 
-def delta_rods_mjcf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None) -> str:
+def delta_rods_mjcf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None, platform_spacing=SPACING) -> str:
     """The MJCF text (metres, radians), closed at ``qpos0``; ``transform`` = (scale, rotation, translation) writes
-    the same robot scaled and placed elsewhere in the world (its base body rotated and moved)."""
+    the same robot scaled and placed elsewhere in the world (its base body rotated and moved);
+    ``platform_spacing``: the rods' spacing at the platform (``SPACING`` at the arms; another makes each pair a
+    trapezoid, not a parallelogram)."""
     scale, rotation, translation = (1.0, np.eye(3), np.zeros(3)) if transform is None else transform
     azimuths = np.radians([90.0, 180.0, 270.0, 0.0]) if azimuths is None else np.asarray(azimuths, dtype=float)
     base, axes, elbows, attach = delta_geometry(centre, azimuths)
@@ -76,7 +78,7 @@ def delta_rods_mjcf(centre=(0.02, -0.03, -0.45), azimuths=None, transform=None) 
     for i, (b, a, e, p) in enumerate(zip(base, axes, elbows, attach), start=1):
         rods = []
         for side, sign in (("a", -1.0), ("b", 1.0)):
-            start, end = e + sign * half * a, p + sign * half * a
+            start, end = e + sign * half * a, p + sign * platform_spacing / 2 * a
             hang = ""
             if i == 1 and side == "a":  # the platform hangs from this rod's far end
                 hang = (f'<body name="platform" pos="{at(end - start)}"><joint name="platform_ball" type="ball"/>'

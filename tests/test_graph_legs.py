@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from delta_rods import ARM, ROD, delta_geometry, delta_rods_mjcf
 from test_gallery import GALLERY, assert_same_bodies, mujoco_residuals, mujoco_state, screwkit_residuals
@@ -270,3 +271,33 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
     one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes the output frame's x y z")
     converted = screwkit("convert", path, tmp_path / "out.urdf")
     one_line_error(converted, "inside a leg", "`screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view`")
+
+
+@pytest.mark.parametrize("transform", [None, (1000.0, np.eye(3), np.zeros(3)),
+                                       (1.0, np.eye(3), np.array([0.3, -1.2, 2.0]))])
+def test_a_delta_whose_rod_pairs_are_trapezoids_is_driven_in_x_y_z(tmp_path, transform):
+    """The rod-level Delta, three legs, with its rods 0.06 m apart at the arms and 0.05 m at the platform, as a
+    published onshape-to-robot Delta draws its pairs (0.04 and 0.0336 m): no pair is a parallelogram, so the platform
+    turns as it moves, and its motion space holds one pure translation (z). The rule took z, then rotations: it read
+    z, roll, pitch (the published one roll, pitch, yaw, which tell its motions apart by 0.0015 to x, y, z's 0.98, in
+    length scales). Its motions move its frame more than they turn it: it reads x, y, z, in m, in mm and in another
+    world frame, and a pose 2 cm off its home in x puts the output frame there (Pinocchio's placement, 1e-9 m) with
+    the platform turned (the coupling is real)."""
+    path = tmp_path / "trapezoids.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], np.radians([90.0, 210.0, 330.0]), transform=transform,
+                                    platform_spacing=0.05))
+    graph = graph_mechanism(read_mjcf(path))
+    assert graph.task_coordinates == ("x", "y", "z")
+    scale = 1.0 if transform is None else transform[0]
+    home = graph.task_pose()
+    target = home + np.array([0.02 * scale, 0.0, 0.0])
+    q, reached = graph.solve(target[None])
+    assert reached.all()
+    model = graph.tree.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q[0])
+    output = pin.SE3(data.oMf[graph.frame_id])  # a copy: data is overwritten below
+    np.testing.assert_allclose(output.translation, target, atol=1e-9 * scale)
+    pin.framesForwardKinematics(model, data, graph.q)
+    turned = data.oMf[graph.frame_id].rotation.T @ output.rotation
+    assert np.arccos(np.clip((np.trace(turned) - 1.0) / 2.0, -1.0, 1.0)) > 1e-3

@@ -38,6 +38,11 @@ __all__ = [
     "choose_task_axes",
 ]
 
+TRANSLATIONAL = np.sqrt(0.5)
+"""The platform's motions are translational when translation coordinates tell them apart by at least this (the
+smallest singular value of their rates on an orthonormal basis of the motion space, lengths in length scales): each
+motion then moves the frame's origin by more length scales than it turns the platform, and the task coordinates
+are translations (:func:`choose_task_axes`)."""
 TASK_RANK_TOLERANCE = 1e-6
 """A pose coordinate is independent of those chosen before it when the rates of the chosen ones
 on an orthonormal basis of the motion space (lengths in units of the length scale) keep a
@@ -269,7 +274,9 @@ def infer_task_axes(mechanism: Mechanism, full_pose: NDArray, joint_values, dof:
     space has twists with no rotation (three for a Delta, none for a spherical wrist whatever point its frame
     is at), chosen in order among those independent on that subspace; then the rotation coordinates
     independent on the whole space, in order (a hexapod's roll, pitch, yaw, a spherical wrist's three rotations
-    rather than the translations of its frame's origin off the centre), then any others. ``joint_values``
+    rather than the translations of its frame's origin off the centre), then any others. Translations alone when they
+    tell every motion apart by :data:`TRANSLATIONAL` (each motion moves the frame more than it turns it: a Delta
+    whose rod pairs are trapezoids, its platform turning a little as it moves). ``joint_values``
     holds one (m_i,) array per chain at the closed configuration ``full_pose``; ``candidates`` restricts the
     coordinates tried (the translations of a point output), in order, with no such split.
     """
@@ -281,9 +288,26 @@ def infer_task_axes(mechanism: Mechanism, full_pose: NDArray, joint_values, dof:
 def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None) -> tuple[int, ...]:
     """The rule of :func:`infer_task_axes` on ``space`` (n_pose, d): the pose-coordinate rates of a basis of the
     motion space (lengths in units of the length scale), ``angular`` which coordinates are angles."""
+    chosen = _task_axes_in_order(space, angular, dof, candidates)
+    if candidates is None and 0 < dof <= int(np.sum(~angular)):  # motions that move the frame more than they turn
+        # it are told apart by translations: a Delta whose rod pairs are not quite parallelograms turns 0.19 rad per
+        # length scale, and its roll, pitch, yaw told its motions apart by 0.0015 against x, y, z's 0.98
+        moved = _task_axes_in_order(space, angular, dof, np.flatnonzero(~angular), split=False)
+        if len(moved) == dof and _separation(space, moved) >= TRANSLATIONAL:
+            return moved
+    return chosen
+
+
+def _separation(space: NDArray, axes) -> float:
+    """How well the coordinates ``axes`` tell the motions of ``space`` apart: their rates' smallest singular value."""
+    return float(np.linalg.svd(space[list(axes)], compute_uv=False)[-1])
+
+
+def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=None, split: bool = True
+                        ) -> tuple[int, ...]:
     order = list(range(space.shape[0])) if candidates is None else list(candidates)
     chosen: list[int] = []
-    if len(order) == space.shape[0] and space.shape[1]:
+    if split and len(order) == space.shape[0] and space.shape[1]:
         _, singular, rows = np.linalg.svd(space[angular], full_matrices=True)
         turning = int(np.sum(singular > TASK_RANK_TOLERANCE))
         translations = space @ rows[turning:].T  # the motions that turn the platform by nothing
