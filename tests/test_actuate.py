@@ -19,6 +19,7 @@ What is checked against what:
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -263,3 +264,21 @@ def test_a_refusal_after_reading_names_the_option_that_named_the_joint():
     published = Path(__file__).parent / "data/gallery/published/example_parallel_robots/5bar_linkage/robot.urdf"
     with pytest.raises(ImportError_, match=r"robot\.yaml: --actuate closedloop1_B is on no leg"):
         read_mechanism_file(published, actuate=("closedloop1_B", "mot1"))
+
+
+def test_analyze_says_in_its_first_line_when_the_actuators_are_guessed(tmp_path):
+    """A file that names no actuator is analysed with the ones guessed from the branches leaving the base, and every
+    fault-tolerance figure is about that guess: `analyze` says so in its first line and in its JSON
+    (``actuators_guessed``), not only in the import report on stderr; not when the file or ``--actuate`` names them.
+    A passive Gazebo four-bar had read "2 actuators, 1 DOF (1 redundant)", F_O1 = 1, with nothing beside it."""
+    guessed, marked = write(tmp_path, five_bar_sdf(marker="")), write(tmp_path, five_bar_sdf(), "marked.sdf")
+    runs = {"guessed": screwkit("analyze", guessed), "marked": screwkit("analyze", marked),
+            "named": screwkit("analyze", guessed, "--actuate", "mot1", "--actuate", "mot2")}
+    for label, run in runs.items():
+        assert run.returncode == 0, (label, run.stderr)
+        assert ("(guessed: the file names none" in run.stdout.splitlines()[0]) == (label == "guessed"), label
+    delta = write(tmp_path, re.sub(r"<plugin .*?</plugin>", "", delta_sdf()), "delta.sdf")  # through the graph
+    for label, path in (("guessed", guessed), ("marked", marked), ("guessed", delta)):
+        run = screwkit("analyze", path, "--json")
+        assert json.loads(run.stdout)["actuators_guessed"] == (label == "guessed"), label
+    assert "4 actuators (guessed: the file names none" in screwkit("analyze", delta).stdout.splitlines()[0]

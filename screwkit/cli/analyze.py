@@ -21,6 +21,7 @@ from screwkit.cli.options import (
 from screwkit.closure import forward
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
+from screwkit.io.locking import GUESSED
 from screwkit.model import Mechanism
 from screwkit.studies import indices_at_pose
 from screwkit.studies.coordinates import shown_number
@@ -52,7 +53,8 @@ def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items()) or "the file's configuration"
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
-    click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators, {report['dof']} DOF "
+    guessed = " (guessed: the file names none; --actuate names them)" if report.get("actuators_guessed") else ""
+    click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators{guessed}, {report['dof']} DOF "
                f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}")
     if report.get("dependent"):
         click.echo("  dependent (parasitic) coordinates: "
@@ -184,6 +186,7 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         report["assembly"] = list(loaded.assembly_notes)
     if loaded.import_report:  # a file of another tool: which body and which point the indices are for
         report["converted"] = list(loaded.import_report)
+        report["actuators_guessed"] = any(GUESSED in line for line in loaded.import_report)
     if as_json:
         click.echo(json.dumps(report))
     else:
@@ -229,6 +232,7 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
         shown = {name: shown_number(name, value, graph.length_scale)
                  for name, value in zip(graph.task_coordinates, graph.task_pose())}
     report = {**result.to_dict(), "mechanism": graph.name, "pose": shown, "converted": graph.report.lines()}
+    report["actuators_guessed"] = any(GUESSED in line for line in report["converted"])
     if as_json:
         click.echo(json.dumps(report))
     else:
