@@ -203,6 +203,7 @@ def test_gepetto_sps_leg_gives_the_leg_line_otis():
 # --- MJCF exports: MuJoCo's geometry, and what screwkit says of them -------------------------------------------
 
 REACHY = PUBLISHED / "reachy_mini" / "reachy_mini.xml"
+IITK = PUBLISHED / "lab_robots_iitk" / "5bar.xml"
 CASSIE = PUBLISHED / "agility_cassie" / "cassie.xml"
 
 
@@ -273,10 +274,11 @@ def mujoco_qpos(tree, mj_model, q) -> np.ndarray:
     return qpos
 
 
-@pytest.mark.parametrize("path", [REACHY, CASSIE], ids=["reachy_mini", "agility_cassie"])
+@pytest.mark.parametrize("path", [REACHY, CASSIE, IITK], ids=["reachy_mini", "agility_cassie", "lab_robots_iitk"])
 def test_mujoco_reads_the_published_mjcf_exports_as_screwkit_does(path):
     """Reachy Mini: sites closed by unnamed <connect>s, ball joints, quaternions to six digits; Cassie: no <compiler
-    angle> (degrees), eulerseq zyx, xyaxes frames, hinge refs, a free joint, ball joints, a home keyframe."""
+    angle> (degrees), eulerseq zyx, xyaxes frames, hinge refs, a free joint, ball joints, a home keyframe; the IITK
+    five-bar: a pen hinged on one distal link and <connect>ed to the other, position actuators."""
     tree = read_mjcf(path)
     mj_model = mujoco_model(path)
     assert mj_model.nq == tree.model.nq
@@ -532,3 +534,49 @@ def test_a_leg_ending_on_any_three_revolutes_that_meet_is_a_ball(tmp_path, axes)
     here, there = indices_at_pose(original, original.home_pose), indices_at_pose(other, original.home_pose)
     np.testing.assert_allclose(there.iti_actuators, here.iti_actuators, rtol=0, atol=1e-9)
     np.testing.assert_allclose([there.lmti, there.f_o[1]], [here.lmti, here.f_o[1]], rtol=0, atol=1e-9)
+
+
+def five_bar_pressure_angles(bases, elbows, point) -> tuple[np.ndarray, float]:
+    """A planar five-bar's textbook indices at its point ``point``: each actuator's ITI, the sine of the angle its
+    proximal link makes with its distal link, and (two actuators, no redundancy) the LMTI, the sine of the angle between
+    the two distal links (each leg's force is along its distal link; the point moves across the other one's)."""
+    def sine(first, second):
+        return abs(first[0] * second[1] - first[1] * second[0]) / np.linalg.norm(first) / np.linalg.norm(second)
+
+    itis = np.array([sine(elbow - base, point - elbow) for base, elbow in zip(bases, elbows)])
+    return itis, sine(point - elbows[0], point - elbows[1])
+
+
+def test_the_lab_robots_five_bar_has_the_textbook_pressure_angles_as_mujoco_places_it():
+    """The IITK teaching five-bar (MIT; 0.2 m links, motors 67 mm apart) opens as written with its pen named as the
+    output, and `analyze` gives the textbook values from MuJoCo's own placement of its bodies at the file's
+    configuration (the elbows 0.0335 m off the motors' line: ITI 0.1675), and at two other pen positions from the
+    elbows found as circle intersections here (the file's working mode: each elbow on its own side)."""
+    model = mujoco_model(IITK)
+    data = mujoco_data(model, model.qpos0.copy())
+    body = {name: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for name in
+            ("l1_left", "l1_right", "l2_left", "l2_right")}
+    bases = [data.xpos[body[name]][:2] for name in ("l1_left", "l1_right")]
+    elbows = [data.xpos[body[name]][:2] for name in ("l2_left", "l2_right")]
+    pen = data.site_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "site_pen")][:2]
+    run = screwkit("analyze", IITK, "--output", "site_pen", "--json")
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout)
+    itis, lmti = five_bar_pressure_angles(bases, elbows, pen)
+    np.testing.assert_allclose(list(found["iti_actuators"].values()), itis, atol=TOLERANCE)
+    assert found["lmti"] == pytest.approx(lmti, abs=TOLERANCE) and found["dof"] == 2
+    np.testing.assert_allclose([found["pose"]["x"], found["pose"]["y"]], pen, atol=TOLERANCE)
+    proximal, distal = 0.2, float(np.linalg.norm(pen - elbows[0]))
+    for point in (np.array([0.33, 0.02]), np.array([0.3, -0.05])):
+        run = screwkit("analyze", IITK, "--output", "site_pen", "--json", "--pose", *(repr(float(v)) for v in point))
+        assert run.returncode == 0, run.stderr
+        found, elbows = json.loads(run.stdout), []
+        for base, side in zip(bases, (1.0, -1.0)):  # the elbow on the motors' own side of the base-to-pen line
+            reach = point - base
+            length = float(np.linalg.norm(reach))
+            along = (proximal**2 - distal**2 + length**2) / (2.0 * length)
+            normal = np.array([-reach[1], reach[0]]) / length
+            elbows.append(base + along * reach / length + side * np.sqrt(proximal**2 - along**2) * normal)
+        itis, lmti = five_bar_pressure_angles(bases, elbows, point)
+        np.testing.assert_allclose(list(found["iti_actuators"].values()), itis, atol=TOLERANCE)
+        assert found["lmti"] == pytest.approx(lmti, abs=TOLERANCE)
