@@ -548,10 +548,11 @@ def five_bar_pressure_angles(bases, elbows, point) -> tuple[np.ndarray, float]:
 
 
 def test_the_lab_robots_five_bar_has_the_textbook_pressure_angles_as_mujoco_places_it():
-    """The IITK teaching five-bar (MIT; 0.2 m links, motors 67 mm apart) opens as written with its pen named as the
-    output, and `analyze` gives the textbook values from MuJoCo's own placement of its bodies at the file's
-    configuration (the elbows 0.0335 m off the motors' line: ITI 0.1675), and at two other pen positions from the
-    elbows found as circle intersections here (the file's working mode: each elbow on its own side)."""
+    """The IITK teaching five-bar (MIT; 0.2 m links, motors 67 mm apart) opens as written, its pen (where its one
+    <connect> joins the legs) the platform as when named as the output, and `analyze` gives the textbook values from
+    MuJoCo's own placement of its bodies at the file's configuration (the elbows 0.0335 m off the motors' line: ITI
+    0.1675), and at two other pen positions from the elbows found as circle intersections here (the file's working mode:
+    each elbow on its own side)."""
     model = mujoco_model(IITK)
     data = mujoco_data(model, model.qpos0.copy())
     body = {name: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for name in
@@ -559,9 +560,10 @@ def test_the_lab_robots_five_bar_has_the_textbook_pressure_angles_as_mujoco_plac
     bases = [data.xpos[body[name]][:2] for name in ("l1_left", "l1_right")]
     elbows = [data.xpos[body[name]][:2] for name in ("l2_left", "l2_right")]
     pen = data.site_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "site_pen")][:2]
-    run = screwkit("analyze", IITK, "--output", "site_pen", "--json")
-    assert run.returncode == 0, run.stderr
+    run, inferred = screwkit("analyze", IITK, "--output", "site_pen", "--json"), screwkit("analyze", IITK, "--json")
+    assert run.returncode == 0 and inferred.returncode == 0, run.stderr + inferred.stderr
     found = json.loads(run.stdout)
+    assert json.loads(inferred.stdout)["iti_actuators"] == pytest.approx(found["iti_actuators"], abs=1e-12)
     itis, lmti = five_bar_pressure_angles(bases, elbows, pen)
     np.testing.assert_allclose(list(found["iti_actuators"].values()), itis, atol=TOLERANCE)
     assert found["lmti"] == pytest.approx(lmti, abs=TOLERANCE) and found["dof"] == 2

@@ -199,7 +199,7 @@ def frame_position(graph) -> np.ndarray:
     """Where the graph's output frame is (world, m)."""
     import pinocchio as pin
 
-    from screwkit.io.star import output_frame
+    from screwkit.io.output import output_frame
 
     data = graph.tree.model.createData()
     pin.framesForwardKinematics(graph.tree.model, data, graph.q)

@@ -321,8 +321,11 @@ def test_two_actuators_on_one_joint_are_one_actuated_joint_as_mujoco_has_them(tm
 
 
 def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_for(tmp_path):
-    """No frame named as an output: the body where most closures meet is the platform, said in the report; with
-    one closure both of its bodies tie, and the file is refused with the option that names the platform."""
+    """No frame named as an output: the body where most closures meet is the platform, said in the report. With one
+    ball or pin closure (a two-legged five-bar), the body it closes onto, its output the point where the legs meet:
+    the indices of the file whose effector is named there, with the closure written either way round (a published
+    teaching five-bar and another needed --output for this). One weld between two legs is refused with the option
+    that names the platform."""
     plain, renamed = tmp_path / "plain.xml", tmp_path / "renamed.xml"
     plain.write_text(five_bar_mjcf())
     renamed.write_text(five_bar_mjcf().replace('name="effector"', 'name="marker"'))
@@ -330,10 +333,23 @@ def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_fo
     assert any("platform inferred: body 'distal_1', where 2 closures meet" in note for note in report.notes), report
     expected, got = (indices_at_pose(load(path), np.array(HOME)) for path in (plain, renamed))
     assert_indices_close(expected, got, TOLERANCE)
-    tie = tmp_path / "tie.xml"
+    named, tie, swapped, welded = (tmp_path / f"{name}.xml" for name in ("named", "tie", "swapped", "welded"))
+    named.write_text(five_bar_mjcf(legs=2))
     tie.write_text(five_bar_mjcf(legs=2).replace('name="effector"', 'name="marker"'))
+    _, report = read_mechanism_file(tie)
+    assert any("platform inferred: body 'distal_1', where closure 'loop_2' joins the legs" in note
+               for note in report.notes), report
+    anchor = " ".join(repr(float(v)) for v in (*(np.asarray(HOME) - five_bar_elbows(HOME)[0]), 0.0))
+    swapped.write_text(re.sub(r'<connect name="loop_2" body1="distal_2" body2="distal_1" anchor="[^"]*"/>',
+                              f'<connect name="loop_2" body1="distal_1" body2="distal_2" anchor="{anchor}"/>',
+                              tie.read_text()))
+    assert swapped.read_text() != tie.read_text()
+    expected = indices_at_pose(load(named), np.array(HOME))
+    for path in (tie, swapped):
+        assert_indices_close(expected, indices_at_pose(load(path), np.array(HOME)), TOLERANCE)
+    welded.write_text(re.sub(r' anchor="[^"]*"', "", tie.read_text().replace("<connect ", "<weld ")))
     with pytest.raises(ValueError, match="which body is the platform.*--output FRAME"):
-        load(tie)
+        load(welded)
 
 
 def test_unnamed_closures_several_world_bodies_and_degrees_open_as_mujoco_reads_them(tmp_path):

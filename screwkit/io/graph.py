@@ -72,7 +72,7 @@ from screwkit.io.graph_kinematics import (
     solve_poses,
 )
 from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
-from screwkit.io.star import output_frame
+from screwkit.io.output import output_frame
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
 

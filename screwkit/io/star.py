@@ -7,8 +7,9 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
 
 1. **Assembly** (:func:`~screwkit.io.closed_tree.assemble`): the closures closed near the file's
    joint values, gaps and working mode reported.
-2. **Platform.** The body carrying the output frame (named, or a frame called effector, eff, ee,
-   tool, tcp, foot or platform). Its own tree path from the root is one leg, welded to the platform.
+2. **Platform.** The body carrying the output frame (:func:`~screwkit.io.output.output_frame`: named, or a
+   frame called effector, eff, ee, tool, tcp, foot or platform, or where the legs meet). Its own tree path from
+   the root is one leg, welded to the platform.
 3. **Legs and loop joints.** Every closure onto the platform joins a leg (a tree path from the
    root that shares no joint with another leg) to it; the joints between the platform body and
    the closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
@@ -64,13 +65,11 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
+from screwkit.io.output import output_frame
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
 from screwkit.model.urdf_writer import UrdfWriter
 
-__all__ = ["convert_tree", "OUTPUT_NAMES", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
-
-OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
-"""Frame names taken as the output when none is given, in this order (case-insensitive)."""
+__all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
 
 UNLIMITED_SLIDE = 1e6
 """Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
@@ -81,35 +80,6 @@ largest, for them to count as independent (as :data:`screwkit.common.tolerances.
 
 
 # -- the star --------------------------------------------------------------------------------------
-
-
-def output_frame(tree: ClosedTree) -> int:
-    model = tree.model
-    names = [frame.name for frame in model.frames]
-    if tree.output is not None:
-        if tree.output not in names:
-            raise ImportError_(f"{tree.source}: no frame named {tree.output!r} for the output; frames are "
-                               + ", ".join(names[1:]) + ".")
-        return names.index(tree.output)
-    lowered = [name.lower() for name in names]
-    for candidate in OUTPUT_NAMES:
-        if candidate in lowered:
-            return lowered.index(candidate)
-    # no frame named as an output: the body where the most closures meet (where every leg ends), if one does
-    counts: dict[int, int] = {}
-    for closure in tree.closures:
-        for joint in {closure.joint_a, closure.joint_b} - {0}:
-            counts[joint] = counts.get(joint, 0) + 1
-    ranked = sorted(counts.items(), key=lambda item: -item[1])
-    if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]):
-        joint = ranked[0][0]
-        for index, frame in enumerate(model.frames):
-            if frame.parentJoint == joint and str(frame.type) == "BODY":
-                tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
-                                  "(name another with --output FRAME)")
-                return index
-    raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
-                       f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
 
 
 def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:

@@ -1,0 +1,52 @@
+"""Which frame of a closed tree is the output: the one named, else one called as outputs are, else where the legs meet.
+
+A file of another tool seldom says which body is the platform. :func:`output_frame` takes the frame given
+(``--output FRAME``), else the first frame called one of :data:`OUTPUT_NAMES`, else the body where the most
+closures meet (where every leg ends), else the body that the one ball or pin closure of a two-legged mechanism
+closes onto (a five-bar's pen: the point where its legs meet is then its output). The notes say which was inferred.
+"""
+
+from __future__ import annotations
+
+from screwkit.io.closed_tree import ClosedTree, ImportError_
+
+__all__ = ["output_frame", "OUTPUT_NAMES"]
+
+OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
+"""Frame names taken as the output when none is given, in this order (case-insensitive)."""
+
+
+def output_frame(tree: ClosedTree) -> int:
+    model = tree.model
+    names = [frame.name for frame in model.frames]
+    if tree.output is not None:
+        if tree.output not in names:
+            raise ImportError_(f"{tree.source}: no frame named {tree.output!r} for the output; frames are "
+                               + ", ".join(names[1:]) + ".")
+        return names.index(tree.output)
+    lowered = [name.lower() for name in names]
+    for candidate in OUTPUT_NAMES:
+        if candidate in lowered:
+            return lowered.index(candidate)
+    # no frame named as an output: the body where the most closures meet (where every leg ends), if one does
+    counts: dict[int, int] = {}
+    for closure in tree.closures:
+        for joint in {closure.joint_a, closure.joint_b} - {0}:
+            counts[joint] = counts.get(joint, 0) + 1
+    ranked = sorted(counts.items(), key=lambda item: -item[1])
+    if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]):
+        joint = ranked[0][0]
+        for index, frame in enumerate(model.frames):
+            if frame.parentJoint == joint and str(frame.type) == "BODY":
+                tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
+                                  "(name another with --output FRAME)")
+                return index
+    if len(tree.closures) == 1 and tree.closures[0].kind == "3d":  # two legs meeting at one ball or pin: its point
+        closure = tree.closures[0]
+        for index, frame in enumerate(model.frames):
+            if frame.parentJoint == (closure.joint_b or closure.joint_a) and str(frame.type) == "BODY":
+                tree.notes.append(f"platform inferred: body {frame.name!r}, where closure {closure.name!r} joins the "
+                                  "legs (name another with --output FRAME)")
+                return index
+    raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
+                       f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
