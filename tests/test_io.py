@@ -632,11 +632,13 @@ def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_co
 
 
 def test_the_output_frame_a_message_asks_for_is_an_option_of_every_command(tmp_path):
-    """A two-leg five-bar with no output frame: its two bodies tie, the one-line error asks for --output FRAME,
-    and analyze, info and sweep take it (the marker site names distal_1: the textbook five-bar)."""
-    tie = tmp_path / "tie.xml"
+    """Two legs welded to each other with no output frame named: the one-line error asks for --output FRAME; a
+    two-leg five-bar (one pin closure: its point is taken) takes it in analyze, info and sweep (the marker site
+    names distal_1: the textbook five-bar)."""
+    tie, welded = tmp_path / "tie.xml", tmp_path / "welded.xml"
     tie.write_text(five_bar_mjcf(legs=2).replace('name="effector"', 'name="marker"'))
-    refused = screwkit("analyze", tie)
+    welded.write_text(re.sub(r' anchor="[^"]*"', "", tie.read_text().replace("<connect ", "<weld ")))
+    refused = screwkit("analyze", welded)
     assert refused.returncode == 1 and refused.stderr.count("\n") == 1 and "--output FRAME" in refused.stderr
     analysed = screwkit("analyze", tie, "--output", "marker", "--json")
     assert analysed.returncode == 0, analysed.stderr
