@@ -12,15 +12,18 @@ holds one. Invariance to the length unit and the world frame is checked on the C
 
 from __future__ import annotations
 
+import re
 from itertools import combinations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
-from helpers import assert_indices_close, couple_cti, moved, random_rotation, screwkit
+from helpers import assert_indices_close, couple_cti, in_unit, moved, random_rotation, screwkit
 from screwkit.closure import chain_screws, solve
+from screwkit.closure.task_space import choose_task_axes
 from screwkit.indices.analysis import analyze
-from screwkit.io.loader import load_text
+from screwkit.io.loader import bundled_path, load_text
 from screwkit.robots.generate import PRS_UPS, prs_mechanism
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.studies.poses import analyze_solution, indices_at_poses
@@ -336,6 +339,47 @@ def test_a_spherical_wrist_is_given_three_rotations_whatever_point_its_frame_is_
     assert inferred.task_coordinates == ("roll", "pitch", "yaw") and inferred.task_source == "inferred"
     poses = declared.home_pose + np.deg2rad([[0.0, 0.0, 0.0], [10.0, -5.0, 15.0]])
     assert_indices_close(indices_at_poses(declared, poses), indices_at_poses(inferred, poses), 1e-12)
+
+
+def three_leg_delta_with_a_turned_universal(turn: float) -> str:
+    """The bundled Delta (robots/delta_4.urdf) with its fourth leg left out and leg 1's platform universal joint's
+    second axis turned by ``turn`` rad: that leg no longer keeps the platform's orientation, which turns a little as
+    it moves (no motion of the platform is a pure translation)."""
+    text = bundled_path("delta_4").read_text(encoding="utf-8")
+    text = re.sub(r'\s*<(link|joint|loop|transmission) name="leg_4[^"]*"(?:(?!</\1>).)*</\1>', "", text, flags=re.S)
+    text = re.sub(r"\s*<named_pose [^>]*/>", "", text)
+    turned = f'<axis2 xyz="{float(np.sin(turn))!r} 0 {float(np.cos(turn))!r}" />'
+    return text.replace('<axis2 xyz="0 0 1.0000000000000002" />', turned, 1)
+
+
+@pytest.mark.parametrize("unit", [1.0, 1e-3])
+def test_a_delta_that_turns_a_little_as_it_moves_is_driven_in_x_y_z(unit):
+    """Three legs of the bundled Delta, one universal joint's axis turned 0.15 rad: the platform turns as it moves
+    (a pose 2 cm off its home in x turns it by more than 1e-3 rad), but every motion moves it more than it turns it
+    (x, y, z tell its motions apart by 0.975 in length scales): its task coordinates are x, y, z, in metres and in
+    millimetres. The rule took x, y, then a rotation (the motion space has two pure translations)."""
+    text = three_leg_delta_with_a_turned_universal(0.15)
+    mechanism = load_text(text if unit == 1.0 else in_unit(text, "mm", 1.0 / unit), "delta_3.urdf")
+    assert mechanism.task_coordinates == ("x", "y", "z") and mechanism.task_source == "inferred"
+    solution = solve(mechanism, mechanism.home_pose + np.array([[0.02 / unit, 0.0, 0.0]]))
+    assert solution.reachable.all()
+    angles = np.asarray(mechanism.pose_angular, dtype=bool)
+    assert np.max(np.abs(solution.full_poses[0][angles] - mechanism.home_full_pose[angles])) > 1e-3
+
+
+@pytest.mark.parametrize("turn", [0.0, 90.0, 33.0])
+def test_the_translations_taken_are_the_same_motions_in_a_turned_world(turn):
+    """A two-DOF motion space, a vertical translation and a motion mostly along one horizontal direction turning a
+    little about the vertical, its world turned about the vertical: the task coordinates are the pair of translations
+    that tells the motions apart best (x, z; y, z; or the better of them), not the first independent in x, y, z order,
+    which took x, 0.01 independent, when the horizontal motion was along y, and then fell back to z and yaw."""
+    rotation = Rotation.from_euler("z", turn, degrees=True).as_matrix()
+    lift, swing = np.array([0, 0, 1.0, 0, 0, 0]), np.array([0.9, 0.01, 0.0, 0.0, 0.0, 0.43])
+    motions = [np.concatenate([rotation @ motion[:3], rotation @ motion[3:]]) for motion in (lift, swing)]
+    space, _ = np.linalg.qr(np.column_stack(motions))
+    axes = choose_task_axes(space, np.array([False] * 3 + [True] * 3), 2)
+    horizontal = rotation @ np.array([0.9, 0.01, 0.0])
+    assert axes == (int(np.argmax(np.abs(horizontal[:2]))), 2)
 
 
 def test_a_spherical_wrist_has_no_cti_and_says_why(tmp_path):

@@ -324,8 +324,8 @@ def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_fo
     """No frame named as an output: the body where most closures meet is the platform, said in the report. With one
     ball or pin closure (a two-legged five-bar), the body it closes onto, its output the point where the legs meet:
     the indices of the file whose effector is named there, with the closure written either way round (a published
-    teaching five-bar and another needed --output for this). One weld between two legs is refused with the option
-    that names the platform."""
+    teaching five-bar and another needed --output for this). One weld between two legs, one pin onto the world, or the
+    two-legged five-bar asked for a frame output (whose body's?) is refused with the option that names the platform."""
     plain, renamed = tmp_path / "plain.xml", tmp_path / "renamed.xml"
     plain.write_text(five_bar_mjcf())
     renamed.write_text(five_bar_mjcf().replace('name="effector"', 'name="marker"'))
@@ -348,8 +348,11 @@ def test_the_platform_is_the_body_where_most_closures_meet_and_a_tie_is_asked_fo
     for path in (tie, swapped):
         assert_indices_close(expected, indices_at_pose(load(path), np.array(HOME)), TOLERANCE)
     welded.write_text(re.sub(r' anchor="[^"]*"', "", tie.read_text().replace("<connect ", "<weld ")))
-    with pytest.raises(ValueError, match="which body is the platform.*--output FRAME"):
-        load(welded)
+    grounded = tmp_path / "grounded.xml"  # the closure onto the world: one leg, no meeting of two
+    grounded.write_text(tie.read_text().replace(' body2="distal_1"', ""))
+    for path, options in ((welded, {}), (grounded, {}), (tie, {"output_type": "frame"})):  # (a frame: whose?)
+        with pytest.raises(ValueError, match="which body is the platform.*--output FRAME"):
+            load(path, **options)
 
 
 def test_unnamed_closures_several_world_bodies_and_degrees_open_as_mujoco_reads_them(tmp_path):

@@ -12,6 +12,7 @@ constraining chains together, with continuation from the reference assembly.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 
 import numpy as np
 from numpy.typing import NDArray
@@ -289,12 +290,14 @@ def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None
     """The rule of :func:`infer_task_axes` on ``space`` (n_pose, d): the pose-coordinate rates of a basis of the
     motion space (lengths in units of the length scale), ``angular`` which coordinates are angles."""
     chosen = _task_axes_in_order(space, angular, dof, candidates)
-    if candidates is None and 0 < dof <= int(np.sum(~angular)):  # motions that move the frame more than they turn
-        # it are told apart by translations: a Delta whose rod pairs are not quite parallelograms turns 0.19 rad per
+    every = candidates is None or len(list(candidates)) == space.shape[0]  # (not a point output's translations)
+    if every and 0 < dof <= int(np.sum(~angular)) and any(angular[axis] for axis in chosen):
+        # motions that move the frame more than they turn it are told apart by translations, the set of them that
+        # does so best (in any world frame): a Delta whose rod pairs are not quite parallelograms turns 0.19 rad per
         # length scale, and its roll, pitch, yaw told its motions apart by 0.0015 against x, y, z's 0.98
-        moved = _task_axes_in_order(space, angular, dof, np.flatnonzero(~angular), split=False)
-        if len(moved) == dof and _separation(space, moved) >= TRANSLATIONAL:
-            return moved
+        best = max(combinations(np.flatnonzero(~angular), dof), key=lambda axes: _separation(space, axes))
+        if _separation(space, best) >= TRANSLATIONAL:
+            return tuple(int(axis) for axis in best)
     return chosen
 
 
@@ -303,11 +306,10 @@ def _separation(space: NDArray, axes) -> float:
     return float(np.linalg.svd(space[list(axes)], compute_uv=False)[-1])
 
 
-def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=None, split: bool = True
-                        ) -> tuple[int, ...]:
+def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=None) -> tuple[int, ...]:
     order = list(range(space.shape[0])) if candidates is None else list(candidates)
     chosen: list[int] = []
-    if split and len(order) == space.shape[0] and space.shape[1]:
+    if len(order) == space.shape[0] and space.shape[1]:
         _, singular, rows = np.linalg.svd(space[angular], full_matrices=True)
         turning = int(np.sum(singular > TASK_RANK_TOLERANCE))
         translations = space @ rows[turning:].T  # the motions that turn the platform by nothing

@@ -41,10 +41,13 @@ def output_frame(tree: ClosedTree) -> int:
                 tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
                                   "(name another with --output FRAME)")
                 return index
-    if len(tree.closures) == 1 and tree.closures[0].kind == "3d":  # two legs meeting at one ball or pin: its point
-        closure = tree.closures[0]
+    closure = tree.closures[0] if len(tree.closures) == 1 else None
+    if closure is not None and closure.kind == "3d" and closure.joint_a and closure.joint_b \
+            and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
+        # two legs meeting at one ball or pin the file places: its point is the output, the same on either body
+        # (their frames are not, nor the point of a loop cut where the file's order puts the cut)
         for index, frame in enumerate(model.frames):
-            if frame.parentJoint == (closure.joint_b or closure.joint_a) and str(frame.type) == "BODY":
+            if frame.parentJoint == closure.joint_b and str(frame.type) == "BODY":
                 tree.notes.append(f"platform inferred: body {frame.name!r}, where closure {closure.name!r} joins the "
                                   "legs (name another with --output FRAME)")
                 return index

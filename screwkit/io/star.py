@@ -290,9 +290,10 @@ def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
 
 
 def _base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
-    """World frame of the written base: z along a planar mechanism's normal; its origin the world's, or where a world
-    axis the normal is parallel to the file's rounding meets the plane through ``point``: the plane's x, y are then
-    the world's to second order in the rounding however far the plane is (turned about the origin, they were not)."""
+    """World frame of the written base: z along a planar mechanism's normal, its origin where the world axis nearest
+    to it meets the plane through ``point`` (the world's for a spatial mechanism): the plane's x, y are then the
+    world's to second order in the normal's rounding however far the plane is (turned about the world's origin, they
+    were not), and they change with the normal continuously (a threshold on its tilt left a jump there)."""
     frame = np.eye(4)
     if normal is None:
         return frame
@@ -302,8 +303,7 @@ def _base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
         x = np.array([0.0, 1.0, 0.0]) - z[1] * z
     x, axis = x / np.linalg.norm(x), int(np.argmax(np.abs(z)))
     frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    if np.linalg.norm(np.delete(z, axis)) <= FILE_ROUNDING:
-        frame[axis, 3] = float(z @ point) / z[axis]
+    frame[axis, 3] = float(z @ point) / z[axis]
     return frame
 
 
