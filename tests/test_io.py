@@ -634,6 +634,20 @@ def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_co
     assert again["lmti"] == pytest.approx(json.loads(analysed.stdout)["lmti"], abs=1e-12)
 
 
+@pytest.mark.parametrize("name", ["ee_link", "tool0", "Effector_Frame"])
+def test_a_tool_frame_named_as_ros_packages_name_theirs_is_the_output(tmp_path, name):
+    """A two-legged five-bar whose effector site is called ee_link, tool0 or Effector_Frame (a published Delta's tool
+    frame is ee_link, and `--output ee_link` was needed): it is the output, said in the report, with the indices of
+    the file whose site is called effector."""
+    named, renamed = tmp_path / "named.xml", tmp_path / "renamed.xml"
+    named.write_text(five_bar_mjcf(legs=2))
+    renamed.write_text(five_bar_mjcf(legs=2).replace('name="effector"', f'name="{name}"'))
+    _, report = read_mechanism_file(renamed)
+    assert any(f"output frame inferred: {name!r}" in note for note in report.notes), report.notes
+    assert_indices_close(indices_at_pose(load(named), np.array(HOME)), indices_at_pose(load(renamed), np.array(HOME)),
+                         TOLERANCE)
+
+
 def test_the_output_frame_a_message_asks_for_is_an_option_of_every_command(tmp_path):
     """Two legs welded to each other with no output frame named: the one-line error asks for --output FRAME; a
     two-leg five-bar (one pin closure: its point is taken) takes it in analyze, info and sweep (the marker site

@@ -1,19 +1,22 @@
 """Which frame of a closed tree is the output: the one named, else one called as outputs are, else where the legs meet.
 
-A file of another tool seldom says which body is the platform. :func:`output_frame` takes the frame given
-(``--output FRAME``), else the first frame called one of :data:`OUTPUT_NAMES`, else the body where the most
-closures meet (where every leg ends), else the body that the one ball or pin closure of a two-legged mechanism
-closes onto (a five-bar's pen: the point where its legs meet is then its output). The notes say which was inferred.
+A file of another tool seldom says which body is the platform. :func:`output_frame` takes the frame given (``--output
+FRAME``), else the first frame called one of :data:`OUTPUT_NAMES`, else the body where the most closures meet (where
+every leg ends), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one ball or
+pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is then its output).
+The notes say which was inferred.
 """
 
 from __future__ import annotations
 
 from screwkit.io.closed_tree import ClosedTree, ImportError_
 
-__all__ = ["output_frame", "OUTPUT_NAMES"]
+__all__ = ["output_frame", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
 
 OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
 """Frame names taken as the output when none is given, in this order (case-insensitive)."""
+OUTPUT_SUFFIXES = ("_link", "_frame", "0")
+"""Endings of the :data:`OUTPUT_NAMES` also taken, after the body where most closures meet (``ee_link``, ``tool0``)."""
 
 
 def output_frame(tree: ClosedTree) -> int:
@@ -41,6 +44,11 @@ def output_frame(tree: ClosedTree) -> int:
                 tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
                                   "(name another with --output FRAME)")
                 return index
+    for candidate in (name + suffix for suffix in OUTPUT_SUFFIXES for name in OUTPUT_NAMES):
+        if candidate in lowered:  # a tool frame named as ROS packages name theirs: ee_link, tool0
+            tree.notes.append(f"output frame inferred: {names[lowered.index(candidate)]!r} (name another with "
+                              "--output FRAME)")
+            return lowered.index(candidate)
     closure = tree.closures[0] if len(tree.closures) == 1 else None
     if closure is not None and closure.kind == "3d" and closure.joint_a and closure.joint_b \
             and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
