@@ -686,7 +686,9 @@ def test_a_file_of_one_dof_is_analysed_and_swept_on_the_command_line(tmp_path):
     assert report["dof"] == 1 and set(report["f_o"]) == {"1", "2"}
     iti = np.array(list(report["iti_actuators"].values()))
     assert 0 < report["lmti"] <= 1 and report["lmti"] <= iti.max() + 1e-12
-    swept = screwkit("sweep", path, "--sweep", "phi:-2:3:1")
+    described = json.loads(screwkit("info", path, "--json").stdout)  # its frame moves more than it turns (in
+    assert [coordinate["name"] for coordinate in described["task_coordinates"]] == ["x"]  # length scales): x
+    swept = screwkit("sweep", path, "--sweep", "x:-0.1:0.15:0.05")
     assert swept.returncode == 0, swept.stderr
     assert len(swept.stdout.splitlines()) == 6
 
