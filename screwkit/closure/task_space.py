@@ -295,8 +295,9 @@ def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None
         # motions that move the frame more than they turn it are told apart by translations, the set of them that
         # does so best (in any world frame): a Delta whose rod pairs are not quite parallelograms turns 0.19 rad per
         # length scale, and its roll, pitch, yaw told its motions apart by 0.0015 against x, y, z's 0.98
-        best = max(combinations(np.flatnonzero(~angular), dof), key=lambda axes: _separation(space, axes))
-        if _separation(space, best) >= TRANSLATIONAL:
+        sets = combinations(np.flatnonzero(~angular), dof)
+        separation, best = max(((_separation(space, axes), axes) for axes in sets), key=lambda pair: pair[0])
+        if separation >= TRANSLATIONAL:
             return tuple(int(axis) for axis in best)
     return chosen
 

@@ -38,12 +38,11 @@ def output_frame(tree: ClosedTree) -> int:
             counts[joint] = counts.get(joint, 0) + 1
     ranked = sorted(counts.items(), key=lambda item: -item[1])
     if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]):
-        joint = ranked[0][0]
-        for index, frame in enumerate(model.frames):
-            if frame.parentJoint == joint and str(frame.type) == "BODY":
-                tree.notes.append(f"platform inferred: body {frame.name!r}, where {ranked[0][1]} closures meet "
-                                  "(name another with --output FRAME)")
-                return index
+        index = _body_frame(model, ranked[0][0])
+        if index is not None:
+            tree.notes.append(f"platform inferred: body {names[index]!r}, where {ranked[0][1]} closures meet "
+                              "(name another with --output FRAME)")
+            return index
     for candidate in (name + suffix for suffix in OUTPUT_SUFFIXES for name in OUTPUT_NAMES):
         if candidate in lowered:  # a tool frame named as ROS packages name theirs: ee_link, tool0
             tree.notes.append(f"output frame inferred: {names[lowered.index(candidate)]!r} (name another with "
@@ -54,10 +53,16 @@ def output_frame(tree: ClosedTree) -> int:
             and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
         # two legs meeting at one ball or pin the file places: its point is the output, the same on either body
         # (their frames are not, nor the point of a loop cut where the file's order puts the cut)
-        for index, frame in enumerate(model.frames):
-            if frame.parentJoint == closure.joint_b and str(frame.type) == "BODY":
-                tree.notes.append(f"platform inferred: body {frame.name!r}, where closure {closure.name!r} joins the "
-                                  "legs (name another with --output FRAME)")
-                return index
+        index = _body_frame(model, closure.joint_b)
+        if index is not None:
+            tree.notes.append(f"platform inferred: body {names[index]!r}, where closure {closure.name!r} joins the "
+                              "legs (name another with --output FRAME)")
+            return index
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
                        f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
+
+
+def _body_frame(model, joint: int) -> int | None:
+    """The index of the body frame moved by ``joint``, if it has one."""
+    return next((index for index, frame in enumerate(model.frames)
+                 if frame.parentJoint == joint and str(frame.type) == "BODY"), None)

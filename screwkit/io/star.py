@@ -207,8 +207,8 @@ def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]
         return _twists(triples + leg.loop_dofs, leg.successor_world[:3, 3], scale)
 
     kept = list(leg.joints)
-    while not _independent(rows(kept), FILE_ROUNDING):
-        rank, best = np.linalg.matrix_rank(rows(kept), tol=FILE_ROUNDING), (0.0, None)
+    while not _independent(current := rows(kept), FILE_ROUNDING):
+        rank, best = np.linalg.matrix_rank(current, tol=FILE_ROUNDING), (0.0, None)
         for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
             trial = np.linalg.svd(rows([j for j in kept if j != joint]), compute_uv=False)
             margin = trial[rank - 1] / trial[0] if trial.size >= rank else 0.0
