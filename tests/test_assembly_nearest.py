@@ -562,16 +562,18 @@ def test_a_weak_closing_direction_within_the_floor_s_reach_is_closed_however_dra
 def test_a_loop_beside_an_independent_rounded_one_closes_as_it_does_alone(opened):
     """The tilted four-bar above, with a rounded 0.5 m four-bar beside it that shares none of its joints and closes
     only to its rounding (1e-6 to 2e-6 m open): the tilted one still closes at q = 0 exactly, as alone, and the other
-    stays on its floor. The floor's cut was taken from every closure's residual: the other's, ten times the tilted
+    stays on its floor, drawn as written or with the tilted one's frames along their axes and the closures listed the
+    other way round. The floor's cut was taken from every closure's residual: the other's, ten times the tilted
     one's, dropped the tilted one's closing direction and slid it back to the file's values (0.003-0.05 rad off)."""
-    alone = tilted_four_bar(opened, 1e-5)
-    model, closures = alone.model, list(alone.closures)
-    rounded_four_bar(model, closures, "other", [0.1, 0.8, 0.0], 0.5, np.random.default_rng(5), 2e-6, crank=0.9)
-    tree = ClosedTree("two loops", model, closures, ["crank", "other_crank"],
-                      np.concatenate([alone.q_reference, np.zeros(3)]))
-    gap = closure_gaps(tree, tree.q_reference)["other_ball"]
-    assert 5e-7 < gap < 5e-6
-    q, _ = assemble(tree)
-    np.testing.assert_allclose(q[:3], 0.0, atol=1e-9)
-    gaps = closure_gaps(tree, q)
-    assert gaps["ball"] < 1e-12 and 0.0 < gaps["other_ball"] <= gap and any("at best" in note for note in tree.notes)
+    for along, order in (((0.0, 0.0, 0.0), 1), ((0.1, -0.2, 0.15), -1)):  # also drawn otherwise, listed reversed
+        alone = tilted_four_bar(opened, 1e-5, along)
+        model, closures = alone.model, list(alone.closures)
+        rounded_four_bar(model, closures, "other", [0.1, 0.8, 0.0], 0.5, np.random.default_rng(5), 2e-6, crank=0.9)
+        tree = ClosedTree("two loops", model, closures[::order], ["crank", "other_crank"],
+                          np.concatenate([alone.q_reference, np.zeros(3)]))
+        gap = closure_gaps(tree, tree.q_reference)["other_ball"]
+        assert 5e-7 < gap < 5e-6
+        q, _ = assemble(tree)
+        np.testing.assert_allclose(q[:3], 0.0, atol=1e-9, err_msg=f"drawn {along}, order {order}")
+        gaps = closure_gaps(tree, q)
+        assert gaps["ball"] < 1e-12 and 0.0 < gaps["other_ball"] <= gap and any("at best" in n for n in tree.notes)
