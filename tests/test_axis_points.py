@@ -226,3 +226,23 @@ def test_the_drawn_point_is_kept_where_the_line_does_not_decide():
     np.testing.assert_allclose(screws.joint_lines(twists, apart, -1), [0, 0, 1.0])  # on its own line
     prismatic = np.array([[0, 0, 0, 1.0, 0, 0]])
     assert not np.any(screws.joint_lines(prismatic, np.zeros((1, 3)), 0))
+
+
+@pytest.mark.parametrize("noise", [0.0, 1e-17, 1.6e-11, 9e-11])
+def test_a_couple_found_with_rounding_in_its_force_has_no_axis(noise):
+    """A constraint couple found by a singular value decomposition carries a force of rounding (1.6e-11 of its
+    moment for a U-P-U leg): its "axis" is then |m| / |f| away, and the moment about a point on it mistook the couple
+    for a force of huge pitch (the numpy reference's CTI of the U-P-U platform 0.0301 against 0.0084). The drawn
+    point is kept, and the power coefficient is the couple's |m . omega| / (|m| |omega|)."""
+    rng = np.random.default_rng(3)
+    moment = np.array([0.0282, 0.0, 0.9996])
+    side = rng.normal(size=3)
+    couple = np.concatenate([noise * side / np.linalg.norm(side), moment])  # |f| = noise |m| (|m| about 1)
+    point, direction = np.array([0.3, -0.2, 1.1]), np.array([0.0, 1.0, 0.0])
+    np.testing.assert_array_equal(screws.nearest_on_axis(couple, point, direction), point)
+    twist = np.array([0.2699, -0.9276, 0.0005, 0.2479, 0.0721, -0.0082])
+    expected = abs(moment @ twist[:3]) / np.linalg.norm(moment) / np.linalg.norm(twist[:3])
+    found = screws.power_coefficient(couple, twist, screws.nearest_on_axis(couple, point, direction), THRESHOLD)
+    assert abs(float(found) - expected) < 1e-9
+    force = np.concatenate([[0.0, 0.0, 1e-6], moment])  # a force of pitch 1e6 lengths: not a couple, on its axis
+    assert np.linalg.norm(screws.nearest_on_axis(force, point, direction) - point) > 1.0

@@ -14,6 +14,7 @@ from screwkit.cli.options import (
     reading_options,
 )
 from screwkit.closure import working_modes
+from screwkit.closure.assembly import MODES_MEET
 from screwkit.common.units import unit_of
 from screwkit.io import GraphMechanism
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES
@@ -111,6 +112,9 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     if report["instantaneous_dof_at_home"] > report["dof"]:
         click.echo(f"  the home pose is a constraint singularity: {report['instantaneous_dof_at_home']} "
                    "instantaneous DOF")
+    modes = [note for note in report["assembly_notes"] if note.startswith(MODES_MEET)]
+    for note in modes:  # where operation modes meet there: which is followed
+        click.echo(f"  {note}")
     if report["output"] == "point":
         click.echo("  output: the platform frame's origin, a point (rotations about it are idle)")
     kind = "planar" if loaded.is_planar else "a leg's body" if isinstance(loaded, GraphMechanism) else "floating"
@@ -123,7 +127,7 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
                    f"loop {chain['loop']} ({chain['loop_type']})")
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
         click.echo(f"      working mode: {chain['working_mode']}")
-    for note in report["assembly_notes"]:
+    for note in (note for note in report["assembly_notes"] if note not in modes):
         click.echo(f"  assembled: {note}")
     if report["import_report"]:
         click.echo("  converted from " + report["import_report"][0])

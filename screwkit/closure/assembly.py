@@ -22,6 +22,7 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
+from screwkit.closure.modes import describe_modes, meeting_modes
 from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form
 from screwkit.closure.task_space import (
@@ -43,7 +44,7 @@ from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 
 __all__ = ["assemble", "mobility", "mobility_notes", "rounded_dof_note", "working_modes", "LIMITS_IGNORED",
-           "DOF_AT_ROUNDING", "DOF_MARGIN", "NOT_OPEN_LOOPS"]
+           "DOF_AT_ROUNDING", "DOF_MARGIN", "MODES_MEET", "NOT_OPEN_LOOPS"]
 
 
 LIMITS_IGNORED = "limits ignored: "
@@ -52,7 +53,13 @@ reference assembly outside a joint's limits, read with ``limits=False``."""
 DOF_AT_ROUNDING = "DOF decided at the file's rounding: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that says the DOF count turns on
 a singular value of the order of a file's rounding (:func:`mobility_notes`)."""
-NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING)
+MODES_MEET = "operation modes: "
+"""How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that names the operation modes
+meeting at a constraint-singular reference assembly and the one followed
+(:func:`screwkit.closure.modes.describe_modes`)."""
+MODE_SAMPLES = 18
+"""Samples added near a constraint-singular reference assembly to find the operation modes that meet there."""
+NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, MODES_MEET)
 """The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
 DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
 """Relative: a singular value counted by :func:`mobility` (above :data:`MOTION_SPACE_TOLERANCE`) but at most this is
@@ -289,16 +296,6 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
                               solver_reason=reason))
     dof, notes = mobility_notes(mechanism, tuple(solved))
     mechanism = replace(mechanism, chains=tuple(solved), assembly_notes=mechanism.assembly_notes + tuple(notes))
-    actuators = mechanism.actuator_names
-    needed = dof  # a point output: its DOF, the rotations about it need no actuator
-    if mechanism.output_point is not None:
-        needed = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains], dof)
-    if len(actuators) < needed:
-        raise mechanism.description.fail(
-            f"<robot name='{mechanism.name}'>",
-            f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
-            f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF; or name "
-            "them with --actuate JOINT in a file of another tool).")
     return replace(mechanism, dof=dof)
 
 
@@ -333,6 +330,18 @@ def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0):
     return chains, poses[converged], [v[converged] for v in values]
 
 
+def _check_actuator_count(mechanism: Mechanism, needed: int) -> None:
+    """At least as many actuators as the output's DOF (its mobility, not the instantaneous DOF at the reference
+    assembly: a 3-UPU built at its constraint singularity has 5 there, and its 3 slides drive it)."""
+    actuators = mechanism.actuator_names
+    if len(actuators) < needed:
+        raise mechanism.description.fail(
+            f"<robot name='{mechanism.name}'>",
+            f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
+            f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF; or name "
+            "them with --actuate JOINT in a file of another tool).")
+
+
 def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) -> Mechanism:
     """The mechanism with its mobility, its instantaneous DOF at the reference assembly and its task coordinates.
 
@@ -349,6 +358,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     mobility, at_pose, at_values = (instantaneous, mechanism.home_full_pose,
                                     [c.reference_values for c in mechanism.chains])
     chains = constraining_chains(mechanism)
+    modes = []
     if chains:
         chain_indices, poses, values = _generic_samples(mechanism)
         if poses.shape[0]:
@@ -361,6 +371,11 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                 at_values = [c.reference_values for c in mechanism.chains]
                 for index, chain_values in zip(chain_indices, values):
                     at_values[index] = chain_values[sample]
+                if not idle:  # a constraint singularity: the operation modes that meet there, each tried
+                    more = _generic_samples(mechanism, MODE_SAMPLES, seed=1)
+                    modes = meeting_modes(mechanism, chain_indices, np.concatenate([poses, more[1]]),
+                                          [np.concatenate(pair) for pair in zip(values, more[2])], mobility,
+                                          None)
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
@@ -372,6 +387,14 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         raise mechanism.description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move: its chains "
                                          "leave it no motion at the reference assembly (DOF 0).")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
+    _check_actuator_count(mechanism, mobility)
+    if len(modes) > 1:
+        if declared is not None:  # the mode in which the declared coordinates are independent, if one
+            axes = [names.index(name) for name in declared if name in names]
+            modes = sorted(modes, key=lambda mode: np.linalg.svd(mode.space[axes], compute_uv=False)[-1] <= 1e-6)
+        at_pose, at_values = modes[0].pose, list(modes[0].values)
+        mechanism = replace(mechanism, assembly_notes=mechanism.assembly_notes
+                            + (MODES_MEET + describe_modes(mechanism, modes),))
     candidates = [i for i, name in enumerate(names) if not (idle and name in ("phi", "roll", "pitch", "yaw"))]
     if declared is not None:
         unknown = [name for name in declared if name not in names]

@@ -85,7 +85,7 @@ def _structure(chains: list[ChainScrews], batch_shape: tuple[int, ...], count: i
         chains = with_idle_joints(chains, idle, idle_points, centre, length, index)
     plan = make_plan(chains, dof, faults, threshold, rank_tolerance, 0 if idle is None else idle.shape[-2])
     # a platform free in all six DoF: every chain's twists span all twists, so no chain holds a constraint wrench
-    constraint_plan = (constraint_plan_of(chains, count) if plan.space.dof < 6
+    constraint_plan = (constraint_plan_of(chains, count, plan.space.dof) if plan.space.dof < 6
                        else ConstraintPlan(tuple(0 for _ in chains), 0))
     return chains, idle, plan, constraint_plan
 

@@ -303,12 +303,13 @@ def joints_of_all_chains(arrays: list[NDArray]):
     return lambda part: np.concatenate([a[part] for a in arrays], axis=1)
 
 
-def constraint_plan_of(chains: list[ChainScrews], count: int) -> ConstraintPlan:
-    """The constraint structure of the chains, found on up to 9 configurations spread over the batch."""
+def constraint_plan_of(chains: list[ChainScrews], count: int, mobility: int | None = None) -> ConstraintPlan:
+    """The constraint structure of the chains, found on up to 9 configurations spread over the batch (``mobility``:
+    :func:`~screwkit.screw.constraints.plan_constraints`)."""
     if not count:
         return ConstraintPlan(tuple(0 for _ in chains), 0)
     _, working, _, _, _ = sampled_working_coordinates(chains)
-    return plan_constraints(working)
+    return plan_constraints(working, mobility)
 
 
 def constraint_chunk(plan: Plan, constraint_plan: ConstraintPlan, spaces: ChunkSpaces, wrenches,

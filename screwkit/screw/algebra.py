@@ -151,7 +151,9 @@ def nearest_on_axis(screw: ArrayLike, point: ArrayLike, direction: ArrayLike, le
     crosses the joint's axis. The projection of ``point`` (:func:`project_on_axis`) when the screw is not a force
     (its pitch above :data:`~screwkit.common.tolerances.ZERO_PITCH` times ``length``, or no axis), the lines are
     parallel (squared sine at or below :data:`~screwkit.common.tolerances.AXIS_PARALLEL`) or ``direction`` is zero
-    (a prismatic joint: its point is the one drawn).
+    (a prismatic joint: its point is the one drawn). ``point`` itself for a pure couple (``|f| length`` at most
+    :data:`~screwkit.common.tolerances.PURE_COUPLE` times its moment about ``point``, the test of
+    :func:`power_coefficient`).
 
     Parameters
     ----------
@@ -181,7 +183,12 @@ def nearest_on_axis(screw: ArrayLike, point: ArrayLike, direction: ArrayLike, le
     dot = np.einsum("...i,...i->...", force, screw[..., 3:])[..., None]
     force_like = np.abs(dot) <= ZERO_PITCH * length * force_sq
     use = (force_sq > 0) & force_like & (direction_sq > 0) & (sine_sq > AXIS_PARALLEL)
-    return np.where(use, projected + along * unit_force, projected)
+    # a pure couple (as power_coefficient tests it, about ``point``) has no axis: the rounding left in its force
+    # would put one about |m| / |f| away (1e11 lengths for a constraint couple found by a singular value
+    # decomposition), and the moment about that point mistake the couple for a force of huge pitch
+    moment = screw[..., 3:] - np.cross(point, force)
+    couple = force_sq * length**2 <= PURE_COUPLE**2 * np.einsum("...i,...i->...", moment, moment)[..., None]
+    return np.where(couple, point, np.where(use, projected + along * unit_force, projected))
 
 
 def joint_lines(twists: ArrayLike, points: ArrayLike, joint: int) -> NDArray[np.float64]:

@@ -175,14 +175,15 @@ def _subsystems(own: list[NDArray], rank: int) -> tuple[tuple[int, ...], ...]:
     return tuple(found)
 
 
-def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
+def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -> ConstraintPlan:
     """The constraint structure of a mechanism from its chains' twists at sample configurations
     (working coordinates). Symmetric in the chains: permuting them permutes the plan.
 
     Only the samples where every chain has its largest rank are read: a chain singular at one sample (a Delta arm
     stretched at the boundary of the workspace) has a constraint wrench more there, and planned from it every
     configuration of the batch had its constraint subsystems wrong (CTI 0 throughout a sweep that touched the
-    boundary)."""
+    boundary). ``mobility``: the platform's DOF (idle rotations of a point output included) where it is known; the
+    wrenches the chains share at every sample are not common to them when they leave the platform more."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
     ranks = [_rank(twists, tolerance) for twists in chain_twists]
     regular = np.all([rank == np.max(rank) for rank in ranks], axis=0)
@@ -195,6 +196,10 @@ def plan_constraints(chain_twists: list[NDArray]) -> ConstraintPlan:
         eigenvalues = np.linalg.eigvalsh(total)
         common = int(np.min(np.sum(eigenvalues <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)))
     else:
+        common = 0
+    if mobility is not None and 6 - common > mobility:
+        # every sample is a constraint singularity, where the chains share wrenches they share nowhere else (a
+        # U-P-U platform drawn with its legs' couples all vertical, analysed there alone): no wrench is common
         common = 0
     own_counts = tuple(max(c - common, 0) for c in counts)
     if not any(own_counts):

@@ -168,7 +168,10 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
     reciprocal to all its twists; those common to every chain are never released; the CTI of a set is the best,
     over the minimal sets of chains whose own constraint wrenches hold every constraint, of the lowest power
     coefficient of a released wrench on a twist it frees (each chain's wrenches and freed twists paired along the
-    principal directions of their pairing). Empty when no chain holds a constraint wrench alone."""
+    principal directions of their pairing). Empty when no chain holds a constraint wrench alone. Wrenches the chains
+    share that leave the platform more than ``dof`` are shared at this configuration only (a constraint singularity,
+    every U-P-U leg's couple vertical), not common: each chain's own, as
+    :func:`screwkit.screw.constraints.plan_constraints` reads them."""
     constraints = [_complement(_span(t)) @ SWAP for t in twists]
     every = np.concatenate(constraints)
     instantaneous = 6 - (len(_span(every)) if len(every) else 0)
@@ -176,6 +179,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
         values, vectors = np.linalg.eigh(sum(np.eye(6) - c.T @ c for c in constraints))
         shared = vectors[:, values <= 1e-8].T  # the intersection: wrenches every chain holds
     else:
+        shared = np.zeros((0, 6))
+    if 6 - len(shared) > dof:  # shared here only (a constraint singularity): none is common to the chains
         shared = np.zeros((0, 6))
     own = [np.linalg.svd(c - c @ shared.T @ shared)[2][:len(c) - len(shared)] if len(c) > len(shared)
            else np.zeros((0, 6)) for c in constraints]
@@ -268,8 +273,8 @@ def reference_indices(twists: list[NDArray], points: list[NDArray], actuated: li
               "instantaneous_dof": instantaneous}
     if cti and not len(idle):  # the CTI is defined for a frame output
         kept_sets = [list(combinations(range(len(actuators)), len(actuators) - j))
-                     for j in range(1, len(actuators) - dof + 1)]
+                     for j in range(1, max(len(actuators) - dof, 1) + 1)]  # (a = n: F_C1 = 0, as F_O1)
         result["cti"] = max(cti.values())
-        result["f_c"] = {j + 1: min(max(v for m, v in cti.items() if set(m) <= set(kept)) for kept in sets_j)
-                         for j, sets_j in enumerate(kept_sets)}
+        result["f_c"] = {j + 1: min(max((v for m, v in cti.items() if set(m) <= set(kept)), default=0.0)
+                                    for kept in sets_j) for j, sets_j in enumerate(kept_sets)}
     return result

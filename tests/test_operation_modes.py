@@ -1,0 +1,136 @@
+"""Operation modes meeting at a constraint-singular reference assembly (screwkit.closure.modes).
+
+A U-P-U platform drawn as a published Gazebo "Stewart platform" draws its legs (every hinge horizontal, every leg's
+couple vertical) is at a constraint singularity where its translational mode meets a mode that turns it. Its task
+coordinates must be those of a mode the closure follows from the reference assembly, whatever the scale, the world
+frame and the order of the legs; the translational mode's poses are checked against its closed form (each slide
+is the change of the distance between its two universal joints, the platform does not turn)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sdformat_models import rotation_z, upu_sdf
+
+from screwkit.closure import actuator_values, solve
+from screwkit.closure.assembly import MODES_MEET
+from screwkit.io.loader import load
+
+VARIANTS = [(3, 1.0, (0.0, (0.0, 0.0, 0.0)), False), (6, 1.0, (0.0, (0.0, 0.0, 0.0)), False),
+            (3, 1000.0, (0.0, (0.0, 0.0, 0.0)), False), (3, 1.0, (0.7, (0.3, -0.2, 0.5)), True),
+            (6, 1e-3, (-2.1, (-5.0, 40.0, 1.0)), True)]
+
+
+def upu(tmp_path, legs, scale, world, reverse, name="upu.sdf"):
+    path = tmp_path / name
+    path.write_text(upu_sdf(legs, scale=scale, world=world, reverse=reverse))
+    return path
+
+
+def joints(legs: int, scale: float, tilt: float = 0.35):
+    """The universal joints' centres of :func:`upu_sdf` in its model frame (foot, head per leg, legs in order)."""
+    feet, heads = [], []
+    for k in range(legs):
+        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3))
+        radial = turn @ np.array([0.0, 1.0, 0.0])
+        feet.append(0.8 * scale * radial)
+        heads.append(feet[-1] + 1.9 * scale * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial))
+    return np.array(feet), np.array(heads)
+
+
+@pytest.mark.parametrize("legs, scale, world, reverse", VARIANTS)
+def test_a_upu_platform_drawn_where_its_modes_meet_translates(tmp_path, legs, scale, world, reverse):
+    mechanism = load(upu(tmp_path, legs, scale, world, reverse))
+    assert (mechanism.dof, mechanism.instantaneous_dof) == (3, 5)
+    assert mechanism.task_coordinates == ("x", "y", "z")
+    notes = [note for note in mechanism.assembly_notes if note.startswith(MODES_MEET)]
+    assert len(notes) == 1 and "followed: the one where the platform translates only (coordinates x, y, z" in notes[0]
+    assert "not followed: the one where the platform turns" in notes[0]
+    rng = np.random.default_rng(4)
+    moves = rng.uniform(-0.15, 0.15, (6, 3)) * scale  # in the model frame
+    yaw, _ = world
+    home = mechanism.home_full_pose
+    solution = solve(mechanism, home[:3] + moves @ rotation_z(yaw).T)
+    assert solution.reachable.all()
+    np.testing.assert_allclose(solution.full_poses[:, 3:] - home[3:], 0.0, atol=1e-9)  # it does not turn
+    feet, heads = joints(legs, scale)
+    lengths = np.linalg.norm(heads[None] + moves[:, None] - feet[None], axis=-1) - 1.9 * scale
+    order = [int(name.split("_")[-1]) for name in mechanism.actuator_names]
+    np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order],
+                               atol=1e-9 * scale)
+
+
+def test_a_3_upu_drawn_at_its_constraint_singularity_opens_with_its_three_slides(tmp_path):
+    """Its 3 slides drive its 3 DOF; at the reference assembly it has 5 instantaneous DOF, which once asked for 5
+    actuators."""
+    mechanism = load(upu(tmp_path, 3, 1.0, (0.0, (0.0, 0.0, 0.0)), False))
+    assert len(mechanism.actuator_names) == 3 and mechanism.dof == 3
+
+
+def test_declared_coordinates_follow_the_mode_they_drive(tmp_path):
+    """Declared coordinates that only the turning mode has independent follow it: a roll of 1 degree closes, turns
+    the platform and moves it sideways (the mode couples them), every loop closed."""
+    from screwkit.closure import closure_residuals
+    from screwkit.io import read_mechanism_file
+    from screwkit.io.loader import load_text
+
+    text, _ = read_mechanism_file(upu(tmp_path, 3, 1.0, (0.0, (0.0, 0.0, 0.0)), False))  # as screwkit convert writes
+    mechanism = load_text(text.replace("</robot>", '<task_coordinates names="x roll pitch" /></robot>'), "upu.urdf")
+    assert mechanism.task_coordinates == ("x", "roll", "pitch") and mechanism.task_source == "declared"
+    notes = [note for note in mechanism.assembly_notes if note.startswith(MODES_MEET)]
+    assert "followed: the one where the platform turns" in notes[0]
+    solution = solve(mechanism, np.array([0.0, np.radians(1.0), 0.0]))
+    assert solution.reachable.all()
+    assert abs(solution.full_poses[3] - np.radians(1.0)) < 1e-12 and abs(solution.full_poses[1]) > 1e-3
+    assert np.max(np.abs(closure_residuals(mechanism, solution))) < 1e-9
+
+
+@pytest.mark.parametrize("legs", [3, 6])
+def test_the_reference_assembly_analysed_alone_is_the_constraint_singularity_it_is(tmp_path, legs):
+    """Analysed alone, the reference assembly's chains share their one couple each, as they do nowhere else: the
+    structure read there once made it a regular pose (no CTI, LMTI 0.91 for 6 legs against 0.51 a few cm away).
+    It is a constraint singularity (5 instantaneous DOF, no 3 slides hold the platform): LMTI and every F_Oj 0, as
+    the numpy reference (which reads the configuration alone) gives, and as the same pose gives in a batch with
+    regular poses."""
+    from test_reference import compare
+
+    mechanism = load(upu(tmp_path, legs, 1.0, (0.0, (0.0, 0.0, 0.0)), False))
+    home = mechanism.home_pose
+    alone = compare(mechanism, home[None])
+    batch = compare(mechanism, home + np.array([[0.0, 0.0, 0.0], [0.05, 0.03, -0.01], [-0.04, 0.02, 0.03]]))
+    for result in (alone.at(0), batch.at(0)):
+        assert result.constraint_singular and result.instantaneous_dof == 5
+        assert result.lmti == 0.0 and all(value == 0.0 for value in result.f_o.values())
+    assert not batch.at(1).constraint_singular and batch.at(1).lmti > 0.1
+
+
+def test_the_commands_say_which_mode_they_follow_and_analyse_the_singular_home_as_such(tmp_path):
+    """As users run it: ``info`` names the modes under the constraint singularity line (and every command says it
+    once on stderr); ``analyze`` at home says CONSTRAINT SINGULARITY with LMTI 0; ``sweep`` across x closes every
+    pose in the translational mode, LMTI 0 only at the singular home."""
+    import json
+
+    import xarray as xr
+
+    from helpers import screwkit
+
+    path = upu(tmp_path, 6, 1.0, (0.0, (0.0, 0.0, 0.0)), False)
+    info = screwkit("info", path)
+    assert info.returncode == 0, info.stderr
+    lines = info.stdout.splitlines()
+    singular = next(i for i, line in enumerate(lines) if "the home pose is a constraint singularity" in line)
+    assert lines[singular + 1].startswith(f"  {MODES_MEET}2 meet at the reference assembly")
+    assert "task coordinates: x (m), y (m), z (m)" in info.stdout
+    assert [line for line in info.stderr.splitlines() if MODES_MEET in line] == [
+        f"{path}: {lines[singular + 1].strip()}"]
+    analyzed = screwkit("analyze", path, "--json")
+    assert analyzed.returncode == 0, analyzed.stderr
+    report = json.loads(analyzed.stdout)
+    assert report["constraint_singular"] and report["instantaneous_dof"] == 5 and report["lmti"] == 0.0
+    assert any(note.startswith(MODES_MEET) for note in report["assembly"])
+    out = tmp_path / "sweep.nc"
+    swept = screwkit("sweep", path, "--sweep", "x:-0.2:0.2:0.1", "--out", out, "--quiet")
+    assert swept.returncode == 0, swept.stderr
+    with xr.open_dataset(out) as sweep:
+        assert bool(sweep["reachable"].all()) and float(sweep["lmti"].sel(x=0.0)) == 0.0
+        assert float(sweep["lmti"].sel(x=0.1)) > 0.1
