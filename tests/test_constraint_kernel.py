@@ -163,3 +163,16 @@ def test_analysis_through_the_constraint_kernel_equals_the_numpy_path(name):
     assert np.array_equal(through_kernel.instantaneous_dof, through_numpy.instantaneous_dof)
     assert np.array_equal(through_kernel.constraint_singular, through_numpy.constraint_singular)
     assert np.isnan(through_kernel.cti).all() == (name == "schoenflies_5")
+
+
+def test_a_wrench_common_to_every_chain_stays_common_when_the_mobility_is_known():
+    """Given the mobility, the plan reads the wrenches the chains share as theirs only where every sample is a
+    constraint singularity (more instantaneous DOF than the mobility): a couple common to three chains that each
+    hold a force of their own is still common (the first form of that rule took any mechanism with wrenches of its
+    own for singular, and its plan lost the compiled kernel)."""
+    rng = np.random.default_rng(4)
+    wrenches, n = constructed("common", rng)
+    twists = [chain_of(w, rng)[0] for w in wrenches]
+    without, given = plan_constraints([t[5::8] for t in twists]), plan_constraints([t[5::8] for t in twists], n)
+    assert (given.common, given.own_counts, given.subsystems) == (without.common, without.own_counts,
+                                                                    without.subsystems) == (1, (1, 1, 1), ((0, 1, 2),))

@@ -134,3 +134,22 @@ def test_the_commands_say_which_mode_they_follow_and_analyse_the_singular_home_a
     with xr.open_dataset(out) as sweep:
         assert bool(sweep["reachable"].all()) and float(sweep["lmti"].sel(x=0.0)) == 0.0
         assert float(sweep["lmti"].sel(x=0.1)) > 0.1
+
+
+@pytest.mark.parametrize("draw", [*range(6), 86])  # 86: only the turning mode found by the random samples
+def test_the_translational_mode_is_found_whatever_the_random_samples(tmp_path, monkeypatch, draw):
+    """The random samples near home fall in the translational mode about one time in ten: with other random draws
+    than the shipped ones, some found only the turning mode (draw 86 of the first 120 with random samples alone), and
+    the file read x, roll, pitch again with no note. The samples offset in the translations alone find it every time
+    (the 120 draws)."""
+    import screwkit.closure.assembly as assembly
+    import screwkit.io.model_cache as model_cache
+
+    monkeypatch.setattr(model_cache, "_folder", lambda: None)  # built, not read back from the cache
+    drawn = assembly._generic_samples
+    monkeypatch.setattr(assembly, "_generic_samples", lambda mechanism, count=6, seed=0, **moving: drawn(
+        mechanism, count, seed + 1000 * (draw + 1), **moving))
+    mechanism = load(upu(tmp_path, 6, 1.0, (0.0, (0.0, 0.0, 0.0)), False))
+    assert mechanism.task_coordinates == ("x", "y", "z")
+    notes = [note for note in mechanism.assembly_notes if note.startswith(MODES_MEET)]
+    assert "followed: the one where the platform translates only" in notes[0]

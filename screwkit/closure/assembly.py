@@ -57,8 +57,9 @@ MODES_MEET = "operation modes: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that names the operation modes
 meeting at a constraint-singular reference assembly and the one followed
 (:func:`screwkit.closure.modes.describe_modes`)."""
-MODE_SAMPLES = 18
-"""Samples added near a constraint-singular reference assembly to find the operation modes that meet there."""
+MODE_SAMPLES = 12
+"""Samples added near a constraint-singular reference assembly to find the operation modes that meet there, of each
+kind (:func:`_mode_samples`)."""
 NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, MODES_MEET)
 """The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
 DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
@@ -315,19 +316,33 @@ def idle_rotation_count(mechanism: Mechanism) -> int:
     return 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)
 
 
-def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0):
+def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0, moving=None):
     """Closed configurations near the reference assembly, off any special pose: random small full-pose
-    offsets, each brought back onto the closure by the least change of every pose coordinate."""
+    offsets (of the pose coordinates ``moving``, a mask; every one by default), each brought back onto the closure by
+    the least change of every pose coordinate."""
     chains = constraining_chains(mechanism)
     rng = np.random.default_rng(seed)
     offsets = rng.uniform(-1.0, 1.0, (count, mechanism.n_pose)) * np.where(
-        mechanism.pose_angular, 0.05, 0.05 * mechanism.length_scale)
+        mechanism.pose_angular, 0.05, 0.05 * mechanism.length_scale) * (1.0 if moving is None else moving)
     poses = mechanism.home_full_pose + offsets
     values = [np.broadcast_to(mechanism.chains[i].reference_values, (count, mechanism.chains[i].n_joints))
               for i in chains]
     poses, values, converged, _ = close_constraining_chains(mechanism, chains, poses, values,
                                                       tuple(range(mechanism.n_pose)), 1e-11, 60, 0.5)
     return chains, poses[converged], [v[converged] for v in values]
+
+
+def _mode_samples(mechanism: Mechanism, poses, values):
+    """The generic samples ``poses``, ``values`` and more, to find the operation modes meeting at the reference
+    assembly: :data:`MODE_SAMPLES` random ones, and as many offset in the translations alone and in the rotations
+    alone (a mode that keeps the platform's orientation is found by the first whatever the random ones find)."""
+    angular = np.asarray(mechanism.pose_angular, dtype=bool)
+    batches = [(poses, values), _generic_samples(mechanism, MODE_SAMPLES, seed=1)[1:],
+               _generic_samples(mechanism, MODE_SAMPLES, seed=2, moving=~angular)[1:],
+               _generic_samples(mechanism, MODE_SAMPLES, seed=3, moving=angular)[1:]]
+    chains = constraining_chains(mechanism)
+    return (chains, np.concatenate([batch[0] for batch in batches]),
+            [np.concatenate([batch[1][k] for batch in batches]) for k in range(len(chains))])
 
 
 def _check_actuator_count(mechanism: Mechanism, needed: int) -> None:
@@ -372,10 +387,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                 for index, chain_values in zip(chain_indices, values):
                     at_values[index] = chain_values[sample]
                 if not idle:  # a constraint singularity: the operation modes that meet there, each tried
-                    more = _generic_samples(mechanism, MODE_SAMPLES, seed=1)
-                    modes = meeting_modes(mechanism, chain_indices, np.concatenate([poses, more[1]]),
-                                          [np.concatenate(pair) for pair in zip(values, more[2])], mobility,
-                                          None)
+                    modes = meeting_modes(mechanism, *_mode_samples(mechanism, poses, values), mobility)
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
@@ -388,13 +400,14 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                                          "leave it no motion at the reference assembly (DOF 0).")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
     _check_actuator_count(mechanism, mobility)
-    if len(modes) > 1:
-        if declared is not None:  # the mode in which the declared coordinates are independent, if one
+    if modes:
+        if declared is not None and len(modes) > 1:  # the mode in which the declared coordinates are independent
             axes = [names.index(name) for name in declared if name in names]
             modes = sorted(modes, key=lambda mode: np.linalg.svd(mode.space[axes], compute_uv=False)[-1] <= 1e-6)
         at_pose, at_values = modes[0].pose, list(modes[0].values)
-        mechanism = replace(mechanism, assembly_notes=mechanism.assembly_notes
-                            + (MODES_MEET + describe_modes(mechanism, modes),))
+        if len(modes) > 1 or modes[0].driven < modes[0].probes:
+            mechanism = replace(mechanism, assembly_notes=mechanism.assembly_notes
+                                + (MODES_MEET + describe_modes(mechanism, modes),))
     candidates = [i for i, name in enumerate(names) if not (idle and name in ("phi", "roll", "pitch", "yaw"))]
     if declared is not None:
         unknown = [name for name in declared if name not in names]

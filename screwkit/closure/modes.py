@@ -9,10 +9,12 @@ assembly from which the mobility and the task coordinates are read can fall in a
 read from a mode that a continuation from the reference assembly does not follow drive nothing (every pose off the
 reference assembly was unreachable).
 
-:func:`meeting_modes` groups the samples by their motion spaces, reads each group's task coordinates and tries
-them: small steps of each coordinate from the reference assembly, closed by the continuation every command uses,
-must land in that mode. The mode whose coordinates drive the most steps is followed; among equals the one that turns
-the platform least (the translational mode of the U-P-U platforms), then the first coordinates in pose order.
+:func:`meeting_modes` groups the samples (random ones, and ones offset in the translations alone and in the
+rotations alone: :func:`screwkit.closure.assembly.task_space`) by their motion spaces, reads each group's task
+coordinates and tries them: small steps of each coordinate from the reference assembly, closed by the continuation
+every command uses, must land in that mode. The mode whose coordinates drive the most steps is followed; among
+equals the one that turns the platform least (the translational mode of the U-P-U platforms), then the first
+coordinates in pose order.
 """
 
 from __future__ import annotations
@@ -62,28 +64,35 @@ def _apart(first: NDArray, second: NDArray) -> float:
     return float(np.linalg.norm(first - second @ (second.T @ first), 2))
 
 
-def meeting_modes(mechanism: Mechanism, chain_indices, poses: NDArray, values, mobility: int,
-                  candidates) -> list[Mode]:
+def meeting_modes(mechanism: Mechanism, chain_indices, poses: NDArray, values, mobility: int) -> list[Mode]:
     """The operation modes the samples ``poses`` (N, n_pose) with the joint values ``values`` of the chains
     ``chain_indices`` show near the reference assembly, each with its task coordinates tried, in the order they are
-    followed (see the module's description). Samples with more than ``mobility`` instantaneous DOF are left out;
-    ``candidates`` restricts the coordinates (:func:`~screwkit.closure.task_space.infer_task_axes`)."""
+    followed (see the module's description). Samples with more than ``mobility`` instantaneous DOF are left out.
+    Each mode is read at the sample of its group that turns the platform least (a sample that closed near the set
+    where the modes meet has rotation rates of the order of its closure's accuracy): how many rotations the mode
+    has, its task coordinates and the pose commands start from."""
     subset = replace(mechanism, chains=tuple(mechanism.chains[i] for i in chain_indices))
     dofs, bases = motion_space_at(subset, poses, values)
     angular = np.asarray(mechanism.pose_angular, dtype=bool)
-    modes: list[Mode] = []
+    groups: list[list[int]] = []
     for sample in np.flatnonzero(dofs == mobility):
         space = bases[sample][:, :mobility]
-        if any(_apart(space, mode.space) <= MODE_SEPARATION for mode in modes):
-            continue
+        group = next((g for g in groups if _apart(space, bases[g[0]][:, :mobility]) <= MODE_SEPARATION), None)
+        if group is None:
+            groups.append([int(sample)])
+        else:
+            group.append(int(sample))
+    modes = []
+    for group in groups:
+        turning = [np.linalg.svd(bases[s][angular, :mobility], compute_uv=False) for s in group]
+        sample = group[int(np.argmin([np.sum(rates) for rates in turning]))]
         every = [np.asarray(c.reference_values) for c in mechanism.chains]
         for index, chain_values in zip(chain_indices, values):
             every[index] = chain_values[sample]
-        axes = infer_task_axes(mechanism, poses[sample], every, mobility, candidates)
-        turning = int(np.sum(np.linalg.svd(space[angular], compute_uv=False) > TASK_RANK_TOLERANCE))
-        modes.append(Mode(space, poses[sample], tuple(every), axes, turning))
-    if len(modes) > 1:
-        modes = [_tried(mechanism, subset, mode, mobility) for mode in modes]
+        axes = infer_task_axes(mechanism, poses[sample], every, mobility)
+        count = min(int(np.sum(rates > TASK_RANK_TOLERANCE)) for rates in turning)
+        modes.append(_tried(mechanism, subset, Mode(bases[sample][:, :mobility], poses[sample], tuple(every), axes,
+                                                   count), mobility))
     return sorted(modes, key=lambda mode: (-mode.driven, mode.turning, mode.axes))
 
 
@@ -105,7 +114,8 @@ def _tried(mechanism: Mechanism, subset: Mechanism, mode: Mode, mobility: int) -
 
 
 def describe_modes(mechanism: Mechanism, modes: list[Mode]) -> str:
-    """A note naming the modes that meet at the reference assembly and the one followed (the first)."""
+    """A note naming the modes that meet at the reference assembly and the one followed (the first); or, one mode
+    found, how far its coordinates drive."""
     def words(mode: Mode) -> str:
         names = ", ".join(mechanism.pose_coordinates[axis] for axis in mode.axes)
         kind = "the platform translates only" if not mode.turning else \
@@ -114,6 +124,10 @@ def describe_modes(mechanism: Mechanism, modes: list[Mode]) -> str:
                 "where the modes meet)")
 
     first, others = modes[0], modes[1:]
+    if not others:  # one mode found, whose coordinates do not drive every step
+        return (f"the reference assembly is a constraint singularity where the one mode found near it is the one "
+                f"where {words(first)}: poses near it may be unreachable; declare other coordinates "
+                "(<task_coordinates> in a screwkit URDF, as screwkit convert writes one) to try them")
     return (f"{len(modes)} meet at the reference assembly, a constraint singularity; followed: the one where "
             f"{words(first)}; not followed: " + "; ".join(f"the one where {words(m)}" for m in others)
             + ". To follow another, declare its coordinates (<task_coordinates> in a screwkit URDF, as screwkit "

@@ -182,8 +182,9 @@ def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -
     Only the samples where every chain has its largest rank are read: a chain singular at one sample (a Delta arm
     stretched at the boundary of the workspace) has a constraint wrench more there, and planned from it every
     configuration of the batch had its constraint subsystems wrong (CTI 0 throughout a sweep that touched the
-    boundary). ``mobility``: the platform's DOF (idle rotations of a point output included) where it is known; the
-    wrenches the chains share at every sample are not common to them when they leave the platform more."""
+    boundary). ``mobility``: the platform's DOF (idle rotations of a point output included) where it is known; when
+    every sample leaves the platform more (each is a constraint singularity), the wrenches the chains share there are
+    not taken for common ones."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
     ranks = [_rank(twists, tolerance) for twists in chain_twists]
     regular = np.all([rank == np.max(rank) for rank in ranks], axis=0)
@@ -197,7 +198,7 @@ def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -
         common = int(np.min(np.sum(eigenvalues <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)))
     else:
         common = 0
-    if mobility is not None and 6 - common > mobility:
+    if mobility is not None and common and 6 - np.max(_rank(np.concatenate(wrenches, axis=-2), tolerance)) > mobility:
         # every sample is a constraint singularity, where the chains share wrenches they share nowhere else (a
         # U-P-U platform drawn with its legs' couples all vertical, analysed there alone): no wrench is common
         common = 0

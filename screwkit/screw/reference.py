@@ -168,9 +168,9 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
     reciprocal to all its twists; those common to every chain are never released; the CTI of a set is the best,
     over the minimal sets of chains whose own constraint wrenches hold every constraint, of the lowest power
     coefficient of a released wrench on a twist it frees (each chain's wrenches and freed twists paired along the
-    principal directions of their pairing). Empty when no chain holds a constraint wrench alone. Wrenches the chains
-    share that leave the platform more than ``dof`` are shared at this configuration only (a constraint singularity,
-    every U-P-U leg's couple vertical), not common: each chain's own, as
+    principal directions of their pairing). Empty when no chain holds a constraint wrench alone. At a constraint
+    singularity (more than ``dof`` instantaneous DOF) the wrenches the chains share are shared there only (every
+    U-P-U leg's couple vertical), not common: each chain's own, as
     :func:`screwkit.screw.constraints.plan_constraints` reads them."""
     constraints = [_complement(_span(t)) @ SWAP for t in twists]
     every = np.concatenate(constraints)
@@ -180,7 +180,7 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
         shared = vectors[:, values <= 1e-8].T  # the intersection: wrenches every chain holds
     else:
         shared = np.zeros((0, 6))
-    if 6 - len(shared) > dof:  # shared here only (a constraint singularity): none is common to the chains
+    if instantaneous > dof:  # shared here only (a constraint singularity): none is common to the chains
         shared = np.zeros((0, 6))
     own = [np.linalg.svd(c - c @ shared.T @ shared)[2][:len(c) - len(shared)] if len(c) > len(shared)
            else np.zeros((0, 6)) for c in constraints]
