@@ -335,7 +335,7 @@ def rss_sdf(tilt: float = 0.0, seed: int = 0, scale: float = 1.0, reverse: bool 
 
 
 def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), reverse: bool = False,
-            tilt: float = 0.35) -> str:
+            tilt: float = 0.35, decimals: int | None = None, jitter: float = 0.0) -> str:
     """A translational U-P-U parallel mechanism written as a published Gazebo "Stewart platform" writes its legs (each
     universal joint two hinges, every joint native): per leg at azimuth psi, a hinge on the base about the radial axis
     y, one about the tangential axis x, the actuated slide along the leg (tilted by ``tilt`` rad about x toward the
@@ -344,18 +344,23 @@ def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), rev
     3-UPU, here with ``legs`` legs). In the file's configuration every x and y is horizontal and every leg's couple is
     vertical: a constraint singularity where the translational operation mode meets others that turn the platform.
     ``scale``: every length times it; ``world``: (yaw in rad, shift in m) of the whole mechanism in the world, through
-    the model's ``<pose>``; ``reverse``: the legs written in reverse order."""
+    the model's ``<pose>``; ``reverse``: the legs written in reverse order; ``decimals``: the joints' points and axes
+    written to so many decimals (as a published file writes them: its legs no longer quite alike); ``jitter``: each
+    leg's azimuth and radius moved by about so much (rad, relative), its hinges still horizontal (the legs not quite
+    alike, every one still a translational U-P-U vertical at home, as in a file whose angles are written 2.0945)."""
     base_radius, length = 0.8 * scale, 1.9 * scale
+    rounded = (lambda values: values) if decimals is None else (lambda values: np.round(values, decimals))
     yaw, shift = world
     lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="upu">',
              f'<pose>{text(shift)} 0 0 {yaw!r}</pose>', '<link name="base"/>',
              '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
              f'<link name="platform"><pose>0 0 {float(length * np.cos(tilt))!r} 0 0 0</pose></link>']
     order = range(legs - 1, -1, -1) if reverse else range(legs)
+    moved = jitter * np.random.default_rng(5).normal(size=(legs, 2))
     for k in order:
-        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3))
+        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3) + moved[k, 0])
         radial, tangential = turn @ np.array([0.0, 1.0, 0.0]), turn @ np.array([1.0, 0.0, 0.0])
-        foot = base_radius * radial
+        foot = base_radius * (1.0 + moved[k, 1]) * radial
         head = foot + length * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial)
         direction = (head - foot) / length
         joints = [("yb", "base", f"ub_{k}", foot, radial, "revolute"),
@@ -363,8 +368,10 @@ def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), rev
                   ("slide", f"cyl_{k}", f"rod_{k}", foot, direction, "prismatic"),
                   ("xp", f"rod_{k}", f"up_{k}", head, tangential, "revolute"),
                   ("yp", f"up_{k}", "platform", head, radial, "revolute")]
+        joints = [(name, parent, child, rounded(point), rounded(axis), kind)
+                  for name, parent, child, point, axis, kind in joints]
         for name, link in ((f"ub_{k}", foot), (f"cyl_{k}", foot), (f"rod_{k}", head), (f"up_{k}", head)):
-            lines.append(f'<link name="{name}"><pose>{text(link)} 0 0 0</pose></link>')
+            lines.append(f'<link name="{name}"><pose>{text(rounded(link))} 0 0 0</pose></link>')
         for name, parent, child, point, axis, kind in joints:
             marked = "<screwkit:actuated/>" if kind == "prismatic" else ""
             bounds = f"<limit><lower>{-0.4 * scale!r}</lower><upper>{0.4 * scale!r}</upper></limit>" \

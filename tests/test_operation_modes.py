@@ -27,15 +27,17 @@ def upu(tmp_path, legs, scale, world, reverse, name="upu.sdf"):
     return path
 
 
-def joints(legs: int, scale: float, tilt: float = 0.35):
+def joints(legs: int, scale: float, tilt: float = 0.35, jitter: float = 0.0, decimals: int | None = None):
     """The universal joints' centres of :func:`upu_sdf` in its model frame (foot, head per leg, legs in order)."""
     feet, heads = [], []
+    moved = jitter * np.random.default_rng(5).normal(size=(legs, 2))
     for k in range(legs):
-        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3))
+        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3) + moved[k, 0])
         radial = turn @ np.array([0.0, 1.0, 0.0])
-        feet.append(0.8 * scale * radial)
+        feet.append(0.8 * scale * (1.0 + moved[k, 1]) * radial)
         heads.append(feet[-1] + 1.9 * scale * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial))
-    return np.array(feet), np.array(heads)
+    feet, heads = np.array(feet), np.array(heads)
+    return (feet, heads) if decimals is None else (np.round(feet, decimals), np.round(heads, decimals))
 
 
 @pytest.mark.parametrize("legs, scale, world, reverse", VARIANTS)
@@ -77,6 +79,7 @@ def test_declared_coordinates_follow_the_mode_they_drive(tmp_path):
     text, _ = read_mechanism_file(upu(tmp_path, 3, 1.0, (0.0, (0.0, 0.0, 0.0)), False))  # as screwkit convert writes
     mechanism = load_text(text.replace("</robot>", '<task_coordinates names="x roll pitch" /></robot>'), "upu.urdf")
     assert mechanism.task_coordinates == ("x", "roll", "pitch") and mechanism.task_source == "declared"
+    assert mechanism.held_axes == ()  # the turning mode: its dependent coordinates are solved
     notes = [note for note in mechanism.assembly_notes if note.startswith(MODES_MEET)]
     assert "followed: the one where the platform turns" in notes[0]
     solution = solve(mechanism, np.array([0.0, np.radians(1.0), 0.0]))
@@ -121,6 +124,10 @@ def test_the_commands_say_which_mode_they_follow_and_analyse_the_singular_home_a
     singular = next(i for i, line in enumerate(lines) if "the home pose is a constraint singularity" in line)
     assert lines[singular + 1].startswith(f"  {MODES_MEET}2 meet at the reference assembly")
     assert "task coordinates: x (m), y (m), z (m)" in info.stdout
+    assert ("  dependent coordinates held at home (the operation mode followed does not turn the platform): roll, "
+            "pitch, yaw") in lines and "solved with the closure" not in info.stdout
+    described = json.loads(screwkit("info", path, "--json").stdout)
+    assert described["held_coordinates"] == ["roll", "pitch", "yaw"]
     assert [line for line in info.stderr.splitlines() if MODES_MEET in line] == [
         f"{path}: {lines[singular + 1].strip()}"]
     analyzed = screwkit("analyze", path, "--json")
@@ -153,3 +160,47 @@ def test_the_translational_mode_is_found_whatever_the_random_samples(tmp_path, m
     assert mechanism.task_coordinates == ("x", "y", "z")
     notes = [note for note in mechanism.assembly_notes if note.startswith(MODES_MEET)]
     assert "followed: the one where the platform translates only" in notes[0]
+
+
+@pytest.mark.parametrize("legs", [3, 6])
+def test_a_pure_lift_stays_where_the_modes_meet(tmp_path, legs):
+    """Every pure lift (x = y = 0) keeps every hinge horizontal and every leg's couple vertical: the constraint
+    singularity of home, 5 instantaneous DOF. There the closure is a double root; with legs not quite alike (a
+    published file's angles written 2.0945) it stopped a few 1e-6 rad into the turning mode and read 3 DOF, LMTI
+    0.55-0.59. The translational mode's orientation is held at home's: the lift is the closed form (each slide the
+    change of its leg's length), singular, LMTI and every F_Oj 0."""
+    from screwkit.studies import indices_at_poses
+
+    path = tmp_path / "upu.sdf"
+    path.write_text(upu_sdf(legs, jitter=1e-3))
+    mechanism = load(path)
+    assert [mechanism.pose_coordinates[i] for i in mechanism.held_axes] == ["roll", "pitch", "yaw"]
+    lifts = np.array([[0.0, 0.0, dz] for dz in (0.05, 0.1, 0.2)])
+    solution = solve(mechanism, mechanism.home_pose + lifts)
+    assert solution.reachable.all()
+    np.testing.assert_array_equal(solution.full_poses[:, 3:], np.broadcast_to(mechanism.home_full_pose[3:], (3, 3)))
+    feet, heads = joints(legs, 1.0, jitter=1e-3)
+    lengths = np.linalg.norm(heads[None] + lifts[:, None] - feet[None], axis=-1) - np.linalg.norm(heads - feet, axis=-1)
+    order = [int(name.split("_")[-1]) for name in mechanism.actuator_names]
+    np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order], atol=1e-9)
+    indices = indices_at_poses(mechanism, mechanism.home_pose + lifts)
+    assert np.all(indices.instantaneous_dof == 5) and np.all(indices.constraint_singular)
+    assert np.all(indices.lmti == 0.0) and all(np.all(value == 0.0) for value in indices.f_o.values())
+
+
+def test_a_six_leg_platform_written_to_four_decimals_keeps_its_mobility(tmp_path):
+    """Written to 4 decimals, the six legs leave the platform its translations alone (no turning mode): none of the
+    random samples near home closed, and the file read DOF 5 (x, y, z, roll, pitch), the instantaneous DOF of home.
+    Samples offset in the translations alone close: DOF 3, x, y, z, its poses the closed form of the rounded file."""
+    path = tmp_path / "upu.sdf"
+    path.write_text(upu_sdf(6, decimals=4))
+    mechanism = load(path)
+    assert (mechanism.dof, mechanism.task_coordinates) == (3, ("x", "y", "z"))
+    moves = np.random.default_rng(2).uniform(-0.15, 0.15, (5, 3))
+    solution = solve(mechanism, mechanism.home_pose + moves)
+    assert solution.reachable.all()
+    np.testing.assert_allclose(solution.full_poses[:, 3:] - mechanism.home_full_pose[3:], 0.0, atol=1e-12)
+    feet, heads = joints(6, 1.0, decimals=4)
+    lengths = np.linalg.norm(heads[None] + moves[:, None] - feet[None], axis=-1) - np.linalg.norm(heads - feet, axis=-1)
+    order = [int(name.split("_")[-1]) for name in mechanism.actuator_names]
+    np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order], atol=1e-9)

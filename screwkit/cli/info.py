@@ -35,7 +35,7 @@ def graph_info(graph: GraphMechanism) -> dict:
         "task_coordinates": [{"name": name, "unit": unit_of(name)} for name in graph.task_coordinates],
         "task_coordinates_source": "declared" if graph.tree.task_coordinates else "inferred",
         "dependent_coordinates": [{"name": name, "unit": unit_of(name)} for name in SPATIAL_TASK_COORDINATES
-                                  if name not in graph.task_coordinates],
+                                  if name not in graph.task_coordinates], "held_coordinates": [],
         "instantaneous_dof_at_home": graph.dof, "output": "frame",
         "platform": {"link": graph.platform_body, "joint": model.names[graph.platform], "base_link": "world",
                      "planar": False},
@@ -71,6 +71,7 @@ def mechanism_info(mechanism) -> dict:
         "dependent_coordinates": [{"name": mechanism.pose_coordinates[i],
                                    "unit": unit_of(mechanism.pose_coordinates[i])}
                                   for i in mechanism.dependent_indices],
+        "held_coordinates": [mechanism.pose_coordinates[i] for i in mechanism.held_axes],
         "instantaneous_dof_at_home": mechanism.instantaneous_dof,
         "output": "frame" if mechanism.output_point is None else "point",
         "platform": {"link": mechanism.platform_link, "joint": mechanism.platform_joint,
@@ -106,9 +107,12 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     source = {"all": "full mobility", "declared": "declared in the file", "inferred": "inferred from the motion space"}
     click.echo(f"  DOF {report['dof']}; task coordinates: {coordinates} "
                f"({source.get(report['task_coordinates_source'], report['task_coordinates_source'])})")
-    if report["dependent_coordinates"]:
-        click.echo("  dependent (parasitic) coordinates, solved with the closure: "
-                   + ", ".join(c["name"] for c in report["dependent_coordinates"]))
+    solved = [c["name"] for c in report["dependent_coordinates"] if c["name"] not in report["held_coordinates"]]
+    if solved:
+        click.echo("  dependent (parasitic) coordinates, solved with the closure: " + ", ".join(solved))
+    if report["held_coordinates"]:
+        click.echo("  dependent coordinates held at home (the operation mode followed does not turn the platform): "
+                   + ", ".join(report["held_coordinates"]))
     if report["instantaneous_dof_at_home"] > report["dof"]:
         click.echo(f"  the home pose is a constraint singularity: {report['instantaneous_dof_at_home']} "
                    "instantaneous DOF")

@@ -22,9 +22,9 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.closure.modes import describe_modes, meeting_modes
+from screwkit.closure.modes import PROBE_STEP, describe_modes, meeting_modes
 from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
-from screwkit.closure.solve import outside_limits, run_closed_form
+from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
     TASK_RANK_TOLERANCE,
     close_constraining_chains,
@@ -57,6 +57,9 @@ MODES_MEET = "operation modes: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that names the operation modes
 meeting at a constraint-singular reference assembly and the one followed
 (:func:`screwkit.closure.modes.describe_modes`)."""
+GENERIC_SAMPLES = 6
+"""Random samples near the reference assembly from which the mobility is read (:func:`_generic_samples`); when one
+does not close, or the reference assembly is a constraint singularity, :func:`_mode_samples` adds more."""
 MODE_SAMPLES = 12
 """Samples added near a constraint-singular reference assembly to find the operation modes that meet there, of each
 kind (:func:`_mode_samples`)."""
@@ -375,7 +378,10 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     chains = constraining_chains(mechanism)
     modes = []
     if chains:
-        chain_indices, poses, values = _generic_samples(mechanism)
+        chain_indices, poses, values = _generic_samples(mechanism, GENERIC_SAMPLES)
+        more = not idle and poses.shape[0] < GENERIC_SAMPLES
+        if more:  # random offsets that do not close: a mode they miss (a U-P-U platform's translations alone left)
+            chain_indices, poses, values = _mode_samples(mechanism, poses, values)
         if poses.shape[0]:
             subset = replace(mechanism, chains=tuple(mechanism.chains[i] for i in chain_indices))
             dofs, _ = motion_space_at(subset, poses, values)
@@ -387,7 +393,9 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                 for index, chain_values in zip(chain_indices, values):
                     at_values[index] = chain_values[sample]
                 if not idle:  # a constraint singularity: the operation modes that meet there, each tried
-                    modes = meeting_modes(mechanism, *_mode_samples(mechanism, poses, values), mobility)
+                    if not more:
+                        chain_indices, poses, values = _mode_samples(mechanism, poses, values)
+                    modes = meeting_modes(mechanism, chain_indices, poses, values, mobility)
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
@@ -425,11 +433,27 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
             raise mechanism.description.fail(
                 "<task_coordinates>", f"{' '.join(declared)} cannot drive a platform of mobility {mobility}: "
                 f"they are not {mobility} independent coordinates of its motion.")
-        return replace(mechanism, task_axes=axes, task_source="declared")
+        return replace(mechanism, task_axes=axes, task_source="declared", held_axes=_held(mechanism, modes, axes))
     if mobility == mechanism.n_pose:
         return mechanism
     axes = infer_task_axes(mechanism, at_pose, at_values, mobility, candidates)
-    return replace(mechanism, task_axes=axes, task_source="inferred")
+    return replace(mechanism, task_axes=axes, task_source="inferred", held_axes=_held(mechanism, modes, axes))
+
+
+def _held(mechanism: Mechanism, modes, axes) -> tuple[int, ...]:
+    """The dependent angles held at the reference assembly's values: every one, when the operation mode followed
+    (the first of ``modes``) does not turn the platform (its least-turning sample has no rotation rate above
+    :data:`~screwkit.closure.task_space.TASK_RANK_TOLERANCE`); else none."""
+    if not modes or modes[0].turning:
+        return ()
+    held = tuple(i for i, angle in enumerate(mechanism.pose_angular) if angle and i not in axes)
+    # the mode's small steps must close with the orientation held (legs that translate the platform only to a file's
+    # rounding would not: they are left to the closure)
+    home = mechanism.home_full_pose[list(axes)]
+    trial = replace(mechanism, task_axes=tuple(axes), held_axes=held, named_poses={"home": home})
+    steps = np.where(trial.angular, PROBE_STEP, PROBE_STEP * mechanism.length_scale)
+    closed = solve(trial, np.concatenate([home + np.diag(steps), home - np.diag(steps)]), limits=False).reachable
+    return held if closed.all() else ()
 
 
 def working_modes(mechanism: Mechanism) -> dict[str, str]:

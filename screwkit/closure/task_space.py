@@ -209,13 +209,13 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
     task_poses = np.asarray(task_poses, dtype=float)
     count = task_poses.shape[0]
     chains = constraining_chains(mechanism)
-    free = mechanism.dependent_indices
+    free = tuple(i for i in mechanism.dependent_indices if i not in mechanism.held_axes)
     if start_poses is None:
         start_poses = np.broadcast_to(mechanism.home_full_pose, (count, mechanism.n_pose))
         start_values = [np.broadcast_to(mechanism.chains[i].reference_values, (count, mechanism.chains[i].n_joints))
                         for i in chains]
     if not chains or not free:
-        return mechanism.full_poses(task_poses, np.asarray(start_poses)[:, list(free)]), [], \
+        return mechanism.full_poses(task_poses, np.asarray(start_poses)[:, list(mechanism.dependent_indices)]), [], \
             np.ones(count, dtype=bool), np.zeros(count)
     start_task = mechanism.task_poses(start_poses)
     distance = np.abs(task_poses - start_task) / np.where(mechanism.angular, 1.0, mechanism.length_scale)

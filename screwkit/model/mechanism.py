@@ -99,6 +99,11 @@ class Mechanism:
     instantaneous_dof : int
         Dimension of the platform's motion space at the reference assembly; larger than
         :attr:`dof` when the reference assembly is a constraint singularity.
+    held_axes : tuple of int
+        Indices into :attr:`pose_coordinates` of dependent coordinates held at their reference-assembly values
+        instead of solved: the orientation, when the operation mode followed from a constraint-singular reference
+        assembly does not turn the platform (:mod:`screwkit.closure.modes`; on the set where the modes meet the
+        closure is a double root, which a solve leaves a few 1e-6 rad off into the other mode).
     assembly_notes : tuple of str
         The loops the file's joint values left open and how far each was (closed at loading).
     import_report : tuple of str
@@ -134,6 +139,7 @@ class Mechanism:
     task_source: str = "all"
     output_point: NDArray[np.float64] | None = field(default=None, repr=False)
     instantaneous_dof: int = 0
+    held_axes: tuple[int, ...] = ()
     assembly_notes: tuple[str, ...] = ()
     import_report: tuple[str, ...] = ()
 
