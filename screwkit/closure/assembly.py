@@ -22,7 +22,7 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.closure.modes import PROBE_STEP, describe_modes, meeting_modes
+from screwkit.closure.modes import describe_modes, meeting_modes, small_steps
 from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
@@ -451,8 +451,7 @@ def _held(mechanism: Mechanism, modes, axes) -> tuple[int, ...]:
     # rounding would not: they are left to the closure)
     home = mechanism.home_full_pose[list(axes)]
     trial = replace(mechanism, task_axes=tuple(axes), held_axes=held, named_poses={"home": home})
-    steps = np.where(trial.angular, PROBE_STEP, PROBE_STEP * mechanism.length_scale)
-    closed = solve(trial, np.concatenate([home + np.diag(steps), home - np.diag(steps)]), limits=False).reachable
+    closed = solve(trial, small_steps(home, trial.angular, mechanism.length_scale), limits=False).reachable
     return held if closed.all() else ()
 
 

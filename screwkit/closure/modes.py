@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from screwkit.closure.task_space import TASK_RANK_TOLERANCE, complete_poses, infer_task_axes, motion_space_at
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["Mode", "meeting_modes", "describe_modes", "MODE_SEPARATION", "PROBE_STEP"]
+__all__ = ["Mode", "meeting_modes", "describe_modes", "small_steps", "MODE_SEPARATION", "PROBE_STEP"]
 
 MODE_SEPARATION = 0.5
 """Two closed samples are of different operation modes when their motion spaces (orthonormal bases in
@@ -96,14 +96,19 @@ def meeting_modes(mechanism: Mechanism, chain_indices, poses: NDArray, values, m
     return sorted(modes, key=lambda mode: (-mode.driven, mode.turning, mode.axes))
 
 
+def small_steps(home: NDArray, angular, length_scale: float) -> NDArray:
+    """Task poses (2 n, n) a step of :data:`PROBE_STEP` (rad, or length scales) either way along each of the ``n``
+    task coordinates from ``home``: what a mode's coordinates must drive."""
+    steps = np.where(np.asarray(angular, dtype=bool), PROBE_STEP, PROBE_STEP * length_scale)
+    return np.concatenate([home + np.diag(steps), home - np.diag(steps)])
+
+
 def _tried(mechanism: Mechanism, subset: Mechanism, mode: Mode, mobility: int) -> Mode:
     """``mode`` with the count of the small steps of its task coordinates from the reference assembly that the
     continuation closes in it (its motion space within :data:`MODE_SEPARATION` of the mode's) or on the singular set
     where the modes meet (more than ``mobility`` instantaneous DOF: a U-P-U platform's pure lift)."""
     following = replace(mechanism, dof=mobility, task_axes=mode.axes)
-    home = following.task_poses(mechanism.home_full_pose[None])[0]
-    steps = np.where(np.asarray(following.angular, dtype=bool), PROBE_STEP, PROBE_STEP * mechanism.length_scale)
-    probes = np.concatenate([home + np.diag(steps), home - np.diag(steps)])
+    probes = small_steps(mechanism.home_full_pose[list(mode.axes)], following.angular, mechanism.length_scale)
     poses, values, converged, _ = complete_poses(following, probes)
     driven = 0
     if converged.any():
