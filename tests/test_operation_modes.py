@@ -162,8 +162,10 @@ def test_the_translational_mode_is_found_whatever_the_random_samples(tmp_path, m
     assert "followed: the one where the platform translates only" in notes[0]
 
 
-@pytest.mark.parametrize("legs", [3, 6])
-def test_a_pure_lift_stays_where_the_modes_meet(tmp_path, legs):
+@pytest.mark.parametrize("legs, scale, world, reverse", [(3, 1.0, (0.0, (0.0, 0.0, 0.0)), False),
+                                                    (6, 1.0, (0.0, (0.0, 0.0, 0.0)), False),
+                                                    (6, 1000.0, (0.7, (300.0, -200.0, 500.0)), True)])
+def test_a_pure_lift_stays_where_the_modes_meet(tmp_path, legs, scale, world, reverse):
     """Every pure lift (x = y = 0) keeps every hinge horizontal and every leg's couple vertical: the constraint
     singularity of home, 5 instantaneous DOF. There the closure is a double root; with legs not quite alike (a
     published file's angles written 2.0945) it stopped a few 1e-6 rad into the turning mode and read 3 DOF, LMTI
@@ -172,17 +174,18 @@ def test_a_pure_lift_stays_where_the_modes_meet(tmp_path, legs):
     from screwkit.studies import indices_at_poses
 
     path = tmp_path / "upu.sdf"
-    path.write_text(upu_sdf(legs, jitter=1e-3))
+    path.write_text(upu_sdf(legs, scale=scale, world=world, reverse=reverse, jitter=1e-3))
     mechanism = load(path)
     assert [mechanism.pose_coordinates[i] for i in mechanism.held_axes] == ["roll", "pitch", "yaw"]
-    lifts = np.array([[0.0, 0.0, dz] for dz in (0.05, 0.1, 0.2)])
+    lifts = np.array([[0.0, 0.0, dz] for dz in (0.05, 0.1, 0.2)]) * scale  # the world's vertical is the model's
     solution = solve(mechanism, mechanism.home_pose + lifts)
     assert solution.reachable.all()
     np.testing.assert_array_equal(solution.full_poses[:, 3:], np.broadcast_to(mechanism.home_full_pose[3:], (3, 3)))
-    feet, heads = joints(legs, 1.0, jitter=1e-3)
+    feet, heads = joints(legs, scale, jitter=1e-3)
     lengths = np.linalg.norm(heads[None] + lifts[:, None] - feet[None], axis=-1) - np.linalg.norm(heads - feet, axis=-1)
     order = [int(name.split("_")[-1]) for name in mechanism.actuator_names]
-    np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order], atol=1e-9)
+    np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order],
+                               atol=1e-9 * scale)
     indices = indices_at_poses(mechanism, mechanism.home_pose + lifts)
     assert np.all(indices.instantaneous_dof == 5) and np.all(indices.constraint_singular)
     assert np.all(indices.lmti == 0.0) and all(np.all(value == 0.0) for value in indices.f_o.values())
