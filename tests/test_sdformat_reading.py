@@ -157,10 +157,21 @@ def test_an_inverted_limit_is_refused_naming_the_joint(tmp_path, kind):
     refused(tmp_path, limited(kind, "1", "-1"), "<joint name='free1'>", "lower 1 > upper -1")
 
 
-def test_equal_limits_a_joint_gazebo_holds_still_are_refused_saying_so(tmp_path):
-    """lower = upper was read as no limit at all; Gazebo holds such a joint at that value."""
-    refused(tmp_path, limited("revolute", "0", "0"), "<joint name='free1'>", "lower = upper = 0", "cannot move",
-            "fixed")
+def test_equal_limits_at_zero_are_the_fixed_joint_gazebo_holds(tmp_path):
+    """lower = upper = 0: Gazebo holds the joint where the file draws it, so it is the fixed joint (a published
+    Codian Delta holds the platform's six ball mounts so, and was refused): read as the file with that joint written
+    fixed, the same DOF, coordinates and indices, and a note names it. Equal limits elsewhere than 0 hold it away
+    from where the file draws it: still refused, naming the joint (lower = upper was once read as no limit)."""
+    old = ('<joint name="free1" type="continuous"><parent>proximal_1</parent><child>distal_1</child><axis><xyz>0 0 1'
+           '</xyz></axis>')
+    fixed = load(write(tmp_path, five_bar_sdf().replace(old, '<joint name="free1" type="fixed"><parent>proximal_1'
+                                                             '</parent><child>distal_1</child>'), "fixed.sdf"))
+    held = load(write(tmp_path, limited("revolute", "0", "0"), "held.sdf"))
+    assert (held.dof, held.task_coordinates) == (fixed.dof, fixed.task_coordinates) == (1, ("x",))
+    same_indices(at_home(held), at_home(fixed))
+    assert any("'free1'" in line and "lower = upper = 0" in line and "fixed" in line for line in held.import_report)
+    refused(tmp_path, limited("revolute", "0.3", "0.3"), "<joint name='free1'>", "lower = upper = 0.3",
+            "cannot move", "fixed")
 
 
 def test_a_continuous_joint_with_inverted_limits_is_read_as_sdformat_reads_it_without(tmp_path):
@@ -287,3 +298,26 @@ def test_fixed_links_inside_a_leg_do_not_move_the_loop_into_it(tmp_path, welded)
 def test_the_command_line_refuses_in_one_line_with_no_warning(tmp_path, text, needles):
     path = write(tmp_path, text)
     one_line_error(screwkit("analyze", path), str(path), *needles)
+
+
+def test_a_tool_turning_on_its_own_joint_after_the_platform_leaves_the_platform_where_the_legs_meet(tmp_path):
+    """A published Codian Delta hangs its tool 'ee' off the platform by a revolute of its own: 'ee' was taken as the
+    platform, and the legs, which meet on the body before it, were refused as a closed-loop transmission. The
+    platform is the body where the closures meet, said in a note, and the Delta reads as without the tool (the
+    indices of the rod-level Delta, as a subprocess)."""
+    from sdformat_models import delta_sdf
+
+    tool = ('<link name="ee"><pose relative_to="platform">0 0 -0.04 0 0 0</pose></link><joint name="tool_spin" '
+            'type="revolute"><parent>platform</parent><child>ee</child><axis><xyz>0 0 1</xyz></axis></joint>')
+    plain = write(tmp_path, delta_sdf(), "plain.sdf")
+    turning = write(tmp_path, delta_sdf().replace("</model>", tool + "</model>"), "turning.sdf")
+    reports = []
+    for path in (plain, turning):
+        analysed = screwkit("analyze", path, "--json")
+        assert analysed.returncode == 0, analysed.stderr
+        reports.append(json.loads(analysed.stdout))
+    assert reports[1]["iti"] == pytest.approx(reports[0]["iti"], abs=1e-9)
+    assert reports[1]["lmti"] == pytest.approx(reports[0]["lmti"], abs=1e-9)
+    described = screwkit("info", turning)
+    assert described.returncode == 0, described.stderr
+    assert "frame 'ee' hangs off it by joint(s) tool_spin, after the parallel part" in described.stdout

@@ -1,10 +1,11 @@
 """Which frame of a closed tree is the output: the one named, else one called as outputs are, else where the legs meet.
 
 A file of another tool seldom says which body is the platform. :func:`output_frame` takes the frame given (``--output
-FRAME``), else the first frame called one of :data:`OUTPUT_NAMES`, else the body where the most closures meet (where
-every leg ends), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one ball or
-pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is then its output).
-The notes say which was inferred.
+FRAME``), else the first frame called one of :data:`OUTPUT_NAMES` (or, when that frame hangs by joints of its own off
+the body where the most closures meet, that body: a Delta's turning tool), else the body where the most closures meet
+(where every leg ends), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one
+ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is then its
+output). The notes say which was inferred.
 """
 
 from __future__ import annotations
@@ -28,17 +29,28 @@ def output_frame(tree: ClosedTree) -> int:
                                + ", ".join(names[1:]) + ".")
         return names.index(tree.output)
     lowered = [name.lower() for name in names]
-    for candidate in OUTPUT_NAMES:
-        if candidate in lowered:
-            return lowered.index(candidate)
-    # no frame named as an output: the body where the most closures meet (where every leg ends), if one does
     counts: dict[int, int] = {}
     for closure in tree.closures:
         for joint in {closure.joint_a, closure.joint_b} - {0}:
             counts[joint] = counts.get(joint, 0) + 1
     ranked = sorted(counts.items(), key=lambda item: -item[1])
-    if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]):
-        index = _body_frame(model, ranked[0][0])
+    meeting = ranked[0][0] if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]) \
+        else None  # the joint of the body where the most closures meet (where every leg ends), if one
+    for candidate in OUTPUT_NAMES:
+        if candidate in lowered:
+            index = lowered.index(candidate)
+            after = _joints_after(model, meeting, int(model.frames[index].parentJoint)) if meeting else []
+            platform = _body_frame(model, meeting) if after and not set(after) & set(counts) else None
+            if platform is None:
+                return index
+            # a tool on a joint of its own after the body where the legs meet (a Delta's turning end effector): the
+            # platform is that body, the joints after it are no part of the parallel mechanism
+            tree.notes.append(f"platform inferred: body {names[platform]!r}, where {ranked[0][1]} closures meet; frame "
+                              f"{names[index]!r} hangs off it by joint(s) {', '.join(model.names[j] for j in after)}, "
+                              "after the parallel part (name another output with --output FRAME)")
+            return platform
+    if meeting is not None:  # no frame named as an output: the body where the most closures meet
+        index = _body_frame(model, meeting)
         if index is not None:
             tree.notes.append(f"platform inferred: body {names[index]!r}, where {ranked[0][1]} closures meet "
                               "(name another with --output FRAME)")
@@ -60,6 +72,16 @@ def output_frame(tree: ClosedTree) -> int:
             return index
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
                        f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
+
+
+def _joints_after(model, ancestor: int, joint: int) -> list[int]:
+    """The moving joints from ``ancestor`` (excluded) down to ``joint`` (included) in the tree, root side first; empty
+    when ``joint`` is ``ancestor`` or not below it."""
+    path = []
+    while joint and joint != ancestor:
+        path.append(joint)
+        joint = int(model.parents[joint])
+    return path[::-1] if joint == ancestor and joint else []
 
 
 def _body_frame(model, joint: int) -> int | None:

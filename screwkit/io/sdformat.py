@@ -324,7 +324,9 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     if platform is not None:  # a leg's last links reached through the platform: reach them from their leg
         tree_joints, loops, base, tied = _spanning_tree(sdf, ends, last=platform)
     builder = _TreeBuilder(sdf, poses)
-    notes = []
+    held = [repr(joint.name) for joint in sdf.joints if joint.held]
+    notes = [f"joint(s) {', '.join(held)}: limits lower = upper = 0, they cannot move (Gazebo holds them where the "
+             "file draws them): read as fixed joints"] if held else []
     if base != WORLD:
         builder.ground(base)
         notes.append(f"no joint to the world: the canonical link {base!r} is the fixed base")

@@ -115,9 +115,12 @@ class SdfJoint:
     relative_to: str
     axes: tuple[SdfAxis, ...]
     where: str
+    held: bool = False
+    """A revolute or prismatic joint whose limits are lower = upper = 0, read as the fixed joint it is (Gazebo holds
+    it there: it cannot move)."""
 
 
-def _axis(element, tag: str, where: str, version: tuple[int, ...]) -> SdfAxis:
+def _axis(element, tag: str, where: str, version: tuple[int, ...], kind: str) -> SdfAxis:
     node = element.find(tag)
     xyz_node = node.find("xyz") if node is not None else None
     xyz = numbers(xyz_node.text if xyz_node is not None else None, 3, "0 0 1", where, f"{tag}><xyz")
@@ -131,25 +134,34 @@ def _axis(element, tag: str, where: str, version: tuple[int, ...]) -> SdfAxis:
         if "degrees" in inner.attrib:
             raise ImportError_(f"{where}: <{tag}>...<{inner.tag} degrees=...>: SDFormat has no degrees there (only "
                                "on <pose>): limits are in radians.")
-    return SdfAxis(xyz / np.linalg.norm(xyz), expressed, _limits(element, tag, where))
+    return SdfAxis(xyz / np.linalg.norm(xyz), expressed, _limits(element, tag, where, kind))
 
 
-def _limits(element, tag: str, where: str) -> tuple[float, float] | None:
-    """An axis's ``<limit>``: None when it has none, the joint is continuous (SDFormat ignores a continuous joint's
-    limits: "omit if joint is continuous") or ball or fixed, or its bounds are SDFormat's defaults (no limit);
-    refused when the lower bound is not below the upper."""
+def _bounds(element, tag: str, where: str) -> NDArray[np.float64] | None:
+    """An axis's ``<limit>`` bounds as written (SDFormat's defaults where one is left out), None without one."""
     node = element.find(f"{tag}/limit")
-    if node is None or element.get("type", "") in ("continuous", "ball", "fixed"):
+    if node is None:
         return None
     lower = node.findtext("lower", "").strip() or str(-UNLIMITED)
     upper = node.findtext("upper", "").strip() or str(UNLIMITED)
-    bounds = numbers(f"{lower} {upper}", 2, "", where, f"{tag}><limit")
+    return numbers(f"{lower} {upper}", 2, "", where, f"{tag}><limit")
+
+
+def _limits(element, tag: str, where: str, kind: str) -> tuple[float, float] | None:
+    """An axis's ``<limit>``: None when it has none, the joint (of type ``kind``) is continuous (SDFormat ignores a
+    continuous joint's limits: "omit if joint is continuous") or ball or fixed, or its bounds are SDFormat's defaults
+    (no limit); refused when the lower bound is not below the upper."""
+    node = element.find(f"{tag}/limit")
+    if node is None or kind in ("continuous", "ball", "fixed"):
+        return None
+    bounds = _bounds(element, tag, where)
     if bounds[0] > bounds[1]:
         raise ImportError_(f"{where}: <{tag}><limit> lower {bounds[0]:g} > upper {bounds[1]:g}: the lower limit must "
                            "be below the upper.")
     if bounds[0] == bounds[1]:
         raise ImportError_(f"{where}: <{tag}><limit> lower = upper = {bounds[0]:g}: the joint cannot move (Gazebo "
-                           "holds it at that value); write a fixed joint, or limits with lower below upper.")
+                           "holds it at that value, away from where the file draws it); write a fixed joint, or limits "
+                           "with lower below upper.")
     if abs(bounds[0]) < UNLIMITED and abs(bounds[1]) < UNLIMITED:
         return float(bounds[0]), float(bounds[1])
     return None
@@ -168,8 +180,12 @@ def parse_joint(element, where: str, version: tuple[int, ...] = (1, 7)) -> SdfJo
             raise ImportError_(f"{where}: no <{tag}>.")
         ends.append(end)
     pose, relative = parse_pose(element.find("pose"), where)
-    axes = tuple(_axis(element, tag, where, version) for tag in ("axis", "axis2"))
-    return SdfJoint(name, element.get("type", ""), ends[0], ends[1], pose, relative, axes, where)
+    kind = element.get("type", "")
+    bounds = _bounds(element, "axis", where) if kind in ("revolute", "prismatic") else None
+    held = bounds is not None and bounds[0] == bounds[1] == 0.0  # held where the file draws it: a fixed joint
+    kind = "fixed" if held else kind
+    axes = tuple(_axis(element, tag, where, version, kind) for tag in ("axis", "axis2"))
+    return SdfJoint(name, kind, ends[0], ends[1], pose, relative, axes, where, held)
 
 
 @dataclass
