@@ -214,6 +214,9 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
         start_poses = np.broadcast_to(mechanism.home_full_pose, (count, mechanism.n_pose))
         start_values = [np.broadcast_to(mechanism.chains[i].reference_values, (count, mechanism.chains[i].n_joints))
                         for i in chains]
+    if mechanism.held_axes:  # held at the reference assembly's values, wherever the continuation starts
+        start_poses = np.array(start_poses, dtype=float)
+        start_poses[:, list(mechanism.held_axes)] = mechanism.home_full_pose[list(mechanism.held_axes)]
     if not chains or not free:
         return mechanism.full_poses(task_poses, np.asarray(start_poses)[:, list(mechanism.dependent_indices)]), [], \
             np.ones(count, dtype=bool), np.zeros(count)
