@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import rotation_from_rpy
+from screwkit.common.xml_text import tolerant_declaration
 from screwkit.io.closed_tree import ImportError_
 
 __all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
@@ -235,7 +236,7 @@ def read_model(path: Path) -> SdfModel:
     """The one model of an SDFormat file (in ``<sdf>`` or in its one ``<world>``), as written."""
     path = Path(path)
     try:
-        root = ElementTree.fromstring(path.read_bytes())
+        root = ElementTree.fromstring(tolerant_declaration(path.read_bytes()))
     except ElementTree.ParseError as error:
         raise ImportError_(f"{path}: not well-formed XML ({error}).") from None
     element = _the_model(path, root)
