@@ -62,3 +62,19 @@ def test_only_the_declaration_is_forgiven(tmp_path):
                       .replace("</model>", "</modle>"))
     with pytest.raises(ImportError_, match=r"broken.sdf: not well-formed XML"):
         load(broken)
+
+
+def test_convert_writes_back_a_screwkit_urdf_declared_so(tmp_path):
+    """`screwkit convert` rewrites a file of screwkit's convention with its reference configuration: a file declared
+    `<? xml ...?>` was refused as malformed XML; read now, its rewriting goes through Python's parser too, which
+    refused it with a traceback (not even a one-line error) before it was told of the declaration."""
+    from helpers import screwkit
+
+    source, out = tmp_path / "declared.urdf", tmp_path / "out.urdf"
+    text = bundled_path("planar_5rrr").read_text()
+    source.write_text(text.replace('<?xml version="1.0"?>', '<? xml version="1.0" ?>', 1))
+    converted = screwkit("convert", source, out)
+    assert converted.returncode == 0 and "Traceback" not in converted.stderr, converted.stderr
+    bundled = load("planar_5rrr")
+    assert_indices_close(indices_at_pose(load(out), bundled.home_pose), indices_at_pose(bundled, bundled.home_pose),
+                         1e-12)
