@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from screwkit.common.lazy import lazy_attributes
 from screwkit.common.units import metres_per
+from screwkit.common.xml_text import tolerant_declaration
 
 if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file in screwkit's convention reads none
     from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
@@ -143,8 +144,6 @@ def with_reference_configuration(text: str, mechanism) -> str:
     a file whose loops were closed at loading (:attr:`~screwkit.model.mechanism.Mechanism.assembly_notes`)
     then closes as written. Comments are kept."""
     import xml.etree.ElementTree as ElementTree
-
-    from screwkit.common.xml_text import tolerant_declaration
 
     fixed = tolerant_declaration(text.encode())  # (the text itself when its declaration needs nothing)
     root = ElementTree.fromstring(text if fixed == text.encode() else fixed.decode(), parser=ElementTree.XMLParser(
