@@ -334,6 +334,20 @@ def rss_sdf(tilt: float = 0.0, seed: int = 0, scale: float = 1.0, reverse: bool 
     return "\n".join(lines)
 
 
+def upu_legs(legs: int, scale: float = 1.0, tilt: float = 0.35, jitter: float = 0.0):
+    """Per leg of :func:`upu_sdf` (model frame, m): its universal joints' centres on the base (foot) and on the
+    platform (head), its radial axis y and its tangential axis x, as the file is drawn."""
+    moved = jitter * np.random.default_rng(5).normal(size=(legs, 2))
+    geometry = []
+    for k in range(legs):
+        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3) + moved[k, 0])
+        radial, tangential = turn @ np.array([0.0, 1.0, 0.0]), turn @ np.array([1.0, 0.0, 0.0])
+        foot = 0.8 * scale * (1.0 + moved[k, 1]) * radial
+        head = foot + 1.9 * scale * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial)
+        geometry.append((foot, head, radial, tangential))
+    return geometry
+
+
 def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), reverse: bool = False,
             tilt: float = 0.35, decimals: int | None = None, jitter: float = 0.0) -> str:
     """A translational U-P-U parallel mechanism written as a published Gazebo "Stewart platform" writes its legs (each
@@ -348,7 +362,7 @@ def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), rev
     written to so many decimals (as a published file writes them: its legs no longer quite alike); ``jitter``: each
     leg's azimuth and radius moved by about so much (rad, relative), its hinges still horizontal (the legs not quite
     alike, every one still a translational U-P-U vertical at home, as in a file whose angles are written 2.0945)."""
-    base_radius, length = 0.8 * scale, 1.9 * scale
+    length = 1.9 * scale
     rounded = (lambda values: values) if decimals is None else (lambda values: np.round(values, decimals))
     yaw, shift = world
     lines = [f'<?xml version="1.0"?>\n<sdf version="1.9" {NAMESPACE}><model name="upu">',
@@ -356,12 +370,9 @@ def upu_sdf(legs: int = 3, scale: float = 1.0, world=(0.0, (0.0, 0.0, 0.0)), rev
              '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>',
              f'<link name="platform"><pose>0 0 {float(length * np.cos(tilt))!r} 0 0 0</pose></link>']
     order = range(legs - 1, -1, -1) if reverse else range(legs)
-    moved = jitter * np.random.default_rng(5).normal(size=(legs, 2))
+    geometry = upu_legs(legs, scale, tilt, jitter)
     for k in order:
-        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3) + moved[k, 0])
-        radial, tangential = turn @ np.array([0.0, 1.0, 0.0]), turn @ np.array([1.0, 0.0, 0.0])
-        foot = base_radius * (1.0 + moved[k, 1]) * radial
-        head = foot + length * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial)
+        foot, head, radial, tangential = geometry[k]
         direction = (head - foot) / length
         joints = [("yb", "base", f"ub_{k}", foot, radial, "revolute"),
                   ("xb", f"ub_{k}", f"cyl_{k}", foot, tangential, "revolute"),

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from sdformat_models import rotation_z, upu_sdf
+from sdformat_models import rotation_z, upu_legs, upu_sdf
 
 from screwkit.closure import actuator_values, solve
 from screwkit.closure.assembly import MODES_MEET
@@ -27,16 +27,11 @@ def upu(tmp_path, legs, scale, world, reverse, name="upu.sdf"):
     return path
 
 
-def joints(legs: int, scale: float, tilt: float = 0.35, jitter: float = 0.0, decimals: int | None = None):
-    """The universal joints' centres of :func:`upu_sdf` in its model frame (foot, head per leg, legs in order)."""
-    feet, heads = [], []
-    moved = jitter * np.random.default_rng(5).normal(size=(legs, 2))
-    for k in range(legs):
-        turn = rotation_z(2.0 * np.pi * k / legs + (0.3 if k % 2 else 0.0) * (legs > 3) + moved[k, 0])
-        radial = turn @ np.array([0.0, 1.0, 0.0])
-        feet.append(0.8 * scale * (1.0 + moved[k, 1]) * radial)
-        heads.append(feet[-1] + 1.9 * scale * (np.cos(tilt) * np.array([0.0, 0.0, 1.0]) - np.sin(tilt) * radial))
-    feet, heads = np.array(feet), np.array(heads)
+def joints(legs: int, scale: float, jitter: float = 0.0, decimals: int | None = None):
+    """The universal joints' centres of :func:`upu_sdf` in its model frame (feet, heads, legs in order), as written
+    to ``decimals``."""
+    geometry = upu_legs(legs, scale, jitter=jitter)
+    feet, heads = np.array([leg[0] for leg in geometry]), np.array([leg[1] for leg in geometry])
     return (feet, heads) if decimals is None else (np.round(feet, decimals), np.round(heads, decimals))
 
 

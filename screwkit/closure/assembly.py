@@ -22,7 +22,7 @@ from screwkit.closure.chain_kinematics import (
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
-from screwkit.closure.modes import describe_modes, meeting_modes, small_steps
+from screwkit.closure.modes import describe_modes, meeting_modes, small_steps, values_at
 from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
@@ -388,10 +388,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
             sample = int(np.argmin(dofs))
             if dofs[sample] < instantaneous:
                 mobility = int(dofs[sample])
-                at_pose = poses[sample]
-                at_values = [c.reference_values for c in mechanism.chains]
-                for index, chain_values in zip(chain_indices, values):
-                    at_values[index] = chain_values[sample]
+                at_pose, at_values = poses[sample], values_at(mechanism, chain_indices, values, sample)
                 if not idle:  # a constraint singularity: the operation modes that meet there, each tried
                     if not more:
                         chain_indices, poses, values = _mode_samples(mechanism, poses, values)

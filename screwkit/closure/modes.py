@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from screwkit.closure.task_space import TASK_RANK_TOLERANCE, complete_poses, infer_task_axes, motion_space_at
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["Mode", "meeting_modes", "describe_modes", "small_steps", "MODE_SEPARATION", "PROBE_STEP"]
+__all__ = ["Mode", "meeting_modes", "describe_modes", "small_steps", "values_at", "MODE_SEPARATION", "PROBE_STEP"]
 
 MODE_SEPARATION = 0.5
 """Two closed samples are of different operation modes when their motion spaces (orthonormal bases in
@@ -64,6 +64,15 @@ def _apart(first: NDArray, second: NDArray) -> float:
     return float(np.linalg.norm(first - second @ (second.T @ first), 2))
 
 
+def values_at(mechanism: Mechanism, chain_indices, values, sample: int) -> list[NDArray]:
+    """Every chain's joint values at closed sample ``sample``: the constraining chains' (``chain_indices``, their
+    ``values`` (N, m_i)) there, the reference assembly's for the others (their twists span every motion)."""
+    every = [np.asarray(chain.reference_values) for chain in mechanism.chains]
+    for index, chain_values in zip(chain_indices, values):
+        every[index] = chain_values[sample]
+    return every
+
+
 def meeting_modes(mechanism: Mechanism, chain_indices, poses: NDArray, values, mobility: int) -> list[Mode]:
     """The operation modes the samples ``poses`` (N, n_pose) with the joint values ``values`` of the chains
     ``chain_indices`` show near the reference assembly, each with its task coordinates tried, in the order they are
@@ -86,9 +95,7 @@ def meeting_modes(mechanism: Mechanism, chain_indices, poses: NDArray, values, m
     for group in groups:
         turning = [np.linalg.svd(bases[s][angular, :mobility], compute_uv=False) for s in group]
         sample = group[int(np.argmin([np.sum(rates) for rates in turning]))]
-        every = [np.asarray(c.reference_values) for c in mechanism.chains]
-        for index, chain_values in zip(chain_indices, values):
-            every[index] = chain_values[sample]
+        every = values_at(mechanism, chain_indices, values, sample)
         axes = infer_task_axes(mechanism, poses[sample], every, mobility)
         count = min(int(np.sum(rates > TASK_RANK_TOLERANCE)) for rates in turning)
         modes.append(_tried(mechanism, subset, Mode(bases[sample][:, :mobility], poses[sample], tuple(every), axes,
