@@ -20,7 +20,7 @@ from sdformat_models import NAMESPACE, five_bar_sdf, hexapod_legs
 
 from helpers import one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy
-from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
+from screwkit.io import ImportError_, graph_mechanism, read_closed_tree, read_mechanism_file
 from screwkit.io.loader import bundled_path, load, load_text
 from screwkit.io.sdformat_text import read_model, world_poses
 from screwkit.studies import indices_at_pose
@@ -321,3 +321,75 @@ def test_a_tool_turning_on_its_own_joint_after_the_platform_leaves_the_platform_
     described = screwkit("info", turning)
     assert described.returncode == 0, described.stderr
     assert "frame 'ee' hangs off it by joint(s) tool_spin, after the parallel part" in described.stdout
+
+
+def bracketed_delta(tmp_path, reverse: bool = False) -> tuple[str, str]:
+    """The rod-level Delta with its platform called 'carrier' (no output name), plain and with each rod's far ball
+    on a bracket welded to the carrier 1 cm below the ball (a Codian Delta's brackets), ``reverse``: the brackets
+    and their welds written in reverse order. The spanning tree reaches a bracket before the carrier."""
+    from sdformat_models import delta_sdf
+
+    plain = delta_sdf().replace("platform", "carrier")
+    root = ElementTree.fromstring(plain.split("\n", 1)[1])
+    model = root.find("model")
+    ends = [joint for joint in model.findall("joint") if joint.get("name").startswith("end_")]
+    poses = world_poses(read_model(write(tmp_path, plain, "plain.sdf")))
+    carrier = poses["carrier"]
+    added = []
+    for joint in ends:
+        name = joint.get("name").replace("end_", "bracket_")
+        ball = poses[joint.get("name")][:3, 3]
+        below = np.linalg.solve(carrier[:3, :3], ball - carrier[:3, 3]) - np.array([0.0, 0.0, 0.01])
+        joint.find("child").text = name
+        pose = joint.find("pose")
+        pose.text = " ".join(repr(float(v)) for v in np.linalg.solve(carrier[:3, :3], ball - carrier[:3, 3])) \
+            + " 0 0 0"
+        pose.set("relative_to", "carrier")
+        added.append((ElementTree.fromstring(f'<link name="{name}"><pose relative_to="carrier">'
+                                             f'{" ".join(repr(float(v)) for v in below)} 0 0 0</pose></link>'),
+                      ElementTree.fromstring(f'<joint name="weld_{name}" type="fixed"><parent>carrier</parent>'
+                                             f'<child>{name}</child></joint>')))
+    for link, weld in (added[::-1] if reverse else added):
+        model.insert(1, link)
+        model.append(weld)
+    return plain, '<?xml version="1.0"?>\n' + ElementTree.tostring(root, encoding="unicode")
+
+
+def output_position(graph) -> np.ndarray:
+    """Where a graph mechanism's output frame is at its configuration (Pinocchio's forward kinematics)."""
+    import pinocchio as pin
+
+    data = graph.tree.model.createData()
+    pin.framesForwardKinematics(graph.tree.model, data, graph.q)
+    return data.oMf[graph.frame_id].translation
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_platform_of_welded_links_is_named_and_placed_after_the_one_they_are_welded_to(tmp_path, reverse):
+    """A published Codian Delta welds a bracket per ball around its platform: the platform was named after the
+    bracket the tree reached first ('A12'), and its pose was that bracket's origin. It is the body the others are
+    welded to, whatever order the file lists the brackets in: its name, its origin as the file's text places it, and
+    the indices of the same Delta without brackets."""
+    plain, bracketed = bracketed_delta(tmp_path, reverse)
+    reference = graph_mechanism(read_closed_tree(tmp_path / "plain.sdf"))
+    found = graph_mechanism(read_closed_tree(write(tmp_path, bracketed, "bracketed.sdf")))
+    assert found.platform_body == reference.platform_body == "carrier"
+    assert "platform inferred: body 'carrier'" in " ".join(found.report.notes)
+    carrier = world_poses(read_model(tmp_path / "plain.sdf"))["carrier"][:3, 3]
+    np.testing.assert_allclose(output_position(found), carrier, atol=1e-12)
+    np.testing.assert_allclose(output_position(reference), carrier, atol=1e-12)
+    same_indices(found.indices(), reference.indices())
+
+
+def test_the_commands_name_and_place_a_welded_platform_after_its_hub(tmp_path):
+    """The same, as users run it: ``info`` names the carrier, ``analyze`` gives its origin as the pose."""
+    _, bracketed = bracketed_delta(tmp_path)
+    path = write(tmp_path, bracketed, "bracketed.sdf")
+    described = screwkit("info", path)
+    assert described.returncode == 0, described.stderr
+    assert "platform 'carrier'" in described.stdout
+    analysed = screwkit("analyze", path, "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    pose = json.loads(analysed.stdout)["pose"]
+    carrier = world_poses(read_model(tmp_path / "plain.sdf"))["carrier"][:3, 3]
+    np.testing.assert_allclose([pose[axis] for axis in "xyz"], carrier, atol=1e-9)

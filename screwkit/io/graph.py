@@ -72,7 +72,7 @@ from screwkit.io.graph_kinematics import (
     solve_poses,
 )
 from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
-from screwkit.io.output import output_frame
+from screwkit.io.output import output_frame, platform_body
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
 
@@ -473,8 +473,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     platform = int(frame.parentJoint)
     if platform == 0:
         raise ImportError_(f"{tree.source}: the output frame {frame.name!r} is on the fixed base.")
-    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
-    report.platform_body = bodies.get(platform, model.names[platform])
+    report.platform_body = platform_body(model, frame_id)
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")

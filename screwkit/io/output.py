@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from screwkit.io.closed_tree import ClosedTree, ImportError_
 
-__all__ = ["output_frame", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
+__all__ = ["output_frame", "platform_body", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
 
 OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
 """Frame names taken as the output when none is given, in this order (case-insensitive)."""
@@ -85,6 +85,21 @@ def _joints_after(model, ancestor: int, joint: int) -> list[int]:
 
 
 def _body_frame(model, joint: int) -> int | None:
-    """The index of the body frame moved by ``joint``, if it has one."""
-    return next((index for index, frame in enumerate(model.frames)
-                 if frame.parentJoint == joint and str(frame.type) == "BODY"), None)
+    """The index of the body frame moved by ``joint``, if it has one: of several (links welded into one body), the
+    one the most others are welded to (a Delta's platform, its ball-joint brackets welded around it, rather than the
+    bracket the tree happened to reach first); the first of those on a tie."""
+    bodies = [index for index, frame in enumerate(model.frames)
+              if frame.parentJoint == joint and str(frame.type) == "BODY"]
+    welds = {index: sum(str(frame.type) == "FIXED_JOINT" for frame in model.frames if frame.parentFrame == index)
+             + (str(model.frames[model.frames[index].parentFrame].type) == "FIXED_JOINT") for index in bodies}
+    return max(bodies, key=welds.__getitem__) if bodies else None
+
+
+def platform_body(model, frame: int) -> str:
+    """The name of the body that output frame ``frame`` is on: the frame itself if it is a body's, else the body
+    :func:`_body_frame` takes of those its joint moves, else the joint's name."""
+    if str(model.frames[frame].type) == "BODY":
+        return model.frames[frame].name
+    joint = int(model.frames[frame].parentJoint)
+    index = _body_frame(model, joint)
+    return model.names[joint] if index is None else model.frames[index].name

@@ -65,7 +65,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import Reduction, compound_legs
-from screwkit.io.output import output_frame
+from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
 from screwkit.model.urdf_writer import UrdfWriter
 
@@ -351,9 +351,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     platform = int(frame.parentJoint)
     if platform == 0:
         raise ImportError_(f"{tree.source}: the output frame {frame.name!r} is on the fixed base.")
-    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
-    body = bodies.get(platform, model.names[platform])
-    report.platform_body = body
+    body = report.platform_body = platform_body(model, frame_index)
     spine = _Leg(path_to(model, platform), "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
     onto_platform = [platform in path_to(model, c.joint_a) or platform in path_to(model, c.joint_b)
                      for c in tree.closures]
