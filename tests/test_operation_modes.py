@@ -8,6 +8,8 @@ is the change of the distance between its two universal joints, the platform doe
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from sdformat_models import rotation_z, upu_legs, upu_sdf
@@ -15,6 +17,7 @@ from sdformat_models import rotation_z, upu_legs, upu_sdf
 from screwkit.closure import actuator_values, solve
 from screwkit.closure.assembly import MODES_MEET
 from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
 
 VARIANTS = [(3, 1.0, (0.0, (0.0, 0.0, 0.0)), False), (6, 1.0, (0.0, (0.0, 0.0, 0.0)), False),
             (3, 1000.0, (0.0, (0.0, 0.0, 0.0)), False), (3, 1.0, (0.7, (0.3, -0.2, 0.5)), True),
@@ -202,3 +205,31 @@ def test_a_six_leg_platform_written_to_four_decimals_keeps_its_mobility(tmp_path
     lengths = np.linalg.norm(heads[None] + moves[:, None] - feet[None], axis=-1) - np.linalg.norm(heads - feet, axis=-1)
     order = [int(name.split("_")[-1]) for name in mechanism.actuator_names]
     np.testing.assert_allclose(actuator_values(mechanism, solution.joint_values), lengths[:, order], atol=1e-9)
+
+
+@pytest.mark.parametrize("scale, world, reverse", [(1.0, (0.0, (0.0, 0.0, 0.0)), True),
+                                                   (1e-3, (-2.1, (-5.0, 40.0, 1.0)), False)])
+def test_the_legs_relabelled_give_the_same_indices_and_the_same_worst_legs(tmp_path, scale, world, reverse):
+    """Six U-P-U legs whose names are permuted (leg k called sigma(k): the sorted actuators are other legs), at a
+    regular pose off the lift line: every index is that of the file as drawn (scaled, moved, its legs listed in either
+    order), and each worst fault set names the same legs, relabelled."""
+    sigma = [3, 5, 0, 4, 1, 2]
+    drawn = load(upu(tmp_path, 6, 1.0, (0.0, (0.0, 0.0, 0.0)), False, "drawn.sdf"))
+    text = re.sub(r"_(\d)(?=[\"<])", lambda match: f"_{sigma[int(match.group(1))]}",
+                  upu_sdf(6, scale=scale, world=world, reverse=reverse))
+    (tmp_path / "relabelled.sdf").write_text(text)
+    relabelled = load(tmp_path / "relabelled.sdf")
+    step = np.array([0.05, 0.03, 0.1])
+    reference = indices_at_pose(drawn, drawn.home_pose + step)
+    found = indices_at_pose(relabelled, relabelled.home_pose + rotation_z(world[0]) @ step * scale)
+    for name in ("iti", "lmti", "cti"):
+        assert float(getattr(found, name)) == pytest.approx(float(getattr(reference, name)), abs=1e-9), name
+    renamed = {f"yb_{k}:slide_{k}": f"yb_{sigma[k]}:slide_{sigma[k]}" for k in range(6)}
+    for j in reference.faults:
+        assert float(found.f_o[j]) == pytest.approx(float(reference.f_o[j]), abs=1e-9)
+        assert float(found.f_io[j]) == pytest.approx(float(reference.f_io[j]), abs=1e-9)
+        assert float(found.f_c[j]) == pytest.approx(float(reference.f_c[j]), abs=1e-9)
+        expected = {frozenset(renamed[name] for name in tie) for tie in reference.worst_fault_ties(j)}
+        assert {frozenset(tie) for tie in found.worst_fault_ties(j)} == expected
+        assert frozenset(found.worst_faults[j]) in expected
+    np.testing.assert_allclose(sorted(found.iti_actuators), sorted(reference.iti_actuators), atol=1e-9)
