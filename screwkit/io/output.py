@@ -96,10 +96,8 @@ def _body_frame(model, joint: int) -> int | None:
 
 
 def platform_body(model, frame: int) -> str:
-    """The name of the body that output frame ``frame`` is on: the frame itself if it is a body's, else the body
-    :func:`_body_frame` takes of those its joint moves, else the joint's name."""
-    if str(model.frames[frame].type) == "BODY":
-        return model.frames[frame].name
+    """The name of the body that output frame ``frame`` is on: of the links its joint moves (welded together), the one
+    :func:`_body_frame` takes; the joint's name if none."""
     joint = int(model.frames[frame].parentJoint)
     index = _body_frame(model, joint)
     return model.names[joint] if index is None else model.frames[index].name
