@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 from sdformat_models import rotation_z, upu_legs, upu_sdf
 
-from screwkit.closure import actuator_values, solve
+from screwkit.closure import actuator_values, chain_screws, solve
 from screwkit.closure.assembly import MODES_MEET
 from screwkit.io.loader import load
-from screwkit.studies import indices_at_pose
+from screwkit.screw.reference import reference_indices
+from screwkit.studies import indices_at_pose, indices_at_poses
 
 VARIANTS = [(3, 1.0, (0.0, (0.0, 0.0, 0.0)), False), (6, 1.0, (0.0, (0.0, 0.0, 0.0)), False),
             (3, 1000.0, (0.0, (0.0, 0.0, 0.0)), False), (3, 1.0, (0.7, (0.3, -0.2, 0.5)), True),
@@ -233,3 +234,32 @@ def test_the_legs_relabelled_give_the_same_indices_and_the_same_worst_legs(tmp_p
         assert {frozenset(tie) for tie in found.worst_fault_ties(j)} == expected
         assert frozenset(found.worst_faults[j]) in expected
     np.testing.assert_allclose(sorted(found.iti_actuators), sorted(reference.iti_actuators), atol=1e-9)
+
+
+@pytest.mark.parametrize("decimals", [4, 5, 6])
+def test_lifts_of_a_rounded_platform_give_each_pose_the_same_indices_in_any_batch(tmp_path, decimals):
+    """Written to 4-6 decimals, the lift line of a 3-U-P-U is a constraint singularity only to 1e-9 to 1e-5: its
+    legs' couples are that near parallel. The eigenvectors that gave the motion space did not resolve the two
+    rotations the legs nearly allow (eigenvalues 1e-16 and below), and the plan read the couples as one common
+    wrench wherever every pose of the batch was a lift, then never found a lift singular: the LMTI of one lift was
+    0.4942 alone and 0.0635 in a batch of lifts (5 decimals), 0 alone and 0.5036 in a batch (6 decimals). Each lift
+    is now the same in any batch, and the numpy reference's, to what so near a singularity resolves (1e-16 over the
+    couples' 1e-9: 1e-7)."""
+    path = tmp_path / "rounded.sdf"
+    path.write_text(upu_sdf(3, decimals=decimals))
+    mechanism = load(path)
+    lifts = mechanism.home_pose + np.array([[0.0, 0.0, dz] for dz in (0.01, 0.05, 0.1, 0.2)])
+    solution = solve(mechanism, lifts)
+    chains = chain_screws(mechanism, solution)
+    for row, pose in enumerate(lifts):
+        single = indices_at_pose(mechanism, pose)
+        expected = reference_indices([c.twists[row] for c in chains], [c.points[row] for c in chains],
+                                     [c.actuated for c in chains], mechanism.dof)
+        assert float(single.lmti) == pytest.approx(expected["lmti"], abs=1e-6)
+        assert float(single.iti) == pytest.approx(expected["iti"], abs=1e-6)
+        assert single.instantaneous_dof == expected["instantaneous_dof"]
+        regular = mechanism.home_pose + np.array([[0.05, 0.03, 0.1]])
+        for batch, at in ((lifts, row), (lifts[::-1], 3 - row), (np.vstack([regular, lifts]), row + 1)):
+            result = indices_at_poses(mechanism, batch)
+            assert float(result.lmti[at]) == pytest.approx(float(single.lmti), abs=1e-6)
+            assert float(result.iti[at]) == pytest.approx(float(single.iti), abs=1e-6)

@@ -38,6 +38,13 @@ MOTION_SPACE_EIGENVALUE = 1e-8
 (``P_i`` the orthogonal projector on chain i's twist space, working coordinates) has an
 eigenvalue at or below this along it (each ``I - P_i`` has eigenvalues 0 and 1)."""
 
+EIGENVALUE_RESOLUTION = 1e-10
+"""Dimensionless: where the eigenvalue of ``sum_i (I - P_i)`` just past the motion space's ``n`` is at or below this,
+its eigenvectors do not tell the motion space from the twists next to it (an eigen-solver resolves eigenvalues to
+about 1e-16 of the matrix's norm, singular values of the chains' complements to about 1e-8): the ``n`` least singular
+directions of the stacked complements are taken instead, resolved to about 1e-16 (a pose 1e-8 from a constraint
+singularity, which :data:`MOTION_SPACE_TOLERANCE` counts as regular; :func:`screwkit.screw.motion.motion_bases`)."""
+
 CONSTANT_BASIS_TOLERANCE = 1e-8
 """Dimensionless: orthonormal motion-space bases (working coordinates) found at sample
 configurations span the same space when one differs from its projection on the other by at

@@ -93,17 +93,36 @@ def chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: fl
 def null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float,
                 decompositions: list | None = None):
     """Per-configuration motion spaces: eigen-decomposition of sum_i (I - P_i) (working coordinates)."""
+    if decompositions is None:
+        decompositions = chain_decompositions(chain_twists)
     values, vectors = np.linalg.eigh(chain_projector_complements(chain_twists, tolerance, decompositions))
-    return motion_bases(values, vectors, dof)
+    return motion_bases(values, vectors, dof, decompositions, tolerance)
 
 
-def motion_bases(values: NDArray, vectors: NDArray, dof: int | None):
+def motion_bases(values: NDArray, vectors: NDArray, dof: int | None, decompositions: list | None = None,
+                 tolerance: float = tolerances.MOTION_SPACE_TOLERANCE):
     """Per-configuration motion spaces from the eigenvalues (K, 6), ascending, and eigenvectors (K, 6, 6) of
     sum_i (I - P_i): their dimensions (eigenvalues at most ``MOTION_SPACE_EIGENVALUE``) and bases (K, n, 6), n
-    ``dof`` or else the largest dimension."""
+    ``dof`` or else the largest dimension.
+
+    Where the eigenvalue after the ``n`` smallest is at most :data:`~screwkit.common.tolerances.
+    EIGENVALUE_RESOLUTION`, the eigenvectors mix the motion space with the twists the chains nearly allow (a pose
+    near a constraint singularity: three U-P-U legs' couples 1e-8 from parallel); those configurations take the
+    ``n`` least singular directions of the chains' stacked complements (``decompositions``, from
+    :func:`chain_decompositions`, ``tolerance`` as :func:`chain_projector_complements` takes it) instead: the same
+    space where the eigenvectors resolve it."""
     dims = np.sum(values <= tolerances.MOTION_SPACE_EIGENVALUE, axis=-1)
     count = int(dims.max()) if dof is None else dof
-    return dims, np.swapaxes(vectors[..., :count], -1, -2)
+    bases = np.swapaxes(vectors[..., :count], -1, -2)
+    if decompositions is None or count >= 6:
+        return dims, bases
+    unresolved = np.flatnonzero(values[:, count] <= tolerances.EIGENVALUE_RESOLUTION)
+    if unresolved.size:
+        rows = np.concatenate([right[unresolved] * (singular[unresolved] <= tolerance * singular[unresolved, :1])
+                               [..., None] for singular, right in decompositions], axis=-2)
+        bases = np.array(bases)
+        bases[unresolved] = np.linalg.svd(rows)[2][:, 6 - count:]
+    return dims, bases
 
 
 def working_coordinates(twists: list[NDArray], points: list[NDArray]):

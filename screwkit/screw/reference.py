@@ -65,9 +65,11 @@ def _span(rows: NDArray, tolerance: float = MOTION_SPACE_TOLERANCE) -> NDArray:
 
 def motion_space(twists: list[NDArray], dof: int) -> NDArray:
     r"""Orthonormal basis (dof, 6) of :math:`\bigcap_i \mathrm{span}(J_i)`: the eigenvectors of
-    :math:`\sum_i (I - P_i)` of smallest eigenvalue (zero on the intersection)."""
-    total = sum(np.eye(6) - basis.T @ basis for basis in map(_span, twists))
-    return np.linalg.eigh(total)[1][:, :dof].T
+    :math:`\sum_i (I - P_i)` of smallest eigenvalue (zero on the intersection), found as the right singular vectors
+    of least singular value of the stacked :math:`I - P_i` (the same vectors: the sum is the stack's Gram matrix),
+    which resolves them to rounding even next to a constraint singularity."""
+    stacked = np.concatenate([np.eye(6) - basis.T @ basis for basis in map(_span, twists)])
+    return np.linalg.svd(stacked)[2][6 - dof:]
 
 
 def actuation_wrench(chain: NDArray, points: NDArray, k: int, basis: NDArray | None = None) -> NDArray:
@@ -171,7 +173,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
     principal directions of their pairing). Empty when no chain holds a constraint wrench alone. At a constraint
     singularity (more than ``dof`` instantaneous DOF) the wrenches the chains share are shared there only (every
     U-P-U leg's couple vertical), not common: each chain's own, as
-    :func:`screwkit.screw.constraints.plan_constraints` reads them."""
+    :func:`screwkit.screw.constraints.plan_constraints` reads them; so too where the wrenches taken as common and
+    the chains' own could not hold the platform to ``dof`` (wrenches alike only to about 1e-4)."""
     constraints = [_complement(_span(t)) @ SWAP for t in twists]
     every = np.concatenate(constraints)
     instantaneous = 6 - (len(_span(every)) if len(every) else 0)
@@ -181,6 +184,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
     else:
         shared = np.zeros((0, 6))
     if instantaneous > dof:  # shared here only (a constraint singularity): none is common to the chains
+        shared = np.zeros((0, 6))
+    if len(shared) + sum(len(c) - len(shared) for c in constraints) < 6 - dof:  # too few to hold n DOF: not common
         shared = np.zeros((0, 6))
     own = [np.linalg.svd(c - c @ shared.T @ shared)[2][:len(c) - len(shared)] if len(c) > len(shared)
            else np.zeros((0, 6)) for c in constraints]
