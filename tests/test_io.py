@@ -130,6 +130,25 @@ def test_an_mjcf_five_bar_has_the_textbook_pressure_angles(tmp_path):
     assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
 
 
+def test_a_point_output_names_the_closure_where_the_legs_meet_not_the_file_s_first(tmp_path):
+    """A published gripper lists the other finger's loop first: the point output of one finger was said to be where
+    that loop closes (its name only: the point was right). Here a rigid pair of rods on the base, closed by a
+    connect listed first, beside a two-legged five-bar: the output names the five-bar's closure, and the indices are
+    the five-bar's alone."""
+    idle = ''.join(f'<body name="idle_{side}" pos="{x} -0.5 0"><joint name="idle_{side}" type="hinge" axis="0 0 1"/>'
+                   '<geom type="sphere" size="0.01"/></body>' for side, x in (("a", -0.5), ("b", -0.2)))
+    text = five_bar_mjcf(legs=2).replace('<body name="base">', '<body name="base">' + idle).replace(
+        "<equality>", '<equality><connect name="idle" body1="idle_a" body2="idle_b" anchor="0.15 0.2 0"/>')
+    (tmp_path / "with_idle.xml").write_text(text)
+    (tmp_path / "plain.xml").write_text(five_bar_mjcf(legs=2))
+    _, report = read_mechanism_file(tmp_path / "with_idle.xml")
+    assert report.output.startswith("the point where the chains meet on body 'distal_1' (closure 'loop_2')")
+    assert "closure 'idle' closes branches that reach no leg: left out (it does not move the platform)" in report.notes
+    plain, found = load(tmp_path / "plain.xml"), load(tmp_path / "with_idle.xml")
+    points = poses_near_home()
+    assert_indices_close(indices_at_poses(found, points, detail=True), indices_at_poses(plain, points, detail=True))
+
+
 @pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
 def test_an_mjcf_file_gives_the_same_indices_in_any_unit_and_world_frame(tmp_path, scale):
     rotation = random_rotation(np.random.default_rng(int(scale * 1000) % 97))

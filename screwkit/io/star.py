@@ -427,7 +427,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                            "point; they do not.")
     if point:
         offset = _in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
-        report.output = (f"the point where the chains meet on body {body!r} (closure {tree.closures[0].name!r}), "
+        report.output = (f"the point where the chains meet on body {body!r} (closure {legs[1].closure!r}), "
                          f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
                          f"frame {frame.name!r}")
     else:
