@@ -149,6 +149,24 @@ def test_a_point_output_names_the_closure_where_the_legs_meet_not_the_file_s_fir
     assert_indices_close(indices_at_poses(found, points, detail=True), indices_at_poses(plain, points, detail=True))
 
 
+def test_info_says_in_which_frame_a_planar_mechanism_s_coordinates_are(tmp_path):
+    """A published five-bar moving in a vertical plane reads x = 0, y = -0.25 for an effector at world (0.02, 0,
+    0.25): x and y are in the plane of motion, which nothing said. ``info`` now gives the base frame in the world
+    (also in its JSON): the home pose mapped through it is the effector where the file draws it."""
+    rotation = random_rotation(np.random.default_rng(3))
+    path = tmp_path / "turned.xml"
+    path.write_text(five_bar_mjcf(rotation, 2.0))
+    described = screwkit("info", path)
+    assert described.returncode == 0, described.stderr
+    assert "task frame: base 'base', origin (" in described.stdout
+    assert "(the plane of motion is its x-y plane)" in described.stdout
+    report = json.loads(screwkit("info", path, "--json").stdout)
+    placed = report["platform"]["base_in_world"]
+    home = report["named_poses"]["home"]
+    world = np.array(placed["origin_m"]) + np.array(placed["axes"]).T @ np.array([home["x"], home["y"], 0.0])
+    np.testing.assert_allclose(world, rotation @ (2.0 * np.array([*HOME, 0.0])), atol=1e-9)
+
+
 @pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
 def test_an_mjcf_file_gives_the_same_indices_in_any_unit_and_world_frame(tmp_path, scale):
     rotation = random_rotation(np.random.default_rng(int(scale * 1000) % 97))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import click
+import numpy as np
 
 from screwkit.cli.options import (
     ignore_limits_option,
@@ -23,6 +24,11 @@ from screwkit.studies.coordinates import shown_number
 __all__ = ["info", "mechanism_info", "graph_info"]
 
 
+def _tidy(value: float) -> float:
+    """A placement's number without round-off noise (a rotation's 6e-17 is 0)."""
+    return 0.0 if abs(value) < 1e-12 else float(value)
+
+
 def graph_info(graph: GraphMechanism) -> dict:
     """:func:`mechanism_info` of a closed-loop graph: its legs (joints, closures), the platform and task coordinates
     inferred from the graph, how poses are solved."""
@@ -38,7 +44,7 @@ def graph_info(graph: GraphMechanism) -> dict:
                                   if name not in graph.task_coordinates], "held_coordinates": [],
         "instantaneous_dof_at_home": graph.dof, "output": "frame",
         "platform": {"link": graph.platform_body, "joint": model.names[graph.platform], "base_link": "world",
-                     "planar": False},
+                     "planar": False, "base_in_world": {"origin_m": [0.0] * 3, "axes": np.eye(3).tolist()}},
         "actuators": list(graph.actuators),
         "chains": [{"name": leg.name, "joints": [model.names[j] for j in leg.joints],
                     "actuated": [model.names[j] for j in leg.actuators],
@@ -75,7 +81,9 @@ def mechanism_info(mechanism) -> dict:
         "instantaneous_dof_at_home": mechanism.instantaneous_dof,
         "output": "frame" if mechanism.output_point is None else "point",
         "platform": {"link": mechanism.platform_link, "joint": mechanism.platform_joint,
-                     "base_link": mechanism.base_link, "planar": mechanism.is_planar},
+                     "base_link": mechanism.base_link, "planar": mechanism.is_planar,
+                     "base_in_world": {"origin_m": [_tidy(v) for v in mechanism.translation_world_base],
+                                       "axes": [[_tidy(v) for v in axis] for axis in mechanism.rotation_world_base.T]}},
         "actuators": list(mechanism.actuator_names),
         "chains": [{"name": chain.name, "joints": list(chain.joint_names),
                     "actuated": [chain.joint_names[k] for k in chain.actuated], "loop": chain.loop_name,
@@ -124,6 +132,13 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     kind = "planar" if loaded.is_planar else "a leg's body" if isinstance(loaded, GraphMechanism) else "floating"
     click.echo(f"  platform {report['platform']['link']!r} on {report['platform']['joint']!r} "
                f"({kind}) from {report['platform']['base_link']!r}")
+    placed = report["platform"]["base_in_world"]
+    if placed["origin_m"] != [0.0] * 3 or placed["axes"] != np.eye(3).tolist():  # poses are not in world coordinates
+        axes = ", ".join(f"{name} along ({', '.join(f'{v:.6g}' for v in axis)})"
+                         for name, axis in zip("xyz", placed["axes"]))
+        click.echo(f"  task frame: base {report['platform']['base_link']!r}, origin ("
+                   f"{', '.join(f'{v:.6g}' for v in placed['origin_m'])}) m in the world; its {axes} in the world's"
+                   + (" (the plane of motion is its x-y plane)" if loaded.is_planar else ""))
     click.echo(f"  {len(report['actuators'])} actuators: {', '.join(report['actuators'])}")
     click.echo("  chains:")
     for chain in report["chains"]:
