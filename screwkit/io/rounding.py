@@ -239,7 +239,7 @@ def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, repo
     for (leg, joint), move in zip(owners, moves):
         if not np.any(move):
             continue
-        end = np.asarray(data.oMi[leg.joints[-1]].rotation)  # the leg end's frame, where the loop frame is written
+        end = np.asarray(data.oMi[leg.joints[-1] if leg.joints else 0].rotation)  # where the loop frame is written
         leg.predecessor = leg.predecessor.copy()
         if joint is None:  # the loop's line: both its frames move with it
             leg.successor_world = leg.successor_world.copy()

@@ -130,9 +130,11 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     kinds = [joint_kind(model, joint) for joint in after]
     if closure.kind == "3d":
         if after:
+            pinned = f"; it pins body {platform_body(model, _frame_on(model, closure.joint_b))!r} to the fixed " \
+                     "base, which --output can name (a four-bar's rocker)" if not a_path else ""
             raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
                                f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
-                               "screwkit supports.")
+                               f"screwkit supports{pinned}.")
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
         return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
@@ -156,6 +158,11 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
                        "one point (a spherical joint).")
+
+
+def _frame_on(model, joint: int) -> int:
+    """The first frame moved by ``joint``."""
+    return next(index for index, frame in enumerate(model.frames) if frame.parentJoint == joint)
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
@@ -360,8 +367,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                                     platform, scale, report)
     owner: dict[int, str] = {}
     for leg in legs:
-        if not leg.joints:
-            raise ImportError_(f"{tree.source}: closure {leg.closure!r} ties the platform to the fixed base: no leg.")
+        if not leg.joints and leg.loop == "fixed":
+            raise ImportError_(f"{tree.source}: closure {leg.closure!r} welds the platform to the fixed base: it "
+                               "cannot move.")
         for joint in leg.joints:
             kind, _ = joint_kind(model, joint)
             if kind not in ("revolute", "prismatic"):
@@ -417,7 +425,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     output_world = homogeneous(data.oMf[frame_index])
     idle = _idle_about_the_meeting_point(legs, normal)
     chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
-    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen)
+    pinned = any(not leg.joints for leg in legs[1:])  # a leg that is its loop joint alone, on the base: a fixed point
+    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned)
     if tree.output_type is None and meet and idle and chosen:  # the meeting point would follow the file's order
         report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
                             "another joint (the file does not say where its legs end), which would move the point "
@@ -451,7 +460,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         writer.link("platform")
         writer.joint("platform_joint", "floating", base, "platform", **_origin(platform_base))
     reference = {}
-    legs.sort(key=lambda leg: leg.joints[0])
+    legs.sort(key=lambda leg: leg.joints[0] if leg.joints else 0)
     for leg in legs:
         parent, end = base, base
         for position, joint in enumerate(leg.joints):
@@ -482,9 +491,10 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                              **_origin(placement))
                 reference[model.names[joint]] = value
             parent, end = link, link
-        name = model.names[leg.joints[0]]
+        name = model.names[leg.joints[0]] if leg.joints else leg.closure  # a loop joint alone: named after its closure
         successor = inverse(platform_world) @ leg.successor_world
-        writer.loop(f"{name}_loop", leg.loop, name, end, _pose(leg.predecessor), "platform", _pose(successor),
+        predecessor = leg.predecessor if leg.joints else inverse(world_base) @ leg.predecessor  # in the base frame
+        writer.loop(f"{name}_loop", leg.loop, name, end, _pose(predecessor), "platform", _pose(successor),
                     axis=None if leg.axis is None else tuple(leg.axis))
         actuated = [model.names[j] for j in leg.joints if j in motor_ids]
         report.chains.append(f"{name}: joints {', '.join(model.names[j] for j in leg.joints)}, loop {leg.loop}"

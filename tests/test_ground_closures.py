@@ -1,0 +1,115 @@
+"""A four-bar written as one serial chain closed onto the fixed base, as physics-engine files write it (a published
+MuJoCo four-bar: crank, coupler and rocker nested, the rocker's far end ``<connect>``-ed to the ground body).
+
+With the rocker as output, its leg is the closure's pin alone, on the base; the crank chain reaches it through the
+coupler. Checked against the four-bar's transmission angles at several rocker angles, in millimetres and in a turned
+and shifted world; the same loop closed by a ``<weld>`` is rigid and said so; the coupler as output is refused in one
+line that names the rocker."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from helpers import screwkit
+from screwkit.closure import solve
+from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_poses
+
+A, B, C, D = (np.array(p) for p in ((0.0, 0.0), (0.0513, 0.141), (0.35, 0.3), (0.4, 0.0)))
+"""The ground pivots A (crank) and D (rocker), the crank-coupler pin B, the coupler-rocker pin C (m, as drawn)."""
+
+
+def four_bar_mjcf(scale: float = 1.0, yaw: float = 0.0, shift=(0.0, 0.0, 0.0), closure: str = "connect") -> str:
+    """Crank (hinge_1 at A), coupler (hinge_2 at B), rocker (hinge_3 at C) nested on the ground body; the rocker
+    pinned to the ground at D by a ``closure`` (``connect``, or ``weld``: rigid). The ground body is turned by
+    ``yaw`` about z and shifted by ``shift`` (m) in the world."""
+
+    def at(point):
+        return " ".join(repr(float(v)) for v in scale * np.array([*point, 0.0]))
+
+    rocker_end = f'<site name="rocker_end" pos="{at(D - C)}"/>'
+    joint = '<joint name="{}" type="hinge" axis="0 0 1"/><geom type="sphere" size="0.01"/>'
+    closing = (f'<connect name="pin_D" body1="ground" body2="rocker" anchor="{at(D)}"/>' if closure == "connect"
+               else '<weld name="pin_D" body1="ground" body2="rocker"/>')
+    return (f'<mujoco model="four_bar"><compiler angle="radian"/><worldbody>'
+            f'<body name="ground" pos="{" ".join(repr(scale * v) for v in shift)}" euler="0 0 {yaw!r}">'
+            f'<body name="crank" pos="{at(A)}">{joint.format("hinge_1")}'
+            f'<body name="coupler" pos="{at(B - A)}">{joint.format("hinge_2")}'
+            f'<body name="rocker" pos="{at(C - B)}">{joint.format("hinge_3")}{rocker_end}'
+            f'</body></body></body></body></worldbody><equality>{closing}</equality>'
+            '<actuator><motor joint="hinge_1"/><motor joint="hinge_2"/></actuator></mujoco>')
+
+
+def arm(point, through, direction) -> float:
+    """The distance from ``point`` to the line through ``through`` along ``direction`` (plane)."""
+    u = direction / np.linalg.norm(direction)
+    r = point - through
+    return abs(r[0] * u[1] - r[1] * u[0])
+
+
+def expected(theta: float) -> dict:
+    """The four-bar's transmission at rocker angle ``theta`` (rad from the drawing), on the branch drawn: crank
+    actuated, the wrench is a force along the coupler BC; coupler-crank pin actuated, a force along AC. Each ITI is
+    its arm about the actuated pin over the length of the link it drives, each OTI its arm about D over the rocker."""
+    turn = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    c = D + turn @ (C - D)
+    crank, coupler = np.linalg.norm(B - A), np.linalg.norm(C - B)
+    gap = np.linalg.norm(c - A)
+    along = (crank**2 - coupler**2 + gap**2) / (2.0 * gap)
+    across = np.sqrt(crank**2 - along**2)
+    unit = (c - A) / gap
+    normal = np.array([-unit[1], unit[0]])
+    b = min((A + along * unit + s * across * normal for s in (1.0, -1.0)), key=lambda p: np.linalg.norm(p - B))
+    rocker = np.linalg.norm(c - D)
+    iti = [arm(A, b, c - b) / crank, arm(b, A, c - A) / coupler]
+    oti = [arm(D, b, c - b) / rocker, arm(D, A, c - A) / rocker]
+    return {"iti": iti, "oti": oti, "lmti": max(oti), "f_o1": min(oti)}
+
+
+ANGLES = np.radians([0.0, 8.0, -5.0, 20.0])  # the rocker reaches -6.18 to 53.7 deg
+
+
+@pytest.mark.parametrize("scale, yaw, shift", [(1.0, 0.0, (0.0, 0.0, 0.0)), (1000.0, 0.9, (0.3, -0.2, 1.5))])
+def test_a_four_bar_pinned_to_the_ground_by_its_closure_has_the_transmission_angles(tmp_path, scale, yaw, shift):
+    """Refused before: "closure 'pin_D' ties the platform to the fixed base: no leg"."""
+    path = tmp_path / "four_bar.xml"
+    path.write_text(four_bar_mjcf(scale, yaw, shift))
+    mechanism = load(path, output="rocker", length_unit="mm" if scale == 1000.0 else None)
+    assert mechanism.dof == 1 and mechanism.task_coordinates == ("phi",)
+    assert mechanism.output_point is None  # the rocker turns about the ground pin: its frame, not that fixed point
+    _, report = read_mechanism_file(path, output="rocker")
+    assert any(chain.startswith("pin_D: joints , loop revolute (closure pin_D)") for chain in report.chains)
+    assert [name.split(":")[1] for name in mechanism.actuator_names] == ["hinge_1", "hinge_2"]
+    poses = mechanism.home_pose + ANGLES[:, None]
+    assert solve(mechanism, poses).reachable.all()
+    result = indices_at_poses(mechanism, poses, detail=True)
+    for row, theta in enumerate(ANGLES):
+        values = expected(theta)
+        np.testing.assert_allclose(result.iti_actuators[row], values["iti"], atol=1e-9)
+        assert result.lmti[row] == pytest.approx(values["lmti"], abs=1e-9)
+        assert result.f_o[1][row] == pytest.approx(values["f_o1"], abs=1e-9)
+
+
+def test_the_loop_welded_to_the_ground_is_rigid_and_the_coupler_output_names_the_rocker(tmp_path):
+    welded = tmp_path / "welded.xml"
+    welded.write_text(four_bar_mjcf(closure="weld"))
+    with pytest.raises(ImportError_, match="closure 'pin_D' welds the platform to the fixed base: it cannot move"):
+        read_mechanism_file(welded, output="rocker")
+    pinned = tmp_path / "pinned.xml"
+    pinned.write_text(four_bar_mjcf())
+    with pytest.raises(ImportError_, match="it pins body 'rocker' to the fixed base, which --output can name"):
+        read_mechanism_file(pinned, output="coupler")
+
+
+def test_the_command_analyses_the_rocker_as_the_file_is_written(tmp_path):
+    path = tmp_path / "four_bar.xml"
+    path.write_text(four_bar_mjcf())
+    analysed = screwkit("analyze", path, "--output", "rocker", "--pose", "20", "--json")  # deg
+    assert analysed.returncode == 0, analysed.stderr
+    values, found = expected(ANGLES[3]), json.loads(analysed.stdout)
+    assert found["lmti"] == pytest.approx(values["lmti"], abs=1e-9)
+    assert found["iti"] == pytest.approx(min(values["iti"]), abs=1e-9)
