@@ -18,6 +18,7 @@ from screwkit.closure import solve
 from screwkit.io import ImportError_, read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_poses
+from screwkit.studies.poses import analyze_solution
 
 A, B, C, D = (np.array(p) for p in ((0.0, 0.0), (0.0513, 0.141), (0.35, 0.3), (0.4, 0.0)))
 """The ground pivots A (crank) and D (rocker), the crank-coupler pin B, the coupler-rocker pin C (m, as drawn)."""
@@ -113,3 +114,64 @@ def test_the_command_analyses_the_rocker_as_the_file_is_written(tmp_path):
     values, found = expected(ANGLES[3]), json.loads(analysed.stdout)
     assert found["lmti"] == pytest.approx(values["lmti"], abs=1e-9)
     assert found["iti"] == pytest.approx(min(values["iti"]), abs=1e-9)
+
+
+CENTRE = np.array([0.0, 0.0, 0.5])
+FEET = np.array([[0.6 * np.cos(a), 0.6 * np.sin(a), 0.0] for a in np.radians([0.0, 120.0, 240.0])])
+HEADS = CENTRE + np.array([[0.25 * np.cos(a), 0.25 * np.sin(a), 0.05] for a in np.radians([40.0, 160.0, 280.0])])
+
+
+def spherical_mjcf(scale: float = 1.0) -> str:
+    """A spherical 3-UPS/S manipulator: three U-P-S legs from FEET to HEADS (the first carries the platform through
+    three hinges at its head, the others ``<connect>``-ed to it) and the platform's centre ``<connect>``-ed to the
+    ground body: a ball from the base straight onto the platform."""
+
+    def at(vector):
+        return " ".join(repr(float(v)) for v in scale * np.asarray(vector))
+
+    legs = []
+    for i, (foot, head) in enumerate(zip(FEET, HEADS), start=1):
+        along = (head - foot) / np.linalg.norm(head - foot)
+        hinges = "".join(f'<joint name="b{axis}_1" type="hinge" axis="{direction}" pos="{at(head - CENTRE)}"/>'
+                         for axis, direction in (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1")))
+        end = (f'<body name="platform" pos="{at(CENTRE - foot)}">{hinges}<geom type="sphere" size="0.02"/></body>'
+               if i == 1 else "")
+        legs.append(f'<body name="leg_{i}" pos="{at(foot)}"><joint name="ux_{i}" type="hinge" axis="1 0 0"/>'
+                    f'<joint name="uy_{i}" type="hinge" axis="0 1 0"/><geom type="sphere" size="0.01"/>'
+                    f'<body name="rod_{i}"><joint name="slide_{i}" type="slide" axis="{at(along / scale)}"/>'
+                    f'<geom type="sphere" size="0.01"/>{end}</body></body>')
+    closures = "".join(f'<connect name="head_{i}" body1="rod_{i}" body2="platform" '
+                       f'anchor="{at(HEADS[i - 1] - FEET[i - 1])}"/>' for i in (2, 3))
+    closures += f'<connect name="centre" body1="ground" body2="platform" anchor="{at(CENTRE)}"/>'
+    motors = "".join(f'<motor joint="slide_{i}"/>' for i in (1, 2, 3))
+    return (f'<mujoco model="spherical"><compiler angle="radian"/><worldbody><body name="ground">{"".join(legs)}'
+            f'</body></worldbody><equality>{closures}</equality><actuator>{motors}</actuator></mujoco>')
+
+
+@pytest.mark.parametrize("scale", [1.0, 1000.0])
+def test_a_platform_on_a_ball_closed_onto_the_base_turns_about_it_with_the_leg_lines_transmission(tmp_path, scale):
+    """The centre's ball is a leg of its loop joint alone; the platform turns about it (3 DOF), and each slide's OTI
+    is the cosine between its leg line and the velocity of its head under the rotation the other two legs' lines
+    allow (about the centre, reciprocal to both)."""
+    from scipy.spatial.transform import Rotation
+
+    path = tmp_path / "spherical.xml"
+    path.write_text(spherical_mjcf(scale))
+    mechanism = load(path, output="platform", length_unit="mm" if scale == 1000.0 else None)
+    assert mechanism.dof == 3 and mechanism.task_coordinates == ("roll", "pitch", "yaw")
+    poses = mechanism.home_pose + np.radians([[0.0, 0.0, 0.0], [4.0, -3.0, 6.0], [-5.0, 2.0, -8.0]])
+    solution = solve(mechanism, poses)
+    assert solution.reachable.all()
+    result = analyze_solution(mechanism, solution, detail=True)
+    for row, full in enumerate(solution.full_poses):
+        turned = Rotation.from_euler("xyz", full[3:]).as_matrix()  # roll, pitch, yaw about the fixed x, y, z
+        heads = CENTRE + (HEADS - CENTRE) @ turned.T
+        lines = (heads - FEET) / np.linalg.norm(heads - FEET, axis=1)[:, None]
+        moments = np.cross(heads - CENTRE, lines)
+        expected = []
+        for i in range(3):
+            j, k = (m for m in range(3) if m != i)
+            velocity = np.cross(np.cross(moments[j], moments[k]), heads[i] - CENTRE)
+            expected.append(abs(lines[i] @ velocity) / np.linalg.norm(velocity))
+        np.testing.assert_allclose(result.at(row).oti_actuators[0], expected, atol=1e-9)
+        np.testing.assert_allclose(result.iti_actuators[row], 1.0, atol=1e-9)
