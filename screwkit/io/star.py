@@ -14,7 +14,9 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
    root that shares no joint with another leg) to it; the joints between the platform body and
    the closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
    ``spherical``), one revolute or prismatic joint (``revolute``/``prismatic``), or three
-   revolute joints through one point or a ball joint (``spherical``). Closures between two legs
+   revolute joints through one point or a ball joint (``spherical``). A closure on the base itself is a leg
+   of its loop joint alone (a four-bar's rocker pinned to the ground, the rocker the platform), or, planar, of its
+   pin and the one joint beyond the platform as the loop joint (the coupler the platform). Closures between two legs
    make **compound legs** (:mod:`screwkit.io.compound`): each keeps its actuated leg and writes
    its passive legs as one equivalent constraint chain, or is refused with the reason. Loops that
    leave a leg's own path, and actuators on branches closed onto other legs (closed-loop
@@ -44,7 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.rotations import rotation_about_axis, rotation_with_z_along, rpy_from_rotation
+from screwkit.common.rotations import rotation_with_z_along
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import (
     GRAPH_HINT,
@@ -64,15 +66,21 @@ from screwkit.io.closed_tree import (
     joint_value,
     path_to,
 )
-from screwkit.io.compound import Reduction, compound_legs
+from screwkit.io.compound import compound_legs
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
+from screwkit.io.star_writing import (
+    UNLIMITED_SLIDE,
+    base_frame,
+    joint_motion,
+    origin_of,
+    pose_of,
+    write_base_dofs,
+    write_equivalent,
+)
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
-
-UNLIMITED_SLIDE = 1e6
-"""Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
 
 INDEPENDENCE_TOLERANCE = 1e-9
 """Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
@@ -112,6 +120,8 @@ class _Leg:
     offsets: dict = field(default_factory=dict)  # world offsets of hinges moved onto a parallelogram's midline
     sources: tuple[Closure, ...] = ()  # the closures onto the platform that make its loop joint (none: the platform
     # body's own path; two ball closures on one hinge's axis, or three or more of a weld)
+    base_dofs: list = field(default_factory=list)  # world (kind, axis, point) of a ball closed on the base itself,
+    # written as the leg's first joints (a four-bar's rocker pinned to the ground, its joint onto the coupler the loop)
 
 
 def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
@@ -129,12 +139,18 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
     kinds = [joint_kind(model, joint) for joint in after]
     if closure.kind == "3d":
+        if after and not a_path and len(after) == 1 and kinds[0][0] in ("revolute", "prismatic"):
+            # a ball on the base itself (a four-bar's rocker pinned to the ground, the coupler the platform): the
+            # leg is that ball, then the joint beyond the platform as its loop joint, as a weld's would be
+            kind, axis = kinds[0]
+            zero = homogeneous(data.oMi[model.parents[after[0]]]) @ homogeneous(model.jointPlacements[after[0]])
+            base = [("revolute", np.eye(3)[:, k], frame_a[:3, 3]) for k in range(3)]
+            return _Leg([], kind, homogeneous(data.oMi[after[0]]), zero, axis, [(kind, zero[:3, :3] @ axis,
+                        zero[:3, 3])], closure.name, sources=(closure,), base_dofs=base)
         if after:
-            pinned = f"; it pins body {platform_body(model, _frame_on(model, closure.joint_b))!r} to the fixed " \
-                     "base, which --output can name (a four-bar's rocker)" if not a_path else ""
             raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
                                f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
-                               f"screwkit supports{pinned}.")
+                               "screwkit supports.")
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
         return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
@@ -158,11 +174,6 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
                        "one point (a spherical joint).")
-
-
-def _frame_on(model, joint: int) -> int:
-    """The first frame moved by ``joint``."""
-    return next(index for index, frame in enumerate(model.frames) if frame.parentJoint == joint)
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
@@ -251,6 +262,8 @@ def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
     """In a planar mechanism, every ball loop becomes the revolute joint about the plane's normal through its
     centre: its two other rotations would turn legs out of the plane, which their joints forbid."""
     for leg in legs:
+        if leg.base_dofs:
+            leg.base_dofs = [("revolute", normal, leg.base_dofs[0][2])]
         if leg.loop == "spherical":
             centre = leg.successor_world[:3, 3]
             leg.loop = "revolute"
@@ -275,66 +288,6 @@ def _idle_about_the_meeting_point(legs: list[_Leg], normal: NDArray | None) -> b
 def _in_plane(vector: NDArray, normal: NDArray | None) -> NDArray:
     """``vector`` without its component along the plane's ``normal`` (all of it in space: no normal)."""
     return vector if normal is None else vector - (vector @ normal) * normal
-
-
-def _origin(matrix: NDArray) -> dict:
-    return dict(zip(("xyz", "rpy"), _pose(matrix)))
-
-
-def _pose(matrix: NDArray) -> tuple:
-    return tuple(matrix[:3, 3]), tuple(rpy_from_rotation(matrix[:3, :3]))
-
-
-def _joint_motion(model, joint: int, q: NDArray) -> NDArray:
-    kind, axis = joint_kind(model, joint)
-    motion = np.eye(4)
-    value = joint_value(model, joint, q)
-    if kind == "revolute":
-        motion[:3, :3] = rotation_about_axis(axis, value)
-    else:
-        motion[:3, 3] = axis * value
-    return motion
-
-
-def _base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
-    """World frame of the written base: z along a planar mechanism's normal, its origin where the world axis nearest
-    to it meets the plane through ``point`` (the world's for a spatial mechanism): the plane's x, y are then the
-    world's to second order in the normal's rounding however far the plane is (turned about the world's origin, they
-    were not), and they change with the normal continuously (a threshold on its tilt left a jump there)."""
-    frame = np.eye(4)
-    if normal is None:
-        return frame
-    z = normal / np.linalg.norm(normal)
-    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
-    if np.linalg.norm(x) < 1e-6:
-        x = np.array([0.0, 1.0, 0.0]) - z[1] * z
-    x, axis = x / np.linalg.norm(x), int(np.argmax(np.abs(z)))
-    frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    frame[axis, 3] = float(z @ point) / z[axis]
-    return frame
-
-
-def _write_equivalent(writer: UrdfWriter, name: str, reduction: Reduction, attachment: NDArray, world_base: NDArray,
-                      platform_world: NDArray) -> list[str]:
-    """An equivalent constraint chain: slides along the reduction's translations, then revolutes along its rotations,
-    from the attachment point, welded there to the platform. Returns its joint names."""
-    to_base = inverse(world_base)
-    point = tuple((to_base @ np.append(attachment, 1.0))[:3])
-    parent, joints = "base", []
-    directions = [("prismatic", d) for d in reduction.translations] + [("continuous", d) for d in reduction.rotations]
-    for position, (kind, direction) in enumerate(directions):
-        joint = f"{name}_{'slide' if kind == 'prismatic' else 'turn'}_{position + 1}"
-        writer.link(f"{joint}_link")
-        writer.joint(joint, kind, parent, f"{joint}_link", xyz=point if position == 0 else (0, 0, 0),
-                     axis=tuple(to_base[:3, :3] @ direction),
-                     limit=(-UNLIMITED_SLIDE, UNLIMITED_SLIDE, 0, 0) if kind == "prismatic" else None)
-        parent = f"{joint}_link"
-        joints.append(joint)
-    end = world_base.copy()
-    end[:3, 3] = attachment
-    writer.loop(f"{name}_loop", "fixed", name, parent, _pose(np.eye(4)), "platform",
-                _pose(inverse(platform_world) @ end))
-    return joints
 
 
 def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
@@ -367,7 +320,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                                     platform, scale, report)
     owner: dict[int, str] = {}
     for leg in legs:
-        if not leg.joints and leg.loop == "fixed":
+        if not leg.joints and not leg.base_dofs and leg.loop == "fixed":
             raise ImportError_(f"{tree.source}: closure {leg.closure!r} welds the platform to the fixed base: it "
                                "cannot move.")
         for joint in leg.joints:
@@ -409,6 +362,11 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     normal = _planar_normal(tree, data, legs)
     if normal is not None:
         _planar_loops(legs, normal)
+    for leg in legs:
+        if len(leg.base_dofs) > 1:  # a ball, not a pin: its centre's three rotations and a joint, never checked
+            raise ImportError_(f"{tree.source}: closure {leg.closure!r} (3d) joins the fixed base to a body beyond the "
+                               "platform: screwkit reads that leg (the pin, then the body's joint onto the platform) "
+                               "in a planar mechanism only.")
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
     meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
@@ -425,7 +383,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     output_world = homogeneous(data.oMf[frame_index])
     idle = _idle_about_the_meeting_point(legs, normal)
     chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
-    pinned = any(not leg.joints for leg in legs[1:])  # a leg that is its loop joint alone, on the base: a fixed point
+    pinned = any(not leg.joints and not leg.base_dofs for leg in legs[1:])  # its loop joint alone, on the base
     point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned)
     if tree.output_type is None and meet and idle and chosen:  # the meeting point would follow the file's order
         report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
@@ -443,14 +401,14 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         report.output = f"frame {frame.name!r} on body {body!r}"
     platform_world = np.eye(4)
     platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
-    world_base = _base_frame(normal, platform_world[:3, 3])
+    world_base = base_frame(normal, platform_world[:3, 3])
     platform_world[:3, :3] = world_base[:3, :3] if (point or normal is not None) else output_world[:3, :3]
     writer = UrdfWriter(tree.source.rsplit("/", 1)[-1].split(".")[0] or "mechanism",
                         f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
     base = "base"
     if normal is not None:
         writer.link("world")
-        writer.joint("world_to_base", "fixed", "world", base, **_origin(world_base))
+        writer.joint("world_to_base", "fixed", "world", base, **origin_of(world_base))
     writer.link(base)
     platform_base = inverse(world_base) @ platform_world
     if normal is not None:
@@ -458,11 +416,14 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         writer.joint("platform_joint", "planar", base, "platform", xyz=tuple(platform_base[:3, 3]), axis=(0, 0, 1))
     else:
         writer.link("platform")
-        writer.joint("platform_joint", "floating", base, "platform", **_origin(platform_base))
+        writer.joint("platform_joint", "floating", base, "platform", **origin_of(platform_base))
     reference = {}
     legs.sort(key=lambda leg: leg.joints[0] if leg.joints else 0)
     for leg in legs:
         parent, end = base, base
+        synthetic = write_base_dofs(writer, leg, world_base, reference)
+        if synthetic:
+            parent = end = f"{synthetic[-1]}_link"
         for position, joint in enumerate(leg.joints):
             placement = homogeneous(model.jointPlacements[joint])
             if position == 0:
@@ -472,7 +433,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             link = f"{model.names[joint]}_link"
             if joint in leg.locked:
                 writer.link(link)
-                writer.joint(model.names[joint], "fixed", parent, link, **_origin(placement @ _joint_motion(
+                writer.joint(model.names[joint], "fixed", parent, link, **origin_of(placement @ joint_motion(
                     model, joint, q)))
                 report.locked.append(model.names[joint])
             else:
@@ -488,20 +449,23 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                     limit = None if kind == "revolute" else (-UNLIMITED_SLIDE, UNLIMITED_SLIDE, 0, 0)
                 writer.link(link)
                 writer.joint(model.names[joint], joint_type, parent, link, axis=tuple(axis), limit=limit,
-                             **_origin(placement))
+                             **origin_of(placement))
                 reference[model.names[joint]] = value
             parent, end = link, link
         name = model.names[leg.joints[0]] if leg.joints else leg.closure  # a loop joint alone: named after its closure
         successor = inverse(platform_world) @ leg.successor_world
         predecessor = leg.predecessor if leg.joints else inverse(world_base) @ leg.predecessor  # in the base frame
-        writer.loop(f"{name}_loop", leg.loop, name, end, _pose(predecessor), "platform", _pose(successor),
+        if leg.base_dofs:  # the last of the ball's joints' frames: the base's axes at the ball's centre
+            predecessor[:3, 3] -= inverse(world_base)[:3, :3] @ leg.base_dofs[0][2] + inverse(world_base)[:3, 3]
+        writer.loop(f"{name}_loop", leg.loop, name, end, pose_of(predecessor), "platform", pose_of(successor),
                     axis=None if leg.axis is None else tuple(leg.axis))
         actuated = [model.names[j] for j in leg.joints if j in motor_ids]
-        report.chains.append(f"{name}: joints {', '.join(model.names[j] for j in leg.joints)}, loop {leg.loop}"
+        report.chains.append(f"{name}: joints {', '.join(synthetic + [model.names[j] for j in leg.joints])}, "
+                             f"loop {leg.loop}"
                              + (f" (closure {leg.closure})" if leg.closure else " (the platform body's own path)")
                              + (f", actuated {', '.join(actuated)}" if actuated else ""))
     for name, reduction, attachment in equivalents:
-        joints = _write_equivalent(writer, name, reduction, attachment, world_base, platform_world)
+        joints = write_equivalent(writer, name, reduction, attachment, world_base, platform_world)
         reference.update(dict.fromkeys(joints, 0.0))
         report.chains.append(f"{name}: joints {', '.join(joints)}, loop fixed (the equivalent constraint chain of a "
                              "compound leg)")
