@@ -176,3 +176,42 @@ def test_a_wrench_common_to_every_chain_stays_common_when_the_mobility_is_known(
     without, given = plan_constraints([t[5::8] for t in twists]), plan_constraints([t[5::8] for t in twists], n)
     assert (given.common, given.own_counts, given.subsystems) == (without.common, without.own_counts,
                                                                     without.subsystems) == (1, (1, 1, 1), ((0, 1, 2),))
+
+
+def flattened_four_bar(eps: float):
+    """A planar four-bar of two R-R dyads onto a coupler, both base pins actuated, its dyads' force lines eps (rad)
+    from collinear: (0, 0)-(1, 0.3 eps) and (3, 0)-(2, eps). The out-of-plane couple and force are common to both
+    dyads; their in-plane forces alike to eps."""
+    from screwkit.screw.chain_screws import ChainScrews
+
+    def revolute(point):
+        return np.concatenate([[0.0, 0.0, 1.0], np.cross(point, [0.0, 0.0, 1.0])])
+
+    dyads = (((0.0, 0.0, 0.0), (1.0, 0.3 * eps, 0.0)), ((3.0, 0.0, 0.0), (2.0, eps, 0.0)))
+    return [ChainScrews(np.array([revolute(np.array(a)), revolute(np.array(b))]), np.array([a, b]), (0,),
+                        name=f"dyad_{k}") for k, (a, b) in enumerate(dyads)]
+
+
+@pytest.mark.parametrize("eps", [1e-3, 3e-5, 1e-6])
+def test_wrenches_only_alike_are_not_common_and_the_truly_common_ones_stay(eps):
+    """Below eps 1e-4 the dyads' in-plane forces are alike to MOTION_SPACE_EIGENVALUE, and the plan took four common
+    wrenches and none of the chains' own: no CTI alone (NaN), 5.1e-5 in a batch with a regular pose (eps 3e-5). The
+    three out-of-plane wrenches stay common, the in-plane forces are each dyad's own; the CTI vanishes linearly with
+    eps (CTI / eps the same at every eps), alone as in a batch, and as the numpy reference computes it."""
+    from screwkit.indices.analysis import analyze, constraint_structure
+    from screwkit.screw.chain_screws import ChainScrews
+    from screwkit.screw.reference import reference_indices
+
+    chains = flattened_four_bar(eps)
+    plan, _, _ = constraint_structure(chains, dof=1)
+    assert (plan.common, plan.own_counts) == (3, (1, 1))
+    alone = analyze(chains, dof=1)
+    regular = flattened_four_bar(1e-2)
+    both = [ChainScrews(np.stack([r.twists, c.twists]), np.stack([r.points, c.points]), (0,), name=c.name)
+            for r, c in zip(regular, chains)]
+    batch = analyze(both, dof=1)
+    assert float(np.asarray(batch.cti)[1]) == pytest.approx(float(alone.cti), abs=1e-12)
+    expected = reference_indices([c.twists for c in chains], [c.points for c in chains], [(0,), (0,)], 1)
+    assert float(alone.cti) == pytest.approx(expected["cti"], abs=1e-10)
+    assert float(alone.cti) / eps == pytest.approx(float(analyze(flattened_four_bar(1e-3), dof=1).cti) / 1e-3,
+                                                   rel=2e-3)

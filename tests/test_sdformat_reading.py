@@ -381,6 +381,26 @@ def test_a_platform_of_welded_links_is_named_and_placed_after_the_one_they_are_w
     same_indices(found.indices(), reference.indices())
 
 
+@pytest.mark.parametrize("reverse", [False, True])
+def test_links_welded_in_a_row_below_the_platform_leave_it_the_platform(tmp_path, reverse):
+    """A flange and its plate welded in a row below the carrier (the carrier holding one weld, the flange two): no
+    hub, the carrier stays the platform, as the file nests them (a rule counting welds alone took the flange, its
+    origin 3 cm lower the output)."""
+    from sdformat_models import delta_sdf
+
+    plain = delta_sdf().replace("platform", "carrier")
+    links = ['<link name="adapter"><pose relative_to="carrier">0 0 -0.03 0 0 0</pose></link>',
+             '<link name="plate"><pose relative_to="carrier">0 0 -0.08 0 0 0</pose></link>']
+    joints = ['<joint name="weld_adapter" type="fixed"><parent>carrier</parent><child>adapter</child></joint>',
+              '<joint name="weld_plate" type="fixed"><parent>adapter</parent><child>plate</child></joint>']
+    order = (lambda items: items[::-1]) if reverse else (lambda items: items)
+    path = write(tmp_path, plain.replace("</model>", "".join(order(links) + order(joints)) + "</model>"), "row.sdf")
+    found = graph_mechanism(read_closed_tree(path))
+    assert found.platform_body == "carrier"
+    carrier = world_poses(read_model(write(tmp_path, plain, "plain.sdf")))["carrier"][:3, 3]
+    np.testing.assert_allclose(output_position(found), carrier, atol=1e-12)
+
+
 def test_the_commands_name_and_place_a_welded_platform_after_its_hub(tmp_path):
     """The same, as users run it: ``info`` names the carrier, ``analyze`` gives its origin as the pose."""
     _, bracketed = bracketed_delta(tmp_path)

@@ -40,10 +40,12 @@ eigenvalue at or below this along it (each ``I - P_i`` has eigenvalues 0 and 1).
 
 EIGENVALUE_RESOLUTION = 1e-10
 """Dimensionless: where the eigenvalue of ``sum_i (I - P_i)`` just past the motion space's ``n`` is at or below this,
-its eigenvectors do not tell the motion space from the twists next to it (an eigen-solver resolves eigenvalues to
-about 1e-16 of the matrix's norm, singular values of the chains' complements to about 1e-8): the ``n`` least singular
-directions of the stacked complements are taken instead, resolved to about 1e-16 (a pose 1e-8 from a constraint
-singularity, which :data:`MOTION_SPACE_TOLERANCE` counts as regular; :func:`screwkit.screw.motion.motion_bases`)."""
+numpy's eigenvectors do not tell the motion space from the twists next to it (its eigen-solver resolves eigenvalues to
+about 1e-16 of the matrix's norm, so the chains' complements' singular values only to about 1e-8): the ``n`` least
+singular directions of the stacked complements are taken instead, as well as the chains' twists determine them (about
+1e-16 over the gap: 1e-7 for legs' couples 1e-9 from parallel, which :data:`MOTION_SPACE_TOLERANCE` counts as
+independent; :func:`screwkit.screw.motion.motion_bases`). The compiled kernel's Jacobi eigen-solver resolves small
+eigenvalues to their own precision and needs no such step."""
 
 CONSTANT_BASIS_TOLERANCE = 1e-8
 """Dimensionless: orthonormal motion-space bases (working coordinates) found at sample

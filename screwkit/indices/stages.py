@@ -215,7 +215,7 @@ class ChunkSpaces:
         """:func:`screwkit.screw.motion.null_spaces` of every configuration of the chunk."""
         if self.compiled is None:
             return null_spaces(self.working[0], dof, tolerances.MOTION_SPACE_TOLERANCE, self.decompositions)
-        return motion_bases(self.compiled[2], self.compiled[3], dof, self.decompositions)
+        return motion_bases(self.compiled[2], self.compiled[3], dof)
 
 
 def analyze_chunk(plan: Plan, twists, points, iti_override, oti_override, detail, keep_twists, idle=None,

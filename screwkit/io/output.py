@@ -84,15 +84,24 @@ def _joints_after(model, ancestor: int, joint: int) -> list[int]:
     return path[::-1] if joint == ancestor and joint else []
 
 
+HUB_WELDS = 3
+"""Welds a body of a welded group needs to be taken for the platform the others are welded around (a Codian Delta's
+platform with its six ball brackets); fewer (a flange, an adapter, a plate welded in a row), the body the tree reaches
+first is the platform, as the file nests them."""
+
+
 def _body_frame(model, joint: int) -> int | None:
     """The index of the body frame moved by ``joint``, if it has one: of several (links welded into one body), the
-    one the most others are welded to (a Delta's platform, its ball-joint brackets welded around it, rather than the
-    bracket the tree happened to reach first); the first of those on a tie."""
+    one the most others are welded to when it holds at least :data:`HUB_WELDS` welds (a Delta's platform, its
+    ball-joint brackets welded around it, rather than the bracket the tree happened to reach first), else the first."""
     bodies = [index for index, frame in enumerate(model.frames)
               if frame.parentJoint == joint and str(frame.type) == "BODY"]
+    if not bodies:
+        return None
     welds = {index: sum(str(frame.type) == "FIXED_JOINT" for frame in model.frames if frame.parentFrame == index)
              + (str(model.frames[model.frames[index].parentFrame].type) == "FIXED_JOINT") for index in bodies}
-    return max(bodies, key=welds.__getitem__) if bodies else None
+    hub = max(bodies, key=welds.__getitem__)
+    return hub if welds[hub] >= HUB_WELDS else bodies[0]
 
 
 def platform_body(model, frame: int) -> str:

@@ -184,7 +184,8 @@ def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -
     configuration of the batch had its constraint subsystems wrong (CTI 0 throughout a sweep that touched the
     boundary). ``mobility``: the platform's DOF (idle rotations of a point output included) where it is known; when
     every sample leaves the platform more (each is a constraint singularity), the wrenches the chains share there are
-    not taken for common ones, nor when they and the chains' own could not hold the platform to its mobility."""
+    not taken for common ones, nor, beyond as many as leave the chains' own able to hold the platform to its mobility,
+    wrenches that are only alike."""
     tolerance = tolerances.MOTION_SPACE_TOLERANCE
     ranks = [_rank(twists, tolerance) for twists in chain_twists]
     regular = np.all([rank == np.max(rank) for rank in ranks], axis=0)
@@ -202,11 +203,12 @@ def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -
         # every sample is a constraint singularity, where the chains share wrenches they share nowhere else (a
         # U-P-U platform drawn with its legs' couples all vertical, analysed there alone): no wrench is common
         common = 0
-    if mobility is not None and common and common + sum(c - common for c in counts) < 6 - mobility:
-        # the wrenches taken as common (alike to about 1e-4, MOTION_SPACE_EIGENVALUE) and the chains' own could not
-        # hold the platform to its mobility: alike, not common (a U-P-U platform written to 6 decimals, on the line
-        # where its legs' couples are parallel to 1e-9; planned with one common couple, no lift was ever singular)
-        common = 0
+    if mobility is not None and common and len(counts) > 1:
+        # the wrenches taken as common (alike to about 1e-4, MOTION_SPACE_EIGENVALUE) and the chains' own must hold
+        # the platform to its mobility, common + sum(c - common) >= 6 - mobility: the most alike are kept common, the
+        # others are only alike (a U-P-U platform written to 6 decimals, on the line where its legs' couples are
+        # parallel to 1e-9; planned with one common couple, no lift was ever singular)
+        common = max(0, min(common, (sum(counts) - 6 + mobility) // (len(counts) - 1)))
     own_counts = tuple(max(c - common, 0) for c in counts)
     if not any(own_counts):
         return ConstraintPlan(counts, common, own_counts)

@@ -173,8 +173,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
     principal directions of their pairing). Empty when no chain holds a constraint wrench alone. At a constraint
     singularity (more than ``dof`` instantaneous DOF) the wrenches the chains share are shared there only (every
     U-P-U leg's couple vertical), not common: each chain's own, as
-    :func:`screwkit.screw.constraints.plan_constraints` reads them; so too where the wrenches taken as common and
-    the chains' own could not hold the platform to ``dof`` (wrenches alike only to about 1e-4)."""
+    :func:`screwkit.screw.constraints.plan_constraints` reads them; and only as many are common as leave the chains'
+    own able to hold the platform to ``dof``, the most alike (wrenches alike only to about 1e-4 are not)."""
     constraints = [_complement(_span(t)) @ SWAP for t in twists]
     every = np.concatenate(constraints)
     instantaneous = 6 - (len(_span(every)) if len(every) else 0)
@@ -185,8 +185,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
         shared = np.zeros((0, 6))
     if instantaneous > dof:  # shared here only (a constraint singularity): none is common to the chains
         shared = np.zeros((0, 6))
-    if len(shared) + sum(len(c) - len(shared) for c in constraints) < 6 - dof:  # too few to hold n DOF: not common
-        shared = np.zeros((0, 6))
+    if len(constraints) > 1:  # as many as leave the chains' own able to hold dof: the others only alike
+        shared = shared[:max(0, (sum(len(c) for c in constraints) - 6 + dof) // (len(constraints) - 1))]
     own = [np.linalg.svd(c - c @ shared.T @ shared)[2][:len(c) - len(shared)] if len(c) > len(shared)
            else np.zeros((0, 6)) for c in constraints]
     holders = [i for i, o in enumerate(own) if len(o)]
