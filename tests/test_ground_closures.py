@@ -71,6 +71,14 @@ def expected(theta: float) -> dict:
     return {"iti": iti, "oti": oti, "lmti": max(oti), "f_o1": min(oti)}
 
 
+def assert_transmission(result, row: int, theta: float) -> None:
+    """Row ``row`` of ``result`` holds the four-bar's ITIs, LMTI and F_O1 at rocker angle ``theta``."""
+    values = expected(theta)
+    np.testing.assert_allclose(result.iti_actuators[row], values["iti"], atol=1e-9)
+    assert result.lmti[row] == pytest.approx(values["lmti"], abs=1e-9)
+    assert result.f_o[1][row] == pytest.approx(values["f_o1"], abs=1e-9)
+
+
 ANGLES = np.radians([0.0, 8.0, -5.0, 20.0])  # the rocker reaches -6.18 to 53.7 deg
 
 
@@ -89,10 +97,7 @@ def test_a_four_bar_pinned_to_the_ground_by_its_closure_has_the_transmission_ang
     assert solve(mechanism, poses).reachable.all()
     result = indices_at_poses(mechanism, poses, detail=True)
     for row, theta in enumerate(ANGLES):
-        values = expected(theta)
-        np.testing.assert_allclose(result.iti_actuators[row], values["iti"], atol=1e-9)
-        assert result.lmti[row] == pytest.approx(values["lmti"], abs=1e-9)
-        assert result.f_o[1][row] == pytest.approx(values["f_o1"], abs=1e-9)
+        assert_transmission(result, row, theta)
 
 
 def test_the_loop_welded_to_the_ground_is_rigid(tmp_path):
@@ -127,11 +132,7 @@ def test_the_coupler_s_pin_to_the_rocker_moves_as_the_rocker_turns(tmp_path, sca
         point = (mechanism.rotation_world_base @ np.array([full[0], full[1], 0.0]) + mechanism.translation_world_base)
         arm = point[:2] - pivot
         start = arm if start is None else start
-        theta = np.arctan2(start[0] * arm[1] - start[1] * arm[0], start @ arm)
-        values = expected(theta)
-        np.testing.assert_allclose(result.iti_actuators[row], values["iti"], atol=1e-9)
-        assert result.lmti[row] == pytest.approx(values["lmti"], abs=1e-9)
-        assert result.f_o[1][row] == pytest.approx(values["f_o1"], abs=1e-9)
+        assert_transmission(result, row, np.arctan2(start[0] * arm[1] - start[1] * arm[0], start @ arm))
 
 
 def test_the_command_analyses_the_rocker_as_the_file_is_written(tmp_path):

@@ -105,7 +105,7 @@ def mechanism_info(mechanism) -> dict:
 def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     """What MECHANISM is: DOF, task coordinates (with units), chains and the solver each uses and why,
     actuators, named poses (m, deg)."""
-    loaded = load_mechanism(mechanism, reading, indices=False, limits=not ignore_limits, graphs=True, notes=False)
+    loaded = load_mechanism(mechanism, reading, indices=False, limits=not ignore_limits, graphs=True)
     report = mechanism_info(loaded)
     if as_json:
         click.echo(json.dumps(report))

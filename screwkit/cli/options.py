@@ -380,7 +380,7 @@ def outputs_options(*, colour_scale: bool = False) -> Callable:
 # -- parsing ---------------------------------------------------------------------------------------
 
 def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: bool = True, graphs: bool = False,
-                   limits: bool = True, batches: bool = True, notes: bool = True):
+                   limits: bool = True, batches: bool = True):
     """Load MECHANISM (a bundled name or a file) as ``reading`` says (a :class:`Reading`, or just a length unit);
     a one-line error if it cannot be loaded.
 
@@ -390,8 +390,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     (:data:`~screwkit.indices.stages.SPACES_COMPILED_FROM`), so those are not compiled ahead. ``graphs``: a file
     whose legs have loops inside them is returned as a :class:`~screwkit.io.GraphMechanism` (analysed at the
     file's configuration) instead of refused. ``limits`` False (``--ignore-limits``): a reference assembly outside
-    a joint's limits is read all the same, and said on stderr. ``notes`` False: what loading noted (limits ignored,
-    loops closed, DOF at the file's rounding) is not said on stderr, the command prints it itself (``info``)."""
+    a joint's limits is read all the same, and said on stderr."""
     if indices:
         compile_ahead(*INDEX_KERNELS)
     reading = reading if isinstance(reading, Reading) else Reading(length_unit=reading)
@@ -412,15 +411,15 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
         rounded = [note for note in graph.report.notes if note.startswith(DOF_AT_ROUNDING)]
-        if rounded and notes and not _quiet():  # as a serial mechanism's, on every command
+        if rounded and not _quiet():  # as a serial mechanism's, on every command
             echo_error(f"{name}: " + "; ".join(rounded))
         return graph
     opened = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]
     ignored = [note for note in mechanism.assembly_notes if note.startswith(NOT_OPEN_LOOPS)]
-    if opened and notes and not _quiet():
+    if opened and not _quiet():
         # a file whose loops are open as written describes another mechanism than the one analysed: say so
         echo_error(f"{name}: loops open at the file's own joint values were closed at loading: " + "; ".join(opened))
-    if ignored and notes and not _quiet():
+    if ignored and not _quiet():
         echo_error(f"{name}: " + "; ".join(ignored))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         from screwkit.studies.kernels import mechanism_kernels  # the closures and indices: commands computing them
