@@ -319,7 +319,7 @@ def idle_rotation_count(mechanism: Mechanism) -> int:
     return 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)
 
 
-def _generic_samples(mechanism: Mechanism, count: int = 6, seed: int = 0, moving=None):
+def _generic_samples(mechanism: Mechanism, count: int = GENERIC_SAMPLES, seed: int = 0, moving=None):
     """Closed configurations near the reference assembly, off any special pose: random small full-pose
     offsets (of the pose coordinates ``moving``, a mask; every one by default), each brought back onto the closure by
     the least change of every pose coordinate."""
@@ -340,10 +340,10 @@ def _mode_samples(mechanism: Mechanism, poses, values):
     assembly: :data:`MODE_SAMPLES` random ones, and as many offset in the translations alone and in the rotations
     alone (a mode that keeps the platform's orientation is found by the first whatever the random ones find)."""
     angular = np.asarray(mechanism.pose_angular, dtype=bool)
-    batches = [(poses, values), _generic_samples(mechanism, MODE_SAMPLES, seed=1)[1:],
-               _generic_samples(mechanism, MODE_SAMPLES, seed=2, moving=~angular)[1:],
-               _generic_samples(mechanism, MODE_SAMPLES, seed=3, moving=angular)[1:]]
-    chains = constraining_chains(mechanism)
+    more = [_generic_samples(mechanism, MODE_SAMPLES, seed=1),
+            _generic_samples(mechanism, MODE_SAMPLES, seed=2, moving=~angular),
+            _generic_samples(mechanism, MODE_SAMPLES, seed=3, moving=angular)]
+    chains, batches = more[0][0], [(poses, values)] + [batch[1:] for batch in more]
     return (chains, np.concatenate([batch[0] for batch in batches]),
             [np.concatenate([batch[1][k] for batch in batches]) for k in range(len(chains))])
 
@@ -378,7 +378,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     chains = constraining_chains(mechanism)
     modes = []
     if chains:
-        chain_indices, poses, values = _generic_samples(mechanism, GENERIC_SAMPLES)
+        chain_indices, poses, values = _generic_samples(mechanism)
         more = not idle and poses.shape[0] < GENERIC_SAMPLES
         if more:  # random offsets that do not close: a mode they miss (a U-P-U platform's translations alone left)
             chain_indices, poses, values = _mode_samples(mechanism, poses, values)
@@ -408,7 +408,8 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     if modes:
         if declared is not None and len(modes) > 1:  # the mode in which the declared coordinates are independent
             axes = [names.index(name) for name in declared if name in names]
-            modes = sorted(modes, key=lambda mode: np.linalg.svd(mode.space[axes], compute_uv=False)[-1] <= 1e-6)
+            modes = sorted(modes, key=lambda mode: np.linalg.svd(mode.space[axes], compute_uv=False)[-1]
+                           <= TASK_RANK_TOLERANCE)
         at_pose, at_values = modes[0].pose, list(modes[0].values)
         if len(modes) > 1 or modes[0].driven < modes[0].probes:
             mechanism = replace(mechanism, assembly_notes=mechanism.assembly_notes

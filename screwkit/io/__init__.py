@@ -145,8 +145,7 @@ def with_reference_configuration(text: str, mechanism) -> str:
     then closes as written. Comments are kept."""
     import xml.etree.ElementTree as ElementTree
 
-    fixed = tolerant_declaration(text.encode())  # (the text itself when its declaration needs nothing)
-    root = ElementTree.fromstring(text if fixed == text.encode() else fixed.decode(), parser=ElementTree.XMLParser(
+    root = ElementTree.fromstring(tolerant_declaration(text.encode()).decode(), parser=ElementTree.XMLParser(
         target=ElementTree.TreeBuilder(insert_comments=True)))
     for old in root.findall("reference_configuration"):
         root.remove(old)

@@ -72,10 +72,11 @@ from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_
 from screwkit.io.star_writing import (
     UNLIMITED_SLIDE,
     base_frame,
+    in_base,
     joint_motion,
     origin_of,
     pose_of,
-    write_base_dofs,
+    write_base_pin,
     write_equivalent,
 )
 from screwkit.model.urdf_writer import UrdfWriter
@@ -421,9 +422,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     legs.sort(key=lambda leg: leg.joints[0] if leg.joints else 0)
     for leg in legs:
         parent, end = base, base
-        synthetic = write_base_dofs(writer, leg, world_base, reference)
+        synthetic = write_base_pin(writer, leg, world_base, reference)
         if synthetic:
-            parent = end = f"{synthetic[-1]}_link"
+            parent = end = f"{leg.closure}_link"
         for position, joint in enumerate(leg.joints):
             placement = homogeneous(model.jointPlacements[joint])
             if position == 0:
@@ -455,8 +456,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         name = model.names[leg.joints[0]] if leg.joints else leg.closure  # a loop joint alone: named after its closure
         successor = inverse(platform_world) @ leg.successor_world
         predecessor = leg.predecessor if leg.joints else inverse(world_base) @ leg.predecessor  # in the base frame
-        if leg.base_dofs:  # the last of the ball's joints' frames: the base's axes at the ball's centre
-            predecessor[:3, 3] -= inverse(world_base)[:3, :3] @ leg.base_dofs[0][2] + inverse(world_base)[:3, 3]
+        if leg.base_dofs:  # in the pin's frame: the base's axes at the ball's centre
+            predecessor[:3, 3] -= in_base(world_base, leg.base_dofs[0][2])
         writer.loop(f"{name}_loop", leg.loop, name, end, pose_of(predecessor), "platform", pose_of(successor),
                     axis=None if leg.axis is None else tuple(leg.axis))
         actuated = [model.names[j] for j in leg.joints if j in motor_ids]

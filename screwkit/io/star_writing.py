@@ -11,8 +11,8 @@ from screwkit.io.closed_tree import inverse, joint_kind, joint_value
 from screwkit.io.compound import Reduction
 from screwkit.model.urdf_writer import UrdfWriter
 
-__all__ = ["UNLIMITED_SLIDE", "origin_of", "pose_of", "joint_motion", "base_frame", "write_equivalent",
-           "write_base_dofs"]
+__all__ = ["UNLIMITED_SLIDE", "origin_of", "pose_of", "in_base", "joint_motion", "base_frame", "write_equivalent",
+           "write_base_pin"]
 
 UNLIMITED_SLIDE = 1e6
 """Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
@@ -60,7 +60,7 @@ def write_equivalent(writer: UrdfWriter, name: str, reduction: Reduction, attach
     """An equivalent constraint chain: slides along the reduction's translations, then revolutes along its rotations,
     from the attachment point, welded there to the platform. Returns its joint names."""
     to_base = inverse(world_base)
-    point = tuple((to_base @ np.append(attachment, 1.0))[:3])
+    point = tuple(in_base(world_base, attachment))
     parent, joints = "base", []
     directions = [("prismatic", d) for d in reduction.translations] + [("continuous", d) for d in reduction.rotations]
     for position, (kind, direction) in enumerate(directions):
@@ -78,20 +78,22 @@ def write_equivalent(writer: UrdfWriter, name: str, reduction: Reduction, attach
     return joints
 
 
+def in_base(world_base: NDArray, point: NDArray) -> NDArray[np.float64]:
+    """A world point in the written base's frame (``world_base``: that frame in the world)."""
+    return (inverse(world_base) @ np.append(point, 1.0))[:3]
 
-def write_base_dofs(writer: UrdfWriter, leg, world_base: NDArray, reference: dict) -> list[str]:
-    """The joints of a ball closed on the base itself (a leg's ``base_dofs`` in :mod:`screwkit.io.star`), written
-    first in the leg: revolutes through its centre, their frames the base's axes there, named after the closure.
-    Returns their names (each joint's link is its name and ``_link``)."""
-    links = []
-    for number, (_, axis, point) in enumerate(leg.base_dofs, start=1):
-        name = leg.closure if len(leg.base_dofs) == 1 else f"{leg.closure}_{number}"
-        origin = np.eye(4)
-        if number == 1:
-            origin[:3, 3] = inverse(world_base)[:3, :3] @ point + inverse(world_base)[:3, 3]
-        writer.link(f"{name}_link")
-        writer.joint(name, "continuous", links[-1] if links else "base", f"{name}_link",
-                     axis=tuple(world_base[:3, :3].T @ axis), **origin_of(origin))
-        reference[name] = 0.0
-        links.append(f"{name}_link")
-    return [link[:-len("_link")] for link in links]
+
+def write_base_pin(writer: UrdfWriter, leg, world_base: NDArray, reference: dict) -> list[str]:
+    """The pin of a ball closed on the base itself (a leg's one ``base_dofs`` entry in :mod:`screwkit.io.star`; a ball
+    is refused before writing), written first in the leg: a revolute through its centre, its frame the base's axes
+    there, named after the closure, its link that name and ``_link``. Returns the names written (none or the pin)."""
+    if not leg.base_dofs:
+        return []
+    (_, axis, point), = leg.base_dofs
+    origin = np.eye(4)
+    origin[:3, 3] = in_base(world_base, point)
+    writer.link(f"{leg.closure}_link")
+    writer.joint(leg.closure, "continuous", "base", f"{leg.closure}_link", axis=tuple(world_base[:3, :3].T @ axis),
+                 **origin_of(origin))
+    reference[leg.closure] = 0.0
+    return [leg.closure]

@@ -84,10 +84,15 @@ def chain_projector_complements(twists: list[NDArray[np.float64]], tolerance: fl
         decompositions = chain_decompositions(twists)
     total = np.zeros((decompositions[0][0].shape[0], 6, 6))
     for singular, right in decompositions:
-        outside = singular <= tolerance * singular[..., :1]
-        rows = right * outside[..., :, None]
+        rows = _complement_rows(singular, right, tolerance)
         total += np.swapaxes(rows, -1, -2) @ rows
     return total
+
+
+def _complement_rows(singular: NDArray, right: NDArray, tolerance: float) -> NDArray:
+    """A chain's right singular vectors (K, 6, 6) spanning its twists' Euclidean complement, the others zeroed: those
+    whose singular values are at most ``tolerance`` times the largest."""
+    return right * (singular <= tolerance * singular[..., :1])[..., :, None]
 
 
 def null_spaces(chain_twists: list[NDArray[np.float64]], dof: int | None, tolerance: float,
@@ -118,8 +123,8 @@ def motion_bases(values: NDArray, vectors: NDArray, dof: int | None, decompositi
         return dims, bases
     unresolved = np.flatnonzero(values[:, count] <= tolerances.EIGENVALUE_RESOLUTION)
     if unresolved.size:
-        rows = np.concatenate([right[unresolved] * (singular[unresolved] <= tolerance * singular[unresolved, :1])
-                               [..., None] for singular, right in decompositions], axis=-2)
+        rows = np.concatenate([_complement_rows(singular[unresolved], right[unresolved], tolerance)
+                               for singular, right in decompositions], axis=-2)
         bases = np.array(bases)
         bases[unresolved] = np.linalg.svd(rows)[2][:, 6 - count:]
     return dims, bases
