@@ -82,12 +82,17 @@ def assert_transmission(result, row: int, theta: float) -> None:
 ANGLES = np.radians([0.0, 8.0, -5.0, 20.0])  # the rocker reaches -6.18 to 53.7 deg
 
 
-@pytest.mark.parametrize("scale, yaw, shift", [(1.0, 0.0, (0.0, 0.0, 0.0)), (1000.0, 0.9, (0.3, -0.2, 1.5))])
+UNITS = {1.0: None, 1000.0: "mm", 1e-3: "km"}
+"""The unit a file written ``scale`` times larger than in metres is in: the same mechanism read back."""
+
+
+@pytest.mark.parametrize("scale, yaw, shift", [(1.0, 0.0, (0.0, 0.0, 0.0)), (1000.0, 0.9, (0.3, -0.2, 1.5)),
+                                               (1e-3, -0.6, (2.0, 1.0, -0.5))])
 def test_a_four_bar_pinned_to_the_ground_by_its_closure_has_the_transmission_angles(tmp_path, scale, yaw, shift):
     """Refused before: "closure 'pin_D' ties the platform to the fixed base: no leg"."""
     path = tmp_path / "four_bar.xml"
     path.write_text(four_bar_mjcf(scale, yaw, shift))
-    mechanism = load(path, output="rocker", length_unit="mm" if scale == 1000.0 else None)
+    mechanism = load(path, output="rocker", length_unit=UNITS[scale])
     assert mechanism.dof == 1 and mechanism.task_coordinates == ("phi",)
     assert mechanism.output_point is None  # the rocker turns about the ground pin: its frame, not that fixed point
     _, report = read_mechanism_file(path, output="rocker")
@@ -109,7 +114,9 @@ def test_the_loop_welded_to_the_ground_is_rigid(tmp_path):
         load(welded, output="coupler")
 
 
-@pytest.mark.parametrize("scale, yaw, shift", [(1.0, 0.0, (0.0, 0.0, 0.0)), (1000.0, -2.2, (-0.4, 0.7, 0.1))])
+@pytest.mark.parametrize("scale, yaw, shift", [(1.0, 0.0, (0.0, 0.0, 0.0)), (1000.0, -2.2, (-0.4, 0.7, 0.1)),
+                                               (1e-3, 2.5, (0.5, -3.0, 0.2))])  # (at yaws -1, -0.6, 0.4 and
+# 1.3 the pin's plane x is nearer its extremum: a step of 0.03 m passes the rocker's reach, whatever the unit)
 def test_the_coupler_s_pin_to_the_rocker_moves_as_the_rocker_turns(tmp_path, scale, yaw, shift):
     """With the coupler as output, the rocker's leg is the ground pin, then its joint onto the coupler, its loop
     joint (refused before: "ends on joints hinge_3 beyond the platform"). Its output is the pin C where the legs meet
@@ -117,7 +124,7 @@ def test_the_coupler_s_pin_to_the_rocker_moves_as_the_rocker_turns(tmp_path, sca
     rocker angle C's position gives."""
     path = tmp_path / "four_bar.xml"
     path.write_text(four_bar_mjcf(scale, yaw, shift))
-    mechanism = load(path, output="coupler", length_unit="mm" if scale == 1000.0 else None)
+    mechanism = load(path, output="coupler", length_unit=UNITS[scale])
     assert mechanism.dof == 1 and mechanism.output_point is not None
     _, report = read_mechanism_file(path, output="coupler")
     assert "pin_D: joints pin_D, loop revolute (closure pin_D)" in report.chains
@@ -177,7 +184,7 @@ def spherical_mjcf(scale: float = 1.0) -> str:
             f'</body></worldbody><equality>{closures}</equality><actuator>{motors}</actuator></mujoco>')
 
 
-@pytest.mark.parametrize("scale", [1.0, 1000.0])
+@pytest.mark.parametrize("scale", [1.0, 1000.0, 1e-3])
 def test_a_platform_on_a_ball_closed_onto_the_base_turns_about_it_with_the_leg_lines_transmission(tmp_path, scale):
     """The centre's ball is a leg of its loop joint alone; the platform turns about it (3 DOF), and each slide's OTI
     is the cosine between its leg line and the velocity of its head under the rotation the other two legs' lines
@@ -186,7 +193,7 @@ def test_a_platform_on_a_ball_closed_onto_the_base_turns_about_it_with_the_leg_l
 
     path = tmp_path / "spherical.xml"
     path.write_text(spherical_mjcf(scale))
-    mechanism = load(path, output="platform", length_unit="mm" if scale == 1000.0 else None)
+    mechanism = load(path, output="platform", length_unit=UNITS[scale])
     assert mechanism.dof == 3 and mechanism.task_coordinates == ("roll", "pitch", "yaw")
     poses = mechanism.home_pose + np.radians([[0.0, 0.0, 0.0], [4.0, -3.0, 6.0], [-5.0, 2.0, -8.0]])
     solution = solve(mechanism, poses)
@@ -219,3 +226,27 @@ def test_a_ball_on_the_base_then_a_hinge_onto_a_spatial_platform_is_refused_in_o
     with pytest.raises(ImportError_, match="closure 'centre' .3d. joins the fixed base to a body beyond the platform: "
                                            "screwkit reads that leg .* in a planar mechanism only"):
         read_mechanism_file(path, output="platform")
+
+
+def test_the_four_bar_s_actuators_renamed_and_listed_the_other_way_name_the_same_worst_fault(tmp_path):
+    """The crank's pin and the coupler's, renamed so that their order by name is the other way, their motors listed in
+    reverse: the same indices, each ITI with its actuator, and the worst fault the same physical actuator."""
+    plain = tmp_path / "plain.xml"
+    plain.write_text(four_bar_mjcf())
+    text = four_bar_mjcf().replace("hinge_1", "z_crank").replace("hinge_2", "a_coupler_pin")
+    text = text.replace('<motor joint="z_crank"/><motor joint="a_coupler_pin"/>',
+                        '<motor joint="a_coupler_pin"/><motor joint="z_crank"/>')
+    renamed = tmp_path / "renamed.xml"
+    renamed.write_text(text)
+    first, second = load(plain, output="rocker"), load(renamed, output="rocker")
+    poses = first.home_pose + ANGLES[:, None]
+    before, after = (indices_at_poses(m, poses, detail=True) for m in (first, second))
+    names = {"hinge_1": "z_crank", "hinge_2": "a_coupler_pin"}
+    order = [[name.split(":")[1] for name in second.actuator_names].index(names[name.split(":")[1]])
+             for name in first.actuator_names]
+    np.testing.assert_allclose(after.iti_actuators[:, order], before.iti_actuators, atol=1e-12)
+    np.testing.assert_allclose(after.lmti, before.lmti, atol=1e-12)
+    np.testing.assert_allclose(after.f_o[1], before.f_o[1], atol=1e-12)
+    for row in range(len(ANGLES)):
+        assert [names[name.split(":")[1]] for name in before.at(row).worst_faults[1]] == \
+            [name.split(":")[1] for name in after.at(row).worst_faults[1]]

@@ -236,8 +236,12 @@ def test_the_legs_relabelled_give_the_same_indices_and_the_same_worst_legs(tmp_p
     np.testing.assert_allclose(sorted(found.iti_actuators), sorted(reference.iti_actuators), atol=1e-9)
 
 
-@pytest.mark.parametrize("decimals", [4, 5, 6])
-def test_lifts_of_a_rounded_platform_give_each_pose_the_same_indices_in_any_batch(tmp_path, decimals):
+@pytest.mark.parametrize("decimals, scale, world, unit, reverse", [
+    (4, 1.0, (0.0, (0.0, 0.0, 0.0)), None, False), (5, 1.0, (0.0, (0.0, 0.0, 0.0)), None, False),
+    (6, 1.0, (0.0, (0.0, 0.0, 0.0)), None, False), (2, 1000.0, (0.0, (300.0, -200.0, 500.0)), "mm", True),
+    (8, 1e-3, (0.0, (0.3e-3, 0.2e-3, -0.1e-3)), "km", True)])
+def test_lifts_of_a_rounded_platform_give_each_pose_the_same_indices_in_any_batch(tmp_path, decimals, scale, world,
+                                                                               unit, reverse):
     """Written to 4-6 decimals, the lift line of a 3-U-P-U is a constraint singularity only to 1e-9 to 1e-5: its
     legs' couples are that near parallel. The eigenvectors that gave the motion space did not resolve the two
     rotations the legs nearly allow (eigenvalues 1e-16 and below), and the plan read the couples as one common
@@ -246,8 +250,8 @@ def test_lifts_of_a_rounded_platform_give_each_pose_the_same_indices_in_any_batc
     is now the same in any batch, and the numpy reference's, to what so near a singularity resolves (1e-16 over the
     couples' 1e-9: 1e-7)."""
     path = tmp_path / "rounded.sdf"
-    path.write_text(upu_sdf(3, decimals=decimals))
-    mechanism = load(path)
+    path.write_text(upu_sdf(3, scale=scale, world=world, reverse=reverse, decimals=decimals))  # as 5 decimals in m
+    mechanism = load(path, length_unit=unit)
     lifts = mechanism.home_pose + np.array([[0.0, 0.0, dz] for dz in (0.01, 0.05, 0.1, 0.2)])
     solution = solve(mechanism, lifts)
     chains = chain_screws(mechanism, solution)

@@ -323,13 +323,13 @@ def test_a_tool_turning_on_its_own_joint_after_the_platform_leaves_the_platform_
     assert "frame 'ee' hangs off it by joint(s) tool_spin, after the parallel part" in described.stdout
 
 
-def bracketed_delta(tmp_path, reverse: bool = False) -> tuple[str, str]:
+def bracketed_delta(tmp_path, reverse: bool = False, transform=None) -> tuple[str, str]:
     """The rod-level Delta with its platform called 'carrier' (no output name), plain and with each rod's far ball
     on a bracket welded to the carrier 1 cm below the ball (a Codian Delta's brackets), ``reverse``: the brackets
     and their welds written in reverse order. The spanning tree reaches a bracket before the carrier."""
     from sdformat_models import delta_sdf
 
-    plain = delta_sdf().replace("platform", "carrier")
+    plain = delta_sdf(transform=transform).replace("platform", "carrier")
     root = ElementTree.fromstring(plain.split("\n", 1)[1])
     model = root.find("model")
     ends = [joint for joint in model.findall("joint") if joint.get("name").startswith("end_")]
@@ -364,13 +364,16 @@ def output_position(graph) -> np.ndarray:
     return data.oMf[graph.frame_id].translation
 
 
-@pytest.mark.parametrize("reverse", [False, True])
-def test_a_platform_of_welded_links_is_named_and_placed_after_the_one_they_are_welded_to(tmp_path, reverse):
+@pytest.mark.parametrize("reverse, transform", [
+    (False, None), (True, None), (True, (1e-3, rotation_from_rpy((0.3, -0.5, 1.1)), np.array([0.4, -0.1, 2.0]))),
+    (False, (1e3, rotation_from_rpy((-1.2, 0.2, 0.7)), np.array([-30.0, 5.0, 100.0])))])
+def test_a_platform_of_welded_links_is_named_and_placed_after_the_one_they_are_welded_to(tmp_path, reverse,
+                                                                                      transform):
     """A published Codian Delta welds a bracket per ball around its platform: the platform was named after the
     bracket the tree reached first ('A12'), and its pose was that bracket's origin. It is the body the others are
     welded to, whatever order the file lists the brackets in: its name, its origin as the file's text places it, and
     the indices of the same Delta without brackets."""
-    plain, bracketed = bracketed_delta(tmp_path, reverse)
+    plain, bracketed = bracketed_delta(tmp_path, reverse, transform)
     reference = graph_mechanism(read_closed_tree(tmp_path / "plain.sdf"))
     found = graph_mechanism(read_closed_tree(write(tmp_path, bracketed, "bracketed.sdf")))
     assert found.platform_body == reference.platform_body == "carrier"
