@@ -250,3 +250,23 @@ def test_the_four_bar_s_actuators_renamed_and_listed_the_other_way_name_the_same
     for row in range(len(ANGLES)):
         assert [names[name.split(":")[1]] for name in before.at(row).worst_faults[1]] == \
             [name.split(":")[1] for name in after.at(row).worst_faults[1]]
+
+
+def test_mujoco_reads_the_test_files_as_the_closed_forms_assume():
+    """The closed forms above take the four-bar's pins at A, B, C, closed at D, and the 3-UPS/S closed at its drawing;
+    MuJoCo's own reading of the same files: its joint anchors there (in the turned, shifted world), every connect
+    closed (constraint residual 0) at the file's configuration."""
+    import mujoco
+
+    yaw, shift = 0.9, (0.3, -0.2, 1.5)
+    turn = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    for text, anchors in ((four_bar_mjcf(1.0, yaw, shift), [turn @ [*p, 0.0] + shift for p in (A, B, C)]),
+                          (spherical_mjcf(), None)):
+        model = mujoco.MjModel.from_xml_string(text)
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        assert data.nefc > 0 and np.abs(data.efc_pos).max() <= 1e-12
+        if anchors is not None:
+            np.testing.assert_allclose(data.xanchor, anchors, atol=1e-12)
+            pin = np.array(model.eq("pin_D").data[:3])  # on the ground body, in its frame
+            np.testing.assert_allclose(turn @ pin + shift, turn @ [*D, 0.0] + shift, atol=1e-12)
