@@ -39,6 +39,7 @@ from screwkit.cli.options import (
     parse_probabilities,
     reading_options,
 )
+from screwkit.common.memory import keep_freed_memory
 from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.indices.registry import column_record
 from screwkit.studies.design.families import FAMILIES, Family, family
@@ -101,6 +102,7 @@ def design_search() -> None:
     assignment (the paper's selection). optimise MECHANISM: search the planar_rrr family from a planar n-RRR's
     design.
     """
+    keep_freed_memory()  # one design after another reuses the pages the last one freed (screwkit.common.memory)
 
 
 def _check(search_options: SearchOptions, outputs, report: Report) -> None:

@@ -13,6 +13,7 @@ search with one line that says what the state file keeps.
 
 The local worker processes end with the process that started them, however it ends (SIGKILL, the out-of-memory
 killer): each asks the kernel for a signal when its parent dies, or (where that cannot be asked) watches its parent.
+Each keeps the memory it frees for the next design (:mod:`screwkit.common.memory`).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.memory import keep_freed_memory
 from screwkit.studies.design.families import Family
 from screwkit.studies.design.objectives import METRICS, Region, region_metrics
 from screwkit.studies.files import atomic_text
@@ -83,6 +85,13 @@ def _end_with_parent(parent: int) -> None:
         threading.Thread(target=watch, daemon=True).start()
     if os.getppid() != parent:  # the parent died before the request was made
         os._exit(1)
+
+
+def _start_worker(parent: int) -> None:
+    """Initializer of the local evaluation processes: end with ``parent``; keep freed memory for the next design
+    (:func:`~screwkit.common.memory.keep_freed_memory`: no page faults on each design's fresh arrays)."""
+    _end_with_parent(parent)
+    keep_freed_memory()
 
 
 class Evaluations:
@@ -254,7 +263,7 @@ class Evaluations:
 
             # spawn: a forked copy of a process that already runs threads (numba, Dask) can deadlock
             self.pool = ProcessPoolExecutor(os.cpu_count(), mp_context=multiprocessing.get_context("spawn"),
-                                            initializer=_end_with_parent, initargs=(os.getpid(),))
+                                            initializer=_start_worker, initargs=(os.getpid(),))
         return list(self.pool.map(evaluate_candidate, *zip(*arguments)))
 
     def close(self) -> None:
