@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 from delta_rods import delta_rods_mjcf
 from sdformat_models import delta_sdf, five_bar_sdf
+from test_gallery_published import GEPETTO
 from test_gazebo import five_bar_gazebo
 from test_graph_legs import POSES, assert_delta_textbook, textbook
 from test_io import assert_textbook, five_bar_gepetto, five_bar_mjcf, poses_near_home
@@ -282,3 +284,17 @@ def test_analyze_says_in_its_first_line_when_the_actuators_are_guessed(tmp_path)
         run = screwkit("analyze", path, "--json")
         assert json.loads(run.stdout)["actuators_guessed"] == (label == "guessed"), label
     assert "4 actuators (guessed: the file names none" in screwkit("analyze", delta).stdout.splitlines()[0]
+
+
+def test_a_fixed_joint_named_as_its_link_is_refused_as_fixed(tmp_path):
+    """A link with its joint's name (allowed in URDF; MuJoCo's custom) makes two frames of one name; the fixed joint's
+    was looked up by name alone, and Pinocchio refused with its own "Several frames match the filter"."""
+    source = GEPETTO / "5bar_linkage"
+    text = re.sub(r'(link|name)="effector"', r'\1="effector_frame"', (source / "robot.urdf").read_text())
+    assert '<link name="effector_frame"' in text and '<child link="effector_frame"' in text
+    (tmp_path / "robot.urdf").write_text(text)
+    shutil.copy(source / "robot.yaml", tmp_path / "robot.yaml")
+    with pytest.raises(ImportError_, match=r"robot\.urdf \+ robot\.yaml: --actuate effector_frame: a fixed joint, "
+                                           r"which cannot drive anything; the joints that can be driven \(revolute or "
+                                           r"prismatic\) are "):
+        read_closed_tree(tmp_path / "robot.urdf", actuate=("effector_frame",))

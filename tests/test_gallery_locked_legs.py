@@ -19,6 +19,8 @@ foot's motion space (its two hinges for digit's ankle, its hinge for cassie's).
 from __future__ import annotations
 
 import json
+import re
+import shutil
 
 import numpy as np
 import pinocchio as pin
@@ -26,9 +28,9 @@ import pytest
 import yaml
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
-from test_gallery_published import GEPETTO
+from test_gallery_published import GEPETTO, PUBLISHED
 
-from helpers import screwkit
+from helpers import one_line_error, screwkit
 from screwkit.io import read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -187,3 +189,40 @@ def test_a_lock_on_a_file_whose_loop_closes_with_the_locked_joint_where_written_
         name.split(":")[-1]: value for name, value in result.joint_values.items() if name.split(":")[-1] in
         ("mot1", "mot2")}})
     assert q[model.joints[model.getJointId("free1")].idx_q] == 0.0  # and the loop closes there (scipy, above)
+
+
+def test_links_named_after_their_joints_lock_the_same(tmp_path):
+    """MuJoCo names a body after its joint, and a URDF may name a link so: the model then has a body frame and a joint
+    frame of one name, and Pinocchio's reduced model (which finds frames by name) refused the lock with its own
+    "Several frames match the filter" and no file named. digit_like with each locked joint's child link renamed to
+    the joint's name is the same robot: the same five locks give the same indices, and the renamed links keep their
+    names (the output body named after its joint is found)."""
+    source = GEPETTO / "digit_like"
+    renamed = {"hip_y": "motor_hip_x", "hip_x": "motor_hip_y", "hip_z": "motor_hip_z", "shin": "motor_knee",
+               "tarsus": "free_knee"}
+    text = (source / "robot.urdf").read_text()
+    for old, new in renamed.items():
+        text = re.sub(rf'(link|name)="{old}"', rf'\1="{new}"', text)
+    assert all(text.count(f'"{new}"') >= 3 for new in renamed.values())  # a link, its joint, its child reference
+    (tmp_path / "robot.urdf").write_text(text)
+    shutil.copy(source / "robot.yaml", tmp_path / "robot.yaml")
+    held = [part for lock in DIGIT_LOCKS for part in ("--lock", lock)]
+    results = []
+    for path in (source / "robot.urdf", tmp_path / "robot.urdf"):
+        done = screwkit("analyze", path, *held, "--json")
+        assert done.returncode == 0, done.stderr
+        results.append(json.loads(done.stdout))
+    original, named = results
+    for key in ("dof", "actuators", "pose", "iti", "lmti", "f_o", "f_io", "cti", "f_c", "iti_actuators",
+                "worst_faults"):
+        assert json.dumps(named[key]) == json.dumps(original[key]), key  # the same numbers as written
+    one_line_error(screwkit("info", tmp_path / "robot.urdf", *held[:-2]), "--lock free_knee")
+
+
+def test_menageries_cassie_takes_a_lock_on_a_joint_named_as_its_body():
+    """MuJoCo Menagerie's Cassie names each body after its joint: ``--lock left-hip-roll`` was Pinocchio's "Several
+    frames match the filter"; it is now held, and the next refusal is screwkit's own line about the legs."""
+    refused = screwkit("info", PUBLISHED / "agility_cassie" / "cassie.xml", "--output", "left-foot", "--lock",
+                       "left-hip-roll")
+    one_line_error(refused, "cassie.xml: leg 'cassie-pelvis' has loops inside it")
+    assert "Several frames" not in refused.stderr

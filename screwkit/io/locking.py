@@ -40,7 +40,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     held, moved = _values_closing_the_loops(tree, locked)
     data = model.createData()
     pin.forwardKinematics(model, data, held)
-    reduced = pin.buildReducedModel(model, locked, held)
+    reduced = _reduced_model(model, locked, held)
 
     def carried(joint: int, placement: NDArray) -> tuple[int, NDArray]:
         while joint in locked:  # the frame rides on the body the locked joint's body is merged into
@@ -70,6 +70,30 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
         other += [tree.notes[k] for k in guessed]
     return replace(tree, model=reduced, closures=closures, motors=motors, q_reference=q, notes=other + notes,
                    locked=tree.locked + names)
+
+
+def _reduced_model(model, locked: list[int], held: NDArray):
+    """Pinocchio's reduced model, frames that share a name (MuJoCo names a body after its joint, and the model has a
+    body frame and a joint frame of that name) told apart while it is built: Pinocchio finds each frame's parent by
+    name, and refuses a name that two frames match. Both models keep the names as written."""
+    import pinocchio as pin
+
+    seen: dict[str, int] = {}
+    for frame in model.frames:
+        seen[frame.name] = seen.get(frame.name, 0) + 1
+    written = {}
+    for index, frame in enumerate(model.frames):
+        if seen[frame.name] > 1 and frame.type != pin.FrameType.JOINT:
+            written[f"{frame.name}\x00{index}"] = frame.name
+            frame.name = f"{frame.name}\x00{index}"
+    try:
+        reduced = pin.buildReducedModel(model, locked, held)
+    finally:
+        for frame in model.frames:
+            frame.name = written.get(frame.name, frame.name)
+    for frame in reduced.frames:
+        frame.name = written.get(frame.name, frame.name)
+    return reduced
 
 
 def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDArray, list[str]]:
@@ -134,6 +158,8 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
     from the branches leaving the base; the mechanism lists its actuators in its legs' order, whatever the order
     given. Each must be a 1-DoF joint (revolute or prismatic) of the tree as read, so not one held by ``--lock``; the
     report says the actuators were given, and which the file had."""
+    import pinocchio as pin
+
     names = joint_names(names, "actuate", tree.source)
     if not names:
         return tree
@@ -147,7 +173,7 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
         elif name in tree.split:
             what = f"{tree.split[name]}, not a 1-DoF joint"
         elif not model.existJointName(name) or model.getJointId(name) == 0:
-            welded = model.existFrame(name) and str(model.frames[model.getFrameId(name)].type) == "FIXED_JOINT"
+            welded = model.existFrame(name, pin.FrameType.FIXED_JOINT)  # (a body may have its joint's name)
             closing = any(closure.name in (name, f"{name}_a") for closure in tree.closures)
             what = ("a fixed joint, which cannot drive anything" if welded else "it closes a loop, which screwkit "
                     "cuts there (a joint of the tree can be driven)" if closing else "no joint of that name")
