@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -115,3 +118,49 @@ def test_the_kernels_compiled_ahead_are_those_a_large_batch_uses(name, monkeypat
     assert set(constraint_kernels(mechanism)) == set(asked) & lower
     if name == "schoenflies_5":  # the case that compiled both for nothing
         assert not set(asked) & lower
+
+
+def test_stopping_ends_the_children_and_the_queue(stand_in_children):
+    """What a command does as it ends: the children compiling are killed, and no queued kernel starts after."""
+    notice.compile_ahead(WRENCH, OUTPUT, notice.NULL_KERNEL, notice.GRAM_KERNEL)  # two run, two wait for a core
+    children = list(notice._children.values())
+    assert len(children) == 2 and notice._queued
+    notice.stop_compiling()
+    assert all(child.poll() is not None for child in children)
+    assert not notice._queued and not notice._children
+    time.sleep(0.3)  # the thread that starts queued kernels as cores free up has nothing left to start
+    assert not notice._children
+
+
+def _compilers_of(cache: str) -> list[int]:
+    """The processes whose environment names ``cache`` as numba's cache (a command's compiling children)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                environment = open(f"/proc/{entry}/environ", "rb").read()
+            except OSError:
+                continue
+            if f"NUMBA_CACHE_DIR={cache}".encode() in environment.split(b"\0"):
+                found.append(int(entry))
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux") or notice._cores() < 2,
+                    reason="children compile only on two cores or more; found through /proc")
+def test_a_command_that_fails_leaves_no_compiler_running(tmp_path):
+    """A first run (nothing cached) whose file is refused after the kernels started compiling: the command ends with
+    its one line, and so do the compilers it started (they kept compiling 25 s after it, and two failed commands in a
+    row had four compilers share two cores)."""
+    cache = str(tmp_path / "numba")
+    (tmp_path / "robot.urdf").write_text("<robot name='r'><link name='a'/><joint name='j' type='revolute'>")
+    environment = dict(os.environ, NUMBA_CACHE_DIR=cache, SCREWKIT_CACHE_DIR=str(tmp_path / "own"))
+    try:
+        done = subprocess.run([sys.executable, "-m", "screwkit.cli", "analyze", str(tmp_path / "robot.urdf")],
+                              capture_output=True, text=True, env=environment, timeout=120)
+        assert done.returncode == 1 and "compiling" in done.stderr and "in 2 processes" in done.stderr, done.stderr
+        assert done.stderr.strip().splitlines()[-1].startswith("Error: "), done.stderr
+        assert _compilers_of(cache) == []
+    finally:
+        for pid in _compilers_of(cache):
+            os.kill(pid, signal.SIGKILL)

@@ -69,6 +69,9 @@ def main() -> None:
     except SystemExit as stop:
         code = stop.code
 
+    compiling = sys.modules.get("screwkit.common.compiling")
+    if compiling is not None:  # no compiler outlives the command (one that failed before it needed its kernels)
+        compiling.stop_compiling()
     server = sys.modules.get("screwkit.viewer.server")  # loaded only if a command used the viewer
     if server is not None and server.servers_to_stop():
         sys.exit(code)

@@ -41,9 +41,10 @@ from pathlib import Path
 
 from screwkit.common.caches import own_folder, private_temporary_folder, user_cache_home, writable
 
-__all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "kernel_is_cached", "silence", "stage_kernels",
-           "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL", "SPACE_KERNEL",
-           "CONSTRAINT_KERNEL", "CLOSED_FORM_KERNEL", "KERNEL_SOURCES", "kernel_sources", "kernel_sources_digest"]
+__all__ = ["announce_compilation", "compile_ahead", "prepare_kernels", "stop_compiling", "kernel_is_cached",
+           "silence", "stage_kernels", "numba_cache", "KERNELS", "INDEX_KERNELS", "NULL_KERNEL", "GRAM_KERNEL",
+           "SPACE_KERNEL", "CONSTRAINT_KERNEL", "CLOSED_FORM_KERNEL", "KERNEL_SOURCES", "kernel_sources",
+           "kernel_sources_digest"]
 
 KERNELS = {
     "screwkit.indices.compiled.wrenches": ("wrench_kernel", 6),
@@ -327,3 +328,18 @@ def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
             child.wait()  # (thread-safe: every thread needing the kernel waits here)
             with _lock:
                 _children.pop(module, None)
+
+
+def stop_compiling() -> None:
+    """End the children still compiling and forget the queued kernels: what a command calls as it ends (one that
+    failed before it needed its kernels), so that no compiler outlives it and competes with the next command for the
+    cores (which, finding the kernels still missing from the cache, starts its own). numba writes a cache entry
+    whole or not at all, so a child ended mid-way leaves the kernel missing, not broken."""
+    with _lock:
+        _queued.clear()
+        for child in _children.values():
+            if child.poll() is None:
+                child.kill()
+        for child in _children.values():
+            child.wait()
+        _children.clear()
