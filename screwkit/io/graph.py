@@ -134,7 +134,7 @@ class GraphMechanism:
     @property
     def actuators(self) -> tuple[str, ...]:
         """``leg:joint`` of every actuator, as the indices name them."""
-        return tuple(f"{leg.name}:{self.tree.model.names[leg.actuators[0]]}" for leg in self.legs)
+        return tuple(f"{leg.name}:{self.tree.model.names[leg.actuators[0]]}" for leg in self.legs if leg.actuators)
 
     @property
     def actuator_names(self) -> tuple[str, ...]:
@@ -343,7 +343,9 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None
     motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
     configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
     model = tree.model
-    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each (_check_actuators)
+    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each, or none (_check_actuators)
+        if not leg.actuators:
+            continue
         actuator = leg.actuators[0]
         name = model.names[actuator]
         carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
@@ -391,7 +393,12 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
     """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
     actuator is named, with the option that holds it)."""
     model = tree.model
+    if not any(leg.actuators for leg in legs):
+        raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
+                           "--actuate names the driven joints.")
     for leg in legs:
+        if not leg.actuators:  # a passive leg: it constrains the platform, its twist system is the whole of it
+            continue
         if len(leg.actuators) != 1:
             stage = [j for j in leg.joints  # joints carrying every actuator of the leg, from the base
                      if len(leg.actuators) > 1 and joint_kind(model, j)[0] in ("revolute", "prismatic")
@@ -503,7 +510,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                            "only to the file's rounding: the graph reads a file as written).")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
-    report.motors = [model.names[leg.actuators[0]] for leg in legs]
+    report.motors = [model.names[leg.actuators[0]] for leg in legs if leg.actuators]
     report.chains = [f"{leg.name}: {len(leg.joints)} joints ({', '.join(model.names[j] for j in leg.joints)}), "
                      f"{len(leg.closures)} closure(s), twist system of dimension {len(chain.twists)}"
                      for leg, chain in zip(legs, chains)]

@@ -26,7 +26,8 @@ __all__ = ["GraphLeg", "LegScrews", "leg_screws", "equivalent_chains", "dimensio
 @dataclass(frozen=True)
 class GraphLeg:
     """One leg of a closed-loop graph: its joints (Pinocchio joint ids, the platform's own joint when the platform
-    hangs on the leg: ``spine``), the closures with an end on it, and its actuated joints."""
+    hangs on the leg: ``spine``), the closures with an end on it, and its actuated joint (none for a passive leg,
+    which only constrains the platform)."""
 
     name: str
     joints: tuple[int, ...]
@@ -152,8 +153,16 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
     out = []
     for leg in legs:
-        actuator = leg.actuators[0]
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
+        if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
+            oti = _attachments(state, leg, platform) + ([state.transforms[:, platform, :3, 3]] if leg.spine else [])
+            if not oti:
+                raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
+            point = np.mean(oti, axis=0)
+            out.append(LegScrews(np.zeros_like(point, shape=point.shape[:1] + (6,)), allowed, allowed_dims, allowed,
+                                 allowed_dims, point, point, point, np.zeros(point.shape[0])))
+            continue
+        actuator = leg.actuators[0]
         locked, locked_dims = _twist_spaces(state, [j for j in leg.joints if j != actuator], leg)
         own = state.working[:, kinematics.idx_v[actuator]]
         own = own / np.linalg.norm(own, axis=1, keepdims=True)
@@ -178,15 +187,17 @@ def equivalent_chains(legs, screws: list[LegScrews], state: _State, rows: NDArra
     centre, scale = state.centre[rows][:, None, :], state.scale
     for leg, leg_screw in zip(legs, screws):
         dims = int(leg_screw.locked_dims[rows[0]])
-        working = np.concatenate([leg_screw.own[rows][:, None, :], leg_screw.locked[rows][:, :dims]], axis=1)
+        own = leg_screw.own[rows][:, None, :] if leg.actuators else np.zeros((len(rows), 0, 6))
+        working = np.concatenate([own, leg_screw.locked[rows][:, :dims]], axis=1)
         world = np.concatenate([working[..., :3], working[..., 3:] * scale + cross(centre, working[..., :3])],
                                axis=-1)
-        points = np.concatenate([leg_screw.actuator_point[rows][:, None, :],
+        points = np.concatenate([leg_screw.actuator_point[rows][:, None][:, :own.shape[1]],
                                  np.repeat(leg_screw.oti_point[rows][:, None, :], dims, axis=1)], axis=1)
-        names = (model.names[leg.actuators[0]],) + tuple(f"{leg.name}_twist_{k + 1}" for k in range(dims))
-        chains.append(ChainScrews(world, points, (0,), leg.name, names))
-    iti = np.stack([s.iti_point[rows] for s in screws], axis=1)
-    oti = np.stack([s.oti_point[rows] for s in screws], axis=1)
+        names = tuple(model.names[j] for j in leg.actuators) + tuple(f"{leg.name}_twist_{k + 1}" for k in range(dims))
+        chains.append(ChainScrews(world, points, (0,) if leg.actuators else (), leg.name, names))
+    actuated = [s for leg, s in zip(legs, screws) if leg.actuators]  # the ITI and OTI points are the actuators'
+    iti = np.stack([s.iti_point[rows] for s in actuated], axis=1)
+    oti = np.stack([s.oti_point[rows] for s in actuated], axis=1)
     return chains, iti, oti
 
 

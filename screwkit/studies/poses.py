@@ -515,7 +515,7 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
         if progress is not None:
             progress(part.stop - part.start)
     chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
-    names = tuple(f"{leg.name}:{model.names[leg.actuators[0]]}" for leg in graph.legs)
+    names = graph.actuators
     fill_unreachable(arrays)
     described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
     result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,

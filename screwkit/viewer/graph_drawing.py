@@ -179,7 +179,7 @@ def graph_markers(graph, frames: Frames, failed: tuple[int, ...]) -> tuple[tuple
                                                                                                  rod.owner)
             markers.append(marker(f"{ROOT_PATH}/joints/{node_label(label)}", "joint", end, end, owner))
         for actuator in failed:
-            joint = graph.legs[actuator].actuators[0]
+            joint = [leg for leg in graph.legs if leg.actuators][actuator].actuators[0]
             label = node_label(graph.actuators[actuator])
             path = f"{ROOT_PATH}/failed/{actuator}-{label}"
             markers.append(Marker(path, "failed_actuator", actuator, origins[frame, joint].copy(),

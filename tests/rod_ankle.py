@@ -1,0 +1,50 @@
+"""A two-rod parallel ankle written as an MJCF file (test helper), the way MuJoCo humanoids write theirs.
+
+The foot hangs from the shank (the fixed base) on a passive universal joint at the ankle centre ``O`` (the origin):
+pitch about y, then roll about x. Two motors on the shank turn cranks about x at ``MOTORS[k]``; each crank (length
+``CRANK``, pointing along -y at zero) carries a rod, on a ``ball`` joint at the crank's end ``C_k`` (``rods="ball"``)
+or on two hinges through it (``rods="hinges"``: the rod's idle spin about its own line left out), whose far end is
+``<connect>``-ed to the foot at ``FOOT[k]``. The rods' lengths are what the drawing gives them (MuJoCo's connect
+holds the anchors together as drawn).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+MOTORS = np.array([[0.0, 0.045, 0.30], [0.0, -0.045, 0.22]])
+CRANK = 0.05
+FOOT = np.array([[-0.03, 0.04, -0.02], [-0.03, -0.04, -0.02]])
+
+
+def text(vector, scale: float = 1.0) -> str:
+    return " ".join(repr(float(v) * scale) for v in vector)
+
+
+def crank_ends() -> np.ndarray:
+    """The cranks' ends ``C_k`` as drawn (every joint at zero)."""
+    return MOTORS + np.array([0.0, -CRANK, 0.0])
+
+
+def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None) -> str:
+    """The ankle's MJCF text; ``scale`` multiplies every length (a file in other units), ``world`` (``pos``,
+    ``quat`` texts) puts the shank in another place of the world."""
+    def rod(k: int) -> str:
+        joint = (f'<joint name="rod_{k}" type="ball"/>' if rods == "ball" else
+                 f'<joint name="rod_{k}_u1" type="hinge" axis="1 0 0"/><joint name="rod_{k}_u2" type="hinge" '
+                 'axis="0 0 1"/>')
+        return (f'<body name="crank_{k}" pos="{text(MOTORS[k - 1], scale)}"><joint name="motor_{k}" type="hinge" '
+                f'axis="1 0 0"/><geom type="sphere" size="{0.01 * scale!r}"/>'
+                f'<body name="rod_{k}" pos="{text([0.0, -CRANK, 0.0], scale)}">{joint}'
+                f'<geom type="sphere" size="{0.01 * scale!r}"/></body></body>')
+
+    pos, quat = world if world is not None else ("0 0 0", "1 0 0 0")
+    connects = "".join(f'<connect name="closure_{k}" body1="foot" body2="rod_{k}" anchor="{text(FOOT[k - 1], scale)}"/>'
+                       for k in (1, 2))
+    motors = "".join(f'<motor name="m{k}" joint="motor_{k}"/>' for k in (1, 2))
+    return (f'<mujoco model="rod_ankle"><compiler angle="radian"/><worldbody><body name="shank" pos="{pos}" '
+            f'quat="{quat}"><geom type="sphere" size="{0.01 * scale!r}"/>{rod(1)}{rod(2)}'
+            '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
+            f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="roll" type="hinge" '
+            f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/></body></body></body>'
+            f'</worldbody><equality>{connects}</equality><actuator>{motors}</actuator></mujoco>')

@@ -1,0 +1,167 @@
+"""A passive leg in a closed-loop graph: the two-rod parallel ankle of MuJoCo humanoids (Digit's, Cassie-like).
+
+The foot hangs from the shank on a passive universal joint; two cranks drive it through rods written as MuJoCo writes
+them, a ``ball`` at the crank and a ``<connect>`` on the foot (``tests/rod_ankle.py``). Each rod then spins idly about
+its own line, so the star reading (serial legs of 1-DoF joints) does not take it and the graph does
+(:mod:`screwkit.io.graph`); but the graph took a leg with no actuator for "loops inside it and no actuators: exactly
+one" and refused the file. The universal-joint leg is a passive leg: it constrains the foot (four constraint
+wrenches), and is analysed as the star analyses a passive chain.
+
+Checked against:
+
+* the same ankle with each rod's ball written as two hinges (no idle spin), which the star reading takes: every
+  actuator's ITI, the LMTI, the OTIs and F_O1 equal at the home pose and at poses about it;
+* the rod lines, from Pinocchio's own forward kinematics of the configurations the graph solves: the actuation
+  wrench of a crank-rod leg is the force along its rod, ITI_k = |f_k . v_C| / |v_C| at the crank's end, and OTI_k =
+  |f_k . v_F| / |v_F| at the rod's foot anchor, v from the foot rotation about the ankle centre reciprocal to the
+  other rod's force;
+* the file in km and mm and in a moved world (the same indices), MuJoCo's own reading of it (the connects closed as
+  drawn, the foot where Pinocchio puts it), and the command line.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from rod_ankle import FOOT, rod_ankle_mjcf
+
+from helpers import one_line_error, screwkit
+from screwkit.io import graph_mechanism, read_closed_tree
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_poses
+from screwkit.studies.poses import graph_indices_at_poses
+
+TOLERANCE = 1e-9
+POSES = np.radians([[0.0, 0.0], [6.0, -4.0], [-8.0, 5.0], [3.0, 10.0], [-5.0, -9.0]])  # roll, pitch of the foot
+
+
+def write(tmp_path, rods="ball", name="ankle.xml", **options):
+    path = tmp_path / name
+    path.write_text(rod_ankle_mjcf(rods, **options))
+    return path
+
+
+def graph_of(path):
+    return graph_mechanism(read_closed_tree(path, output="foot"))
+
+
+def test_the_universal_joint_leg_is_a_passive_leg_of_the_graph(tmp_path):
+    graph = graph_of(write(tmp_path))
+    assert [leg.name for leg in graph.legs] == ["crank_1", "crank_2", "cross"]
+    assert [len(leg.actuators) for leg in graph.legs] == [1, 1, 0]
+    assert graph.actuators == ("crank_1:motor_1", "crank_2:motor_2")
+    assert graph.task_coordinates == ("roll", "pitch")
+    assert [len(chain.twists) for chain in graph.chains] == [6, 6, 2]  # crank + the rod's 5; the foot's 2 rotations
+    assert graph.report.motors == ["motor_1", "motor_2"]
+
+
+def test_rods_on_balls_read_as_a_graph_equal_rods_on_two_hinges_read_as_serial_legs(tmp_path):
+    graph = graph_of(write(tmp_path))
+    serial = load(write(tmp_path, "hinges", "hinges.xml"), output="foot")
+    assert serial.task_coordinates == graph.task_coordinates
+    poses = serial.home_pose + POSES
+    ours = graph_indices_at_poses(graph, graph.home_pose + POSES, detail=True)
+    theirs = indices_at_poses(serial, poses, detail=True)
+    assert np.all(ours.reachable) and np.all(theirs.reachable)
+    for field in ("iti_actuators", "iti", "lmti", "oti_submechanisms"):
+        np.testing.assert_allclose(getattr(ours, field), getattr(theirs, field), atol=TOLERANCE, err_msg=field)
+    np.testing.assert_allclose(graph.indices().oti_actuators, serial_home_otis(serial), atol=TOLERANCE)
+    np.testing.assert_array_equal(ours.f_o[1], 0.0)  # two actuators for two DoF: none may fail
+    np.testing.assert_array_equal(theirs.f_o[1], 0.0)
+
+
+def serial_home_otis(serial):
+    from screwkit.studies import indices_at_pose
+
+    return indices_at_pose(serial, serial.home_pose).oti_actuators
+
+
+def _rod_line_indices(model, q):
+    """ITI per actuator and OTI per actuator from the rod lines, Pinocchio's forward kinematics at q."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+
+    def origin(name):
+        return data.oMi[model.getJointId(name)].translation.copy()
+
+    def axis(name, local):
+        return data.oMi[model.getJointId(name)].rotation @ np.array(local, dtype=float)
+
+    centre = origin("roll")  # the universal joint's centre
+    rotations = np.stack([axis("pitch", (0, 1, 0)), axis("roll", (1, 0, 0))])  # the foot's motion space
+    foot = data.oMi[model.getJointId("roll")]
+    anchors = [foot.act(np.asarray(point)) for point in FOOT]
+    forces, itis = [], []
+    for k, anchor in zip((1, 2), anchors):
+        crank_end = origin(f"rod_{k}")
+        force = (anchor - crank_end) / np.linalg.norm(anchor - crank_end)
+        velocity = np.cross(axis(f"motor_{k}", (1, 0, 0)), crank_end - origin(f"motor_{k}"))
+        forces.append(force)
+        itis.append(abs(force @ velocity) / np.linalg.norm(velocity))
+    otis = []
+    for k in range(2):
+        other = 1 - k
+        # omega = rotations^T c, with f_other . (omega x (F_other - O)) = 0
+        row = np.array([forces[other] @ np.cross(r, anchors[other] - centre) for r in rotations])
+        omega = np.array([row[1], -row[0]]) @ rotations
+        velocity = np.cross(omega, anchors[k] - centre)
+        otis.append(abs(forces[k] @ velocity) / np.linalg.norm(velocity))
+    return np.array(itis), np.array(otis)
+
+
+def test_the_graph_s_indices_are_the_rod_lines(tmp_path):
+    graph = graph_of(write(tmp_path))
+    result, q = graph_indices_at_poses(graph, graph.home_pose + POSES, detail=True, configurations=True)
+    for index in range(len(POSES)):
+        itis, otis = _rod_line_indices(graph.tree.model, q[index])
+        np.testing.assert_allclose(result.iti_actuators[index], itis, atol=TOLERANCE)
+        if index == 0:  # the home pose: each actuator's OTI (a batch keeps the submechanisms' only)
+            np.testing.assert_allclose(graph.indices().oti_actuators[0], otis, atol=TOLERANCE)
+        assert result.lmti[index] == pytest.approx(otis.min(), abs=TOLERANCE)
+        assert result.iti[index] == pytest.approx(itis.min(), abs=TOLERANCE)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_file_in_other_units_and_a_moved_world_gives_the_same_indices(tmp_path, scale):
+    reference = graph_of(write(tmp_path))
+    turned = (f"{0.7 * scale!r} {-1.2 * scale!r} {2.5 * scale!r}", "0.8 0.3 -0.4 0.33")
+    moved = graph_of(write(tmp_path, name="moved.xml", scale=scale, world=turned))
+    ours, theirs = reference.indices(), moved.indices()
+    for field in ("iti_actuators", "iti", "lmti", "oti_actuators", "oti_submechanisms", "cti"):
+        np.testing.assert_allclose(getattr(theirs, field), getattr(ours, field), atol=TOLERANCE, err_msg=field)
+    assert moved.scale == pytest.approx(reference.scale * scale, rel=1e-12)
+
+
+def test_mujoco_reads_the_file_closed_and_its_foot_where_pinocchio_has_it(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    path = write(tmp_path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert model.neq == 2 and np.abs(data.efc_pos[:6]).max() < 1e-12  # both connects closed as drawn
+    graph = graph_of(path)
+    frames = graph.kinematics.transforms(graph.q[None])[0]
+    foot = frames[graph.tree.model.getJointId("roll")]
+    np.testing.assert_allclose(data.xpos[model.body("foot").id], foot[:3, 3], atol=1e-12)
+    np.testing.assert_allclose(data.xmat[model.body("foot").id].reshape(3, 3), foot[:3, :3], atol=1e-12)
+
+
+def test_the_command_analyses_the_ankle_and_refuses_a_graph_with_no_actuator(tmp_path):
+    path = write(tmp_path)
+    done = screwkit("analyze", path, "--output", "foot", "--json")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["actuators"] == ["crank_1:motor_1", "crank_2:motor_2"]
+    assert report["lmti"] == pytest.approx(graph_of(path).indices().lmti, abs=1e-12)
+    bare = tmp_path / "bare.xml"
+    bare.write_text(path.read_text().replace('<motor name="m1" joint="motor_1"/><motor name="m2" joint="motor_2"/>',
+                                             ""))
+    one_line_error(screwkit("analyze", bare, "--output", "foot"), "bare.xml: ", "nothing is actuated")
+    tree = read_closed_tree(path, output="foot")
+    with pytest.raises(ValueError, match=r"ankle\.xml: no leg has an actuator \(legs crank_1, crank_2, cross\): "
+                                         r"--actuate names the driven joints\."):
+        graph_mechanism(replace(tree, motors=[]))
