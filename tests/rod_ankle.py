@@ -15,6 +15,8 @@ import numpy as np
 MOTORS = np.array([[0.0, 0.045, 0.30], [0.0, -0.045, 0.22]])
 CRANK = 0.05
 FOOT = np.array([[-0.03, 0.04, -0.02], [-0.03, -0.04, -0.02]])
+SOLE = np.array([0.02, -0.01, -0.06])
+"""A site on the foot's sole, away from the ankle centre (an output frame whose position follows the foot's turns)."""
 
 
 def text(vector, scale: float = 1.0) -> str:
@@ -46,5 +48,6 @@ def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None) -> str:
             f'quat="{quat}"><geom type="sphere" size="{0.01 * scale!r}"/>{rod(1)}{rod(2)}'
             '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
             f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="roll" type="hinge" '
-            f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/></body></body></body>'
+            f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'
+            f'<site name="sole" pos="{text(SOLE, scale)}"/></body></body></body>'
             f'</worldbody><equality>{connects}</equality><actuator>{motors}</actuator></mujoco>')

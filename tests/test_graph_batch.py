@@ -281,8 +281,10 @@ def test_what_is_beyond_reach_is_the_same_in_millimetres_in_another_frame_and_wi
 
 def test_the_command_refuses_a_pose_beyond_reach_in_one_line():
     one_line_error(screwkit("analyze", "delta_rods_4", "--pose", "0 0 -750"), "delta_rods_4",
+                   "(x=0, y=0, z=-750): it is never farther than 1.416 m from the world origin")
+    one_line_error(screwkit("analyze", "delta_rods_4", "--pose", "0 0 -750 0 0 0"), "delta_rods_4",
                    "[0.0, 0.0, -750.0] m", "out of reach: the output frame is never farther than 1.416 m from the "
-                   "world origin")
+                   "world origin")  # the frame's whole pose
 
 
 def test_a_stewart_platform_through_the_graph_moves_in_six_coordinates():

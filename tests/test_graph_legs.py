@@ -266,9 +266,10 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
     assert report["pose"] == pytest.approx(dict(zip("xyz", target)), abs=1e-12)
     one_line_error(screwkit("analyze", path, "--actuators", "0", "0", "0", "0"), "loops inside them",
                    "leave out --actuators")
-    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration reached from the",
-                   "out of reach")
-    one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes the output frame's x y z")
+    one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration puts the output "
+                   "frame at (x=0, y=0, z=-5): it is never farther than")  # as a map or a sweep says it
+    one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes its task coordinates x y z (m, deg), "
+                   "or the output frame's x y z")
     converted = screwkit("convert", path, tmp_path / "out.urdf")
     one_line_error(converted, "inside a leg", "`screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view`")
 

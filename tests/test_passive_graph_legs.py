@@ -165,3 +165,27 @@ def test_the_command_analyses_the_ankle_and_refuses_a_graph_with_no_actuator(tmp
     with pytest.raises(ValueError, match=r"ankle\.xml: no leg has an actuator \(legs crank_1, crank_2, cross\): "
                                          r"--actuate names the driven joints\."):
         graph_mechanism(replace(tree, motors=[]))
+
+
+def test_the_command_poses_the_ankle_by_its_task_coordinates(tmp_path):
+    """``--pose roll pitch`` (the task coordinates ``info`` lists) closes the ankle there, the sole's position (a
+    dependent coordinate) wherever the foot's turn puts it. ``--pose`` took the output frame's x y z [roll pitch yaw]
+    only, and held the frame's position or its whole pose: a mechanism whose output frame moves along with its task
+    coordinates (this sole; a Delta whose platform frame turns as it moves) reached no pose but the file's."""
+    path = write(tmp_path)
+    graph = graph_mechanism(read_closed_tree(path, output="sole"))
+    assert graph.task_coordinates == ("roll", "pitch")
+    target = graph.home_pose + np.radians([6.0, -4.0])
+    done = screwkit("analyze", path, "--output", "sole", "--pose", " ".join(repr(float(v)) for v in np.degrees(target)),
+                    "--json")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    expected = graph_indices_at_poses(graph, target[None], detail=True)
+    assert report["lmti"] == pytest.approx(float(expected.lmti[0]), abs=1e-12)
+    assert report["iti"] == pytest.approx(float(expected.iti[0]), abs=1e-12)
+    assert report["pose"] == pytest.approx(dict(zip(("roll", "pitch"), np.degrees(target))), abs=1e-9)
+    moved = graph.solve(target[None])[0][0]
+    sole = graph.frame_pose(moved)[:3]
+    assert np.linalg.norm(sole - graph.frame_pose()[:3]) > 1e-3  # the sole moved: its position is no task coordinate
+    one_line_error(screwkit("analyze", path, "--output", "sole", "--pose", "1 2 3 4"), "ankle.xml: ",
+                   "--pose takes its task coordinates roll pitch (m, deg), or the output frame's x y z")

@@ -150,8 +150,9 @@ def pose_from_actuators(mechanism, text: str, start):
 @mechanism_argument
 @click.option("--pose", cls=GreedyOption, metavar="VALUES|NAME",
               help="Platform pose: x y phi (planar) or x y z roll pitch yaw, in m and deg, or a named pose "
-                   "(screwkit info lists them). Default: the file's home pose. Legs with loops inside them: the "
-                   "output frame's x y z [roll pitch yaw].")
+                   "(screwkit info lists them). Default: the file's home pose. Legs with loops inside them: the task "
+                   "coordinates screwkit info lists (the others follow), or the output frame's x y z [roll pitch "
+                   "yaw].")
 @click.option("--actuators", "actuator_values", cls=GreedyOption, metavar="VALUES",
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
@@ -196,8 +197,9 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
 
 
 def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:
-    """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration, or with the output
-    frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
+    """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration, at ``--pose`` given
+    as its task coordinates (m, deg; the dependent ones wherever the closures put them, as in a map), or with the
+    output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
     if by_actuators:
         raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by the output frame only: leave out "
                    "--actuators (give --pose x y z [roll pitch yaw]).")
@@ -211,18 +213,23 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
             values = [float(word) for word in pose.split()]
         except ValueError:
             values = []
-        if len(values) not in (3, 6) or not np.all(np.isfinite(values)):
-            raise fail(f"{graph.tree.source}: its legs have loops inside them: --pose takes the output frame's "
-                       f"x y z (m) and optionally roll pitch yaw (deg), got {pose!r}.")
-        for angle in values[3:]:
-            if abs(angle) > angle_limit(degrees=True):
-                raise fail(str(angle_beyond_limit("--pose", angle, degrees=True)))
-        rpy = np.radians(values[3:]) if len(values) == 6 else None
-        try:
-            graph = graph.at_pose(values[:3], rpy)
-        except ValueError as error:
-            raise fail(str(error)) from None
-        shown = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), values))
+        if len(values) not in (graph.n_task, 3, 6) or not np.all(np.isfinite(values)):
+            raise fail(f"{graph.tree.source}: its legs have loops inside them: --pose takes its task coordinates "
+                       f"{' '.join(graph.task_coordinates)} (m, deg), or the output frame's x y z (m) and optionally "
+                       f"roll pitch yaw (deg), got {pose!r}.")
+        if len(values) == graph.n_task:  # the task coordinates, as map and sweep take them: the dependent ones follow
+            graph, shown = _graph_at_task_pose(graph, values, analysis.limits), dict(zip(graph.task_coordinates,
+                                                                                         values))
+        else:  # the output frame's position, its orientation given or the one it has
+            for angle in values[3:]:
+                if abs(angle) > angle_limit(degrees=True):
+                    raise fail(str(angle_beyond_limit("--pose", angle, degrees=True)))
+            rpy = np.radians(values[3:]) if len(values) == 6 else None
+            try:
+                graph = graph.at_pose(values[:3], rpy, limits=analysis.limits)
+            except ValueError as error:
+                raise fail(str(error)) from None
+            shown = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), values))
     try:
         result = graph.indices(threshold=analysis.threshold, fault_type=analysis.fault_type)
     except ValueError as error:
@@ -238,3 +245,19 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     else:
         print_report({**report, "pose": {}} if at_file else report)  # "at the file's configuration"
         click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)
+
+
+def _graph_at_task_pose(graph, values: list[float], limits: bool):
+    """The graph closed with its task coordinates at ``values`` (m, deg), its dependent (parasitic) ones wherever the
+    closures put them, reached by continuation from the file's configuration (as :meth:`GraphMechanism.solve` solves
+    the poses of a map)."""
+    from screwkit.io.graph import graph_mechanism  # the graph reader: when a graph is analysed
+
+    try:
+        task = graph.poses_from_degrees(values, where="--pose")
+    except ValueError as error:
+        raise fail(str(error)) from None
+    q, reached = graph.solve(task[None], limits=limits)
+    if not reached[0]:
+        raise fail(graph.unreachable(task, limits=limits)[1] + ".")
+    return graph_mechanism(graph.tree, q=q[0], scale=graph.scale)
