@@ -577,3 +577,29 @@ def test_a_loop_beside_an_independent_rounded_one_closes_as_it_does_alone(opened
         np.testing.assert_allclose(q[:3], 0.0, atol=1e-9, err_msg=f"drawn {along}, order {order}")
         gaps = closure_gaps(tree, q)
         assert gaps["ball"] < 1e-12 and 0.0 < gaps["other_ball"] <= gap and any("at best" in n for n in tree.notes)
+
+
+@pytest.mark.parametrize("name", OPEN_FILES)
+def test_the_report_of_a_file_in_millimetres_gives_its_lengths_in_millimetres(tmp_path, name):
+    """Read with --length-unit mm, a file of another tool is converted as written and scaled after: its report gave
+    the file's millimetres labelled metres ("gap 150 m"), and one largest joint change over angles and lengths
+    ("4.99 rad or m" for 0.0534 rad). The gaps are now the metre file's times 1000, in mm, and the largest change of an
+    angle and of a slide are given apart, each in its unit."""
+    source = GEPETTO / name
+    (tmp_path / "robot.urdf").write_text(in_unit((source / "robot.urdf").read_text(), "mm", 1000.0))
+    (tmp_path / "robot.yaml").write_text((source / "robot.yaml").read_text())
+    metres = load(source / "robot.urdf").import_report
+    millimetres = load(tmp_path / "robot.urdf", length_unit="mm").import_report
+    pattern = re.compile(r"closure (\S+): gap (\S+) (\S+) at the file's joint values")
+    gaps = [pattern.search(line).groups() for line in metres if pattern.search(line)]
+    assert gaps and all(unit == "m" for _, _, unit in gaps)
+    scaled = [pattern.search(line).groups() for line in millimetres if pattern.search(line)]
+    assert [(closure, unit) for closure, _, unit in scaled] == [(closure, "mm") for closure, _, _ in gaps]
+    np.testing.assert_allclose([float(value) for _, value, _ in scaled],
+                               [1000.0 * float(value) for _, value, _ in gaps], rtol=2e-3)  # printed to 3 digits
+    change = re.compile(r"the largest joint change (\S+) rad(?:, (\S+) (\S+))?\)")
+    (angle, length, unit), = [change.search(line).groups() for line in metres if change.search(line)]
+    (angle_mm, length_mm, unit_mm), = [change.search(line).groups() for line in millimetres if change.search(line)]
+    assert angle_mm == angle and (length is None) == (length_mm is None)
+    if length is not None:
+        assert (unit, unit_mm) == ("m", "mm") and float(length_mm) == pytest.approx(1000 * float(length), rel=2e-3)

@@ -277,3 +277,28 @@ def test_sweep_at_x_y_of_a_planar_point_output_without_phi():
     rows = rows[next(k for k, row in enumerate(rows) if row.startswith("x,reachable,")) + 1:]
     assert [float(row.split(",")[0]) for row in rows] == [-0.05, 0.0, 0.05], swept.stdout
     assert all(row.split(",")[1] == "True" for row in rows), swept.stdout
+
+
+def test_a_small_mechanism_s_slides_are_printed_to_their_digits(tmp_path):
+    """The plain report printed a slide's value to 6 decimals: the 8-UPS hexapod written a million times smaller (its
+    legs a micrometre long) read ``s1 = 0.000000 m`` for each actuator; they now read to 6 significant digits, the
+    values of the JSON."""
+    from helpers import in_unit
+    from screwkit.io.loader import bundled_path
+
+    path = tmp_path / "tiny.urdf"
+    path.write_text(in_unit(bundled_path("ups_hexapod_8").read_text(), "m", 1e-6))
+    at_home = screwkit("analyze", path)
+    assert at_home.returncode == 0, at_home.stderr
+    assert "leg_1:leg_1_joint_slider = 0 m," in at_home.stdout  # round-off at home: 0, not 1e-22
+    pose = ["--pose", "1e-08 -2e-08 1.02e-06 3 -2 5"]
+    printed = screwkit("analyze", path, *pose)
+    assert printed.returncode == 0, printed.stderr
+    line = next(line for line in printed.stdout.splitlines() if line.startswith("  actuators: "))
+    shown = {name: float(value.removesuffix(" m")) for name, value in
+             (part.split(" = ") for part in line.removeprefix("  actuators: ").split(", "))}
+    configuration = json.loads(screwkit("analyze", path, *pose, "--json").stdout)["configuration"]
+    expected = {name: entry["value"] for name, entry in configuration.items() if entry["actuated"]}
+    assert len(shown) == 8 and shown.keys() == expected.keys()
+    assert all(abs(value) > 0 for value in shown.values())
+    np.testing.assert_allclose(list(shown.values()), list(expected.values()), rtol=1e-5)

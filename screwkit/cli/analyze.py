@@ -70,7 +70,8 @@ def print_report(report: dict) -> None:
             click.echo("  working mode: " + "; ".join(f"{chain} {mode}" for chain, mode in modes.items()))
     configuration = report.get("configuration", {})
     if configuration:
-        actuated = [f"{name} = {entry['value'] + 0.0:.{6 if entry['unit'] == 'm' else 3}f} {entry['unit']}"
+        actuated = [f"{name} = " + (f"{_slide(entry['value']):.6g}" if entry["unit"] == "m" else
+                                    f"{entry['value'] + 0.0:.3f}") + f" {entry['unit']}"
                     for name, entry in configuration.items() if entry["actuated"]]
         click.echo("  actuators: " + ", ".join(actuated))
     click.echo("")
@@ -194,6 +195,12 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         print_report(report)
     for number, line in enumerate([] if as_json else loaded.import_report):  # (with --json: its "converted")
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
+
+
+def _slide(value: float) -> float:
+    """A slide's value as printed: to its significant digits whatever the mechanism's size (a slide of a micrometre
+    robot read 0.000000 m to six decimals), below a femtometre (round-off of a slide at 0) as 0."""
+    return 0.0 if abs(value) < 1e-15 else value + 0.0
 
 
 def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:

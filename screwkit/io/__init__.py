@@ -122,20 +122,25 @@ def _read_tree(path: Path, output: str | None, output_type: str | None) -> Close
 
 
 def read_mechanism_file(path: Path, *, output: str | None = None, output_type: str | None = None,
-                        lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> tuple[str, ImportReport]:
+                        lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
+                        length_unit: str | None = None) -> tuple[str, ImportReport]:
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
     ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says); ``lock``: joints held at their
     values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part);
     ``actuate``: the actuated joints, instead of the file's or the guessed ones
-    (:func:`screwkit.io.locking.actuate_joints`). A leg
+    (:func:`screwkit.io.locking.actuate_joints`); ``length_unit``: the unit the file is written in, which the text
+    keeps (its loader scales it) and the report's lengths are given in. A leg
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).
     """
+    from dataclasses import replace
+
     from screwkit.io.star import convert_tree  # the conversion: only for a file of another tool
 
-    return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate))
+    tree = read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate)
+    return convert_tree(replace(tree, unit=length_unit) if length_unit else tree)
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

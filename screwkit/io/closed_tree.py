@@ -90,6 +90,7 @@ class ClosedTree:
     actuated: tuple[str, ...] = ()  # the actuators as the user named them (--actuate), not the file (idem)
     unactuated: str = ""  # why the file's own actuators cannot be taken: refused unless --actuate names them
     length_unit: str | None = None  # the unit the file was written in, its lengths now in m (screwkit.io.tree_units)
+    unit: str = "m"  # the unit of its lengths, for messages: the file's own when it is converted as written
     split: dict[str, str] = field(default_factory=dict)
     """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
     it is, for messages (none is an actuator)."""
@@ -145,6 +146,7 @@ class ImportReport:
     motors: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     task_coordinates: str = ""
+    unit: str = "m"  # of the lengths it gives (the file's own, for a file converted as written and scaled after)
 
     def lines(self) -> list[str]:
         """The report as lines of text."""
@@ -152,7 +154,7 @@ class ImportReport:
         planar = ", planar" if self.planar else ""
         out = [f"{self.source}: {self.file_format}{platform}, output {self.output}{planar}"]
         for name in self.gaps_before:
-            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} m at the file's joint values, "
+            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} {self.unit} at the file's joint values, "
                        f"{self.gaps_after[name]:.1e} after assembly")
         out += [f"  chain {line}" for line in self.chains]
         out.append(f"  actuators: {', '.join(self.motors)}")
@@ -431,11 +433,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         gaps = closure_gaps(tree, q)
         worst = max(gaps, key=gaps.get)
         if np.max(np.abs(error)) < INCONSISTENCY_TOLERANCE:
-            tree.notes.append(f"the closures close to {gaps[worst]:.3g} m at best (closure {worst!r}): the file's "
-                              "numbers disagree by that much (redundant closures written rounded)")
+            tree.notes.append(f"the closures close to {gaps[worst]:.3g} {tree.unit} at best (closure {worst!r}): the "
+                              "file's numbers disagree by that much (redundant closures written rounded)")
             return q, scale
         raise ImportError_(f"{tree.source}: the loops cannot be closed near the file's joint values: closure "
-                           f"{worst!r} still misses by {gaps[worst]:.3g} m after assembly (gaps: "
-                           + ", ".join(f"{k} {v:.3g} m" for k, v in gaps.items()) + ").")
+                           f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (gaps: "
+                           + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items()) + ").")
     return q, scale
 

@@ -158,7 +158,7 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
-                                                    actuate=actuate)
+                                                    actuate=actuate, length_unit=length_unit)
             mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
     if output is not None or output_type is not None or lock or actuate:

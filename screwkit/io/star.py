@@ -213,6 +213,20 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
     return legs
 
 
+def _largest_changes(model, change: NDArray, unit: str) -> str:
+    """The largest change of a joint angle (rad) and, when a joint slides, of a length (``unit``), between two
+    configurations (``change``: Pinocchio's difference, velocity coordinates)."""
+    angles, lengths = [0.0], []
+    for joint in range(1, model.njoints):
+        part = np.abs(change[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv])
+        kind, _ = joint_kind(model, joint)
+        if kind == "prismatic" or (kind == "JointModelFreeFlyer" and part.size == 6):
+            lengths.append(float(part[:3].max()))
+            part = part[3:]
+        angles.append(float(part.max(initial=0.0)))
+    return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
+
+
 def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
     """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
     removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
@@ -296,13 +310,13 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
-    report = ImportReport(source=tree.source, file_format=tree.file_format)
+    report = ImportReport(source=tree.source, file_format=tree.file_format, unit=tree.unit)
     report.gaps_before = closure_gaps(tree, tree.q_reference)
     q, scale = assemble(tree)
     report.gaps_after = closure_gaps(tree, q)
-    change = pin.difference(model, tree.q_reference, q)
+    changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
     report.notes.append(f"working mode: the closed configuration nearest to the file's joint values (the largest "
-                        f"joint change {float(np.max(np.abs(change), initial=0.0)):.3g} rad or m)")
+                        f"joint change {changes})")
     data = model.createData()
     pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
@@ -396,8 +410,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     if point:
         offset = _in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
         report.output = (f"the point where the chains meet on body {body!r} (closure {legs[1].closure!r}), "
-                         f"{float(np.linalg.norm(offset)):.4g} m {'in the plane ' if normal is not None else ''}from "
-                         f"frame {frame.name!r}")
+                         f"{float(np.linalg.norm(offset)):.4g} {tree.unit} "
+                         f"{'in the plane ' if normal is not None else ''}from frame {frame.name!r}")
     else:
         report.output = f"frame {frame.name!r} on body {body!r}"
     platform_world = np.eye(4)
