@@ -535,7 +535,8 @@ def test_a_tree_without_loops_or_yaml_says_what_is_missing(tmp_path):
     (tmp_path / "robot.urdf").write_text(urdf)  # no robot.yaml beside it
     with pytest.raises(ValueError, match="a tree with no <loop>: a closed-loop robot of another tool needs its "
                                          "robot.yaml beside it, closing_<name>_1 / closing_<name>_2 frame pairs as "
-                                         "onshape-to-robot writes them, <gazebo><joint> elements, or an MJCF file"):
+                                         "onshape-to-robot writes them, <gazebo><joint> or <drake:ball_constraint> "
+                                         "elements, or an MJCF file"):
         load(tmp_path / "robot.urdf")
 
 

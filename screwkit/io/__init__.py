@@ -3,7 +3,8 @@
 * :func:`read_mechanism_file`: MJCF (``.xml``/``.mjcf``, through Pinocchio's own parser), a URDF
   tree with a Gepetto ``robot.yaml`` beside it, or an onshape-to-robot URDF whose loops are
   ``closing_`` frame pairs (:mod:`screwkit.io.onshape`) or a URDF whose loops are ``<gazebo><joint>``
-  elements (:mod:`screwkit.io.gazebo`), or an SDFormat model (``.sdf``) whose loops are native joints
+  elements (:mod:`screwkit.io.gazebo`) or Drake's ``<drake:ball_constraint>`` elements (:mod:`screwkit.io.drake`),
+  or an SDFormat model (``.sdf``) whose loops are native joints
   (:mod:`screwkit.io.sdformat`), as the text of a URDF in screwkit's convention
   and an :class:`~screwkit.io.closed_tree.ImportReport`;
 * :func:`is_foreign`: whether a path is such a file (the loader then imports it).
@@ -21,10 +22,11 @@ from typing import TYPE_CHECKING
 
 from screwkit.common.lazy import lazy_attributes
 from screwkit.common.units import metres_per
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 
 if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file in screwkit's convention reads none
     from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, ImportReport, LegWithLoops
+    from screwkit.io.drake import read_drake
     from screwkit.io.gazebo import read_gazebo
     from screwkit.io.gepetto import read_gepetto
     from screwkit.io.graph import GraphMechanism, graph_mechanism
@@ -36,14 +38,15 @@ if TYPE_CHECKING:  # imported on first use (__getattr__), so that loading a file
 
 __all__ = ["read_mechanism_file", "read_closed_tree", "is_foreign", "convert_tree", "ClosedTree", "Closure",
            "ImportReport", "ImportError_", "LegWithLoops", "GraphMechanism", "graph_mechanism", "read_gepetto",
-           "read_onshape", "read_gazebo", "read_mjcf", "read_sdformat", "lock_joints", "actuate_joints",
+           "read_onshape", "read_gazebo", "read_drake", "read_mjcf", "read_sdformat", "lock_joints", "actuate_joints",
            "with_reference_configuration"]
 
 _READERS = {
     **dict.fromkeys(("ClosedTree", "Closure", "ImportError_", "ImportReport", "LegWithLoops"),
                     "screwkit.io.closed_tree"),
     **dict.fromkeys(("GraphMechanism", "graph_mechanism"), "screwkit.io.graph"),
-    "read_gazebo": "screwkit.io.gazebo", "read_gepetto": "screwkit.io.gepetto", "read_mjcf": "screwkit.io.mjcf",
+    "read_gazebo": "screwkit.io.gazebo", "read_drake": "screwkit.io.drake",
+    "read_gepetto": "screwkit.io.gepetto", "read_mjcf": "screwkit.io.mjcf",
     "read_onshape": "screwkit.io.onshape", "convert_tree": "screwkit.io.star", "lock_joints": "screwkit.io.locking",
     "actuate_joints": "screwkit.io.locking", "read_sdformat": "screwkit.io.sdformat",
 }
@@ -58,8 +61,9 @@ MJCF_SUFFIXES = (".xml", ".mjcf")
 
 def is_foreign(path: Path) -> bool:
     """An MJCF or SDFormat file, or a URDF with no ``<loop>`` of its own and a Gepetto ``robot.yaml`` beside it or
-    onshape-to-robot ``closing_`` frame pairs or ``<gazebo><joint>`` elements."""
-    from screwkit.io.gazebo import has_gazebo_joints  # the readers: only for a file given by its path
+    onshape-to-robot ``closing_`` frame pairs or ``<gazebo><joint>`` or ``<drake:ball_constraint>`` elements."""
+    from screwkit.io.drake import has_drake_constraints  # the readers: only for a file given by its path
+    from screwkit.io.gazebo import has_gazebo_joints  # (idem)
     from screwkit.io.gepetto import yaml_beside  # (idem)
     from screwkit.io.onshape import has_closing_frames  # (idem)
     from screwkit.io.sdformat import SDFORMAT_SUFFIXES  # (idem)
@@ -68,7 +72,7 @@ def is_foreign(path: Path) -> bool:
     if path.suffix.lower() in MJCF_SUFFIXES + SDFORMAT_SUFFIXES:
         return True
     if path.suffix.lower() == ".urdf" and (yaml_beside(path) is not None or has_closing_frames(path)
-                                           or has_gazebo_joints(path)):
+                                           or has_gazebo_joints(path) or has_drake_constraints(path)):
         with open(path, "rb") as handle:  # the head alone
             head = handle.read(4_000_000)
         return b"<loop" not in head
@@ -98,6 +102,7 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
 
 def _read_tree(path: Path, output: str | None, output_type: str | None) -> ClosedTree:
     from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
+    from screwkit.io.drake import has_drake_constraints, read_drake  # (idem)
     from screwkit.io.gazebo import has_gazebo_joints, read_gazebo  # (idem)
     from screwkit.io.gepetto import read_gepetto, yaml_beside  # (idem)
     from screwkit.io.mjcf import read_mjcf  # (idem)
@@ -117,8 +122,10 @@ def _read_tree(path: Path, output: str | None, output_type: str | None) -> Close
         return read_onshape(path, output=output, output_type=output_type)
     if has_gazebo_joints(path):
         return read_gazebo(path, output=output, output_type=output_type)
-    raise ImportError_(f"{path}: no robot.yaml beside it, no closing_ frame pairs and no <gazebo><joint>: not a "
-                       "closed-loop tree screwkit reads.")
+    if has_drake_constraints(path):
+        return read_drake(path, output=output, output_type=output_type)
+    raise ImportError_(f"{path}: no robot.yaml beside it, no closing_ frame pairs, no <gazebo><joint> and no "
+                       "<drake:ball_constraint>: not a closed-loop tree screwkit reads.")
 
 
 def read_mechanism_file(path: Path, *, output: str | None = None, output_type: str | None = None,
@@ -150,7 +157,7 @@ def with_reference_configuration(text: str, mechanism) -> str:
     then closes as written. Comments are kept."""
     import xml.etree.ElementTree as ElementTree
 
-    root = ElementTree.fromstring(tolerant_declaration(text.encode()).decode(), parser=ElementTree.XMLParser(
+    root = ElementTree.fromstring(tolerant_xml(text).decode(), parser=ElementTree.XMLParser(
         target=ElementTree.TreeBuilder(insert_comments=True)))
     for old in root.findall("reference_configuration"):
         root.remove(old)

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
@@ -108,7 +108,7 @@ def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
     import xml.etree.ElementTree as ElementTree
 
     try:
-        root = ElementTree.fromstring(tolerant_declaration(urdf_text))
+        root = ElementTree.fromstring(tolerant_xml(urdf_text))
     except ElementTree.ParseError:
         return None
     names = [element.get("names", "").split() for element in root.findall("task_coordinates")]
@@ -121,7 +121,7 @@ def transmitted_joints(urdf_text: bytes) -> list[str]:
     import xml.etree.ElementTree as ElementTree
 
     try:
-        root = ElementTree.fromstring(tolerant_declaration(urdf_text))
+        root = ElementTree.fromstring(tolerant_xml(urdf_text))
     except ElementTree.ParseError:
         return []
     joints = [joint.get("name") or (joint.text or "").strip() for transmission in root.findall("transmission")

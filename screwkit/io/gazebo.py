@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -58,7 +58,7 @@ def has_gazebo_joints(path: Path) -> bool:
 
 def _gazebo_joints(text: bytes) -> list:
     try:
-        root = ElementTree.fromstring(tolerant_declaration(text))
+        root = ElementTree.fromstring(tolerant_xml(text))
     except ElementTree.ParseError:
         return []
     return [joint for gazebo in root.findall("gazebo") for joint in gazebo.findall("joint")]

@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.mjcf_classes import bodies_named, check_body_joints, defaults_merged, top_class_renamed
 from screwkit.io.mjcf_pose import (
     MIN_AXIS,
@@ -93,7 +93,7 @@ CLOSURE_ATTRIBUTES = {"connect": {*_COMMON, "body1", "body2", "anchor", "site1",
 
 def _parse(path: Path) -> ElementTree.Element:
     try:
-        return ElementTree.fromstring(tolerant_declaration(path.read_bytes()))
+        return ElementTree.fromstring(tolerant_xml(path.read_bytes()))
     except ElementTree.ParseError as error:
         raise MjcfError(f"{path}: not well-formed XML ({error}).") from None
     except OSError as error:

@@ -32,8 +32,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import rotation_from_rpy
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import ImportError_
+from screwkit.io.drake import drake_elements
 
 __all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
            "attached_link", "WORLD", "MODEL_FRAME"]
@@ -236,13 +237,18 @@ def read_model(path: Path) -> SdfModel:
     """The one model of an SDFormat file (in ``<sdf>`` or in its one ``<world>``), as written."""
     path = Path(path)
     try:
-        root = ElementTree.fromstring(tolerant_declaration(path.read_bytes()))
+        root = ElementTree.fromstring(tolerant_xml(path.read_bytes()))
     except ElementTree.ParseError as error:
         raise ImportError_(f"{path}: not well-formed XML ({error}).") from None
     element = _the_model(path, root)
     version = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2] if part.isdigit())
     label = f"{path}: <model name='{element.get('name')}'>"
     _check_names(element, label)
+    drake = sorted({name for name, _ in drake_elements(element)})
+    if drake:  # closures of Drake's own: left out, the model would be another mechanism
+        raise ImportError_(f"{label}: <drake:{drake[0]}> ties links together in a way screwkit does not read in an "
+                           "SDFormat file (it reads <drake:ball_constraint> in a URDF); analysing the model without it "
+                           "would analyse another mechanism.")
     links = [link.get("name", "") for link in element.findall("link")]
     if not links:
         raise ImportError_(f"{label}: no <link>.")

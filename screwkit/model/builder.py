@@ -62,7 +62,8 @@ def read_platform(description: UrdfDescription, model, name: str) -> Platform:
         found = ", ".join(repr(joint.name) for joint in candidates) or "none"
         hint = ("" if candidates or description.loops else " (a tree with no <loop>: a closed-loop robot of another "
                 "tool needs its robot.yaml beside it, closing_<name>_1 / closing_<name>_2 frame pairs as "
-                "onshape-to-robot writes them, <gazebo><joint> elements, or an MJCF file; see docs/other-formats.md)")
+                "onshape-to-robot writes them, <gazebo><joint> or <drake:ball_constraint> elements, or an MJCF file; "
+                "see docs/other-formats.md)")
         raise description.fail(
             f"<robot name='{name}'>",
             f"expected exactly one floating or planar joint attaching the platform to the base, found {found}{hint}.",

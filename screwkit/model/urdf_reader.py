@@ -40,7 +40,7 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 from screwkit.common.units import LENGTH_UNITS, metres_per
-from screwkit.common.xml_text import tolerant_declaration
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.model.urdf_description import AXIS_JOINT_TYPES as AXIS_JOINT_TYPES
 from screwkit.model.urdf_description import PLATFORM_JOINT_TYPES as PLATFORM_JOINT_TYPES
 from screwkit.model.urdf_description import TREE_JOINT_TYPES as TREE_JOINT_TYPES
@@ -109,7 +109,7 @@ def parse_urdf(document: str | bytes, source: str = "<string>", *, length_unit: 
             "declarations are refused (entity expansion is unsafe and URDF does not need them)."
         )
     try:
-        root = ElementTree.fromstring(tolerant_declaration(data))
+        root = ElementTree.fromstring(tolerant_xml(data))
     except ElementTree.ParseError as error:
         raise ValueError(f"{source}: malformed XML: {error}.") from None
     try:
