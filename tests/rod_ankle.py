@@ -28,9 +28,10 @@ def crank_ends() -> np.ndarray:
     return MOTORS + np.array([0.0, -CRANK, 0.0])
 
 
-def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None) -> str:
+def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False) -> str:
     """The ankle's MJCF text; ``scale`` multiplies every length (a file in other units), ``world`` (``pos``,
-    ``quat`` texts) puts the shank in another place of the world."""
+    ``quat`` texts) puts the shank in another place of the world; ``floating``: the shank on an unnamed free joint
+    (a humanoid's leg, its pelvis floating)."""
     def rod(k: int) -> str:
         joint = (f'<joint name="rod_{k}" type="ball"/>' if rods == "ball" else
                  f'<joint name="rod_{k}_u1" type="hinge" axis="1 0 0"/><joint name="rod_{k}_u2" type="hinge" '
@@ -45,7 +46,8 @@ def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None) -> str:
                        for k in (1, 2))
     motors = "".join(f'<motor name="m{k}" joint="motor_{k}"/>' for k in (1, 2))
     return (f'<mujoco model="rod_ankle"><compiler angle="radian"/><worldbody><body name="shank" pos="{pos}" '
-            f'quat="{quat}"><geom type="sphere" size="{0.01 * scale!r}"/>{rod(1)}{rod(2)}'
+            f'quat="{quat}">{"<freejoint/>" if floating else ""}<geom type="sphere" size="{0.01 * scale!r}"/>'
+            f'{rod(1)}{rod(2)}'
             '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
             f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="roll" type="hinge" '
             f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'

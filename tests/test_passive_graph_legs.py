@@ -189,3 +189,19 @@ def test_the_command_poses_the_ankle_by_its_task_coordinates(tmp_path):
     assert np.linalg.norm(sole - graph.frame_pose()[:3]) > 1e-3  # the sole moved: its position is no task coordinate
     one_line_error(screwkit("analyze", path, "--output", "sole", "--pose", "1 2 3 4"), "ankle.xml: ",
                    "--pose takes its task coordinates roll pitch (m, deg), or the output frame's x y z")
+
+
+def test_a_floating_ankle_names_its_free_joint_and_locked_there_is_the_fixed_one(tmp_path):
+    """A humanoid's file floats its pelvis on an unnamed free joint: the whole robot is then one leg from the world
+    with every actuator on it, refused with nothing to say how on (the free joint's name, Pinocchio's, appeared
+    only after a wrong --lock). The refusal names it; locked, the ankle is the fixed one."""
+    path = write(tmp_path, name="floating.xml", floating=True)
+    refused = screwkit("info", path, "--output", "foot")
+    message = one_line_error(refused, "floating.xml: leg 'shank' has loops inside it and 2 actuators",
+                             "every actuator rides on the free joint")
+    name = message.split("--lock ")[1].split()[0]
+    held = graph_mechanism(read_closed_tree(path, output="foot", lock=(name,)))
+    fixed = graph_of(write(tmp_path))
+    for field in ("iti_actuators", "iti", "lmti", "oti_actuators", "cti"):
+        np.testing.assert_allclose(getattr(held.indices(), field), getattr(fixed.indices(), field), atol=1e-12,
+                                   err_msg=field)

@@ -401,7 +401,7 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
             continue
         if len(leg.actuators) != 1:
             stage = [j for j in leg.joints  # joints carrying every actuator of the leg, from the base
-                     if len(leg.actuators) > 1 and joint_kind(model, j)[0] in ("revolute", "prismatic")
+                     if joint_kind(model, j)[0] in ("revolute", "prismatic", "JointModelFreeFlyer")
                      and all(j in path_to(model, a) for a in leg.actuators if a != j)]
             advice = ""
             if stage:
@@ -410,8 +410,12 @@ def _check_actuators(tree: ClosedTree, legs) -> None:
                            else f"joint {name!r} carries every actuator of it")
                 advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
                           "on the body it turns")
+                if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
+                    advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
+                              f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
+                              "analysed on it")
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                               f"{len(leg.actuators) or 'no'} actuators: screwkit analyses such a leg with exactly "
+                               f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet)"
                                f"{advice}.")
         kind, _ = joint_kind(model, leg.actuators[0])
