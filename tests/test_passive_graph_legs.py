@@ -57,6 +57,7 @@ def test_the_universal_joint_leg_is_a_passive_leg_of_the_graph(tmp_path):
     assert graph.task_coordinates == ("roll", "pitch")
     assert [len(chain.twists) for chain in graph.chains] == [6, 6, 2]  # crank + the rod's 5; the foot's 2 rotations
     assert graph.report.motors == ["motor_1", "motor_2"]
+    assert "leg(s) cross: no actuator, passive: each constrains the platform only" in graph.report.notes
 
 
 def test_rods_on_balls_read_as_a_graph_equal_rods_on_two_hinges_read_as_serial_legs(tmp_path):
@@ -205,3 +206,19 @@ def test_a_floating_ankle_names_its_free_joint_and_locked_there_is_the_fixed_one
     for field in ("iti_actuators", "iti", "lmti", "oti_actuators", "cti"):
         np.testing.assert_allclose(getattr(held.indices(), field), getattr(fixed.indices(), field), atol=1e-12,
                                    err_msg=field)
+
+
+def test_the_viewer_marks_the_failed_actuator_s_leg_not_the_passive_one(tmp_path):
+    """The viewer took an actuator's index for its leg's: with the passive leg sorted first ('a_cross'), failing
+    crank_1's motor drew the passive leg as failed and the crank as sound."""
+    from screwkit.viewer.graph_drawing import graph_markers, solve_graph_frames
+
+    path = tmp_path / "ankle.xml"
+    path.write_text(rod_ankle_mjcf().replace('name="cross"', 'name="a_cross"'))
+    graph = graph_of(path)
+    assert [leg.name for leg in graph.legs] == ["a_cross", "crank_1", "crank_2"] and graph.actuator_legs == (1, 2)
+    frames = solve_graph_frames(graph, graph.home_pose[None], 1e-6, True)
+    for actuator, leg in ((0, 1), (1, 2)):
+        marked = {(marker.chain, marker.kind) for marker in graph_markers(graph, frames, (actuator,))[0]
+                  if marker.failed}
+        assert {chain for chain, _ in marked} == {leg} and (leg, "failed_actuator") in marked, marked

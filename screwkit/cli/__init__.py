@@ -68,10 +68,11 @@ def main() -> None:
         code = 0
     except SystemExit as stop:
         code = stop.code
-
-    compiling = sys.modules.get("screwkit.common.compiling")
-    if compiling is not None:  # no compiler outlives the command (one that failed before it needed its kernels)
-        compiling.stop_compiling()
+    except BaseException:
+        _stop_compilers()
+        raise
+    if code:  # a command that failed before it needed its kernels: no compiler outlives it (a command that succeeds
+        _stop_compilers()  # has waited for those it used; one it started ahead and did not use fills the cache)
     server = sys.modules.get("screwkit.viewer.server")  # loaded only if a command used the viewer
     if server is not None and server.servers_to_stop():
         sys.exit(code)
@@ -86,3 +87,9 @@ def main() -> None:
         code = 1
     sys.stderr.flush()
     os._exit(code or 0)
+
+
+def _stop_compilers() -> None:
+    compiling = sys.modules.get("screwkit.common.compiling")  # loaded only if the command computes indices
+    if compiling is not None:
+        compiling.stop_compiling()

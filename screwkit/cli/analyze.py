@@ -151,9 +151,9 @@ def pose_from_actuators(mechanism, text: str, start):
 @mechanism_argument
 @click.option("--pose", cls=GreedyOption, metavar="VALUES|NAME",
               help="Platform pose: x y phi (planar) or x y z roll pitch yaw, in m and deg, or a named pose "
-                   "(screwkit info lists them). Default: the file's home pose. Legs with loops inside them: the task "
-                   "coordinates screwkit info lists (the others follow), or the output frame's x y z [roll pitch "
-                   "yaw].")
+                   "(screwkit info lists them). Default: the file's home pose. Legs with loops inside them: as many "
+                   "values as it has task coordinates (screwkit info lists them; the others follow), else the output "
+                   "frame's x y z [roll pitch yaw] (3 or 6 values).")
 @click.option("--actuators", "actuator_values", cls=GreedyOption, metavar="VALUES",
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
@@ -209,7 +209,7 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
     if by_actuators:
         raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by the output frame only: leave out "
-                   "--actuators (give --pose x y z [roll pitch yaw]).")
+                   "--actuators (give --pose with its task coordinates, or the output frame's x y z [roll pitch yaw]).")
     try:
         graph.check_study(fault_type=analysis.fault_type)
     except ValueError as error:
@@ -267,4 +267,7 @@ def _graph_at_task_pose(graph, values: list[float], limits: bool):
     q, reached = graph.solve(task[None], limits=limits)
     if not reached[0]:
         raise fail(graph.unreachable(task, limits=limits)[1] + ".")
-    return graph_mechanism(graph.tree, q=q[0], scale=graph.scale)
+    try:
+        return graph_mechanism(graph.tree, q=q[0], scale=graph.scale)
+    except ValueError as error:
+        raise fail(str(error)) from None

@@ -331,9 +331,9 @@ def prepare_kernels(modules: tuple[str, ...] = INDEX_KERNELS) -> None:
 
 
 def stop_compiling() -> None:
-    """End the children still compiling and forget the queued kernels: what a command calls as it ends (one that
-    failed before it needed its kernels), so that no compiler outlives it and competes with the next command for the
-    cores (which, finding the kernels still missing from the cache, starts its own). numba writes a cache entry
+    """End the children still compiling and forget the queued kernels: what a command that fails calls as it ends
+    (before it needed its kernels), so that no compiler outlives it and competes with the next command for the cores
+    (which, finding the kernels still missing from the cache, starts its own). numba writes a cache entry
     whole or not at all, so a child ended mid-way leaves the kernel missing, not broken."""
     with _lock:
         _queued.clear()

@@ -141,6 +141,11 @@ class GraphMechanism:
         return self.actuators
 
     @property
+    def actuator_legs(self) -> tuple[int, ...]:
+        """The leg (index into :attr:`legs`) of each actuator: passive legs have none."""
+        return tuple(index for index, leg in enumerate(self.legs) if leg.actuators)
+
+    @property
     def is_planar(self) -> bool:
         return False
 
@@ -519,6 +524,9 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                      f"{len(leg.closures)} closure(s), twist system of dimension {len(chain.twists)}"
                      for leg, chain in zip(legs, chains)]
     report.notes.append("legs with loops inside them: analysed as a graph (screwkit.io.graph)")
+    passive = [leg.name for leg in legs if not leg.actuators]
+    if passive:  # said: a leg whose motor the file leaves out reads so too
+        report.notes.append(f"leg(s) {', '.join(passive)}: no actuator, passive: each constrains the platform only")
     report.output = f"the frame of body {report.platform_body!r}"
     report.task_coordinates = " ".join(SPATIAL_TASK_COORDINATES[a] for a in task_axes)
     return GraphMechanism(Path(tree.source).stem, tree, q, scale, platform, report.platform_body, tuple(legs),

@@ -485,7 +485,7 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
 
     poses = graph.check_poses(poses)
     n_task = graph.n_task
-    _check_settings(faults, threshold, progress, chunk_size, len(graph.legs), n_task)
+    _check_settings(faults, threshold, progress, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]

@@ -160,9 +160,11 @@ def graph_markers(graph, frames: Frames, failed: tuple[int, ...]) -> tuple[tuple
     origins = transforms[:, :, :3, 3]
     shortest = 1e-9 * float(graph.length_scale)
 
+    failed_legs = {graph.actuator_legs[actuator] for actuator in failed}  # (a passive leg has no actuator)
+
     def marker(path: str, kind: str, start: NDArray, end: NDArray, owner: int | str) -> Marker:
         leg = owner if isinstance(owner, int) else None
-        return Marker(path, kind, None, start.copy(), end.copy(), failed=leg is not None and leg in failed,
+        return Marker(path, kind, None, start.copy(), end.copy(), failed=leg is not None and leg in failed_legs,
                       chain=leg, body=None if leg is not None else str(owner))
 
     every = []
@@ -179,10 +181,11 @@ def graph_markers(graph, frames: Frames, failed: tuple[int, ...]) -> tuple[tuple
                                                                                                  rod.owner)
             markers.append(marker(f"{ROOT_PATH}/joints/{node_label(label)}", "joint", end, end, owner))
         for actuator in failed:
-            joint = [leg for leg in graph.legs if leg.actuators][actuator].actuators[0]
+            leg = graph.actuator_legs[actuator]
+            joint = graph.legs[leg].actuators[0]
             label = node_label(graph.actuators[actuator])
             path = f"{ROOT_PATH}/failed/{actuator}-{label}"
             markers.append(Marker(path, "failed_actuator", actuator, origins[frame, joint].copy(),
-                                  origins[frame, joint].copy(), failed=True, chain=actuator))
+                                  origins[frame, joint].copy(), failed=True, chain=leg))
         every.append(tuple(markers))
     return tuple(every)

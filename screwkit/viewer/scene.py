@@ -388,7 +388,7 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
     result = frames.result
     chain_values = np.stack([chain_index_values(mechanism, result, frame, failed, color_by) for frame in range(count)])
     chain_colors = colors_from_values(chain_values[0])
-    for chain in (set(failed) if is_graph else geometry.failed_chains):  # a graph's leg has one actuator
+    for chain in ({mechanism.actuator_legs[a] for a in failed} if is_graph else geometry.failed_chains):
         chain_colors[chain] = FAILED_COLOR
 
     server = None
