@@ -89,8 +89,8 @@ def test_a_closure_drake_has_and_screwkit_does_not_read_is_refused_by_name(tmp_p
     weld = ('<drake:weld_constraint><drake:weld_constraint_body_A name="distal_2"/>'
             '<drake:weld_constraint_body_B name="effector"/></drake:weld_constraint>')
     path.write_text(five_bar_drake().replace("</robot>", weld + "</robot>"))
-    with pytest.raises(ImportError_, match=r"robot\.urdf: <drake:weld_constraint> ties bodies together in a way "
-                                           r"screwkit does not read \(it reads <drake:ball_constraint>\)"):
+    with pytest.raises(ImportError_, match=r"robot\.urdf: <drake:weld_constraint>, Drake's own, joins bodies in a "
+                                           r"way screwkit does not read \(it reads <drake:ball_constraint>\)"):
         read_closed_tree(path)
     path.write_text(five_bar_drake().replace('name="effector"/><drake:ball', 'name="nowhere"/><drake:ball', 1))
     with pytest.raises(ImportError_, match=r"<drake:ball_constraint> 1: <drake:ball_constraint_body_B "
@@ -110,7 +110,7 @@ def test_the_command_analyses_a_drake_five_bar(tmp_path):
     assert "URDF + Drake ball constraints" in done.stderr
     weld = '<drake:linear_bushing_rpy><drake:bushing_frameA name="x"/></drake:linear_bushing_rpy>'
     path.write_text(five_bar_drake().replace("</robot>", weld + "</robot>"))
-    one_line_error(screwkit("analyze", path), "robot.urdf: <drake:linear_bushing_rpy> ties bodies together")
+    one_line_error(screwkit("analyze", path), "robot.urdf: <drake:linear_bushing_rpy>, Drake's own, joins bodies")
 
 
 def test_an_sdformat_model_with_drake_s_closures_is_refused_naming_them(tmp_path):
@@ -124,8 +124,19 @@ def test_an_sdformat_model_with_drake_s_closures_is_refused_naming_them(tmp_path
             "<drake:ball_constraint_p_BQ>0 0 0</drake:ball_constraint_p_BQ></drake:ball_constraint>")
     path = tmp_path / "robot.sdf"
     path.write_text(five_bar_sdf(marker="").replace("</model>", ball + "</model>", 1))
-    with pytest.raises(ImportError_, match=r"robot\.sdf: <model name='\w+'>: <drake:ball_constraint> ties links "
-                                           r"together in a way screwkit does not read in an SDFormat file"):
+    with pytest.raises(ImportError_, match=r"robot\.sdf: <model name='\w+'>: <drake:ball_constraint>, Drake's own, "
+                                           r"joins links in a way screwkit does not read in an SDFormat file"):
+        read_closed_tree(path)
+
+
+def test_a_drake_joint_is_refused_naming_it(tmp_path):
+    """A joint of Drake's own (``drake:joint``, e.g. planar) is skipped by Pinocchio: its child link read as a free
+    body, the refusal said so; it is refused as what it is."""
+    path = tmp_path / "robot.urdf"
+    joint = ('<drake:joint name="slide" type="planar"><drake:parent link="effector"/><drake:child link="extra"/>'
+             '</drake:joint><link name="extra"/>')
+    path.write_text(five_bar_drake().replace("</robot>", joint + "</robot>"))
+    with pytest.raises(ImportError_, match=r"robot\.urdf: <drake:joint>, Drake's own, joins bodies"):
         read_closed_tree(path)
 
 

@@ -222,3 +222,9 @@ def test_the_viewer_marks_the_failed_actuator_s_leg_not_the_passive_one(tmp_path
         marked = {(marker.chain, marker.kind) for marker in graph_markers(graph, frames, (actuator,))[0]
                   if marker.failed}
         assert {chain for chain, _ in marked} == {leg} and (leg, "failed_actuator") in marked, marked
+
+
+def test_a_batch_checks_its_faults_against_the_actuators_not_the_legs(tmp_path):
+    graph = graph_of(write(tmp_path))  # 2 actuators, 2 DoF, 3 legs
+    with pytest.raises(ValueError, match=r"1\.\.a-n = 1\.\.0"):
+        graph_indices_at_poses(graph, graph.home_pose[None], faults=[2])  # (F_O1 = 0 is allowed: j <= max(a-n, 1))

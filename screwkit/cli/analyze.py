@@ -70,7 +70,7 @@ def print_report(report: dict) -> None:
             click.echo("  working mode: " + "; ".join(f"{chain} {mode}" for chain, mode in modes.items()))
     configuration = report.get("configuration", {})
     if configuration:
-        actuated = [f"{name} = " + (f"{_slide(entry['value']):.6g}" if entry["unit"] == "m" else
+        actuated = [f"{name} = " + (_slide(entry["value"]) if entry["unit"] == "m" else
                                     f"{entry['value'] + 0.0:.3f}") + f" {entry['unit']}"
                     for name, entry in configuration.items() if entry["actuated"]]
         click.echo("  actuators: " + ", ".join(actuated))
@@ -197,10 +197,11 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
 
 
-def _slide(value: float) -> float:
-    """A slide's value as printed: to its significant digits whatever the mechanism's size (a slide of a micrometre
-    robot read 0.000000 m to six decimals), below a femtometre (round-off of a slide at 0) as 0."""
-    return 0.0 if abs(value) < 1e-15 else value + 0.0
+def _slide(value: float) -> str:
+    """A slide's value as printed: to the micrometre, or to 6 significant digits below a millimetre (a slide of a
+    micrometre robot read 0.000000 m), round-off below a femtometre (a slide at 0) as 0."""
+    value = 0.0 if abs(value) < 1e-15 else value + 0.0
+    return f"{value:.6f}" if abs(value) >= 1e-3 else f"{value:.6g}"
 
 
 def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:

@@ -18,12 +18,14 @@ from __future__ import annotations
 import ctypes
 import sys
 
-__all__ = ["keep_freed_memory", "KEPT_BYTES"]
+__all__ = ["keep_freed_memory", "KEPT_BYTES", "OLD_LARGEST"]
 
 KEPT_BYTES = 1 << 30
 """Blocks up to this size come from the heap, and up to this much free memory is kept at its top (1 GiB: above the
 arrays of a design evaluation, tens of megabytes)."""
 
+OLD_LARGEST = 32 << 20
+"""The largest mmap threshold every glibc takes (64 bits)."""
 _M_TRIM_THRESHOLD = -1  # glibc's malloc.h
 _M_MMAP_THRESHOLD = -3
 
@@ -37,4 +39,6 @@ def keep_freed_memory(kept: int = KEPT_BYTES) -> bool:
     except (OSError, AttributeError):  # a C library without mallopt
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
-    return bool(mallopt(_M_MMAP_THRESHOLD, kept)) and bool(mallopt(_M_TRIM_THRESHOLD, kept))
+    # a glibc may refuse an mmap threshold above 32 MiB (half its largest heap on 64 bits): then 32 MiB
+    mapped = bool(mallopt(_M_MMAP_THRESHOLD, kept)) or bool(mallopt(_M_MMAP_THRESHOLD, min(kept, OLD_LARGEST)))
+    return bool(mallopt(_M_TRIM_THRESHOLD, kept)) and mapped

@@ -81,16 +81,21 @@ def is_foreign(path: Path) -> bool:
 
 def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None,
                      lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
-                     length_unit: str | None = None) -> ClosedTree:
+                     length_unit: str | None = None, unit: str | None = None) -> ClosedTree:
     """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
     ``lock``, ``actuate``: as :func:`read_mechanism_file`; ``length_unit``: the unit the file is written in, its
     lengths then brought to metres, :func:`screwkit.io.tree_units.in_metres`; a file read through
-    :func:`read_mechanism_file` is scaled as its converted text is loaded instead)."""
+    :func:`read_mechanism_file` is scaled as its converted text is loaded instead, and its lengths are said in
+    ``unit``, the unit its numbers are kept in)."""
+    from dataclasses import replace
+
     from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
     from screwkit.io.locking import actuate_joints, lock_joints  # (idem)
     from screwkit.io.tree_units import in_metres  # (idem)
 
     tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
+    if unit:
+        tree = replace(tree, unit=unit)
     if tree.unactuated and not actuate:
         raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints.")
     tree = actuate_joints(lock_joints(tree, lock), actuate)
@@ -142,12 +147,10 @@ def read_mechanism_file(path: Path, *, output: str | None = None, output_type: s
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).
     """
-    from dataclasses import replace
-
     from screwkit.io.star import convert_tree  # the conversion: only for a file of another tool
 
-    tree = read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate)
-    return convert_tree(replace(tree, unit=length_unit) if length_unit else tree)
+    return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate,
+                                         unit=length_unit))
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

@@ -12,8 +12,8 @@ Drake (``drake::multibody``) closes a URDF's loops with elements of its own name
 
 (``MultibodyPlant::AddBallConstraint``). Each is a ``3d`` closure: the point both bodies keep, closed near the file's
 joint values as every closure is (:func:`screwkit.io.closed_tree.assemble`). Drake's URDFs may leave the ``world``
-link implicit (a joint whose parent is ``world`` with no such link): it is added. The other closures of Drake's
-namespace (``drake:weld_constraint``, ``drake:linear_bushing_rpy``, ``drake:distance_constraint``, ...) are refused by
+link implicit (a joint whose parent is ``world`` with no such link): it is added. Drake's other elements that join
+bodies (``drake:linear_bushing_rpy``, ``drake:tendon_constraint``, a ``drake:joint`` of its own, ...) are refused by
 name rather than left out, which would analyse another mechanism. The actuated joints are those of the URDF's
 ``<transmission>`` elements, else guessed as for onshape-to-robot files (said in the import report).
 """
@@ -41,9 +41,10 @@ __all__ = ["has_drake_constraints", "read_drake", "drake_elements"]
 
 NAMESPACES = ("http://drake.mit.edu", UNDECLARED + "drake")
 """Drake's namespace as its files declare it, and as an undeclared ``drake:`` prefix is read."""
-CLOSURES = ("ball_constraint", "weld_constraint", "linear_bushing_rpy", "distance_constraint", "coupler_constraint",
-            "tendon_constraint")
-"""Drake's elements that tie two bodies (or joints) of a model together: only ball constraints are read."""
+CLOSURES = ("ball_constraint", "joint", "linear_bushing_rpy", "tendon_constraint", "weld_constraint")
+"""Drake's elements that join bodies (or joints) of a model, as its parsers list them (``weld_constraint`` as its
+development files write it): only ball constraints are read. (``linear_spring_damper`` and
+``collision_filter_group`` join nothing: they are left to Drake.)"""
 
 
 def drake_elements(root) -> list[tuple[str, object]]:
@@ -94,8 +95,8 @@ def read_drake(urdf: Path, *, output: str | None = None, output_type: str | None
     elements = drake_elements(root)
     other = sorted({name for name, _ in elements if name != "ball_constraint"})
     if other:
-        raise ImportError_(f"{urdf}: <drake:{other[0]}> ties bodies together in a way screwkit does not read (it reads "
-                           "<drake:ball_constraint>); analysing the file without it would analyse another mechanism.")
+        raise ImportError_(f"{urdf}: <drake:{other[0]}>, Drake's own, joins bodies in a way screwkit does not read (it "
+                           "reads <drake:ball_constraint>); the file without it would be another mechanism.")
     text = data.decode("utf-8", errors="replace")
     links = [link.get("name") for link in root.iter("link")]
     if "world" not in links and any(parent.get("link") == "world" for parent in root.iter("parent")):

@@ -235,7 +235,7 @@ def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, repo
     if not largest:
         return
     report.notes.append(f"joint axes that meet to the file's rounding written through one point (the largest move "
-                        f"{largest:.2g} m)")
+                        f"{largest:.2g} {report.unit})")
     for (leg, joint), move in zip(owners, moves):
         if not np.any(move):
             continue

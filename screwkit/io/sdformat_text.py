@@ -246,9 +246,9 @@ def read_model(path: Path) -> SdfModel:
     _check_names(element, label)
     drake = sorted({name for name, _ in drake_elements(element)})
     if drake:  # closures of Drake's own: left out, the model would be another mechanism
-        raise ImportError_(f"{label}: <drake:{drake[0]}> ties links together in a way screwkit does not read in an "
-                           "SDFormat file (it reads <drake:ball_constraint> in a URDF); analysing the model without it "
-                           "would analyse another mechanism.")
+        raise ImportError_(f"{label}: <drake:{drake[0]}>, Drake's own, joins links in a way screwkit does not read in "
+                           "an SDFormat file (it reads <drake:ball_constraint> in a URDF); the model without it would "
+                           "be another mechanism.")
     links = [link.get("name", "") for link in element.findall("link")]
     if not links:
         raise ImportError_(f"{label}: no <link>.")

@@ -220,10 +220,11 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
     for joint in range(1, model.njoints):
         part = np.abs(change[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv])
         kind, _ = joint_kind(model, joint)
-        if kind == "prismatic" or (kind == "JointModelFreeFlyer" and part.size == 6):
-            lengths.append(float(part[:3].max()))
-            part = part[3:]
-        angles.append(float(part.max(initial=0.0)))
+        slides = {"prismatic": 1, "JointModelFreeFlyer": 3, "JointModelPlanar": 2, "JointModelTranslation": 3}.get(
+            kind, 0)  # (Pinocchio's velocity coordinates: the lengths first)
+        if slides:
+            lengths.append(float(part[:slides].max()))
+        angles.append(float(part[slides:].max(initial=0.0)))
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
 
 
