@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-MOTORS = np.array([[0.0, 0.045, 0.30], [0.0, -0.045, 0.22]])
+MOTORS = np.array([[0.0, 0.045, 0.30], [0.0, -0.045, 0.22], [0.05, 0.0, 0.26]])
 CRANK = 0.05
-FOOT = np.array([[-0.03, 0.04, -0.02], [-0.03, -0.04, -0.02]])
+FOOT = np.array([[-0.03, 0.04, -0.02], [-0.03, -0.04, -0.02], [0.04, 0.01, -0.025]])
 SOLE = np.array([0.02, -0.01, -0.06])
 """A site on the foot's sole, away from the ankle centre (an output frame whose position follows the foot's turns)."""
 
@@ -28,10 +28,10 @@ def crank_ends() -> np.ndarray:
     return MOTORS + np.array([0.0, -CRANK, 0.0])
 
 
-def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False) -> str:
+def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False, cranks: int = 2) -> str:
     """The ankle's MJCF text; ``scale`` multiplies every length (a file in other units), ``world`` (``pos``,
     ``quat`` texts) puts the shank in another place of the world; ``floating``: the shank on an unnamed free joint
-    (a humanoid's leg, its pelvis floating)."""
+    (a humanoid's leg, its pelvis floating); ``cranks`` 3: a third crank and rod (one redundant actuator)."""
     def rod(k: int) -> str:
         joint = (f'<joint name="rod_{k}" type="ball"/>' if rods == "ball" else
                  f'<joint name="rod_{k}_u1" type="hinge" axis="1 0 0"/><joint name="rod_{k}_u2" type="hinge" '
@@ -43,11 +43,11 @@ def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating:
 
     pos, quat = world if world is not None else ("0 0 0", "1 0 0 0")
     connects = "".join(f'<connect name="closure_{k}" body1="foot" body2="rod_{k}" anchor="{text(FOOT[k - 1], scale)}"/>'
-                       for k in (1, 2))
-    motors = "".join(f'<motor name="m{k}" joint="motor_{k}"/>' for k in (1, 2))
+                       for k in range(1, cranks + 1))
+    motors = "".join(f'<motor name="m{k}" joint="motor_{k}"/>' for k in range(1, cranks + 1))
     return (f'<mujoco model="rod_ankle"><compiler angle="radian"/><worldbody><body name="shank" pos="{pos}" '
             f'quat="{quat}">{"<freejoint/>" if floating else ""}<geom type="sphere" size="{0.01 * scale!r}"/>'
-            f'{rod(1)}{rod(2)}'
+            f'{"".join(rod(k) for k in range(1, cranks + 1))}'
             '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
             f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="roll" type="hinge" '
             f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'

@@ -228,3 +228,19 @@ def test_a_batch_checks_its_faults_against_the_actuators_not_the_legs(tmp_path):
     graph = graph_of(write(tmp_path))  # 2 actuators, 2 DoF, 3 legs
     with pytest.raises(ValueError, match=r"1\.\.a-n = 1\.\.0"):
         graph_indices_at_poses(graph, graph.home_pose[None], faults=[2])  # (F_O1 = 0 is allowed: j <= max(a-n, 1))
+
+
+def test_with_a_redundant_crank_the_fault_indices_of_both_readings_agree(tmp_path):
+    """Three cranks for two DoF (one redundant): with the passive leg among the chains, F_O1, F_IO1, the worst single
+    fault and the CTI after a fault (F_C1) of the graph equal those of the serial reading at five poses."""
+    graph = graph_of(write(tmp_path, cranks=3))
+    serial = load(write(tmp_path, "hinges", "hinges.xml", cranks=3), output="foot")
+    assert graph.dof == 2 and len(graph.actuators) == 3
+    ours = graph_indices_at_poses(graph, graph.home_pose + POSES, detail=True)
+    theirs = indices_at_poses(serial, serial.home_pose + POSES, detail=True)
+    for field in ("iti_actuators", "lmti", "oti_submechanisms"):
+        np.testing.assert_allclose(getattr(ours, field), getattr(theirs, field), atol=TOLERANCE, err_msg=field)
+    np.testing.assert_allclose(ours.f_o[1], theirs.f_o[1], atol=TOLERANCE)
+    np.testing.assert_allclose(ours.f_io[1], theirs.f_io[1], atol=TOLERANCE)
+    assert np.all(ours.f_o[1] > 0.05)  # a fault is survivable here: the comparison is not of zeros
+    np.testing.assert_array_equal(ours.worst_fault_indices[1], theirs.worst_fault_indices[1])
