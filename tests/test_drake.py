@@ -11,7 +11,7 @@ Drake and every tinyxml2 reader take) read; a closure Drake has and screwkit doe
 from __future__ import annotations
 
 import pytest
-from test_io import assert_textbook, poses_near_home, text
+from test_io import assert_textbook, assert_three_leg_five_bar, poses_near_home, text
 from test_lower_mobility import DISTAL
 from test_onshape import MOVED, assert_moved_textbook, five_bar_links, onshape_urdf
 
@@ -50,10 +50,7 @@ def test_a_five_bar_closed_by_drake_ball_constraints_has_the_textbook_pressure_a
     assert report.file_format == "URDF + Drake ball constraints (<drake:ball_constraint>)" and report.planar
     assert report.motors == ["mot1", "mot2", "mot3"]
     assert all(gap < 1e-12 for gap in report.gaps_before.values())  # the drawing closes the loops
-    mechanism = load(path)
-    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
-    points = poses_near_home()
-    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+    assert_three_leg_five_bar(path)
 
 
 @pytest.mark.parametrize("transform", MOVED)

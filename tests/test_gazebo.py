@@ -11,7 +11,7 @@ import json
 
 import numpy as np
 import pytest
-from test_io import HOME, assert_textbook, poses_near_home, text
+from test_io import HOME, assert_textbook, assert_three_leg_five_bar, poses_near_home, text
 from test_lower_mobility import DISTAL, five_bar_expected
 from test_onshape import MOVED, assert_moved_textbook, five_bar_links, onshape_urdf
 
@@ -58,10 +58,7 @@ def test_a_five_bar_closed_by_gazebo_joints_has_the_textbook_pressure_angles(tmp
     assert any("the hinge through them" in note for note in report.notes), report.notes
     guessed = any("actuators guessed" in note for note in report.notes)
     assert guessed is not transmissions
-    mechanism = load(path)
-    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
-    points = poses_near_home()
-    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+    assert_three_leg_five_bar(path)
 
 
 @pytest.mark.parametrize("transform", MOVED)

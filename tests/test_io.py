@@ -119,6 +119,17 @@ def assert_textbook(result, points, legs=(0, 1, 2)):
         assert result.f_o.keys() == {1} and np.all(result.f_o[1] == 0.0) and np.all(result.f_io[1] == 0.0)
 
 
+def assert_three_leg_five_bar(path):
+    """The file at ``path`` loads as the three-legged five-bar (2 DoF, 3 actuators) with the textbook pressure angles
+    at points near its home."""
+    from screwkit.io.loader import load
+
+    mechanism = load(path)
+    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
+    points = poses_near_home()
+    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+
+
 def test_an_mjcf_five_bar_has_the_textbook_pressure_angles(tmp_path):
     path = tmp_path / "five_bar.xml"
     path.write_text(five_bar_mjcf())

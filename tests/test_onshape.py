@@ -12,7 +12,7 @@ import json
 
 import numpy as np
 import pytest
-from test_io import HOME, assert_textbook, poses_near_home, text
+from test_io import HOME, assert_textbook, assert_three_leg_five_bar, poses_near_home, text
 from test_lower_mobility import DISTAL, FIVE_BAR_BASE, PROXIMAL, five_bar_elbows, five_bar_expected
 
 from helpers import screwkit
@@ -115,10 +115,7 @@ def test_an_onshape_five_bar_opens_as_written_with_the_textbook_pressure_angles(
     assert "closing_ pairs read as ball joints (a URDF does not say the mate's type): closing_loop2, closing_loop3" \
         in lines
     assert "actuators guessed from the branches leaving the base" in lines and "name_mot" in lines
-    mechanism = load(path)
-    assert mechanism.dof == 2 and len(mechanism.actuators) == 3
-    points = poses_near_home()
-    assert_textbook(indices_at_poses(mechanism, points, detail=True), points)
+    assert_three_leg_five_bar(path)
 
 
 @pytest.mark.parametrize("transform", MOVED)
