@@ -209,7 +209,7 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     as its task coordinates (m, deg; the dependent ones wherever the closures put them, as in a map), or with the
     output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
     if by_actuators:
-        raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by the output frame only: leave out "
+        raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by their platform only: leave out "
                    "--actuators (give --pose with its task coordinates, or the output frame's x y z [roll pitch yaw]).")
     try:
         graph.check_study(fault_type=analysis.fault_type)
