@@ -110,19 +110,53 @@ def test_the_command_analyses_a_drake_five_bar(tmp_path):
     one_line_error(screwkit("analyze", path), "robot.urdf: <drake:linear_bushing_rpy>, Drake's own, joins bodies")
 
 
-def test_an_sdformat_model_with_drake_s_closures_is_refused_naming_them(tmp_path):
-    """An SDFormat model whose loops Drake closes (``drake:ball_constraint`` as text children, or a bushing) was read
-    as the tree of its joints: another mechanism, or a tree with no loop. It is refused naming the element."""
+def sdformat_five_bar_drake(transform=(1.0, 0.0, (0.0, 0.0, 0.0))) -> str:
+    """The SDFormat five-bar (tests/sdformat_models.py) with the loops of legs 2 and 3 written as Drake's ball
+    constraints onto the effector (P at the distal link's far end, Q the effector's origin) instead of revolute
+    joints."""
+    import re
+
     from sdformat_models import five_bar_sdf
 
-    ball = ("<drake:ball_constraint><drake:ball_constraint_body_A>distal_2</drake:ball_constraint_body_A>"
-            "<drake:ball_constraint_body_B>distal_1</drake:ball_constraint_body_B>"
-            "<drake:ball_constraint_p_AP>0 0 0</drake:ball_constraint_p_AP>"
-            "<drake:ball_constraint_p_BQ>0 0 0</drake:ball_constraint_p_BQ></drake:ball_constraint>")
+    text_ = five_bar_sdf(transform=transform, marker="")
+    for leg in (2, 3):
+        text_, count = re.subn(rf'<joint name="loop_{leg}" type="revolute">.*?</joint>', "", text_)
+        assert count == 1
+    balls = "".join(
+        f"<drake:ball_constraint><drake:ball_constraint_body_A>distal_{leg}</drake:ball_constraint_body_A>"
+        f"<drake:ball_constraint_p_AP>{text((transform[0] * DISTAL, 0.0, 0.0))}</drake:ball_constraint_p_AP>"
+        "<drake:ball_constraint_body_B>effector</drake:ball_constraint_body_B>"
+        "<drake:ball_constraint_p_BQ>0 0 0</drake:ball_constraint_p_BQ></drake:ball_constraint>" for leg in (2, 3))
+    return text_.replace("</model>", balls + "</model>", 1)
+
+
+@pytest.mark.parametrize("transform", MOVED)
+def test_an_sdformat_drake_five_bar_in_another_unit_and_frame(tmp_path, transform):
     path = tmp_path / "robot.sdf"
-    path.write_text(five_bar_sdf(marker="").replace("</model>", ball + "</model>", 1))
-    with pytest.raises(ImportError_, match=r"robot\.sdf: <model name='\w+'>: <drake:ball_constraint>, Drake's own, "
-                                           r"joins links in a way screwkit does not read in an SDFormat file"):
+    path.write_text(sdformat_five_bar_drake(transform))
+    assert_moved_textbook(load(path), transform, {f"mot{leg + 1}": leg for leg in range(3)}.get)
+
+
+def test_an_sdformat_five_bar_closed_by_drake_ball_constraints_has_the_textbook_pressure_angles(tmp_path):
+    """The SDFormat five-bar with its legs 2 and 3 closed onto the effector by Drake's ball constraints (the links'
+    names and P, Q as the elements' text) instead of revolute joints: the textbook pressure angles. Before, they
+    were left out (the model a tree, refused); a bushing is refused naming it."""
+    path = tmp_path / "robot.sdf"
+    written = sdformat_five_bar_drake()
+    path.write_text(written)
+    tree = read_closed_tree(path)
+    assert [closure.name for closure in tree.closures if closure.name.startswith("ball")] == ["ball_constraint_1",
+                                                                                           "ball_constraint_2"]
+    assert_three_leg_five_bar(path)
+    bushing = ('<drake:linear_bushing_rpy><drake:bushing_frameA>distal_2</drake:bushing_frameA>'
+               '</drake:linear_bushing_rpy>')
+    path.write_text(written.replace("</model>", bushing + "</model>", 1))
+    with pytest.raises(ImportError_, match=r"robot\.sdf: <model name='\w+'>: <drake:linear_bushing_rpy>, Drake's own, "
+                                           r"joins links in a way screwkit does not read"):
+        read_closed_tree(path)
+    path.write_text(written.replace("<drake:ball_constraint_body_A>distal_3", "<drake:ball_constraint_body_A>nowhere"))
+    with pytest.raises(ImportError_, match=r"<drake:ball_constraint> 2: <drake:ball_constraint_body_A> 'nowhere' is no "
+                                           r"link of the model"):
         read_closed_tree(path)
 
 

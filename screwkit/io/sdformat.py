@@ -264,6 +264,24 @@ def _loop_closures(builder: _TreeBuilder, joint: SdfJoint, ends: tuple[str, str]
     return [closure(f"{joint.name}_a", world, "3d"), closure(f"{joint.name}_b", second, "3d", axis_point=True)]
 
 
+def _drake_closures(builder: _TreeBuilder, sdf: SdfModel, poses: dict) -> list[Closure]:
+    """Drake's ball constraints (``sdf.ball_constraints``): P on link A and Q on link B kept together, each side in its
+    joint's frame (a gap the drawing leaves is closed by the assembly, as every closure's)."""
+    closures = []
+    for number, (link_a, p_ap, link_b, p_bq, where) in enumerate(sdf.ball_constraints, start=1):
+        sides = []
+        for tag, link, point in (("body_A", link_a, p_ap), ("body_B", link_b, p_bq)):
+            if link not in builder.placed or link == WORLD:
+                raise ImportError_(f"{where}: <drake:ball_constraint_{tag}> {link!r} is no link of the model.")
+            joint, _ = builder.placed[link]
+            at = poses[link].copy()
+            at[:3, 3] = poses[link][:3, :3] @ point + poses[link][:3, 3]
+            sides.append((joint, inverse(builder.joint_world[joint]) @ at))
+        (joint_a, on_a), (joint_b, on_b) = sides
+        closures.append(Closure(f"ball_constraint_{number}", joint_a, on_a, joint_b, on_b, "3d"))
+    return closures
+
+
 def _hung_from_platform(tree_joints, loops, ends: dict[str, tuple[str, str]]) -> str | None:
     """The platform (the link where most loops close) when the tree hangs from it links where a loop closes too: the
     last links of a leg (a ball joint written as three revolute joints through two massless links), reached through
@@ -339,7 +357,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     closing = {joint.name: _loop_closures(builder, joint, ends[joint.name], scale,
                                           touches[ends[joint.name][0]] > touches[ends[joint.name][1]])
                for joint in loops}
-    closures = [closure for made in closing.values() for closure in made]
+    closures = [closure for made in closing.values() for closure in made] + _drake_closures(builder, sdf, poses)
     # where the tree joint the order put in the tree is elsewhere than the loop joint, the cut moves with the order
     # (not along the common axis of two coaxial pins: closed at either, it is the same hinge)
     cut_by_order = tuple(closure.name for name, other in tied for closure in closing[name]

@@ -205,6 +205,9 @@ class SdfModel:
     canonical: str
     poses: dict[str, tuple[str, NDArray[np.float64]]] = field(default_factory=dict)
     where: dict[str, str] = field(default_factory=dict)
+    ball_constraints: list[tuple[str, NDArray[np.float64], str, NDArray[np.float64], str]] = field(
+        default_factory=list)
+    """Drake's ``<drake:ball_constraint>`` elements: (link A, P in A, link B, Q in B, where), P and Q coinciding."""
 
 
 def _the_model(path: Path, root) -> object:
@@ -244,16 +247,17 @@ def read_model(path: Path) -> SdfModel:
     version = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2] if part.isdigit())
     label = f"{path}: <model name='{element.get('name')}'>"
     _check_names(element, label)
-    drake = sorted({name for name, _ in drake_elements(element)})
-    if drake:  # closures of Drake's own: left out, the model would be another mechanism
-        raise ImportError_(f"{label}: <drake:{drake[0]}>, Drake's own, joins links in a way screwkit does not read in "
-                           "an SDFormat file (it reads <drake:ball_constraint> in a URDF); the model without it would "
-                           "be another mechanism.")
+    drake = sorted({name for name, _ in drake_elements(element)} - {"ball_constraint"})
+    if drake:  # Drake's own joints and ties: left out, the model would be another mechanism
+        raise ImportError_(f"{label}: <drake:{drake[0]}>, Drake's own, joins links in a way screwkit does not read (it "
+                           "reads <drake:ball_constraint>); the model without it would be another mechanism.")
     links = [link.get("name", "") for link in element.findall("link")]
     if not links:
         raise ImportError_(f"{label}: no <link>.")
     model = SdfModel(str(path), element.get("name", ""), element, links, [], {}, element.get("canonical_link") or
                      links[0])
+    model.ball_constraints = [_ball_constraint(node, f"{label}: <drake:ball_constraint> {number}")
+                              for number, (_, node) in enumerate(drake_elements(element), start=1)]
     pose, relative = parse_pose(element.find("pose"), label)
     if relative not in ("", WORLD):
         raise ImportError_(f"{label}: <pose relative_to={relative!r}>: a model's pose is read in the world only.")
@@ -276,6 +280,17 @@ def read_model(path: Path) -> SdfModel:
     if model.canonical not in links:
         raise ImportError_(f"{label}: canonical_link {model.canonical!r} is not one of its links.")
     return model
+
+
+def _ball_constraint(node, where: str) -> tuple[str, NDArray, str, NDArray, str]:
+    """A ``<drake:ball_constraint>`` of an SDFormat model (its children's text: the links' names, P and Q in them)."""
+    written = {child.tag.rsplit("}", 1)[-1]: (child.text or "").strip() for child in node if isinstance(child.tag, str)}
+    read = []
+    for tag in ("ball_constraint_body_A", "ball_constraint_p_AP", "ball_constraint_body_B", "ball_constraint_p_BQ"):
+        if not written.get(tag):
+            raise ImportError_(f"{where}: no <drake:{tag}>.")
+        read.append(written[tag] if "body" in tag else numbers(written[tag], 3, "", where, f"drake:{tag}"))
+    return (*read, where)
 
 
 def _check_names(element, label: str) -> None:
