@@ -27,15 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.common.xml_text import UNDECLARED, tolerant_xml
-from screwkit.io.closed_tree import (
-    ClosedTree,
-    Closure,
-    ImportError_,
-    declared_task_coordinates,
-    homogeneous,
-    transmitted_joints,
-)
-from screwkit.io.onshape import guessed_motors
+from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, homogeneous
+from screwkit.io.onshape import transmitted_tree
 
 __all__ = ["has_drake_constraints", "read_drake", "drake_elements"]
 
@@ -129,14 +122,5 @@ def read_drake(urdf: Path, *, output: str | None = None, output_type: str | None
             sides.append((int(frame.parentJoint), homogeneous(frame.placement) @ placement))
         (joint_a, on_a), (joint_b, on_b) = sides
         closures.append(Closure(name, joint_a, on_a, joint_b, on_b, "3d"))
-    transmitted = transmitted_joints(data)
-    motors = transmitted or guessed_motors(model, closures)
-    unknown = [motor for motor in motors if motor not in list(model.names)]
-    unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
-    tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, pin.neutral(model), output, output_type,
-                      "URDF + Drake ball constraints (<drake:ball_constraint>)",
-                      task_coordinates=declared_task_coordinates(data), unactuated=unactuated)
-    if not transmitted:
-        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
-                          f"{', '.join(motors)}; --actuate JOINT says otherwise")
-    return tree
+    return transmitted_tree(urdf, data, model, closures, pin.neutral(model), output, output_type,
+                            "URDF + Drake ball constraints (<drake:ball_constraint>)")

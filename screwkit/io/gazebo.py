@@ -35,12 +35,10 @@ from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
     ImportError_,
-    declared_task_coordinates,
     homogeneous,
     inverse,
-    transmitted_joints,
 )
-from screwkit.io.onshape import guessed_motors
+from screwkit.io.onshape import transmitted_tree
 from screwkit.io.sdformat_text import parse_joint
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
@@ -78,7 +76,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     bodies = {frame.name: index for index, frame in enumerate(model.frames) if frame.type == pin.FrameType.BODY}
     scale = max(float(np.max(np.abs([np.asarray(frame.translation) for frame in data.oMf]))), 1e-3)
     closures = []
-    for element in _gazebo_joints(urdf.read_bytes()):
+    written = urdf.read_bytes()
+    for element in _gazebo_joints(written):
         name = element.get("name") or f"gazebo_joint_{len(closures) + 1}"
         where = f"{urdf}: <gazebo><joint name='{name}'>"
         kind = element.get("type", "")
@@ -108,14 +107,6 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
                                     on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
                                     axis_point=number == 1))
-    transmitted = transmitted_joints(urdf.read_bytes())
-    motors = transmitted or guessed_motors(model, closures)
-    unknown = [motor for motor in motors if motor not in list(model.names)]
-    unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
-    tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, q, output, output_type,
-                      "URDF + Gazebo joints (<gazebo><joint>)", task_coordinates=declared_task_coordinates(
-                          urdf.read_bytes()), unactuated=unactuated)  # refused unless --actuate (read_closed_tree)
-    if not transmitted:
-        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
-                          f"{', '.join(motors)}; --actuate JOINT says otherwise")
-    return tree
+    return transmitted_tree(urdf, written, model, closures, q, output, output_type,
+                            "URDF + Gazebo joints (<gazebo><joint>)")
+

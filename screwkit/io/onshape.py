@@ -34,7 +34,7 @@ from screwkit.io.closed_tree import (
     transmitted_joints,
 )
 
-__all__ = ["CLOSING", "closing_pairs", "read_onshape"]
+__all__ = ["CLOSING", "closing_pairs", "read_onshape", "transmitted_tree"]
 
 CLOSING = re.compile(r"closing_(.+)_([12])")
 """The name of a closing frame: ``closing_<name>_1`` or ``closing_<name>_2``."""
@@ -115,3 +115,21 @@ def guessed_motors(model, closures: list[Closure]) -> list[str]:
         if kinds[chosen] in ("revolute", "prismatic"):
             motors.append(str(model.names[chosen]))
     return motors
+
+
+def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q, output: str | None,
+                     output_type: str | None, file_format: str) -> ClosedTree:
+    """The closed tree of a URDF whose closures another tool's elements write (Gazebo's, Drake's): its actuators
+    those of its ``<transmission>`` elements, else guessed from the branches leaving the base (said in its notes); a
+    transmission naming no joint of the tree is refused unless --actuate names them (read_closed_tree). ``data``: the
+    file's bytes, as read."""
+    transmitted = transmitted_joints(data)
+    motors = transmitted or guessed_motors(model, closures)
+    unknown = [motor for motor in motors if motor not in list(model.names)]
+    unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
+    tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, q, output, output_type, file_format,
+                      task_coordinates=declared_task_coordinates(data), unactuated=unactuated)
+    if not transmitted:
+        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
+                          f"{', '.join(motors)}; --actuate JOINT says otherwise")
+    return tree
