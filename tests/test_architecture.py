@@ -26,6 +26,7 @@ LAYERS = {
     "screwkit.plots": 5, "screwkit.viewer": 5,
     "screwkit.cli": 6,
     "screwkit": 7,  # the top-level API, imported lazily
+    "screwkit.__main__": 7,  # python -m screwkit
 }
 """Layer of each module or package, bottom up: a module may import its own layer and those below."""
 
