@@ -179,7 +179,7 @@ def test_a_string_is_one_name_and_a_file_in_screwkits_convention_refuses_the_opt
         with pytest.raises(ImportError_, match=rf"robot\.sdf: --actuate: expected joint names \(strings\), got "
                                                rf"{shown}"):
             read_closed_tree(path, actuate=wrong)
-    with pytest.raises(ValueError, match=r"five_bar_3\.urdf: an output frame or type, locked joints or actuated "
+    with pytest.raises(ValueError, match=r"five_bar_3\.urdf: an output frame or type, locked, actuated or initial "
                                          r"joints named apart from the file apply to files of other tools"):
         load("five_bar_3", actuate=("motor_1",))
 
@@ -207,7 +207,7 @@ def test_the_command_line_drives_the_joints_named(tmp_path):
     one_line_error(screwkit("analyze", guessed, "--actuate", "nope"), "robot.sdf: --actuate nope: no joint of that "
                    "name")
     one_line_error(screwkit("analyze", "five_bar_3", "--actuate", "motor_1"), "five_bar_3.urdf: an output frame or "
-                   "type, locked joints or actuated joints")
+                   "type, locked, actuated or initial joints")
 
 
 def _gepetto_without_name_mot(tmp_path):

@@ -262,6 +262,23 @@ def test_analyze_and_info_open_sdformat_files_on_the_command_line(tmp_path):
                    "read")
 
 
+@pytest.mark.cli
+def test_a_model_joined_to_no_world_says_its_fixed_base_on_the_first_line(tmp_path):
+    """Gazebo lets a model with no joint to the world float; screwkit fixes its canonical link and says so where the
+    guessed actuators are said, not only among the import report's lines (the same indices as anchored)."""
+    anchored = screwkit("analyze", write(tmp_path, five_bar_sdf(), "anchored.sdf"), "--json")
+    floating = write(tmp_path, five_bar_sdf().replace(
+        '<joint name="anchor" type="fixed"><parent>world</parent><child>base</child></joint>', ""), "floating.sdf")
+    assert floating.read_text() != five_bar_sdf()
+    text = screwkit("analyze", floating)
+    assert text.returncode == 0, text.stderr
+    assert text.stdout.splitlines()[0].endswith("; no joint to the world: the canonical link 'base' is the fixed base "
+                                                "(Gazebo would let the model float)")
+    report, before = json.loads(screwkit("analyze", floating, "--json").stdout), json.loads(anchored.stdout)
+    assert report["base_guessed"].startswith("no joint to the world") and before["base_guessed"] is None
+    assert report["lmti"] == pytest.approx(before["lmti"], abs=1e-12)
+
+
 def test_map_verify_and_sweep_of_a_serial_leg_sdformat_file_and_a_graph_sweep(tmp_path):
     """The commands of serial legs on a five-bar written as SDFormat (map against indices_at_poses at its grid
     points, verify's closed forms), and a sweep of the rod-level Delta written as SDFormat (a graph)."""

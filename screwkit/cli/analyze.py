@@ -21,6 +21,7 @@ from screwkit.cli.options import (
 from screwkit.closure import forward
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
+from screwkit.io.closed_tree import GROUNDED
 from screwkit.io.locking import GUESSED
 from screwkit.model import Mechanism
 from screwkit.studies import indices_at_pose
@@ -49,13 +50,19 @@ def _limiting(detail: dict) -> str:
             + f", limited by {_names(detail['limiting'])}")
 
 
+def _grounded(lines) -> str | None:
+    """The import report's note on a model that joins no link to the world (its canonical link held fixed), if any."""
+    return next((line.strip() for line in lines if GROUNDED in line), None)
+
+
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items()) or "the file's configuration"
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
     guessed = " (guessed: the file names none; --actuate names them)" if report.get("actuators_guessed") else ""
+    grounded = f"; {report['base_guessed']}" if report.get("base_guessed") else ""
     click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators{guessed}, {report['dof']} DOF "
-               f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}")
+               f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}{grounded}")
     if report.get("dependent"):
         click.echo("  dependent (parasitic) coordinates: "
                    + ", ".join(f"{k} = {v:.6g}" for k, v in report["dependent"].items()))
@@ -189,6 +196,7 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
     if loaded.import_report:  # a file of another tool: which body and which point the indices are for
         report["converted"] = list(loaded.import_report)
         report["actuators_guessed"] = any(GUESSED in line for line in loaded.import_report)
+        report["base_guessed"] = _grounded(loaded.import_report)
     if as_json:
         click.echo(json.dumps(report))
     else:
@@ -248,6 +256,7 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
                  for name, value in zip(graph.task_coordinates, graph.task_pose())}
     report = {**result.to_dict(), "mechanism": graph.name, "pose": shown, "converted": graph.report.lines()}
     report["actuators_guessed"] = any(GUESSED in line for line in report["converted"])
+    report["base_guessed"] = _grounded(report["converted"])
     if as_json:
         click.echo(json.dumps(report))
     else:

@@ -7,8 +7,15 @@ from pathlib import Path
 
 import click
 
-from screwkit.cli.options import fail, ignore_limits_option, json_option, overwrite_option, quiet_option
-from screwkit.cli.reading import actuate_option, lock_option
+from screwkit.cli.options import (
+    fail,
+    ignore_limits_option,
+    json_option,
+    option_group,
+    overwrite_option,
+    quiet_option,
+)
+from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
 from screwkit.closure.assembly import NOT_OPEN_LOOPS
 from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
 from screwkit.io.loader import load, load_text
@@ -20,20 +27,13 @@ __all__ = ["convert"]
 @click.command()
 @click.argument("source", type=click.Path(dir_okay=False, path_type=Path))
 @click.argument("out", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--output", "output_frame", default=None, metavar="FRAME",
-              help="The frame (MJCF: site or body) whose body is the platform; default a frame named effector, "
-                   "end_effector, eff, ee, tool, tcp, foot or platform.")
-@click.option("--output-type", type=click.Choice(["point", "frame"]), default=None,
-              help="A point output (where the chains meet) or the output frame; default: the point when every "
-                   "closure meets the platform at one point, else the frame.")
-@lock_option
-@actuate_option
+@option_group("reading", reading_record, *FILE_OPTIONS)
 @ignore_limits_option
 @overwrite_option
 @quiet_option
 @json_option
-def convert(source: Path, out: Path, output_frame, output_type, lock, actuate, ignore_limits: bool,
-            overwrite: bool, quiet: bool, as_json: bool) -> None:
+def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, overwrite: bool, quiet: bool,
+            as_json: bool) -> None:
     """Write SOURCE (an MJCF or SDFormat file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
     URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
     already in the convention whose joint values leave loops open is written back with them closed. With
@@ -50,12 +50,12 @@ def convert(source: Path, out: Path, output_frame, output_type, lock, actuate, i
         raise fail(str(error)) from None
     try:
         if is_foreign(source):
-            text, report = read_mechanism_file(source, output=output_frame, output_type=output_type, lock=tuple(lock),
-                                               actuate=tuple(actuate))
+            text, report = read_mechanism_file(source, output=reading.output, output_type=reading.output_type,
+                                               lock=reading.lock, actuate=reading.actuate, initial=reading.initial)
         else:  # screwkit's own convention: the loops the file leaves open, closed and written back (the options of
             # files of other tools refused by the loader, as on every command)
-            own = load(source, limits=not ignore_limits, output=output_frame, output_type=output_type,
-                       lock=tuple(lock), actuate=tuple(actuate))
+            own = load(source, limits=not ignore_limits, output=reading.output, output_type=reading.output_type,
+                       lock=reading.lock, actuate=reading.actuate, initial=reading.initial)
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))

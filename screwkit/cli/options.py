@@ -397,7 +397,8 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
     length_unit = reading.length_unit
     try:
         mechanism = load(name, length_unit=length_unit, limits=limits, output=reading.output,
-                         output_type=reading.output_type, lock=reading.lock, actuate=reading.actuate)
+                         output_type=reading.output_type, lock=reading.lock, actuate=reading.actuate,
+                         initial=reading.initial)
     except ValueError as error:
         from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree  # readers of other tools: when used
 
@@ -407,7 +408,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
             source = bundled_path(name) if name in bundled_graph_names() else name
             graph = graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
                                                      lock=reading.lock, actuate=reading.actuate,
-                                                     length_unit=length_unit))
+                                                     initial=reading.initial, length_unit=length_unit))
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
         rounded = [note for note in graph.report.notes if note.startswith(DOF_AT_ROUNDING)]

@@ -7,27 +7,29 @@ from typing import Callable
 
 import click
 
-__all__ = ["Reading", "reading_record", "lock_option", "actuate_option", "output_frame_option", "output_type_option",
-           "LOCK_HELP", "ACTUATE_HELP", "FILE_OPTIONS"]
+__all__ = ["Reading", "reading_record", "lock_option", "actuate_option", "initial_option", "output_frame_option",
+           "output_type_option", "LOCK_HELP", "ACTUATE_HELP", "INITIAL_HELP", "FILE_OPTIONS"]
 
 
 @dataclass(frozen=True)
 class Reading:
     """How MECHANISM's file is read: its length unit, and for a file of another tool the frame whose body is the
     platform and whether the output is a point or that frame (``--length-unit``, ``--output``, ``--output-type``),
-    the joints held at their values in the file (``--lock``) and the actuated joints named instead of the file's
-    (``--actuate``)."""
+    the joints held at their values in the file (``--lock``), the actuated joints named instead of the file's
+    (``--actuate``) and the joint values the assembly starts from instead of the file's (``--initial``)."""
 
     length_unit: str | None = None
     output: str | None = None
     output_type: str | None = None
     lock: tuple[str, ...] = ()
     actuate: tuple[str, ...] = ()
+    initial: tuple[tuple[str, float], ...] = ()
 
 
-def reading_record(length_unit: str | None, output_frame: str | None, output_type: str | None, lock,
-                   actuate=()) -> Reading:
-    return Reading(length_unit, output_frame, output_type, tuple(lock or ()), tuple(actuate or ()))
+def reading_record(length_unit: str | None = None, output_frame: str | None = None, output_type: str | None = None,
+                   lock=(), actuate=(), initial=()) -> Reading:
+    return Reading(length_unit, output_frame, output_type, tuple(lock or ()), tuple(actuate or ()),
+                   tuple(tuple(pair) for pair in initial or ()))
 
 
 LOCK_HELP = ("For a file of another tool: hold this joint at its value in the file (repeatable): a serial stage "
@@ -39,12 +41,23 @@ ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the 
                 "instead of those the file marks or screwkit guesses (listed, as ever, in the legs' order).")
 
 
+INITIAL_HELP = ("For a file of another tool: start the reference assembly with this joint at VALUE (deg for a revolute "
+              "joint, m for a prismatic one) instead of the file's value, held there while the loops close "
+              "(repeatable): a file written at a dead centre (a crank and its rod on one line) or with a joint "
+              "outside its limits; --lock then holds the joint at VALUE.")
+
+
 def lock_option(function: Callable) -> Callable:
     return click.option("--lock", multiple=True, metavar="JOINT", help=LOCK_HELP)(function)
 
 
 def actuate_option(function: Callable) -> Callable:
     return click.option("--actuate", multiple=True, metavar="JOINT", help=ACTUATE_HELP)(function)
+
+
+def initial_option(function: Callable) -> Callable:
+    return click.option("--initial", multiple=True, nargs=2, type=(str, float), metavar="JOINT VALUE",
+                        help=INITIAL_HELP)(function)
 
 
 def output_frame_option(function: Callable) -> Callable:
@@ -61,5 +74,5 @@ def output_type_option(function: Callable) -> Callable:
                              "rotations about it are idle, else the frame.")(function)
 
 
-FILE_OPTIONS = (output_frame_option, output_type_option, lock_option, actuate_option)
+FILE_OPTIONS = (output_frame_option, output_type_option, lock_option, actuate_option, initial_option)
 """The options of a file of another tool, in the order every command that reads MECHANISM shows them."""

@@ -31,6 +31,7 @@ from screwkit.closure.task_space import (
     constraining_chains,
     infer_task_axes,
     motion_space_at,
+    singular_chains,
 )
 from screwkit.common.rotations import wrap_angle
 from screwkit.common.tolerances import (
@@ -146,8 +147,11 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
         where = (f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "
                  f"limits [{_tidy(lower)}, {_tidy(upper)}]")
         if limits:
-            raise description.fail(f"<joint name='{chain.joint_names[outside]}'>",
-                                   f"{where} (--ignore-limits, or limits=False, reads it all the same).")
+            name = chain.joint_names[outside]
+            start = (f"; --initial {name} VALUE (deg for a revolute joint, m for a prismatic one) starts the assembly "
+                     "inside them" if description.converted_from else "")
+            raise description.fail(f"<joint name='{name}'>",
+                                   f"{where} (--ignore-limits, or limits=False, reads it all the same{start}).")
         limit_note = f"{LIMITS_IGNORED}joint {chain.joint_names[outside]!r}: {where}"
         return values, [n for n in (note, limit_note) if n]
     return values, [note] if note else []
@@ -348,6 +352,25 @@ def _mode_samples(mechanism: Mechanism, poses, values):
             [np.concatenate([batch[1][k] for batch in batches]) for k in range(len(chains))])
 
 
+def _check_not_at_dead_centre(mechanism: Mechanism) -> None:
+    """Refuse a platform that cannot move at the reference assembly because a chain is stretched or folded there (a
+    crank and its rod on one line: the platform at the end of its travel), naming the chains and how to give joint
+    values away from it; a platform that cannot move with every chain regular is left to the caller's refusal."""
+    chains = singular_chains(mechanism)
+    if not chains:
+        return
+    description = mechanism.description
+    remedy = ("give joint values away from it: --initial JOINT VALUE (an actuated joint away from its dead centre, "
+              "held there while the loops close)" + (", or a keyframe named 'home'"
+                                                      if description.converted_from == "MJCF" else "")
+              if description.converted_from else "write its <reference_configuration> away from it")
+    raise description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move at the reference assembly "
+                           f"(DOF {mechanism.dof}) because chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
+                           f"{'are' if len(chains) > 1 else 'is'} stretched or folded there (its joints' twists span "
+                           "less than at joint values near it: a dead centre, such as a crank and its rod on one "
+                           f"line), where the working mode is not decided; {remedy}.")
+
+
 def _check_actuator_count(mechanism: Mechanism, needed: int) -> None:
     """At least as many actuators as the output's DOF (its mobility, not the instantaneous DOF at the reference
     assembly: a 3-UPU built at its constraint singularity has 5 there, and its 3 slides drive it)."""
@@ -397,6 +420,8 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
+    if mobility < 1:
+        _check_not_at_dead_centre(mechanism)
     if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")

@@ -69,14 +69,30 @@ def pose_rates(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float64]
     return rates
 
 
-def _chain_rank(mechanism: Mechanism, index: int) -> int:
+def _chain_rank(mechanism: Mechanism, index: int, values: NDArray | None = None) -> int:
+    """The dimension of the twists chain ``index``'s joints span at joint ``values`` (its reference ones by
+    default)."""
     chain = mechanism.chains[index]
-    frames = chain_forward_kinematics(chain.geometry, chain.reference_values)
+    frames = chain_forward_kinematics(chain.geometry, chain.reference_values if values is None else values)
     twists = twists_from_axes_and_points(frames.axes, frames.points, chain.prismatic)
     twists = twists / np.maximum(np.linalg.norm(twists, axis=-1, keepdims=True), 1e-300)
     rows = [2, 3, 4] if mechanism.is_planar else list(range(6))
     singular = np.linalg.svd(twists[:, rows], compute_uv=False)
     return int(np.sum(singular > MOTION_SPACE_TOLERANCE * max(singular[0], 1e-300))) if singular.size else 0
+
+
+def singular_chains(mechanism: Mechanism, samples: int = 4) -> list[str]:
+    """The chains whose joints span fewer twists at the reference assembly than at joint values near it (every
+    joint moved by up to 0.05 rad or 0.05 length scales; the most of ``samples`` random ones, seeded): stretched or
+    folded, as a crank and its rod on one line."""
+    rng, found = np.random.default_rng(0), []
+    for index, chain in enumerate(mechanism.chains):
+        step = np.where(np.asarray(chain.geometry.dof_prismatic, dtype=bool), 0.05 * mechanism.length_scale, 0.05)
+        near = max(_chain_rank(mechanism, index, chain.reference_values + rng.uniform(-1.0, 1.0, chain.n_joints) * step)
+                   for _ in range(samples))
+        if near > _chain_rank(mechanism, index):
+            found.append(chain.name)
+    return found
 
 
 def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:

@@ -81,16 +81,16 @@ def is_foreign(path: Path) -> bool:
 
 def read_closed_tree(path: Path, *, output: str | None = None, output_type: str | None = None,
                      lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
-                     length_unit: str | None = None, unit: str | None = None) -> ClosedTree:
+                     length_unit: str | None = None, unit: str | None = None, initial=()) -> ClosedTree:
     """The closed tree of an MJCF file, an SDFormat file or a URDF of another tool (``output``, ``output_type``,
-    ``lock``, ``actuate``: as :func:`read_mechanism_file`; ``length_unit``: the unit the file is written in, its
-    lengths then brought to metres, :func:`screwkit.io.tree_units.in_metres`; a file read through
+    ``lock``, ``actuate``, ``initial``: as :func:`read_mechanism_file`; ``length_unit``: the unit the file is written
+    in, its lengths then brought to metres, :func:`screwkit.io.tree_units.in_metres`; a file read through
     :func:`read_mechanism_file` is scaled as its converted text is loaded instead, and its lengths are said in
     ``unit``, the unit its numbers are kept in)."""
     from dataclasses import replace
 
     from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
-    from screwkit.io.locking import actuate_joints, lock_joints  # (idem)
+    from screwkit.io.locking import actuate_joints, lock_joints, set_initial  # (idem)
     from screwkit.io.tree_units import in_metres  # (idem)
 
     tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
@@ -98,7 +98,7 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
         tree = replace(tree, unit=unit)
     if tree.unactuated and not actuate:
         raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints.")
-    tree = actuate_joints(lock_joints(tree, lock), actuate)
+    tree = actuate_joints(lock_joints(set_initial(tree, initial), lock), actuate)
     if not tree.motors:
         raise ImportError_(f"{tree.source}: nothing to actuate: the file names no actuated joint and no 1-DoF joint "
                            "leaves the base on the way to a closure (--actuate JOINT names them).")
@@ -135,22 +135,24 @@ def _read_tree(path: Path, output: str | None, output_type: str | None) -> Close
 
 def read_mechanism_file(path: Path, *, output: str | None = None, output_type: str | None = None,
                         lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
-                        length_unit: str | None = None) -> tuple[str, ImportReport]:
+                        length_unit: str | None = None, initial=()) -> tuple[str, ImportReport]:
     """The URDF text (screwkit's convention) of an MJCF file or a URDF + robot.yaml, and the import report.
 
     ``output``: the frame (MJCF: a site or body) whose body is the platform; ``output_type``:
     ``"point"`` or ``"frame"`` (default: decided as :mod:`screwkit.io.star` says); ``lock``: joints held at their
     values in the file (:func:`screwkit.io.locking.lock_joints`: a serial stage before the parallel part);
     ``actuate``: the actuated joints, instead of the file's or the guessed ones
-    (:func:`screwkit.io.locking.actuate_joints`); ``length_unit``: the unit the file is written in, which the text
-    keeps (its loader scales it) and the report's lengths are given in. A leg
+    (:func:`screwkit.io.locking.actuate_joints`); ``initial``: pairs of a joint name and its value (deg for a revolute
+    joint, m for a prismatic one) that the assembly starts from and holds instead of the file's
+    (:func:`screwkit.io.locking.set_initial`: a file written at a dead centre); ``length_unit``: the unit the file
+    is written in, which the text keeps (its loader scales it) and the report's lengths are given in. A leg
     with loops inside it raises :class:`~screwkit.io.closed_tree.LegWithLoops` (:func:`graph_mechanism` analyses
     it).
     """
     from screwkit.io.star import convert_tree  # the conversion: only for a file of another tool
 
     return convert_tree(read_closed_tree(path, output=output, output_type=output_type, lock=lock, actuate=actuate,
-                                         unit=length_unit))
+                                         unit=length_unit, initial=initial))
 
 
 def with_reference_configuration(text: str, mechanism) -> str:

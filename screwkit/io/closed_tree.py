@@ -56,6 +56,11 @@ GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `v
 """What a :class:`LegWithLoops` message adds."""
 
 
+GROUNDED = "no joint to the world: the canonical link"
+"""How a reader's note on a model that joins no link to the world begins (its canonical link taken as the fixed base,
+where Gazebo would let the model float): said on the first line of a report."""
+
+
 @dataclass(frozen=True)
 class Closure:
     """Two frames of the tree that must coincide: ``kind`` "3d" (origins) or "6d" (frames)."""
@@ -88,12 +93,23 @@ class ClosedTree:
     task_coordinates: tuple[str, ...] | None = None  # a URDF source's <task_coordinates names="...">, kept
     locked: tuple[str, ...] = ()  # joints held at their values in the file (screwkit.io.locking)
     actuated: tuple[str, ...] = ()  # the actuators as the user named them (--actuate), not the file (idem)
+    initial: tuple[tuple[str, float], ...] = ()  # joint values given instead of the file's (--initial; idem)
     unactuated: str = ""  # why the file's own actuators cannot be taken: refused unless --actuate names them
     length_unit: str | None = None  # the unit the file was written in, its lengths now in m (screwkit.io.tree_units)
     unit: str = "m"  # the unit of its lengths, for messages: the file's own when it is converted as written
     split: dict[str, str] = field(default_factory=dict)
     """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
     it is, for messages (none is an actuator)."""
+
+    def initial_joints(self) -> list[int]:
+        """The ids of the joints ``--initial`` gave values to that the model still has (a locked one is merged away):
+        the assembly holds them (:func:`screwkit.io.locking.set_initial`)."""
+        return [self.model.getJointId(name) for name, _ in self.initial if self.model.existJointName(name)]
+
+    def start_phrase(self) -> str:
+        """Where the assembly starts, for messages: the file's joint values, or those ``--initial`` gave."""
+        return ("the joint values given (--initial) and the file's for the others" if self.initial else
+                "the file's joint values")
 
     def motor_label(self, name: str) -> str:
         """How a message names the actuated joint ``name``: by the option that named it, else as the file's."""
@@ -147,6 +163,7 @@ class ImportReport:
     notes: list[str] = field(default_factory=list)
     task_coordinates: str = ""
     unit: str = "m"  # of the lengths it gives (the file's own, for a file converted as written and scaled after)
+    values: str = "the file's joint values"  # where the assembly started (ClosedTree.start_phrase)
 
     def lines(self) -> list[str]:
         """The report as lines of text."""
@@ -154,7 +171,7 @@ class ImportReport:
         planar = ", planar" if self.planar else ""
         out = [f"{self.source}: {self.file_format}{platform}, output {self.output}{planar}"]
         for name in self.gaps_before:
-            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} {self.unit} at the file's joint values, "
+            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} {self.unit} at {self.values}, "
                        f"{self.gaps_after[name]:.1e} after assembly")
         out += [f"  chain {line}" for line in self.chains]
         out.append(f"  actuators: {', '.join(self.motors)}")
@@ -436,7 +453,9 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             tree.notes.append(f"the closures close to {gaps[worst]:.3g} {tree.unit} at best (closure {worst!r}): the "
                               "file's numbers disagree by that much (redundant closures written rounded)")
             return q, scale
-        raise ImportError_(f"{tree.source}: the loops cannot be closed near the file's joint values: closure "
+        where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
+                 "values for the other joints)" if tree.initial else "near the file's joint values")
+        raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "
                            f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (gaps: "
                            + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items()) + ").")
     return q, scale

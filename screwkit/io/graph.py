@@ -482,7 +482,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     report = ImportReport(source=tree.source, file_format=tree.file_format)
     at_file = q is None or scale is None
     if at_file:
-        q, scale = assemble(tree)
+        q, scale = assemble(tree, held=tree.initial_joints())
     frame_id = output_frame(tree)
     frame = model.frames[frame_id]
     report.notes[:0] = tree.notes

@@ -97,7 +97,8 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
 
 def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
          max_bytes: int = MAX_FILE_BYTES, limits: bool = True, output: str | None = None,
-         output_type: str | None = None, lock: tuple[str, ...] = (), actuate: tuple[str, ...] = ()) -> Mechanism:
+         output_type: str | None = None, lock: tuple[str, ...] = (), actuate: tuple[str, ...] = (),
+         initial=()) -> Mechanism:
     """Load a mechanism by bundled name (see :func:`bundled_names`) or file path.
 
     Parameters
@@ -127,6 +128,10 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     actuate : tuple of str
         For a file of another tool: the actuated joints, in this order, instead of those the file marks or that
         are guessed (``--actuate``; :func:`screwkit.io.locking.actuate_joints`).
+    initial : sequence of (str, float) pairs
+        For a file of another tool: joint values (deg for a revolute joint, m for a prismatic one) the reference
+        assembly starts from and holds instead of the file's (``--initial``; a file written at a dead centre or with a
+        joint outside its limits, :func:`screwkit.io.locking.set_initial`).
 
     Raises
     ------
@@ -145,7 +150,8 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     if not looks_like_path and (text in bundled_names() or not os.path.isdir(text)):
         path = bundled_path(text)
         if path.suffix == ".xml":  # a bundled graph: as its file (refused with LegWithLoops, for graph_mechanism)
-            read_mechanism_file(path, output=output, output_type=output_type, lock=lock, actuate=actuate)
+            read_mechanism_file(path, output=output, output_type=output_type, lock=lock, actuate=actuate,
+                                initial=initial)
     else:
         path = Path(text)
         if path.is_dir():
@@ -158,11 +164,13 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
-                                                    actuate=actuate, length_unit=length_unit)
-            mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits)
+                                                    actuate=actuate, length_unit=length_unit, initial=initial)
+            description = replace(parse_urdf(converted, str(path), length_unit=length_unit),
+                                  converted_from=report.file_format)
+            mechanism = mechanism_from_description(description, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
-    if output is not None or output_type is not None or lock or actuate:
-        raise ValueError(f"{path}: an output frame or type, locked joints or actuated joints named apart from the "
+    if output is not None or output_type is not None or lock or actuate or initial:
+        raise ValueError(f"{path}: an output frame or type, locked, actuated or initial joints named apart from the "
                          "file apply to files of other tools (MJCF, SDFormat, URDF + robot.yaml, onshape-to-robot "
                          "URDFs); this file is in screwkit's convention (its output is its platform, its "
                          "<transmission>s name its actuators).")

@@ -1,5 +1,7 @@
-"""Locking and driving joints of a closed tree: a serial stage before the parallel part held at the file's value
-(``--lock``), and the actuated joints named by the user instead of the file (``--actuate``)."""
+"""Locking, driving and starting joints of a closed tree: a serial stage before the parallel part held at the file's
+value (``--lock``), the actuated joints named by the user instead of the file (``--actuate``), and joint values the
+assembly starts from and holds instead of the file's (``--initial``: a file written at a dead centre or outside a
+joint's limits)."""
 
 from __future__ import annotations
 
@@ -8,10 +10,20 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, assemble, homogeneous, joint_value, path_to
+from screwkit.common.units import LENGTH_UNITS
+from screwkit.io.closed_tree import (
+    ClosedTree,
+    Closure,
+    ImportError_,
+    assemble,
+    homogeneous,
+    joint_kind,
+    joint_value,
+    path_to,
+)
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "joint_names"]
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names"]
 
 GUESSED = "actuators guessed"
 """How a reader's note on guessed actuators begins."""
@@ -103,8 +115,9 @@ def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDAr
     the notes saying which moved."""
     model, held = tree.model, np.array(tree.q_reference, dtype=float)
     quiet = replace(tree, notes=[])  # (the assembly's own notes are said when it runs again, on the locked tree)
+    initial = [joint for joint in tree.initial_joints() if joint not in locked]
     try:
-        assemble(quiet, held=locked)
+        assemble(quiet, held=locked + initial)
         return held, []  # the file's values close: as written
     except ImportError_ as error:
         refusal = error
@@ -117,7 +130,7 @@ def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDAr
         raise ImportError_(f"{refusal} (with --lock {', --lock '.join(model.names[j] for j in locked)} held at the "
                            "file's values)") from None
     try:
-        closed, _ = assemble(quiet, held=[joint for joint in locked if joint not in inside])
+        closed, _ = assemble(quiet, held=[joint for joint in locked if joint not in inside] + initial)
     except ImportError_ as error:
         raise ImportError_(f"{error} (with --lock {', --lock '.join(model.names[j] for j in locked)}: the passive "
                            f"{', '.join(model.names[j] for j in inside)} free to close the loops, the others held at "
@@ -189,3 +202,73 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
             f"{'were guessed' if had else 'are'}: {', '.join(tree.motors) or 'none'}")
     notes.append(f"actuators as given (--actuate): {', '.join(names)}; the file's {file}")
     return replace(tree, motors=list(names), notes=notes, actuated=names)
+
+
+def set_initial(tree: ClosedTree, values) -> ClosedTree:
+    """The tree with the joints of ``values`` (pairs of a joint name and a value: degrees for a revolute joint, metres
+    for a prismatic one, as ``--actuators`` takes them) at those values instead of the file's (``--initial``). The
+    assembly holds them there and closes the loops with the other joints, so a file written
+    at a dead centre (a crank and its rod on one line) or with a joint outside its limits is read at a configuration
+    the user chooses, without editing it (:meth:`~screwkit.io.closed_tree.ClosedTree.initial_joints`); ``--lock``
+    then holds such a joint at its initial value."""
+    pairs = initial_values(values, tree.source)
+    if not pairs:
+        return tree
+    model, q = tree.model, np.array(tree.q_reference, dtype=float)
+    startable = ", ".join(str(n) for n in list(model.names)[1:]
+                          if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
+    said = []
+    for name, value in pairs:
+        joint = model.getJointId(name) if model.existJointName(name) else 0
+        kind = joint_kind(model, joint)[0] if joint else ""
+        what = (f"{tree.split[name]}, not a 1-DoF joint" if name in tree.split else
+                "no joint of that name" if not joint else
+                f"a joint of {model.joints[joint].nv} DoF ({model.joints[joint].shortname()}), not a 1-DoF joint"
+                if kind not in ("revolute", "prismatic") else None)
+        if what is not None:
+            raise ImportError_(f"{tree.source}: --initial {name} {value:g}: {what}; the joints that can be given one "
+                               f"(revolute or prismatic) are {startable}.")
+        start = model.joints[joint].idx_q
+        if kind == "revolute":
+            angle = np.radians(value)
+            q[start:start + model.joints[joint].nq] = ([np.cos(angle), np.sin(angle)] if model.joints[joint].nq == 2
+                                                       else [angle])
+            said.append(f"{name} {value:g} deg")
+        else:
+            q[start] = value / LENGTH_UNITS[tree.unit]  # the tree keeps the file's numbers when read as written
+            said.append(f"{name} {value:g} m")
+    note = (f"joint values given (--initial): {', '.join(said)}, instead of the file's; the loops closed with them "
+            "held there")
+    return replace(tree, q_reference=q, initial=pairs, notes=[*tree.notes, note])
+
+
+def initial_values(values, source: str) -> tuple[tuple[str, float], ...]:
+    """``values`` (pairs of a joint name and a finite number) as a tuple of pairs; anything else, or a joint given
+    twice, refused naming the file ``source`` and ``--initial``."""
+    if values is None:
+        return ()
+    if isinstance(values, dict):
+        values = tuple(values.items())
+    if isinstance(values, (str, bytes, bytearray)) or not hasattr(values, "__iter__"):
+        raise ImportError_(f"{source}: --initial: expected pairs of a joint name and a value, got "
+                           f"{type(values).__name__} {values!r:.60}.")
+    pairs = []
+    for pair in values:
+        try:
+            name, value = pair
+        except (TypeError, ValueError):
+            raise ImportError_(f"{source}: --initial: expected pairs of a joint name and a value, got {pair!r:.60}.") \
+                from None
+        if not isinstance(name, str) or not name:
+            raise ImportError_(f"{source}: --initial: expected a joint name, got {name!r:.60}.")
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            number = float("nan")
+        if isinstance(value, bool) or not np.isfinite(number):
+            raise ImportError_(f"{source}: --initial {name} {value!r:.40}: expected a finite number (deg for a "
+                               "revolute joint, m for a prismatic one).")
+        if any(name == other for other, _ in pairs):
+            raise ImportError_(f"{source}: --initial {name}: given twice.")
+        pairs.append((name, number))
+    return tuple(pairs)

@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, inverse
+from screwkit.io.closed_tree import GROUNDED, ClosedTree, Closure, ImportError_, inverse
 from screwkit.io.onshape import guessed_motors
 from screwkit.io.sdformat_text import WORLD, SdfJoint, SdfModel, attached_link, read_model, world_poses
 
@@ -347,7 +347,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
              "file draws them): read as fixed joints"] if held else []
     if base != WORLD:
         builder.ground(base)
-        notes.append(f"no joint to the world: the canonical link {base!r} is the fixed base")
+        notes.append(f"{GROUNDED} {base!r} is the fixed base (Gazebo would let the model float)")
     for joint, parent_node, child_node in tree_joints:
         builder.tree_joint(joint, parent_node, child_node)
     builder.frames()

@@ -24,7 +24,9 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
 4. **Idle joints.** A leg whose joint twists are dependent at the assembly (a second pin coaxial
    with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
    assembled values, from its end backwards, until they are independent: the span of the leg's
-   twists, so the platform's motion and every index, is unchanged; the report names them.
+   twists, so the platform's motion and every index, is unchanged; the report names them. A leg
+   whose twists are dependent at the assembly only (independent at joint values near it: a crank
+   and its rod on one line, a dead centre) is refused, naming ``--initial``.
 5. **Output.** When every closure onto the platform meets it at one point (in a plane: on one line along the
    normal, wherever along their pins they are drawn) and joins it by every rotation about that point (ball
    joints; pins about the plane's normal in a planar mechanism),
@@ -228,19 +230,25 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
 
 
-def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]) -> None:
+def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int], q: NDArray) -> None:
     """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
     removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
     loop that closes it to 3e-7 rad, kept, gave the leg a fourth joint in its plane and its home no closure; the first
-    hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it."""
+    hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it. Twists that
+    are dependent at the assembly only (:func:`_check_not_stretched`) are refused, not locked."""
     model = tree.model
 
-    def rows(kept):
-        triples = [(kind, np.asarray(data.oMi[joint].rotation) @ axis, np.asarray(data.oMi[joint].translation))
+    def rows(kept, at=data, carry=None):
+        carry = np.eye(4) if carry is None else carry  # the loop's DoFs moved with the leg's end
+        triples = [(kind, np.asarray(at.oMi[joint].rotation) @ axis, np.asarray(at.oMi[joint].translation))
                    for joint in kept for kind, axis in [joint_kind(model, joint)]]
-        return _twists(triples + leg.loop_dofs, leg.successor_world[:3, 3], scale)
+        loop = [(kind, carry[:3, :3] @ axis, carry[:3, :3] @ point + carry[:3, 3])
+                for kind, axis, point in leg.loop_dofs]
+        return _twists(triples + loop, carry[:3, :3] @ leg.successor_world[:3, 3] + carry[:3, 3], scale)
 
     kept = list(leg.joints)
+    if not _independent(rows(kept), FILE_ROUNDING):
+        _check_not_stretched(tree, leg, q, scale, lambda at, carry: rows(kept, at, carry))
     while not _independent(current := rows(kept), FILE_ROUNDING):
         rank, best = np.linalg.matrix_rank(current, tol=FILE_ROUNDING), (0.0, None)
         for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
@@ -255,6 +263,37 @@ def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int]
     if not _independent(rows(kept)):
         raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
                            "its idle passive joints (its actuated joints are dependent at the assembly).")
+
+
+def _check_not_stretched(tree: ClosedTree, leg: _Leg, q: NDArray, scale: float, rows, samples: int = 4) -> None:
+    """Refuse a leg whose joint twists (``rows(data, carry)``: at the joint frames of ``data``, its loop's DoFs carried
+    by ``carry`` with the leg's end) are dependent at the assembly and independent at each of ``samples`` joint values
+    near it (every joint of the leg moved by up to 0.05 rad or 0.05 length scales, seeded): the leg is stretched or
+    folded there, as a crank and its rod on one line -- a dead centre, not an idle joint, which would stay dependent.
+    Locking a joint there would analyse another mechanism, and the working mode is not decided there."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model, rng = tree.model, np.random.default_rng(0)
+    end = leg.joints[-1] if leg.joints else 0
+    data, moved = model.createData(), model.createData()
+    pin.forwardKinematics(model, data, q)
+    for _ in range(samples):
+        v = np.zeros(model.nv)
+        for joint in leg.joints:
+            kind = joint_kind(model, joint)[0]
+            start, width = model.joints[joint].idx_v, model.joints[joint].nv
+            v[start:start + width] = rng.uniform(-1.0, 1.0, width) * (0.05 * scale if kind == "prismatic" else 0.05)
+        pin.forwardKinematics(model, moved, pin.integrate(model, q, v))
+        carry = homogeneous(moved.oMi[end]) @ np.linalg.inv(homogeneous(data.oMi[end]))
+        if not _independent(rows(moved, carry), FILE_ROUNDING):
+            return  # dependent away from the assembly too: idle joints, locked by the caller
+    names = ", ".join(model.names[joint] for joint in leg.joints)
+    remedy = ("--initial JOINT VALUE (an actuated joint away from its dead centre, held there while the loops close)"
+              + (", or a keyframe named 'home'" if tree.file_format == "MJCF" else ""))
+    raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} (joints {names}) is stretched or folded at "
+                       "the assembly: its joints' twists are dependent there and independent at joint values near it "
+                       "(a dead centre, such as a crank and its rod on one line), where the platform's motion and the "
+                       f"working mode are not decided; give joint values away from it: {remedy}.")
 
 
 def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
@@ -311,12 +350,12 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
-    report = ImportReport(source=tree.source, file_format=tree.file_format, unit=tree.unit)
+    report = ImportReport(source=tree.source, file_format=tree.file_format, unit=tree.unit, values=tree.start_phrase())
     report.gaps_before = closure_gaps(tree, tree.q_reference)
-    q, scale = assemble(tree)
+    q, scale = assemble(tree, held=tree.initial_joints())
     report.gaps_after = closure_gaps(tree, q)
     changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
-    report.notes.append(f"working mode: the closed configuration nearest to the file's joint values (the largest "
+    report.notes.append(f"working mode: the closed configuration nearest to {tree.start_phrase()} (the largest "
                         f"joint change {changes})")
     data = model.createData()
     pin.forwardKinematics(model, data, q)
@@ -388,7 +427,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
-        _lock_idle(tree, data, leg, scale, set(motor_ids))
+        _lock_idle(tree, data, leg, scale, set(motor_ids), q)
     axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report)
     absorbed = set()
     for closure in tree.closures:

@@ -7,6 +7,7 @@ They are read by :func:`screwkit.model.urdf_reader.parse_urdf`.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -119,6 +120,10 @@ class UrdfDescription:
     document : UrdfDocument or None
         The records a writer built this description from (:meth:`UrdfDocument.description`), which
         write :attr:`text` when it is asked for; None for a description read from a text.
+    converted_from : str
+        The format of the file of another tool this text was converted from (``"MJCF"``, ...; empty for a
+        file in screwkit's convention): its errors then name what the user wrote (a joint, a chain, an option),
+        not the elements of the text converted in memory (:meth:`fail`).
     """
 
     source: str
@@ -134,6 +139,7 @@ class UrdfDescription:
     output: str = "frame"
     read_text: str = field(default="", repr=False)
     document: Any = field(default=None, repr=False, compare=False)
+    converted_from: str = ""
 
     @cached_property
     def text(self) -> str:
@@ -142,10 +148,33 @@ class UrdfDescription:
         return self.document.text() if self.document is not None else self.read_text
 
     def fail(self, element: str, problem: str) -> ValueError:
-        """A one-line error naming this file, an element and a problem."""
-        return file_error(self.source, element, problem)
+        """A one-line error naming this file, an element and a problem (for a file of another tool, what the element
+        of the converted text stands for in it: :func:`as_written`)."""
+        return file_error(self.source, as_written(element) if self.converted_from else element, problem)
+
+
+CONVERTED_ELEMENTS = (
+    (re.compile(r"<robot name='[^']*'>"), lambda match: ""),
+    (re.compile(r"<output type='point'>"), lambda match: ""),  # (each message says "the output point")
+    (re.compile(r"<loop name='(.*)_loop'>"), lambda match: f"chain '{match.group(1)}'"),
+    (re.compile(r"<loop name='(.*)'>"), lambda match: f"closure '{match.group(1)}'"),
+    (re.compile(r"<transmission name='(.*)_transmission'>"), lambda match: f"actuated joint '{match.group(1)}'"),
+)
+"""The elements of a text converted from a file of another tool (:mod:`screwkit.io.star` writes them) and what they
+stand for in that file; any other is named as it is (a ``<joint>``, and a URDF source's ``<task_coordinates>``, are
+the file's own)."""
+
+
+def as_written(element: str) -> str:
+    """``element`` of a converted text named as the file of another tool has it (:data:`CONVERTED_ELEMENTS`)."""
+    for pattern, named in CONVERTED_ELEMENTS:
+        match = pattern.fullmatch(element)
+        if match:
+            return named(match)
+    return element
 
 
 def file_error(source: str, element: str, problem: str) -> ValueError:
-    """``ValueError("<file>: <element>: <problem>")``, the form of every URDF error."""
-    return ValueError(f"{source}: {element}: {problem}")
+    """``ValueError("<file>: <element>: <problem>")``, the form of every URDF error (``<file>: <problem>`` when no
+    element is named)."""
+    return ValueError(f"{source}: {element}: {problem}" if element else f"{source}: {problem}")

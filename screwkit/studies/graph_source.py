@@ -26,6 +26,7 @@ class GraphSource:
     lock: tuple[str, ...] = ()
     actuate: tuple[str, ...] = ()
     length_unit: str | None = None
+    initial: tuple[tuple[str, float], ...] = ()
 
 
 @functools.lru_cache(maxsize=4)
@@ -38,11 +39,12 @@ def cached_graph(source: GraphSource) -> GraphMechanism:
     if hashlib.sha256(data).hexdigest() != source.digest:
         raise ValueError(f"{source.path}: the file changed while the map was computed.")
     return graph_mechanism(read_closed_tree(Path(source.path), output=source.output, output_type=source.output_type,
-                                            lock=source.lock, actuate=source.actuate, length_unit=source.length_unit))
+                                            lock=source.lock, actuate=source.actuate, length_unit=source.length_unit,
+                                            initial=source.initial))
 
 
 def graph_source(graph: GraphMechanism) -> GraphSource:
     """What a task elsewhere needs to rebuild ``graph`` as read (:func:`cached_graph`)."""
     digest = hashlib.sha256(Path(graph.tree.source).read_bytes()).hexdigest()
     return GraphSource(str(graph.tree.source), graph.tree.output, graph.tree.output_type, digest, graph.tree.locked,
-                       graph.tree.actuated, graph.tree.length_unit)
+                       graph.tree.actuated, graph.tree.length_unit, graph.tree.initial)
