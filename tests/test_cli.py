@@ -190,7 +190,6 @@ def test_list_names_the_bundled_robots():
                                      "sweep,", "map,", "trajectory,", "view)"]
 
 
-
 def test_python_dash_m_screwkit_is_the_command():
     """``python -m screwkit`` runs the command line, as ``python -m screwkit.cli`` and the ``screwkit`` script do."""
     package = subprocess.run([sys.executable, "-W", "error", "-m", "screwkit", "list"], capture_output=True,
@@ -200,6 +199,7 @@ def test_python_dash_m_screwkit_is_the_command():
     wrong = subprocess.run([sys.executable, "-m", "screwkit", "analyze", "no_such_robot"], capture_output=True,
                            text=True, timeout=120)
     assert wrong.returncode == 1 and "Unknown bundled mechanism 'no_such_robot'" in wrong.stderr
+
 
 def test_console_entry_point_exits_with_the_status_and_complete_output(tmp_path):
     """main() ends the process without the interpreter's teardown: nothing may be lost."""

@@ -190,6 +190,9 @@ def test_an_initial_slide_is_in_metres_whatever_the_file_s_unit(tmp_path, scale,
     with pytest.raises(ImportError_, match=r"the loops cannot be closed with --initial crank 30, --initial slider "
                                            r"0\.01 held \(the file's values for the other joints\)"):
         load(path, output="slider", length_unit=unit, initial=[("crank", crank), ("slider", 0.01)])
+    tree = read_closed_tree(path, output="slider", length_unit=unit, initial=[("slider", 0.01)])  # a graph's reading
+    slide = tree.model.joints[tree.model.getJointId("slider")].idx_q
+    assert tree.unit == "m" and tree.q_reference[slide] == pytest.approx(0.01, abs=1e-15)  # the file in metres
 
 
 def test_a_file_in_screwkits_convention_at_its_dead_centre_names_the_stretched_chain(tmp_path):
@@ -242,13 +245,46 @@ def test_a_ball_joint_cannot_be_given_an_initial_value(tmp_path):
 
 
 def test_lock_holds_a_joint_at_its_initial_value(tmp_path):
-    """--lock after --initial: the crank held where --initial put it (the rocker then the platform's only motion left,
-    driven by nothing: refused as such, with the crank at 20 deg in the locked tree)."""
+    """--lock after --initial: the crank merged into the base where --initial put it, so the rod hangs from the
+    crank's pin at 20 deg (at 0 deg before --initial was taken into account)."""
     path = written(tmp_path, four_bar())
     tree = read_closed_tree(path, output="foot", initial=[("crank", 20.0)], lock=["crank"], actuate=["rod"])
-    assert "crank" not in [str(name) for name in tree.model.names]
+    model = tree.model
+    assert "crank" not in [str(name) for name in model.names]
     assert tree.initial == (("crank", 20.0),) and tree.initial_joints() == []
-    assert any("locked at their values in the file (--lock)" in note for note in tree.notes)
+    hinge = np.asarray(model.jointPlacements[model.getJointId("rod")].translation)[:2]
+    assert hinge == pytest.approx(CRANK * np.array([np.cos(np.radians(20.0)), np.sin(np.radians(20.0))]), abs=1e-12)
+    assert any("locked at their values in the file (crank at its --initial value) (--lock)" in note
+               for note in tree.notes)
+
+
+def test_an_idle_joint_beside_a_dead_centre_does_not_hide_it(tmp_path):
+    """A second hinge coaxial with the rod's (an idle joint, dependent at every configuration) on the four-bar at its
+    dead centre: the leg's twists span less there than near it, so it is refused as stretched (it was locked down to
+    the dead centre's rank and refused as "DOF 0"); given the crank, only the idle hinge is locked."""
+    path = written(tmp_path, four_bar().replace('<joint name="rod" type="hinge" axis="0 0 1"/>',
+                                                '<joint name="rod" type="hinge" axis="0 0 1"/><joint name="rod2" '
+                                                'type="hinge" axis="0 0 1"/>'))
+    for output_type in ("point", "frame"):
+        with pytest.raises(ImportError_, match=r"the leg closed by 'connect_1' \(joints crank, rod, rod2\) is "
+                                               r"stretched or folded at the assembly"):
+            load(path, output="foot", output_type=output_type)
+    mechanism = load(path, output="foot", output_type="frame", initial=[("crank", 20.0)])
+    assert mechanism.chains[0].joint_names == ("crank", "rod", "crank_loop")
+    assert indices_at_home(mechanism).iti[0] == pytest.approx(four_bar_closed_form(20.0)["iti"], abs=1e-9)
+
+
+def test_the_platform_body_s_own_path_stretched_is_named_so(tmp_path):
+    """The coupler's tip hinged at the rod's end, carrying the connect and the output: the platform's own path (crank,
+    rod, wrist) is the stretched one, named as such (it was "the leg closed by ''")."""
+    path = written(tmp_path, four_bar().replace('<site name="rod_end" pos="0.3 0.0 0.0"/>',
+                                                '<body name="tip" pos="0.3 0.0 0.0"><joint name="wrist" type="hinge" '
+                                                'axis="0 0 1"/><geom type="sphere" size="0.01"/><site name="rod_end" '
+                                                'pos="0 0 0"/></body>'))
+    assert 'name="wrist"' in path.read_text()
+    with pytest.raises(ImportError_, match=r"the platform body's own path \(joints crank, rod, wrist\) is stretched or "
+                                           r"folded at the assembly"):
+        load(path, output="tip", output_type="frame")
 
 
 def test_a_graph_rebuilt_elsewhere_keeps_its_initial_values(tmp_path):
@@ -289,10 +325,15 @@ def test_the_command_line_takes_initial_values_converts_and_refuses_in_one_line(
     one_line_error(wrong, "the loops cannot be closed with --initial crank 80 held")
     limited = written(tmp_path, four_bar().replace('name="foot" type="hinge"', 'name="foot" type="hinge" '
                                                    'range="5 40"'), "limited.xml")
+    hint = ("--initial JOINT VALUE on this joint (5 to 40 deg) or on the one driving it, in place of another value "
+            "given, starts the assembly inside them")
     one_line_error(screwkit("analyze", limited, "--output", "foot", "--initial", "crank", "20"),
-                   "<joint name='foot'>: the reference assembly puts the joint at 0.0702626, outside its limits",
-                   "--initial foot VALUE (deg for a revolute joint, m for a prismatic one) starts the assembly inside "
-                   "them")
+                   "<joint name='foot'>: the reference assembly puts the joint at 0.0702626, outside its limits", hint)
+    refused = one_line_error(screwkit("convert", limited, tmp_path / "limited.urdf", "--output", "foot", "--initial",
+                                      "crank", "20"), "<joint name='foot'>: the reference assembly", hint)
+    assert not (tmp_path / "limited.urdf").exists() and "<output" not in refused
+    opened = screwkit("analyze", limited, "--output", "foot", "--initial", "crank", "60", "--json")
+    assert opened.returncode == 0, opened.stderr
 
 
 PINOCCHIO_CASSIE = Path(__file__).parent / "data/gallery/published/pinocchio_closed_chain/closed_chain.xml"

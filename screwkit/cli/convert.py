@@ -61,7 +61,8 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
                                   planar=own.is_planar, motors=list(own.actuator_names))
             report.notes = [f"assembled: {note}" for note in own.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)
                             ] or ["every loop closes as written"]  # (the others: below, from the file written)
-        mechanism = load_text(text, str(source), limits=not ignore_limits)  # what is written must load
+        mechanism = load_text(text, str(source), limits=not ignore_limits,  # what is written must load
+                              converted_from=report.file_format if is_foreign(source) else "")
     except (ImportError_, ValueError) as error:
         raise fail(str(error)) from None
     still_open = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]

@@ -41,10 +41,10 @@ ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the 
                 "instead of those the file marks or screwkit guesses (listed, as ever, in the legs' order).")
 
 
-INITIAL_HELP = ("For a file of another tool: start the reference assembly with this joint at VALUE (deg for a revolute "
-              "joint, m for a prismatic one) instead of the file's value, held there while the loops close "
-              "(repeatable): a file written at a dead centre (a crank and its rod on one line) or with a joint "
-              "outside its limits; --lock then holds the joint at VALUE.")
+INITIAL_HELP = ("For a file of another tool: start the reference assembly with this joint at VALUE (deg for a "
+                "revolute joint, m for a prismatic one) instead of the file's value, held there while the loops close "
+                "(repeatable): a file written at a dead centre (a crank and its rod on one line) or with a joint "
+                "outside its limits; --lock then holds the joint at VALUE.")
 
 
 def lock_option(function: Callable) -> Callable:

@@ -148,8 +148,9 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
                  f"limits [{_tidy(lower)}, {_tidy(upper)}]")
         if limits:
             name = chain.joint_names[outside]
-            start = (f"; --initial {name} VALUE (deg for a revolute joint, m for a prismatic one) starts the assembly "
-                     "inside them" if description.converted_from else "")
+            degrees = "" if chain.prismatic[outside] else f" ({np.degrees(lower):.6g} to {np.degrees(upper):.6g} deg)"
+            start = (f"; --initial JOINT VALUE on this joint{degrees} or on the one driving it, in place of another "
+                     "value given, starts the assembly inside them" if description.converted_from else "")
             raise description.fail(f"<joint name='{name}'>",
                                    f"{where} (--ignore-limits, or limits=False, reads it all the same{start}).")
         limit_note = f"{LIMITS_IGNORED}joint {chain.joint_names[outside]!r}: {where}"
@@ -352,7 +353,7 @@ def _mode_samples(mechanism: Mechanism, poses, values):
             [np.concatenate([batch[1][k] for batch in batches]) for k in range(len(chains))])
 
 
-def _check_not_at_dead_centre(mechanism: Mechanism) -> None:
+def _check_not_at_dead_centre(mechanism: Mechanism, mobility: int) -> None:
     """Refuse a platform that cannot move at the reference assembly because a chain is stretched or folded there (a
     crank and its rod on one line: the platform at the end of its travel), naming the chains and how to give joint
     values away from it; a platform that cannot move with every chain regular is left to the caller's refusal."""
@@ -365,7 +366,7 @@ def _check_not_at_dead_centre(mechanism: Mechanism) -> None:
                                                       if description.converted_from == "MJCF" else "")
               if description.converted_from else "write its <reference_configuration> away from it")
     raise description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move at the reference assembly "
-                           f"(DOF {mechanism.dof}) because chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
+                           f"(DOF {mobility}) because chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
                            f"{'are' if len(chains) > 1 else 'is'} stretched or folded there (its joints' twists span "
                            "less than at joint values near it: a dead centre, such as a crank and its rod on one "
                            f"line), where the working mode is not decided; {remedy}.")
@@ -421,7 +422,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                                   instantaneous)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
     if mobility < 1:
-        _check_not_at_dead_centre(mechanism)
+        _check_not_at_dead_centre(mechanism, mobility)
     if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")

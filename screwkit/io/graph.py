@@ -479,7 +479,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                else f"{type(tree).__name__}")
         raise TypeError(f"graph_mechanism expects a ClosedTree (from screwkit.io.read_closed_tree), got {got}.")
     model = tree.model
-    report = ImportReport(source=tree.source, file_format=tree.file_format)
+    report = ImportReport(source=tree.source, file_format=tree.file_format, values=tree.start_phrase())
     at_file = q is None or scale is None
     if at_file:
         q, scale = assemble(tree, held=tree.initial_joints())

@@ -165,9 +165,8 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
                                                     actuate=actuate, length_unit=length_unit, initial=initial)
-            description = replace(parse_urdf(converted, str(path), length_unit=length_unit),
+            mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
                                   converted_from=report.file_format)
-            mechanism = mechanism_from_description(description, limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
     if output is not None or output_type is not None or lock or actuate or initial:
         raise ValueError(f"{path}: an output frame or type, locked, actuated or initial joints named apart from the "
@@ -188,12 +187,18 @@ def _content(path: Path, max_bytes: int) -> bytes | None:
         return None
 
 
-def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None, limits: bool = True) -> Mechanism:
-    """Load a mechanism from the text of a URDF (``source`` names it in messages; ``limits``: as :func:`load`)."""
+def load_text(text: str, source: str = "<string>", *, length_unit: str | None = None, limits: bool = True,
+              converted_from: str = "") -> Mechanism:
+    """Load a mechanism from the text of a URDF (``source`` names it in messages; ``limits``: as :func:`load`;
+    ``converted_from``: the format of the file of another tool ``source`` is, whose conversion ``text`` is, so that
+    messages name what that file has, :attr:`~screwkit.model.urdf_description.UrdfDescription.converted_from`)."""
     if not isinstance(text, (str, bytes, bytearray, memoryview)):
         hint = ": a file or a bundled name is opened by screwkit.load(path)" if isinstance(text, os.PathLike) else ""
         raise TypeError(f"load_text expects the text of a URDF (str or bytes), got {type(text).__name__}{hint}.")
-    return mechanism_from_description(parse_urdf(text, source, length_unit=length_unit), limits=limits)
+    description = parse_urdf(text, source, length_unit=length_unit)
+    if converted_from:
+        description = replace(description, converted_from=converted_from)
+    return mechanism_from_description(description, limits=limits)
 
 
 @functools.lru_cache(maxsize=8)

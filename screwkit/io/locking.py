@@ -69,8 +69,11 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     kept = [joint for joint in range(1, model.njoints) if joint not in locked]
     q = np.concatenate([tree.q_reference[model.joints[j].idx_q:model.joints[j].idx_q + model.joints[j].nq]
                         for j in kept]) if kept else np.zeros(0)
-    notes = [f"joints {', '.join(names)} locked at their values in the file (--lock): the legs analysed on the body "
-             "they turn"] + moved
+    given = [name for name in names if name in dict(tree.initial)]
+    values = (f"values in the file ({', '.join(given)} at {'its' if len(given) == 1 else 'their'} --initial value"
+              f"{'' if len(given) == 1 else 's'})" if given else "values in the file")
+    notes = [f"joints {', '.join(names)} locked at their {values} (--lock): the legs analysed on the body they turn"
+             ] + moved
     motors = [motor for motor in tree.motors if motor not in names]
     guessed = [k for k, note in enumerate(tree.notes) if note.startswith(GUESSED)]
     other = [note for k, note in enumerate(tree.notes) if k not in guessed]

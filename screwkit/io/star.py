@@ -69,6 +69,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import compound_legs
+from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
 from screwkit.io.star_writing import (
@@ -85,29 +86,8 @@ from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
 
-INDEPENDENCE_TOLERANCE = 1e-9
-"""Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
-largest, for them to count as independent (as :data:`screwkit.common.tolerances.MOTION_SPACE_TOLERANCE`)."""
-
 
 # -- the star --------------------------------------------------------------------------------------
-
-
-def _twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
-    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples."""
-    rows = []
-    for kind, axis, point in axis_kinds:
-        row = np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else \
-            np.concatenate([axis, np.cross(point - centre, axis) / scale])
-        rows.append(row / np.linalg.norm(row))
-    return np.array(rows).reshape(-1, 6)
-
-
-def _independent(rows: NDArray, tolerance: float = INDEPENDENCE_TOLERANCE) -> bool:
-    if rows.shape[0] == 0:
-        return True
-    singular = np.linalg.svd(rows, compute_uv=False)
-    return rows.shape[0] <= 6 and singular[-1] > tolerance * singular[0]
 
 
 @dataclass
@@ -228,72 +208,6 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
             lengths.append(float(part[:slides].max()))
         angles.append(float(part[slides:].max(initial=0.0)))
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
-
-
-def _lock_idle(tree: ClosedTree, data, leg: _Leg, scale: float, motors: set[int], q: NDArray) -> None:
-    """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
-    removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
-    loop that closes it to 3e-7 rad, kept, gave the leg a fourth joint in its plane and its home no closure; the first
-    hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it. Twists that
-    are dependent at the assembly only (:func:`_check_not_stretched`) are refused, not locked."""
-    model = tree.model
-
-    def rows(kept, at=data, carry=None):
-        carry = np.eye(4) if carry is None else carry  # the loop's DoFs moved with the leg's end
-        triples = [(kind, np.asarray(at.oMi[joint].rotation) @ axis, np.asarray(at.oMi[joint].translation))
-                   for joint in kept for kind, axis in [joint_kind(model, joint)]]
-        loop = [(kind, carry[:3, :3] @ axis, carry[:3, :3] @ point + carry[:3, 3])
-                for kind, axis, point in leg.loop_dofs]
-        return _twists(triples + loop, carry[:3, :3] @ leg.successor_world[:3, 3] + carry[:3, 3], scale)
-
-    kept = list(leg.joints)
-    if not _independent(rows(kept), FILE_ROUNDING):
-        _check_not_stretched(tree, leg, q, scale, lambda at, carry: rows(kept, at, carry))
-    while not _independent(current := rows(kept), FILE_ROUNDING):
-        rank, best = np.linalg.matrix_rank(current, tol=FILE_ROUNDING), (0.0, None)
-        for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
-            trial = np.linalg.svd(rows([j for j in kept if j != joint]), compute_uv=False)
-            margin = trial[rank - 1] / trial[0] if trial.size >= rank else 0.0
-            if margin > FILE_ROUNDING and margin > best[0] * (1.0 + 1e-6):
-                best = (margin, joint)
-        if best[1] is None:
-            break
-        kept.remove(best[1])
-        leg.locked.append(best[1])
-    if not _independent(rows(kept)):
-        raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
-                           "its idle passive joints (its actuated joints are dependent at the assembly).")
-
-
-def _check_not_stretched(tree: ClosedTree, leg: _Leg, q: NDArray, scale: float, rows, samples: int = 4) -> None:
-    """Refuse a leg whose joint twists (``rows(data, carry)``: at the joint frames of ``data``, its loop's DoFs carried
-    by ``carry`` with the leg's end) are dependent at the assembly and independent at each of ``samples`` joint values
-    near it (every joint of the leg moved by up to 0.05 rad or 0.05 length scales, seeded): the leg is stretched or
-    folded there, as a crank and its rod on one line -- a dead centre, not an idle joint, which would stay dependent.
-    Locking a joint there would analyse another mechanism, and the working mode is not decided there."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    model, rng = tree.model, np.random.default_rng(0)
-    end = leg.joints[-1] if leg.joints else 0
-    data, moved = model.createData(), model.createData()
-    pin.forwardKinematics(model, data, q)
-    for _ in range(samples):
-        v = np.zeros(model.nv)
-        for joint in leg.joints:
-            kind = joint_kind(model, joint)[0]
-            start, width = model.joints[joint].idx_v, model.joints[joint].nv
-            v[start:start + width] = rng.uniform(-1.0, 1.0, width) * (0.05 * scale if kind == "prismatic" else 0.05)
-        pin.forwardKinematics(model, moved, pin.integrate(model, q, v))
-        carry = homogeneous(moved.oMi[end]) @ np.linalg.inv(homogeneous(data.oMi[end]))
-        if not _independent(rows(moved, carry), FILE_ROUNDING):
-            return  # dependent away from the assembly too: idle joints, locked by the caller
-    names = ", ".join(model.names[joint] for joint in leg.joints)
-    remedy = ("--initial JOINT VALUE (an actuated joint away from its dead centre, held there while the loops close)"
-              + (", or a keyframe named 'home'" if tree.file_format == "MJCF" else ""))
-    raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} (joints {names}) is stretched or folded at "
-                       "the assembly: its joints' twists are dependent there and independent at joint values near it "
-                       "(a dead centre, such as a crank and its rod on one line), where the platform's motion and the "
-                       f"working mode are not decided; give joint values away from it: {remedy}.")
 
 
 def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
@@ -427,7 +341,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
-        _lock_idle(tree, data, leg, scale, set(motor_ids), q)
+        lock_idle(tree, data, leg, scale, set(motor_ids), q)
     axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report)
     absorbed = set()
     for closure in tree.closures:

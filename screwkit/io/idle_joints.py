@@ -1,0 +1,115 @@
+"""Idle joints of a leg, and legs stretched or folded at the assembly (:mod:`screwkit.io.star`, step 4).
+
+A leg whose joint twists are dependent at the assembly has an idle joint (a second pin coaxial with the closure's,
+the spin of an S-S rod), which :func:`lock_idle` locks, or it is stretched or folded there (a crank and its rod on
+one line: a dead centre), which :func:`check_not_stretched` refuses: the twists of an idle joint stay as dependent at
+joint values near the assembly, those of a dead centre do not.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.common.tolerances import FILE_ROUNDING
+from screwkit.io.closed_tree import ClosedTree, ImportError_, homogeneous, joint_kind
+
+__all__ = ["INDEPENDENCE_TOLERANCE", "joint_twists", "independent", "lock_idle", "check_not_stretched"]
+
+INDEPENDENCE_TOLERANCE = 1e-9
+"""Smallest singular value of a leg's unit joint twists (working coordinates), relative to the
+largest, for them to count as independent (as :data:`screwkit.common.tolerances.MOTION_SPACE_TOLERANCE`)."""
+
+
+def joint_twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
+    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples."""
+    rows = []
+    for kind, axis, point in axis_kinds:
+        row = np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else \
+            np.concatenate([axis, np.cross(point - centre, axis) / scale])
+        rows.append(row / np.linalg.norm(row))
+    return np.array(rows).reshape(-1, 6)
+
+
+def independent(rows: NDArray, tolerance: float = INDEPENDENCE_TOLERANCE) -> bool:
+    """Whether twist rows are independent: at most six, the smallest singular value above ``tolerance`` times the
+    largest."""
+    if rows.shape[0] == 0:
+        return True
+    singular = np.linalg.svd(rows, compute_uv=False)
+    return rows.shape[0] <= 6 and singular[-1] > tolerance * singular[0]
+
+
+def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: NDArray) -> None:
+    """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
+    removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
+    loop that closes it to 3e-7 rad, kept, gave the leg a fourth joint in its plane and its home no closure; the first
+    hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it. Twists that
+    are dependent at the assembly only (:func:`check_not_stretched`) are refused, not locked."""
+    model = tree.model
+
+    def rows(kept, at=data, carry=None):
+        carry = np.eye(4) if carry is None else carry  # the loop's DoFs moved with the leg's end
+        triples = [(kind, np.asarray(at.oMi[joint].rotation) @ axis, np.asarray(at.oMi[joint].translation))
+                   for joint in kept for kind, axis in [joint_kind(model, joint)]]
+        loop = [(kind, carry[:3, :3] @ axis, carry[:3, :3] @ point + carry[:3, 3])
+                for kind, axis, point in leg.loop_dofs]
+        return joint_twists(triples + loop, carry[:3, :3] @ leg.successor_world[:3, 3] + carry[:3, 3], scale)
+
+    kept = list(leg.joints)
+    if not independent(rows(kept), FILE_ROUNDING):
+        check_not_stretched(tree, leg, q, scale, lambda at, carry: rows(kept, at, carry))
+    while not independent(current := rows(kept), FILE_ROUNDING):
+        rank, best = np.linalg.matrix_rank(current, tol=FILE_ROUNDING), (0.0, None)
+        for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
+            trial = np.linalg.svd(rows([j for j in kept if j != joint]), compute_uv=False)
+            margin = trial[rank - 1] / trial[0] if trial.size >= rank else 0.0
+            if margin > FILE_ROUNDING and margin > best[0] * (1.0 + 1e-6):
+                best = (margin, joint)
+        if best[1] is None:
+            break
+        kept.remove(best[1])
+        leg.locked.append(best[1])
+    if not independent(rows(kept)):
+        raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
+                           "its idle passive joints (its actuated joints are dependent at the assembly).")
+
+
+def check_not_stretched(tree: ClosedTree, leg, q: NDArray, scale: float, rows, samples: int = 4) -> None:
+    """Refuse a leg whose joint twists (``rows(data, carry)``: at the joint frames of ``data``, its loop's DoFs carried
+    by ``carry`` with the leg's end) span less at the assembly than at each of ``samples`` joint values near it (every
+    joint of the leg moved by up to 0.05 rad or 0.05 length scales, seeded): the leg is stretched or folded there, as
+    a crank and its rod on one line -- a dead centre, where an idle joint (a pin coaxial with another, an S-S rod's
+    spin) keeps the rank it has, with a dead centre or without. Locking a joint there would analyse another
+    mechanism, and the working mode is not decided there."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model, rng = tree.model, np.random.default_rng(0)
+    end = leg.joints[-1] if leg.joints else 0
+    data, moved = model.createData(), model.createData()
+    pin.forwardKinematics(model, data, q)
+    at = _rank(rows(data, np.eye(4)))
+    for _ in range(samples):
+        v = np.zeros(model.nv)
+        for joint in leg.joints:
+            kind = joint_kind(model, joint)[0]
+            start, width = model.joints[joint].idx_v, model.joints[joint].nv
+            v[start:start + width] = rng.uniform(-1.0, 1.0, width) * (0.05 * scale if kind == "prismatic" else 0.05)
+        pin.forwardKinematics(model, moved, pin.integrate(model, q, v))
+        carry = homogeneous(moved.oMi[end]) @ np.linalg.inv(homogeneous(data.oMi[end]))
+        if _rank(rows(moved, carry)) <= at:
+            return  # as dependent away from the assembly: idle joints, locked by the caller
+    names = ", ".join(model.names[joint] for joint in leg.joints)
+    which = f"the leg closed by {leg.closure!r}" if leg.closure else "the platform body's own path"
+    remedy = ("--initial JOINT VALUE (an actuated joint away from its dead centre, held there while the loops close)"
+              + (", or a keyframe named 'home'" if tree.file_format == "MJCF" else ""))
+    raise ImportError_(f"{tree.source}: {which} (joints {names}) is stretched or folded at the assembly: its joints' "
+                       "twists span less there than at joint values near it (a dead centre, such as a crank and its "
+                       "rod on one line), where the platform's motion and the working mode are not decided; give "
+                       f"joint values away from it: {remedy}.")
+
+
+def _rank(rows: NDArray) -> int:
+    """The rank of twist rows, to the file's rounding (relative to the largest singular value)."""
+    singular = np.linalg.svd(rows, compute_uv=False) if rows.size else np.zeros(0)
+    return int(np.sum(singular > FILE_ROUNDING * singular[0])) if singular.size else 0
