@@ -380,3 +380,30 @@ def moving(model, data, joint: str, point):
     index = model.joint(joint).id
     moved = np.cross(data.xaxis[index], point - data.xanchor[index])
     return moved / np.linalg.norm(moved)
+
+
+def test_a_rod_delta_drawn_with_a_forearm_in_line_with_its_arm_opens_with_that_motor_given(tmp_path):
+    """A Delta of ball-jointed rods (a closed-loop graph) drawn with leg 4's rods in line with its arm: refused as
+    written at a singular configuration of that leg, now with the way out; given motor_4 at -10 deg, the graph
+    assembles there (MuJoCo's own reading: every connect closed, the motor where it was given) and its leg 4
+    transmits again."""
+    from delta_rods import ARM, BASE, PLATFORM, ROD, delta_rods_mjcf
+    from test_gallery import mujoco_residuals
+    from test_gallery_published import mujoco_qpos
+
+    turn = np.radians(105.0)  # leg 4 (azimuth 0) stretched, the arm pointing down and inwards
+    centre = (BASE - PLATFORM + (ARM + ROD) * np.cos(turn), 0.0, -(ARM + ROD) * np.sin(turn))
+    path = written(tmp_path, delta_rods_mjcf(centre), "delta.xml")
+    with pytest.raises(ImportError_, match=r"delta\.xml: locking actuated joint 'motor_4' leaves the platform of leg "
+                                           r"'arm_4' as free as before at the file's joint values, .* singular "
+                                           r"configuration of the leg .*--initial JOINT VALUE"):
+        graph_mechanism(read_closed_tree(path))
+    graph = graph_mechanism(read_closed_tree(path, initial=[("motor_4", -10.0)]))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    data.qpos[:] = mujoco_qpos(graph.tree, model, graph.q)
+    mujoco.mj_kinematics(model, data)
+    assert max(np.abs(gap).max() for gap in mujoco_residuals(model, data).values()) < 1e-9
+    assert data.qpos[model.joint("motor_4").qposadr[0]] == pytest.approx(np.radians(-10.0), abs=1e-12)
+    result = graph.indices()
+    assert graph.dof == 3 and result.iti_actuators[3] > 0.05

@@ -361,7 +361,9 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None
                                    f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
                                    "away at closed configurations near them: the file is written at a singular "
                                    "configuration of the leg (its links on one line, stretched or folded); give "
-                                   "joint values away from it (a keyframe, the joints' initial values).")
+                                   "joint values away from it: --initial JOINT VALUE (an actuated joint away from its "
+                                   "dead centre, held there while the loops close), or a keyframe named 'home' "
+                                   "(MJCF).")
             raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
                                f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
