@@ -340,6 +340,26 @@ def test_cassie_needs_its_output_named_and_is_refused_for_its_transmissions():
     assert_refusal_documented(error)
 
 
+CASSIE_LEFT_LEG = ("cassie-pelvis_free", "left-hip-roll", "left-hip-yaw", "left-hip-pitch", "left-knee", "left-shin",
+                   "left-tarsus")
+"""The joints Cassie's refusals name one after the other, down to the left ankle."""
+
+
+def test_cassie_with_its_left_leg_held_drives_its_foot_directly_the_other_leg_s_motors_left_out():
+    """Held down to the ankle, the left foot is on its own hinge, which the file's foot motor drives (Menagerie puts
+    the motor on the foot joint, the plantar rod a passive chain that spans every planar motion): a direct drive,
+    whose actuation wrench is the couple about the hinge and whose output twist is that hinge's rotation, so ITI =
+    OTI = 1. The other leg's five motors reach no leg and are left out, said (they refused it as a closed-loop
+    transmission)."""
+    mechanism = load(CASSIE, output="left-foot", output_type="frame", lock=CASSIE_LEFT_LEG)
+    report = "\n".join(mechanism.import_report)
+    assert ("actuated joints right-hip-roll, right-hip-yaw, right-hip-pitch, right-knee, right-foot on branches that "
+            "reach no leg: left out (they do not move the platform)") in report
+    assert mechanism.actuator_names == ("left-foot:left-foot",) and mechanism.dof == 1
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert result.iti == pytest.approx(1.0, abs=1e-12) and result.lmti == pytest.approx(1.0, abs=1e-12)
+
+
 def test_reachy_mini_with_its_yaw_stage_locked_gives_the_leg_line_indices_of_its_stewart_head(tmp_path):
     """``--lock yaw_body`` holds the turntable every leg stands on: six R-S-S legs remain (a crank motor, a rod
     ball-jointed at both ends; leg 6 carries the head on its rod's far ball). Each leg's actuation wrench is the

@@ -68,7 +68,7 @@ from screwkit.io.closed_tree import (
     joint_value,
     path_to,
 )
-from screwkit.io.compound import compound_legs
+from screwkit.io.compound import compound_groups, compound_legs
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
@@ -313,13 +313,18 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                                    "loop inside a leg (a parallelogram of rods, a transmission), which screwkit "
                                    "cannot write as serial legs" + GRAPH_HINT + stage + ".")
             owner[joint] = leg.closure
-    motor_ids = {}
+    motor_ids, idle_motors = {}, []
+    joined = {c.name for members, group in compound_groups(model, [leg.joints for leg in legs], couplings) if members
+              for c in group}  # closures that reach a leg
     for name in tree.motors:
         if not model.existJointName(name):
             raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is not a joint of the tree.")
         joint = model.getJointId(name)
         if joint not in owner:
             through = [c.name for c in couplings if joint in path_to(model, c.joint_a) + path_to(model, c.joint_b)]
+            if name not in tree.actuated and not joined.intersection(through):
+                idle_motors.append(name)  # a motor of another limb (a humanoid's other leg): no leg, no platform
+                continue
             if through:
                 raise ImportError_(f"{tree.source}: {tree.motor_label(name)} drives through closure {through[0]!r}, "
                                    "which ends on another leg's link, not on the platform (a closed-loop "
@@ -328,6 +333,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is on no leg (a leg is a tree path from the "
                                "base to the platform or to a closure).")
         motor_ids[joint] = name
+    if idle_motors:
+        report.notes.append(f"actuated joints {', '.join(idle_motors)} on branches that reach no leg: left out (they "
+                            "do not move the platform)")
     normal = _planar_normal(tree, data, legs)
     if normal is not None:
         _planar_loops(legs, normal)
