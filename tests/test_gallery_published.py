@@ -351,6 +351,11 @@ def test_cassie_with_its_left_leg_held_drives_its_foot_directly_the_other_leg_s_
     whose actuation wrench is the couple about the hinge and whose output twist is that hinge's rotation, so ITI =
     OTI = 1. The other leg's five motors reach no leg and are left out, said (they refused it as a closed-loop
     transmission)."""
+    with pytest.raises(ImportError_) as error:  # the base held, the refusal names the rest at once, in turn
+        graph_mechanism(read_closed_tree(CASSIE, output="left-foot", lock=CASSIE_LEFT_LEG[:1]))
+    assert str(error.value).endswith(f"joints {', '.join(CASSIE_LEFT_LEG[1:])} carry every actuator of it in turn (a "
+                                     "serial stage before the parallel part): --lock "
+                                     f"{' --lock '.join(CASSIE_LEFT_LEG[1:])} analyses the legs on the body they turn.")
     mechanism = load(CASSIE, output="left-foot", output_type="frame", lock=CASSIE_LEFT_LEG)
     report = "\n".join(mechanism.import_report)
     assert ("actuated joints right-hip-roll, right-hip-yaw, right-hip-pitch, right-knee, right-foot on branches that "

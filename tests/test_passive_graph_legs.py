@@ -190,6 +190,15 @@ def test_the_command_poses_the_ankle_by_its_task_coordinates(tmp_path):
     assert np.linalg.norm(sole - graph.frame_pose()[:3]) > 1e-3  # the sole moved: its position is no task coordinate
     one_line_error(screwkit("analyze", path, "--output", "sole", "--pose", "1 2 3 4"), "ankle.xml: ",
                    "--pose takes its task coordinates roll pitch (m, deg), or the output frame's x y z")
+    home = dict(zip(("roll", "pitch"), np.degrees(graph.home_pose)))  # the foot drawn level: 0 and 0
+    assert home == pytest.approx({"roll": 0.0, "pitch": 0.0}, abs=1e-9)
+    one_line_error(screwkit("analyze", path, "--output", "sole", "--pose", "90 80"), "ankle.xml: no closed "
+                   "configuration reached from the file's by continuation puts the output frame at (roll=90 deg, "
+                   "pitch=80 deg); the file's configuration has it at (roll=0 deg, pitch=0 deg).")
+    text = screwkit("analyze", path, "--output", "sole")  # the text names where the file's configuration is too
+    assert text.returncode == 0, text.stderr
+    assert text.stdout.splitlines()[0] == "ankle: 2 actuators, 2 DOF (no redundancy), at the file's configuration " \
+                                          "(roll = 0, pitch = 0)"
 
 
 def test_a_floating_ankle_names_its_free_joint_and_locked_there_is_the_fixed_one(tmp_path):

@@ -57,11 +57,14 @@ def _grounded(lines) -> str | None:
 
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
-    pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items()) or "the file's configuration"
+    pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
+    if report.get("at_file"):  # a graph at the file's configuration: where its output frame is there
+        pose = f"the file's configuration ({pose})" if pose else "the file's configuration"
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
     guessed = " (guessed: the file names none; --actuate names them)" if report.get("actuators_guessed") else ""
     grounded = f"; {report['base_guessed']}" if report.get("base_guessed") else ""
-    click.echo(f"{report['mechanism']}: {len(report['actuators'])} actuators{guessed}, {report['dof']} DOF "
+    count = len(report["actuators"])
+    click.echo(f"{report['mechanism']}: {count} actuator{'' if count == 1 else 's'}{guessed}, {report['dof']} DOF "
                f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}{grounded}")
     if report.get("dependent"):
         click.echo("  dependent (parasitic) coordinates: "
@@ -260,7 +263,7 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     if as_json:
         click.echo(json.dumps(report))
     else:
-        print_report({**report, "pose": {}} if at_file else report)  # "at the file's configuration"
+        print_report({**report, "at_file": at_file})
         click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)
 
 

@@ -63,6 +63,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import TWIST_RANK_TOLERANCE, closed_samples
+from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_kinematics import (
     TreeKinematics,
     beyond_reach,
@@ -223,7 +224,8 @@ class GraphMechanism:
             return "joint limit", (f"{self.tree.source}: at ({names}) a joint is beyond its limits in the "
                                    "configuration reached from the file's by continuation")
         return "closure", (f"{self.tree.source}: no closed configuration reached from the file's by continuation "
-                           f"puts the output frame at ({names})")
+                           f"puts the output frame at ({names}); the file's configuration has it at "
+                           f"({spelled_pose(self.task_coordinates, self.task_pose() + 0.0)})")  # (no -0)
 
     def at_pose(self, position, rpy=None, *, limits: bool = True) -> GraphMechanism:
         """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default
@@ -348,7 +350,7 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None
     motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
     configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
     model = tree.model
-    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each, or none (_check_actuators)
+    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each, or none (check_actuators)
         if not leg.actuators:
             continue
         actuator = leg.actuators[0]
@@ -394,41 +396,6 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
                            f"meet, or motors the file does not name; actuators {', '.join(tree.motors)}"
                            f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; "
                            "analysable through serial legs as a point output, not through the graph.")
-
-
-def _check_actuators(tree: ClosedTree, legs) -> None:
-    """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
-    actuator is named, with the option that holds it)."""
-    model = tree.model
-    if not any(leg.actuators for leg in legs):
-        raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
-                           "--actuate names the driven joints.")
-    for leg in legs:
-        if not leg.actuators:  # a passive leg: it constrains the platform, its twist system is the whole of it
-            continue
-        if len(leg.actuators) != 1:
-            stage = [j for j in leg.joints  # joints carrying every actuator of the leg, from the base
-                     if joint_kind(model, j)[0] in ("revolute", "prismatic", "JointModelFreeFlyer")
-                     and all(j in path_to(model, a) for a in leg.actuators if a != j)]
-            advice = ""
-            if stage:
-                name = model.names[stage[0]]
-                carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
-                           else f"joint {name!r} carries every actuator of it")
-                advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
-                          "on the body it turns")
-                if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
-                    advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
-                              f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
-                              "analysed on it")
-            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                               f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
-                               "one (a leg with loops and several actuators has no per-actuator twist system yet)"
-                               f"{advice}.")
-        kind, _ = joint_kind(model, leg.actuators[0])
-        if kind not in ("revolute", "prismatic"):
-            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
-                               "actuator drives one revolute or prismatic joint.")
 
 
 def _motion_space(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:
@@ -495,7 +462,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
-    _check_actuators(tree, legs)
+    check_actuators(tree, legs)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
     if at_file:

@@ -1,0 +1,61 @@
+"""The actuators of a closed-loop graph's legs (:mod:`screwkit.io.graph`): one revolute or prismatic actuator per leg,
+and, for a leg with several, the serial stage a user can hold with ``--lock`` to analyse the legs on the body it
+turns."""
+
+from __future__ import annotations
+
+from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
+
+__all__ = ["check_actuators", "serial_stage"]
+
+
+def check_actuators(tree: ClosedTree, legs) -> None:
+    """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
+    actuator is named, with the option that holds it)."""
+    model = tree.model
+    if not any(leg.actuators for leg in legs):
+        raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
+                           "--actuate names the driven joints.")
+    for leg in legs:
+        if not leg.actuators:  # a passive leg: it constrains the platform, its twist system is the whole of it
+            continue
+        if len(leg.actuators) != 1:
+            stage = serial_stage(model, leg)
+            advice = ""
+            if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
+                names = [str(model.names[j]) for j in stage]
+                advice = (f"; joints {', '.join(names)} carry every actuator of it in turn (a serial stage before the "
+                          f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn")
+            elif stage:
+                name = model.names[stage[0]]
+                carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
+                           else f"joint {name!r} carries every actuator of it")
+                advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
+                          "on the body it turns")
+                if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
+                    advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
+                              f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
+                              "analysed on it")
+            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
+                               f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
+                               "one (a leg with loops and several actuators has no per-actuator twist system yet)"
+                               f"{advice}.")
+        kind, _ = joint_kind(model, leg.actuators[0])
+        if kind not in ("revolute", "prismatic"):
+            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
+                               "actuator drives one revolute or prismatic joint.")
+
+
+def serial_stage(model, leg) -> list[int]:
+    """The joints of ``leg`` that carry every actuator still driven, from the base: each actuated one found is held
+    and the next sought among the rest, until one actuator is left (a floating base's slides and ball, a hip's motors
+    one after the other, then the passive knee joints the ankle's motors ride on)."""
+    remaining, stage = set(leg.actuators), []
+    for joint in sorted(leg.joints):  # a joint's id is below those of the joints it carries
+        others = [actuator for actuator in remaining if actuator != joint]
+        if not others:
+            break
+        if all(joint in path_to(model, actuator) for actuator in others):
+            stage.append(joint)
+            remaining.discard(joint)
+    return stage
