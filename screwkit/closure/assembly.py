@@ -27,6 +27,7 @@ from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_r
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
     TASK_RANK_TOLERANCE,
+    chain_ranks,
     close_constraining_chains,
     constraining_chains,
     infer_task_axes,
@@ -353,11 +354,12 @@ def _mode_samples(mechanism: Mechanism, poses, values):
             [np.concatenate([batch[1][k] for batch in batches]) for k in range(len(chains))])
 
 
-def _check_not_at_dead_centre(mechanism: Mechanism, mobility: int) -> None:
-    """Refuse a platform that cannot move at the reference assembly because a chain is stretched or folded there (a
-    crank and its rod on one line: the platform at the end of its travel), naming the chains and how to give joint
-    values away from it; a platform that cannot move with every chain regular is left to the caller's refusal."""
-    chains = singular_chains(mechanism)
+def _check_not_at_dead_centre(mechanism: Mechanism, ranks: list[int]) -> None:
+    """Refuse a reference assembly where a chain is stretched or folded (a crank and its rod on one line: its
+    joints' twists span less there than at joint values near it): the platform's DOF there is not its mobility (a
+    five-bar drawn with a leg stretched read as a redundant 1-DOF mechanism), and the working mode is not decided.
+    Names the chains and how to give joint values away from it."""
+    chains = singular_chains(mechanism, ranks)
     if not chains:
         return
     description = mechanism.description
@@ -365,11 +367,12 @@ def _check_not_at_dead_centre(mechanism: Mechanism, mobility: int) -> None:
               "held there while the loops close)" + (", or a keyframe named 'home'"
                                                       if description.converted_from == "MJCF" else "")
               if description.converted_from else "write its <reference_configuration> away from it")
-    raise description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move at the reference assembly "
-                           f"(DOF {mobility}) because chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
+    raise description.fail(f"<robot name='{mechanism.name}'>", f"the reference assembly is a singular configuration: "
+                           f"chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
                            f"{'are' if len(chains) > 1 else 'is'} stretched or folded there (its joints' twists span "
                            "less than at joint values near it: a dead centre, such as a crank and its rod on one "
-                           f"line), where the working mode is not decided; {remedy}.")
+                           "line), where the platform moves less than the mechanism does elsewhere and the working "
+                           f"mode is not decided; {remedy}.")
 
 
 def _check_actuator_count(mechanism: Mechanism, needed: int) -> None:
@@ -399,7 +402,9 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     instantaneous = mechanism.dof
     mobility, at_pose, at_values = (instantaneous, mechanism.home_full_pose,
                                     [c.reference_values for c in mechanism.chains])
-    chains = constraining_chains(mechanism)
+    ranks = chain_ranks(mechanism)
+    _check_not_at_dead_centre(mechanism, ranks)
+    chains = constraining_chains(mechanism, ranks)
     modes = []
     if chains:
         chain_indices, poses, values = _generic_samples(mechanism)
@@ -421,8 +426,6 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
-    if mobility < 1:
-        _check_not_at_dead_centre(mechanism, mobility)
     if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")

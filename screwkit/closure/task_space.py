@@ -69,35 +69,49 @@ def pose_rates(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float64]
     return rates
 
 
-def _chain_rank(mechanism: Mechanism, index: int, values: NDArray | None = None) -> int:
+def _chain_rank(mechanism: Mechanism, index: int, values: NDArray | None = None):
     """The dimension of the twists chain ``index``'s joints span at joint ``values`` (its reference ones by
-    default)."""
+    default: an int; a batch (k, joints): an array (k,))."""
     chain = mechanism.chains[index]
     frames = chain_forward_kinematics(chain.geometry, chain.reference_values if values is None else values)
     twists = twists_from_axes_and_points(frames.axes, frames.points, chain.prismatic)
     twists = twists / np.maximum(np.linalg.norm(twists, axis=-1, keepdims=True), 1e-300)
     rows = [2, 3, 4] if mechanism.is_planar else list(range(6))
-    singular = np.linalg.svd(twists[:, rows], compute_uv=False)
-    return int(np.sum(singular > MOTION_SPACE_TOLERANCE * max(singular[0], 1e-300))) if singular.size else 0
+    if twists.shape[-2] == 0:
+        return 0 if values is None or np.ndim(values) == 1 else np.zeros(len(values), dtype=int)
+    singular = np.linalg.svd(twists[..., rows], compute_uv=False)
+    ranks = np.sum(singular > MOTION_SPACE_TOLERANCE * np.maximum(singular[..., :1], 1e-300), axis=-1)
+    return int(ranks) if np.ndim(ranks) == 0 else ranks
 
 
-def singular_chains(mechanism: Mechanism, samples: int = 4) -> list[str]:
-    """The chains whose joints span fewer twists at the reference assembly than at joint values near it (every
-    joint moved by up to 0.05 rad or 0.05 length scales; the most of ``samples`` random ones, seeded): stretched or
-    folded, as a crank and its rod on one line."""
+def chain_ranks(mechanism: Mechanism) -> list[int]:
+    """The dimension of the twists each chain's joints span at the reference assembly."""
+    return [_chain_rank(mechanism, index) for index in range(len(mechanism.chains))]
+
+
+def singular_chains(mechanism: Mechanism, ranks: list[int] | None = None, samples: int = 4) -> list[str]:
+    """The chains whose joints span fewer twists at the reference assembly (``ranks``, :func:`chain_ranks`) than at
+    joint values near it (every joint moved by up to 0.05 rad or 0.05 length scales; ``samples`` random ones, seeded,
+    one batch): stretched or folded, as a crank and its rod on one line."""
     rng, found = np.random.default_rng(0), []
+    ranks = chain_ranks(mechanism) if ranks is None else ranks
     for index, chain in enumerate(mechanism.chains):
+        if ranks[index] == min(chain.n_joints, 3 if mechanism.is_planar else 6):
+            continue  # as many as the chain can span: no more near it (most chains, at one batch of FK)
         step = np.where(np.asarray(chain.geometry.dof_prismatic, dtype=bool), 0.05 * mechanism.length_scale, 0.05)
-        near = max(_chain_rank(mechanism, index, chain.reference_values + rng.uniform(-1.0, 1.0, chain.n_joints) * step)
-                   for _ in range(samples))
-        if near > _chain_rank(mechanism, index):
+        values = chain.reference_values + np.vstack([np.zeros(chain.n_joints),
+                                                     rng.uniform(-1.0, 1.0, (samples, chain.n_joints)) * step])
+        ranks = _chain_rank(mechanism, index, values)
+        if np.max(ranks[1:]) > ranks[0]:
             found.append(chain.name)
     return found
 
 
-def constraining_chains(mechanism: Mechanism) -> tuple[int, ...]:
-    """Chains whose joints do not span every platform motion: those whose closure ties the dependent coordinates."""
-    return tuple(index for index in range(len(mechanism.chains)) if _chain_rank(mechanism, index) < mechanism.n_pose)
+def constraining_chains(mechanism: Mechanism, ranks: list[int] | None = None) -> tuple[int, ...]:
+    """Chains whose joints do not span every platform motion: those whose closure ties the dependent coordinates
+    (``ranks``: :func:`chain_ranks`, computed when not given)."""
+    ranks = chain_ranks(mechanism) if ranks is None else ranks
+    return tuple(index for index, rank in enumerate(ranks) if rank < mechanism.n_pose)
 
 
 def packed_geometry(mechanism: Mechanism, chains: tuple[int, ...]) -> dict:
