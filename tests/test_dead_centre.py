@@ -217,24 +217,29 @@ def test_a_file_in_screwkits_convention_at_its_dead_centre_names_the_stretched_c
         "the working mode is not decided; write its <reference_configuration> away from it.")
 
 
-def test_a_five_bar_in_screwkits_convention_drawn_with_a_leg_stretched_is_refused_not_read_as_one_dof(tmp_path):
-    """The bundled five-bar (2 DOF) with its output point written 0.5 m from leg 1's base joint, the sum of its
-    links, and leg 1 written straight: the platform moves along one line there only (DOF 1), and it was read as a
+@pytest.mark.parametrize("leg, turn_deg", [(1, 70.0), (2, 110.0)])
+def test_a_five_bar_in_screwkits_convention_drawn_with_a_leg_stretched_is_refused_not_read_as_one_dof(tmp_path, leg,
+                                                                                                     turn_deg):
+    """The bundled five-bar (2 DOF) with its output point written 0.5 m from a leg's base joint, the sum of its
+    links, and that leg written straight: the platform moves along one line there only, and it was read as a
     redundant 1-DOF mechanism, every fault-tolerance figure of another mechanism (or refused for its task
-    coordinates x y, 'not 1 independent coordinates'). It is refused naming the stretched chain."""
+    coordinates x y, 'not 1 independent coordinates'). It is refused naming the stretched chain, the first or the
+    second."""
     from screwkit.io.loader import bundled_path
 
     text = bundled_path("five_bar").read_text()
-    turn = np.radians(70.0)  # leg 1 from A_1 = (-0.1, 0) along 70 deg: P = A_1 + 0.5 (cos, sin)
-    point = [float(v) for v in np.array([-0.1, 0.0]) + 0.5 * np.array([np.cos(turn), np.sin(turn)])]
-    assert np.linalg.norm(np.subtract(point, [0.1, 0.0])) < 0.5  # leg 2 reaches it
+    turn = np.radians(turn_deg)  # the leg from A_k = (-+0.1, 0) along turn: P = A_k + 0.5 (cos, sin)
+    base_joint = np.array([-0.1 if leg == 1 else 0.1, 0.0])
+    point = [float(v) for v in base_joint + 0.5 * np.array([np.cos(turn), np.sin(turn)])]
+    other = np.array([0.1 if leg == 1 else -0.1, 0.0])
+    assert np.linalg.norm(np.subtract(point, other)) < 0.5  # the other leg reaches it
     written_text = text.replace('<origin xyz="0 0.35 0" rpy="0 0 0" />', f'<origin xyz="{point[0]!r} {point[1]!r} 0" '
                                 'rpy="0 0 0" />')
-    base = float(re.search(r'name="chain_1_joint_b".*?rpy="0 0 ([^"]+)"', text, re.S).group(1))
-    elbow = float(re.search(r'name="chain_1_joint_c".*?rpy="0 0 ([^"]+)"', text, re.S).group(1))
+    base = float(re.search(rf'name="chain_{leg}_joint_b".*?rpy="0 0 ([^"]+)"', text, re.S).group(1))
+    elbow = float(re.search(rf'name="chain_{leg}_joint_c".*?rpy="0 0 ([^"]+)"', text, re.S).group(1))
     straight = f"""  <reference_configuration>
-    <joint name="chain_1_joint_b" value="{float(turn) - base!r}" />
-    <joint name="chain_1_joint_c" value="{-elbow!r}" />
+    <joint name="chain_{leg}_joint_b" value="{float(turn) - base!r}" />
+    <joint name="chain_{leg}_joint_c" value="{-elbow!r}" />
   </reference_configuration>
   <output type="point" />"""
     written_text = written_text.replace('  <output type="point" />', straight)
@@ -242,9 +247,9 @@ def test_a_five_bar_in_screwkits_convention_drawn_with_a_leg_stretched_is_refuse
     for declared in (True, False):
         path = tmp_path / f"stretched_{declared}.urdf"
         path.write_text(written_text if declared else re.sub(r"\s*<task_coordinates[^>]*/>", "", written_text))
-        with pytest.raises(ValueError, match=r"the reference assembly is a singular configuration: chain chain_1 is "
-                                             r"stretched or folded there .* where the platform moves less than the "
-                                             r"mechanism does elsewhere"):
+        with pytest.raises(ValueError, match=rf"the reference assembly is a singular configuration: chain chain_{leg} "
+                                             r"is stretched or folded there .* where the platform moves less than "
+                                             r"the mechanism does elsewhere"):
             load(path)
     assert load("five_bar").dof == 2
 

@@ -101,8 +101,8 @@ def singular_chains(mechanism: Mechanism, ranks: list[int] | None = None, sample
         step = np.where(np.asarray(chain.geometry.dof_prismatic, dtype=bool), 0.05 * mechanism.length_scale, 0.05)
         values = chain.reference_values + np.vstack([np.zeros(chain.n_joints),
                                                      rng.uniform(-1.0, 1.0, (samples, chain.n_joints)) * step])
-        ranks = _chain_rank(mechanism, index, values)
-        if np.max(ranks[1:]) > ranks[0]:
+        batch = _chain_rank(mechanism, index, values)
+        if np.max(batch[1:]) > batch[0]:
             found.append(chain.name)
     return found
 
