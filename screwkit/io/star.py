@@ -25,8 +25,8 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
    with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
    assembled values, from its end backwards, until they are independent: the span of the leg's
    twists, so the platform's motion and every index, is unchanged; the report names them. A leg
-   whose twists are dependent at the assembly only (independent at joint values near it: a crank
-   and its rod on one line, a dead centre) is refused, naming ``--initial``.
+   whose twists span less at the assembly than at joint values near it (a crank and its rod on
+   one line, a dead centre) is refused, naming ``--initial`` (:mod:`screwkit.io.idle_joints`).
 5. **Output.** When every closure onto the platform meets it at one point (in a plane: on one line along the
    normal, wherever along their pins they are drawn) and joins it by every rotation about that point (ball
    joints; pins about the plane's normal in a planar mechanism),
