@@ -44,6 +44,7 @@ from screwkit.common.tolerances import (
 )
 from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
+from screwkit.model.urdf_description import initial_remedy
 
 __all__ = ["assemble", "mobility", "mobility_notes", "rounded_dof_note", "working_modes", "LIMITS_IGNORED",
            "DOF_AT_ROUNDING", "DOF_MARGIN", "MODES_MEET", "NOT_OPEN_LOOPS"]
@@ -363,10 +364,8 @@ def _check_not_at_dead_centre(mechanism: Mechanism, ranks: list[int]) -> None:
     if not chains:
         return
     description = mechanism.description
-    remedy = ("give joint values away from it: --initial JOINT VALUE (an actuated joint away from its dead centre, "
-              "held there while the loops close)" + (", or a keyframe named 'home'"
-                                                      if description.converted_from == "MJCF" else "")
-              if description.converted_from else "write its <reference_configuration> away from it")
+    remedy = (initial_remedy(description.converted_from) if description.converted_from else
+              "write its <reference_configuration> away from it")
     raise description.fail(f"<robot name='{mechanism.name}'>", f"the reference assembly is a singular configuration: "
                            f"chain{'s' if len(chains) > 1 else ''} {', '.join(chains)} "
                            f"{'are' if len(chains) > 1 else 'is'} stretched or folded there (its joints' twists span "

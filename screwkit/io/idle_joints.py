@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, ImportError_, homogeneous, joint_kind
+from screwkit.model.urdf_description import initial_remedy
 
 __all__ = ["INDEPENDENCE_TOLERANCE", "joint_twists", "independent", "lock_idle", "check_not_stretched"]
 
@@ -101,12 +102,10 @@ def check_not_stretched(tree: ClosedTree, leg, q: NDArray, scale: float, rows, s
             return  # as dependent away from the assembly: idle joints, locked by the caller
     names = ", ".join(model.names[joint] for joint in leg.joints)
     which = f"the leg closed by {leg.closure!r}" if leg.closure else "the platform body's own path"
-    remedy = ("--initial JOINT VALUE (an actuated joint away from its dead centre, held there while the loops close)"
-              + (", or a keyframe named 'home'" if tree.file_format == "MJCF" else ""))
     raise ImportError_(f"{tree.source}: {which} (joints {names}) is stretched or folded at the assembly: its joints' "
                        "twists span less there than at joint values near it (a dead centre, such as a crank and its "
-                       "rod on one line), where the platform's motion and the working mode are not decided; give "
-                       f"joint values away from it: {remedy}.")
+                       "rod on one line), where the platform's motion and the working mode are not decided; "
+                       f"{initial_remedy(tree.file_format)}.")
 
 
 def _rank(rows: NDArray) -> int:

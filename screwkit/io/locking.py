@@ -180,8 +180,7 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
     if not names:
         return tree
     model = tree.model
-    drivable = ", ".join(str(n) for n in list(model.names)[1:]
-                         if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
+    drivable = _one_dof_joints(tree)
     for name in names:
         what = None
         if name in tree.locked:
@@ -207,6 +206,14 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
     return replace(tree, motors=list(names), notes=notes, actuated=names)
 
 
+def _one_dof_joints(tree: ClosedTree) -> str:
+    """The tree's 1-DoF joints, as the refusals of ``--actuate`` and ``--initial`` list them (not a hinge a reader
+    wrote for part of a ball or universal joint)."""
+    model = tree.model
+    return ", ".join(str(n) for n in list(model.names)[1:]
+                     if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
+
+
 def set_initial(tree: ClosedTree, values) -> ClosedTree:
     """The tree with the joints of ``values`` (pairs of a joint name and a value: degrees for a revolute joint, metres
     for a prismatic one, as ``--actuators`` takes them) at those values instead of the file's (``--initial``). The
@@ -218,8 +225,7 @@ def set_initial(tree: ClosedTree, values) -> ClosedTree:
     if not pairs:
         return tree
     model, q = tree.model, np.array(tree.q_reference, dtype=float)
-    startable = ", ".join(str(n) for n in list(model.names)[1:]
-                          if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
+    startable = _one_dof_joints(tree)
     said = []
     for name, value in pairs:
         joint = model.getJointId(name) if model.existJointName(name) else 0

@@ -165,6 +165,13 @@ stand for in that file; any other is named as it is (a ``<joint>``, and a URDF s
 the file's own)."""
 
 
+def initial_remedy(file_format: str) -> str:
+    """How a file of another tool drawn at a dead centre is read away from it: ``--initial`` (and, for MJCF, a
+    keyframe named 'home'), for the refusals of :mod:`screwkit.io.idle_joints` and :mod:`screwkit.closure.assembly`."""
+    return ("give joint values away from it: --initial JOINT VALUE (an actuated joint away from its dead centre, held "
+            "there while the loops close)" + (", or a keyframe named 'home'" if file_format == "MJCF" else ""))
+
+
 def as_written(element: str) -> str:
     """``element`` of a converted text named as the file of another tool has it (:data:`CONVERTED_ELEMENTS`)."""
     for pattern, named in CONVERTED_ELEMENTS:
