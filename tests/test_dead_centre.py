@@ -156,6 +156,26 @@ def test_an_initial_crank_is_held_and_gives_the_four_bar_pressure_angles(tmp_pat
         assert point.home_pose[0] == pytest.approx(expected["c"][0], abs=1e-9)
 
 
+def test_the_legs_listed_the_other_way_and_renamed_give_the_same_indices(tmp_path):
+    """The four-bar with its rocker's body written before the crank's and every joint renamed: refused at its dead
+    centre naming the renamed leg, and with the renamed crank given, the same closed-form pressure angles."""
+    text = four_bar()
+    crank = text[text.index('    <body name="crank"'):text.index('    <body name="foot"')]
+    foot = text[text.index('    <body name="foot"'):text.index("  </worldbody>")]
+    moved = text.replace(crank + foot, foot.rstrip("\n") + "\n" + crank.rstrip("\n") + "\n")
+    for old, name in (("crank", "driver"), ("rod", "coupler"), ("foot", "rocker")):
+        moved = moved.replace(f'<joint name="{old}"', f'<joint name="{name}"').replace(f'<motor joint="{old}"',
+                                                                                     f'<motor joint="{name}"')
+    assert moved.index('<body name="foot"') < moved.index('<body name="crank"') and 'joint name="driver"' in moved
+    path = written(tmp_path, moved, "relabelled.xml")
+    with pytest.raises(ImportError_, match=r"\(joints driver, coupler\) is stretched or folded at the assembly"):
+        load(path, output="foot")
+    expected = four_bar_closed_form(20.0)
+    result = indices_at_home(load(path, output="foot", output_type="frame", initial=[("driver", 20.0)]))
+    assert result.iti[0] == pytest.approx(expected["iti"], abs=1e-9)
+    assert result.lmti[0] == pytest.approx(expected["oti"], abs=1e-9)
+
+
 def test_mujoco_reads_the_configuration_assembled_as_closed(tmp_path):
     """MuJoCo's own reading: the joint values screwkit assembled (crank held at 20 deg) close the file's connect,
     and the rocker is where the closed form puts it."""
