@@ -321,6 +321,34 @@ def point_dof(mechanism: Mechanism, full_pose, joint_values, dof: int) -> int:
     return int(np.sum(singular > TASK_RANK_TOLERANCE))
 
 
+def _locking_chains(mechanism: Mechanism, full_pose, joint_values) -> str:
+    """What a DOF-0 refusal adds: the chains each of which, left out, lets the platform move (a loop whose joints'
+    axes are not quite aligned, as a CAD export or a cambered axle writes them: the others would move it)."""
+    if len(mechanism.chains) < 2:
+        return ""
+    locking = []
+    for left_out in range(len(mechanism.chains)):
+        kept = [k for k in range(len(mechanism.chains)) if k != left_out]
+        others = replace(mechanism, chains=tuple(mechanism.chains[k] for k in kept))
+        dofs, _ = motion_space_at(others, np.asarray(full_pose)[None],
+                                  [np.asarray(joint_values[k])[None] for k in kept])
+        if dofs[0] >= 1:
+            chain = mechanism.chains[left_out]  # (a converted file's loop joints are its closure's, not joints)
+            joints = [name for name in chain.joint_names
+                      if not (mechanism.description.converted_from and name.startswith(f"{chain.name}_loop"))]
+            locking.append((f"{chain.name} (joint{'s' if len(joints) > 1 else ''} {', '.join(joints)})",
+                            int(dofs[0])))
+    if not locking:
+        return "; no one chain locks it: without any one of them it still cannot move"
+    rigid = ("a joint axis slightly out of line with the rest of its loop (as a CAD export's rounding or a cambered "
+             "axle writes it) makes a loop rigid, and the file is read as written")
+    if len(locking) == len(mechanism.chains):
+        return (f"; any one chain left out, the others would let it move (chains "
+                f"{', '.join(name for name, _ in locking)}): {rigid}")
+    without = " or ".join(f"{name} it would move ({dof} DOF)" for name, dof in locking)
+    return f"; without chain {without}: {rigid}"
+
+
 def idle_rotation_count(mechanism: Mechanism) -> int:
     """Rotations of the platform about a point output (none for a frame output): 1 planar, 3 spatial."""
     return 0 if mechanism.output_point is None else (1 if mechanism.is_planar else 3)
@@ -430,7 +458,8 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                                                                   "motion is a rotation about it.")
     if mobility < 1:  # rigid: its closures leave the platform no motion (as a CAD export's rounding can make them)
         raise mechanism.description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move: its chains "
-                                         "leave it no motion at the reference assembly (DOF 0).")
+                                         "leave it no motion at the reference assembly (DOF 0)"
+                                         + _locking_chains(mechanism, at_pose, at_values) + ".")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
     _check_actuator_count(mechanism, mobility)
     if modes:

@@ -22,6 +22,9 @@ from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
 
+GUESSED = "actuators guessed"
+"""How a reader's note on guessed actuators begins."""
+
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point", "LENGTH_COORDINATES",
@@ -112,8 +115,14 @@ class ClosedTree:
                 "the file's joint values")
 
     def motor_label(self, name: str) -> str:
-        """How a message names the actuated joint ``name``: by the option that named it, else as the file's."""
-        return f"--actuate {name}" if name in self.actuated else f"actuated joint {name!r}"
+        """How a message names the actuated joint ``name``: by the option that named it, as guessed (the file marks
+        none), else as the file's."""
+        if name in self.actuated:
+            return f"--actuate {name}"
+        if any(note.startswith(GUESSED) for note in self.notes):
+            return (f"guessed actuator {name!r} (the file marks none; --actuate JOINT names the joints that are "
+                    "driven)")
+        return f"actuated joint {name!r}"
     cut_by_order: tuple[str, ...] = ()
     """Closures of loops the file could as well have closed at another joint, where the reader chose by the file's
     order (SDFormat's breadth-first tree tied): no point output is taken at them unless asked."""

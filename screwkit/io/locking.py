@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.units import LENGTH_UNITS
 from screwkit.io.closed_tree import (
+    GUESSED,
     ClosedTree,
     Closure,
     ImportError_,
@@ -23,10 +24,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names"]
-
-GUESSED = "actuators guessed"
-"""How a reader's note on guessed actuators begins."""
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "GUESSED"]
 
 
 def lock_joints(tree: ClosedTree, names) -> ClosedTree:
