@@ -58,8 +58,8 @@ def _grounded(lines) -> str | None:
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
-    if report.get("at_file"):  # a graph at the file's configuration: where its output frame is there
-        pose = f"the file's configuration ({pose})" if pose else "the file's configuration"
+    if report.get("at_file"):  # a graph at the file's configuration (or --initial's): where its output frame is there
+        pose = f"{report['at_file']} ({pose})" if pose else report["at_file"]
     redundancy = report.get("redundancy", len(report["actuators"]) - report["dof"])
     guessed = " (guessed: the file names none; --actuate names them)" if report.get("actuators_guessed") else ""
     grounded = f"; {report['base_guessed']}" if report.get("base_guessed") else ""
@@ -263,7 +263,9 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     if as_json:
         click.echo(json.dumps(report))
     else:
-        print_report({**report, "at_file": at_file})
+        started = ", ".join(f"--initial {name} {value:g}" for name, value in graph.tree.initial)
+        print_report({**report, "at_file": at_file and (f"the configuration assembled from {started}" if started
+                                                        else "the file's configuration")})
         click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)
 
 

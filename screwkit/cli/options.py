@@ -21,7 +21,7 @@ import numpy as np
 
 from screwkit.cli.option_checks import execution_record, finite_threshold
 from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
-from screwkit.closure.assembly import DOF_AT_ROUNDING, NOT_OPEN_LOOPS
+from screwkit.closure.assembly import NOT_OPEN_LOOPS
 from screwkit.common.compiling import (
     INDEX_KERNELS,
     compile_ahead,
@@ -409,11 +409,11 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
             graph = graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
                                                      lock=reading.lock, actuate=reading.actuate,
                                                      initial=reading.initial, length_unit=length_unit))
+            said = graph.reading_notes(limits=limits)  # as a serial mechanism's, on every command
         except ValueError as graph_error:
             raise fail(str(graph_error)) from None
-        rounded = [note for note in graph.report.notes if note.startswith(DOF_AT_ROUNDING)]
-        if rounded and not _quiet():  # as a serial mechanism's, on every command
-            echo_error(f"{name}: " + "; ".join(rounded))
+        if said and not _quiet():
+            echo_error(f"{name}: " + "; ".join(said))
         return graph
     opened = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]
     ignored = [note for note in mechanism.assembly_notes if note.startswith(NOT_OPEN_LOOPS)]

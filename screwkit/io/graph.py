@@ -40,13 +40,14 @@ output is the platform frame.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from os import PathLike
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.closure.assembly import DOF_MARGIN, rounded_dof_note
+from screwkit.closure.assembly import DOF_AT_ROUNDING, DOF_MARGIN, LIMITS_IGNORED, rounded_dof_note
 from screwkit.closure.task_space import choose_task_axes
 from screwkit.common.rotations import cross
 from screwkit.common.units import is_angular, spelled_pose
@@ -67,6 +68,7 @@ from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_kinematics import (
     TreeKinematics,
     beyond_reach,
+    limits_phrase,
     reach_bound,
     rpy_of,
     rpy_rates_inverse,
@@ -196,7 +198,28 @@ class GraphMechanism:
         targets = np.repeat(self.frame_pose()[None], poses.shape[0], axis=0)
         targets[:, list(self.task_axes)] = poses
         return solve_poses(self.tree, self.q, self.scale, self.frame_id, targets, self.task_axes, limits=limits,
-                           kinematics=self.kinematics)
+                           kinematics=self.kinematics, limited=self.limited)
+
+    def reading_notes(self, *, limits: bool = True) -> list[str]:
+        """What a command says of this reading, as of a serial mechanism's: a DOF found at the file's rounding, and
+        the legs' joints the configuration puts beyond their limits (a file drawn with a joint outside its range, as
+        MuJoCo's qpos0 often is): refused (a ValueError), or said with ``limits`` False (``--ignore-limits``)."""
+        said = [note for note in self.report.notes if note.startswith(DOF_AT_ROUNDING)]
+        beyond = limits_phrase(self.tree.model, self.kinematics, self.q, self.limited)
+        plural = ";" in beyond
+        if beyond and limits:
+            raise ValueError(f"{self.tree.source}: the configuration puts the joint{'s' if plural else ''} of its "
+                             f"legs beyond {'their' if plural else 'its'} limits: {beyond} (--ignore-limits reads "
+                             "it all the same; --initial JOINT VALUE on such a joint, or on the one driving it, "
+                             "starts the assembly inside them).")
+        return said + ([f"{LIMITS_IGNORED}{beyond}"] if beyond else [])
+
+    @cached_property
+    def limited(self) -> NDArray[np.bool_]:
+        """(nv,) the velocity coordinates of the legs' joints: those whose limits a pose keeps (a branch that
+        reaches no leg, a biped's other leg, does not move with the platform and is not checked)."""
+        joints = {joint for leg in self.legs for joint in leg.joints}
+        return np.array([int(joint) in joints for joint in self.kinematics.column_joint], dtype=bool)
 
     def reach(self, *, limits: bool = True) -> float:
         """The farthest the output frame can be from the world origin (m), an upper bound
@@ -220,9 +243,13 @@ class GraphMechanism:
         if self._beyond_reach(target, self.task_axes, limits=False):
             return "closure", (f"{self.tree.source}: no closed configuration puts the output frame at ({names}): it "
                                f"is never farther than {self.reach(limits=False):.4g} m from the world origin")
-        if limits and self.solve(np.asarray(pose, dtype=float)[None], limits=False)[1][0]:
-            return "joint limit", (f"{self.tree.source}: at ({names}) a joint is beyond its limits in the "
-                                   "configuration reached from the file's by continuation")
+        free_q, free_reached = self.solve(np.asarray(pose, dtype=float)[None], limits=False)
+        if limits and free_reached[0]:
+            beyond = limits_phrase(self.tree.model, self.kinematics, free_q[0], self.limited)
+            plural = ";" in beyond
+            return "joint limit", (f"{self.tree.source}: at ({names}) the configuration reached from the file's by "
+                                   f"continuation puts {'joints' if plural else 'a joint'} beyond "
+                                   f"{'their' if plural else 'its'} limits: {beyond}")
         return "closure", (f"{self.tree.source}: no closed configuration reached from the file's by continuation "
                            f"puts the output frame at ({names}); the file's configuration has it at "
                            f"({spelled_pose(self.task_coordinates, self.task_pose() + 0.0)})")  # (no -0)
@@ -240,7 +267,7 @@ class GraphMechanism:
         if rpy is not None:
             target[3:] = np.asarray(rpy, dtype=float)
         q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
-                                 limits=limits, kinematics=self.kinematics)
+                                 limits=limits, kinematics=self.kinematics, limited=self.limited)
         if not reached[0]:
             why = (f"out of reach: the output frame is never farther than {self.reach(limits=limits):.4g} m from the "
                    "world origin" if self._beyond_reach(target, tuple(range(6)), limits)

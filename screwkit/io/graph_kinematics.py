@@ -32,7 +32,8 @@ from numpy.typing import NDArray
 from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
-__all__ = ["TreeKinematics", "solve_poses", "reach_bound", "rpy_of", "rpy_rates_inverse", "STAGE_LENGTH",
+__all__ = ["TreeKinematics", "solve_poses", "beyond_limits", "limits_phrase", "reach_bound", "rpy_of",
+           "rpy_rates_inverse", "STAGE_LENGTH",
            "MAX_ITERATIONS", "STAGE_TOLERANCE", "FINAL_TOLERANCE"]
 
 STAGE_LENGTH = 0.05
@@ -48,6 +49,10 @@ FINAL_TOLERANCE = 1e-14
 rounding); a pose counts as reached below
 :data:`~screwkit.io.closed_tree.ASSEMBLY_TOLERANCE` times ten, or the residual the file's own configuration
 keeps."""
+GIMBAL_LOCK = 1e-4
+"""A pose whose roll or yaw is a task coordinate is not reached where the cosine of the output frame's pitch is
+below this (within 0.006 deg of +-90 deg): there roll and yaw are one angle, and Newton meets any value of either
+(a foot held in roll met 120 and 170 deg at one configuration, 1.7e-6 and 8e-7 from the lock)."""
 
 
 def _rotation(axis: NDArray, angle: NDArray) -> NDArray:
@@ -378,10 +383,12 @@ def beyond_reach(kinematics: TreeKinematics, joint: int, placement: NDArray, tar
 
 
 def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int, targets: NDArray,
-                task_axes: tuple[int, ...], *, limits: bool = True, kinematics: TreeKinematics | None = None):
+                task_axes: tuple[int, ...], *, limits: bool = True, kinematics: TreeKinematics | None = None,
+                limited: NDArray | None = None):
     """Closed configurations (n, nq) putting the output frame's task coordinates at ``targets`` (n, 6: x, y, z in m
     and roll, pitch, yaw in rad, world frame; only ``task_axes`` of them are held), by continuation from the closed
-    configuration ``q_start``; and which of them are reached (closures closed, joints within their limits)."""
+    configuration ``q_start``; and which of them are reached (closures closed, joints within their limits: those of
+    the velocity coordinates ``limited``, a mask (nv,), when given; a graph's, its legs')."""
     model = tree.model
     kinematics = TreeKinematics.of(model, tree.source) if kinematics is None else kinematics
     frame = model.frames[frame_id]
@@ -424,10 +431,35 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
                                                      origin + move[rows] * (stage / stages[rows])[:, None],
                                                      iterations, tolerance)
     reached = norm < reach_tolerance
+    if 3 in task_axes or 5 in task_axes:  # roll and yaw at a gimbal lock: one angle, either value "reached" there
+        pitch = rpy_of(residual.frame(kinematics.transforms(q))[:, :3, :3])[:, 1]
+        reached &= np.abs(np.cos(pitch)) > GIMBAL_LOCK
     if limits:
-        values = np.zeros((count, kinematics.nv))
-        for joint, kind in enumerate(kinematics.kinds):
-            if kind in ("revolute", "prismatic"):
-                values[:, kinematics.idx_v[joint]] = q[:, kinematics.idx_q[joint]]
-        reached &= np.all((values >= kinematics.lower - 1e-9) & (values <= kinematics.upper + 1e-9), axis=1)
+        reached &= ~np.any(beyond_limits(kinematics, q, limited), axis=1)
     return q, reached
+
+
+def beyond_limits(kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> NDArray[np.bool_]:
+    """(n, nv): which 1-DoF joints (by velocity coordinate; only those of the mask ``limited`` when given) of
+    configurations ``q`` (n, nq) are beyond their position limits (by more than 1e-9)."""
+    values = np.zeros((q.shape[0], kinematics.nv))
+    for joint, kind in enumerate(kinematics.kinds):
+        if kind in ("revolute", "prismatic"):
+            values[:, kinematics.idx_v[joint]] = q[:, kinematics.idx_q[joint]]
+    beyond = (values < kinematics.lower - 1e-9) | (values > kinematics.upper + 1e-9)
+    return beyond if limited is None else beyond & np.asarray(limited, dtype=bool)
+
+
+def limits_phrase(model, kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> str:
+    """The joints of one configuration ``q`` (nq,) beyond their limits (those of ``limited``), each with its value
+    and limits (deg for a revolute joint, m for a prismatic one), for a message; "" if none."""
+    said = []
+    for column in np.flatnonzero(beyond_limits(kinematics, q[None], limited)[0]):
+        joint = int(kinematics.column_joint[column])
+        value, low, high = float(q[kinematics.idx_q[joint]]), kinematics.lower[column], kinematics.upper[column]
+        if kinematics.kinds[joint] == "revolute":
+            value, low, high = np.degrees([value, low, high])
+            said.append(f"{model.names[joint]!r} at {value:.6g} deg, limits [{low:.6g}, {high:.6g}] deg")
+        else:
+            said.append(f"{model.names[joint]!r} at {value:.6g} m, limits [{low:.6g}, {high:.6g}] m")
+    return "; ".join(said)

@@ -1,0 +1,150 @@
+"""Which pose coordinate a mechanism's motion is read in, when one barely moves: a coordinate is taken in its order
+(x, y, z, roll, pitch, yaw) only if its rates tell the motions apart within a tenth as well as the best one of its
+kind. A published Cassie (example-robot-data's ``cassie_v2.sdf``, its foot drawn at a pitch of 77 deg and turning
+about the world's y axis to within 4e-6 rad) read its foot's motion as roll, whose rate is 1.6e-5 of the pitch's,
+and then put the foot at the gimbal lock for any roll asked ("at roll = 120" and "at roll = 170" were one
+configuration)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from screwkit.closure.task_space import choose_task_axes
+from screwkit.io import graph_mechanism, read_closed_tree
+from screwkit.io.graph_kinematics import rpy_of, solve_poses
+
+CASSIE = Path(__file__).parent / "data" / "gallery" / "published" / "example_robot_data_cassie" / "cassie_v2.sdf"
+HIPS = ("left-roll-op", "left-yaw-op", "left-pitch-op", "left-knee-op", "left-knee-shin-joint")
+ANGULAR = np.array([False] * 3 + [True] * 3)
+
+
+def test_a_coordinate_that_barely_moves_is_not_taken_before_one_that_moves():
+    """The Cassie foot's rates (x, y, z, roll, pitch, yaw on its one motion): pitch. A rotation at 45 deg between
+    roll and pitch, or tilted 30 deg from pitch towards roll: roll, first in order, as before."""
+    foot = np.array([[-2.3e-15], [5.0e-16], [-6.2e-17], [1.59e-5], [1.0], [1.63e-5]])
+    assert choose_task_axes(foot, ANGULAR, 1) == (4,)
+    for turn in (np.radians(45.0), np.radians(30.0)):
+        between = np.array([[0.0], [0.0], [0.0], [np.sin(turn)], [np.cos(turn)], [0.0]])
+        assert choose_task_axes(between, ANGULAR, 1) == (3,)
+    slide = np.array([[1e-5], [1.0], [0.0], [0.0], [0.0], [0.0]])  # a slide along y, drawn 1e-5 off
+    assert choose_task_axes(slide, ANGULAR, 1) == (1,)
+
+
+def cassie_foot():
+    tree = read_closed_tree(CASSIE, output="left-foot", actuate=["left-foot-op"], lock=list(HIPS))
+    return tree, graph_mechanism(tree)
+
+
+def foot_rotation(tree, graph, q) -> np.ndarray:
+    return graph.kinematics.transforms(q[None])[0, tree.model.frames[graph.frame_id].parentJoint][:3, :3] @ np.asarray(
+        tree.model.frames[graph.frame_id].placement.rotation)
+
+
+def test_the_published_cassie_s_foot_is_read_in_the_angle_it_turns():
+    """The foot turns about its hinge (the actuated joint): the task coordinate is pitch, and each pose's foot is the
+    file's turned about that hinge's world axis by the change of pitch asked (Rodrigues, numpy alone)."""
+    tree, graph = cassie_foot()
+    assert graph.task_axes == (4,)
+    home = foot_rotation(tree, graph, graph.q)
+    home_pitch = float(rpy_of(home)[1])
+    assert np.degrees(home_pitch) == pytest.approx(77.0, abs=1e-3)
+    model, data = tree.model, tree.model.createData()  # the hinge's world axis, as Pinocchio places it
+    pin.computeJointJacobians(model, data, graph.q)
+    axis = pin.getJointJacobian(model, data, model.getJointId("left-foot-op"), pin.WORLD)[3:,
+                                                                                        model.joints[model.getJointId(
+                                                                                            "left-foot-op")].idx_v]
+    axis = axis / np.linalg.norm(axis)
+    asked = np.radians([70.0, 60.0, 45.0, 85.0])
+    targets = np.zeros((asked.size, 6))
+    targets[:, 4] = asked
+    q, reached = solve_poses(tree, graph.q, graph.scale, graph.frame_id, targets, graph.task_axes, limits=False)
+    assert reached.all()
+    for row, pitch in enumerate(asked):
+        turned = foot_rotation(tree, graph, q[row])
+        np.testing.assert_allclose(rpy_of(turned)[1], pitch, atol=1e-9)
+        relative = turned @ home.T  # a rotation about the hinge's world axis, by the pitch's change
+        angle = np.arccos(np.clip((np.trace(relative) - 1) / 2, -1, 1))
+        assert angle == pytest.approx(abs(pitch - home_pitch), abs=1e-6)
+        spin = np.array([relative[2, 1] - relative[1, 2], relative[0, 2] - relative[2, 0],
+                         relative[1, 0] - relative[0, 1]]) / (2 * np.sin(angle))
+        assert abs(abs(spin @ axis) - 1.0) < 1e-6
+
+
+def test_a_roll_asked_at_the_gimbal_lock_is_not_reached():
+    """Held in roll (the coordinate the rule no longer takes), the foot met any roll at the gimbal lock, where roll
+    and yaw are one angle (120 and 170 deg at one configuration): those poses are not reached now; the file's own
+    roll still is, where the file has the foot."""
+    tree, graph = cassie_foot()
+    home = rpy_of(foot_rotation(tree, graph, graph.q))
+    targets = np.zeros((3, 6))
+    targets[:, 3] = [np.radians(120.0), np.radians(170.0), home[0]]
+    q, reached = solve_poses(tree, graph.q, graph.scale, graph.frame_id, targets, (3,), limits=False)
+    assert not reached[0] and not reached[1]
+    assert reached[2]
+    np.testing.assert_allclose(rpy_of(foot_rotation(tree, graph, q[2])), home, atol=1e-9)
+
+
+# --- its joint limits: the legs' joints, named with their values ------------------------------------------------
+
+def sdf_limits_deg(name: str) -> tuple[float, float]:
+    """A joint's <lower>, <upper> as the SDFormat text writes them (rad), in degrees: read with ElementTree alone."""
+    import xml.etree.ElementTree as ElementTree
+
+    text = CASSIE.read_text()
+    root = ElementTree.fromstring(text[text.index("<sdf"):])
+    joint = next(j for j in root.iter("joint") if j.get("name") == name)
+    return tuple(float(np.degrees(float(joint.find(f"axis/limit/{tag}").text))) for tag in ("lower", "upper"))
+
+
+def test_the_file_s_configuration_beyond_the_legs_limits_is_refused_naming_them():
+    """The file draws the foot's crank and hinge at 0, outside their limits (-140 to -35 deg): refused naming both,
+    with their values and limits as the file writes them; the other leg's joints, also at 0 but moved by nothing,
+    are not named (they made every pose of the foot "a joint is beyond its limits")."""
+    _, graph = cassie_foot()
+    with pytest.raises(ValueError) as refused:
+        graph.reading_notes(limits=True)
+    message = str(refused.value)
+    for name in ("left-tarsus-crank-joint", "left-foot-op"):
+        low, high = sdf_limits_deg(name)
+        assert f"{name!r} at 0 deg, limits [{low:.6g}, {high:.6g}] deg" in message, message
+    assert "right-" not in message and "--initial JOINT VALUE" in message and "--ignore-limits" in message
+    notes = graph.reading_notes(limits=False)
+    assert any(note.startswith("limits ignored: 'left-tarsus-crank-joint' at 0 deg") for note in notes), notes
+
+
+def test_a_pose_beyond_the_limits_names_the_joints_and_their_values():
+    """Started inside the limits (--initial on the crank), a pitch the foot reaches only past its hinge's upper
+    limit is refused naming the hinge, at the value the continuation reached (checked against the configuration
+    solved without limits)."""
+    tree = read_closed_tree(CASSIE, output="left-foot", actuate=["left-foot-op"], lock=list(HIPS),
+                            initial=[("left-tarsus-crank-joint", -80.0)])
+    graph = graph_mechanism(tree)
+    assert graph.reading_notes(limits=True) == []
+    q, reached = graph.solve(np.radians([[80.0]]), limits=False)
+    assert reached[0]
+    hinge = np.degrees(q[0, tree.model.joints[tree.model.getJointId("left-foot-op")].idx_q])
+    assert hinge > sdf_limits_deg("left-foot-op")[1]
+    kind, reason = graph.unreachable(np.radians([80.0]))
+    assert kind == "joint limit"
+    assert f"'left-foot-op' at {hinge:.6g} deg, limits" in reason and "right-" not in reason, reason
+
+
+def test_the_command_line_refuses_the_file_s_configuration_and_says_where_it_started(tmp_path):
+    from helpers import one_line_error, screwkit
+
+    words = ["analyze", CASSIE, "--output", "left-foot", "--actuate", "left-foot-op"]
+    for joint in HIPS:
+        words += ["--lock", joint]
+    one_line_error(screwkit(*words), "cassie_v2.sdf", "'left-foot-op' at 0 deg", "--ignore-limits")
+    ignored = screwkit(*words, "--ignore-limits")
+    assert ignored.returncode == 0, ignored.stderr
+    assert "limits ignored: 'left-tarsus-crank-joint' at 0 deg" in ignored.stderr
+    assert "at the file's configuration (pitch = 76.99" in ignored.stdout.splitlines()[0]
+    started = screwkit(*words, "--initial", "left-tarsus-crank-joint", "-80")
+    assert started.returncode == 0, started.stderr
+    assert ("at the configuration assembled from --initial left-tarsus-crank-joint -80 (pitch = "
+            in started.stdout.splitlines()[0])
