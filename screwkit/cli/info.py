@@ -139,7 +139,8 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
         click.echo(f"  task frame: base {report['platform']['base_link']!r}, origin ("
                    f"{', '.join(f'{v:.6g}' for v in placed['origin_m'])}) m in the world; its {axes} in the world's"
                    + (" (the plane of motion is its x-y plane)" if loaded.is_planar else ""))
-    click.echo(f"  {len(report['actuators'])} actuators: {', '.join(report['actuators'])}")
+    count = len(report['actuators'])
+    click.echo(f"  {count} actuator{'' if count == 1 else 's'}: {', '.join(report['actuators'])}")
     click.echo("  chains:")
     for chain in report["chains"]:
         click.echo(f"    {chain['name']}: {' - '.join(chain['joints'])} (actuated: {', '.join(chain['actuated'])}); "

@@ -34,7 +34,8 @@ def reading_record(length_unit: str | None = None, output_frame: str | None = No
 
 LOCK_HELP = ("For a file of another tool: hold this joint at its value in the file (repeatable): a serial stage "
              "before the parallel part, such as a turntable every leg stands on; a passive joint inside a loop that "
-             "the file writes open is held where the loops close.")
+             "the file writes open is held where the loops close; a ball or universal joint is held whole by its "
+             "name.")
 
 
 ACTUATE_HELP = ("For a file of another tool: drive this joint (repeatable): the actuators are the joints named "

@@ -13,6 +13,7 @@ tree in screwkit's convention.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -113,6 +114,12 @@ class ClosedTree:
         """Where the assembly starts, for messages: the file's joint values, or those ``--initial`` gave."""
         return ("the joint values given (--initial) and the file's for the others" if self.initial else
                 "the file's joint values")
+
+    def written_joint(self, name: str) -> str:
+        """The file's joint that the model's joint ``name`` stands for: a ball or universal joint a reader wrote as
+        hinges (:attr:`split`), else ``name`` itself."""
+        match = re.fullmatch(r"one hinge of \w+ joint '(.*)'", self.split.get(name, ""))
+        return match.group(1) if match else name
 
     def motor_label(self, name: str) -> str:
         """How a message names the actuated joint ``name``: by the option that named it, as guessed (the file marks

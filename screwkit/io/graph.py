@@ -356,8 +356,9 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
             placed.update(actuated)
             continue
         joints = tuple(sorted(group + ([platform] if spine else [])))
-        first = min(group, key=lambda b: (len(path_to(model, b)), b))
-        legs.append(GraphLeg(body_names.get(first, model.names[first]), joints, tuple(ends), spine, actuated))
+        first = min(group, key=lambda b: (b not in body_names, len(path_to(model, b)), b))  # a body, if any
+        legs.append(GraphLeg(body_names.get(first, tree.written_joint(model.names[first])), joints, tuple(ends), spine,
+                             actuated))
         placed.update(actuated)
     if model.parents[platform] == 0:
         kind, _ = joint_kind(model, platform)
@@ -407,7 +408,7 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None
                                f"the actuated joint joins the base to the rest of its leg{hint}.")
 
 
-def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
+def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
     """The platform's frame is the output of a graph: refused when a point is asked for, or when the platform still
     moves with every actuator locked (an effector turning freely on the pin where the legs meet: its frame is no
     output any actuator controls, and its indices would be zero everywhere)."""
@@ -418,11 +419,15 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str) -> None:
     if len(idle):
         guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
                         if note.startswith("actuators guessed")), "")
+        model = tree.model
+        passive = dict.fromkeys(tree.written_joint(model.names[j]) for leg in legs for j in leg.joints
+                                if model.names[j] not in tree.motors and model.joints[j].nv == 1)
         raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
                            "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
-                           f"meet, or motors the file does not name; actuators {', '.join(tree.motors)}"
-                           f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; "
-                           "analysable through serial legs as a point output, not through the graph.")
+                           f"meet, a spring joint, or motors the file does not name; actuators {', '.join(tree.motors)}"
+                           f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; --lock "
+                           f"holds a passive joint that moves it (the legs' passive joints: {', '.join(passive)}), "
+                           "--actuate names a joint that drives it.")
 
 
 def _motion_space(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:
@@ -498,7 +503,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
             return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else []
 
         _check_legs(tree, legs, screws, nearby)
-        _check_output(tree, screws, report.platform_body)
+        _check_output(tree, screws, report.platform_body, legs)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     counted = []

@@ -23,15 +23,18 @@ def check_actuators(tree: ClosedTree, legs) -> None:
             stage = serial_stage(model, leg)
             advice = ""
             if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
-                names = [str(model.names[j]) for j in stage]
+                names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
+                given = [name for name in names if name in tree.actuated]
                 advice = (f"; joints {', '.join(names)} carry every actuator of it in turn (a serial stage before the "
-                          f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn")
+                          f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn"
+                          + (f" (leave {', '.join(given)} out of --actuate)" if given else ""))
             elif stage:
                 name = model.names[stage[0]]
                 carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
                            else f"joint {name!r} carries every actuator of it")
                 advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
-                          "on the body it turns")
+                          "on the body it turns" + (f" (leave {name} out of --actuate)" if name in tree.actuated
+                                                    else ""))
                 if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
                     advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
                               f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "

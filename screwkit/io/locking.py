@@ -42,6 +42,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     if not names:
         return tree
     model = tree.model
+    names = tuple(hinge for name in names for hinge in _hinges_of(tree, name))
     for name in names:
         if not model.existJointName(name) or model.getJointId(name) == 0:
             raise ImportError_(f"{tree.source}: --lock {name}: no joint of that name; joints are "
@@ -76,13 +77,21 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     guessed = [k for k, note in enumerate(tree.notes) if note.startswith(GUESSED)]
     other = [note for k, note in enumerate(tree.notes) if k not in guessed]
     if guessed and len(motors) < len(tree.motors):
-        motors = guessed_motors(reduced, closures)
+        motors = guessed_motors(reduced, closures, tree.split)
         other.append(f"actuators guessed from the branches leaving the base once the locked joints are held: "
                      f"{', '.join(motors)}")
     else:
         other += [tree.notes[k] for k in guessed]
     return replace(tree, model=reduced, closures=closures, motors=motors, q_reference=q, notes=other + notes,
                    locked=tree.locked + names)
+
+
+def _hinges_of(tree: ClosedTree, name: str) -> list[str]:
+    """The model's joints that ``--lock name`` holds: the hinges a reader wrote for the file's ball or universal
+    joint ``name``, else ``name``."""
+    if tree.model.existJointName(name):
+        return [name]
+    return [hinge for hinge in tree.split if hinge != name and tree.written_joint(hinge) == name] or [name]
 
 
 def _reduced_model(model, locked: list[int], held: NDArray):

@@ -98,8 +98,9 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
     return tree
 
 
-def guessed_motors(model, closures: list[Closure]) -> list[str]:
-    """On each branch leaving the base towards a closure: its one prismatic joint on the way, else its first joint."""
+def guessed_motors(model, closures: list[Closure], hinges=()) -> list[str]:
+    """On each branch leaving the base towards a closure: its one prismatic joint on the way, else its first joint
+    that is not one of ``hinges`` (those a reader wrote for a ball or universal joint, which no motor drives)."""
     branches: dict[int, list[int]] = {}
     for closure in closures:
         for joint in (closure.joint_a, closure.joint_b):
@@ -111,7 +112,8 @@ def guessed_motors(model, closures: list[Closure]) -> list[str]:
     for first, members in sorted(branches.items()):
         kinds = {joint: joint_kind(model, joint)[0] for joint in members}
         prismatic = [joint for joint in members if kinds[joint] == "prismatic"]
-        chosen = prismatic[0] if len(prismatic) == 1 else first
+        chosen = prismatic[0] if len(prismatic) == 1 else next(
+            (joint for joint in members if str(model.names[joint]) not in hinges), first)
         if kinds[chosen] in ("revolute", "prismatic"):
             motors.append(str(model.names[chosen]))
     return motors

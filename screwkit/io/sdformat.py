@@ -374,7 +374,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                 "is not a joint of the model" if name not in kinds else
                 f"is a {kinds[name]} joint, not a 1-DoF one" if kinds[name] not in (*HINGES, "prismatic") else
                 f"closes a loop of the tree grown from {fixed}")
-    motors = [] if unactuated else stated or guessed_motors(model, closures)
+    motors = [] if unactuated else stated or guessed_motors(model, closures, builder.split)
     if not stated:
         silent = any(CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
                      for plugin in sdf.element.findall("plugin"))  # a controller whose joints its own code names

@@ -1,9 +1,14 @@
-"""Which pose coordinate a mechanism's motion is read in, when one barely moves: a coordinate is taken in its order
-(x, y, z, roll, pitch, yaw) only if its rates tell the motions apart within a tenth as well as the best one of its
-kind. A published Cassie (example-robot-data's ``cassie_v2.sdf``, its foot drawn at a pitch of 77 deg and turning
-about the world's y axis to within 4e-6 rad) read its foot's motion as roll, whose rate is 1.6e-5 of the pitch's,
-and then put the foot at the gimbal lock for any roll asked ("at roll = 120" and "at roll = 170" were one
-configuration)."""
+"""example-robot-data's Cassie in SDFormat (``cassie_v2.sdf``, as published), opened as a user opens it, and what
+it found:
+
+* which pose coordinate a mechanism's motion is read in when one barely moves: a coordinate is taken in its order
+  (x, y, z, roll, pitch, yaw) only if its rates tell the motions apart within a tenth as well as the best one of
+  its kind. The foot, drawn at a pitch of 77 deg and turning about the world's y axis to within 4e-6 rad, read
+  roll, whose rate is 1.6e-5 of the pitch's, and was then put at the gimbal lock for any roll asked ("at roll =
+  120" and "at roll = 170" were one configuration);
+* its legs' joint limits: the file draws the foot's crank and hinge outside theirs, and a biped's other leg too;
+* the names its messages give: its legs after their bodies, not after the hinges a reader writes for a ball joint;
+  no such hinge guessed as an actuator; the passive joints to lock when the foot moves with its actuator locked."""
 
 from __future__ import annotations
 
@@ -148,3 +153,57 @@ def test_the_command_line_refuses_the_file_s_configuration_and_says_where_it_sta
     assert started.returncode == 0, started.stderr
     assert ("at the configuration assembled from --initial left-tarsus-crank-joint -80 (pitch = "
             in started.stdout.splitlines()[0])
+
+
+def test_its_legs_and_guesses_are_named_as_the_file_has_them():
+    """The foot's leg starts at a ball joint (left-pitch-rod-joint), which the reader writes as three hinges
+    ``_x``, ``_y``, ``_z``: the leg is named after its first body, and the actuators guessed when --actuate is
+    not given are no such hinge."""
+    tree, graph = cassie_foot()
+    assert [leg.name for leg in graph.legs] == ["left-achilles-rod"]
+    for lock in ((), HIPS):  # guessed as read, and again once the hips are held (the leg's first joint: the ball)
+        guessed = read_closed_tree(CASSIE, output="left-foot", lock=list(lock))
+        assert guessed.motors and not any(motor in guessed.split for motor in guessed.motors), guessed.motors
+        assert "left-achilles-spring-joint" in guessed.motors or not lock, guessed.motors
+
+
+def test_a_foot_its_springs_leave_free_names_the_passive_joints_to_lock():
+    """With the knee's shin spring left free, the foot moves with its actuator locked: the refusal lists the legs'
+    passive joints as the file names them (the ball once, the springs among them), and holding the spring opens it
+    (the test above)."""
+    from screwkit.io import ImportError_
+
+    tree = read_closed_tree(CASSIE, output="left-foot", actuate=["left-foot-op"], lock=list(HIPS[:-1]))
+    with pytest.raises(ImportError_) as refused:
+        graph_mechanism(tree)
+    message = str(refused.value)
+    assert "moves with every actuator locked" in message
+    passive = message.split("the legs' passive joints: ")[1].split(")")[0].split(", ")
+    assert "left-knee-shin-joint" in passive and "left-pitch-rod-joint" in passive and "left-foot-op" not in passive
+    assert not any(name.endswith(("_x", "_y", "_z")) for name in passive), passive
+
+
+def test_the_serial_stage_advice_says_to_leave_the_named_actuators_out_of_actuate():
+    """The hip's motors named with --actuate and suggested for --lock: the advice says to leave them out of
+    --actuate (with both, the next run was refused for naming a joint both ways)."""
+    from screwkit.io import ImportError_
+
+    hip = ["left-roll-op", "left-yaw-op", "left-pitch-op"]
+    tree = read_closed_tree(CASSIE, output="left-foot", actuate=hip + ["left-knee-op", "left-foot-op"])
+    with pytest.raises(ImportError_) as refused:
+        graph_mechanism(tree)
+    assert (f"--lock {' --lock '.join(hip)} analyses the legs on the body they turn (leave {', '.join(hip)} out "
+            "of --actuate)") in str(refused.value), str(refused.value)
+
+
+def test_a_ball_joint_is_locked_by_its_own_name():
+    """--lock names a ball joint as the file does: the three hinges the reader wrote for it are held, the same
+    model as naming them."""
+    ball = "left-pitch-rod-joint"
+    by_name = read_closed_tree(CASSIE, output="left-foot", lock=list(HIPS) + [ball])
+    hinges = [hinge for hinge in read_closed_tree(CASSIE).split if hinge.startswith(ball + "_")]
+    assert sorted(hinges) == [f"{ball}_{axis}" for axis in "xyz"]
+    by_hinges = read_closed_tree(CASSIE, output="left-foot", lock=list(HIPS) + hinges)
+    assert list(by_name.model.names) == list(by_hinges.model.names)
+    assert not any(name.startswith(ball) for name in by_name.model.names)
+    np.testing.assert_array_equal(by_name.q_reference, by_hinges.q_reference)
