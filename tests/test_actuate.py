@@ -245,10 +245,14 @@ def _sdformat_marking_a_ball(tmp_path):
 ])
 def test_a_file_whose_own_marking_is_wrong_is_refused_as_written_and_opens_with_its_actuators_named(tmp_path, make,
                                                                                                       message):
-    """Each reader refused the file's wrong or missing marking before --actuate could replace it."""
+    """Each reader refused the file's wrong or missing marking before --actuate could replace it, listing the joints
+    that can be driven (those that open it among them)."""
     path, named = make(tmp_path)
-    with pytest.raises(ImportError_, match=message + r"; --actuate JOINT names the actuated joints\.$"):
+    with pytest.raises(ImportError_, match=message + r"; --actuate JOINT names the actuated joints \(those that can "
+                                                     r"be driven, revolute or prismatic: .*\)\.$") as refused:
         read_closed_tree(path)
+    listed = str(refused.value).rsplit("revolute or prismatic: ", 1)[1].removesuffix(").").split(", ")
+    assert set(named) <= set(listed), listed
     tree = read_closed_tree(path, actuate=named)
     assert tree.motors == list(named)
     assert any(note.startswith("actuators as given (--actuate)") and "the file's could not be taken" in note

@@ -39,6 +39,7 @@ from screwkit.cli.options import (
     parse_probabilities,
     reading_options,
 )
+from screwkit.common.compiling import compile_ahead
 from screwkit.common.memory import keep_freed_memory
 from screwkit.indices.average import MEAN_NAME, is_mean_column
 from screwkit.indices.registry import column_record
@@ -126,6 +127,9 @@ def _run(chosen: Family, fixed: dict, initial: dict, options: SearchOptions, reg
             start_mechanism = None  # (a start that does not build scores 0, as any such design)
     if start_mechanism is not None:
         check_region_against(where, start_mechanism)
+        from screwkit.studies.kernels import constraint_kernels  # a design's region takes them (compiled_chunks)
+
+        compile_ahead(*constraint_kernels(start_mechanism))  # compiled while the search starts, on a first run
     free = options.free or _varied(chosen, fixed)
     try:
         study = Study(chosen, where, tuple(options.objectives) or ("area",), free=tuple(free), fixed=fixed,

@@ -7,7 +7,9 @@ Only numpy is imported here (numba when the kernels first run).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import threading
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -32,7 +34,7 @@ from screwkit.screw.outputs import quotient_bases
 
 __all__ = ["Plan", "make_plan", "run_kernel", "ChunkSpaces", "analyze_chunk", "joints_of_all_chains",
            "constraint_plan_of", "constraint_chunk", "at_constraint_singularities", "CONSTRAINTS_COMPILED_FROM",
-           "square_subsystems", "compiled_constraint_stage", "checked_faults", "checked_threshold",
+           "compiled_chunks", "square_subsystems", "compiled_constraint_stage", "checked_faults", "checked_threshold",
            "checked_rank_tolerance", "checked_chunk_size"]
 
 
@@ -171,7 +173,31 @@ SPACES_COMPILED_FROM = 512
 """Chunks of at least this many configurations take their chain decompositions and motion spaces from the
 compiled :func:`screwkit.indices.compiled.spaces.space_kernel`; smaller ones from numpy
 (:func:`screwkit.screw.motion.chain_decompositions`, :func:`screwkit.screw.motion.null_spaces`), which needs
-no compiling."""
+no compiling (:func:`compiled_chunks`: every chunk)."""
+
+_COMPILED_EVERYWHERE = [0]  # the compiled_chunks blocks open in this process
+_COMPILED_LOCK = threading.Lock()
+
+
+@contextmanager
+def compiled_chunks() -> Iterator[None]:
+    """A block in which chunks of any size take the compiled space and constraint kernels, not only those of
+    :data:`SPACES_COMPILED_FROM` (:data:`CONSTRAINTS_COMPILED_FROM`) configurations or more: for a study that
+    evaluates many small batches (a design search's regions, 81 to 1,183 configurations a design), which pays
+    the kernels' compiling once and numpy's per-call cost at every batch. The same indices to rounding (the
+    kernels' tests: 1e-12). Process-wide while open: the threads of one study share it."""
+    with _COMPILED_LOCK:
+        _COMPILED_EVERYWHERE[0] += 1
+    try:
+        yield
+    finally:
+        with _COMPILED_LOCK:
+            _COMPILED_EVERYWHERE[0] -= 1
+
+
+def _compiled_from(smallest: int) -> int:
+    """The least chunk the compiled kernels serve: ``smallest``, or 1 in a :func:`compiled_chunks` block."""
+    return 1 if _COMPILED_EVERYWHERE[0] else smallest
 
 
 class ChunkSpaces:
@@ -193,7 +219,7 @@ class ChunkSpaces:
         """The space kernel's singular values (C, N, 6), right singular vectors (C, N, 6, 6), eigenvalues (N, 6)
         and eigenvectors (N, 6, 6) for a chunk of :data:`SPACES_COMPILED_FROM` configurations or more; else None."""
         count, chains = self.twists.shape[0], len(self.plan.chain_start) - 1
-        if count < SPACES_COMPILED_FROM:
+        if count < _compiled_from(SPACES_COMPILED_FROM):
             return None
         prepare_kernels((SPACE_KERNEL,))
         from screwkit.indices.compiled.spaces import space_kernel  # numba: compiled for lower mobility only
@@ -365,7 +391,8 @@ def compiled_constraint_stage(constraint_plan: ConstraintPlan, submechanisms: ND
     n = submechanisms.shape[1]
     own_counts = np.array(constraint_plan.own_counts, dtype=np.int64)
     members = subsystem_members(constraint_plan)
-    if count < CONSTRAINTS_COMPILED_FROM or not constraint_plan.count or not square_subsystems(constraint_plan, n):
+    if (count < _compiled_from(CONSTRAINTS_COMPILED_FROM) or not constraint_plan.count
+            or not square_subsystems(constraint_plan, n)):
         return None
     wrench_start = np.cumsum((0,) + constraint_plan.chain_counts).astype(np.int64)
     sets = np.ascontiguousarray(submechanisms, dtype=np.int64)

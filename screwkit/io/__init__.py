@@ -90,14 +90,15 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     from dataclasses import replace
 
     from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
-    from screwkit.io.locking import actuate_joints, lock_joints, set_initial  # (idem)
+    from screwkit.io.locking import actuate_joints, drivable_joints, lock_joints, set_initial  # (idem)
     from screwkit.io.tree_units import in_metres  # (idem)
 
     tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
     if unit:
         tree = replace(tree, unit=unit)
     if tree.unactuated and not actuate:
-        raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints.")
+        raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints (those that can be driven, "
+                           f"revolute or prismatic: {drivable_joints(tree)}).")
     tree = actuate_joints(lock_joints(set_initial(tree, initial), lock), actuate)
     if not tree.motors:
         raise ImportError_(f"{tree.source}: nothing to actuate: the file names no actuated joint and no 1-DoF joint "

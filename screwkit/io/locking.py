@@ -24,7 +24,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "GUESSED"]
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "GUESSED"]
 
 
 def lock_joints(tree: ClosedTree, names) -> ClosedTree:
@@ -187,7 +187,7 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
     if not names:
         return tree
     model = tree.model
-    drivable = _one_dof_joints(tree)
+    drivable = drivable_joints(tree)
     for name in names:
         what = None
         if name in tree.locked:
@@ -213,7 +213,7 @@ def actuate_joints(tree: ClosedTree, names) -> ClosedTree:
     return replace(tree, motors=list(names), notes=notes, actuated=names)
 
 
-def _one_dof_joints(tree: ClosedTree) -> str:
+def drivable_joints(tree: ClosedTree) -> str:
     """The tree's 1-DoF joints, as the refusals of ``--actuate`` and ``--initial`` list them (not a hinge a reader
     wrote for part of a ball or universal joint)."""
     model = tree.model
@@ -232,7 +232,7 @@ def set_initial(tree: ClosedTree, values) -> ClosedTree:
     if not pairs:
         return tree
     model, q = tree.model, np.array(tree.q_reference, dtype=float)
-    startable = _one_dof_joints(tree)
+    startable = drivable_joints(tree)
     said = []
     for name, value in pairs:
         joint = model.getJointId(name) if model.existJointName(name) else 0

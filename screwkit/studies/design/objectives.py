@@ -20,6 +20,7 @@ from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
 from screwkit.indices.average import MEAN_NAME, averaging, is_mean_column
 from screwkit.indices.registry import column_record
+from screwkit.indices.stages import compiled_chunks
 from screwkit.model import Mechanism
 from screwkit.studies.maps import (
     MapBlock,
@@ -479,7 +480,8 @@ def region_maps(mechanism: Mechanism, region: Region) -> dict[str, NDArray]:
         if value is not None:
             at[names.index(region.layers[0])] = value
         block = MapBlock(at, names.index(x_name), x_values, names.index(y_name), y_values, mask, over_axes, over_values)
-        values = map_block(mechanism, block, analysis)
+        with compiled_chunks():  # a design's region is small, and a search evaluates hundreds
+            values = map_block(mechanism, block, analysis)
         for key, column in values.items():
             grid = out.setdefault(key, np.full((len(layer_values),) + shape, np.nan))
             grid[k][mask] = column
