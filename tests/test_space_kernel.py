@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers import bundled
+from helpers import assert_same_indices, bundled
 from screwkit.closure import solve
 from screwkit.common import tolerances
 from screwkit.indices.compiled.spaces import space_kernel
@@ -113,11 +113,4 @@ def test_analysis_through_the_kernel_equals_the_numpy_path(name):
     assert poses.shape[0] >= SPACES_COMPILED_FROM
     through_kernel = indices_at_poses(mechanism, poses, detail=True, chunk_size=poses.shape[0], threads=1)
     through_numpy = indices_at_poses(mechanism, poses, detail=True, chunk_size=100, threads=1)
-    for key in ("iti", "lmti", "iti_actuators", "oti_submechanisms", "cti", "cti_submechanisms"):
-        expected = getattr(through_numpy, key)
-        if expected is not None:
-            np.testing.assert_allclose(getattr(through_kernel, key), expected, rtol=0, atol=1e-12, equal_nan=True,
-                                       err_msg=key)
-    for j in through_numpy.f_o:
-        np.testing.assert_allclose(through_kernel.f_o[j], through_numpy.f_o[j], rtol=0, atol=1e-12)
-    assert np.array_equal(through_kernel.instantaneous_dof, through_numpy.instantaneous_dof)
+    assert_same_indices(through_kernel, through_numpy)

@@ -18,6 +18,7 @@ from screwkit.cli.options import (
     check_outputs,
     echo_error,
     fail,
+    ignore_limits_option,
     load_mechanism,
     mechanism_argument,
     option_group,
@@ -76,10 +77,12 @@ def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, lin
 
 @dataclass(frozen=True)
 class Colouring:
-    """What the chains are coloured by, and the singularity threshold of the indices (m)."""
+    """What the chains are coloured by, the singularity threshold of the indices (m), and whether the joints'
+    limits count (``--ignore-limits``: a file drawn beyond them is read all the same, a pose beyond them drawn)."""
 
     color_by: str
     threshold: float
+    ignore_limits: bool = False
 
     def __post_init__(self):
         if not self.threshold >= 0:  # (as `analyze` takes it: inf allowed)
@@ -251,7 +254,7 @@ def _say(message: str) -> None:
     "colouring", Colouring,
     click.option("--color-by", type=click.Choice(["iti", "oti"]), default="iti", show_default=True,
                  help="Colour chains by their lowest ITI or by the OTI of their best working submechanism."),
-    threshold_option)
+    threshold_option, ignore_limits_option)
 @reading_options
 @click.option("--open", "open_browser", is_flag=True, help="Open the viewer in the default browser.")
 @overwrite_option
@@ -291,7 +294,8 @@ def _view(mechanism, pose, failed, html_path, motion: Motion, colouring: Colouri
           quiet, serving: list) -> None:
     """The command once its outputs are checked: returns once the HTML is written; serves until the server stops
     (an error) or a signal ends it (``serving`` gets True just before the URL is shown)."""
-    loaded = load_mechanism(mechanism, reading, graphs=True)
+    limits = not colouring.ignore_limits
+    loaded = load_mechanism(mechanism, reading, graphs=True, limits=limits)
     target = parse_pose(loaded, pose)
     failures = list(failed)  # indices or names, see screwkit.viewer.resolve_actuators
     resampled = []
@@ -300,9 +304,11 @@ def _view(mechanism, pose, failed, html_path, motion: Motion, colouring: Colouri
         if animated is not None:
             poses, times = animated
             scene = animate_sweep(loaded, poses, failed=failures, threshold=colouring.threshold,
-                                  color_by=colouring.color_by, frame_rate=motion.frame_rate, times=times)
+                                  color_by=colouring.color_by, frame_rate=motion.frame_rate, times=times,
+                                  limits=limits)
         else:
-            scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by)
+            scene = show(loaded, target, failed=failures, threshold=colouring.threshold, color_by=colouring.color_by,
+                         limits=limits)
     except (ValueError, RuntimeError) as error:
         raise fail(str(error)) from None
     with scene:  # whatever ends the command from here (an error, Ctrl+C, SIGTERM, SIGHUP) stops the server

@@ -340,13 +340,13 @@ def _locking_chains(mechanism: Mechanism, full_pose, joint_values) -> str:
                             int(dofs[0])))
     if not locking:
         return "; no one chain locks it: without any one of them it still cannot move"
-    rigid = ("a joint axis slightly out of line with the rest of its loop (as a CAD export's rounding or a cambered "
-             "axle writes it) makes a loop rigid, and the file is read as written")
+    rigid = ("a loop with no motion: a structure, or a joint axis slightly out of line with the rest of its loop "
+             "(as a CAD export's rounding or a cambered axle writes it); the file is read as written")
     if len(locking) == len(mechanism.chains):
         return (f"; any one chain left out, the others would let it move (chains "
                 f"{', '.join(name for name, _ in locking)}): {rigid}")
-    without = " or ".join(f"{name} it would move ({dof} DOF)" for name, dof in locking)
-    return f"; without chain {without}: {rigid}"
+    without = " or ".join(f"without chain {name} it would move ({dof} DOF)" for name, dof in locking)
+    return f"; {without}: {rigid}"
 
 
 def idle_rotation_count(mechanism: Mechanism) -> int:

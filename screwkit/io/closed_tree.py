@@ -118,8 +118,8 @@ class ClosedTree:
     def written_joint(self, name: str) -> str:
         """The file's joint that the model's joint ``name`` stands for: a ball or universal joint a reader wrote as
         hinges (:attr:`split`), else ``name`` itself."""
-        match = re.fullmatch(r"one hinge of \w+ joint '(.*)'", self.split.get(name, ""))
-        return match.group(1) if match else name
+        match = re.fullmatch(r"one hinge of \w+ joint (['\"])(.*)\1", self.split.get(name, ""))
+        return match.group(2) if match else name
 
     def motor_label(self, name: str) -> str:
         """How a message names the actuated joint ``name``: by the option that named it, as guessed (the file marks

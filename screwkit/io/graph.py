@@ -66,6 +66,7 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import TWIST_RANK_TOLERANCE, closed_samples
 from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_kinematics import (
+    GIMBAL_LOCK,
     TreeKinematics,
     beyond_reach,
     limits_phrase,
@@ -208,8 +209,8 @@ class GraphMechanism:
         beyond = limits_phrase(self.tree.model, self.kinematics, self.q, self.limited)
         plural = ";" in beyond
         if beyond and limits:
-            raise ValueError(f"{self.tree.source}: the configuration puts the joint{'s' if plural else ''} of its "
-                             f"legs beyond {'their' if plural else 'its'} limits: {beyond} (--ignore-limits reads "
+            raise ValueError(f"{self.tree.source}: the configuration puts {'joints' if plural else 'a joint'} of "
+                             f"its legs beyond {'their' if plural else 'its'} limits: {beyond} (--ignore-limits reads "
                              "it all the same; --initial JOINT VALUE on such a joint, or on the one driving it, "
                              "starts the assembly inside them).")
         return said + ([f"{LIMITS_IGNORED}{beyond}"] if beyond else [])
@@ -244,6 +245,10 @@ class GraphMechanism:
             return "closure", (f"{self.tree.source}: no closed configuration puts the output frame at ({names}): it "
                                f"is never farther than {self.reach(limits=False):.4g} m from the world origin")
         free_q, free_reached = self.solve(np.asarray(pose, dtype=float)[None], limits=False)
+        if {3, 5} & set(self.task_axes) and abs(np.cos(self.frame_pose(free_q[0])[4])) <= GIMBAL_LOCK:
+            return "closure", (f"{self.tree.source}: the output frame is met at ({names}) only at a gimbal lock (its "
+                               "pitch at +-90 deg, where roll and yaw are one angle and any value of either reads as "
+                               "met): not a pose this frame's angles tell")
         if limits and free_reached[0]:
             beyond = limits_phrase(self.tree.model, self.kinematics, free_q[0], self.limited)
             plural = ";" in beyond
@@ -421,13 +426,14 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: li
                         if note.startswith("actuators guessed")), "")
         model = tree.model
         passive = dict.fromkeys(tree.written_joint(model.names[j]) for leg in legs for j in leg.joints
-                                if model.names[j] not in tree.motors and model.joints[j].nv == 1)
+                                if model.names[j] not in tree.motors and model.joints[j].nv < 6)
         raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
                            "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
                            f"meet, a spring joint, or motors the file does not name; actuators {', '.join(tree.motors)}"
                            f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; --lock "
-                           f"holds a passive joint that moves it (the legs' passive joints: {', '.join(passive)}), "
-                           "--actuate names a joint that drives it.")
+                           "holds a passive joint that moves it"
+                           + (f" (the legs' passive joints: {', '.join(passive)})" if passive else "")
+                           + ", --actuate names a joint that drives it.")
 
 
 def _motion_space(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:

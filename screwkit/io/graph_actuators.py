@@ -29,7 +29,7 @@ def check_actuators(tree: ClosedTree, legs) -> None:
                           f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn"
                           + (f" (leave {', '.join(given)} out of --actuate)" if given else ""))
             elif stage:
-                name = model.names[stage[0]]
+                name = tree.written_joint(model.names[stage[0]])
                 carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
                            else f"joint {name!r} carries every actuator of it")
                 advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "

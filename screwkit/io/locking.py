@@ -42,7 +42,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     if not names:
         return tree
     model = tree.model
-    names = tuple(hinge for name in names for hinge in _hinges_of(tree, name))
+    asked, names = names, tuple(dict.fromkeys(hinge for name in names for hinge in _hinges_of(tree, name)))
     for name in names:
         if not model.existJointName(name) or model.getJointId(name) == 0:
             raise ImportError_(f"{tree.source}: --lock {name}: no joint of that name; joints are "
@@ -71,7 +71,7 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     given = [name for name in names if name in dict(tree.initial)]
     values = (f"values in the file ({', '.join(given)} at {'its' if len(given) == 1 else 'their'} --initial value"
               f"{'' if len(given) == 1 else 's'})" if given else "values in the file")
-    notes = [f"joints {', '.join(names)} locked at their {values} (--lock): the legs analysed on the body they turn"
+    notes = [f"joints {', '.join(asked)} locked at their {values} (--lock): the legs analysed on the body they turn"
              ] + moved
     motors = [motor for motor in tree.motors if motor not in names]
     guessed = [k for k, note in enumerate(tree.notes) if note.startswith(GUESSED)]

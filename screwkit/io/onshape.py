@@ -109,12 +109,12 @@ def guessed_motors(model, closures: list[Closure], hinges=()) -> list[str]:
                 members = branches.setdefault(path[0], [])
                 members += [j for j in path if j not in members]
     motors = []
-    for first, members in sorted(branches.items()):
+    for _, members in sorted(branches.items()):
         kinds = {joint: joint_kind(model, joint)[0] for joint in members}
         prismatic = [joint for joint in members if kinds[joint] == "prismatic"]
         chosen = prismatic[0] if len(prismatic) == 1 else next(
-            (joint for joint in members if str(model.names[joint]) not in hinges), first)
-        if kinds[chosen] in ("revolute", "prismatic"):
+            (joint for joint in members if str(model.names[joint]) not in hinges), None)
+        if chosen is not None and kinds[chosen] in ("revolute", "prismatic"):
             motors.append(str(model.names[chosen]))
     return motors
 

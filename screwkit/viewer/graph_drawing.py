@@ -113,18 +113,19 @@ def _outline(plate: int, owner: str, points: list[NDArray], length: float) -> li
             for index, (start, end) in enumerate(pieces)]
 
 
-def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool) -> Frames:
+def solve_graph_frames(graph, poses: NDArray, threshold: float, strict: bool, limits: bool = True) -> Frames:
     """The closed configurations and indices at ``poses`` (the unreachable ones left out, or with ``strict`` a
     ValueError naming the first), as :func:`screwkit.viewer.markers.solve_frames` gives them for serial legs;
     ``chain_points`` are each leg's joint origins."""
     from screwkit.studies.poses import graph_indices_at_poses  # graphs only
 
-    result, q = graph_indices_at_poses(graph, poses, detail=True, threshold=threshold, configurations=True)
+    result, q = graph_indices_at_poses(graph, poses, detail=True, threshold=threshold, configurations=True,
+                                       limits=limits)
     reachable = np.asarray(result.reachable, dtype=bool).reshape(-1)
     kept = np.flatnonzero(reachable)
     if kept.size < reachable.size:
         if strict:
-            raise ValueError(graph.unreachable(poses[int(np.flatnonzero(~reachable)[0])])[1] + ".")
+            raise ValueError(graph.unreachable(poses[int(np.flatnonzero(~reachable)[0])], limits=limits)[1] + ".")
         if not kept.size:
             raise ValueError(f"None of the {poses.shape[0]} poses is reachable for mechanism {graph.name!r}.")
         # each pose is closed and analysed alone (as in any batch): the reachable ones' rows are what a batch of

@@ -213,17 +213,17 @@ class Frames:
     kept: NDArray = None  # (F,) which of the poses asked for these frames are (the reachable ones)
 
 
-def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool) -> Frames:
-    solution = solve(mechanism, poses)
+def solve_frames(mechanism, poses: NDArray, threshold: float, strict: bool, limits: bool = True) -> Frames:
+    solution = solve(mechanism, poses, limits=limits)
     reachable = np.asarray(solution.reachable)
     kept = np.flatnonzero(reachable)
     if not np.all(reachable):
         if strict:
-            solve_one(mechanism, poses[int(np.flatnonzero(~reachable)[0])])  # raises, naming the chains
+            solve_one(mechanism, poses[int(np.flatnonzero(~reachable)[0])], limits=limits)  # raises, naming them
         if not np.any(reachable):
             raise ValueError(f"None of the {poses.shape[0]} poses is reachable for mechanism {mechanism.name!r}.")
         poses = poses[reachable]
-        solution = solve(mechanism, poses)
+        solution = solve(mechanism, poses, limits=limits)
     screws = chain_screws(mechanism, solution)
     result = analyze_solution(mechanism, solution, threshold=threshold, keep_twists=True)
     configurations = configuration_vector(mechanism, solution.joint_values, solution.full_poses)

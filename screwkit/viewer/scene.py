@@ -153,7 +153,8 @@ class Scene:
 
 
 def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
-         color_by: Literal["iti", "oti"] = "iti", viewer=None, open_browser: bool = False) -> Scene:
+         color_by: Literal["iti", "oti"] = "iti", viewer=None, open_browser: bool = False,
+         limits: bool = True) -> Scene:
     """Draw a mechanism at one pose, coloured by its indices, with its screws.
 
     See the module docstring for what is drawn and in which colours.
@@ -176,6 +177,8 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
         start a server on 127.0.0.1 (:func:`start_viewer`), stopped by :meth:`Scene.close`.
     open_browser : bool
         Open the viewer page in the default browser.
+    limits : bool
+        Whether a pose that puts a joint beyond its position limits is unreachable (``--ignore-limits``: False).
 
     Returns
     -------
@@ -192,12 +195,13 @@ def show(mechanism, pose: ArrayLike | None = None, *, failed=None, threshold: fl
     if pose.ndim != 1:
         raise ValueError(f"Expected one pose with shape ({mechanism.n_task},), got {pose.shape}; "
                          "use animate_sweep for several poses.")
-    return _draw(mechanism, pose[None], failed, threshold, color_by, viewer, open_browser, None)
+    return _draw(mechanism, pose[None], failed, threshold, color_by, viewer, open_browser, None, limits)
 
 
 def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float = SINGULARITY_THRESHOLD,
                   color_by: Literal["iti", "oti"] = "iti", viewer=None, frame_rate: float = 10.0,
-                  loop: bool = True, open_browser: bool = False, times: ArrayLike | None = None) -> Scene:
+                  loop: bool = True, open_browser: bool = False, times: ArrayLike | None = None,
+                  limits: bool = True) -> Scene:
     """Animate the mechanism along a sweep of poses or a path, with its screws and colours following.
 
     The first reachable pose is drawn as by :func:`show` (chain colours from its indices);
@@ -219,7 +223,7 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
     poses : array_like, shape (frames, n_task), or Path
         Platform poses in metres and radians, in the order to play them, or a
         :class:`~screwkit.studies.paths.Path` (its samples; with its times, if it has any).
-    failed, threshold, color_by, viewer, open_browser
+    failed, threshold, color_by, viewer, open_browser, limits
         As for :func:`show`.
     frame_rate : float
         Keyframes per second (without times); with times, the clip's time base (keyframe numbers per second).
@@ -246,7 +250,7 @@ def animate_sweep(mechanism, poses: ArrayLike, *, failed=None, threshold: float 
     if not frame_rate > 0:
         raise ValueError(f"Expected `frame_rate` > 0, got {frame_rate}.")
     return _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser,
-                 _Animation(float(frame_rate), loop, checked_times(times, poses.shape[0])))
+                 _Animation(float(frame_rate), loop, checked_times(times, poses.shape[0])), limits)
 
 
 def export_html(target, path: str | os.PathLike) -> Path:
@@ -322,9 +326,9 @@ class _Geometry:
     failed_chains: set
 
 
-def _serial_drawing(mechanism, poses, failed, threshold, strict: bool):
+def _serial_drawing(mechanism, poses, failed, threshold, strict: bool, limits: bool = True):
     """Frames, markers and geometry of a mechanism of serial legs."""
-    frames = solve_frames(mechanism, poses, threshold, strict)
+    frames = solve_frames(mechanism, poses, threshold, strict, limits)
     best = tuple(best_submechanism(frames.result, frame, failed) for frame in range(frames.poses.shape[0]))
     visual_model = load_visual_model(mechanism)
     owners, bare = geometry_owners(mechanism, visual_model)
@@ -340,9 +344,9 @@ def _serial_drawing(mechanism, poses, failed, threshold, strict: bool):
     return frames, best, markers, _Geometry(visual_model, owners, failed_joints, failed_chains)
 
 
-def _graph_drawing(mechanism, poses, failed, threshold, strict: bool):
+def _graph_drawing(mechanism, poses, failed, threshold, strict: bool, limits: bool = True):
     """Frames and markers of a mechanism whose legs have loops inside them (no geometry: rods and spheres)."""
-    frames = solve_graph_frames(mechanism, poses, threshold, strict)
+    frames = solve_graph_frames(mechanism, poses, threshold, strict, limits)
     best = tuple(best_submechanism(frames.result, frame, failed) for frame in range(frames.poses.shape[0]))
     return frames, best, graph_markers(mechanism, frames, failed), None
 
@@ -371,7 +375,8 @@ def _show_geometry(meshcat_viewer, mechanism, geometry: _Geometry, chain_colors,
     return visualizer
 
 
-def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None) -> Scene:
+def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, animation: _Animation | None,
+          limits: bool = True) -> Scene:
     """Draw :func:`show`'s one pose (``animation`` None: an unreachable pose is an error) or
     :func:`animate_sweep`'s poses (the unreachable ones skipped); a mechanism whose legs have loops inside them as
     rods and spheres (:mod:`screwkit.viewer.graph_drawing`)."""
@@ -383,7 +388,7 @@ def _draw(mechanism, poses, failed, threshold, color_by, viewer, open_browser, a
     one_pose = animation is None
     is_graph = isinstance(mechanism, GraphMechanism)
     frames, best, markers, geometry = (_graph_drawing if is_graph else _serial_drawing)(
-        mechanism, poses, failed, threshold, one_pose)
+        mechanism, poses, failed, threshold, one_pose, limits)
     count = frames.poses.shape[0]
     result = frames.result
     chain_values = np.stack([chain_index_values(mechanism, result, frame, failed, color_by) for frame in range(count)])
