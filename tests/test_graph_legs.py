@@ -302,3 +302,22 @@ def test_a_delta_whose_rod_pairs_are_trapezoids_is_driven_in_x_y_z(tmp_path, tra
     pin.framesForwardKinematics(model, data, graph.q)
     turned = data.oMf[graph.frame_id].rotation.T @ output.rotation
     assert np.arccos(np.clip((np.trace(turned) - 1.0) / 2.0, -1.0, 1.0)) > 1e-3
+
+
+def test_a_position_asked_of_a_delta_turned_a_quarter_turn_is_met_as_in_the_unturned_world(tmp_path):
+    """GraphMechanism.at_pose with no orientation holds the position and the task coordinates, not the frame's
+    roll, pitch and yaw as they are: the rod Delta's world turned 90 deg about y puts its platform frame at a pitch
+    of 90 deg, a gimbal lock of those angles, and no position could be asked there. The same move gives the
+    textbook's indices in both worlds (the world-frame invariance of the position asked)."""
+    turn = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # 90 deg about y
+    shift = np.array([0.1, -0.2, 0.3])
+    _, plain = open_delta(tmp_path, name="plain.xml")
+    _, turned = open_delta(tmp_path, name="turned.xml", transform=(1.0, turn, shift))
+    assert abs(np.cos(turned.frame_pose()[4])) < 1e-6  # the frame at the lock
+    move = np.array([0.01, -0.015, 0.02])
+    here = plain.at_pose(plain.frame_pose()[:3] + move)
+    there = turned.at_pose(turned.frame_pose()[:3] + turn @ move)
+    np.testing.assert_allclose(there.frame_pose()[:3], turn @ here.frame_pose()[:3] + shift, atol=1e-9)
+    expected = textbook(np.array(POSES[0]) + move)
+    for graph in (here, there):
+        assert_delta_textbook(graph.indices(), expected)

@@ -205,7 +205,6 @@ class GraphMechanism:
         """What a command says of this reading, as of a serial mechanism's: a DOF found at the file's rounding, and
         the legs' joints the configuration puts beyond their limits (a file drawn with a joint outside its range, as
         MuJoCo's qpos0 often is): refused (a ValueError), or said with ``limits`` False (``--ignore-limits``)."""
-        said = [note for note in self.report.notes if note.startswith(DOF_AT_ROUNDING)]
         beyond = limits_phrase(self.tree.model, self.kinematics, self.q, self.limited)
         plural = ";" in beyond
         if beyond and limits:
@@ -213,7 +212,8 @@ class GraphMechanism:
                              f"its legs beyond {'their' if plural else 'its'} limits: {beyond} (--ignore-limits reads "
                              "it all the same; --initial JOINT VALUE on such a joint, or on the one driving it, "
                              "starts the assembly inside them).")
-        return said + ([f"{LIMITS_IGNORED}{beyond}"] if beyond else [])
+        return ([note for note in self.report.notes if note.startswith(DOF_AT_ROUNDING)]
+                + ([f"{LIMITS_IGNORED}{beyond}"] if beyond else []))
 
     @cached_property
     def limited(self) -> NDArray[np.bool_]:
@@ -260,10 +260,10 @@ class GraphMechanism:
                            f"({spelled_pose(self.task_coordinates, self.task_pose() + 0.0)})")  # (no -0)
 
     def at_pose(self, position, rpy=None, *, limits: bool = True) -> GraphMechanism:
-        """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default
-        the one it has), reached by continuation from this configuration (the working mode followed). A
-        ValueError names the pose when the frame cannot be put there (out of reach, a rotation the legs do not
-        allow, or a joint beyond its limits)."""
+        """The mechanism with its output frame at ``position`` (m, world frame) and orientation ``rpy`` (rad; default:
+        its task coordinates' angles as they are, any other angle where the closures put it), reached by continuation
+        from this configuration (the working mode followed). A ValueError names the pose when the frame cannot be
+        put there (out of reach, a rotation the legs do not allow, or a joint beyond its limits)."""
         position = np.asarray(position, dtype=float).reshape(-1)
         if position.shape != (3,) or not np.all(np.isfinite(position)):
             raise ValueError(f"Expected a finite position (x, y, z), got {position.tolist()}.")
@@ -271,11 +271,12 @@ class GraphMechanism:
         target[:3] = position
         if rpy is not None:
             target[3:] = np.asarray(rpy, dtype=float)
-        q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], tuple(range(6)),
+        held = tuple(range(6)) if rpy is not None else tuple(sorted({0, 1, 2} | set(self.task_axes)))
+        q, reached = solve_poses(self.tree, self.q, self.scale, self.frame_id, target[None], held,
                                  limits=limits, kinematics=self.kinematics, limited=self.limited)
         if not reached[0]:
             why = (f"out of reach: the output frame is never farther than {self.reach(limits=limits):.4g} m from the "
-                   "world origin" if self._beyond_reach(target, tuple(range(6)), limits)
+                   "world origin" if self._beyond_reach(target, held, limits)
                    else "out of reach, a rotation the legs do not allow, or a joint beyond its limits")
             raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
                              f"output frame at {np.round(position, 9).tolist()} m"
@@ -424,9 +425,8 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: li
     if len(idle):
         guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
                         if note.startswith("actuators guessed")), "")
-        model = tree.model
-        passive = dict.fromkeys(tree.written_joint(model.names[j]) for leg in legs for j in leg.joints
-                                if model.names[j] not in tree.motors and model.joints[j].nv < 6)
+        passive = dict.fromkeys(tree.written_joint(tree.model.names[j]) for leg in legs for j in leg.joints
+                                if tree.model.names[j] not in tree.motors and tree.model.joints[j].nv < 6)
         raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
                            "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
                            f"meet, a spring joint, or motors the file does not name; actuators {', '.join(tree.motors)}"
