@@ -37,6 +37,10 @@ def test_a_coordinate_that_barely_moves_is_not_taken_before_one_that_moves():
         assert choose_task_axes(between, ANGULAR, 1) == (3,)
     slide = np.array([[1e-5], [1.0], [0.0], [0.0], [0.0], [0.0]])  # a slide along y, drawn 1e-5 off
     assert choose_task_axes(slide, ANGULAR, 1) == (1,)
+    # two motions: roll passed over for pitch, then yaw barely moving beside pitch: roll is taken after all (the
+    # choice never comes short of the DOF while coordinates independent of those chosen are left)
+    passed_over = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.05], [1.0, 0.0], [0.0, 0.001]])
+    assert choose_task_axes(passed_over, ANGULAR, 2) == (3, 4)
 
 
 def cassie_foot():

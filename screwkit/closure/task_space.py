@@ -374,4 +374,9 @@ def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=N
         if axis not in chosen and _telling(space, chosen, axis, [a for a in order if a not in chosen
                                                                   and angular[a] == angular[axis]]):
             chosen.append(axis)
+    for axis in order:  # one passed over for a better one that a later choice then made worse: independence alone
+        if len(chosen) == dof:
+            break
+        if axis not in chosen and _separation(space, chosen + [axis]) > TASK_RANK_TOLERANCE:
+            chosen.append(axis)
     return tuple(sorted(chosen))
