@@ -66,16 +66,25 @@ def rrr3(tilted: int | None = None, tilt_deg: float = 3.0, scale: float = 1.0, s
                           f'<child link="{bodies[j]}"/><origin xyz="{xyz(offsets[j])}"/><axis xyz="{axis}"/>'
                           '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
         if k:
-            links += [f'<link name="end_{k + 1}"/>', f'<link name="tip_{k + 1}"/>']
-            joints.append(f'<joint name="end_{k + 1}_frame" type="fixed"><parent link="{bodies[2]}"/>'
-                          f'<child link="end_{k + 1}"/></joint>')
-            joints.append(f'<joint name="tip_{k + 1}_frame" type="fixed"><parent link="platform"/>'
-                          f'<child link="tip_{k + 1}"/><origin xyz="{xyz(tip - PLATFORM_PINS[0])}"/></joint>')
+            welded(k + 1, bodies[2], xyz((0.0, 0.0)), xyz(tip - PLATFORM_PINS[0]), links, joints)
     urdf = '<robot name="rrr3">' + "".join(links) + "".join(joints) + "</robot>"
-    closures = [k + 1 for k in legs if k]
-    yaml = (f"closed_loop: [{', '.join(f'[end_{k}, tip_{k}]' for k in closures)}]\n"
-            f"type: [{', '.join('6d' for _ in closures)}]\nname_mot: [{', '.join(f'leg_{k + 1}_a' for k in legs)}]\n")
-    return urdf, yaml
+    return urdf, gepetto_yaml([k + 1 for k in legs if k], [f"leg_{k + 1}_a" for k in legs])
+
+
+def welded(leg: int, body: str, at_end: str, at_platform: str, links: list, joints: list) -> None:
+    """Add the frames a Gepetto '6d' closure welds: ``end_<leg>`` on the leg's last body ``body`` (at ``at_end``)
+    and ``tip_<leg>`` on the platform (at ``at_platform``; URDF xyz texts)."""
+    links += [f'<link name="end_{leg}"/>', f'<link name="tip_{leg}"/>']
+    joints.append(f'<joint name="end_{leg}_frame" type="fixed"><parent link="{body}"/><child link="end_{leg}"/>'
+                  f'<origin xyz="{at_end}"/></joint>')
+    joints.append(f'<joint name="tip_{leg}_frame" type="fixed"><parent link="platform"/><child link="tip_{leg}"/>'
+                  f'<origin xyz="{at_platform}"/></joint>')
+
+
+def gepetto_yaml(closures: list[int], motors: list[str]) -> str:
+    """The robot.yaml of legs ``closures`` welded to the platform ('6d') and the actuated joints ``motors``."""
+    return (f"closed_loop: [{', '.join(f'[end_{k}, tip_{k}]' for k in closures)}]\n"
+            f"type: [{', '.join('6d' for _ in closures)}]\nname_mot: [{', '.join(motors)}]\n")
 
 
 def write(folder, urdf_yaml):
@@ -152,6 +161,73 @@ def test_the_command_line_refuses_the_rigid_file_in_one_line(tmp_path):
     path = write(tmp_path, rrr3(1))
     one_line_error(screwkit("analyze", path, "--output", "platform"), "robot.urdf", "(DOF 0)",
                    "without chain leg_2_a (joints leg_2_a, leg_2_b, leg_2_c) it would move (3 DOF)")
+
+
+def rr_legs(count: int):
+    """``count`` planar RR legs (a base pin, an elbow pin) in Gepetto's form, leg 1 carrying the platform, the others
+    welded to it ('6d'): its URDF, robot.yaml, base pins and platform points."""
+    angles = np.radians(np.arange(count) * 360.0 / count + 90.0)
+    base = [np.array([np.cos(a), np.sin(a)]) for a in angles]
+    tip = [0.3 * b for b in base]
+    def xyz(v):
+        return " ".join(repr(float(x)) for x in (*v, 0.0))
+    links, joints = ['<link name="base"/>', '<link name="platform"/>'], []
+    for k in range(count):
+        d = tip[k] - base[k]
+        elbow = (base[k] + tip[k]) / 2 + 0.25 * np.array([-d[1], d[0]]) / np.linalg.norm(d)
+        a, b = f"l{k + 1}a", f"l{k + 1}b"
+        links += [f'<link name="{a}"/>', f'<link name="{b}"/>']
+        for name, parent, child, offset in ((f"leg_{k + 1}_a", "base", a, base[k]),
+                                            (f"leg_{k + 1}_b", a, b, elbow - base[k])):
+            joints.append(f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+                          f'<origin xyz="{xyz(offset)}"/><axis xyz="0 0 1"/>'
+                          '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+        if k == 0:
+            joints.append(f'<joint name="platform_frame" type="fixed"><parent link="{b}"/><child link="platform"/>'
+                          f'<origin xyz="{xyz(tip[k] - elbow)}"/></joint>')
+        else:
+            welded(k + 1, b, xyz(tip[k] - elbow), xyz(tip[k] - tip[0]), links, joints)
+    urdf = '<robot name="rr">' + "".join(links) + "".join(joints) + "</robot>"
+    return urdf, gepetto_yaml(list(range(2, count + 1)), [f"leg_{k + 1}_a" for k in range(count)]), base, tip
+
+
+def planar_common_motion(legs: list[list[np.ndarray]]) -> int:
+    """The dimension of the plane twists (w, v_x, v_y) every leg allows, each leg's twists those of its pins (unit
+    turns about z at the pins): numpy alone, as :func:`common_motion` does in space."""
+    twists = [np.column_stack([[1.0, pin[1], -pin[0]] for pin in pins]) for pins in legs]
+    first, rest = twists[0], twists[1:]
+    blocks = np.zeros((3 * len(rest), sum(t.shape[1] for t in twists)))
+    column = first.shape[1]
+    for r, other in enumerate(rest):
+        blocks[3 * r:3 * r + 3, :first.shape[1]] = first
+        blocks[3 * r:3 * r + 3, column:column + other.shape[1]] = -other
+        column += other.shape[1]
+    singular = np.linalg.svd(blocks, compute_uv=False)  # (each leg's pins distinct: its twists independent)
+    return int(blocks.shape[1] - np.sum(singular > 1e-9))
+
+
+@pytest.mark.parametrize("count", [3, 4])
+def test_rigid_legs_name_every_chain_or_none(tmp_path, count):
+    """Planar RR legs: three leave the platform no motion, and any two of them one (every chain named); four leave
+    it none, and any three none (no one chain locks it): the legs' common twists, numpy alone, then the refusal."""
+    urdf, yaml, base, tip = rr_legs(count)
+    pins = []
+    for k in range(count):
+        d = tip[k] - base[k]
+        pins.append([base[k], (base[k] + tip[k]) / 2 + 0.25 * np.array([-d[1], d[0]]) / np.linalg.norm(d)])
+    assert planar_common_motion(pins) == 0
+    without = [planar_common_motion(pins[:k] + pins[k + 1:]) for k in range(count)]
+    assert without == [1] * count if count == 3 else without == [0] * count
+    with pytest.raises(ValueError) as refused:
+        load(write(tmp_path, (urdf, yaml)), output="platform")
+    message = str(refused.value)
+    assert "(DOF 0)" in message
+    if count == 3:
+        assert "any one chain left out, the others would let it move (chains leg_1_a (joints leg_1_a, leg_1_b), " \
+               "leg_2_a (joints leg_2_a, leg_2_b), leg_3_a (joints leg_3_a, leg_3_b))" in message, message
+    else:
+        assert message.endswith("(DOF 0); no one chain locks it: without any one of them it still cannot "
+                                "move."), message
 
 
 def rrp_onto_another_leg(marked: bool) -> str:
