@@ -69,7 +69,7 @@ from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
     TreeKinematics,
     beyond_reach,
-    limits_phrase,
+    joints_beyond_limits,
     reach_bound,
     rpy_of,
     rpy_rates_inverse,
@@ -205,15 +205,15 @@ class GraphMechanism:
         """What a command says of this reading, as of a serial mechanism's: a DOF found at the file's rounding, and
         the legs' joints the configuration puts beyond their limits (a file drawn with a joint outside its range, as
         MuJoCo's qpos0 often is): refused (a ValueError), or said with ``limits`` False (``--ignore-limits``)."""
-        beyond = limits_phrase(self.tree.model, self.kinematics, self.q, self.limited)
-        plural = ";" in beyond
+        beyond = joints_beyond_limits(self.tree.model, self.kinematics, self.q, self.limited)
+        plural = len(beyond) > 1
         if beyond and limits:
             raise ValueError(f"{self.tree.source}: the configuration puts {'joints' if plural else 'a joint'} of "
-                             f"its legs beyond {'their' if plural else 'its'} limits: {beyond} (--ignore-limits reads "
-                             "it all the same; --initial JOINT VALUE on such a joint, or on the one driving it, "
-                             "starts the assembly inside them).")
+                             f"its legs beyond {'their' if plural else 'its'} limits: {'; '.join(beyond)} "
+                             "(--ignore-limits reads it all the same; --initial JOINT VALUE on such a joint, or on "
+                             "the one driving it, starts the assembly inside them).")
         return ([note for note in self.report.notes if note.startswith(DOF_AT_ROUNDING)]
-                + ([f"{LIMITS_IGNORED}{beyond}"] if beyond else []))
+                + ([f"{LIMITS_IGNORED}{'; '.join(beyond)}"] if beyond else []))
 
     @cached_property
     def limited(self) -> NDArray[np.bool_]:
@@ -250,11 +250,11 @@ class GraphMechanism:
                                "pitch at +-90 deg, where roll and yaw are one angle and any value of either reads as "
                                "met): not a pose this frame's angles tell")
         if limits and free_reached[0]:
-            beyond = limits_phrase(self.tree.model, self.kinematics, free_q[0], self.limited)
-            plural = ";" in beyond
+            beyond = joints_beyond_limits(self.tree.model, self.kinematics, free_q[0], self.limited)
+            plural = len(beyond) > 1
             return "joint limit", (f"{self.tree.source}: at ({names}) the configuration reached from the file's by "
                                    f"continuation puts {'joints' if plural else 'a joint'} beyond "
-                                   f"{'their' if plural else 'its'} limits: {beyond}")
+                                   f"{'their' if plural else 'its'} limits: {'; '.join(beyond)}")
         return "closure", (f"{self.tree.source}: no closed configuration reached from the file's by continuation "
                            f"puts the output frame at ({names}); the file's configuration has it at "
                            f"({spelled_pose(self.task_coordinates, self.task_pose() + 0.0)})")  # (no -0)

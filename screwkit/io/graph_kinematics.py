@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
-__all__ = ["TreeKinematics", "solve_poses", "beyond_limits", "limits_phrase", "reach_bound", "rpy_of",
+__all__ = ["TreeKinematics", "solve_poses", "beyond_limits", "joints_beyond_limits", "reach_bound", "rpy_of",
            "rpy_rates_inverse", "STAGE_LENGTH",
            "MAX_ITERATIONS", "STAGE_TOLERANCE", "FINAL_TOLERANCE"]
 
@@ -450,9 +450,9 @@ def beyond_limits(kinematics: TreeKinematics, q: NDArray, limited: NDArray | Non
     return beyond if limited is None else beyond & np.asarray(limited, dtype=bool)
 
 
-def limits_phrase(model, kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> str:
-    """The joints of one configuration ``q`` (nq,) beyond their limits (those of ``limited``), each with its value
-    and limits (deg for a revolute joint, m for a prismatic one), for a message; "" if none."""
+def joints_beyond_limits(model, kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> list[str]:
+    """The joints of one configuration ``q`` (nq,) beyond their limits (those of ``limited``), each said with its
+    value and limits (deg for a revolute joint, m for a prismatic one), for a message."""
     said = []
     for column in np.flatnonzero(beyond_limits(kinematics, q[None], limited)[0]):
         joint = int(kinematics.column_joint[column])
@@ -462,4 +462,4 @@ def limits_phrase(model, kinematics: TreeKinematics, q: NDArray, limited: NDArra
             said.append(f"{model.names[joint]!r} at {value:.6g} deg, limits [{low:.6g}, {high:.6g}] deg")
         else:
             said.append(f"{model.names[joint]!r} at {value:.6g} m, limits [{low:.6g}, {high:.6g}] m")
-    return "; ".join(said)
+    return said
