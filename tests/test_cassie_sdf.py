@@ -43,8 +43,9 @@ def test_a_coordinate_that_barely_moves_is_not_taken_before_one_that_moves():
     assert choose_task_axes(passed_over, ANGULAR, 2) == (3, 4)
 
 
-def cassie_foot():
-    tree = read_closed_tree(CASSIE, output="left-foot", actuate=["left-foot-op"], lock=list(HIPS))
+def cassie_foot(length_unit=None):
+    tree = read_closed_tree(CASSIE, output="left-foot", actuate=["left-foot-op"], lock=list(HIPS),
+                            length_unit=length_unit)
     return tree, graph_mechanism(tree)
 
 
@@ -53,10 +54,12 @@ def foot_rotation(tree, graph, q) -> np.ndarray:
         tree.model.frames[graph.frame_id].placement.rotation)
 
 
-def test_the_published_cassie_s_foot_is_read_in_the_angle_it_turns():
+@pytest.mark.parametrize("length_unit", [None, "mm", "km"])  # the file read in m, and its lengths x 1e-3 and x 1e3
+def test_the_published_cassie_s_foot_is_read_in_the_angle_it_turns(length_unit):
     """The foot turns about its hinge (the actuated joint): the task coordinate is pitch, and each pose's foot is the
-    file's turned about that hinge's world axis by the change of pitch asked (Rodrigues, numpy alone)."""
-    tree, graph = cassie_foot()
+    file's turned about that hinge's world axis by the change of pitch asked (Rodrigues, numpy alone), whatever the
+    unit its lengths are read in."""
+    tree, graph = cassie_foot(length_unit)
     assert graph.task_axes == (4,)
     home = foot_rotation(tree, graph, graph.q)
     home_pitch = float(rpy_of(home)[1])
@@ -244,3 +247,21 @@ def test_view_reads_a_file_beyond_its_limits_with_ignore_limits(tmp_path):
     done = screwkit(*words, "--html", page, "--ignore-limits")
     assert done.returncode == 0, done.stderr
     assert page.stat().st_size > 0 and "limits ignored: 'left-tarsus-crank-joint' at 0 deg" in done.stderr
+
+
+def test_info_and_a_file_without_actuators_on_the_command_line():
+    """`info` counts one actuator in the singular; a file that marks no actuator (Pinocchio's MJCF Cassie, no
+    <actuator>) is refused in one line listing the joints --actuate can name, its foot crank among them."""
+    from helpers import one_line_error, screwkit
+
+    words = ["info", CASSIE, "--output", "left-foot", "--actuate", "left-foot-op",
+             "--initial", "left-tarsus-crank-joint", "-80"]  # (started inside the crank's limits)
+    for joint in HIPS:
+        words += ["--lock", joint]
+    shown = screwkit(*words)
+    assert shown.returncode == 0, shown.stderr
+    assert "  1 actuator: " in shown.stdout, shown.stdout
+    pinocchio_cassie = CASSIE.parents[1] / "pinocchio_closed_chain" / "closed_chain.xml"
+    message = one_line_error(screwkit("info", pinocchio_cassie), "closed_chain.xml", "no <actuator> drives a joint")
+    listed = message.rsplit("revolute or prismatic: ", 1)[1].removesuffix(").").split(", ")
+    assert "left-foot-crank" in listed and "left-plantar-rod" in listed, listed
