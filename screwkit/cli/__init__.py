@@ -14,7 +14,7 @@ import sys
 
 import click
 
-from screwkit.cli.options import ScrewkitGroup
+from screwkit.cli.options import ScrewkitGroup, report_error
 
 __all__ = ["app", "main", "COMMANDS"]
 
@@ -68,6 +68,11 @@ def main() -> None:
         code = 0
     except SystemExit as stop:
         code = stop.code
+    except MemoryError as error:  # beyond what a study's size check foresaw (screwkit.studies.sizes): one line
+        said = str(error).split(" for an array")[0]  # numpy's "Unable to allocate 641. MiB for an array ..."
+        report_error(f"Ran out of memory{': ' + said if said else ''}: ask for a smaller study (fewer poses or "
+                     "samples, a coarser grid), or split it into parts.", sys.argv[1:])
+        code = 1
     except BaseException:
         _stop_compilers()
         raise

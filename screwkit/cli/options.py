@@ -65,6 +65,7 @@ __all__ = [
     "connected",
     "fail",
     "echo_error",
+    "report_error",
 ]
 
 
@@ -90,7 +91,7 @@ class ScrewkitGroup(click.Group):
             message = error.format_message()
             if isinstance(error, click.UsageError) and error.ctx is not None:  # one line, not click's usage block
                 message = f"{message} See '{error.ctx.command_path} --help'."
-            _report(message, arguments)
+            report_error(message, arguments)
             if standalone_mode:
                 sys.exit(1)
             raise
@@ -99,7 +100,7 @@ class ScrewkitGroup(click.Group):
 
             if not isinstance(error, WriteError) and error.errno not in _WRITE_FAILURES:
                 raise
-            _report(str(error) if isinstance(error, WriteError) else
+            report_error(str(error) if isinstance(error, WriteError) else
                     f"Cannot write {error.filename or 'to stdout'}: {error.strerror}.", arguments)
             if standalone_mode:
                 sys.exit(1)
@@ -118,7 +119,7 @@ _WRITE_FAILURES = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}
 """What a write that fails says: no space left, quota exceeded, file too large, read-only file system."""
 
 
-def _report(message: str, arguments: list[str]) -> None:
+def report_error(message: str, arguments: list[str]) -> None:
     """An error as one line: ``Error: ...`` on stderr, or ``{"error": ...}`` on stdout with ``--json`` (on
     stderr if stdout itself cannot be written)."""
     if "--json" in arguments:

@@ -28,6 +28,7 @@ from screwkit.cli.options import (
 from screwkit.model import Mechanism
 from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.path_mechanisms import check_path_size, path_mechanism
 from screwkit.studies.paths import PathFileError, checked_tolerance, circle_path, line_path, read_path, through_path
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
@@ -244,8 +245,13 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     keywords = faults.keywords()
     loaded = load_mechanism(mechanism, reading, limits=analysis.limits, graphs=True)
     check_average(analysis, loaded)
+    sized = _sized(loaded, analysis)
+    if source.path_file is None:  # a generated path, before it is generated
+        sized(source.samples, f"--samples {source.samples}: the path")
     path = source.read(loaded)
     try:
+        if source.path_file is not None:
+            sized(path.samples, f"{source.path_file}: the path")
         if faults.tolerance is not None:  # what the refinement can honour on this path, named as given
             checked_tolerance(path, faults.tolerance, "--tolerance")
         result = run_trajectory(loaded, path, analysis=analysis, aggregate=analysis.aggregate,
@@ -258,6 +264,22 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     elif not quiet:
         print_summary(summary)
     _write(result, outputs, quiet or as_json, to_stdout=not as_json)
+
+
+def _sized(mechanism, analysis):
+    """``check(samples, where)``: a path of that many samples refused in one line if it would not fit in memory."""
+    try:
+        along = path_mechanism(mechanism, analysis, {})
+    except ValueError as error:  # what a graph cannot be asked (closed forms, link faults)
+        raise fail(str(error)) from None
+
+    def check(samples: int, where: str) -> None:
+        try:
+            check_path_size(along, samples, where)
+        except ValueError as error:
+            raise fail(str(error)) from None
+
+    return check
 
 
 def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:

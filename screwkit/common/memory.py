@@ -1,6 +1,13 @@
-"""Freed memory kept for the next design instead of handed back to the system and faulted in again.
+"""How much memory a study may take (:func:`available_memory`), and freed memory kept for the next design.
 
-A design evaluation allocates its arrays afresh (the joint screws of every configuration of its region, tens of
+A study that would not fit is refused before it computes (a map's result, a path's samples), against what this
+process can still be given: the least of the memory the system could free for it (``MemAvailable``, which counts
+the page cache it would drop, where ``sysconf``'s free pages alone would refuse a study on a machine that has
+written large files), what its container's control group leaves it, and what its address-space limit
+(``ulimit -v``) leaves it.
+
+Freed memory is kept for the next design instead of handed back to the system and faulted in again. A design
+evaluation allocates its arrays afresh (the joint screws of every configuration of its region, tens of
 megabytes for a planar disc) and frees them when it returns. glibc's allocator serves blocks above its mmap
 threshold (128 KiB, rising to at most 32 MiB as blocks are freed) by ``mmap``, hands them back on ``free``, and
 trims the heap's free top above its trim threshold: the next design touches new pages, and the kernel zeroes each
@@ -16,9 +23,70 @@ it has reached anyway. Elsewhere than glibc (macOS, Windows, musl) it does nothi
 from __future__ import annotations
 
 import ctypes
+import os
 import sys
+from pathlib import Path
 
-__all__ = ["keep_freed_memory", "KEPT_BYTES", "OLD_LARGEST"]
+__all__ = ["available_memory", "byte_size", "keep_freed_memory", "KEPT_BYTES", "OLD_LARGEST"]
+
+_CGROUP = Path("/sys/fs/cgroup")
+_MEMINFO = Path("/proc/meminfo")
+
+
+def available_memory() -> int | None:
+    """Bytes this process can still be given (module docstring); None where none of the three can be read."""
+    found = [_system_available(), _cgroup_available(), _address_space_available()]
+    known = [value for value in found if value is not None]
+    return max(0, min(known)) if known else None
+
+
+def _system_available() -> int | None:
+    try:
+        for line in _MEMINFO.read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _cgroup_available() -> int | None:
+    """The limit of this process's control group less what it uses (v2, then v1); None without a limit."""
+    for limit, used in (("memory.max", "memory.current"),
+                        ("memory/memory.limit_in_bytes", "memory/memory.usage_in_bytes")):
+        try:
+            text = (_CGROUP / limit).read_text().strip()
+            if text == "max" or int(text) >= 1 << 60:  # v1 writes "no limit" as a huge number
+                return None
+            return int(text) - int((_CGROUP / used).read_text().strip())
+        except (OSError, ValueError):
+            continue
+    return None
+
+
+def _address_space_available() -> int | None:
+    """The address-space limit (``ulimit -v``) less the process's size now; None without a limit."""
+    try:
+        import resource  # (POSIX only)
+
+        limit = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if limit == resource.RLIM_INFINITY:
+            return None
+        return limit - int(Path("/proc/self/statm").read_text().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (ImportError, OSError, ValueError, IndexError, AttributeError):
+        return None
+
+
+def byte_size(count: int) -> str:
+    """``count`` bytes in GiB, MiB, KiB or B (one decimal)."""
+    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if count >= size:
+            return f"{count / size:.1f} {unit}"
+    return f"{count} B"
+
 
 KEPT_BYTES = 1 << 30
 """Blocks up to this size come from the heap, and up to this much free memory is kept at its top (1 GiB: above the

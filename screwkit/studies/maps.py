@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.common.memory import available_memory, byte_size
 from screwkit.common.units import unit_of
 from screwkit.indices.registry import index_columns
 from screwkit.io.graph import GraphMechanism
@@ -95,33 +96,19 @@ class MapSize:
     def check(self, *, max_configurations: int = MAX_CONFIGURATIONS, proceed: bool = False,
               available_bytes: int | None = None) -> None:
         """Refuse, with one line, a map that would not fit in memory or is larger than stated without ``proceed``."""
-        available = _available_memory() if available_bytes is None else available_bytes
+        available = available_memory() if available_bytes is None else available_bytes
         summary = self.description
         if available is not None and self.memory_bytes > 0.8 * available:
-            raise ValueError(f"The map has {summary}; its result alone needs {_bytes(self.memory_bytes)}, more than "
-                             f"this machine can give ({_bytes(available)} available): use a coarser grid.")
+            raise ValueError(f"The map has {summary}; its result alone needs {byte_size(self.memory_bytes)}, more than "
+                             f"this machine can give ({byte_size(available)} available): use a coarser grid.")
         if self.configurations > max_configurations and not proceed:
             raise ValueError(f"The map has {summary}, more than {max_configurations:,}; it would run for a long time "
-                             f"and its result needs {_bytes(self.memory_bytes)}: use a coarser grid, or pass --yes "
+                             f"and its result needs {byte_size(self.memory_bytes)}: use a coarser grid, or pass --yes "
                              "to proceed.")
 
 
 def _count(count: int, noun: str) -> str:
     return f"{count:,} {noun}{'' if count == 1 else 's'}"
-
-
-def _bytes(count: int) -> str:
-    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if count >= size:
-            return f"{count / size:.1f} {unit}"
-    return f"{count} B"
-
-
-def _available_memory() -> int | None:
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
 
 
 @dataclass

@@ -30,8 +30,9 @@ from screwkit.studies.poses import (
     indices_and_joint_values,
     indices_at_poses,
 )
+from screwkit.studies.sizes import check_fits, pose_bytes
 
-__all__ = ["SerialPath", "GraphPath", "path_mechanism"]
+__all__ = ["SerialPath", "GraphPath", "path_mechanism", "check_path_size"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,11 @@ class SerialPath:
     @property
     def chains(self) -> tuple[ChainJoints, ...]:
         return chain_joints(self.mechanism)
+
+    @property
+    def joint_coordinates(self) -> int:
+        """The joint values kept per sample (each chain's tree joints)."""
+        return sum(chain.geometry.n_tree_joints for chain in self.mechanism.chains)
 
     def samples(self, poses: NDArray) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
         """Every index (with detail) at ``poses``, and per chain its tree joints' values."""
@@ -87,6 +93,11 @@ class GraphPath:
         kinds = self.graph.kinematics.kinds
         return tuple(ChainJoints(leg.name, tuple(model.names[j] for j in self._joints(leg)),
                                  tuple(kinds[j] == "prismatic" for j in self._joints(leg))) for leg in self.graph.legs)
+
+    @property
+    def joint_coordinates(self) -> int:
+        """The joint values kept per sample (the tree's configuration and each leg's joints)."""
+        return self.graph.tree.model.nq + sum(len(self._joints(leg)) for leg in self.graph.legs)
 
     def _joints(self, leg) -> tuple[int, ...]:
         kinds = self.graph.kinematics.kinds
@@ -135,3 +146,12 @@ def path_mechanism(mechanism: Any, analysis: AnalysisOptions, keywords: dict) ->
         graph_keywords = {k: v for k, v in keywords.items() if k not in ("closed_forms", "fault_type")}
         return GraphPath(mechanism, analysis, graph_keywords)
     return SerialPath(mechanism, analysis, keywords)
+
+
+def check_path_size(along: SerialPath | GraphPath, samples: int, where: str = "the path",
+                    available_bytes: int | None = None) -> None:
+    """A ValueError, in one line, for a path whose samples would not fit in memory
+    (:func:`~screwkit.studies.sizes.check_fits`), before anything is computed."""
+    mechanism = along.graph if isinstance(along, GraphPath) else along.mechanism
+    check_fits(samples, pose_bytes(mechanism, along.analysis.faults, along.joint_coordinates),
+               f"{where} has {samples:,} samples", available_bytes)

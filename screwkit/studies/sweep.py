@@ -21,6 +21,7 @@ from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.coordinates import one_pose, pose_text, shown_values
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
+from screwkit.studies.sizes import check_fits, pose_bytes
 
 __all__ = ["sweep"]
 
@@ -80,6 +81,7 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         raise ValueError(f"Expected finite `values`, got {values[~np.isfinite(values)][0]}.")
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"Expected `values` with shape (k,), k >= 1, got {values.shape}.")
+    check_fits(values.size, pose_bytes(mechanism, faults), f"the sweep has {values.size:,} values of {coordinate}")
     axis = mechanism.task_coordinates.index(coordinate)
     poses = np.repeat(at[None], values.size, axis=0)
     poses[:, axis] = values

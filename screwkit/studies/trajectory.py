@@ -44,7 +44,7 @@ from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions, checked_analysis
-from screwkit.studies.path_mechanisms import GraphPath, SerialPath, path_mechanism
+from screwkit.studies.path_mechanisms import GraphPath, SerialPath, check_path_size, path_mechanism
 from screwkit.studies.paths import Path, checked_tolerance, path_from_poses
 from screwkit.studies.refinement import (
     bisected_crossings,
@@ -281,6 +281,7 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     tolerance = checked_tolerance(path, tolerance)  # from a few ulps of the arc length to below the path's length
 
     along = path_mechanism(mechanism, analysis, dict(analysis.keywords(), detail=True, threads=threads))
+    check_path_size(along, path.samples)  # before anything is computed
     samples, joint_values = along.samples(path.poses)
     faults = samples.faults
     failed_sets = [(j, failed) for j in faults for failed in samples.failed_sets(j)]
