@@ -518,8 +518,8 @@ def working_modes(mechanism: Mechanism) -> dict[str, str]:
         if chain.closed_form is not None:
             modes[chain.name] = f"{chain.closed_form.describe_branch(chain.branch)} ({chain.solver})"
         elif chain.branch is not None:
-            modes[chain.name] = (f"the reference assembly's, followed from it (sign of the chain's joint-twist "
-                                 f"determinant {int(chain.branch):+d}; damped Newton)")
+            modes[chain.name] = (f"the reference assembly's sign of the chain's joint-twist determinant "
+                                 f"({int(chain.branch):+d}), kept from it (damped Newton)")
         else:
             modes[chain.name] = "the reference assembly's, followed from it (damped Newton)"
     return modes

@@ -1,0 +1,116 @@
+"""A pose reached past a configuration where a chain's joints are singular is said to be so.
+
+A square four-bar (every link as long: Genesis's ``four_bar_linkage.xml`` is one, here rewritten) has a change point
+at the crank's 90 deg: the crank's end lands on the rocker's pivot, and the parallelogram assembly meets the folded
+one. A chain closed by damped Newton keeps the reference's working-mode sign of its joint-twist determinant, which
+past that point is the folded assembly (the crank held at 90 deg while the rocker turns), not the parallelogram a
+motion through it may continue into. ``analyze --pose`` now says where the way from the reference pose meets such
+a configuration. The closed form: with the ground pivot A at the origin and the rocker's pivot D a side above it,
+the crank's end B = A + side (cos t, sin t) lands on D at t = 90 deg, where the rocker's angle phi is 90 deg too
+(the parallelogram keeps the rocker parallel to the crank) and A, B = D and C = D + side (0, 1) are on one line.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from helpers import random_rotation, screwkit
+from screwkit.closure.on_the_way import singular_on_the_way
+from screwkit.io.loader import load
+
+SIDE = 4.0
+
+
+def square_four_bar(scale: float = 1.0, world=None) -> str:
+    """A square four-bar in MJCF as Genesis writes it (hinges about x, the loop closed by a ``<connect>``), sides
+    ``SIDE`` times ``scale``, its ground link placed by ``world`` (rotation, translation) in the world."""
+    rotation, shift = (np.eye(3), np.zeros(3)) if world is None else world
+    w, x, y, z = _quaternion(rotation)
+    side = SIDE * scale
+
+    def at(*values):
+        return " ".join(repr(float(v)) for v in values)
+
+    return f"""<mujoco>
+  <worldbody>
+    <body name="link_1" pos="{at(*shift)}" quat="{at(w, x, y, z)}">
+      <geom type="capsule" fromto="0 0 0 0 0 {side}" size="{0.05 * side}"/>
+      <body name="link_2" pos="{at(0.125 * side, 0, 0)}">
+        <joint name="hinge_1" pos="0 0 0" axis="1 0 0"/>
+        <geom type="capsule" fromto="0 0 0 0 {side} 0" size="{0.05 * side}"/>
+        <body name="link_3" pos="{at(-0.125 * side, side, 0)}">
+          <joint name="hinge_2" pos="0 0 0" axis="1 0 0"/>
+          <geom type="capsule" fromto="0 0 0 0 0 {side}" size="{0.05 * side}"/>
+          <body name="link_4" pos="{at(0.125 * side, 0, side)}">
+            <joint name="hinge_3" pos="0 0 0" axis="1 0 0"/>
+            <geom type="capsule" fromto="0 0 0 0 {-side} 0" size="{0.05 * side}"/>
+          </body>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <equality>
+    <connect name="kinematic_link1" body1="link_1" body2="link_4" anchor="0 0 {side}"/>
+  </equality>
+  <actuator>
+    <motor joint="hinge_1"/>
+    <motor joint="hinge_2"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def _quaternion(rotation) -> tuple[float, float, float, float]:
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(rotation).as_quat()
+    return w, x, y, z
+
+
+def test_the_square_four_bar_s_change_point_is_found_where_the_closed_form_puts_it():
+    a, d = np.zeros(2), np.array([0.0, SIDE])
+    b = a + SIDE * np.array([np.cos(np.pi / 2), np.sin(np.pi / 2)])
+    c = b + (d - a)  # the parallelogram at the crank's 90 deg: its rocker at 90 deg too
+    along, across = b - a, c - a
+    assert np.allclose(b, d) and abs(along[0] * across[1] - along[1] * across[0]) < 1e-12  # A, B, C on one line
+
+
+WORLDS = {"as written": None, "moved": (random_rotation(np.random.default_rng(3)), np.array([0.7, -1.2, 2.0]))}
+
+
+@pytest.mark.parametrize("world", WORLDS)
+@pytest.mark.parametrize(("scale", "unit"), [(1.0, None), (1e3, "mm"), (1e-3, None)])
+def test_a_pose_past_the_change_point_names_the_chain_and_where(tmp_path, world, scale, unit):
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar(scale, WORLDS[world]))
+    mechanism = load(path, output="link_4", length_unit=unit)
+    assert mechanism.task_coordinates == ("phi",)
+    for degrees in (200.0, 120.0, 91.0):
+        (passed,) = singular_on_the_way(mechanism, np.radians([degrees]))
+        assert passed[0] == "hinge_1"
+        assert np.degrees(passed[1][0]) == pytest.approx(90.0, abs=1e-3)
+    for degrees in (80.0, 89.0, -60.0, 0.0):  # the way from 0 does not reach 90 deg
+        assert singular_on_the_way(mechanism, np.radians([degrees])) == []
+
+
+def test_analyze_says_so_on_the_command_line_and_in_json(tmp_path):
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    run = screwkit("analyze", path, "--output", "link_4", "--pose", "200")
+    assert run.returncode == 0, run.stderr
+    (note,) = [line for line in run.stdout.splitlines() if "NOTE:" in line]
+    assert "chain hinge_1's joints are singular at phi = 90: two of its assemblies meet there" in note
+    assert "--initial JOINT VALUE on each actuator" in note
+    run = screwkit("analyze", path, "--output", "link_4", "--pose", "200", "--json")
+    assert run.returncode == 0, run.stderr
+    (passed,) = json.loads(run.stdout)["singular_on_the_way"]
+    assert passed["chain"] == "hinge_1" and passed["pose"]["phi"] == pytest.approx(90.0, abs=1e-3)
+    for pose in ("80", "-60"):
+        run = screwkit("analyze", path, "--output", "link_4", "--pose", pose, "--json")
+        assert run.returncode == 0, run.stderr
+        assert "singular_on_the_way" not in json.loads(run.stdout)
+    run = screwkit("analyze", path, "--output", "link_4")  # the reference pose itself: no way to pass
+    assert run.returncode == 0 and "NOTE:" not in run.stdout
