@@ -17,7 +17,7 @@ import json
 import numpy as np
 import pytest
 
-from helpers import random_rotation, screwkit
+from helpers import one_line_error, random_rotation, screwkit
 from screwkit.closure.on_the_way import singular_on_the_way
 from screwkit.io.loader import load
 
@@ -114,3 +114,17 @@ def test_analyze_says_so_on_the_command_line_and_in_json(tmp_path):
         assert "singular_on_the_way" not in json.loads(run.stdout)
     run = screwkit("analyze", path, "--output", "link_4")  # the reference pose itself: no way to pass
     assert run.returncode == 0 and "NOTE:" not in run.stdout
+    run = screwkit("info", path, "--output", "link_4")  # the ground pin's chain: its loop alone, passive
+    assert run.returncode == 0, run.stderr
+    assert "kinematic_link1: kinematic_link1_loop (passive); loop kinematic_link1_loop (revolute)" in run.stdout
+    assert "chain kinematic_link1: no joint but its loop, loop revolute (closure kinematic_link1)" in run.stdout
+
+
+def test_a_chain_of_its_closure_alone_is_named_so_when_it_locks_the_platform(tmp_path):
+    """The four-bar welded to its ground instead of pinned: a structure; leaving out either chain frees it."""
+    path = tmp_path / "welded.xml"
+    path.write_text(square_four_bar().replace('<connect name="kinematic_link1" body1="link_1" body2="link_4" '
+                                              f'anchor="0 0 {SIDE}"/>', '<weld name="kinematic_link1" '
+                                              'body1="link_1" body2="link_4"/>'))
+    run = screwkit("analyze", path, "--output", "link_3")
+    one_line_error(run, "any one chain left out, the others would let it move", "kinematic_link1 (its closure's joint)")

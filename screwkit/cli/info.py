@@ -143,7 +143,8 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     click.echo(f"  {count} actuator{'' if count == 1 else 's'}: {', '.join(report['actuators'])}")
     click.echo("  chains:")
     for chain in report["chains"]:
-        click.echo(f"    {chain['name']}: {' - '.join(chain['joints'])} (actuated: {', '.join(chain['actuated'])}); "
+        actuated = f"actuated: {', '.join(chain['actuated'])}" if chain["actuated"] else "passive"
+        click.echo(f"    {chain['name']}: {' - '.join(chain['joints']) or 'no joint but its loop'} ({actuated}); "
                    f"loop {chain['loop']} ({chain['loop_type']})")
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
         click.echo(f"      working mode: {chain['working_mode']}")

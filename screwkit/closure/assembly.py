@@ -336,8 +336,8 @@ def _locking_chains(mechanism: Mechanism, full_pose, joint_values) -> str:
             chain = mechanism.chains[left_out]  # (a converted file's loop joints are its closure's, not joints)
             joints = [name for name in chain.joint_names
                       if not (mechanism.description.converted_from and name.startswith(f"{chain.name}_loop"))]
-            locking.append((f"{chain.name} (joint{'s' if len(joints) > 1 else ''} {', '.join(joints)})",
-                            int(dofs[0])))
+            joints = f"joint{'s' if len(joints) > 1 else ''} {', '.join(joints)}" if joints else "its closure's joint"
+            locking.append((f"{chain.name} ({joints})", int(dofs[0])))
     if not locking:
         return "; no one chain locks it: without any one of them it still cannot move"
     rigid = ("a loop with no motion: a structure, or a joint axis slightly out of line with the rest of its loop "

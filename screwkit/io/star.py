@@ -437,8 +437,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         writer.loop(f"{name}_loop", leg.loop, name, end, pose_of(predecessor), "platform", pose_of(successor),
                     axis=None if leg.axis is None else tuple(leg.axis))
         actuated = [model.names[j] for j in leg.joints if j in motor_ids]
-        report.chains.append(f"{name}: joints {', '.join(synthetic + [model.names[j] for j in leg.joints])}, "
-                             f"loop {leg.loop}"
+        listed = synthetic + [model.names[j] for j in leg.joints]
+        report.chains.append(f"{name}: " + (f"joints {', '.join(listed)}, " if listed else "no joint but its loop, ")
+                             + f"loop {leg.loop}"
                              + (f" (closure {leg.closure})" if leg.closure else " (the platform body's own path)")
                              + (f", actuated {', '.join(actuated)}" if actuated else ""))
     for name, reduction, attachment in equivalents:
