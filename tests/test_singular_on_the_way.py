@@ -88,11 +88,11 @@ def test_a_pose_past_the_change_point_names_the_chain_and_where(tmp_path, world,
     path.write_text(square_four_bar(scale, WORLDS[world]))
     mechanism = load(path, output="link_4", length_unit=unit)
     assert mechanism.task_coordinates == ("phi",)
-    for degrees in (200.0, 120.0, 91.0):
+    for degrees in (200.0, 120.0, 91.0, 90.2, 300.0):  # (300: past 269.5 deg, where the chain does not close)
         (passed,) = singular_on_the_way(mechanism, np.radians([degrees]))
         assert passed[0] == "hinge_1"
         assert np.degrees(passed[1][0]) == pytest.approx(90.0, abs=1e-3)
-    for degrees in (80.0, 89.0, -60.0, 0.0):  # the way from 0 does not reach 90 deg
+    for degrees in (80.0, 89.0, 89.9, -60.0, 0.0):  # the way from 0 does not reach 90 deg
         assert singular_on_the_way(mechanism, np.radians([degrees])) == []
 
 

@@ -42,8 +42,9 @@ _DIP = 0.2
 
 def singular_on_the_way(mechanism: Mechanism, pose: NDArray) -> list[tuple[str, NDArray[np.float64]]]:
     """Per chain closed by damped Newton with a working-mode sign, the first singular configuration of its joints
-    on the straight way from the reference pose to ``pose`` (task coordinates, m and rad), as ``(chain name, the
-    pose there)``; none for a chain whose way has none, or that does not close all along it."""
+    on the straight way in task coordinates from the reference pose to ``pose`` (m and rad), as ``(chain name, the
+    pose there)``; none for a chain whose way has none. Dips between samples where the chain does not close are
+    looked at as well."""
     chains = [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
               and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
     if not chains:
@@ -55,12 +56,12 @@ def singular_on_the_way(mechanism: Mechanism, pose: NDArray) -> list[tuple[str, 
     found = []
     for k in chains:
         values = _determinants(mechanism, k, start + way[:, None] * (pose - start))
-        if not np.all(np.isfinite(values)):
-            continue
-        dips = [i for i in range(1, SAMPLES - 1) if values[i] <= values[i - 1] and values[i] <= values[i + 1]
-                and values[i] < _DIP]
-        for i in dips:
-            at, value = _refined(mechanism, k, start, pose, way[i - 1], way[i + 1])
+        dips = [i for i in range(1, SAMPLES - 1) if np.all(np.isfinite(values[i - 1:i + 2]))
+                and values[i] <= values[i - 1] and values[i] <= values[i + 1] and values[i] < _DIP]
+        if np.all(np.isfinite(values[-2:])) and values[-1] < min(values[-2], _DIP):
+            dips.append(SAMPLES - 1)  # falling to the end: a singular configuration in the last interval, or near it
+        for i in dips:  # (samples where the chain does not close break the way: the dips between them are refined)
+            at, value = _refined(mechanism, k, start, pose, way[i - 1], way[min(i + 1, SAMPLES - 1)])
             if value < SINGULAR:
                 found.append((mechanism.chains[k].name, start + at * (pose - start)))
                 break

@@ -30,6 +30,7 @@ from pathlib import Path
 __all__ = ["available_memory", "byte_size", "keep_freed_memory", "KEPT_BYTES", "OLD_LARGEST"]
 
 _CGROUP = Path("/sys/fs/cgroup")
+_SELF_CGROUP = Path("/proc/self/cgroup")
 _MEMINFO = Path("/proc/meminfo")
 
 
@@ -54,17 +55,42 @@ def _system_available() -> int | None:
 
 
 def _cgroup_available() -> int | None:
-    """The limit of this process's control group less what it uses (v2, then v1); None without a limit."""
-    for limit, used in (("memory.max", "memory.current"),
-                        ("memory/memory.limit_in_bytes", "memory/memory.usage_in_bytes")):
+    """The limit of this process's control group (its own, from ``/proc/self/cgroup``, else the mount's root: a
+    container's) less what it uses, the page cache it could drop (``inactive_file``) not counted, as container
+    runtimes count it; v2, then v1. None without a limit."""
+    for folder, limit, used, dropped in _cgroup_files():
         try:
-            text = (_CGROUP / limit).read_text().strip()
+            text = (folder / limit).read_text().strip()
             if text == "max" or int(text) >= 1 << 60:  # v1 writes "no limit" as a huge number
                 return None
-            return int(text) - int((_CGROUP / used).read_text().strip())
+            in_use = int((folder / used).read_text().strip())
         except (OSError, ValueError):
             continue
+        try:
+            stat = dict(line.split(None, 1) for line in (folder / "memory.stat").read_text().splitlines() if line)
+            in_use -= int(stat.get(dropped, 0))
+        except (OSError, ValueError):
+            pass
+        return int(text) - in_use
     return None
+
+
+def _cgroup_files():
+    """``(folder, limit, usage, droppable)`` to look at in turn: v2 (this process's group, then the root), v1."""
+    own: dict[str, str] = {}
+    try:
+        for line in _SELF_CGROUP.read_text().splitlines():
+            number, controllers, path = line.split(":", 2)
+            if number == "0" and not controllers:
+                own["v2"] = path.lstrip("/")
+            elif "memory" in controllers.split(","):
+                own["v1"] = path.lstrip("/")
+    except (OSError, ValueError):
+        pass
+    for folder in ([_CGROUP / own["v2"]] if own.get("v2") else []) + [_CGROUP]:
+        yield folder, "memory.max", "memory.current", "inactive_file"
+    for folder in ([_CGROUP / "memory" / own["v1"]] if own.get("v1") else []) + [_CGROUP / "memory"]:
+        yield folder, "memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"
 
 
 def _address_space_available() -> int | None:

@@ -133,5 +133,7 @@ def _header(name: str) -> set[str]:
                 return set(handle.variables)
         with open(name, encoding="utf-8-sig") as handle:
             return {cell.strip() for cell in handle.readline().split(",")}
+    except MemoryError:
+        raise
     except Exception:  # whatever a file that is not one raises: read_columns says what is wrong with it
         return set()

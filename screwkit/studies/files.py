@@ -251,6 +251,8 @@ def open_netcdf(path: str, error: type[Exception] = ValueError):
     try:
         with xr.open_dataset(path, engine="scipy") as dataset:
             return dataset.load()
+    except MemoryError:
+        raise
     except Exception as failure:  # whatever the netCDF reader makes of a file that is not one
         reason = str(failure).splitlines()[0] if str(failure) else type(failure).__name__
         reason = reason.removeprefix("Error: ")
