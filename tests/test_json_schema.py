@@ -130,3 +130,12 @@ def test_a_mechanism_whose_legs_have_loops_inside_reports_valid_json(tmp_path):
     info = validate("info", [path])
     assert info["dof"] == 3 and [c["name"] for c in info["task_coordinates"]] == ["x", "y", "z"]
     assert [chain["loop_type"] for chain in info["chains"]] == ["graph"] * 4
+
+
+def test_a_pose_past_a_chain_s_singular_configuration_validates(tmp_path):
+    from test_singular_on_the_way import square_four_bar
+
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    report = validate("analyze", [path, "--output", "link_4", "--pose", "200"])
+    assert [passed["chain"] for passed in report["singular_on_the_way"]] == ["hinge_1"]
