@@ -128,3 +128,21 @@ def test_a_chain_of_its_closure_alone_is_named_so_when_it_locks_the_platform(tmp
                                               'body1="link_1" body2="link_4"/>'))
     run = screwkit("analyze", path, "--output", "link_3")
     one_line_error(run, "any one chain left out, the others would let it move", "kinematic_link1 (its closure's joint)")
+
+
+def test_initial_values_that_still_assemble_a_dead_centre_are_told_to_give_more_joints(tmp_path):
+    """--initial hinge_1 200 alone closes the loop from the file's other values onto the kite where the coupler's end
+    falls on the crank's pivot (hinge_1 and hinge_3 coaxial): refused, now saying which joints to give as well; with
+    the coupler's value too, the parallelogram at 200 deg opens."""
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    run = screwkit("analyze", path, "--output", "link_4", "--initial", "hinge_1", "200")
+    one_line_error(run, "the platform body's own path (joints hinge_1, hinge_2, hinge_3) is stretched or folded",
+                   "the values given (--initial hinge_1 200) assemble it so: give values to more of its joints "
+                   "(hinge_2, hinge_3) to start from another assembly.")
+    run = screwkit("analyze", path, "--output", "link_4", "--initial", "hinge_1", "200", "--initial", "hinge_2",
+                   "-200", "--json")
+    assert run.returncode == 0, run.stderr
+    values = {name: entry["value"] for name, entry in json.loads(run.stdout)["configuration"].items()}
+    assert values["hinge_1:hinge_1"] % 360 == pytest.approx(200.0)  # held where given
+    assert values["hinge_1:hinge_2"] % 360 == pytest.approx(160.0)

@@ -105,7 +105,19 @@ def check_not_stretched(tree: ClosedTree, leg, q: NDArray, scale: float, rows, s
     raise ImportError_(f"{tree.source}: {which} (joints {names}) is stretched or folded at the assembly: its joints' "
                        "twists span less there than at joint values near it (a dead centre, such as a crank and its "
                        "rod on one line), where the platform's motion and the working mode are not decided; "
-                       f"{initial_remedy(tree.file_format)}.")
+                       f"{_remedy(tree, leg)}.")
+
+
+def _remedy(tree: ClosedTree, leg) -> str:
+    """What to do about a leg stretched at the assembly: ``--initial``, or, when values were given and the
+    assembly they start still is so, values for more of its joints (another assembly of the same joints)."""
+    given = {name for name, _ in tree.initial}
+    if not given:
+        return initial_remedy(tree.file_format)
+    others = [tree.model.names[joint] for joint in leg.joints if tree.model.names[joint] not in given]
+    told = " ".join(f"--initial {name} {value:g}" for name, value in tree.initial)
+    return (f"the values given ({told}) assemble it so: give values to more of its joints"
+            + (f" ({', '.join(others)})" if others else "") + " to start from another assembly")
 
 
 def _rank(rows: NDArray) -> int:
