@@ -139,3 +139,12 @@ def test_a_pose_past_a_chain_s_singular_configuration_validates(tmp_path):
     path.write_text(square_four_bar())
     report = validate("analyze", [path, "--output", "link_4", "--pose", "200"])
     assert [passed["chain"] for passed in report["singular_on_the_way"]] == ["hinge_1"]
+
+
+def test_a_path_past_a_chain_s_singular_configuration_validates(tmp_path):
+    from test_singular_on_the_way import square_four_bar
+
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    report = validate("trajectory", [path, "--output", "link_4", "--line", "0", "200", "--samples", "51"])
+    assert [event["kind"] for event in report["events"]] == ["singular"]

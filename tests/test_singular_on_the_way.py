@@ -146,3 +146,33 @@ def test_initial_values_that_still_assemble_a_dead_centre_are_told_to_give_more_
     values = {name: entry["value"] for name, entry in json.loads(run.stdout)["configuration"].items()}
     assert values["hinge_1:hinge_1"] % 360 == pytest.approx(200.0)  # held where given
     assert values["hinge_1:hinge_2"] % 360 == pytest.approx(160.0)
+
+
+@pytest.mark.parametrize("samples", [201, 64])
+def test_a_path_through_the_change_point_reports_it_where_the_closed_form_puts_it(tmp_path, samples):
+    """A path of the rocker from 0 to 200 deg: one "singular" event, at 90 deg of it (0.45 of its length), whether
+    90 deg is a sample (201) or between two (64); a path from 0 to 80 deg has none."""
+    from screwkit.studies.paths import line_path
+    from screwkit.studies.trajectory import trajectory
+
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar(1e3, WORLDS["moved"]))
+    mechanism = load(path, output="link_4", length_unit="mm")
+    result = trajectory(mechanism, line_path(mechanism, np.radians([0.0]), np.radians([200.0]), samples))
+    (event,) = [e for e in result.events if e.kind == "singular"]
+    assert event.start / result.path.length == pytest.approx(0.45, abs=1e-6)
+    assert "chain hinge_1's joints are singular here" in event.reason
+    first, last = event.samples
+    assert result.path.arc_length[first] <= event.start <= result.path.arc_length[last]
+    shorter = trajectory(mechanism, line_path(mechanism, np.radians([0.0]), np.radians([80.0]), samples))
+    assert not [e for e in shorter.events if e.kind == "singular"]
+
+
+def test_the_trajectory_command_says_so(tmp_path):
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    run = screwkit("trajectory", path, "--output", "link_4", "--line", "0", "200", "--samples", "101", "--out",
+                   tmp_path / "t.csv")
+    assert run.returncode == 0, run.stderr
+    (line,) = [line for line in run.stderr.splitlines() if line.startswith("  SINGULAR at ")]
+    assert "chain hinge_1's joints are singular here" in line

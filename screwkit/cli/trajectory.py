@@ -116,6 +116,9 @@ def print_summary(summary: dict) -> None:
         if event["kind"] == "branch":
             echo_error(f"  BRANCH CHANGE: {event['reason']}")
             continue
+        if event["kind"] == "singular":
+            echo_error(f"  SINGULAR at {event['start_m']:.6g} m: {event['reason']}")
+            continue
         echo_error(f"  {'UNREACHABLE' if event['kind'] == 'closure' else 'JOINT LIMIT'} from "
                    f"{event['start_m']:.6g} m to {event['stop_m']:.6g} m (samples {event['samples'][0]}-"
                    f"{event['samples'][1]}): {event['reason']}")

@@ -9,9 +9,10 @@ assembly of the chain, not the one a motion through that configuration may conti
 parallelogram and the folded assembly meet, and beyond it the reference's sign is the folded one, where the crank
 stays at 90 deg while the rocker turns (published: Genesis's ``four_bar_linkage.xml``).
 
-:func:`singular_on_the_way` samples the way, finds where the chain's normalised determinant dips, and refines the
-dip (golden-section search on the way's parameter) to tell a configuration where the joints are singular
-(the determinant below :data:`SINGULAR`) from one merely near it; it names the chain and the pose there.
+:func:`singular_on_the_way` samples the way (for ``analyze --pose``), :func:`singular_along` takes a path's
+samples (a ``"singular"`` event of ``screwkit trajectory``); both find where the chain's normalised determinant
+dips, and refine the dip (golden-section search on the way's parameter, or the path's arc length) to tell a
+configuration where the joints are singular (the determinant below :data:`SINGULAR`) from one merely near it.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from screwkit.closure.newton import task_rows
 from screwkit.closure.solve import solve
 from screwkit.model import Mechanism
 
-__all__ = ["singular_on_the_way", "SAMPLES", "SINGULAR"]
+__all__ = ["singular_on_the_way", "singular_along", "SAMPLES", "SINGULAR"]
 
 SAMPLES = 129
 """Poses sampled on the way from the reference pose (both ends included)."""
@@ -45,34 +46,55 @@ def singular_on_the_way(mechanism: Mechanism, pose: NDArray) -> list[tuple[str, 
     on the straight way in task coordinates from the reference pose to ``pose`` (m and rad), as ``(chain name, the
     pose there)``; none for a chain whose way has none. Dips between samples where the chain does not close are
     looked at as well."""
-    chains = [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
-              and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
-    if not chains:
-        return []
     start, pose = np.asarray(mechanism.home_pose, dtype=float), np.asarray(pose, dtype=float)
     if np.array_equal(start, pose):
         return []
     way = np.linspace(0.0, 1.0, SAMPLES)
+    found = singular_along(mechanism, start + way[:, None] * (pose - start), way,
+                           lambda t: start + t * (pose - start), first_only=True)
+    return [(name, start + at * (pose - start)) for name, at, _ in found]
+
+
+def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *, values=None,
+                   first_only: bool = False) -> list[tuple[str, float, int]]:
+    """Per chain closed by damped Newton with a working-mode sign, the singular configurations of its joints along
+    the samples ``poses`` (n, n_task) at parameters ``at`` (n,, increasing), ``pose_at(t)`` giving the pose at any
+    parameter between them: ``(chain name, the parameter there, the sample nearest before it)``, refined between
+    the samples either side of each dip of its normalised determinant (and in the first and last intervals).
+    ``values``: per chain its joint values at the samples, where already solved (a chain's are used when they are
+    all its joints); ``first_only``: the first per chain."""
+    chains = [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
+              and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
     found = []
+    last = len(at) - 1
     for k in chains:
-        values = _determinants(mechanism, k, start + way[:, None] * (pose - start))
-        dips = [i for i in range(1, SAMPLES - 1) if np.all(np.isfinite(values[i - 1:i + 2]))
-                and values[i] <= values[i - 1] and values[i] <= values[i + 1] and values[i] < _DIP]
-        if np.all(np.isfinite(values[-2:])) and values[-1] < min(values[-2], _DIP):
-            dips.append(SAMPLES - 1)  # falling to the end: a singular configuration in the last interval, or near it
-        for i in dips:  # (samples where the chain does not close break the way: the dips between them are refined)
-            at, value = _refined(mechanism, k, start, pose, way[i - 1], way[min(i + 1, SAMPLES - 1)])
+        given = None if values is None else np.asarray(values[k], dtype=float)
+        determinants = (_normalised(mechanism, k, given) if given is not None
+                        and given.shape[-1] == mechanism.chains[k].geometry.n_dofs
+                        else _determinants(mechanism, k, poses))
+        finite = np.isfinite(determinants)
+        dips = [i for i in range(1, last) if finite[i - 1:i + 2].all() and determinants[i] < _DIP
+                and determinants[i] <= determinants[i - 1] and determinants[i] <= determinants[i + 1]]
+        ends = [(0, 1), (last, last - 1)] if last >= 1 else []
+        dips += [i for i, j in ends if finite[i] and finite[j] and determinants[i] < min(determinants[j], _DIP)]
+        for i in sorted(dips):  # (samples where the chain does not close break the way: the dips between them count)
+            where, value = _refined(mechanism, k, pose_at, at[max(i - 1, 0)], at[min(i + 1, last)])
             if value < SINGULAR:
-                found.append((mechanism.chains[k].name, start + at * (pose - start)))
-                break
+                found.append((mechanism.chains[k].name, where, int(np.searchsorted(at, where, side="right")) - 1))
+                if first_only:
+                    break
     return found
 
 
 def _determinants(mechanism: Mechanism, k: int, poses: NDArray) -> NDArray[np.float64]:
     """Chain ``k``'s normalised |joint-twist determinant| at ``poses`` (NaN where it does not close)."""
     solution = solve(mechanism, poses, limits=False)
+    return _normalised(mechanism, k, np.asarray(solution.joint_values[k], dtype=float))
+
+
+def _normalised(mechanism: Mechanism, k: int, values: NDArray) -> NDArray[np.float64]:
+    """Chain ``k``'s normalised |joint-twist determinant| at its joint values (..., m; NaN where not closed)."""
     geometry = mechanism.chains[k].geometry
-    values = np.asarray(solution.joint_values[k], dtype=float)
     closed = np.all(np.isfinite(values), axis=-1)
     frames = chain_forward_kinematics(geometry, np.nan_to_num(values))
     points = frames.points - np.mean(frames.points, axis=-2, keepdims=True)  # moments about the chain's own centre
@@ -83,14 +105,14 @@ def _determinants(mechanism: Mechanism, k: int, poses: NDArray) -> NDArray[np.fl
     return np.where(closed, np.abs(np.linalg.det(twists)), np.nan)
 
 
-def _refined(mechanism: Mechanism, k: int, start: NDArray, pose: NDArray, low: float, high: float,
+def _refined(mechanism: Mechanism, k: int, pose_at, low: float, high: float,
              iterations: int = 20) -> tuple[float, float]:
-    """The least normalised determinant of chain ``k`` between the way's parameters ``low`` and ``high`` (golden
+    """The least normalised determinant of chain ``k`` between the parameters ``low`` and ``high`` (golden
     section): the parameter and the value."""
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
 
     def value(t: float) -> float:
-        found = _determinants(mechanism, k, (start + t * (pose - start))[None])[0]
+        found = _determinants(mechanism, k, np.asarray(pose_at(t), dtype=float)[None])[0]
         return float(found) if np.isfinite(found) else np.inf
 
     a, b = low, high

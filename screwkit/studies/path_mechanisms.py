@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
+from screwkit.closure.on_the_way import singular_along
 from screwkit.closure.solve import ChainStatus
 from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism
@@ -55,6 +56,12 @@ class SerialPath:
     def samples(self, poses: NDArray) -> tuple[Indices, tuple[NDArray[np.float64], ...]]:
         """Every index (with detail) at ``poses``, and per chain its tree joints' values."""
         return indices_and_joint_values(self.mechanism, poses, tree_only=True, **self.keywords)
+
+    def singular(self, path, joint_values) -> list[tuple[str, float, int]]:
+        """Where a chain's joints are singular along ``path`` (:func:`~screwkit.closure.on_the_way.singular_along`:
+        chain, arc length, the sample before), from its tree joints' values at the samples where they are all."""
+        return singular_along(self.mechanism, path.poses, path.arc_length, lambda s: path.at(np.array([s]))[0],
+                              values=joint_values)
 
     def indices(self, poses: NDArray) -> Indices:
         return indices_at_poses(self.mechanism, poses, **self.keywords)
@@ -119,6 +126,10 @@ class GraphPath:
     def samples(self, poses: NDArray) -> tuple[Indices, list[NDArray[np.float64]]]:
         indices, q = graph_indices_at_poses(self.graph, poses, configurations=True, **self.keywords)
         return indices, self._values(q)
+
+    def singular(self, path, joint_values) -> list:
+        """None looked for: the graph is closed whole, by continuation (no working-mode sign kept)."""
+        return []
 
     def indices(self, poses: NDArray) -> Indices:
         return graph_indices_at_poses(self.graph, poses, **self.keywords)

@@ -17,9 +17,10 @@ whose minimum over the sets is :math:`F_{Oj}` (Eq. 12):
   of points a round); every round evaluates all its brackets in one batched call;
 * the **margin** of each index (its minimum over the samples and where; F_Oj's also over the refined minima);
 * the **events** of the path: where it leaves the reachable set, because a chain cannot close in its working
-  mode or because a joint crosses its limit, located by bisection and explained chain by chain; and where a
+  mode or because a joint crosses its limit, located by bisection and explained chain by chain; where a
   chain changes working mode between two samples (its joint values jump, :mod:`~screwkit.studies.branches`),
-  located to the tolerance, never silently jumped.
+  located to the tolerance, never silently jumped; and where a chain's joints are singular, two of its
+  assemblies meeting, past which its working-mode sign is kept (:mod:`~screwkit.closure.on_the_way`).
 
 With ``aggregate="mean"`` the average case is reported beside the worst case: the mean of the LMTI left over
 the sets of ``j`` failures, or their probability-weighted mean (screwkit's extension of Eq. 12, which the
@@ -115,10 +116,16 @@ class Margin:
     sample: int | None
 
 
+SINGULAR_REASON = ("chain {chain}'s joints are singular here: two of its assemblies meet, and past it the path keeps "
+                   "its working-mode sign, not necessarily the assembly a motion through it continues into")
+"""What a ``"singular"`` event says (:func:`~screwkit.closure.on_the_way.singular_along`)."""
+
+
 @dataclass(frozen=True)
 class PathEvent:
     """Where the path cannot be followed in the working mode: ``kind`` is ``"closure"`` (a chain cannot close),
-    ``"joint limit"`` or ``"branch"`` (a chain's joint values jump: it changes working mode); ``start``/``stop``
+    ``"joint limit"``, ``"branch"`` (a chain's joint values jump: it changes working mode) or ``"singular"`` (a
+    chain's joints are singular, :data:`SINGULAR_REASON`); ``start``/``stop``
     the stretch of arc length (m, located to the tolerance), ``samples`` its first and last sample (for a branch
     change, or a stretch out of reach between two samples, the samples either side), ``reason`` the chains and
     joints concerned."""
@@ -368,7 +375,9 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     changes = branch_changes(chains, mechanism.length_scale, s, joint_values,
                              lambda at: along.joint_values(path.at(at)), tolerance)
     events = _events(along, path, samples, unreachable) + tuple(
-        PathEvent(c.kind, c.start, c.stop, c.samples, describe(chains, c)) for c in changes)
+        PathEvent(c.kind, c.start, c.stop, c.samples, describe(chains, c)) for c in changes) + tuple(
+        PathEvent("singular", at, at, (i, min(i + 1, len(s) - 1)), SINGULAR_REASON.format(chain=name))
+        for name, at, i in along.singular(path, joint_values))
     weights = {j: failure_weights(samples.actuator_count, j, probabilities) for j in faults}
     mean = mean_remaining_lmti(samples.remaining_lmti, samples.actuator_count, probabilities) \
         if aggregate == "mean" else {}
