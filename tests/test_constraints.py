@@ -280,7 +280,8 @@ def test_cli_pose_from_actuator_values(tmp_path):
     refused = screwkit("analyze", "prs_3_ups", "--actuators", *[repr(float(v)) for v in inconsistent])
     assert refused.returncode == 1 and refused.stderr.strip().splitlines() == [
         "Error: No closed pose of 'prs_3_ups' has these actuator values near the start pose (redundant actuators "
-        "must agree with one another; give another start with --pose)."]
+        "must agree with one another, and the pose may lie on another assembly, past a singular configuration from "
+        "the start; give another start with --pose, or for a file of another tool --initial on each actuator)."]
 
 
 def test_cli_sweep_and_map_say_their_fault_type(tmp_path):

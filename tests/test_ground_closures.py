@@ -3,8 +3,8 @@ MuJoCo four-bar: crank, coupler and rocker nested, the rocker's far end ``<conne
 
 With the rocker as output, its leg is the closure's pin alone, on the base; the crank chain reaches it through the
 coupler. Checked against the four-bar's transmission angles at several rocker angles, in millimetres and in a turned
-and shifted world; the same loop closed by a ``<weld>`` is rigid and said so; the coupler as output is refused in one
-line that names the rocker."""
+and shifted world; the same loop closed by a ``<weld>`` is rigid and said so; with the coupler as output, the output
+is the coupler's pin to the rocker, which turns with the rocker."""
 
 from __future__ import annotations
 

@@ -176,3 +176,17 @@ def test_the_trajectory_command_says_so(tmp_path):
     assert run.returncode == 0, run.stderr
     (line,) = [line for line in run.stderr.splitlines() if line.startswith("  SINGULAR at ")]
     assert "chain hinge_1's joints are singular here" in line
+
+
+def test_actuator_values_past_the_change_point_are_refused_saying_the_pose_may_be_on_another_assembly(tmp_path):
+    """The parallelogram at 100 deg (crank 100, coupler -100: the loop closes exactly) is not reached from the start
+    poses --pose gives, which keep the reference's sign past 90 deg; with --initial on both it is."""
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    run = screwkit("analyze", path, "--output", "link_4", "--actuators", "100", "-100")
+    one_line_error(run, "the pose may lie on another assembly, past a singular configuration from the start",
+                   "--initial on each actuator")
+    run = screwkit("analyze", path, "--output", "link_4", "--initial", "hinge_1", "100", "--initial", "hinge_2",
+                   "-100", "--json")
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["configuration"]["hinge_1:hinge_1"]["value"] == pytest.approx(100.0)

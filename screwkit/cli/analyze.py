@@ -160,7 +160,9 @@ def pose_from_actuators(mechanism, text: str, start):
     solution = forward(mechanism, values, start)
     if not bool(np.asarray(solution.reachable).reshape(-1)[0]):
         raise fail(f"No closed pose of {mechanism.name!r} has these actuator values near the start pose "
-                   "(redundant actuators must agree with one another; give another start with --pose).")
+                   "(redundant actuators must agree with one another, and the pose may lie on another assembly, past "
+                   "a singular configuration from the start; give another start with --pose, or for a file of "
+                   "another tool --initial on each actuator).")
     return np.asarray(solution.poses).reshape(-1)
 
 
