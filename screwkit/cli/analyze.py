@@ -20,7 +20,7 @@ from screwkit.cli.options import (
 )
 from screwkit.closure import forward
 from screwkit.closure.on_the_way import singular_on_the_way
-from screwkit.common.units import angle_beyond_limit, angle_limit, is_angular
+from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
 from screwkit.io.closed_tree import GROUNDED
 from screwkit.io.locking import GUESSED
@@ -205,7 +205,9 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
     report = result.to_dict()
     passed = singular_on_the_way(loaded, target) if pose is not None or actuator_values is not None else []
     if passed:  # the working mode's sign kept past a configuration where two assemblies of a chain meet
-        report["singular_on_the_way"] = [{"chain": chain, "pose": _task_values(loaded, at)} for chain, at in passed]
+        report["singular_on_the_way"] = [
+            {"chain": chain, "pose": {name: shown_number(name, value, loaded.length_scale)
+                                      for name, value in zip(loaded.task_coordinates, at)}} for chain, at in passed]
     if loaded.assembly_notes:  # the file's loops were open as written (also said on stderr when loading)
         report["assembly"] = list(loaded.assembly_notes)
     if loaded.import_report:  # a file of another tool: which body and which point the indices are for
@@ -218,12 +220,6 @@ def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
         print_report(report)
     for number, line in enumerate([] if as_json else loaded.import_report):  # (with --json: its "converted")
         click.echo(f"(converted from {line})" if number == 0 else f" {line}", err=True)
-
-
-def _task_values(mechanism, pose) -> dict[str, float]:
-    """A pose by task coordinate, m and deg, as the report gives its own."""
-    return {name: float(np.degrees(value) if is_angular(name) else value)
-            for name, value in zip(mechanism.task_coordinates, pose)}
 
 
 def _slide(value: float) -> str:

@@ -101,7 +101,7 @@ class ScrewkitGroup(click.Group):
             if not isinstance(error, WriteError) and error.errno not in _WRITE_FAILURES:
                 raise
             report_error(str(error) if isinstance(error, WriteError) else
-                    f"Cannot write {error.filename or 'to stdout'}: {error.strerror}.", arguments)
+                         f"Cannot write {error.filename or 'to stdout'}: {error.strerror}.", arguments)
             if standalone_mode:
                 sys.exit(1)
             raise

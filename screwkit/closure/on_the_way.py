@@ -65,13 +65,15 @@ def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *
     all its joints); ``first_only``: the first per chain."""
     chains = [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
               and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
-    found = []
+    found, solved = [], None
     last = len(at) - 1
     for k in chains:
         given = None if values is None else np.asarray(values[k], dtype=float)
-        determinants = (_normalised(mechanism, k, given) if given is not None
-                        and given.shape[-1] == mechanism.chains[k].geometry.n_dofs
-                        else _determinants(mechanism, k, poses))
+        if given is None or given.shape[-1] != mechanism.chains[k].geometry.n_dofs:
+            if solved is None:  # every chain's closure at the samples, solved once for all the chains looked at
+                solved = solve(mechanism, poses, limits=False).joint_values
+            given = np.asarray(solved[k], dtype=float)
+        determinants = _normalised(mechanism, k, given)
         finite = np.isfinite(determinants)
         dips = [i for i in range(1, last) if finite[i - 1:i + 2].all() and determinants[i] < _DIP
                 and determinants[i] <= determinants[i - 1] and determinants[i] <= determinants[i + 1]]
