@@ -190,3 +190,22 @@ def test_actuator_values_past_the_change_point_are_refused_saying_the_pose_may_b
                    "-100", "--json")
     assert run.returncode == 0, run.stderr
     assert json.loads(run.stdout)["configuration"]["hinge_1:hinge_1"]["value"] == pytest.approx(100.0)
+
+
+def test_joints_renamed_and_motors_listed_the_other_way_name_the_renamed_chain_at_the_same_pose(tmp_path):
+    text = square_four_bar()
+    for old, new in (("hinge_1", "crank_pin"), ("hinge_2", "coupler_pin"), ("hinge_3", "rocker_pin")):
+        text = text.replace(f'"{old}"', f'"{new}"')
+    text = text.replace('<motor joint="crank_pin"/>\n    <motor joint="coupler_pin"/>',
+                        '<motor joint="coupler_pin"/>\n    <motor joint="crank_pin"/>')
+    path = tmp_path / "renamed.xml"
+    path.write_text(text)
+    mechanism = load(path, output="link_4")
+    assert sorted(name.split(":")[1] for name in mechanism.actuator_names) == ["coupler_pin", "crank_pin"]
+    (passed,) = singular_on_the_way(mechanism, np.radians([200.0]))
+    assert passed[0] == "crank_pin" and np.degrees(passed[1][0]) == pytest.approx(90.0, abs=1e-3)
+    run = screwkit("trajectory", path, "--output", "link_4", "--line", "0", "200", "--samples", "51", "--json")
+    assert run.returncode == 0, run.stderr
+    (event,) = json.loads(run.stdout)["events"]
+    assert event["kind"] == "singular" and "chain crank_pin's joints" in event["reason"]
+    assert event["start_m"] / json.loads(run.stdout)["length_m"] == pytest.approx(0.45, abs=1e-6)
