@@ -39,6 +39,8 @@ def check_actuators(tree: ClosedTree, legs) -> None:
                     advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
                               f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
                               "analysed on it")
+            else:
+                advice = _transmission_advice(tree, leg)
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet)"
@@ -47,6 +49,24 @@ def check_actuators(tree: ClosedTree, legs) -> None:
         if kind not in ("revolute", "prismatic"):
             raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
                                "actuator drives one revolute or prismatic joint.")
+
+
+def _transmission_advice(tree: ClosedTree, leg) -> str:
+    """For a leg whose actuators no one joint carries: an actuator that drives, through a loop of the leg, a passive
+    joint carrying every other actuator (a knee motor turning the shin, and the ankle's motors, through a four-bar),
+    with the options that hold both; or nothing."""
+    model = tree.model
+    for actuator in leg.actuators:
+        others = [other for other in leg.actuators if other != actuator]
+        carriers = [joint for joint in sorted(leg.joints) if joint not in leg.actuators
+                    and joint not in path_to(model, actuator) and all(joint in path_to(model, o) for o in others)]
+        if carriers:
+            name, carrier = (tree.written_joint(model.names[j]) for j in (actuator, carriers[0]))
+            rest = ", ".join(tree.written_joint(model.names[o]) for o in others)
+            return (f"; actuated joint {name!r} drives joint {carrier!r} through a loop, and {carrier!r} carries every "
+                    f"other actuator of it ({rest}): --lock {name} --lock {carrier} analyses the legs on the body "
+                    f"{carrier!r} turns")
+    return ""
 
 
 def serial_stage(model, leg) -> list[int]:
