@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import json
 import shutil
+import xml.etree.ElementTree as ElementTree
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -25,7 +27,7 @@ from scipy.optimize import least_squares
 from test_gallery_published import GEPETTO
 
 from helpers import in_millimetres, one_line_error, screwkit
-from screwkit.io import read_mechanism_file
+from screwkit.io import graph_mechanism, read_closed_tree, read_mechanism_file
 from screwkit.io.gepetto import replaced_joints
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -139,37 +141,46 @@ def analysed(path, **options):
     return result, motors, float(note.split(" locked at ")[1].split(",")[0])
 
 
-def test_battobot_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
-    path = BATTOBOT / "robot.urdf"
-    result, motors, knee = analysed(path)
-    assert sorted(motors) == sorted(RODS) and result.dof == 2
-    model = gepetto_model(path, BATTOBOT / "robot.yaml")
-    spec = yaml.safe_load((BATTOBOT / "robot.yaml").read_text())
+def rod_line_indices(path, held: dict[str, float], rods: dict, hinges: tuple[str, str]):
+    """The ITI and OTI of each actuator (sorted by name) of a two-rod ankle, from the rod lines of Gepetto's own
+    reading of ``path`` closed by scipy with the joints ``held`` (the motors among them), and that configuration;
+    ``rods``: each motor's crank-end and foot-end joint (at the joint centres), ``hinges``: the foot's two."""
+    model = gepetto_model(path, path.parent / "robot.yaml")
+    spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
     pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
-    data, q = closed_by_scipy(model, pairs, {name: 0.0 for name in LOCKS[:4]} | motors)
-    assert q[model.joints[model.getJointId("knee_left")].idx_q] == pytest.approx(knee, abs=1e-8)
-    assert abs(knee) > 1e-3  # (the file writes 0, where the knee's loop does not close)
+    data, q = closed_by_scipy(model, pairs, held)
     forces, itis = {}, []
-    for motor in sorted(motors):
-        (crank, _), (end, _) = (centre_and_axis(model, data, name) for name in RODS[motor])
+    for motor in sorted(rods):
+        (crank, _), (end, _) = (centre_and_axis(model, data, name) for name in rods[motor])
         force = (end - crank) / np.linalg.norm(end - crank)
         origin, axis = centre_and_axis(model, data, motor)
         velocity = np.cross(axis, crank - origin)
         itis.append(abs(force @ velocity) / np.linalg.norm(velocity))
         forces[motor] = (force, crank, end)
-    hinges = [centre_and_axis(model, data, name) for name in ("ankley_left", "anklex_left")]
-    space = np.array([np.concatenate([axis, np.cross(point, axis)]) for point, axis in hinges]).T  # (omega, v at 0)
+    lines = [centre_and_axis(model, data, name) for name in hinges]
+    space = np.array([np.concatenate([axis, np.cross(point, axis)]) for point, axis in lines]).T  # (omega, v at 0)
 
     def power(force, at, twist):
         return force @ (twist[3:] + np.cross(twist[:3], at))
 
     otis = []
-    for motor in sorted(motors):
+    for motor in sorted(rods):
         force, _, end = forces[motor]
         other, other_at, _ = next(value for key, value in forces.items() if key != motor)
         twist = space @ np.array([-power(other, other_at, space[:, 1]), power(other, other_at, space[:, 0])])
         velocity = twist[3:] + np.cross(twist[:3], end)
         otis.append(abs(force @ velocity) / np.linalg.norm(velocity))
+    return np.array(itis), np.array(otis), model, q
+
+
+def test_battobot_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
+    path = BATTOBOT / "robot.urdf"
+    result, motors, knee = analysed(path)
+    assert sorted(motors) == sorted(RODS) and result.dof == 2
+    itis, otis, model, q = rod_line_indices(path, {name: 0.0 for name in LOCKS[:4]} | motors, RODS,
+                                            ("ankley_left", "anklex_left"))
+    assert q[model.joints[model.getJointId("knee_left")].idx_q] == pytest.approx(knee, abs=1e-8)
+    assert abs(knee) > 1e-3  # (the file writes 0, where the knee's loop does not close)
     assert [name.split(":")[-1] for name in result.actuators] == sorted(motors)
     np.testing.assert_allclose(result.iti_actuators, itis, atol=TOLERANCE)
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
@@ -177,31 +188,89 @@ def test_battobot_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
     assert 0.05 < result.lmti < 1.0 and 0.05 < result.iti < 1.0  # neither singular nor trivially 1
 
 
-def test_battobot_s_ankle_is_the_same_in_millimetres_in_a_moved_world_and_listed_back(tmp_path):
-    """The file in mm (--length-unit mm), and hung from a new world frame turned and moved (its root link is
-    ``hip_z_axis_2_leg_assembly``), and its robot.yaml's lists written back to front: the same motors' values and
-    indices, and the same foot angles but in the moved world."""
-    result, motors, _ = analysed(BATTOBOT / "robot.urdf")
-    text = (BATTOBOT / "robot.urdf").read_text()
-    root = '<link name="hip_z_axis_2_leg_assembly">'
-    moved = text.replace(root, '<link name="world"/><joint name="world_to_root" type="fixed"><parent link="world"/>'
-                         '<child link="hip_z_axis_2_leg_assembly"/><origin xyz="0.7 -1.3 0.4" rpy="0.3 -1.1 2.0"/>'
-                         '</joint>' + root, 1)
-    spec = yaml.safe_load((BATTOBOT / "robot.yaml").read_text())
-    listed_back = {key: value[::-1] for key, value in spec.items()}  # loops, motors and replaced joints reversed
-    for folder, written, options in (("mm", in_millimetres(text), {"length_unit": "mm"}), ("moved", moved, {}),
-                                     ("listed back", text, {})):
-        (tmp_path / folder).mkdir()
-        (tmp_path / folder / "robot.urdf").write_text(written)
-        (tmp_path / folder / "robot.yaml").write_text(yaml.safe_dump(listed_back if folder == "listed back" else spec))
-        other, other_motors, _ = analysed(tmp_path / folder / "robot.urdf", **options)
-        order = [other.actuators.index(name) for name in result.actuators]
-        np.testing.assert_allclose(other.iti_actuators[order], result.iti_actuators, atol=1e-9)
-        np.testing.assert_allclose(other.oti_actuators[:, order], result.oti_actuators, atol=1e-9)
+DIGIT_LOCKS = ("motor_hip_x", "motor_hip_z", "motor_hip_y", "motor_knee", "free_knee")
+DIGIT_RODS = {  # each motor's rod: its crank-end and foot-end joints, as the two files write them
+    "digit_like_2legs": {"motor_shin1": ("spherical_free_shin2", "spherical_free_foot2_X"),
+                         "motor_shin2": ("spherical_free_shin1", "spherical_free_foot1_X")},
+    "digit_like_2legs_6D": {"motor_shin1": ("crank_toe_b_2/2_rev0", "foot_part_toe_b_1/2_2_rev0"),
+                            "motor_shin2": ("crank_2_toe_b_2/2_2_rev0", "foot_part_toe_b_1/2_rev0")}}
+
+
+def digit_ankle(path, *, serial: bool, **options):
+    """screwkit's indices of the ankle of a two-legged digit with the leg held, at the file's configuration, and the
+    motors' values: ``digit_like_2legs`` (ball joints inside its legs) is a graph mechanism, ``digit_like_2legs_6D``
+    (its balls three revolutes, a universal joint at each rod's foot end: a universal loop joint) ``serial`` legs."""
+    if serial:
+        mechanism = load(path, lock=DIGIT_LOCKS, **options)
+        result = indices_at_pose(mechanism, mechanism.home_pose)
+    else:
+        graph = graph_mechanism(read_closed_tree(path, lock=DIGIT_LOCKS, **options))
+        result = replace(graph.indices(), poses=graph.task_pose())
+    motors = {name.split(":")[-1]: value for name, value in result.joint_values.items()
+              if name.split(":")[-1] in ("motor_shin1", "motor_shin2")}
+    return result, motors
+
+
+@pytest.mark.parametrize("robot", sorted(DIGIT_RODS))
+def test_a_two_legged_digit_s_ankle_has_the_rod_line_indices(robot):
+    """Both files opened as written (before, the first was refused for its joint_type and the second for the two
+    revolutes beyond the foot at each rod's end), with the locks their refusals name."""
+    path = GEPETTO / robot / "robot.urdf"
+    result, motors = digit_ankle(path, serial=robot.endswith("6D"))
+    assert sorted(motors) == ["motor_shin1", "motor_shin2"] and result.dof == 2
+    itis, otis, _, _ = rod_line_indices(path, {name: 0.0 for name in DIGIT_LOCKS[:4]} | motors, DIGIT_RODS[robot],
+                                        ("free_foot1", "free_foot2"))
+    assert [name.split(":")[-1] for name in result.actuators] == sorted(motors)
+    np.testing.assert_allclose(np.ravel(result.iti_actuators), itis, atol=TOLERANCE)
+    np.testing.assert_allclose(np.ravel(result.oti_actuators), otis, atol=TOLERANCE)
+    assert 0.5 < result.lmti < 1.0
+
+
+def variants(path, tmp_path):
+    """The file in mm (read with ``length_unit="mm"``), hung from a new world frame turned and moved, and with its
+    robot.yaml's lists written back to front (loops, motors, replaced joints): (name, path, options) of each."""
+    text = path.read_text()
+    tree = ElementTree.fromstring(text)
+    children = {joint.find("child").get("link") for joint in tree.iter("joint")}
+    root = next(link.get("name") for link in tree.iter("link") if link.get("name") not in children)
+    moved = text.replace(f'<link name="{root}">', '<link name="world"/><joint name="world_to_root" type="fixed">'
+                         f'<parent link="world"/><child link="{root}"/><origin xyz="0.7 -1.3 0.4" rpy="0.3 -1.1 2.0"/>'
+                         f'</joint><link name="{root}">', 1)
+    assert moved != text
+    spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
+    listed_back = {key: value[::-1] for key, value in spec.items()}
+    for name, written, written_spec, options in (("mm", in_millimetres(text), spec, {"length_unit": "mm"}),
+                                                 ("moved", moved, spec, {}), ("listed back", text, listed_back, {})):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "robot.urdf").write_text(written)
+        (tmp_path / name / "robot.yaml").write_text(yaml.safe_dump(written_spec))
+        yield name, tmp_path / name / "robot.urdf", options
+
+
+def ankle(robot: str, path, **options):
+    """The indices and motors' values of battobot's ankle or a two-legged digit's, the file at ``path``."""
+    if robot == "battobot_6d":
+        result, motors, _ = analysed(path, **options)
+        return result, motors
+    return digit_ankle(path, serial=robot.endswith("6D"), **options)
+
+
+@pytest.mark.parametrize("robot", ["battobot_6d", "digit_like_2legs_6D", "digit_like_2legs"])
+def test_an_ankle_is_the_same_in_millimetres_in_a_moved_world_and_listed_back(tmp_path, robot):
+    """The same motors' values and indices; the same foot angles but in the moved world (whose base frame is
+    another)."""
+    path = GEPETTO / robot / "robot.urdf"
+    result, motors = ankle(robot, path)
+    for name, other_path, options in variants(path, tmp_path):
+        other, other_motors = ankle(robot, other_path, **options)
+        order = [other.actuators.index(actuator) for actuator in result.actuators]
+        np.testing.assert_allclose(np.ravel(other.iti_actuators)[order], np.ravel(result.iti_actuators), atol=1e-9)
+        np.testing.assert_allclose(np.asarray(other.oti_actuators).reshape(-1)[order],
+                                   np.asarray(result.oti_actuators).reshape(-1), atol=1e-9)
         np.testing.assert_allclose(other.lmti, result.lmti, atol=1e-9)
-        if folder != "moved":  # (in the moved world the foot's angles are measured from another base frame)
+        if name != "moved":
             np.testing.assert_allclose(other.poses, result.poses, atol=1e-9)
-        assert other_motors == pytest.approx(motors, abs=1e-8)
+        assert other_motors == pytest.approx(motors, abs=1e-8), name
 
 
 def test_the_command_line_follows_its_own_lock_suggestions_to_battobot_s_ankle(tmp_path):
@@ -270,3 +339,39 @@ def test_a_fixed_joint_after_universal_joints_is_the_one_named_where_the_loader_
     assert len(held_instead) == 1 and ours.njoints == theirs.njoints
     assert set(theirs.names) - set(ours.names) == {"ankley_right"}
     assert "robot.yaml's joint_type holds ankley_right at 0 (FIXED)" in notes
+
+
+def test_the_command_line_opens_the_two_legged_digit_whose_rods_end_on_universal_joints(tmp_path):
+    """digit_like_2legs_6D: the refusal names the five joints to hold; with them the ankle's rods close on the foot
+    through universal loop joints, and the file ``convert`` writes (its <loop type="universal">) gives the same
+    indices."""
+    path = GEPETTO / "digit_like_2legs_6D" / "robot.urdf"
+    one_line_error(screwkit("info", path), " ".join(f"--lock {name}" for name in DIGIT_LOCKS))
+    held = [part for name in DIGIT_LOCKS for part in ("--lock", name)]
+    info = screwkit("info", path, *held)
+    assert info.returncode == 0, info.stderr
+    assert "loop motor_shin1_loop (universal)" in info.stdout and "loop motor_shin2_loop (universal)" in info.stdout
+    done = screwkit("analyze", path, *held, "--json")
+    assert done.returncode == 0, done.stderr
+    converted = screwkit("convert", path, tmp_path / "ankle.urdf", *held)
+    assert converted.returncode == 0, converted.stderr
+    assert '<loop name="motor_shin1_loop" type="universal"' in (tmp_path / "ankle.urdf").read_text()
+    again = screwkit("analyze", tmp_path / "ankle.urdf", "--json")
+    assert again.returncode == 0, again.stderr
+    for key in ("iti", "lmti"):
+        assert json.loads(again.stdout)[key] == pytest.approx(json.loads(done.stdout)[key], abs=1e-12)
+
+
+def test_two_hinges_beyond_the_foot_whose_axes_miss_each_other_are_refused_naming_them(tmp_path):
+    """A universal joint needs its two axes to meet: with the second hinge of one rod's foot end moved 1 cm off the
+    first's axis, the closure is refused naming both hinges and what is supported."""
+    source = GEPETTO / "digit_like_2legs_6D"
+    text = (source / "robot.urdf").read_text()
+    hinge = '<joint name="foot_part_toe_b_1/2_2_rev1" type="revolute">'
+    assert text.count(hinge) == 1
+    (tmp_path / "robot.urdf").write_text(text.replace(hinge, hinge + '<origin xyz="0 0 0.01" rpy="0 0 0"/>'))
+    shutil.copy(source / "robot.yaml", tmp_path / "robot.yaml")
+    held = [part for name in DIGIT_LOCKS for part in ("--lock", name)]
+    one_line_error(screwkit("info", tmp_path / "robot.urdf", *held), "foot_part_toe_b_1/2_2_rev0 (revolute), "
+                   "foot_part_toe_b_1/2_2_rev1 (revolute) beyond the platform",
+                   "two revolute joints whose axes meet (a universal joint)")

@@ -28,8 +28,8 @@ GUESSED = "actuators guessed"
 
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
-           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "at_point", "LENGTH_COORDINATES",
-           "nearest_to_lines"]
+           "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "meeting_point", "at_point",
+           "LENGTH_COORDINATES", "nearest_to_lines"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -318,14 +318,23 @@ def ball_of_revolutes(model, joints: list[int], kinds: list[tuple], first: NDArr
     lines."""
     if len(joints) == 1 and kinds[0][0] == "spherical":
         return np.asarray(first, dtype=float)[:3, 3]
-    if len(joints) != 3 or any(kind[0] != "revolute" for kind in kinds):
+    return meeting_point(model, joints, kinds, first, scale) if len(joints) == 3 else None
+
+
+def meeting_point(model, joints: list[int], kinds: list[tuple], first: NDArray, scale: float) -> NDArray | None:
+    r"""The point where the axis lines of revolute ``joints`` in a row meet (two: a universal joint; three: a ball),
+    or None: their lines, each at zero motion of the ones before (``first`` the first one's frame, 4x4, world; the
+    ``kinds`` from :func:`joint_kind`), pass within :data:`MEETING` of the length ``scale`` of one point, wherever
+    along them the file draws each joint, no two in a row nearly parallel (squared sine above
+    :data:`PARALLEL_FOOT`); the point is the one nearest to the lines."""
+    if len(joints) < 2 or any(kind[0] != "revolute" for kind in kinds):
         return None
     frames = [np.asarray(first, dtype=float)]
     for joint in joints[1:]:  # each at zero motion of the ones before
         frames.append(frames[-1] @ homogeneous(model.jointPlacements[joint]))
     units = np.array([frame[:3, :3] @ kind[1] / np.linalg.norm(kind[1]) for frame, kind in zip(frames, kinds)])
     points = np.array([frame[:3, 3] for frame in frames])
-    if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(2)):
+    if any(np.sum(np.cross(units[k], units[k + 1]) ** 2) <= PARALLEL_FOOT for k in range(len(joints) - 1)):
         return None  # two in a row on (nearly) one direction turn about one axis: no ball
     centre, offsets = nearest_to_lines(np.eye(3)[None] - units[:, :, None] * units[:, None, :], points)
     return centre if np.all(np.linalg.norm(offsets, axis=1) <= MEETING * scale) else None

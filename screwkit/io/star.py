@@ -13,13 +13,13 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
 3. **Legs and loop joints.** Every closure onto the platform joins a leg (a tree path from the
    root that shares no joint with another leg) to it; the joints between the platform body and
    the closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
-   ``spherical``), one revolute or prismatic joint (``revolute``/``prismatic``), or three
-   revolute joints through one point or a ball joint (``spherical``). A closure on the base itself is a leg
-   of its loop joint alone (a four-bar's rocker pinned to the ground, the rocker the platform), or, planar, of its
-   pin and the one joint beyond the platform as the loop joint (the coupler the platform). Closures between two legs
-   make **compound legs** (:mod:`screwkit.io.compound`): each keeps its actuated leg and writes
-   its passive legs as one equivalent constraint chain, or is refused with the reason. Loops that
-   leave a leg's own path, and actuators on branches closed onto other legs (closed-loop
+   ``spherical``), one revolute or prismatic joint (``revolute``/``prismatic``), two revolute joints whose
+   axes meet (``universal``), or three revolute joints through one point or a ball joint (``spherical``). A
+   closure on the base itself is a leg of its loop joint alone (a four-bar's rocker pinned to the ground, the
+   rocker the platform), or, planar, of its pin and the one joint beyond the platform as the loop joint (the
+   coupler the platform). Closures between two legs make **compound legs** (:mod:`screwkit.io.compound`): each
+   keeps its actuated leg and writes its passive legs as one equivalent constraint chain, or is refused with the
+   reason. Loops that leave a leg's own path, and actuators on branches closed onto other legs (closed-loop
    transmissions), are refused with the closure named.
 4. **Idle joints.** A leg whose joint twists are dependent at the assembly (a second pin coaxial
    with the closure pin, the free spin of an S-P-S leg) has passive joints locked at their
@@ -66,6 +66,7 @@ from screwkit.io.closed_tree import (
     inverse,
     joint_kind,
     joint_value,
+    meeting_point,
     path_to,
 )
 from screwkit.io.compound import compound_groups, compound_legs
@@ -93,7 +94,7 @@ __all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
 @dataclass
 class _Leg:
     joints: list[int]
-    loop: str  # fixed, revolute, prismatic, spherical
+    loop: str  # fixed, revolute, prismatic, universal, spherical
     predecessor: NDArray  # 4x4 in the leg end's joint frame
     successor_world: NDArray  # 4x4 world pose of the platform-side loop frame at the assembly
     axis: NDArray | None
@@ -105,6 +106,7 @@ class _Leg:
     # body's own path; two ball closures on one hinge's axis, or three or more of a weld)
     base_dofs: list = field(default_factory=list)  # world (kind, axis, point) of a ball closed on the base itself,
     # written as the leg's first joints (a four-bar's rocker pinned to the ground, its joint onto the coupler the loop)
+    axis2: NDArray | None = None  # a universal loop's second axis, in the loop frame
 
 
 def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
@@ -153,10 +155,18 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         zero, predecessor = at_point(zero, ball), at_point(predecessor, ball, homogeneous(data.oMi[closure.joint_a]))
         axes = [("revolute", zero[:3, k], ball) for k in range(3)]
         return _Leg(a_path, "spherical", predecessor, zero, None, axes, closure.name, sources=(closure,))
+    centre = meeting_point(model, after, kinds, zero, scale) if len(after) == 2 else None
+    if centre is not None:  # a universal joint, seen from the leg: its second hinge's turn, then its first's
+        second = homogeneous(model.jointPlacements[after[1]])
+        predecessor = at_point(predecessor @ inverse(second), centre, homogeneous(data.oMi[closure.joint_a]))
+        axes = (second[:3, :3] @ kinds[1][1], kinds[0][1])  # in the loop frames, which both hinges at 0 make one
+        return _Leg(a_path, "universal", predecessor, at_point(zero, centre), axes[0],
+                    [("revolute", zero[:3, :3] @ axis, centre) for axis in axes], closure.name, sources=(closure,),
+                    axis2=axes[1])
     raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
-                       "screwkit supports none, one revolute or prismatic joint, or three revolute joints through "
-                       "one point (a spherical joint).")
+                       "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
+                       "(a universal joint), or three revolute joints through one point (a spherical joint).")
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
@@ -435,7 +445,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         if leg.base_dofs:  # in the pin's frame: the base's axes at the ball's centre
             predecessor[:3, 3] -= in_base(world_base, leg.base_dofs[0][2])
         writer.loop(f"{name}_loop", leg.loop, name, end, pose_of(predecessor), "platform", pose_of(successor),
-                    axis=None if leg.axis is None else tuple(leg.axis))
+                    axis=None if leg.axis is None else tuple(leg.axis),
+                    second_axis=None if leg.axis2 is None else tuple(leg.axis2))
         actuated = [model.names[j] for j in leg.joints if j in motor_ids]
         listed = synthetic + [model.names[j] for j in leg.joints]
         report.chains.append(f"{name}: " + (f"joints {', '.join(listed)}, " if listed else "no joint but its loop, ")
