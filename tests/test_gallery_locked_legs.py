@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from scipy.optimize import least_squares
+from rod_lines import closed_by_scipy, joint_line, two_rod_indices
 from scipy.spatial.transform import Rotation
 from test_gallery_published import GEPETTO, PUBLISHED
 
@@ -40,42 +40,14 @@ DIGIT_LOCKS = ("motor_hip_x", "motor_hip_y", "motor_hip_z", "motor_knee", "free_
 CASSIE_LOCKS = ("motor_hip1", "motor_hip2", "motor_tigh", "motor_knee", "free_knee")
 
 
-def closed_by_scipy(path, held: dict[str, float]) -> tuple[object, object, np.ndarray]:
+def closed_from_file(path, held: dict[str, float]) -> tuple[object, object, np.ndarray]:
     """The file's tree (Pinocchio's own reading) with every loop of its robot.yaml closed by scipy's least squares
     over the joints not ``held`` (those at the given values), from the file's zero configuration."""
     model = pin.buildModelFromUrdf(str(path))
-    data = model.createData()
     spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
-    pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
-    names = [str(name) for name in list(model.names)[1:]]
-    free = [name for name in names if name not in held]
-    index = {name: model.joints[model.getJointId(name)].idx_q for name in names}
-
-    def configuration(x):
-        q = pin.neutral(model)
-        for name, value in held.items():
-            q[index[name]] = value
-        for name, value in zip(free, x):
-            q[index[name]] = value
-        return q
-
-    def residuals(x):
-        pin.framesForwardKinematics(model, data, configuration(x))
-        return np.concatenate([pin.log6(data.oMf[a].inverse() * data.oMf[b]).vector for a, b in pairs])
-
-    solved = least_squares(residuals, np.zeros(len(free)), xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    assert np.abs(residuals(solved.x)).max() < 1e-10  # every loop closed
-    q = configuration(solved.x)
-    pin.forwardKinematics(model, data, q)
+    data, q = closed_by_scipy(model, [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]],
+                              held)
     return model, data, q
-
-
-def point_and_axis(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
-    joint = model.getJointId(name)
-    axis = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}.get(
-        model.joints[joint].shortname())
-    axis = np.array(axis, dtype=float) if axis is not None else np.asarray(model.joints[joint].extract().axis)
-    return data.oMi[joint].translation.copy(), data.oMi[joint].rotation @ axis
 
 
 def analysed(path, locks):
@@ -91,8 +63,8 @@ def analysed(path, locks):
 
 
 def rod_force(model, data, crank_ball: str, platform_ball: str):
-    crank, _ = point_and_axis(model, data, crank_ball)
-    end, _ = point_and_axis(model, data, platform_ball)
+    crank, _ = joint_line(model, data, crank_ball)
+    end, _ = joint_line(model, data, platform_ball)
     return (end - crank) / np.linalg.norm(end - crank), crank, end
 
 
@@ -101,31 +73,12 @@ def test_digit_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
     result, motors, knee = analysed(path, DIGIT_LOCKS)
     assert sorted(motors) == ["motor_shin1", "motor_shin2"] and result.dof == 2
     held = {name: 0.0 for name in DIGIT_LOCKS[:4]} | motors
-    model, data, q = closed_by_scipy(path, held)
+    model, data, q = closed_from_file(path, held)
     assert q[model.joints[model.getJointId("free_knee")].idx_q] == pytest.approx(knee, abs=1e-8)
     assert knee == pytest.approx(0.7163546, abs=1e-6)  # (what the file writes: 0)
     legs = {"motor_shin1": ("crank_toe_b_2/2_rev0", "foot_part_toe_b_1/2_2_rev0"),
             "motor_shin2": ("crank_2_toe_b_2/2_2_rev0", "foot_part_toe_b_1/2_rev0")}
-    forces, itis = {}, []
-    for motor in sorted(motors):
-        force, crank, end = rod_force(model, data, *legs[motor])
-        origin, axis = point_and_axis(model, data, motor)
-        velocity = np.cross(axis, crank - origin)
-        itis.append(abs(force @ velocity) / np.linalg.norm(velocity))
-        forces[motor] = (force, crank, end)
-    hinges = [point_and_axis(model, data, name) for name in ("free_foot1", "free_foot2")]
-    space = np.array([np.concatenate([axis, np.cross(point, axis)]) for point, axis in hinges]).T  # (omega, v at 0)
-
-    def power(force, at, twist):
-        return force @ (twist[3:] + np.cross(twist[:3], at))
-
-    otis = []
-    for motor in sorted(motors):
-        force, crank, end = forces[motor]
-        other, other_at, _ = next(value for key, value in forces.items() if key != motor)
-        twist = space @ np.array([-power(other, other_at, space[:, 1]), power(other, other_at, space[:, 0])])
-        velocity = twist[3:] + np.cross(twist[:3], end)
-        otis.append(abs(force @ velocity) / np.linalg.norm(velocity))
+    itis, otis = two_rod_indices(model, data, legs, ("free_foot1", "free_foot2"))
     order = [name.split(":")[-1] for name in result.actuators]
     assert order == sorted(motors)
     np.testing.assert_allclose(result.iti_actuators, itis, atol=TOLERANCE)
@@ -137,11 +90,11 @@ def test_cassie_s_plantar_four_bar_with_its_leg_locked_has_the_rod_line_indices(
     path = GEPETTO / "cassie_like" / "robot.urdf"
     result, motors, knee = analysed(path, CASSIE_LOCKS)
     assert list(motors) == ["motor_ankle"] and result.dof == 1
-    model, data, q = closed_by_scipy(path, {name: 0.0 for name in CASSIE_LOCKS[:4]} | motors)
+    model, data, q = closed_from_file(path, {name: 0.0 for name in CASSIE_LOCKS[:4]} | motors)
     assert q[model.joints[model.getJointId("free_knee")].idx_q] == pytest.approx(knee, abs=1e-8)
     force, crank, end = rod_force(model, data, "servo_gauche_half_planta_rode_rev0", "foot_2_half_planta_rode_2_rev0")
-    origin, axis = point_and_axis(model, data, "motor_ankle")
-    foot, hinge = point_and_axis(model, data, "free_ankle")
+    origin, axis = joint_line(model, data, "motor_ankle")
+    foot, hinge = joint_line(model, data, "free_ankle")
     at_crank, at_foot = np.cross(axis, crank - origin), np.cross(hinge, end - foot)
     np.testing.assert_allclose(result.iti_actuators, [abs(force @ at_crank) / np.linalg.norm(at_crank)],
                                atol=TOLERANCE)
@@ -185,7 +138,7 @@ def test_a_lock_on_a_file_whose_loop_closes_with_the_locked_joint_where_written_
     assert mechanism.dof == 1 and result.iti > 0.5
     _, report = read_mechanism_file(path, lock=("free1",))
     assert not any("inside a loop) locked at" in note for note in report.notes)  # free1 kept at the file's 0
-    model, data, q = closed_by_scipy(path, {"free1": 0.0, **{
+    model, data, q = closed_from_file(path, {"free1": 0.0, **{
         name.split(":")[-1]: value for name, value in result.joint_values.items() if name.split(":")[-1] in
         ("mot1", "mot2")}})
     assert q[model.joints[model.getJointId("free1")].idx_q] == 0.0  # and the loop closes there (scipy, above)

@@ -23,7 +23,7 @@ import pinocchio as pin
 import pytest
 import yaml
 from gepetto_loader import gepetto_model
-from scipy.optimize import least_squares
+from rod_lines import closed_by_scipy, two_rod_indices
 from test_gallery_published import GEPETTO
 
 from helpers import in_millimetres, one_line_error, screwkit
@@ -99,38 +99,6 @@ def test_the_replaced_joints_are_gepetto_s_own_reading(tmp_path, change):
                 "holds ankley_right at 0 (FIXED)") in note for note in notes), notes
 
 
-def closed_by_scipy(model, pairs, held: dict[str, float]):
-    """``model`` with every loop (frame ``pairs``) closed by scipy's least squares over the velocity coordinates of
-    the joints not ``held`` (those at the given values), from the neutral configuration."""
-    data = model.createData()
-    start = pin.neutral(model)
-    for name, value in held.items():
-        start[model.joints[model.getJointId(name)].idx_q] = value
-    held_v = {model.joints[model.getJointId(name)].idx_v for name in held}
-    free = [index for index in range(model.nv) if index not in held_v]
-
-    def configuration(x):
-        step = np.zeros(model.nv)
-        step[free] = x
-        return pin.integrate(model, start, step)
-
-    def residuals(x):
-        pin.framesForwardKinematics(model, data, configuration(x))
-        return np.concatenate([pin.log6(data.oMf[a].inverse() * data.oMf[b]).vector for a, b in pairs])
-
-    solved = least_squares(residuals, np.zeros(len(free)), xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    assert np.abs(residuals(solved.x)).max() < 1e-10  # every loop closed
-    q = configuration(solved.x)
-    pin.forwardKinematics(model, data, q)
-    return data, q
-
-
-def centre_and_axis(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
-    joint = model.getJointId(name)
-    axis = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}.get(model.joints[joint].shortname())
-    return data.oMi[joint].translation.copy(), None if axis is None else data.oMi[joint].rotation[:, axis].copy()
-
-
 def analysed(path, **options):
     mechanism = load(path, output="foot_right", lock=LOCKS, **options)
     result = indices_at_pose(mechanism, mechanism.home_pose)
@@ -149,28 +117,8 @@ def rod_line_indices(path, held: dict[str, float], rods: dict, hinges: tuple[str
     spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
     pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
     data, q = closed_by_scipy(model, pairs, held)
-    forces, itis = {}, []
-    for motor in sorted(rods):
-        (crank, _), (end, _) = (centre_and_axis(model, data, name) for name in rods[motor])
-        force = (end - crank) / np.linalg.norm(end - crank)
-        origin, axis = centre_and_axis(model, data, motor)
-        velocity = np.cross(axis, crank - origin)
-        itis.append(abs(force @ velocity) / np.linalg.norm(velocity))
-        forces[motor] = (force, crank, end)
-    lines = [centre_and_axis(model, data, name) for name in hinges]
-    space = np.array([np.concatenate([axis, np.cross(point, axis)]) for point, axis in lines]).T  # (omega, v at 0)
-
-    def power(force, at, twist):
-        return force @ (twist[3:] + np.cross(twist[:3], at))
-
-    otis = []
-    for motor in sorted(rods):
-        force, _, end = forces[motor]
-        other, other_at, _ = next(value for key, value in forces.items() if key != motor)
-        twist = space @ np.array([-power(other, other_at, space[:, 1]), power(other, other_at, space[:, 0])])
-        velocity = twist[3:] + np.cross(twist[:3], end)
-        otis.append(abs(force @ velocity) / np.linalg.norm(velocity))
-    return np.array(itis), np.array(otis), model, q
+    itis, otis = two_rod_indices(model, data, rods, hinges)
+    return itis, otis, model, q
 
 
 def test_battobot_s_ankle_with_its_leg_locked_has_the_rod_line_indices():
