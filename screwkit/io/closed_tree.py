@@ -480,8 +480,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             return q, scale
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
+        advice = ("" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE "
+                  "gives joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "
-                           f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (gaps: "
-                           + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items()) + ").")
+                           f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (every closure's "
+                           "gap after assembly: " + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items())
+                           + f"){advice}.")
     return q, scale
 
