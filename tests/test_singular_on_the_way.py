@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 
 from helpers import one_line_error, random_rotation, screwkit
-from screwkit.closure.on_the_way import singular_on_the_way
+from screwkit.closure.on_the_way import singular_on_the_way, singular_on_the_ways
 from screwkit.io.loader import load
+from screwkit.studies.sweep import sweep
 
 SIDE = 4.0
 
@@ -209,3 +210,58 @@ def test_joints_renamed_and_motors_listed_the_other_way_name_the_renamed_chain_a
     (event,) = json.loads(run.stdout)["events"]
     assert event["kind"] == "singular" and "chain crank_pin's joints" in event["reason"]
     assert event["start_m"] / json.loads(run.stdout)["length_m"] == pytest.approx(0.45, abs=1e-6)
+
+
+SWEPT = np.array([-100.0, -60.0, 0.0, 45.0, 80.0, 89.0, 90.5, 91.0, 120.0, 200.0])
+
+
+@pytest.mark.parametrize("world", WORLDS)
+@pytest.mark.parametrize(("scale", "unit"), [(1.0, None), (1e3, "mm"), (1e-3, None)])
+def test_a_sweep_marks_the_poses_past_the_change_point(tmp_path, world, scale, unit):
+    """The sweep's poses all lie on one line through the reference pose (phi from 0): the line is sampled once; the
+    poses past 90 deg and past -90 deg, and only those, are marked, with the chain, whatever the unit and the world
+    frame. (At -90 deg the parallelogram lies flat: C on A, every joint on one line, the joints singular too.)"""
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar(scale, WORLDS[world]))
+    mechanism = load(path, output="link_4", length_unit=unit)
+    dataset = sweep(mechanism, mechanism.home_pose, "phi", np.radians(SWEPT))
+    assert list(dataset["singular_chain"].values) == ["hinge_1"]
+    np.testing.assert_array_equal(dataset["past_singular"].values[:, 0], np.abs(SWEPT) > 90.0)
+
+
+def test_the_ways_sampled_once_on_their_line_agree_with_each_way_sampled_alone(tmp_path):
+    """singular_on_the_ways samples one line for poses on a line through the reference pose, and each way apart
+    otherwise (analyze's single pose): both find the same poses past the change point, at the same place."""
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    mechanism = load(path, output="link_4")
+    ((name, passed, where),) = singular_on_the_ways(mechanism, np.radians(SWEPT)[:, None])
+    assert name == "hinge_1"
+    np.testing.assert_array_equal(passed, np.abs(SWEPT) > 90.0)
+    for degrees, past, at in zip(SWEPT, passed, where):
+        alone = singular_on_the_way(mechanism, np.radians([degrees]))
+        assert past == bool(alone)
+        if past:
+            assert np.degrees(at[0]) == pytest.approx(np.degrees(alone[0][1][0]), abs=1e-3)
+            assert np.degrees(at[0]) == pytest.approx(np.sign(degrees) * 90.0, abs=1e-3)
+        else:
+            assert np.isnan(at).all()
+
+
+def test_the_sweep_command_says_so_and_writes_the_mark(tmp_path):
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    run = screwkit("sweep", path, "--output", "link_4", "--sweep", "phi:0:200:20", "--out", tmp_path / "s.csv")
+    assert run.returncode == 0, run.stderr
+    (note,) = [line for line in run.stderr.splitlines() if line.startswith("NOTE:")]
+    assert "at phi = 100, 120, 140, 160, 180 (5 of 10 values)" in note
+    assert "chain hinge_1's joints are singular" in note and "--initial JOINT VALUE" in note
+    rows = (tmp_path / "s.csv").read_text().splitlines()
+    column = rows[0].split(",").index("past_singular[hinge_1]")
+    assert [row.split(",")[column] for row in rows[1:]] == ["False"] * 5 + ["True"] * 5
+    quiet = screwkit("sweep", path, "--output", "link_4", "--sweep", "phi:0:200:20", "--out", tmp_path / "q.csv",
+                     "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == "", quiet.stderr
+    plain = screwkit("sweep", "planar_5rrr", "--phi", "0:40:10", "--out", tmp_path / "p.csv")
+    assert plain.returncode == 0 and "NOTE:" not in plain.stderr  # (no chain keeps a sign: nothing to mark)
+    assert "past_singular" not in (tmp_path / "p.csv").read_text().splitlines()[0]

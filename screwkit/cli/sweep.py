@@ -110,4 +110,21 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, read
                 if np.any(np.isfinite(series)):
                     at_min = dataset[coordinate].values[np.nanargmin(series)]
                     echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
+            if "past_singular" in dataset:
+                _say_past_singular(dataset, coordinate)
         write_outputs(dataset, outputs, sweep_figure, quiet)
+
+
+def _say_past_singular(dataset, coordinate: str) -> None:
+    """A NOTE for each chain whose joints are singular somewhere on the way from the reference pose to some of the
+    swept poses: those poses are on the assembly that keeps the reference's working-mode sign."""
+    values = dataset[coordinate].values
+    for chain in dataset["singular_chain"].values:
+        passed = dataset["past_singular"].sel(singular_chain=chain).values
+        if passed.any():
+            shown = ", ".join(f"{value:g}" for value in values[passed][:6]) + (", ..." if passed.sum() > 6 else "")
+            echo_error(f"NOTE: at {coordinate} = {shown} ({int(passed.sum())} of {values.size} values), the straight "
+                       f"way from the reference pose passes a configuration where chain {chain}'s joints are "
+                       "singular: two of its assemblies meet there, and these poses are on the one that keeps the "
+                       "reference's working-mode sign, not the one a motion through it may continue into "
+                       "(analyze --pose says where; --initial JOINT VALUE on each actuator assembles the other)")

@@ -9,10 +9,11 @@ assembly of the chain, not the one a motion through that configuration may conti
 parallelogram and the folded assembly meet, and beyond it the reference's sign is the folded one, where the crank
 stays at 90 deg while the rocker turns (published: Genesis's ``four_bar_linkage.xml``).
 
-:func:`singular_on_the_way` samples the way (for ``analyze --pose``), :func:`singular_along` takes a path's
-samples (a ``"singular"`` event of ``screwkit trajectory``); both find where the chain's normalised determinant
-dips, and refine the dip (golden-section search on the way's parameter, or the path's arc length) to tell a
-configuration where the joints are singular (the determinant below :data:`SINGULAR`) from one merely near it.
+:func:`singular_on_the_ways` samples the ways to a batch of poses (a sweep's, or ``analyze --pose``'s one, through
+:func:`singular_on_the_way`), :func:`singular_along` takes a path's samples (a ``"singular"`` event of ``screwkit
+trajectory``); both find where the chain's normalised determinant dips, and refine the dips (golden-section search
+on the way's parameter, or the path's arc length, every dip of a batch at once) to tell a configuration where the
+joints are singular (the determinant below :data:`SINGULAR`) from one merely near it.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from screwkit.closure.newton import task_rows
 from screwkit.closure.solve import solve
 from screwkit.model import Mechanism
 
-__all__ = ["singular_on_the_way", "singular_along", "SAMPLES", "SINGULAR"]
+__all__ = ["singular_on_the_way", "singular_on_the_ways", "singular_along", "SAMPLES", "SINGULAR"]
 
 SAMPLES = 129
 """Poses sampled on the way from the reference pose (both ends included)."""
@@ -41,51 +42,128 @@ _DIP = 0.2
 """A sampled dip (a local minimum inside the way) refined only if it is below this."""
 
 
+WAYS_PER_BATCH = 1024
+"""Ways sampled and solved at a time by :func:`singular_on_the_ways` (their samples' memory bounded)."""
+
+
+def sign_kept_chains(mechanism: Mechanism) -> list[int]:
+    """The chains closed by damped Newton with a working-mode sign and as many joints as task rows: those whose
+    assembly past a singular configuration of their joints is the other one (their determinant is square)."""
+    return [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
+            and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
+
+
 def singular_on_the_way(mechanism: Mechanism, pose: NDArray) -> list[tuple[str, NDArray[np.float64]]]:
     """Per chain closed by damped Newton with a working-mode sign, the first singular configuration of its joints
     on the straight way in task coordinates from the reference pose to ``pose`` (m and rad), as ``(chain name, the
     pose there)``; none for a chain whose way has none. Dips between samples where the chain does not close are
     looked at as well."""
-    start, pose = np.asarray(mechanism.home_pose, dtype=float), np.asarray(pose, dtype=float)
-    if np.array_equal(start, pose):
-        return []
+    found = singular_on_the_ways(mechanism, np.asarray(pose, dtype=float)[None])
+    return [(name, where[0]) for name, passed, where in found if passed[0]]
+
+
+def singular_on_the_ways(mechanism: Mechanism, poses: NDArray) -> list[tuple[str, NDArray, NDArray]]:
+    """:func:`singular_on_the_way` for a batch of poses (n, n_task): per chain it applies to, ``(chain name, whether
+    the way to each pose passes a singular configuration of its joints (n,), the first such pose on each way
+    (n, n_task; NaN where none))``. The ways are sampled (:data:`SAMPLES` poses each, solved in batches of
+    :data:`WAYS_PER_BATCH` ways) and their dips refined together."""
+    poses = np.asarray(poses, dtype=float).reshape(-1, mechanism.n_task)
+    chains = sign_kept_chains(mechanism)
+    start = np.asarray(mechanism.home_pose, dtype=float)
+    passed = {k: np.zeros(len(poses), dtype=bool) for k in chains}
+    where = {k: np.full(poses.shape, np.nan) for k in chains}
+    direction = _one_line(poses - start) if chains else None
+    if direction is not None:  # every way a stretch of one line (a sweep from the reference pose): sampled once
+        along = (poses - start) @ direction
+        line = np.linspace(min(along.min(), 0.0), max(along.max(), 0.0), SAMPLES)
+        found = singular_along(mechanism, start + line[:, None] * direction, line,
+                               lambda t: start + np.asarray(t)[..., None] * direction)
+        names = [mechanism.chains[k].name for k in chains]
+        for name, t, _ in sorted(found, key=lambda item: abs(item[1]), reverse=True):  # the nearest written last
+            k = chains[names.index(name)]
+            beyond = (np.sign(along) == np.sign(t)) & (np.abs(along) >= abs(t)) & (t != 0.0)
+            passed[k] |= beyond
+            where[k][beyond] = start + t * direction
+        return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
     way = np.linspace(0.0, 1.0, SAMPLES)
-    found = singular_along(mechanism, start + way[:, None] * (pose - start), way,
-                           lambda t: start + t * (pose - start), first_only=True)
-    return [(name, start + at * (pose - start)) for name, at, _ in found]
+    for first in range(0, len(poses) if chains else 0, WAYS_PER_BATCH):
+        rows = np.arange(first, min(first + WAYS_PER_BATCH, len(poses)))
+        rows = rows[np.any(poses[rows] != start, axis=1)]  # (the reference pose's own way has no length)
+        if not rows.size:
+            continue
+        sampled = start + way[None, :, None] * (poses[rows] - start)[:, None, :]
+        solved = solve(mechanism, sampled.reshape(-1, mechanism.n_task), limits=False).joint_values
+        for k in chains:
+            determinants = _normalised(mechanism, k, np.asarray(solved[k], dtype=float)).reshape(len(rows), SAMPLES)
+            candidates = [(row, i) for row, line in zip(rows, determinants) for i in _dips(line)]
+            if not candidates:
+                continue
+            owner = np.array([row for row, _ in candidates])
+            lows = np.array([way[max(i - 1, 0)] for _, i in candidates])
+            highs = np.array([way[min(i + 1, SAMPLES - 1)] for _, i in candidates])
+            at, values = _refined(mechanism, k, lambda t, r=owner: start + t[:, None] * (poses[r] - start), lows, highs)
+            for row, t in sorted(zip(owner[values < SINGULAR], at[values < SINGULAR]), key=lambda pair: pair[1],
+                                 reverse=True):  # the first on each way written last
+                passed[k][row], where[k][row] = True, start + t * (poses[row] - start)
+    return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
 
 
 def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *, values=None,
                    first_only: bool = False) -> list[tuple[str, float, int]]:
     """Per chain closed by damped Newton with a working-mode sign, the singular configurations of its joints along
-    the samples ``poses`` (n, n_task) at parameters ``at`` (n,, increasing), ``pose_at(t)`` giving the pose at any
-    parameter between them: ``(chain name, the parameter there, the sample nearest before it)``, refined between
-    the samples either side of each dip of its normalised determinant (and in the first and last intervals).
-    ``values``: per chain its joint values at the samples, where already solved (a chain's are used when they are
-    all its joints); ``first_only``: the first per chain."""
-    chains = [k for k, chain in enumerate(mechanism.chains) if chain.closed_form is None and chain.branch is not None
-              and chain.geometry.n_dofs == len(task_rows(mechanism.is_planar))]
+    the samples ``poses`` (n, n_task) at parameters ``at`` (n,, increasing), ``pose_at(t)`` giving the poses at the
+    parameters ``t`` (k,) between them (k, n_task): ``(chain name, the parameter there, the sample nearest before
+    it)``, refined between the samples either side of each dip of its normalised determinant (and in the first and
+    last intervals). ``values``: per chain its joint values at the samples, where already solved (a chain's are used
+    when they are all its joints); ``first_only``: the first per chain."""
     found, solved = [], None
     last = len(at) - 1
-    for k in chains:
+    for k in sign_kept_chains(mechanism):
         given = None if values is None else np.asarray(values[k], dtype=float)
         if given is None or given.shape[-1] != mechanism.chains[k].geometry.n_dofs:
             if solved is None:  # every chain's closure at the samples, solved once for all the chains looked at
                 solved = solve(mechanism, poses, limits=False).joint_values
             given = np.asarray(solved[k], dtype=float)
-        determinants = _normalised(mechanism, k, given)
-        finite = np.isfinite(determinants)
-        dips = [i for i in range(1, last) if finite[i - 1:i + 2].all() and determinants[i] < _DIP
-                and determinants[i] <= determinants[i - 1] and determinants[i] <= determinants[i + 1]]
-        ends = [(0, 1), (last, last - 1)] if last >= 1 else []
-        dips += [i for i, j in ends if finite[i] and finite[j] and determinants[i] < min(determinants[j], _DIP)]
-        for i in sorted(dips):  # (samples where the chain does not close break the way: the dips between them count)
-            where, value = _refined(mechanism, k, pose_at, at[max(i - 1, 0)], at[min(i + 1, last)])
-            if value < SINGULAR:
-                found.append((mechanism.chains[k].name, where, int(np.searchsorted(at, where, side="right")) - 1))
-                if first_only:
-                    break
+        dips = _dips(_normalised(mechanism, k, given))
+        if not dips:
+            continue
+        lows = np.array([at[max(i - 1, 0)] for i in dips])
+        highs = np.array([at[min(i + 1, last)] for i in dips])
+        where, value = _refined(mechanism, k, pose_at, lows, highs)
+        singular = [float(t) for t in where[value < SINGULAR]]  # (in the dips' order: along the path)
+        for t in singular[:1] if first_only else singular:
+            found.append((mechanism.chains[k].name, t, int(np.searchsorted(at, t, side="right")) - 1))
     return found
+
+
+def _one_line(offsets: NDArray) -> NDArray | None:
+    """The unit direction of the line through the reference pose that every pose lies on (their ``offsets`` from
+    it, (n, n_task), to 1e-12 of the farthest), or None."""
+    lengths = np.linalg.norm(offsets, axis=1)
+    if len(offsets) < 2 or not lengths.max() > 0.0:
+        return None
+    direction = offsets[np.argmax(lengths)] / lengths.max()
+    across = offsets - (offsets @ direction)[:, None] * direction
+    return direction if np.linalg.norm(across, axis=1).max() <= 1e-12 * lengths.max() else None
+
+
+def _dips(determinants: NDArray) -> list[int]:
+    """The samples (in order) where a normalised determinant along a way or path dips below :data:`_DIP`: inside,
+    no higher than either neighbour; at an end, lower than its neighbour. A neighbour where the chain does not close
+    (damped Newton may fail right beside a singular configuration) is left out of the comparison: the refinement
+    looks between them."""
+    finite = np.isfinite(determinants)
+    last = len(determinants) - 1
+    dips = []
+    for i in np.flatnonzero(finite & (np.where(finite, determinants, np.inf) < _DIP)):
+        neighbours = [j for j in (i - 1, i + 1) if 0 <= j <= last and finite[j]]
+        if i in (0, last) and last > 0:
+            keep = all(determinants[i] < determinants[j] for j in neighbours)
+        else:
+            keep = all(determinants[i] <= determinants[j] for j in neighbours)
+        if keep:
+            dips.append(int(i))
+    return dips
 
 
 def _determinants(mechanism: Mechanism, k: int, poses: NDArray) -> NDArray[np.float64]:
@@ -107,26 +185,26 @@ def _normalised(mechanism: Mechanism, k: int, values: NDArray) -> NDArray[np.flo
     return np.where(closed, np.abs(np.linalg.det(twists)), np.nan)
 
 
-def _refined(mechanism: Mechanism, k: int, pose_at, low: float, high: float,
-             iterations: int = 20) -> tuple[float, float]:
-    """The least normalised determinant of chain ``k`` between the parameters ``low`` and ``high`` (golden
-    section): the parameter and the value."""
+def _refined(mechanism: Mechanism, k: int, poses_at, lows: NDArray, highs: NDArray,
+             iterations: int = 20) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The least normalised determinant of chain ``k`` between each pair of parameters ``lows`` and ``highs`` (k,),
+    found by golden section, every interval at once (``poses_at(t)``: the poses (k, n_task) at parameters t (k,)):
+    the parameters and the values."""
     ratio = (math.sqrt(5.0) - 1.0) / 2.0
 
-    def value(t: float) -> float:
-        found = _determinants(mechanism, k, np.asarray(pose_at(t), dtype=float)[None])[0]
-        return float(found) if np.isfinite(found) else np.inf
+    def value(t: NDArray) -> NDArray:
+        found = _determinants(mechanism, k, np.asarray(poses_at(t), dtype=float))
+        return np.where(np.isfinite(found), found, np.inf)
 
-    a, b = low, high
+    a, b = np.asarray(lows, dtype=float).copy(), np.asarray(highs, dtype=float).copy()
     c, d = b - ratio * (b - a), a + ratio * (b - a)
     fc, fd = value(c), value(d)
     for _ in range(iterations):
-        if fc <= fd:
-            b, d, fd = d, c, fc
-            c = b - ratio * (b - a)
-            fc = value(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + ratio * (b - a)
-            fd = value(d)
-    return (c, fc) if fc <= fd else (d, fd)
+        left = fc <= fd  # the least lies in [a, d] (d's place taken by c), else in [c, b] (c's by d)
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        kept, f_kept = np.where(left, c, d), np.where(left, fc, fd)
+        probe = np.where(left, b - ratio * (b - a), a + ratio * (b - a))
+        f_probe = value(probe)
+        c, fc = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
+        d, fd = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
+    return np.where(fc <= fd, c, d), np.where(fc <= fd, fc, fd)

@@ -60,7 +60,7 @@ class SerialPath:
     def singular(self, path, joint_values) -> list[tuple[str, float, int]]:
         """Where a chain's joints are singular along ``path`` (:func:`~screwkit.closure.on_the_way.singular_along`:
         chain, arc length, the sample before), from its tree joints' values at the samples where they are all."""
-        return singular_along(self.mechanism, path.poses, path.arc_length, lambda s: path.at(np.array([s]))[0],
+        return singular_along(self.mechanism, path.poses, path.arc_length, lambda s: path.at(np.asarray(s)),
                               values=joint_values)
 
     def indices(self, poses: NDArray) -> Indices:

@@ -14,6 +14,7 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.closure.on_the_way import singular_on_the_ways
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
 from screwkit.indices.results import set_label
@@ -60,6 +61,10 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         ``f_o{j}``, ``f_io{j}``, ``worst_fault{j}``, ``mutual_interference``, ``reachable``
         (those of :meth:`screwkit.indices.results.Indices.to_dataset` along the swept coordinate,
         and the LMTI of every set left after j faults). Attribute ``fixed_pose``: the other coordinates (m, deg).
+        For a mechanism with chains closed by damped Newton with a working-mode sign, also ``past_singular``
+        (``coordinate``, ``singular_chain``): whether the straight way from the reference pose to each pose passes
+        a configuration where the chain's joints are singular (two of its assemblies meet there, and the pose is on
+        the one that keeps the reference's sign; :func:`~screwkit.closure.on_the_way.singular_on_the_ways`).
     """
 
     graph = isinstance(mechanism, GraphMechanism)
@@ -104,6 +109,12 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
             stacked = np.stack([np.asarray(result.lmti_of(e)) for e in remaining], axis=-1)
             dataset[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
                                              {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
+    passed = [] if graph else singular_on_the_ways(mechanism, poses)
+    if passed:
+        dataset.coords["singular_chain"] = ("singular_chain", [name for name, _, _ in passed])
+        dataset["past_singular"] = ((coordinate, "singular_chain"), np.stack([mask for _, mask, _ in passed], axis=1),
+                                    {"long_name": "the way from the reference pose passes a configuration where the "
+                                                  "chain's joints are singular"})
     dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
                          fixed_pose=pose_text(mechanism.task_coordinates, at, mechanism.length_scale, [coordinate]),
                          method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
