@@ -321,3 +321,29 @@ def test_a_position_asked_of_a_delta_turned_a_quarter_turn_is_met_as_in_the_untu
     expected = textbook(np.array(POSES[0]) + move)
     for graph in (here, there):
         assert_delta_textbook(graph.indices(), expected)
+
+
+def test_a_platform_no_twist_moves_is_refused_naming_the_legs_that_hold_it():
+    """What the refusal of a graph whose platform cannot move names, from each leg's twist system (hand-made here:
+    unit rows in working coordinates): a leg that allows no twist on its own; else the legs any one of which left out
+    frees the platform; else every leg's dimension."""
+    from screwkit.io.graph_screws import LegScrews, locking_legs
+
+    def leg(*axes):
+        rows = np.zeros((1, 6, 6))
+        rows[0, :len(axes)] = np.eye(6)[list(axes)]
+        empty = np.zeros((1, 3))
+        return LegScrews(np.zeros((1, 6)), rows, np.array([len(axes)]), rows, np.array([len(axes)]), empty, empty,
+                         empty, np.zeros(1))
+
+    class Leg:
+        def __init__(self, name):
+            self.name = name
+
+    translations_xy, translation_z, rotation_z = leg(3, 4), leg(5), leg(2)
+    assert locking_legs([Leg("a"), Leg("b"), Leg("c")], [translations_xy, leg(), translation_z]) == \
+        ": leg(s) b allow it no twist on their own"
+    assert locking_legs([Leg("a"), Leg("b")], [translations_xy, translation_z]) == \
+        ": with any one of legs a, b left out, the others would let it move"
+    assert locking_legs([Leg("a"), Leg("b"), Leg("c")], [translations_xy, translation_z, rotation_z]) == \
+        ": the legs allow twist systems of dimension 2 (a), 1 (b), 1 (c)"  # (any two left: still none in common)

@@ -174,8 +174,12 @@ def test_the_graph_reading_agrees_on_the_exact_file_and_refuses_the_rounded_one_
     assert_textbook(graph, graph.indices(), textbook(geometry(*POSES[0])), TOLERANCE)
     path = tmp_path / "rounded.sdf"
     path.write_text(hinged_delta_sdf(digits=6))
-    with pytest.raises(ImportError_, match=r"rounded.sdf: the platform 'platform' cannot move: analysed as a graph"):
-        graph_mechanism(read_closed_tree(path))
+    with pytest.raises(ImportError_, match=r"rounded.sdf: the platform 'platform' cannot move: analysed as a graph, "
+                                           r"its legs allow no twist in common at the file's configuration: the legs "
+                                           r"allow twist systems of dimension 3 \(arm_1\), 3 \(arm_2\), 3 \(arm_3\), "
+                                           r"3 \(arm_4\) \("):
+        graph_mechanism(read_closed_tree(path))  # (each parallelogram rigid: one translation fewer than the exact 4)
+    assert all(line.endswith("twist system of dimension 4") for line in graph.report.chains)  # the exact file's
 
 
 def test_analyze_opens_the_rounded_file_on_the_command_line(tmp_path):

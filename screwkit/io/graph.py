@@ -63,7 +63,7 @@ from screwkit.io.closed_tree import (
     joint_value,
     path_to,
 )
-from screwkit.io.compound import TWIST_RANK_TOLERANCE, closed_samples
+from screwkit.io.compound import closed_samples
 from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
@@ -75,7 +75,15 @@ from screwkit.io.graph_kinematics import (
     rpy_rates_inverse,
     solve_poses,
 )
-from screwkit.io.graph_screws import GraphLeg, LegScrews, dimension_groups, equivalent_chains, leg_screws
+from screwkit.io.graph_screws import (
+    GraphLeg,
+    LegScrews,
+    common_motions,
+    dimension_groups,
+    equivalent_chains,
+    leg_screws,
+    locking_legs,
+)
 from screwkit.io.output import output_frame, platform_body
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
@@ -421,7 +429,7 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: li
     if tree.output_type == "point":
         raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
                            f"frame of their platform {body!r} only.")
-    idle = _motion_space(screws, locked=True)
+    idle = common_motions(screws, locked=True)
     if len(idle):
         guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
                         if note.startswith("actuators guessed")), "")
@@ -434,26 +442,6 @@ def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: li
                            "holds a passive joint that moves it"
                            + (f" (the legs' passive joints: {', '.join(passive)})" if passive else "")
                            + ", --actuate names a joint that drives it.")
-
-
-def _motion_space(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:
-    """Orthonormal rows (d, 6) spanning the platform twists every leg allows (working coordinates), at the first
-    configuration of a batch; ``locked``: with every actuator locked (the motions no actuator controls);
-    ``counted``: a list that gets the singular values counted of the legs' stacked complements."""
-    complements = []
-    for screw in screws:
-        rows = (screw.locked[0][:int(screw.locked_dims[0])] if locked else
-                screw.allowed[0][:int(screw.allowed_dims[0])])
-        _, values, right = np.linalg.svd(np.vstack([rows, np.zeros((6 - len(rows), 6))]) if len(rows) < 6 else rows)
-        complements.append(right[int(np.sum(values > TWIST_RANK_TOLERANCE)):])
-    stacked = np.vstack(complements)
-    if not len(stacked):
-        return np.eye(6)
-    _, values, right = np.linalg.svd(np.vstack([stacked, np.zeros((max(6 - len(stacked), 0), 6))]))
-    rank = int(np.sum(values > TWIST_RANK_TOLERANCE))
-    if counted is not None:
-        counted.extend(values[:rank])
-    return right[rank:]
 
 
 def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple[int, ...]:
@@ -513,7 +501,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     counted = []
-    motion = _motion_space(screws, counted=counted)
+    motion = common_motions(screws, counted=counted)
     counted = np.array(counted)
     small = counted[counted <= DOF_MARGIN]
     if small.size:  # as closure.assembly.mobility_notes says it of serial legs
@@ -521,9 +509,9 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     task_axes = _task_axes(tree, state, frame_id, motion)
     if not task_axes:
         raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move: analysed as a graph, "
-                           "its legs allow no twist in common at the file's configuration (a loop inside a leg "
-                           "that the file's numbers make rigid reads so, e.g. a parallelogram of hinges parallel "
-                           "only to the file's rounding: the graph reads a file as written).")
+                           f"its legs allow no twist in common at the file's configuration{locking_legs(legs, screws)} "
+                           "(a loop inside a leg that the file's numbers make rigid reads so, e.g. a parallelogram of "
+                           "hinges parallel only to the file's rounding: the graph reads a file as written).")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.motors = [model.names[leg.actuators[0]] for leg in legs if leg.actuators]

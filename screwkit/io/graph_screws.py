@@ -20,7 +20,8 @@ from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
 from screwkit.screw.chain_screws import ChainScrews
 
-__all__ = ["GraphLeg", "LegScrews", "leg_screws", "equivalent_chains", "dimension_groups"]
+__all__ = ["GraphLeg", "LegScrews", "leg_screws", "equivalent_chains", "dimension_groups", "common_motions",
+           "locking_legs"]
 
 
 @dataclass(frozen=True)
@@ -207,3 +208,38 @@ def dimension_groups(screws: list[LegScrews]) -> list[NDArray[np.int64]]:
     signature = np.stack([s.locked_dims for s in screws], axis=1)
     _, inverse = np.unique(signature, axis=0, return_inverse=True)
     return [np.flatnonzero(inverse.reshape(-1) == group) for group in range(int(inverse.max()) + 1)]
+
+
+def common_motions(screws: list[LegScrews], locked: bool = False, counted: list | None = None) -> NDArray[np.float64]:
+    """Orthonormal rows (d, 6) spanning the platform twists every leg allows (working coordinates), at the first
+    configuration of a batch; ``locked``: with every actuator locked (the motions no actuator controls);
+    ``counted``: a list that gets the singular values counted of the legs' stacked complements."""
+    complements = []
+    for screw in screws:
+        rows = (screw.locked[0][:int(screw.locked_dims[0])] if locked else
+                screw.allowed[0][:int(screw.allowed_dims[0])])
+        _, values, right = np.linalg.svd(np.vstack([rows, np.zeros((6 - len(rows), 6))]) if len(rows) < 6 else rows)
+        complements.append(right[int(np.sum(values > TWIST_RANK_TOLERANCE)):])
+    stacked = np.vstack(complements)
+    if not len(stacked):
+        return np.eye(6)
+    _, values, right = np.linalg.svd(np.vstack([stacked, np.zeros((max(6 - len(stacked), 0), 6))]))
+    rank = int(np.sum(values > TWIST_RANK_TOLERANCE))
+    if counted is not None:
+        counted.extend(values[:rank])
+    return right[rank:]
+
+
+def locking_legs(legs, screws: list[LegScrews]) -> str:
+    """What holds a platform no twist moves, for the refusal: the legs that allow it none on their own, else those
+    any one of which left out would let it move, else every leg's twist-system dimension (at the first
+    configuration of a batch)."""
+    rigid = [leg.name for leg, screw in zip(legs, screws) if int(screw.allowed_dims[0]) == 0]
+    if rigid:
+        return f": leg(s) {', '.join(rigid)} allow it no twist on their own"
+    freeing = [leg.name for k, leg in enumerate(legs) if len(common_motions(screws[:k] + screws[k + 1:]))]
+    if freeing:
+        return f": with any one of legs {', '.join(freeing)} left out, the others would let it move"
+    return ": the legs allow twist systems of dimension " + ", ".join(
+        f"{int(screw.allowed_dims[0])} ({leg.name})" for leg, screw in zip(legs, screws))
+
