@@ -57,12 +57,23 @@ def joint_line(model, data, name: str) -> tuple[np.ndarray, np.ndarray | None]:
     return data.oMi[joint].translation.copy(), None if axis is None else np.array(axis)
 
 
+def joint_centre(model, data, joint) -> np.ndarray:
+    """A joint's origin (a name), or the point where two revolute joints' lines meet (a pair of names: a universal
+    joint drawn anywhere along its hinges' lines), in the world."""
+    if isinstance(joint, str):
+        return joint_line(model, data, joint)[0]
+    (p, u), (q, w) = (joint_line(model, data, name) for name in joint)
+    s, t = np.linalg.solve(np.array([[u @ u, -u @ w], [u @ w, -w @ w]]), np.array([(q - p) @ u, (q - p) @ w]))
+    return (p + s * u + q + t * w) / 2
+
+
 def two_rod_indices(model, data, rods: dict, hinges: tuple[str, str]) -> tuple[np.ndarray, np.ndarray]:
-    """The ITI and OTI of each motor (sorted by name) of ``rods``, each motor's (crank-end joint, foot-end joint),
-    the foot's two ``hinges`` named, at the configuration of ``data`` (its joint placements computed)."""
+    """The ITI and OTI of each motor (sorted by name) of ``rods``, each motor's (crank-end joint, foot-end joint;
+    either a pair of hinges, see :func:`joint_centre`), the foot's two ``hinges`` named, at the configuration of
+    ``data`` (its joint placements computed)."""
     forces, itis = {}, []
     for motor in sorted(rods):
-        (crank, _), (end, _) = (joint_line(model, data, name) for name in rods[motor])
+        crank, end = (joint_centre(model, data, joint) for joint in rods[motor])
         force = (end - crank) / np.linalg.norm(end - crank)
         origin, axis = joint_line(model, data, motor)
         velocity = np.cross(axis, crank - origin)

@@ -23,10 +23,12 @@ import pinocchio as pin
 import pytest
 import yaml
 from gepetto_loader import gepetto_model
-from rod_lines import closed_by_scipy, two_rod_indices
+from rod_lines import closed_by_scipy, joint_line, two_rod_indices
 from test_gallery_published import GEPETTO
+from universal_ankle import universal_ankle
 
 from helpers import in_millimetres, one_line_error, screwkit
+from screwkit.closure import solve
 from screwkit.io import graph_mechanism, read_closed_tree, read_mechanism_file
 from screwkit.io.gepetto import replaced_joints
 from screwkit.io.loader import load
@@ -323,3 +325,49 @@ def test_two_hinges_beyond_the_foot_whose_axes_miss_each_other_are_refused_namin
     one_line_error(screwkit("info", tmp_path / "robot.urdf", *held), "foot_part_toe_b_1/2_2_rev0 (revolute), "
                    "foot_part_toe_b_1/2_2_rev1 (revolute) beyond the platform",
                    "two revolute joints whose axes meet (a universal joint)")
+
+
+UNIVERSAL_ANKLES = {  # universal_ankle's options, and the joint values (deg) the loops are closed with
+    "as drawn": ({}, ()),
+    "hinges drawn off and turned": ({"off1": 0.03, "off2": -0.02, "turn2": (0.4, -0.7, 1.1),
+                                     "angles": (np.radians(20.0), np.radians(-15.0))},
+                                    (("uA1", 20.0), ("uB1", -15.0), ("uA2", 20.0), ("uB2", -15.0))),
+    "a Hooke joint at 90 deg": ({"rod_aligned": True, "angles": (np.pi / 2, 0.0)}, (("uA1", 90.0), ("uA2", 90.0))),
+}
+
+
+@pytest.mark.parametrize("case", UNIVERSAL_ANKLES)
+def test_a_universal_loop_joint_turns_about_the_file_s_hinges_where_they_are_assembled(tmp_path, case):
+    """Rods closed on the foot through two hinges whose axes meet (a universal loop joint): at the file's pose and
+    another, each of the loop's two joint lines is the line of the file's hinge (Pinocchio, the loader's model
+    closed by scipy at the same motor values) -- the second hinge's first, then the first's -- also where the first
+    hinge is assembled far from 0 (the Hooke joint, whose second hinge is drawn along the rod at 0: read at 0 it
+    would double the ball's turn about the rod, and the ankle was refused as unable to move); and the indices are
+    the rod lines'."""
+    options, initial = UNIVERSAL_ANKLES[case]
+    path = universal_ankle(tmp_path / "ankle", **options)
+    mechanism = load(path, output="foot", initial=initial)
+    assert mechanism.dof == 2 and [chain.loop_type for chain in mechanism.chains].count("universal") == 2
+    model = gepetto_model(path, path.parent / "robot.yaml")
+    pairs = [(model.getFrameId(f"rodend{i}"), model.getFrameId(f"uend{i}")) for i in (1, 2)]
+    for turn in ((0.0, 0.0), (8.0, -5.0)):
+        pose = mechanism.home_pose + np.radians(turn)
+        result = indices_at_pose(mechanism, pose)
+        motors = {name.split(":")[-1]: value for name, value in result.joint_values.items()
+                  if name.split(":")[-1] in ("motor1", "motor2")}
+        data, _ = closed_by_scipy(model, pairs, motors)
+        solution = solve(mechanism, pose[None])
+        for k, chain in enumerate(mechanism.chains):
+            if chain.loop_type != "universal":
+                continue
+            rod = next(name for name in chain.joint_names if name.startswith("motor"))[-1]
+            axes = solution.joint_axes[k][0] @ mechanism.rotation_world_base.T
+            points = solution.joint_points[k][0] @ mechanism.rotation_world_base.T + mechanism.translation_world_base
+            for dof, hinge in ((-2, f"uB{rod}"), (-1, f"uA{rod}")):
+                point, axis = joint_line(model, data, hinge)
+                assert abs(abs(axes[dof] @ axis) - 1.0) < 1e-9, (case, turn, hinge)
+                assert np.linalg.norm(np.cross(points[dof] - point, axis)) < 1e-9, (case, turn, hinge)
+        rods = {f"motor{i}": (f"sph{i}", (f"uA{i}", f"uB{i}")) for i in (1, 2)}  # (the universal's centre)
+        itis, otis = two_rod_indices(model, data, rods, ("ankle_y", "ankle_x"))
+        np.testing.assert_allclose(np.ravel(result.iti_actuators), itis, atol=TOLERANCE)
+        np.testing.assert_allclose(np.ravel(result.oti_actuators), otis, atol=TOLERANCE)

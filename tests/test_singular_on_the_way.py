@@ -265,3 +265,50 @@ def test_the_sweep_command_says_so_and_writes_the_mark(tmp_path):
     plain = screwkit("sweep", "planar_5rrr", "--phi", "0:40:10", "--out", tmp_path / "p.csv")
     assert plain.returncode == 0 and "NOTE:" not in plain.stderr  # (no chain keeps a sign: nothing to mark)
     assert "past_singular" not in (tmp_path / "p.csv").read_text().splitlines()[0]
+
+
+def crank_rocker(crank: float, coupler: float, rocker: float) -> str:
+    """A four-bar as Genesis writes it with the crank, coupler and rocker lengths given (ground 1, the pivots on the
+    y axis): a Grashof crank-rocker for (1, 4, 3), whose chain is singular only where it is stretched out, at the edge
+    of its workspace."""
+    return f"""<mujoco>
+  <worldbody>
+    <body name="link_1">
+      <body name="link_2" pos="0.5 0 0">
+        <joint name="hinge_1" pos="0 0 0" axis="1 0 0"/>
+        <geom type="capsule" fromto="0 0 0 0 {crank} 0" size="0.05"/>
+        <body name="link_3" pos="-0.5 {crank} 0">
+          <joint name="hinge_2" pos="0 0 0" axis="1 0 0"/>
+          <geom type="capsule" fromto="0 0 0 0 0 {coupler}" size="0.05"/>
+          <body name="link_4" pos="0.5 0 {coupler}">
+            <joint name="hinge_3" pos="0 0 0" axis="1 0 0"/>
+            <geom type="capsule" fromto="0 0 0 0 {-rocker} 0" size="0.05"/>
+          </body>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <equality>
+    <connect name="kinematic_link1" body1="link_1" body2="link_4" anchor="0.5 {crank - rocker} {coupler}"/>
+  </equality>
+  <actuator>
+    <motor joint="hinge_1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("stop", [6.0, 6.25, 6.5, 7.0])
+def test_the_edge_of_the_workspace_is_not_taken_for_a_singular_configuration_on_the_way(tmp_path, stop):
+    """Swept past the edge of its workspace, where the chain is stretched out (singular) and closes no more beyond:
+    no pose is marked, whichever way the samples fall (a dip beside samples that never close again is the edge,
+    not a configuration the way passes); the poses beyond are out of reach."""
+    path = tmp_path / "crank_rocker.xml"
+    path.write_text(crank_rocker(1.0, 4.0, 3.0))
+    mechanism = load(path, output="link_4")
+    assert mechanism.task_coordinates == ("y",)
+    values = np.arange(4.0, stop, 0.25)
+    dataset = sweep(mechanism, mechanism.home_pose, "y", values)
+    assert not dataset["past_singular"].values.any()
+    assert not dataset["reachable"].values[values >= 5.0].any() and dataset["reachable"].values[values < 4.9].all()
+    assert all(singular_on_the_way(mechanism, np.array([y])) == [] for y in (5.0, stop))

@@ -150,17 +150,23 @@ def _one_line(offsets: NDArray) -> NDArray | None:
 def _dips(determinants: NDArray) -> list[int]:
     """The samples (in order) where a normalised determinant along a way or path dips below :data:`_DIP`: inside,
     no higher than either neighbour; at an end, lower than its neighbour. A neighbour where the chain does not close
-    (damped Newton may fail right beside a singular configuration) is left out of the comparison: the refinement
-    looks between them."""
+    is left out of the comparison when the chain closes again beyond it (damped Newton may fail right beside a
+    singular configuration it passes: the refinement looks between them); where it never closes again on that side
+    (the edge of the workspace, where a chain stretched out is singular too), the sample is no dip."""
     finite = np.isfinite(determinants)
     last = len(determinants) - 1
+    closes_before = np.cumsum(finite) - finite > 0  # some sample before closes
+    closes_after = np.cumsum(finite[::-1])[::-1] - finite > 0  # some sample after closes
     dips = []
     for i in np.flatnonzero(finite & (np.where(finite, determinants, np.inf) < _DIP)):
-        neighbours = [j for j in (i - 1, i + 1) if 0 <= j <= last and finite[j]]
+        neighbours = [j for j in (i - 1, i + 1) if 0 <= j <= last]
+        if any(not finite[j] and not (closes_before[j] if j < i else closes_after[j]) for j in neighbours):
+            continue
+        closing = [j for j in neighbours if finite[j]]
         if i in (0, last) and last > 0:
-            keep = all(determinants[i] < determinants[j] for j in neighbours)
+            keep = all(determinants[i] < determinants[j] for j in closing)
         else:
-            keep = all(determinants[i] <= determinants[j] for j in neighbours)
+            keep = all(determinants[i] <= determinants[j] for j in closing)
         if keep:
             dips.append(int(i))
     return dips

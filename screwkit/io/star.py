@@ -160,9 +160,9 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         second = homogeneous(model.jointPlacements[after[1]])
         predecessor = at_point(predecessor @ inverse(second), centre, homogeneous(data.oMi[closure.joint_a]))
         axes = (second[:3, :3] @ kinds[1][1], kinds[0][1])  # in the loop frames, which both hinges at 0 make one
+        world = (np.asarray(data.oMi[after[1]].rotation) @ kinds[1][1], zero[:3, :3] @ kinds[0][1])  # as assembled
         return _Leg(a_path, "universal", predecessor, at_point(zero, centre), axes[0],
-                    [("revolute", zero[:3, :3] @ axis, centre) for axis in axes], closure.name, sources=(closure,),
-                    axis2=axes[1])
+                    [("revolute", axis, centre) for axis in world], closure.name, sources=(closure,), axis2=axes[1])
     raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "

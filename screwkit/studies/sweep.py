@@ -112,7 +112,9 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
     passed = [] if graph else singular_on_the_ways(mechanism, poses)
     if passed:
         dataset.coords["singular_chain"] = ("singular_chain", [name for name, _, _ in passed])
-        dataset["past_singular"] = ((coordinate, "singular_chain"), np.stack([mask for _, mask, _ in passed], axis=1),
+        reachable = np.asarray(result.reachable, dtype=bool)[:, None]  # (a pose out of reach is on no assembly)
+        dataset["past_singular"] = ((coordinate, "singular_chain"),
+                                    np.stack([mask for _, mask, _ in passed], axis=1) & reachable,
                                     {"long_name": "the way from the reference pose passes a configuration where the "
                                                   "chain's joints are singular"})
     dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
