@@ -419,7 +419,7 @@ def test_unnamed_closures_several_world_bodies_and_degrees_open_as_mujoco_reads_
     written = tmp_path / "written.xml"
     written.write_text(text)
     _, report = read_mechanism_file(written)
-    assert any("2 unnamed closure(s) named" in note for note in report.notes), report.notes
+    assert "2 unnamed closure(s) named in file order: connect_1, connect_2" in report.notes, report.notes
     assert any("2 bodies under <worldbody>" in note for note in report.notes)
     assert any("angles in degrees" in note for note in report.notes)
     first, second = load(plain), load(written)

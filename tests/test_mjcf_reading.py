@@ -505,3 +505,17 @@ def test_a_five_bar_written_with_every_link_on_one_line_is_refused_as_a_singular
                      r"closed configurations near them: the file is written at a singular configuration", message), \
         message
     assert "--lock" not in message
+
+
+def test_a_tree_with_no_closure_is_refused_as_such_before_any_actuator_is_looked_for(tmp_path):
+    """A serial arm with no <equality> and no <actuator> (as Drake's four_bar.sdf is, its loop a force element added
+    in code): the refusal says there is no closure, not that there is nothing to actuate (which --actuate answered
+    only with the same "no closure" next)."""
+    path = tmp_path / "arm.xml"
+    path.write_text('<mujoco><worldbody><body name="upper"><joint name="shoulder" type="hinge" axis="0 0 1"/>'
+                    '<geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/><body name="lower" pos="0.3 0 0">'
+                    '<joint name="elbow" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.3 0 0" '
+                    'size="0.02"/></body></body></worldbody></mujoco>')
+    for options in ((), ("--actuate", "shoulder")):
+        line = one_line_error(screwkit("info", path, *options), "arm.xml: no closure: nothing closes the tree")
+        assert "actuate" not in line

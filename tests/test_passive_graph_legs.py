@@ -29,10 +29,10 @@ import pinocchio as pin
 import pytest
 from rod_ankle import FOOT, rod_ankle_mjcf
 
-from helpers import one_line_error, screwkit
+from helpers import assert_indices_close, one_line_error, screwkit
 from screwkit.io import graph_mechanism, read_closed_tree
 from screwkit.io.loader import load
-from screwkit.studies import indices_at_poses
+from screwkit.studies import indices_at_pose, indices_at_poses
 from screwkit.studies.poses import graph_indices_at_poses
 
 TOLERANCE = 1e-9
@@ -253,3 +253,23 @@ def test_with_a_redundant_crank_the_fault_indices_of_both_readings_agree(tmp_pat
     np.testing.assert_allclose(ours.f_io[1], theirs.f_io[1], atol=TOLERANCE)
     assert np.all(ours.f_o[1] > 0.05)  # a fault is survivable here: the comparison is not of zeros
     np.testing.assert_array_equal(ours.worst_fault_indices[1], theirs.worst_fault_indices[1])
+
+
+def test_a_closure_beyond_the_platform_on_a_ball_is_refused_naming_the_lock_that_holds_it(tmp_path):
+    """Two platforms joined by a ball (a published nine-motor robot has one on each side of a central sphere): the
+    second rod closed onto a toe that turns on a ball in the foot. The refusal names ``--lock`` on that ball; held
+    where the file draws it, the toe moves with the foot, and the ankle's indices are those of the rod closed on the
+    foot itself at the same point."""
+    plain = tmp_path / "plain.xml"
+    plain.write_text(rod_ankle_mjcf("hinges"))
+    toed = tmp_path / "toe.xml"
+    toed.write_text(rod_ankle_mjcf("hinges").replace(
+        '<site name="sole"', '<body name="toe"><joint name="toe_ball" type="ball"/><geom type="sphere" size="0.01"/>'
+        '</body><site name="sole"').replace('body1="foot" body2="rod_2"', 'body1="toe" body2="rod_2"'))
+    refused = screwkit("info", toed, "--output", "foot")
+    one_line_error(refused, "closure 'closure_2' (3d) ends on joints toe_ball beyond the platform",
+                   "--lock toe_ball holds it where the file puts it, the bodies beyond moving with the platform")
+    held = load(toed, output="foot", lock=("toe_ball",))
+    expected = load(plain, output="foot")
+    for pose in (expected.home_pose, expected.home_pose + np.radians([4.0, -3.0])):
+        assert_indices_close(indices_at_pose(expected, pose), indices_at_pose(held, pose), atol=1e-12)

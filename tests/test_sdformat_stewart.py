@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from sdformat_models import ups_sdf
 
-from screwkit.io import read_closed_tree
+from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -79,3 +79,28 @@ def test_sdformat_1_4_axes_are_read_in_the_model_frame(tmp_path):
         np.testing.assert_allclose(axes[1][name], axis, atol=1e-12, err_msg=name)
     pitch = np.array([axes[0][f"leg_{k}_pitch"] for k in range(1, 9)])  # written "0 1 0" in each leg's frame
     assert np.all(np.linalg.norm(pitch - [0.0, 1.0, 0.0], axis=1) > 0.1)  # so the two frames differ for each
+
+
+def test_a_joint_named_as_a_link_is_renamed_before_sdformat_1_7_and_refused_from_it(tmp_path):
+    """SDFormat before 1.7 let a joint share a link's name (Gazebo's own demo_joint_types does), and libsdformat
+    renames such a joint ``<name>_joint`` with a warning; 1.7 puts links, joints and frames in one namespace. Each leg's
+    pitch joint named as the link it carries: as 1.6, the file opens, the report says which joints were renamed, and
+    the indices are those of the file as written apart; as 1.9, it is refused naming the clash."""
+    plain = load(write(tmp_path, ups_sdf("1.6"), "plain.sdf"))
+    text = ups_sdf("1.6")
+    legs = sorted({name.split('"')[1][:-len("_pitch")] for name in text.split("<joint name=")[1:]
+                   if name.split('"')[1].endswith("_pitch")})
+    for leg in legs:
+        text = text.replace(f'<joint name="{leg}_pitch"', f'<joint name="{leg}_top"')
+    clashing = write(tmp_path, text, "clashing.sdf")
+    renamed = load(clashing)
+    notes = read_closed_tree(clashing).notes
+    assert f"joint '{legs[0]}_top' named '{legs[0]}_top_joint': a link of this SDFormat 1.6 file has its name" in \
+        " ".join(notes)
+    assert sum("named" in note and "_top_joint" in note for note in notes) == len(legs) == 8
+    np.testing.assert_allclose(indices_at_pose(renamed, renamed.home_pose).lmti,
+                               indices_at_pose(plain, plain.home_pose).lmti, atol=1e-12)
+    newer = write(tmp_path, text.replace('<sdf version="1.6"', '<sdf version="1.9"'), "newer.sdf")
+    with pytest.raises(ImportError_, match=r"the name '.*_top' is already <link name='.*_top'> \(links, joints and "
+                                           r"frames share one namespace\)"):
+        read_closed_tree(newer)

@@ -96,6 +96,8 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
     if unit:
         tree = replace(tree, unit=unit)
+    if not tree.closures:  # before its actuators are looked for: a tree has none to guess
+        raise ImportError_(f"{tree.source}: no closure: nothing closes the tree into a parallel mechanism.")
     if tree.unactuated and not actuate:
         raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints (those that can be driven, "
                            f"revolute or prismatic: {drivable_joints(tree)}).")

@@ -395,16 +395,17 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
         if len(bodies) > 1:
             notes.append(f"{len(bodies)} bodies under <worldbody> ({', '.join(b.get('name', '?') for b in bodies)}) "
                          "held in one, 'screwkit_world', at the origin")
-    unnamed, taken = 0, {element.get("name") for element in ([] if equality is None else equality)}
+    named, taken = [], {element.get("name") for element in ([] if equality is None else equality)}
     for element in ([] if equality is None else list(equality)):
         if element.tag in ("connect", "weld") and not element.get("name"):
-            unnamed += 1
-            name = f"{element.tag}_{unnamed}"
+            name = f"{element.tag}_{len(named) + 1}"
             while name in taken:  # a closure of the file has that name
                 name = f"{name}_"
             element.set("name", name)
-    if unnamed:
-        notes.append(f"{unnamed} unnamed closure(s) named in file order (connect_1, weld_1, ...)")
+            named.append(name)
+    if named:
+        notes.append(f"{len(named)} unnamed closure(s) named in file order: {', '.join(named[:4])}"
+                     + (", ..." if len(named) > 4 else ""))
     _merged(root, "actuator")
     top_class_renamed(root)
     text = ElementTree.tostring(root, encoding="unicode")

@@ -343,8 +343,8 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
         tree_joints, loops, base, tied = _spanning_tree(sdf, ends, last=platform)
     builder = _TreeBuilder(sdf, poses)
     held = [repr(joint.name) for joint in sdf.joints if joint.held]
-    notes = [f"joint(s) {', '.join(held)}: limits lower = upper = 0, they cannot move (Gazebo holds them where the "
-             "file draws them): read as fixed joints"] if held else []
+    notes = list(sdf.renamed) + ([f"joint(s) {', '.join(held)}: limits lower = upper = 0, they cannot move (Gazebo "
+                                  "holds them where the file draws them): read as fixed joints"] if held else [])
     if base != WORLD:
         builder.ground(base)
         notes.append(f"{GROUNDED} {base!r} is the fixed base (Gazebo would let the model float)")

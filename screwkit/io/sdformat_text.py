@@ -208,6 +208,8 @@ class SdfModel:
     ball_constraints: list[tuple[str, NDArray[np.float64], str, NDArray[np.float64], str]] = field(
         default_factory=list)
     """Drake's ``<drake:ball_constraint>`` elements: (link A, P in A, link B, Q in B, where), P and Q coinciding."""
+    renamed: list[str] = field(default_factory=list)
+    """What reading renamed (an SDFormat 1.6 joint named as a link), for the import report."""
 
 
 def _the_model(path: Path, root) -> object:
@@ -267,6 +269,8 @@ def read_model(path: Path) -> SdfModel:
         where = f"{path}: <link name='{link.get('name')}'>"
         pose, relative = parse_pose(link.find("pose"), where)
         _declare(model, link.get("name", ""), relative or MODEL_FRAME, pose, where)
+    if version < (1, 7):  # before 1.7 a joint could share a link's name: libsdformat renames the joint, and warns
+        _rename_joints_named_as_links(model, element, version)
     for joint in element.findall("joint"):
         parsed = parse_joint(joint, f"{path}: <joint name='{joint.get('name')}'>", version)
         model.joints.append(parsed)
@@ -291,6 +295,23 @@ def _ball_constraint(node, where: str) -> tuple[str, NDArray, str, NDArray, str]
             raise ImportError_(f"{where}: no <drake:{tag}>.")
         read.append(written[tag] if "body" in tag else numbers(written[tag], 3, "", where, f"drake:{tag}"))
     return (*read, where)
+
+
+def _rename_joints_named_as_links(model: SdfModel, element, version: tuple[int, ...]) -> None:
+    """A joint of a file before SDFormat 1.7 named as a link gets the name ``<name>_joint`` (``<name>_joint<k>``
+    while that is taken), as libsdformat gives it; said in ``model.renamed``."""
+    taken = {child.get("name", "") for tag in ("link", "joint", "frame") for child in element.findall(tag)}
+    for joint in element.findall("joint"):
+        name = joint.get("name", "")
+        if name not in model.links:
+            continue
+        new, count = f"{name}_joint", 0
+        while new in taken:
+            new, count = f"{name}_joint{count}", count + 1
+        joint.set("name", new)
+        taken.add(new)
+        model.renamed.append(f"joint {name!r} named {new!r}: a link of this SDFormat {'.'.join(map(str, version))} "
+                             "file has its name, and libsdformat renames the joint so (1.7 refuses the file)")
 
 
 def _check_names(element, label: str) -> None:

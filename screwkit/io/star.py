@@ -135,7 +135,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         if after:
             raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
                                f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
-                               "screwkit supports.")
+                               f"screwkit supports{_held_beyond(tree, after)}.")
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
         return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
@@ -166,7 +166,17 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
                        f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                        "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
-                       "(a universal joint), or three revolute joints through one point (a spherical joint).")
+                       "(a universal joint), or three revolute joints through one point (a spherical joint)"
+                       f"{_held_beyond(tree, after)}.")
+
+
+def _held_beyond(tree: ClosedTree, after: list[int]) -> str:
+    """The options that hold the joints between the platform body and a closure (the bodies beyond then move with
+    the platform as one body: two platforms joined by a ball, analysed as one)."""
+    names = list(dict.fromkeys(tree.written_joint(tree.model.names[j]) for j in after))
+    them = "it" if len(names) == 1 else "them"
+    return (f"; --lock {' --lock '.join(names)} holds {them} where the file puts {them}, the bodies beyond moving with "
+            "the platform as one body")
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
