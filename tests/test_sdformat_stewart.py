@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from sdformat_models import ups_sdf
 
+from helpers import screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -100,6 +101,8 @@ def test_a_joint_named_as_a_link_is_renamed_before_sdformat_1_7_and_refused_from
     assert sum("named" in note and "_top_joint" in note for note in notes) == len(legs) == 8
     np.testing.assert_allclose(indices_at_pose(renamed, renamed.home_pose).lmti,
                                indices_at_pose(plain, plain.home_pose).lmti, atol=1e-12)
+    info = screwkit("info", clashing)
+    assert info.returncode == 0 and f"joint '{legs[0]}_top' named '{legs[0]}_top_joint'" in info.stdout, info.stderr
     newer = write(tmp_path, text.replace('<sdf version="1.6"', '<sdf version="1.9"'), "newer.sdf")
     with pytest.raises(ImportError_, match=r"the name '.*_top' is already <link name='.*_top'> \(links, joints and "
                                            r"frames share one namespace\)"):
