@@ -312,3 +312,22 @@ def test_the_edge_of_the_workspace_is_not_taken_for_a_singular_configuration_on_
     assert not dataset["past_singular"].values.any()
     assert not dataset["reachable"].values[values >= 5.0].any() and dataset["reachable"].values[values < 4.9].all()
     assert all(singular_on_the_way(mechanism, np.array([y])) == [] for y in (5.0, stop))
+
+
+def test_the_sweep_figure_hatches_the_poses_past_the_change_point(tmp_path):
+    """Drawn, the poses past 90 deg (where F_O1 reads 0 on the folded assembly) are hatched in every panel, the
+    legend naming the chain; the poses before are not."""
+    from screwkit.plots import sweep_figure
+
+    path = tmp_path / "square.xml"
+    path.write_text(square_four_bar())
+    mechanism = load(path, output="link_4")
+    dataset = sweep(mechanism, mechanism.home_pose, "phi", np.radians(np.arange(0.0, 200.0, 10.0)))
+    figure = sweep_figure(dataset)
+    for ax in figure.axes:
+        hatched = [patch for patch in ax.patches if patch.get_hatch() == "//"]
+        assert len(hatched) == 1, ax.get_title("left")
+        left, right = hatched[0].get_x(), hatched[0].get_x() + hatched[0].get_width()
+        assert (left, right) == pytest.approx((95.0, 195.0))  # the poses 100 ... 190 deg, half a step either side
+        labels = [text.get_text() for text in ax.get_legend().get_texts()]
+        assert any(label.startswith("past a singular configuration of chain hinge_1") for label in labels)

@@ -30,6 +30,7 @@ THIN = {"linewidth": 1.0, "alpha": 0.9, "zorder": 2}
 MANY = {"color": "0.55", "linewidth": 0.6, "alpha": 0.6, "zorder": 1}
 F_IO_STYLE = {"color": "#D55E00", "linewidth": 1.4, "linestyle": (0, (4, 2)), "zorder": 5}  # Okabe-Ito vermilion
 UNREACHABLE_COLOR = "0.82"
+PAST_SINGULAR_COLOR = "#CC79A7"  # Okabe-Ito reddish purple: the hatching of poses past a singular configuration
 LINESTYLES = ("-", "--", "-.", ":")
 TITLE_SIZE = 9
 LEGEND_SIZE = 7

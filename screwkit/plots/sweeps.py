@@ -16,6 +16,7 @@ from screwkit.plots.style import (
     LINESTYLES,
     MANY,
     MAX_LABELLED_CURVES,
+    PAST_SINGULAR_COLOR,
     THIN,
     TITLE_SIZE,
     UNREACHABLE_COLOR,
@@ -94,18 +95,33 @@ def _bold(ax, x, values, label: str, **style):
     return line
 
 
-def _shade_unreachable(ax, x, reachable) -> list:
-    """Grey bands where the pose is unreachable (indices are NaN there); their legend entry, if any."""
-    reachable = np.asarray(reachable, dtype=bool)
-    if reachable.all() or x.size == 0:
+def _bands(ax, x, mask, label: str, **style) -> list:
+    """Bands over the runs of poses where ``mask`` holds; their legend entry, if any."""
+    mask = np.asarray(mask, dtype=bool)
+    if not mask.any() or x.size == 0:
         return []
     half = np.diff(x).min() / 2 if x.size > 1 else 0.5
-    padded = np.concatenate([[False], ~reachable, [False]]).astype(int)
+    padded = np.concatenate([[False], mask, [False]]).astype(int)
     starts, stops = np.flatnonzero(np.diff(padded) == 1), np.flatnonzero(np.diff(padded) == -1) - 1
-    spans = [ax.axvspan(x[start] - half, x[stop] + half, color=UNREACHABLE_COLOR, zorder=0)
-             for start, stop in zip(starts, stops)]
-    spans[0].set_label("unreachable pose")
+    spans = [ax.axvspan(x[start] - half, x[stop] + half, zorder=0, **style) for start, stop in zip(starts, stops)]
+    spans[0].set_label(label)
     return spans[:1]
+
+
+def _shade_unreachable(ax, x, reachable) -> list:
+    """Grey bands where the pose is unreachable (indices are NaN there); their legend entry, if any."""
+    return _bands(ax, x, ~np.asarray(reachable, dtype=bool), "unreachable pose", color=UNREACHABLE_COLOR)
+
+
+def _hatch_past_singular(ax, x, dataset) -> list:
+    """Hatched bands over the poses whose way from the reference pose passes a configuration where a chain's joints
+    are singular (``past_singular``: the assembly there keeps the reference's sign); their legend entry, if any."""
+    if "past_singular" not in dataset.data_vars:
+        return []
+    past = dataset["past_singular"].values
+    chains = [str(name) for name, any_past in zip(dataset["singular_chain"].values, past.any(axis=0)) if any_past]
+    return _bands(ax, x, past.any(axis=1), f"past a singular configuration of chain {', '.join(chains)} (the "
+                  "reference's sign kept)", facecolor="none", edgecolor=PAST_SINGULAR_COLOR, hatch="//", linewidth=0.0)
 
 
 def _short_names(names: list[str]) -> list[str]:
@@ -138,7 +154,8 @@ def sweep_figure(dataset):
     variables and gets the first two panels only. Panels with more than
     :data:`MAX_LABELLED_CURVES` thin curves (e.g. the 28 submechanisms of an 8-actuator
     hexapod) draw them in grey with one legend entry giving their number: a legend with more
-    entries cannot be matched to the curves by colour. Unreachable poses are shaded grey.
+    entries cannot be matched to the curves by colour. Unreachable poses are shaded grey, and poses past a
+    singular configuration of a chain on the way from the reference pose (``past_singular``) hatched.
     The x axis is labelled with the swept coordinate and its unit; the suptitle names the
     mechanism, the other (fixed) coordinates as the dataset records them, and the method.
 
@@ -243,6 +260,7 @@ def sweep_figure(dataset):
                      f"fault{'s' if j > 1 else ''} (thin); {index_label(f'f_io{j}')} dashed")
         if reachable is not None:
             bold += _shade_unreachable(ax, x, reachable)
+        bold += _hatch_past_singular(ax, x, dataset)
         ax.set_title(wrap_text(title, width - 1.2, TITLE_SIZE), loc="left", fontsize=TITLE_SIZE)
         ax.set_ylim(INDEX_RANGE[0] - 0.03, INDEX_RANGE[1] + 0.05)
         ax.grid(alpha=0.3)
