@@ -372,12 +372,12 @@ COUPLINGS = {
 @pytest.mark.parametrize("kind", sorted(COUPLINGS))
 def test_an_active_coupling_is_refused_naming_the_element(tmp_path, kind):
     """MuJoCo reads a coupling (it changes the mechanism's mobility); screwkit does not model one: refused, not
-    left out without a word."""
+    left out without a word (a joint coupling once the joints analysed are known: here both are)."""
     element, tendons, message = COUPLINGS[kind]
     text = five_bar_mjcf().replace("</equality>", element + "</equality>" + tendons)
     assert mujoco.MjModel.from_xml_string(text).neq == 3
     with pytest.raises(ImportError_, match=re.escape(f"robot.xml: {message}") + ".*screwkit does not model it"):
-        read_mjcf(written(tmp_path, text))
+        read_mechanism_file(written(tmp_path, text))
 
 
 def test_the_command_refuses_a_joint_coupling_in_one_line(tmp_path):
@@ -519,3 +519,55 @@ def test_a_tree_with_no_closure_is_refused_as_such_before_any_actuator_is_looked
     for options in ((), ("--actuate", "shoulder")):
         line = one_line_error(screwkit("info", path, *options), "arm.xml: no closure: nothing closes the tree")
         assert "actuate" not in line
+
+
+def two_fingers(coupling: str) -> str:
+    """Two four-bar fingers side by side (a gripper; each finger a crank-rocker of Genesis's writing, its crank
+    driven), with ``coupling`` written into ``<equality>`` after their closures."""
+    from test_singular_on_the_way import crank_rocker
+
+    finger = crank_rocker(1.0, 4.0, 3.0)
+    parts = {}
+    for side, shift in (("left", "0 0 0"), ("right", "2 0 0")):
+        text = finger.replace('name="link_', f'name="{side}_link_').replace('body1="link_', f'body1="{side}_link_')
+        text = text.replace('body2="link_', f'body2="{side}_link_').replace('"hinge_', f'"{side}_hinge_')
+        text = text.replace('name="kinematic_link1"', f'name="{side}_loop"')
+        text = text.replace(f'<body name="{side}_link_1">', f'<body name="{side}_link_1" pos="{shift}">')
+        parts[side] = text
+    body = {side: text[text.index("<worldbody>") + 11:text.index("</worldbody>")] for side, text in parts.items()}
+    closure = {side: text[text.index("<equality>") + 10:text.index("</equality>")] for side, text in parts.items()}
+    return (f'<mujoco><worldbody>{body["left"]}{body["right"]}</worldbody><equality>{closure["left"]}'
+            f'{closure["right"]}{coupling}</equality><actuator><motor joint="left_hinge_1"/>'
+            '<motor joint="right_hinge_1"/></actuator></mujoco>')
+
+
+def test_a_coupling_to_a_finger_not_analysed_is_left_out_and_one_inside_is_refused(tmp_path):
+    """A gripper's fingers coupled by ``<equality><joint>`` (as MuJoCo Menagerie's hands are): with one finger
+    analysed, the other follows its coupled joint and constrains nothing, so the file opens as written, saying so,
+    with the indices of the finger alone; a coupling of two joints of the finger analysed, of one to a value, or to
+    a joint held by --lock changes its mobility and is refused naming the element and the joint."""
+    from test_singular_on_the_way import crank_rocker
+
+    alone = tmp_path / "finger.xml"
+    alone.write_text(crank_rocker(1.0, 4.0, 3.0))
+    expected = load(alone, output="link_4")
+    coupled = tmp_path / "gripper.xml"
+    coupled.write_text(two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1"/>'))
+    mechanism = load(coupled, output="left_link_4")
+    for turn in (0.0, np.radians(20.0)):
+        got, want = (indices_at_pose(m, m.home_pose + turn) for m in (mechanism, expected))
+        np.testing.assert_allclose([got.iti, got.lmti], [want.iti, want.lmti], atol=1e-12)
+    info = screwkit("info", coupled, "--output", "left_link_4")
+    assert info.returncode == 0, info.stderr
+    assert ("<equality><joint joint1='left_hinge_1' joint2='right_hinge_1'>: ties joint 'left_hinge_1' to "
+            "'right_hinge_1', of a branch that reaches no leg, which follows it: left out") in info.stdout
+    for coupling, options, needle in (
+            ('<joint joint1="left_hinge_1" joint2="left_hinge_2"/>', (), "ties joint 'left_hinge_1' of the mechanism "
+             "analysed to joint 'left_hinge_2'"),
+            ('<joint joint1="left_hinge_2"/>', (), "ties joint 'left_hinge_2' of the mechanism analysed to a value"),
+            ('<joint joint1="left_hinge_1" joint2="right_hinge_1"/>', ("--lock", "right_hinge_1"),
+             "to joint 'right_hinge_1', held (--lock)")):
+        path = tmp_path / "inside.xml"
+        path.write_text(two_fingers(coupling))
+        one_line_error(screwkit("info", path, "--output", "left_link_4", *options), "<equality><joint joint1=",
+                       needle, "remove the element (or set active='false')")

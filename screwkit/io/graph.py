@@ -57,6 +57,7 @@ from screwkit.io.closed_tree import (
     ImportError_,
     ImportReport,
     assemble,
+    check_couplings,
     closure_gaps,
     homogeneous,
     joint_kind,
@@ -488,6 +489,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
+    check_couplings(tree, {joint for leg in legs for joint in leg.joints}, report.notes)
     check_actuators(tree, legs)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)

@@ -33,7 +33,7 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
 
     source = str(path)
     try:
-        text, notes, root = prepared_mjcf(Path(path))
+        text, notes, root, couplings = prepared_mjcf(Path(path))
     except MjcfError as error:
         raise ImportError_(str(error)) from None
     motors, unactuated = [], ""
@@ -106,7 +106,7 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
                                     "3d" if element.tag == "connect" else "6d"))
     q = references.get("home", qpos0)
     return ClosedTree(source, model, closures, motors, np.asarray(q, dtype=float), output, output_type, "MJCF",
-                      notes, unactuated=unactuated)
+                      notes, unactuated=unactuated, couplings=tuple(couplings))
 
 
 def sites_placed(model, root) -> None:

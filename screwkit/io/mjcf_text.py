@@ -231,11 +231,15 @@ def _check_keys(root: ElementTree.Element, path: Path) -> None:
                                     "finite number.")
 
 
-def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element | None, path: Path) -> list[str]:
+def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element | None,
+                      path: Path) -> tuple[list[str], list[tuple[str, str | None, str]]]:
     """The equalities, as MuJoCo reads them: ``active`` from the element or its class; an active coupling of
-    joints is refused (screwkit does not model it), an inactive one left out. Returns what was left out."""
+    tendons or flexes is refused (screwkit does not model it), an inactive one left out. Returns what was left out,
+    and the active couplings of two joints (or one held), taken out of the text too: ``(joint1, joint2 or None,
+    where)``, which refuse the mechanism only if it has the joints (a gripper's two fingers, one analysed:
+    :func:`~screwkit.io.closed_tree.check_couplings`)."""
     classes = class_attributes(root, "equality")
-    ignored = []
+    ignored, couplings = [], []
     for element in ([] if equality is None else list(equality)):
         named = " ".join(f"{key}='{element.get(key)}'" for key in ("name", *IDENTIFYING) if element.get(key))
         where = f"{path}: <equality><{element.tag}{' ' + named if named else ''}>"
@@ -250,6 +254,10 @@ def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element |
         if active not in ("true", "false"):
             raise MjcfError(f"{where}: active='{active}': expected true or false.")
         element.set("active", active)
+        if element.tag == "joint" and active == "true" and element.get("joint1"):
+            couplings.append((element.get("joint1"), element.get("joint2"), where))
+            equality.remove(element)
+            continue
         if element.tag in COUPLINGS and active == "true":
             raise MjcfError(f"{where}: {COUPLINGS[element.tag]} changes the mechanism's mobility and screwkit "
                             "does not model it; remove the element (or set active='false') to analyse the joints "
@@ -257,7 +265,7 @@ def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element |
         if element.tag in COUPLINGS:
             ignored.append(f"<{element.tag}{' ' + repr(element.get('name')) if element.get('name') else ''}>")
             equality.remove(element)
-    return ignored
+    return ignored, couplings
 
 
 def _check_names(root: ElementTree.Element, path: Path) -> None:
@@ -320,8 +328,9 @@ def _check_joints(root: ElementTree.Element, path: Path, autolimits: bool) -> li
     return dropped
 
 
-def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
-    """The text of an MJCF file as Pinocchio should read it, what was changed, and its element tree."""
+def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list]:
+    """The text of an MJCF file as Pinocchio should read it, what was changed, its element tree, and its active
+    joint couplings (taken out of the text: :func:`_check_equalities`)."""
     path = Path(path)
     root = _parse(path)
     if root.tag != "mujoco":
@@ -347,7 +356,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
                         "longer read by MuJoCo (since 2.3.3; it refuses the file): write it in local coordinates.")
     defaults_merged(root, path)
     equality = _merged(root, "equality")
-    ignored = _check_equalities(root, equality, path)  # before the tendons go: <equality><tendon> is one
+    ignored, couplings = _check_equalities(root, equality, path)  # before the tendons go: <equality><tendon> is one
     if ignored:
         notes.append(f"inactive equality coupling(s) left out, as MuJoCo leaves them out: {', '.join(ignored)}")
     for parent in list(root.iter()):
@@ -409,7 +418,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element]:
     _merged(root, "actuator")
     top_class_renamed(root)
     text = ElementTree.tostring(root, encoding="unicode")
-    return text, notes, root
+    return text, notes, root, couplings
 
 
 # -- MuJoCo's closure geometry -------------------------------------------------------------------------

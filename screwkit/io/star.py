@@ -61,6 +61,7 @@ from screwkit.io.closed_tree import (
     at_point,
     ball_line,
     ball_of_revolutes,
+    check_couplings,
     closure_gaps,
     homogeneous,
     inverse,
@@ -356,6 +357,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     if idle_motors:
         report.notes.append(f"actuated joints {', '.join(idle_motors)} on branches that reach no leg: left out (they "
                             "do not move the platform)")
+    check_couplings(tree, set(owner).union(*(path_to(model, c.joint_a) + path_to(model, c.joint_b)
+                                             for c in couplings if c.name in joined)), report.notes)
     normal = _planar_normal(tree, data, legs)
     if normal is not None:
         _planar_loops(legs, normal)
