@@ -371,3 +371,36 @@ def test_a_universal_loop_joint_turns_about_the_file_s_hinges_where_they_are_ass
         itis, otis = two_rod_indices(model, data, rods, ("ankle_y", "ankle_x"))
         np.testing.assert_allclose(np.ravel(result.iti_actuators), itis, atol=TOLERANCE)
         np.testing.assert_allclose(np.ravel(result.oti_actuators), otis, atol=TOLERANCE)
+
+
+def with_mimic(text: str, joint: str, mimicked: str) -> str:
+    start = text.index(f'<joint name="{joint}"')
+    end = text.index("</joint>", start)
+    return text[:end] + f'<mimic joint="{mimicked}" multiplier="1" offset="0"/>' + text[end:]
+
+
+def test_a_urdf_mimic_is_read_as_a_coupling_not_passed_over(tmp_path):
+    """Pinocchio's URDF reader takes a <mimic> joint as independent: read so, the mechanism would silently have a
+    mobility the file does not give it. A mimic between joints of battobot's other leg (left out), or tying an
+    analysed ankle motor to the other leg's, constrains nothing analysed: said, and the indices are the file's; one
+    tying two joints of the ankle is refused naming the element."""
+    text = (BATTOBOT / "robot.urdf").read_text()
+    expected, _, _ = analysed(BATTOBOT / "robot.urdf")
+    for joint, mimicked, said in (("knee_right", "motor_knee_right", "couples joints of branches that reach no leg"),
+                                  ("motor_ankle1_left", "motor_ankle1_right", "ties joint 'motor_ankle1_left' to "
+                                   "'motor_ankle1_right', of a branch that reaches no leg, which follows it")):
+        folder = tmp_path / joint
+        folder.mkdir()
+        (folder / "robot.urdf").write_text(with_mimic(text, joint, mimicked))
+        shutil.copy(BATTOBOT / "robot.yaml", folder / "robot.yaml")
+        got, _, _ = analysed(folder / "robot.urdf")
+        np.testing.assert_allclose(got.iti_actuators, expected.iti_actuators, atol=1e-12)
+        np.testing.assert_allclose(got.lmti, expected.lmti, atol=1e-12)
+        _, report = read_mechanism_file(folder / "robot.urdf", output="foot_right", lock=LOCKS)
+        assert any(f"<joint name='{joint}'><mimic joint='{mimicked}'>: {said}" in note for note in report.notes)
+    (tmp_path / "robot.urdf").write_text(with_mimic(text, "anklex_left", "ankley_left"))
+    shutil.copy(BATTOBOT / "robot.yaml", tmp_path / "robot.yaml")
+    held = [part for name in LOCKS for part in ("--lock", name)]
+    one_line_error(screwkit("info", tmp_path / "robot.urdf", "--output", "foot_right", *held),
+                   "<joint name='anklex_left'><mimic joint='ankley_left'>: a joint coupling ties joint 'anklex_left' "
+                   "of the mechanism analysed to joint 'ankley_left'", "remove the element to analyse")

@@ -107,3 +107,17 @@ def test_a_joint_named_as_a_link_is_renamed_before_sdformat_1_7_and_refused_from
     with pytest.raises(ImportError_, match=r"the name '.*_top' is already <link name='.*_top'> \(links, joints and "
                                            r"frames share one namespace\)"):
         read_closed_tree(newer)
+
+
+def test_an_axis_mimic_is_read_as_a_coupling_and_refused_between_legs(tmp_path):
+    """SDFormat 1.11's <axis><mimic> couples a joint to another; read as independent joints the mechanism would
+    have a mobility the file does not give it: one slide mimicking another leg's is refused naming the element."""
+    text = ups_sdf()
+    sliders = [part.split('"')[1] for part in text.split("<joint name=")[1:] if part.split('"')[1].endswith("_slider")]
+    start = text.index(f'<joint name="{sliders[0]}"')
+    end = text.index("</axis>", start)
+    text = text[:end] + f'<mimic joint="{sliders[1]}" axis="axis"/>' + text[end:]
+    with pytest.raises(ImportError_, match=rf"<joint name='{sliders[0]}'><axis><mimic joint='{sliders[1]}'>: a joint "
+                                           rf"coupling ties joint '{sliders[0]}' of the mechanism analysed to joint "
+                                           rf"'{sliders[1]}'"):
+        load(write(tmp_path, text))

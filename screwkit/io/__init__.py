@@ -89,13 +89,16 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     ``unit``, the unit its numbers are kept in)."""
     from dataclasses import replace
 
-    from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
+    from screwkit.io.closed_tree import ImportError_, mimicked_joints  # the readers: only for a file of another tool
     from screwkit.io.locking import actuate_joints, drivable_joints, lock_joints, set_initial  # (idem)
+    from screwkit.io.sdformat import SDFORMAT_SUFFIXES  # (idem)
     from screwkit.io.tree_units import in_metres  # (idem)
 
     tree = in_metres(_read_tree(Path(path), output, output_type), length_unit)
     if unit:
         tree = replace(tree, unit=unit)
+    if Path(path).suffix.lower() not in (*MJCF_SUFFIXES, *SDFORMAT_SUFFIXES):  # a URDF read through Pinocchio
+        tree = replace(tree, couplings=tree.couplings + mimicked_joints(Path(path).read_bytes(), str(path)))
     if not tree.closures:  # before its actuators are looked for: a tree has none to guess
         raise ImportError_(f"{tree.source}: no closure: nothing closes the tree into a parallel mechanism.")
     if tree.unactuated and not actuate:

@@ -29,7 +29,7 @@ GUESSED = "actuators guessed"
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "meeting_point", "at_point",
-           "LENGTH_COORDINATES", "nearest_to_lines", "check_couplings"]
+           "LENGTH_COORDINATES", "nearest_to_lines", "check_couplings", "mimicked_joints"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -148,6 +148,20 @@ def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
         return None
     names = [element.get("names", "").split() for element in root.findall("task_coordinates")]
     return tuple(names[-1]) if names and names[-1] else None
+
+
+def mimicked_joints(urdf_text: bytes, source: str) -> tuple[tuple[str, str, str], ...]:
+    """A URDF's ``<mimic>`` couplings (Pinocchio's reader takes the joints as independent): ``(joint, the joint it
+    mimics, where)`` for :attr:`ClosedTree.couplings`."""
+    import xml.etree.ElementTree as ElementTree
+
+    try:
+        root = ElementTree.fromstring(tolerant_xml(urdf_text))
+    except ElementTree.ParseError:
+        return ()
+    return tuple((joint.get("name", ""), mimic.get("joint", ""), f"{source}: <joint name='{joint.get('name')}'>"
+                  f"<mimic joint='{mimic.get('joint')}'>") for joint in root.findall("joint")
+                 for mimic in joint.findall("mimic"))
 
 
 def transmitted_joints(urdf_text: bytes) -> list[str]:
@@ -514,6 +528,7 @@ def check_couplings(tree: ClosedTree, analysed: set[int], notes: list[str]) -> N
         else:
             other = ("to a value" if partner is None else f"to joint {partner!r}" +
                      ("" if ids[partner] is not None else ", held (--lock)"))
+            undo = " (or set active='false')" if "<equality>" in where else ""
             raise ImportError_(f"{where}: a joint coupling ties joint {tied[0]!r} of the mechanism analysed {other}: "
-                               "it changes the mechanism's mobility and screwkit does not model it; remove the "
-                               "element (or set active='false') to analyse the joints as independent.")
+                               f"it changes the mechanism's mobility and screwkit does not model it; remove the "
+                               f"element{undo} to analyse the joints as independent.")

@@ -382,5 +382,23 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
         notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/>, {plugins}): "
                      f"{', '.join(motors)}; --actuate JOINT says otherwise")
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
-                      "SDFormat (joints closing loops)", notes,
-                      cut_by_order=cut_by_order, split=builder.split, unactuated=unactuated)
+                      "SDFormat (joints closing loops)", notes, cut_by_order=cut_by_order, split=builder.split,
+                      unactuated=unactuated, couplings=_mimics(sdf))
+
+
+def _mimics(sdf) -> tuple[tuple[str, str, str], ...]:
+    """The ``<axis><mimic>`` couplings of an SDFormat model (1.11), by the model's joint names (a two-axis joint's
+    ``<name>_axis`` and ``<name>_axis2``), for :func:`~screwkit.io.closed_tree.check_couplings`."""
+    kinds = {joint.name: joint.kind for joint in sdf.joints}
+
+    def hinge(name: str, axis: str) -> str:
+        return f"{name}_{axis}" if kinds.get(name) in TWO_AXES else name
+
+    found = []
+    for joint in sdf.element.findall("joint"):
+        for axis in ("axis", "axis2"):
+            for mimic in joint.findall(f"{axis}/mimic"):
+                name, other = joint.get("name", ""), mimic.get("joint", "")
+                found.append((hinge(name, axis), hinge(other, mimic.get("axis", "axis")),
+                              f"{sdf.source}: <joint name='{name}'><{axis}><mimic joint='{other}'>"))
+    return tuple(found)
