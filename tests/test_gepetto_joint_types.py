@@ -386,9 +386,9 @@ def test_a_urdf_mimic_is_read_as_a_coupling_not_passed_over(tmp_path):
     tying two joints of the ankle is refused naming the element."""
     text = (BATTOBOT / "robot.urdf").read_text()
     expected, _, _ = analysed(BATTOBOT / "robot.urdf")
-    for joint, mimicked, said in (("knee_right", "motor_knee_right", "couples joints of branches that reach no leg"),
-                                  ("motor_ankle1_left", "motor_ankle1_right", "ties joint 'motor_ankle1_left' to "
-                                   "'motor_ankle1_right', of a branch that reaches no leg, which follows it")):
+    for joint, mimicked in (("knee_right", "motor_knee_right"), ("motor_ankle1_left", "motor_ankle1_right")):
+        said = (f"ties joint {joint!r} to {mimicked!r}, which constrains no motion of the mechanism analysed (the "
+                "branch it ties follows): left out")
         folder = tmp_path / joint
         folder.mkdir()
         (folder / "robot.urdf").write_text(with_mimic(text, joint, mimicked))
@@ -403,4 +403,5 @@ def test_a_urdf_mimic_is_read_as_a_coupling_not_passed_over(tmp_path):
     held = [part for name in LOCKS for part in ("--lock", name)]
     one_line_error(screwkit("info", tmp_path / "robot.urdf", "--output", "foot_right", *held),
                    "<joint name='anklex_left'><mimic joint='ankley_left'>: a joint coupling ties joint 'anklex_left' "
-                   "of the mechanism analysed to joint 'ankley_left'", "remove the element to analyse")
+                   "to joint 'ankley_left', which holds the mechanism analysed to fewer motions",
+                   "remove the element to analyse")

@@ -541,33 +541,83 @@ def two_fingers(coupling: str) -> str:
             '<motor joint="right_hinge_1"/></actuator></mujoco>')
 
 
-def test_a_coupling_to_a_finger_not_analysed_is_left_out_and_one_inside_is_refused(tmp_path):
-    """A gripper's fingers coupled by ``<equality><joint>`` (as MuJoCo Menagerie's hands are): with one finger
-    analysed, the other follows its coupled joint and constrains nothing, so the file opens as written, saying so,
-    with the indices of the finger alone; a coupling of two joints of the finger analysed, of one to a value, or to
-    a joint held by --lock changes its mobility and is refused naming the element and the joint."""
+def with_pendulum(coupling: str, pinned: bool) -> str:
+    """The crank-rocker with a pendulum hung beside it (a branch that reaches no leg), ``pinned`` to the ground by a
+    <connect> (then it cannot move), and ``coupling`` written after the closures."""
     from test_singular_on_the_way import crank_rocker
 
-    alone = tmp_path / "finger.xml"
-    alone.write_text(crank_rocker(1.0, 4.0, 3.0))
-    expected = load(alone, output="link_4")
-    coupled = tmp_path / "gripper.xml"
-    coupled.write_text(two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1"/>'))
-    mechanism = load(coupled, output="left_link_4")
+    text = crank_rocker(1.0, 4.0, 3.0).replace("</worldbody>", '<body name="pendulum" pos="3 0 0"><joint '
+                                               'name="swing" axis="1 0 0"/><geom type="capsule" fromto="0 0 0 0 1 0" '
+                                               'size="0.05"/></body></worldbody>')
+    pin = '<connect name="pin" body1="pendulum" body2="link_1" anchor="0 1 0"/>' if pinned else ""
+    return text.replace("</equality>", pin + coupling + "</equality>")
+
+
+def mujoco_motions(text: str, joints) -> int:
+    """MuJoCo's own word: the rank of the motions of ``joints`` its equality constraints allow at qpos0 (the null
+    space of its constraint Jacobian, restricted to their velocity coordinates)."""
+    model = mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    rows = [i for i in range(data.nefc) if data.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
+    jacobian = data.efc_J.reshape(data.nefc, model.nv)[rows]
+    _, values, right = np.linalg.svd(np.vstack([jacobian, np.zeros((model.nv, model.nv))]))
+    null = right[int(np.sum(values > 1e-9)):]
+    columns = [model.jnt_dofadr[model.joint(name).id] for name in joints]
+    return int(np.linalg.matrix_rank(null[:, columns], 1e-9)) if null.size else 0
+
+
+LEFT = ("left_hinge_1", "left_hinge_2", "left_hinge_3")
+COUPLED = {  # (the file, its output body, the joints analysed)
+    "to the other finger": (two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1"/>'), "left_link_4", LEFT),
+    "to a free pendulum": (with_pendulum('<joint joint1="hinge_1" joint2="swing"/>', False), "link_4",
+                           ("hinge_1", "hinge_2", "hinge_3")),
+    "inside the finger": (two_fingers('<joint joint1="left_hinge_1" joint2="left_hinge_2"/>'), "left_link_4", LEFT),
+    "to a value": (two_fingers('<joint joint1="left_hinge_2"/>'), "left_link_4", LEFT),
+    "at a zero slope": (two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1" polycoef="0 0 1 0 0"/>'),
+                        "left_link_4", LEFT),
+    "chained back into the finger": (two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1"/><joint '
+                                                 'joint1="left_hinge_2" joint2="right_hinge_1"/>'), "left_link_4",
+                                     LEFT),
+    "to a finger held": (two_fingers('<joint joint1="left_hinge_1" joint2="right_hinge_1"/><joint '
+                                     'joint1="right_hinge_2"/>'), "left_link_4", LEFT),
+    "to a pinned pendulum": (with_pendulum('<joint joint1="hinge_1" joint2="swing"/>', True), "link_4",
+                             ("hinge_1", "hinge_2", "hinge_3")),
+    "to the loop joint beyond the platform": (two_fingers("").replace(
+        "</equality>", '<joint joint1="left_hinge_1" joint2="left_hinge_3"/></equality>'), "left_link_3", LEFT),
+}
+
+
+@pytest.mark.parametrize("case", COUPLED)
+def test_a_joint_coupling_is_left_out_only_where_mujoco_keeps_the_motions_analysed(tmp_path, case):
+    """A gripper's fingers coupled by ``<equality><joint>`` (as MuJoCo Menagerie's hands are): with one finger
+    analysed, a coupling to a branch that follows it constrains nothing there, and the file opens as written,
+    saying so, with the indices of the file without it; any other is refused naming the element. Which is which is
+    MuJoCo's verdict here: whether its constraint Jacobian, with the coupling, leaves the joints analysed the motions
+    they have without it."""
+    text, output, joints = COUPLED[case]
+    path = tmp_path / "coupled.xml"
+    path.write_text(text)
+    plain = tmp_path / "plain.xml"
+    plain.write_text(re.sub(r"<joint joint1=[^>]*/>", "", text))
+    kept = mujoco_motions(text, joints) == mujoco_motions(plain.read_text(), joints)
+    assert kept is case.startswith(("to the other finger", "to a free pendulum"))  # (the cases as meant)
+    run = screwkit("info", path, "--output", output)
+    if not kept:
+        one_line_error(run, "coupled.xml: <equality><joint joint1=", "a joint coupling ties joint",
+                       "which holds the mechanism analysed to fewer motions", "remove the element (or set "
+                       "active='false')")
+        return
+    assert run.returncode == 0, run.stderr
+    assert "which constrains no motion of the mechanism analysed (the branch it ties follows): left out" in run.stdout
     for turn in (0.0, np.radians(20.0)):
-        got, want = (indices_at_pose(m, m.home_pose + turn) for m in (mechanism, expected))
+        got, want = (indices_at_pose(m, m.home_pose + turn) for m in (load(path, output=output),
+                                                                      load(plain, output=output)))
         np.testing.assert_allclose([got.iti, got.lmti], [want.iti, want.lmti], atol=1e-12)
-    info = screwkit("info", coupled, "--output", "left_link_4")
-    assert info.returncode == 0, info.stderr
-    assert ("<equality><joint joint1='left_hinge_1' joint2='right_hinge_1'>: ties joint 'left_hinge_1' to "
-            "'right_hinge_1', of a branch that reaches no leg, which follows it: left out") in info.stdout
-    for coupling, options, needle in (
-            ('<joint joint1="left_hinge_1" joint2="left_hinge_2"/>', (), "ties joint 'left_hinge_1' of the mechanism "
-             "analysed to joint 'left_hinge_2'"),
-            ('<joint joint1="left_hinge_2"/>', (), "ties joint 'left_hinge_2' of the mechanism analysed to a value"),
-            ('<joint joint1="left_hinge_1" joint2="right_hinge_1"/>', ("--lock", "right_hinge_1"),
-             "to joint 'right_hinge_1', held (--lock)")):
-        path = tmp_path / "inside.xml"
-        path.write_text(two_fingers(coupling))
-        one_line_error(screwkit("info", path, "--output", "left_link_4", *options), "<equality><joint joint1=",
-                       needle, "remove the element (or set active='false')")
+
+
+def test_a_coupling_to_a_joint_held_by_lock_is_refused_saying_so(tmp_path):
+    path = tmp_path / "gripper.xml"
+    path.write_text(COUPLED["to the other finger"][0])
+    one_line_error(screwkit("info", path, "--output", "left_link_4", "--lock", "right_hinge_1"),
+                   "ties joint 'left_hinge_1' to joint 'right_hinge_1', held (--lock)")

@@ -118,6 +118,25 @@ def test_an_axis_mimic_is_read_as_a_coupling_and_refused_between_legs(tmp_path):
     end = text.index("</axis>", start)
     text = text[:end] + f'<mimic joint="{sliders[1]}" axis="axis"/>' + text[end:]
     with pytest.raises(ImportError_, match=rf"<joint name='{sliders[0]}'><axis><mimic joint='{sliders[1]}'>: a joint "
-                                           rf"coupling ties joint '{sliders[0]}' of the mechanism analysed to joint "
-                                           rf"'{sliders[1]}'"):
+                                           rf"coupling ties joint '{sliders[0]}' to joint '{sliders[1]}', which holds "
+                                           r"the mechanism analysed to fewer motions"):
         load(write(tmp_path, text))
+
+
+def test_renamed_joints_follow_libsdformat_s_order(tmp_path):
+    """libsdformat (Model.cc, before 1.7) renames in file order against the links and the joints already named: a
+    pitch joint named as its link becomes ``<link>_joint``, and a later joint written with that very name becomes
+    ``<link>_joint_joint`` (not the other way round); the indices are the file's as written apart."""
+    text = ups_sdf("1.6")
+    leg = next(part.split('"')[1][:-len("_pitch")] for part in text.split("<joint name=")[1:]
+               if part.split('"')[1].endswith("_pitch"))
+    assert text.index(f'<joint name="{leg}_pitch"') < text.index(f'<joint name="{leg}_s"')
+    text = text.replace(f'<joint name="{leg}_pitch"', f'<joint name="{leg}_top"')
+    text = text.replace(f'<joint name="{leg}_s"', f'<joint name="{leg}_top_joint"')
+    path = write(tmp_path, text)
+    notes = " ".join(read_closed_tree(path).notes)
+    assert f"joint '{leg}_top' named '{leg}_top_joint': a link of this SDFormat 1.6 file" in notes
+    assert f"joint '{leg}_top_joint' named '{leg}_top_joint_joint': a joint before it" in notes
+    plain = load(write(tmp_path, ups_sdf("1.6"), "plain.sdf"))
+    np.testing.assert_allclose(indices_at_pose(load(path), plain.home_pose).lmti,
+                               indices_at_pose(plain, plain.home_pose).lmti, atol=1e-12)

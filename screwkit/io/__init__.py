@@ -89,7 +89,8 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     ``unit``, the unit its numbers are kept in)."""
     from dataclasses import replace
 
-    from screwkit.io.closed_tree import ImportError_, mimicked_joints  # the readers: only for a file of another tool
+    from screwkit.io.closed_tree import ImportError_  # the readers: only for a file of another tool
+    from screwkit.io.couplings import mimicked_joints  # (idem)
     from screwkit.io.locking import actuate_joints, drivable_joints, lock_joints, set_initial  # (idem)
     from screwkit.io.sdformat import SDFORMAT_SUFFIXES  # (idem)
     from screwkit.io.tree_units import in_metres  # (idem)

@@ -29,7 +29,7 @@ GUESSED = "actuators guessed"
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "meeting_point", "at_point",
-           "LENGTH_COORDINATES", "nearest_to_lines", "check_couplings", "mimicked_joints"]
+           "LENGTH_COORDINATES", "nearest_to_lines"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -101,9 +101,10 @@ class ClosedTree:
     unactuated: str = ""  # why the file's own actuators cannot be taken: refused unless --actuate names them
     length_unit: str | None = None  # the unit the file was written in, its lengths now in m (screwkit.io.tree_units)
     unit: str = "m"  # the unit of its lengths, for messages: the file's own when it is converted as written
-    couplings: tuple[tuple[str, str | None, str], ...] = ()
-    """A file's couplings of two joints (``joint2`` None: one joint held), each with where it is written: none may
-    tie a joint of the mechanism analysed (:func:`check_couplings`)."""
+    couplings: tuple[tuple[str, str | None, float, str], ...] = ()
+    """A file's couplings of two joints, ``(joint1, joint2, slope, where)``: joint1 moves ``slope`` times as joint2
+    (``joint2`` None: joint1 held), each with where it is written; left out only where they constrain nothing
+    analysed (:func:`screwkit.io.couplings.check_couplings`)."""
     split: dict[str, str] = field(default_factory=dict)
     """A file's joint of several DoF written as hinges (SDFormat's ball and universal joints), and each hinge: what
     it is, for messages (none is an actuator)."""
@@ -148,20 +149,6 @@ def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
         return None
     names = [element.get("names", "").split() for element in root.findall("task_coordinates")]
     return tuple(names[-1]) if names and names[-1] else None
-
-
-def mimicked_joints(urdf_text: bytes, source: str) -> tuple[tuple[str, str, str], ...]:
-    """A URDF's ``<mimic>`` couplings (Pinocchio's reader takes the joints as independent): ``(joint, the joint it
-    mimics, where)`` for :attr:`ClosedTree.couplings`."""
-    import xml.etree.ElementTree as ElementTree
-
-    try:
-        root = ElementTree.fromstring(tolerant_xml(urdf_text))
-    except ElementTree.ParseError:
-        return ()
-    return tuple((joint.get("name", ""), mimic.get("joint", ""), f"{source}: <joint name='{joint.get('name')}'>"
-                  f"<mimic joint='{mimic.get('joint')}'>") for joint in root.findall("joint")
-                 for mimic in joint.findall("mimic"))
 
 
 def transmitted_joints(urdf_text: bytes) -> list[str]:
@@ -506,29 +493,3 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     return q, scale
 
 
-
-def check_couplings(tree: ClosedTree, analysed: set[int], notes: list[str]) -> None:
-    """A file's joint couplings against the joints of the mechanism analysed (``analysed``, ids in ``tree.model``).
-    One that ties two such joints, or one to a joint merged away by ``--lock`` or to a value, changes the
-    mechanism's mobility: refused. One whose other joint is on a branch that reaches no leg constrains nothing here
-    (that branch follows: a gripper's fingers coupled, one finger analysed), nor one between such branches: left
-    out, said in ``notes``."""
-    model = tree.model
-    for first, second, where in tree.couplings:
-        ids = {name: model.getJointId(name) if model.existJointName(name) else None for name in (first, second) if name}
-        tied = [name for name in ids if ids[name] in analysed]
-        partner = next((name for name in ids if not tied or name != tied[0]), None)
-        element = where.split(": ", 1)[-1]
-        if not tied:
-            notes.append(f"{element}: couples joints of branches that reach no leg: left out (it constrains nothing "
-                         "analysed)")
-        elif partner is not None and ids[partner] is not None and ids[partner] not in analysed:
-            notes.append(f"{element}: ties joint {tied[0]!r} to {partner!r}, of a branch that reaches no leg, which "
-                         "follows it: left out (it constrains nothing analysed)")
-        else:
-            other = ("to a value" if partner is None else f"to joint {partner!r}" +
-                     ("" if ids[partner] is not None else ", held (--lock)"))
-            undo = " (or set active='false')" if "<equality>" in where else ""
-            raise ImportError_(f"{where}: a joint coupling ties joint {tied[0]!r} of the mechanism analysed {other}: "
-                               f"it changes the mechanism's mobility and screwkit does not model it; remove the "
-                               f"element{undo} to analyse the joints as independent.")

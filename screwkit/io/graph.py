@@ -57,7 +57,6 @@ from screwkit.io.closed_tree import (
     ImportError_,
     ImportReport,
     assemble,
-    check_couplings,
     closure_gaps,
     homogeneous,
     joint_kind,
@@ -65,6 +64,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import closed_samples
+from screwkit.io.couplings import check_couplings
 from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
@@ -489,7 +489,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
-    check_couplings(tree, {joint for leg in legs for joint in leg.joints}, report.notes)
+    check_couplings(tree, q, scale, {joint for leg in legs for joint in leg.joints}, platform, report.notes)
     check_actuators(tree, legs)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)

@@ -232,12 +232,12 @@ def _check_keys(root: ElementTree.Element, path: Path) -> None:
 
 
 def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element | None,
-                      path: Path) -> tuple[list[str], list[tuple[str, str | None, str]]]:
+                      path: Path) -> tuple[list[str], list[tuple[str, str | None, float, str]]]:
     """The equalities, as MuJoCo reads them: ``active`` from the element or its class; an active coupling of
     tendons or flexes is refused (screwkit does not model it), an inactive one left out. Returns what was left out,
     and the active couplings of two joints (or one held), taken out of the text too: ``(joint1, joint2 or None,
-    where)``, which refuse the mechanism only if it has the joints (a gripper's two fingers, one analysed:
-    :func:`~screwkit.io.closed_tree.check_couplings`)."""
+    slope, where)``, which refuse the mechanism only where they constrain it (a gripper's two fingers, one analysed:
+    :func:`~screwkit.io.couplings.check_couplings`)."""
     classes = class_attributes(root, "equality")
     ignored, couplings = [], []
     for element in ([] if equality is None else list(equality)):
@@ -255,7 +255,12 @@ def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element |
             raise MjcfError(f"{where}: active='{active}': expected true or false.")
         element.set("active", active)
         if element.tag == "joint" and active == "true" and element.get("joint1"):
-            couplings.append((element.get("joint1"), element.get("joint2"), where))
+            words = (element.get("polycoef") or "0 1 0 0 0").split()  # joint1 - its ref = polynomial of joint2's
+            try:
+                slope = float(words[1]) if len(words) > 1 else 0.0  # (the slope at joint2's reference)
+            except ValueError:
+                raise MjcfError(f"{where}: polycoef={element.get('polycoef')!r}: expected numbers.") from None
+            couplings.append((element.get("joint1"), element.get("joint2"), slope, where))
             equality.remove(element)
             continue
         if element.tag in COUPLINGS and active == "true":

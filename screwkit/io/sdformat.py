@@ -386,7 +386,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                       unactuated=unactuated, couplings=_mimics(sdf))
 
 
-def _mimics(sdf) -> tuple[tuple[str, str, str], ...]:
+def _mimics(sdf) -> tuple[tuple[str, str, float, str], ...]:
     """The ``<axis><mimic>`` couplings of an SDFormat model (1.11), by the model's joint names (a two-axis joint's
     ``<name>_axis`` and ``<name>_axis2``), for :func:`~screwkit.io.closed_tree.check_couplings`."""
     kinds = {joint.name: joint.kind for joint in sdf.joints}
@@ -399,6 +399,10 @@ def _mimics(sdf) -> tuple[tuple[str, str, str], ...]:
         for axis in ("axis", "axis2"):
             for mimic in joint.findall(f"{axis}/mimic"):
                 name, other = joint.get("name", ""), mimic.get("joint", "")
-                found.append((hinge(name, axis), hinge(other, mimic.get("axis", "axis")),
-                              f"{sdf.source}: <joint name='{name}'><{axis}><mimic joint='{other}'>"))
+                where = f"{sdf.source}: <joint name='{name}'><{axis}><mimic joint='{other}'>"
+                try:
+                    slope = float((mimic.findtext("multiplier") or "1").strip())
+                except ValueError:
+                    raise ImportError_(f"{where}<multiplier>: not a number.") from None
+                found.append((hinge(name, axis), hinge(other, mimic.get("axis", "axis")), slope, where))
     return tuple(found)

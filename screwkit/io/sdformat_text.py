@@ -298,20 +298,22 @@ def _ball_constraint(node, where: str) -> tuple[str, NDArray, str, NDArray, str]
 
 
 def _rename_joints_named_as_links(model: SdfModel, element, version: tuple[int, ...]) -> None:
-    """A joint of a file before SDFormat 1.7 named as a link gets the name ``<name>_joint`` (``<name>_joint<k>``
-    while that is taken), as libsdformat gives it; said in ``model.renamed``."""
-    taken = {child.get("name", "") for tag in ("link", "joint", "frame") for child in element.findall(tag)}
+    """A joint of a file before SDFormat 1.7 named as a link or as a joint before it gets the name ``<name>_joint``
+    (``<name>_joint<k>`` while that is taken), as libsdformat gives it: in file order, against the links and the
+    joints already named; said in ``model.renamed``."""
+    taken = set(model.links)
     for joint in element.findall("joint"):
-        name = joint.get("name", "")
-        if name not in model.links:
-            continue
-        new, count = f"{name}_joint", 0
+        name = new = joint.get("name", "")
+        count = 0
         while new in taken:
-            new, count = f"{name}_joint{count}", count + 1
-        joint.set("name", new)
+            new, count = f"{name}_joint{count - 1 if count else ''}", count + 1
+        if new != name:
+            joint.set("name", new)
+            what = "a link" if name in model.links else "a joint before it"
+            model.renamed.append(f"joint {name!r} named {new!r}: {what} of this SDFormat "
+                                 f"{'.'.join(map(str, version))} file has its name, and libsdformat renames the "
+                                 "joint so (1.7 refuses the file)")
         taken.add(new)
-        model.renamed.append(f"joint {name!r} named {new!r}: a link of this SDFormat {'.'.join(map(str, version))} "
-                             "file has its name, and libsdformat renames the joint so (1.7 refuses the file)")
 
 
 def _check_names(element, label: str) -> None:

@@ -61,7 +61,6 @@ from screwkit.io.closed_tree import (
     at_point,
     ball_line,
     ball_of_revolutes,
-    check_couplings,
     closure_gaps,
     homogeneous,
     inverse,
@@ -71,6 +70,7 @@ from screwkit.io.closed_tree import (
     path_to,
 )
 from screwkit.io.compound import compound_groups, compound_legs
+from screwkit.io.couplings import check_couplings
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
@@ -357,8 +357,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     if idle_motors:
         report.notes.append(f"actuated joints {', '.join(idle_motors)} on branches that reach no leg: left out (they "
                             "do not move the platform)")
-    check_couplings(tree, set(owner).union(*(path_to(model, c.joint_a) + path_to(model, c.joint_b)
-                                             for c in couplings if c.name in joined)), report.notes)
+    check_couplings(tree, q, scale, set(owner).union(*(path_to(model, c.joint_a) + path_to(model, c.joint_b)
+                                                       for c in couplings if c.name in joined)), platform, report.notes)
     normal = _planar_normal(tree, data, legs)
     if normal is not None:
         _planar_loops(legs, normal)
