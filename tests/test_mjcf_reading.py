@@ -532,7 +532,9 @@ def two_fingers(coupling: str) -> str:
         text = finger.replace('name="link_', f'name="{side}_link_').replace('body1="link_', f'body1="{side}_link_')
         text = text.replace('body2="link_', f'body2="{side}_link_').replace('"hinge_', f'"{side}_hinge_')
         text = text.replace('name="kinematic_link1"', f'name="{side}_loop"')
-        text = text.replace(f'<body name="{side}_link_1">', f'<body name="{side}_link_1" pos="{shift}">')
+        ground = f'<body name="{side}_link_1" pos="0.0 0.0 0.0"'
+        assert ground in text
+        text = text.replace(ground, f'<body name="{side}_link_1" pos="{shift}"')
         parts[side] = text
     body = {side: text[text.index("<worldbody>") + 11:text.index("</worldbody>")] for side, text in parts.items()}
     closure = {side: text[text.index("<equality>") + 10:text.index("</equality>")] for side, text in parts.items()}

@@ -28,37 +28,45 @@ SIDE = 4.0
 def square_four_bar(scale: float = 1.0, world=None) -> str:
     """A square four-bar in MJCF as Genesis writes it (hinges about x, the loop closed by a ``<connect>``), sides
     ``SIDE`` times ``scale``, its ground link placed by ``world`` (rotation, translation) in the world."""
+    side = SIDE * scale
+    return genesis_four_bar(side, side, side, 0.125 * side, 0.0, 0.05 * side, ("hinge_1", "hinge_2"), world)
+
+
+def genesis_four_bar(crank: float, coupler: float, rocker: float, offset: float, anchor_x: float, thickness: float,
+                     motors: tuple[str, ...], world=None) -> str:
+    """A four-bar in MJCF as Genesis's ``four_bar_linkage.xml`` writes it: from the ground link, the crank along y,
+    the coupler along z, the rocker along -y, hinges about x (each drawn ``offset`` along it), the rocker's end
+    ``<connect>``-ed back to the ground at ``anchor_x`` along x; ``motors`` driven; the ground link placed by
+    ``world`` (rotation, translation)."""
     rotation, shift = (np.eye(3), np.zeros(3)) if world is None else world
     w, x, y, z = _quaternion(rotation)
-    side = SIDE * scale
 
     def at(*values):
         return " ".join(repr(float(v)) for v in values)
 
+    actuators = "".join(f'\n    <motor joint="{motor}"/>' for motor in motors)
     return f"""<mujoco>
   <worldbody>
     <body name="link_1" pos="{at(*shift)}" quat="{at(w, x, y, z)}">
-      <geom type="capsule" fromto="0 0 0 0 0 {side}" size="{0.05 * side}"/>
-      <body name="link_2" pos="{at(0.125 * side, 0, 0)}">
+      <geom type="capsule" fromto="0 0 0 0 0 {coupler}" size="{thickness}"/>
+      <body name="link_2" pos="{at(offset, 0, 0)}">
         <joint name="hinge_1" pos="0 0 0" axis="1 0 0"/>
-        <geom type="capsule" fromto="0 0 0 0 {side} 0" size="{0.05 * side}"/>
-        <body name="link_3" pos="{at(-0.125 * side, side, 0)}">
+        <geom type="capsule" fromto="0 0 0 0 {crank} 0" size="{thickness}"/>
+        <body name="link_3" pos="{at(-offset, crank, 0)}">
           <joint name="hinge_2" pos="0 0 0" axis="1 0 0"/>
-          <geom type="capsule" fromto="0 0 0 0 0 {side}" size="{0.05 * side}"/>
-          <body name="link_4" pos="{at(0.125 * side, 0, side)}">
+          <geom type="capsule" fromto="0 0 0 0 0 {coupler}" size="{thickness}"/>
+          <body name="link_4" pos="{at(offset, 0, coupler)}">
             <joint name="hinge_3" pos="0 0 0" axis="1 0 0"/>
-            <geom type="capsule" fromto="0 0 0 0 {-side} 0" size="{0.05 * side}"/>
+            <geom type="capsule" fromto="0 0 0 0 {-rocker} 0" size="{thickness}"/>
           </body>
         </body>
       </body>
     </body>
   </worldbody>
   <equality>
-    <connect name="kinematic_link1" body1="link_1" body2="link_4" anchor="0 0 {side}"/>
+    <connect name="kinematic_link1" body1="link_1" body2="link_4" anchor="{at(anchor_x, crank - rocker, coupler)}"/>
   </equality>
-  <actuator>
-    <motor joint="hinge_1"/>
-    <motor joint="hinge_2"/>
+  <actuator>{actuators}
   </actuator>
 </mujoco>
 """
@@ -124,9 +132,9 @@ def test_analyze_says_so_on_the_command_line_and_in_json(tmp_path):
 def test_a_chain_of_its_closure_alone_is_named_so_when_it_locks_the_platform(tmp_path):
     """The four-bar welded to its ground instead of pinned: a structure; leaving out either chain frees it."""
     path = tmp_path / "welded.xml"
-    path.write_text(square_four_bar().replace('<connect name="kinematic_link1" body1="link_1" body2="link_4" '
-                                              f'anchor="0 0 {SIDE}"/>', '<weld name="kinematic_link1" '
-                                              'body1="link_1" body2="link_4"/>'))
+    text = square_four_bar()
+    connect = text[text.index("<connect "):text.index("/>", text.index("<connect ")) + 2]
+    path.write_text(text.replace(connect, '<weld name="kinematic_link1" body1="link_1" body2="link_4"/>'))
     run = screwkit("analyze", path, "--output", "link_3")
     one_line_error(run, "any one chain left out, the others would let it move", "kinematic_link1 (its closure's joint)")
 
@@ -271,31 +279,7 @@ def crank_rocker(crank: float, coupler: float, rocker: float) -> str:
     """A four-bar as Genesis writes it with the crank, coupler and rocker lengths given (ground 1, the pivots on the
     y axis): a Grashof crank-rocker for (1, 4, 3), whose chain is singular only where it is stretched out, at the edge
     of its workspace."""
-    return f"""<mujoco>
-  <worldbody>
-    <body name="link_1">
-      <body name="link_2" pos="0.5 0 0">
-        <joint name="hinge_1" pos="0 0 0" axis="1 0 0"/>
-        <geom type="capsule" fromto="0 0 0 0 {crank} 0" size="0.05"/>
-        <body name="link_3" pos="-0.5 {crank} 0">
-          <joint name="hinge_2" pos="0 0 0" axis="1 0 0"/>
-          <geom type="capsule" fromto="0 0 0 0 0 {coupler}" size="0.05"/>
-          <body name="link_4" pos="0.5 0 {coupler}">
-            <joint name="hinge_3" pos="0 0 0" axis="1 0 0"/>
-            <geom type="capsule" fromto="0 0 0 0 {-rocker} 0" size="0.05"/>
-          </body>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-  <equality>
-    <connect name="kinematic_link1" body1="link_1" body2="link_4" anchor="0.5 {crank - rocker} {coupler}"/>
-  </equality>
-  <actuator>
-    <motor joint="hinge_1"/>
-  </actuator>
-</mujoco>
-"""
+    return genesis_four_bar(crank, coupler, rocker, 0.5, 0.5, 0.05, ("hinge_1",))
 
 
 @pytest.mark.parametrize("stop", [6.0, 6.25, 6.5, 7.0])
