@@ -29,7 +29,7 @@ GUESSED = "actuators guessed"
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "meeting_point", "at_point",
-           "LENGTH_COORDINATES", "nearest_to_lines"]
+           "LENGTH_COORDINATES", "nearest_to_lines", "closure_motions"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -365,6 +365,20 @@ def _frames(model, data, closure: Closure) -> tuple[NDArray, NDArray]:
             homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b)
 
 
+def closure_motions(model, data, closure: Closure) -> list[tuple[NDArray, NDArray, NDArray]]:
+    """Per side of a closure (a, then b), at the configuration of ``data`` (its joint Jacobians computed): the rows
+    (3, nv) of its frame origin's velocity and of its angular velocity on the velocity coordinates, both in world
+    axes, and the frame (4x4, world)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    motions = []
+    for joint, frame in zip((closure.joint_a, closure.joint_b), _frames(model, data, closure)):
+        jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+        offset = frame[:3, 3] - data.oMi[joint].translation
+        motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), jacobian[3:], frame))
+    return motions
+
+
 def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     """Distance (m) between the two frame origins of every closure at q."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
@@ -429,15 +443,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         pin.computeJointJacobians(model, data, configuration(v))
         rows = []
         for closure in tree.closures:
-            motions = []
-            for joint, frame in zip((closure.joint_a, closure.joint_b), _frames(model, data, closure)):
-                jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
-                offset = frame[:3, 3] - data.oMi[joint].translation
-                turning = np.einsum("ijl,jk,lc->ick", LEVI_CIVITA, jacobian[3:], frame[:3, :3])  # w x each column
-                motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), turning))
-            rows.append((motions[1][0] - motions[0][0]) / scale)
-            if closure.kind == "6d":
-                rows.append((motions[1][1] - motions[0][1]).reshape(9, -1))
+            (moves_a, turns_a, frame_a), (moves_b, turns_b, frame_b) = closure_motions(model, data, closure)
+            rows.append((moves_b - moves_a) / scale)
+            if closure.kind == "6d":  # the rotation matrices' rates: w x each column
+                rows.append((np.einsum("ijl,jk,lc->ick", LEVI_CIVITA, turns_b, frame_b[:3, :3])
+                             - np.einsum("ijl,jk,lc->ick", LEVI_CIVITA, turns_a, frame_a[:3, :3])).reshape(9, -1))
         chain = pin.dIntegrate(model, tree.q_reference, v * unit, pin.ARG1) * unit
         return np.vstack(rows) @ chain @ directions.T
 

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.xml_text import tolerant_xml
-from screwkit.io.closed_tree import ClosedTree, ImportError_, homogeneous, path_to
+from screwkit.io.closed_tree import ClosedTree, ImportError_, closure_motions, path_to
 
 __all__ = ["check_couplings", "mimicked_joints", "RANK_TOLERANCE"]
 
@@ -116,12 +116,8 @@ def _closure_rows(tree: ClosedTree, q: NDArray, scale: float) -> NDArray[np.floa
     pin.computeJointJacobians(model, data, q)
     rows = []
     for closure in tree.closures:
-        motions = []
-        for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
-            jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
-            offset = (homogeneous(data.oMi[joint]) @ placement)[:3, 3] - data.oMi[joint].translation
-            motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), jacobian[3:]))
-        rows.append((motions[1][0] - motions[0][0]) / scale)
+        (moves_a, turns_a, _), (moves_b, turns_b, _) = closure_motions(model, data, closure)
+        rows.append((moves_b - moves_a) / scale)
         if closure.kind == "6d":
-            rows.append(motions[1][1] - motions[0][1])
+            rows.append(turns_b - turns_a)
     return np.vstack(rows) if rows else np.zeros((0, model.nv))
