@@ -19,7 +19,7 @@ from screwkit.cli.options import (
     reading_options,
 )
 from screwkit.closure import forward
-from screwkit.closure.on_the_way import singular_on_the_way
+from screwkit.closure.on_the_way import OTHER_ASSEMBLY, singular_on_the_way
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
 from screwkit.io.closed_tree import GROUNDED
@@ -83,8 +83,7 @@ def print_report(report: dict) -> None:
         at = ", ".join(f"{k} = {v:.6g}" for k, v in passed["pose"].items())
         click.echo(f"  NOTE: on the straight way from the reference pose, chain {passed['chain']}'s joints are "
                    f"singular at {at}: two of its assemblies meet there, and this one keeps the reference's "
-                   "working-mode sign, not necessarily the assembly a motion through it continues into (--initial "
-                   "JOINT VALUE on each actuator assembles the other)")
+                   f"working-mode sign, {OTHER_ASSEMBLY} (--initial JOINT VALUE on each actuator assembles the other)")
     configuration = report.get("configuration", {})
     if configuration:
         actuated = [f"{name} = " + (_slide(entry["value"]) if entry["unit"] == "m" else

@@ -20,6 +20,7 @@ from screwkit.cli.options import (
     quiet_option,
     reading_options,
 )
+from screwkit.closure.on_the_way import OTHER_ASSEMBLY
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import column_record, is_column
 from screwkit.plots import save_figure, sweep_figure
@@ -125,6 +126,6 @@ def _say_past_singular(dataset, coordinate: str) -> None:
             shown = ", ".join(f"{value:g}" for value in values[passed][:6]) + (", ..." if passed.sum() > 6 else "")
             echo_error(f"NOTE: at {coordinate} = {shown} ({int(passed.sum())} of {values.size} values), the straight "
                        f"way from the reference pose passes a configuration where chain {chain}'s joints are "
-                       "singular: two of its assemblies meet there, and these poses are on the one that keeps the "
-                       "reference's working-mode sign, not the one a motion through it may continue into "
-                       "(analyze --pose says where; --initial JOINT VALUE on each actuator assembles the other)")
+                       "singular: two of its assemblies meet there, and these poses keep the reference's working-mode "
+                       f"sign, {OTHER_ASSEMBLY} (analyze --pose says where; --initial JOINT VALUE on each actuator "
+                       "assembles the other)")

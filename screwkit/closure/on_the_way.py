@@ -28,7 +28,7 @@ from screwkit.closure.newton import task_rows
 from screwkit.closure.solve import solve
 from screwkit.model import Mechanism
 
-__all__ = ["singular_on_the_way", "singular_on_the_ways", "singular_along", "SAMPLES", "SINGULAR"]
+__all__ = ["singular_on_the_way", "singular_on_the_ways", "singular_along", "SAMPLES", "SINGULAR", "OTHER_ASSEMBLY"]
 
 SAMPLES = 129
 """Poses sampled on the way from the reference pose (both ends included)."""
@@ -37,6 +37,9 @@ SINGULAR = 1e-4
 """A chain's normalised joint-twist determinant (moments about the centre of its joints' points, in length scales;
 each twist made unit: the same whatever the world frame and the unit) below which its joints count as singular: a
 dip refined to below it is a configuration where two of its assemblies meet."""
+
+OTHER_ASSEMBLY = "not necessarily the assembly a motion through it continues into"
+"""How every message of a pose past such a configuration ends: what the working-mode sign kept there does not say."""
 
 _DIP = 0.2
 """A sampled dip (a local minimum inside the way) refined only if it is below this."""
@@ -108,14 +111,14 @@ def singular_on_the_ways(mechanism: Mechanism, poses: NDArray) -> list[tuple[str
     return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
 
 
-def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *, values=None,
-                   first_only: bool = False) -> list[tuple[str, float, int]]:
+def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *,
+                   values=None) -> list[tuple[str, float, int]]:
     """Per chain closed by damped Newton with a working-mode sign, the singular configurations of its joints along
     the samples ``poses`` (n, n_task) at parameters ``at`` (n,, increasing), ``pose_at(t)`` giving the poses at the
     parameters ``t`` (k,) between them (k, n_task): ``(chain name, the parameter there, the sample nearest before
     it)``, refined between the samples either side of each dip of its normalised determinant (and in the first and
     last intervals). ``values``: per chain its joint values at the samples, where already solved (a chain's are used
-    when they are all its joints); ``first_only``: the first per chain."""
+    when they are all its joints)."""
     found, solved = [], None
     last = len(at) - 1
     for k in sign_kept_chains(mechanism):
@@ -130,9 +133,8 @@ def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *
         lows = np.array([at[max(i - 1, 0)] for i in dips])
         highs = np.array([at[min(i + 1, last)] for i in dips])
         where, value = _refined(mechanism, k, pose_at, lows, highs)
-        singular = [float(t) for t in where[value < SINGULAR]]  # (in the dips' order: along the path)
-        for t in singular[:1] if first_only else singular:
-            found.append((mechanism.chains[k].name, t, int(np.searchsorted(at, t, side="right")) - 1))
+        for t in where[value < SINGULAR]:  # (in the dips' order: along the path)
+            found.append((mechanism.chains[k].name, float(t), int(np.searchsorted(at, t, side="right")) - 1))
     return found
 
 

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.closure.on_the_way import OTHER_ASSEMBLY
 from screwkit.common.tolerances import WORST_FAULT_TIE
 from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining_lmti
 from screwkit.indices.exports import indices_variables, set_label
@@ -117,7 +118,7 @@ class Margin:
 
 
 SINGULAR_REASON = ("chain {chain}'s joints are singular here: two of its assemblies meet, and past it the path keeps "
-                   "its working-mode sign, not necessarily the assembly a motion through it continues into")
+                   f"its working-mode sign, {OTHER_ASSEMBLY}")
 """What a ``"singular"`` event says (:func:`~screwkit.closure.on_the_way.singular_along`)."""
 
 
