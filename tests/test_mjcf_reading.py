@@ -623,3 +623,36 @@ def test_a_coupling_to_a_joint_held_by_lock_is_refused_saying_so(tmp_path):
     path.write_text(COUPLED["to the other finger"][0])
     one_line_error(screwkit("info", path, "--output", "left_link_4", "--lock", "right_hinge_1"),
                    "ties joint 'left_hinge_1' to joint 'right_hinge_1', held (--lock)")
+
+
+def scaled_and_moved(text: str, factor: float) -> str:
+    """An MJCF file's kinematic lengths (``pos``, ``fromto``, ``anchor``; the geoms' radii kept, for MuJoCo's masses)
+    times ``factor``, and its bodies hung in a moved and turned frame (written here, apart from screwkit's reading)."""
+    def times(match):
+        numbers = " ".join(repr(float(word) * factor) for word in match.group(2).split())
+        return f'{match.group(1)}="{numbers}"'
+
+    text = re.sub(r'\b(pos|fromto|anchor)="([^"]*)"', times, text)
+    start, end = text.index("<worldbody>") + len("<worldbody>"), text.index("</worldbody>")
+    return (text[:start] + f'<body name="frame" pos="{0.3 * factor!r} {-0.7 * factor!r} {0.2 * factor!r}" '
+            'quat="0.9238795 0.2209424 0.3314136 0.1767767">' + text[start:end] + "</body>" + text[end:])
+
+
+@pytest.mark.parametrize("factor", [1e-3, 1e3])
+@pytest.mark.parametrize("case", ["to the other finger", "at a zero slope", "to the loop joint beyond the platform"])
+def test_a_coupling_s_verdict_is_the_same_in_other_units_and_a_moved_world(tmp_path, case, factor):
+    """The couplings' check compares ranks on lengths in the mechanism's own scale: the file at 1e-3 and 1e3 of its
+    size, hung in a moved and turned frame, gets MuJoCo's verdict on that file and the same one as written."""
+    text, output, joints = COUPLED[case]
+    moved = scaled_and_moved(text, factor)
+    plain = re.sub(r"<joint joint1=[^>]*/>", "", moved)
+    kept = mujoco_motions(moved, joints) == mujoco_motions(plain, joints)
+    assert kept is (case == "to the other finger")
+    path = tmp_path / "coupled.xml"
+    path.write_text(moved)
+    if kept:
+        _, report = read_mechanism_file(path, output=output)
+        assert any("constrains no motion of the mechanism analysed" in note for note in report.notes)
+    else:
+        with pytest.raises(ImportError_, match="which holds the mechanism analysed to fewer motions"):
+            read_mechanism_file(path, output=output)
