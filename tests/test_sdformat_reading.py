@@ -15,8 +15,10 @@ import json
 import xml.etree.ElementTree as ElementTree
 
 import numpy as np
+import pinocchio as pin
 import pytest
-from sdformat_models import NAMESPACE, five_bar_sdf, hexapod_legs
+from sdformat_models import NAMESPACE, PROXIMAL, five_bar_elbows, five_bar_sdf, hexapod_legs
+from test_io import HOME
 
 from helpers import one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy
@@ -124,6 +126,49 @@ def test_degrees_that_sdformat_does_not_define_are_refused(tmp_path, edit, needl
     text = edit(five_bar_sdf())
     assert text != five_bar_sdf()
     refused(tmp_path, text, *needles)
+
+
+def _parent_frame(offset: float, scale: float, relative: bool = False) -> str:
+    """The five-bar at ``scale`` with joint free1's <parent> a <frame> on proximal_1 drawn ``offset`` (in units of the
+    five-bar) along it beyond the elbow, where free1 is; ``relative``: free1's pose given relative to that frame."""
+    frame = (f'<frame name="pin1" attached_to="proximal_1"><pose relative_to="proximal_1">'
+             f'{scale * (PROXIMAL + offset)!r} 0 0 0 0 0</pose></frame>')
+    old = '<joint name="free1" type="continuous"><parent>proximal_1</parent>'
+    new = '<joint name="free1" type="continuous"><parent>pin1</parent>' + (
+        '<pose relative_to="pin1">0 0 0 0 0 0</pose>' if relative else "")
+    text_ = five_bar_sdf((scale, 0.3, (0.4 * scale, -0.2 * scale, 0.1 * scale)))
+    assert old in text_
+    return text_.replace(old, new).replace('<link name="base"/>', '<link name="base"/>' + frame)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_a_parent_frame_away_from_its_joint_is_said_with_its_distance(tmp_path, scale):
+    """SDFormat places a joint at its child frame and <pose>; a <parent> <frame> only names the link. A file drawn as
+    if the parent frame placed the joint (Drake's 'aspirational' four-bar) was read without a word: a note names the
+    joint, the frame and how far apart they are, at any scale; none when the frame is at the joint, or when the
+    joint's pose is given relative to it."""
+    away = read_closed_tree(write(tmp_path, _parent_frame(0.05, scale), "away.sdf"))
+    said = [note for note in away.notes if "'free1'" in note]
+    assert len(said) == 1 and "'pin1'" in said[0] and "relative_to" in said[0], away.notes
+    distance = float(said[0].split("'pin1' is ")[1].split(" m")[0])
+    assert distance == pytest.approx(0.05 * scale, rel=1e-3)
+    for text_ in (_parent_frame(0.0, scale), _parent_frame(0.05, scale, relative=True)):
+        tree = read_closed_tree(write(tmp_path, text_, "at.sdf"))
+        assert not any("<parent> is a <frame>" in note for note in tree.notes), tree.notes
+    # the joint is where SDFormat puts it: at the elbow (the child), not at the frame
+    model, data = away.model, away.model.createData()
+    pin.forwardKinematics(model, data, away.q_reference)
+    elbow = five_bar_elbows(HOME)[0]
+    at = data.oMi[model.getJointId("free1")].translation
+    turn = np.array([[np.cos(0.3), -np.sin(0.3)], [np.sin(0.3), np.cos(0.3)]])
+    expected = np.array([*(scale * turn @ elbow + scale * np.array([0.4, -0.2])), 0.1 * scale])
+    np.testing.assert_allclose(at, expected, atol=1e-9 * scale)
+
+
+def test_info_says_which_joint_s_parent_frame_is_away(tmp_path):
+    result = screwkit("info", write(tmp_path, _parent_frame(0.05, 1.0), "away.sdf"))
+    assert result.returncode == 0, result.stderr
+    assert "'free1' ('pin1' is 0.05 m from it)" in result.stdout, result.stdout
 
 
 # -- joint limits -----------------------------------------------------------------------------------------------------

@@ -330,6 +330,21 @@ def _one_hinge(builder, sdf, poses: dict, name: str, other: str, scale: float) -
                 and np.linalg.norm(gap - (gap @ axis) * axis) <= 1e-9 * scale)
 
 
+def _parent_frames_away(sdf: SdfModel, poses: dict, scale: float) -> list[str]:
+    """A note naming the joints whose ``<parent>`` is a ``<frame>`` away from the joint, the joint's pose not given
+    relative to it: SDFormat places a joint at its child frame (and its ``<pose>``); the parent frame only names the
+    link the joint is on, so a file drawn as if the parent frame placed the joint reads otherwise than meant."""
+    away = [f"{joint.name!r} ({joint.parent!r} is {distance:.3g} m from it)" for joint in sdf.joints
+            if joint.parent in sdf.frames and joint.relative_to != joint.parent
+            and (distance := float(np.linalg.norm(poses[joint.parent][:3, 3] - poses[joint.name][:3, 3])))
+            > 1e-9 * scale]
+    if not away:
+        return []
+    return [f"joint(s) {', '.join(away)}: each <parent> is a <frame> away from the joint, which SDFormat places at its "
+            "child frame and <pose> (the parent frame only names the link the joint is on): read so; if the parent "
+            "frame was meant to place the joint, write <pose relative_to='PARENT_FRAME'/> in the joint"]
+
+
 def read_sdformat(path: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
     """The closed tree of an SDFormat file's model (its loops closed by native joints; the module docstring)."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
@@ -353,6 +368,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     builder.frames()
     origins = np.array([poses[link][:3, 3] for link in sdf.links])
     scale = float(np.max(np.linalg.norm(origins - origins.mean(axis=0), axis=1), initial=0.0)) or 1.0
+    notes += _parent_frames_away(sdf, poses, scale)
     touches = Counter(end for joint in loops for end in ends[joint.name])  # the platform: where most loops close
     closing = {joint.name: _loop_closures(builder, joint, ends[joint.name], scale,
                                           touches[ends[joint.name][0]] > touches[ends[joint.name][1]])
