@@ -163,7 +163,8 @@ def analyze(
     its axis the joint is drawn); the joint's point projected on the wrench axis for a wrench with
     a pitch, a prismatic joint, a universal or ball joint written as revolutes
     (:func:`~screwkit.screw.algebra.joint_lines`) and an axis parallel to the force's (overridable
-    with ``iti_points`` / ``oti_points``, used as given). The chains' points are taken as given; the
+    with ``iti_points`` / ``oti_points``, projected on the wrench axis: the paper rotates a wrench about a point on
+    it). The chains' points are taken as given; the
     loader draws every revolute of a file at a point its geometry decides
     (:mod:`screwkit.closure.canonical`), so that ``L``, the representative and these points do not
     depend on where along its axis the file draws it.
@@ -213,7 +214,8 @@ def analyze(
     rank_tolerance : float
         Relative tolerance for dependent actuation wrenches (dimensionless).
     iti_points, oti_points : array_like, shape (..., a, 3), optional
-        Characteristic points overriding the defaults (world frame).
+        Characteristic points overriding the defaults (world frame), each projected on its actuator's wrench axis
+        (the point of the axis nearest to it; a pure couple keeps it).
     detail : bool
         Keep per-actuator and per-submechanism arrays (needed by :meth:`Indices.lmti_of`).
     keep_twists : bool

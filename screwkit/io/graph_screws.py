@@ -96,15 +96,20 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
 
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
     """World points (n, 3) where the leg's joints (to its children) and closures meet ``body`` (a hinge closed by
-    two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`)."""
+    two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`). A weld (``6d``) makes the
+    body at its other end part of ``body``: the leg meets ``body`` at the joint that moves that end, not at the
+    weld's frame, which a file may put anywhere (a CAD export welds each leg's last link to the platform at the
+    platform's origin)."""
     model = state.model
     points = [state.transforms[:, j, :3, 3] for j in leg.joints if model.parents[j] == body]
     for closure in leg.closures:
         if closure.axis_point:
             continue
-        for joint, placement in ((closure.joint_a, closure.placement_a), (closure.joint_b, closure.placement_b)):
+        for joint, placement, other in ((closure.joint_a, closure.placement_a, closure.joint_b),
+                                        (closure.joint_b, closure.placement_b, closure.joint_a)):
             if joint == body:
-                points.append((state.transforms[:, joint] @ placement)[:, :3, 3])
+                points.append(state.transforms[:, other, :3, 3] if closure.kind == "6d" and other != 0 else
+                              (state.transforms[:, joint] @ placement)[:, :3, 3])
     return points
 
 

@@ -117,10 +117,18 @@ def on_wrench_axis(joint_lanes, act, r, row, f0, f1, f2, axis0, axis1, axis2, pi
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def given_point(override, index, act, centres, r, inverse):
-    """A characteristic point the caller gave (world frame and unit), in working coordinates."""
-    return ((override[index, act, 0] - centres[0, r]) * inverse, (override[index, act, 1] - centres[1, r]) * inverse,
-            (override[index, act, 2] - centres[2, r]) * inverse)
+def given_point(override, index, act, centres, r, inverse, f0, f1, f2, axis0, axis1, axis2, forceful):
+    """A characteristic point the caller gave (world frame and unit), in working coordinates, projected on the axis
+    of the unit-force wrench (through ``axis``): the paper rotates a wrench about a point *on* it (Sec. 2, Eq. 5), and
+    a point beside it (the hinge of a universal joint whose other hinge is the actuator, on the actuator's own axis)
+    measured a velocity the wrench never meets. A couple keeps the point."""
+    p0 = (override[index, act, 0] - centres[0, r]) * inverse
+    p1 = (override[index, act, 1] - centres[1, r]) * inverse
+    p2 = (override[index, act, 2] - centres[2, r]) * inverse
+    if not forceful:
+        return p0, p1, p2
+    along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
+    return axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -130,9 +138,9 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
     """Each actuator's unit wrench about the centroid, its ITI (Eq. 6) and its OTI
     characteristic point, lane by lane.
 
-    The characteristic points are the caller's (``iti_override``, ``oti_override``), else the joint after the
-    actuated one (ITI) and the platform joint d (OTI), each where the wrench axis comes nearest to the joint's axis
-    (:func:`on_wrench_axis`).
+    The characteristic points are the caller's (``iti_override``, ``oti_override``) projected on the wrench axis
+    (:func:`given_point`), else the joint after the actuated one (ITI) and the platform joint d (OTI), each where the
+    wrench axis comes nearest to the joint's axis (:func:`on_wrench_axis`).
     """
     for act in range(forces.shape[0]):
         for r in range(width):
@@ -169,7 +177,8 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
             # Characteristic points on the wrench axis (unit force).
             axis0, axis1, axis2 = cross(f0, f1, f2, m0, m1, m2)
             if iti_override.shape[0] > 0:
-                p0, p1, p2 = given_point(iti_override, first_index + r, act, centres, r, inverse_lengths[r])
+                p0, p1, p2 = given_point(iti_override, first_index + r, act, centres, r, inverse_lengths[r], f0, f1, f2,
+                                         axis0, axis1, axis2, forceful)
             else:
                 p0, p1, p2 = on_wrench_axis(joint_lanes, act, r, 6, f0, f1, f2, axis0, axis1, axis2, pitch, forceful)
             # ITI (Eq. 6): power coefficient on the actuated joint's own twist.
@@ -180,7 +189,8 @@ def unit_wrench_lanes(forces, joint_lanes, pure_couple_sq, iti_override, oti_ove
             reference = omega if forceful else 0.0
             iti_lanes[act, r] = power_coefficient(work_done * factor, arm, reference, thresholds[r])
             if oti_override.shape[0] > 0:
-                p0, p1, p2 = given_point(oti_override, first_index + r, act, centres, r, inverse_lengths[r])
+                p0, p1, p2 = given_point(oti_override, first_index + r, act, centres, r, inverse_lengths[r], f0, f1, f2,
+                                         axis0, axis1, axis2, forceful)
             else:
                 p0, p1, p2 = on_wrench_axis(joint_lanes, act, r, 9, f0, f1, f2, axis0, axis1, axis2, pitch, forceful)
             point_lanes[act, 0, r] = p0

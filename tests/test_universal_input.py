@@ -1,0 +1,103 @@
+"""A leg driven by one hinge of a universal joint: the ITI's characteristic point on the actuation wrench.
+
+Gepetto's ``custom_1`` (``tests/data/gallery/published``, BSD-3-Clause) has three legs R-R-S under a foot: a hip
+(held), a motor whose hinge meets the knee's at one point O (a universal joint written as two revolutes), a shank to
+a ball S on the foot. The leg carries a constraint force along the shank (through O and S) and, as actuation
+wrench, the force through S reciprocal to the knee and orthogonal to that constraint (moments about the leg's
+platform joint S): along ``f = k - (k . d) d`` (k the knee's axis, d the shank's direction). The paper rotates a
+wrench about a characteristic point *on* it (Sec. 2, Eq. 5): the knee's point O, where the rest of the leg meets
+the motor's link, is on the motor's own axis and off that force, so the ITI read there was 0 at every pose, without
+a word; projected on the force it is S, and ITI = |f . v_S| / (|f| |v_S|), v_S = a x (S - O) for the motor's axis a.
+
+Checked on the model Gepetto's own loader builds (``tests/gepetto_loader.py``), closed by scipy with the motors at
+the values screwkit assembles, as written (where the knees are square to the motors and the shanks: ITI 1) and with
+the three knees' axes tilted in their joint frames (the same points, the same assembly at the file's
+configuration; ITI below 1); and the same in millimetres, in a moved world and with the robot.yaml listed back.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import yaml
+from gepetto_loader import gepetto_model
+from rod_lines import closed_by_scipy, joint_line
+from test_gallery_published import GEPETTO
+from test_gepetto_joint_types import variants
+
+from screwkit.io import graph_mechanism, read_closed_tree
+
+CUSTOM = GEPETTO / "custom_1"
+HIPS = ("mot_1", "mot_3", "mot_4")
+LEGS = {"mot_2": ("free_knee1", "to_rotule_1"), "mot_6": ("free_knee3", "to_rotule_3"),
+        "mot_5": ("free_knee2", "to_rotule_2")}  # each motor: its knee, its ball on the foot
+
+
+def tilted(tmp_path, axis: str = "0.45 -0.3 1"):
+    """custom_1 with every knee's axis written ``axis`` in its joint frame (the knee's point stays on the motor's
+    axis: still a universal joint, oblique)."""
+    text = (CUSTOM / "robot.urdf").read_text()
+    for knee, _ in LEGS.values():
+        text, count = re.subn(rf'(<joint name="{knee}" type="revolute">.*?<axis xyz=")0 0 1(")', rf"\g<1>{axis}\g<2>",
+                              text, count=1, flags=re.S)
+        assert count == 1, knee
+    (tmp_path / "robot.urdf").write_text(text)
+    (tmp_path / "robot.yaml").write_text((CUSTOM / "robot.yaml").read_text())
+    return tmp_path / "robot.urdf"
+
+
+def screwkit_itis(path, **options):
+    """screwkit's ITI of each motor (by joint name) and the motors' values at the file's configuration."""
+    graph = graph_mechanism(read_closed_tree(path, lock=HIPS, **options))  # (a ball inside each leg: a graph)
+    result = graph.indices()
+    itis = {name.split(":")[-1]: float(value) for name, value in zip(result.actuators, result.iti_actuators)}
+    motors = {name.split(":")[-1]: value for name, value in result.joint_values.items()
+              if name.split(":")[-1] in LEGS}
+    return itis, motors, result
+
+
+def force_line_itis(path, motors: dict[str, float]) -> dict[str, float]:
+    """Each motor's ITI from the leg's lines alone, on Gepetto's own reading of ``path`` closed by scipy with the
+    hips at 0 and the motors at ``motors``."""
+    model = gepetto_model(path, path.parent / "robot.yaml")
+    spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
+    pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
+    data, _ = closed_by_scipy(model, pairs, {name: 0.0 for name in HIPS} | motors)
+    itis = {}
+    for motor, (knee, ball) in LEGS.items():
+        origin, a = joint_line(model, data, motor)
+        o, k = joint_line(model, data, knee)
+        s = data.oMi[model.getJointId(ball)].translation
+        assert abs(np.dot(o - origin, np.cross(a, k))) < 1e-9 and np.linalg.norm(np.cross(a, k)) > 0.1  # they meet
+        d = (s - o) / np.linalg.norm(s - o)
+        f = k - (k @ d) * d
+        v = np.cross(a, s - o)
+        itis[motor] = abs(f @ v) / (np.linalg.norm(f) * np.linalg.norm(v))
+    return itis
+
+
+@pytest.mark.parametrize("knees", ["as written", "tilted"])
+def test_a_motor_that_is_one_hinge_of_a_universal_joint_has_the_force_line_iti(tmp_path, knees):
+    path = CUSTOM / "robot.urdf" if knees == "as written" else tilted(tmp_path)
+    itis, motors, result = screwkit_itis(path)
+    assert sorted(motors) == sorted(LEGS) and result.dof == 3
+    expected = force_line_itis(path, motors)
+    for motor in LEGS:
+        assert itis[motor] == pytest.approx(expected[motor], abs=1e-9), motor
+    if knees == "tilted":
+        assert all(0.05 < value < 0.99 for value in itis.values()), itis  # neither singular nor trivially 1
+    else:
+        assert all(value == pytest.approx(1.0, abs=1e-9) for value in itis.values()), itis
+
+
+def test_the_oblique_universal_input_is_the_same_in_millimetres_in_a_moved_world_and_listed_back(tmp_path):
+    (tmp_path / "tilted").mkdir()
+    path = tilted(tmp_path / "tilted")
+    itis, motors, result = screwkit_itis(path)
+    for name, other_path, options in variants(path, tmp_path):
+        other, other_motors, other_result = screwkit_itis(other_path, **options)
+        assert other == pytest.approx(itis, abs=1e-9), name
+        assert other_motors == pytest.approx(motors, abs=1e-8), name
+        assert other_result.lmti == pytest.approx(result.lmti, abs=1e-9), name
