@@ -140,6 +140,22 @@ def test_a_stewart_platform_through_the_graph_has_the_indices_of_its_serial_legs
         [a.split(":")[1] for a in serial.actuators]
     assert_indices_close(serial, result, TOLERANCE, fields=("iti", "iti_actuators", "oti_actuators",
                                                             "oti_submechanisms", "lmti"))
+    # and the leg lines' own: each leg's force along its line from the base's universal joint B_k to the
+    # platform's T_k; T_k the twist reciprocal to the five other lines; OTI_k = |f . v(T_k)| / |v(T_k)|
+    model = graph.tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, np.asarray(graph.q).reshape(-1))
+    lines = []
+    for k in range(1, 7):
+        base, top = (data.oMi[model.getJointId(f"{name}{k}")].translation for name in ("r_xb", "r_xt"))
+        lines.append(((top - base) / np.linalg.norm(top - base), top))
+    expected = []
+    for k, (force, top) in enumerate(lines):
+        rows = np.array([np.concatenate([np.cross(t, f), f]) for j, (f, t) in enumerate(lines) if j != k])
+        omega, v0 = np.split(np.linalg.svd(rows)[2][-1], 2)  # (m_0, f) . (omega, v_0) = 0 for the five
+        velocity = v0 + np.cross(omega, top)
+        expected.append(abs(force @ velocity) / np.linalg.norm(velocity))
+    np.testing.assert_allclose(np.ravel(result.oti_actuators), expected, atol=TOLERANCE)
 
 
 @pytest.mark.parametrize("name", bundled_names())
