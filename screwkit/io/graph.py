@@ -375,12 +375,16 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
         legs.append(GraphLeg(body_names.get(first, tree.written_joint(model.names[first])), joints, tuple(ends), spine,
                              actuated))
         placed.update(actuated)
-    if model.parents[platform] == 0:
+    if model.parents[platform] == 0 and model.joints[platform].nv != 6:
         kind, _ = joint_kind(model, platform)
-        if model.joints[platform].nv != 6:
-            raise ImportError_(f"{tree.source}: the platform body is joined to the base by joint "
-                               f"{model.names[platform]!r} ({kind}): a leg without links, which screwkit does not "
-                               "analyse; free the platform (a free joint) or join it through a leg.")
+        name = tree.written_joint(model.names[platform])
+        if platform in motors:
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} ({kind}) turns the platform body on the base "
+                               "directly, with no link between: a leg screwkit does not analyse (the actuation wrench "
+                               "acts on no link of its own).")
+        # a pin (or slide, ball...) holding the platform on the base: a passive leg of that one joint, whose twist
+        # system is the joint's (a foot on its ankle pin, turned by a crank and rod)
+        legs.append(GraphLeg(name, (platform,), (), True, ()))
     for joint, name in motors.items():
         if joint not in placed:
             raise ImportError_(f"{tree.source}: actuated joint {name!r} is on no leg (a leg joins the base to the "
@@ -490,7 +494,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
     check_couplings(tree, q, scale, {joint for leg in legs for joint in leg.joints}, platform, report.notes)
-    check_actuators(tree, legs)
+    check_actuators(tree, legs, platform)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
     if at_file:

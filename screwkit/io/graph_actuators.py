@@ -9,9 +9,9 @@ from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_t
 __all__ = ["check_actuators", "serial_stage"]
 
 
-def check_actuators(tree: ClosedTree, legs) -> None:
+def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
     """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
-    actuator is named, with the option that holds it)."""
+    actuator is named, with the option that holds it); ``platform``: the platform body's joint."""
     model = tree.model
     if not any(leg.actuators for leg in legs):
         raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
@@ -40,7 +40,7 @@ def check_actuators(tree: ClosedTree, legs) -> None:
                               f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
                               "analysed on it")
             else:
-                advice = _transmission_advice(tree, leg)
+                advice = _transmission_advice(tree, leg, platform)
             raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
                                f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
                                "one (a leg with loops and several actuators has no per-actuator twist system yet)"
@@ -51,15 +51,21 @@ def check_actuators(tree: ClosedTree, legs) -> None:
                                "actuator drives one revolute or prismatic joint.")
 
 
-def _transmission_advice(tree: ClosedTree, leg) -> str:
+def _transmission_advice(tree: ClosedTree, leg, platform: int) -> str:
     """For a leg whose actuators no one joint carries: an actuator that drives, through a loop of the leg, a passive
     joint carrying every other actuator (a knee motor turning the shin, and the ankle's motors, through a four-bar),
-    with the options that hold both; or nothing."""
+    with the options that hold both; or nothing. Only where a loop of the leg still reaches the platform from
+    beyond that joint: else the other actuators would be left driving the platform in series (a foot motor on an
+    ankle that a crank and rod turn: that loop ends on the ankle, not on the foot)."""
     model = tree.model
     for actuator in leg.actuators:
         others = [other for other in leg.actuators if other != actuator]
         carriers = [joint for joint in sorted(leg.joints) if joint not in leg.actuators
-                    and joint not in path_to(model, actuator) and all(joint in path_to(model, o) for o in others)]
+                    and joint not in path_to(model, actuator) and all(joint in path_to(model, o) for o in others)
+                    and any(platform in path_to(model, end) and joint in path_to(model, other_end)
+                            for closure in leg.closures
+                            for end, other_end in ((closure.joint_a, closure.joint_b),
+                                                   (closure.joint_b, closure.joint_a)))]
         if carriers:
             name, carrier = (tree.written_joint(model.names[j]) for j in (actuator, carriers[0]))
             rest = ", ".join(tree.written_joint(model.names[o]) for o in others)

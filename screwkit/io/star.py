@@ -308,6 +308,16 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     couplings = [c for c, onto in zip(tree.closures, onto_platform) if not onto]
     legs = [spine] + _platform_legs(tree, data, [c for c, onto in zip(tree.closures, onto_platform) if onto],
                                     platform, scale, report)
+    chain_joints = set(path_to(model, platform))
+    if len(legs) == 1 and not any(chain_joints & set(path_to(model, end)) for closure in tree.closures
+                                  for end in (closure.joint_a, closure.joint_b)):
+        # every loop closes away from the platform's chain (the joints held may have made it so)
+        chain = ", ".join(tree.written_joint(model.names[j]) for j in path_to(model, platform))
+        raise ImportError_(f"{tree.source}: no loop acts on the platform {body!r}: it hangs on its own chain "
+                           f"({chain}) alone, a serial arm, which screwkit does not analyse"
+                           + (" (with the joints --lock holds)" if tree.locked else "")
+                           + "; name another --output, on a body the loops reach" + (", or hold fewer joints"
+                                                                                      if tree.locked else "") + ".")
     owner: dict[int, str] = {}
     for leg in legs:
         if not leg.joints and not leg.base_dofs and leg.loop == "fixed":
