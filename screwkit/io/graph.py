@@ -392,7 +392,7 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     return sorted(legs, key=lambda leg: leg.name)
 
 
-def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None:
+def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform: int) -> None:
     """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
     motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
     configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
@@ -418,7 +418,8 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby) -> None
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
         if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
-            below = [model.names[j] for j in path_to(model, actuator)[:-1] if j in leg.joints]  # carrying it
+            below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
+                     if j in leg.joints and j != platform]
             one = len(below) == 1
             hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
                     f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else "")
@@ -502,7 +503,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
             samples = closed_samples(tree, q, scale, count=3)
             return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else []
 
-        _check_legs(tree, legs, screws, nearby)
+        _check_legs(tree, legs, screws, nearby, platform)
         _check_output(tree, screws, report.platform_body, legs)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]

@@ -120,7 +120,14 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                           closure.kind, closure.axis_point)
         a_path, b_path = b_path, a_path
     elif on_platform_a:
-        raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side.")
+        bodies = [frame.name for frame in model.frames if int(frame.parentJoint) == platform
+                  and str(frame.type) == "BODY"]
+        named = f"body {bodies[0]!r}" if bodies else f"the body joint {model.names[platform]!r} turns"
+        raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side (the "
+                           f"platform: {named}, "
+                           + ("as --output names it" if tree.output else "taken as the file names none")
+                           + "): a loop the platform carries, which joins it to no leg; --output names another "
+                           "platform, a body the loops reach from the base.")
     after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
     frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
     kinds = [joint_kind(model, joint) for joint in after]
@@ -134,9 +141,9 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
             return _Leg([], kind, homogeneous(data.oMi[after[0]]), zero, axis, [(kind, zero[:3, :3] @ axis,
                         zero[:3, 3])], closure.name, sources=(closure,), base_dofs=base)
         if after:
-            raise ImportError_(f"{tree.source}: closure {closure.name!r} (3d) ends on joints "
-                               f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
-                               f"screwkit supports{_held_beyond(tree, after)}.")
+            _refuse_beyond(tree, after, f"closure {closure.name!r} (3d) ends on joints "
+                           f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
+                           "screwkit supports")
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
         return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
@@ -164,20 +171,25 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         world = (np.asarray(data.oMi[after[1]].rotation) @ kinds[1][1], zero[:3, :3] @ kinds[0][1])  # as assembled
         return _Leg(a_path, "universal", predecessor, at_point(zero, centre), axes[0],
                     [("revolute", axis, centre) for axis in world], closure.name, sources=(closure,), axis2=axes[1])
-    raise ImportError_(f"{tree.source}: closure {closure.name!r} ends on joints "
-                       f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
-                       "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
-                       "(a universal joint), or three revolute joints through one point (a spherical joint)"
-                       f"{_held_beyond(tree, after)}.")
+    _refuse_beyond(tree, after, f"closure {closure.name!r} ends on joints "
+                   f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
+                   "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
+                   "(a universal joint), or three revolute joints through one point (a spherical joint)")
 
 
-def _held_beyond(tree: ClosedTree, after: list[int]) -> str:
-    """The options that hold the joints between the platform body and a closure (the bodies beyond then move with
-    the platform as one body: two platforms joined by a ball, analysed as one)."""
+def _refuse_beyond(tree: ClosedTree, after: list[int], what: str) -> None:
+    """Refuse a closure that ends on joints ``after`` between the platform body and it (``what`` says so), with the
+    options that hold them (the bodies beyond then move with the platform as one body: two platforms joined by a
+    ball, analysed as one); with an actuated joint among them, no such advice (held, it would drive nothing: the
+    platform carries the actuator, which drives the loop from there) but the graph's reading, which models it."""
     names = list(dict.fromkeys(tree.written_joint(tree.model.names[j]) for j in after))
+    motors = [name for name in names if name in tree.motors]
+    if motors:
+        raise LegWithLoops(f"{tree.source}: {what}, and actuated joint(s) {', '.join(motors)} among them (an actuator "
+                           "the platform carries drives the loop)" + GRAPH_HINT + ".")
     them = "it" if len(names) == 1 else "them"
-    return (f"; --lock {' --lock '.join(names)} holds {them} where the file puts {them}, the bodies beyond moving with "
-            "the platform as one body")
+    raise ImportError_(f"{tree.source}: {what}; --lock {' --lock '.join(names)} holds {them} where the file puts "
+                       f"{them}, the bodies beyond moving with the platform as one body.")
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,
