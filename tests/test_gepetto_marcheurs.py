@@ -15,6 +15,7 @@ files since removed from that repository's tree), each with its hip and knee hel
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import yaml
 from gepetto_loader import gepetto_model
@@ -90,3 +91,35 @@ def test_a_foot_left_on_its_motor_alone_is_refused_in_one_line_and_not_advised(t
         result = screwkit(command, BALL_ANKLE, "--output", "pied", *[f"--lock={name}" for name in held])
         one_line_error(result, "no loop acts on the platform 'pied'", "(mot_pied_droit)", "serial arm", "--output",
                        "hold fewer joints")
+
+
+LUDO = GEPETTO / "robot_ludo" / "robot.urdf"
+
+
+def ludo(path, **options):
+    graph = graph_mechanism(read_closed_tree(path, output="effecteur", lock=("pivot2",), **options))
+    return graph, graph.indices()
+
+
+def test_a_slide_that_carries_the_platform_itself_has_the_iti_of_its_force_along_it(tmp_path):
+    """robot_ludo with the effector's pin held: its R-P leg's slide carries the effector with no link after it. A
+    slide's ITI takes no point (its twist turns nothing): the cosine between the actuation force and the slide,
+    read here from the force screwkit derives and the slide's axis in Pinocchio's frame. It was refused, "no joint
+    after its actuator"."""
+    graph, result = ludo(LUDO)
+    assert result.dof == 2 and sorted(name.split(":")[-1] for name in result.actuators) == ["motor1", "motor2"]
+    model = graph.tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, np.asarray(graph.q).reshape(-1))
+    slide = data.oMi[model.getJointId("motor1")].rotation[:, 2]  # JointModelPZ
+    index = [name.split(":")[-1] for name in result.actuators].index("motor1")
+    force = np.asarray(result.actuation_wrenches)[index, :3]
+    assert result.iti_actuators[index] == pytest.approx(abs(force @ slide) / np.linalg.norm(force), abs=1e-12)
+    assert 0.5 < result.iti_actuators[index] <= 1.0
+    for name, path, options in variants(LUDO, tmp_path):
+        _, other = ludo(path, **options)
+        order = [other.actuators.index(actuator) for actuator in result.actuators]
+        np.testing.assert_allclose(np.ravel(other.iti_actuators)[order], np.ravel(result.iti_actuators), atol=1e-9,
+                                   err_msg=name)
+        np.testing.assert_allclose(np.ravel(other.oti_actuators)[order], np.ravel(result.oti_actuators), atol=1e-9,
+                                   err_msg=name)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import yaml
 from gepetto_loader import gepetto_model
@@ -27,6 +28,7 @@ from rod_lines import closed_by_scipy, joint_line
 from test_gallery_published import GEPETTO
 from test_gepetto_joint_types import variants
 
+from helpers import one_line_error, screwkit
 from screwkit.io import graph_mechanism, read_closed_tree
 
 CUSTOM = GEPETTO / "custom_1"
@@ -101,3 +103,33 @@ def test_the_oblique_universal_input_is_the_same_in_millimetres_in_a_moved_world
         assert other == pytest.approx(itis, abs=1e-9), name
         assert other_motors == pytest.approx(motors, abs=1e-8), name
         assert other_result.lmti == pytest.approx(result.lmti, abs=1e-9), name
+
+
+def test_a_weld_open_in_rotation_alone_says_its_angle_as_gepetto_s_model_has_it():
+    """custom_1's two welds are drawn with their origins together and their frames turned apart: the report said
+    "gap 2e-14 m" alone, as if they were closed; it now says the angle too, the one Gepetto's own model has between
+    the two frames at the file's joint values (all zero)."""
+    result = screwkit("info", CUSTOM / "robot.urdf", *[f"--lock={name}" for name in HIPS])
+    assert result.returncode == 0, result.stderr
+    model = gepetto_model(CUSTOM / "robot.urdf", CUSTOM / "robot.yaml")
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    spec = yaml.safe_load((CUSTOM / "robot.yaml").read_text())
+    for first, second in spec["closed_loop"]:
+        a, b = (data.oMf[model.getFrameId(name)] for name in (first, second))
+        angle = np.degrees(np.linalg.norm(pin.log3(a.rotation.T @ b.rotation)))
+        assert angle > 1.0
+        line = next(line for line in result.stdout.splitlines() if line.strip().startswith(f"closure {first}-{second}")
+                    or line.strip().startswith(f"closure {second}-{first}"))
+        assert f" and {angle:.3g} deg at the file's joint values" in line, (angle, line)
+
+
+def test_the_refusal_names_every_leg_s_serial_stage_at_once():
+    """Each of the three legs has its hip motor before the parallel part: one refusal named one hip a run, three runs
+    to learn the set; it names all three, and with them held the foot opens."""
+    message = one_line_error(screwkit("info", CUSTOM / "robot.urdf"), "leg 'cuisse2' has loops inside it",
+                             "legs 'cuisse2_2', 'cuisse2_3' likewise, all at once: --lock mot_1 --lock mot_3 "
+                             "--lock mot_4")
+    held = message.rsplit("all at once: ", 1)[1].rstrip(".").replace("--lock ", "").split()
+    assert sorted(held) == sorted(HIPS)
+    assert screwkit("info", CUSTOM / "robot.urdf", *[f"--lock={name}" for name in held]).returncode == 0

@@ -40,6 +40,8 @@ many."""
 LEVI_CIVITA = np.zeros((3, 3, 3))
 LEVI_CIVITA[[0, 1, 2], [1, 2, 0], [2, 0, 1]], LEVI_CIVITA[[0, 1, 2], [2, 0, 1], [1, 2, 0]] = 1.0, -1.0
 INCONSISTENCY_TOLERANCE = FILE_ROUNDING
+TURN_SAID = 1e-6
+"""A weld's angle (rad) at the start that the report says beside its gap (below it, a file's rounding)."""
 """Residual (the same units) that a file's closures may keep when no configuration closes them all exactly:
 redundant closures written with rounded numbers (a hinge written as two ball joints on its axis, by a CAD
 exporter) disagree by that much. The assembly then closes them as well as they close, and says by how much."""
@@ -179,6 +181,7 @@ class ImportReport:
     dropped: list[str] = field(default_factory=list)
     gaps_before: dict = field(default_factory=dict)
     gaps_after: dict = field(default_factory=dict)
+    turns_before: dict = field(default_factory=dict)  # a weld's angle at the start, where it is open in rotation
     motors: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     task_coordinates: str = ""
@@ -191,7 +194,9 @@ class ImportReport:
         planar = ", planar" if self.planar else ""
         out = [f"{self.source}: {self.file_format}{platform}, output {self.output}{planar}"]
         for name in self.gaps_before:
-            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} {self.unit} at {self.values}, "
+            turn = self.turns_before.get(name, 0.0)
+            turned = f" and {np.degrees(turn):.3g} deg" if turn > TURN_SAID else ""
+            out.append(f"  closure {name}: gap {self.gaps_before[name]:.3g} {self.unit}{turned} at {self.values}, "
                        f"{self.gaps_after[name]:.1e} after assembly")
         out += [f"  chain {line}" for line in self.chains]
         out.append(f"  actuators: {', '.join(self.motors)}")
@@ -387,6 +392,21 @@ def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     pin.forwardKinematics(tree.model, data, q)
     return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c in tree.closures for a, b in [_frames(
         tree.model, data, c)]}
+
+
+def closure_turns(tree: ClosedTree, q: NDArray) -> dict[str, float]:
+    """The angle (rad) between the two frames of every ``6d`` closure at q: a weld can be open in rotation alone."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    data = tree.model.createData()
+    pin.forwardKinematics(tree.model, data, q)
+    turns = {}
+    for closure in tree.closures:
+        if closure.kind == "6d":
+            a, b = _frames(tree.model, data, closure)
+            cosine = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1.0) / 2.0
+            turns[closure.name] = float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    return turns
 
 
 def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, float]:

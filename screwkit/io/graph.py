@@ -58,6 +58,7 @@ from screwkit.io.closed_tree import (
     ImportReport,
     assemble,
     closure_gaps,
+    closure_turns,
     homogeneous,
     joint_kind,
     joint_value,
@@ -521,6 +522,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                            "hinges parallel only to the file's rounding: the graph reads a file as written).")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
+    report.turns_before = closure_turns(tree, tree.q_reference)
     report.motors = [model.names[leg.actuators[0]] for leg in legs if leg.actuators]
     report.chains = [f"{leg.name}: {len(leg.joints)} joints ({', '.join(model.names[j] for j in leg.joints)}), "
                      f"{len(leg.closures)} closure(s), twist system of dimension {len(chain.twists)}"

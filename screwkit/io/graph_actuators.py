@@ -11,47 +11,57 @@ __all__ = ["check_actuators", "serial_stage"]
 
 def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
     """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
-    actuator is named, with the option that holds it); ``platform``: the platform body's joint."""
+    actuator is named, with the option that holds it, and every other leg's that needs one, so that one run names
+    them all); ``platform``: the platform body's joint."""
     model = tree.model
     if not any(leg.actuators for leg in legs):
         raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
                            "--actuate names the driven joints.")
+    several = [leg for leg in legs if len(leg.actuators) > 1]
+    if several:
+        leg = several[0]
+        advice, _ = _leg_advice(tree, leg, platform)
+        others = [(other, _leg_advice(tree, other, platform)[1]) for other in several[1:]]
+        if advice and others and all(locks for _, locks in others):
+            every = _leg_advice(tree, leg, platform)[1] + [name for _, locks in others for name in locks]
+            advice += (f"; legs {', '.join(repr(other.name) for other, _ in others)} likewise, all at once: --lock "
+                       + " --lock ".join(dict.fromkeys(every)))
+        raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
+                           f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
+                           "one (a leg with loops and several actuators has no per-actuator twist system yet)"
+                           f"{advice}.")
     for leg in legs:
-        if not leg.actuators:  # a passive leg: it constrains the platform, its twist system is the whole of it
-            continue
-        if len(leg.actuators) != 1:
-            stage = serial_stage(model, leg)
-            advice = ""
-            if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
-                names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
-                given = [name for name in names if name in tree.actuated]
-                advice = (f"; joints {', '.join(names)} carry every actuator of it in turn (a serial stage before the "
-                          f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn"
-                          + (f" (leave {', '.join(given)} out of --actuate)" if given else ""))
-            elif stage:
-                name = tree.written_joint(model.names[stage[0]])
-                carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
-                           else f"joint {name!r} carries every actuator of it")
-                advice = (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs "
-                          "on the body it turns" + (f" (leave {name} out of --actuate)" if name in tree.actuated
-                                                    else ""))
-                if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
-                    advice = (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's "
-                              f"pelvis): --lock {name} holds the base where the file puts it, and the legs are "
-                              "analysed on it")
-            else:
-                advice = _transmission_advice(tree, leg, platform)
-            raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                               f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
-                               "one (a leg with loops and several actuators has no per-actuator twist system yet)"
-                               f"{advice}.")
-        kind, _ = joint_kind(model, leg.actuators[0])
-        if kind not in ("revolute", "prismatic"):
-            raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
-                               "actuator drives one revolute or prismatic joint.")
+        if leg.actuators:
+            kind, _ = joint_kind(model, leg.actuators[0])
+            if kind not in ("revolute", "prismatic"):
+                raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
+                                   "actuator drives one revolute or prismatic joint.")
 
 
-def _transmission_advice(tree: ClosedTree, leg, platform: int) -> str:
+def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
+    """For a leg with several actuators: what holds the serial stage that carries them (the refusal's end) and the
+    joints it holds (none: no advice)."""
+    model = tree.model
+    stage = serial_stage(model, leg)
+    if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
+        names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
+        given = [name for name in names if name in tree.actuated]
+        return (f"; joints {', '.join(names)} carry every actuator of it in turn (a serial stage before the "
+                f"parallel part): --lock {' --lock '.join(names)} analyses the legs on the body they turn"
+                + (f" (leave {', '.join(given)} out of --actuate)" if given else "")), names
+    if stage:
+        name = tree.written_joint(model.names[stage[0]])
+        if joint_kind(model, stage[0])[0] == "JointModelFreeFlyer":  # (unnamed in an MJCF file: Pinocchio's)
+            return (f"; every actuator rides on the free joint {name!r} (a floating base: a humanoid's pelvis): "
+                    f"--lock {name} holds the base where the file puts it, and the legs are analysed on it"), [name]
+        carrier = (f"the actuated joint {name!r} carries every other one" if stage[0] in leg.actuators
+                   else f"joint {name!r} carries every actuator of it")
+        return (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs on the body "
+                "it turns" + (f" (leave {name} out of --actuate)" if name in tree.actuated else "")), [name]
+    return _transmission_advice(tree, leg, platform)
+
+
+def _transmission_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
     """For a leg whose actuators no one joint carries: an actuator that drives, through a loop of the leg, a passive
     joint carrying every other actuator (a knee motor turning the shin, and the ankle's motors, through a four-bar),
     with the options that hold both; or nothing. Only where a loop of the leg still reaches the platform from
@@ -71,8 +81,8 @@ def _transmission_advice(tree: ClosedTree, leg, platform: int) -> str:
             rest = ", ".join(tree.written_joint(model.names[o]) for o in others)
             return (f"; actuated joint {name!r} drives joint {carrier!r} through a loop, and {carrier!r} carries every "
                     f"other actuator of it ({rest}): --lock {name} --lock {carrier} analyses the legs on the body "
-                    f"{carrier!r} turns")
-    return ""
+                    f"{carrier!r} turns"), [name, carrier]
+    return "", []
 
 
 def serial_stage(model, leg) -> list[int]:

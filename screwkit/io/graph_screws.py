@@ -154,6 +154,11 @@ class LegScrews:
     outside: NDArray[np.float64]
 
 
+def model_name(tree: ClosedTree, joint: int) -> str:
+    """The file's name of the model's joint ``joint`` (a ball or universal joint written as hinges: the file's)."""
+    return tree.written_joint(tree.model.names[joint])
+
+
 def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
     """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
@@ -177,9 +182,14 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
         if leg.spine:
             oti.append(state.transforms[:, platform, :3, 3])
-        if not iti or not oti:
-            raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint after its actuator or none on the "
-                               "platform.")
+        if not iti and kinematics.kinds[actuator] == "prismatic":  # a slide's ITI takes no point: its twist turns
+            iti = [state.transforms[:, actuator, :3, 3]]  # nothing (the slide carrying the platform itself)
+        if not iti:
+            raise ImportError_(f"{tree.source}: leg {leg.name!r}: actuated joint {model_name(tree, actuator)!r} turns "
+                               "the platform itself, with no link after it: its ITI has no point where the actuation "
+                               "wrench acts on a link of the leg.")
+        if not oti:
+            raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
         out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, state.transforms[:, actuator, :3, 3],
                              np.mean(iti, axis=0), np.mean(oti, axis=0), np.linalg.norm(own - projection, axis=1)))
     return out, state

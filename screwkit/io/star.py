@@ -62,6 +62,7 @@ from screwkit.io.closed_tree import (
     ball_line,
     ball_of_revolutes,
     closure_gaps,
+    closure_turns,
     homogeneous,
     inverse,
     joint_kind,
@@ -299,6 +300,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     model = tree.model
     report = ImportReport(source=tree.source, file_format=tree.file_format, unit=tree.unit, values=tree.start_phrase())
     report.gaps_before = closure_gaps(tree, tree.q_reference)
+    report.turns_before = closure_turns(tree, tree.q_reference)
     q, scale = assemble(tree, held=tree.initial_joints())
     report.gaps_after = closure_gaps(tree, q)
     changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
