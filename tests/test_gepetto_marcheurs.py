@@ -15,9 +15,9 @@ files since removed from that repository's tree), each with its hip and knee hel
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 import pytest
 import yaml
+from along_axes import shifted_along_axis
 from gepetto_loader import gepetto_model
 from rod_lines import closed_by_scipy, joint_line
 from test_gallery_published import GEPETTO
@@ -96,30 +96,26 @@ def test_a_foot_left_on_its_motor_alone_is_refused_in_one_line_and_not_advised(t
 LUDO = GEPETTO / "robot_ludo" / "robot.urdf"
 
 
-def ludo(path, **options):
-    graph = graph_mechanism(read_closed_tree(path, output="effecteur", lock=("pivot2",), **options))
-    return graph, graph.indices()
+def test_a_slide_that_carries_the_platform_itself_is_refused_in_one_line():
+    """robot_ludo with the effector's pin held: its R-P leg's slide carries the effector with no link after it. Taken
+    about the effector's joint, which a file may draw anywhere on the slide's line, its actuation wrench turned with
+    that point (ITI 0.9964 to 0.9987, OTI 0.45 to 0.90 as it was drawn 0.3 m either way): refused, naming the slide;
+    with the base's pivot held instead, the R-P-R leg opens."""
+    message = one_line_error(screwkit("info", LUDO, "--output", "effecteur", "--lock", "pivot2"), "leg 'part_2_3'",
+                             "actuated joint 'motor1' moves the platform itself, with no link after it")
+    assert "Traceback" not in message
+    assert screwkit("info", LUDO, "--output", "effecteur", "--lock", "pivot").returncode == 0
 
 
-def test_a_slide_that_carries_the_platform_itself_has_the_iti_of_its_force_along_it(tmp_path):
-    """robot_ludo with the effector's pin held: its R-P leg's slide carries the effector with no link after it. A
-    slide's ITI takes no point (its twist turns nothing): the cosine between the actuation force and the slide,
-    read here from the force screwkit derives and the slide's axis in Pinocchio's frame. It was refused, "no joint
-    after its actuator"."""
-    graph, result = ludo(LUDO)
-    assert result.dof == 2 and sorted(name.split(":")[-1] for name in result.actuators) == ["motor1", "motor2"]
-    model = graph.tree.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, np.asarray(graph.q).reshape(-1))
-    slide = data.oMi[model.getJointId("motor1")].rotation[:, 2]  # JointModelPZ
-    index = [name.split(":")[-1] for name in result.actuators].index("motor1")
-    force = np.asarray(result.actuation_wrenches)[index, :3]
-    assert result.iti_actuators[index] == pytest.approx(abs(force @ slide) / np.linalg.norm(force), abs=1e-12)
-    assert 0.5 < result.iti_actuators[index] <= 1.0
-    for name, path, options in variants(LUDO, tmp_path):
-        _, other = ludo(path, **options)
-        order = [other.actuators.index(actuator) for actuator in result.actuators]
-        np.testing.assert_allclose(np.ravel(other.iti_actuators)[order], np.ravel(result.iti_actuators), atol=1e-9,
-                                   err_msg=name)
-        np.testing.assert_allclose(np.ravel(other.oti_actuators)[order], np.ravel(result.oti_actuators), atol=1e-9,
-                                   err_msg=name)
+@pytest.mark.parametrize("joint, distance", [("libre_cheville", 0.1), ("libre_cheville", -0.5), (CRANK, -0.2)])
+def test_the_foot_pin_or_crank_drawn_elsewhere_along_its_axis_changes_no_index(tmp_path, joint, distance):
+    """The foot's pin drawn 0.1 m or -0.5 m along its axis gave a CTI of 0.9960 or 0.8914 for 0.9987 (its drawn point
+    was the passive leg's); the crank's, 1e-4 on the CTI. The pin is now at the foot of the perpendicular from the
+    rod's ball, the crank where its ball's perpendicular meets it."""
+    result, crank, knee = ankle(ANKLE)
+    (tmp_path / "robot.urdf").write_text(shifted_along_axis(ANKLE.read_text(), joint, distance))
+    (tmp_path / "robot.yaml").write_text((ANKLE.parent / "robot.yaml").read_text())
+    other, other_crank, other_knee = ankle(tmp_path / "robot.urdf")
+    for name in ("iti_actuators", "oti_actuators", "lmti", "cti"):
+        np.testing.assert_allclose(getattr(other, name), getattr(result, name), atol=1e-9, err_msg=name)
+    assert (other_crank, other_knee) == pytest.approx((crank, knee), abs=1e-8)

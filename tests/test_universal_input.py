@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
+from along_axes import shifted_along_axis
 from gepetto_loader import gepetto_model
 from rod_lines import closed_by_scipy, joint_line
 from test_gallery_published import GEPETTO
@@ -40,6 +41,7 @@ LEGS = {"mot_2": ("free_knee1", "to_rotule_1"), "mot_6": ("free_knee3", "to_rotu
 def tilted(tmp_path, axis: str = "0.45 -0.3 1"):
     """custom_1 with every knee's axis written ``axis`` in its joint frame (the knee's point stays on the motor's
     axis: still a universal joint, oblique)."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
     text = (CUSTOM / "robot.urdf").read_text()
     for knee, _ in LEGS.values():
         text, count = re.subn(rf'(<joint name="{knee}" type="revolute">.*?<axis xyz=")0 0 1(")', rf"\g<1>{axis}\g<2>",
@@ -133,3 +135,20 @@ def test_the_refusal_names_every_leg_s_serial_stage_at_once():
     held = message.rsplit("all at once: ", 1)[1].rstrip(".").replace("--lock ", "").split()
     assert sorted(held) == sorted(HIPS)
     assert screwkit("info", CUSTOM / "robot.urdf", *[f"--lock={name}" for name in held]).returncode == 0
+
+
+@pytest.mark.parametrize("joint, distance", [("free_knee1", 0.05), ("free_knee3", -0.2), ("mot_6", 0.1),
+                                             ("mot_5", -0.04)])
+def test_a_joint_drawn_elsewhere_along_its_axis_changes_no_index(tmp_path, joint, distance):
+    """The same robot with one joint drawn elsewhere on its line (its child's joints moved back): the knee's drawn
+    point, projected on the actuation force, moved the ITI point along the force (0.9876 for 1 with the first knee
+    5 cm along); the points are now where the hinges meet."""
+    itis, motors, result = screwkit_itis(tilted(tmp_path / "as drawn"))
+    (tmp_path / "moved").mkdir()
+    text = shifted_along_axis((tmp_path / "as drawn" / "robot.urdf").read_text(), joint, distance)
+    (tmp_path / "moved" / "robot.urdf").write_text(text)
+    (tmp_path / "moved" / "robot.yaml").write_text((CUSTOM / "robot.yaml").read_text())
+    other, other_motors, other_result = screwkit_itis(tmp_path / "moved" / "robot.urdf")
+    assert other == pytest.approx(itis, abs=1e-9) and other_motors == pytest.approx(motors, abs=1e-8)
+    for name in ("oti_actuators", "lmti", "cti"):
+        np.testing.assert_allclose(getattr(other_result, name), getattr(result, name), atol=1e-9, err_msg=name)

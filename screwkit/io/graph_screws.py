@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.rotations import cross
+from screwkit.common.tolerances import MEETING, PARALLEL_FOOT
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
@@ -94,23 +95,99 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
     return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
 
 
+HINGES = ("revolute", "unbounded")
+
+
+def _axis_line(state: _State, joint: int) -> tuple[NDArray, NDArray]:
+    """A revolute joint's drawn origin and unit axis (n, 3 each), in the world."""
+    transforms = state.transforms[:, joint]
+    return transforms[:, :3, 3], transforms[:, :3, :3] @ state.kinematics.axes[joint]
+
+
+def _joint_point(state: _State, joint: int) -> NDArray:
+    """Where ``joint`` is (n, 3), whatever point of its axis a file draws a revolute at (the same mechanism drawn
+    otherwise gives the same point): a revolute whose axis meets a neighbouring revolute's (its parent's or a
+    child's, not parallel to it, within :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal
+    joint written as two hinges) is where they meet (the mean, if both meet it), the point
+    :mod:`screwkit.closure.canonical` gives such a joint of a serial chain; any other joint at its drawn origin (a
+    ball's centre; a hinge on parallel ones, whose drawn point lies in the plane of the motion)."""
+    origin = state.transforms[:, joint, :3, 3]
+    kinds = state.kinematics.kinds
+    if kinds[joint] not in HINGES:
+        return origin
+    model = state.model
+    neighbours = [j for j in (model.parents[joint], *range(joint + 1, model.njoints))
+                  if j != 0 and kinds[j] in HINGES and (j == model.parents[joint] or model.parents[j] == joint)]
+    point, axis = _axis_line(state, joint)
+    meetings = []
+    for neighbour in neighbours:
+        other_point, other_axis = _axis_line(state, neighbour)
+        cosine = np.sum(axis * other_axis, axis=1)
+        sine_squared = 1.0 - cosine * cosine
+        if not np.all(sine_squared > PARALLEL_FOOT):
+            continue
+        normal = np.cross(axis, other_axis) / np.sqrt(sine_squared)[:, None]
+        if np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale):
+            gap = point - other_point
+            along = (cosine * np.sum(other_axis * gap, axis=1) - np.sum(axis * gap, axis=1)) / sine_squared
+            meetings.append(point + along[:, None] * axis)
+    return np.mean(meetings, axis=0) if meetings else origin
+
+
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
     """World points (n, 3) where the leg's joints (to its children) and closures meet ``body`` (a hinge closed by
-    two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`). A weld (``6d``) makes the
-    body at its other end part of ``body``: the leg meets ``body`` at the joint that moves that end, not at the
-    weld's frame, which a file may put anywhere (a CAD export welds each leg's last link to the platform at the
-    platform's origin)."""
+    two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`), each joint where
+    :func:`_joint_point` puts it. A weld (``6d``) makes the body at its other end part of ``body``: the leg meets
+    ``body`` at the joint that moves that end, not at the weld's frame, which a file may put anywhere (a CAD export
+    welds each leg's last link to the platform at the platform's origin)."""
     model = state.model
-    points = [state.transforms[:, j, :3, 3] for j in leg.joints if model.parents[j] == body]
+    points = [_joint_point(state, j) for j in leg.joints if model.parents[j] == body]
     for closure in leg.closures:
         if closure.axis_point:
             continue
         for joint, placement, other in ((closure.joint_a, closure.placement_a, closure.joint_b),
                                         (closure.joint_b, closure.placement_b, closure.joint_a)):
             if joint == body:
-                points.append(state.transforms[:, other, :3, 3] if closure.kind == "6d" and other != 0 else
+                points.append(_joint_point(state, other) if closure.kind == "6d" and other != 0 else
                               (state.transforms[:, joint] @ placement)[:, :3, 3])
     return points
+
+
+def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray:
+    """Where an actuated joint is (n, 3), whatever point of its line a file draws it at: a hinge that meets a
+    neighbouring hinge where they meet (:func:`_joint_point`), else (a hinge on the base, a slide) at the foot, on its
+    line, of the perpendicular from its ITI point (the links it moves: the foot from a neighbour that is a point, as
+    :mod:`screwkit.closure.canonical` places a serial chain's). It enters the working length of the leg's equivalent
+    chain, on which the CTI depends."""
+    kinds = state.kinematics.kinds
+    met = _joint_point(state, actuator)
+    if kinds[actuator] in HINGES and not np.array_equal(met, state.transforms[:, actuator, :3, 3]):
+        return met  # where it meets a neighbouring hinge
+    if kinds[actuator] not in HINGES + ("prismatic",):
+        return state.transforms[:, actuator, :3, 3]
+    point, axis = _axis_line(state, actuator)
+    return point + np.sum((iti_point - point) * axis, axis=1)[:, None] * axis
+
+
+def _platform_centre(state: _State, legs, platform: int) -> NDArray:
+    """The mean (n, 3) of the points where the legs meet the platform (:func:`_attachments`; a spine leg's platform
+    joint where :func:`_joint_point` puts it, unless it is the platform's own joint on the base), else the platform
+    joint's drawn origin."""
+    points = [point for leg in legs for point in _attachments(state, leg, platform)]
+    points += [_joint_point(state, platform) for leg in legs if leg.spine and leg.joints != (platform,)]
+    return np.mean(points, axis=0) if points else state.transforms[:, platform, :3, 3]
+
+
+def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
+    """Where a platform's own joint on the base is (n, 3): a hinge at the foot, on its axis, of the perpendicular from
+    the mean of the other legs' points on the platform (``others``), which the geometry decides, not the file's drawn
+    point; any other joint (or with no other point) at its drawn origin."""
+    origin = state.transforms[:, platform, :3, 3]
+    if state.kinematics.kinds[platform] not in HINGES or not others:
+        return origin
+    point, axis = _axis_line(state, platform)
+    centre = np.mean(others, axis=0)
+    return point + np.sum((centre - point) * axis, axis=1)[:, None] * axis
 
 
 @dataclass(frozen=True)
@@ -127,10 +204,16 @@ class _State:
     scale: float
 
     @classmethod
-    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float) -> _State:
+    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float,
+           legs=()) -> _State:
+        """The batch at q, its working coordinates about where the ``legs`` meet the platform
+        (:func:`_platform_centre`): the bases of the twist systems, and the equivalent chains made of them, then do
+        not turn with where a file draws the platform's joint (a foot's pin drawn 0.5 m along its axis moved a CTI
+        by 7e-4)."""
         transforms = kinematics.transforms(q)
         twists = kinematics.twists(transforms)
-        centre = transforms[:, platform, :3, 3]
+        drawn = cls(tree.model, kinematics, platform, transforms, twists, transforms[:, platform, :3, 3], scale)
+        centre = _platform_centre(drawn, legs, platform)
         omega = twists[..., :3]
         working = np.concatenate([omega, (twists[..., 3:] + cross(omega, centre[:, None, :])) / scale], axis=-1)
         return cls(tree.model, kinematics, platform, transforms, working, centre, scale)
@@ -161,12 +244,15 @@ def model_name(tree: ClosedTree, joint: int) -> str:
 
 def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
     """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
-    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
+    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale, legs)
     out = []
-    for leg in legs:
+    pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
+    others = [point for leg, pin in zip(legs, pinned) if not pin for point in _attachments(state, leg, platform)]
+    for leg, pin in zip(legs, pinned):
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
-            oti = _attachments(state, leg, platform) + ([state.transforms[:, platform, :3, 3]] if leg.spine else [])
+            oti = _attachments(state, leg, platform) + ([_pin_point(state, platform, others) if pin else
+                                                         _joint_point(state, platform)] if leg.spine else [])
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
             point = np.mean(oti, axis=0)
@@ -181,17 +267,18 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
         iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
         if leg.spine:
-            oti.append(state.transforms[:, platform, :3, 3])
-        if not iti and kinematics.kinds[actuator] == "prismatic":  # a slide's ITI takes no point: its twist turns
-            iti = [state.transforms[:, actuator, :3, 3]]  # nothing (the slide carrying the platform itself)
-        if not iti:
-            raise ImportError_(f"{tree.source}: leg {leg.name!r}: actuated joint {model_name(tree, actuator)!r} turns "
-                               "the platform itself, with no link after it: its ITI has no point where the actuation "
-                               "wrench acts on a link of the leg.")
+            oti.append(_joint_point(state, platform))
+        if not iti:  # (a slide too: the actuation wrench taken about the platform's joint, drawn anywhere on the
+            # slide's line, would turn with where the file draws it)
+            raise ImportError_(f"{tree.source}: leg {leg.name!r}: actuated joint {model_name(tree, actuator)!r} moves "
+                               "the platform itself, with no link after it: a leg screwkit does not analyse (its "
+                               "actuation wrench acts on no link of the leg's own).")
         if not oti:
             raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
-        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, state.transforms[:, actuator, :3, 3],
-                             np.mean(iti, axis=0), np.mean(oti, axis=0), np.linalg.norm(own - projection, axis=1)))
+        iti_point = np.mean(iti, axis=0)
+        at = _actuator_point(state, actuator, iti_point)
+        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.mean(oti, axis=0),
+                             np.linalg.norm(own - projection, axis=1)))
     return out, state
 
 
