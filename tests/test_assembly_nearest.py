@@ -590,13 +590,14 @@ def test_the_report_of_a_file_in_millimetres_gives_its_lengths_in_millimetres(tm
     (tmp_path / "robot.yaml").write_text((source / "robot.yaml").read_text())
     metres = load(source / "robot.urdf").import_report
     millimetres = load(tmp_path / "robot.urdf", length_unit="mm").import_report
-    pattern = re.compile(r"closure (\S+): gap (\S+) (\S+) at the file's joint values")
+    pattern = re.compile(r"closure (\S+): gap (\S+) (\S+)(?: and (\S+) deg)? at the file's joint values")
     gaps = [pattern.search(line).groups() for line in metres if pattern.search(line)]
-    assert gaps and all(unit == "m" for _, _, unit in gaps)
+    assert gaps and all(unit == "m" for _, _, unit, _ in gaps)
     scaled = [pattern.search(line).groups() for line in millimetres if pattern.search(line)]
-    assert [(closure, unit) for closure, _, unit in scaled] == [(closure, "mm") for closure, _, _ in gaps]
-    np.testing.assert_allclose([float(value) for _, value, _ in scaled],
-                               [1000.0 * float(value) for _, value, _ in gaps], rtol=2e-3)  # printed to 3 digits
+    assert [(closure, unit) for closure, _, unit, _ in scaled] == [(closure, "mm") for closure, _, _, _ in gaps]
+    np.testing.assert_allclose([float(value) for _, value, _, _ in scaled],
+                               [1000.0 * float(value) for _, value, _, _ in gaps], rtol=2e-3)  # printed to 3 digits
+    assert [turn for *_, turn in scaled] == [turn for *_, turn in gaps]  # a weld's angle: the same in any unit
     change = re.compile(r"the largest joint change (\S+) rad(?:, (\S+) (\S+))?\)")
     (angle, length, unit), = [change.search(line).groups() for line in metres if change.search(line)]
     (angle_mm, length_mm, unit_mm), = [change.search(line).groups() for line in millimetres if change.search(line)]

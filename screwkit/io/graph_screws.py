@@ -171,10 +171,10 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
 
 def _platform_centre(state: _State, legs, platform: int) -> NDArray:
     """The mean (n, 3) of the points where the legs meet the platform (:func:`_attachments`; a spine leg's platform
-    joint where :func:`_joint_point` puts it, unless it is the platform's own joint on the base), else the platform
-    joint's drawn origin."""
+    joint at its drawn origin, unless it is the platform's own joint on the base), else the platform joint's drawn
+    origin."""
     points = [point for leg in legs for point in _attachments(state, leg, platform)]
-    points += [_joint_point(state, platform) for leg in legs if leg.spine and leg.joints != (platform,)]
+    points += [state.transforms[:, platform, :3, 3] for leg in legs if leg.spine and leg.joints != (platform,)]
     return np.mean(points, axis=0) if points else state.transforms[:, platform, :3, 3]
 
 
@@ -252,7 +252,7 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
             oti = _attachments(state, leg, platform) + ([_pin_point(state, platform, others) if pin else
-                                                         _joint_point(state, platform)] if leg.spine else [])
+                                                         state.transforms[:, platform, :3, 3]] if leg.spine else [])
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
             point = np.mean(oti, axis=0)
@@ -266,8 +266,8 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
         projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
         iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
-        if leg.spine:
-            oti.append(_joint_point(state, platform))
+        if leg.spine:  # (as drawn: a hinged Delta's wrist runs along the bar its two rods end on, and meets each)
+            oti.append(state.transforms[:, platform, :3, 3])
         if not iti:  # (a slide too: the actuation wrench taken about the platform's joint, drawn anywhere on the
             # slide's line, would turn with where the file draws it)
             raise ImportError_(f"{tree.source}: leg {leg.name!r}: actuated joint {model_name(tree, actuator)!r} moves "
