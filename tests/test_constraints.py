@@ -281,7 +281,12 @@ def test_cli_pose_from_actuator_values(tmp_path):
     assert refused.returncode == 1 and refused.stderr.strip().splitlines() == [
         "Error: No closed pose of 'prs_3_ups' has these actuator values near the start pose (redundant actuators "
         "must agree with one another, and the pose may lie on another assembly, past a singular configuration from "
-        "the start; give another start with --pose, or for a file of another tool --initial on each actuator)."]
+        "the start, or out of reach; give another start with --pose, or for a file of another tool --initial on each "
+        "actuator)."]
+    # a mechanism without redundancy is not told its actuators must agree (it has none to spare)
+    far = screwkit("analyze", "five_bar", "--actuators", "0", "180")  # arms pointing apart: beyond the distal links
+    assert far.returncode == 1 and "No closed pose of 'five_bar'" in far.stderr, far.stderr
+    assert "redundant" not in far.stderr and "out of reach" in far.stderr, far.stderr
 
 
 def test_cli_sweep_and_map_say_their_fault_type(tmp_path):

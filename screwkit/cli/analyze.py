@@ -158,10 +158,11 @@ def pose_from_actuators(mechanism, text: str, start):
               for value, (c, k) in zip(values, positions)]
     solution = forward(mechanism, values, start)
     if not bool(np.asarray(solution.reachable).reshape(-1)[0]):
+        agree = "redundant actuators must agree with one another, and " if len(names) > mechanism.dof else ""
         raise fail(f"No closed pose of {mechanism.name!r} has these actuator values near the start pose "
-                   "(redundant actuators must agree with one another, and the pose may lie on another assembly, past "
-                   "a singular configuration from the start; give another start with --pose, or for a file of "
-                   "another tool --initial on each actuator).")
+                   f"({agree}the pose may lie on another assembly, past a singular configuration from the start, or "
+                   "out of reach; give another start with --pose, or for a file of another tool --initial on each "
+                   "actuator).")
     return np.asarray(solution.poses).reshape(-1)
 
 
