@@ -284,7 +284,7 @@ def test_cli_pose_from_actuator_values(tmp_path):
         "the start, or out of reach; give another start with --pose, or for a file of another tool --initial on each "
         "actuator)."]
     # a mechanism without redundancy is not told its actuators must agree (it has none to spare)
-    far = screwkit("analyze", "five_bar", "--actuators", "0", "180")  # arms pointing apart: beyond the distal links
+    far = screwkit("analyze", "five_bar", "--actuators", "0", "180")  # no closed pose near the start
     assert far.returncode == 1 and "No closed pose of 'five_bar'" in far.stderr, far.stderr
     assert "redundant" not in far.stderr and "out of reach" in far.stderr, far.stderr
 
