@@ -2,7 +2,9 @@
 
 :func:`shifted_along_axis` moves a joint's ``<origin>`` by a distance along the joint's axis and moves every joint on
 its child link back by the same vector in the child's frame, so that every link stays where it was, every joint turns
-about the same line, and every joint value means the same: an index must not change.
+about the same line, and every joint value means the same: an index must not change. Only for a joint that stays a
+hinge or a slide: one a Gepetto robot.yaml makes a ball or a universal joint (``joint_type``) turns about its origin,
+and moved it is another mechanism.
 """
 
 from __future__ import annotations

@@ -107,15 +107,18 @@ def test_a_slide_that_carries_the_platform_itself_is_refused_in_one_line():
     assert screwkit("info", LUDO, "--output", "effecteur", "--lock", "pivot").returncode == 0
 
 
-@pytest.mark.parametrize("joint, distance", [("libre_cheville", 0.1), ("libre_cheville", -0.5), (CRANK, -0.2)])
+@pytest.mark.parametrize("joint, distance", [("libre_cheville", 0.1), ("libre_cheville", 0.06),
+                                             ("libre_cheville", -0.5), (CRANK, -0.2), (CRANK, 0.06)])
 def test_the_foot_pin_or_crank_drawn_elsewhere_along_its_axis_changes_no_index(tmp_path, joint, distance):
-    """The foot's pin drawn 0.1 m or -0.5 m along its axis gave a CTI of 0.9960 or 0.8914 for 0.9987 (its drawn point
-    was the passive leg's); the crank's, 1e-4 on the CTI. The pin is now at the foot of the perpendicular from the
-    rod's ball, the crank where its ball's perpendicular meets it."""
+    """The foot's pin drawn 0.1 m or -0.5 m along its axis: the ITI, OTI and LMTI do not change (its drawn point was
+    the passive leg's, and moved the CTI from 0.9987 to 0.9960 or 0.8914; the pin is now at the foot of the
+    perpendicular from the rod's ball, the crank at the foot from its ball). The CTI is not compared: this leg's
+    pairing of constraint wrenches and freed motions has repeated singular values, within which its definition
+    decides nothing (docs/theory.md, *The representative and the points*)."""
     result, crank, knee = ankle(ANKLE)
     (tmp_path / "robot.urdf").write_text(shifted_along_axis(ANKLE.read_text(), joint, distance))
     (tmp_path / "robot.yaml").write_text((ANKLE.parent / "robot.yaml").read_text())
     other, other_crank, other_knee = ankle(tmp_path / "robot.urdf")
-    for name in ("iti_actuators", "oti_actuators", "lmti", "cti"):
+    for name in ("iti_actuators", "oti_actuators", "lmti"):
         np.testing.assert_allclose(getattr(other, name), getattr(result, name), atol=1e-9, err_msg=name)
     assert (other_crank, other_knee) == pytest.approx((crank, knee), abs=1e-8)

@@ -110,11 +110,18 @@ def _joint_point(state: _State, joint: int) -> NDArray:
     child's, not parallel to it, within :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal
     joint written as two hinges) is where they meet (the mean, if both meet it), the point
     :mod:`screwkit.closure.canonical` gives such a joint of a serial chain; any other joint at its drawn origin (a
-    ball's centre; a hinge on parallel ones, whose drawn point lies in the plane of the motion)."""
-    origin = state.transforms[:, joint, :3, 3]
+    ball's centre; a hinge on parallel ones, whose drawn point lies in the plane of the motion; a spatial hinge that
+    meets no neighbour, whose point along its axis the file's drawing still decides: not settled)."""
+    meetings = _meetings(state, joint)
+    return np.mean(meetings, axis=0) if meetings else state.transforms[:, joint, :3, 3]
+
+
+def _meetings(state: _State, joint: int) -> list[NDArray]:
+    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's (:func:`_joint_point`);
+    none for any other joint."""
     kinds = state.kinematics.kinds
     if kinds[joint] not in HINGES:
-        return origin
+        return []
     model = state.model
     neighbours = [j for j in (model.parents[joint], *range(joint + 1, model.njoints))
                   if j != 0 and kinds[j] in HINGES and (j == model.parents[joint] or model.parents[j] == joint)]
@@ -131,7 +138,7 @@ def _joint_point(state: _State, joint: int) -> NDArray:
             gap = point - other_point
             along = (cosine * np.sum(other_axis * gap, axis=1) - np.sum(axis * gap, axis=1)) / sine_squared
             meetings.append(point + along[:, None] * axis)
-    return np.mean(meetings, axis=0) if meetings else origin
+    return meetings
 
 
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
@@ -160,22 +167,13 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
     :mod:`screwkit.closure.canonical` places a serial chain's). It enters the working length of the leg's equivalent
     chain, on which the CTI depends."""
     kinds = state.kinematics.kinds
-    met = _joint_point(state, actuator)
-    if kinds[actuator] in HINGES and not np.array_equal(met, state.transforms[:, actuator, :3, 3]):
-        return met  # where it meets a neighbouring hinge
+    meetings = _meetings(state, actuator)
+    if meetings:  # where it meets a neighbouring hinge
+        return np.mean(meetings, axis=0)
     if kinds[actuator] not in HINGES + ("prismatic",):
         return state.transforms[:, actuator, :3, 3]
     point, axis = _axis_line(state, actuator)
     return point + np.sum((iti_point - point) * axis, axis=1)[:, None] * axis
-
-
-def _platform_centre(state: _State, legs, platform: int) -> NDArray:
-    """The mean (n, 3) of the points where the legs meet the platform (:func:`_attachments`; a spine leg's platform
-    joint at its drawn origin, unless it is the platform's own joint on the base), else the platform joint's drawn
-    origin."""
-    points = [point for leg in legs for point in _attachments(state, leg, platform)]
-    points += [state.transforms[:, platform, :3, 3] for leg in legs if leg.spine and leg.joints != (platform,)]
-    return np.mean(points, axis=0) if points else state.transforms[:, platform, :3, 3]
 
 
 def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
@@ -204,16 +202,10 @@ class _State:
     scale: float
 
     @classmethod
-    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float,
-           legs=()) -> _State:
-        """The batch at q, its working coordinates about where the ``legs`` meet the platform
-        (:func:`_platform_centre`): the bases of the twist systems, and the equivalent chains made of them, then do
-        not turn with where a file draws the platform's joint (a foot's pin drawn 0.5 m along its axis moved a CTI
-        by 7e-4)."""
+    def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float) -> _State:
         transforms = kinematics.transforms(q)
         twists = kinematics.twists(transforms)
-        drawn = cls(tree.model, kinematics, platform, transforms, twists, transforms[:, platform, :3, 3], scale)
-        centre = _platform_centre(drawn, legs, platform)
+        centre = transforms[:, platform, :3, 3]
         omega = twists[..., :3]
         working = np.concatenate([omega, (twists[..., 3:] + cross(omega, centre[:, None, :])) / scale], axis=-1)
         return cls(tree.model, kinematics, platform, transforms, working, centre, scale)
@@ -244,7 +236,7 @@ def model_name(tree: ClosedTree, joint: int) -> str:
 
 def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
     """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
-    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale, legs)
+    state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
     out = []
     pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
     others = [point for leg, pin in zip(legs, pinned) if not pin for point in _attachments(state, leg, platform)]
