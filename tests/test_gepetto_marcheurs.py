@@ -1,5 +1,6 @@
-"""Two walking robots' legs from Gepetto's example-parallel-robots (``tests/data/gallery/published``, BSD-3-Clause;
-files since removed from that repository's tree), each with its hip and knee held (``--lock``).
+"""Walking robots' legs and a two-legged effector from Gepetto's example-parallel-robots
+(``tests/data/gallery/published``, BSD-3-Clause; files since removed from that repository's tree), the legs with
+their hip and knee held (``--lock``).
 
 * ``robot_marcheur_3``: the foot turns on a pin at the end of the shin, driven by a crank on the shin and a rod with
   a ball at each end. The platform hangs on the base (the shin) by that one pin: a passive leg of one joint, which
@@ -10,6 +11,7 @@ files since removed from that repository's tree), each with its hip and knee hel
 * ``robot_marcheur_2``: an ankle ball driven by a crank and rod, a foot motor on it. Holding the crank's motor and
   the ankle (which a refusal once advised) leaves the foot on its motor alone: a traceback (``IndexError`` in
   the conversion); now one line, and the advice is no longer given.
+* ``robot_ludo`` with its effector's pin held: a slide that carries the effector itself, refused in one line.
 """
 
 from __future__ import annotations
