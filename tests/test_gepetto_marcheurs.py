@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from along_axes import shifted_along_axis
 from gepetto_loader import gepetto_model
 from rod_lines import closed_by_scipy, joint_line
+from test_axis_points import revolutes_moved
 from test_gallery_published import GEPETTO
 from test_gepetto_joint_types import variants
 
@@ -118,7 +118,7 @@ def test_the_foot_pin_or_crank_drawn_elsewhere_along_its_axis_changes_no_index(t
     pairing of constraint wrenches and freed motions has repeated singular values, within which its definition
     decides nothing (docs/theory.md, *The representative and the points*)."""
     result, crank, knee = ankle(ANKLE)
-    (tmp_path / "robot.urdf").write_text(shifted_along_axis(ANKLE.read_text(), joint, distance))
+    (tmp_path / "robot.urdf").write_text(revolutes_moved(ANKLE.read_text(), {joint: distance}))
     (tmp_path / "robot.yaml").write_text((ANKLE.parent / "robot.yaml").read_text())
     other, other_crank, other_knee = ankle(tmp_path / "robot.urdf")
     for name in ("iti_actuators", "oti_actuators", "lmti"):

@@ -23,9 +23,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from along_axes import shifted_along_axis
 from gepetto_loader import gepetto_model
 from rod_lines import closed_by_scipy, joint_line
+from test_axis_points import revolutes_moved
 from test_gallery_published import GEPETTO
 from test_gepetto_joint_types import variants
 
@@ -138,14 +138,15 @@ def test_the_refusal_names_every_leg_s_serial_stage_at_once():
 
 
 @pytest.mark.parametrize("joint, distance", [("free_knee1", 0.05), ("free_knee3", -0.2), ("mot_6", 0.1),
-                                             ("mot_5", -0.04)])
+                                             ("mot_5", -0.04)])  # hinges only: a ball robot.yaml makes turns about
+# its origin, and moved it is another mechanism
 def test_a_joint_drawn_elsewhere_along_its_axis_changes_no_index(tmp_path, joint, distance):
     """The same robot with one joint drawn elsewhere on its line (its child's joints moved back): the knee's drawn
     point, projected on the actuation force, moved the ITI point along the force (0.9876 for 1 with the first knee
     5 cm along); the points are now where the hinges meet."""
     itis, motors, result = screwkit_itis(tilted(tmp_path / "as drawn"))
     (tmp_path / "moved").mkdir()
-    text = shifted_along_axis((tmp_path / "as drawn" / "robot.urdf").read_text(), joint, distance)
+    text = revolutes_moved((tmp_path / "as drawn" / "robot.urdf").read_text(), {joint: distance})
     (tmp_path / "moved" / "robot.urdf").write_text(text)
     (tmp_path / "moved" / "robot.yaml").write_text((CUSTOM / "robot.yaml").read_text())
     other, other_motors, other_result = screwkit_itis(tmp_path / "moved" / "robot.urdf")
