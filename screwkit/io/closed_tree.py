@@ -387,26 +387,24 @@ def closure_motions(model, data, closure: Closure) -> list[tuple[NDArray, NDArra
 
 def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     """Distance (m) between the two frame origins of every closure at q."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    data = tree.model.createData()
-    pin.forwardKinematics(tree.model, data, q)
-    return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c in tree.closures for a, b in [_frames(
-        tree.model, data, c)]}
+    return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c, a, b in _closure_frames(tree, q)}
 
 
 def closure_turns(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     """The angle (rad) between the two frames of every ``6d`` closure at q: a weld can be open in rotation alone."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
+    return {c.name: float(np.linalg.norm(pin.log3(a[:3, :3].T @ b[:3, :3]))) for c, a, b in _closure_frames(tree, q)
+            if c.kind == "6d"}
+
+
+def _closure_frames(tree: ClosedTree, q: NDArray) -> list[tuple[Closure, NDArray, NDArray]]:
+    """Every closure with its two frames (4x4, world) at q."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
     data = tree.model.createData()
     pin.forwardKinematics(tree.model, data, q)
-    turns = {}
-    for closure in tree.closures:
-        if closure.kind == "6d":
-            a, b = _frames(tree.model, data, closure)
-            turns[closure.name] = float(np.linalg.norm(pin.log3(a[:3, :3].T @ b[:3, :3])))
-    return turns
+    return [(closure, *_frames(tree.model, data, closure)) for closure in tree.closures]
 
 
 def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, float]:

@@ -20,10 +20,10 @@ def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
     several = [leg for leg in legs if len(leg.actuators) > 1]
     if several:
         leg = several[0]
-        advice, _ = _leg_advice(tree, leg, platform)
+        advice, held = _leg_advice(tree, leg, platform)
         others = [(other, _leg_advice(tree, other, platform)[1]) for other in several[1:]]
         if advice and others and all(locks for _, locks in others):
-            every = _leg_advice(tree, leg, platform)[1] + [name for _, locks in others for name in locks]
+            every = held + [name for _, locks in others for name in locks]
             advice += (f"; legs {', '.join(repr(other.name) for other, _ in others)} likewise, all at once: --lock "
                        + " --lock ".join(dict.fromkeys(every)))
         raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "

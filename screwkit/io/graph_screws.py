@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closure.canonical import foot_on_line
 from screwkit.common.rotations import cross
 from screwkit.common.tolerances import MEETING, PARALLEL_FOOT
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
@@ -135,9 +136,7 @@ def _meetings(state: _State, joint: int) -> list[NDArray]:
             continue
         normal = np.cross(axis, other_axis) / np.sqrt(sine_squared)[:, None]
         if np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale):
-            gap = point - other_point
-            along = (cosine * np.sum(other_axis * gap, axis=1) - np.sum(axis * gap, axis=1)) / sine_squared
-            meetings.append(point + along[:, None] * axis)
+            meetings.append(foot_on_line(point, axis, other_point, other_axis))
     return meetings
 
 
@@ -172,8 +171,7 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
         return np.mean(meetings, axis=0)
     if kinds[actuator] not in HINGES + ("prismatic",):
         return state.transforms[:, actuator, :3, 3]
-    point, axis = _axis_line(state, actuator)
-    return point + np.sum((iti_point - point) * axis, axis=1)[:, None] * axis
+    return _foot_from(*_axis_line(state, actuator), iti_point)
 
 
 def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
@@ -183,9 +181,12 @@ def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
     origin = state.transforms[:, platform, :3, 3]
     if state.kinematics.kinds[platform] not in HINGES or not others:
         return origin
-    point, axis = _axis_line(state, platform)
-    centre = np.mean(others, axis=0)
-    return point + np.sum((centre - point) * axis, axis=1)[:, None] * axis
+    return _foot_from(*_axis_line(state, platform), np.mean(others, axis=0))
+
+
+def _foot_from(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
+    """The foot (n, 3) on each line (``point``, unit ``axis``) of the perpendicular from ``other``."""
+    return point + np.sum((other - point) * axis, axis=1)[:, None] * axis
 
 
 @dataclass(frozen=True)
@@ -239,11 +240,12 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
     out = []
     pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
-    others = [point for leg, pin in zip(legs, pinned) if not pin for point in _attachments(state, leg, platform)]
-    for leg, pin in zip(legs, pinned):
+    on_platform = [_attachments(state, leg, platform) for leg in legs]
+    others = [point for points, pin in zip(on_platform, pinned) if not pin for point in points]
+    for leg, pin, platform_points in zip(legs, pinned, on_platform):
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
-            oti = _attachments(state, leg, platform) + ([_pin_point(state, platform, others) if pin else
+            oti = platform_points + ([_pin_point(state, platform, others) if pin else
                                                          state.transforms[:, platform, :3, 3]] if leg.spine else [])
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
@@ -257,7 +259,7 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         own = own / np.linalg.norm(own, axis=1, keepdims=True)
         valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
         projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
-        iti, oti = _attachments(state, leg, actuator), _attachments(state, leg, platform)
+        iti, oti = _attachments(state, leg, actuator), list(platform_points)
         if leg.spine:  # (as drawn: a hinged Delta's wrist runs along the bar its two rods end on, and meets each)
             oti.append(state.transforms[:, platform, :3, 3])
         if not iti:  # (a slide too: the actuation wrench taken about the platform's joint, drawn anywhere on the
