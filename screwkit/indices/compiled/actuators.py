@@ -108,8 +108,7 @@ def on_wrench_axis(joint_lanes, act, r, row, f0, f1, f2, axis0, axis1, axis2, pi
     p0, p1, p2 = joint_lanes[act, row, r], joint_lanes[act, row + 1, r], joint_lanes[act, row + 2, r]
     if not forceful:
         return p0, p1, p2
-    along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
-    q0, q1, q2 = axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
+    q0, q1, q2 = projected(p0, p1, p2, f0, f1, f2, axis0, axis1, axis2)
     if abs(pitch) > ZERO_PITCH:
         return q0, q1, q2
     return crossing_point(p0, p1, p2, q0, q1, q2, f0, f1, f2, 1.0, joint_lanes[act, row + 6, r],
@@ -127,6 +126,12 @@ def given_point(override, index, act, centres, r, inverse, f0, f1, f2, axis0, ax
     p2 = (override[index, act, 2] - centres[2, r]) * inverse
     if not forceful:
         return p0, p1, p2
+    return projected(p0, p1, p2, f0, f1, f2, axis0, axis1, axis2)
+
+
+@njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def projected(p0, p1, p2, f0, f1, f2, axis0, axis1, axis2):
+    """The point p projected on the axis of a unit force f through the point ``axis``."""
     along = (p0 - axis0) * f0 + (p1 - axis1) * f1 + (p2 - axis2) * f2
     return axis0 + along * f0, axis1 + along * f1, axis2 + along * f2
 
