@@ -245,8 +245,8 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     for leg, pin, platform_points in zip(legs, pinned, on_platform):
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
-            oti = platform_points + ([_pin_point(state, platform, others) if pin else
-                                                         state.transforms[:, platform, :3, 3]] if leg.spine else [])
+            oti = platform_points + ([_pin_point(state, platform, others) if pin else _joint_point(state, platform)]
+                                     if leg.spine else [])  # (a universal joint's hinge: where its axes meet)
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
             point = np.mean(oti, axis=0)
