@@ -218,6 +218,7 @@ def test_an_ankle_is_the_same_in_millimetres_in_a_moved_world_and_listed_back(tm
         np.testing.assert_allclose(np.asarray(other.oti_actuators).reshape(-1)[order],
                                    np.asarray(result.oti_actuators).reshape(-1), atol=1e-9)
         np.testing.assert_allclose(other.lmti, result.lmti, atol=1e-9)
+        np.testing.assert_allclose(other.cti, result.cti, atol=1e-9, err_msg=name)
         if name != "moved":
             np.testing.assert_allclose(other.poses, result.poses, atol=1e-9)
         assert other_motors == pytest.approx(motors, abs=1e-8), name

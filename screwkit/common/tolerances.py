@@ -57,6 +57,12 @@ OUTSIDE_CONSTANT_SPACE = 1e-9
 outside the space is larger than this times its norm (working coordinates); the configuration
 then gets its own motion space."""
 
+REPEATED_PAIRING = 1e-6
+"""Relative: singular values of a chain's pairing of released constraint wrenches with the twists their release frees
+(orthonormal bases, working coordinates) that differ by at most this times the largest are one repeated value. Its
+singular vectors are then any rotation of each other within their block, and the CTI takes the block's worst
+rotation (:func:`screwkit.screw.constraints.worst_in_blocks`)."""
+
 PURE_COUPLE = 1e-10
 """Relative: a wrench is a pure couple (infinite pitch) when ``|f| * L`` is at or below this
 times ``|m|`` (the moment about the centroid; :func:`screwkit.screw.algebra.power_coefficient` takes

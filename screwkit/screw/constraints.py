@@ -27,7 +27,8 @@ are listed. The conventions below are screwkit's, stated with their reasons in `
   constraints kept frees the twists ``F_i`` reciprocal to every other wrench. Each freed twist is
   paired with the constraint wrench of ``C_i`` that resists it along the principal directions of
   the pairing (the singular vectors of ``C_i o F_i``, working coordinates; one pair when the chain
-  holds one constraint wrench), and
+  holds one constraint wrench; a block of repeated singular values, whose vectors any rotation of the block
+  gives as well, takes its worst rotation: :mod:`screwkit.screw.principal_pairs`), and
 
   .. math:: \kappa = \frac{|C \circ T|}{|C \circ T|_{\max}}, \qquad
             CTI_{N,L} = \min_{i \in L,\ \text{pairs}} \kappa, \qquad CTI_N = \max_L CTI_{N,L},
@@ -54,12 +55,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common import tolerances
-from screwkit.screw.algebra import joint_lines, nearest_on_axis
+from screwkit.screw.algebra import SWAP, joint_lines
 from screwkit.screw.motion import chain_decompositions
+from screwkit.screw.principal_pairs import pair_coefficients, released_pairs, worst_in_blocks
 
 __all__ = ["ConstraintPlan", "plan_constraints", "constraint_indices", "chain_constraint_wrenches"]
 
-_SWAP = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 
 
 @dataclass(frozen=True)
@@ -115,7 +116,7 @@ def chain_constraint_wrenches(twists: NDArray, count: int, decomposition: tuple 
     if count == 0:
         return np.zeros(twists.shape[:-2] + (0, 6))
     _, right = decomposition if decomposition is not None else chain_decompositions([twists])[0]
-    return right[..., 6 - count:, :] @ _SWAP  # twists reciprocal to ... -> wrenches: swap the halves
+    return right[..., 6 - count:, :] @ SWAP  # twists reciprocal to ... -> wrenches: swap the halves
 
 
 def _rank(rows: NDArray, tolerance: float) -> NDArray[np.int64]:
@@ -217,47 +218,6 @@ def plan_constraints(chain_twists: list[NDArray], mobility: int | None = None) -
     return ConstraintPlan(counts, common, own_counts, rank, _subsystems(own, rank))
 
 
-def _coefficient(wrench: NDArray, twist: NDArray, point: NDArray, threshold: NDArray) -> NDArray:
-    """Power coefficient of unit constraint wrenches on twists (the kernel's definition, working coordinates)."""
-    force, moment = wrench[..., :3], wrench[..., 3:]
-    omega, velocity = twist[..., :3], twist[..., 3:]
-    numerator = np.abs(np.sum(force * velocity, -1) + np.sum(moment * omega, -1))
-    force_norm = np.linalg.norm(force, axis=-1)
-    moment_norm = np.linalg.norm(moment, axis=-1)
-    forceful = force_norm > tolerances.PURE_COUPLE * moment_norm
-    safe = np.where(forceful, force_norm, 1.0)
-    pitch = np.where(forceful, np.sum(force * moment, -1) / safe**2, 0.0)
-    arm_vector = velocity + np.cross(omega, point) + pitch[..., None] * omega
-    omega_norm = np.linalg.norm(omega, axis=-1)
-    arm = np.where(forceful, np.linalg.norm(arm_vector, axis=-1), omega_norm)
-    scale = np.where(forceful, force_norm, moment_norm)
-    reference = np.where(forceful, omega_norm, 0.0)
-    singular = (arm <= threshold * reference) | (arm * scale <= 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        value = numerator / np.where(singular, 1.0, arm * scale)
-    return np.where(singular, 0.0, np.minimum(value, 1.0))
-
-
-def _released_pairs(own: NDArray, freed: NDArray, valid: NDArray | None = None):
-    """Principal pairs of a chain's own constraint wrenches (..., c, 6) and the twists (..., 6, d) their release
-    frees: wrenches ``U^T C`` and twists ``F V`` from the singular vectors of the pairing
-    ``C o F = U S V^T`` (orthonormal ``F``), so that each wrench is reciprocal to every freed twist but its own.
-    ``valid`` (..., d): which columns of ``freed`` are freed twists (the others are ignored). Returns wrenches
-    (..., d, 6), twists (..., d, 6) and a mask (..., d) of the pairs that exist. One wrench and one freed
-    twist are their own pair."""
-    if own.shape[-2] == 1 and freed.shape[-1] == 1:
-        exists = np.ones(own.shape[:-2] + (1,), dtype=bool) if valid is None else valid
-        return own, np.swapaxes(freed, -1, -2), exists
-    if valid is not None:
-        freed = freed * valid[..., None, :]
-    pairing = own @ _SWAP @ freed  # (..., c, d): C_k o F_l
-    left, singular, right = np.linalg.svd(pairing, full_matrices=False)  # d <= c where the system is regular
-    wrenches = np.swapaxes(left, -1, -2) @ own  # (..., d, 6)
-    twists = np.swapaxes(freed @ np.swapaxes(right, -1, -2), -1, -2)  # (..., d, 6)
-    exists = singular > tolerances.RANK_TOLERANCE * np.maximum(singular[..., :1], 1e-300)
-    return wrenches, twists, exists
-
-
 def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], members: tuple[int, ...],
                    points: list[NDArray], threshold: NDArray) -> NDArray:
     """:math:`CTI_{N,L}` (N, S) of every actuator set (their unit wrenches ``actuation``, (N, S, n, 6)) and one
@@ -278,7 +238,7 @@ def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], memb
         start = actuation.shape[-2]
         freed_of = []
         for block in blocks:
-            columns = _SWAP @ inverse[..., start:start + block.shape[-2]]
+            columns = SWAP @ inverse[..., start:start + block.shape[-2]]
             freed_of.append(columns if block.shape[-2] == 1 else np.linalg.qr(columns)[0])  # same span, orthonormal
             start += block.shape[-2]
         valid_of = [None] * len(blocks)
@@ -291,11 +251,12 @@ def _subsystem_cti(actuation: NDArray, shared: NDArray, own: list[NDArray], memb
             _, singular, right = np.linalg.svd(np.concatenate([_unit_rows(rest), padding], axis=-2))
             size = block.shape[-2]
             valid_of.append(singular[..., -size:] <= tolerances.RANK_TOLERANCE * singular[..., :1])
-            freed_of.append(_SWAP @ np.swapaxes(right[..., -size:, :], -1, -2))
+            freed_of.append(SWAP @ np.swapaxes(right[..., -size:, :], -1, -2))
     for index, block, freed, valid in zip(members, blocks, freed_of, valid_of):
-        wrenches, twists, exists = _released_pairs(block, freed, valid)
-        centres = nearest_on_axis(wrenches, points[index][:, None, None, :3], points[index][:, None, None, 3:])
-        kappa = _coefficient(wrenches, twists, centres, threshold[:, None, None])
+        wrenches, twists, singular, exists = released_pairs(block, freed, valid)
+        joint, limit = points[index][:, None], threshold[:, None]
+        kappa = pair_coefficients(wrenches, twists, joint, limit)
+        kappa = worst_in_blocks(kappa, singular, exists, wrenches, twists, joint, limit)
         values = np.minimum(values, np.where(exists, kappa, np.inf).min(axis=-1))
     return np.where(regular & np.isfinite(values), values, 0.0)
 
@@ -364,12 +325,19 @@ def constraint_indices(plan: ConstraintPlan, chain_twists: list[NDArray], chain_
         for j in fault_members:
             result[f"f_c{j}"] = nothing.copy()
         return result
-    if per_set is None:
-        shared, own = _own_wrenches(constraints, plan.common, plan.own_counts)
-        actuation = wrenches[:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
-        per_set = np.zeros((count, submechanisms.shape[0]))
+    # the numpy code: every configuration, or those where the compiled stage met a repeated block (NaN)
+    rows = slice(None) if per_set is None else np.flatnonzero(np.isnan(per_set).any(axis=-1))
+    if per_set is None or rows.size:
+        shared, own = _own_wrenches([c[rows] for c in constraints], plan.common, plan.own_counts)
+        actuation = wrenches[rows][:, submechanisms]  # (N, S, n, 6): every non-redundant actuator set at once
+        found = np.zeros((actuation.shape[0], submechanisms.shape[0]))
         for subsystem in plan.subsystems:
-            per_set = np.maximum(per_set, _subsystem_cti(actuation, shared, own, subsystem, points, threshold))
+            found = np.maximum(found, _subsystem_cti(actuation, shared, own, subsystem, [p[rows] for p in points],
+                                                     threshold[rows]))
+        if per_set is None:
+            per_set = found
+        else:
+            per_set[rows] = found
     per_set[singular] = 0.0
     result["cti_submechanisms"] = per_set
     result["cti"] = per_set.max(axis=-1)

@@ -38,7 +38,8 @@ __all__ = ["constraint_kernel"]
 
 # The one signature: every array C-contiguous.
 _SIGNATURE = ("void(float64[:, :, ::1], int64[::1], int64[::1], int64, float64[:, :, ::1], float64[:, :, ::1], "
-              "int64[:, ::1], int64[:, ::1], float64[::1], float64, float64, float64, int64[::1], float64[:, ::1])")
+              "int64[:, ::1], int64[:, ::1], float64[::1], float64, float64, float64, float64, int64[::1], "
+              "float64[:, ::1])")
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH)
@@ -264,18 +265,21 @@ def freed_twists(lu, permutation, size, start, count, basis, freed, column):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def released_pairs(own, chain, size, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch):
+def released_pairs(own, chain, size, freed, rank_tolerance, repeated_pairing, pairing, wrenches, twists, exists,
+                   scratch):
     """The principal pairs of a chain's own wrenches own[chain, :size] and the twists freed[:size] their release frees
     (as ``_released_pairs``): wrenches U^T C and twists F V from the singular vectors of the pairing
     ``C o F = U S V^T``; ``exists[i]``: singular value i above ``rank_tolerance`` times the largest. One wrench
-    and one freed twist are their own pair."""
+    and one freed twist are their own pair. Returns whether two pairs that exist have singular values within
+    ``repeated_pairing`` times the largest (a repeated block, whose worst rotation the numpy code finds:
+    :func:`screwkit.screw.principal_pairs.worst_in_blocks`)."""
     vectors, norms, order, singular, right = scratch
     if size == 1:
         for p in range(6):
             wrenches[0, p] = own[chain, 0, p]
             twists[0, p] = freed[0, p]
         exists[0] = True
-        return
+        return False
     frobenius = 0.0
     for k in range(size):
         for j in range(size):
@@ -296,6 +300,11 @@ def released_pairs(own, chain, size, freed, rank_tolerance, pairing, wrenches, t
                 twist += freed[k, p] * right[i, k]
             wrenches[i, p] = wrench
             twists[i, p] = twist
+    repeated = False
+    for i in range(1, size):
+        if exists[i] and singular[i - 1] - singular[i] <= repeated_pairing * singular[0]:
+            repeated = True
+    return repeated
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
@@ -341,8 +350,8 @@ def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
     when the set's and the subsystem's wrenches do not span every wrench, else the lowest power coefficient of a
     released constraint wrench on the twist it frees (as ``_subsystem_cti``). ``held``: the product of the held
     rows' norms and their sqrt(det(rows rows^T)) (:func:`complement`), the size of the complement, the
-    tolerances."""
-    volume, held_volume, size, rank_tolerance, pure_couple = held
+    tolerances. -1 where a chain's pairs have a repeated singular value (:func:`released_pairs`)."""
+    volume, held_volume, size, rank_tolerance, pure_couple, repeated_pairing = held
     permutation, basis, reduced, block, freed, column, pairing, wrenches, twists, exists, scratch = work
     row, chain_row = 0, 0
     for c in range(own_counts.shape[0]):  # the square block: the subsystem's own wrenches in the complement
@@ -365,7 +374,9 @@ def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
         if not members[subsystem, c] or count == 0:
             continue
         freed_twists(block, permutation, size, start, count, basis, freed, column)
-        released_pairs(own, c, count, freed, rank_tolerance, pairing, wrenches, twists, exists, scratch)
+        if released_pairs(own, c, count, freed, rank_tolerance, repeated_pairing, pairing, wrenches, twists, exists,
+                          scratch):
+            return -1.0
         for i in range(count):
             if exists[i]:
                 value = min(value, coefficient(wrenches, twists, i, points, index, c, threshold[index], pure_couple))
@@ -375,7 +386,8 @@ def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def constraint_kernel(constraints, wrench_start, own_counts, common, points, wrenches, submechanisms, members,
-                      threshold, motion_tolerance, rank_tolerance, pure_couple, instantaneous, per_set):
+                      threshold, motion_tolerance, rank_tolerance, pure_couple, repeated_pairing, instantaneous,
+                      per_set):
     """Instantaneous DOF and :math:`CTI_N` of every non-redundant actuator set of N configurations.
 
     Parameters (N configurations, C chains, K constraint wrenches in all, S sets of n actuators, L subsystems)
@@ -389,9 +401,11 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
     wrenches (N, a, 6) : unit actuation wrenches in working coordinates.
     submechanisms (S, n) : the actuator sets; members (L, C) : 1 for the chains of each subsystem.
     threshold (N,) : the singularity threshold in working coordinates (p / L).
-    motion_tolerance, rank_tolerance, pure_couple : MOTION_SPACE_TOLERANCE, RANK_TOLERANCE, PURE_COUPLE.
+    motion_tolerance, rank_tolerance, pure_couple, repeated_pairing : MOTION_SPACE_TOLERANCE, RANK_TOLERANCE,
+        PURE_COUPLE, REPEATED_PAIRING.
     instantaneous (N,), per_set (N, S) : out, six minus the rank of all constraint wrenches, and the best
-        :math:`CTI_{N,L}` over the subsystems (before constraint singularities are zeroed).
+        :math:`CTI_{N,L}` over the subsystems (before constraint singularities are zeroed); NaN where a chain's
+        pairs have a repeated singular value, whose worst rotation the numpy code finds.
     """
     count = wrench_start[wrench_start.shape[0] - 1]
     columns = np.empty((max(count, 6), 6))
@@ -412,7 +426,8 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
             best = 0.0
             if held_volume > 0.0:
                 for subsystem in range(members.shape[0]):
-                    best = max(best, subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
-                                                   (volume, held_volume, 6 - held, rank_tolerance, pure_couple),
-                                                   work))
+                    value = subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
+                                          (volume, held_volume, 6 - held, rank_tolerance, pure_couple,
+                                           repeated_pairing), work)
+                    best = np.nan if value < 0.0 or np.isnan(best) else max(best, value)
             per_set[index, s] = best
