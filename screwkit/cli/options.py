@@ -412,7 +412,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
                                                      initial=reading.initial, length_unit=length_unit))
             said = graph.reading_notes(limits=limits)  # as a serial mechanism's, on every command
         except ValueError as graph_error:
-            raise fail(str(graph_error)) from None
+            raise fail(str(error.refusal(graph_error))) from None
         if said and not _quiet():
             echo_error(f"{name}: " + "; ".join(said))
         return graph

@@ -55,7 +55,17 @@ class ImportError_(ValueError):
 class LegWithLoops(ImportError_):
     """A leg with loops inside it (a parallelogram of ball-jointed rods, a ball joint inside a leg): not a serial
     chain, so not written in screwkit's convention; :mod:`screwkit.io.graph` analyses it at the file's
-    configuration."""
+    configuration. ``held``: the serial reading's own advice, where it has one (a closure that ends on passive
+    joints beyond the platform, taken with them held), which stands if the graph reading refuses the file too."""
+
+    def __init__(self, message: str, held: str | None = None):
+        super().__init__(message)
+        self.held = held
+
+    def refusal(self, graph_error: ValueError) -> ValueError:
+        """What to raise when the graph reading refuses the file too: the serial reading's advice, where it gave one
+        (a toe on a ball beyond the foot: hold it), else the graph's reason."""
+        return ImportError_(self.held) if self.held else graph_error
 
 
 GRAPH_HINT = ("; `screwkit analyze`, `info`, `sweep`, `map`, `trajectory` and `view` (or "

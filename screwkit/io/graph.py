@@ -380,9 +380,12 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
         kind, _ = joint_kind(model, platform)
         name = tree.written_joint(model.names[platform])
         if platform in motors:
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} ({kind}) turns the platform body on the base "
+            others = ", ".join(motor for joint, motor in motors.items() if joint != platform)
+            verb = "moves" if kind == "prismatic" else "turns"
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} ({kind}) {verb} the platform body on the base "
                                "directly, with no link between: a leg screwkit does not analyse (the actuation wrench "
-                               "acts on no link of its own).")
+                               "acts on no link of its own)" + (f"; --actuate names the actuators without it (the "
+                                                                f"file's others: {others})." if others else "."))
         # a pin (or slide, ball...) holding the platform on the base: a passive leg of that one joint, whose twist
         # system is the joint's (a foot on its ankle pin, turned by a crank and rod)
         legs.append(GraphLeg(name, (platform,), (), True, ()))

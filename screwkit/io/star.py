@@ -189,8 +189,11 @@ def _refuse_beyond(tree: ClosedTree, after: list[int], what: str) -> None:
         raise LegWithLoops(f"{tree.source}: {what}, and actuated joint(s) {', '.join(motors)} among them (an actuator "
                            "the platform carries drives the loop)" + GRAPH_HINT + ".")
     them = "it" if len(names) == 1 else "them"
-    raise ImportError_(f"{tree.source}: {what}; --lock {' --lock '.join(names)} holds {them} where the file puts "
-                       f"{them}, the bodies beyond moving with the platform as one body.")
+    held = (f"{tree.source}: {what}; --lock {' --lock '.join(names)} holds {them} where the file puts {them}, the "
+            "bodies beyond moving with the platform as one body")
+    # the graph reading takes them as joints of the leg the closure ends (a slider-crank's rod hinged on the slider
+    # taken as the platform, which held would not move); where it cannot, holding them is the advice
+    raise LegWithLoops(held + GRAPH_HINT + ".", held=held + ".")
 
 
 def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: int, scale: float,

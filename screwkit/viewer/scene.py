@@ -287,11 +287,14 @@ def mechanism_of(mechanism):
         return mechanism
     try:
         return load(mechanism)
-    except LegWithLoops:
+    except LegWithLoops as error:
         from screwkit.io import graph_mechanism, read_closed_tree  # readers of other tools: for such a file only
 
         name = os.fspath(mechanism)
-        return graph_mechanism(read_closed_tree(bundled_path(name) if name in bundled_graph_names() else name))
+        try:
+            return graph_mechanism(read_closed_tree(bundled_path(name) if name in bundled_graph_names() else name))
+        except ValueError as graph_error:
+            raise error.refusal(graph_error) from None
 
 
 def meshcat_viewer_of(target):
