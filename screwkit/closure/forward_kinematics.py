@@ -15,6 +15,9 @@ from screwkit.model.mechanism import Mechanism, require_mechanism
 
 __all__ = ["forward"]
 
+_SHORTENED_STEPS = 12
+"""Newton steps on the pose that end where the loops do not close are halved, at most this many times each."""
+
 
 def _task_to_pose_rates(mechanism: Mechanism, full_poses: NDArray, joint_values) -> NDArray[np.float64]:
     """d(pose coordinates)/d(task coordinates) (N, n_pose, n_task) on the closure: the identity at full
@@ -92,32 +95,49 @@ def forward(
     targets = np.broadcast_to(targets, batch + (len(selected),)).reshape(-1, len(selected))
     poses = np.array(np.broadcast_to(poses, batch + (mechanism.n_task,)).reshape(-1, mechanism.n_task))
     angular = np.array([not mechanism.chains[chain].prismatic[joint] for chain, joint in selected])
-    converged = np.zeros(poses.shape[0], dtype=bool)
-    active = np.arange(poses.shape[0])
-    last = np.full(poses.shape[0], np.inf)  # each pose's mismatch at the step before
+    count = poses.shape[0]
+    converged = np.zeros(count, dtype=bool)
+    active = np.arange(count)
+    last = np.full(count, np.inf)  # each pose's mismatch at the step before
     scales = np.where(angular, 1.0, mechanism.length_scale)
-    previous = None
-    for _ in range(max_iterations):
+    closed, step = poses.copy(), np.zeros_like(poses)  # each pose's last closed pose, and the step taken from it
+    shortened = np.zeros(count, dtype=int)
+    known = None  # each chain's joint values (count, m_i) at each pose's last closed pose
+    for _ in range(max_iterations + _SHORTENED_STEPS):
         if active.size == 0:
             break
-        solution = solve(mechanism, poses[active], initial=previous, limits=False)
+        solution = solve(mechanism, poses[active], initial=None if known is None else [k[active] for k in known],
+                         limits=False)
         values = np.stack([solution.joint_values[chain][..., joint] for chain, joint in selected], -1)
         error = values - targets[active]
         error[:, angular] = wrap_angle(error[:, angular])
+        shut = np.all(np.isfinite(error), axis=-1)
+        if known is None:
+            known = [np.zeros((count,) + chain_values.shape[1:]) for chain_values in solution.joint_values]
+        for chain_known, chain_values in zip(known, solution.joint_values):
+            chain_known[active[shut]] = chain_values[shut]
+        closed[active[shut]] = poses[active[shut]]
+        # a step past where the loops close (past the turning point of a task coordinate: a crank pin's x on its
+        # circle) is halved from the last closed pose, at most _SHORTENED_STEPS times
+        back = active[~shut & np.any(step[active] != 0.0, axis=-1) & (shortened[active] < _SHORTENED_STEPS)]
+        step[back] /= 2.0
+        poses[back] = closed[back] + step[back]
+        shortened[back] += 1
         mismatch = np.max(np.abs(error) / scales, axis=-1)
-        done = mismatch < tolerance
-        done |= (mismatch < agreement) & (mismatch > 0.5 * last[active])  # as close as Newton gets
-        last[active] = mismatch
+        done = shut & (mismatch < tolerance)
+        done |= shut & (mismatch < agreement) & (mismatch > 0.5 * last[active])  # as close as Newton gets
+        last[active[shut]] = mismatch[shut]
         converged[active[done]] = True
-        keep = ~done & np.all(np.isfinite(error), axis=-1)
-        previous = [chain_values[keep] for chain_values in solution.joint_values]
-        active, error = active[keep], error[keep]
-        if active.size == 0:
-            break
-        full = solution.full_poses[keep]
+        stepping = shut & ~done
+        rows, error = active[stepping], error[stepping]
+        active = np.sort(np.concatenate([rows, back]))
+        if rows.size == 0:
+            continue
+        full = solution.full_poses[stepping]
+        previous = [chain_values[stepping] for chain_values in solution.joint_values]
         rates = pose_rates(mechanism, full) @ _task_to_pose_rates(mechanism, full, previous)  # (N, 6, n_task)
         rotation, translation = mechanism.transforms_from_poses(full)
-        jacobian = np.empty((active.size, len(selected), mechanism.n_task))
+        jacobian = np.empty((rows.size, len(selected), mechanism.n_task))
         for row, (chain_index, joint) in enumerate(selected):
             chain = mechanism.chains[chain_index]
             frames = chain_forward_kinematics(chain.geometry, previous[chain_index])
@@ -133,7 +153,8 @@ def forward(
         largest = np.max(np.abs(update) / np.where(mechanism.angular, 1.0, mechanism.length_scale), axis=-1)
         update *= np.minimum(1.0, 0.2 / np.maximum(largest, 1e-300))[:, None]
         usable = np.all(np.isfinite(update), axis=-1)
-        poses[active[usable]] += update[usable]
+        step[rows[usable]] = update[usable]
+        poses[rows[usable]] += update[usable]
     solution = solve(mechanism, poses.reshape(batch + (mechanism.n_task,)), limits=limits)
     converged = converged.reshape(batch)
     return Solution(
