@@ -386,6 +386,27 @@ def test_the_command_refuses_a_joint_coupling_in_one_line(tmp_path):
                    "does not model it")
 
 
+DEFORMABLE = {  # a deformable body beside the five-bar (MuJoCo makes bodies of the first; the second joins two)
+    "flexcomp": ('<body name="frame" pos="0 0 0.5"><flexcomp name="strip" type="grid" count="3 1 1" '
+                 'spacing="0.02 0.02 0.02" dim="1" radius="0.002"/></body>', ""),
+    "flex": ('<body name="a" pos="0 0 0.5"><freejoint/><geom size="0.01"/></body><body name="b" pos="0.1 0 0.5">'
+             '<freejoint/><geom size="0.01"/></body>', '<deformable><flex name="strip" dim="1" body="a b" '
+             'vertex="0 0 0 0 0 0" element="0 1" radius="0.002"/></deformable>'),
+}
+
+
+@pytest.mark.parametrize("tag", sorted(DEFORMABLE))
+def test_a_deformable_body_is_refused_naming_its_element(tmp_path, tag):
+    """MuJoCo reads it (and makes bodies of a ``<flexcomp>``); Pinocchio does not, and its refusal named a body the
+    file does not write (``rod_0_0_0`` for MuJoCo's own ``model/flex/mechanisms/slidercrank.xml``, whose
+    ``<flexcomp name='rod'>`` it is made from, and to which its connects attach): the element is named."""
+    bodies, section = DEFORMABLE[tag]
+    text = five_bar_mjcf().replace("</worldbody>", bodies + "</worldbody>" + section)
+    assert mujoco.MjModel.from_xml_string(text).nflex == 1
+    one_line_error(screwkit("info", written(tmp_path, text)), "robot.xml", f"<{tag} name='strip'> is a deformable "
+                   "body, which screwkit does not model")
+
+
 def test_a_distance_equality_mujoco_refuses_is_refused_naming_it(tmp_path):
     text = five_bar_mjcf().replace("</equality>", '<distance geom1="g1" geom2="g2" distance="0.1"/></equality>')
     with pytest.raises(ValueError):

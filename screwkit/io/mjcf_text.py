@@ -273,6 +273,22 @@ def _check_equalities(root: ElementTree.Element, equality: ElementTree.Element |
     return ignored, couplings
 
 
+DEFORMABLE = {"flexcomp": "a deformable body", "flex": "a deformable body"}
+"""Elements that make bodies MuJoCo generates or deforms: screwkit analyses rigid links only."""
+
+
+def _check_deformable(root: ElementTree.Element, path: Path) -> None:
+    """A deformable or generated body is refused naming its element (Pinocchio would name the body it did not find:
+    ``rod_0_0_0``, which MuJoCo generates from ``<flexcomp name='rod'>`` and the file's connects attach to)."""
+    for tag, what in DEFORMABLE.items():
+        found = root.find(f".//{tag}")
+        if found is not None:
+            named = f" name='{found.get('name')}'" if found.get("name") else ""
+            raise MjcfError(f"{path}: <{tag}{named}> is {what}, which screwkit does not model (it analyses rigid "
+                            "links joined by joints and closures); a rigid mechanism inside the file can be written "
+                            "without it.")
+
+
 def _check_names(root: ElementTree.Element, path: Path) -> None:
     """No name twice in one of MuJoCo's namespaces that screwkit reads (MuJoCo refuses the file; Pinocchio would
     merge two joints into one, or take either of two bodies, sites, closures or keyframes)."""
@@ -342,6 +358,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
         hint = " (a URDF: give it the suffix .urdf)" if root.tag == "robot" else ""
         raise MjcfError(f"{path}: the root element is <{root.tag}>, not <mujoco>{hint}.")
     _resolve_includes(root, path.parent, (path.resolve(),))
+    _check_deformable(root, path)
     notes = []
     compilers = root.findall("compiler")
     compiler = _merged(root, "compiler")
