@@ -115,13 +115,15 @@ def test_the_slider_reads_the_same_in_millimetres_in_a_moved_world_and_written_t
         np.testing.assert_allclose(getattr(other, name), getattr(reference, name), atol=1e-9, err_msg=name)
 
 
-def test_the_command_line_analyses_the_slider_and_names_the_option_for_the_file_as_written(tmp_path):
+def test_the_command_line_analyses_the_slider_and_names_the_options_for_the_file_as_written(tmp_path):
     path = written(tmp_path)
     done = screwkit("analyze", path, "--output", "SliderRod", "--actuate", "CrankHinge", "--json")
     assert done.returncode == 0, done.stderr
     report, expected = json.loads(done.stdout), closed_form(DRAWN)
     assert report["iti"] == pytest.approx(expected["iti"], abs=1e-9)
     assert report["lmti"] == pytest.approx(expected["oti"], abs=1e-9)
+    one_line_error(screwkit("info", path), "which body is the platform? Name its output frame (--output FRAME)",
+                   "the closures join bodies 'ConnectingRod', 'Crank'")
     one_line_error(screwkit("analyze", path, "--output", "SliderRod"), "actuated joint 'Slider' (prismatic) moves "
                    "the platform body on the base directly", "--actuate names the actuators without it (the file's "
                    "others: CrankHinge, RodHinge)")

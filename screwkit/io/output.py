@@ -70,8 +70,11 @@ def output_frame(tree: ClosedTree) -> int:
             tree.notes.append(f"platform inferred: body {names[index]!r}, where closure {closure.name!r} joins the "
                               "legs (name another with --output FRAME)")
             return index
+    joined = [names[i] for i in dict.fromkeys(_body_frame(model, joint) for joint, _ in ranked) if i is not None]
+    said = f" (the closures join bodies {', '.join(map(repr, joined[:6]))}{', ...' if len(joined) > 6 else ''})"
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
-                       f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet.")
+                       f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet"
+                       + (said if joined else "") + ".")
 
 
 def _joints_after(model, ancestor: int, joint: int) -> list[int]:
