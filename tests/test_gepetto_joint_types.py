@@ -14,6 +14,7 @@ joints are named ``_left``.)
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import xml.etree.ElementTree as ElementTree
 from dataclasses import replace
@@ -29,7 +30,7 @@ from universal_ankle import universal_ankle
 
 from helpers import in_millimetres, one_line_error, screwkit
 from screwkit.closure import solve
-from screwkit.io import graph_mechanism, read_closed_tree, read_mechanism_file
+from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree, read_mechanism_file
 from screwkit.io.gepetto import replaced_joints
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -313,19 +314,25 @@ def test_the_command_line_opens_the_two_legged_digit_whose_rods_end_on_universal
         assert json.loads(again.stdout)[key] == pytest.approx(json.loads(done.stdout)[key], abs=1e-12)
 
 
-def test_two_hinges_beyond_the_foot_whose_axes_miss_each_other_are_refused_naming_them(tmp_path):
-    """A universal joint needs its two axes to meet: with the second hinge of one rod's foot end moved 1 cm off the
-    first's axis, the closure is refused naming both hinges and what is supported."""
+def test_two_hinges_beyond_the_foot_whose_axes_miss_each_other_go_to_the_graph_reading(tmp_path):
+    """A universal loop joint needs its two axes to meet: with the second hinge of one rod's foot end moved 1 cm off
+    the first's axis, the serial reading refuses the closure naming both hinges and what it supports; the commands
+    then read it as a graph, whose legs may have any joints (2 DOF, the rod's foot end two offset hinges)."""
     source = GEPETTO / "digit_like_2legs_6D"
     text = (source / "robot.urdf").read_text()
     hinge = '<joint name="foot_part_toe_b_1/2_2_rev1" type="revolute">'
     assert text.count(hinge) == 1
     (tmp_path / "robot.urdf").write_text(text.replace(hinge, hinge + '<origin xyz="0 0 0.01" rpy="0 0 0"/>'))
     shutil.copy(source / "robot.yaml", tmp_path / "robot.yaml")
+    refusal = re.escape("foot_part_toe_b_1/2_2_rev0 (revolute), foot_part_toe_b_1/2_2_rev1 (revolute) beyond the "
+                        "platform") + ".*" + re.escape("two revolute joints whose axes meet (a universal joint)")
+    with pytest.raises(LegWithLoops, match=refusal):
+        load(tmp_path / "robot.urdf", lock=DIGIT_LOCKS)
     held = [part for name in DIGIT_LOCKS for part in ("--lock", name)]
-    one_line_error(screwkit("info", tmp_path / "robot.urdf", *held), "foot_part_toe_b_1/2_2_rev0 (revolute), "
-                   "foot_part_toe_b_1/2_2_rev1 (revolute) beyond the platform",
-                   "two revolute joints whose axes meet (a universal joint)")
+    opened = screwkit("info", tmp_path / "robot.urdf", *held)
+    assert opened.returncode == 0, opened.stderr
+    assert "DOF 2; task coordinates: roll (deg), pitch (deg)" in opened.stdout, opened.stdout
+    assert "analysed as a graph" in opened.stdout, opened.stdout
 
 
 UNIVERSAL_ANKLES = {  # universal_ankle's options, and the joint values (deg) the loops are closed with
