@@ -30,6 +30,7 @@ from screwkit.indices import stages
 from screwkit.indices.stages import compiled_chunks
 from screwkit.io import graph_mechanism, read_closed_tree
 from screwkit.io.loader import load
+from screwkit.screw.algebra import SWAP
 from screwkit.studies.poses import graph_indices_at_poses, indices_at_pose, indices_at_poses
 
 DIGIT = GEPETTO / "digit_like_2legs" / "robot.urdf"
@@ -194,3 +195,31 @@ def test_blocks_are_the_runs_of_repeated_singular_values_that_exist():
     apart[0, 1] = 1.0 - 10 * tolerances.REPEATED_PAIRING
     np.testing.assert_allclose(principal_pairs.worst_in_blocks(kappa, apart, exists, wrenches, twists, joint,
                                                                threshold)[0, :3], kappa[0, :3], atol=0)
+
+
+def synthetic_block(seed: int, size: int):
+    """Wrenches W (size, 6) orthonormal and twists T = W with halves swapped (their pairing the identity: every
+    singular value 1), and a platform joint (a point and an axis): a block of ``size`` repeated pairs."""
+    rng = np.random.default_rng(seed)
+    wrenches = np.linalg.qr(rng.normal(size=(6, 6)))[0][:size]
+    joint = np.concatenate([rng.uniform(-1.0, 1.0, 3), rng.normal(size=3)])
+    joint[3:] /= np.linalg.norm(joint[3:])
+    return wrenches, wrenches @ SWAP, joint
+
+
+@pytest.mark.parametrize("size, tolerance", [(2, 1e-9), (3, 1e-9), (4, 1e-9), (5, 1e-3)])
+def test_a_block_s_worst_rotation_does_not_depend_on_the_basis_it_is_given_in(size, tolerance):
+    """Synthetic blocks of two to five pairs, each given in six bases (the same block turned by R): the same worst
+    value, to 1e-9 for the blocks a geometry makes (up to four) and 1e-3 for five, which only an accident of numbers
+    makes (eight starts missed its lowest by 0.024 in some bases; thirty-two by 3.4e-4 at most, where the point on
+    a wrench's axis jumps as its pitch leaves zero); and for two and three pairs the value scipy finds."""
+    for seed in range(3) if size < 5 else (0, 4):
+        wrenches, twists, joint = synthetic_block(seed, size)
+        values = []
+        for turn_seed in range(6):
+            turn = np.linalg.qr(np.random.default_rng(100 + turn_seed).normal(size=(size, size)))[0]
+            values.append(principal_pairs.worst_rotation((turn.T @ wrenches)[None], (turn.T @ twists)[None],
+                                                         joint[None], np.full(1, 1e-5))[0])
+        assert np.ptp(values) <= tolerance, values
+        if size <= 3:
+            assert min(values) == pytest.approx(scipy_lowest(wrenches, twists, joint, np.array(1e-5), seed), abs=1e-9)

@@ -61,7 +61,8 @@ REPEATED_PAIRING = 1e-6
 """Relative: singular values of a chain's pairing of released constraint wrenches with the twists their release frees
 (orthonormal bases, working coordinates) that differ by at most this times the largest are one repeated value. Its
 singular vectors are then any rotation of each other within their block, and the CTI takes the block's worst
-rotation (:func:`screwkit.screw.constraints.worst_in_blocks`)."""
+rotation (:func:`screwkit.screw.principal_pairs.worst_in_blocks`). A convention at its edge: values that differ by
+a little more are paired by their singular vectors, which the block's worst rotation need not be the limit of."""
 
 PURE_COUPLE = 1e-10
 """Relative: a wrench is a pure couple (infinite pitch) when ``|f| * L`` is at or below this

@@ -105,27 +105,29 @@ def _axis_line(state: _State, joint: int) -> tuple[NDArray, NDArray]:
     return transforms[:, :3, 3], transforms[:, :3, :3] @ state.kinematics.axes[joint]
 
 
-def _joint_point(state: _State, joint: int) -> NDArray:
+def _joint_point(state: _State, joint: int, among=None) -> NDArray:
     """Where ``joint`` is (n, 3), whatever point of its axis a file draws a revolute at (the same mechanism drawn
     otherwise gives the same point): a revolute whose axis meets a neighbouring revolute's (its parent's or a
     child's, not parallel to it, within :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal
     joint written as two hinges) is where they meet (the mean, if both meet it), the point
     :mod:`screwkit.closure.canonical` gives such a joint of a serial chain; any other joint at its drawn origin (a
     ball's centre; a hinge on parallel ones, whose drawn point lies in the plane of the motion; a spatial hinge that
-    meets no neighbour, whose point along its axis the file's drawing still decides: not settled)."""
-    meetings = _meetings(state, joint)
+    meets no neighbour, whose point along its axis the file's drawing still decides: not settled). ``among``: the
+    joints that count as neighbours (all, if not given)."""
+    meetings = _meetings(state, joint, among)
     return np.mean(meetings, axis=0) if meetings else state.transforms[:, joint, :3, 3]
 
 
-def _meetings(state: _State, joint: int) -> list[NDArray]:
-    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's (:func:`_joint_point`);
-    none for any other joint."""
+def _meetings(state: _State, joint: int, among=None) -> list[NDArray]:
+    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's (:func:`_joint_point`;
+    only those ``among`` these joints, if given); none for any other joint."""
     kinds = state.kinematics.kinds
     if kinds[joint] not in HINGES:
         return []
     model = state.model
     neighbours = [j for j in (model.parents[joint], *range(joint + 1, model.njoints))
-                  if j != 0 and kinds[j] in HINGES and (j == model.parents[joint] or model.parents[j] == joint)]
+                  if j != 0 and kinds[j] in HINGES and (j == model.parents[joint] or model.parents[j] == joint)
+                  and (among is None or j in among)]
     point, axis = _axis_line(state, joint)
     meetings = []
     for neighbour in neighbours:
@@ -245,8 +247,9 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     for leg, pin, platform_points in zip(legs, pinned, on_platform):
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
-            oti = platform_points + ([_pin_point(state, platform, others) if pin else _joint_point(state, platform)]
-                                     if leg.spine else [])  # (a universal joint's hinge: where its axes meet)
+            oti = platform_points + ([_pin_point(state, platform, others) if pin
+                                      else _joint_point(state, platform, leg.joints)]  # (its own universal joint's)
+                                     if leg.spine else [])
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
             point = np.mean(oti, axis=0)

@@ -267,12 +267,12 @@ def freed_twists(lu, permutation, size, start, count, basis, freed, column):
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def released_pairs(own, chain, size, freed, rank_tolerance, repeated_pairing, pairing, wrenches, twists, exists,
                    scratch):
-    """The principal pairs of a chain's own wrenches own[chain, :size] and the twists freed[:size] their release frees
-    (as ``_released_pairs``): wrenches U^T C and twists F V from the singular vectors of the pairing
-    ``C o F = U S V^T``; ``exists[i]``: singular value i above ``rank_tolerance`` times the largest. One wrench
-    and one freed twist are their own pair. Returns whether two pairs that exist have singular values within
-    ``repeated_pairing`` times the largest (a repeated block, whose worst rotation the numpy code finds:
-    :func:`screwkit.screw.principal_pairs.worst_in_blocks`)."""
+    """The principal pairs of a chain's own wrenches own[chain, :size] and the twists freed[:size] their release
+    frees (as :func:`screwkit.screw.principal_pairs.released_pairs`): wrenches U^T C and twists F V from the
+    singular vectors of the pairing ``C o F = U S V^T``; ``exists[i]``: singular value i above ``rank_tolerance``
+    times the largest. One wrench and one freed twist are their own pair. Returns whether two pairs that exist have
+    singular values within ``repeated_pairing`` times the largest (a repeated block, whose worst rotation the numpy
+    code finds: :func:`screwkit.screw.principal_pairs.worst_in_blocks`)."""
     vectors, norms, order, singular, right = scratch
     if size == 1:
         for p in range(6):
@@ -310,9 +310,10 @@ def released_pairs(own, chain, size, freed, rank_tolerance, repeated_pairing, pa
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_couple):
     """Power coefficient of the unit constraint wrench ``wrenches[pair]`` on the twist ``twists[pair]`` (as
-    ``_coefficient``), its characteristic point the point of the wrench's axis nearest to the chain's platform joint
-    ``points[index, chain, :3]`` or, for a force and when the joint has one, its axis ``points[index, chain, 3:]``
-    (:func:`screwkit.screw.algebra.nearest_on_axis`; a couple: |m . omega| / |m||omega|)."""
+    :func:`screwkit.screw.principal_pairs.power_coefficients`), its characteristic point the point of the wrench's axis
+    nearest to the chain's platform joint ``points[index, chain, :3]`` or, for a force and when the joint has one, its
+    axis ``points[index, chain, 3:]`` (:func:`screwkit.screw.algebra.nearest_on_axis`; a couple: |m . omega| /
+    |m||omega|)."""
     f0, f1, f2 = wrenches[pair, 0], wrenches[pair, 1], wrenches[pair, 2]
     m0, m1, m2 = wrenches[pair, 3], wrenches[pair, 4], wrenches[pair, 5]
     w0, w1, w2 = twists[pair, 0], twists[pair, 1], twists[pair, 2]
