@@ -62,7 +62,6 @@ from screwkit.screw.principal_pairs import pair_coefficients, released_pairs, wo
 __all__ = ["ConstraintPlan", "plan_constraints", "constraint_indices", "chain_constraint_wrenches"]
 
 
-
 @dataclass(frozen=True)
 class ConstraintPlan:
     """How a mechanism's constraint wrenches are organised (found on sample configurations).

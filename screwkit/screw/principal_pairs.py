@@ -38,7 +38,8 @@ _STEP_FLOOR = 1e-9
 :math:`\\kappa` is quadratic in the step, so it is found to about its square."""
 
 _SEARCH_STEPS = 400
-"""At most this many steps of the compass search (each halves the step or moves by it)."""
+"""At most this many steps of the compass search (each moves and doubles the step, up to the samples' spacing, or
+halves it)."""
 
 _STARTS = 8
 """Compass searches from this many of the lowest sampled directions, apart from each other (blocks of up to four
@@ -147,9 +148,10 @@ def worst_rotation(wrenches: NDArray, twists: NDArray, joint: NDArray, threshold
     """The lowest :math:`\\kappa` of the pairs ``(a W, a T)`` over unit ``a`` of one repeated block of M chains'
     pairs: wrenches and twists (M, k, 6), ``joint`` (M, 6), ``threshold`` (M,). Returns (M,).
 
-    Sampled on fixed directions, then a compass search (steps along and against each axis of R^k, renormalised;
-    halved where none is lower) from the lowest samples in :data:`_STARTS` valleys at once: the sphere has several
-    (five on Gepetto's ``robot_marcheur_3`` foot pin, whose lowest a search from the lowest sample alone missed)."""
+    Sampled on fixed directions, then compass searches (steps along and against the axes of turned frames of R^k,
+    renormalised; doubled after a move, halved where none is lower) from :data:`_STARTS` of the lowest samples, apart
+    from each other, at once: the sphere has several valleys (five on Gepetto's ``robot_marcheur_3`` foot pin, whose
+    lowest a search from the lowest sample alone missed)."""
     count, size = wrenches.shape[:2]
     directions, spacing = _directions(size)
     chunk = max(1, _BATCH // directions.shape[0])
