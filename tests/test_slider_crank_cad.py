@@ -40,9 +40,10 @@ def closed_form(angle: float) -> dict:
     return {"b": b, "c": c, "iti": abs(u @ np.array([-np.sin(angle), np.cos(angle)])), "oti": abs(u[0])}
 
 
-def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False) -> str:
+def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False, reordered: bool = False) -> str:
     """The MJCF text, lengths times ``scale``, drawn at the crank angle :data:`DRAWN` (every joint value zero),
-    hung in a frame placed by ``world`` (pos, quat), the connects' bodies in the other order if ``swapped``."""
+    hung in a frame placed by ``world`` (pos, quat), the connects' bodies in the other order if ``swapped``, the
+    crank's body written before the slider's if ``reordered``."""
     def n(*values):
         return " ".join(repr(float(v) * scale) for v in values)
 
@@ -51,7 +52,7 @@ def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False) -> s
     pairs = [("ConnectingRod", "Crank"), ("Crank", "ConnectingRod")][swapped]
     connects = "".join(f'<connect body1="{pairs[0]}" body2="{pairs[1]}" name="pin_{k}" anchor="{n(bx, by, z)}"/>'
                        for k, z in ((1, 0.0), (2, 0.01)))
-    bodies = f"""
+    slider = f"""
       <body name="SliderRod" pos="0 0 0">
         <joint type="slide" name="Slider" pos="{n(cx, cy, 0)}" axis="1 0 0"/>
         <geom type="box" pos="{n(cx, cy, 0)}" size="{n(0.005, 0.005, 0.005)}"/>
@@ -59,11 +60,13 @@ def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False) -> s
           <joint type="hinge" name="RodHinge" pos="{n(cx, cy, 0)}" axis="0 0 1"/>
           <geom type="capsule" fromto="{n(bx, by, 0, cx, cy, 0)}" size="{n(0.002)}"/>
         </body>
-      </body>
+      </body>"""
+    crank = f"""
       <body name="Crank" pos="0 0 0">
         <joint type="hinge" name="CrankHinge" pos="0 0 0" axis="0 0 1"/>
         <geom type="capsule" fromto="{n(0, 0, 0, bx, by, 0)}" size="{n(0.002)}"/>
       </body>"""
+    bodies = crank + slider if reordered else slider + crank
     if world is not None:
         bodies = f'<body name="frame" pos="{n(*map(float, world[0].split()))}" quat="{world[1]}">{bodies}</body>'
     return f"""<mujoco model="crank_and_slider">
@@ -105,11 +108,11 @@ def test_the_slider_is_the_output_with_the_textbook_pressure_angles(tmp_path):
     assert 0.5 < expected["iti"] < 0.99 and 0.5 < expected["oti"] < 0.99  # neither trivial nor singular
 
 
-@pytest.mark.parametrize("variant", ["mm", "moved", "swapped"])
+@pytest.mark.parametrize("variant", ["mm", "moved", "swapped", "reordered"])
 def test_the_slider_reads_the_same_in_millimetres_in_a_moved_world_and_written_the_other_way(tmp_path, variant):
     _, reference = slider_indices(written(tmp_path))
     options, reading = {"mm": ({"scale": 1e3}, {"length_unit": "mm"}), "moved": ({"world": TURN}, {}),
-                        "swapped": ({"swapped": True}, {})}[variant]
+                        "swapped": ({"swapped": True}, {}), "reordered": ({"reordered": True}, {})}[variant]
     _, other = slider_indices(written(tmp_path, f"{variant}.xml", **options), **reading)
     for name in ("iti_actuators", "oti_actuators", "lmti", "cti"):
         np.testing.assert_allclose(getattr(other, name), getattr(reference, name), atol=1e-9, err_msg=name)
