@@ -25,6 +25,7 @@ from test_gepetto_joint_types import DIGIT_LOCKS
 
 import screwkit.screw.constraints as constraints
 import screwkit.screw.principal_pairs as principal_pairs
+from helpers import in_unit
 from screwkit.common import tolerances
 from screwkit.indices import stages
 from screwkit.indices.stages import compiled_chunks
@@ -41,16 +42,16 @@ SERIAL = {name: (GEPETTO / name / "robot.urdf", {"lock": DIGIT_LOCKS}, 2) for na
 CASES = {"digit_like_2legs": (DIGIT, {"lock": DIGIT_LOCKS}, 2), "robot_marcheur_3": (ANKLE, ANKLE_OPTIONS, 4)} | SERIAL
 
 
-def cti(path, **options) -> float:
-    """The CTI at the file's configuration: a graph mechanism's, or serial legs' (``digit_like``, and
+def cti(path, serial: bool = False, **options) -> float:
+    """The CTI at the file's configuration: a graph mechanism's, or ``serial`` legs' (``digit_like``, and
     ``digit_like_2legs_6D``, whose balls are written as three revolutes)."""
-    if path in [serial_path for serial_path, _, _ in SERIAL.values()]:
+    if serial:
         mechanism = load(path, **options)
         return float(np.ravel(indices_at_pose(mechanism, mechanism.home_pose).cti)[0])
     return float(np.ravel(graph_mechanism(read_closed_tree(path, **options)).indices().cti)[0])
 
 
-def blocks_met(monkeypatch, path, options) -> list[tuple]:
+def blocks_met(monkeypatch, name: str) -> list[tuple]:
     """Every repeated block :func:`~screwkit.screw.principal_pairs.worst_rotation` is asked about while the file is
     analysed: (wrenches, twists, joint, threshold, its answer)."""
     met, search = [], principal_pairs.worst_rotation
@@ -61,7 +62,8 @@ def blocks_met(monkeypatch, path, options) -> list[tuple]:
         return value
 
     monkeypatch.setattr(principal_pairs, "worst_rotation", spy)
-    cti(path, **options)
+    path, options, _ = CASES[name]
+    cti(path, name in SERIAL, **options)
     monkeypatch.undo()
     return met
 
@@ -91,8 +93,8 @@ def scipy_lowest(wrenches, twists, joint, threshold, seed=0) -> float:
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_a_repeated_block_takes_its_worst_rotation_as_scipy_finds_it(monkeypatch, name):
-    path, options, size = CASES[name]
-    met = blocks_met(monkeypatch, path, options)
+    size = CASES[name][2]
+    met = blocks_met(monkeypatch, name)
     assert met and {wrenches.shape[1] for wrenches, *_ in met} == {size}
     for wrenches, twists, joint, threshold, value in met[:2]:  # (the first actuator sets': each takes seconds)
         for row in range(min(wrenches.shape[0], 2)):
@@ -124,10 +126,10 @@ def rotated_picks(monkeypatch, seed: int) -> None:
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_the_cti_does_not_depend_on_numpy_s_pick_within_a_repeated_block(monkeypatch, name):
     path, options, _ = CASES[name]
-    value = cti(path, **options)
+    value = cti(path, name in SERIAL, **options)
     for seed in range(4):
         rotated_picks(monkeypatch, seed)
-        assert cti(path, **options) == pytest.approx(value, abs=1e-9)
+        assert cti(path, name in SERIAL, **options) == pytest.approx(value, abs=1e-9)
         monkeypatch.undo()
     assert 0.98 < value < 0.999
 
@@ -223,3 +225,17 @@ def test_a_block_s_worst_rotation_does_not_depend_on_the_basis_it_is_given_in(si
         assert np.ptp(values) <= tolerance, values
         if size <= 3:
             assert min(values) == pytest.approx(scipy_lowest(wrenches, twists, joint, np.array(1e-5), seed), abs=1e-9)
+
+
+@pytest.mark.parametrize("factor", [1e-3, 1e3])
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_the_cti_of_a_repeated_block_is_the_same_for_the_mechanism_scaled(tmp_path, name, factor):
+    """The file's lengths times 1e-3 or 1e3, read in metres (a mechanism a thousand times smaller or larger, not the
+    same one in another unit): the block's worst rotation, found in working coordinates, does not change."""
+    path, options, _ = CASES[name]
+    scaled = tmp_path / name / "robot.urdf"
+    scaled.parent.mkdir()
+    scaled.write_text(in_unit(path.read_text(), "m", factor))
+    (scaled.parent / "robot.yaml").write_text((path.parent / "robot.yaml").read_text())
+    serial = name in SERIAL
+    assert cti(scaled, serial, **options) == pytest.approx(cti(path, serial, **options), abs=1e-9)

@@ -108,11 +108,14 @@ def test_the_slider_is_the_output_with_the_textbook_pressure_angles(tmp_path):
     assert 0.5 < expected["iti"] < 0.99 and 0.5 < expected["oti"] < 0.99  # neither trivial nor singular
 
 
-@pytest.mark.parametrize("variant", ["mm", "moved", "swapped", "reordered"])
+@pytest.mark.parametrize("variant", ["mm", "moved", "swapped", "reordered", "1e-3 as large", "1e3 as large"])
 def test_the_slider_reads_the_same_in_millimetres_in_a_moved_world_and_written_the_other_way(tmp_path, variant):
+    """The same mechanism in millimetres, in a moved world, written the other way round; and the mechanism a
+    thousand times smaller or larger (read in metres): the same indices."""
     _, reference = slider_indices(written(tmp_path))
     options, reading = {"mm": ({"scale": 1e3}, {"length_unit": "mm"}), "moved": ({"world": TURN}, {}),
-                        "swapped": ({"swapped": True}, {}), "reordered": ({"reordered": True}, {})}[variant]
+                        "swapped": ({"swapped": True}, {}), "reordered": ({"reordered": True}, {}),
+                        "1e-3 as large": ({"scale": 1e-3}, {}), "1e3 as large": ({"scale": 1e3}, {})}[variant]
     _, other = slider_indices(written(tmp_path, f"{variant}.xml", **options), **reading)
     for name in ("iti_actuators", "oti_actuators", "lmti", "cti"):
         np.testing.assert_allclose(getattr(other, name), getattr(reference, name), atol=1e-9, err_msg=name)
