@@ -16,6 +16,7 @@ published file: 28 degrees of 43.6). A step past where the loops close is now ha
 from __future__ import annotations
 
 import json
+import re
 
 import mujoco
 import numpy as np
@@ -40,10 +41,17 @@ def closed_form(angle: float) -> dict:
     return {"b": b, "c": c, "iti": abs(u @ np.array([-np.sin(angle), np.cos(angle)])), "oti": abs(u[0])}
 
 
-def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False, reordered: bool = False) -> str:
+RENAMED = {"SliderRod": "zz_carriage", "ConnectingRod": "aa_link", "Crank": "m_arm", "Slider": "q0", "RodHinge": "a9",
+           "CrankHinge": "b_drive", "pin_": "loop_"}
+"""Other names for every body, joint, actuator and closure (sorted otherwise than the file's own)."""
+
+
+def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False, reordered: bool = False,
+                     renamed: bool = False) -> str:
     """The MJCF text, lengths times ``scale``, drawn at the crank angle :data:`DRAWN` (every joint value zero),
     hung in a frame placed by ``world`` (pos, quat), the connects' bodies in the other order if ``swapped``, the
-    crank's body written before the slider's if ``reordered``."""
+    crank's body written before the slider's if ``reordered``, every name replaced by :data:`RENAMED`'s if
+    ``renamed``."""
     def n(*values):
         return " ".join(repr(float(v) * scale) for v in values)
 
@@ -69,13 +77,17 @@ def cad_slider_crank(scale: float = 1.0, world=None, swapped: bool = False, reor
     bodies = crank + slider if reordered else slider + crank
     if world is not None:
         bodies = f'<body name="frame" pos="{n(*map(float, world[0].split()))}" quat="{world[1]}">{bodies}</body>'
-    return f"""<mujoco model="crank_and_slider">
+    text = f"""<mujoco model="crank_and_slider">
   <worldbody><body name="Base">{bodies}</body></worldbody>
   <equality>{connects}</equality>
   <actuator><position name="Slider" joint="Slider"/><position name="CrankHinge" joint="CrankHinge"/>
     <position name="RodHinge" joint="RodHinge"/></actuator>
 </mujoco>
 """
+    if renamed:
+        longest_first = "|".join(sorted(RENAMED, key=len, reverse=True))
+        text = re.sub(f'"({longest_first})', lambda match: '"' + RENAMED[match.group(1)], text)
+    return text
 
 
 def written(tmp_path, name: str = "crank_and_slider.xml", **options):
@@ -84,8 +96,10 @@ def written(tmp_path, name: str = "crank_and_slider.xml", **options):
     return path
 
 
-def slider_indices(path, **options):
-    graph = graph_mechanism(read_closed_tree(path, output="SliderRod", actuate=("CrankHinge",), **options))
+def slider_indices(path, renamed: bool = False, **options):
+    names = RENAMED if renamed else {}
+    graph = graph_mechanism(read_closed_tree(path, output=names.get("SliderRod", "SliderRod"),
+                                             actuate=(names.get("CrankHinge", "CrankHinge"),), **options))
     return graph, graph.indices()
 
 
@@ -108,13 +122,15 @@ def test_the_slider_is_the_output_with_the_textbook_pressure_angles(tmp_path):
     assert 0.5 < expected["iti"] < 0.99 and 0.5 < expected["oti"] < 0.99  # neither trivial nor singular
 
 
-@pytest.mark.parametrize("variant", ["mm", "moved", "swapped", "reordered", "1e-3 as large", "1e3 as large"])
+@pytest.mark.parametrize("variant", ["mm", "moved", "swapped", "reordered", "renamed", "1e-3 as large",
+                                     "1e3 as large"])
 def test_the_slider_reads_the_same_in_millimetres_in_a_moved_world_and_written_the_other_way(tmp_path, variant):
-    """The same mechanism in millimetres, in a moved world, written the other way round; and the mechanism a
-    thousand times smaller or larger (read in metres): the same indices."""
+    """The same mechanism in millimetres, in a moved world, written the other way round, with every name changed;
+    and the mechanism a thousand times smaller or larger (read in metres): the same indices."""
     _, reference = slider_indices(written(tmp_path))
     options, reading = {"mm": ({"scale": 1e3}, {"length_unit": "mm"}), "moved": ({"world": TURN}, {}),
                         "swapped": ({"swapped": True}, {}), "reordered": ({"reordered": True}, {}),
+                        "renamed": ({"renamed": True}, {"renamed": True}),
                         "1e-3 as large": ({"scale": 1e-3}, {}), "1e3 as large": ({"scale": 1e3}, {})}[variant]
     _, other = slider_indices(written(tmp_path, f"{variant}.xml", **options), **reading)
     for name in ("iti_actuators", "oti_actuators", "lmti", "cti"):
