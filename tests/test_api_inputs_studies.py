@@ -304,6 +304,16 @@ def test_trajectory_says_what_level_and_analysis_are(five):
     assert trajectory(five, path, analysis=AnalysisOptions(faults=1)).indices.faults == (1,)
 
 
+def test_trajectory_refuses_times_beside_a_path_that_carries_its_own(five):
+    """Before: times given with a Path were dropped without a word (the result had no time coordinate)."""
+    path = line_path(five, [0, 0, 0], [0.1, 0, 0], 5)
+    with pytest.raises(ValueError, match=r"^Expected `times` only with a path given as poses: a Path carries its own "
+                                         r"\(screwkit.studies.paths.path_from_poses\(mechanism, poses, times\)\)\.$"):
+        trajectory(five, path, times=np.linspace(0.0, 1.0, 5))
+    timed = trajectory(five, path.poses, times=np.linspace(0.0, 1.0, 5))
+    np.testing.assert_array_equal(timed.plain_dataset().coords["t"][1], np.linspace(0.0, 1.0, 5))
+
+
 @pytest.mark.parametrize("samples", [2.5, 5.0, "5", True, 1])
 def test_paths_refuse_a_sample_count_that_is_no_whole_number(five, samples):
     """Before: numpy's ''float' object cannot be interpreted as an integer'."""

@@ -24,8 +24,9 @@ from screwkit.closure.on_the_way import OTHER_ASSEMBLY
 from screwkit.common.units import is_angular
 from screwkit.indices.registry import column_record, is_column
 from screwkit.plots import save_figure, sweep_figure
-from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.files import write_dataset
 from screwkit.studies.sweep import sweep as run_sweep
+from screwkit.studies.tables import wide_csv
 
 __all__ = ["sweep", "fixed_pose", "write_outputs"]
 
@@ -45,9 +46,7 @@ def write_outputs(dataset, outputs: Outputs, figure_function, quiet: bool, **fig
     """
     out, figure_path = outputs.out, outputs.figure
     if not out and not figure_path:
-        if hasattr(dataset, "to_dataset"):
-            dataset = dataset.to_dataset()
-        click.echo(wide_table(dataset).to_csv(index=False), nl=False)
+        click.echo(wide_csv(dataset), nl=False)  # (a map's GridMap without xarray)
         return
     if out:
         write_dataset(dataset, out)

@@ -27,9 +27,10 @@ from screwkit.cli.options import (
 )
 from screwkit.model import Mechanism
 from screwkit.studies.actuator_paths import read_actuator_path
-from screwkit.studies.files import wide_table, write_dataset
+from screwkit.studies.files import write_dataset
 from screwkit.studies.path_mechanisms import check_path_size, path_mechanism
 from screwkit.studies.paths import PathFileError, checked_tolerance, circle_path, line_path, read_path, through_path
+from screwkit.studies.tables import wide_csv
 from screwkit.studies.trajectory import trajectory as run_trajectory
 
 __all__ = ["trajectory", "generated_path", "print_summary", "PathSource", "FaultOptions", "line_option",
@@ -288,7 +289,7 @@ def _sized(mechanism, analysis):
 def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:
     """The data file and the figure (checked before the computation); with neither, the CSV table on stdout."""
     if outputs.out:
-        write_dataset(result.plain_dataset(), outputs.out)  # netCDF without xarray (CSV through it)
+        write_dataset(result.plain_dataset(), outputs.out)  # netCDF or CSV, without xarray
         if not quiet:
             echo_error(f"wrote {outputs.out}")
     if outputs.figure:
@@ -298,4 +299,4 @@ def _write(result, outputs: Outputs, quiet: bool, to_stdout: bool) -> None:
         if not quiet:
             echo_error(f"wrote {outputs.figure}")
     if not outputs.out and not outputs.figure and to_stdout:
-        click.echo(wide_table(result.to_dataset()).to_csv(index=False), nl=False)
+        click.echo(wide_csv(result.plain_dataset()), nl=False)

@@ -19,6 +19,8 @@ import re
 import time
 from typing import Callable
 
+from screwkit.studies.tables import wide_csv
+
 __all__ = ["check_output", "check_distinct", "output_suffix", "write_dataset", "read_result", "open_netcdf",
            "atomic_write", "atomic_text", "save_figure", "WriteError", "DATA_SUFFIXES", "FIGURE_SUFFIXES", "FORMATS"]
 
@@ -201,46 +203,27 @@ def atomic_text(path: str | os.PathLike, text: str) -> None:
     atomic_write(path, write)
 
 
-def wide_table(dataset):
-    """A dataset as one row per point of the dimensions every variable shares, one column per series.
-
-    Variables over exactly those dimensions are columns (a sweep's ``phi``; a map's ``y`` and
-    ``x``); a variable with one more dimension (e.g. the ITI per actuator) gives one column per
-    label, ``iti_actuator[chain_1:joint]``.
-    """
-    import pandas as pd
-
-    shared = [d for d in dataset.dims if all(d in dataset[v].dims for v in dataset.data_vars)]
-    if not shared:
-        raise ValueError(f"Cannot write a table: the variables share no dimension ({dict(dataset.sizes)}).")
-    frame = dataset[[v for v in dataset.data_vars if set(dataset[v].dims) == set(shared)]].to_dataframe()
-    frame = frame.reset_index()
-    columns = {}
-    for name in dataset.data_vars:
-        extra = [d for d in dataset[name].dims if d not in shared]
-        if len(extra) == 1:
-            for label in dataset[extra[0]].values:
-                columns[f"{name}[{label}]"] = dataset[name].sel({extra[0]: label}).transpose(*shared).values.ravel()
-    return pd.concat([frame, pd.DataFrame(columns)], axis=1)
-
-
 def write_dataset(dataset, path) -> None:
     """Write a netCDF (``.nc``) or CSV file (the suffix in any case) atomically (:func:`atomic_write`).
 
-    ``dataset`` is an ``xarray.Dataset`` or a :class:`~screwkit.studies.maps.GridMap` (written
-    to netCDF without xarray).
+    ``dataset`` is an ``xarray.Dataset``, a :class:`~screwkit.studies.maps.GridMap` or a
+    :class:`~screwkit.studies.netcdf.PlainDataset` (both written without xarray). A CSV file is its wide table
+    (:func:`screwkit.studies.tables.wide_csv`).
     """
     path = os.fspath(path)
     kind = output_suffix(path, DATA_SUFFIXES)
-    if hasattr(dataset, "write_netcdf"):
-        if kind == ".nc":
-            dataset.write_netcdf(path)
-            return
-        dataset = dataset.to_dataset()
     if kind == ".csv":
-        atomic_write(path, lambda temporary: wide_table(dataset).to_csv(temporary, index=False))
+        text = wide_csv(dataset)
+        atomic_write(path, lambda temporary: _write_text(temporary, text))
+    elif hasattr(dataset, "write_netcdf"):
+        dataset.write_netcdf(path)
     else:
         atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))
+
+
+def _write_text(path: str, text: str) -> None:
+    with open(path, "w", encoding="utf-8", newline="") as handle:
+        handle.write(text)
 
 
 def open_netcdf(path: str, error: type[Exception] = ValueError):

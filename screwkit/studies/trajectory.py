@@ -277,6 +277,9 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
     """
     if not isinstance(mechanism, GraphMechanism):
         require_mechanism(mechanism, "trajectory")
+    if isinstance(path, Path) and times is not None:  # (a Path's own times would be silently replaced, or not)
+        raise ValueError("Expected `times` only with a path given as poses: a Path carries its own "
+                         "(screwkit.studies.paths.path_from_poses(mechanism, poses, times)).")
     path = path if isinstance(path, Path) else path_from_poses(mechanism, path, times)
     analysis = checked_analysis(analysis, "trajectory")
     if aggregate not in AGGREGATES:
