@@ -28,10 +28,14 @@ def crank_ends() -> np.ndarray:
     return MOTORS + np.array([0.0, -CRANK, 0.0])
 
 
-def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False, cranks: int = 2) -> str:
+def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False, cranks: int = 2,
+                   roll_offset=(0.0, 0.0, 0.0), roll_drawn: float = 0.0) -> str:
     """The ankle's MJCF text; ``scale`` multiplies every length (a file in other units), ``world`` (``pos``,
     ``quat`` texts) puts the shank in another place of the world; ``floating``: the shank on an unnamed free joint
-    (a humanoid's leg, its pelvis floating); ``cranks`` 3: a third crank and rod (one redundant actuator)."""
+    (a humanoid's leg, its pelvis floating); ``cranks`` 3: a third crank and rod (one redundant actuator);
+    ``roll_offset``: the roll hinge's axis passes there instead of through ``O`` (a humanoid's roll hinge 12 mm below
+    its pitch hinge: the two axes do not meet), drawn ``roll_drawn`` along its own axis from that point (the same
+    mechanism)."""
     def rod(k: int) -> str:
         joint = (f'<joint name="rod_{k}" type="ball"/>' if rods == "ball" else
                  f'<joint name="rod_{k}_u1" type="hinge" axis="1 0 0"/><joint name="rod_{k}_u2" type="hinge" '
@@ -42,14 +46,16 @@ def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating:
                 f'<geom type="sphere" size="{0.01 * scale!r}"/></body></body>')
 
     pos, quat = world if world is not None else ("0 0 0", "1 0 0 0")
-    connects = "".join(f'<connect name="closure_{k}" body1="foot" body2="rod_{k}" anchor="{text(FOOT[k - 1], scale)}"/>'
-                       for k in range(1, cranks + 1))
+    offset = np.asarray(roll_offset, dtype=float)  # the foot's frame there: its anchors and site given in it
+    connects = "".join(f'<connect name="closure_{k}" body1="foot" body2="rod_{k}" '
+                       f'anchor="{text(FOOT[k - 1] - offset, scale)}"/>' for k in range(1, cranks + 1))
     motors = "".join(f'<motor name="m{k}" joint="motor_{k}"/>' for k in range(1, cranks + 1))
     return (f'<mujoco model="rod_ankle"><compiler angle="radian"/><worldbody><body name="shank" pos="{pos}" '
             f'quat="{quat}">{"<freejoint/>" if floating else ""}<geom type="sphere" size="{0.01 * scale!r}"/>'
             f'{"".join(rod(k) for k in range(1, cranks + 1))}'
             '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
-            f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="roll" type="hinge" '
-            f'axis="1 0 0"/><geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'
-            f'<site name="sole" pos="{text(SOLE, scale)}"/></body></body></body>'
+            f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot" pos="{text(offset, scale)}">'
+            f'<joint name="roll" type="hinge" axis="1 0 0" pos="{text([roll_drawn, 0.0, 0.0], scale)}"/>'
+            f'<geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'
+            f'<site name="sole" pos="{text(SOLE - offset, scale)}"/></body></body></body>'
             f'</worldbody><equality>{connects}</equality><actuator>{motors}</actuator></mujoco>')

@@ -273,3 +273,48 @@ def test_a_closure_beyond_the_platform_on_a_ball_is_refused_naming_the_lock_that
     expected = load(plain, output="foot")
     for pose in (expected.home_pose, expected.home_pose + np.radians([4.0, -3.0])):
         assert_indices_close(indices_at_pose(expected, pose), indices_at_pose(held, pose), atol=1e-12)
+
+
+OFFSET = (0.0, 0.002, -0.012)
+"""The roll hinge's axis 12 mm below the pitch hinge's and 2 mm aside (a humanoid's ankle: the axes do not meet)."""
+
+
+@pytest.mark.parametrize("drawn", [0.05, -0.03, 0.2])
+def test_a_roll_hinge_below_the_pitch_hinge_gives_the_same_indices_wherever_drawn_along_its_axis(tmp_path, drawn):
+    """The foot's roll hinge, whose axis passes the pitch hinge's without meeting it, is where their common
+    perpendicular meets it, as a serial chain's canonical point: drawn 3 to 20 cm along its axis (MuJoCo: the same
+    bodies at every configuration), the ankle has the same ITI, OTIs, LMTI and CTI at the file's configuration and at
+    poses about it. Before, the hinge's drawn point was the passive leg's point on the foot, and the CTI of a
+    published humanoid's ankle read 0.9332, 0.8923 or 0.8859 as its roll hinge was drawn 0, 5 or -3 cm along it.
+    The ITI, OTIs and LMTI are those of the rods on two hinges, read as serial legs."""
+    reference = graph_of(write(tmp_path, roll_offset=OFFSET))
+    other = graph_of(write(tmp_path, name="drawn.xml", roll_offset=OFFSET, roll_drawn=drawn))
+    ours = graph_indices_at_poses(reference, reference.home_pose + POSES, detail=True)
+    theirs = graph_indices_at_poses(other, other.home_pose + POSES, detail=True)
+    assert np.all(ours.reachable) and np.all(theirs.reachable)
+    assert np.all(ours.cti > 0.1) and np.ptp(ours.cti) > 0.01  # neither vanishing nor constant over the poses
+    for field in ("iti_actuators", "lmti", "oti_submechanisms", "cti"):
+        np.testing.assert_allclose(getattr(theirs, field), getattr(ours, field), atol=TOLERANCE, err_msg=field)
+    serial = load(write(tmp_path, "hinges", "hinges.xml", roll_offset=OFFSET, roll_drawn=drawn), output="foot")
+    on_hinges = indices_at_poses(serial, serial.home_pose + POSES, detail=True)
+    for field in ("iti_actuators", "lmti", "oti_submechanisms"):
+        np.testing.assert_allclose(getattr(on_hinges, field), getattr(ours, field), atol=TOLERANCE, err_msg=field)
+
+
+def test_mujoco_reads_the_roll_hinge_drawn_along_its_axis_as_the_same_mechanism(tmp_path):
+    import mujoco
+
+    sites = []
+    for drawn in (0.0, 0.2):
+        model = mujoco.MjModel.from_xml_string(rod_ankle_mjcf(roll_offset=OFFSET, roll_drawn=drawn))
+        data = mujoco.MjData(model)
+        placed = []
+        for angles in np.radians([[0.0, 0.0], [7.0, -4.0], [-5.0, 9.0]]):
+            data.qpos[:] = 0.0
+            for joint, angle in (("roll", angles[0]), ("pitch", angles[1])):
+                data.qpos[model.jnt_qposadr[model.joint(joint).id]] = angle
+            mujoco.mj_kinematics(model, data)
+            placed.append(data.site("sole").xpos.copy())
+        sites.append(placed)
+    np.testing.assert_allclose(sites[0], sites[1], atol=1e-15)
+    assert not np.allclose(sites[0][0], sites[0][1])  # (the foot turns)

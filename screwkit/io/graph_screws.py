@@ -107,39 +107,48 @@ def _axis_line(state: _State, joint: int) -> tuple[NDArray, NDArray]:
 
 def _joint_point(state: _State, joint: int, among=None) -> NDArray:
     """Where ``joint`` is (n, 3), whatever point of its axis a file draws a revolute at (the same mechanism drawn
-    otherwise gives the same point): a revolute whose axis meets a neighbouring revolute's (its parent's or a
-    child's, not parallel to it, within :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal
-    joint written as two hinges) is where they meet (the mean, if both meet it), the point
-    :mod:`screwkit.closure.canonical` gives such a joint of a serial chain; any other joint at its drawn origin (a
-    ball's centre; a hinge on parallel ones, whose drawn point lies in the plane of the motion; a spatial hinge that
-    meets no neighbour, whose point along its axis the file's drawing still decides: not settled). ``among``: the
-    joints that count as neighbours (all, if not given)."""
-    meetings = _meetings(state, joint, among)
-    return np.mean(meetings, axis=0) if meetings else state.transforms[:, joint, :3, 3]
+    otherwise gives the same point), as :mod:`screwkit.closure.canonical` places a serial chain's: a revolute whose
+    axis meets a neighbouring revolute's (its parent's or a child's, not parallel to it, within
+    :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal joint written as two hinges) where
+    they meet (the mean, if both meet it); one whose axis passes a neighbouring revolute's at a clear angle (squared
+    sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`) without meeting it, or a neighbouring ball, at the
+    foot on its axis of their common perpendicular, or of the perpendicular from the ball's centre (the mean of
+    both neighbours'; a foot's roll hinge 12 mm below its pitch hinge); any other joint at its drawn origin (a ball's
+    centre; a hinge among parallel ones, whose drawn point lies in the plane of the motion). ``among``: the joints
+    that count as neighbours (all, if not given)."""
+    meetings, feet = _meetings(state, joint, among)
+    if meetings:
+        return np.mean(meetings, axis=0)
+    return np.mean(feet, axis=0) if feet else state.transforms[:, joint, :3, 3]
 
 
-def _meetings(state: _State, joint: int, among=None) -> list[NDArray]:
-    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's (:func:`_joint_point`;
-    only those ``among`` these joints, if given); none for any other joint."""
+def _meetings(state: _State, joint: int, among=None) -> tuple[list[NDArray], list[NDArray]]:
+    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's, and the feet on it
+    of the common perpendiculars with the neighbouring revolutes' axes it passes at a clear angle and of the
+    perpendiculars from neighbouring balls' centres (:func:`_joint_point`; only neighbours ``among`` these joints,
+    if given); none for any other joint."""
     kinds = state.kinematics.kinds
     if kinds[joint] not in HINGES:
-        return []
+        return [], []
     model = state.model
     neighbours = [j for j in (model.parents[joint], *range(joint + 1, model.njoints))
-                  if j != 0 and kinds[j] in HINGES and (j == model.parents[joint] or model.parents[j] == joint)
-                  and (among is None or j in among)]
+                  if j != 0 and kinds[j] in (*HINGES, "ball")
+                  and (j == model.parents[joint] or model.parents[j] == joint) and (among is None or j in among)]
     point, axis = _axis_line(state, joint)
-    meetings = []
+    meetings, feet = [], []
     for neighbour in neighbours:
+        if kinds[neighbour] == "ball":
+            feet.append(_foot_from(point, axis, state.transforms[:, neighbour, :3, 3]))
+            continue
         other_point, other_axis = _axis_line(state, neighbour)
         cosine = np.sum(axis * other_axis, axis=1)
         sine_squared = 1.0 - cosine * cosine
         if not np.all(sine_squared > PARALLEL_FOOT):
             continue
         normal = np.cross(axis, other_axis) / np.sqrt(sine_squared)[:, None]
-        if np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale):
-            meetings.append(foot_on_line(point, axis, other_point, other_axis))
-    return meetings
+        met = np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale)
+        (meetings if met else feet).append(foot_on_line(point, axis, other_point, other_axis))
+    return meetings, feet
 
 
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
@@ -168,7 +177,7 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
     :mod:`screwkit.closure.canonical` places a serial chain's). It enters the working length of the leg's equivalent
     chain, on which the CTI depends."""
     kinds = state.kinematics.kinds
-    meetings = _meetings(state, actuator)
+    meetings, _ = _meetings(state, actuator)
     if meetings:  # where it meets a neighbouring hinge
         return np.mean(meetings, axis=0)
     if kinds[actuator] not in HINGES + ("prismatic",):
