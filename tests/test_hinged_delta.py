@@ -27,7 +27,7 @@ from hinged_delta import AZIMUTHS, geometry, hinged_delta_sdf, textbook
 from test_gallery import assert_same_bodies, mujoco_residuals, mujoco_state
 from test_io import mjcf_of_tree
 
-from helpers import random_rotation, screwkit
+from helpers import one_line_error, random_rotation, screwkit
 from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
 from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
@@ -213,3 +213,53 @@ def test_parallel_axes_makes_nearly_parallel_directions_parallel_in_any_order_ke
     again, turn_again = parallel_axes(directions[order])
     np.testing.assert_allclose(again, turned[order], atol=1e-15)
     assert turn_again == pytest.approx(turn, rel=1e-9)
+
+
+ANCHOR = "<joint name='anchor' type='fixed'><parent>world</parent><child>base</child></joint>"
+
+
+def floating(platform_first: bool = False, canonical: str | None = None) -> str:
+    """The hinged Delta with no joint to the world (Gazebo would let it float), its platform's <link> written before
+    the base's if ``platform_first``, the base named by ``<model canonical_link=...>`` if ``canonical``."""
+    text = hinged_delta_sdf().replace(ANCHOR, "")
+    starts = [text.index(f"<link name='{name}'>") for name in ("base", "platform")]
+    base, platform = (text[start:text.index("</link>", start) + len("</link>")] for start in starts)
+    if platform_first:
+        text = text.replace(base + platform, platform + base)
+    if canonical:
+        text = text.replace("<model name='hinged_delta'>", f"<model name='hinged_delta' canonical_link='{canonical}'>")
+    return text
+
+
+def test_a_model_with_no_joint_to_the_world_says_which_link_it_fixed_when_refused(tmp_path):
+    """No joint to the world, and the platform's <link> first: SDFormat's canonical link, which screwkit fixes, is the
+    platform, and the mechanism read is another one (here its output is on the fixed base). The refusal names the
+    link fixed and what names another; with ``<model canonical_link='base'>`` the file reads as the anchored one."""
+    anchored = indices(tmp_path)[1]
+    (tmp_path / "first.sdf").write_text(floating(platform_first=True))
+    message = one_line_error(screwkit("analyze", tmp_path / "first.sdf"))
+    assert message.endswith("(The fixed base is the model's first <link> 'platform', as no joint is to the world: a "
+                            "joint from the world, or <model canonical_link=...>, names another.)"), message
+    for name, text in (("named.sdf", floating(platform_first=True, canonical="base")), ("floating.sdf", floating())):
+        (tmp_path / name).write_text(text)
+        mechanism = load(tmp_path / name)
+        result = indices_at_pose(mechanism, mechanism.home_pose)
+        for field in ("iti_actuators", "oti_submechanisms", "lmti"):
+            np.testing.assert_allclose(getattr(result, field), getattr(anchored, field), atol=TOLERANCE,
+                                       err_msg=f"{name} {field}")
+
+
+def test_the_chosen_base_is_said_only_where_screwkit_chose_it(tmp_path):
+    from screwkit.io.sdformat import with_chosen_base
+
+    cases = {"first.sdf": floating(platform_first=True), "named.sdf": floating(platform_first=True, canonical="base"),
+             "anchored.sdf": hinged_delta_sdf()}
+    for name, text in cases.items():
+        (tmp_path / name).write_text(text)
+    assert with_chosen_base(tmp_path / "first.sdf", "refused.").startswith("refused. (The fixed base is the model's "
+                                                                          "first <link> 'platform'")
+    for name in ("named.sdf", "anchored.sdf"):
+        assert with_chosen_base(tmp_path / name, "refused.") == "refused."
+    assert with_chosen_base(tmp_path / "first.sdf", "loose: on the way to the canonical link 'platform'.") == \
+        "loose: on the way to the canonical link 'platform'."  # (said already)
+    assert with_chosen_base(tmp_path / "missing.sdf", "refused.") == "refused."  # (unreadable: as it was)

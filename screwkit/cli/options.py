@@ -120,8 +120,8 @@ _WRITE_FAILURES = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}
 
 
 def report_error(message: str, arguments: list[str]) -> None:
-    """An error as one line: ``Error: ...`` on stderr, or ``{"error": ...}`` on stdout with ``--json`` (on
-    stderr if stdout itself cannot be written)."""
+    """An error as one line: ``Error: ...`` on stderr, or ``{"error": ...}`` on stdout with ``--json`` (stderr if
+    stdout cannot be written)."""
     if "--json" in arguments:
         try:
             click.echo(json.dumps({"error": message}))
@@ -367,8 +367,7 @@ def _outputs(out: str | None, figure_path: str | None, overwrite: bool, vmin: fl
 
 
 def outputs_options(*, colour_scale: bool = False) -> Callable:
-    """``--out``, ``--figure`` (with ``--vmin`` and ``--vmax`` if ``colour_scale``) and ``--overwrite``, as
-    ``outputs``, an :class:`Outputs`."""
+    """``--out``, ``--figure`` (with ``--vmin``, ``--vmax`` if ``colour_scale``), ``--overwrite``: ``outputs``."""
     return option_group(
         "outputs", _outputs,
         click.option("--out", type=click.Path(dir_okay=False), help="Data file: .nc (netCDF) or .csv."),
@@ -402,9 +401,10 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
                          initial=reading.initial)
     except ValueError as error:
         from screwkit.io import LegWithLoops, graph_mechanism, read_closed_tree  # readers of other tools: when used
+        from screwkit.io.sdformat import with_chosen_base  # (idem)
 
         if not isinstance(error, LegWithLoops) or not graphs:
-            raise fail(str(error)) from None
+            raise fail(with_chosen_base(name, str(error))) from None
         try:
             source = bundled_path(name) if name in bundled_graph_names() else name
             graph = graph_mechanism(read_closed_tree(source, output=reading.output, output_type=reading.output_type,
@@ -412,7 +412,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
                                                      initial=reading.initial, length_unit=length_unit))
             said = graph.reading_notes(limits=limits)  # as a serial mechanism's, on every command
         except ValueError as graph_error:
-            raise fail(str(error.refusal(graph_error))) from None
+            raise fail(with_chosen_base(name, str(error.refusal(graph_error)))) from None
         if said and not _quiet():
             echo_error(f"{name}: " + "; ".join(said))
         return graph

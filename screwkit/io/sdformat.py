@@ -298,6 +298,22 @@ def _hung_from_platform(tree_joints, loops, ends: dict[str, tuple[str, str]]) ->
     return platform if any(end in hung for joint in loops for end in ends[joint.name]) else None
 
 
+def with_chosen_base(path, message: str) -> str:
+    """A refusal of an SDFormat file whose model no joint ties to the world and no ``canonical_link`` names a base,
+    with the link screwkit fixed (its first: SDFormat's canonical link), which decides every leg, actuator and output
+    that follows (a Stewart platform whose platform link is written first is read upside down); ``message``
+    unchanged for any other file, or one it cannot read."""
+    if Path(path).suffix.lower() not in SDFORMAT_SUFFIXES or "canonical link" in message:
+        return message
+    try:
+        sdf = read_model(Path(path))
+        chosen = not sdf.element.get("canonical_link") and not any(WORLD in pair for pair in _ends(sdf).values())
+    except (ImportError_, OSError, ValueError):
+        return message
+    return (f"{message} (The fixed base is the model's first <link> {sdf.canonical!r}, as no joint is to the world: "
+            "a joint from the world, or <model canonical_link=...>, names another.)") if chosen else message
+
+
 def _ends(sdf: SdfModel) -> dict[str, tuple[str, str]]:
     ends = {}
     for joint in sdf.joints:
