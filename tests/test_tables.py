@@ -6,6 +6,9 @@ with no coordinate, a variable with two more dimensions)."""
 from __future__ import annotations
 
 import io
+import json
+import subprocess
+import sys
 
 import numpy as np
 import pandas as pd
@@ -126,3 +129,38 @@ def test_the_commands_print_and_write_the_table_pandas_writes_from_their_netcdf_
                             for text in (printed.stdout, expected))
         assert sorted(table.columns) == sorted(reference.columns) and len(table) == len(reference) >= 9, name
         pd.testing.assert_frame_equal(table, reference[table.columns])  # every cell's text
+
+
+LEAN = """
+import json, sys
+from screwkit.cli import app
+try:
+    app(sys.argv[1:], standalone_mode=False)
+finally:
+    print(json.dumps(sorted(m for m in ("xarray", "pandas", "dask") if m in sys.modules)), file=sys.stderr)
+"""
+
+
+@pytest.mark.parametrize("arguments", [
+    ["map", "planar_5rrr", "--radius", "0.1", "--step", "0.1", "--phi-step", "90", "--quiet"],
+    ["sweep", "planar_5rrr", "--at", "-0.2 0", "--phi", "0:360:30", "--quiet"],
+    ["trajectory", "planar_5rrr", "--line", "-0.2 -0.1 -20", "0.2 0.1 20", "--samples", "5", "--quiet"]])
+@pytest.mark.parametrize("out", [None, "csv", "nc"])
+def test_the_studies_print_and_write_without_importing_xarray_pandas_or_dask(tmp_path, arguments, out):
+    """What pandas needs xarray and xarray imports dask.array for (0.5 s of a command that prints its table)."""
+    given = arguments + ([] if out is None else ["--out", str(tmp_path / f"result.{out}")])
+    result = subprocess.run([sys.executable, "-W", "error", "-c", LEAN, *given], capture_output=True, text=True,
+                            timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stderr.strip().splitlines()[-1]) == []
+    assert (result.stdout.count("\n") > 3) == (out is None)
+
+
+def test_the_sweep_command_s_file_reads_back_as_the_dataset_the_api_returns(tmp_path):
+    five = bundled("planar_5rrr")
+    swept = sweep(five, [-0.2, 0.0, 0.0], "phi", np.radians(np.arange(0.0, 360.0, 30.0)))
+    written = screwkit("sweep", "planar_5rrr", "--at", "-0.2 0", "--phi", "0:360:30", "--quiet", "--out",
+                       tmp_path / "sweep.nc")
+    assert written.returncode == 0, written.stderr
+    with xr.open_dataset(tmp_path / "sweep.nc", engine="scipy") as dataset:
+        xr.testing.assert_identical(dataset.load(), swept)

@@ -46,14 +46,14 @@ def write_outputs(dataset, outputs: Outputs, figure_function, quiet: bool, **fig
     """
     out, figure_path = outputs.out, outputs.figure
     if not out and not figure_path:
-        click.echo(wide_csv(dataset), nl=False)  # (a map's GridMap without xarray)
+        click.echo(wide_csv(dataset), nl=False)  # (a map's GridMap, a sweep's PlainDataset: without xarray)
         return
     if out:
         write_dataset(dataset, out)
         if not quiet:
             echo_error(f"wrote {out}")
     if figure_path:
-        data = dataset.to_dataset() if hasattr(dataset, "to_dataset") else dataset  # a map's GridMap
+        data = dataset.to_dataset() if hasattr(dataset, "to_dataset") else dataset  # a GridMap, a PlainDataset
         save_figure(figure_function(data, **figure_options), figure_path)
         if not quiet:
             echo_error(f"wrote {figure_path}")
@@ -95,32 +95,33 @@ def sweep(mechanism, at, phi_range, sweep_spec, outputs: Outputs, analysis, read
     values = parse_range(text, "--phi" if phi_range else "--sweep", angular=is_angular(coordinate))
     with analysis.indices():  # the average case registered, if asked: computed, summarised, written
         try:
-            dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, **analysis.keywords())
+            dataset = run_sweep(loaded, fixed_pose(loaded, at), coordinate, values, **analysis.keywords(),
+                                as_dataset=False)  # (plain arrays: written and printed without xarray)
         except ValueError as error:
             raise fail(str(error)) from None
         if not quiet:
-            reachable = dataset["reachable"].values
-            echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values ({int(reachable.sum())} "
-                       "reachable)")
+            series_of = {name: np.asarray(entry[1]) for name, entry in dataset.variables.items()}
+            swept = np.asarray(dataset.coords[coordinate][1])
+            echo_error(f"{loaded.name}: swept {coordinate} over {values.size} values "
+                       f"({int(series_of['reachable'].sum())} reachable)")
             redundant = len(loaded.actuators) > loaded.dof
             if not redundant:
                 echo_error("  no redundancy (a = n): F_O1 = F_IO1 = 0 everywhere")
-            for name in [v for v in dataset.data_vars if is_column(v) and (redundant or column_record(v)[1] is None)]:
-                series = dataset[name].values
+            for name in [v for v in series_of if is_column(v) and (redundant or column_record(v)[1] is None)]:
+                series = series_of[name]
                 if np.any(np.isfinite(series)):
-                    at_min = dataset[coordinate].values[np.nanargmin(series)]
-                    echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = {at_min:g}")
-            if "past_singular" in dataset:
-                _say_past_singular(dataset, coordinate)
+                    echo_error(f"  min {name:<6s} {np.nanmin(series):.4f} at {coordinate} = "
+                               f"{swept[np.nanargmin(series)]:g}")
+            if "past_singular" in series_of:
+                _say_past_singular(swept, dataset.coords["singular_chain"][1], series_of["past_singular"], coordinate)
         write_outputs(dataset, outputs, sweep_figure, quiet)
 
 
-def _say_past_singular(dataset, coordinate: str) -> None:
+def _say_past_singular(values, chains, past, coordinate: str) -> None:
     """A NOTE for each chain whose joints are singular somewhere on the way from the reference pose to some of the
-    swept poses: those poses are on the assembly that keeps the reference's working-mode sign."""
-    values = dataset[coordinate].values
-    for chain in dataset["singular_chain"].values:
-        passed = dataset["past_singular"].sel(singular_chain=chain).values
+    swept poses (``past``, (values, chains)): those poses are on the assembly that keeps the reference's working-mode
+    sign."""
+    for chain, passed in zip(chains, np.asarray(past).T):
         if passed.any():
             shown = ", ".join(f"{value:g}" for value in values[passed][:6]) + (", ..." if passed.sum() > 6 else "")
             echo_error(f"NOTE: at {coordinate} = {shown} ({int(passed.sum())} of {values.size} values), the straight "

@@ -1,4 +1,4 @@
-"""Sweeps of one pose coordinate: every series of the paper's Fig. 4, as an xarray Dataset.
+"""Sweeps of one pose coordinate: every series of the paper's Fig. 4, as an xarray Dataset (or plain arrays).
 
 :func:`sweep` varies one task coordinate (the platform angle ``phi`` of a planar mechanism,
 or any coordinate of a spatial one) with the others fixed and returns, along the swept
@@ -17,10 +17,12 @@ from numpy.typing import ArrayLike
 from screwkit.closure.on_the_way import singular_on_the_ways
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.common.units import is_angular
+from screwkit.indices.exports import indices_variables
 from screwkit.indices.results import set_label
 from screwkit.io.graph import GraphMechanism
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.coordinates import one_pose, pose_text, shown_values
+from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.poses import check_graph_analysis, graph_indices_at_poses, indices_at_poses
 from screwkit.studies.sizes import check_fits, pose_bytes
 
@@ -29,7 +31,7 @@ __all__ = ["sweep"]
 
 def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLike, *,
           threshold: float = SINGULARITY_THRESHOLD, faults=None, closed_forms: bool = False, limits: bool = True,
-          fault_type: str = "free-swinging"):
+          fault_type: str = "free-swinging", as_dataset: bool = True):
     """Every index along one swept task coordinate.
 
     Parameters
@@ -51,10 +53,13 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
         Use the planar closed forms instead of the generic screw path.
     limits : bool
         Whether joint limits make a pose unreachable (default).
+    as_dataset : bool
+        Return an ``xarray.Dataset`` (default) or the same as a :class:`~screwkit.studies.netcdf.PlainDataset` (plain
+        arrays: the command writes it, or prints its table, without importing xarray).
 
     Returns
     -------
-    xarray.Dataset
+    xarray.Dataset or PlainDataset
         Dimension ``coordinate`` (degrees for angles), ``actuator``, ``submechanism`` and for
         each j ``remaining{j}`` (the actuator sets left after j faults). Variables:
         ``iti``, ``iti_actuator``, ``oti_submechanism``, ``lmti``, ``lmti_remaining{j}``,
@@ -98,27 +103,28 @@ def sweep(mechanism: Mechanism, at: ArrayLike, coordinate: str, values: ArrayLik
                                   closed_forms=closed_forms, limits=limits, fault_type=fault_type)
     angular = is_angular(coordinate)
     shown = shown_values(coordinate, values)  # degrees as written: 30, not 29.999999999999996
-    dataset = result.to_dataset(dims=(coordinate,),
-                                coords={coordinate: (coordinate, shown, {"units": "deg" if angular else "m"})})
+    variables, coords, attrs = indices_variables(
+        result, (coordinate,), {coordinate: (coordinate, shown, {"units": "deg" if angular else "m"})})
     a = result.actuator_count
     for j in result.faults:
         remaining = list(combinations(range(a), a - j))
         dimension = f"remaining{j}"
-        dataset.coords[dimension] = (dimension, [set_label(e) for e in remaining])
+        coords[dimension] = (dimension, [set_label(e) for e in remaining])
         if result.oti_submechanisms is not None and fault_type == "free-swinging":
             stacked = np.stack([np.asarray(result.lmti_of(e)) for e in remaining], axis=-1)
-            dataset[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
-                                             {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
+            variables[f"lmti_remaining{j}"] = ((coordinate, dimension), stacked,
+                                               {"long_name": f"LMTI of each actuator set left after {j} fault(s)"})
     passed = [] if graph else singular_on_the_ways(mechanism, poses)
     if passed:
-        dataset.coords["singular_chain"] = ("singular_chain", [name for name, _, _ in passed])
+        coords["singular_chain"] = ("singular_chain", [name for name, _, _ in passed])
         reachable = np.asarray(result.reachable, dtype=bool)[:, None]  # (a pose out of reach is on no assembly)
-        dataset["past_singular"] = ((coordinate, "singular_chain"),
-                                    np.stack([mask for _, mask, _ in passed], axis=1) & reachable,
-                                    {"long_name": "the way from the reference pose passes a configuration where the "
-                                                  "chain's joints are singular"})
-    dataset.attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
-                         fixed_pose=pose_text(mechanism.task_coordinates, at, mechanism.length_scale, [coordinate]),
-                         method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
-    return dataset
+        variables["past_singular"] = ((coordinate, "singular_chain"),
+                                      np.stack([mask for _, mask, _ in passed], axis=1) & reachable,
+                                      {"long_name": "the way from the reference pose passes a configuration where "
+                                                    "the chain's joints are singular"})
+    attrs.update(mechanism=mechanism.name, swept=coordinate, threshold_m=threshold,
+                 fixed_pose=pose_text(mechanism.task_coordinates, at, mechanism.length_scale, [coordinate]),
+                 method="closed forms" if closed_forms else "generic screw path", fault_type=fault_type)
+    plain = PlainDataset(variables, coords, attrs)
+    return plain.to_dataset() if as_dataset else plain
 
