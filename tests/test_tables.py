@@ -96,10 +96,12 @@ def test_every_kind_of_cell_is_written_as_pandas_writes_it():
                    "unlabelled": (("row", "free"), rng.normal(size=(4, 2)))},
         coords={"row": ("row", np.array([0.5, 1.0, 1.5, 2.0])),
                 "column": ("column", np.array(["a", "b,c", 'd"e'], dtype=object)),
-                "weight": ("row", np.array([1.0, np.nan, 3.0, 4.0]))})
+                "weight": ("row", np.array([1.0, np.nan, 3.0, 4.0])), "scale": ((), 2.5),
+                "origin": ((), "x, y")})
     text = wide_csv(plain)
     assert text == pandas_table(plain.to_dataset())
     assert '"value[b,c]"' in text.splitlines()[0] and "cube" not in text  # (two more dimensions: left out)
+    assert ',2.5,"x, y",' in text.splitlines()[1]  # (the scalar coordinates, in every row)
 
 
 def test_variables_that_share_no_dimension_are_refused_in_one_line():

@@ -2,9 +2,9 @@
 
 A table has one row per point of the dimensions every variable shares (a map's ``y`` and ``x``, a path's
 ``sample``, a sweep's swept coordinate): their coordinates first, then each variable over exactly those
-dimensions, then the other coordinates over them (a path's ``arc_length``), then one column ``name[label]`` per
-label of a variable with one more dimension (``iti_actuator[chain_1:joint]``; variables with two more are left
-out). It is the table pandas writes from the ``xarray.Dataset`` (``to_dataframe``, ``reset_index``,
+dimensions, then the other coordinates over them or over none (a path's ``arc_length``), then one column
+``name[label]`` per label of a variable with one more dimension (``iti_actuator[chain_1:joint]``; variables with two
+more are left out). It is the table pandas writes from the ``xarray.Dataset`` (``to_dataframe``, ``reset_index``,
 ``to_csv(index=False)``), byte for byte (``tests/test_tables.py``), for a map (:class:`~screwkit.studies.maps.GridMap`),
 a path (:class:`~screwkit.studies.netcdf.PlainDataset`) or any dataset, without importing xarray, pandas and,
 through xarray, dask.array: 0.4 s of a map command that prints its result.
@@ -42,8 +42,7 @@ def wide_csv(dataset) -> str:
         values = coords[d][1] if d in coords else np.arange(_size(d, coords, variables))
         names.append(d)
         cells.append(_grid(np.asarray(values), order.index(d), sizes))
-    others = [name for name, (c_dims, _) in coords.items()
-              if name not in dims and c_dims and set(c_dims) <= set(shared)]
+    others = [name for name, (c_dims, _) in coords.items() if name not in dims and set(c_dims) <= set(shared)]
     for name in exact:
         names.append(name)
         cells.append(_along(variables[name], order))
