@@ -29,13 +29,14 @@ def crank_ends() -> np.ndarray:
 
 
 def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating: bool = False, cranks: int = 2,
-                   roll_offset=(0.0, 0.0, 0.0), roll_drawn: float = 0.0) -> str:
+                   roll_offset=(0.0, 0.0, 0.0), roll_drawn: float = 0.0, toe=None) -> str:
     """The ankle's MJCF text; ``scale`` multiplies every length (a file in other units), ``world`` (``pos``,
     ``quat`` texts) puts the shank in another place of the world; ``floating``: the shank on an unnamed free joint
     (a humanoid's leg, its pelvis floating); ``cranks`` 3: a third crank and rod (one redundant actuator);
     ``roll_offset``: the roll hinge's axis passes there instead of through ``O`` (a humanoid's roll hinge 12 mm below
     its pitch hinge: the two axes do not meet), drawn ``roll_drawn`` along its own axis from that point (the same
-    mechanism)."""
+    mechanism); ``toe`` (a point and an axis): the foot on a third hinge there, after the roll hinge (three DoF,
+    for three cranks)."""
     def rod(k: int) -> str:
         joint = (f'<joint name="rod_{k}" type="ball"/>' if rods == "ball" else
                  f'<joint name="rod_{k}_u1" type="hinge" axis="1 0 0"/><joint name="rod_{k}_u2" type="hinge" '
@@ -54,8 +55,11 @@ def rod_ankle_mjcf(rods: str = "ball", scale: float = 1.0, world=None, floating:
             f'quat="{quat}">{"<freejoint/>" if floating else ""}<geom type="sphere" size="{0.01 * scale!r}"/>'
             f'{"".join(rod(k) for k in range(1, cranks + 1))}'
             '<body name="cross"><joint name="pitch" type="hinge" axis="0 1 0"/>'
-            f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot" pos="{text(offset, scale)}">'
+            f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="{"heel" if toe else "foot"}" '
+            f'pos="{text(offset, scale)}">'
             f'<joint name="roll" type="hinge" axis="1 0 0" pos="{text([roll_drawn, 0.0, 0.0], scale)}"/>'
-            f'<geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'
-            f'<site name="sole" pos="{text(SOLE - offset, scale)}"/></body></body></body>'
+            + (f'<geom type="sphere" size="{0.01 * scale!r}"/><body name="foot"><joint name="toe" type="hinge" '
+               f'pos="{text(toe[0], scale)}" axis="{text(toe[1])}"/>' if toe else "")
+            + f'<geom type="box" size="{text([0.05, 0.03, 0.01], scale)}"/>'
+            f'<site name="sole" pos="{text(SOLE - offset, scale)}"/>{"</body>" if toe else ""}</body></body></body>'
             f'</worldbody><equality>{connects}</equality><actuator>{motors}</actuator></mujoco>')

@@ -318,3 +318,30 @@ def test_mujoco_reads_the_roll_hinge_drawn_along_its_axis_as_the_same_mechanism(
         sites.append(placed)
     np.testing.assert_allclose(sites[0], sites[1], atol=1e-15)
     assert not np.allclose(sites[0][0], sites[0][1])  # (the foot turns)
+
+
+TOE_AXIS = np.array([0.3, 0.5, 0.81]) / np.linalg.norm([0.3, 0.5, 0.81])
+TOE = np.array([0.01, 0.03, -0.03])  # the toe hinge's axis passes here, skew to the roll hinge's (x, through O)
+
+
+@pytest.mark.parametrize("drawn", [0.0, 0.1, -0.07])
+def test_a_hinge_after_a_universal_joint_is_at_the_foot_of_the_perpendicular_from_its_centre(tmp_path, drawn):
+    """The foot on a third hinge after the pitch-roll universal joint (three cranks): the passive leg's point on the
+    foot is the toe hinge's, at the foot on its axis of the perpendicular from the universal joint's centre O, as the
+    serial canonical points place it (:func:`screwkit.closure.canonical.offsets_along_axes` on the leg's three
+    lines), not the foot of its common perpendicular with the roll hinge's axis (3.2 mm away here); drawn elsewhere
+    along its axis, the same point and the same indices."""
+    from screwkit.closure.canonical import offsets_along_axes
+
+    reference = graph_of(write(tmp_path, cranks=3, toe=(TOE, TOE_AXIS)))
+    other = graph_of(write(tmp_path, name="drawn.xml", cranks=3, toe=(TOE + drawn * TOE_AXIS, TOE_AXIS)))
+    lines = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], TOE_AXIS]), np.array([np.zeros(3), np.zeros(3), TOE])
+    canonical = TOE + offsets_along_axes((False, False, False), *lines)[2] * TOE_AXIS
+    expected = TOE - (TOE @ TOE_AXIS) * TOE_AXIS  # the foot from O = (0, 0, 0)
+    np.testing.assert_allclose(canonical, expected, atol=1e-12)
+    for graph in (reference, other):
+        assert [leg.name for leg in graph.legs][-1] == "cross" and graph.dof == 3
+        np.testing.assert_allclose(graph.chains[-1].points, np.broadcast_to(expected, (3, 3)), atol=1e-12)
+    ours, theirs = reference.indices(), other.indices()
+    for field in ("iti_actuators", "oti_actuators", "lmti", "cti"):
+        np.testing.assert_allclose(getattr(theirs, field), getattr(ours, field), atol=TOLERANCE, err_msg=field)

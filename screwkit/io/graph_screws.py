@@ -110,10 +110,11 @@ def _joint_point(state: _State, joint: int, among=None) -> NDArray:
     otherwise gives the same point), as :mod:`screwkit.closure.canonical` places a serial chain's: a revolute whose
     axis meets a neighbouring revolute's (its parent's or a child's, not parallel to it, within
     :data:`~screwkit.common.tolerances.MEETING` of the length scale: a universal joint written as two hinges) where
-    they meet (the mean, if both meet it); one whose axis passes a neighbouring revolute's at a clear angle (squared
-    sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`) without meeting it, or a neighbouring ball, at the
-    foot on its axis of their common perpendicular, or of the perpendicular from the ball's centre (the mean of
-    both neighbours'; a foot's roll hinge 12 mm below its pitch hinge); any other joint at its drawn origin (a ball's
+    they meet (the mean, if both meet it); any other revolute at the foot on its axis of the perpendicular from each
+    neighbour that is at a point (a ball's centre, where a neighbouring revolute meets its own neighbour: a
+    universal joint's centre), or of the common perpendicular with each other neighbouring revolute's axis it
+    passes at a clear angle (squared sine above :data:`~screwkit.common.tolerances.PARALLEL_FOOT`; a foot's roll
+    hinge 12 mm below its pitch hinge), the mean of both neighbours'; any other joint at its drawn origin (a ball's
     centre; a hinge among parallel ones, whose drawn point lies in the plane of the motion). ``among``: the joints
     that count as neighbours (all, if not given)."""
     meetings, feet = _meetings(state, joint, among)
@@ -122,11 +123,10 @@ def _joint_point(state: _State, joint: int, among=None) -> NDArray:
     return np.mean(feet, axis=0) if feet else state.transforms[:, joint, :3, 3]
 
 
-def _meetings(state: _State, joint: int, among=None) -> tuple[list[NDArray], list[NDArray]]:
-    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's, and the feet on it
-    of the common perpendiculars with the neighbouring revolutes' axes it passes at a clear angle and of the
-    perpendiculars from neighbouring balls' centres (:func:`_joint_point`; only neighbours ``among`` these joints,
-    if given); none for any other joint."""
+def _meetings(state: _State, joint: int, among=None, feet: bool = True) -> tuple[list[NDArray], list[NDArray]]:
+    """The points (n, 3 each) where a revolute ``joint``'s axis meets a neighbouring revolute's, and (``feet``) the
+    feet on it that :func:`_joint_point` takes where it meets none (only neighbours ``among`` these joints, if
+    given); none for any other joint."""
     kinds = state.kinematics.kinds
     if kinds[joint] not in HINGES:
         return [], []
@@ -135,20 +135,31 @@ def _meetings(state: _State, joint: int, among=None) -> tuple[list[NDArray], lis
                   if j != 0 and kinds[j] in (*HINGES, "ball")
                   and (j == model.parents[joint] or model.parents[j] == joint) and (among is None or j in among)]
     point, axis = _axis_line(state, joint)
-    meetings, feet = [], []
-    for neighbour in neighbours:
-        if kinds[neighbour] == "ball":
-            feet.append(_foot_from(point, axis, state.transforms[:, neighbour, :3, 3]))
-            continue
+    meetings, lines = [], {}
+    for neighbour in (j for j in neighbours if kinds[j] in HINGES):
         other_point, other_axis = _axis_line(state, neighbour)
         cosine = np.sum(axis * other_axis, axis=1)
         sine_squared = 1.0 - cosine * cosine
         if not np.all(sine_squared > PARALLEL_FOOT):
             continue
         normal = np.cross(axis, other_axis) / np.sqrt(sine_squared)[:, None]
-        met = np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale)
-        (meetings if met else feet).append(foot_on_line(point, axis, other_point, other_axis))
-    return meetings, feet
+        if np.all(np.abs(np.sum((point - other_point) * normal, axis=1)) <= MEETING * state.scale):
+            meetings.append(foot_on_line(point, axis, other_point, other_axis))
+        else:
+            lines[neighbour] = foot_on_line(point, axis, other_point, other_axis)
+    if meetings or not feet:
+        return meetings, []
+    found = []
+    for neighbour in neighbours:  # (as a serial chain's canonical points: a neighbour at a point first)
+        if kinds[neighbour] == "ball":
+            found.append(_foot_from(point, axis, state.transforms[:, neighbour, :3, 3]))
+            continue
+        centres, _ = _meetings(state, neighbour, among, feet=False)
+        if centres:  # a universal joint's centre
+            found.append(_foot_from(point, axis, np.mean(centres, axis=0)))
+        elif neighbour in lines:
+            found.append(lines[neighbour])
+    return meetings, found
 
 
 def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
@@ -158,7 +169,7 @@ def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
     ``body`` at the joint that moves that end, not at the weld's frame, which a file may put anywhere (a CAD export
     welds each leg's last link to the platform at the platform's origin)."""
     model = state.model
-    points = [_joint_point(state, j) for j in leg.joints if model.parents[j] == body]
+    points = [_joint_point(state, j, leg.joints) for j in leg.joints if model.parents[j] == body]
     for closure in leg.closures:
         if closure.axis_point:
             continue
@@ -177,7 +188,7 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
     :mod:`screwkit.closure.canonical` places a serial chain's). It enters the working length of the leg's equivalent
     chain, on which the CTI depends."""
     kinds = state.kinematics.kinds
-    meetings, _ = _meetings(state, actuator)
+    meetings, _ = _meetings(state, actuator, feet=False)
     if meetings:  # where it meets a neighbouring hinge
         return np.mean(meetings, axis=0)
     if kinds[actuator] not in HINGES + ("prismatic",):
