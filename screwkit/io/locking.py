@@ -17,6 +17,7 @@ from screwkit.io.closed_tree import (
     Closure,
     ImportError_,
     assemble,
+    closure_motions,
     homogeneous,
     joint_kind,
     joint_value,
@@ -24,7 +25,8 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "GUESSED"]
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "platform_moves",
+           "GUESSED"]
 
 
 def lock_joints(tree: ClosedTree, names) -> ClosedTree:
@@ -288,3 +290,28 @@ def initial_values(values, source: str) -> tuple[tuple[str, float], ...]:
             raise ImportError_(f"{source}: --initial {name}: given twice.")
         pairs.append((name, number))
     return tuple(pairs)
+
+
+def platform_moves(tree: ClosedTree, data, platform: int, held, scale: float) -> bool:
+    """Whether the platform's joint keeps a motion with the joints ``held`` locked and every closure kept, at the
+    configuration of ``data`` (its forward kinematics computed): the platform's twist on the null space of the
+    closures' velocity rows over the other velocity coordinates (an idle spin, which moves no platform, does not
+    count). An advice to hold joints is checked against it before it is given."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    pin.computeJointJacobians(model, data)
+    free = np.ones(model.nv, dtype=bool)
+    for joint in held:
+        free[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv] = False
+    rows = [np.zeros((0, model.nv))]
+    for closure in tree.closures:
+        (moves_a, turns_a, _), (moves_b, turns_b, _) = closure_motions(model, data, closure)
+        rows += [(moves_b - moves_a) / scale] + ([turns_b - turns_a] if closure.kind == "6d" else [])
+    matrix = np.vstack(rows)[:, free]
+    padded = np.vstack([matrix, np.zeros((max(0, matrix.shape[1] - len(matrix)), matrix.shape[1]))])
+    _, singular, right = np.linalg.svd(padded)
+    null = right[int(np.sum(singular > 1e-9 * max(float(singular[0]) if singular.size else 0.0, 1.0))):]
+    twist = pin.getJointJacobian(model, data, platform, pin.LOCAL_WORLD_ALIGNED)[:, free]
+    twist = np.vstack([twist[:3] / scale, twist[3:]])
+    return bool(null.size) and float(np.linalg.norm(twist @ null.T, ord=2)) > 1e-9

@@ -73,6 +73,7 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import compound_groups, compound_legs
 from screwkit.io.couplings import check_couplings
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
+from screwkit.io.locking import platform_moves
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
 from screwkit.io.star_writing import (
@@ -144,7 +145,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         if after:
             _refuse_beyond(tree, after, f"closure {closure.name!r} (3d) ends on joints "
                            f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
-                           "screwkit supports")
+                           "screwkit supports", data, platform, scale)
         centre = frame_a[:3, 3]
         axes = [("revolute", frame_a[:3, k], centre) for k in range(3)]
         return _Leg(a_path, "spherical", closure.placement_a, frame_a, None, axes, closure.name, sources=(closure,))
@@ -175,14 +176,17 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
     _refuse_beyond(tree, after, f"closure {closure.name!r} ends on joints "
                    f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                    "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
-                   "(a universal joint), or three revolute joints through one point (a spherical joint)")
+                   "(a universal joint), or three revolute joints through one point (a spherical joint)",
+                   data, platform, scale)
 
 
-def _refuse_beyond(tree: ClosedTree, after: list[int], what: str) -> None:
+def _refuse_beyond(tree: ClosedTree, after: list[int], what: str, data, platform: int, scale: float) -> None:
     """Refuse a closure that ends on joints ``after`` between the platform body and it (``what`` says so), with the
     options that hold them (the bodies beyond then move with the platform as one body: two platforms joined by a
-    ball, analysed as one); with an actuated joint among them, no such advice (held, it would drive nothing: the
-    platform carries the actuator, which drives the loop from there) but the graph's reading, which models it."""
+    ball, analysed as one) where the platform then still moves (:func:`~screwkit.io.locking.platform_moves`: held,
+    a four-bar's coupler and rocker hinges beyond its crank leave a structure), else naming ``--output``; with an
+    actuated joint among them, no such advice (held, it would drive nothing: the platform carries the actuator,
+    which drives the loop from there) but the graph's reading, which models it."""
     names = list(dict.fromkeys(tree.written_joint(tree.model.names[j]) for j in after))
     motors = [name for name in names if name in tree.motors]
     if motors:
@@ -191,6 +195,9 @@ def _refuse_beyond(tree: ClosedTree, after: list[int], what: str) -> None:
     them = "it" if len(names) == 1 else "them"
     held = (f"{tree.source}: {what}; --lock {' --lock '.join(names)} holds {them} where the file puts {them}, the "
             "bodies beyond moving with the platform as one body")
+    if not platform_moves(tree, data, platform, after, scale):
+        held = (f"{tree.source}: {what}; held, {'it' if len(names) == 1 else 'they'} would leave the platform no "
+                "motion (a structure): --output names another platform, a body the loops reach from the base")
     # the graph reading takes them as joints of the leg the closure ends (a slider-crank's rod hinged on the slider
     # taken as the platform, which held would not move); where it cannot, holding them is the advice
     raise LegWithLoops(held + GRAPH_HINT + ".", held=held + ".")

@@ -1,0 +1,87 @@
+"""A four-bar written as a hand-made MJCF knee is (a published humanoid leg's): the crank on the base, the coupler and
+the rocker hung beyond it, the rocker's end ``<connect>``-ed back to the base.
+
+Taken as the platform, the crank has the loop close beyond it, on the coupler's and rocker's hinges. The refusal used
+to advise holding both: a four-bar with two of its hinges held is a structure (MuJoCo: no motion left), and the next
+run said DOF 0. An advice to hold joints is now checked first (the platform must keep a motion); here the refusal
+names ``--output`` instead, and the coupler taken as the platform opens with the textbook four-bar's indices.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import one_line_error, screwkit
+from screwkit.io import ImportError_
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+A, B, C, D = (np.array(p) for p in ([0.0, 0.0, 0.0], [0.05, 0.08, 0.0], [0.20, 0.10, 0.0], [0.16, -0.02, 0.0]))
+"""The crank's pivot A on the base, the crank-coupler pin B, the coupler-rocker pin C, the rocker's pivot D on the base
+(every axis along z)."""
+
+
+def four_bar_mjcf() -> str:
+    """The knee's MJCF text: every body's frame at its first joint's pin but the coupler's, at C (its output point)."""
+    def text(point) -> str:
+        return " ".join(repr(float(v)) for v in point)
+
+    sphere = '<geom type="sphere" size="0.005"/>'
+    return (f'<mujoco model="knee"><worldbody><body name="base">{sphere}'
+            f'<body name="crank"><joint name="crank" type="hinge" axis="0 0 1" pos="{text(A)}"/>{sphere}'
+            f'<body name="coupler" pos="{text(C)}"><joint name="coupler" type="hinge" axis="0 0 1" '
+            f'pos="{text(B - C)}"/>{sphere}'
+            f'<body name="rocker"><joint name="rocker" type="hinge" axis="0 0 1"/>{sphere}'
+            '</body></body></body></body></worldbody><equality>'
+            f'<connect name="pivot" body1="rocker" body2="base" anchor="{text(D - C)}"/>'
+            f'<connect name="pivot_z" body1="rocker" body2="base" anchor="{text(D - C + [0.0, 0.0, 0.01])}"/>'
+            '</equality><actuator><motor name="m" joint="crank"/></actuator></mujoco>')
+
+
+def mobility(model, free) -> int:
+    """MuJoCo's own count: the velocities ``free`` (the others held) that keep the connects closed."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    jacobian = data.efc_J.reshape(-1, model.nv)[:, free]
+    return len(free) - int(np.linalg.matrix_rank(jacobian, tol=1e-9))
+
+
+@pytest.fixture
+def knee(tmp_path):
+    path = tmp_path / "knee.xml"
+    path.write_text(four_bar_mjcf())
+    return path
+
+
+def test_mujoco_reads_one_motion_and_none_with_the_coupler_and_rocker_held(knee):
+    model = mujoco.MjModel.from_xml_string(four_bar_mjcf())
+    assert model.nv == 3 and mobility(model, [0, 1, 2]) == 1 and mobility(model, [0]) == 0
+
+
+def test_the_crank_as_platform_is_refused_naming_the_output_not_a_hold_that_leaves_a_structure(knee):
+    with pytest.raises(ImportError_) as refused:
+        load(knee, output="crank")
+    assert "--lock" not in str(refused.value.held) and "would leave the platform no motion (a structure): --output " \
+        "names another platform" in str(refused.value.held)
+    message = one_line_error(screwkit("analyze", knee, "--output", "crank"))
+    assert message.endswith("beyond the platform: not a loop joint screwkit supports; held, they would leave the "
+                            "platform no motion (a structure): --output names another platform, a body the loops "
+                            "reach from the base.")
+
+
+def sine(u, v) -> float:
+    return abs(float(u[0] * v[1] - u[1] * v[0])) / np.linalg.norm(u) / np.linalg.norm(v)
+
+
+def test_the_coupler_as_platform_has_the_textbook_four_bar_indices(knee):
+    """With the coupler as the platform (its output point the pin C), the crank drives C through the coupler BC and
+    the rocker makes C move normal to DC: ITI = |sin(AB, BC)|, OTI = |sin(BC, DC)| (the five-bar's pressure angles,
+    ``docs/theory.md``, *Point outputs*), as the published knee's check found them."""
+    mechanism = load(knee, output="coupler")
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert mechanism.dof == 1
+    np.testing.assert_allclose(np.ravel(result.iti_actuators), [sine(B - A, C - B)], atol=1e-9)
+    np.testing.assert_allclose(result.lmti, sine(C - B, C - D), atol=1e-9)
+    assert 0.2 < sine(B - A, C - B) < 0.95 and 0.2 < sine(C - B, C - D) < 0.95
