@@ -259,16 +259,33 @@ def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
     (:func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count: in a mechanism
     whose other joints all move in one plane, only their rotation about the plane's normal moves
     (:func:`_planar_loops` writes them so)."""
-    model = tree.model
+    axes = _joint_axes(tree, data, legs)
+    return plane_normal([axis for kind, axis in axes if kind == "revolute"],
+                        [axis for kind, axis in axes if kind == "prismatic"])
+
+
+def _joint_axes(tree: ClosedTree, data, legs: list[_Leg]) -> list[tuple[str, NDArray]]:
+    """Every leg joint's kind and world axis, its loop joint's but a ball's."""
     axes = []
     for leg in legs:
         for joint in leg.joints:
-            kind, axis = joint_kind(model, joint)
+            kind, axis = joint_kind(tree.model, joint)
             axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
         if leg.loop != "spherical":
             axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
-    return plane_normal([axis for kind, axis in axes if kind == "revolute"],
-                        [axis for kind, axis in axes if kind == "prismatic"])
+    return axes
+
+
+def _nearly_planar(tree: ClosedTree, data, legs: list[_Leg]) -> str:
+    """Where a mechanism is not planar only because its revolute axes are out of parallel by less than a degree
+    (more than the file's rounding: a right angle written 1.57 tilts an axis by 0.046 deg), what says so."""
+    revolutes = np.array([axis for kind, axis in _joint_axes(tree, data, legs) if kind == "revolute"])
+    if len(revolutes) < 2:
+        return ""
+    angle = float(np.degrees(np.max(np.arcsin(np.clip(np.linalg.norm(np.cross(revolutes, revolutes[0]), axis=1),
+                                                      0.0, 1.0)))))
+    return (f" (its revolute axes are parallel to within {angle:.2g} deg only, beyond the file's rounding: an angle "
+            "such as pi/2 written 1.57 tilts an axis so)") if 0.0 < angle < 1.0 else ""
 
 
 def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
@@ -400,7 +417,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         if len(leg.base_dofs) > 1:  # a ball, not a pin: its centre's three rotations and a joint, never checked
             raise ImportError_(f"{tree.source}: closure {leg.closure!r} (3d) joins the fixed base to a body beyond the "
                                "platform: screwkit reads that leg (the pin, then the body's joint onto the platform) "
-                               "in a planar mechanism only.")
+                               f"in a planar mechanism only{_nearly_planar(tree, data, legs)}.")
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
     meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
