@@ -37,6 +37,10 @@ from screwkit.studies.poses import graph_indices_at_poses
 
 TOLERANCE = 1e-9
 POSES = np.radians([[0.0, 0.0], [6.0, -4.0], [-8.0, 5.0], [3.0, 10.0], [-5.0, -9.0]])  # roll, pitch of the foot
+OFFSET = (0.0, 0.002, -0.012)
+"""The roll hinge's axis 12 mm below the pitch hinge's and 2 mm aside (a humanoid's ankle: the axes do not meet)."""
+TOE_AXIS = np.array([0.3, 0.5, 0.81]) / np.linalg.norm([0.3, 0.5, 0.81])
+TOE = np.array([0.01, 0.03, -0.03])  # the toe hinge's axis passes here, skew to the roll hinge's (x, through O)
 
 
 def write(tmp_path, rods="ball", name="ankle.xml", **options):
@@ -126,11 +130,16 @@ def test_the_graph_s_indices_are_the_rod_lines(tmp_path):
         assert result.iti[index] == pytest.approx(itis.min(), abs=TOLERANCE)
 
 
+@pytest.mark.parametrize("shape", ["as drawn", "roll hinge below", "toe hinge"])
 @pytest.mark.parametrize("scale", [1e-3, 1e3])
-def test_the_file_in_other_units_and_a_moved_world_gives_the_same_indices(tmp_path, scale):
-    reference = graph_of(write(tmp_path))
+def test_the_file_in_other_units_and_a_moved_world_gives_the_same_indices(tmp_path, scale, shape):
+    """Also with the roll hinge below the pitch hinge (drawn 5 cm along its axis) and with a toe hinge after the
+    universal joint, whose points the geometry decides."""
+    options = {"as drawn": {}, "roll hinge below": {"roll_offset": OFFSET, "roll_drawn": 0.05},
+               "toe hinge": {"cranks": 3, "toe": (TOE, TOE_AXIS)}}[shape]
+    reference = graph_of(write(tmp_path, **options))
     turned = (f"{0.7 * scale!r} {-1.2 * scale!r} {2.5 * scale!r}", "0.8 0.3 -0.4 0.33")
-    moved = graph_of(write(tmp_path, name="moved.xml", scale=scale, world=turned))
+    moved = graph_of(write(tmp_path, name="moved.xml", scale=scale, world=turned, **options))
     ours, theirs = reference.indices(), moved.indices()
     for field in ("iti_actuators", "iti", "lmti", "oti_actuators", "oti_submechanisms", "cti"):
         np.testing.assert_allclose(getattr(theirs, field), getattr(ours, field), atol=TOLERANCE, err_msg=field)
@@ -275,9 +284,6 @@ def test_a_closure_beyond_the_platform_on_a_ball_is_refused_naming_the_lock_that
         assert_indices_close(indices_at_pose(expected, pose), indices_at_pose(held, pose), atol=1e-12)
 
 
-OFFSET = (0.0, 0.002, -0.012)
-"""The roll hinge's axis 12 mm below the pitch hinge's and 2 mm aside (a humanoid's ankle: the axes do not meet)."""
-
 
 @pytest.mark.parametrize("drawn", [0.05, -0.03, 0.2])
 def test_a_roll_hinge_below_the_pitch_hinge_gives_the_same_indices_wherever_drawn_along_its_axis(tmp_path, drawn):
@@ -320,8 +326,6 @@ def test_mujoco_reads_the_roll_hinge_drawn_along_its_axis_as_the_same_mechanism(
     assert not np.allclose(sites[0][0], sites[0][1])  # (the foot turns)
 
 
-TOE_AXIS = np.array([0.3, 0.5, 0.81]) / np.linalg.norm([0.3, 0.5, 0.81])
-TOE = np.array([0.01, 0.03, -0.03])  # the toe hinge's axis passes here, skew to the roll hinge's (x, through O)
 
 
 @pytest.mark.parametrize("drawn", [0.0, 0.1, -0.07])
