@@ -213,17 +213,11 @@ def write_dataset(dataset, path) -> None:
     path = os.fspath(path)
     kind = output_suffix(path, DATA_SUFFIXES)
     if kind == ".csv":
-        text = wide_csv(dataset)
-        atomic_write(path, lambda temporary: _write_text(temporary, text))
+        atomic_text(path, wide_csv(dataset))
     elif hasattr(dataset, "write_netcdf"):
         dataset.write_netcdf(path)
     else:
         atomic_write(path, lambda temporary: dataset.to_netcdf(temporary, engine="scipy"))
-
-
-def _write_text(path: str, text: str) -> None:
-    with open(path, "w", encoding="utf-8", newline="") as handle:
-        handle.write(text)
 
 
 def open_netcdf(path: str, error: type[Exception] = ValueError):

@@ -41,7 +41,7 @@ def wide_csv(dataset) -> str:
     for d in order:  # the grid of the index, C order
         values = coords[d][1] if d in coords else np.arange(_size(d, coords, variables))
         names.append(d)
-        cells.append(_grid(np.asarray(values), order.index(d), sizes))
+        cells.append(_along(((d,), np.asarray(values)), order, sizes))
     others = [name for name, (c_dims, _) in coords.items() if name not in dims and set(c_dims) <= set(shared)]
     for name in exact:
         names.append(name)
@@ -93,15 +93,9 @@ def _size(dim: str, coords: dict, variables: dict) -> int:
     raise KeyError(dim)
 
 
-def _grid(values: np.ndarray, axis: int, sizes: list[int]) -> np.ndarray:
-    """The values of the index level ``axis`` at every row (C order over ``sizes``)."""
-    shape = [1] * len(sizes)
-    shape[axis] = sizes[axis]
-    return np.broadcast_to(values.reshape(shape), sizes).reshape(-1)
-
-
 def _along(entry: tuple, order: list[str], sizes: list[int] | None = None) -> np.ndarray:
-    """A variable over some or all of ``order``'s dimensions, at every row."""
+    """A variable over some or all of ``order``'s dimensions (one: an index level's coordinate), at every row (C
+    order over ``sizes``, which a variable over fewer dimensions than ``order`` needs)."""
     v_dims, values = entry
     moved = np.moveaxis(values, [v_dims.index(d) for d in order if d in v_dims],
                         range(sum(d in v_dims for d in order)))
