@@ -23,17 +23,18 @@ A, B, C, D = (np.array(p) for p in ([0.0, 0.0, 0.0], [0.05, 0.08, 0.0], [0.20, 0
 (every axis along z)."""
 
 
-def four_bar_mjcf(single: bool = False, tilt: float = 0.0) -> str:
+def four_bar_mjcf(single: bool = False, tilt: float = 0.0, scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
     """The knee's MJCF text: every body's frame at its first joint's pin but the coupler's, at C (its output point);
     ``single``: the rocker's pivot one ``<connect>`` (a ball, as the published knee writes it), not two on its axis;
-    ``tilt``: the crank's axis turned that far (rad) about x."""
-    def text(point) -> str:
-        return " ".join(repr(float(v)) for v in point)
+    ``tilt``: the crank's axis turned that far (rad) about x; ``scale`` multiplies every length, ``world`` (``pos``,
+    ``quat`` texts) places the base."""
+    def text(point, factor=scale) -> str:
+        return " ".join(repr(float(v) * factor) for v in point)
 
-    sphere = '<geom type="sphere" size="0.005"/>'
-    return (f'<mujoco model="knee"><worldbody><body name="base">{sphere}'
-            f'<body name="crank"><joint name="crank" type="hinge" axis="{text([0.0, -np.sin(tilt), np.cos(tilt)])}" '
-            f'pos="{text(A)}"/>{sphere}'
+    sphere = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    axis = text([0.0, -np.sin(tilt), np.cos(tilt)], 1.0)
+    return (f'<mujoco model="knee"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">{sphere}'
+            f'<body name="crank"><joint name="crank" type="hinge" axis="{axis}" pos="{text(A)}"/>{sphere}'
             f'<body name="coupler" pos="{text(C)}"><joint name="coupler" type="hinge" axis="0 0 1" '
             f'pos="{text(B - C)}"/>{sphere}'
             f'<body name="rocker"><joint name="rocker" type="hinge" axis="0 0 1"/>{sphere}'
@@ -102,6 +103,23 @@ def test_a_ball_pivot_in_a_knee_whose_axis_a_rounded_angle_tilts_is_refused_sayi
                             "beyond the file's rounding: an angle such as pi/2 written 1.57 tilts an axis so).")
     (tmp_path / "exact.xml").write_text(four_bar_mjcf(single=True))
     mechanism = load(tmp_path / "exact.xml", output="coupler")
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    np.testing.assert_allclose([float(np.ravel(result.iti_actuators)[0]), result.lmti],
+                               [sine(B - A, C - B), sine(C - B, C - D)], atol=1e-9)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_knee_reads_the_same_in_other_scales_and_a_moved_world(tmp_path, scale):
+    """The refusal of the crank as platform, and the coupler's indices, in a knee a thousand times smaller or larger
+    (read in metres) and placed elsewhere in the world."""
+    world = (f"{0.4 * scale!r} {-0.3 * scale!r} {1.1 * scale!r}", "0.8 0.3 -0.4 0.33")
+    path = tmp_path / "knee.xml"
+    path.write_text(four_bar_mjcf(scale=scale, world=world))
+    with pytest.raises(ImportError_) as refused:
+        load(path, output="crank")
+    assert "would leave the platform no motion (a structure): --output names another platform" in str(
+        refused.value.held)
+    mechanism = load(path, output="coupler")
     result = indices_at_pose(mechanism, mechanism.home_pose)
     np.testing.assert_allclose([float(np.ravel(result.iti_actuators)[0]), result.lmti],
                                [sine(B - A, C - B), sine(C - B, C - D)], atol=1e-9)
