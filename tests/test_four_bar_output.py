@@ -92,15 +92,17 @@ def test_the_coupler_as_platform_has_the_textbook_four_bar_indices(knee):
     assert 0.2 < sine(B - A, C - B) < 0.95 and 0.2 < sine(C - B, C - D) < 0.95
 
 
-def test_a_ball_pivot_in_a_knee_whose_axis_a_rounded_angle_tilts_is_refused_saying_so(tmp_path):
-    """The published knee writes its rocker's pivot as one ball and a right angle as 1.57: its crank's axis is
-    0.046 deg out of parallel with the others, so the mechanism is not planar, and such a ball pivot is read in a
-    planar mechanism only. The refusal said only that; it now gives the angle and its likely cause. Written exactly,
-    the same knee opens with the four-bar's pressure angles."""
+def test_a_ball_pivot_in_a_knee_whose_axis_is_tilted_is_refused_saying_so(tmp_path):
+    """The published knee writes its rocker's pivot as one ball, and its crank's axis is 0.046 deg out of parallel
+    with the others (a right angle written 1.57). Here the tilt is written in the axis's direction to 17 digits,
+    which no rounding explains: the mechanism is not planar, and such a ball pivot is read in a planar mechanism
+    only. The refusal gives the angle and what the file's rounding allows (the published knee itself, whose
+    rounded angles allow it, opens: ``tests/test_written_angles.py``). Written exactly, the same knee opens with the
+    four-bar's pressure angles."""
     (tmp_path / "tilted.xml").write_text(four_bar_mjcf(single=True, tilt=np.pi / 2 - 1.57))
     message = one_line_error(screwkit("analyze", tmp_path / "tilted.xml", "--output", "coupler"))
     assert message.endswith("in a planar mechanism only (its revolute axes are parallel to within 0.046 deg only, "
-                            "beyond the file's rounding: an angle such as pi/2 written 1.57 tilts an axis so).")
+                            "more than the file's rounding allows: 0.00057 deg).")
     (tmp_path / "exact.xml").write_text(four_bar_mjcf(single=True))
     mechanism = load(tmp_path / "exact.xml", output="coupler")
     result = indices_at_pose(mechanism, mechanism.home_pose)

@@ -84,12 +84,13 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def plane_normal(revolutes, prismatics) -> NDArray[np.float64] | None:
+def plane_normal(revolutes, prismatics, tolerance: float = FILE_ROUNDING) -> NDArray[np.float64] | None:
     """The normal of the plane a mechanism moves in: the common direction of its ``revolutes`` axes when its
     ``prismatics`` are perpendicular to it, else None. Parallel to 1e-9, the first revolute's direction as written;
-    else, all parallel to the file's rounding (one group of :func:`parallel_axes`, slides perpendicular to
-    :data:`FILE_ROUNDING`), the direction they are written along. A CAD export's five-bar, its axes parallel to 3e-7
-    rad, read as a spatial mechanism otherwise: other task coordinates, and a home it could not reach."""
+    else, all parallel to the file's rounding (one group of :func:`parallel_axes` within ``tolerance``, slides
+    perpendicular to it: :func:`screwkit.io.written_angles.axis_tolerance`), the direction they are written along.
+    A CAD export's five-bar, its axes parallel to 3e-7 rad, read as a spatial mechanism otherwise: other task
+    coordinates, and a home it could not reach."""
     if not len(revolutes):
         return None
     revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))
@@ -99,8 +100,8 @@ def plane_normal(revolutes, prismatics) -> NDArray[np.float64] | None:
         return axes[0] if parallel and np.all(np.abs(prismatics @ axes[0]) <= slides) else None
 
     exact = normal_of(revolutes, 1e-9)
-    return exact if exact is not None else normal_of(parallel_axes(revolutes)[0],
-                                                     FILE_ROUNDING * np.linalg.norm(prismatics, axis=1))
+    return exact if exact is not None else normal_of(parallel_axes(revolutes, tolerance)[0],
+                                                     tolerance * np.linalg.norm(prismatics, axis=1))
 
 
 def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: float = FILE_ROUNDING
@@ -169,14 +170,17 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
     return moves, largest, left
 
 
-def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report) -> tuple[dict[int, NDArray], list]:
+def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report, tolerance: float = FILE_ROUNDING,
+                why: str = "") -> tuple[dict[int, NDArray], list]:
     """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and the
     legs' revolute lines (joints and revolute loops) with :func:`meeting_lines` applied.
 
     ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes, loop frames and
     joint offsets are set in place (a leg's loop frame stays where it is when its last joint moves). Returns each
     1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations turned; the
-    import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale.
+    import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale; ``tolerance``: how
+    far apart parallel axes may be written (:func:`screwkit.io.written_angles.axis_tolerance`), ``why`` an angle of
+    the file that makes it more than :data:`FILE_ROUNDING`.
     """
     owners, directions = [], []
     for leg in legs:
@@ -192,10 +196,11 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
         directions += list(reduction.rotations)
     if not directions:
         return {}, equivalents
-    turned, turn = parallel_axes(np.array(directions))
+    turned, turn = parallel_axes(np.array(directions), tolerance)
     if turn:
         report.notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn "
-                            f"{turn:.2g} rad)")
+                            f"{turn:.2g} rad" + (f"; the file writes angles rounded, {why}" if why and
+                                                 turn > FILE_ROUNDING else "") + ")")
     local: dict[int, NDArray] = {}
     rotations = [np.array(reduction.rotations, dtype=float) for _, reduction, _ in equivalents]
     for (kind, owner), direction in zip(owners, turned):

@@ -86,6 +86,7 @@ from screwkit.io.star_writing import (
     write_base_pin,
     write_equivalent,
 )
+from screwkit.io.written_angles import axis_tolerance
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -254,14 +255,14 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
 
 
-def _planar_normal(tree: ClosedTree, data, legs: list[_Leg]) -> NDArray | None:
+def _planar_normal(tree: ClosedTree, data, legs: list[_Leg], tolerance: float) -> NDArray | None:
     """The common direction of every revolute axis when slides are perpendicular to it, to the file's rounding
-    (:func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count: in a mechanism
-    whose other joints all move in one plane, only their rotation about the plane's normal moves
+    (``tolerance``: :func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count:
+    in a mechanism whose other joints all move in one plane, only their rotation about the plane's normal moves
     (:func:`_planar_loops` writes them so)."""
     axes = _joint_axes(tree, data, legs)
     return plane_normal([axis for kind, axis in axes if kind == "revolute"],
-                        [axis for kind, axis in axes if kind == "prismatic"])
+                        [axis for kind, axis in axes if kind == "prismatic"], tolerance)
 
 
 def _joint_axes(tree: ClosedTree, data, legs: list[_Leg]) -> list[tuple[str, NDArray]]:
@@ -276,16 +277,18 @@ def _joint_axes(tree: ClosedTree, data, legs: list[_Leg]) -> list[tuple[str, NDA
     return axes
 
 
-def _nearly_planar(tree: ClosedTree, data, legs: list[_Leg]) -> str:
-    """Where a mechanism is not planar only because its revolute axes are out of parallel by less than a degree
-    (more than the file's rounding: a right angle written 1.57 tilts an axis by 0.046 deg), what says so."""
+def _nearly_planar(tree: ClosedTree, data, legs: list[_Leg], tolerance: float, why: str) -> str:
+    """Where a mechanism is not planar only because its revolute axes are out of parallel by less than a degree,
+    more than the file's rounding allows (``tolerance``, rad; ``why``, an angle of the file that widens it), what
+    says so."""
     revolutes = np.array([axis for kind, axis in _joint_axes(tree, data, legs) if kind == "revolute"])
     if len(revolutes) < 2:
         return ""
     angle = float(np.degrees(np.max(np.arcsin(np.clip(np.linalg.norm(np.cross(revolutes, revolutes[0]), axis=1),
                                                       0.0, 1.0)))))
-    return (f" (its revolute axes are parallel to within {angle:.2g} deg only, beyond the file's rounding: an angle "
-            "such as pi/2 written 1.57 tilts an axis so)") if 0.0 < angle < 1.0 else ""
+    allowed = float(np.degrees(np.arcsin(min(tolerance, 1.0))))
+    return (f" (its revolute axes are parallel to within {angle:.2g} deg only, more than the file's rounding allows: "
+            f"{allowed:.2g} deg{f', its angles written as {why}' if why else ''})") if 0.0 < angle < 1.0 else ""
 
 
 def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
@@ -410,21 +413,22 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                             "do not move the platform)")
     check_couplings(tree, q, scale, set(owner).union(*(path_to(model, c.joint_a) + path_to(model, c.joint_b)
                                                        for c in couplings if c.name in joined)), platform, report.notes)
-    normal = _planar_normal(tree, data, legs)
+    tolerance, why = axis_tolerance(tree.source)  # (wider than FILE_ROUNDING where the file writes 1.57 for pi/2)
+    normal = _planar_normal(tree, data, legs, tolerance)
     if normal is not None:
         _planar_loops(legs, normal)
     for leg in legs:
         if len(leg.base_dofs) > 1:  # a ball, not a pin: its centre's three rotations and a joint, never checked
             raise ImportError_(f"{tree.source}: closure {leg.closure!r} (3d) joins the fixed base to a body beyond the "
                                "platform: screwkit reads that leg (the pin, then the body's joint onto the platform) "
-                               f"in a planar mechanism only{_nearly_planar(tree, data, legs)}.")
+                               f"in a planar mechanism only{_nearly_planar(tree, data, legs, tolerance, why)}.")
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
     meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         lock_idle(tree, data, leg, scale, set(motor_ids), q)
-    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report)
+    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, tolerance, why)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):
