@@ -101,8 +101,8 @@ def test_a_ball_pivot_in_a_knee_whose_axis_is_tilted_is_refused_saying_so(tmp_pa
     four-bar's pressure angles."""
     (tmp_path / "tilted.xml").write_text(four_bar_mjcf(single=True, tilt=np.pi / 2 - 1.57))
     message = one_line_error(screwkit("analyze", tmp_path / "tilted.xml", "--output", "coupler"))
-    assert message.endswith("in a planar mechanism only (its revolute axes are parallel to within 0.046 deg only, "
-                            "more than the file's rounding allows: 0.00057 deg).")
+    assert message.endswith("in a planar mechanism only (revolute axes 'crank' and 'coupler' are 0.046 deg out of "
+                            "parallel, more than the file's rounding allows them: 0.00057 deg).")
     (tmp_path / "exact.xml").write_text(four_bar_mjcf(single=True))
     mechanism = load(tmp_path / "exact.xml", output="coupler")
     result = indices_at_pose(mechanism, mechanism.home_pose)

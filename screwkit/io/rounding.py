@@ -49,31 +49,28 @@ EXACT = 1e-12
 of their meeting point already meet: a group of them is left as written."""
 
 
-def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
+def parallel_axes(axes: NDArray, tolerance: float | NDArray = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
     """Unit directions (n, 3) with each group of nearly parallel ones made parallel, and the largest turn (rad).
 
-    Two directions are in one group when the norm of their cross product is at most ``tolerance`` (linked
-    pairwise: a chain of such pairs is one group).
+    Two directions are in one group when the norm of their cross product is at most ``tolerance`` (a number, or
+    one per pair, (n, n): :meth:`screwkit.io.written_angles.WrittenTurns.allowances`), linked pairwise: a chain of
+    such pairs is one group, unless two of its members are further apart than their own tolerance (directions at 0,
+    0.4 and 0.8 deg with 0.5 deg allowed): then its members are grouped at :data:`FILE_ROUNDING` only.
     """
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     units = axes / np.linalg.norm(axes, axis=1, keepdims=True)
     count = units.shape[0]
-    parent = list(range(count))
-
-    def find(index: int) -> int:
-        while parent[index] != index:
-            parent[index] = parent[parent[index]]
-            index = parent[index]
-        return index
-
+    allowed = np.broadcast_to(np.asarray(tolerance, dtype=float), (count, count))
     crosses = np.linalg.norm(np.cross(units[:, None, :], units[None, :, :]), axis=-1)
-    for first, second in zip(*np.nonzero(np.triu(crosses <= tolerance, k=1))):
-        parent[find(int(first))] = find(int(second))
+    groups = []
+    for members in _linked(crosses <= allowed):
+        block = np.ix_(members, members)
+        if np.all(crosses[block] <= allowed[block]):
+            groups.append(members)
+        else:
+            groups += [[members[k] for k in inner] for inner in _linked(crosses[block] <= FILE_ROUNDING)]
     result, turn = units.copy(), 0.0
-    groups: dict[int, list[int]] = {}
-    for index in range(count):
-        groups.setdefault(find(index), []).append(index)
-    for members in groups.values():
+    for members in groups:
         if len(members) < 2 or float(np.max(crosses[np.ix_(members, members)])) <= EXACT:
             continue
         senses = np.sign(units[members] @ units[members[0]])  # whichever member comes first, each keeps its sense
@@ -84,13 +81,34 @@ def parallel_axes(axes: NDArray, tolerance: float = FILE_ROUNDING) -> tuple[NDAr
     return result, turn
 
 
-def plane_normal(revolutes, prismatics, tolerance: float = FILE_ROUNDING) -> NDArray[np.float64] | None:
+def _linked(links: NDArray[np.bool_]) -> list[list[int]]:
+    """The groups (each in increasing order) that the pairs ``links`` (n, n) link, a chain of pairs being one."""
+    count = links.shape[0]
+    parent = list(range(count))
+
+    def find(index: int) -> int:
+        while parent[index] != index:
+            parent[index] = parent[parent[index]]
+            index = parent[index]
+        return index
+
+    for first, second in zip(*np.nonzero(np.triu(links, k=1))):
+        parent[find(int(first))] = find(int(second))
+    groups: dict[int, list[int]] = {}
+    for index in range(count):
+        groups.setdefault(find(index), []).append(index)
+    return list(groups.values())
+
+
+def plane_normal(revolutes, prismatics, tolerance: float | NDArray = FILE_ROUNDING,
+                 slides: float | NDArray = FILE_ROUNDING) -> NDArray[np.float64] | None:
     """The normal of the plane a mechanism moves in: the common direction of its ``revolutes`` axes when its
     ``prismatics`` are perpendicular to it, else None. Parallel to 1e-9, the first revolute's direction as written;
-    else, all parallel to the file's rounding (one group of :func:`parallel_axes` within ``tolerance``, slides
-    perpendicular to it: :func:`screwkit.io.written_angles.axis_tolerance`), the direction they are written along.
-    A CAD export's five-bar, its axes parallel to 3e-7 rad, read as a spatial mechanism otherwise: other task
-    coordinates, and a home it could not reach."""
+    else, all parallel to the file's rounding (one group of :func:`parallel_axes` within ``tolerance``, a number or
+    one per pair of revolutes, and each slide perpendicular to it within ``slides``, a number or one per slide:
+    :class:`screwkit.io.written_angles.WrittenTurns`), the direction they are written along. A CAD export's five-bar,
+    its axes parallel to 3e-7 rad, read as a spatial mechanism otherwise: other task coordinates, and a home it could
+    not reach."""
     if not len(revolutes):
         return None
     revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))
@@ -101,7 +119,7 @@ def plane_normal(revolutes, prismatics, tolerance: float = FILE_ROUNDING) -> NDA
 
     exact = normal_of(revolutes, 1e-9)
     return exact if exact is not None else normal_of(parallel_axes(revolutes, tolerance)[0],
-                                                     tolerance * np.linalg.norm(prismatics, axis=1))
+                                                     np.asarray(slides) * np.linalg.norm(prismatics, axis=1))
 
 
 def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: float = FILE_ROUNDING
@@ -170,17 +188,17 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
     return moves, largest, left
 
 
-def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report, tolerance: float = FILE_ROUNDING,
-                why: str = "") -> tuple[dict[int, NDArray], list]:
+def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report, turns=None
+                ) -> tuple[dict[int, NDArray], list]:
     """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and the
     legs' revolute lines (joints and revolute loops) with :func:`meeting_lines` applied.
 
     ``legs``: :mod:`screwkit.io.star`'s legs at the assembly held in ``data``; their loop axes, loop frames and
     joint offsets are set in place (a leg's loop frame stays where it is when its last joint moves). Returns each
     1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations turned; the
-    import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale; ``tolerance``: how
-    far apart parallel axes may be written (:func:`screwkit.io.written_angles.axis_tolerance`), ``why`` an angle of
-    the file that makes it more than :data:`FILE_ROUNDING`.
+    import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale; ``turns``: the
+    file's rounded angles (:class:`screwkit.io.written_angles.WrittenTurns`: how far apart two joints' axes drawn
+    parallel may be written), none for :data:`FILE_ROUNDING` between every two axes.
     """
     owners, directions = [], []
     for leg in legs:
@@ -196,11 +214,18 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
         directions += list(reduction.rotations)
     if not directions:
         return {}, equivalents
-    turned, turn = parallel_axes(np.array(directions), tolerance)
+    names = [model.names[owner] if kind == "joint" else owner.loop_names[0] if kind == "loop" and owner.loop_names
+             else None for kind, owner in owners]
+    allowed = turns.allowances(names) if turns is not None else FILE_ROUNDING
+    turned, turn = parallel_axes(np.array(directions), allowed)
     if turn:
+        turns_each = np.linalg.norm(np.cross(turned, np.array(directions) / np.linalg.norm(directions, axis=1,
+                                                                                            keepdims=True)), axis=1)
+        most = names[int(np.argmax(turns_each))]
         report.notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn "
-                            f"{turn:.2g} rad" + (f"; the file writes angles rounded, {why}" if why and
-                                                 turn > FILE_ROUNDING else "") + ")")
+                            f"{turn:.2g} rad{f', of joint {most!r}' if most else ''}"
+                            + (f"; the file writes angles rounded, {turns.example}" if turn > FILE_ROUNDING and
+                               turns is not None and turns.example else "") + ")")
     local: dict[int, NDArray] = {}
     rotations = [np.array(reduction.rotations, dtype=float) for _, reduction, _ in equivalents]
     for (kind, owner), direction in zip(owners, turned):

@@ -75,7 +75,8 @@ from screwkit.io.couplings import check_couplings
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.locking import platform_moves
 from screwkit.io.output import output_frame, platform_body
-from screwkit.io.rounding import drawn_lines, held_limits, plane_normal, turned_joint
+from screwkit.io.rounding import drawn_lines, held_limits, turned_joint
+from screwkit.io.star_plane import idle_about_the_meeting_point, in_plane, nearly_planar, planar_loops, planar_normal
 from screwkit.io.star_writing import (
     UNLIMITED_SLIDE,
     base_frame,
@@ -86,7 +87,7 @@ from screwkit.io.star_writing import (
     write_base_pin,
     write_equivalent,
 )
-from screwkit.io.written_angles import axis_tolerance
+from screwkit.io.written_angles import written_turns
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["convert_tree", "UNLIMITED_SLIDE", "INDEPENDENCE_TOLERANCE"]
@@ -111,6 +112,7 @@ class _Leg:
     base_dofs: list = field(default_factory=list)  # world (kind, axis, point) of a ball closed on the base itself,
     # written as the leg's first joints (a four-bar's rocker pinned to the ground, its joint onto the coupler the loop)
     axis2: NDArray | None = None  # a universal loop's second axis, in the loop frame
+    loop_names: tuple[str, ...] = ()  # the model joints its loop DoFs are, where they are joints (the file's rounding)
 
 
 def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: float) -> _Leg:
@@ -142,7 +144,8 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
             zero = homogeneous(data.oMi[model.parents[after[0]]]) @ homogeneous(model.jointPlacements[after[0]])
             base = [("revolute", np.eye(3)[:, k], frame_a[:3, 3]) for k in range(3)]
             return _Leg([], kind, homogeneous(data.oMi[after[0]]), zero, axis, [(kind, zero[:3, :3] @ axis,
-                        zero[:3, 3])], closure.name, sources=(closure,), base_dofs=base)
+                        zero[:3, 3])], closure.name, sources=(closure,), base_dofs=base,
+                        loop_names=(model.names[after[0]],))
         if after:
             _refuse_beyond(tree, after, f"closure {closure.name!r} (3d) ends on joints "
                            f"{', '.join(model.names[j] for j in after)} beyond the platform: not a loop joint "
@@ -160,7 +163,7 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         kind, axis = kinds[0]
         world_axis = zero[:3, :3] @ axis
         return _Leg(a_path, kind, predecessor, zero, axis, [(kind, world_axis, zero[:3, 3])], closure.name,
-                    sources=(closure,))
+                    sources=(closure,), loop_names=(model.names[first],))
     ball = ball_of_revolutes(model, after, kinds, zero, scale)
     if ball is not None:  # both loop frames at the ball's centre, wherever the file draws its revolutes
         zero, predecessor = at_point(zero, ball), at_point(predecessor, ball, homogeneous(data.oMi[closure.joint_a]))
@@ -173,7 +176,8 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         axes = (second[:3, :3] @ kinds[1][1], kinds[0][1])  # in the loop frames, which both hinges at 0 make one
         world = (np.asarray(data.oMi[after[1]].rotation) @ kinds[1][1], zero[:3, :3] @ kinds[0][1])  # as assembled
         return _Leg(a_path, "universal", predecessor, at_point(zero, centre), axes[0],
-                    [("revolute", axis, centre) for axis in world], closure.name, sources=(closure,), axis2=axes[1])
+                    [("revolute", axis, centre) for axis in world], closure.name, sources=(closure,), axis2=axes[1],
+                    loop_names=(model.names[after[1]], model.names[after[0]]))
     _refuse_beyond(tree, after, f"closure {closure.name!r} ends on joints "
                    f"{', '.join(f'{model.names[j]} ({k[0]})' for j, k in zip(after, kinds))} beyond the platform: "
                    "screwkit supports none, one revolute or prismatic joint, two revolute joints whose axes meet "
@@ -253,74 +257,6 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
             lengths.append(float(part[:slides].max()))
         angles.append(float(part[slides:].max(initial=0.0)))
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
-
-
-def _planar_normal(tree: ClosedTree, data, legs: list[_Leg], tolerance: float) -> NDArray | None:
-    """The common direction of every revolute axis when slides are perpendicular to it, to the file's rounding
-    (``tolerance``: :func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count:
-    in a mechanism whose other joints all move in one plane, only their rotation about the plane's normal moves
-    (:func:`_planar_loops` writes them so)."""
-    axes = _joint_axes(tree, data, legs)
-    return plane_normal([axis for kind, axis in axes if kind == "revolute"],
-                        [axis for kind, axis in axes if kind == "prismatic"], tolerance)
-
-
-def _joint_axes(tree: ClosedTree, data, legs: list[_Leg]) -> list[tuple[str, NDArray]]:
-    """Every leg joint's kind and world axis, its loop joint's but a ball's."""
-    axes = []
-    for leg in legs:
-        for joint in leg.joints:
-            kind, axis = joint_kind(tree.model, joint)
-            axes.append((kind, np.asarray(data.oMi[joint].rotation) @ axis))
-        if leg.loop != "spherical":
-            axes += [(kind, axis) for kind, axis, _ in leg.loop_dofs]
-    return axes
-
-
-def _nearly_planar(tree: ClosedTree, data, legs: list[_Leg], tolerance: float, why: str) -> str:
-    """Where a mechanism is not planar only because its revolute axes are out of parallel by less than a degree,
-    more than the file's rounding allows (``tolerance``, rad; ``why``, an angle of the file that widens it), what
-    says so."""
-    revolutes = np.array([axis for kind, axis in _joint_axes(tree, data, legs) if kind == "revolute"])
-    if len(revolutes) < 2:
-        return ""
-    angle = float(np.degrees(np.max(np.arcsin(np.clip(np.linalg.norm(np.cross(revolutes, revolutes[0]), axis=1),
-                                                      0.0, 1.0)))))
-    allowed = float(np.degrees(np.arcsin(min(tolerance, 1.0))))
-    return (f" (its revolute axes are parallel to within {angle:.2g} deg only, more than the file's rounding allows: "
-            f"{allowed:.2g} deg{f', its angles written as {why}' if why else ''})") if 0.0 < angle < 1.0 else ""
-
-
-def _planar_loops(legs: list[_Leg], normal: NDArray) -> None:
-    """In a planar mechanism, every ball loop becomes the revolute joint about the plane's normal through its
-    centre: its two other rotations would turn legs out of the plane, which their joints forbid."""
-    for leg in legs:
-        if leg.base_dofs:
-            leg.base_dofs = [("revolute", normal, leg.base_dofs[0][2])]
-        if leg.loop == "spherical":
-            centre = leg.successor_world[:3, 3]
-            leg.loop = "revolute"
-            leg.axis = leg.successor_world[:3, :3].T @ normal  # in the loop frame
-            leg.loop_dofs = [("revolute", normal, centre)]
-
-
-def _idle_about_the_meeting_point(legs: list[_Leg], normal: NDArray | None) -> bool:
-    """Whether every leg closed onto the platform joins it by every rotation about the point where they meet (a
-    ball, or in a plane a pin about the normal): the platform's rotations about that point are then idle, and
-    the output is the point. A weld or a pin in another direction makes them the actuators' to control."""
-    for leg in legs[1:]:
-        if leg.loop == "spherical" and normal is None:
-            continue
-        if leg.loop == "revolute" and normal is not None and \
-                abs(abs(float(leg.loop_dofs[0][1] @ normal)) - 1.0) < 1e-9:
-            continue
-        return False
-    return True
-
-
-def _in_plane(vector: NDArray, normal: NDArray | None) -> NDArray:
-    """``vector`` without its component along the plane's ``normal`` (all of it in space: no normal)."""
-    return vector if normal is None else vector - (vector @ normal) * normal
 
 
 def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
@@ -413,22 +349,22 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                             "do not move the platform)")
     check_couplings(tree, q, scale, set(owner).union(*(path_to(model, c.joint_a) + path_to(model, c.joint_b)
                                                        for c in couplings if c.name in joined)), platform, report.notes)
-    tolerance, why = axis_tolerance(tree.source)  # (wider than FILE_ROUNDING where the file writes 1.57 for pi/2)
-    normal = _planar_normal(tree, data, legs, tolerance)
+    turns = written_turns(tree.source)  # (axes written rounded: 1.57 for pi/2)
+    normal = planar_normal(tree, data, legs, turns)
     if normal is not None:
-        _planar_loops(legs, normal)
+        planar_loops(legs, normal)
     for leg in legs:
         if len(leg.base_dofs) > 1:  # a ball, not a pin: its centre's three rotations and a joint, never checked
             raise ImportError_(f"{tree.source}: closure {leg.closure!r} (3d) joins the fixed base to a body beyond the "
                                "platform: screwkit reads that leg (the pin, then the body's joint onto the platform) "
-                               f"in a planar mechanism only{_nearly_planar(tree, data, legs, tolerance, why)}.")
+                               f"in a planar mechanism only{nearly_planar(tree, data, legs, turns)}.")
     centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
-    meet = all(np.linalg.norm(_in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
+    meet = all(np.linalg.norm(in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
     for leg in legs:
         lock_idle(tree, data, leg, scale, set(motor_ids), q)
-    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, tolerance, why)
+    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, turns)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):
@@ -436,7 +372,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.dropped = [model.names[j] for j in range(1, model.njoints) if j not in owner and j not in absorbed]
     report.planar = normal is not None
     output_world = homogeneous(data.oMf[frame_index])
-    idle = _idle_about_the_meeting_point(legs, normal)
+    idle = idle_about_the_meeting_point(legs, normal)
     chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
     pinned = any(not leg.joints and not leg.base_dofs for leg in legs[1:])  # its loop joint alone, on the base
     point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned)
@@ -448,7 +384,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
                            "point; they do not.")
     if point:
-        offset = _in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
+        offset = in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
         report.output = (f"the point where the chains meet on body {body!r} (closure {legs[1].closure!r}), "
                          f"{float(np.linalg.norm(offset)):.4g} {tree.unit} "
                          f"{'in the plane ' if normal is not None else ''}from frame {frame.name!r}")

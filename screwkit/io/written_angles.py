@@ -1,43 +1,58 @@
-"""Right angles written 1.57: how far a file's rounded angles can turn its joint axes.
+"""Right angles written 1.57: how far a file's rounded angles can turn two of its joint axes apart.
 
-A hand-written file gives a right angle as ``1.57`` (MJCF ``euler`` in radians, a URDF ``rpy``, an SDFormat
-``<pose>``), and a four-bar drawn with it has one hinge 8e-4 rad (0.046 deg) out of parallel with the others: read
-exactly, a loop that cannot move, or a mechanism no longer planar. Its author drew parallel hinges, and wrote every
-angle to two decimals. :func:`axis_tolerance` reads how far the file's angles are from the angles they round: an
-angle written with at least two decimals that lies within half a unit of its last decimal of a nonzero multiple of
-15 deg (``1.57`` and ``-1.57`` of pi/2, ``0.785`` of pi/4, ``3.1416`` of pi) is that multiple rounded, off by the
-difference. Summed along a body's path from the root (each turn moves every direction beyond it by at most its own
-angle), the largest such sum bounds how far the rounding turned any one frame of the file; twice it, how far it
-moved two axes apart. Axes within that of parallel are the author's parallel axes
-(:func:`screwkit.io.rounding.parallel_axes`), as those within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of
-it are in a file written to 6 decimals. Angles that round no such multiple (0, 0.5, 1, a value in degrees) turn
-nothing the author did not draw, and count for nothing.
+A hand-written file gives a right angle as ``1.57`` (an MJCF ``euler`` in radians, a URDF ``rpy``), and a four-bar
+drawn with it has one hinge 8e-4 rad (0.046 deg) out of parallel with the others: read exactly, a loop that cannot
+move, or a mechanism no longer planar. Its author drew parallel hinges, and wrote every angle to two decimals.
 
-The paths are the file's own: MJCF bodies nested in ``<worldbody>`` (angles in radians only, ``<compiler
-angle="radian">``: MuJoCo's degrees are written whole), URDF joints from parent link to child link; an SDFormat
-file's poses, which may be relative to any frame, all summed (a bound as well, looser).
+An angle written with at least two decimals that lies within half a unit of its last decimal of a nonzero multiple
+of 15 deg (``1.57`` and ``-1.57`` of pi/2, ``0.785`` of pi/4, ``3.1416`` of pi) is that multiple rounded, off by the
+difference (:func:`rounded_angle`); angles that round no such multiple (``0``, ``0.5``, ``1.56``, a value in
+degrees) count for nothing. Each joint's axis is turned by the rotations of the frames on its path from the root
+(MJCF: the ``<body>`` and ``<frame>`` elements it is nested in; URDF: the origins of the joints from the root link
+to it, its own included), and a rotation moves every direction beyond it by at most its own angle. Two axes turn
+apart only by the rotations on one path and not the other, those below the frame they share (a rotation above both,
+as the world pose of a floating base, turns them together): their **allowance** is
+:data:`~screwkit.common.tolerances.FILE_ROUNDING` plus the sum of those rotations' rounding, at most
+:data:`WIDENING_LIMIT` (:meth:`WrittenTurns.allowance`). Axes within their allowance of parallel are the author's
+parallel axes (:func:`screwkit.io.rounding.parallel_axes`), as those within ``FILE_ROUNDING`` are in a file written
+to 6 decimals. Geoms, sites, cameras and lights turn no joint, and count for nothing.
+
+What is not read (the allowance is then ``FILE_ROUNDING``, as for an exact file: such a file is read as before):
+``quat``, ``xyaxes``, ``zaxis`` and axis vectors written rounded, ``<default>`` orientations, ``<include>``\\ d files,
+MuJoCo's ``<replicate>``, angles in degrees, joints the file leaves unnamed, and SDFormat files (whose poses may be
+relative to any frame).
 """
 
 from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass, field
 from fractions import Fraction
 from xml.etree import ElementTree
 
-from screwkit.common.tolerances import FILE_ROUNDING
+import numpy as np
+from numpy.typing import NDArray
 
-__all__ = ["ANGLE_STEP", "rounded_angle", "axis_tolerance"]
+from screwkit.common.tolerances import FILE_ROUNDING
+from screwkit.common.xml_text import tolerant_xml
+
+__all__ = ["ANGLE_STEP", "WIDENING_LIMIT", "WrittenTurns", "rounded_angle", "written_turns"]
 
 ANGLE_STEP = math.pi / 12
 """The angles a file's author writes rounded: nonzero multiples of 15 deg."""
 
-_DECIMALS = re.compile(r"[+-]?\d*\.(\d{2,})")
+WIDENING_LIMIT = math.radians(0.5)
+"""The most an allowance is widened beyond ``FILE_ROUNDING`` (rad): a tilt of more than half a degree is the
+author's, however many rounded angles lie between the axes (seven bodies deep, two right angles written 1.57 each,
+already sum to 0.64 deg; two-decimal roundings of pi/4 and pi/6, 0.79 and 0.52, are off by 4.6e-3 and 3.6e-3)."""
+
+_DECIMALS = re.compile(r"[+-]?[0-9]*\.([0-9]{2,})")
 
 
 def rounded_angle(text: str) -> float:
     """How far the angle written ``text`` (rad) is from the nonzero multiple of pi/12 it rounds to its written
-    decimals (``1.57``: pi/2 - 1.57 = 7.96e-4), or 0 if it rounds none (``0``, ``0.5``, ``1``, ``0.3``, an
+    decimals (``1.57``: pi/2 - 1.57 = 7.96e-4), or 0 if it rounds none (``0``, ``0.5``, ``1``, ``1.56``, an
     exponent)."""
     match = _DECIMALS.fullmatch(text.strip())
     if match is None:
@@ -48,78 +63,123 @@ def rounded_angle(text: str) -> float:
     return off if step and off <= 0.5 * 10.0 ** -len(match.group(1)) else 0.0
 
 
-def axis_tolerance(source: str) -> tuple[float, str]:
-    """How far apart two joint axes of the file ``source`` may be and still be the parallel axes its author drew
-    (rad, compared with the norm of their cross product): :data:`FILE_ROUNDING` plus twice the largest sum of
-    rounded angles along one path (module docstring); and, when that sum is not zero, an angle of the file that
-    says why (``"1.57 for pi/2"``). :data:`FILE_ROUNDING` and "" for a file that cannot be read again."""
+@dataclass(frozen=True)
+class WrittenTurns:
+    """Per named joint of a file, the rounded rotations on its path from the root (``{frame: rounding, rad}``, the
+    frames by their order in the file), and an angle of the file that says why (``"1.57 for pi/2"``; "" if none)."""
+
+    paths: dict[str, dict[int, float]] = field(default_factory=dict)
+    example: str = ""
+
+    def allowance(self, first: str | None, second: str | None) -> float:
+        """How far apart (rad, the norm of their cross product) the axes of joints ``first`` and ``second`` may be
+        and still be the parallel axes the author drew (module docstring); ``FILE_ROUNDING`` for a joint not read
+        (None: an axis that is no joint's)."""
+        if first not in self.paths or second not in self.paths:
+            return FILE_ROUNDING
+        one, other = self.paths[first], self.paths[second]
+        apart = sum(off for frame, off in one.items() if frame not in other) + \
+            sum(off for frame, off in other.items() if frame not in one)
+        return FILE_ROUNDING + min(apart, WIDENING_LIMIT)
+
+    def furthest_beyond(self, axes: NDArray, names) -> tuple[int, int, float, float] | None:
+        """Of the directions ``axes`` (n, 3) of joints ``names``, the two furthest out of parallel beyond their
+        allowance (up to sense), their angle and their allowance as an angle (rad); None if every two are within."""
+        units = axes / np.linalg.norm(axes, axis=1, keepdims=True)
+        angles = np.arcsin(np.clip(np.linalg.norm(np.cross(units[:, None], units[None]), axis=-1), 0.0, 1.0))
+        allowed = np.arcsin(np.clip(self.allowances(names), 0.0, 1.0))
+        first, second = np.unravel_index(int(np.argmax(angles - allowed)), angles.shape) if len(units) else (0, 0)
+        if not len(units) or angles[first, second] <= allowed[first, second]:
+            return None
+        return int(first), int(second), float(angles[first, second]), float(allowed[first, second])
+
+    def allowances(self, names) -> NDArray[np.float64]:
+        """The allowances (n, n) of every two of the axes of joints ``names`` (None: an axis that is no joint's)."""
+        names = list(names)
+        return np.array([[self.allowance(a, b) for b in names] for a in names]).reshape(len(names), len(names))
+
+
+def written_turns(source: str) -> WrittenTurns:
+    """The :class:`WrittenTurns` of the file ``source`` (an MJCF or URDF file; none for any other, or one that
+    cannot be read again), parsed as the readers of other tools parse it (:func:`~screwkit.common.xml_text.
+    tolerant_xml`)."""
     try:
-        root = ElementTree.parse(source).getroot()
-    except (OSError, ElementTree.ParseError):
-        return FILE_ROUNDING, ""
-    angles: list[str] = []
-    if root.tag == "mujoco":
-        largest = _mjcf_path_sum(root, angles)
-    elif root.tag == "robot":
-        largest = _urdf_path_sum(root, angles)
-    elif root.tag == "sdf":
-        poses = [pose for pose in root.iter("pose") if pose.get("degrees", "false").strip().lower() != "true"]
-        largest = sum(_angles(" ".join((pose.text or "").split()[3:6]), angles) for pose in poses)
-    else:
-        largest = 0.0
-    if not largest:
-        return FILE_ROUNDING, ""
-    example = max(angles, key=rounded_angle)
-    multiple = Fraction(round(float(example) / ANGLE_STEP), 12)
-    sign = "-" if multiple < 0 else ""
+        with open(source, "rb") as handle:
+            root = ElementTree.fromstring(tolerant_xml(handle.read()))
+    except (OSError, ElementTree.ParseError, ValueError):
+        return WrittenTurns()
+    found: list[tuple[float, str]] = []  # every rounded angle on a joint's path, in the file's order
+    paths = _mjcf_paths(root, found) if root.tag == "mujoco" else _urdf_paths(root, found) if root.tag == "robot" \
+        else {}
+    if not any(paths.values()):  # (a joint whose path has none is kept: its axis turns apart from a rounded one's)
+        return WrittenTurns()
+    largest = max(off for off, _ in found)
+    example = next(text for off, text in found if off == largest)
+    return WrittenTurns(paths, f"{example} for {_multiple(example)}")
+
+
+def _multiple(text: str) -> str:
+    """The multiple of pi that the angle written ``text`` rounds: ``pi/2``, ``-pi``, ``3pi/4``."""
+    multiple = Fraction(round(float(text) / ANGLE_STEP), 12)
     numerator = "" if abs(multiple.numerator) == 1 else str(abs(multiple.numerator))
-    name = f"{sign}{numerator}pi" + (f"/{multiple.denominator}" if multiple.denominator != 1 else "")
-    return FILE_ROUNDING + 2.0 * largest, f"{example} for {name}"
+    return ("-" if multiple < 0 else "") + f"{numerator}pi" + (f"/{multiple.denominator}"
+                                                               if multiple.denominator != 1 else "")
 
 
-def _angles(text: str | None, found: list[str]) -> float:
-    """The sum of :func:`rounded_angle` over the numbers of ``text``, those that round one added to ``found``."""
+def _rounding(words: list[str], found: list[tuple[float, str]]) -> float:
+    """The sum of :func:`rounded_angle` over ``words``, each that rounds a multiple added to ``found``."""
     total = 0.0
-    for word in (text or "").split():
+    for word in words:
         off = rounded_angle(word)
         if off:
             total += off
-            found.append(word)
+            found.append((off, word))
     return total
 
 
-def _mjcf_path_sum(root: ElementTree.Element, found: list[str]) -> float:
-    """The largest sum of rounded ``euler`` and ``axisangle`` angles along a path of nested elements of the
-    ``<worldbody>`` (none when the file's angles are in degrees)."""
+def _mjcf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, float]]:
+    """Each named joint's rounded ``euler`` and ``axisangle`` rotations of the ``<body>`` and ``<frame>`` elements
+    it is nested in (none when the file's angles are in degrees, MuJoCo's default)."""
     compilers = [c for c in root.iter("compiler") if c.get("angle")]
     if not compilers or compilers[-1].get("angle", "").strip().lower() != "radian":
-        return 0.0
-    largest = 0.0
-    pending = [(element, 0.0) for element in root.findall("worldbody")]
-    while pending:
-        element, above = pending.pop()
-        axisangle = (element.get("axisangle") or "").split()
-        here = above + _angles(element.get("euler"), found) + _angles(" ".join(axisangle[3:4]), found)
-        largest = max(largest, here)
-        pending += [(child, here) for child in element]
-    return largest
+        return {}
+    paths: dict[str, dict[int, float]] = {}
+    order = 0
+
+    def visit(element: ElementTree.Element, path: dict[int, float]) -> None:
+        nonlocal order
+        for child in element:
+            order += 1
+            if child.tag in ("joint", "freejoint") and child.get("name"):
+                paths[child.get("name")] = path
+            elif child.tag in ("body", "frame"):
+                words = (child.get("euler") or "").split() + (child.get("axisangle") or "").split()[3:4]
+                off = _rounding(words, found)
+                visit(child, {**path, order: off} if off else path)
+
+    for world in root.findall("worldbody"):
+        visit(world, {})
+    return paths
 
 
-def _urdf_path_sum(root: ElementTree.Element, found: list[str]) -> float:
-    """The largest sum of rounded ``rpy`` angles of the joints' origins along a path from a root link."""
-    parent_of: dict[str, tuple[str, float]] = {}
-    for joint in root.findall("joint"):
+def _urdf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, float]]:
+    """Each joint's rounded ``rpy`` rotations of the joints' origins from the root link to it, its own included."""
+    joints = {}
+    for order, joint in enumerate(root.findall("joint")):
         parent, child, origin = joint.find("parent"), joint.find("child"), joint.find("origin")
-        if parent is None or child is None:
+        if parent is None or child is None or not joint.get("name"):
             continue
-        turn = _angles(origin.get("rpy") if origin is not None else None, found)
-        parent_of[child.get("link", "")] = (parent.get("link", ""), turn)
-    largest = 0.0
-    for link in parent_of:
-        total, seen, current = 0.0, set(), link
-        while current in parent_of and current not in seen:  # (a file whose joints form a cycle: each link once)
+        off = _rounding((origin.get("rpy") or "").split() if origin is not None else [], found)
+        joints[joint.get("name")] = (parent.get("link", ""), child.get("link", ""), order, off)
+    into = {child: name for name, (_, child, _, _) in joints.items()}  # each link's joint from its parent
+    paths: dict[str, dict[int, float]] = {}
+    for name in joints:
+        path, current, seen = {}, name, set()
+        while current is not None and current not in seen:  # (a file whose joints form a cycle: each joint once)
             seen.add(current)
-            current, turn = parent_of[current]
-            total += turn
-        largest = max(largest, total)
-    return largest
+            parent, _, order, off = joints[current]
+            if off:
+                path[order] = off
+            current = into.get(parent)
+        paths[name] = path
+    return paths
