@@ -20,12 +20,17 @@ import mujoco
 import numpy as np
 import pytest
 from test_gallery_published import PUBLISHED, without_meshes
+from test_io import HOME
+from test_lower_mobility import five_bar_expected
+from test_onshape import five_bar_onshape
 
 from helpers import one_line_error, screwkit
+from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io import ImportError_
 from screwkit.io.loader import load
-from screwkit.io.rounding import parallel_axes
+from screwkit.io.rounding import parallel_axes, plane_normal
+from screwkit.io.star_writing import base_frame
 from screwkit.io.written_angles import WIDENING_LIMIT, WrittenTurns, rounded_angle, written_turns
 from screwkit.studies import indices_at_pose
 
@@ -238,3 +243,59 @@ def test_the_command_opens_the_published_knee_and_refuses_a_tilt_beyond_its_roun
     assert message.endswith("in a planar mechanism only (revolute axes '3BR_Joint' and '2R_Joint' are 0.62 deg out "
                             "of parallel, more than the file's rounding allows them: 0.046 deg, its angles written as "
                             "1.57 for pi/2).")
+
+
+def turned_world(urdf: str, rpy: str) -> str:
+    """An onshape URDF with its whole mechanism turned by ``rpy`` (the text of a fixed-axis roll, pitch, yaw) about the
+    world's origin: each joint on the base link placed by that turn composed with its own origin."""
+    turn = rotation_from_rpy([float(v) for v in rpy.split()])
+    root = ET.fromstring(urdf)
+    for joint in root.findall("joint"):
+        if joint.find("parent").get("link") == "base":
+            origin = joint.find("origin")
+            xyz = turn @ np.array([float(v) for v in origin.get("xyz").split()])
+            own = rotation_from_rpy([float(v) for v in origin.get("rpy").split()])
+            origin.set("xyz", " ".join(repr(float(v)) for v in xyz))
+            origin.set("rpy", " ".join(repr(float(v)) for v in rpy_from_rotation(turn @ own)))
+    return ET.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize("scale", [1.0, 10.0, 1e3])
+@pytest.mark.parametrize("rpy", ["0 1.5708 0", "0 -1.5708 0", "0 3.14159 0", "0 1.5708 1.0"])
+def test_a_five_bar_turned_by_a_rounded_right_angle_opens_at_its_home(tmp_path, rpy, scale):
+    """The onshape five-bar turned so that its plane's normal is a few microradians from the world's x axis (a right
+    angle written 1.5708 or 3.14159): the plane's frame took its x from the world's, 1 - n_x**2 of nearly equal
+    numbers, and came out 4e-11 rad from perpendicular to the normal; the legs written in it left the plane by that,
+    and the file's own home was refused as unreachable, missing by 1.6e-11 m (a published five-bar, LevinTamir's,
+    based on rpy 0 3.14159 0, its links 0.4 to 0.6 m long). Now its home opens with the textbook pressure angles
+    there, at 1, 10 and 1000 times the five-bar's size."""
+    path = tmp_path / "robot.urdf"
+    path.write_text(turned_world(five_bar_onshape(transform=(scale, 0.0, (0.0, 0.0, 0.0))), rpy))
+    mechanism = load(path)
+    assert mechanism.task_coordinates == ("x", "y")
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    expected = five_bar_expected(HOME)
+    legs = [int(name.split(":")[-1].removeprefix("motor")) - 1 for name in mechanism.actuator_names]
+    np.testing.assert_allclose(np.ravel(result.iti_actuators), expected["iti_actuators"][legs], atol=1e-9)
+    np.testing.assert_allclose([result.lmti, result.f_o[1]], [expected["lmti"], expected["f_o1"]], atol=1e-9)
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1e-9, 2.65e-6, 9e-7, 1e-3, 0.3])
+def test_the_plane_s_frame_is_orthonormal_whatever_its_normal_s_tilt_from_the_world_s_x(tilt):
+    for normal in ([np.cos(tilt), 0.0, np.sin(tilt)], [-np.cos(tilt), np.sin(tilt) / 2, np.sin(tilt)]):
+        frame = base_frame(np.array(normal), np.array([0.3, -0.2, 0.1]))[:3, :3]
+        np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-15, rtol=0)
+        np.testing.assert_allclose(frame[:, 2], np.array(normal) / np.linalg.norm(normal), atol=1e-15, rtol=0)
+
+
+def test_the_plane_s_normal_is_the_direction_its_axes_are_written_parallel_to():
+    """Axes parallel to 1e-10 (more than to the last digit, less than the file's rounding): the normal is the
+    direction they are all made parallel to, not the first one's as written, which left the others 1e-10 rad off
+    the plane's normal in the legs written in it."""
+    rng = np.random.default_rng(5)
+    axes = np.array([0.0, 0.0, 1.0]) + rng.normal(0.0, 1e-10, (4, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    normal = plane_normal(axes, np.zeros((0, 3)))
+    turned, turn = parallel_axes(axes)
+    assert 1e-11 < turn < 1e-9
+    np.testing.assert_allclose(turned, np.tile(normal, (4, 1)), atol=1e-15, rtol=0)

@@ -164,20 +164,6 @@ def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
     return tuple(names[-1]) if names and names[-1] else None
 
 
-def transmitted_joints(urdf_text: bytes) -> list[str]:
-    """The joints a URDF's ``<transmission>`` elements drive (``<joint name="...">`` or the joint's name as text),
-    in file order, once each: the file's own word for which joints are actuated."""
-    import xml.etree.ElementTree as ElementTree
-
-    try:
-        root = ElementTree.fromstring(tolerant_xml(urdf_text))
-    except ElementTree.ParseError:
-        return []
-    joints = [joint.get("name") or (joint.text or "").strip() for transmission in root.findall("transmission")
-              for joint in transmission.findall("joint")]
-    return list(dict.fromkeys(name for name in joints if name))
-
-
 @dataclass
 class ImportReport:
     """What an import did: for ``screwkit convert`` and ``screwkit info``."""

@@ -39,7 +39,7 @@ from screwkit.io.closed_tree import (
     inverse,
 )
 from screwkit.io.onshape import transmitted_tree
-from screwkit.io.sdformat_text import parse_joint
+from screwkit.io.sdformat_text import controlled_joints, detachable_joints, parse_joint
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
 
@@ -48,18 +48,25 @@ TYPES = (*HINGE_TYPES, "ball", "fixed")
 
 
 def has_gazebo_joints(path: Path) -> bool:
-    """Whether a URDF file has a ``<joint>`` inside a ``<gazebo>`` element (read as text, quickly)."""
+    """Whether a URDF file has a ``<joint>`` or a DetachableJoint ``<plugin>`` inside a ``<gazebo>`` element (read as
+    text, quickly)."""
     with open(path, "rb") as handle:  # the head alone (a file over the size cap is refused unread)
         head = handle.read(4_000_000)
     return b"<gazebo" in head and _gazebo_joints(head) != []
 
 
-def _gazebo_joints(text: bytes) -> list:
+def _gazebo_joints(text: bytes) -> list[tuple[object, str]]:
+    """The ``<gazebo><joint>`` elements of a URDF's text, and for each DetachableJoint plugin joining two of its
+    own links the fixed joint it makes (:func:`~screwkit.io.sdformat_text.detachable_joints`); each with how it is
+    written, for messages."""
     try:
         root = ElementTree.fromstring(tolerant_xml(text))
     except ElementTree.ParseError:
         return []
-    return [joint for gazebo in root.findall("gazebo") for joint in gazebo.findall("joint")]
+    joints = [(joint, f"<gazebo><joint name='{joint.get('name')}'>") for gazebo in root.findall("gazebo")
+              for joint in gazebo.findall("joint")]
+    links = {link.get("name") for link in root.findall("link")}
+    return joints + detachable_joints(root.findall("gazebo"), links)
 
 
 def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -77,9 +84,9 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     scale = max(float(np.max(np.abs([np.asarray(frame.translation) for frame in data.oMf]))), 1e-3)
     closures = []
     written = urdf.read_bytes()
-    for element in _gazebo_joints(written):
+    for element, written_as in _gazebo_joints(written):
         name = element.get("name") or f"gazebo_joint_{len(closures) + 1}"
-        where = f"{urdf}: <gazebo><joint name='{name}'>"
+        where = f"{urdf}: {written_as}"
         kind = element.get("type", "")
         if kind not in TYPES:
             raise ImportError_(f"{where}: type {kind!r} cannot close a loop here (expected one of {', '.join(TYPES)}).")
@@ -107,6 +114,12 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
                                     on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
                                     axis_point=number == 1))
-    return transmitted_tree(urdf, written, model, closures, q, output, output_type,
-                            "URDF + Gazebo joints (<gazebo><joint>)")
+    root = ElementTree.fromstring(tolerant_xml(written))  # (read well-formed by _gazebo_joints)
+    tree = transmitted_tree(urdf, written, model, closures, q, output, output_type,
+                            "URDF + Gazebo joints (<gazebo><joint>)", controlled_joints(root.findall("gazebo")))
+    plugins = [joint.get("name") for joint, written_as in _gazebo_joints(written) if written_as.startswith("<plugin")]
+    if plugins:
+        tree.notes.append(f"closures {', '.join(plugins)}: the fixed joints Gazebo's DetachableJoint plugins make at "
+                          "start, the links where the file places them")
+    return tree
 

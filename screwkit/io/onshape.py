@@ -23,6 +23,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import (
     ClosedTree,
     Closure,
@@ -31,10 +32,9 @@ from screwkit.io.closed_tree import (
     homogeneous,
     joint_kind,
     path_to,
-    transmitted_joints,
 )
 
-__all__ = ["CLOSING", "closing_pairs", "read_onshape", "transmitted_tree"]
+__all__ = ["CLOSING", "closing_pairs", "read_onshape", "transmitted_tree", "transmitted_joints"]
 
 CLOSING = re.compile(r"closing_(.+)_([12])")
 """The name of a closing frame: ``closing_<name>_1`` or ``closing_<name>_2``."""
@@ -55,6 +55,28 @@ def has_closing_frames(path: Path) -> bool:
     with open(path, "rb") as handle:  # the head alone (a file over the size cap is refused unread)
         head = handle.read(4_000_000).decode("utf-8", errors="replace")
     return bool(closing_pairs(re.findall(r"<link\s+name\s*=\s*[\"']([^\"']+)[\"']", head)))
+
+
+def transmitted_joints(urdf_text: bytes, passive: bool = False) -> list[str]:
+    """The joints a URDF's ``<transmission>`` elements drive (``<joint name="...">`` or the joint's name as text),
+    in file order, once each: the file's own word for which joints are actuated. A joint whose every
+    ``<hardwareInterface>`` is a passive one (``PassiveJointInterface``: a closed-loop simulator's joints that the
+    loop moves) is driven by none; with ``passive``, those joints instead."""
+    import xml.etree.ElementTree as ElementTree
+
+    try:
+        root = ElementTree.fromstring(tolerant_xml(urdf_text))
+    except ElementTree.ParseError:
+        return []
+    joints = [(joint.get("name") or (joint.text or "").strip(), _passive(joint))
+              for transmission in root.findall("transmission") for joint in transmission.findall("joint")]
+    return list(dict.fromkeys(name for name, idle in joints if name and idle == passive))
+
+
+def _passive(joint) -> bool:
+    """Whether a transmission's joint names hardware interfaces, all of them passive ones."""
+    interfaces = [(node.text or "").strip() for node in joint.iter("hardwareInterface")]
+    return bool(interfaces) and all("passive" in interface.rsplit("/", 1)[-1].lower() for interface in interfaces)
 
 
 def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -95,6 +117,7 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
                           f"{', '.join(motors)}; --actuate JOINT or a robot.yaml beside the file (name_mot) says "
                           "otherwise")
+    passive_note(tree, urdf.read_bytes())
     return tree
 
 
@@ -120,12 +143,12 @@ def guessed_motors(model, closures: list[Closure], hinges=()) -> list[str]:
 
 
 def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q, output: str | None,
-                     output_type: str | None, file_format: str) -> ClosedTree:
+                     output_type: str | None, file_format: str, driven: list[str] = ()) -> ClosedTree:
     """The closed tree of a URDF whose closures another tool's elements write (Gazebo's, Drake's): its actuators
-    those of its ``<transmission>`` elements, else guessed from the branches leaving the base (said in its notes); a
-    transmission naming no joint of the tree is refused unless --actuate names them (read_closed_tree). ``data``: the
-    file's bytes, as read."""
-    transmitted = transmitted_joints(data)
+    those of its ``<transmission>`` elements, else those its joint controllers drive (``driven``: Gazebo's
+    plugins), else guessed from the branches leaving the base (said in its notes); a transmission naming no joint of
+    the tree is refused unless --actuate names them (read_closed_tree). ``data``: the file's bytes, as read."""
+    transmitted = transmitted_joints(data) or list(driven)
     motors = transmitted or guessed_motors(model, closures)
     unknown = [motor for motor in motors if motor not in list(model.names)]
     unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
@@ -134,4 +157,16 @@ def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q,
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
                           f"{', '.join(motors)}; --actuate JOINT says otherwise")
+    elif not transmitted_joints(data):
+        tree.notes.append(f"actuators: the joints the file's joint controller plugins drive, {', '.join(motors)} (no "
+                          "<transmission>)")
+    passive_note(tree, data)
     return tree
+
+
+def passive_note(tree: ClosedTree, data: bytes) -> None:
+    """The import report's line on transmissions whose joints' hardware interfaces are all passive ones."""
+    passive = transmitted_joints(data, passive=True)
+    if passive:
+        tree.notes.append(f"joints {', '.join(passive)}: their <transmission>s' hardware interfaces are passive "
+                          "(PassiveJointInterface): moved by the loops, not actuators")

@@ -114,7 +114,7 @@ def plane_normal(revolutes, prismatics, tolerance: float | NDArray = FILE_ROUNDI
     revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))
 
     def normal_of(axes, slides: float) -> NDArray | None:  # the first axis, if every one is parallel to it
-        parallel = np.all(np.linalg.norm(np.cross(axes, axes[0]), axis=1) <= 1e-9)
+        parallel = np.all(np.linalg.norm(np.cross(axes, axes[0]), axis=1) <= EXACT)
         return axes[0] if parallel and np.all(np.abs(prismatics @ axes[0]) <= slides) else None
 
     exact = normal_of(revolutes, 1e-9)

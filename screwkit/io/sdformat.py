@@ -34,7 +34,6 @@ Types other than these (``screw``, ``gearbox``) are refused by name.
 
 from __future__ import annotations
 
-import re
 from collections import Counter
 from pathlib import Path
 
@@ -43,7 +42,16 @@ from numpy.typing import NDArray
 
 from screwkit.io.closed_tree import GROUNDED, ClosedTree, Closure, ImportError_, inverse
 from screwkit.io.onshape import guessed_motors
-from screwkit.io.sdformat_text import WORLD, SdfJoint, SdfModel, attached_link, read_model, world_poses
+from screwkit.io.sdformat_text import (
+    WORLD,
+    SdfJoint,
+    SdfModel,
+    attached_link,
+    controlled_joints,
+    controllers,
+    read_model,
+    world_poses,
+)
 
 __all__ = ["read_sdformat", "SDFORMAT_SUFFIXES", "TYPES", "actuated_joints"]
 
@@ -51,8 +59,6 @@ SDFORMAT_SUFFIXES = (".sdf",)
 HINGES = ("revolute", "continuous")
 TWO_AXES = ("universal", "revolute2")
 TYPES = (*HINGES, "prismatic", "ball", *TWO_AXES, "fixed")
-CONTROLLER = re.compile(r"joint.*controller", re.IGNORECASE)
-"""A joint-controller plugin's ``filename`` or ``name`` (its ``<joint_name>`` joints are driven)."""
 
 
 def _local_name(tag: str) -> tuple[str, str]:
@@ -65,10 +71,7 @@ def actuated_joints(sdf: SdfModel) -> list[str]:
     marked = [joint.get("name", "") for joint in sdf.element.findall("joint")
               if any(_local_name(child.tag)[1] == "actuated" and "screwkit" in _local_name(child.tag)[0]
                      for child in joint)]
-    driven = [(node.text or "").strip() for plugin in sdf.element.findall("plugin")
-              if CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
-              for node in plugin.iter("joint_name") if (node.text or "").strip()]
-    return list(dict.fromkeys(marked + driven))
+    return list(dict.fromkeys(marked + controlled_joints([sdf.element])))
 
 
 def _spanning_tree(sdf: SdfModel, ends: dict[str, tuple[str, str]], last: str | None = None):
@@ -408,8 +411,7 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
                 f"closes a loop of the tree grown from {fixed}")
     motors = [] if unactuated else stated or guessed_motors(model, closures, builder.split)
     if not stated:
-        silent = any(CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))
-                     for plugin in sdf.element.findall("plugin"))  # a controller whose joints its own code names
+        silent = bool(controllers([sdf.element]))  # a controller whose joints its own code names
         plugins = "its joint controller plugin names no <joint_name>" if silent else "no joint controller plugin"
         notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/>, {plugins}): "
                      f"{', '.join(motors)}; --actuate JOINT says otherwise")

@@ -24,6 +24,7 @@ limits are ignored, as SDFormat says ("omit if joint is continuous").
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,7 +38,8 @@ from screwkit.io.closed_tree import ImportError_
 from screwkit.io.drake import drake_elements
 
 __all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
-           "attached_link", "WORLD", "MODEL_FRAME"]
+           "attached_link", "controllers", "controlled_joints", "detachable_joints", "WORLD", "MODEL_FRAME",
+           "CONTROLLER"]
 
 WORLD = "world"
 MODEL_FRAME = "__model__"
@@ -169,6 +171,45 @@ def _limits(element, tag: str, where: str, kind: str) -> tuple[float, float] | N
     return None
 
 
+CONTROLLER = re.compile(r"joint.*controller", re.IGNORECASE)
+"""A joint-controller plugin's ``filename`` or ``name`` (its ``<joint_name>`` joints are driven)."""
+
+
+def controllers(parents) -> list:
+    """The joint-controller ``<plugin>`` elements among the children of ``parents`` (a model; a URDF's ``<gazebo>``)."""
+    return [plugin for parent in parents for plugin in parent.findall("plugin")
+            if CONTROLLER.search(plugin.get("filename", "")) or CONTROLLER.search(plugin.get("name", ""))]
+
+
+def controlled_joints(parents) -> list[str]:
+    """The joints that the joint-controller plugins among the children of ``parents`` drive (their ``<joint_name>``,
+    in file order, once each)."""
+    return list(dict.fromkeys((node.text or "").strip() for plugin in controllers(parents)
+                              for node in plugin.iter("joint_name") if (node.text or "").strip()))
+
+
+def detachable_joints(parents, links) -> list[tuple[object, str]]:
+    """The fixed joints that Gazebo's DetachableJoint plugins among the children of ``parents`` make when the
+    simulation starts, between ``<parent_link>`` and ``<child_link>`` as the file places them: a loop where both are
+    among the model's ``links`` (its ``<child_model>`` names the model as it is spawned, which may not be the file's
+    name; a plugin that attaches another model's link, to be picked up, is no loop); each as an SDFormat ``<joint>``
+    element with how the file writes it, for messages."""
+    found = []
+    for parent in parents:
+        for plugin in parent.findall("plugin"):
+            if "DetachableJoint" not in plugin.get("name", "") and \
+                    "detachable-joint" not in plugin.get("filename", "").lower():
+                continue
+            ends = [(plugin.findtext(tag) or "").strip() for tag in ("parent_link", "child_link")]
+            if not all(end in links for end in ends):
+                continue
+            joint = ElementTree.Element("joint", name=f"{ends[0]}_to_{ends[1]}", type="fixed")
+            ElementTree.SubElement(joint, "parent").text = ends[0]
+            ElementTree.SubElement(joint, "child").text = ends[1]
+            found.append((joint, f"<plugin name='{plugin.get('name', '')}'> ({ends[0]} to {ends[1]})"))
+    return found
+
+
 def parse_joint(element, where: str, version: tuple[int, ...] = (1, 7)) -> SdfJoint:
     """An SDFormat ``<joint>`` element as written (``where``: the file and element, for messages; ``version``: the
     file's SDFormat version: 1.5 and 1.6 read ``<use_parent_model_frame>``, 1.4 and earlier write every axis in the
@@ -212,7 +253,9 @@ class SdfModel:
     """What reading renamed (an SDFormat 1.6 joint named as a link), for the import report."""
 
 
-def _the_model(path: Path, root) -> object:
+def _the_model(path: Path, root) -> tuple[object, str]:
+    """The one model of an SDFormat file, and the world's other models, static and without joints (a ground plane),
+    which it leaves out (their names, quoted, for the import report; "" if none)."""
     if root.tag != "sdf":
         raise ImportError_(f"{path}: the root element is <{root.tag}>, not <sdf>: not an SDFormat file.")
     parents = {child: parent for parent in root.iter() for child in parent}
@@ -222,10 +265,16 @@ def _the_model(path: Path, root) -> object:
         raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
                            f"not read (this one in <{scope.tag}{named}>); write the model in the file.")
     models = root.findall("model") + root.findall("world/model")
-    if len(models) != 1:
-        names = ", ".join(repr(model.get("name")) for model in models)
-        raise ImportError_(f"{path}: {len(models)} <model> elements ({names or 'none'}); screwkit reads one model.")
-    model = models[0]
+    scenery = [model for model in models if (model.findtext("static") or "").strip().lower() in ("true", "1")
+               and model.find("joint") is None]  # a world's ground plane, its walls: none of the mechanism
+    moving = [model for model in models if model not in scenery] or models
+    if len(moving) != 1:
+        names = ", ".join(repr(model.get("name")) for model in moving)
+        aside = f", besides {len(scenery)} static without joints" if len(moving) < len(models) else ""
+        raise ImportError_(f"{path}: {len(moving)} <model> elements ({names or 'none'}{aside}); screwkit reads one "
+                           "model: write the mechanism's model alone in a file.")
+    model = moving[0]
+    left_out = ", ".join(repr(other.get("name")) for other in models if other is not model)
     if not (model.get("name") or "").strip():
         raise ImportError_(f"{path}: <model> has no name (SDFormat requires one).")
     for nested in model.iter("model"):
@@ -235,7 +284,7 @@ def _the_model(path: Path, root) -> object:
     if model.get("placement_frame"):
         raise ImportError_(f"{path}: <model name='{model.get('name')}' placement_frame=...>: not read; write the "
                            "model's <pose> in the world.")
-    return model
+    return model, left_out
 
 
 def read_model(path: Path) -> SdfModel:
@@ -245,7 +294,7 @@ def read_model(path: Path) -> SdfModel:
         root = ElementTree.fromstring(tolerant_xml(path.read_bytes()))
     except ElementTree.ParseError as error:
         raise ImportError_(f"{path}: not well-formed XML ({error}).") from None
-    element = _the_model(path, root)
+    element, scenery = _the_model(path, root)
     version = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2] if part.isdigit())
     label = f"{path}: <model name='{element.get('name')}'>"
     _check_names(element, label)
@@ -258,6 +307,8 @@ def read_model(path: Path) -> SdfModel:
         raise ImportError_(f"{label}: no <link>.")
     model = SdfModel(str(path), element.get("name", ""), element, links, [], {}, element.get("canonical_link") or
                      links[0])
+    if scenery:
+        model.renamed.append(f"models {scenery} of the world left out: static, without joints (a ground plane)")
     model.ball_constraints = [_ball_constraint(node, f"{label}: <drake:ball_constraint> {number}")
                               for number, (_, node) in enumerate(drake_elements(element), start=1)]
     pose, relative = parse_pose(element.find("pose"), label)
@@ -271,10 +322,15 @@ def read_model(path: Path) -> SdfModel:
         _declare(model, link.get("name", ""), relative or MODEL_FRAME, pose, where)
     if version < (1, 7):  # before 1.7 a joint could share a link's name: libsdformat renames the joint, and warns
         _rename_joints_named_as_links(model, element, version)
-    for joint in element.findall("joint"):
-        parsed = parse_joint(joint, f"{path}: <joint name='{joint.get('name')}'>", version)
+    written = [(joint, f"<joint name='{joint.get('name')}'>") for joint in element.findall("joint")]
+    for joint, written_as in written + detachable_joints([element], links):
+        parsed = parse_joint(joint, f"{path}: {written_as}", version)
         model.joints.append(parsed)
         _declare(model, parsed.name, parsed.relative_to or parsed.child, parsed.pose, parsed.where)
+    plugins = [joint.get("name") for joint, _ in detachable_joints([element], links)]
+    if plugins:
+        model.renamed.append(f"joints {', '.join(plugins)}: the fixed joints Gazebo's DetachableJoint plugins make at "
+                             "start, the links where the file places them")
     for frame in element.findall("frame"):
         where = f"{path}: <frame name='{frame.get('name')}'>"
         attached = frame.get("attached_to", "").strip() or MODEL_FRAME

@@ -49,6 +49,8 @@ def base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
     x = np.array([1.0, 0.0, 0.0]) - z[0] * z
     if np.linalg.norm(x) < 1e-6:
         x = np.array([0.0, 1.0, 0.0]) - z[1] * z
+    x = x / np.linalg.norm(x)
+    x -= (x @ z) * z  # once more: near the world's x, 1 - z[0]**2 loses digits, and x was z's normal to 4e-11 only
     x, axis = x / np.linalg.norm(x), int(np.argmax(np.abs(z)))
     frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
     frame[axis, 3] = float(z @ point) / z[axis]

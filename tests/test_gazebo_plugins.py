@@ -1,0 +1,255 @@
+"""Loops that Gazebo's plugins close, and the rest of what a Gazebo user writes around a mechanism.
+
+* Gazebo (gz-sim) users close a loop with the DetachableJoint plugin, which makes a fixed joint between
+  ``<parent_link>`` and ``<child_link>`` when the simulation starts: a URDF five-bar and 3-R-S-S Delta
+  (``tests/data/gallery/published/ros2_closed_loop_ws``, MIT) and an SDFormat five-bar
+  (``ros2_closed_loop_demo``, MIT), published so. Read as the weld it is, against the indices that Pinocchio's own
+  placement of their joints gives (the five-bar's pressure angles; the Delta's rod lines), in millimetres and in a
+  turned world; the SDFormat five-bar against the same model with the plugin written as a fixed joint.
+* Their actuators are the joints their joint-controller plugins drive (the Delta's planning chain is no motor).
+* A ``<transmission>`` whose joint's hardware interface is passive (``PassiveJointInterface``) drives nothing.
+* A world's static models without joints (its ground plane) are left out.
+
+The five-bar's base is turned by ``rpy="0 3.14159 0"``: its plane's normal 2.65e-6 rad from the world's x axis. The
+plane's frame, its x taken from the world's as 1 - n_x**2 of nearly equal numbers, came out 4e-11 rad from
+perpendicular to the normal, and the file's own home was refused as unreachable (missing by 1.6e-11 m).
+"""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from test_gallery_published import PUBLISHED
+
+from helpers import in_unit, one_line_error, screwkit
+from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
+from screwkit.io import ImportError_, read_mechanism_file
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+FIVE_BAR = PUBLISHED / "ros2_closed_loop_ws" / "fivebar_linkage.urdf"
+DELTA = PUBLISHED / "ros2_closed_loop_ws" / "3dof_delta.urdf"
+SDF_FIVE_BAR = PUBLISHED / "ros2_closed_loop_demo" / "model.sdf"
+TURN = ("0.4 -0.3 1.1", "0.3 -0.2 0.5")
+"""A world the mechanisms are turned (rpy) and moved (xyz, m) into."""
+
+
+def pinocchio_placements(path):
+    """Pinocchio's reading of a URDF tree at its file's joint values (0, where these files' loops close): each
+    joint's origin and unit axis in the world, by name."""
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+
+    def line(name):
+        joint = model.getJointId(name)
+        placement = data.oMi[joint]
+        local = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}.get(
+            model.joints[joint].shortname())
+        axis = placement.rotation @ (np.array(local, dtype=float) if local is not None
+                                     else model.joints[joint].extract().axis)
+        return placement.translation.copy(), axis / np.linalg.norm(axis)
+
+    return line
+
+
+def five_bar_textbook(path) -> dict:
+    """The five-bar's pressure angles at its file's configuration: ITI_i = |sin(proximal_i, distal_i)|, the LMTI
+    |sin(distal_1, distal_2)| at the closure pin P, in the plane normal to the hinges."""
+    line = pinocchio_placements(path)
+    normal = line("Chain1_1")[1]
+
+    def sine(u, v):
+        u, v = u - (u @ normal) * normal, v - (v @ normal) * normal
+        return abs(np.cross(u, v) @ normal) / np.linalg.norm(u) / np.linalg.norm(v)
+
+    (a1, _), (b1, _), (p, _) = (line(name) for name in ("Chain1_1", "Chain1_2", "Chain1_closure"))
+    (a2, _), (b2, _) = (line(name) for name in ("Chain2_1", "Chain2_2"))
+    return {"Chain1_1": sine(b1 - a1, p - b1), "Chain2_1": sine(b2 - a2, p - b2), "lmti": sine(p - b1, p - b2)}
+
+
+def delta_textbook(path) -> dict:
+    """The Delta's indices from its rod lines (a translating platform): each ball's centre where its three revolutes'
+    axes meet (least squares), the rod u_i from the platform's ball to the elbow's, ITI_i = |u_i . t_i| with t_i the
+    elbow's velocity direction about the crank, OTI_i = |u_i . (u_j x u_k)| / |u_j x u_k|."""
+    line = pinocchio_placements(path)
+
+    def meeting(names):
+        lines = [line(name) for name in names]
+        projector = [np.eye(3) - np.outer(axis, axis) for _, axis in lines]
+        return np.linalg.solve(sum(projector), sum(p @ point for p, (point, _) in zip(projector, lines)))
+
+    rods, found = [], {}
+    for leg in (1, 2, 3):
+        elbow = meeting([f"Chain{leg}_top_{k}" for k in "ABC"])
+        foot = meeting([f"Chain{leg}_cl_{k}" for k in "ABC"])
+        crank, axis = line(f"Chain{leg}_1")
+        rod = (elbow - foot) / np.linalg.norm(elbow - foot)
+        velocity = np.cross(axis, elbow - crank)
+        found[f"Chain{leg}_1"] = abs(rod @ velocity) / np.linalg.norm(velocity)
+        rods.append(rod)
+    for leg in range(3):
+        across = np.cross(rods[(leg + 1) % 3], rods[(leg + 2) % 3])
+        found[f"oti{leg + 1}"] = abs(rods[leg] @ across) / np.linalg.norm(across)
+    return found
+
+
+def turned(urdf: str, rpy: str, xyz: str) -> str:
+    """A URDF whose joints on its root link are placed by a turn (``rpy``) and a shift (``xyz``) of the world
+    composed with their own origins: the same mechanism elsewhere in the world."""
+    root = ET.fromstring(urdf)
+    children = {joint.find("child").get("link") for joint in root.findall("joint")}
+    base = next(link.get("name") for link in root.findall("link") if link.get("name") not in children)
+    turn, shift = rotation_from_rpy([float(v) for v in rpy.split()]), np.array([float(v) for v in xyz.split()])
+    for joint in root.findall("joint"):
+        if joint.find("parent").get("link") == base:
+            origin = joint.find("origin")
+            place = np.array([float(v) for v in origin.get("xyz", "0 0 0").split()])
+            own = rotation_from_rpy([float(v) for v in origin.get("rpy", "0 0 0").split()])
+            origin.set("xyz", " ".join(repr(float(v)) for v in turn @ place + shift))
+            origin.set("rpy", " ".join(repr(float(v)) for v in rpy_from_rotation(turn @ own)))
+    return ET.tostring(root, encoding="unicode")
+
+
+def indices(path, **options) -> dict:
+    mechanism = load(path, **options)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    found = {name.split(":")[-1]: float(v) for name, v in zip(mechanism.actuator_names,
+                                                                np.ravel(result.iti_actuators))}
+    found["lmti"] = float(result.lmti)
+    return found
+
+
+def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_with_pinocchios_pressure_angles():
+    """Its output the point where the legs meet (the pin that the plugin's weld and Chain1_closure make), where the
+    pressure angles are measured; its default output, the frame of the body welded to the right leg's distal link,
+    has the same LMTI."""
+    mechanism = load(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1"]
+    notes = " | ".join(read_mechanism_file(FIVE_BAR, output="Chain1_dummy")[1].notes)
+    assert "closures Chain2_tip_to_Chain1_dummy: the fixed joints Gazebo's DetachableJoint plugins make" in notes
+    assert "the joints the file's joint controller plugins drive, Chain1_1, Chain2_1" in notes
+    expected = five_bar_textbook(FIVE_BAR)
+    found = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    assert found.keys() == expected.keys()
+    for key in expected:
+        assert found[key] == pytest.approx(expected[key], abs=1e-9), key
+    assert indices(FIVE_BAR, output="Chain1_dummy")["lmti"] == pytest.approx(expected["lmti"], abs=1e-9)
+
+
+@pytest.mark.parametrize("unit, factor, world", [("mm", 1e3, None), (None, 1.0, TURN), ("km", 1e-3, TURN)])
+def test_the_published_five_bar_reads_the_same_in_another_unit_and_world(tmp_path, unit, factor, world):
+    expected = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    text = FIVE_BAR.read_text()
+    if world is not None:
+        text = turned(text, *world)
+    if unit is not None:
+        text = in_unit(text, unit, factor)
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(text)
+    found = indices(path, output="Chain1_dummy", output_type="point", length_unit=unit)
+    for key in expected:
+        assert found[key] == pytest.approx(expected[key], abs=1e-9), key
+
+
+def test_the_published_delta_closed_by_three_detachable_joints_has_its_rod_lines_indices(tmp_path):
+    """Its actuators the three cranks its controllers drive (the prismatic chain a motion planner moves the
+    platform with is no motor, and was guessed one); its ITIs and OTIs those of the rod lines, also turned."""
+    mechanism = load(DELTA)
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1", "Chain3_1"]
+    expected = delta_textbook(DELTA)
+    for path in (DELTA, tmp_path / "turned.urdf"):
+        if path != DELTA:
+            path.write_text(turned(DELTA.read_text(), *TURN))
+        loaded = load(path)
+        result = indices_at_pose(loaded, loaded.home_pose)
+        itis = dict(zip((name.split(":")[-1] for name in loaded.actuator_names), np.ravel(result.iti_actuators)))
+        for name, value in itis.items():
+            assert value == pytest.approx(expected[name], abs=1e-9), name
+        assert float(result.lmti) == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)
+
+
+def with_plugin_as_joint(text: str) -> str:
+    """The SDFormat five-bar with its DetachableJoint plugin written as the fixed joint it makes."""
+    root = ET.fromstring(text)
+    model = root.find("model")
+    plugin = next(p for p in model.findall("plugin") if "DetachableJoint" in p.get("name", ""))
+    model.remove(plugin)
+    joint = ET.SubElement(model, "joint", name="loop", type="fixed")
+    ET.SubElement(joint, "parent").text = plugin.findtext("parent_link").strip()
+    ET.SubElement(joint, "child").text = plugin.findtext("child_link").strip()
+    return ET.tostring(root, encoding="unicode")
+
+
+GROUND = ('<model name="ground_plane"><static>true</static><link name="link"><collision name="c"><geometry><plane>'
+          '<normal>0 0 1</normal></plane></geometry></collision></link></model>')
+
+
+def test_the_published_sdformat_five_bar_reads_as_its_plugin_written_as_a_fixed_joint_and_in_a_world(tmp_path):
+    expected = indices(SDF_FIVE_BAR, output="link_4")
+    native = tmp_path / "native.sdf"
+    native.write_text(with_plugin_as_joint(SDF_FIVE_BAR.read_text()))
+    assert indices(native, output="link_4") == pytest.approx(expected, abs=1e-12)
+    model = ET.tostring(ET.fromstring(SDF_FIVE_BAR.read_text()).find("model"), encoding="unicode")
+    world = tmp_path / "world.sdf"
+    world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}</world></sdf>')
+    assert indices(world, output="link_4") == pytest.approx(expected, abs=1e-12)
+    assert any("models 'ground_plane' of the world left out: static, without joints" in note
+               for note in read_mechanism_file(world, output="link_4")[1].notes)
+    other = model.replace("name='closed_loop_demo'", "name='second'").replace('name="closed_loop_demo"',
+                                                                               'name="second"')
+    world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}{other}</world></sdf>')
+    with pytest.raises(ImportError_, match=r": 2 <model> elements \('closed_loop_demo', 'second', besides 1 static "
+                                           r"without joints\); screwkit reads one model: write the mechanism's model "
+                                           r"alone in a file\.$"):
+        load(world, output="link_4")
+
+
+def test_a_detachable_joint_to_another_models_link_closes_no_loop(tmp_path):
+    """A gripper's plugin that attaches an object to pick up: no loop of this model."""
+    text = SDF_FIVE_BAR.read_text().replace("<child_link>dummy_link</child_link>", "<child_link>box</child_link>")
+    path = tmp_path / "model.sdf"
+    path.write_text(text)
+    with pytest.raises(ImportError_, match="no closure: nothing closes the tree into a parallel mechanism"):
+        load(path, output="link_4")
+
+
+def test_a_transmission_with_a_passive_hardware_interface_drives_nothing(tmp_path):
+    """The five-bar with transmissions on its motors (an effort interface) and on a passive joint of each leg (the
+    PassiveJointInterface of a closed-loop simulator): two actuators, as the controllers say, and the passive joints
+    named in the report."""
+    def transmission(joint: str, interface: str) -> str:
+        return (f'<transmission name="{joint}_trans"><type>transmission_interface/SimpleTransmission</type>'
+                f'<joint name="{joint}"><hardwareInterface>hardware_interface/{interface}</hardwareInterface></joint>'
+                f'<actuator name="{joint}_motor"><mechanicalReduction>1</mechanicalReduction></actuator>'
+                '</transmission>')
+
+    added = "".join(transmission(joint, interface) for joint, interface in (
+        ("Chain1_1", "EffortJointInterface"), ("Chain1_2", "PassiveJointInterface"),
+        ("Chain2_1", "PositionJointInterface"), ("Chain2_2", "PassiveJointInterface")))
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(FIVE_BAR.read_text().replace("</robot>", added + "</robot>"))
+    mechanism = load(path, output="Chain1_dummy")
+    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1"]
+    assert any(note.startswith("joints Chain1_2, Chain2_2: their <transmission>s' hardware interfaces are passive")
+               for note in read_mechanism_file(path, output="Chain1_dummy")[1].notes)
+    assert indices(path, output="Chain1_dummy") == pytest.approx(indices(FIVE_BAR, output="Chain1_dummy"), abs=1e-12)
+
+
+def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_many_of(tmp_path):
+    done = screwkit("analyze", FIVE_BAR, "--output", "Chain1_dummy", "--output-type", "point", "--json")
+    assert done.returncode == 0, done.stderr
+    printed = json.loads(done.stdout)
+    expected = five_bar_textbook(FIVE_BAR)
+    assert [printed["iti"], printed["lmti"]] == pytest.approx([min(expected["Chain1_1"], expected["Chain2_1"]),
+                                                               expected["lmti"]], abs=1e-9)
+    model = ET.tostring(ET.fromstring(SDF_FIVE_BAR.read_text()).find("model"), encoding="unicode")
+    world = tmp_path / "world.sdf"
+    world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}{model.replace("closed_loop_demo", "b")}'
+                     '</world></sdf>')
+    one_line_error(screwkit("analyze", world, "--output", "link_4"), "2 <model> elements",
+                   "write the mechanism's model alone in a file")
