@@ -253,3 +253,10 @@ def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_m
                      '</world></sdf>')
     one_line_error(screwkit("analyze", world, "--output", "link_4"), "2 <model> elements",
                    "write the mechanism's model alone in a file")
+
+
+def test_a_converted_mechanism_is_named_by_its_whole_file_name(tmp_path):
+    """A file named for a variant, ``fivebar_lt_3.1416.urdf``, was called ``fivebar_lt_3``."""
+    path = tmp_path / "fivebar_linkage_3.1416.urdf"
+    path.write_text(FIVE_BAR.read_text())
+    assert load(path, output="Chain1_dummy").name == "fivebar_linkage_3.1416"

@@ -44,6 +44,7 @@ The result is the text of a URDF in screwkit's convention and an
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -394,7 +395,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
     world_base = base_frame(normal, platform_world[:3, 3])
     platform_world[:3, :3] = world_base[:3, :3] if (point or normal is not None) else output_world[:3, :3]
-    writer = UrdfWriter(tree.source.rsplit("/", 1)[-1].split(".")[0] or "mechanism",
+    writer = UrdfWriter(Path(tree.source).stem or "mechanism",
                         f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
     base = "base"
     if normal is not None:
