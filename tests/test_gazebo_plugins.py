@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -28,7 +29,7 @@ from test_gallery_published import PUBLISHED
 from helpers import in_unit, one_line_error, screwkit
 from screwkit.common.rotations import rotation_from_rpy, rpy_from_rotation
 from screwkit.io import ImportError_, read_mechanism_file
-from screwkit.io.loader import load
+from screwkit.io.loader import load, load_text
 from screwkit.studies import indices_at_pose
 
 FIVE_BAR = PUBLISHED / "ros2_closed_loop_ws" / "fivebar_linkage.urdf"
@@ -132,6 +133,8 @@ def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_wi
     assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1"]
     notes = " | ".join(read_mechanism_file(FIVE_BAR, output="Chain1_dummy")[1].notes)
     assert "closures Chain2_tip_to_Chain1_dummy: the fixed joints Gazebo's DetachableJoint plugins make" in notes
+    assert read_mechanism_file(FIVE_BAR, output="Chain1_dummy")[1].file_format == \
+        "URDF + Gazebo joints (DetachableJoint plugins)"
     assert "the joints the file's joint controller plugins drive, Chain1_1, Chain2_1" in notes
     expected = five_bar_textbook(FIVE_BAR)
     found = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
@@ -198,8 +201,14 @@ def test_the_published_sdformat_five_bar_reads_as_its_plugin_written_as_a_fixed_
     world = tmp_path / "world.sdf"
     world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}</world></sdf>')
     assert indices(world, output="link_4") == pytest.approx(expected, abs=1e-12)
-    assert any("models 'ground_plane' of the world left out: static, without joints" in note
+    assert any("models 'ground_plane' of the world left out: scenery (static without joints" in note
                for note in read_mechanism_file(world, output="link_4")[1].notes)
+    world.write_text(f'<sdf version="1.9"><world name="w"><include><uri>model://sun</uri></include><include><uri>'
+                     'https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground Plane</uri></include>'
+                     f'{model}</world></sdf>')
+    assert indices(world, output="link_4") == pytest.approx(expected, abs=1e-12)
+    assert any("models 'model://sun', 'https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground Plane' of the world "
+               "left out" in note for note in read_mechanism_file(world, output="link_4")[1].notes)
     other = model.replace("name='closed_loop_demo'", "name='second'").replace('name="closed_loop_demo"',
                                                                                'name="second"')
     world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}{other}</world></sdf>')
@@ -260,3 +269,69 @@ def test_a_converted_mechanism_is_named_by_its_whole_file_name(tmp_path):
     path = tmp_path / "fivebar_linkage_3.1416.urdf"
     path.write_text(FIVE_BAR.read_text())
     assert load(path, output="Chain1_dummy").name == "fivebar_linkage_3.1416"
+    assert load(PUBLISHED / "example_parallel_robots" / "5bar_linkage" / "robot.urdf").name == "robot"  # + robot.yaml
+
+
+def test_joints_that_apply_joint_force_plugins_drive_are_the_actuators_and_an_end_effector_link_the_output(tmp_path):
+    """Gazebo's ApplyJointForce plugins name the joints a user drives by effort: the SDFormat five-bar driven at its
+    left motor and its right elbow (not the joints a guess picks, the two leaving the base), named in the report;
+    its link ``link_4`` renamed ``endEffector`` is taken as the output, however the name is written."""
+    plugins = "".join(f'<plugin filename="libignition-gazebo-apply-joint-force-system.so" '
+                      f'name="ignition::gazebo::systems::ApplyJointForce"><joint_name>{joint}</joint_name></plugin>'
+                      for joint in ("joint_A0", "joint_B"))
+    text = SDF_FIVE_BAR.read_text().replace("</model>", plugins + "</model>")
+    path = tmp_path / "model.sdf"
+    path.write_text(text)
+    mechanism = load(path, output="link_4")
+    assert [name.split(":")[-1] for name in mechanism.actuator_names] == ["joint_A0", "joint_B"]
+    notes = read_mechanism_file(path, output="link_4")[1].notes
+    assert not any("guessed" in note for note in notes), notes
+    expected = indices(path, output="link_4")
+    for spelled in ("endEffector", "End-Effector", "end_effector"):
+        path.write_text(text.replace("'link_4'", f"'{spelled}'").replace(">link_4<", f">{spelled}<"))
+        assert indices(path) == pytest.approx(expected, abs=1e-12), spelled
+
+
+def test_what_the_report_says_of_plugins_and_transmissions(tmp_path):
+    """A plugin spawned under another name says so; a joint with an effort and a passive transmission is an actuator,
+    not passive; transmissions all passive leave the controllers' joints, said without "no <transmission>"; a
+    controller naming no joint of the tree is refused naming the controllers; a plugin whose made-up name a joint
+    of the file already has is named apart."""
+    notes = read_mechanism_file(SDF_FIVE_BAR, output="link_4")[1].notes
+    assert any("its <child_model> 'closed_loop_demo_model' read as this model spawned so" in note for note in notes)
+
+    def transmission(joint: str, interface: str) -> str:
+        return (f'<transmission name="{joint}_{interface}"><joint name="{joint}"><hardwareInterface>'
+                f'hardware_interface/{interface}</hardwareInterface></joint></transmission>')
+
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(FIVE_BAR.read_text().replace("</robot>", transmission("Chain1_1", "EffortJointInterface")
+                                                 + transmission("Chain1_1", "PassiveJointInterface")
+                                                 + transmission("Chain2_1", "EffortJointInterface") + "</robot>"))
+    notes = read_mechanism_file(path, output="Chain1_dummy")[1].notes
+    assert not any("passive" in note for note in notes), notes
+    path.write_text(FIVE_BAR.read_text().replace("</robot>", transmission("Chain1_2", "PassiveJointInterface")
+                                                 + "</robot>"))
+    notes = read_mechanism_file(path, output="Chain1_dummy")[1].notes
+    assert any(note.startswith("actuators: the joints the file's joint controller plugins drive, Chain1_1, Chain2_1 "
+                               "(no <transmission> drives a joint)") for note in notes), notes
+    path.write_text(FIVE_BAR.read_text().replace("<joint_name>Chain1_1</joint_name>",
+                                                 "<joint_name>Chain1_9</joint_name>"))
+    with pytest.raises(ImportError_, match="its joint controller plugins name joint.s. Chain1_9, not in the tree"):
+        load(path, output="Chain1_dummy")
+    clash = tmp_path / "model.sdf"
+    clash.write_text(SDF_FIVE_BAR.read_text().replace("name='joint_A'", "name='link_2_to_dummy_link'"))
+    assert indices(clash, output="link_4") == pytest.approx(indices(SDF_FIVE_BAR, output="link_4"), abs=1e-12)
+    notes = read_mechanism_file(clash, output="link_4")[1].notes
+    assert any("joints link_2_to_dummy_link_2:" in note for note in notes), notes
+
+
+def test_a_passive_transmission_drives_nothing_in_screwkits_own_convention_too():
+    """The bundled five-bar with a third transmission, its interface PassiveJointInterface, on a distal joint: two
+    actuators, as before, where it read three."""
+    text = (Path(__file__).resolve().parents[1] / "robots" / "five_bar.urdf").read_text()
+    passive = ('<transmission name="chain_1_joint_c_transmission"><type>transmission_interface/SimpleTransmission'
+               '</type><joint name="chain_1_joint_c"><hardwareInterface>hardware_interface/PassiveJointInterface'
+               '</hardwareInterface></joint></transmission>')
+    plain = load_text(text)
+    assert load_text(text.replace("</robot>", passive + "</robot>")).actuator_names == plain.actuator_names

@@ -264,11 +264,10 @@ def turned_world(urdf: str, rpy: str) -> str:
 @pytest.mark.parametrize("rpy", ["0 1.5708 0", "0 -1.5708 0", "0 3.14159 0", "0 1.5708 1.0"])
 def test_a_five_bar_turned_by_a_rounded_right_angle_opens_at_its_home(tmp_path, rpy, scale):
     """The onshape five-bar turned so that its plane's normal is a few microradians from the world's x axis (a right
-    angle written 1.5708 or 3.14159): the plane's frame took its x from the world's, 1 - n_x**2 of nearly equal
-    numbers, and came out 4e-11 rad from perpendicular to the normal; the legs written in it left the plane by that,
-    and the file's own home was refused as unreachable, missing by 1.6e-11 m (a published five-bar, LevinTamir's,
-    based on rpy 0 3.14159 0, its links 0.4 to 0.6 m long). Now its home opens with the textbook pressure angles
-    there, at 1, 10 and 1000 times the five-bar's size."""
+    angle written 1.5708 or 3.14159), at 1, 10 and 1000 times its size: its home has the textbook pressure angles.
+    (Its closures close in closed form; the published five-bar of ``tests/test_gazebo_plugins.py``, whose closure is
+    solved by Newton's method, is the one the plane's frame 4e-11 rad from orthonormal left unreachable at its
+    home.)"""
     path = tmp_path / "robot.urdf"
     path.write_text(turned_world(five_bar_onshape(transform=(scale, 0.0, (0.0, 0.0, 0.0))), rpy))
     mechanism = load(path)
@@ -299,3 +298,22 @@ def test_the_plane_s_normal_is_the_direction_its_axes_are_written_parallel_to():
     turned, turn = parallel_axes(axes)
     assert 1e-11 < turn < 1e-9
     np.testing.assert_allclose(turned, np.tile(normal, (4, 1)), atol=1e-15, rtol=0)
+
+
+@pytest.mark.parametrize("axis", range(3))
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_the_plane_s_frame_turns_with_its_normal_continuously_near_every_world_axis(axis, sense):
+    """A normal on a world axis gives that axis's two others (x, y about z; x, -z about y; y, z about x, with the
+    sense); tilted from it by 1e-12 to 1e-3 rad in any direction, a frame as far from that one as the tilt (the
+    plane's x jumped by 90 deg at 1e-6 rad from the world's x)."""
+    normal = sense * np.eye(3)[axis]
+    square = base_frame(normal, np.zeros(3))[:3, :3]
+    others = [k for k in range(3) if k != axis]
+    np.testing.assert_allclose(square[:, 0], np.eye(3)[others[0]], atol=0)
+    np.testing.assert_allclose(square[:, 2], normal, atol=0)
+    rng = np.random.default_rng(axis)
+    for tilt in (1e-12, 1e-9, 9e-7, 1.1e-6, 2.65e-6, 1e-3):
+        for _ in range(4):
+            tilted = normal + tilt * rng.normal(size=3) / np.sqrt(3)
+            frame = base_frame(tilted, np.zeros(3))[:3, :3]
+            assert np.max(np.abs(frame - square)) < 4 * tilt

@@ -39,7 +39,7 @@ from screwkit.io.closed_tree import (
     inverse,
 )
 from screwkit.io.onshape import transmitted_tree
-from screwkit.io.sdformat_text import controlled_joints, detachable_joints, parse_joint
+from screwkit.io.sdformat_text import controlled_joints, detachable_joints, parse_joint, plugin_note
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
 
@@ -66,7 +66,8 @@ def _gazebo_joints(text: bytes) -> list[tuple[object, str]]:
     joints = [(joint, f"<gazebo><joint name='{joint.get('name')}'>") for gazebo in root.findall("gazebo")
               for joint in gazebo.findall("joint")]
     links = {link.get("name") for link in root.findall("link")}
-    return joints + detachable_joints(root.findall("gazebo"), links)
+    taken = [joint.get("name") for joint in root.iter("joint")]
+    return joints + detachable_joints(root.findall("gazebo"), links, root.get("name", ""), taken)
 
 
 def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -115,11 +116,13 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
                                     on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
                                     axis_point=number == 1))
     root = ElementTree.fromstring(tolerant_xml(written))  # (read well-formed by _gazebo_joints)
+    plugins = [(joint, written_as) for joint, written_as in _gazebo_joints(written) if written_as.startswith("<plugin")]
+    written_with = ["<gazebo><joint>"] * (len(plugins) < len(_gazebo_joints(written))) + \
+        ["DetachableJoint plugins"] * bool(plugins)
     tree = transmitted_tree(urdf, written, model, closures, q, output, output_type,
-                            "URDF + Gazebo joints (<gazebo><joint>)", controlled_joints(root.findall("gazebo")))
-    plugins = [joint.get("name") for joint, written_as in _gazebo_joints(written) if written_as.startswith("<plugin")]
+                            f"URDF + Gazebo joints ({', '.join(written_with)})",
+                            controlled_joints(root.findall("gazebo")))
     if plugins:
-        tree.notes.append(f"closures {', '.join(plugins)}: the fixed joints Gazebo's DetachableJoint plugins make at "
-                          "start, the links where the file places them")
+        tree.notes.append(plugin_note(plugins, "closures"))
     return tree
 

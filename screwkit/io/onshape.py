@@ -33,6 +33,7 @@ from screwkit.io.closed_tree import (
     joint_kind,
     path_to,
 )
+from screwkit.model.urdf_element_reader import passive_joint
 
 __all__ = ["CLOSING", "closing_pairs", "read_onshape", "transmitted_tree", "transmitted_joints"]
 
@@ -68,15 +69,9 @@ def transmitted_joints(urdf_text: bytes, passive: bool = False) -> list[str]:
         root = ElementTree.fromstring(tolerant_xml(urdf_text))
     except ElementTree.ParseError:
         return []
-    joints = [(joint.get("name") or (joint.text or "").strip(), _passive(joint))
+    joints = [(joint.get("name") or (joint.text or "").strip(), passive_joint(joint))
               for transmission in root.findall("transmission") for joint in transmission.findall("joint")]
     return list(dict.fromkeys(name for name, idle in joints if name and idle == passive))
-
-
-def _passive(joint) -> bool:
-    """Whether a transmission's joint names hardware interfaces, all of them passive ones."""
-    interfaces = [(node.text or "").strip() for node in joint.iter("hardwareInterface")]
-    return bool(interfaces) and all("passive" in interface.rsplit("/", 1)[-1].lower() for interface in interfaces)
 
 
 def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | None = None) -> ClosedTree:
@@ -148,25 +143,29 @@ def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q,
     those of its ``<transmission>`` elements, else those its joint controllers drive (``driven``: Gazebo's
     plugins), else guessed from the branches leaving the base (said in its notes); a transmission naming no joint of
     the tree is refused unless --actuate names them (read_closed_tree). ``data``: the file's bytes, as read."""
-    transmitted = transmitted_joints(data) or list(driven)
+    declared = transmitted_joints(data)
+    transmitted = declared or list(driven)
     motors = transmitted or guessed_motors(model, closures)
     unknown = [motor for motor in motors if motor not in list(model.names)]
-    unactuated = f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
+    naming = "<transmission> names" if declared else "its joint controller plugins name"
+    unactuated = f"{urdf}: {naming} joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
     tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, q, output, output_type, file_format,
                       task_coordinates=declared_task_coordinates(data), unactuated=unactuated)
+    passive = transmitted_joints(data, passive=True)
     if not transmitted:
-        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
-                          f"{', '.join(motors)}; --actuate JOINT says otherwise")
-    elif not transmitted_joints(data):
+        tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>"
+                          f"{' drives a joint' if passive else ''}): {', '.join(motors)}; --actuate JOINT says "
+                          "otherwise")
+    elif not declared:
         tree.notes.append(f"actuators: the joints the file's joint controller plugins drive, {', '.join(motors)} (no "
-                          "<transmission>)")
+                          f"<transmission>{' drives a joint' if passive else ''})")
     passive_note(tree, data)
     return tree
 
 
 def passive_note(tree: ClosedTree, data: bytes) -> None:
     """The import report's line on transmissions whose joints' hardware interfaces are all passive ones."""
-    passive = transmitted_joints(data, passive=True)
+    passive = [joint for joint in transmitted_joints(data, passive=True) if joint not in transmitted_joints(data)]
     if passive:
         tree.notes.append(f"joints {', '.join(passive)}: their <transmission>s' hardware interfaces are passive "
                           "(PassiveJointInterface): moved by the loops, not actuators")

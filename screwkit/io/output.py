@@ -15,9 +15,16 @@ from screwkit.io.closed_tree import ClosedTree, ImportError_
 __all__ = ["output_frame", "platform_body", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
 
 OUTPUT_NAMES = ("effector", "end_effector", "eff", "ee", "tool", "tcp", "foot", "platform")
-"""Frame names taken as the output when none is given, in this order (case-insensitive)."""
+"""Frame names taken as the output when none is given, in this order (however written: ``endEffector``,
+``End-Effector``, ``EE``)."""
 OUTPUT_SUFFIXES = ("_link", "_frame", "0")
 """Endings of the :data:`OUTPUT_NAMES` also taken, after the body where most closures meet (``ee_link``, ``tool0``)."""
+
+
+def _spelled(name: str) -> str:
+    """A frame's name as :data:`OUTPUT_NAMES` are compared: lower case, without ``_`` or ``-`` (``endEffector``,
+    ``end_effector`` and ``End-Effector`` alike)."""
+    return name.lower().replace("_", "").replace("-", "")
 
 
 def output_frame(tree: ClosedTree) -> int:
@@ -28,7 +35,7 @@ def output_frame(tree: ClosedTree) -> int:
             raise ImportError_(f"{tree.source}: no frame named {tree.output!r} for the output; frames are "
                                + ", ".join(names[1:]) + ".")
         return names.index(tree.output)
-    lowered = [name.lower() for name in names]
+    lowered = [_spelled(name) for name in names]
     counts: dict[int, int] = {}
     for closure in tree.closures:
         for joint in {closure.joint_a, closure.joint_b} - {0}:
@@ -36,7 +43,7 @@ def output_frame(tree: ClosedTree) -> int:
     ranked = sorted(counts.items(), key=lambda item: -item[1])
     meeting = ranked[0][0] if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]) \
         else None  # the joint of the body where the most closures meet (where every leg ends), if one
-    for candidate in OUTPUT_NAMES:
+    for candidate in map(_spelled, OUTPUT_NAMES):
         if candidate in lowered:
             index = lowered.index(candidate)
             after = _joints_after(model, meeting, int(model.frames[index].parentJoint)) if meeting else []
@@ -55,7 +62,7 @@ def output_frame(tree: ClosedTree) -> int:
             tree.notes.append(f"platform inferred: body {names[index]!r}, where {ranked[0][1]} closures meet "
                               "(name another with --output FRAME)")
             return index
-    for candidate in (name + suffix for suffix in OUTPUT_SUFFIXES for name in OUTPUT_NAMES):
+    for candidate in (_spelled(name + suffix) for suffix in OUTPUT_SUFFIXES for name in OUTPUT_NAMES):
         if candidate in lowered:  # a tool frame named as ROS packages name theirs: ee_link, tool0
             tree.notes.append(f"output frame inferred: {names[lowered.index(candidate)]!r} (name another with "
                               "--output FRAME)")

@@ -38,8 +38,8 @@ from screwkit.io.closed_tree import ImportError_
 from screwkit.io.drake import drake_elements
 
 __all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
-           "attached_link", "controllers", "controlled_joints", "detachable_joints", "WORLD", "MODEL_FRAME",
-           "CONTROLLER"]
+           "attached_link", "controllers", "controlled_joints", "detachable_joints", "plugin_note", "WORLD",
+           "MODEL_FRAME", "CONTROLLER"]
 
 WORLD = "world"
 MODEL_FRAME = "__model__"
@@ -171,8 +171,12 @@ def _limits(element, tag: str, where: str, kind: str) -> tuple[float, float] | N
     return None
 
 
-CONTROLLER = re.compile(r"joint.*controller", re.IGNORECASE)
-"""A joint-controller plugin's ``filename`` or ``name`` (its ``<joint_name>`` joints are driven)."""
+SCENERY = ("ground_plane", "sun")
+"""The models a Gazebo world includes that are none of a mechanism (``model://ground_plane``, Fuel's
+``.../models/Ground Plane``, ``model://sun``): left out, said."""
+CONTROLLER = re.compile(r"joint.*controller|apply.?joint.?force", re.IGNORECASE)
+"""A joint-controller plugin's ``filename`` or ``name`` (its ``<joint_name>`` joints are driven), or one that applies a
+force or torque at joints (Gazebo's ``ApplyJointForce``: an effort input)."""
 
 
 def controllers(parents) -> list:
@@ -188,13 +192,15 @@ def controlled_joints(parents) -> list[str]:
                               for node in plugin.iter("joint_name") if (node.text or "").strip()))
 
 
-def detachable_joints(parents, links) -> list[tuple[object, str]]:
+def detachable_joints(parents, links, model: str, taken=()) -> list[tuple[object, str]]:
     """The fixed joints that Gazebo's DetachableJoint plugins among the children of ``parents`` make when the
     simulation starts, between ``<parent_link>`` and ``<child_link>`` as the file places them: a loop where both are
-    among the model's ``links`` (its ``<child_model>`` names the model as it is spawned, which may not be the file's
-    name; a plugin that attaches another model's link, to be picked up, is no loop); each as an SDFormat ``<joint>``
-    element with how the file writes it, for messages."""
-    found = []
+    among the model's ``links``; each as an SDFormat ``<joint>`` element (named apart from the joints ``taken``) with
+    how the file writes it, for messages, which says when the plugin's ``<child_model>`` is neither ``__model__`` nor
+    the model's name ``model`` (the name it is spawned under, as a published five-bar's; else another model, whose
+    link of that name it would attach: then no loop of this mechanism). A plugin attaching a link this model does not
+    have is no loop."""
+    found, names = [], set(taken)
     for parent in parents:
         for plugin in parent.findall("plugin"):
             if "DetachableJoint" not in plugin.get("name", "") and \
@@ -203,11 +209,24 @@ def detachable_joints(parents, links) -> list[tuple[object, str]]:
             ends = [(plugin.findtext(tag) or "").strip() for tag in ("parent_link", "child_link")]
             if not all(end in links for end in ends):
                 continue
-            joint = ElementTree.Element("joint", name=f"{ends[0]}_to_{ends[1]}", type="fixed")
+            name = next(f"{ends[0]}_to_{ends[1]}{suffix}" for suffix in ("", *(f"_{k}" for k in range(2, 99)))
+                        if f"{ends[0]}_to_{ends[1]}{suffix}" not in names)
+            names.add(name)
+            joint = ElementTree.Element("joint", name=name, type="fixed")
             ElementTree.SubElement(joint, "parent").text = ends[0]
             ElementTree.SubElement(joint, "child").text = ends[1]
-            found.append((joint, f"<plugin name='{plugin.get('name', '')}'> ({ends[0]} to {ends[1]})"))
+            spawned = (plugin.findtext("child_model") or "").strip()
+            other = f"; its <child_model> {spawned!r} read as this model spawned so" \
+                if spawned not in ("", "__model__", model) else ""
+            found.append((joint, f"<plugin name='{plugin.get('name', '')}'> ({ends[0]} to {ends[1]}{other})"))
     return found
+
+
+def plugin_note(plugins: list[tuple[object, str]], what: str) -> str:
+    """The import report's line on the fixed joints (``what``: joints, closures) that :func:`detachable_joints` made."""
+    said = "; ".join(written.split("(", 1)[1].rstrip(")") for _, written in plugins)
+    return (f"{what} {', '.join(joint.get('name') for joint, _ in plugins)}: the fixed joints Gazebo's DetachableJoint "
+            f"plugins make at start, the links where the file places them ({said})")
 
 
 def parse_joint(element, where: str, version: tuple[int, ...] = (1, 7)) -> SdfJoint:
@@ -259,8 +278,13 @@ def _the_model(path: Path, root) -> tuple[object, str]:
     if root.tag != "sdf":
         raise ImportError_(f"{path}: the root element is <{root.tag}>, not <sdf>: not an SDFormat file.")
     parents = {child: parent for parent in root.iter() for child in parent}
+    scenery_included = []
     for include in root.iter("include"):  # wherever it is: in <sdf>, a <world>, a <model>, a nested one
         scope = parents[include]
+        uri = include.findtext("uri", "").strip()
+        if scope.tag == "world" and uri.rstrip("/").rsplit("/", 1)[-1].lower().replace(" ", "_") in SCENERY:
+            scenery_included.append(repr(uri))  # Gazebo's own ground plane and sun: none of the mechanism
+            continue
         named = f" name='{scope.get('name')}'" if scope.get("name") is not None else ""
         raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
                            f"not read (this one in <{scope.tag}{named}>); write the model in the file.")
@@ -274,7 +298,7 @@ def _the_model(path: Path, root) -> tuple[object, str]:
         raise ImportError_(f"{path}: {len(moving)} <model> elements ({names or 'none'}{aside}); screwkit reads one "
                            "model: write the mechanism's model alone in a file.")
     model = moving[0]
-    left_out = ", ".join(repr(other.get("name")) for other in models if other is not model)
+    left_out = ", ".join([repr(other.get("name")) for other in models if other is not model] + scenery_included)
     if not (model.get("name") or "").strip():
         raise ImportError_(f"{path}: <model> has no name (SDFormat requires one).")
     for nested in model.iter("model"):
@@ -308,7 +332,8 @@ def read_model(path: Path) -> SdfModel:
     model = SdfModel(str(path), element.get("name", ""), element, links, [], {}, element.get("canonical_link") or
                      links[0])
     if scenery:
-        model.renamed.append(f"models {scenery} of the world left out: static, without joints (a ground plane)")
+        model.renamed.append(f"models {scenery} of the world left out: scenery (static without joints, or Gazebo's "
+                             "ground plane and sun included)")
     model.ball_constraints = [_ball_constraint(node, f"{label}: <drake:ball_constraint> {number}")
                               for number, (_, node) in enumerate(drake_elements(element), start=1)]
     pose, relative = parse_pose(element.find("pose"), label)
@@ -323,14 +348,13 @@ def read_model(path: Path) -> SdfModel:
     if version < (1, 7):  # before 1.7 a joint could share a link's name: libsdformat renames the joint, and warns
         _rename_joints_named_as_links(model, element, version)
     written = [(joint, f"<joint name='{joint.get('name')}'>") for joint in element.findall("joint")]
-    for joint, written_as in written + detachable_joints([element], links):
+    plugins = detachable_joints([element], links, model.name, [joint.get("name") for joint, _ in written])
+    for joint, written_as in written + plugins:
         parsed = parse_joint(joint, f"{path}: {written_as}", version)
         model.joints.append(parsed)
         _declare(model, parsed.name, parsed.relative_to or parsed.child, parsed.pose, parsed.where)
-    plugins = [joint.get("name") for joint, _ in detachable_joints([element], links)]
     if plugins:
-        model.renamed.append(f"joints {', '.join(plugins)}: the fixed joints Gazebo's DetachableJoint plugins make at "
-                             "start, the links where the file places them")
+        model.renamed.append(plugin_note(plugins, "joints"))
     for frame in element.findall("frame"):
         where = f"{path}: <frame name='{frame.get('name')}'>"
         attached = frame.get("attached_to", "").strip() or MODEL_FRAME

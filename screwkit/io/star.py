@@ -395,7 +395,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     platform_world[:3, 3] = centres[0] if point else output_world[:3, 3]
     world_base = base_frame(normal, platform_world[:3, 3])
     platform_world[:3, :3] = world_base[:3, :3] if (point or normal is not None) else output_world[:3, :3]
-    writer = UrdfWriter(Path(tree.source).stem or "mechanism",
+    writer = UrdfWriter(Path(tree.source.split(" + ", 1)[0]).stem or "mechanism",  # (a Gepetto pair: its URDF)
                         f"Converted by screwkit from {tree.source} ({tree.file_format}); " + report.lines()[0])
     base = "base"
     if normal is not None:

@@ -38,20 +38,30 @@ def joint_motion(model, joint: int, q: NDArray) -> NDArray:
 
 
 def base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
-    """World frame of the written base: z along a planar mechanism's normal, its origin where the world axis nearest
-    to it meets the plane through ``point`` (the world's for a spatial mechanism): the plane's x, y are then the
-    world's to second order in the normal's rounding however far the plane is (turned about the world's origin, they
-    were not), and they change with the normal continuously (a threshold on its tilt left a jump there)."""
+    """World frame of the written base: z along a planar mechanism's normal, x and y the world's axes turned with it,
+    its origin where the world axis nearest to the normal meets the plane through ``point`` (the world's frame for a
+    spatial mechanism).
+
+    The world's axis nearest to the normal (with its sense) is turned onto the normal by the least rotation, and the
+    first of the other two world axes with it is the plane's x: a plane whose normal is a world axis has that axis's
+    two others (x, y about z; x, -z about y; y, z about x), and one whose normal the file's rounding tilts from it has
+    them turned by the tilt, continuously and with every digit (the plane of a five-bar based on ``rpy="0 3.14159
+    0"``, its normal 2.65e-6 rad from the world's x, took its x from the world's x, nearly along the normal: 4e-11
+    rad from perpendicular, and along the world's -z where ``3.1415926`` gave the world's y). The origin: the plane's
+    x, y are the world's to second order in the normal's rounding however far the plane is (turned about the world's
+    origin, they were not)."""
     frame = np.eye(4)
     if normal is None:
         return frame
     z = normal / np.linalg.norm(normal)
-    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
-    if np.linalg.norm(x) < 1e-6:
-        x = np.array([0.0, 1.0, 0.0]) - z[1] * z
-    x = x / np.linalg.norm(x)
-    x -= (x @ z) * z  # once more: near the world's x, 1 - z[0]**2 loses digits, and x was z's normal to 4e-11 only
-    x, axis = x / np.linalg.norm(x), int(np.argmax(np.abs(z)))
+    axis = int(np.argmax(np.abs(z)))
+    nearest = np.zeros(3)
+    nearest[axis] = np.sign(z[axis])
+    turn = np.cross(nearest, z)  # the least rotation taking the nearest axis onto z (Rodrigues), at most 55 deg
+    first = np.eye(3)[1 if axis == 0 else 0]
+    x = first + np.cross(turn, first) + np.cross(turn, np.cross(turn, first)) / (1.0 + float(nearest @ z))
+    x -= (x @ z) * z
+    x /= np.linalg.norm(x)
     frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
     frame[axis, 3] = float(z @ point) / z[axis]
     return frame

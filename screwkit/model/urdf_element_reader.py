@@ -338,4 +338,12 @@ class ElementReader:
         joints = tuple(self.required_attribute(joint, f"{tag}<joint>", "name") for joint in element.findall("joint"))
         if not joints:
             raise self.fail(tag, "drives no joint (expected <joint name='...'> inside).")
-        return TransmissionElement(name=name, joints=joints)
+        driven = tuple(joint for joint, node in zip(joints, element.findall("joint")) if not passive_joint(node))
+        return TransmissionElement(name=name, joints=driven)
+
+
+def passive_joint(joint: ElementTree.Element) -> bool:
+    """Whether a ``<transmission>``'s ``<joint>`` names hardware interfaces, all of them passive ones
+    (``PassiveJointInterface``: a closed-loop simulator's joint that the loop moves): it drives nothing."""
+    interfaces = [(node.text or "").strip() for node in joint.iter("hardwareInterface")]
+    return bool(interfaces) and all("passive" in interface.rsplit("/", 1)[-1].lower() for interface in interfaces)
