@@ -335,3 +335,15 @@ def test_a_passive_transmission_drives_nothing_in_screwkits_own_convention_too()
                '</hardwareInterface></joint></transmission>')
     plain = load_text(text)
     assert load_text(text.replace("</robot>", passive + "</robot>")).actuator_names == plain.actuator_names
+
+
+def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_element(tmp_path):
+    """urdfdom says what is wrong on standard error (four lines), then Pinocchio that the file holds no valid URDF
+    model: the one line now carries urdfdom's first complaint, and nothing else is written."""
+    text = FIVE_BAR.read_text()
+    axis = text.index("<axis", text.index('name="Chain1_2"'))
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(text[:axis] + '<axis xyz="1 0zzz 0"/>' + text[text.index("/>", axis) + 2:])
+    one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"),
+                   "Pinocchio cannot read the tree: Malformed axis element for joint [Chain1_2]: Unable to parse "
+                   "component [0zzz] to a double")

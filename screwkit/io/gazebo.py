@@ -40,6 +40,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import transmitted_tree
 from screwkit.io.sdformat_text import controlled_joints, detachable_joints, parse_joint, plugin_note
+from screwkit.io.urdf_tree import urdf_model
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
 
@@ -74,10 +75,7 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     """The closed tree of a URDF whose loops are ``<gazebo><joint>`` elements."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    try:
-        model = pin.buildModelFromUrdf(str(urdf))
-    except (RuntimeError, ValueError) as error:
-        raise ImportError_(f"{urdf}: Pinocchio cannot read the tree ({error}).") from None
+    model = urdf_model(urdf)
     data = model.createData()
     q = pin.neutral(model)
     pin.framesForwardKinematics(model, data, q)

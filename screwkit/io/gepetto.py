@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, declared_task_coordinates, homogeneous
+from screwkit.io.urdf_tree import urdf_model
 
 __all__ = ["read_gepetto", "yaml_beside", "replaced_joints"]
 
@@ -53,10 +54,7 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
     motors = motors if not unactuated else []  # refused unless --actuate names them (screwkit.io.read_closed_tree)
     if len(kinds) != len(pairs):
         raise ImportError_(f"{yaml_path}: {len(pairs)} closed_loop pair(s) but {len(kinds)} type(s).")
-    try:
-        model = pin.buildModelFromUrdf(str(urdf))
-    except (RuntimeError, ValueError) as error:
-        raise ImportError_(f"{urdf}: Pinocchio cannot read the tree ({error}).") from None
+    model = urdf_model(urdf)
     if spec.get("joint_name") is not None or spec.get("joint_type") is not None:
         model, notes = replaced_joints(model, spec.get("joint_name"), spec.get("joint_type"), f"{yaml_path}")
     else:

@@ -33,6 +33,7 @@ from screwkit.io.closed_tree import (
     joint_kind,
     path_to,
 )
+from screwkit.io.urdf_tree import urdf_model
 from screwkit.model.urdf_element_reader import passive_joint
 
 __all__ = ["CLOSING", "closing_pairs", "read_onshape", "transmitted_tree", "transmitted_joints"]
@@ -78,10 +79,7 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
     """The closed tree of an onshape-to-robot URDF whose loops are ``closing_`` frame pairs."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    try:
-        model = pin.buildModelFromUrdf(str(urdf))
-    except (RuntimeError, ValueError) as error:
-        raise ImportError_(f"{urdf}: Pinocchio cannot read the tree ({error}).") from None
+    model = urdf_model(urdf)
     frames = {frame.name: frame for frame in model.frames if frame.type == pin.FrameType.BODY}
     pairs = closing_pairs(frames)
     unpaired = sorted(name for name in frames if CLOSING.fullmatch(name)

@@ -1,0 +1,48 @@
+"""Pinocchio's reading of the tree of a URDF of another tool, and what its parser says of a file it refuses, in one
+line.
+
+Pinocchio reads a URDF through urdfdom, which writes what is wrong with a file on the process's standard error (two
+lines each: ``Error:   Malformed axis element for joint [j3]: Unable to parse component [1zzz] to a double ...`` and
+where in urdfdom's sources), and then raises that the file "does not contain a valid URDF model". Its standard error
+is held while the tree is read: a file it reads gives back what urdfdom wrote (its warnings), a file it refuses is
+refused in one line with urdfdom's first complaint, which names the element.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from screwkit.io.closed_tree import ImportError_
+
+__all__ = ["urdf_model"]
+
+
+def urdf_model(urdf: Path):
+    """Pinocchio's model of the URDF ``urdf``'s tree; an :class:`~screwkit.io.closed_tree.ImportError_` in one line
+    naming the file and urdfdom's complaint if it cannot read it."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    sys.stderr.flush()
+    kept = os.dup(2)
+    with tempfile.TemporaryFile() as said:
+        os.dup2(said.fileno(), 2)
+        try:
+            model, error = pin.buildModelFromUrdf(str(urdf)), None
+        except (RuntimeError, ValueError) as raised:
+            model, error = None, raised
+        finally:
+            os.dup2(kept, 2)
+            os.close(kept)
+        said.seek(0)
+        text = said.read()
+    if error is None:
+        if text:  # urdfdom's warnings on a file it reads, as they were
+            os.write(2, text)
+        return model
+    complaints = [line.strip().removeprefix("Error:").strip() for line in text.decode(errors="replace").splitlines()
+                  if line.strip().startswith("Error:")]
+    raise ImportError_(f"{urdf}: Pinocchio cannot read the tree: "
+                       + (f"{complaints[0]}." if complaints else f"{error}.").replace("..", "."))
