@@ -347,3 +347,28 @@ def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_ele
     one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"),
                    "Pinocchio cannot read the tree: Malformed axis element for joint [Chain1_2]: Unable to parse "
                    "component [0zzz] to a double")
+
+
+def test_the_published_four_axis_delta_names_its_wrist_and_opens_with_it_held(tmp_path):
+    """LevinTamir's 4-DOF Delta: three R-S-S legs, each ending on a ball written as three hinges on the tool holder
+    (the body its planning chain moves), and a wrist, the driven hinge Chain4_1 that turns the tool on the holder,
+    with a passive telescopic shaft from the base to the tool. Each rod's closure ends on its own hinge, so no joint
+    had two closures and the tool0 frame was taken as the platform: refused as a closed-loop transmission. The three
+    balls' closures now meet on the holder, the platform; the wrist, moving inside the shaft's loop, is refused
+    naming --lock Chain4_1, which opens it with the rod lines' indices, also in a turned world."""
+    path = PUBLISHED / "ros2_closed_loop_ws" / "4dof_delta.urdf"
+    one_line_error(screwkit("analyze", path), "actuated joint 'Chain4_1' moves inside a loop of leg",
+                   "it turns a body on the platform (a wrist after the parallel part): --lock Chain4_1 holds it")
+    notes = read_mechanism_file(path, lock=("Chain4_1",))[1].notes
+    assert any(note.startswith("platform inferred: body 'tool_holder', where 4 closures meet") for note in notes)
+    expected = delta_textbook(path)
+    turned_path = tmp_path / "4dof_delta.urdf"
+    turned_path.write_text(turned(path.read_text(), *TURN))
+    for source in (path, turned_path):
+        loaded = load(source, lock=("Chain4_1",))
+        result = indices_at_pose(loaded, loaded.home_pose)
+        itis = dict(zip((name.split(":")[-1] for name in loaded.actuator_names), np.ravel(result.iti_actuators)))
+        assert sorted(itis) == ["Chain1_1", "Chain2_1", "Chain3_1"]
+        for name, value in itis.items():
+            assert value == pytest.approx(expected[name], abs=1e-9), name
+        assert float(result.lmti) == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)

@@ -7,13 +7,11 @@ graph itself, following the paper's definitions leg by leg (``docs/theory.md``, 
 
 * **legs**: the bodies other than the base and the platform, joined by tree joints and closures, fall into
   connected groups; a group joined to both the base and the platform is a **leg**, one joined to the platform only
-  is a tool carried by the platform (a gripper: left out, said in the report), one joined to the base only an idle
-  branch (left out, said);
+  a tool it carries (a gripper), one joined to the base only an idle branch (both left out, said in the report);
 * a leg's **twist system** :math:`S_i`: the platform-twist part of the null space of the leg's closure Jacobian
   (:func:`screwkit.io.compound.platform_twists`: the rates of the leg's joints and the platform twist as unknowns,
   one block of rows per closure of the leg); with actuator ``k`` locked, :math:`S_i^k`. Idle motions (a rod
-  spinning about its own axis between two ball joints) lie in the null space but move no platform twist: they
-  drop out by construction;
+  spinning about its own axis between two ball joints) lie in the null space but move no platform twist;
 * the leg's **actuation wrench**: reciprocal to :math:`S_i^k` and not to :math:`S_i` -- for a serial leg, the
   paper's wrench reciprocal to every passive joint, since :math:`S_i^k` is then their span. It is computed by
   :func:`screwkit.indices.analysis.analyze` from an **equivalent chain**: the actuated joint's own twist followed
@@ -426,7 +424,9 @@ def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platfor
                      if j in leg.joints and j != platform]
             one = len(below) == 1
             hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
-                    f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else "")
+                    f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else
+                    f"; it turns a body on the platform (a wrist after the parallel part): --lock {name} holds it, "
+                    "and the legs are analysed on the platform" if model.parents[actuator] == platform else "")
             raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
                                "twist is not a motion the leg allows: the leg has no serial input); analysable when "
                                f"the actuated joint joins the base to the rest of its leg{hint}.")

@@ -3,14 +3,17 @@
 A file of another tool seldom says which body is the platform. :func:`output_frame` takes the frame given (``--output
 FRAME``), else the first frame called one of :data:`OUTPUT_NAMES` (or, when that frame hangs by joints of its own off
 the body where the most closures meet, that body: a Delta's turning tool), else the body where the most closures meet
-(where every leg ends), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one
+(where every leg ends; failing one, where the most closures meet through balls written as three hinges each: a
+Delta's rods on the platform), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one
 ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is then its
 output). The notes say which was inferred.
 """
 
 from __future__ import annotations
 
-from screwkit.io.closed_tree import ClosedTree, ImportError_
+import numpy as np
+
+from screwkit.io.closed_tree import ClosedTree, ImportError_, ball_of_revolutes, homogeneous, joint_kind
 
 __all__ = ["output_frame", "platform_body", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
 
@@ -36,13 +39,9 @@ def output_frame(tree: ClosedTree) -> int:
                                + ", ".join(names[1:]) + ".")
         return names.index(tree.output)
     lowered = [_spelled(name) for name in names]
-    counts: dict[int, int] = {}
-    for closure in tree.closures:
-        for joint in {closure.joint_a, closure.joint_b} - {0}:
-            counts[joint] = counts.get(joint, 0) + 1
-    ranked = sorted(counts.items(), key=lambda item: -item[1])
-    meeting = ranked[0][0] if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]) \
-        else None  # the joint of the body where the most closures meet (where every leg ends), if one
+    counts, ranked, meeting = _meeting(tree, {})
+    if meeting is None:  # closures that each end on a ball written as three hinges: where the balls are
+        counts, ranked, meeting = _meeting(tree, _ball_carriers(tree))
     for candidate in map(_spelled, OUTPUT_NAMES):
         if candidate in lowered:
             index = lowered.index(candidate)
@@ -82,6 +81,42 @@ def output_frame(tree: ClosedTree) -> int:
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
                        f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet"
                        + (said if joined else "") + ".")
+
+
+def _meeting(tree: ClosedTree, carriers: dict[int, int]):
+    """How many closures end on each joint's body (an end on a joint of ``carriers`` counted on its carrier's), the
+    joints ranked by it, and the joint of the one body where the most closures meet (where every leg ends), if one."""
+    counts: dict[int, int] = {}
+    for closure in tree.closures:
+        for joint in {carriers.get(closure.joint_a, closure.joint_a), carriers.get(closure.joint_b, closure.joint_b)} \
+                - {0}:
+            counts[joint] = counts.get(joint, 0) + 1
+    ranked = sorted(counts.items(), key=lambda item: -item[1])
+    meeting = ranked[0][0] if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]) \
+        else None
+    return counts, ranked, meeting
+
+
+def _ball_carriers(tree: ClosedTree) -> dict[int, int]:
+    """For each closure's end on the last of three revolute joints in a row that make a ball (their axes through one
+    point at the file's joint values: :func:`~screwkit.io.closed_tree.ball_of_revolutes`), the joint of the body that
+    carries the ball: the closure ends on that body through the ball (a Delta's rods, each on a ball written as three
+    hinges on the platform, meet there, not on three bodies)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, tree.q_reference)
+    scale = max(max(float(np.linalg.norm(placement.translation)) for placement in data.oMi), 1e-9)
+    carriers = {}
+    for joint in {end for closure in tree.closures for end in (closure.joint_a, closure.joint_b)} - {0}:
+        path = [joint, int(model.parents[joint]), int(model.parents[int(model.parents[joint])])][::-1]
+        if 0 in path:
+            continue
+        first = homogeneous(data.oMi[int(model.parents[path[0]])]) @ homogeneous(model.jointPlacements[path[0]])
+        if ball_of_revolutes(model, path, [joint_kind(model, j) for j in path], first, scale) is not None:
+            carriers[joint] = int(model.parents[path[0]])
+    return carriers
 
 
 def _joints_after(model, ancestor: int, joint: int) -> list[int]:
