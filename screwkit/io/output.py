@@ -4,9 +4,9 @@ A file of another tool seldom says which body is the platform. :func:`output_fra
 FRAME``), else the first frame called one of :data:`OUTPUT_NAMES` (or, when that frame hangs by joints of its own off
 the body where the most closures meet, that body: a Delta's turning tool), else the body where the most closures meet
 (where every leg ends; failing one, where the most closures meet through balls written as three hinges each: a
-Delta's rods on the platform), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that the one
-ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is then its
-output). The notes say which was inferred.
+Delta's rods on the platform), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that
+the one ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is
+then its output). The notes say which was inferred.
 """
 
 from __future__ import annotations
