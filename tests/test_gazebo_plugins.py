@@ -18,6 +18,8 @@ perpendicular to the normal, and the file's own home was refused as unreachable 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -372,3 +374,22 @@ def test_the_published_four_axis_delta_names_its_wrist_and_opens_with_it_held(tm
         for name, value in itis.items():
             assert value == pytest.approx(expected[name], abs=1e-9), name
         assert float(result.lmti) == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)
+
+
+@pytest.mark.parametrize("name, body, output", [("spherical_eye", "platform", "platform"),
+                                                ("spherical_eye_ee", "moving_plate", "ee_link")])
+def test_three_hinges_meeting_in_a_spherical_mechanism_are_no_ball_that_moves_its_platform(name, body, output):
+    """A 3-RRR spherical mechanism (``tests/data/spherical_eye``, written for this test: every axis through one
+    centre, its loops closed by Gazebo fixed joints between the halves of legs 2 and 3): the three hinges of leg 1's
+    path and a closed leg's are no ball (driven, or links that carry more than the next hinge), and the body named
+    ``platform`` (or the frame ``ee_link``) stays the output, as before balls were counted."""
+    report = read_mechanism_file(PUBLISHED.parents[1] / "spherical_eye" / f"{name}.urdf")[1]
+    assert (report.platform_body, report.output) == (body, f"frame {output!r} on body {body!r}")
+
+
+def test_a_urdf_is_read_with_no_standard_error_to_hold():
+    """A process whose standard error is closed (a daemon, ``2>&-``) reads a URDF of another tool as before."""
+    code = ("import os; os.close(2); from screwkit.io.loader import load; "
+            f"print(load({str(FIVE_BAR)!r}, output='Chain1_dummy').dof)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip() == "2", done.stdout

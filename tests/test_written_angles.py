@@ -266,7 +266,7 @@ def test_a_five_bar_turned_by_a_rounded_right_angle_opens_at_its_home(tmp_path, 
     """The onshape five-bar turned so that its plane's normal is a few microradians from the world's x axis (a right
     angle written 1.5708 or 3.14159), at 1, 10 and 1000 times its size: its home has the textbook pressure angles.
     (Its closures close in closed form; the published five-bar of ``tests/test_gazebo_plugins.py``, whose closure is
-    solved by Newton's method, is the one the plane's frame 4e-11 rad from orthonormal left unreachable at its
+    solved by Newton's method, is the one the plane's frame 2.3e-11 rad from orthonormal left unreachable at its
     home.)"""
     path = tmp_path / "robot.urdf"
     path.write_text(turned_world(five_bar_onshape(transform=(scale, 0.0, (0.0, 0.0, 0.0))), rpy))
@@ -317,3 +317,15 @@ def test_the_plane_s_frame_turns_with_its_normal_continuously_near_every_world_a
             tilted = normal + tilt * rng.normal(size=3) / np.sqrt(3)
             frame = base_frame(tilted, np.zeros(3))[:3, :3]
             assert np.max(np.abs(frame - square)) < 4 * tilt
+
+
+def test_a_plane_on_a_diagonal_keeps_its_frame_whatever_its_rounding():
+    """A normal at 45 deg between the world's x and z (or x, y and z alike), written with its last digits rounded
+    either way: one frame, its nearest axis chosen x before y before z (the least rotation onto the normal turns
+    by 90 deg between a normal nearer x and one nearer z, and rounding decided which)."""
+    for normal in (np.array([1.0, 0.0, 1.0]), np.array([1.0, 1.0, 1.0]), np.array([0.0, -1.0, 1.0])):
+        normal = normal / np.linalg.norm(normal)
+        frames = [base_frame(normal + noise, np.zeros(3))[:3, :3]
+                  for noise in np.random.default_rng(3).normal(0.0, 1e-12, (8, 3))]
+        for frame in frames:
+            np.testing.assert_allclose(frame, frames[0], atol=1e-10, rtol=0)

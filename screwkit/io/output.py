@@ -40,8 +40,6 @@ def output_frame(tree: ClosedTree) -> int:
         return names.index(tree.output)
     lowered = [_spelled(name) for name in names]
     counts, ranked, meeting = _meeting(tree, {})
-    if meeting is None:  # closures that each end on a ball written as three hinges: where the balls are
-        counts, ranked, meeting = _meeting(tree, _ball_carriers(tree))
     for candidate in map(_spelled, OUTPUT_NAMES):
         if candidate in lowered:
             index = lowered.index(candidate)
@@ -55,6 +53,8 @@ def output_frame(tree: ClosedTree) -> int:
                               f"{names[index]!r} hangs off it by joint(s) {', '.join(model.names[j] for j in after)}, "
                               "after the parallel part (name another output with --output FRAME)")
             return platform
+    if meeting is None:  # closures that each end on a ball written as three hinges: where the balls are
+        counts, ranked, meeting = _meeting(tree, _ball_carriers(tree))
     if meeting is not None:  # no frame named as an output: the body where the most closures meet
         index = _body_frame(model, meeting)
         if index is not None:
@@ -99,20 +99,25 @@ def _meeting(tree: ClosedTree, carriers: dict[int, int]):
 
 def _ball_carriers(tree: ClosedTree) -> dict[int, int]:
     """For each closure's end on the last of three revolute joints in a row that make a ball (their axes through one
-    point at the file's joint values: :func:`~screwkit.io.closed_tree.ball_of_revolutes`), the joint of the body that
-    carries the ball: the closure ends on that body through the ball (a Delta's rods, each on a ball written as three
-    hinges on the platform, meet there, not on three bodies)."""
+    point at the file's joint values: :func:`~screwkit.io.closed_tree.ball_of_revolutes`; the two links between them
+    carrying nothing but the next hinge, none of them driven), the joint of the body that carries the ball: the
+    closure ends on that body through the ball (a Delta's rods, each on a ball written as three hinges on the
+    platform, meet there, not on three bodies). Used only where no body has two closures and no frame is named as
+    an output (:data:`OUTPUT_NAMES`): in a spherical mechanism every three hinges' axes meet."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
     data = model.createData()
     pin.forwardKinematics(model, data, tree.q_reference)
     scale = max(max(float(np.linalg.norm(placement.translation)) for placement in data.oMi), 1e-9)
+    ends = [end for closure in tree.closures for end in (closure.joint_a, closure.joint_b)]
+    children = [[k for k in range(1, model.njoints) if model.parents[k] == joint] for joint in range(model.njoints)]
+    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
     carriers = {}
-    for joint in {end for closure in tree.closures for end in (closure.joint_a, closure.joint_b)} - {0}:
+    for joint in set(ends) - {0}:
         path = [joint, int(model.parents[joint]), int(model.parents[int(model.parents[joint])])][::-1]
-        if 0 in path:
-            continue
+        if 0 in path or motors & set(path) or any(children[j] != [k] or j in ends for j, k in zip(path, path[1:])):
+            continue  # a ball's two inner links carry its next hinge alone, and no motor drives a ball
         first = homogeneous(data.oMi[int(model.parents[path[0]])]) @ homogeneous(model.jointPlacements[path[0]])
         if ball_of_revolutes(model, path, [joint_kind(model, j) for j in path], first, scale) is not None:
             carriers[joint] = int(model.parents[path[0]])

@@ -37,6 +37,12 @@ def joint_motion(model, joint: int, q: NDArray) -> NDArray:
     return motion
 
 
+TIE = 1e-9
+"""Components of a plane's normal within this of the largest are a tie, broken towards the world's x, then y: a
+normal written on a diagonal (a plane at 45 deg) keeps its frame whatever its rounding (the frame turns by 90 deg
+where the nearest world axis changes, at these diagonals, and nowhere else)."""
+
+
 def base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
     """World frame of the written base: z along a planar mechanism's normal, x and y the world's axes turned with it,
     its origin where the world axis nearest to the normal meets the plane through ``point`` (the world's frame for a
@@ -46,7 +52,7 @@ def base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
     first of the other two world axes with it is the plane's x: a plane whose normal is a world axis has that axis's
     two others (x, y about z; x, -z about y; y, z about x), and one whose normal the file's rounding tilts from it has
     them turned by the tilt, continuously and with every digit (the plane of a five-bar based on ``rpy="0 3.14159
-    0"``, its normal 2.65e-6 rad from the world's x, took its x from the world's x, nearly along the normal: 4e-11
+    0"``, its normal 2.65e-6 rad from the world's x, took its x from the world's x, nearly along the normal: 2.3e-11
     rad from perpendicular, and along the world's -z where ``3.1415926`` gave the world's y). The origin: the plane's
     x, y are the world's to second order in the normal's rounding however far the plane is (turned about the world's
     origin, they were not)."""
@@ -54,7 +60,7 @@ def base_frame(normal: NDArray | None, point: NDArray) -> NDArray:
     if normal is None:
         return frame
     z = normal / np.linalg.norm(normal)
-    axis = int(np.argmax(np.abs(z)))
+    axis = int(np.flatnonzero(np.abs(z) >= np.max(np.abs(z)) - TIE)[0])  # (x before y before z in a near tie)
     nearest = np.zeros(3)
     nearest[axis] = np.sign(z[axis])
     turn = np.cross(nearest, z)  # the least rotation taking the nearest axis onto z (Rodrigues), at most 55 deg

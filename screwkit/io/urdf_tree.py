@@ -26,7 +26,15 @@ def urdf_model(urdf: Path):
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     sys.stderr.flush()
-    kept = os.dup(2)
+    try:
+        kept = os.dup(2)
+    except OSError:  # no standard error to hold (closed: a daemon, 2>&-): read as it is
+        kept = None
+    if kept is None:
+        try:
+            return pin.buildModelFromUrdf(str(urdf))
+        except (RuntimeError, ValueError) as error:
+            raise ImportError_(f"{urdf}: Pinocchio cannot read the tree: {error}") from None
     with tempfile.TemporaryFile() as said:
         os.dup2(said.fileno(), 2)
         try:
