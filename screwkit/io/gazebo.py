@@ -57,13 +57,17 @@ def has_gazebo_joints(path: Path) -> bool:
 
 
 def _gazebo_joints(text: bytes) -> list[tuple[object, str]]:
-    """The ``<gazebo><joint>`` elements of a URDF's text, and for each DetachableJoint plugin joining two of its
-    own links the fixed joint it makes (:func:`~screwkit.io.sdformat_text.detachable_joints`); each with how it is
-    written, for messages."""
+    """:func:`_joints_of` the URDF's text (none if it is not well-formed)."""
     try:
-        root = ElementTree.fromstring(tolerant_xml(text))
+        return _joints_of(ElementTree.fromstring(tolerant_xml(text)))
     except ElementTree.ParseError:
         return []
+
+
+def _joints_of(root) -> list[tuple[object, str]]:
+    """The ``<gazebo><joint>`` elements of a URDF (its ``root`` element), and for each DetachableJoint plugin joining
+    two of its own links the fixed joint it makes (:func:`~screwkit.io.sdformat_text.detachable_joints`); each with
+    how it is written, for messages."""
     joints = [(joint, f"<gazebo><joint name='{joint.get('name')}'>") for gazebo in root.findall("gazebo")
               for joint in gazebo.findall("joint")]
     links = {link.get("name") for link in root.findall("link")}
@@ -83,7 +87,9 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     scale = max(float(np.max(np.abs([np.asarray(frame.translation) for frame in data.oMf]))), 1e-3)
     closures = []
     written = urdf.read_bytes()
-    for element, written_as in _gazebo_joints(written):
+    root = ElementTree.fromstring(tolerant_xml(written))  # (well-formed: Pinocchio has read it)
+    found = _joints_of(root)
+    for element, written_as in found:
         name = element.get("name") or f"gazebo_joint_{len(closures) + 1}"
         where = f"{urdf}: {written_as}"
         kind = element.get("type", "")
@@ -113,10 +119,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             closures.append(Closure(name if len(points) == 1 else f"{name}_{'ab'[number]}", int(parent.parentJoint),
                                     on_parent, int(child.parentJoint), on_child, "6d" if kind == "fixed" else "3d",
                                     axis_point=number == 1))
-    root = ElementTree.fromstring(tolerant_xml(written))  # (read well-formed by _gazebo_joints)
-    plugins = [(joint, written_as) for joint, written_as in _gazebo_joints(written) if written_as.startswith("<plugin")]
-    written_with = ["<gazebo><joint>"] * (len(plugins) < len(_gazebo_joints(written))) + \
-        ["DetachableJoint plugins"] * bool(plugins)
+    plugins = [(joint, written_as) for joint, written_as in found if written_as.startswith("<plugin")]
+    written_with = ["<gazebo><joint>"] * (len(plugins) < len(found)) + ["DetachableJoint plugins"] * bool(plugins)
     tree = transmitted_tree(urdf, written, model, closures, q, output, output_type,
                             f"URDF + Gazebo joints ({', '.join(written_with)})",
                             controlled_joints(root.findall("gazebo")))

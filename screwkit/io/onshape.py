@@ -94,7 +94,8 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
         a, b = frames[first], frames[second]
         closures.append(Closure(f"closing_{key}", int(a.parentJoint), homogeneous(a.placement),
                                 int(b.parentJoint), homogeneous(b.placement), "3d"))
-    transmitted = transmitted_joints(urdf.read_bytes())
+    written = urdf.read_bytes()
+    transmitted = transmitted_joints(written)
     unknown = [name for name in transmitted if not model.existJointName(name)
                or model.joints[model.getJointId(name)].nv != 1]
     unactuated = (f"{urdf}: <transmission> names joint(s) {', '.join(unknown)}, not 1-DoF joints of the tree"
@@ -110,7 +111,7 @@ def read_onshape(urdf: Path, *, output: str | None = None, output_type: str | No
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>): "
                           f"{', '.join(motors)}; --actuate JOINT or a robot.yaml beside the file (name_mot) says "
                           "otherwise")
-    passive_note(tree, urdf.read_bytes())
+    passive_note(tree, written, transmitted)
     return tree
 
 
@@ -149,7 +150,7 @@ def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q,
     unactuated = f"{urdf}: {naming} joint(s) {', '.join(unknown)}, not in the tree" if unknown else ""
     tree = ClosedTree(str(urdf), model, closures, [] if unknown else motors, q, output, output_type, file_format,
                       task_coordinates=declared_task_coordinates(data), unactuated=unactuated)
-    passive = transmitted_joints(data, passive=True)
+    passive = passive_note(tree, data, declared)
     if not transmitted:
         tree.notes.append(f"actuators guessed from the branches leaving the base (no <transmission>"
                           f"{' drives a joint' if passive else ''}): {', '.join(motors)}; --actuate JOINT says "
@@ -157,13 +158,14 @@ def transmitted_tree(urdf: Path, data: bytes, model, closures: list[Closure], q,
     elif not declared:
         tree.notes.append(f"actuators: the joints the file's joint controller plugins drive, {', '.join(motors)} (no "
                           f"<transmission>{' drives a joint' if passive else ''})")
-    passive_note(tree, data)
     return tree
 
 
-def passive_note(tree: ClosedTree, data: bytes) -> None:
-    """The import report's line on transmissions whose joints' hardware interfaces are all passive ones."""
-    passive = [joint for joint in transmitted_joints(data, passive=True) if joint not in transmitted_joints(data)]
+def passive_note(tree: ClosedTree, data: bytes, driven: list[str]) -> list[str]:
+    """The joints of the URDF ``data``'s transmissions whose hardware interfaces are all passive ones, but those
+    another transmission drives (``driven``); the import report's line on them, if any."""
+    passive = [joint for joint in transmitted_joints(data, passive=True) if joint not in driven]
     if passive:
         tree.notes.append(f"joints {', '.join(passive)}: their <transmission>s' hardware interfaces are passive "
                           "(PassiveJointInterface): moved by the loops, not actuators")
+    return passive

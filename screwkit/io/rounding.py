@@ -104,13 +104,12 @@ def plane_normal(revolutes, prismatics, tolerance: float | NDArray = FILE_ROUNDI
                  slides: float | NDArray = FILE_ROUNDING) -> NDArray[np.float64] | None:
     """The normal of the plane a mechanism moves in: the common direction of its ``revolutes`` axes when its
     ``prismatics`` are perpendicular to it, else None. Parallel to :data:`EXACT`, the first revolute's direction as
-    written (the axes within 1e-9 of it were made parallel to their common direction by :func:`drawn_lines`, which
-    the legs written in the plane then left by up to 1e-9 rad);
-    else, all parallel to the file's rounding (one group of :func:`parallel_axes` within ``tolerance``, a number or
-    one per pair of revolutes, and each slide perpendicular to it within ``slides``, a number or one per slide:
-    :class:`screwkit.io.written_angles.WrittenTurns`), the direction they are written along. A CAD export's five-bar,
-    its axes parallel to 3e-7 rad, read as a spatial mechanism otherwise: other task coordinates, and a home it could
-    not reach."""
+    written; else (from 1e-12 on, the axes :func:`drawn_lines` makes parallel to their common direction, which the
+    normal must then be), all parallel to the file's rounding (one group of :func:`parallel_axes` within
+    ``tolerance``, a number or one per pair of revolutes, and each slide perpendicular to it within ``slides``, a
+    number or one per slide: :class:`screwkit.io.written_angles.WrittenTurns`), the direction they are written along.
+    A CAD export's five-bar, its axes parallel to 3e-7 rad, read as a spatial mechanism otherwise: other task
+    coordinates, and a home it could not reach."""
     if not len(revolutes):
         return None
     revolutes, prismatics = np.reshape(revolutes, (-1, 3)), np.reshape(prismatics, (-1, 3))

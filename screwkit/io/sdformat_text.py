@@ -286,7 +286,7 @@ def _the_model(path: Path, root) -> tuple[object, str]:
             scenery_included.append(repr(uri))  # Gazebo's own ground plane and sun: none of the mechanism
             continue
         named = f" name='{scope.get('name')}'" if scope.get("name") is not None else ""
-        raise ImportError_(f"{path}: <include> of {include.findtext('uri', '').strip()!r}: included models are "
+        raise ImportError_(f"{path}: <include> of {uri!r}: included models are "
                            f"not read (this one in <{scope.tag}{named}>); write the model in the file.")
     models = root.findall("model") + root.findall("world/model")
     scenery = [model for model in models if (model.findtext("static") or "").strip().lower() in ("true", "1")

@@ -23,7 +23,7 @@ def planar_normal(tree: ClosedTree, data, legs: list, turns: WrittenTurns) -> ND
     """The common direction of every revolute axis when slides are perpendicular to it, to the file's rounding
     (``turns``: :func:`~screwkit.io.rounding.plane_normal`), else None. Ball loops (a ``connect``) do not count: in
     a mechanism whose other joints all move in one plane, only their rotation about the plane's normal moves
-    (:func:`_planar_loops` writes them so)."""
+    (:func:`planar_loops` writes them so)."""
     axes = joint_axes(tree, data, legs)
     revolutes = [(axis, name) for kind, axis, name in axes if kind == "revolute"]
     prismatics = [(axis, name) for kind, axis, name in axes if kind == "prismatic"]
