@@ -146,36 +146,76 @@ def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_wi
     assert indices(FIVE_BAR, output="Chain1_dummy")["lmti"] == pytest.approx(expected["lmti"], abs=1e-9)
 
 
-@pytest.mark.parametrize("unit, factor, world", [("mm", 1e3, None), (None, 1.0, TURN), ("km", 1e-3, TURN)])
-def test_the_published_five_bar_reads_the_same_in_another_unit_and_world(tmp_path, unit, factor, world):
+@pytest.mark.parametrize("unit, factor, world, relabel", [("mm", 1e3, None, False), (None, 1.0, TURN, False),
+                                                            ("km", 1e-3, TURN, False), (None, 1.0, None, True)])
+def test_the_published_five_bar_reads_the_same_in_another_unit_and_world(tmp_path, unit, factor, world, relabel):
+    """In mm and km, turned, and with its motors renamed and its joints and links written in reverse order (each
+    ITI follows its motor)."""
     expected = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
     text = FIVE_BAR.read_text()
     if world is not None:
         text = turned(text, *world)
     if unit is not None:
         text = in_unit(text, unit, factor)
+    if relabel:
+        text = relabelled(text)
     path = tmp_path / "fivebar_linkage.urdf"
     path.write_text(text)
     found = indices(path, output="Chain1_dummy", output_type="point", length_unit=unit)
+    back = {new: old for old, new in RENAMED.items()}
+    found = {back.get(key, key): value for key, value in found.items()}
+    assert found.keys() == expected.keys()
     for key in expected:
         assert found[key] == pytest.approx(expected[key], abs=1e-9), key
 
 
-def test_the_published_delta_closed_by_three_detachable_joints_has_its_rod_lines_indices(tmp_path):
+RENAMED = {"Chain1_1": "drive_c", "Chain2_1": "drive_a", "Chain3_1": "drive_b"}
+"""The Deltas' motors renamed, so that their order by name is another."""
+
+
+def relabelled(urdf: str) -> str:
+    """A Delta URDF with its motors renamed (:data:`RENAMED`, in the joints and the controllers) and its joints and
+    links written in reverse order: its legs read in another order."""
+    for old, new in RENAMED.items():
+        urdf = urdf.replace(f'"{old}"', f'"{new}"').replace(f">{old}<", f">{new}<")
+    root = ET.fromstring(urdf)
+    elements = [child for child in root if child.tag in ("joint", "link")]
+    for child in elements:
+        root.remove(child)
+    for child in reversed(elements):
+        root.append(child)
+    return ET.tostring(root, encoding="unicode")
+
+
+DELTA_VARIANTS = {"as written": (lambda text: text, None), "turned": (lambda text: turned(text, *TURN), None),
+                  "mm": (lambda text: in_unit(text, "mm", 1e3), "mm"),
+                  "km, turned": (lambda text: in_unit(turned(text, *TURN), "km", 1e-3), "km"),
+                  "relabelled": (relabelled, None)}
+
+
+def delta_indices(path, unit, **options) -> tuple[dict, float]:
+    """Each motor's ITI by its name in the file before any renaming, and the LMTI, at the file's home."""
+    loaded = load(path, length_unit=unit, **options)
+    result = indices_at_pose(loaded, loaded.home_pose)
+    back = {new: old for old, new in RENAMED.items()}
+    names = [back.get(name.split(":")[-1], name.split(":")[-1]) for name in loaded.actuator_names]
+    return dict(zip(names, np.ravel(result.iti_actuators))), float(result.lmti)
+
+
+@pytest.mark.parametrize("variant", DELTA_VARIANTS)
+def test_the_published_delta_closed_by_three_detachable_joints_has_its_rod_lines_indices(tmp_path, variant):
     """Its actuators the three cranks its controllers drive (the prismatic chain a motion planner moves the
-    platform with is no motor, and was guessed one); its ITIs and OTIs those of the rod lines, also turned."""
-    mechanism = load(DELTA)
-    assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1", "Chain3_1"]
+    platform with is no motor, and was guessed one); its ITIs and OTIs those of the rod lines, also turned, in mm
+    and km, and with its motors renamed and its legs written in another order (each ITI follows its motor)."""
+    rewrite, unit = DELTA_VARIANTS[variant]
+    path = tmp_path / "3dof_delta.urdf"
+    path.write_text(rewrite(DELTA.read_text()))
     expected = delta_textbook(DELTA)
-    for path in (DELTA, tmp_path / "turned.urdf"):
-        if path != DELTA:
-            path.write_text(turned(DELTA.read_text(), *TURN))
-        loaded = load(path)
-        result = indices_at_pose(loaded, loaded.home_pose)
-        itis = dict(zip((name.split(":")[-1] for name in loaded.actuator_names), np.ravel(result.iti_actuators)))
-        for name, value in itis.items():
-            assert value == pytest.approx(expected[name], abs=1e-9), name
-        assert float(result.lmti) == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)
+    itis, lmti = delta_indices(path, unit)
+    assert sorted(itis) == ["Chain1_1", "Chain2_1", "Chain3_1"]
+    for name, value in itis.items():
+        assert value == pytest.approx(expected[name], abs=1e-9), name
+    assert lmti == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)
 
 
 def with_plugin_as_joint(text: str) -> str:
@@ -357,23 +397,23 @@ def test_the_published_four_axis_delta_names_its_wrist_and_opens_with_it_held(tm
     with a passive telescopic shaft from the base to the tool. Each rod's closure ends on its own hinge, so no joint
     had two closures and the tool0 frame was taken as the platform: refused as a closed-loop transmission. The three
     balls' closures now meet on the holder, the platform; the wrist, moving inside the shaft's loop, is refused
-    naming --lock Chain4_1, which opens it with the rod lines' indices, also in a turned world."""
+    naming --lock Chain4_1, which opens it with the rod lines' indices, also turned, in mm and km, and
+    relabelled."""
     path = PUBLISHED / "ros2_closed_loop_ws" / "4dof_delta.urdf"
     one_line_error(screwkit("analyze", path), "actuated joint 'Chain4_1' moves inside a loop of leg",
                    "it turns a body on the platform (a wrist after the parallel part): --lock Chain4_1 holds it")
     notes = read_mechanism_file(path, lock=("Chain4_1",))[1].notes
     assert any(note.startswith("platform inferred: body 'tool_holder', where 4 closures meet") for note in notes)
     expected = delta_textbook(path)
-    turned_path = tmp_path / "4dof_delta.urdf"
-    turned_path.write_text(turned(path.read_text(), *TURN))
-    for source in (path, turned_path):
-        loaded = load(source, lock=("Chain4_1",))
-        result = indices_at_pose(loaded, loaded.home_pose)
-        itis = dict(zip((name.split(":")[-1] for name in loaded.actuator_names), np.ravel(result.iti_actuators)))
-        assert sorted(itis) == ["Chain1_1", "Chain2_1", "Chain3_1"]
+    for variant, (rewrite, unit) in DELTA_VARIANTS.items():
+        written = tmp_path / variant.replace(" ", "_").replace(",", "") / "4dof_delta.urdf"
+        written.parent.mkdir()
+        written.write_text(rewrite(path.read_text()))
+        itis, lmti = delta_indices(written, unit, lock=("Chain4_1",))
+        assert sorted(itis) == ["Chain1_1", "Chain2_1", "Chain3_1"], variant
         for name, value in itis.items():
-            assert value == pytest.approx(expected[name], abs=1e-9), name
-        assert float(result.lmti) == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9)
+            assert value == pytest.approx(expected[name], abs=1e-9), (variant, name)
+        assert lmti == pytest.approx(min(expected[f"oti{k}"] for k in (1, 2, 3)), abs=1e-9), variant
 
 
 @pytest.mark.parametrize("name, body, output", [("spherical_eye", "platform", "platform"),

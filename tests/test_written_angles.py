@@ -329,3 +329,24 @@ def test_a_plane_on_a_diagonal_keeps_its_frame_whatever_its_rounding():
                   for noise in np.random.default_rng(3).normal(0.0, 1e-12, (8, 3))]
         for frame in frames:
             np.testing.assert_allclose(frame, frames[0], atol=1e-10, rtol=0)
+
+
+def test_the_published_knee_reads_the_same_relabelled(tmp_path):
+    """Its hinges renamed and the coupler's two child bodies written in the other order: the same indices, and the
+    allowances follow the names (two right angles between the crank and the coupler, three to the rocker)."""
+    text = rewritten(KAYRA.read_text())
+    for old, new in (("3BR_Joint", "crank"), ("2R_Joint", "coupler"), ("3FU_Joint", "rocker"), ("1R_Joint", "toe")):
+        text = text.replace(f'"{old}"', f'"{new}"')
+    root = ET.fromstring(text)
+    coupler = next(body for body in root.iter("body") if body.get("name") == "2R_Link")
+    children = [child for child in coupler if child.tag == "body"]
+    for child in children:
+        coupler.remove(child)
+    for child in reversed(children):
+        coupler.append(child)
+    path = tmp_path / "knee.xml"
+    path.write_text(ET.tostring(root, encoding="unicode"))
+    np.testing.assert_allclose(knee_indices(path), knee_indices(KAYRA), atol=1e-12, rtol=0)
+    turns = written_turns(str(path))
+    assert turns.allowance("crank", "coupler") == pytest.approx(FILE_ROUNDING + 2 * OFF, rel=1e-12)
+    assert turns.allowance("crank", "rocker") == pytest.approx(FILE_ROUNDING + 3 * OFF, rel=1e-12)
