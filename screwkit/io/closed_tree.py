@@ -29,7 +29,7 @@ GUESSED = "actuators guessed"
 __all__ = ["Closure", "ClosedTree", "declared_task_coordinates", "ImportReport", "ImportError_", "LegWithLoops",
            "GRAPH_HINT", "ASSEMBLY_TOLERANCE", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to",
            "closure_gaps", "assemble", "ball_line", "ball_of_revolutes", "meeting_point", "at_point",
-           "LENGTH_COORDINATES", "nearest_to_lines", "closure_motions"]
+           "LENGTH_COORDINATES", "nearest_to_lines", "closure_motions", "closure_rows"]
 
 ASSEMBLY_TOLERANCE = 1e-10
 """Closure residual (lengths in units of the mechanism's length scale, rad) below which a closure is closed."""
@@ -379,6 +379,17 @@ def closure_motions(model, data, closure: Closure) -> list[tuple[NDArray, NDArra
         offset = frame[:3, 3] - data.oMi[joint].translation
         motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), jacobian[3:], frame))
     return motions
+
+
+def closure_rows(model, data, closures, scale: float) -> NDArray[np.float64]:
+    """The closures' velocity rows (k, nv) at the configuration of ``data`` (its joint Jacobians computed): per
+    closure the relative velocity of its two frames' origins (in length scales ``scale``) and, for ``6d``, of their
+    rotations (the angular velocities' difference)."""
+    rows = [np.zeros((0, model.nv))]
+    for closure in closures:
+        (moves_a, turns_a, _), (moves_b, turns_b, _) = closure_motions(model, data, closure)
+        rows += [(moves_b - moves_a) / scale] + ([turns_b - turns_a] if closure.kind == "6d" else [])
+    return np.vstack(rows)
 
 
 def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.xml_text import tolerant_xml
-from screwkit.io.closed_tree import ClosedTree, ImportError_, closure_motions, path_to
+from screwkit.io.closed_tree import ClosedTree, ImportError_, closure_rows, path_to
 
 __all__ = ["check_couplings", "mimicked_joints", "RANK_TOLERANCE"]
 
@@ -107,17 +107,9 @@ def _free_rank(rows: NDArray, columns: list[int]) -> int:
 
 
 def _closure_rows(tree: ClosedTree, q: NDArray, scale: float) -> NDArray[np.float64]:
-    """The closures' Jacobian at ``q`` on the velocity coordinates: per closure the relative velocity of its two
-    frames' origins (in length scales) and, for ``6d``, of their rotations."""
+    """The closures' Jacobian at ``q`` on the velocity coordinates (:func:`~screwkit.io.closed_tree.closure_rows`)."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    model = tree.model
-    data = model.createData()
-    pin.computeJointJacobians(model, data, q)
-    rows = []
-    for closure in tree.closures:
-        (moves_a, turns_a, _), (moves_b, turns_b, _) = closure_motions(model, data, closure)
-        rows.append((moves_b - moves_a) / scale)
-        if closure.kind == "6d":
-            rows.append(turns_b - turns_a)
-    return np.vstack(rows) if rows else np.zeros((0, model.nv))
+    data = tree.model.createData()
+    pin.computeJointJacobians(tree.model, data, q)
+    return closure_rows(tree.model, data, tree.closures, scale)

@@ -17,7 +17,7 @@ from screwkit.io.closed_tree import (
     Closure,
     ImportError_,
     assemble,
-    closure_motions,
+    closure_rows,
     homogeneous,
     joint_kind,
     joint_value,
@@ -304,11 +304,7 @@ def platform_moves(tree: ClosedTree, data, platform: int, held, scale: float) ->
     free = np.ones(model.nv, dtype=bool)
     for joint in held:
         free[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv] = False
-    rows = [np.zeros((0, model.nv))]
-    for closure in tree.closures:
-        (moves_a, turns_a, _), (moves_b, turns_b, _) = closure_motions(model, data, closure)
-        rows += [(moves_b - moves_a) / scale] + ([turns_b - turns_a] if closure.kind == "6d" else [])
-    matrix = np.vstack(rows)[:, free]
+    matrix = closure_rows(model, data, tree.closures, scale)[:, free]
     padded = np.vstack([matrix, np.zeros((max(0, matrix.shape[1] - len(matrix)), matrix.shape[1]))])
     _, singular, right = np.linalg.svd(padded)
     null = right[int(np.sum(singular > 1e-9 * max(float(singular[0]) if singular.size else 0.0, 1.0))):]
