@@ -2,7 +2,8 @@
 
 Each faster way is checked against the plain definition it replaced, bit for bit: chunks side by side against
 a chunk at a time, the local minima and the branch screening against their stacked forms, a CSV read straight
-from the file against its whole text, the streamed netCDF writer against scipy's own.
+from the file against its whole text, a netCDF path read by scipy's reader against xarray's reading, the streamed
+netCDF writer against scipy's own.
 """
 
 from __future__ import annotations
@@ -14,7 +15,14 @@ from helpers import bundled
 from screwkit.studies import netcdf, poses
 from screwkit.studies.branches import STEP_FLOOR, suspect_segments
 from screwkit.studies.netcdf import PlainDataset
-from screwkit.studies.paths import _read_csv_text, _read_plain_csv, read_path
+from screwkit.studies.paths import (
+    PathFileError,
+    _read_csv_text,
+    _read_netcdf,
+    _read_plain_csv,
+    _read_plain_netcdf,
+    read_path,
+)
 from screwkit.studies.refinement import local_minima
 
 
@@ -183,3 +191,92 @@ def test_rows_no_chunk_wrote_hold_nan_minus_one_and_false():
         assert np.all(np.isnan(result.f_o[j][~reachable])) and np.all(np.isnan(result.remaining_lmti[j][~reachable]))
         assert np.all(result.worst_fault_indices[j][~reachable] == -1)
         assert np.all(result.worst_fault_indices[j][reachable] >= 0)
+
+
+def _xarray_columns(path):
+    """Every one-dimensional numeric variable of a netCDF file as xarray decodes it, its units and values."""
+    import xarray as xr
+
+    with xr.open_dataset(path, engine="scipy") as dataset:
+        return {str(key): (np.asarray(variable.values, dtype=float), str(variable.attrs.get("units", "")))
+                for key, variable in {**dataset.coords, **dataset.data_vars}.items()
+                if variable.ndim == 1 and np.issubdtype(variable.dtype, np.number)}
+
+
+def _netcdf_paths(folder):
+    """netCDF path files as xarray writes them: (file, whether scipy's reader alone reads it)."""
+    import xarray as xr
+
+    rng = np.random.default_rng(5)
+    x, y, phi = rng.normal(size=(3, 40)) * [[0.1], [0.1], [30.0]]
+    y[7] = np.nan
+    plain = {"x": ("s", x, {"units": "m"}), "y": ("s", y), "phi": ("s", phi, {"units": "deg"})}
+    files = {
+        "plain.nc": (xr.Dataset(plain, coords={"t": ("s", np.arange(40.0), {"units": "s"})}), {}, True),
+        # a fill value other than NaN, and a missing value: both read as NaN
+        "fill.nc": (xr.Dataset(plain), {"y": {"_FillValue": -999.0}, "x": {"_FillValue": 1e30}}, True),
+        "missing_value.nc": (xr.Dataset(plain), {"y": {"missing_value": -5.0, "_FillValue": -5.0}}, True),
+        "integers.nc": (xr.Dataset({**plain, "x": ("s", np.arange(40, dtype=np.int32))}), {}, True),
+        # strings, booleans and a two-dimensional variable beside the columns: not columns
+        "others.nc": (xr.Dataset({**plain, "name": ("s", np.array(["a", "bc"] * 20)),
+                                  "ok": ("s", np.arange(40) % 2 == 0), "grid": (("s", "k"), np.ones((40, 2)))}),
+                      {}, True),
+        # packed values and times since a date: decoded by xarray, so read through it
+        "packed.nc": (xr.Dataset(plain), {"x": {"dtype": "int16", "scale_factor": 1e-4, "add_offset": 0.0,
+                                                 "_FillValue": -32768}}, False),
+        "dated.nc": (xr.Dataset(plain, coords={"t": ("s", np.arange(40.0), {"units": "seconds since 2000-01-01"})}),
+                     {}, False),
+    }
+    made = []
+    for name, (dataset, encoding, alone) in files.items():
+        dataset.to_netcdf(folder / name, engine="scipy", encoding=encoding)
+        made.append((folder / name, alone))
+    return made
+
+
+def test_a_netcdf_path_is_read_as_xarray_reads_it(tmp_path):
+    """scipy's reader alone gives every column xarray gives (values, NaN where a fill value is written, units);
+    a file xarray decodes further (packed values, dates) is left to xarray, which reads it as before."""
+    for path, alone in _netcdf_paths(tmp_path):
+        assert (_read_plain_netcdf(str(path), ("x", "y", "phi")) is not None) == alone, path.name
+        expected = _xarray_columns(path)
+        found = _read_netcdf(str(path), ("x", "y", "phi"))
+        assert set(found) == set(expected), path.name
+        for key, (values, units) in expected.items():
+            np.testing.assert_array_equal(found[key][0], values, err_msg=f"{path.name}: {key}")
+            assert found[key][1] == units
+            assert ("sample 7" in found[key][2]) == (key == "y" or (key == "x" and path.name == "fill.nc"
+                                                                        and np.isnan(values).any()))
+    assert _read_plain_netcdf(str(tmp_path / "plain.nc"), ("x", "y", "theta")) is None  # a column missing
+    (tmp_path / "empty.nc").write_bytes(b"")  # nothing scipy reads: xarray's reading says what is wrong
+    assert _read_plain_netcdf(str(tmp_path / "empty.nc"), ("x",)) is None
+    with pytest.raises(PathFileError, match=r"empty.nc: cannot be read as a netCDF file \(") as error:
+        _read_netcdf(str(tmp_path / "empty.nc"), ("x",))
+    assert "\n" not in str(error.value)
+
+
+READ_ALONE = """
+import sys
+from screwkit.io.loader import load
+from screwkit.studies.paths import read_path
+path = read_path(load("planar_5rrr"), sys.argv[1])
+print(path.poses.shape[0], "xarray" in sys.modules, "pandas" in sys.modules)
+"""
+
+
+def test_a_netcdf_path_is_read_without_importing_xarray(tmp_path):
+    """Reading a netCDF path imported xarray, pandas and dask.array: a quarter of a second of the command."""
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    five = bundled("planar_5rrr")
+    home = np.asarray(five.home_pose, dtype=float)
+    poses_ = home + np.linspace(0.0, 1.0, 5)[:, None] * np.array([0.02, 0.01, np.deg2rad(5.0)])
+    xr.Dataset({"x": ("s", poses_[:, 0]), "y": ("s", poses_[:, 1]),
+                "phi": ("s", poses_[:, 2], {"units": "rad"})}).to_netcdf(tmp_path / "p.nc", engine="scipy")
+    result = subprocess.run([sys.executable, "-c", READ_ALONE, str(tmp_path / "p.nc")], capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0 and result.stdout.split() == ["5", "False", "False"], result.stderr
+    np.testing.assert_array_equal(read_path(five, tmp_path / "p.nc").poses, poses_)

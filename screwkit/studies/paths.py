@@ -245,7 +245,7 @@ def read_columns(name: str, wanted, angular, expected: str) -> tuple[NDArray[np.
     suffix = os.path.splitext(name)[1].lower()
     if suffix not in (".csv", ".nc"):
         raise PathFileError(f"{name}: a path file must end in .csv or .nc, got {suffix or 'no suffix'!r}.")
-    columns = _read_netcdf(name) if suffix == ".nc" else _read_csv(name, (*wanted, TIME_COLUMN))
+    columns = _read_netcdf(name, wanted) if suffix == ".nc" else _read_csv(name, (*wanted, TIME_COLUMN))
     missing = [column for column in wanted if column not in columns]
     if missing:
         raise PathFileError(f"{name}: no column {', '.join(repr(m) for m in missing)}; {expected} and optionally "
@@ -401,16 +401,61 @@ def _read_csv_cells(name: str, text: str, positions: dict[str, int], columns: di
     return columns
 
 
-def _read_netcdf(name: str) -> dict[str, tuple[NDArray[np.float64], str, str]]:
+def _read_netcdf(name: str, wanted) -> dict[str, tuple[NDArray[np.float64], str, str]]:
     """Every one-dimensional numeric variable (and coordinate) of a netCDF file, with its ``units`` and what is
-    wrong with its first value that is not a finite number ("" if none)."""
+    wrong with its first value that is not a finite number ("" if none).
+
+    A netCDF-3 file whose variables need no decoding but their fill values, and that has the columns ``wanted``, is
+    read by scipy's reader alone (:func:`_read_plain_netcdf`: the same numbers, without importing xarray, pandas and
+    dask.array, a quarter of a second); any other file through xarray, which decodes it and says what is wrong."""
+    plain = _read_plain_netcdf(name, wanted)
+    if plain is not None:
+        return plain
     dataset = open_netcdf(name, PathFileError)
+    return {str(key): _netcdf_column(str(key), variable.values, str(variable.attrs.get("units", "")))
+            for key, variable in {**dataset.coords, **dataset.data_vars}.items()
+            if variable.ndim == 1 and np.issubdtype(variable.dtype, np.number)}
+
+
+_DECODED = ("scale_factor", "add_offset", "calendar", "dtype", "_Unsigned", "_Encoding", "compress", "flag_values")
+"""Attributes by which xarray decodes a variable into other values or another type: a file with any of them is
+read through xarray."""
+
+
+def _read_plain_netcdf(name: str, wanted) -> dict[str, tuple[NDArray[np.float64], str, str]] | None:
+    """:func:`_read_netcdf` by ``scipy.io.netcdf_file``, with xarray's decoding of the fill values (``_FillValue``
+    and ``missing_value`` read as NaN) and nothing else; None for a file it would decode otherwise (an attribute
+    of :data:`_DECODED`, times in units "... since ..."), one that lacks a column ``wanted``, or one scipy's reader
+    does not read (netCDF-4, not netCDF: xarray's reading says what is wrong)."""
+    from screwkit.studies.netcdf import netcdf_file  # scipy's netCDF module alone: only where a file is read
+
     columns = {}
-    for key, variable in {**dataset.coords, **dataset.data_vars}.items():
-        if variable.ndim == 1 and np.issubdtype(variable.dtype, np.number):
-            values = np.asarray(variable.values, dtype=float)
-            bad = np.flatnonzero(~np.isfinite(values))
-            problem = (f"variable {key!r}, sample {int(bad[0])}: expected a finite number, got {values[bad[0]]}."
-                       if bad.size else "")
-            columns[str(key)] = (values, str(variable.attrs.get("units", "")), problem)
-    return columns
+    try:
+        with netcdf_file()(name, "r", mmap=False) as handle:
+            for key, variable in handle.variables.items():
+                attributes = {str(k): v.decode("utf-8") if isinstance(v, bytes) else v
+                              for k, v in variable._attributes.items()}
+                if (len(variable.dimensions) != 1 or not np.issubdtype(variable.data.dtype, np.number)
+                        or attributes.get("dtype") == "bool"):
+                    continue  # not a column: strings (characters along a second dimension), booleans
+                units = attributes.get("units", "")
+                if set(attributes) & set(_DECODED) or not isinstance(units, str) or " since " in units:
+                    return None
+                values = np.array(variable.data, dtype=float)  # a copy, its fill values masked in place
+                for fill in (attributes.get("_FillValue"), attributes.get("missing_value")):
+                    if fill is not None:
+                        values[np.isin(values, np.asarray(fill, dtype=float))] = np.nan
+                columns[str(key)] = _netcdf_column(str(key), values, units)
+    except Exception:  # whatever scipy's reader makes of a file it does not read: xarray's reading says it
+        return None
+    return columns if all(column in columns for column in wanted) else None
+
+
+def _netcdf_column(key: str, values, units: str) -> tuple[NDArray[np.float64], str, str]:
+    """A netCDF variable's values as floats, its units and what is wrong with its first value that is not a finite
+    number ("" if none)."""
+    values = np.asarray(values, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(values))
+    problem = (f"variable {key!r}, sample {int(bad[0])}: expected a finite number, got {values[bad[0]]}."
+               if bad.size else "")
+    return values, units, problem
