@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from screwkit.io.closed_tree import GROUNDED, ClosedTree, Closure, ImportError_, inverse
 from screwkit.io.onshape import guessed_motors
 from screwkit.io.sdformat_text import (
+    MODEL_FRAME,
     WORLD,
     SdfJoint,
     SdfModel,
@@ -301,6 +302,17 @@ def _hung_from_platform(tree_joints, loops, ends: dict[str, tuple[str, str]]) ->
     return platform if any(end in hung for joint in loops for end in ends[joint.name]) else None
 
 
+def _output_link(sdf: SdfModel, output: str | None) -> str | None:
+    """The link of the output frame named (``--output``: a link, a frame or a joint of the model), which is the
+    platform: reached last, so that each leg reaches it at its end and a loop through it is closed there, not at
+    the joint the file happens to list last (the same legs, and indices, whatever the order of the joints); None
+    when no output is named, or the name is none of the model's (the output's reading refuses it)."""
+    if output is None or output not in sdf.poses or output == MODEL_FRAME:
+        return None
+    link = attached_link(sdf, output)
+    return None if link == WORLD else link
+
+
 def with_chosen_base(path, message: str) -> str:
     """A refusal of an SDFormat file whose model no joint ties to the world and no ``canonical_link`` names a base,
     with the link screwkit fixed (its first: SDFormat's canonical link), which decides every leg, actuator and output
@@ -372,8 +384,8 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
     poses = world_poses(sdf)
     ends = _ends(sdf)
     tree_joints, loops, base, tied = _spanning_tree(sdf, ends)
-    platform = _hung_from_platform(tree_joints, loops, ends)
-    if platform is not None:  # a leg's last links reached through the platform: reach them from their leg
+    platform = _output_link(sdf, output) or _hung_from_platform(tree_joints, loops, ends)
+    if platform is not None:  # every leg ends on the platform, whatever the order of the file's joints
         tree_joints, loops, base, tied = _spanning_tree(sdf, ends, last=platform)
     builder = _TreeBuilder(sdf, poses)
     held = [repr(joint.name) for joint in sdf.joints if joint.held]
