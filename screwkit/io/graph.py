@@ -65,6 +65,7 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import closed_samples
 from screwkit.io.couplings import check_couplings
 from screwkit.io.graph_actuators import check_actuators
+from screwkit.io.graph_checks import IN_LOOP_TOLERANCE, check_legs, check_output, refuse_couples_of_forces
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
     TreeKinematics,
@@ -90,11 +91,6 @@ from screwkit.screw.chain_screws import ChainScrews
 
 __all__ = ["GraphLeg", "GraphMechanism", "LegScrews", "graph_legs", "graph_mechanism", "leg_screws",
            "equivalent_chains", "dimension_groups", "IN_LOOP_TOLERANCE"]
-
-IN_LOOP_TOLERANCE = 1e-8
-"""Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
-which the joint moves inside a loop of the leg (its twist is not a motion of the leg)."""
-
 
 @dataclass(frozen=True)
 class GraphMechanism:
@@ -394,66 +390,6 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     return sorted(legs, key=lambda leg: leg.name)
 
 
-def _check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform: int) -> None:
-    """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
-    motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
-    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
-    model = tree.model
-    for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each, or none (check_actuators)
-        if not leg.actuators:
-            continue
-        actuator = leg.actuators[0]
-        name = model.names[actuator]
-        carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
-        if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
-            around = nearby()
-            if around and np.any(around[index].locked_dims < around[index].allowed_dims):
-                raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
-                                   f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
-                                   "away at closed configurations near them: the file is written at a singular "
-                                   "configuration of the leg (its links on one line, stretched or folded); give "
-                                   "joint values away from it: --initial JOINT VALUE (an actuated joint away from its "
-                                   "dead centre, held there while the loops close), or a keyframe named 'home' "
-                                   "(MJCF).")
-            raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
-                               f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
-                               "(motors the file does not name, or a leg with no input); if it is a serial stage "
-                               f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
-        if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
-            below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
-                     if j in leg.joints and j != platform]
-            one = len(below) == 1
-            hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
-                    f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else
-                    f"; it turns a body on the platform (a wrist after the parallel part): --lock {name} holds it, "
-                    "and the legs are analysed on the platform" if model.parents[actuator] == platform else "")
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
-                               "twist is not a motion the leg allows: the leg has no serial input); analysable when "
-                               f"the actuated joint joins the base to the rest of its leg{hint}.")
-
-
-def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
-    """The platform's frame is the output of a graph: refused when a point is asked for, or when the platform still
-    moves with every actuator locked (an effector turning freely on the pin where the legs meet: its frame is no
-    output any actuator controls, and its indices would be zero everywhere)."""
-    if tree.output_type == "point":
-        raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
-                           f"frame of their platform {body!r} only.")
-    idle = common_motions(screws, locked=True)
-    if len(idle):
-        guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
-                        if note.startswith("actuators guessed")), "")
-        passive = dict.fromkeys(tree.written_joint(tree.model.names[j]) for leg in legs for j in leg.joints
-                                if tree.model.names[j] not in tree.motors and tree.model.joints[j].nv < 6)
-        raise ImportError_(f"{tree.source}: the platform {body!r} moves with every actuator locked ({len(idle)} "
-                           "motion(s) no actuator controls, e.g. an effector turning freely on the pin where the legs "
-                           f"meet, a spring joint, or motors the file does not name; actuators {', '.join(tree.motors)}"
-                           f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; --lock "
-                           "holds a passive joint that moves it"
-                           + (f" (the legs' passive joints: {', '.join(passive)})" if passive else "")
-                           + ", --actuate names a joint that drives it.")
-
-
 def _task_axes(tree: ClosedTree, state, frame_id: int, motion: NDArray) -> tuple[int, ...]:
     """The output frame's task coordinates among x, y, z, roll, pitch, yaw: the file's declared ones, else chosen
     from the motion space (:func:`screwkit.closure.task_space.choose_task_axes`)."""
@@ -507,8 +443,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
             samples = closed_samples(tree, q, scale, count=3)
             return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else []
 
-        _check_legs(tree, legs, screws, nearby, platform)
-        _check_output(tree, screws, report.platform_body, legs)
+        check_legs(tree, legs, screws, nearby, platform)
+        check_output(tree, screws, report.platform_body, legs)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     counted = []
@@ -523,6 +459,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                            f"its legs allow no twist in common at the file's configuration{locking_legs(legs, screws)} "
                            "(a loop inside a leg that the file's numbers make rigid reads so, e.g. a parallelogram of "
                            "hinges parallel only to the file's rounding: the graph reads a file as written).")
+    if at_file:
+        refuse_couples_of_forces(tree, legs, chains, state)
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.turns_before = closure_turns(tree, tree.q_reference)
