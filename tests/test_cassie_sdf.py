@@ -29,12 +29,13 @@ ANGULAR = np.array([False] * 3 + [True] * 3)
 
 def test_a_coordinate_that_barely_moves_is_not_taken_before_one_that_moves():
     """The Cassie foot's rates (x, y, z, roll, pitch, yaw on its one motion): pitch. A rotation at 45 deg between
-    roll and pitch, or tilted 30 deg from pitch towards roll: roll, first in order, as before."""
+    roll and pitch: roll, first in order among equals; tilted 30 deg from pitch towards roll: pitch, which it moves
+    along faster (one motion's coordinate is the fastest of its kind; of two or more, the first that moves)."""
     foot = np.array([[-2.3e-15], [5.0e-16], [-6.2e-17], [1.59e-5], [1.0], [1.63e-5]])
     assert choose_task_axes(foot, ANGULAR, 1) == (4,)
-    for turn in (np.radians(45.0), np.radians(30.0)):
+    for turn, expected in ((np.radians(45.0), 3), (np.radians(30.0), 4), (np.radians(60.0), 3)):
         between = np.array([[0.0], [0.0], [0.0], [np.sin(turn)], [np.cos(turn)], [0.0]])
-        assert choose_task_axes(between, ANGULAR, 1) == (3,)
+        assert choose_task_axes(between, ANGULAR, 1) == (expected,)
     slide = np.array([[1e-5], [1.0], [0.0], [0.0], [0.0], [0.0]])  # a slide along y, drawn 1e-5 off
     assert choose_task_axes(slide, ANGULAR, 1) == (1,)
     # two motions: roll passed over for pitch, then yaw barely moving beside pitch: roll is taken after all (the

@@ -51,6 +51,13 @@ smallest singular value above this."""
 TASK_CHOICE_FRACTION = 0.1
 """A pose coordinate is taken in its order only when its rates tell the motions apart (the smallest singular value
 above) at least this fraction as well as the best coordinate of its kind not yet taken (:func:`choose_task_axes`)."""
+ONE_MOTION_FRACTION = 1.0 - 1e-9
+""":data:`TASK_CHOICE_FRACTION` of a mechanism of one DoF: its coordinate is the one of its kind the motion runs
+along fastest (the first in order among equals), not the first that moves: a coordinate that moves a tenth as fast
+as another turns back within a few degrees of the stroke (a gripper's fingertip moving along the world's y, x taken
+for moving at a third of y's rate, reached its largest x 12 deg into a 46 deg stroke, and the poses past it could
+not be asked; the same file turned in the world read them). The fastest moves at least 1/sqrt(3) of the speed (1/sqrt(2)
+in a plane of two axes), so along a circle its extremum is at least 35 deg (45 deg) away, in any world frame."""
 
 
 def pose_rates(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float64]:
@@ -338,7 +345,8 @@ def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None
     return chosen
 
 
-def _telling(space: NDArray, chosen: list[int], axis: int, pool: list[int]) -> bool:
+def _telling(space: NDArray, chosen: list[int], axis: int, pool: list[int], fraction: float = TASK_CHOICE_FRACTION
+             ) -> bool:
     """Whether the coordinate ``axis`` joins ``chosen``: independent of them (above :data:`TASK_RANK_TOLERANCE`)
     and within :data:`TASK_CHOICE_FRACTION` of the best coordinate of its kind left in ``pool``. The rule takes
     coordinates in order, but not one that barely moves: a foot turning about the world's y axis to within 4e-6 rad,
@@ -347,7 +355,7 @@ def _telling(space: NDArray, chosen: list[int], axis: int, pool: list[int]) -> b
     separation = _separation(space, chosen + [axis])
     if separation <= TASK_RANK_TOLERANCE:
         return False
-    return separation >= TASK_CHOICE_FRACTION * max(_separation(space, chosen + [other]) for other in pool)
+    return separation >= fraction * max(_separation(space, chosen + [other]) for other in pool)
 
 
 def _separation(space: NDArray, axes) -> float:
@@ -358,6 +366,7 @@ def _separation(space: NDArray, axes) -> float:
 def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=None) -> tuple[int, ...]:
     order = list(range(space.shape[0])) if candidates is None else list(candidates)
     chosen: list[int] = []
+    fraction = ONE_MOTION_FRACTION if dof == 1 else TASK_CHOICE_FRACTION
     if len(order) == space.shape[0] and space.shape[1]:
         _, singular, rows = np.linalg.svd(space[angular], full_matrices=True)
         turning = int(np.sum(singular > TASK_RANK_TOLERANCE))
@@ -365,14 +374,14 @@ def _task_axes_in_order(space: NDArray, angular: NDArray, dof: int, candidates=N
         for axis in (axis for axis in order if not angular[axis]):
             if len(chosen) == translations.shape[1]:
                 break
-            if _telling(translations, chosen, axis, [a for a in order if not angular[a] and a not in chosen]):
+            if _telling(translations, chosen, axis, [a for a in order if not angular[a] and a not in chosen], fraction):
                 chosen.append(axis)
         order = [axis for axis in order if angular[axis]] + [axis for axis in order if not angular[axis]]
     for axis in order:
         if len(chosen) == dof:
             break
         if axis not in chosen and _telling(space, chosen, axis, [a for a in order if a not in chosen
-                                                                  and angular[a] == angular[axis]]):
+                                                                  and angular[a] == angular[axis]], fraction):
             chosen.append(axis)
     for axis in order:  # one passed over for a better one that a later choice then made worse: independence alone
         if len(chosen) == dof:
