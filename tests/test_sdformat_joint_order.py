@@ -9,7 +9,8 @@ platform, the platform is reached last, so each leg ends on it whatever the orde
 
 The indices are checked against the four-bar's closed forms (the coupler's pressure angles on the crank and on the
 rocker), at three drawn configurations, for every order of the four joints, with the links reversed, in mm, and
-in a turned and shifted world.
+in a turned and shifted world. The same four-bar, turned so that its rocker's pin moves mostly along y, takes y
+for its one task coordinate (the fastest), and reaches the whole stroke.
 """
 
 from __future__ import annotations
@@ -119,3 +120,25 @@ def test_the_command_reads_both_orders_alike(tmp_path):
     assert forward["pose"] == reverse["pose"] and forward["dependent"] == reverse["dependent"]
     for key in ("iti", "lmti", "cti"):
         assert reverse[key] == pytest.approx(forward[key], abs=1e-12), key
+
+
+@pytest.mark.parametrize("turn", [np.deg2rad(40.0), np.deg2rad(-140.0)])
+def test_one_motion_takes_the_coordinate_it_runs_along_fastest(tmp_path, turn):
+    """The rocker's pin as the output, the four-bar turned so that the pin moves mostly along y, 9 deg from the
+    place where its x turns back: x, first in order and moving at 0.16 of the speed, was taken, and crank angles
+    past that place could not be asked. y is taken now, and every crank angle of the stroke is reached, with the
+    closed forms' indices."""
+    from screwkit.closure.forward_kinematics import forward
+
+    theta = np.deg2rad(180.0)
+    path = tmp_path / "turned.sdf"
+    path.write_text(four_bar_sdf(theta, world=(turn, (0.0, 0.0, 0.0))))
+    mechanism = load(path, output="rocker", actuate=("crank_pin",), output_type="point")
+    assert mechanism.task_coordinates == ("y",)
+    for change in (-10.0, -25.0, -40.0, -60.0, -80.0):
+        solution = forward(mechanism, [np.deg2rad(change)], mechanism.home_pose)
+        assert bool(np.ravel(solution.reachable)[0]), change
+        b, c = _points(theta + np.deg2rad(change))
+        result = indices_at_pose(mechanism, np.ravel(solution.poses))
+        assert float(result.iti) == pytest.approx(_sine(b - A, c - b), abs=1e-9), change
+        assert float(result.lmti) == pytest.approx(_sine(c - b, c - D), abs=1e-9), change
