@@ -677,3 +677,42 @@ def test_a_coupling_s_verdict_is_the_same_in_other_units_and_a_moved_world(tmp_p
     else:
         with pytest.raises(ImportError_, match="which holds the mechanism analysed to fewer motions"):
             read_mechanism_file(path, output=output)
+
+
+def geared_stage(coupled: bool = True) -> str:
+    """The crank-rocker on a turntable (``stage_turn``, about z) that a gear beside it turns (``gear_spin``, coupled
+    by ``<equality><joint>`` at a ratio of 2), as a humanoid's hip yaw is geared to its motor."""
+    from test_singular_on_the_way import crank_rocker
+
+    text = crank_rocker(1.0, 4.0, 3.0).replace('<geom type="capsule" fromto="0 0 0 0 0 4.0" size="0.05"/>\n      <body '
+                                               'name="link_2"', '<joint name="stage_turn" axis="0 0 1"/><geom '
+                                               'type="capsule" fromto="0 0 0 0 0 4.0" size="0.05"/>\n      <body '
+                                               'name="link_2"', 1)
+    assert 'name="stage_turn"' in text
+    text = text.replace("</worldbody>", '<body name="gear" pos="2 0 0"><joint name="gear_spin" axis="0 0 1"/><geom '
+                                        'type="cylinder" size="0.3 0.05"/></body></worldbody>')
+    coupling = '<joint joint1="stage_turn" joint2="gear_spin" polycoef="0 2 0 0 0"/>' if coupled else ""
+    return text.replace("</equality>", coupling + "</equality>")
+
+
+def test_a_coupling_to_a_stage_held_holds_only_its_gear_and_is_left_out(tmp_path):
+    """Held by --lock, the stage leaves the coupling nothing to hold but the gear, on which nothing hangs: it is
+    left out, saying so, with the indices of the file without it (MuJoCo's word: the stage held by an equality, the
+    coupling leaves the four-bar's joints their motions). Free, the stage is named to hold (--lock), not the
+    coupling to remove (ToddlerBot's hip-yaw gear pair was blamed for a waist left free)."""
+    path, plain = tmp_path / "geared.xml", tmp_path / "plain.xml"
+    path.write_text(geared_stage())
+    plain.write_text(geared_stage(coupled=False))
+    held = '<joint joint1="stage_turn"/></equality>'
+    assert mujoco_motions(geared_stage().replace("</equality>", held), ("hinge_1", "hinge_2", "hinge_3")) == \
+        mujoco_motions(geared_stage(False).replace("</equality>", held), ("hinge_1", "hinge_2", "hinge_3"))
+    run = screwkit("info", path, "--output", "link_4", "--lock", "stage_turn")
+    assert run.returncode == 0, run.stderr
+    assert "its other joint held (--lock or the file), it holds only a body nothing else hangs on" in run.stdout
+    got = load(path, output="link_4", lock=("stage_turn",))
+    want = load(plain, output="link_4", lock=("stage_turn",))
+    for turn in (0.0, np.radians(20.0)):
+        a, b = (indices_at_pose(m, m.home_pose + turn) for m in (got, want))
+        np.testing.assert_allclose([a.iti, a.lmti], [b.iti, b.lmti], atol=1e-12)
+    free = one_line_error(screwkit("info", path, "--output", "link_4"), "--lock stage_turn")
+    assert "remove the element" not in free or "--lock stage_turn holds" in free, free

@@ -61,27 +61,50 @@ def check_couplings(tree: ClosedTree, q: NDArray, scale: float, analysed: set[in
             path = path_to(model, joint)
             if platform in path:
                 analysed = analysed | set(path[path.index(platform) + 1:])
+    couplings, idle = _holding_an_idle_body(tree, platform)
+    for _, _, _, where in idle:
+        notes.append(f"{where.split(': ', 1)[-1]}: its other joint held (--lock or the file), it holds only a body "
+                     "nothing else hangs on (a gear of a stage held): left out")
+    if not couplings:
+        return
     columns = [model.joints[j].idx_v + k for j in sorted(analysed) for k in range(model.joints[j].nv)]
     closures = _closure_rows(tree, q, scale)
-    rows = [_coupling_row(model, coupling) for coupling in tree.couplings]
+    rows = [_coupling_row(model, coupling) for coupling in couplings]
     free = _free_rank(closures, columns)
     together = _free_rank(np.vstack([closures, *rows]), columns)
     if together == free:
-        for first, second, _, where in tree.couplings:
+        for first, second, _, where in couplings:
             element = where.split(": ", 1)[-1]
             notes.append(f"{element}: ties joint {first!r}" + (f" to {second!r}" if second else "") + ", which "
                          "constrains no motion of the mechanism analysed (the branch it ties follows): left out")
         return
     alone = [k for k, row in enumerate(rows) if _free_rank(np.vstack([closures, row]), columns) < free]
-    first, second, _, where = tree.couplings[alone[0] if alone else 0]
+    first, second, _, where = couplings[alone[0] if alone else 0]
     named = "" if alone else " (with the file's other couplings)"
     partner = ("to a value" if not second else f"to joint {second!r}" +
                (", held (--lock)" if second in tree.locked else "" if model.existJointName(second) else
                 ", not a joint that moves in the model"))
+    held = first if model.existJointName(first) else second
     raise ImportError_(f"{where}: a joint coupling ties joint {first!r} {partner}{named}, which holds the mechanism "
-                       "analysed to fewer motions: screwkit does not model it; remove the element"
-                       + (" (or set active='false')" if "<equality>" in where else "")
-                       + " to analyse the joints as independent.")
+                       f"analysed to fewer motions: screwkit does not model it; --lock {held} holds the coupled "
+                       "joints where the file draws them (a geared stage before the parallel part), or remove the "
+                       "element" + (" (or set active='false')" if "<equality>" in where else "")
+                       + " to analyse the joints as independent (a joint it drives then passive).")
+
+
+def _holding_an_idle_body(tree: ClosedTree, platform: int) -> tuple[list, list]:
+    """The couplings of ``tree`` split into those to check and those that, their other joint held (merged away by
+    ``--lock``, or no joint of the model), hold only a joint whose body, and all that hangs on it, is no end of a
+    closure nor the platform: a gear of a stage held, whose own spin is all the coupling stops (before, ToddlerBot's
+    hip-yaw gear pair, its driven joint held, was blamed for a waist left free)."""
+    model = tree.model
+    ends = {platform} | {joint for closure in tree.closures for joint in (closure.joint_a, closure.joint_b)}
+    checked, idle = [], []
+    for coupling in tree.couplings:
+        moving = [model.getJointId(name) for name in coupling[:2] if name and model.existJointName(name)]
+        alone = len(moving) == 1 and not any(moving[0] in path_to(model, end) for end in ends)
+        (idle if alone else checked).append(coupling)
+    return checked, idle
 
 
 def _coupling_row(model, coupling) -> NDArray[np.float64]:

@@ -434,8 +434,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
+    check_actuators(tree, legs, platform)  # (first: a serial stage left free is what to hold, whatever it couples)
     check_couplings(tree, q, scale, {joint for leg in legs for joint in leg.joints}, platform, report.notes)
-    check_actuators(tree, legs, platform)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
     if at_file:
