@@ -716,3 +716,49 @@ def test_a_coupling_to_a_stage_held_holds_only_its_gear_and_is_left_out(tmp_path
         np.testing.assert_allclose([a.iti, a.lmti], [b.iti, b.lmti], atol=1e-12)
     free = one_line_error(screwkit("info", path, "--output", "link_4"), "--lock stage_turn")
     assert "remove the element" not in free or "--lock stage_turn holds" in free, free
+
+
+def bent_crank_rocker() -> str:
+    """The crank-rocker whose coupler bends at a hinge ``spring`` halfway along it (an adaptive finger: two DoF, one
+    motor)."""
+    from test_singular_on_the_way import crank_rocker
+
+    plain = crank_rocker(1.0, 4.0, 3.0)
+    link_4 = '<body name="link_4" pos="0.5 0.0 4.0">'
+    assert link_4 in plain
+    bent = plain.replace(link_4, '<body name="link_3b" pos="0 0 2.0"><joint name="spring" axis="1 0 0"/><geom '
+                                 'type="sphere" size="0.1"/><body name="link_4" pos="0.5 0.0 2.0">')
+    return bent.replace("</body>\n        </body>", "</body></body>\n        </body>", 1)
+
+
+def test_a_leg_that_moves_with_its_ends_held_is_refused_not_locked(tmp_path):
+    """The bent coupler's four hinges in one plane are dependent at every configuration, as an idle joint's are, and
+    the spring was locked as one: the finger read as the rigid crank-rocker, without a word. MuJoCo's constraint
+    Jacobian leaves it a motion with the motor held; it is refused naming --lock, and held there it is the
+    crank-rocker, its indices the plain file's. An idle spin (two coaxial pins, an S-S rod) is still locked."""
+    from test_singular_on_the_way import crank_rocker
+
+    path, reference = tmp_path / "finger.xml", tmp_path / "plain.xml"
+    path.write_text(bent_crank_rocker())
+    reference.write_text(crank_rocker(1.0, 4.0, 3.0))
+    held = bent_crank_rocker().replace("</equality>", '<joint joint1="hinge_1"/></equality>')
+    assert mujoco_motions(held, ("hinge_2", "spring", "hinge_3")) == 1
+    line = one_line_error(screwkit("info", path, "--output", "link_4"), "moves with its ends held",
+                          "turns joints hinge_2, spring, hinge_3 about points it moves", "--lock JOINT")
+    assert "\n" not in line
+    got, want = load(path, output="link_4", lock=("spring",)), load(reference, output="link_4")
+    a, b = (indices_at_pose(m, m.home_pose) for m in (got, want))
+    np.testing.assert_allclose([a.iti, a.lmti], [b.iti, b.lmti], atol=1e-12)
+
+
+def test_an_underactuated_five_bar_s_refusal_names_its_passive_joints_to_hold(tmp_path):
+    """The teaching five-bar with its right motor left out: one actuator for two DoF, refused naming --lock and the
+    chains' passive joints (a gripper's spring-loaded finger, held at its spring joint, opens so)."""
+    source = Path(__file__).parent / "data" / "gallery" / "published" / "lab_robots_iitk" / "5bar.xml"
+    text = re.sub(r'\s*<position name="motor_pos_right"[^>]*/>', "", source.read_text())
+    path = tmp_path / "5bar.xml"
+    path.write_text(text)
+    line = one_line_error(screwkit("info", path, "--output", "pen"), "1 actuator(s)", "for an output with 2 DOF",
+                          "--lock JOINT", "passive joints:")
+    passive = line.split("passive joints:")[1]
+    assert "j1_right" in passive and "j1_left" not in passive, line

@@ -407,11 +407,17 @@ def _check_actuator_count(mechanism: Mechanism, needed: int) -> None:
     assembly: a 3-UPU built at its constraint singularity has 5 there, and its 3 slides drive it)."""
     actuators = mechanism.actuator_names
     if len(actuators) < needed:
+        driven = {name.split(":", 1)[-1] for name in actuators}
+        passive = list(dict.fromkeys(name for chain in mechanism.chains for name in
+                                     chain.joint_names[:chain.geometry.n_tree_joints] if name not in driven))
+        held = (f"; or hold a passive joint that moves it, --lock JOINT (an adaptive finger's spring joint; the "
+                f"chains' passive joints: {', '.join(passive[:8])}{', ...' if len(passive) > 8 else ''})"
+                if mechanism.description.converted_from and passive else "")
         raise mechanism.description.fail(
             f"<robot name='{mechanism.name}'>",
             f"{len(actuators)} actuator(s) ({', '.join(actuators)}) for an output with {needed} DOF: at least "
             f"{needed} are needed (mark the actuated joints: a <transmission> in URDF, an <actuator> in MJCF; or name "
-            "them with --actuate JOINT in a file of another tool).")
+            f"them with --actuate JOINT in a file of another tool{held}).")
 
 
 def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) -> Mechanism:

@@ -49,17 +49,30 @@ def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: ND
     are dependent at the assembly only (:func:`check_not_stretched`) are refused, not locked."""
     model = tree.model
 
-    def rows(kept, at=data, carry=None):
+    def triples(kept, at=data, carry=None):
         carry = np.eye(4) if carry is None else carry  # the loop's DoFs moved with the leg's end
-        triples = [(kind, np.asarray(at.oMi[joint].rotation) @ axis, np.asarray(at.oMi[joint].translation))
-                   for joint in kept for kind, axis in [joint_kind(model, joint)]]
-        loop = [(kind, carry[:3, :3] @ axis, carry[:3, :3] @ point + carry[:3, 3])
-                for kind, axis, point in leg.loop_dofs]
-        return joint_twists(triples + loop, carry[:3, :3] @ leg.successor_world[:3, 3] + carry[:3, 3], scale)
+        joints = [(kind, np.asarray(at.oMi[joint].rotation) @ axis, np.asarray(at.oMi[joint].translation))
+                  for joint in kept for kind, axis in [joint_kind(model, joint)]]
+        return joints + [(kind, carry[:3, :3] @ axis, carry[:3, :3] @ point + carry[:3, 3])
+                         for kind, axis, point in leg.loop_dofs]
+
+    def rows(kept, at=data, carry=None):
+        carry = np.eye(4) if carry is None else carry
+        return joint_twists(triples(kept, at, carry), carry[:3, :3] @ leg.successor_world[:3, 3] + carry[:3, 3], scale)
 
     kept = list(leg.joints)
     if not independent(rows(kept), FILE_ROUNDING):
         check_not_stretched(tree, leg, q, scale, lambda at, carry: rows(kept, at, carry))
+        moving = _moving_self_motion(triples(kept), scale)
+        passive = [model.names[joint] for k, joint in enumerate(kept) if k in moving and joint not in motors]
+        if passive:
+            which = f"the leg closed by {leg.closure!r}" if leg.closure else "the platform body's own path"
+            raise ImportError_(f"{tree.source}: {which} moves with its ends held: its joints "
+                               f"{', '.join(model.names[joint] for joint in kept)} make a motion of their own that "
+                               f"turns joints {', '.join(passive)} about points it moves (no idle spin): a motion no "
+                               "actuator drives (a spring joint, as an adaptive finger's), so the mechanism has more "
+                               "motions than its actuators; --lock JOINT holds one of them, --actuate names another "
+                               "actuator.")
     while not independent(current := rows(kept), FILE_ROUNDING):
         rank, best = np.linalg.matrix_rank(current, tol=FILE_ROUNDING), (0.0, None)
         for joint in reversed([j for j in kept if j not in motors]):  # the one leaving the others most independent
@@ -74,6 +87,53 @@ def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: ND
     if not independent(rows(kept)):
         raise ImportError_(f"{tree.source}: the leg closed by {leg.closure!r} keeps dependent joints after locking "
                            "its idle passive joints (its actuated joints are dependent at the assembly).")
+
+
+def _moving_self_motion(triples, scale: float) -> set[int]:
+    """The items of a leg's (kind, world axis, world point) ``triples`` (base to end) that take part in a self-motion
+    of the leg (joint rates that move its end by nothing) which moves its links, not an idle spin: in an idle spin
+    (two coaxial pins, an S-S rod about its own line, a ball's hinges about their centre) each link that moves turns
+    about a line that meets both of its joints' axes (a slide's: along it), so the leg's shape stays; a planar chain
+    of four hinges (an adaptive finger's spring joint) moves its links otherwise. Empty when every self-motion is
+    idle. A hinge's drawn point may be anywhere on its axis: only the axes count."""
+    tolerance = 10 * FILE_ROUNDING
+    twists = np.array([np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else
+                       np.concatenate([axis, np.cross(point / scale, axis)]) for kind, axis, point in triples])
+    _, singular, right = np.linalg.svd(twists.T)  # (rates in rad/s, a slide's in length scales/s)
+    rank = int(np.sum(singular > FILE_ROUNDING * singular[0])) if singular.size else 0
+    moving = set()
+    for rates in right[rank:]:
+        body = np.cumsum(rates[:, None] * twists, axis=0)  # the twist of the link after each item
+        for k in range(len(triples) - 1):
+            if not _turns_about_both(body[k], triples[k], triples[k + 1], scale, tolerance):
+                moving |= {j for j, rate in enumerate(rates) if abs(rate) > tolerance * np.max(np.abs(rates))}
+                break
+    return moving
+
+
+def _turns_about_both(twist: NDArray, joint, other, scale: float, tolerance: float) -> bool:
+    """Whether a link with ``twist`` (omega, the velocity of the world origin in length scales) between two joints
+    (kind, axis, point) stays still or turns about a line that meets both axes (along a slide's)."""
+    omega, velocity = twist[:3], twist[3:]
+    spin = float(np.linalg.norm(omega))
+    if spin <= tolerance:
+        return float(np.linalg.norm(velocity)) <= tolerance
+    direction = omega / spin
+    if abs(float(direction @ velocity)) / spin > tolerance:  # a screw motion, not a turn
+        return False
+    through = np.cross(omega, velocity) / spin**2  # a point of the turning line (length scales)
+    for kind, axis, point in (joint, other):
+        if kind == "prismatic":
+            if float(np.linalg.norm(np.cross(direction, axis))) > tolerance:
+                return False
+            continue
+        normal = np.cross(direction, axis)
+        offset = point / scale - through
+        apart = (abs(float(offset @ normal)) / float(np.linalg.norm(normal)) if np.linalg.norm(normal) > tolerance
+                 else float(np.linalg.norm(np.cross(offset, axis))))  # parallel: the same line, or not
+        if apart > tolerance:
+            return False
+    return True
 
 
 def check_not_stretched(tree: ClosedTree, leg, q: NDArray, scale: float, rows, samples: int = 4) -> None:
