@@ -4,8 +4,8 @@ SDFormat writes a loop as joints among links: which joint closes the loop is scr
 it grows from the base). The choice followed the file's order: a four-bar whose rocker is the output, its joints
 written in reverse, was cut at the crank's coupler pin instead of the rocker's, read as a leg with a loop inside
 (a graph) instead of serial legs, with another task coordinate and another CTI (gazebosim/sdformat's
-``test/sdf/four_bar.sdf``: 0.98974 against 0.98624 at the same configuration). With ``--output`` naming the
-platform, the platform is reached last, so each leg ends on it whatever the order.
+``test/sdf/four_bar.sdf``: 0.98974 in the file's order, 0.98624 in reverse, at the same configuration). With
+``--output`` naming the platform, the platform is reached last, so each leg ends on it whatever the order.
 
 The indices are checked against the four-bar's closed forms (the coupler's pressure angles on the crank and on the
 rocker), at three drawn configurations, for every order of the four joints, with the links reversed, in mm, and

@@ -62,9 +62,10 @@ def check_couplings(tree: ClosedTree, q: NDArray, scale: float, analysed: set[in
             if platform in path:
                 analysed = analysed | set(path[path.index(platform) + 1:])
     couplings, idle = _holding_an_idle_body(tree, platform)
-    for _, _, _, where in idle:
-        notes.append(f"{where.split(': ', 1)[-1]}: its other joint held (--lock or the file), it holds only a body "
-                     "nothing else hangs on (a gear of a stage held): left out")
+    for _, second, _, where in idle:
+        held = "its other joint held (--lock or the file), it" if second else "a joint held at a value, it"
+        notes.append(f"{where.split(': ', 1)[-1]}: {held} holds only a body nothing else hangs on (a gear of a stage "
+                     "held): left out")
     if not couplings:
         return
     columns = [model.joints[j].idx_v + k for j in sorted(analysed) for k in range(model.joints[j].nv)]

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure.canonical import foot_on_line
 from screwkit.common.rotations import cross
-from screwkit.common.tolerances import MEETING, PARALLEL_FOOT
+from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
@@ -394,8 +394,8 @@ def couples_of_forces(legs, chains: list[ChainScrews], state: _State) -> list[tu
                      if end == actuator and closure.kind == "3d"]
         welded = [closure for closure in leg.closures if actuator in (closure.joint_a, closure.joint_b)
                   and closure.kind != "3d"]
-        forces_only = all(kinds[j] == "ball" or (kinds[j] in HINGES and abs(abs(float(
-            _axis_line(state, j)[1][0] @ axis)) - 1.0) < 1e-9) for j in carriers if j in leg.joints)
+        forces_only = all(kinds[j] == "ball" or (kinds[j] in HINGES and float(np.linalg.norm(np.cross(
+            _axis_line(state, j)[1][0], axis))) <= 10 * FILE_ROUNDING) for j in carriers if j in leg.joints)
         if len(carriers) >= 2 and forces_only and not welded:
             found.append((leg, tuple(carriers)))
     return found

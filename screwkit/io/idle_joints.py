@@ -92,43 +92,48 @@ def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: ND
 def _moving_self_motion(triples, scale: float) -> set[int]:
     """The items of a leg's (kind, world axis, world point) ``triples`` (base to end) that take part in a self-motion
     of the leg (joint rates that move its end by nothing) which moves its links, not an idle spin: in an idle spin
-    (two coaxial pins, an S-S rod about its own line, a ball's hinges about their centre) each link that moves turns
-    about a line that meets both of its joints' axes (a slide's: along it), so the leg's shape stays; a planar chain
-    of four hinges (an adaptive finger's spring joint) moves its links otherwise. Empty when every self-motion is
-    idle. A hinge's drawn point may be anywhere on its axis: only the axes count."""
+    (two coaxial pins, an S-S rod about its own line, a ball's hinges about their centre, two slides along one line)
+    each link that moves turns about a line that meets its hinges' axes, or slides along its joints' axes, so the
+    leg keeps its shape; a planar chain of four hinges (an adaptive finger's spring joint) moves its links otherwise.
+    Empty when every self-motion is idle. A hinge's drawn point may be anywhere on its axis: only the axes count;
+    points are taken about the leg's own centroid, in length scales, so the verdict is the same wherever the file
+    puts the leg and in any unit."""
     tolerance = 10 * FILE_ROUNDING
+    centre = np.mean([point for _, _, point in triples], axis=0)
+    local = [(kind, axis, (point - centre) / scale) for kind, axis, point in triples]
     twists = np.array([np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else
-                       np.concatenate([axis, np.cross(point / scale, axis)]) for kind, axis, point in triples])
+                       np.concatenate([axis, np.cross(point, axis)]) for kind, axis, point in local])
     _, singular, right = np.linalg.svd(twists.T)  # (rates in rad/s, a slide's in length scales/s)
     rank = int(np.sum(singular > FILE_ROUNDING * singular[0])) if singular.size else 0
     moving = set()
     for rates in right[rank:]:
         body = np.cumsum(rates[:, None] * twists, axis=0)  # the twist of the link after each item
-        for k in range(len(triples) - 1):
-            if not _turns_about_both(body[k], triples[k], triples[k + 1], scale, tolerance):
+        for k in range(len(local) - 1):
+            if not _keeps_shape(body[k], local[k], local[k + 1], tolerance):
                 moving |= {j for j, rate in enumerate(rates) if abs(rate) > tolerance * np.max(np.abs(rates))}
                 break
     return moving
 
 
-def _turns_about_both(twist: NDArray, joint, other, scale: float, tolerance: float) -> bool:
-    """Whether a link with ``twist`` (omega, the velocity of the world origin in length scales) between two joints
-    (kind, axis, point) stays still or turns about a line that meets both axes (along a slide's)."""
+def _keeps_shape(twist: NDArray, joint, other, tolerance: float) -> bool:
+    """Whether a link with ``twist`` (omega, the velocity of the origin; lengths in length scales) between two joints
+    (kind, axis, point) stays still, turns about a line that meets its hinges' axes (a slide lets any turn of both
+    its sides), or slides along every one of its joints' axes."""
     omega, velocity = twist[:3], twist[3:]
     spin = float(np.linalg.norm(omega))
     if spin <= tolerance:
-        return float(np.linalg.norm(velocity)) <= tolerance
+        speed = float(np.linalg.norm(velocity))
+        return speed <= tolerance or all(float(np.linalg.norm(np.cross(velocity / speed, axis))) <= tolerance
+                                         for _, axis, _ in (joint, other))
     direction = omega / spin
     if abs(float(direction @ velocity)) / spin > tolerance:  # a screw motion, not a turn
         return False
-    through = np.cross(omega, velocity) / spin**2  # a point of the turning line (length scales)
+    through = np.cross(omega, velocity) / spin**2  # a point of the turning line
     for kind, axis, point in (joint, other):
         if kind == "prismatic":
-            if float(np.linalg.norm(np.cross(direction, axis))) > tolerance:
-                return False
             continue
         normal = np.cross(direction, axis)
-        offset = point / scale - through
+        offset = point - through
         apart = (abs(float(offset @ normal)) / float(np.linalg.norm(normal)) if np.linalg.norm(normal) > tolerance
                  else float(np.linalg.norm(np.cross(offset, axis))))  # parallel: the same line, or not
         if apart > tolerance:
