@@ -277,3 +277,20 @@ def test_revolute_joint_without_limit_is_refused_before_urdfdom_prints_anything(
     result = screwkit("analyze", path, "--json")  # the error as JSON on stdout, nothing on stderr
     assert (result.returncode, result.stderr) == (1, "")
     assert json.loads(result.stdout)["error"].startswith(expected)
+
+
+def test_a_tree_with_mimic_joints_and_no_loop_is_told_what_a_closed_loop_file_needs(tmp_path):
+    """A Delta written as a tree whose arms mimic one another (published as such) was told to remove the <mimic>,
+    then refused as a tree: the first refusal now says the file closes no loop either; a file with loops is told
+    only of the <mimic>."""
+    path = tmp_path / "tree.urdf"
+    path.write_text('<robot name="delta"><link name="base"/><link name="arm_1"/><link name="arm_2"/>'
+                    '<joint name="j1" type="revolute"><parent link="base"/><child link="arm_1"/><axis xyz="0 0 1"/>'
+                    '<limit effort="1" velocity="1"/></joint><joint name="j2" type="revolute"><parent link="base"/>'
+                    '<child link="arm_2"/><axis xyz="0 0 1"/><limit effort="1" velocity="1"/><mimic joint="j1"/>'
+                    '</joint></robot>')
+    with pytest.raises(ValueError) as error:
+        read_urdf(path)
+    message = str(error.value)
+    assert "coupled (mimic) joints are not modelled" in message and "the file closes no loop either" in message
+    assert "\n" not in message

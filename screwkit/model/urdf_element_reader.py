@@ -65,6 +65,7 @@ class ElementReader:
             links[name] = None
         link_set = links.keys()
         joints: dict[str, JointElement] = {}
+        self.closes = root.find("loop") is not None  # (a <mimic>'s refusal says when the file closes no loop)
         for element in root.findall("joint"):
             joint = self.read_joint(element, link_set)
             if joint.name in joints:
@@ -247,9 +248,13 @@ class ElementReader:
         mimic = element.find("mimic")
         if mimic is not None:
             mimicked = (mimic.get("joint") or "").strip()
+            tree = ("" if getattr(self, "closes", True) else "; the file closes no loop either (no <loop>): a "
+                    "closed-loop robot of another tool needs its robot.yaml beside it, closing_<name>_1 / "
+                    "closing_<name>_2 frame pairs, <gazebo><joint> or <drake:ball_constraint> elements, or an MJCF "
+                    "file (docs/other-formats.md); a parallel robot written as a tree with <mimic> joints is not one")
             raise self.fail(f"{tag}<mimic joint='{mimicked}'>" if mimicked else f"{tag}<mimic>",
                             "coupled (mimic) joints are not modelled; remove the <mimic> element to analyse the joints "
-                            "as independent.")
+                            f"as independent{tree}.")
         return JointElement(
             name=name,
             type=joint_type,
