@@ -85,11 +85,13 @@ def check_couplings(tree: ClosedTree, q: NDArray, scale: float, analysed: set[in
     partner = ("to a value" if not second else f"to joint {second!r}" +
                (", held (--lock)" if second in tree.locked else "" if model.existJointName(second) else
                 ", not a joint that moves in the model"))
-    held = first if model.existJointName(first) else second
+    ends = [platform] + [joint for closure in tree.closures for joint in (closure.joint_a, closure.joint_b)]
+    stages = [name for name in (first, second) if name and model.existJointName(name)  # carrying every leg
+              and all(model.getJointId(name) in path_to(model, end) for end in ends)]
+    hold = (f"--lock {stages[0]} holds the geared stage where the file draws it, or " if stages else "")
     raise ImportError_(f"{where}: a joint coupling ties joint {first!r} {partner}{named}, which holds the mechanism "
-                       f"analysed to fewer motions: screwkit does not model it; --lock {held} holds the coupled "
-                       "joints where the file draws them (a geared stage before the parallel part), or remove the "
-                       "element" + (" (or set active='false')" if "<equality>" in where else "")
+                       f"analysed to fewer motions: screwkit does not model it; {hold}remove the element"
+                       + (" (or set active='false')" if "<equality>" in where else "")
                        + " to analyse the joints as independent (a joint it drives then passive).")
 
 
