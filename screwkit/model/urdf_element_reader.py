@@ -39,6 +39,16 @@ level and crashes the process on a stack overflow at a few hundred levels in a t
 small stack (about 230 with 512 KiB, 3,800 with 8 MiB), so deeper trees are refused."""
 
 
+MIMIC_REFUSED = ("coupled (mimic) joints are not modelled; remove the <mimic> element to analyse the joints as "
+                 "independent")
+NO_LOOP_EITHER = ("; the file closes no loop either (no <loop>): a closed-loop robot of another tool needs its "
+                  "robot.yaml beside it, closing_<name>_1 / closing_<name>_2 frame pairs, <gazebo><joint> or "
+                  "<drake:ball_constraint> elements, or an MJCF file (docs/other-formats.md); a parallel robot written "
+                  "as a tree with <mimic> joints is not one.")
+"""What a ``<mimic>``'s refusal adds when the file has no ``<loop>``: removing the ``<mimic>`` would only meet the
+refusal of a tree."""
+
+
 class ElementReader:
     """Element-by-element reading with file-and-element error messages."""
 
@@ -248,13 +258,8 @@ class ElementReader:
         mimic = element.find("mimic")
         if mimic is not None:
             mimicked = (mimic.get("joint") or "").strip()
-            tree = ("" if getattr(self, "closes", True) else "; the file closes no loop either (no <loop>): a "
-                    "closed-loop robot of another tool needs its robot.yaml beside it, closing_<name>_1 / "
-                    "closing_<name>_2 frame pairs, <gazebo><joint> or <drake:ball_constraint> elements, or an MJCF "
-                    "file (docs/other-formats.md); a parallel robot written as a tree with <mimic> joints is not one")
             raise self.fail(f"{tag}<mimic joint='{mimicked}'>" if mimicked else f"{tag}<mimic>",
-                            "coupled (mimic) joints are not modelled; remove the <mimic> element to analyse the joints "
-                            f"as independent{tree}.")
+                            MIMIC_REFUSED + ("." if getattr(self, "closes", True) else NO_LOOP_EITHER))
         return JointElement(
             name=name,
             type=joint_type,
