@@ -85,9 +85,8 @@ def check_couplings(tree: ClosedTree, q: NDArray, scale: float, analysed: set[in
     partner = ("to a value" if not second else f"to joint {second!r}" +
                (", held (--lock)" if second in tree.locked else "" if model.existJointName(second) else
                 ", not a joint that moves in the model"))
-    ends = [platform] + [joint for closure in tree.closures for joint in (closure.joint_a, closure.joint_b)]
     stages = [name for name in (first, second) if name and model.existJointName(name)  # carrying every leg
-              and all(model.getJointId(name) in path_to(model, end) for end in ends)]
+              and all(model.getJointId(name) in path_to(model, end) for end in _ends(tree, platform))]
     hold = (f"--lock {stages[0]} holds the geared stage where the file draws it, or " if stages else "")
     raise ImportError_(f"{where}: a joint coupling ties joint {first!r} {partner}{named}, which holds the mechanism "
                        f"analysed to fewer motions: screwkit does not model it; {hold}remove the element"
@@ -100,14 +99,18 @@ def _holding_an_idle_body(tree: ClosedTree, platform: int) -> tuple[list, list]:
     ``--lock``, or no joint of the model), hold only a joint whose body, and all that hangs on it, is no end of a
     closure nor the platform: a gear of a stage held, whose own spin is all the coupling stops (before, ToddlerBot's
     hip-yaw gear pair, its driven joint held, was blamed for a waist left free)."""
-    model = tree.model
-    ends = {platform} | {joint for closure in tree.closures for joint in (closure.joint_a, closure.joint_b)}
+    model, ends = tree.model, _ends(tree, platform)
     checked, idle = [], []
     for coupling in tree.couplings:
         moving = [model.getJointId(name) for name in coupling[:2] if name and model.existJointName(name)]
         alone = len(moving) == 1 and not any(moving[0] in path_to(model, end) for end in ends)
         (idle if alone else checked).append(coupling)
     return checked, idle
+
+
+def _ends(tree: ClosedTree, platform: int) -> set[int]:
+    """The platform and the joints every closure ends on: what a leg reaches."""
+    return {platform} | {joint for closure in tree.closures for joint in (closure.joint_a, closure.joint_b)}
 
 
 def _coupling_row(model, coupling) -> NDArray[np.float64]:

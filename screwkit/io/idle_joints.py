@@ -22,13 +22,16 @@ INDEPENDENCE_TOLERANCE = 1e-9
 largest, for them to count as independent (as :data:`screwkit.common.tolerances.MOTION_SPACE_TOLERANCE`)."""
 
 
-def joint_twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float) -> NDArray:
-    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples."""
+def joint_twists(axis_kinds: list[tuple[str, NDArray, NDArray]], centre: NDArray, scale: float,
+                 unit: bool = True) -> NDArray:
+    """Unit joint twists (omega, v / scale) about ``centre`` of (kind, world axis, world point) triples (``unit``
+    False: not scaled to unit norm, so that a combination's coefficients are the joints' rates, rad/s and length
+    scales/s)."""
     rows = []
     for kind, axis, point in axis_kinds:
         row = np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else \
             np.concatenate([axis, np.cross(point - centre, axis) / scale])
-        rows.append(row / np.linalg.norm(row))
+        rows.append(row / np.linalg.norm(row) if unit else row)
     return np.array(rows).reshape(-1, 6)
 
 
@@ -101,8 +104,7 @@ def _moving_self_motion(triples, scale: float) -> set[int]:
     tolerance = 10 * FILE_ROUNDING
     centre = np.mean([point for _, _, point in triples], axis=0)
     local = [(kind, axis, (point - centre) / scale) for kind, axis, point in triples]
-    twists = np.array([np.concatenate([np.zeros(3), axis]) if kind == "prismatic" else
-                       np.concatenate([axis, np.cross(point, axis)]) for kind, axis, point in local])
+    twists = joint_twists(triples, centre, scale, unit=False)
     _, singular, right = np.linalg.svd(twists.T)  # (rates in rad/s, a slide's in length scales/s)
     rank = int(np.sum(singular > FILE_ROUNDING * singular[0])) if singular.size else 0
     moving = set()
