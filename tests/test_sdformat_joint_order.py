@@ -122,8 +122,9 @@ def test_the_command_reads_both_orders_alike(tmp_path):
         assert reverse[key] == pytest.approx(forward[key], abs=1e-12), key
 
 
-@pytest.mark.parametrize("turn", [np.deg2rad(40.0), np.deg2rad(-140.0)])
-def test_one_motion_takes_the_coordinate_it_runs_along_fastest(tmp_path, turn):
+@pytest.mark.parametrize("turn, scale", [(np.deg2rad(40.0), 1.0), (np.deg2rad(-140.0), 1.0),
+                                         (np.deg2rad(40.0), 1e3), (np.deg2rad(40.0), 1e-3)])
+def test_one_motion_takes_the_coordinate_it_runs_along_fastest(tmp_path, turn, scale):
     """The rocker's pin as the output, the four-bar turned so that the pin moves mostly along y, 9 deg from the
     place where its x turns back: x, first in order and moving at 0.16 of the speed, was taken, and crank angles
     past that place could not be asked. y is taken now, and every crank angle of the stroke is reached, with the
@@ -132,8 +133,9 @@ def test_one_motion_takes_the_coordinate_it_runs_along_fastest(tmp_path, turn):
 
     theta = np.deg2rad(180.0)
     path = tmp_path / "turned.sdf"
-    path.write_text(four_bar_sdf(theta, world=(turn, (0.0, 0.0, 0.0))))
-    mechanism = load(path, output="rocker", actuate=("crank_pin",), output_type="point")
+    path.write_text(four_bar_sdf(theta, scale=scale, world=(turn, (0.0, 0.0, 0.0))))
+    unit = {1e3: "mm", 1e-3: "km"}.get(scale)  # (the file written in that unit, read in metres)
+    mechanism = load(path, output="rocker", actuate=("crank_pin",), output_type="point", length_unit=unit)
     assert mechanism.task_coordinates == ("y",)
     for change in (-10.0, -25.0, -40.0, -60.0, -80.0):
         solution = forward(mechanism, [np.deg2rad(change)], mechanism.home_pose)

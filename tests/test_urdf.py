@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from helpers import one_line_error, screwkit
 from screwkit.io.loader import bundled_names, bundled_path
 from screwkit.model.urdf_reader import parse_urdf, read_urdf
 
@@ -294,3 +295,4 @@ def test_a_tree_with_mimic_joints_and_no_loop_is_told_what_a_closed_loop_file_ne
     message = str(error.value)
     assert "coupled (mimic) joints are not modelled" in message and "the file closes no loop either" in message
     assert "\n" not in message
+    one_line_error(screwkit("info", path), "tree.urdf", "<mimic joint='j1'>", "the file closes no loop either")
