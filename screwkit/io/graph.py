@@ -454,6 +454,10 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     if small.size:  # as closure.assembly.mobility_notes says it of serial legs
         report.notes.append(rounded_dof_note(len(motion), small, "legs"))
     task_axes = _task_axes(tree, state, frame_id, motion)
+    if not task_axes and not at_file:  # the file's configuration moved: a pose asked on a singularity
+        raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move at the pose asked: its "
+                           f"legs allow no twist in common there{locking_legs(legs, screws)} (a singular pose, such as "
+                           "legs stretched or folded at the workspace's boundary: a pose beside it reads the indices)")
     if not task_axes:
         raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move: analysed as a graph, "
                            f"its legs allow no twist in common at the file's configuration{locking_legs(legs, screws)} "

@@ -1,0 +1,110 @@
+"""A published MuJoCo Delta (D-sorganization/Golf_Modeling_Suite, MIT; ``tests/data/gallery/published/
+golf_modeling_suite``): three motor arms, each carrying two rods on hinges parallel to its motor, the rods pinned to
+a free platform by ``<connect>``s, the rods of an arm kept parallel by ``<equality><joint>``.
+
+Its hinges leave the platform one motion, along z. Each leg is then a planar crank and rod in its own vertical
+plane: ITI = |sin| of the angle between arm and rod, OTI = the rod's cosine with z. The plane's constants (motor
+pivot, arm and rod lengths) are read here from MuJoCo's own placement of the joints and connects, and the leg closed
+by two circles; screwkit analyses the file as a graph (its rods are loops inside the legs).
+
+At z = pivot - arm - rod every arm and its rods are on one line: the workspace's boundary, where ITI falls to 0.
+Posed there exactly, the platform has no motion left; the refusal said "at the file's configuration" and blamed the
+file's rounding, where the file opens and is not rounded. It now names the pose asked.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import one_line_error, screwkit
+from screwkit.io import ImportError_, read_closed_tree
+from screwkit.io.graph import graph_mechanism
+
+DELTA = Path(__file__).parent / "data" / "gallery" / "published" / "golf_modeling_suite" / "delta_robot.xml"
+START = [("joint1", 30.0), ("joint2", 30.0), ("joint3", 30.0)]
+"""The file draws every arm and rod straight down (a dead centre, refused); the refusal advises --initial."""
+
+
+def _plane() -> tuple[float, float, float, float]:
+    """Arm 1's vertical plane as MuJoCo places it at qpos0: the motor pivot's radius and height, the arm's and the
+    rod's lengths (in the plane normal to the hinges' common axis)."""
+    model = mujoco.MjModel.from_xml_path(str(DELTA))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    joint = {model.joint(k).name: k for k in range(model.njnt)}
+    pivot, elbow = data.xanchor[joint["joint1"]], data.xanchor[joint["elbow1a"]]
+    axis = data.xaxis[joint["joint1"]]
+    connect = next(k for k in range(model.neq) if model.eq_type[k] == mujoco.mjtEq.mjEQ_CONNECT)
+    body = model.eq_obj1id[connect]
+    end = data.xpos[body] + data.xmat[body].reshape(3, 3) @ model.eq_data[connect][:3]
+
+    def in_plane(v):
+        return float(np.linalg.norm(v - np.dot(v, axis) * axis))
+
+    return float(np.hypot(*pivot[:2])), float(pivot[2]), in_plane(elbow - pivot), in_plane(end - elbow)
+
+
+def _closed_form(z: float) -> tuple[float, float]:
+    """ITI and OTI of a leg with the platform's joint line at height ``z`` (the elbow on the arm's side inward, as
+    the legs assemble from 30 deg)."""
+    radius, height, arm, rod = _plane()
+    pivot, joint = np.array([radius, height]), np.array([radius, z])
+    apart = np.linalg.norm(joint - pivot)
+    along = (arm ** 2 + apart ** 2 - rod ** 2) / (2 * apart)
+    across = np.sqrt(max(arm ** 2 - along ** 2, 0.0))
+    middle = pivot + along * (joint - pivot) / apart
+    normal = np.array([-(joint - pivot)[1], (joint - pivot)[0]]) / apart
+    elbow = min((middle + across * normal, middle - across * normal), key=lambda e: e[0])
+    u, v = (elbow - pivot) / arm, (joint - elbow) / rod
+    return abs(u[0] * v[1] - u[1] * v[0]), abs(v[1])
+
+
+def _scaled(tmp_path: Path, factor: float) -> Path:
+    """The file with every length times ``factor``."""
+    def times(match):
+        return f'{match.group(1)}="{" ".join(repr(float(x) * factor) for x in match.group(2).split())}"'
+
+    text = re.sub(r'\b(pos|anchor|fromto|size)="([^"]*)"', times, DELTA.read_text())
+    path = tmp_path / "delta_mm.xml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("unit", ["m", "mm"])
+def test_indices_are_the_legs_pressure_angles_where_mujoco_places_them(tmp_path, unit):
+    path, unit_option = (DELTA, None) if unit == "m" else (_scaled(tmp_path, 1000.0), "mm")
+    graph = graph_mechanism(read_closed_tree(path, initial=START, length_unit=unit_option))
+    assert graph.task_axes == (2,)
+    for z in (-1.2, -2.06, -2.5, -2.9, -2.99):
+        result = graph.at_pose([0.0, 0.0, z]).indices()
+        iti, oti = _closed_form(z)
+        assert float(result.iti) == pytest.approx(iti, abs=1e-9)
+        assert float(result.lmti) == pytest.approx(oti, abs=1e-9)
+
+
+def test_the_boundary_is_refused_as_the_pose_asked_not_the_file():
+    radius, height, arm, rod = _plane()
+    graph = graph_mechanism(read_closed_tree(DELTA, initial=START))
+    boundary = height - arm - rod
+    beside = graph.at_pose([0.0, 0.0, boundary + 1e-6]).indices()
+    assert float(beside.iti) == pytest.approx(_closed_form(boundary + 1e-6)[0], abs=1e-9)
+    assert float(beside.iti) < 2e-3
+    with pytest.raises(ImportError_, match="cannot move at the pose asked") as refused:
+        graph.at_pose([0.0, 0.0, boundary])
+    assert "file's" not in str(refused.value)
+
+
+def test_the_command_names_the_pose_asked_at_the_boundary():
+    initial = [word for name, value in START for word in ("--initial", name, str(value))]
+    opened = screwkit("analyze", DELTA, *initial, "--pose", "-2.5")
+    assert opened.returncode == 0, opened.stderr
+    assert f"ITI  (Eq. 7)                        {_closed_form(-2.5)[0]:.4f}" in opened.stdout
+    radius, height, arm, rod = _plane()
+    refused = screwkit("analyze", DELTA, *initial, "--pose", repr(height - arm - rod))
+    line = one_line_error(refused, "cannot move at the pose asked", "arm1")
+    assert "file's" not in line
