@@ -75,13 +75,37 @@ def _scaled(tmp_path: Path, factor: float) -> Path:
     return path
 
 
-@pytest.mark.parametrize("unit", ["m", "mm"])
-def test_indices_are_the_legs_pressure_angles_where_mujoco_places_them(tmp_path, unit):
-    path, unit_option = (DELTA, None) if unit == "m" else (_scaled(tmp_path, 1000.0), "mm")
+def _turned(tmp_path: Path) -> Path:
+    """The file with its world body's contents in a ``<frame>`` moved by :data:`SHIFT` and turned by :data:`TURN`
+    (a ``<body>`` would hold the platform's free joint, which MuJoCo refuses there)."""
+    text = DELTA.read_text()
+    start, end = text.index("<worldbody>") + len("<worldbody>"), text.index("</worldbody>")
+    quat = " ".join(repr(v) for v in TURN)
+    path = tmp_path / "delta_turned.xml"
+    path.write_text(f'{text[:start]}<frame pos="{" ".join(map(repr, SHIFT))}" quat="{quat}">{text[start:end]}'
+                    f"</frame>{text[end:]}")
+    return path
+
+
+SHIFT, TURN = (0.3, -0.7, 1.9), (0.8, 0.3, -0.4, 0.33)
+
+
+def _rotation(quat) -> np.ndarray:
+    w, x, y, z = np.asarray(quat) / np.linalg.norm(quat)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+@pytest.mark.parametrize("variant", ["m", "mm", "turned"])
+def test_indices_are_the_legs_pressure_angles_where_mujoco_places_them(tmp_path, variant):
+    path, unit_option = {"m": (DELTA, None), "mm": (_scaled(tmp_path, 1000.0), "mm"),
+                         "turned": (_turned(tmp_path), None)}[variant]
     graph = graph_mechanism(read_closed_tree(path, initial=START, length_unit=unit_option))
-    assert graph.task_axes == (2,)
+    place = (lambda p: _rotation(TURN) @ p + np.array(SHIFT)) if variant == "turned" else (lambda p: p)
+    assert len(graph.task_axes) == 1
     for z in (-1.2, -2.06, -2.5, -2.9, -2.99):
-        result = graph.at_pose([0.0, 0.0, z]).indices()
+        result = graph.at_pose(place(np.array([0.0, 0.0, z]))).indices()
         iti, oti = _closed_form(z)
         assert float(result.iti) == pytest.approx(iti, abs=1e-9)
         assert float(result.lmti) == pytest.approx(oti, abs=1e-9)
