@@ -28,6 +28,7 @@ from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
     TASK_RANK_TOLERANCE,
     chain_ranks,
+    check_idle_turns,
     close_constraining_chains,
     constraining_chains,
     infer_task_axes,
@@ -458,6 +459,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
+        check_idle_turns(mechanism, at_pose, at_values, mobility)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
     if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "

@@ -37,6 +37,10 @@ __all__ = [
     "motion_space_at",
     "infer_task_axes",
     "choose_task_axes",
+    "driven_idle_turns",
+    "check_idle_turns",
+    "DrivenIdleTurns",
+    "DRIVEN_TURNS",
 ]
 
 TRANSLATIONAL = np.sqrt(0.5)
@@ -270,13 +274,16 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
     return poses, values, converged, residual * mechanism.length_scale
 
 
-def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values) -> tuple[NDArray, NDArray]:
+def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values, *, locked: bool = False
+                    ) -> tuple[NDArray, NDArray]:
     """The platform's motion space at closed configurations, in pose-coordinate rates.
 
     Parameters
     ----------
     full_poses : ndarray (N, n_pose)
     joint_values : sequence of ndarray (N, m_i), one per chain
+    locked : bool
+        With every actuator held: the motions the passive joints alone allow.
 
     Returns
     -------
@@ -295,6 +302,11 @@ def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values) -> 
         twists = twists_from_axes_and_points(frames.axes, frames.points - translation[:, None, :], chain.prismatic)
         twists = np.concatenate([twists[..., :3], twists[..., 3:] / mechanism.length_scale], axis=-1)[..., rows]
         twists = twists / np.maximum(np.linalg.norm(twists, axis=-1, keepdims=True), 1e-300)
+        if locked:
+            twists = np.delete(twists, list(chain.actuated), axis=-2)
+        if not twists.shape[-2]:  # a chain of actuators alone, held: it holds the platform
+            total += np.eye(len(rows))
+            continue
         left, singular, _ = np.linalg.svd(np.swapaxes(twists, -1, -2), full_matrices=False)
         mask = singular > MOTION_SPACE_TOLERANCE * np.maximum(singular[..., :1], 1e-300)
         basis = left * mask[..., None, :]
@@ -308,6 +320,41 @@ def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values) -> 
     coordinates = np.linalg.pinv(rates) @ eigenvectors
     basis, _ = np.linalg.qr(coordinates)
     return dof, basis
+
+
+class DrivenIdleTurns(ValueError):
+    """A point output whose turns about the point an actuator drives (:func:`check_idle_turns`): a file of another
+    tool whose output type the user left to screwkit is read with its frame instead."""
+
+
+DRIVEN_TURNS = ("an actuator turns the platform about the output point (a point on a link that one leg holds on a "
+                "circle, the other actuators turning the rest about it): a point output counts that motion as none, "
+                "and would read the actuators driving it as redundant; take a frame for the output (--output-type "
+                "frame, or --output naming another body's frame)")
+
+
+def check_idle_turns(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> None:
+    """:class:`DrivenIdleTurns` when a point output's idle turns are driven (:func:`driven_idle_turns`)."""
+    if driven_idle_turns(mechanism, np.asarray(full_pose, dtype=float), joint_values, dof):
+        raise DrivenIdleTurns(str(mechanism.description.fail("<output type='point'>", DRIVEN_TURNS)))
+
+
+def driven_idle_turns(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> bool:
+    """Whether a point output's idle turns are driven: the platform's motions (``dof`` of them at the closed
+    configuration ``full_pose``) that keep the point still, which a point output counts as none, are not all
+    allowed with every actuator held (an actuator drives one: a leg's output point on a crank, the other motor
+    turning the leg's links about it: a published rat robot's five-bar leg read 2 actuators as 1 DOF, 1 redundant,
+    F_O1 0.2435, where it has 2 DOF and no redundancy)."""
+    _, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
+    space = basis[0][:, :dof]
+    translations = space[~mechanism.pose_angular]
+    _, singular, rows = np.linalg.svd(translations, full_matrices=True)
+    still = space @ rows[int(np.sum(singular > TASK_RANK_TOLERANCE)):].T  # the motions that keep the point still
+    if not still.shape[1]:
+        return False
+    held, free = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values], locked=True)
+    allowed = free[0][:, :int(held[0])]
+    return bool(np.linalg.norm(still - allowed @ (allowed.T @ still)) > TASK_RANK_TOLERANCE ** 0.5)
 
 
 def infer_task_axes(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int,

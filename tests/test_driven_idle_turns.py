@@ -1,0 +1,128 @@
+"""A leg whose closure joins a servo horn to the thigh: the point where the legs meet is on the horn's circle.
+
+The leg (a published rat robot's, NeRmo's, written small here): a hip motor, a knee and an ankle hinge carry the thigh;
+a servo's horn is pinned to the thigh by a ``<connect>``. MuJoCo leaves the leg 2 DOF (4 hinges, a connect of rank
+2) for its 2 motors. Taken by default as the output, the point where the legs meet is a point of the horn: it moves
+on a circle whatever the hip does, and the hip motor's motion, the thigh turning about that point, was counted as
+the point output's idle turn. The published leg read "2 actuators, 1 DOF (1 redundant)", F_O1 0.2435, where it
+has no redundancy.
+
+Now the idle turns of a point output must be free with every actuator held; a point output whose turns an actuator
+drives is refused, and left to screwkit (no ``--output-type``), the file is read with the frame of the body the
+closure joins instead. The frame reading's indices are the leg's pressure angles as MuJoCo places its joints: the
+hip drives the thigh through the lower link, whose line K-A carries its force (ITI = |sin| of upper link to lower
+link; with the servo held the thigh turns about the horn's pin P, so OTI = |sin| of the line K-A to the line P-A);
+the servo's force through P normal to the horn (ITI = OTI = 1).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import one_line_error, screwkit
+from screwkit.closure.forward_kinematics import forward
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+PIN = np.array([0.1, 0.11, 0.0])
+"""The horn's pin on the thigh, in the world at the file's configuration."""
+
+
+def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """The leg's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat`` texts)."""
+    def at(*values) -> str:
+        return " ".join(repr(v * scale) for v in values)
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    return (f'<mujoco model="horn_leg"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
+            f'<body name="upper"><joint name="hip" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="lower" pos="{at(0.1, -0.02, 0)}"><joint name="knee" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="thigh" pos="{at(0.03, 0.09, 0)}"><joint name="ankle" type="hinge" axis="0 0 1"/>{ball}'
+            '</body></body></body>'
+            f'<body name="horn" pos="{at(0.06, 0.12, 0)}"><joint name="servo" type="hinge" axis="0 0 1"/>{ball}'
+            '</body></body></worldbody><equality>'
+            f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(0.04, -0.01, 0)}"/></equality>'
+            '<actuator><motor name="m1" joint="hip"/><motor name="m2" joint="servo"/></actuator></mujoco>')
+
+
+VARIANTS = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
+            "turned": (1.0, None, ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"))}
+
+
+@pytest.fixture(params=sorted(VARIANTS))
+def leg(request, tmp_path):
+    scale, unit, world = VARIANTS[request.param]
+    path = tmp_path / f"leg_{request.param}.xml"
+    path.write_text(leg_mjcf(scale, world))
+    return path, unit
+
+
+def _mujoco_indices(path: Path, values: dict[str, float]) -> tuple[float, float]:
+    """The hip's ITI and OTI from MuJoCo's placement of the joints at joint ``values`` (rad), the connect closed."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    for name, value in values.items():
+        data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-9 * (1.0 + np.abs(data.xpos).max())  # the loop closed where screwkit put it
+    anchor = {name: data.xanchor[model.joint(name).id] for name in ("hip", "knee", "ankle")}
+    pin = data.xpos[model.body("horn").id] + data.xmat[model.body("horn").id].reshape(3, 3) @ model.eq_data[0][:3]
+
+    def sine(u, v):
+        return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
+
+    lower = anchor["ankle"] - anchor["knee"]
+    return sine(anchor["knee"] - anchor["hip"], lower), sine(lower, anchor["ankle"] - pin)
+
+
+def test_mujoco_leaves_the_leg_two_motions(tmp_path):
+    path = tmp_path / "leg.xml"
+    path.write_text(leg_mjcf())
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    jacobian = data.efc_J.reshape(-1, model.nv)
+    assert model.nv - np.linalg.matrix_rank(jacobian, tol=1e-9) == 2
+    assert np.linalg.norm(data.xpos[model.body("horn").id] + model.eq_data[0][:3] - PIN) < 1e-15
+
+
+def test_the_leg_reads_two_dof_and_its_pressure_angles(leg):
+    path, unit = leg
+    mechanism = load(path, length_unit=unit)
+    assert mechanism.dof == 2 and len(mechanism.actuators) == 2
+    assert mechanism.output_point is None
+    assert any("not the point where the legs meet" in line for line in mechanism.import_report)
+    home = indices_at_pose(mechanism, mechanism.home_pose)
+    assert dict(home.f_o) == {1: 0.0}  # no redundancy: one failure leaves the platform uncontrolled
+    for change in ((0.0, 0.0), (0.15, -0.1), (-0.08, 0.09)):
+        start = np.array([home.joint_values[name] for name in ("hip:hip", "servo:servo")])
+        solution = forward(mechanism, start + np.array(change), mechanism.home_pose)  # (rad)
+        assert bool(np.ravel(solution.reachable)[0])
+        result = indices_at_pose(mechanism, np.ravel(solution.poses))
+        values = {name.split(":")[1]: value for name, value in result.joint_values.items()
+                  if name.split(":")[1] in ("hip", "knee", "ankle", "servo")}  # (not the converted loop joints)
+        iti, oti = _mujoco_indices(path, values)
+        assert float(result.iti) == pytest.approx(iti, abs=1e-9)  # the servo's is 1
+        assert float(result.lmti) == pytest.approx(oti, abs=1e-9)  # the servo's OTI is 1
+
+
+def test_a_point_output_there_is_refused(leg):
+    path, unit = leg
+    with pytest.raises(ValueError, match="an actuator turns the platform about the output point"):
+        load(path, length_unit=unit, output="thigh", output_type="point")
+
+
+def test_the_command_reads_the_frame_and_refuses_the_point(tmp_path):
+    path = tmp_path / "leg.xml"
+    path.write_text(leg_mjcf())
+    read = screwkit("analyze", path, "--json")
+    assert read.returncode == 0, read.stderr
+    result = json.loads(read.stdout)
+    assert result["dof"] == 2 and result["f_o"] == {"1": 0.0}
+    refused = screwkit("analyze", path, "--output", "thigh", "--output-type", "point")
+    one_line_error(refused, "an actuator turns the platform about the output point", "--output-type frame")
