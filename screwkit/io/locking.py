@@ -25,7 +25,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "platform_moves",
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "platform_motions",
            "GUESSED"]
 
 
@@ -292,11 +292,11 @@ def initial_values(values, source: str) -> tuple[tuple[str, float], ...]:
     return tuple(pairs)
 
 
-def platform_moves(tree: ClosedTree, data, platform: int, held, scale: float) -> bool:
-    """Whether the platform's joint keeps a motion with the joints ``held`` locked and every closure kept, at the
-    configuration of ``data`` (its forward kinematics computed): the platform's twist on the null space of the
-    closures' velocity rows over the other velocity coordinates (an idle spin, which moves no platform, does not
-    count). An advice to hold joints is checked against it before it is given."""
+def platform_motions(tree: ClosedTree, data, platform: int, held, scale: float) -> int:
+    """How many motions the platform's joint keeps with the joints ``held`` locked and every closure kept, at the
+    configuration of ``data`` (its forward kinematics computed): the rank of the platform's twist on the null space
+    of the closures' velocity rows over the other velocity coordinates (an idle spin, which moves no platform, does
+    not count). An advice to hold joints is checked against it before it is given."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     model = tree.model
@@ -310,4 +310,6 @@ def platform_moves(tree: ClosedTree, data, platform: int, held, scale: float) ->
     null = right[int(np.sum(singular > 1e-9 * max(float(singular[0]) if singular.size else 0.0, 1.0))):]
     twist = pin.getJointJacobian(model, data, platform, pin.LOCAL_WORLD_ALIGNED)[:, free]
     twist = np.vstack([twist[:3] / scale, twist[3:]])
-    return bool(null.size) and float(np.linalg.norm(twist @ null.T, ord=2)) > 1e-9
+    if not null.size:
+        return 0
+    return int(np.sum(np.linalg.svd(twist @ null.T, compute_uv=False) > 1e-9))

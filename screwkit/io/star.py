@@ -74,7 +74,7 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import compound_groups, compound_legs
 from screwkit.io.couplings import check_couplings
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
-from screwkit.io.locking import platform_moves
+from screwkit.io.locking import platform_motions
 from screwkit.io.output import output_frame, platform_body
 from screwkit.io.rounding import drawn_lines, held_limits, turned_joint
 from screwkit.io.star_plane import idle_about_the_meeting_point, in_plane, nearly_planar, planar_loops, planar_normal
@@ -189,8 +189,9 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
 def _refuse_beyond(tree: ClosedTree, after: list[int], what: str, data, platform: int, scale: float) -> None:
     """Refuse a closure that ends on joints ``after`` between the platform body and it (``what`` says so), with the
     options that hold them (the bodies beyond then move with the platform as one body: two platforms joined by a
-    ball, analysed as one) where the platform then still moves (:func:`~screwkit.io.locking.platform_moves`: held,
-    a four-bar's coupler and rocker hinges beyond its crank leave a structure), else naming ``--output``; with an
+    ball, analysed as one) where the platform then keeps every motion (:func:`~screwkit.io.locking.platform_motions`:
+    held, a four-bar's coupler and rocker hinges beyond its crank leave a structure, a five-bar leg's knee beyond its
+    foot one motion of two), else naming ``--output``; with an
     actuated joint among them, no such advice (held, it would drive nothing: the platform carries the actuator,
     which drives the loop from there) but the graph's reading, which models it."""
     names = list(dict.fromkeys(tree.written_joint(tree.model.names[j]) for j in after))
@@ -201,9 +202,12 @@ def _refuse_beyond(tree: ClosedTree, after: list[int], what: str, data, platform
     them = "it" if len(names) == 1 else "them"
     held = (f"{tree.source}: {what}; --lock {' --lock '.join(names)} holds {them} where the file puts {them}, the "
             "bodies beyond moving with the platform as one body")
-    if not platform_moves(tree, data, platform, after, scale):
-        held = (f"{tree.source}: {what}; held, {'it' if len(names) == 1 else 'they'} would leave the platform no "
-                "motion (a structure): --output names another platform, a body the loops reach from the base")
+    left, whole = (platform_motions(tree, data, platform, held_joints, scale) for held_joints in (after, ()))
+    if left < whole:  # held, the loop's joints would take the platform's motions away (a five-bar leg's knee: 2 to 1)
+        lost = (f"leave the platform {left} of its {whole} motions" if left else "leave the platform no motion "
+                "(a structure)")
+        held = (f"{tree.source}: {what}; held, {'it' if len(names) == 1 else 'they'} would {lost}: --output names "
+                "another platform, a body the loops reach from the base")
     # the graph reading takes them as joints of the leg the closure ends (a slider-crank's rod hinged on the slider
     # taken as the platform, which held would not move); where it cannot, holding them is the advice
     raise LegWithLoops(held + GRAPH_HINT + ".", held=held + ".")
