@@ -9,6 +9,8 @@ names ``--output`` instead, and the coupler taken as the platform opens with the
 
 from __future__ import annotations
 
+import json
+
 import mujoco
 import numpy as np
 import pytest
@@ -126,3 +128,42 @@ def test_the_knee_reads_the_same_in_other_scales_and_a_moved_world(tmp_path, sca
     np.testing.assert_allclose([float(np.ravel(result.iti_actuators)[0]), result.lmti],
                                [sine(B - A, C - B), sine(C - B, C - D)], atol=1e-9)
 
+
+
+def _carrying_a_loop(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """The knee with a loop of its own on the coupler: two links hung from it, closed by a ``<connect>`` (a tool, as
+    a biped's ankle rods ride on the shin taken as the platform)."""
+    def at(*values) -> str:
+        return " ".join(repr(v * scale) for v in values)
+
+    ball = f'<geom type="sphere" size="{0.002 * scale!r}"/>'
+    tool = (f'<body name="tool_a" pos="{at(0.01, 0, 0)}"><joint name="ta" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="tool_a2" pos="{at(0.02, 0, 0)}"><joint name="ta2" type="hinge" axis="0 0 1"/>{ball}'
+            f'</body></body><body name="tool_b" pos="{at(0.01, 0.02, 0)}"><joint name="tb" type="hinge" '
+            f'axis="0 0 1"/>{ball}</body>')
+    text = four_bar_mjcf(scale=scale, world=world)
+    start = text.index('<joint name="coupler"')
+    end = text.index("/>", start) + 2
+    closure = f'<connect name="tool" body1="tool_b" body2="tool_a2" anchor="{at(0.01, -0.02, 0)}"/>'
+    return (text[:end] + tool + text[end:]).replace("</equality>", closure + "</equality>")
+
+
+@pytest.mark.parametrize("variant", ["m", "mm", "turned"])
+def test_a_loop_the_platform_carries_is_left_out(tmp_path, variant):
+    """A loop riding on the platform was refused by the serial reading ("a loop the platform carries"), whatever was
+    held, so that a biped's knee with its ankle rods on the shin could not be read. The graph reading leaves it out,
+    said, and reads the knee: the crank drives the coupler on its own path (ITI 1, as a graph reads a motor on the
+    platform's path), and the rocker's constraint force along DC, released, lets the coupler turn about B: CTI =
+    |sin(BC, DC)|."""
+    scale, unit, world = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
+                          "turned": (1.0, None, ("0.4 -0.3 1.1", "0.8 0.3 -0.4 0.33"))}[variant]
+    path = tmp_path / "carrying.xml"
+    path.write_text(_carrying_a_loop(scale, world))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert mobility(model, list(range(model.nv))) == 2  # the knee's motion and the tool's own
+    run = screwkit("analyze", path, "--output", "coupler", "--json", *(["--length-unit", unit] if unit else []))
+    assert run.returncode == 0, run.stderr
+    assert "joints ta, ta2, tb: a tool carried by the platform, not a leg: left out" in run.stdout
+    result = json.loads(run.stdout)
+    assert result["iti"] == pytest.approx(1.0, abs=1e-9)
+    assert result["cti"] == pytest.approx(sine(C - B, C - D), abs=1e-9)

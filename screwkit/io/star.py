@@ -129,11 +129,13 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
         bodies = [frame.name for frame in model.frames if int(frame.parentJoint) == platform
                   and str(frame.type) == "BODY"]
         named = f"body {bodies[0]!r}" if bodies else f"the body joint {model.names[platform]!r} turns"
-        raise ImportError_(f"{tree.source}: closure {closure.name!r} has both frames on the platform's side (the "
-                           f"platform: {named}, "
-                           + ("as --output names it" if tree.output else "taken as the file names none")
-                           + "): a loop the platform carries, which joins it to no leg; --output names another "
-                           "platform, a body the loops reach from the base.")
+        carried = (f"{tree.source}: closure {closure.name!r} has both frames on the platform's side (the platform: "
+                   f"{named}, " + ("as --output names it" if tree.output else "taken as the file names none")
+                   + "): a loop the platform carries, which joins it to no leg; --output names another platform, a "
+                   "body the loops reach from the base.")
+        # the graph reading leaves a loop the platform carries out (a foot's toe rods on the shin taken as the
+        # platform); where it refuses the file too, this is the reason given
+        raise LegWithLoops(carried, held=carried[:-1])
     after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
     frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
     kinds = [joint_kind(model, joint) for joint in after]
