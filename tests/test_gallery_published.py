@@ -607,3 +607,21 @@ def test_the_lab_robots_five_bar_has_the_textbook_pressure_angles_as_mujoco_plac
         itis, lmti = five_bar_pressure_angles(bases, elbows, point)
         np.testing.assert_allclose(list(found["iti_actuators"].values()), itis, atol=TOLERANCE)
         assert found["lmti"] == pytest.approx(lmti, abs=TOLERANCE)
+
+
+def test_gepetto_five_bar_says_beside_its_pose_that_the_pose_is_the_pins():
+    """Its output frame ``effector`` is 0.0675 m from the pin where the legs meet, which is the output point: the
+    pose printed is the pin's. That used to be said only in the conversion's report, after the indices; it is now
+    said beside the pose, with the distance as Pinocchio places the two frames, and the point's coordinates are the
+    pin's."""
+    path = GEPETTO / "5bar_linkage" / "robot.urdf"
+    tree, _, data = assembled(path)
+    pin.updateFramePlacements(tree.model, data)
+    effector = data.oMf[tree.model.getFrameId("effector")].translation
+    offset, normal = effector - joint_point(tree, data, "closedloop1_A"), joint_axis(tree, data, "mot1")
+    apart = np.linalg.norm(offset - (offset @ normal) * normal)  # in the plane of motion
+    run = screwkit("analyze", path)
+    assert run.returncode == 0, run.stderr
+    line = run.stdout.splitlines()[1]
+    assert line.startswith("  output: the point where the chains meet on body 'end_rod'")
+    assert f"{apart:.4g} m in the plane from frame 'effector'" in line

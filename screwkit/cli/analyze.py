@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import click
 import numpy as np
@@ -56,6 +57,14 @@ def _grounded(lines) -> str | None:
     return next((line.strip() for line in lines if GROUNDED in line), None)
 
 
+def _point_away(lines) -> str | None:
+    """From a converted file's report, its point output when it lies away from the frame the output was named by:
+    ``the point where the chains meet on body ..., 0.0158 m in the plane from frame ...``; else None."""
+    found = re.search(r"output (the point where the chains meet on body .*? ([0-9.e+-]+) \w+ (?:in the plane )?"
+                      r"from frame '[^']*')", lines[0]) if lines else None
+    return found.group(1) if found and float(found.group(2)) > 0 else None
+
+
 def print_report(report: dict) -> None:
     """The indices at one pose as text (from :meth:`screwkit.indices.results.Indices.to_dict`)."""
     pose = ", ".join(f"{k} = {v:g}" for k, v in report["pose"].items())
@@ -67,6 +76,9 @@ def print_report(report: dict) -> None:
     count = len(report["actuators"])
     click.echo(f"{report['mechanism']}: {count} actuator{'' if count == 1 else 's'}{guessed}, {report['dof']} DOF "
                f"({f'{redundancy} redundant' if redundancy else 'no redundancy'}), at {pose}{grounded}")
+    moved = _point_away(report.get("converted", []))
+    if moved:  # the pose is the meeting point's, not the named (or found) frame's: said beside it, not only at the end
+        click.echo(f"  output: {moved} (--output-type frame: the frame's)")
     if report.get("dependent"):
         click.echo("  dependent (parasitic) coordinates: "
                    + ", ".join(f"{k} = {v:.6g}" for k, v in report["dependent"].items()))
