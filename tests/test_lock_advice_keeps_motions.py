@@ -76,6 +76,7 @@ def test_holding_the_hinge_would_take_a_motion_away(leg):
     assert "--lock" not in str(refused.value)
     graph = graph_mechanism(read_closed_tree(path, output="toe", length_unit=unit))
     assert len(graph.task_axes) == 2
+    assert "output frame 'toe' on body 'foot'" in graph.report.lines()[0]  # the site named, not the body's frame
 
 
 def test_the_command_refuses_the_point_without_advising_the_hold(tmp_path):

@@ -476,7 +476,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     passive = [leg.name for leg in legs if not leg.actuators]
     if passive:  # said: a leg whose motor the file leaves out reads so too
         report.notes.append(f"leg(s) {', '.join(passive)}: no actuator, passive: each constrains the platform only")
-    report.output = f"the frame of body {report.platform_body!r}"
+    report.output = (f"the frame of body {report.platform_body!r}" if frame.name == report.platform_body
+                     else f"frame {frame.name!r} on body {report.platform_body!r}")  # (a site on it, named)
     report.task_coordinates = " ".join(SPATIAL_TASK_COORDINATES[a] for a in task_axes)
     return GraphMechanism(Path(tree.source).stem, tree, q, scale, platform, report.platform_body, tuple(legs),
                           tuple(chains), iti_points[0], oti_points[0], report, kinematics, frame_id, task_axes)
