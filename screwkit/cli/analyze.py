@@ -247,7 +247,8 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
     output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
     if by_actuators:
         raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by their platform only: leave out "
-                   "--actuators (give --pose with its task coordinates, or the output frame's x y z [roll pitch yaw]).")
+                   "--actuators (give --pose with its task coordinates, or the output frame's x y z [roll pitch yaw]; "
+                   "--initial JOINT VALUE on each actuator assembles the file with its actuators there).")
     try:
         graph.check_study(fault_type=analysis.fault_type)
     except ValueError as error:
