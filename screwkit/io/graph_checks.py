@@ -44,6 +44,13 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
                                f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
+        if screw.rigid_input is not None and not screw.rigid_input[0] and screw.outside[0] <= IN_LOOP_TOLERANCE:
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
+                               "the leg's other joints held it cannot move: it drives a loop that closes on the base, "
+                               "whose links then drive the rest; the power coefficient on its own twist would pair "
+                               "its motion with a wrench on links it never pushes); analysable when the actuated joint "
+                               "joins the base to the rest of its leg: the link it drives taken as the output "
+                               "(--output) reads its own transmission.")
         if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
             below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
                      if j in leg.joints and j != platform]

@@ -68,6 +68,39 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
     frames (6 rows for ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves
     with T plus the joints of ``joints`` beyond the platform, unless the leg is the platform's spine (the
     platform's own path is among its joints): then T is tied to the platform body's twist."""
+    matrix = _closure_matrix(state, joints, leg)
+    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
+    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(matrix.shape[0]), 1.0)
+    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
+    null = right[:, :, -6:] * (np.arange(right.shape[1])[None, :] >= rank[:, None])[:, :, None]
+    _, values, rows = np.linalg.svd(null, full_matrices=False)
+    return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
+
+
+def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bool_]:
+    """Whether the actuated joint moves with every other joint of ``leg`` held, its closures closed (n,): it joins
+    the base to the rest of the leg, which then turns rigidly about its twist (a Delta's or Stewart's leg driven from
+    the base). False where it moves inside a loop of the leg that closes on the base (an excavator's bucket cylinder,
+    pivoted on the arm and pushing a link pinned to the arm): its twist may still lie in the leg's twist system (a
+    planar leg's spans every planar twist), but the power coefficient on it would pair the actuator's motion with a
+    wrench acting on bodies it never pushes."""
+    matrix = _closure_matrix(state, [actuator], leg)
+    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
+    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(matrix.shape[0]), 1.0)
+    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
+    free = np.arange(right.shape[1])[None, :] >= rank[:, None]  # the null space's rows of right
+    width = len(_columns(state.kinematics, [actuator]))
+    return np.linalg.norm(right[:, :, :width] * free[:, :, None], axis=(1, 2)) > IN_LOOP_RATE
+
+
+IN_LOOP_RATE = 1e-6
+"""The actuated joint's rate, in a unit null vector of its leg's closures with every other joint held, above which it
+moves (:func:`drives_rigidly`)."""
+
+
+def _closure_matrix(state: _State, joints, leg: GraphLeg) -> NDArray:
+    """The rows (n, r, len(columns) + 6) of :func:`_twist_spaces`: the closures' relative velocities over the rates
+    of ``joints`` and the platform twist."""
     model, kinematics = state.model, state.kinematics
     columns = _columns(kinematics, joints)
     count = state.working.shape[0]
@@ -88,13 +121,7 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
         moves = kinematics.supports(model, state.platform)[columns]
         own = np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
         blocks.append(np.concatenate([own, np.broadcast_to(-np.eye(6), (count, 6, 6))], axis=2))
-    matrix = np.concatenate(blocks, axis=1)
-    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
-    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(count), 1.0)
-    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
-    null = right[:, :, -6:] * (np.arange(right.shape[1])[None, :] >= rank[:, None])[:, :, None]
-    _, values, rows = np.linalg.svd(null, full_matrices=False)
-    return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
+    return np.concatenate(blocks, axis=1)
 
 
 HINGES = ("revolute", "unbounded")
@@ -251,6 +278,7 @@ class LegScrews:
     iti_point: NDArray[np.float64]
     oti_point: NDArray[np.float64]
     outside: NDArray[np.float64]
+    rigid_input: NDArray[np.bool_] | None = None  # (:func:`drives_rigidly`, for a leg that is not the platform's path)
 
 
 def model_name(tree: ClosedTree, joint: int) -> str:
@@ -296,7 +324,8 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         iti_point = np.mean(iti, axis=0)
         at = _actuator_point(state, actuator, iti_point)
         out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.mean(oti, axis=0),
-                             np.linalg.norm(own - projection, axis=1)))
+                             np.linalg.norm(own - projection, axis=1),
+                             None if leg.spine else drives_rigidly(state, leg, actuator)))
     return out, state
 
 

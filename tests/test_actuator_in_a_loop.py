@@ -1,0 +1,108 @@
+"""An excavator's bucket linkage: the cylinder drives a loop that closes on the base, and that loop drives the rest.
+
+The cylinder is pivoted on the base (the arm) at I and pushes the H link at J; the H link is pinned to the base at K,
+and carries at J' the side link that turns the bucket, pinned to the base at M, at L (a published MuJoCo excavator,
+KennyVilella/excavator_simulator_mujoco, writes its bucket so). Read as a graph with the bucket as output, the
+cylinder's leg (barrel, rod, H link, side link) gave ITI = |cos| of the side link to the cylinder, two bodies that
+never push on each other (0.6886 here; the published file read 0.9570 where the cylinder's own pressure angle is
+0.6987): the cylinder's twist lies in the leg's twist system (a planar leg allows every planar twist), which is all
+that was checked. Now an actuated joint must move with its leg's other joints held (``drives_rigidly``): this one
+cannot, and the leg is refused. The H link taken as the output reads the cylinder's own transmission: ITI 1 (the
+force along the cylinder) and OTI |sin(IJ, KJ)|, here from MuJoCo's placement of the joints, in m, mm and a turned
+world.
+"""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import one_line_error, screwkit
+from screwkit.io import ImportError_, read_closed_tree
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+I, J, K = np.array([0.0, 0.0, 0.0]), np.array([0.25, 0.17, 0.0]), np.array([0.3, 0.05, 0.0])
+JP, M, L = np.array([0.32, 0.2, 0.0]), np.array([0.5, -0.1, 0.0]), np.array([0.55, 0.15, 0.0])
+"""The cylinder's pivot I, its rod's end J on the H link, the H link's pivot K, the side link's pin J' on the H link,
+the bucket's pivot M, the side link's pin L on the bucket (the plane z = 0, every hinge along z)."""
+
+
+def bucket_linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """The linkage's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat``)."""
+    def at(point) -> str:
+        return " ".join(repr(float(v) * scale) for v in point)
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    ram = (J - I) / np.linalg.norm(J - I)
+    return (f'<mujoco model="bucket_linkage"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
+            f'<body name="barrel" pos="{at(I)}"><joint name="pivot" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="rod"><joint name="ram" type="slide" axis="{" ".join(repr(float(v)) for v in ram)}"/>{ball}'
+            f'<body name="hlink" pos="{at(J - I)}"><joint name="hpin" type="hinge" axis="0 0 1"/>{ball}'
+            '</body></body></body>'
+            f'<body name="bucket" pos="{at(M)}"><joint name="bpivot" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="side" pos="{at(L - M)}"><joint name="sidepin" type="hinge" axis="0 0 1"/>{ball}'
+            '</body></body></body></worldbody><equality>'
+            f'<connect name="hpivot" body1="hlink" body2="base" anchor="{at(K - J)}"/>'
+            f'<connect name="side_end" body1="side" body2="hlink" anchor="{at(JP - L)}"/>'
+            '</equality><actuator><motor name="m" joint="ram"/></actuator></mujoco>')
+
+
+VARIANTS = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
+            "turned": (1.0, None, ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"))}
+
+
+@pytest.fixture(params=sorted(VARIANTS))
+def linkage(request, tmp_path):
+    scale, unit, world = VARIANTS[request.param]
+    path = tmp_path / f"bucket_{request.param}.xml"
+    path.write_text(bucket_linkage(scale, world))
+    return path, unit
+
+
+def _sine(u, v) -> float:
+    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
+
+
+def _mujoco_points(path) -> dict[str, np.ndarray]:
+    """I, J and K as MuJoCo places them at the file's configuration (closed: its connects' residuals are zero)."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
+    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 1  # one motion
+    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    hlink = model.body("hlink").id
+    pivot = data.xpos[hlink] + data.xmat[hlink].reshape(3, 3) @ model.eq_data[0][:3]  # the connect's point on it
+    return {"I": anchor["pivot"], "J": anchor["hpin"], "K": pivot}
+
+
+def test_the_bucket_is_refused_as_driven_through_a_loop(linkage):
+    path, unit = linkage
+    with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel' \\(with the leg's other "
+                                           "joints held it cannot move"):
+        graph_mechanism(read_closed_tree(path, output="bucket", length_unit=unit))
+
+
+def test_the_h_link_reads_the_cylinders_own_transmission(linkage):
+    path, unit = linkage
+    mechanism = load(path, output="hlink", length_unit=unit)  # (serial legs: the H link's pivot, the cylinder)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    points = _mujoco_points(path)
+    assert float(result.iti) == pytest.approx(1.0, abs=1e-9)  # the force along the cylinder, on its own slide
+    assert float(result.lmti) == pytest.approx(_sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
+    assert _sine(J - I, J - K) == pytest.approx(0.97959, abs=1e-5)
+
+
+def test_the_command_refuses_the_bucket_and_reads_the_h_link(tmp_path):
+    path = tmp_path / "bucket.xml"
+    path.write_text(bucket_linkage())
+    one_line_error(screwkit("analyze", path, "--output", "bucket"), "--output")
+    read = screwkit("analyze", path, "--output", "hlink", "--json")
+    assert read.returncode == 0, read.stderr
+    result = json.loads(read.stdout)
+    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
