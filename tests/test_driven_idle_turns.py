@@ -7,9 +7,14 @@ on a circle whatever the hip does, and the hip motor's motion, the thigh turning
 the point output's idle turn. The published leg read "2 actuators, 1 DOF (1 redundant)", F_O1 0.2435, where it
 has no redundancy.
 
-Now the idle turns of a point output must be free with every actuator held; a point output whose turns an actuator
-drives is refused, and left to screwkit (no ``--output-type``), the file is read with the frame of the body the
-closure joins instead. The frame reading's indices are the leg's pressure angles as MuJoCo places its joints: the
+Now the idle turns of a point output are checked: free with every actuator held, at the reference assembly and at
+closed configurations a step away along each platform motion (the pin drawn on the line of the knee and the ankle,
+where the held leg frees the turn to first order, hid it). Where an actuator drives them, a file whose output type
+is left to screwkit is read with the frame of the body the closure joins instead, and a point output asked for reads
+the point's indices alone with a note that says so. A five-bar whose platform turns freely on the pin where its
+legs meet keeps its point output and the textbook pressure angles.
+
+The frame reading's indices are the leg's pressure angles as MuJoCo places its joints: the
 hip drives the thigh through the lower link, whose line K-A carries its force (ITI = |sin| of upper link to lower
 link; with the servo held the thigh turns about the horn's pin P, so OTI = |sin| of the line K-A to the line P-A);
 the servo's force through P normal to the horn (ITI = OTI = 1).
@@ -24,7 +29,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import screwkit
 from screwkit.closure.forward_kinematics import forward
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -33,8 +38,9 @@ PIN = np.array([0.1, 0.11, 0.0])
 """The horn's pin on the thigh, in the world at the file's configuration."""
 
 
-def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
-    """The leg's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat`` texts)."""
+def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01)) -> str:
+    """The leg's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat`` texts), the
+    pin at ``pin`` on the horn (from its pivot)."""
     def at(*values) -> str:
         return " ".join(repr(v * scale) for v in values)
 
@@ -46,7 +52,7 @@ def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
             '</body></body></body>'
             f'<body name="horn" pos="{at(0.06, 0.12, 0)}"><joint name="servo" type="hinge" axis="0 0 1"/>{ball}'
             '</body></body></worldbody><equality>'
-            f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(0.04, -0.01, 0)}"/></equality>'
+            f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(*pin, 0)}"/></equality>'
             '<actuator><motor name="m1" joint="hip"/><motor name="m2" joint="servo"/></actuator></mujoco>')
 
 
@@ -111,18 +117,63 @@ def test_the_leg_reads_two_dof_and_its_pressure_angles(leg):
         assert float(result.lmti) == pytest.approx(oti, abs=1e-9)  # the servo's OTI is 1
 
 
-def test_a_point_output_there_is_refused(leg):
+def test_a_point_output_asked_for_reads_the_point_alone_and_says_so(leg):
     path, unit = leg
-    with pytest.raises(ValueError, match="an actuator turns the platform about the output point"):
-        load(path, length_unit=unit, output="thigh", output_type="point")
+    mechanism = load(path, length_unit=unit, output="thigh", output_type="point")
+    assert mechanism.dof == 1 and mechanism.output_point is not None
+    assert any(note.startswith("point output: an actuator turns the platform") for note in mechanism.assembly_notes)
 
 
-def test_the_command_reads_the_frame_and_refuses_the_point(tmp_path):
+@pytest.mark.parametrize("off", [0.0, 1e-6])
+def test_a_pin_on_the_line_of_knee_and_ankle_does_not_hide_the_driven_turn(tmp_path, off):
+    """The pin on the line through the knee K and the ankle A (A + (K->A)/2 = (0.145, 0.115), 0.085 and -0.005 from
+    the horn's pivot): with both motors held the thigh turns about it to first order, so at the file's
+    configuration the turn looks free; a step away it is driven."""
+    path = tmp_path / "leg.xml"
+    path.write_text(leg_mjcf(pin=(0.085, -0.005 + off)))
+    mechanism = load(path)
+    assert mechanism.dof == 2 and mechanism.output_point is None
+
+
+def five_bar_on_a_pin() -> str:
+    """A five-bar whose platform hangs on distal link 1 by a hinge at P, distal link 2 pinned to it there: the
+    platform turns freely about P, the point where the legs meet."""
+    return ('<mujoco model="pinned"><worldbody><body name="base">'
+            '<body name="crank1"><joint name="m1" type="hinge" axis="0 0 1"/><geom type="sphere" size="0.005"/>'
+            '<body name="distal1" pos="0.03 0.1 0"><joint name="p1" type="hinge" axis="0 0 1"/>'
+            '<geom type="sphere" size="0.005"/><body name="platform" pos="0.07 0.1 0"><joint name="spin" '
+            'type="hinge" axis="0 0 1"/><geom type="sphere" size="0.005"/></body></body></body>'
+            '<body name="crank2" pos="0.2 0 0"><joint name="m2" type="hinge" axis="0 0 1"/>'
+            '<geom type="sphere" size="0.005"/><body name="distal2" pos="-0.03 0.1 0"><joint name="p2" '
+            'type="hinge" axis="0 0 1"/><geom type="sphere" size="0.005"/></body></body></body></worldbody>'
+            '<equality><connect name="pin" body1="distal2" body2="platform" anchor="-0.07 0.1 0"/></equality>'
+            '<actuator><motor joint="m1"/><motor joint="m2"/></actuator></mujoco>')
+
+
+def test_a_platform_turning_freely_on_the_pin_keeps_its_point_output(tmp_path):
+    path = tmp_path / "pinned.xml"
+    path.write_text(five_bar_on_a_pin())
+    mechanism = load(path, output="platform")
+    assert mechanism.dof == 2 and mechanism.output_point is not None
+    assert not any(note.startswith("point output:") for note in mechanism.assembly_notes)
+    a1, a2, b1, b2, p = (np.array(v) for v in ([0, 0], [0.2, 0], [0.03, 0.1], [0.17, 0.1], [0.1, 0.2]))
+
+    def sine(u, v):
+        return abs(float(u[0] * v[1] - u[1] * v[0])) / np.linalg.norm(u) / np.linalg.norm(v)
+
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    np.testing.assert_allclose(sorted(np.ravel(result.iti_actuators)), sorted([sine(b1 - a1, p - b1),
+                                                                             sine(b2 - a2, p - b2)]), atol=1e-9)
+    assert float(result.lmti) == pytest.approx(sine(p - b1, p - b2), abs=1e-9)
+
+
+def test_the_command_reads_the_frame_and_says_so_for_the_point(tmp_path):
     path = tmp_path / "leg.xml"
     path.write_text(leg_mjcf())
     read = screwkit("analyze", path, "--json")
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
     assert result["dof"] == 2 and result["f_o"] == {"1": 0.0}
-    refused = screwkit("analyze", path, "--output", "thigh", "--output-type", "point")
-    one_line_error(refused, "an actuator turns the platform about the output point", "--output-type frame")
+    point = screwkit("analyze", path, "--output", "thigh", "--output-type", "point")
+    assert point.returncode == 0, point.stderr
+    assert "2 actuators, 1 DOF" in point.stdout and "point output: an actuator turns the platform" in point.stderr

@@ -612,8 +612,7 @@ def test_the_lab_robots_five_bar_has_the_textbook_pressure_angles_as_mujoco_plac
 def test_gepetto_five_bar_says_beside_its_pose_that_the_pose_is_the_pins():
     """Its output frame ``effector`` is 0.0675 m from the pin where the legs meet, which is the output point: the
     pose printed is the pin's. That used to be said only in the conversion's report, after the indices; it is now
-    said beside the pose, with the distance as Pinocchio places the two frames, and the point's coordinates are the
-    pin's."""
+    said beside the pose, with the distance as Pinocchio places the two frames."""
     path = GEPETTO / "5bar_linkage" / "robot.urdf"
     tree, _, data = assembled(path)
     pin.updateFramePlacements(tree.model, data)

@@ -200,7 +200,7 @@ def test_a_gepetto_style_urdf_and_yaml_with_open_loops_is_assembled(tmp_path):
     assert report.locked == ["closure_2a"]  # coaxial with the welded pin closure_2b: the idle DoF
     assert report.planar is True  # every axis along z: planar, the 3d closure written as a pin about z
     assert report.output.startswith("the point where the chains meet on body 'distal_1'")
-    assert report.output.endswith("0 m in the plane from frame 'effector'")
+    assert report.output.endswith("at frame 'effector'")  # (the point and the frame one, to the rounding)
     mechanism = load(tmp_path / "robot.urdf")
     assert mechanism.dof == 2 and mechanism.actuator_names[0].endswith("mot1")
     points = poses_near_home()

@@ -58,11 +58,12 @@ def _grounded(lines) -> str | None:
 
 
 def _point_away(lines) -> str | None:
-    """From a converted file's report, its point output when it lies away from the frame the output was named by:
-    ``the point where the chains meet on body ..., 0.0158 m in the plane from frame ...``; else None."""
-    found = re.search(r"output (the point where the chains meet on body .*? ([0-9.e+-]+) \w+ (?:in the plane )?"
-                      r"from frame '[^']*')", lines[0]) if lines else None
-    return found.group(1) if found and float(found.group(2)) > 0 else None
+    """From a converted file's report, its point output when it lies away from the frame the output was named by
+    (further than the file's rounding: ``the point where the chains meet on body ..., 0.0158 m in the plane from frame
+    ...``, where one at the frame reads ``at frame ...``); else None."""
+    found = re.search(r"output (the point where the chains meet on body .*? from frame '[^']*')", lines[0]) \
+        if lines else None
+    return found.group(1) if found else None
 
 
 def print_report(report: dict) -> None:

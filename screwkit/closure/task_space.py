@@ -38,9 +38,6 @@ __all__ = [
     "infer_task_axes",
     "choose_task_axes",
     "driven_idle_turns",
-    "check_idle_turns",
-    "DrivenIdleTurns",
-    "DRIVEN_TURNS",
 ]
 
 TRANSLATIONAL = np.sqrt(0.5)
@@ -322,30 +319,15 @@ def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values, *, 
     return dof, basis
 
 
-class DrivenIdleTurns(ValueError):
-    """A point output whose turns about the point an actuator drives (:func:`check_idle_turns`): a file of another
-    tool whose output type the user left to screwkit is read with its frame instead."""
-
-
-DRIVEN_TURNS = ("an actuator turns the platform about the output point (a point on a link that one leg holds on a "
-                "circle, the other actuators turning the rest about it): a point output counts that motion as none, "
-                "and would read the actuators driving it as redundant; take a frame for the output (--output-type "
-                "frame, or --output naming another body's frame)")
-
-
-def check_idle_turns(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> None:
-    """:class:`DrivenIdleTurns` when a point output's idle turns are driven (:func:`driven_idle_turns`)."""
-    if driven_idle_turns(mechanism, np.asarray(full_pose, dtype=float), joint_values, dof):
-        raise DrivenIdleTurns(str(mechanism.description.fail("<output type='point'>", DRIVEN_TURNS)))
-
-
 def driven_idle_turns(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> bool:
     """Whether a point output's idle turns are driven: the platform's motions (``dof`` of them at the closed
     configuration ``full_pose``) that keep the point still, which a point output counts as none, are not all
     allowed with every actuator held (an actuator drives one: a leg's output point on a crank, the other motor
     turning the leg's links about it: a published rat robot's five-bar leg read 2 actuators as 1 DOF, 1 redundant,
     F_O1 0.2435, where it has 2 DOF and no redundancy)."""
-    _, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
+    dofs, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
+    if int(dofs[0]) != dof:  # a singular configuration: another number of motions, nothing to tell
+        return False
     space = basis[0][:, :dof]
     translations = space[~mechanism.pose_angular]
     _, singular, rows = np.linalg.svd(translations, full_matrices=True)

@@ -134,8 +134,8 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                    + "): a loop the platform carries, which joins it to no leg; --output names another platform, a "
                    "body the loops reach from the base.")
         # the graph reading leaves a loop the platform carries out (a foot's toe rods on the shin taken as the
-        # platform); where it refuses the file too, this is the reason given
-        raise LegWithLoops(carried, held=carried[:-1])
+        # platform); where it refuses the file too, its own reason is given
+        raise LegWithLoops(carried[:-1] + GRAPH_HINT + ".")
     after = b_path[b_path.index(platform) + 1:]  # joints between the platform body and frame b
     frame_a = homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a
     kinds = [joint_kind(model, joint) for joint in after]
@@ -391,10 +391,10 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
                            "point; they do not.")
     if point:
-        offset = in_plane(output_world[:3, 3] - centres[0], normal)  # the distance in the plane of motion
-        report.output = (f"the point where the chains meet on body {body!r} (closure {legs[1].closure!r}), "
-                         f"{float(np.linalg.norm(offset)):.4g} {tree.unit} "
-                         f"{'in the plane ' if normal is not None else ''}from frame {frame.name!r}")
+        offset = float(np.linalg.norm(in_plane(output_world[:3, 3] - centres[0], normal)))  # in the plane of motion
+        where = (f"at frame {frame.name!r}" if offset <= FILE_ROUNDING * scale else  # (one point, to the rounding)
+                 f"{offset:.4g} {tree.unit} {'in the plane ' if normal is not None else ''}from frame {frame.name!r}")
+        report.output = f"the point where the chains meet on body {body!r} (closure {legs[1].closure!r}), {where}"
     else:
         report.output = f"frame {frame.name!r} on body {body!r}"
     platform_world = np.eye(4)
