@@ -266,6 +266,28 @@ def _largest_changes(model, change: NDArray, unit: str) -> str:
     return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
 
 
+def _without_carried_loops(tree: ClosedTree, platform: int, report: ImportReport) -> list[Closure]:
+    """The closures but the loops the platform carries (both frames beyond the platform: an excavator's arm and
+    bucket linkages on its boom taken as the platform), left out and said, as the graph reading leaves out a tool
+    the platform carries; all of them where another closure onto the platform ends beyond it through a joint such a
+    loop moves (the loop may hold that joint)."""
+    model = tree.model
+
+    def beyond(joint: int) -> list[int]:
+        path = path_to(model, joint)
+        return path[path.index(platform) + 1:] if platform in path else []
+
+    carried = [c for c in tree.closures if platform in path_to(model, c.joint_a) and platform in
+               path_to(model, c.joint_b)]
+    moved = {j for c in carried for j in beyond(c.joint_a) + beyond(c.joint_b)}
+    others = [c for c in tree.closures if c not in carried]
+    if not carried or any(set(beyond(c.joint_a) + beyond(c.joint_b)) & moved for c in others):
+        return list(tree.closures)
+    report.notes.append(f"closure(s) {', '.join(repr(c.name) for c in carried)}: loop(s) the platform carries (both "
+                        "frames beyond it), joined to no leg: left out, moving with the platform")
+    return others
+
+
 def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     """The URDF text of a closed tree in screwkit's convention, and what was done (see the module docstring)."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
@@ -290,10 +312,11 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         raise ImportError_(f"{tree.source}: the output frame {frame.name!r} is on the fixed base.")
     body = report.platform_body = platform_body(model, frame_index)
     spine = _Leg(path_to(model, platform), "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
+    closures = _without_carried_loops(tree, platform, report)
     onto_platform = [platform in path_to(model, c.joint_a) or platform in path_to(model, c.joint_b)
-                     for c in tree.closures]
-    couplings = [c for c, onto in zip(tree.closures, onto_platform) if not onto]
-    legs = [spine] + _platform_legs(tree, data, [c for c, onto in zip(tree.closures, onto_platform) if onto],
+                     for c in closures]
+    couplings = [c for c, onto in zip(closures, onto_platform) if not onto]
+    legs = [spine] + _platform_legs(tree, data, [c for c, onto in zip(closures, onto_platform) if onto],
                                     platform, scale, report)
     chain_joints = set(path_to(model, platform))
     if len(legs) == 1 and not any(chain_joints & set(path_to(model, end)) for closure in tree.closures
