@@ -2,8 +2,8 @@
 MuJoCo Menagerie's ``toddlerbot_2xc_fixed.xml``, MIT, in ``tests/data/gallery/excerpts``), whose motor rides on
 the head and turns a plate that two rods hold to the yaw link (a parallelogram drawn 7 micrometres off).
 
-* With no ``--output``, the body taken as the platform carries the loop: the refusal names that body and
-  ``--output``.
+* With no ``--output``, the body taken as the platform carries the loop, which is left out: then no loop acts on
+  it, and the refusal names that body and ``--output``.
 * With ``--output head``, the serial-leg reading advised ``--lock neck_pitch_act --lock neck_pitch_front``: holding
   the only actuator, which then ends in "no leg has an actuator". It now hands the file to the graph reading, which
   advises holding the yaw joint that carries the head and the motor (not the head's own pin), and then says the
@@ -25,8 +25,8 @@ PITCH_SIDE = ("neck_pitch", "neck_pitch_act", "neck_pitch_front", "neck_pitch_ba
 
 
 def test_a_platform_that_carries_the_loop_is_named_with_the_option_that_moves_it():
-    one_line_error(screwkit("info", NECK), "closure 'connect_1' has both frames on the platform's side",
-                   "body 'neck_yaw_link'", "taken as the file names none", "--output names another platform")
+    one_line_error(screwkit("info", NECK), "no loop acts on the platform 'neck_yaw_link'",
+                   "name another --output, on a body the loops reach")
 
 
 def test_the_advice_holds_no_actuator_and_ends_where_mujoco_finds_the_neck_rigid_as_written():

@@ -319,7 +319,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     legs = [spine] + _platform_legs(tree, data, [c for c, onto in zip(closures, onto_platform) if onto],
                                     platform, scale, report)
     chain_joints = set(path_to(model, platform))
-    if len(legs) == 1 and not any(chain_joints & set(path_to(model, end)) for closure in tree.closures
+    if len(legs) == 1 and not any(chain_joints & set(path_to(model, end)) for closure in closures
                                   for end in (closure.joint_a, closure.joint_b)):
         # every loop closes away from the platform's chain (the joints held may have made it so)
         chain = ", ".join(tree.written_joint(model.names[j]) for j in path_to(model, platform))
