@@ -83,8 +83,8 @@ def _mujoco_points(path) -> dict[str, np.ndarray]:
 
 def test_the_bucket_is_refused_as_driven_through_a_loop(linkage):
     path, unit = linkage
-    with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel' \\(with the leg's other "
-                                           "joints held it cannot move"):
+    with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel' \\(with the other joints of "
+                                           "its path to the platform held it cannot move"):
         graph_mechanism(read_closed_tree(path, output="bucket", length_unit=unit))
 
 
@@ -106,3 +106,48 @@ def test_the_command_refuses_the_bucket_and_reads_the_h_link(tmp_path):
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
     assert (result["iti"], result["lmti"]) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+
+
+def doubled_crank(distal_on: str) -> str:
+    """A five-bar whose second crank A2-B2 is doubled by a parallelogram (coupler B2-B3, crank A3-B3 on the base), its
+    distal link B2-P hinged on the crank itself (``distal_on="crank"``) or on the coupler, at B2 too."""
+    def at(point) -> str:
+        return " ".join(repr(float(v)) for v in point)
+
+    ball = '<geom type="sphere" size="0.005"/>'
+    a2, b2, a3, b3, p, b1 = (np.array(v, dtype=float) for v in ((0.2, 0, 0), (0.17, 0.1, 0), (0.25, 0, 0),
+                                                                  (0.22, 0.1, 0), (0.1, 0.2, 0), (0.03, 0.1, 0)))
+    distal = f'<body name="distal2" pos="{at(b2 - a2)}"><joint name="p2" type="hinge" axis="0 0 1"/>{ball}</body>'
+    inner = f'<body name="distal2"><joint name="p2" type="hinge" axis="0 0 1"/>{ball}</body>'
+    coupler = (f'<body name="coupler" pos="{at(b2 - a2)}"><joint name="c2" type="hinge" axis="0 0 1"/>{ball}'
+               + (inner if distal_on == "coupler" else "") + "</body>")
+    return (f'<mujoco model="doubled"><worldbody><body name="base">'
+            f'<body name="crank1"><joint name="m1" type="hinge" axis="0 0 1"/>{ball}'
+            f'<body name="distal1" pos="{at(b1)}"><joint name="p1" type="hinge" axis="0 0 1"/>{ball}</body></body>'
+            f'<body name="crank2" pos="{at(a2)}"><joint name="m2" type="hinge" axis="0 0 1"/>{ball}{coupler}'
+            + (distal if distal_on == "crank" else "") + '</body>'
+            f'<body name="crank3" pos="{at(a3)}"><joint name="m3" type="hinge" axis="0 0 1"/>{ball}</body>'
+            '</body></worldbody><equality>'
+            f'<connect name="para" body1="crank3" body2="coupler" anchor="{at(b3 - a3)}"/>'
+            f'<connect name="pin" body1="distal2" body2="distal1" anchor="{at(p - b2)}"/>'
+            '</equality><actuator><motor joint="m1"/><motor joint="m2"/></actuator></mujoco>')
+
+
+def test_a_crank_doubled_by_a_parallelogram_off_its_path_drives_its_leg(tmp_path):
+    """The parallelogram off the crank's path to the platform follows it and carries none of the load (its coupler
+    and third crank are two-force members that cannot balance each other at B3): the leg's input is the crank's,
+    ITI = |sin(A2B2, B2P)|, the textbook five-bar's, as before. Drawn with the distal link on the coupler, at the
+    same pin B2, the loop runs through the crank's path and the leg is refused (where the coupler carries the distal
+    link elsewhere than the crank's tip, the load is shared and the old reading was wrong)."""
+    a2, b2, p = np.array([0.2, 0.0, 0.0]), np.array([0.17, 0.1, 0.0]), np.array([0.1, 0.2, 0.0])
+    path = tmp_path / "doubled.xml"
+    path.write_text(doubled_crank("crank"))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 2  # closed, 2 DOF
+    result = graph_mechanism(read_closed_tree(path, output="distal1")).indices()
+    assert float(np.ravel(result.iti_actuators)[1]) == pytest.approx(_sine(b2 - a2, p - b2), abs=1e-9)
+    path.write_text(doubled_crank("coupler"))
+    with pytest.raises(ImportError_, match="'m2' moves inside a loop"):
+        graph_mechanism(read_closed_tree(path, output="distal1"))

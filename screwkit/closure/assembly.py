@@ -24,7 +24,7 @@ from screwkit.closure.chain_kinematics import (
 )
 from screwkit.closure.modes import describe_modes, meeting_modes, small_steps, values_at
 from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
-from screwkit.closure.point_turns import DRIVEN_NOTE, DRIVEN_TURNS, turns_driven
+from screwkit.closure.point_turns import check_turns
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
     TASK_RANK_TOLERANCE,
@@ -67,7 +67,7 @@ does not close, or the reference assembly is a constraint singularity, :func:`_m
 MODE_SAMPLES = 12
 """Samples added near a constraint-singular reference assembly to find the operation modes that meet there, of each
 kind (:func:`_mode_samples`)."""
-NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, MODES_MEET, DRIVEN_TURNS)
+NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, MODES_MEET)
 """The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
 DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
 """Relative: a singular value counted by :func:`mobility` (above :data:`MOTION_SPACE_TOLERANCE`) but at most this is
@@ -459,8 +459,7 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
-        if turns_driven(mechanism, at_pose, at_values, mobility):
-            mechanism = replace(mechanism, assembly_notes=mechanism.assembly_notes + (DRIVEN_NOTE,))
+        check_turns(mechanism, at_pose, at_values, mobility)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
     if mobility < 1 and idle:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "

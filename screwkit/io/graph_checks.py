@@ -46,11 +46,11 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
         if screw.rigid_input is not None and not screw.rigid_input[0] and screw.outside[0] <= IN_LOOP_TOLERANCE:
             raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
-                               "the leg's other joints held it cannot move: it drives a loop that closes on the base, "
-                               "whose links then drive the rest; the power coefficient on its own twist would pair "
-                               "its motion with a wrench on links it never pushes); analysable when the actuated joint "
-                               "joins the base to the rest of its leg: the link it drives taken as the output "
-                               "(--output) reads its own transmission.")
+                               "the other joints of its path to the platform held it cannot move: a loop through that "
+                               "path closes on the base and shares the load the leg carries, so the power coefficient "
+                               "on its own twist is not the leg's input); analysable when the actuated joint joins the "
+                               "base to the rest of its leg: the link it drives taken as the output (--output) reads "
+                               "its own transmission.")
         if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
             below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
                      if j in leg.joints and j != platform]

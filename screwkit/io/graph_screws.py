@@ -68,34 +68,45 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
     frames (6 rows for ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves
     with T plus the joints of ``joints`` beyond the platform, unless the leg is the platform's spine (the
     platform's own path is among its joints): then T is tied to the platform body's twist."""
-    matrix = _closure_matrix(state, joints, leg)
-    _, singular, right = np.linalg.svd(matrix, full_matrices=True)
-    largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(matrix.shape[0]), 1.0)
-    rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
-    null = right[:, :, -6:] * (np.arange(right.shape[1])[None, :] >= rank[:, None])[:, :, None]
+    right, free = _null_rows(_closure_matrix(state, joints, leg))
+    null = right[:, :, -6:] * free[:, :, None]
     _, values, rows = np.linalg.svd(null, full_matrices=False)
     return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
 
 
-def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bool_]:
-    """Whether the actuated joint moves with every other joint of ``leg`` held, its closures closed (n,): it joins
-    the base to the rest of the leg, which then turns rigidly about its twist (a Delta's or Stewart's leg driven from
-    the base). False where it moves inside a loop of the leg that closes on the base (an excavator's bucket cylinder,
-    pivoted on the arm and pushing a link pinned to the arm): its twist may still lie in the leg's twist system (a
-    planar leg's spans every planar twist), but the power coefficient on it would pair the actuator's motion with a
-    wrench acting on bodies it never pushes."""
-    matrix = _closure_matrix(state, [actuator], leg)
+def _null_rows(matrix: NDArray) -> tuple[NDArray, NDArray]:
+    """The right singular vectors (n, c, c) of ``matrix`` (n, r, c) and which of them (n, c) span its null space."""
     _, singular, right = np.linalg.svd(matrix, full_matrices=True)
     largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(matrix.shape[0]), 1.0)
     rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
-    free = np.arange(right.shape[1])[None, :] >= rank[:, None]  # the null space's rows of right
-    width = len(_columns(state.kinematics, [actuator]))
-    return np.linalg.norm(right[:, :, :width] * free[:, :, None], axis=(1, 2)) > IN_LOOP_RATE
+    return right, np.arange(right.shape[1])[None, :] >= rank[:, None]
+
+
+def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bool_]:
+    """Whether the actuated joint moves with the other joints of its own path in ``leg`` held, the leg's closures
+    closed (n,): the joints from the base to it and from it to where the leg meets the platform, the joints of loops
+    off that path left free (a parallelogram that doubles a crank follows it, and carries none of its load). It then
+    drives the leg as its first joint would, and the power coefficient on its twist is the leg's input (a Delta's or
+    Stewart's leg driven from the base). False where it moves inside a loop that closes on the base through its path
+    (an excavator's bucket cylinder, pivoted on the arm, pushing an H link pinned to the arm that carries the side
+    link): its twist may lie in the leg's twist system (a planar leg's holds every planar twist), but the power
+    coefficient on it would pair the actuator's motion with a wrench on links it never pushes."""
+    model = state.model
+    ends = [c.joint_b if state.platform in path_to(model, c.joint_a) else c.joint_a for c in leg.closures
+            if state.platform in path_to(model, c.joint_a) or state.platform in path_to(model, c.joint_b)]
+    path = set(path_to(model, actuator)) | {j for end in ends for j in path_to(model, end)
+                                            if actuator in path_to(model, j)}
+    free = [j for j in leg.joints if j == actuator or j not in path]
+    columns = _columns(state.kinematics, free)
+    right, null = _null_rows(_closure_matrix(state, free, leg))
+    own = np.isin(columns, _columns(state.kinematics, [actuator]))
+    return np.linalg.norm(right[:, :, :len(columns)][:, :, own] * null[:, :, None], axis=(1, 2)) > IN_LOOP_RATE
 
 
 IN_LOOP_RATE = 1e-6
-"""The actuated joint's rate, in a unit null vector of its leg's closures with every other joint held, above which it
-moves (:func:`drives_rigidly`)."""
+"""The actuated joint's rate in the unit null vectors of its leg's closure rows, with the other joints of its path
+held, above which it moves (:func:`drives_rigidly`; the rows' columns are joint rates in working coordinates, a
+slide's over the length scale, so that the verdict does not turn on the unit)."""
 
 
 def _closure_matrix(state: _State, joints, leg: GraphLeg) -> NDArray:
@@ -325,6 +336,8 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         at = _actuator_point(state, actuator, iti_point)
         out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.mean(oti, axis=0),
                              np.linalg.norm(own - projection, axis=1),
+                             # (a leg that is the platform's own path ties T to it: its input is checked by the
+                             # twist system's tests alone, as before)
                              None if leg.spine else drives_rigidly(state, leg, actuator)))
     return out, state
 

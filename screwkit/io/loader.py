@@ -20,7 +20,7 @@ import numpy as np
 
 from screwkit.closure.assembly import assemble, task_space
 from screwkit.closure.canonical import canonical_geometry
-from screwkit.closure.point_turns import DRIVEN_NOTE
+from screwkit.closure.point_turns import DrivenIdleTurns
 from screwkit.io import is_foreign, read_mechanism_file
 from screwkit.io.model_cache import load_cached
 from screwkit.model.builder import read_chains, read_platform
@@ -166,17 +166,20 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
             converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
                                                     actuate=actuate, length_unit=length_unit, initial=initial)
-            mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
-                                  converted_from=report.file_format)
-            if output_type is None and DRIVEN_NOTE in mechanism.assembly_notes:
+            try:
+                mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
+                                      converted_from=report.file_format)
+            except DrivenIdleTurns:
+                if output_type is not None:
+                    raise
                 # the point where the legs meet, taken by default: an actuator turns the platform about it, so the
                 # frame instead (the one --output names, else the platform body's)
                 body = report.platform_body
                 converted, report = read_mechanism_file(path, output=output or body, output_type="frame", lock=lock,
                                                         actuate=actuate, length_unit=length_unit, initial=initial)
                 report.notes.append(f"output the frame {output or body!r}, not the point where the legs meet on body "
-                                    f"{body!r}: an actuator turns it about that point (--output-type point reads "
-                                    "the point's indices alone)")
+                                    f"{body!r}: an actuator turns it about that point (--output-type point is "
+                                    "refused so)")
                 mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
                                       converted_from=report.file_format)
             return replace(mechanism, import_report=tuple(report.lines()))
