@@ -321,3 +321,17 @@ def assert_same_indices(got, expected, atol: float = 1e-12) -> None:
     for j in expected.f_o:
         np.testing.assert_allclose(got.f_o[j], expected.f_o[j], rtol=0, atol=atol)
     assert np.array_equal(got.instantaneous_dof, expected.instantaneous_dof)
+
+
+MJCF_WORLDS = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
+               "turned": (1.0, None, ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"))}
+"""An MJCF file written three ways for invariance tests: ``(scale, --length-unit, (base pos, base quat))``: in
+metres, every length times 1000 read in millimetres, and its base moved and turned in the world."""
+
+
+def mjcf_variant(tmp_path, name: str, variant: str, write) -> tuple:
+    """The file ``write(scale, world)`` gives, written as ``variant`` of :data:`MJCF_WORLDS`: (path, length unit)."""
+    scale, unit, world = MJCF_WORLDS[variant]
+    path = tmp_path / f"{name}_{variant}.xml"
+    path.write_text(write(scale, world))
+    return path, unit

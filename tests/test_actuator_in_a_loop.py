@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -52,16 +52,9 @@ def bucket_linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
             '</equality><actuator><motor name="m" joint="ram"/></actuator></mujoco>')
 
 
-VARIANTS = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
-            "turned": (1.0, None, ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"))}
-
-
-@pytest.fixture(params=sorted(VARIANTS))
+@pytest.fixture(params=sorted(MJCF_WORLDS))
 def linkage(request, tmp_path):
-    scale, unit, world = VARIANTS[request.param]
-    path = tmp_path / f"bucket_{request.param}.xml"
-    path.write_text(bucket_linkage(scale, world))
-    return path, unit
+    return mjcf_variant(tmp_path, "bucket", request.param, bucket_linkage)
 
 
 def _sine(u, v) -> float:

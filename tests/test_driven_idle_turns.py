@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
 from screwkit.closure.forward_kinematics import forward
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -57,16 +57,9 @@ def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01)) 
             '<actuator><motor name="m1" joint="hip"/><motor name="m2" joint="servo"/></actuator></mujoco>')
 
 
-VARIANTS = {"m": (1.0, None, ("0 0 0", "1 0 0 0")), "mm": (1000.0, "mm", ("0 0 0", "1 0 0 0")),
-            "turned": (1.0, None, ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"))}
-
-
-@pytest.fixture(params=sorted(VARIANTS))
+@pytest.fixture(params=sorted(MJCF_WORLDS))
 def leg(request, tmp_path):
-    scale, unit, world = VARIANTS[request.param]
-    path = tmp_path / f"leg_{request.param}.xml"
-    path.write_text(leg_mjcf(scale, world))
-    return path, unit
+    return mjcf_variant(tmp_path, "leg", request.param, leg_mjcf)
 
 
 def _mujoco_indices(path: Path, values: dict[str, float]) -> tuple[float, float]:
