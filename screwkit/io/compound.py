@@ -47,10 +47,12 @@ from numpy.typing import NDArray
 from screwkit.common.rotations import skew_matrix
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import (
+    GRAPH_HINT,
     ClosedTree,
     Closure,
     ImportError_,
     ImportReport,
+    LegWithLoops,
     assemble,
     ball_line,
     homogeneous,
@@ -375,8 +377,10 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
             rounding = max(rounding, absorbed)
         try:
             reduction = equivalent_constraint(systems, paths, normal)
-        except NotReducible as error:
-            raise ImportError_(f"{tree.source}: {label} cannot be written as serial chains: {error}.") from None
+        except NotReducible as error:  # the graph reading may model it (a crank doubled by a parallelogram off its
+            # path, its distal link hinged on the crank); where it refuses too, this reason stands
+            refusal = f"{tree.source}: {label} cannot be written as serial chains: {error}"
+            raise LegWithLoops(refusal + GRAPH_HINT + ".", held=refusal + ".") from None
         passive = [index for index in members if index not in actuated]
         removed.update(passive)
         first = legs[passive[0]] if passive else legs[members[0]]
