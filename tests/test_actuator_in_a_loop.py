@@ -32,24 +32,29 @@ JP, M, L = np.array([0.32, 0.2, 0.0]), np.array([0.5, -0.1, 0.0]), np.array([0.5
 the bucket's pivot M, the side link's pin L on the bucket (the plane z = 0, every hinge along z)."""
 
 
-def bucket_linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
-    """The linkage's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat``)."""
+def bucket_linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), reverse: bool = False) -> str:
+    """The linkage's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat``);
+    ``reverse``: the bucket's branch and the second closure written first."""
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
 
     ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
     ram = (J - I) / np.linalg.norm(J - I)
+    cylinder = (f'<body name="barrel" pos="{at(I)}"><joint name="pivot" type="hinge" axis="0 0 1"/>{ball}'
+                f'<body name="rod"><joint name="ram" type="slide" axis="{" ".join(repr(float(v)) for v in ram)}"/>'
+                f'{ball}<body name="hlink" pos="{at(J - I)}"><joint name="hpin" type="hinge" axis="0 0 1"/>{ball}'
+                '</body></body></body>')
+    bucket = (f'<body name="bucket" pos="{at(M)}"><joint name="bpivot" type="hinge" axis="0 0 1"/>{ball}'
+              f'<body name="side" pos="{at(L - M)}"><joint name="sidepin" type="hinge" axis="0 0 1"/>{ball}'
+              '</body></body>')
+    closures = [f'<connect name="hpivot" body1="hlink" body2="base" anchor="{at(K - J)}"/>',
+                f'<connect name="side_end" body1="side" body2="hlink" anchor="{at(JP - L)}"/>']
+    branches = [cylinder, bucket]
+    if reverse:
+        branches, closures = branches[::-1], closures[::-1]
     return (f'<mujoco model="bucket_linkage"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
-            f'<body name="barrel" pos="{at(I)}"><joint name="pivot" type="hinge" axis="0 0 1"/>{ball}'
-            f'<body name="rod"><joint name="ram" type="slide" axis="{" ".join(repr(float(v)) for v in ram)}"/>{ball}'
-            f'<body name="hlink" pos="{at(J - I)}"><joint name="hpin" type="hinge" axis="0 0 1"/>{ball}'
-            '</body></body></body>'
-            f'<body name="bucket" pos="{at(M)}"><joint name="bpivot" type="hinge" axis="0 0 1"/>{ball}'
-            f'<body name="side" pos="{at(L - M)}"><joint name="sidepin" type="hinge" axis="0 0 1"/>{ball}'
-            '</body></body></body></worldbody><equality>'
-            f'<connect name="hpivot" body1="hlink" body2="base" anchor="{at(K - J)}"/>'
-            f'<connect name="side_end" body1="side" body2="hlink" anchor="{at(JP - L)}"/>'
-            '</equality><actuator><motor name="m" joint="ram"/></actuator></mujoco>')
+            + "".join(branches) + '</body></worldbody><equality>' + "".join(closures)
+            + '</equality><actuator><motor name="m" joint="ram"/></actuator></mujoco>')
 
 
 @pytest.fixture(params=sorted(MJCF_WORLDS))
@@ -89,6 +94,16 @@ def test_the_h_link_reads_the_cylinders_own_transmission(linkage):
     assert float(result.iti) == pytest.approx(1.0, abs=1e-9)  # the force along the cylinder, on its own slide
     assert float(result.lmti) == pytest.approx(_sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
     assert _sine(J - I, J - K) == pytest.approx(0.97959, abs=1e-5)
+
+
+def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path):
+    path = tmp_path / "reversed.xml"
+    path.write_text(bucket_linkage(reverse=True))
+    with pytest.raises(ImportError_, match="'ram' moves inside a loop"):
+        graph_mechanism(read_closed_tree(path, output="bucket"))
+    mechanism = load(path, output="hlink")
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
 
 
 def test_the_command_refuses_the_bucket_and_reads_the_h_link(tmp_path):

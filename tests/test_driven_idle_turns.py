@@ -39,22 +39,26 @@ PIN = np.array([0.1, 0.11, 0.0])
 """The horn's pin on the thigh, in the world at the file's configuration."""
 
 
-def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01)) -> str:
+def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01), reverse: bool = False) -> str:
     """The leg's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat`` texts), the
-    pin at ``pin`` on the horn (from its pivot)."""
+    pin at ``pin`` on the horn (from its pivot); ``reverse``: the horn's branch and the servo's motor written first."""
     def at(*values) -> str:
         return " ".join(repr(v * scale) for v in values)
 
     ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    branches = [f'<body name="upper"><joint name="hip" type="hinge" axis="0 0 1"/>{ball}'
+                f'<body name="lower" pos="{at(0.1, -0.02, 0)}"><joint name="knee" type="hinge" axis="0 0 1"/>{ball}'
+                f'<body name="thigh" pos="{at(0.03, 0.09, 0)}"><joint name="ankle" type="hinge" axis="0 0 1"/>{ball}'
+                '</body></body></body>',
+                f'<body name="horn" pos="{at(0.06, 0.12, 0)}"><joint name="servo" type="hinge" axis="0 0 1"/>{ball}'
+                '</body>']
+    motors = ['<motor name="m1" joint="hip"/>', '<motor name="m2" joint="servo"/>']
+    if reverse:
+        branches, motors = branches[::-1], motors[::-1]
     return (f'<mujoco model="horn_leg"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
-            f'<body name="upper"><joint name="hip" type="hinge" axis="0 0 1"/>{ball}'
-            f'<body name="lower" pos="{at(0.1, -0.02, 0)}"><joint name="knee" type="hinge" axis="0 0 1"/>{ball}'
-            f'<body name="thigh" pos="{at(0.03, 0.09, 0)}"><joint name="ankle" type="hinge" axis="0 0 1"/>{ball}'
-            '</body></body></body>'
-            f'<body name="horn" pos="{at(0.06, 0.12, 0)}"><joint name="servo" type="hinge" axis="0 0 1"/>{ball}'
-            '</body></body></worldbody><equality>'
+            + "".join(branches) + '</body></worldbody><equality>'
             f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(*pin, 0)}"/></equality>'
-            '<actuator><motor name="m1" joint="hip"/><motor name="m2" joint="servo"/></actuator></mujoco>')
+            '<actuator>' + "".join(motors) + '</actuator></mujoco>')
 
 
 @pytest.fixture(params=sorted(MJCF_WORLDS))
@@ -133,6 +137,15 @@ def test_a_pin_on_the_line_of_knee_and_ankle_does_not_hide_the_driven_turn(tmp_p
     path.write_text(leg_mjcf(pin=(0.085, -0.005 + off)))
     mechanism = load(path)
     assert mechanism.dof == 2 and mechanism.output_point is None
+
+
+def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path):
+    path = tmp_path / "reversed.xml"
+    path.write_text(leg_mjcf(reverse=True))
+    mechanism = load(path)
+    assert mechanism.dof == 2 and mechanism.output_point is None
+    with pytest.raises(ValueError, match="an actuator turns the platform about the output point"):
+        load(path, output="thigh", output_type="point")
 
 
 def five_bar_on_a_pin() -> str:
