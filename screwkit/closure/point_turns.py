@@ -18,7 +18,7 @@ import numpy as np
 
 from screwkit.closure.modes import small_steps
 from screwkit.closure.solve import solve
-from screwkit.closure.task_space import driven_idle_turns, infer_task_axes
+from screwkit.closure.task_space import driven_idle_turns, infer_task_axes, still_motions
 from screwkit.model.mechanism import Mechanism
 
 __all__ = ["DrivenIdleTurns", "check_turns", "turns_driven"]
@@ -48,9 +48,13 @@ def turns_driven(mechanism: Mechanism, at_pose, at_values, dof: int) -> bool:
     """Whether an actuator drives a turn of the platform about its output point (``dof`` platform motions, before
     the point's own count) at ``at_pose`` (joint values ``at_values``, one array per chain) or at the closed
     configurations a step either way along each platform motion from the reference assembly."""
-    if driven_idle_turns(mechanism, np.asarray(at_pose, dtype=float), at_values, dof):
+    at_pose = np.asarray(at_pose, dtype=float)
+    still = still_motions(mechanism, at_pose, at_values, dof)
+    if still is not None and not still.shape[1]:  # no motion keeps the point still at a regular configuration, nor
+        return False  # generically (their number only grows where the translations' rank drops): no turn to drive
+    if driven_idle_turns(mechanism, at_pose, at_values, dof):
         return True
-    axes = tuple(int(a) for a in infer_task_axes(mechanism, np.asarray(at_pose, dtype=float), at_values, dof))
+    axes = tuple(int(a) for a in infer_task_axes(mechanism, at_pose, at_values, dof))
     following = replace(mechanism, dof=dof, task_axes=axes if dof < mechanism.n_pose else (), held_axes=())
     home = mechanism.home_full_pose[list(following.task_indices)]
     following = replace(following, named_poses={"home": home})

@@ -37,6 +37,7 @@ __all__ = [
     "motion_space_at",
     "infer_task_axes",
     "choose_task_axes",
+    "still_motions",
     "driven_idle_turns",
 ]
 
@@ -319,20 +320,26 @@ def motion_space_at(mechanism: Mechanism, full_poses: NDArray, joint_values, *, 
     return dof, basis
 
 
+def still_motions(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> NDArray | None:
+    """The platform's motions (columns of pose-coordinate rates) that keep a point output still, at the closed
+    configuration ``full_pose`` (``joint_values`` one array per chain) where the platform has ``dof`` motions; None
+    where it has another number there (a singular configuration: nothing to tell)."""
+    dofs, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
+    if int(dofs[0]) != dof:
+        return None
+    space = basis[0][:, :dof]
+    _, singular, rows = np.linalg.svd(space[~mechanism.pose_angular], full_matrices=True)
+    return space @ rows[int(np.sum(singular > TASK_RANK_TOLERANCE)):].T
+
+
 def driven_idle_turns(mechanism: Mechanism, full_pose: NDArray, joint_values, dof: int) -> bool:
     """Whether a point output's idle turns are driven: the platform's motions (``dof`` of them at the closed
-    configuration ``full_pose``) that keep the point still, which a point output counts as none, are not all
-    allowed with every actuator held (an actuator drives one: a leg's output point on a crank, the other motor
-    turning the leg's links about it: a published rat robot's five-bar leg read 2 actuators as 1 DOF, 1 redundant,
-    F_O1 0.2435, where it has 2 DOF and no redundancy)."""
-    dofs, basis = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values])
-    if int(dofs[0]) != dof:  # a singular configuration: another number of motions, nothing to tell
-        return False
-    space = basis[0][:, :dof]
-    translations = space[~mechanism.pose_angular]
-    _, singular, rows = np.linalg.svd(translations, full_matrices=True)
-    still = space @ rows[int(np.sum(singular > TASK_RANK_TOLERANCE)):].T  # the motions that keep the point still
-    if not still.shape[1]:
+    configuration ``full_pose``) that keep the point still (:func:`still_motions`), which a point output counts as
+    none, are not all allowed with every actuator held (an actuator drives one: a leg's output point on a crank, the
+    other motor turning the leg's links about it: a published rat robot's five-bar leg read 2 actuators as 1 DOF, 1
+    redundant, F_O1 0.2435, where it has 2 DOF and no redundancy)."""
+    still = still_motions(mechanism, full_pose, joint_values, dof)
+    if still is None or not still.shape[1]:
         return False
     held, free = motion_space_at(mechanism, full_pose[None], [np.asarray(v)[None] for v in joint_values], locked=True)
     allowed = free[0][:, :int(held[0])]

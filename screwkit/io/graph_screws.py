@@ -92,10 +92,11 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     link): its twist may lie in the leg's twist system (a planar leg's holds every planar twist), but the power
     coefficient on it would pair the actuator's motion with a wrench on links it never pushes."""
     model = state.model
-    ends = [c.joint_b if state.platform in path_to(model, c.joint_a) else c.joint_a for c in leg.closures
-            if state.platform in path_to(model, c.joint_a) or state.platform in path_to(model, c.joint_b)]
-    path = set(path_to(model, actuator)) | {j for end in ends for j in path_to(model, end)
-                                            if actuator in path_to(model, j)}
+    onto = [(c.joint_a, c.joint_b) if state.platform in path_to(model, c.joint_b) else (c.joint_b, c.joint_a)
+            for c in leg.closures]
+    ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
+    beyond = [path_to(model, end) for end in ends]
+    path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
     free = [j for j in leg.joints if j == actuator or j not in path]
     columns = _columns(state.kinematics, free)
     right, null = _null_rows(_closure_matrix(state, free, leg))
