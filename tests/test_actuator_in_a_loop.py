@@ -173,3 +173,75 @@ def test_the_command_reads_the_doubled_crank(tmp_path):
     assert result["iti_actuators"]["crank2:m2"] == pytest.approx(_sine(b2 - a2, p - b2), abs=1e-9)
     path.write_text(doubled_crank("coupler"))
     one_line_error(screwkit("analyze", path, "--output", "distal1"), "cannot be written as serial chains")
+
+
+def test_the_h_link_read_as_a_graph_equals_its_serial_reading(linkage):
+    """The H link is pinned to the base by a closure alone (no joint of its own between): a passive leg of no joint,
+    whose twist system is the pin's. The graph reading left it out (it joins no body of a leg) and refused the H
+    link as moving with the cylinder locked, "2 motions"; it reads the serial reading's numbers now."""
+    path, unit = linkage
+    graph = graph_mechanism(read_closed_tree(path, output="hlink", length_unit=unit)).indices()
+    points = _mujoco_points(path)
+    assert float(graph.iti) == pytest.approx(1.0, abs=1e-9)
+    assert float(graph.lmti) == pytest.approx(_sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
+
+
+def bucket_along_path(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), reverse: bool = False) -> str:
+    """The same linkage written along the bucket's path: barrel, rod, H link, side link, bucket, one chain from the
+    base; the H link's pivot K and the bucket's pivot M closed on the base (``reverse``: the bucket's first)."""
+    def at(point) -> str:
+        return " ".join(repr(float(v) * scale) for v in point)
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    ram = " ".join(repr(float(v)) for v in (J - I) / np.linalg.norm(J - I))
+    hinge = '<joint name="{}" type="hinge" axis="0 0 1"/>' + ball
+    closures = [f'<connect name="hpivot" body1="hlink" body2="base" anchor="{at(K - J)}"/>',
+                f'<connect name="bpivot" body1="bucket" body2="base" anchor="{at(M - L)}"/>']
+    return (f'<mujoco model="bucket_along_path"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
+            f'<body name="barrel" pos="{at(I)}">{hinge.format("pivot")}'
+            f'<body name="rod"><joint name="ram" type="slide" axis="{ram}"/>{ball}'
+            f'<body name="hlink" pos="{at(J - I)}">{hinge.format("hpin")}'
+            f'<body name="side" pos="{at(JP - J)}">{hinge.format("sidepin")}'
+            f'<body name="bucket" pos="{at(L - JP)}">{hinge.format("lpin")}'
+            '</body></body></body></body></body></body></worldbody><equality>'
+            + "".join(closures[::-1] if reverse else closures)
+            + '</equality><actuator><motor name="m" joint="ram"/></actuator></mujoco>')
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_the_bucket_on_its_own_path_is_refused_as_driven_through_a_loop(tmp_path, variant):
+    """Written along the bucket's path, the cylinder's leg is the platform's own path (its spine), which
+    ``drives_rigidly`` did not check: the bucket was refused as moving with the cylinder locked (the bucket's pivot,
+    a closure alone, was no leg) and the command called the path "a motion no actuator drives". Now the cylinder is
+    refused as moving inside a loop, as in the linkage's other drawing, and the H link reads its transmission."""
+    path, unit = mjcf_variant(tmp_path, "along", variant, bucket_along_path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 1  # MuJoCo: one motion
+    with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel' \\(with the other joints of "
+                                           "its path to the platform held it cannot move"):
+        graph_mechanism(read_closed_tree(path, output="bucket", length_unit=unit))
+    result = graph_mechanism(read_closed_tree(path, output="hlink", length_unit=unit)).indices()  # (bucket beyond)
+    points = _mujoco_points(path)
+    assert (float(result.iti), float(result.lmti)) == pytest.approx(
+        (1.0, _sine(points["J"] - points["I"], points["J"] - points["K"])), abs=1e-9)
+
+
+def test_the_command_refuses_the_bucket_on_its_own_path_and_reads_its_h_link(tmp_path):
+    path = tmp_path / "along.xml"
+    path.write_text(bucket_along_path())
+    one_line_error(screwkit("analyze", path, "--output", "bucket"), "'ram' moves inside a loop", "--output")
+    read = screwkit("analyze", path, "--output", "hlink", "--json")
+    assert read.returncode == 0, read.stderr
+    result = json.loads(read.stdout)
+    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+
+
+def test_the_bucket_on_its_own_path_reads_the_same_with_its_closures_listed_the_other_way_round(tmp_path):
+    path = tmp_path / "reversed.xml"
+    path.write_text(bucket_along_path(reverse=True))
+    with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel'"):
+        graph_mechanism(read_closed_tree(path, output="bucket"))
+    result = graph_mechanism(read_closed_tree(path, output="hlink")).indices()
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)

@@ -370,6 +370,10 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
         legs.append(GraphLeg(body_names.get(first, tree.written_joint(model.names[first])), joints, tuple(ends), spine,
                              actuated))
         placed.update(actuated)
+    direct = tuple(c for c in tree.closures if {c.joint_a, c.joint_b} == {0, platform})
+    if direct:  # the platform pinned to the base by closures alone (an H link's pivot on the arm): a passive leg
+        # of no joint, whose twist system the closures leave (a ball's turns about its point; two on an axis, a hinge)
+        legs.append(GraphLeg(direct[0].name, (), direct, False, ()))
     if model.parents[platform] == 0 and model.joints[platform].nv != 6:
         kind, _ = joint_kind(model, platform)
         name = tree.written_joint(model.names[platform])

@@ -95,7 +95,7 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     onto = [(c.joint_a, c.joint_b) if state.platform in path_to(model, c.joint_b) else (c.joint_b, c.joint_a)
             for c in leg.closures]
     ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
-    beyond = [path_to(model, end) for end in ends]
+    beyond = [path_to(model, end) for end in ends + ([state.platform] if leg.spine else [])]  # (a spine: its own)
     path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
     free = [j for j in leg.joints if j == actuator or j not in path]
     columns = _columns(state.kinematics, free)
@@ -290,7 +290,7 @@ class LegScrews:
     iti_point: NDArray[np.float64]
     oti_point: NDArray[np.float64]
     outside: NDArray[np.float64]
-    rigid_input: NDArray[np.bool_] | None = None  # (:func:`drives_rigidly`, for a leg that is not the platform's path)
+    rigid_input: NDArray[np.bool_] | None = None  # (:func:`drives_rigidly`; None for a passive leg)
 
 
 def model_name(tree: ClosedTree, joint: int) -> str:
@@ -337,9 +337,7 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         at = _actuator_point(state, actuator, iti_point)
         out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.mean(oti, axis=0),
                              np.linalg.norm(own - projection, axis=1),
-                             # (a leg that is the platform's own path ties T to it: its input is checked by the
-                             # twist system's tests alone, as before)
-                             None if leg.spine else drives_rigidly(state, leg, actuator)))
+                             drives_rigidly(state, leg, actuator)))
     return out, state
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io.closed_tree import ClosedTree, ImportError_, homogeneous, joint_kind
+from screwkit.io.closed_tree import GRAPH_HINT, ClosedTree, ImportError_, LegWithLoops, homogeneous, joint_kind
 from screwkit.model.urdf_description import initial_remedy
 
 __all__ = ["INDEPENDENCE_TOLERANCE", "joint_twists", "independent", "lock_idle", "check_not_stretched"]
@@ -44,12 +44,16 @@ def independent(rows: NDArray, tolerance: float = INDEPENDENCE_TOLERANCE) -> boo
     return rows.shape[0] <= 6 and singular[-1] > tolerance * singular[0]
 
 
-def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: NDArray) -> None:
+def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: NDArray, loops: list[str] = ()
+              ) -> None:
     """Lock passive joints while the leg's joint twists are dependent to the file's rounding, each time the one whose
     removal leaves the others most independent (ties: from the leg's end backwards). A hinge coaxial with the revolute
     loop that closes it to 3e-7 rad, kept, gave the leg a fourth joint in its plane and its home no closure; the first
     hinge whose removal kept the rank left an S-S rod its spin beside a ball's hinge 4e-5 rad from it. Twists that
-    are dependent at the assembly only (:func:`check_not_stretched`) are refused, not locked."""
+    are dependent at the assembly only (:func:`check_not_stretched`) are refused, not locked. ``loops``: closures
+    between the leg's links and elsewhere (not the platform), which may hold a motion its joints alone have: the leg
+    then has a loop inside it, for :mod:`screwkit.io.graph` (an H link pinned to an excavator's arm, on the bucket's
+    path)."""
     model = tree.model
 
     def triples(kept, at=data, carry=None):
@@ -68,8 +72,13 @@ def lock_idle(tree: ClosedTree, data, leg, scale: float, motors: set[int], q: ND
         check_not_stretched(tree, leg, q, scale, lambda at, carry: rows(kept, at, carry))
         moving = _moving_self_motion(triples(kept), scale)
         passive = [model.names[joint] for k, joint in enumerate(kept) if k in moving and joint not in motors]
+        which = f"the leg closed by {leg.closure!r}" if leg.closure else "the platform body's own path"
+        if passive and loops:
+            raise LegWithLoops(f"{tree.source}: {which} ({', '.join(model.names[joint] for joint in kept)}) has more "
+                               f"motions than its ends hold, and closure(s) {', '.join(map(repr, loops))} join its "
+                               "links to others: a loop inside a leg, which screwkit cannot write as serial legs"
+                               + GRAPH_HINT + ".")
         if passive:
-            which = f"the leg closed by {leg.closure!r}" if leg.closure else "the platform body's own path"
             raise ImportError_(f"{tree.source}: {which} moves with its ends held: its joints "
                                f"{', '.join(model.names[joint] for joint in kept)} make a motion of their own that "
                                f"turns joints {', '.join(passive)} about points it moves (no idle spin): a motion no "

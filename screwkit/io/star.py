@@ -392,8 +392,9 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
     meet = all(np.linalg.norm(in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
-    for leg in legs:
-        lock_idle(tree, data, leg, scale, set(motor_ids), q)
+    for leg in legs:  # (a coupling that reaches the leg's joints makes a loop inside it, which may hold it)
+        lock_idle(tree, data, leg, scale, set(motor_ids), q, [c.name for c in couplings if c.name in joined and set(
+            leg.joints).intersection(path_to(model, c.joint_a) + path_to(model, c.joint_b))])
     axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, turns)
     absorbed = set()
     for closure in tree.closures:
