@@ -378,9 +378,10 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
         try:
             reduction = equivalent_constraint(systems, paths, normal)
         except NotReducible as error:  # the graph reading may model it (a crank doubled by a parallelogram off its
-            # path, its distal link hinged on the crank); where it refuses too, this reason stands
-            refusal = f"{tree.source}: {label} cannot be written as serial chains: {error}"
-            raise LegWithLoops(refusal + GRAPH_HINT + ".", held=refusal + ".") from None
+            # path, its distal link hinged on the crank); where it refuses too, its reason is the mechanism's, where
+            # this one is the serial writer's (a planar leg closed by balls "leaves the plane of motion")
+            raise LegWithLoops(f"{tree.source}: {label} cannot be written as serial chains: {error}" + GRAPH_HINT
+                               + ".") from None
         passive = [index for index in members if index not in actuated]
         removed.update(passive)
         first = legs[passive[0]] if passive else legs[members[0]]
