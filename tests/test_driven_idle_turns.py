@@ -189,3 +189,20 @@ def test_the_command_reads_the_frame_and_refuses_the_point(tmp_path):
     assert result["dof"] == 2 and result["f_o"] == {"1": 0.0}
     refused = screwkit("analyze", path, "--output", "thigh", "--output-type", "point")
     one_line_error(refused, "an actuator turns the platform about the output point", "--output-type frame")
+
+
+def test_convert_writes_the_frame_the_analysis_reads(tmp_path):
+    """``convert`` refused the leg where ``analyze`` read the frame: both read it now, and the file written reads the
+    same indices as the leg itself; a point asked for is refused by both."""
+    path, out = tmp_path / "leg.xml", tmp_path / "leg.urdf"
+    path.write_text(leg_mjcf())
+    converted = screwkit("convert", path, out, "--json")
+    assert converted.returncode == 0, converted.stderr
+    assert any("not the point where the legs meet" in note for note in json.loads(converted.stdout)["notes"])
+    original, written = (json.loads(screwkit("analyze", p, "--json").stdout) for p in (path, out))
+    assert written["dof"] == original["dof"] == 2
+    for key in ("iti", "lmti", "iti_actuators"):
+        assert written[key] == pytest.approx(original[key], abs=1e-12), key
+    refused = screwkit("convert", path, tmp_path / "point.urdf", "--output", "thigh", "--output-type", "point")
+    one_line_error(refused, "an actuator turns the platform about the output point", "--output-type frame")
+    assert not (tmp_path / "point.urdf").exists()

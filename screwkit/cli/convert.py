@@ -17,8 +17,8 @@ from screwkit.cli.options import (
 )
 from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
 from screwkit.closure.assembly import NOT_OPEN_LOOPS
-from screwkit.io import ImportError_, ImportReport, is_foreign, read_mechanism_file, with_reference_configuration
-from screwkit.io.loader import load, load_text
+from screwkit.io import ImportError_, ImportReport, is_foreign, with_reference_configuration
+from screwkit.io.loader import converted_mechanism, load, load_text
 from screwkit.studies.files import atomic_text, check_output
 
 __all__ = ["convert"]
@@ -49,9 +49,11 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
     except ValueError as error:
         raise fail(str(error)) from None
     try:
-        if is_foreign(source):
-            text, report = read_mechanism_file(source, output=reading.output, output_type=reading.output_type,
-                                               lock=reading.lock, actuate=reading.actuate, initial=reading.initial)
+        if is_foreign(source):  # (the frame read where an actuator turns the legs' meeting point, as analyze does)
+            text, report, mechanism = converted_mechanism(source, output=reading.output,
+                                                          output_type=reading.output_type, lock=reading.lock,
+                                                          actuate=reading.actuate, initial=reading.initial,
+                                                          limits=not ignore_limits)
         else:  # screwkit's own convention: the loops the file leaves open, closed and written back (the options of
             # files of other tools refused by the loader, as on every command)
             own = load(source, limits=not ignore_limits, output=reading.output, output_type=reading.output_type,
@@ -61,8 +63,7 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
                                   planar=own.is_planar, motors=list(own.actuator_names))
             report.notes = [f"assembled: {note}" for note in own.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)
                             ] or ["every loop closes as written"]  # (the others: below, from the file written)
-        mechanism = load_text(text, str(source), limits=not ignore_limits,  # what is written must load
-                              converted_from=report.file_format if is_foreign(source) else "")
+            mechanism = load_text(text, str(source), limits=not ignore_limits)  # what is written must load
     except (ImportError_, ValueError) as error:
         raise fail(str(error)) from None
     still_open = [note for note in mechanism.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)]

@@ -29,7 +29,7 @@ from screwkit.model.pinocchio_bridge import build_model
 from screwkit.model.urdf_description import UrdfDescription
 from screwkit.model.urdf_reader import MAX_FILE_BYTES, parse_urdf, read_urdf
 
-__all__ = ["load", "load_text", "mechanism_from_description", "bundled_names", "bundled_path"]
+__all__ = ["load", "load_text", "converted_mechanism", "mechanism_from_description", "bundled_names", "bundled_path"]
 
 
 @functools.cache
@@ -164,24 +164,9 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
         if is_foreign(path):  # MJCF, SDFormat, or a URDF of another tool (robot.yaml, closing_ frames, Gazebo joints)
             if path.stat().st_size > max_bytes:
                 raise ValueError(f"{path}: {path.stat().st_size} bytes, more than the {max_bytes} read.")
-            converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
-                                                    actuate=actuate, length_unit=length_unit, initial=initial)
-            try:
-                mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
-                                      converted_from=report.file_format)
-            except DrivenIdleTurns:
-                if output_type is not None:
-                    raise
-                # the point where the legs meet, taken by default: an actuator turns the platform about it, so the
-                # frame instead (the one --output names, else the platform body's)
-                body = report.platform_body
-                converted, report = read_mechanism_file(path, output=output or body, output_type="frame", lock=lock,
-                                                        actuate=actuate, length_unit=length_unit, initial=initial)
-                report.notes.append(f"output the frame {output or body!r}, not the point where the legs meet on body "
-                                    f"{body!r}: an actuator turns it about that point (--output-type point is "
-                                    "refused so)")
-                mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
-                                      converted_from=report.file_format)
+            _, report, mechanism = converted_mechanism(path, output=output, output_type=output_type, lock=lock,
+                                                       actuate=actuate, length_unit=length_unit, initial=initial,
+                                                       limits=limits)
             return replace(mechanism, import_report=tuple(report.lines()))
     if output is not None or output_type is not None or lock or actuate or initial:
         raise ValueError(f"{path}: an output frame or type, locked, actuated or initial joints named apart from the "
@@ -191,6 +176,33 @@ def load(name_or_path: str | os.PathLike, *, length_unit: str | None = None,
     return load_cached(_content(path, max_bytes), ("file", str(path), length_unit, limits, max_bytes),
                        lambda: mechanism_from_description(read_urdf(path, length_unit=length_unit, max_bytes=max_bytes),
                                                           limits=limits))
+
+
+def converted_mechanism(path: Path, *, output=None, output_type=None, lock=(), actuate=(), length_unit=None,
+                        initial=(), limits: bool = True):
+    """A file of another tool in screwkit's convention: its URDF text, the :class:`~screwkit.io.ImportReport` and
+    the mechanism loaded from that text (:func:`load` and ``screwkit convert``). Where the output type is left to
+    screwkit and the point where the legs meet is turned about by an actuator, the platform's frame is read
+    instead, and the report says so."""
+    converted, report = read_mechanism_file(path, output=output, output_type=output_type, lock=lock,
+                                            actuate=actuate, length_unit=length_unit, initial=initial)
+    try:
+        mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
+                              converted_from=report.file_format)
+    except DrivenIdleTurns:
+        if output_type is not None:
+            raise
+        # the point where the legs meet, taken by default: an actuator turns the platform about it, so the
+        # frame instead (the one --output names, else the platform body's)
+        body = report.platform_body
+        converted, report = read_mechanism_file(path, output=output or body, output_type="frame", lock=lock,
+                                                actuate=actuate, length_unit=length_unit, initial=initial)
+        report.notes.append(f"output the frame {output or body!r}, not the point where the legs meet on body "
+                            f"{body!r}: an actuator turns it about that point (--output-type point is "
+                            "refused so)")
+        mechanism = load_text(converted, str(path), length_unit=length_unit, limits=limits,
+                              converted_from=report.file_format)
+    return converted, report, mechanism
 
 
 def _content(path: Path, max_bytes: int) -> bytes | None:
