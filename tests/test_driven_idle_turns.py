@@ -39,9 +39,11 @@ PIN = np.array([0.1, 0.11, 0.0])
 """The horn's pin on the thigh, in the world at the file's configuration."""
 
 
-def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01), reverse: bool = False) -> str:
+def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01), reverse: bool = False,
+             thigh_first: bool = False) -> str:
     """The leg's MJCF text, every length times ``scale``, its base placed by ``world`` (``pos``, ``quat`` texts), the
-    pin at ``pin`` on the horn (from its pivot); ``reverse``: the horn's branch and the servo's motor written first."""
+    pin at ``pin`` on the horn (from its pivot); ``reverse``: the horn's branch and the servo's motor written first;
+    ``thigh_first``: the connect written from the thigh (its anchor on the thigh)."""
     def at(*values) -> str:
         return " ".join(repr(v * scale) for v in values)
 
@@ -57,7 +59,9 @@ def leg_mjcf(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), pin=(0.04, -0.01), 
         branches, motors = branches[::-1], motors[::-1]
     return (f'<mujoco model="horn_leg"><worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
             + "".join(branches) + '</body></worldbody><equality>'
-            f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(*pin, 0)}"/></equality>'
+            + (f'<connect name="pin" body1="thigh" body2="horn" anchor="{at(pin[0] - 0.07, pin[1] + 0.05, 0)}"/>'
+               if thigh_first else f'<connect name="pin" body1="horn" body2="thigh" anchor="{at(*pin, 0)}"/>')
+            + '</equality>'
             '<actuator>' + "".join(motors) + '</actuator></mujoco>')
 
 
@@ -139,11 +143,19 @@ def test_a_pin_on_the_line_of_knee_and_ankle_does_not_hide_the_driven_turn(tmp_p
     assert mechanism.dof == 2 and mechanism.output_point is None
 
 
-def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path):
+@pytest.mark.parametrize("order", [dict(reverse=True), dict(thigh_first=True), dict(reverse=True, thigh_first=True)])
+def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path, order):
+    """Branches, motors and the connect's two bodies in either order: the same platform (the thigh, further from the
+    base than the horn; the connect written from the thigh took the horn and refused the leg), the same indices."""
     path = tmp_path / "reversed.xml"
-    path.write_text(leg_mjcf(reverse=True))
+    path.write_text(leg_mjcf(**order))
     mechanism = load(path)
     assert mechanism.dof == 2 and mechanism.output_point is None
+    path.with_name("leg.xml").write_text(leg_mjcf())
+    reference = load(path.with_name("leg.xml"))
+    result, expected = (indices_at_pose(m, m.home_pose) for m in (mechanism, reference))
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((float(expected.iti), float(expected.lmti)),
+                                                                    abs=1e-12)
     with pytest.raises(ValueError, match="an actuator turns the platform about the output point"):
         load(path, output="thigh", output_type="point")
 

@@ -114,7 +114,8 @@ def sites_placed(model, root) -> None:
     MuJoCo places it. Pinocchio 4.1's parser leaves out the offset of a body's joint (its ``pos``) for the sites of
     a body without a joint of its own under it, so such a site would sit off by that offset (a platform's output
     site, or a closure's, under a hinge drawn away from its body's origin), reads no ``fromto``, and makes no frame
-    of a site of ``<worldbody>`` itself (a closure's anchor on the ground), which is added on the world's frame."""
+    of a site of ``<worldbody>`` itself (a closure's anchor on the ground), which is added on the world's frame, nor
+    of a site of a body without a joint at the world's origin (a fixed base's ground pivot), added on that body's."""
     import pinocchio as pin
 
     for world in root.findall("worldbody"):
@@ -128,7 +129,16 @@ def sites_placed(model, root) -> None:
     for body in root.iter("body"):
         for site in body.findall("site"):
             name = site.get("name")
-            if name is None or not model.existFrame(name, pin.FrameType.OP_FRAME):
+            if name is None:
+                continue
+            if not model.existFrame(name, pin.FrameType.OP_FRAME):
+                # a site of a body with no joint that the parser makes a frame without its sites (the ground
+                # pivot on a fixed base body at the world's origin): added on the body's frame
+                if body.get("name") is not None and model.existFrame(body.get("name"), pin.FrameType.BODY):
+                    owner = model.getFrameId(body.get("name"), pin.FrameType.BODY)
+                    position, quaternion = site_pose(site)
+                    model.addFrame(pin.Frame(name, model.frames[owner].parentJoint, owner, model.frames[owner].placement
+                                             * pin.SE3(rotation_matrix(quaternion), position), pin.FrameType.OP_FRAME))
                 continue
             index = model.getFrameId(name, pin.FrameType.OP_FRAME)
             frame = model.frames[index]

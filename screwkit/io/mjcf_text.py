@@ -428,6 +428,8 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
                          "held in one, 'screwkit_world', at the origin")
     named, taken = [], {element.get("name") for element in ([] if equality is None else equality)}
     for element in ([] if equality is None else list(equality)):
+        if element.tag in ("connect", "weld") and element.get("body2") == "world":
+            element.attrib.pop("body2")  # MuJoCo's world body, as body2 left out means (Pinocchio knows no 'world')
         if element.tag in ("connect", "weld") and not element.get("name"):
             name = f"{element.tag}_{len(named) + 1}"
             while name in taken:  # a closure of the file has that name

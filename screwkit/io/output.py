@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.io.closed_tree import ClosedTree, ImportError_, ball_of_revolutes, homogeneous, joint_kind
+from screwkit.io.closed_tree import ClosedTree, ImportError_, ball_of_revolutes, homogeneous, joint_kind, path_to
 
 __all__ = ["output_frame", "platform_body", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
 
@@ -70,8 +70,11 @@ def output_frame(tree: ClosedTree) -> int:
     if closure is not None and closure.kind == "3d" and closure.joint_a and closure.joint_b \
             and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
         # two legs meeting at one ball or pin the file places: its point is the output, the same on either body
-        # (their frames are not, nor the point of a loop cut where the file's order puts the cut)
-        index = _body_frame(model, closure.joint_b)
+        # (their frames are not, nor the point of a loop cut where the file's order puts the cut); the platform is
+        # the body further from the base, whichever end the file writes first (a servo's horn pinned to a thigh that
+        # a hip, a knee and an ankle carry: the thigh), the second end on a tie
+        ends = (closure.joint_a, closure.joint_b)
+        index = _body_frame(model, max(ends[::-1], key=lambda joint: len(path_to(model, joint))))
         if index is not None:
             tree.notes.append(f"platform inferred: body {names[index]!r}, where closure {closure.name!r} joins the "
                               "legs (name another with --output FRAME)")

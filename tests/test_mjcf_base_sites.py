@@ -1,0 +1,76 @@
+"""A closure's anchor on a site of the fixed base body, the base written with no joint and no ``pos``.
+
+MJCF files of wheel legs and linkages often write their ground pivots as sites of a jointless base body at the
+world's origin (``<body name="base"><site name="D_ground" .../>``). Pinocchio's parser makes that body a frame and
+leaves its sites out, and the closure was refused: "no site named 'D_ground'" (a base with a ``pos`` was read, its
+sites kept). The site is now placed on the body's frame, and the four-bar reads the textbook pressure angles of
+MuJoCo's own placement of its joints and sites, in m, mm and a moved, turned world.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import MJCF_WORLDS, mjcf_variant
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+
+def four_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """A crank A-B, coupler B-C and rocker C-D (pins along y), D a site of the base body; the base written bare
+    where ``world`` is the identity."""
+    def at(*values) -> str:
+        return " ".join(repr(v * scale) for v in values)
+
+    placed = "" if world == ("0 0 0", "1 0 0 0") else f' pos="{world[0]}" quat="{world[1]}"'
+    ball = f'<geom type="sphere" size="{0.01 * scale!r}"/>'
+    return ('<mujoco model="fourbar"><option><flag contact="disable"/></option>'
+            f'<worldbody><body name="base"{placed}>{ball}'
+            f'<site name="D_ground" pos="{at(0.3, 0, 0.02)}"/>'
+            f'<body name="crank"><joint name="jA" type="hinge" axis="0 1 0"/>{ball}'
+            f'<body name="coupler" pos="{at(0, 0, 0.1)}"><joint name="jB" type="hinge" axis="0 1 0"/>{ball}'
+            f'<body name="rocker" pos="{at(0.3, 0, 0.1)}"><joint name="jC" type="hinge" axis="0 1 0"/>{ball}'
+            f'<site name="D_link" pos="{at(0, 0, -0.18)}"/></body></body></body></body></worldbody>'
+            '<equality><connect name="D" site1="D_link" site2="D_ground"/></equality>'
+            '<actuator><motor name="m" joint="jA"/></actuator></mujoco>')
+
+
+def _sine(u, v) -> float:
+    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_ground_site_of_a_bare_base_body_closes_the_loop(tmp_path, variant):
+    path, unit = mjcf_variant(tmp_path, "fourbar", variant, four_bar)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())  # closed as written
+    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    a, b, c, d = anchor["jA"], anchor["jB"], anchor["jC"], data.site_xpos[model.site("D_ground").id]
+    mechanism = load(path, output="coupler", length_unit=unit)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert float(result.iti) == pytest.approx(_sine(b - a, c - b), abs=1e-9)  # the crank drives the coupler at B
+    assert float(result.lmti) == pytest.approx(_sine(c - b, c - d), abs=1e-9)  # the rocker holds it at C
+
+
+@pytest.mark.parametrize("world", ['body2="world" ', ""])
+def test_a_connect_to_the_world_body_named_or_left_out_reads_the_same(tmp_path, world):
+    """``body2="world"`` is MuJoCo's world body, as ``body2`` left out: it was refused with Pinocchio's words ("Model
+    does not have any body named world")."""
+    path = tmp_path / "world.xml"
+    path.write_text(four_bar().replace('<connect name="D" site1="D_link" site2="D_ground"/>',
+                                       f'<connect name="D" body1="rocker" {world}anchor="0.0 0.0 -0.18"/>'))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-12
+    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    a, b, c = anchor["jA"], anchor["jB"], anchor["jC"]
+    d = c + data.xmat[model.body("rocker").id].reshape(3, 3) @ np.array([0.0, 0.0, -0.18])
+    mechanism = load(path, output="coupler")
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((_sine(b - a, c - b), _sine(c - b, c - d)),
+                                                                    abs=1e-9)
