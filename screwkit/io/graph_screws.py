@@ -60,15 +60,16 @@ def _select(offset: NDArray, kind: str) -> NDArray:
     return np.concatenate([-skew, np.broadcast_to(np.eye(3), (count, 3, 3))], axis=2)
 
 
-def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArray]:
+def _twist_spaces(state: _State, joints, leg: GraphLeg, cuts=()) -> tuple[NDArray, NDArray]:
     """Orthonormal rows (n, 6, 6) spanning the platform twists ``joints`` of ``leg`` allow with its closures closed
     (working coordinates; the first ``dims[n]`` rows of configuration n), and ``dims`` (n,).
 
     Unknowns: the rates of ``joints`` and the platform twist T. Each closure adds the relative velocity of its two
     frames (6 rows for ``6d``, the velocity of its point for ``3d``); a frame whose path passes the platform moves
     with T plus the joints of ``joints`` beyond the platform, unless the leg is the platform's spine (the
-    platform's own path is among its joints): then T is tied to the platform body's twist."""
-    right, free = _null_rows(_closure_matrix(state, joints, leg))
+    platform's own path is among its joints): then T is tied to the platform body's twist. ``cuts``: connections of
+    the leg left out (:func:`_closure_matrix`)."""
+    right, free = _null_rows(_closure_matrix(state, joints, leg, cuts))
     null = right[:, :, -6:] * free[:, :, None]
     _, values, rows = np.linalg.svd(null, full_matrices=False)
     return rows, np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
@@ -76,6 +77,9 @@ def _twist_spaces(state: _State, joints, leg: GraphLeg) -> tuple[NDArray, NDArra
 
 def _null_rows(matrix: NDArray) -> tuple[NDArray, NDArray]:
     """The right singular vectors (n, c, c) of ``matrix`` (n, r, c) and which of them (n, c) span its null space."""
+    if matrix.shape[1] == 0:  # no row (every connection of a leg left out): all of it
+        return (np.broadcast_to(np.eye(matrix.shape[2]), (matrix.shape[0],) + matrix.shape[2:] * 2),
+                np.ones((matrix.shape[0], matrix.shape[2]), dtype=bool))
     _, singular, right = np.linalg.svd(matrix, full_matrices=True)
     largest = np.maximum(singular[:, 0] if singular.shape[1] else np.zeros(matrix.shape[0]), 1.0)
     rank = np.sum(singular > TWIST_RANK_TOLERANCE * largest[:, None], axis=1)
@@ -110,15 +114,20 @@ held, above which it moves (:func:`drives_rigidly`; the rows' columns are joint 
 slide's over the length scale, so that the verdict does not turn on the unit)."""
 
 
-def _closure_matrix(state: _State, joints, leg: GraphLeg) -> NDArray:
+def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:
     """The rows (n, r, len(columns) + 6) of :func:`_twist_spaces`: the closures' relative velocities over the rates
-    of ``joints`` and the platform twist."""
+    of ``joints`` and the platform twist. ``cuts``: connections left out, ``("closures", (k, ...))`` the leg's
+    closures k, ...,
+    ``("joint", j)`` joint j made free in all six directions (six more columns before the platform twist's)."""
     model, kinematics = state.model, state.kinematics
     columns = _columns(kinematics, joints)
     count = state.working.shape[0]
+    freed = [j for kind, j in cuts if kind == "joint"]
     blocks = []
-    for closure in leg.closures:
-        rows_q, rows_t = 0.0, 0.0
+    for index, closure in enumerate(leg.closures):
+        if any(kind == "closures" and index in which for kind, which in cuts):
+            continue
+        rows_q, rows_t, rows_f = 0.0, 0.0, [0.0] * len(freed)
         for joint, placement, sign in ((closure.joint_a, closure.placement_a, 1.0),
                                        (closure.joint_b, closure.placement_b, -1.0)):
             world = state.transforms[:, joint] @ placement
@@ -127,13 +136,17 @@ def _closure_matrix(state: _State, joints, leg: GraphLeg) -> NDArray:
             rows_q = rows_q + sign * select @ np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
             if not leg.spine and state.platform in path_to(model, joint):
                 rows_t = rows_t + sign * select
+            rows_f = [f + sign * select if j in path_to(model, joint) else f for f, j in zip(rows_f, freed)]
         rows_q = np.broadcast_to(rows_q, (count, 6 if closure.kind != "3d" else 3, len(columns)))
-        blocks.append(np.concatenate([rows_q, np.broadcast_to(rows_t, rows_q.shape[:2] + (6,))], axis=2))
+        blocks.append(np.concatenate([rows_q] + [np.broadcast_to(f, rows_q.shape[:2] + (6,)) for f in rows_f]
+                                     + [np.broadcast_to(rows_t, rows_q.shape[:2] + (6,))], axis=2))
     if leg.spine:
         moves = kinematics.supports(model, state.platform)[columns]
         own = np.swapaxes(state.working[:, columns] * moves[None, :, None], 1, 2)
-        blocks.append(np.concatenate([own, np.broadcast_to(-np.eye(6), (count, 6, 6))], axis=2))
-    return np.concatenate(blocks, axis=1)
+        carried = [np.broadcast_to(np.eye(6) if j in path_to(model, state.platform) else np.zeros((6, 6)),
+                                   (count, 6, 6)) for j in freed]
+        blocks.append(np.concatenate([own, *carried, np.broadcast_to(-np.eye(6), (count, 6, 6))], axis=2))
+    return np.concatenate(blocks, axis=1) if blocks else np.zeros((count, 0, len(columns) + 6 * len(freed) + 6))
 
 
 HINGES = ("revolute", "unbounded")
@@ -202,14 +215,22 @@ def _meetings(state: _State, joint: int, among=None, feet: bool = True) -> tuple
     return meetings, found
 
 
-def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
+def _attachments(state: _State, leg: GraphLeg, body: int, actuator: int | None = None, own: NDArray | None = None
+                 ) -> list[NDArray]:
     """World points (n, 3) where the leg's joints (to its children) and closures meet ``body`` (a hinge closed by
     two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`), each joint where
     :func:`_joint_point` puts it. A weld (``6d``) makes the body at its other end part of ``body``: the leg meets
     ``body`` at the joint that moves that end, not at the weld's frame, which a file may put anywhere (a CAD export
-    welds each leg's last link to the platform at the platform's origin)."""
+    welds each leg's last link to the platform at the platform's origin). Where some of them carry no load (an idle
+    dyad hung between a parallelogram's rocker and its coupler), the others only (:func:`_loaded`; ``actuator``: the
+    leg's actuated joint, whose locked twist system must not change either); ``own``: where the platform's own joint
+    is, for a leg that is the platform's path (its connection to it)."""
     model = state.model
-    points = [_joint_point(state, j, leg.joints) for j in leg.joints if model.parents[j] == body]
+    children = [j for j in leg.joints if model.parents[j] == body]
+    points, cuts = [_joint_point(state, j, leg.joints) for j in children], [("joint", j) for j in children]
+    if own is not None:
+        points.append(own)
+        cuts.append(("joint", body))
     for closure in leg.closures:
         if closure.axis_point:
             continue
@@ -218,7 +239,38 @@ def _attachments(state: _State, leg: GraphLeg, body: int) -> list[NDArray]:
             if joint == body:
                 points.append(_joint_point(state, other) if closure.kind == "6d" and other != 0 else
                               (state.transforms[:, joint] @ placement)[:, :3, 3])
-    return points
+                cuts.append(("closures", tuple(k for k, c in enumerate(leg.closures)  # (a hinge's both points)
+                                               if {c.joint_a, c.joint_b} == {closure.joint_a, closure.joint_b})))
+    if len(points) < 2:
+        return points
+    loaded = _loaded(state, leg, cuts, actuator)  # (n, k)
+    return [np.where(loaded[:, [k]], point, np.nan) for k, point in enumerate(points)]
+
+
+def _loaded(state: _State, leg: GraphLeg, cuts: list, actuator: int | None) -> NDArray[np.bool_]:
+    """Which of a leg's connections ``cuts`` to one body carry load (n, k): all but those that, left out each on its
+    own, leave the leg's twist systems as they are (with every joint free and with ``actuator`` locked), provided
+    leaving all of those out together does too (a third bar of a parallelogram, each bar idle beside the other two,
+    keeps all three: which to leave out would turn on the order). Such a connection only hangs a load-free linkage on
+    the body (a dyad between two links that move as the dyad allows: its two-force links cannot balance each other)."""
+    systems = [[j for j in leg.joints]] + ([[j for j in leg.joints if j != actuator]] if actuator is not None else [])
+    whole = [_twist_spaces(state, joints, leg)[1] for joints in systems]
+
+    def same(cut) -> NDArray[np.bool_]:  # (n,): the leg's twist systems as they are with ``cut`` left out
+        kept = np.ones(whole[0].shape, dtype=bool)
+        for joints, dims in zip(systems, whole):  # (the locked one only where the free one is the same)
+            if kept.any():
+                kept &= _twist_spaces(state, joints, leg, cut)[1] == dims
+        return kept
+
+    idle = np.stack([same((cut,)) for cut in cuts], axis=1)  # (n, k)
+    together = np.ones(idle.shape[0], dtype=bool)
+    for row in {tuple(r) for r in idle if r.any()}:
+        rows = np.all(idle == np.array(row), axis=1)
+        together[rows] = same(tuple(cut for cut, out in zip(cuts, row) if out))[rows]
+    drop = idle & together[:, None]
+    drop[drop.all(axis=1)] = False  # (a leg that constrains nothing, whatever it meets the body by: every one)
+    return ~drop
 
 
 def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray:
@@ -243,7 +295,7 @@ def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
     origin = state.transforms[:, platform, :3, 3]
     if state.kinematics.kinds[platform] not in HINGES or not others:
         return origin
-    return _foot_from(*_axis_line(state, platform), np.mean(others, axis=0))
+    return _foot_from(*_axis_line(state, platform), np.nanmean(others, axis=0))
 
 
 def _foot_from(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
@@ -303,17 +355,20 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
     out = []
     pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
-    on_platform = [_attachments(state, leg, platform) for leg in legs]
+    on_platform = [_attachments(state, leg, platform, leg.actuators[0] if leg.actuators else None,
+                                # (the platform's own joint: a universal joint's, or as drawn, a hinged Delta's wrist
+                                # running along the bar its two rods end on, meeting each)
+                                None if not leg.spine or pin else _joint_point(state, platform, leg.joints)
+                                if not leg.actuators else state.transforms[:, platform, :3, 3])
+                   for leg, pin in zip(legs, pinned)]
     others = [point for points, pin in zip(on_platform, pinned) if not pin for point in points]
     for leg, pin, platform_points in zip(legs, pinned, on_platform):
         allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
-            oti = platform_points + ([_pin_point(state, platform, others) if pin
-                                      else _joint_point(state, platform, leg.joints)]  # (its own universal joint's)
-                                     if leg.spine else [])
+            oti = platform_points + ([_pin_point(state, platform, others)] if pin else [])
             if not oti:
                 raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
-            point = np.mean(oti, axis=0)
+            point = np.nanmean(oti, axis=0)
             out.append(LegScrews(np.zeros_like(point, shape=point.shape[:1] + (6,)), allowed, allowed_dims, allowed,
                                  allowed_dims, point, point, point, np.zeros(point.shape[0])))
             continue
@@ -323,9 +378,7 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         own = own / np.linalg.norm(own, axis=1, keepdims=True)
         valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
         projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
-        iti, oti = _attachments(state, leg, actuator), list(platform_points)
-        if leg.spine:  # (as drawn: a hinged Delta's wrist runs along the bar its two rods end on, and meets each)
-            oti.append(state.transforms[:, platform, :3, 3])
+        iti, oti = _attachments(state, leg, actuator, actuator), list(platform_points)
         if not iti:  # (a slide too: the actuation wrench taken about the platform's joint, drawn anywhere on the
             # slide's line, would turn with where the file draws it)
             raise ImportError_(f"{tree.source}: leg {leg.name!r}: actuated joint {model_name(tree, actuator)!r} moves "
@@ -333,9 +386,9 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
                                "actuation wrench acts on no link of the leg's own).")
         if not oti:
             raise ImportError_(f"{tree.source}: leg {leg.name!r}: no joint on the platform.")
-        iti_point = np.mean(iti, axis=0)
+        iti_point = np.nanmean(iti, axis=0)
         at = _actuator_point(state, actuator, iti_point)
-        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.mean(oti, axis=0),
+        out.append(LegScrews(own, locked, locked_dims, allowed, allowed_dims, at, iti_point, np.nanmean(oti, axis=0),
                              np.linalg.norm(own - projection, axis=1),
                              drives_rigidly(state, leg, actuator)))
     return out, state

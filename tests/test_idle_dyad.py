@@ -1,0 +1,113 @@
+"""A load-free linkage hung on a leg does not move where the leg meets the platform.
+
+A da Vinci arm's remote-centre mechanism doubles its parallelogram: a second pair of links hangs between the first
+parallelogram's rocker (or crank) and its coupler. Those two links, pinned at three points, form a dyad that
+imposes nothing on the coupler and, unloaded, carries nothing (each of its links can only push along its own pin
+line, and the two lines cross). Read as a graph, the dyad's pin on the coupler was averaged with the parallelogram's
+into the point a leg meets the platform, which the CTI (and, with the dyad on the crank, the ITI and OTI) is taken
+about: a published ECM file read CTI 0.5284 where its parallelogram's is 0.9965. A connection is left out of that
+point where leaving it out changes none of the leg's twist systems (``graph_screws._loaded``).
+
+The parallelogram here: crank A-B (driven), coupler B-C (the platform, which translates), rocker D-C; the dyad
+F-G-E from the rocker (or the crank) to the coupler; every pin along y, each closure a hinge written as two
+connects on its axis. With the dyad and without it the indices are the parallelogram's: ITI = LMTI = 1 (the coupler
+translates with the crank) and CTI = |sin(BC, DC)|, from MuJoCo's placement of the pins.
+"""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from helpers import MJCF_WORLDS, mjcf_variant, screwkit
+from screwkit.io import read_closed_tree
+from screwkit.io.graph import graph_mechanism
+
+A, B, C, D = (np.array(p, dtype=float) for p in ((0, 0, 0), (0.08, 0, 0.2), (0.38, 0, 0.2), (0.3, 0, 0)))
+E, G = np.array([0.25, 0.0, 0.35]), np.array([0.48, 0.0, 0.33])
+"""The pins in the plane y = 0: the dyad from F (half way along the rocker or the crank) through G to E on the
+coupler."""
+
+
+def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "rocker",
+            reverse: bool = False) -> str:
+    """The parallelogram's MJCF text, every length times ``scale``, its base placed by ``world``; ``dyad``: the link
+    the dyad hangs from ("rocker", "crank" or None); ``reverse``: branches and closures listed the other way round."""
+    def at(point) -> str:
+        return " ".join(repr(float(v) * scale) for v in point)
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    hinge = '<joint name="{}" type="hinge" axis="0 1 0"/>' + ball
+    start = D if dyad == "rocker" else A
+    f = start + (C - D) / 2
+    links = (f'<body name="link1" pos="{at(f - start)}">{hinge.format("fpin")}'
+             f'<body name="link2" pos="{at(G - f)}">{hinge.format("gpin")}</body></body>') if dyad else ""
+    crank = (f'<body name="crank" pos="{at(A)}">{hinge.format("crank")}'
+             f'<body name="coupler" pos="{at(B - A)}">{hinge.format("bpin")}</body>'
+             + (links if dyad == "crank" else "") + '</body>')
+    rocker = f'<body name="rocker" pos="{at(D)}">{hinge.format("rocker")}' + (links if dyad == "rocker" else "") \
+        + '</body>'
+    lift = np.array([0.0, 0.04, 0.0])  # the second point of each closing hinge, along its axis
+
+    def pin(name, body1, body2, point, origin) -> list[str]:
+        return [f'<connect name="{name}{k}" body1="{body1}" body2="{body2}" anchor="{at(point + k * lift - origin)}"/>'
+                for k in (0, 1)]
+
+    closures = pin("cpin", "rocker", "coupler", C, D) + (pin("epin", "link2", "coupler", E, G) if dyad else [])
+    branches = [crank, rocker]
+    if reverse:
+        branches, closures = branches[::-1], closures[::-1]
+    return ('<mujoco model="parallelogram"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">' + "".join(branches) + '</body></worldbody>'
+            '<equality>' + "".join(closures) + '</equality><actuator><motor name="m" joint="crank"/></actuator>'
+            '</mujoco>')
+
+
+def _sine(u, v) -> float:
+    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
+
+
+def _mujoco_sine(path) -> float:
+    """|sin(BC, DC)| from MuJoCo's placement of the pins, the linkage checked closed and of one motion."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
+    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 1
+    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    rocker = model.body("rocker").id
+    c = data.xpos[rocker] + data.xmat[rocker].reshape(3, 3) @ model.eq_data[model.equality("cpin0").id][:3]
+    return _sine(c - anchor["bpin"], c - anchor["rocker"])
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+@pytest.mark.parametrize("dyad", [None, "rocker", "crank"])
+def test_an_idle_dyad_leaves_the_parallelograms_indices(tmp_path, variant, dyad):
+    path, unit = mjcf_variant(tmp_path, f"para_{dyad}", variant, lambda s, w: linkage(s, w, dyad=dyad))
+    expected = _mujoco_sine(path)
+    assert expected == pytest.approx(_sine(C - B, C - D), abs=1e-12)
+    result = graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit)).indices()
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, 1.0), abs=1e-9)
+    assert float(result.cti) == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("dyad", ["rocker", "crank"])
+def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path, dyad):
+    path = tmp_path / "reversed.xml"
+    path.write_text(linkage(dyad=dyad, reverse=True))
+    result = graph_mechanism(read_closed_tree(path, output="coupler")).indices()
+    assert (float(result.iti), float(result.lmti), float(result.cti)) == pytest.approx(
+        (1.0, 1.0, _sine(C - B, C - D)), abs=1e-9)
+
+
+def test_the_command_reads_the_doubled_parallelogram(tmp_path):
+    path = tmp_path / "doubled.xml"
+    path.write_text(linkage(dyad="crank"))
+    read = screwkit("analyze", path, "--output", "coupler", "--json")
+    assert read.returncode == 0, read.stderr
+    result = json.loads(read.stdout)
+    assert (result["iti"], result["lmti"], result["cti"]) == pytest.approx((1.0, 1.0, _sine(C - B, C - D)),
+                                                                           abs=1e-9)
