@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from helpers import MJCF_WORLDS, mjcf_variant, screwkit
-from screwkit.io import read_closed_tree
+from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 
 A, B, C, D = (np.array(p, dtype=float) for p in ((0, 0, 0), (0.08, 0, 0.2), (0.38, 0, 0.2), (0.3, 0, 0)))
@@ -111,3 +111,15 @@ def test_the_command_reads_the_doubled_parallelogram(tmp_path):
     result = json.loads(read.stdout)
     assert (result["iti"], result["lmti"], result["cti"]) == pytest.approx((1.0, 1.0, _sine(C - B, C - D)),
                                                                            abs=1e-9)
+
+
+def test_the_dyad_taken_as_the_output_is_refused_with_the_loop_through_the_cranks_path(tmp_path):
+    """With the dyad's end link as the output, the parallelogram's loop closes on the base through the crank's path:
+    held along that path, the crank cannot move (the reason, and the way out, of an excavator's bucket). The refusal
+    said instead that the crank's twist is no motion of its leg, "the leg has no serial input", of a crank on the
+    base (a published da Vinci PSM with its instrument's link as the output was refused so)."""
+    path = tmp_path / "doubled.xml"
+    path.write_text(linkage(dyad="crank"))
+    with pytest.raises(ImportError_, match="'crank' moves inside a loop of leg 'crank' \\(with the other joints of its "
+                                           "path to the platform held it cannot move"):
+        graph_mechanism(read_closed_tree(path, output="link2"))

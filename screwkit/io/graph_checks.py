@@ -44,7 +44,7 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
                                f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
-        if screw.rigid_input is not None and not screw.rigid_input[0] and screw.outside[0] <= IN_LOOP_TOLERANCE:
+        if screw.rigid_input is not None and not screw.rigid_input[0]:  # (its twist in the leg's system or not)
             raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
                                "the other joints of its path to the platform held it cannot move: a loop through that "
                                "path closes on the base and shares the load the leg carries, so the power coefficient "
