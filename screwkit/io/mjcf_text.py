@@ -289,6 +289,39 @@ def _check_deformable(root: ElementTree.Element, path: Path) -> None:
                             "without it.")
 
 
+def _without_replicates(root: ElementTree.Element, path: Path) -> list[str]:
+    """MuJoCo's ``<replicate>`` (copies of a subtree, each named with its index) is not expanded: one that nothing the
+    mechanism is read by names (closures, actuators, tendons; the obstacles of a test scene) is left out, and said;
+    any other is refused, naming what refers into it and how to write the copies out."""
+    parents = {child: parent for parent in root.iter() for child in parent}
+    dropped = []
+    outermost = [r for r in root.iter("replicate") if not any(a.tag == "replicate" for a in _ancestors(r, parents))]
+    for replicate in outermost:
+        inside = {element.get("name") for element in replicate.iter() if element.get("name")}
+        referring = next((f"<{element.tag} {key}='{value}'>" for section in ("equality", "actuator", "tendon")
+                          for block in root.findall(section) for element in block.iter()
+                          for key, value in element.attrib.items() if value in inside), None)
+        if referring is None and root.find("keyframe") is not None:
+            referring = "<keyframe> (its qpos counts every copy's joints)"
+        if referring is not None:
+            raise MjcfError(f"{path}: <replicate count='{replicate.get('count')}'> holds elements {referring} refers "
+                            "to: screwkit does not expand MuJoCo's <replicate>; write the copies out (MuJoCo writes "
+                            "a model expanded with mj_saveLastXML).")
+        parents[replicate].remove(replicate)
+        names = f" ({', '.join(sorted(inside)[:3])}{', ...' if len(inside) > 3 else ''})" if inside else ""
+        dropped.append(f"count {replicate.get('count')}{names}")
+    return [f"<replicate> block(s) nothing the mechanism is read by refers to, left out: {'; '.join(dropped)}"] \
+        if dropped else []
+
+
+def _ancestors(element: ElementTree.Element, parents: dict) -> list[ElementTree.Element]:
+    found = []
+    while element in parents:
+        element = parents[element]
+        found.append(element)
+    return found
+
+
 def _check_names(root: ElementTree.Element, path: Path) -> None:
     """No name twice in one of MuJoCo's namespaces that screwkit reads (MuJoCo refuses the file; Pinocchio would
     merge two joints into one, or take either of two bodies, sites, closures or keyframes)."""
@@ -359,7 +392,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
         raise MjcfError(f"{path}: the root element is <{root.tag}>, not <mujoco>{hint}.")
     _resolve_includes(root, path.parent, (path.resolve(),))
     _check_deformable(root, path)
-    notes = []
+    notes = _without_replicates(root, path)
     compilers = root.findall("compiler")
     compiler = _merged(root, "compiler")
     if compiler is None:
