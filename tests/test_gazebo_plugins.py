@@ -391,6 +391,20 @@ def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_ele
                    "component [0zzz] to a double")
 
 
+def test_a_xacro_file_given_as_a_urdf_is_refused_naming_xacro(tmp_path):
+    """A ROS Delta's package ships its xacro source as ``delta_robot.urdf``: it was refused with Pinocchio's complaint
+    about a mass that is an expression (``${mass_base}``), leaving the user to guess; a xacro whose expressions
+    happen to parse would be read as another robot. Refused now, naming xacro and how to expand it."""
+    text = FIVE_BAR.read_text().replace("<robot", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"', 1)
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(text)  # the namespace alone (xacro's output keeps it): a URDF, read
+    assert screwkit("analyze", path, "--output", "Chain1_dummy").returncode == 0
+    link = text.index("<link")
+    path.write_text(text[:link] + '<xacro:property name="mass_base" value="1.0"/>' + text[link:])
+    one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"), "a xacro file (it holds '<xacro:')",
+                   "xacro fivebar_linkage.urdf -o robot.urdf")
+
+
 def test_the_published_four_axis_delta_names_its_wrist_and_opens_with_it_held(tmp_path):
     """LevinTamir's 4-DOF Delta: three R-S-S legs, each ending on a ball written as three hinges on the tool holder
     (the body its planning chain moves), and a wrist, the driven hinge Chain4_1 that turns the tool on the holder,

@@ -11,6 +11,7 @@ refused in one line with urdfdom's first complaint, which names the element.
 from __future__ import annotations
 
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -25,6 +26,7 @@ def urdf_model(urdf: Path):
     naming the file and urdfdom's complaint if it cannot read it."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
+    _refuse_xacro(urdf)
     sys.stderr.flush()
     try:
         kept = os.dup(2)
@@ -54,3 +56,18 @@ def urdf_model(urdf: Path):
                   if line.strip().startswith("Error:")]
     raise ImportError_(f"{urdf}: Pinocchio cannot read the tree: "
                        + (f"{complaints[0]}." if complaints else f"{error}.").replace("..", "."))
+
+
+def _refuse_xacro(urdf: Path) -> None:
+    """A xacro file (ROS's macro language for URDF) given as a URDF is refused in one line: its macros, properties and
+    ``${...}`` expressions are not URDF, and what Pinocchio would make of it is another robot or a complaint about a
+    number that is an expression."""
+    try:
+        text = re.sub(r"<!--.*?-->", "", Path(urdf).read_text(errors="replace"), flags=re.DOTALL)  # (not comments)
+    except OSError:
+        return  # (the reader says why)
+    found = next((mark for mark in ("<xacro:", "${", "$(") if mark in text), None)  # (not the namespace alone:
+    # xacro's output keeps it on <robot>)
+    if found is not None:
+        raise ImportError_(f"{urdf}: a xacro file (it holds {found!r}), not a URDF: expand it first, e.g. "
+                           f"`xacro {Path(urdf).name} -o robot.urdf` (ROS's xacro), and read robot.urdf.")
