@@ -42,6 +42,14 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
     """For a leg with several actuators: what holds the serial stage that carries them (the refusal's end) and the
     joints it holds (none: no advice)."""
     model = tree.model
+    riding = [tree.written_joint(model.names[a]) for a in leg.actuators
+              if a != platform and platform in path_to(model, a)]
+    if riding and len(riding) < len(leg.actuators):  # (a wheel on a wheel leg's end link, where its closure ends)
+        one = len(riding) == 1
+        return (f"; actuated joint{'' if one else 's'} {', '.join(map(repr, riding))} ride{'s' if one else ''} on the "
+                "platform (a wheel or a tool it carries, through which the leg's closure reaches it): --lock "
+                f"{' --lock '.join(riding)} holds {'it' if one else 'them'}, or --output names the body "
+                f"{'it turns' if one else 'they turn'}"), riding
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
         names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
