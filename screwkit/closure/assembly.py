@@ -456,12 +456,13 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
                     if not more:
                         chain_indices, poses, values = _mode_samples(mechanism, poses, values)
                     modes = meeting_modes(mechanism, chain_indices, poses, values, mobility)
+    frame_mobility = mobility  # (the platform's own; a point output's is fewer where it turns about the point)
     if idle:
         instantaneous = point_dof(mechanism, mechanism.home_full_pose, [c.reference_values for c in mechanism.chains],
                                   instantaneous)
         check_turns(mechanism, at_pose, at_values, mobility)
         mobility = point_dof(mechanism, at_pose, at_values, mobility)
-    if mobility < 1 and idle:
+    if mobility < 1 and idle and frame_mobility > 0:
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")
     if mobility < 1:  # rigid: its closures leave the platform no motion (as a CAD export's rounding can make them)
