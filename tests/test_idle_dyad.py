@@ -33,9 +33,11 @@ coupler."""
 
 
 def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "rocker",
-            reverse: bool = False) -> str:
+            reverse: bool = False, rocker_lift: float = 0.0) -> str:
     """The parallelogram's MJCF text, every length times ``scale``, its base placed by ``world``; ``dyad``: the link
-    the dyad hangs from ("rocker", "crank" or None); ``reverse``: branches and closures listed the other way round."""
+    the dyad hangs from ("rocker", "crank" or None); ``reverse``: branches and closures listed the other way round;
+    ``rocker_lift``: the rocker's pivot drawn that far above D (no dyad)."""
+    pivot = D + np.array([0.0, 0.0, rocker_lift])
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
 
@@ -48,7 +50,7 @@ def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "
     crank = (f'<body name="crank" pos="{at(A)}">{hinge.format("crank")}'
              f'<body name="coupler" pos="{at(B - A)}">{hinge.format("bpin")}</body>'
              + (links if dyad == "crank" else "") + '</body>')
-    rocker = f'<body name="rocker" pos="{at(D)}">{hinge.format("rocker")}' + (links if dyad == "rocker" else "") \
+    rocker = f'<body name="rocker" pos="{at(pivot)}">{hinge.format("rocker")}' + (links if dyad == "rocker" else "") \
         + '</body>'
     lift = np.array([0.0, 0.04, 0.0])  # the second point of each closing hinge, along its axis
 
@@ -56,7 +58,7 @@ def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "
         return [f'<connect name="{name}{k}" body1="{body1}" body2="{body2}" anchor="{at(point + k * lift - origin)}"/>'
                 for k in (0, 1)]
 
-    closures = pin("cpin", "rocker", "coupler", C, D) + (pin("epin", "link2", "coupler", E, G) if dyad else [])
+    closures = pin("cpin", "rocker", "coupler", C, pivot) + (pin("epin", "link2", "coupler", E, G) if dyad else [])
     branches = [crank, rocker]
     if reverse:
         branches, closures = branches[::-1], closures[::-1]
@@ -123,3 +125,16 @@ def test_the_dyad_taken_as_the_output_is_refused_with_the_loop_through_the_crank
     with pytest.raises(ImportError_, match="'crank' moves inside a loop of leg 'crank' \\(with the other joints of its "
                                            "path to the platform held it cannot move"):
         graph_mechanism(read_closed_tree(path, output="link2"))
+
+
+@pytest.mark.parametrize("world", [("0 0 0", "1 0 0 0"), ("0.3 -0.2 0.5", "0.8 0.3 -0.4 0.2"),
+                                   ("0 0 0", "0.9 0.2 0.3 0.25")])
+def test_a_nearly_translating_coupler_takes_a_translation_as_its_coordinate_in_any_world(tmp_path, world):
+    """The rocker's pivot drawn 0.1 mm off the parallelogram's (a file's rounding): the coupler turns 1e-3 rad a unit
+    of its translation. In a turned world its translation moves each of x, y and z less than 0.71 length scales a
+    unit, and the pitch it barely turns was taken as its task coordinate (a published ECM in a turned world): the
+    translations are now judged on all three at once, which no turn of the world changes."""
+    path = tmp_path / "slanted.xml"
+    path.write_text(linkage(world=world, dyad=None, rocker_lift=1e-4))
+    graph = graph_mechanism(read_closed_tree(path, output="coupler"))
+    assert graph.task_coordinates[0] in ("x", "y", "z"), graph.task_coordinates

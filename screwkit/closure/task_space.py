@@ -376,7 +376,10 @@ def choose_task_axes(space: NDArray, angular: NDArray, dof: int, candidates=None
         # length scale, and its roll, pitch, yaw told its motions apart by 0.0015 against x, y, z's 0.98
         sets = combinations(np.flatnonzero(~angular), dof)
         separation, best = max(((_separation(space, axes), axes) for axes in sets), key=lambda pair: pair[0])
-        if separation >= TRANSLATIONAL:
+        # (whether they do is read on every translation coordinate at once, which no turn of the world changes: a
+        # parallelogram's coupler translating along a slant of a turned world moves each of x, y, z 0.6 length
+        # scales a unit, and took the pitch it turns 1e-4 rad with the file's rounding)
+        if _separation(space, np.flatnonzero(~angular)) >= TRANSLATIONAL and separation > TASK_RANK_TOLERANCE:
             return tuple(int(axis) for axis in best)
     return chosen
 
