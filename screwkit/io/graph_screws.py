@@ -9,7 +9,7 @@ actuated joint's own twist and its ITI and OTI points, and from them the equival
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -254,6 +254,28 @@ def _loaded(state: _State, leg: GraphLeg, cuts: list, actuator: int | None) -> N
     keeps all three: which to leave out would turn on the order). Such a connection only hangs a load-free linkage on
     the body (a dyad between two links that move as the dyad allows: its two-force links cannot balance each other)."""
     systems = [[j for j in leg.joints]] + ([[j for j in leg.joints if j != actuator]] if actuator is not None else [])
+    count = state.working.shape[0]
+    if count > _SCREENED:  # first at a few configurations of the batch: where no connection is idle at any of them
+        # (a Delta's rod pairs, each rod holding the platform's turns), none is taken to be at the others, whose
+        # twist systems are not computed again (an idle one shows at every regular configuration)
+        sample = _sampled(state, np.unique(np.linspace(0, count - 1, _SCREENED).astype(int)))
+        if not _loaded(sample, leg, cuts, actuator).all():
+            return _loaded_at_each(state, leg, cuts, systems)
+        return np.ones((count, len(cuts)), dtype=bool)
+    return _loaded_at_each(state, leg, cuts, systems)
+
+
+_SCREENED = 4
+"""Configurations of a batch at which :func:`_loaded` first looks for an idle connection."""
+
+
+def _sampled(state: _State, rows: NDArray) -> _State:
+    """The configurations ``rows`` of a batch."""
+    return replace(state, transforms=state.transforms[rows], working=state.working[rows], centre=state.centre[rows])
+
+
+def _loaded_at_each(state: _State, leg: GraphLeg, cuts: list, systems: list) -> NDArray[np.bool_]:
+    """:func:`_loaded` at every configuration of the batch."""
     whole = [_twist_spaces(state, joints, leg)[1] for joints in systems]
 
     def same(cut) -> NDArray[np.bool_]:  # (n,): the leg's twist systems as they are with ``cut`` left out
