@@ -9,6 +9,9 @@ MuJoCo's own placement of its joints and sites, in m, mm and a moved, turned wor
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import mujoco
 import numpy as np
 import pytest
@@ -74,3 +77,16 @@ def test_a_connect_to_the_world_body_named_or_left_out_reads_the_same(tmp_path, 
     result = indices_at_pose(mechanism, mechanism.home_pose)
     assert (float(result.iti), float(result.lmti)) == pytest.approx((_sine(b - a, c - b), _sine(c - b, c - d)),
                                                                     abs=1e-9)
+
+
+def test_connects_on_sites_read_over_and_over_do_not_crash_the_process(tmp_path):
+    """Pinocchio 4.1's parser of ``<connect site1=... site2=...>`` faults now and then (a segmentation fault within
+    a few hundred readings of this file, in a test run and in a user's sweep of files); screwkit places closures
+    itself, and the text Pinocchio reads no longer holds the ``<equality>`` section. Read 400 times in a process of
+    its own, which a fault would end with a signal."""
+    path = tmp_path / "fourbar.xml"
+    path.write_text(four_bar())
+    code = ("import sys\nfrom screwkit.io import read_closed_tree\n"
+            "for _ in range(400):\n    read_closed_tree(sys.argv[1], output='coupler')\n")
+    run = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, (run.returncode, run.stderr[-2000:])

@@ -44,16 +44,18 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
                                f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                                "(motors the file does not name, or a leg with no input); if it is a serial stage "
                                f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
-        if screw.rigid_input is not None and not screw.rigid_input[0]:  # (its twist in the leg's system or not)
+        outside = screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1
+        below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
+                 if j in leg.joints and j != platform]
+        if screw.rigid_input is not None and not screw.rigid_input[0] and not (outside and below):
+            # (where joints of the leg carry it, holding them is the way out named below)
             raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
                                "the other joints of its path to the platform held it cannot move: a loop through that "
                                "path closes on the base and shares the load the leg carries, so the power coefficient "
                                "on its own twist is not the leg's input); analysable when the actuated joint joins the "
                                "base to the rest of its leg: the link it drives taken as the output (--output) reads "
                                "its own transmission.")
-        if screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1:
-            below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
-                     if j in leg.joints and j != platform]
+        if outside:
             one = len(below) == 1
             hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
                     f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else

@@ -474,7 +474,15 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
                      + (", ..." if len(named) > 4 else ""))
     _merged(root, "actuator")
     top_class_renamed(root)
+    # the text Pinocchio reads holds no <equality>: screwkit places the closures itself (closure_placements), and
+    # Pinocchio 4.1's parser of connects written on sites crashes the process now and then (a heap fault, read over
+    # and over on the same file)
+    kept = [(index, element) for index, element in enumerate(root) if element.tag == "equality"]
+    for _, element in kept:
+        root.remove(element)
     text = ElementTree.tostring(root, encoding="unicode")
+    for index, element in kept:
+        root.insert(index, element)
     return text, notes, root, couplings
 
 
