@@ -394,18 +394,18 @@ def closure_rows(model, data, closures, scale: float) -> NDArray[np.float64]:
 
 def closure_gaps(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     """Distance (m) between the two frame origins of every closure at q."""
-    return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c, a, b in _closure_frames(tree, q)}
+    return {c.name: float(np.linalg.norm(a[:3, 3] - b[:3, 3])) for c, a, b in closure_frames(tree, q)}
 
 
 def closure_turns(tree: ClosedTree, q: NDArray) -> dict[str, float]:
     """The angle (rad) between the two frames of every ``6d`` closure at q: a weld can be open in rotation alone."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    return {c.name: float(np.linalg.norm(pin.log3(a[:3, :3].T @ b[:3, :3]))) for c, a, b in _closure_frames(tree, q)
+    return {c.name: float(np.linalg.norm(pin.log3(a[:3, :3].T @ b[:3, :3]))) for c, a, b in closure_frames(tree, q)
             if c.kind == "6d"}
 
 
-def _closure_frames(tree: ClosedTree, q: NDArray) -> list[tuple[Closure, NDArray, NDArray]]:
+def closure_frames(tree: ClosedTree, q: NDArray) -> list[tuple[Closure, NDArray, NDArray]]:
     """Every closure with its two frames (4x4, world) at q."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
@@ -519,8 +519,10 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             return q, scale
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
-        advice = ("" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE "
-                  "gives joints values nearer one")
+        from screwkit.io.rounding import gap_along_pins  # (rounding reads closed_tree's frames)
+
+        advice = gap_along_pins(tree, q, worst) or ("" if tree.initial else ": if the file draws the robot far from "
+                                                    "an assembly, --initial JOINT VALUE gives joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "
                            f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (every closure's "
                            "gap after assembly: " + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items())
