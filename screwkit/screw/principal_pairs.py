@@ -12,7 +12,11 @@ every freed twist but ``F V_b a``, and its power on it is ``s``. The pairs' :mat
 with ``R``, and numpy's pick follows the rounding of its input, so the CTI would move with a change of drawing or of
 unit. The block instead takes its **worst rotation**: the lowest :math:`\kappa` of ``(a^T U_b^T C, F V_b a)`` over
 every unit ``a`` (any unit ``a`` is the first column of some ``R``), the worst case the paper's indices take
-everywhere; it is no higher than any pick's. Found by a fixed set of directions on the half sphere (``a`` and ``-a``
+everywhere; it is no higher than any pick's. Each rotated wrench is taken at the chain's joint point projected on its
+axis, not where it crosses the joint's line (:func:`~screwkit.screw.algebra.nearest_on_axis`, as a pair of its own
+is): a rotation that turns a force almost along a pin makes it cross the pin's axis arbitrarily far away, where the
+crossing moves fast and :math:`\kappa` vanishes, and the search would find that edge (an excavator boom read as a
+graph: 1.0e-6). Found by a fixed set of directions on the half sphere (``a`` and ``-a``
 are the same pair) and compass searches from the lowest of them, apart from each other (:data:`_STARTS`; steps along
 and against turned axes, doubled after a move and halved after none, down to :data:`_STEP_FLOOR`): equal to scipy's
 minimisation from many starts to 1e-12 on every block a published file makes (two and four pairs), to 4e-4 on
@@ -210,6 +214,7 @@ def worst_in_blocks(kappa: NDArray, singular: NDArray, exists: NDArray, wrenches
             block = bounded[..., start + 1:stop].all(axis=-1) & ~bounded[..., start] & ~bounded[..., stop]
             if not block.any():
                 continue
+            point = joint[block] * np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])  # (the joint's point, not its line)
             kappa[block, start:stop] = worst_rotation(wrenches[block][:, start:stop], twists[block][:, start:stop],
-                                                      joint[block], threshold[block])[:, None]
+                                                      point, threshold[block])[:, None]
     return kappa
