@@ -231,7 +231,9 @@ def test_a_dyad_pinned_inside_a_leg_constrains_nothing_and_leaves_the_five_bar(t
 @pytest.mark.parametrize("options, message", [
     (dict(distort=0.02), "cannot be written as serial chains: its constraint is not one of rotations about fixed "
                          "directions"),
-    (dict(motors=("mot1_rod1", "mot1_rod2", "free1_rod3")), r"has 2 actuated legs \(mot1_rod2, free1_rod3\)"),
+    (dict(motors=("mot1_rod1", "mot1_rod2", "free1_rod3")), r"has 2 actuated legs \(mot1_rod2, free1_rod3\), the legs "
+                                                            r"from those joints, with actuated joints mot1_rod2, "
+                                                            r"free1_rod3: .* --lock holds the others"),
 ])
 def test_a_compound_leg_screwkit_cannot_write_is_refused_by_name(tmp_path, options, message):
     path = write(tmp_path, *delta_gepetto(**options))

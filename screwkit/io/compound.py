@@ -350,9 +350,12 @@ def compound_legs(tree: ClosedTree, q: NDArray, scale: float, legs: list, coupli
             continue
         actuated = [index for index in members if motors & set(legs[index].joints)]
         if len(actuated) > 1:
+            driven = [model.names[j] for i in actuated for j in legs[i].joints if j in motors]
             raise ImportError_(f"{tree.source}: {label} has {len(actuated)} actuated legs "
-                               f"({', '.join(model.names[legs[i].joints[0]] for i in actuated)}): screwkit writes a "
-                               "compound leg with one actuator.")
+                               f"({', '.join(model.names[legs[i].joints[0]] for i in actuated)}), the legs from "
+                               f"those joints, with actuated joints {', '.join(driven)}: screwkit writes a compound "
+                               "leg with one actuator; --lock holds the others where the file puts them, or --actuate "
+                               "names the actuated joints to read.")
         closures = list(group_couplings) + [closure for i in members for closure in legs[i].sources]
         spine = 0 in members
         joints = joints_of(closures, members, spine)
