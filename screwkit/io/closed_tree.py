@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
+from screwkit.io.pin_gaps import along_pins
 
 GUESSED = "actuators guessed"
 """How a reader's note on guessed actuators begins."""
@@ -519,10 +520,11 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             return q, scale
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
-        from screwkit.io.rounding import gap_along_pins  # (rounding reads closed_tree's frames)
-
-        advice = gap_along_pins(tree, q, worst) or ("" if tree.initial else ": if the file draws the robot far from "
-                                                    "an assembly, --initial JOINT VALUE gives joints values nearer one")
+        closure, first, second = next(item for item in closure_frames(tree, q) if item[0].name == worst)
+        loop = sorted(set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b)))
+        advice = along_pins(model, q, first, second, [(j, *joint_kind(model, j)) for j in loop]) or (
+            "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "
+            "joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "
                            f"{worst!r} still misses by {gaps[worst]:.3g} {tree.unit} after assembly (every closure's "
                            "gap after assembly: " + ", ".join(f"{k} {v:.3g} {tree.unit}" for k, v in gaps.items())

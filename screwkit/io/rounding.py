@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 from screwkit.closure.canonical import foot_on_line
 from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
-from screwkit.io.closed_tree import closure_frames, joint_kind, nearest_to_lines, path_to
+from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
 __all__ = ["parallel_axes", "plane_normal", "meeting_lines", "drawn_lines", "turned_joint", "held_limits", "EXACT"]
 
@@ -331,28 +331,3 @@ def held_limits(model, joint: int, value: float, kind: str, scale: float, report
         report.notes.append(f"joint {model.names[joint]!r}: its limits moved out to {value:.6g}, where the assembly "
                             "puts it, beyond them by less than the file's rounding")
     return lower, upper
-
-
-def gap_along_pins(tree, q: NDArray, name: str) -> str:
-    """What to say of closure ``name`` left open at q where its gap lies along its loop's hinges, all parallel: the
-    anchors drawn at different depths on parallel pins (a CAD export's), which no joint values close; else ''."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    model = tree.model
-    closure, first, second = next(item for item in closure_frames(tree, q) if item[0].name == name)
-    data = model.createData()
-    pin.forwardKinematics(model, data, q)
-    loop = set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b))
-    kinds = [(joint, *joint_kind(model, joint)) for joint in sorted(loop)]
-    axes = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "revolute"]
-    gap = first[:3, 3] - second[:3, 3]
-    if len(axes) < 2 or len(axes) < len(kinds) or not np.linalg.norm(gap) > 0:
-        return ""
-    across = [np.linalg.norm(np.cross(axes[0], axis)) for axis in axes] + [
-        np.linalg.norm(np.cross(axes[0], gap)) / np.linalg.norm(gap)]
-    if max(across) > 1e-3:  # (about 0.06 deg)
-        return ""
-    hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
-    return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
-            "different depths on one pin, which no joint values close: moved along the pin onto one plane (the "
-            "connect's anchor or site), the loop closes")
