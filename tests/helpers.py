@@ -335,3 +335,20 @@ def mjcf_variant(tmp_path, name: str, variant: str, write) -> tuple:
     path = tmp_path / f"{name}_{variant}.xml"
     path.write_text(write(scale, world))
     return path, unit
+
+
+def sine(u, v) -> float:
+    """|sin| of the angle between two vectors: a textbook pressure angle's transmission."""
+    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
+
+
+def mujoco_closed(path) -> tuple:
+    """MuJoCo's own reading of an MJCF file at its configuration, checked closed as written (its constraints'
+    residuals zero): (model, data, each joint's anchor in the world by name)."""
+    import mujoco  # (MuJoCo's reading, for the tests of MJCF files)
+
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
+    return model, data, {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}

@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -62,9 +62,6 @@ def linkage(request, tmp_path):
     return mjcf_variant(tmp_path, "bucket", request.param, bucket_linkage)
 
 
-def _sine(u, v) -> float:
-    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
-
 
 def _mujoco_points(path) -> dict[str, np.ndarray]:
     """I, J and K as MuJoCo places them at the file's configuration (closed: its connects' residuals are zero)."""
@@ -92,8 +89,8 @@ def test_the_h_link_reads_the_cylinders_own_transmission(linkage):
     result = indices_at_pose(mechanism, mechanism.home_pose)
     points = _mujoco_points(path)
     assert float(result.iti) == pytest.approx(1.0, abs=1e-9)  # the force along the cylinder, on its own slide
-    assert float(result.lmti) == pytest.approx(_sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
-    assert _sine(J - I, J - K) == pytest.approx(0.97959, abs=1e-5)
+    assert float(result.lmti) == pytest.approx(sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
+    assert sine(J - I, J - K) == pytest.approx(0.97959, abs=1e-5)
 
 
 def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_path):
@@ -103,7 +100,7 @@ def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_pat
         graph_mechanism(read_closed_tree(path, output="bucket"))
     mechanism = load(path, output="hlink")
     result = indices_at_pose(mechanism, mechanism.home_pose)
-    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, sine(J - I, J - K)), abs=1e-9)
 
 
 def test_the_command_refuses_the_bucket_and_reads_the_h_link(tmp_path):
@@ -113,7 +110,7 @@ def test_the_command_refuses_the_bucket_and_reads_the_h_link(tmp_path):
     read = screwkit("analyze", path, "--output", "hlink", "--json")
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
-    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, sine(J - I, J - K)), abs=1e-9)
 
 
 def doubled_crank(distal_on: str) -> str:
@@ -155,7 +152,7 @@ def test_a_crank_doubled_by_a_parallelogram_off_its_path_drives_its_leg(tmp_path
     mujoco.mj_forward(model, data)
     assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 2  # closed, 2 DOF
     result = graph_mechanism(read_closed_tree(path, output="distal1")).indices()
-    assert float(np.ravel(result.iti_actuators)[1]) == pytest.approx(_sine(b2 - a2, p - b2), abs=1e-9)
+    assert float(np.ravel(result.iti_actuators)[1]) == pytest.approx(sine(b2 - a2, p - b2), abs=1e-9)
     path.write_text(doubled_crank("coupler"))
     with pytest.raises(ImportError_, match="'m2' moves inside a loop"):
         graph_mechanism(read_closed_tree(path, output="distal1"))
@@ -172,7 +169,7 @@ def test_the_command_reads_the_doubled_crank(tmp_path):
     read = screwkit("analyze", path, "--output", "distal1", "--json")
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
-    assert result["iti_actuators"]["crank2:m2"] == pytest.approx(_sine(b2 - a2, p - b2), abs=1e-9)
+    assert result["iti_actuators"]["crank2:m2"] == pytest.approx(sine(b2 - a2, p - b2), abs=1e-9)
     path.write_text(doubled_crank("coupler"))
     one_line_error(screwkit("analyze", path, "--output", "distal1"), "'m2' moves inside a loop of leg 'crank2'")
 
@@ -185,7 +182,7 @@ def test_the_h_link_read_as_a_graph_equals_its_serial_reading(linkage):
     graph = graph_mechanism(read_closed_tree(path, output="hlink", length_unit=unit)).indices()
     points = _mujoco_points(path)
     assert float(graph.iti) == pytest.approx(1.0, abs=1e-9)
-    assert float(graph.lmti) == pytest.approx(_sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
+    assert float(graph.lmti) == pytest.approx(sine(points["J"] - points["I"], points["J"] - points["K"]), abs=1e-9)
 
 
 def bucket_along_path(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), reverse: bool = False) -> str:
@@ -227,7 +224,7 @@ def test_the_bucket_on_its_own_path_is_refused_as_driven_through_a_loop(tmp_path
     result = graph_mechanism(read_closed_tree(path, output="hlink", length_unit=unit)).indices()  # (bucket beyond)
     points = _mujoco_points(path)
     assert (float(result.iti), float(result.lmti)) == pytest.approx(
-        (1.0, _sine(points["J"] - points["I"], points["J"] - points["K"])), abs=1e-9)
+        (1.0, sine(points["J"] - points["I"], points["J"] - points["K"])), abs=1e-9)
 
 
 def test_the_command_refuses_the_bucket_on_its_own_path_and_reads_its_h_link(tmp_path):
@@ -237,7 +234,7 @@ def test_the_command_refuses_the_bucket_on_its_own_path_and_reads_its_h_link(tmp
     read = screwkit("analyze", path, "--output", "hlink", "--json")
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
-    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+    assert (result["iti"], result["lmti"]) == pytest.approx((1.0, sine(J - I, J - K)), abs=1e-9)
 
 
 def test_the_bucket_on_its_own_path_reads_the_same_with_its_closures_listed_the_other_way_round(tmp_path):
@@ -246,4 +243,4 @@ def test_the_bucket_on_its_own_path_reads_the_same_with_its_closures_listed_the_
     with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel'"):
         graph_mechanism(read_closed_tree(path, output="bucket"))
     result = graph_mechanism(read_closed_tree(path, output="hlink")).indices()
-    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, _sine(J - I, J - K)), abs=1e-9)
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, sine(J - I, J - K)), abs=1e-9)

@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 
@@ -68,11 +68,8 @@ def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "
             '</mujoco>')
 
 
-def _sine(u, v) -> float:
-    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
 
-
-def _mujoco_sine(path) -> float:
+def _mujocosine(path) -> float:
     """|sin(BC, DC)| from MuJoCo's placement of the pins, the linkage checked closed and of one motion."""
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
@@ -82,15 +79,15 @@ def _mujoco_sine(path) -> float:
     anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
     rocker = model.body("rocker").id
     c = data.xpos[rocker] + data.xmat[rocker].reshape(3, 3) @ model.eq_data[model.equality("cpin0").id][:3]
-    return _sine(c - anchor["bpin"], c - anchor["rocker"])
+    return sine(c - anchor["bpin"], c - anchor["rocker"])
 
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
 @pytest.mark.parametrize("dyad", [None, "rocker", "crank"])
 def test_an_idle_dyad_leaves_the_parallelograms_indices(tmp_path, variant, dyad):
     path, unit = mjcf_variant(tmp_path, f"para_{dyad}", variant, lambda s, w: linkage(s, w, dyad=dyad))
-    expected = _mujoco_sine(path)
-    assert expected == pytest.approx(_sine(C - B, C - D), abs=1e-12)
+    expected = _mujocosine(path)
+    assert expected == pytest.approx(sine(C - B, C - D), abs=1e-12)
     result = graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit)).indices()
     assert (float(result.iti), float(result.lmti)) == pytest.approx((1.0, 1.0), abs=1e-9)
     assert float(result.cti) == pytest.approx(expected, abs=1e-9)
@@ -102,7 +99,7 @@ def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_pat
     path.write_text(linkage(dyad=dyad, reverse=True))
     result = graph_mechanism(read_closed_tree(path, output="coupler")).indices()
     assert (float(result.iti), float(result.lmti), float(result.cti)) == pytest.approx(
-        (1.0, 1.0, _sine(C - B, C - D)), abs=1e-9)
+        (1.0, 1.0, sine(C - B, C - D)), abs=1e-9)
 
 
 def test_the_command_reads_the_doubled_parallelogram(tmp_path):
@@ -111,7 +108,7 @@ def test_the_command_reads_the_doubled_parallelogram(tmp_path):
     read = screwkit("analyze", path, "--output", "coupler", "--json")
     assert read.returncode == 0, read.stderr
     result = json.loads(read.stdout)
-    assert (result["iti"], result["lmti"], result["cti"]) == pytest.approx((1.0, 1.0, _sine(C - B, C - D)),
+    assert (result["iti"], result["lmti"], result["cti"]) == pytest.approx((1.0, 1.0, sine(C - B, C - D)),
                                                                            abs=1e-9)
 
 

@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, sine
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -40,23 +40,16 @@ def four_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
             '<actuator><motor name="m" joint="jA"/></actuator></mujoco>')
 
 
-def _sine(u, v) -> float:
-    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
-
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
 def test_a_ground_site_of_a_bare_base_body_closes_the_loop(tmp_path, variant):
     path, unit = mjcf_variant(tmp_path, "fourbar", variant, four_bar)
-    model = mujoco.MjModel.from_xml_path(str(path))
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())  # closed as written
-    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    model, data, anchor = mujoco_closed(path)  # closed as written
     a, b, c, d = anchor["jA"], anchor["jB"], anchor["jC"], data.site_xpos[model.site("D_ground").id]
     mechanism = load(path, output="coupler", length_unit=unit)
     result = indices_at_pose(mechanism, mechanism.home_pose)
-    assert float(result.iti) == pytest.approx(_sine(b - a, c - b), abs=1e-9)  # the crank drives the coupler at B
-    assert float(result.lmti) == pytest.approx(_sine(c - b, c - d), abs=1e-9)  # the rocker holds it at C
+    assert float(result.iti) == pytest.approx(sine(b - a, c - b), abs=1e-9)  # the crank drives the coupler at B
+    assert float(result.lmti) == pytest.approx(sine(c - b, c - d), abs=1e-9)  # the rocker holds it at C
 
 
 @pytest.mark.parametrize("world", ['body2="world" ', ""])
@@ -75,7 +68,7 @@ def test_a_connect_to_the_world_body_named_or_left_out_reads_the_same(tmp_path, 
     d = c + data.xmat[model.body("rocker").id].reshape(3, 3) @ np.array([0.0, 0.0, -0.18])
     mechanism = load(path, output="coupler")
     result = indices_at_pose(mechanism, mechanism.home_pose)
-    assert (float(result.iti), float(result.lmti)) == pytest.approx((_sine(b - a, c - b), _sine(c - b, c - d)),
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((sine(b - a, c - b), sine(c - b, c - d)),
                                                                     abs=1e-9)
 
 

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import json
 
-import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, one_line_error, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -45,27 +44,20 @@ def wheel_leg(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
             '<actuator><motor joint="q1"/><motor joint="q4"/><motor joint="wheel_joint"/></actuator></mujoco>')
 
 
-def _sine(u, v) -> float:
-    return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
-
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
 def test_the_distal_link_names_the_wheel_joint_and_reads_with_it_held(tmp_path, variant):
     path, unit = mjcf_variant(tmp_path, "wheel_leg", variant, wheel_leg)
-    model = mujoco.MjModel.from_xml_path(str(path))
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
-    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+    _, _, anchor = mujoco_closed(path)
     with pytest.raises(ImportError_, match="actuated joint 'wheel_joint' rides on the platform .*--lock wheel_joint"):
         graph_mechanism(read_closed_tree(path, output="link_BC", length_unit=unit))  # (the command's reading)
     mechanism = load(path, output="link_BC", lock=("wheel_joint",), length_unit=unit)
     result = indices_at_pose(mechanism, mechanism.home_pose)
     itis = dict(zip(mechanism.actuator_names, np.ravel(result.iti_actuators)))
     a, b, c, e, d = (anchor[name] for name in ("q1", "q2", "wheel_joint", "q4", "q3"))
-    assert itis["q1:q1"] == pytest.approx(_sine(b - a, c - b), abs=1e-9)
-    assert itis["q4:q4"] == pytest.approx(_sine(d - e, c - d), abs=1e-9)
-    assert _sine(B - A, C - B) != pytest.approx(_sine(D - E, C - D), abs=1e-3)  # (the legs told apart)
+    assert itis["q1:q1"] == pytest.approx(sine(b - a, c - b), abs=1e-9)
+    assert itis["q4:q4"] == pytest.approx(sine(d - e, c - d), abs=1e-9)
+    assert sine(B - A, C - B) != pytest.approx(sine(D - E, C - D), abs=1e-3)  # (the legs told apart)
 
 
 def test_the_command_names_the_wheel_joint(tmp_path):
@@ -75,4 +67,4 @@ def test_the_command_names_the_wheel_joint(tmp_path):
                    "platform", "--lock wheel_joint holds it")
     read = screwkit("analyze", path, "--output", "link_BC", "--lock", "wheel_joint", "--json")
     assert read.returncode == 0, read.stderr
-    assert json.loads(read.stdout)["iti_actuators"]["q1:q1"] == pytest.approx(_sine(B - A, C - B), abs=1e-9)
+    assert json.loads(read.stdout)["iti_actuators"]["q1:q1"] == pytest.approx(sine(B - A, C - B), abs=1e-9)
