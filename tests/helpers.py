@@ -352,3 +352,10 @@ def mujoco_closed(path) -> tuple:
     mujoco.mj_forward(model, data)
     assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
     return model, data, {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
+
+
+def mujoco_rows(model, data) -> np.ndarray:
+    """MuJoCo's constraint Jacobian (nefc, nv), dense: its ``efc_J`` buffer may hold more rows than the constraints
+    found (rows MuJoCo leaves out, a connect between two bodies turning on one pin, are not written, and what is left
+    there is whatever the memory held)."""
+    return data.efc_J[:data.nefc * model.nv].reshape(data.nefc, model.nv)

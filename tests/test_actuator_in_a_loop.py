@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit, sine
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, one_line_error, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -69,7 +69,7 @@ def _mujoco_points(path) -> dict[str, np.ndarray]:
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
-    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 1  # one motion
+    assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # one motion
     anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
     hlink = model.body("hlink").id
     pivot = data.xpos[hlink] + data.xmat[hlink].reshape(3, 3) @ model.eq_data[0][:3]  # the connect's point on it
@@ -150,7 +150,7 @@ def test_a_crank_doubled_by_a_parallelogram_off_its_path_drives_its_leg(tmp_path
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 2  # closed, 2 DOF
+    assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 2  # closed, 2 DOF
     result = graph_mechanism(read_closed_tree(path, output="distal1")).indices()
     assert float(np.ravel(result.iti_actuators)[1]) == pytest.approx(sine(b2 - a2, p - b2), abs=1e-9)
     path.write_text(doubled_crank("coupler"))
@@ -217,7 +217,7 @@ def test_the_bucket_on_its_own_path_is_refused_as_driven_through_a_loop(tmp_path
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    assert model.nv - np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9) == 1  # MuJoCo: one motion
+    assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # MuJoCo: one motion
     with pytest.raises(ImportError_, match="'ram' moves inside a loop of leg 'barrel' \\(with the other joints of "
                                            "its path to the platform held it cannot move"):
         graph_mechanism(read_closed_tree(path, output="bucket", length_unit=unit))

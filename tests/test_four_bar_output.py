@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import mujoco_rows, one_line_error, screwkit
 from screwkit.io import ImportError_
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -51,7 +51,7 @@ def mobility(model, free) -> int:
     """MuJoCo's own count: the velocities ``free`` (the others held) that keep the connects closed."""
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    jacobian = data.efc_J.reshape(-1, model.nv)[:, free]
+    jacobian = mujoco_rows(model, data)[:, free]
     return len(free) - int(np.linalg.matrix_rank(jacobian, tol=1e-9))
 
 

@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, one_line_error, screwkit
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -51,7 +51,7 @@ def _foot_motions(path: Path, held: tuple[str, ...]) -> int:
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    rows = data.efc_J.reshape(-1, model.nv)
+    rows = mujoco_rows(model, data)
     free = [model.jnt_dofadr[model.joint(k).id] for k in range(model.njnt) if model.joint(k).name not in held]
     _, singular, right = np.linalg.svd(rows[:, free])
     null = right[int(np.sum(singular > 1e-9)):]

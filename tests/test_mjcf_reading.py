@@ -19,7 +19,7 @@ import pytest
 from test_io import HOME, assert_textbook, five_bar_mjcf, poses_near_home
 from test_lower_mobility import five_bar_expected
 
-from helpers import assert_indices_close, one_line_error, random_reachable_poses, random_rotation, screwkit
+from helpers import assert_indices_close, mujoco_rows, one_line_error, random_reachable_poses, random_rotation, screwkit
 from screwkit.io import ImportError_, read_mechanism_file
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
@@ -583,7 +583,7 @@ def mujoco_motions(text: str, joints) -> int:
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     rows = [i for i in range(data.nefc) if data.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
-    jacobian = data.efc_J.reshape(data.nefc, model.nv)[rows]
+    jacobian = mujoco_rows(model, data)[rows]
     _, values, right = np.linalg.svd(np.vstack([jacobian, np.zeros((model.nv, model.nv))]))
     null = right[int(np.sum(values > 1e-9)):]
     columns = [model.jnt_dofadr[model.joint(name).id] for name in joints]

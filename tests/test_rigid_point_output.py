@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, one_line_error, screwkit
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -39,7 +39,7 @@ def _mobility(path) -> int:
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    return model.nv - int(np.linalg.matrix_rank(data.efc_J.reshape(-1, model.nv), tol=1e-9))
+    return model.nv - int(np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9))
 
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))

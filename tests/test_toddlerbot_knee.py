@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import mujoco_rows, one_line_error, screwkit
 from screwkit.closure import actuator_values, solve
 from screwkit.closure.forward_kinematics import forward
 from screwkit.io.loader import load
@@ -76,7 +76,7 @@ def _mujoco_pressure_angles(path: Path, motor: float) -> tuple[float, float]:
         residual = data.efc_pos[rows]
         if np.linalg.norm(residual) < 1e-14:
             break
-        jacobian = data.efc_J.reshape(data.nefc, model.nv)[rows][:, [model.jnt_dofadr[j] for j in free]]
+        jacobian = mujoco_rows(model, data)[rows][:, [model.jnt_dofadr[j] for j in free]]
         step = np.linalg.lstsq(jacobian, -residual, rcond=None)[0]
         for j, change in zip(free, step):
             data.qpos[model.jnt_qposadr[j]] += change

@@ -10,6 +10,7 @@ actuated joint's own twist and its ITI and OTI points, and from them the equival
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from itertools import combinations
 
 import numpy as np
 from numpy.typing import NDArray
@@ -248,11 +249,14 @@ def _attachments(state: _State, leg: GraphLeg, body: int, actuator: int | None =
 
 
 def _loaded(state: _State, leg: GraphLeg, cuts: list, actuator: int | None) -> NDArray[np.bool_]:
-    """Which of a leg's connections ``cuts`` to one body carry load (n, k): all but those that, left out each on its
-    own, leave the leg's twist systems as they are (with every joint free and with ``actuator`` locked), provided
-    leaving all of those out together does too (a third bar of a parallelogram, each bar idle beside the other two,
-    keeps all three: which to leave out would turn on the order). Such a connection only hangs a load-free linkage on
-    the body (a dyad between two links that move as the dyad allows: its two-force links cannot balance each other)."""
+    """Which of a leg's connections ``cuts`` to one body are kept in the point where the leg meets it (n, k): all but
+    those that, left out each on its own, leave the leg's twist systems as they are (with every joint free and with
+    ``actuator`` locked) and are not idle only beside another idle one (two bearings of one pin, a third bar of a
+    parallelogram: each is idle while the other holds, and which to leave out would turn on the order, so both are
+    kept), provided leaving all of them out together does too. Such a connection adds no constraint to the leg: a
+    dyad hung between two of its links, which, unloaded, carries nothing in its plane (two links on three pins, each
+    pushing only along its own pin line); or a support the leg already has, whose share of the load the geometry
+    does not decide (a second carriage pinned to the platform on a rail parallel to its own)."""
     systems = [[j for j in leg.joints]] + ([[j for j in leg.joints if j != actuator]] if actuator is not None else [])
     count = state.working.shape[0]
     if count > _SCREENED:  # first at a few configurations of the batch: where no connection is idle at any of them
@@ -286,11 +290,17 @@ def _loaded_at_each(state: _State, leg: GraphLeg, cuts: list, systems: list) -> 
         return kept
 
     idle = np.stack([same((cut,)) for cut in cuts], axis=1)  # (n, k)
-    together = np.ones(idle.shape[0], dtype=bool)
-    for row in {tuple(r) for r in idle if r.any()}:
-        rows = np.all(idle == np.array(row), axis=1)
-        together[rows] = same(tuple(cut for cut, out in zip(cuts, row) if out))[rows]
-    drop = idle & together[:, None]
+    backed = np.zeros_like(idle)  # idle only beside another idle one (two bearings of one pin, parallel bars)
+    for i, j in combinations(range(len(cuts)), 2):
+        both = idle[:, i] & idle[:, j]
+        if both.any():
+            apart = both & ~same((cuts[i], cuts[j]))
+            backed[:, i] |= apart
+            backed[:, j] |= apart
+    drop = idle & ~backed
+    for row in {tuple(r) for r in drop if r.any()}:  # (and all of them out together)
+        rows = np.all(drop == np.array(row), axis=1)
+        drop[rows] &= same(tuple(cut for cut, out in zip(cuts, row) if out))[rows, None]
     drop[drop.all(axis=1)] = False  # (a leg that constrains nothing, whatever it meets the body by: every one)
     return ~drop
 
