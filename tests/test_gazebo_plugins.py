@@ -399,6 +399,11 @@ def test_a_xacro_file_given_as_a_urdf_is_refused_naming_xacro(tmp_path):
     path = tmp_path / "fivebar_linkage.urdf"
     path.write_text(text)  # the namespace alone (xacro's output keeps it): a URDF, read
     assert screwkit("analyze", path, "--output", "Chain1_dummy").returncode == 0
+    meshed = text.replace('<link name="world"/>', '<link name="world"><visual><geometry><mesh filename="$(find '
+                          'fivebar)/a.stl"/></geometry></visual></link>', 1)  # nor a $(find ...) in a mesh's name
+    assert meshed != text
+    path.write_text(meshed)
+    assert screwkit("analyze", path, "--output", "Chain1_dummy").returncode == 0
     link = text.index("<link")
     path.write_text(text[:link] + '<xacro:property name="mass_base" value="1.0"/>' + text[link:])
     one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"), "a xacro file (it holds '<xacro:')",

@@ -10,8 +10,10 @@ point where leaving it out changes none of the leg's twist systems (``graph_scre
 
 The parallelogram here: crank A-B (driven), coupler B-C (the platform, which translates), rocker D-C; the dyad
 F-G-E from the rocker (or the crank) to the coupler; every pin along y, each closure a hinge written as two
-connects on its axis. With the dyad and without it the indices are the parallelogram's: ITI = LMTI = 1 (the coupler
-translates with the crank) and CTI = |sin(BC, DC)|, from MuJoCo's placement of the pins.
+connects on its axis. Read as a graph (as the command reads it with the dyad: a leg with a loop inside), with the
+dyad and without it the indices are the parallelogram's: ITI = LMTI = 1 (the coupler translates with the crank) and
+CTI = |sin(BC, DC)|, from MuJoCo's placement of the pins. (Without the dyad the command reads the linkage as serial
+legs, with the point where they meet as the output, by default.)
 """
 
 from __future__ import annotations

@@ -52,13 +52,15 @@ def test_a_ground_site_of_a_bare_base_body_closes_the_loop(tmp_path, variant):
     assert float(result.lmti) == pytest.approx(sine(c - b, c - d), abs=1e-9)  # the rocker holds it at C
 
 
-@pytest.mark.parametrize("world", ['body2="world" ', ""])
-def test_a_connect_to_the_world_body_named_or_left_out_reads_the_same(tmp_path, world):
-    """``body2="world"`` is MuJoCo's world body, as ``body2`` left out: it was refused with Pinocchio's words ("Model
-    does not have any body named world")."""
+@pytest.mark.parametrize("connect", ['body1="rocker" body2="world" anchor="0.0 0.0 -0.18"',
+                                     'body1="rocker" anchor="0.0 0.0 -0.18"',
+                                     'body1="world" body2="rocker" anchor="0.3 0.0 0.02"'])
+def test_a_connect_to_the_world_body_named_or_left_out_reads_the_same(tmp_path, connect):
+    """``body2="world"`` (or ``body1``) is MuJoCo's world body, as ``body2`` left out: it was refused with Pinocchio's
+    words ("Model does not have any body named world")."""
     path = tmp_path / "world.xml"
     path.write_text(four_bar().replace('<connect name="D" site1="D_link" site2="D_ground"/>',
-                                       f'<connect name="D" body1="rocker" {world}anchor="0.0 0.0 -0.18"/>'))
+                                       f'<connect name="D" {connect}/>'))
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

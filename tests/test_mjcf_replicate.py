@@ -55,3 +55,14 @@ def test_the_command_reads_the_scene_and_refuses_the_replicated_legs(tmp_path):
     legs.write_text(replicated_legs())
     assert screwkit("analyze", scene, "--output", "coupler").returncode == 0
     one_line_error(screwkit("analyze", legs, "--output", "coupler"), "<replicate count='2'>", "mj_saveLastXML")
+
+
+def test_a_closure_on_a_copy_named_by_its_number_refers_into_the_block(tmp_path):
+    """MuJoCo names the copies ball0, ball1, ...: a connect on ball1 refers into the block, which was left out, and
+    the file then refused with Pinocchio's words."""
+    path = tmp_path / "copies.xml"
+    path.write_text(four_bar().replace("</worldbody>", BALLS + "</worldbody>").replace(
+        "</equality>", '<connect name="X" body1="ball1" anchor="0 0 0"/></equality>'))
+    mujoco.MjModel.from_xml_path(str(path))  # (valid MJCF: ball1 is a copy)
+    with pytest.raises(ValueError, match="<replicate count='4'> holds elements <connect body1='ball1'> refers to"):
+        load(path, output="coupler")

@@ -300,7 +300,8 @@ def _without_replicates(root: ElementTree.Element, path: Path) -> list[str]:
         inside = {element.get("name") for element in replicate.iter() if element.get("name")}
         referring = next((f"<{element.tag} {key}='{value}'>" for section in ("equality", "actuator", "tendon")
                           for block in root.findall(section) for element in block.iter()
-                          for key, value in element.attrib.items() if value in inside), None)
+                          for key, value in element.attrib.items()
+                          if _copy_of(value, inside, replicate.get("sep", ""))), None)
         if referring is None and root.find("keyframe") is not None:
             referring = "<keyframe> (its qpos counts every copy's joints)"
         if referring is not None:
@@ -314,12 +315,17 @@ def _without_replicates(root: ElementTree.Element, path: Path) -> list[str]:
         if dropped else []
 
 
+def _copy_of(value: str, inside: set, sep: str) -> bool:
+    """Whether ``value`` names an element of a ``<replicate>`` (its names ``inside``): one of them, or a copy's, which
+    MuJoCo numbers (ball0, ball1, ..., after ``sep``)."""
+    return value in inside or any(value.startswith(name + sep) and value[len(name + sep):].isdigit() for name in inside)
+
+
 def _ancestors(element: ElementTree.Element, parents: dict) -> list[ElementTree.Element]:
-    found = []
-    while element in parents:
-        element = parents[element]
-        found.append(element)
-    return found
+    found = [element]
+    while found[-1] in parents:
+        found.append(parents[found[-1]])
+    return found[1:]
 
 
 def _check_names(root: ElementTree.Element, path: Path) -> None:
@@ -474,9 +480,8 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
                      + (", ..." if len(named) > 4 else ""))
     _merged(root, "actuator")
     top_class_renamed(root)
-    # the text Pinocchio reads holds no <equality>: screwkit places the closures itself (closure_placements), and
-    # Pinocchio 4.1's parser of connects written on sites crashes the process now and then (a heap fault, read over
-    # and over on the same file)
+    # no <equality> in the text Pinocchio reads: screwkit places closures itself (closure_placements), and Pinocchio
+    # 4.1's parser of connects on sites crashes the process now and then (read over and over on one file)
     kept = [(index, element) for index, element in enumerate(root) if element.tag == "equality"]
     for _, element in kept:
         root.remove(element)

@@ -71,8 +71,9 @@ def output_frame(tree: ClosedTree) -> int:
             and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
         # two legs meeting at one ball or pin the file places: its point is the output, the same on either body
         # (their frames are not, nor the point of a loop cut where the file's order puts the cut); the platform is
-        # the body further from the base, whichever end the file writes first (a servo's horn pinned to a thigh that
-        # a hip, a knee and an ankle carry: the thigh), the second end on a tie
+        # the body more joints from the base, whichever end the file writes first (a servo's horn pinned to a thigh
+        # that a hip, a knee and an ankle carry: the thigh), the second end on a tie (a five-bar's two distal links,
+        # whose point reads the same either way)
         ends = (closure.joint_a, closure.joint_b)
         index = _body_frame(model, max(ends[::-1], key=lambda joint: len(path_to(model, joint))))
         if index is not None:

@@ -66,8 +66,8 @@ def _refuse_xacro(urdf: Path) -> None:
         text = re.sub(r"<!--.*?-->", "", Path(urdf).read_text(errors="replace"), flags=re.DOTALL)  # (not comments)
     except OSError:
         return  # (the reader says why)
-    found = next((mark for mark in ("<xacro:", "${", "$(") if mark in text), None)  # (not the namespace alone:
-    # xacro's output keeps it on <robot>)
+    found = next((mark for mark in ("<xacro:", "${") if mark in text), None)  # (not the namespace alone, which
+    # xacro's output keeps on <robot>, nor a $(find ...) in a mesh's file name, which is not read)
     if found is not None:
         raise ImportError_(f"{urdf}: a xacro file (it holds {found!r}), not a URDF: expand it first, e.g. "
                            f"`xacro {Path(urdf).name} -o robot.urdf` (ROS's xacro), and read robot.urdf.")
