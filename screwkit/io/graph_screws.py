@@ -118,8 +118,8 @@ slide's over the length scale, so that the verdict does not turn on the unit).""
 def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:
     """The rows (n, r, len(columns) + 6) of :func:`_twist_spaces`: the closures' relative velocities over the rates
     of ``joints`` and the platform twist. ``cuts``: connections left out, ``("closures", (k, ...))`` the leg's
-    closures k, ...,
-    ``("joint", j)`` joint j made free in all six directions (six more columns before the platform twist's)."""
+    closures k, ..., ``("joint", j)`` joint j made free in all six directions (six more columns before the platform
+    twist's)."""
     model, kinematics = state.model, state.kinematics
     columns = _columns(kinematics, joints)
     count = state.working.shape[0]
