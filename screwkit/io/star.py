@@ -406,7 +406,17 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     idle = idle_about_the_meeting_point(legs, normal)
     chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
     pinned = any(not leg.joints and not leg.base_dofs for leg in legs[1:])  # its loop joint alone, on the base
-    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned)
+    # a loop closed on a link that one actuator turns alone from the base: the point there is that link's (a
+    # four-bar's coupler closed at the crank's pin read ITI = OTI = 1 at every pose; closed at the rocker's, the
+    # linkage's transmission)
+    crank = [leg for leg in legs[1:] if not leg.base_dofs and len(leg.joints) == 1 and leg.joints[0] in motor_ids]
+    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned
+                                            and not crank)
+    if tree.output_type is None and meet and idle and crank and not chosen and not pinned:
+        driver = motor_ids[crank[0].joints[0]]
+        report.notes.append(f"output the platform's frame, not the point where the legs meet (closure "
+                            f"{crank[0].closure!r}): it is on the link actuated joint {driver!r} turns alone from the "
+                            "base, whose point it reads, whatever the linkage; --output-type point takes it there")
     if tree.output_type is None and meet and idle and chosen:  # the meeting point would follow the file's order
         report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
                             "another joint (the file does not say where its legs end), which would move the point "
