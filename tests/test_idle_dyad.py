@@ -35,11 +35,11 @@ coupler."""
 
 
 def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "rocker",
-            reverse: bool = False, rocker_lift: float = 0.0, washer: bool = False) -> str:
+            reverse: bool = False, rocker_lift: float = 0.0, washer: bool = False, spacing: float = 0.04) -> str:
     """The parallelogram's MJCF text, every length times ``scale``, its base placed by ``world``; ``dyad``: the link
     the dyad hangs from ("rocker", "crank" or None); ``reverse``: branches and closures listed the other way round;
     ``rocker_lift``: the rocker's pivot drawn that far above D (no dyad); ``washer``: a second bearing of the pin B, a
-    body on the crank hinged at B and closed onto the coupler there."""
+    body on the crank hinged at B and closed onto the coupler there; ``spacing``: of a closing hinge's two connects."""
     pivot = D + np.array([0.0, 0.0, rocker_lift])
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
@@ -56,7 +56,7 @@ def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "
              + (links if dyad == "crank" else "") + '</body>')
     rocker = f'<body name="rocker" pos="{at(pivot)}">{hinge.format("rocker")}' + (links if dyad == "rocker" else "") \
         + '</body>'
-    lift = np.array([0.0, 0.04, 0.0])  # the second point of each closing hinge, along its axis
+    lift = np.array([0.0, spacing, 0.0])  # the second point of each closing hinge, along its axis
 
     def pin(name, body1, body2, point, origin) -> list[str]:
         return [f'<connect name="{name}{k}" body1="{body1}" body2="{body2}" anchor="{at(point + k * lift - origin)}"/>'
@@ -152,3 +152,21 @@ def test_a_second_bearing_of_a_pin_beside_the_dyad_leaves_the_dyad_out(tmp_path,
     expected = _mujoco_sine(path, motions=2)  # (the washer's own spin)
     result = graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit)).indices()
     assert (float(result.iti), float(result.lmti), float(result.cti)) == pytest.approx((1.0, 1.0, expected), abs=1e-9)
+
+
+@pytest.mark.parametrize("dyad", [None, "rocker"])
+def test_a_hinge_written_as_two_connects_reads_the_same_whatever_their_spacing(tmp_path, dyad):
+    """Each closing hinge is two connects on its axis; the point where a leg meets the coupler averaged both, so the
+    CTI moved with their spacing (a rocker on a ball at its pivot read 0.9285 to 0.8802 as they went 1 mm to 0.4 apart)
+    though MuJoCo's mechanism is the same. It is now the foot on the hinge's axis from the leg's joints."""
+    values = []
+    for spacing, reverse in ((0.001, False), (0.04, False), (0.4, False), (0.4, True)):
+        path = tmp_path / f"spaced_{spacing}_{reverse}.xml"
+        text = linkage(dyad=dyad, spacing=spacing, reverse=reverse)
+        path.write_text(text.replace('<joint name="rocker" type="hinge" axis="0 1 0"/>', '<joint name="rocker" '
+                                     'type="ball"/>') if dyad is None else text)
+        assert _mujoco_sine(path) == pytest.approx(sine(C - B, C - D), abs=1e-12)
+        result = graph_mechanism(read_closed_tree(path, output="coupler")).indices()
+        values.append((float(result.iti), float(result.lmti), float(result.cti)))
+    for value in values:
+        assert value == pytest.approx((1.0, 1.0, sine(C - B, C - D)), abs=1e-9)

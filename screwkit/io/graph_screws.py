@@ -110,9 +110,8 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
 
 
 IN_LOOP_RATE = 1e-6
-"""The actuated joint's rate in the unit null vectors of its leg's closure rows, with the other joints of its path
-held, above which it moves (:func:`drives_rigidly`; the rows' columns are joint rates in working coordinates, a
-slide's over the length scale, so that the verdict does not turn on the unit)."""
+"""The actuated joint's rate in the unit null vectors of its leg's closure rows, its path's other joints held, above
+which it moves (:func:`drives_rigidly`; joint rates in working coordinates: the verdict does not turn on the unit)."""
 
 
 def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:
@@ -222,41 +221,57 @@ def _attachments(state: _State, leg: GraphLeg, body: int, actuator: int | None =
     two points at its joint only: :attr:`~screwkit.io.closed_tree.Closure.axis_point`), each joint where
     :func:`_joint_point` puts it. A weld (``6d``) makes the body at its other end part of ``body``: the leg meets
     ``body`` at the joint that moves that end, not at the weld's frame, which a file may put anywhere (a CAD export
-    welds each leg's last link to the platform at the platform's origin). Where some of them carry no load (an idle
-    dyad hung between a parallelogram's rocker and its coupler), the others only (:func:`_loaded`; ``actuator``: the
-    leg's actuated joint, whose locked twist system must not change either); ``own``: where the platform's own joint
-    is, for a leg that is the platform's path (its connection to it)."""
+    welds each leg's last link to the platform at the platform's origin). Idle ones (:func:`_loaded`; ``actuator``:
+    the leg's actuated joint) are NaN; ``own``: the platform's own joint's point, for the platform's path."""
     model = state.model
     children = [j for j in leg.joints if model.parents[j] == body]
     points, cuts = [_joint_point(state, j, leg.joints) for j in children], [("joint", j) for j in children]
     if own is not None:
         points.append(own)
         cuts.append(("joint", body))
+    pins: dict[tuple, list[NDArray]] = {}  # the points of the closures between one pair of bodies
     for closure in leg.closures:
         if closure.axis_point:
             continue
         for joint, placement, other in ((closure.joint_a, closure.placement_a, closure.joint_b),
                                         (closure.joint_b, closure.placement_b, closure.joint_a)):
             if joint == body:
-                points.append(_joint_point(state, other) if closure.kind == "6d" and other != 0 else
-                              (state.transforms[:, joint] @ placement)[:, :3, 3])
-                cuts.append(("closures", tuple(k for k, c in enumerate(leg.closures)  # (a hinge's both points)
-                                               if {c.joint_a, c.joint_b} == {closure.joint_a, closure.joint_b})))
+                cut = ("closures", tuple(k for k, c in enumerate(leg.closures)  # (a hinge's both points)
+                                         if {c.joint_a, c.joint_b} == {closure.joint_a, closure.joint_b}))
+                point = (_joint_point(state, other) if closure.kind == "6d" and other != 0 else
+                         (state.transforms[:, joint] @ placement)[:, :3, 3])
+                pins.setdefault(cut, []).append(point)
+    for cut, drawn in pins.items():
+        points.append(_pin_on_axis(state, leg, drawn))
+        cuts.append(cut)
     if len(points) < 2:
         return points
     loaded = _loaded(state, leg, cuts, actuator)  # (n, k)
     return [np.where(loaded[:, [k]], point, np.nan) for k, point in enumerate(points)]
 
 
+def _pin_on_axis(state: _State, leg: GraphLeg, drawn: list[NDArray]) -> NDArray:
+    """Where closures between two bodies meet them (n, 3): one's point; two or more on a line (a hinge written as two
+    connects on its axis) the foot on it from the leg's joints' mean, whatever their spacing or order; else the mean."""
+    if len(drawn) == 1:
+        return drawn[0]
+    first, axis = drawn[0], drawn[1] - drawn[0]
+    length = np.linalg.norm(axis, axis=1, keepdims=True)
+    unit = axis / np.where(length > 0, length, 1.0)
+    off = [np.linalg.norm(np.cross(point - first, unit), axis=1) for point in drawn[2:]]
+    if not np.all(length > FILE_ROUNDING * state.scale) or any(np.any(o > FILE_ROUNDING * state.scale) for o in off):
+        return np.mean(drawn, axis=0)
+    reference = np.mean([state.transforms[:, j, :3, 3] for j in leg.joints], axis=0) if leg.joints else \
+        np.mean(drawn, axis=0)
+    return _foot_from(first, unit, reference)
+
+
 def _loaded(state: _State, leg: GraphLeg, cuts: list, actuator: int | None) -> NDArray[np.bool_]:
     """Which of a leg's connections ``cuts`` to one body are kept in the point where the leg meets it (n, k): all but
-    those that, left out each on its own, leave the leg's twist systems as they are (with every joint free and with
-    ``actuator`` locked) and are not idle only beside another idle one (two bearings of one pin, a third bar of a
-    parallelogram: each is idle while the other holds, and which to leave out would turn on the order, so both are
-    kept), provided leaving all of them out together does too. Such a connection adds no constraint to the leg: a
-    dyad hung between two of its links, which, unloaded, carries nothing in its plane (two links on three pins, each
-    pushing only along its own pin line); or a support the leg already has, whose share of the load the geometry
-    does not decide (a second carriage pinned to the platform on a rail parallel to its own)."""
+    those whose removal leaves the leg's twist systems (every joint free; ``actuator`` locked) as they are, unless
+    idle only beside another idle one (two bearings of one pin, parallel bars: both kept, whatever the order), if all
+    of them out together do too. They add no constraint: a dyad hung between two of the leg's links, which, unloaded,
+    carries nothing in its plane; or a support the leg already has (a second carriage on a parallel rail)."""
     systems = [[j for j in leg.joints]] + ([[j for j in leg.joints if j != actuator]] if actuator is not None else [])
     count = state.working.shape[0]
     if count > _SCREENED:  # first at a few configurations of the batch: where no connection is idle at any of them
@@ -273,8 +288,7 @@ _SCREENED = 4
 """Configurations of a batch at which :func:`_loaded` first looks for an idle connection."""
 
 
-def _sampled(state: _State, rows: NDArray) -> _State:
-    """The configurations ``rows`` of a batch."""
+def _sampled(state: _State, rows: NDArray) -> _State:  # (the configurations ``rows`` of a batch)
     return replace(state, transforms=state.transforms[rows], working=state.working[rows], centre=state.centre[rows])
 
 
@@ -387,11 +401,9 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
     out = []
     pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
-    on_platform = [_attachments(state, leg, platform, leg.actuators[0] if leg.actuators else None,
-                                # (the platform's own joint: a universal joint's, or as drawn, a hinged Delta's wrist
-                                # running along the bar its two rods end on, meeting each)
-                                None if not leg.spine or pin else _joint_point(state, platform, leg.joints)
-                                if not leg.actuators else state.transforms[:, platform, :3, 3])
+    on_platform = [_attachments(state, leg, platform, leg.actuators[0] if leg.actuators else None,  # (the own joint:
+                                None if not leg.spine or pin else _joint_point(state, platform, leg.joints)  # as a U's,
+                                if not leg.actuators else state.transforms[:, platform, :3, 3])  # or as drawn)
                    for leg, pin in zip(legs, pinned)]
     others = [point for points, pin in zip(on_platform, pinned) if not pin for point in points]
     for leg, pin, platform_points in zip(legs, pinned, on_platform):
