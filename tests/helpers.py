@@ -17,6 +17,15 @@ def screwkit(*arguments, timeout=300, **options) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=timeout, **options)
 
 
+def screwkit_json(*arguments, **options) -> dict:
+    """What ``screwkit ARGUMENTS --json`` prints, the command checked to succeed."""
+    import json  # (the commands' JSON, for these tests)
+
+    read = screwkit(*arguments, "--json", **options)
+    assert read.returncode == 0, read.stderr
+    return json.loads(read.stdout)
+
+
 def one_line_error(result: subprocess.CompletedProcess, *needles: str, after: tuple[str, ...] = ()) -> str:
     """The single ``Error: ...`` line of a failed command, checked to contain every needle.
 

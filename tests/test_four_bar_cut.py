@@ -10,12 +10,10 @@ whichever pin closes the loop. Checked against MuJoCo's placement of the pins in
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, screwkit, sine
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, screwkit_json, sine
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -79,8 +77,6 @@ def test_closed_at_the_rocker_the_point_reads_the_linkage_and_at_the_crank_the_f
 def test_the_command_says_it_reads_the_frame(tmp_path):
     path = tmp_path / "cut_b.xml"
     path.write_text(four_bar(cut="B"))
-    read = screwkit("analyze", path, "--output", "coupler", "--json")
-    assert read.returncode == 0, read.stderr
-    result = json.loads(read.stdout)
+    result = screwkit_json("analyze", path, "--output", "coupler")
     assert any("not the point where the legs meet" in line for line in result["converted"])
     assert (result["iti"], result["lmti"]) == pytest.approx((1.0, 1.0), abs=1e-9)

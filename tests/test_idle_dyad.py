@@ -18,13 +18,11 @@ legs, with the point where they meet as the output, by default.)
 
 from __future__ import annotations
 
-import json
-
 import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, screwkit, sine
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, screwkit_json, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 
@@ -110,9 +108,7 @@ def test_the_reading_does_not_turn_on_the_order_the_file_lists_things_in(tmp_pat
 def test_the_command_reads_the_doubled_parallelogram(tmp_path):
     path = tmp_path / "doubled.xml"
     path.write_text(linkage(dyad="crank"))
-    read = screwkit("analyze", path, "--output", "coupler", "--json")
-    assert read.returncode == 0, read.stderr
-    result = json.loads(read.stdout)
+    result = screwkit_json("analyze", path, "--output", "coupler")
     assert (result["iti"], result["lmti"], result["cti"]) == pytest.approx((1.0, 1.0, sine(C - B, C - D)),
                                                                            abs=1e-9)
 
