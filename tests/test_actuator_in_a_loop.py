@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, one_line_error, screwkit, sine
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, mujoco_rows, one_line_error, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -65,12 +65,8 @@ def linkage(request, tmp_path):
 
 def _mujoco_points(path) -> dict[str, np.ndarray]:
     """I, J and K as MuJoCo places them at the file's configuration (closed: its connects' residuals are zero)."""
-    model = mujoco.MjModel.from_xml_path(str(path))
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
+    model, data, anchor = mujoco_closed(path)
     assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # one motion
-    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
     hlink = model.body("hlink").id
     pivot = data.xpos[hlink] + data.xmat[hlink].reshape(3, 3) @ model.eq_data[0][:3]  # the connect's point on it
     return {"I": anchor["pivot"], "J": anchor["hpin"], "K": pivot}

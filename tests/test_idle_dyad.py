@@ -18,11 +18,10 @@ legs, with the point where they meet as the output, by default.)
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, mujoco_rows, screwkit_json, sine
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, mujoco_rows, screwkit_json, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 
@@ -74,12 +73,8 @@ def linkage(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), dyad: str | None = "
 
 def _mujoco_sine(path, motions: int = 1) -> float:
     """|sin(BC, DC)| from MuJoCo's placement of the pins, the linkage checked closed and of ``motions`` motions."""
-    model = mujoco.MjModel.from_xml_path(str(path))
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    assert np.abs(data.efc_pos).max() < 1e-12 * (1.0 + np.abs(data.xpos).max())
+    model, data, anchor = mujoco_closed(path)
     assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == motions
-    anchor = {model.joint(k).name: data.xanchor[k] for k in range(model.njnt)}
     rocker = model.body("rocker").id
     c = data.xpos[rocker] + data.xmat[rocker].reshape(3, 3) @ model.eq_data[model.equality("cpin0").id][:3]
     return sine(c - anchor["bpin"], c - anchor["rocker"])

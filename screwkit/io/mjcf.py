@@ -118,13 +118,18 @@ def sites_placed(model, root) -> None:
     of a site of a body without a joint at the world's origin (a fixed base's ground pivot), added on that body's."""
     import pinocchio as pin
 
+    def placed(site):  # the site's pose on its body
+        position, quaternion = site_pose(site)
+        return pin.SE3(rotation_matrix(quaternion), position)
+
+    def added(site, owner: int) -> None:  # a frame for the site on frame ``owner`` (0: the world's)
+        model.addFrame(pin.Frame(site.get("name"), model.frames[owner].parentJoint, owner,
+                                 model.frames[owner].placement * placed(site), pin.FrameType.OP_FRAME))
+
     for world in root.findall("worldbody"):
         for site in world.findall("site"):
-            name = site.get("name")
-            if name is not None and not model.existFrame(name, pin.FrameType.OP_FRAME):
-                position, quaternion = site_pose(site)
-                model.addFrame(pin.Frame(name, 0, 0, pin.SE3(rotation_matrix(quaternion), position),
-                                         pin.FrameType.OP_FRAME))
+            if site.get("name") is not None and not model.existFrame(site.get("name"), pin.FrameType.OP_FRAME):
+                added(site, 0)
 
     for body in root.iter("body"):
         for site in body.findall("site"):
@@ -135,16 +140,12 @@ def sites_placed(model, root) -> None:
                 # a site of a body with no joint that the parser makes a frame without its sites (the ground
                 # pivot on a fixed base body at the world's origin): added on the body's frame
                 if body.get("name") is not None and model.existFrame(body.get("name"), pin.FrameType.BODY):
-                    owner = model.getFrameId(body.get("name"), pin.FrameType.BODY)
-                    position, quaternion = site_pose(site)
-                    model.addFrame(pin.Frame(name, model.frames[owner].parentJoint, owner, model.frames[owner].placement
-                                             * pin.SE3(rotation_matrix(quaternion), position), pin.FrameType.OP_FRAME))
+                    added(site, model.getFrameId(body.get("name"), pin.FrameType.BODY))
                 continue
             index = model.getFrameId(name, pin.FrameType.OP_FRAME)
             frame = model.frames[index]
             parent = model.frames[frame.parentFrame]
             if parent.type != pin.FrameType.BODY or body.get("name") not in (None, parent.name):
                 continue  # not the frame of the site's body (Pinocchio names an unnamed body itself)
-            position, quaternion = site_pose(site)
-            frame.placement = parent.placement * pin.SE3(rotation_matrix(quaternion), position)
+            frame.placement = parent.placement * placed(site)
             model.frames[index] = frame

@@ -293,10 +293,8 @@ def _without_replicates(root: ElementTree.Element, path: Path) -> list[str]:
     """MuJoCo's ``<replicate>`` (copies of a subtree, each named with its index) is not expanded: one that nothing the
     mechanism is read by names (closures, actuators, tendons; the obstacles of a test scene) is left out, and said;
     any other is refused, naming what refers into it and how to write the copies out."""
-    parents = {child: parent for parent in root.iter() for child in parent}
     dropped = []
-    outermost = [r for r in root.iter("replicate") if not any(a.tag == "replicate" for a in _ancestors(r, parents))]
-    for replicate in outermost:
+    for parent, replicate in list(_outermost(root, "replicate")):
         inside = {element.get("name") for element in replicate.iter() if element.get("name")}
         referring = next((f"<{element.tag} {key}='{value}'>" for section in ("equality", "actuator", "tendon")
                           for block in root.findall(section) for element in block.iter()
@@ -308,7 +306,7 @@ def _without_replicates(root: ElementTree.Element, path: Path) -> list[str]:
             raise MjcfError(f"{path}: <replicate count='{replicate.get('count')}'> holds elements {referring} refers "
                             "to: screwkit does not expand MuJoCo's <replicate>; write the copies out (MuJoCo writes "
                             "a model expanded with mj_saveLastXML).")
-        parents[replicate].remove(replicate)
+        parent.remove(replicate)
         names = f" ({', '.join(sorted(inside)[:3])}{', ...' if len(inside) > 3 else ''})" if inside else ""
         dropped.append(f"count {replicate.get('count')}{names}")
     return [f"<replicate> block(s) nothing the mechanism is read by refers to, left out: {'; '.join(dropped)}"] \
@@ -321,11 +319,13 @@ def _copy_of(value: str, inside: set, sep: str) -> bool:
     return value in inside or any(value.startswith(name + sep) and value[len(name + sep):].isdigit() for name in inside)
 
 
-def _ancestors(element: ElementTree.Element, parents: dict) -> list[ElementTree.Element]:
-    found = [element]
-    while found[-1] in parents:
-        found.append(parents[found[-1]])
-    return found[1:]
+def _outermost(element: ElementTree.Element, tag: str):
+    """(parent, element) of each ``tag`` element under ``element`` that no other such holds."""
+    for child in element:
+        if child.tag == tag:
+            yield element, child
+        else:
+            yield from _outermost(child, tag)
 
 
 def _check_names(root: ElementTree.Element, path: Path) -> None:

@@ -410,14 +410,14 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     # four-bar's coupler closed at the crank's pin read ITI = OTI = 1 at every pose; closed at the rocker's, the
     # linkage's transmission)
     crank = [leg for leg in legs[1:] if not leg.base_dofs and len(leg.joints) == 1 and leg.joints[0] in motor_ids]
-    point = tree.output_type == "point" or (tree.output_type is None and meet and idle and not chosen and not pinned
-                                            and not crank)
-    if tree.output_type is None and meet and idle and crank and not chosen and not pinned:
+    meeting = tree.output_type is None and meet and idle  # (the default, where nothing below rules it out)
+    point = tree.output_type == "point" or (meeting and not chosen and not pinned and not crank)
+    if meeting and crank and not chosen and not pinned:
         driver = motor_ids[crank[0].joints[0]]
         report.notes.append(f"output the platform's frame, not the point where the legs meet (closure "
                             f"{crank[0].closure!r}): it is on the link actuated joint {driver!r} turns alone from the "
                             "base, whose point it reads, whatever the linkage; --output-type point takes it there")
-    if tree.output_type is None and meet and idle and chosen:  # the meeting point would follow the file's order
+    if meeting and chosen:  # the meeting point would follow the file's order
         report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
                             "another joint (the file does not say where its legs end), which would move the point "
                             "where the chains meet; --output-type point takes the point there")
