@@ -161,3 +161,20 @@ def test_a_hinge_written_as_two_connects_reads_the_same_whatever_their_spacing(t
         values.append((float(result.iti), float(result.lmti), float(result.cti)))
     for value in values:
         assert value == pytest.approx((1.0, 1.0, sine(C - B, C - D)), abs=1e-9)
+
+
+@pytest.mark.parametrize("factor", [1e-3, 1e3])
+def test_the_dyad_is_left_out_for_the_linkage_scaled_and_its_joints_renamed(tmp_path, factor):
+    """Every length times 1e-3 or 1e3, read in metres (a mechanism that much smaller or larger), and every joint and
+    the actuator renamed: the same indices, the actuator's under its new name."""
+    path = tmp_path / "scaled.xml"
+    text = linkage(scale=factor, dyad="crank")
+    for name in ("crank", "bpin", "rocker", "fpin", "gpin"):
+        text = text.replace(f'joint name="{name}"', f'joint name="{name}_renamed"').replace(
+            f'joint="{name}"', f'joint="{name}_renamed"')
+    path.write_text(text)
+    mechanism = graph_mechanism(read_closed_tree(path, output="coupler"))
+    result = mechanism.indices()
+    assert mechanism.actuators == ("crank:crank_renamed",)
+    assert (float(result.iti), float(result.lmti), float(result.cti)) == pytest.approx(
+        (1.0, 1.0, sine(C - B, C - D)), abs=1e-9)

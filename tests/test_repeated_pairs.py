@@ -300,3 +300,14 @@ def test_a_rotated_force_nearly_along_the_pin_does_not_take_the_cti_to_zero(monk
                           method="Nelder-Mead", options={"xatol": 1e-11, "fatol": 1e-14, "maxiter": 5000}).fun
                  for start in starts)
     assert found[0] == pytest.approx(lowest, abs=1e-9)
+
+
+@pytest.mark.parametrize("factor", [1e-3, 1e3])
+def test_the_boom_s_cti_is_the_same_for_the_mechanism_scaled(tmp_path, factor):
+    """The boom's lengths times 1e-3 or 1e3, read in metres: its repeated block's value does not move."""
+    values = []
+    for scale in (1.0, factor):
+        path = tmp_path / f"boom_{scale}.xml"
+        path.write_text(boom(scale))
+        values.append(float(np.ravel(graph_mechanism(read_closed_tree(path, output="boom")).indices().cti)[0]))
+    assert values[1] == pytest.approx(values[0], abs=1e-9) and values[0] > 0.99
