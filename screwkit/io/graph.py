@@ -76,6 +76,7 @@ from screwkit.io.graph_kinematics import (
     rpy_rates_inverse,
     solve_poses,
 )
+from screwkit.io.graph_rounding import drawn_tree
 from screwkit.io.graph_screws import (
     GraphLeg,
     LegScrews,
@@ -423,11 +424,15 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                "name's path from screwkit.io.loader.bundled_path(name)" if isinstance(tree, (str, PathLike))
                else f"{type(tree).__name__}")
         raise TypeError(f"graph_mechanism expects a ClosedTree (from screwkit.io.read_closed_tree), got {got}.")
-    model = tree.model
     report = ImportReport(source=tree.source, file_format=tree.file_format, values=tree.start_phrase())
     at_file = q is None or scale is None
     if at_file:
         q, scale = assemble(tree, held=tree.initial_joints())
+        drawn = drawn_tree(tree, q)  # (axes parallel to the file's rounding: parallel, then assembled again)
+        if drawn is not tree:
+            tree = drawn
+            q, scale = assemble(tree, held=tree.initial_joints())
+    model = tree.model
     frame_id = output_frame(tree)
     frame = model.frames[frame_id]
     report.notes[:0] = tree.notes

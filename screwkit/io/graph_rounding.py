@@ -1,0 +1,111 @@
+"""A closed-loop graph's joint axes that agree to the file's rounding, written parallel before it is analysed.
+
+The serial reading (:mod:`screwkit.io.star`) reads a file's rounding as what its author drew
+(:func:`screwkit.io.rounding.parallel_axes`); the graph reading read the file as written, and a published parallelogram
+whose hand-written closing hinges (``-1 0 0``) miss the exported ones (``-1 -0 -3e-06``) by 3 microradians read as
+rigid: a four-bar of hinges not quite parallel is a spatial 4R loop, which does not move. :func:`drawn_tree` gives
+each group of directions within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of each other one direction, as the
+serial reading does, among the tree's 1-DoF joints and the hinges the file closes by two points on an axis (two
+``3d`` closures between the same two joints: SDFormat's and Gazebo's revolute loop joints, two MJCF connects). A
+tree joint is turned with :func:`screwkit.io.rounding.turned_joint` (its frame, and every frame after it, stays where
+the assembly put it); a closed hinge's second point is turned about its first, on both bodies. A file whose axes
+are parallel, or apart by more than the rounding, is returned as it is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.io.closed_tree import ClosedTree, joint_kind, joint_value
+from screwkit.io.rounding import parallel_axes, turned_joint
+
+__all__ = ["drawn_tree", "closed_hinges"]
+
+
+def closed_hinges(tree: ClosedTree) -> list[tuple[int, int]]:
+    """The pairs of closures (indices, in file order) that close a hinge: the only two ``3d`` closures between the
+    same two joints."""
+    between: dict[frozenset, list[int]] = {}
+    for index, closure in enumerate(tree.closures):
+        if closure.kind == "3d":
+            between.setdefault(frozenset((closure.joint_a, closure.joint_b)), []).append(index)
+    return [(pair[0], pair[1]) for pair in between.values() if len(pair) == 2]
+
+
+def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
+    """``tree`` with its nearly parallel axes made parallel at the closed configuration ``q`` (the module's
+    docstring), its notes saying the largest turn; ``tree`` itself when no axis turns."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, np.asarray(q, dtype=float))
+    world = [np.asarray(data.oMi[j].homogeneous) for j in range(model.njoints)]
+    owners, directions = [], []
+    for joint in range(1, model.njoints):
+        kind, axis = joint_kind(model, joint)
+        if axis is not None:
+            owners.append(joint)
+            directions.append(world[joint][:3, :3] @ axis)
+    hinges = closed_hinges(tree)
+    for first, second in hinges:
+        a, b = tree.closures[first], tree.closures[second]
+        owners.append((first, second))
+        directions.append((world[b.joint_a] @ b.placement_a - world[a.joint_a] @ a.placement_a)[:3, 3])
+    if len(directions) < 2 or not all(np.linalg.norm(d) > 0.0 for d in directions):
+        return tree
+    units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
+    turned, turn = parallel_axes(units)
+    if not turn:
+        return tree
+    moved = model.copy()
+    closures = list(tree.closures)
+    turns = np.linalg.norm(np.cross(turned, units), axis=1)
+    for owner, direction, amount in zip(owners, turned, turns):
+        if not amount:
+            continue
+        if isinstance(owner, tuple):
+            first, second = tree.closures[owner[0]], tree.closures[owner[1]]
+            sides = []
+            for joint, start, end in ((first.joint_a, first.placement_a, second.placement_a),
+                                      (first.joint_b, first.placement_b, second.placement_b)):
+                from_point = world[joint] @ start
+                length = np.linalg.norm((world[joint] @ end - from_point)[:3, 3])
+                placed = np.array(end, dtype=float)
+                target = np.append(from_point[:3, 3] + length * direction, 1.0)
+                placed[:3, 3] = np.linalg.solve(world[joint], target)[:3]
+                sides.append(placed)
+            closures[owner[1]] = replace(second, placement_a=sides[0], placement_b=sides[1])
+            continue
+        kind, axis = joint_kind(model, owner)
+        local = world[owner][:3, :3].T @ direction
+        placement, local = turned_joint(np.asarray(model.jointPlacements[owner].homogeneous), kind, axis, local,
+                                        joint_value(model, owner, q))
+        moved.joints[owner] = _joint_model(model.joints[owner], kind, local)
+        moved.jointPlacements[owner] = pin.SE3(placement)
+    most = owners[int(np.argmax(turns))]
+    named = (f"joint {model.names[most]!r}" if not isinstance(most, tuple)
+             else f"the hinge closed by {tree.closures[most[0]].name!r} and {tree.closures[most[1]].name!r}")
+    note = (f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} rad, of "
+            f"{named})")
+    return replace(tree, model=moved, closures=closures, notes=[*tree.notes, note])
+
+
+def _joint_model(joint_model, kind: str, axis: NDArray):
+    """A joint model like ``joint_model`` (its indices, bounded or not) about or along the unit ``axis``."""
+    import pinocchio as pin
+
+    axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    if kind == "prismatic":
+        made = pin.JointModelPrismaticUnaligned(axis)
+    elif joint_model.nq == 2:  # an unbounded hinge: Pinocchio's bindings take its axis only through a file
+        text = ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="continuous"><parent link="a"/>'
+                f'<child link="b"/><axis xyz="{" ".join(repr(float(a)) for a in axis)}"/></joint></robot>')
+        made = pin.buildModelFromXML(text).joints[1].extract()
+    else:
+        made = pin.JointModelRevoluteUnaligned(axis)
+    made.setIndexes(joint_model.id, joint_model.idx_q, joint_model.idx_v)
+    return made
