@@ -39,6 +39,11 @@ def rounded(scale=1.0, world=("0 0 0", "1 0 0 0"), tilt=ROUNDED, which=None, rev
     return text
 
 
+def _written(path, text: str):
+    path.write_text(text)
+    return path
+
+
 def _indices(path, unit=None):
     result = graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit)).indices()
     return float(result.iti), float(result.lmti), float(result.cti)
@@ -149,3 +154,51 @@ def test_the_rounded_linkage_sweeps_as_the_exact_one(tmp_path):
     for name in ("iti", "lmti", "cti"):
         first, second = (np.asarray(s.variables[name][1]) for s in sweeps)
         assert np.all(np.isfinite(first)) and np.max(np.abs(first - second)) < 1e-5, name
+
+
+def _rocker_turned_by(angle_text: str) -> str:
+    """The dyad linkage with the rocker's frame turned half a turn about x, written ``angle_text`` (rad), and every
+    position in it and in the links it carries written as if that were pi exactly (``x -y -z``): the rocker, its
+    dyad and their pins turn by the angle's rounding of pi about the rocker's pivot, its hinge and the line of its
+    closing connects (in its frame) together, out of parallel with the crank's and the coupler's."""
+    from xml.etree import ElementTree
+
+    root = ElementTree.fromstring(linkage(dyad="rocker"))
+    root.insert(0, ElementTree.Element("compiler", angle="radian"))
+
+    def flipped(text: str) -> str:
+        x, y, z = (float(v) for v in text.split())
+        return f"{x!r} {-y!r} {-z!r}"
+
+    rocker = next(body for body in root.iter("body") if body.get("name") == "rocker")
+    rocker.set("euler", f"{angle_text} 0 0")
+    carried = {body.get("name") for body in rocker.iter("body")}
+    for body in rocker.iter("body"):
+        if body is not rocker:
+            body.set("pos", flipped(body.get("pos")))
+    for connect in root.iter("connect"):
+        if connect.get("body1") in carried:
+            connect.set("anchor", flipped(connect.get("anchor")))
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def test_a_hinge_off_by_an_angle_written_rounded_is_made_parallel_as_the_serial_reading_makes_it(tmp_path):
+    """A half turn written rounded (``3.14``) turns the rocker's hinge 1.6e-3 rad off the others: more than the
+    rounding of numbers, and what the serial reading allows for angles written so (``screwkit.io.written_angles``);
+    the graph reading allows it too, and says the angle. Written with pi to 17 digits, the file is the exact
+    linkage; with ``3.1``, 0.042 rad off and no rounding of pi to one decimal, it is refused as rigid."""
+    exact = tmp_path / "exact.xml"
+    exact.write_text(linkage(dyad="rocker"))
+    expected = _indices(exact)
+    path = tmp_path / "half_turn.xml"
+    path.write_text(_rocker_turned_by("3.14"))
+    graph = graph_mechanism(read_closed_tree(path, output="coupler"))
+    result = graph.indices()
+    assert (float(result.iti), float(result.lmti), float(result.cti)) == pytest.approx(expected, abs=1e-5)
+    [note] = [note for note in graph.report.notes if "rounding written parallel" in note]
+    assert "3.14 for pi" in note, note
+    assert _rocker_turned_by(repr(np.pi)) != linkage(dyad="rocker")
+    assert _indices(_written(tmp_path / "pi.xml", _rocker_turned_by(repr(np.pi)))) == pytest.approx(expected, abs=1e-12)
+    path.write_text(_rocker_turned_by("3.1"))  # (0.042 rad: not a rounding of pi to its written decimals)
+    with pytest.raises(ImportError_, match="cannot move"):
+        graph_mechanism(read_closed_tree(path, output="coupler"))

@@ -28,6 +28,7 @@ from test_gallery import assert_same_bodies, mujoco_residuals, mujoco_state
 from test_io import mjcf_of_tree
 
 from helpers import one_line_error, random_rotation, screwkit
+from screwkit.closure.assembly import DOF_AT_ROUNDING
 from screwkit.io import ImportError_, read_closed_tree, read_mechanism_file
 from screwkit.io.closed_tree import assemble
 from screwkit.io.graph import graph_mechanism
@@ -164,22 +165,25 @@ def test_a_trapezoid_is_not_read_as_a_parallelogram_and_is_refused_by_name(tmp_p
         read_mechanism_file(path)
 
 
-def test_the_graph_reading_agrees_on_the_exact_file_and_refuses_the_rounded_one_by_name(tmp_path):
+def test_the_graph_reading_agrees_on_the_exact_file_and_says_the_rounded_one_s_count_turns_on_the_rounding(tmp_path):
     """The graph derivation (the leg's wrench system from its closure Jacobian, not the serial path and equivalent
-    chain) gives the same textbook values; it reads a file exactly, so the rounded one cannot move, and says so in
-    one line instead of failing inside the index computation."""
+    chain) gives the same textbook values. Of the rounded file it makes the hinge axes parallel (as the serial
+    reading does), but leaves its hinges' positions as written: three of the legs allow the horizontal translations
+    only to 1.4e-6 to 2.7e-6, and the count of 1 DOF is said to turn on the rounding (the serial reading,
+    which the command takes first, reads 3: the next test)."""
     path = tmp_path / "exact.sdf"
     path.write_text(hinged_delta_sdf(platform_leg=1, half_width=-0.025))
     graph = graph_mechanism(read_closed_tree(path))
     assert_textbook(graph, graph.indices(), textbook(geometry(*POSES[0])), TOLERANCE)
+    assert all(line.endswith("twist system of dimension 4") for line in graph.report.chains)
+    assert not [note for note in graph.report.notes if "rounding" in note], graph.report.notes
     path = tmp_path / "rounded.sdf"
     path.write_text(hinged_delta_sdf(digits=6))
-    with pytest.raises(ImportError_, match=r"rounded.sdf: the platform 'platform' cannot move: analysed as a graph, "
-                                           r"its legs allow no twist in common at the file's configuration: the legs "
-                                           r"allow twist systems of dimension 3 \(arm_1\), 3 \(arm_2\), 3 \(arm_3\), "
-                                           r"3 \(arm_4\) \("):
-        graph_mechanism(read_closed_tree(path))  # (each parallelogram rigid: one translation fewer than the exact 4)
-    assert all(line.endswith("twist system of dimension 4") for line in graph.report.chains)  # the exact file's
+    rounded = graph_mechanism(read_closed_tree(path))
+    assert all(line.endswith("twist system of dimension 4") for line in rounded.report.chains)  # (3 before)
+    [turned] = [note for note in rounded.report.notes if note.startswith("joint axes that agree to the file's")]
+    [count] = [note for note in rounded.report.notes if note.startswith(DOF_AT_ROUNDING)]
+    assert rounded.dof == 1 and "may have up to 3 DOF" in count, count
 
 
 def test_analyze_opens_the_rounded_file_on_the_command_line(tmp_path):

@@ -470,8 +470,9 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     if not task_axes:
         raise ImportError_(f"{tree.source}: the platform {report.platform_body!r} cannot move: analysed as a graph, "
                            f"its legs allow no twist in common at the file's configuration{locking_legs(legs, screws)} "
-                           "(a loop inside a leg that the file's numbers make rigid reads so, e.g. a parallelogram of "
-                           "hinges parallel only to the file's rounding: the graph reads a file as written).")
+                           "(a loop inside a leg that the file's numbers make rigid reads so: hinges drawn parallel "
+                           "but written further apart than the file's rounding, 1e-5 rad, or lines drawn through one "
+                           "point that miss it: the graph makes parallel only axes within the rounding).")
     if at_file:
         refuse_couples_of_forces(tree, legs, chains, state)
     gaps = closure_gaps(tree, tree.q_reference)

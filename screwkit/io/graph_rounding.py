@@ -4,8 +4,9 @@ The serial reading (:mod:`screwkit.io.star`) reads a file's rounding as what its
 (:func:`screwkit.io.rounding.parallel_axes`); the graph reading read the file as written, and a published parallelogram
 whose hand-written closing hinges (``-1 0 0``) miss the exported ones (``-1 -0 -3e-06``) by 3 microradians read as
 rigid: a four-bar of hinges not quite parallel is a spatial 4R loop, which does not move. :func:`drawn_tree` gives
-each group of directions within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of each other one direction, as the
-serial reading does, among the tree's 1-DoF joints and the hinges the file closes by two points on an axis (two
+each group of directions within :data:`~screwkit.common.tolerances.FILE_ROUNDING` of each other (or further, where the
+file writes rounded angles between them: :mod:`screwkit.io.written_angles`) one direction, as the serial reading
+does, among the tree's 1-DoF joints and the hinges the file closes by two points on an axis (two
 ``3d`` closures between the same two joints: SDFormat's and Gazebo's revolute loop joints, two MJCF connects). A
 tree joint is turned with :func:`screwkit.io.rounding.turned_joint` (its frame, and every frame after it, stays where
 the assembly put it); a closed hinge's second point is turned about its first, on both bodies. A file whose axes
@@ -19,8 +20,10 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, joint_kind, joint_value
 from screwkit.io.rounding import parallel_axes, turned_joint
+from screwkit.io.written_angles import written_turns
 
 __all__ = ["drawn_tree", "closed_hinges"]
 
@@ -58,13 +61,18 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
     if len(directions) < 2 or not all(np.linalg.norm(d) > 0.0 for d in directions):
         return tree
     units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
-    turned, turn = parallel_axes(units)
+    turns = written_turns(tree.source)  # (axes written rounded, 1.57 for pi/2: as the serial reading allows them)
+    # (a closed hinge's points are written in its first body's frame: their line turns as that body's joint does)
+    names = [model.names[owner] if not isinstance(owner, tuple) else
+             model.names[tree.closures[owner[0]].joint_a] if tree.closures[owner[0]].joint_a else None
+             for owner in owners]
+    turned, turn = parallel_axes(units, turns.allowances(names))
     if not turn:
         return tree
     moved = model.copy()
     closures = list(tree.closures)
-    turns = np.linalg.norm(np.cross(turned, units), axis=1)
-    for owner, direction, amount in zip(owners, turned, turns):
+    amounts = np.linalg.norm(np.cross(turned, units), axis=1)
+    for owner, direction, amount in zip(owners, turned, amounts):
         if not amount:
             continue
         if isinstance(owner, tuple):
@@ -86,11 +94,12 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
                                         joint_value(model, owner, q))
         moved.joints[owner] = _joint_model(model.joints[owner], kind, local)
         moved.jointPlacements[owner] = pin.SE3(placement)
-    most = owners[int(np.argmax(turns))]
+    most = owners[int(np.argmax(amounts))]
     named = (f"joint {model.names[most]!r}" if not isinstance(most, tuple)
              else f"the hinge closed by {tree.closures[most[0]].name!r} and {tree.closures[most[1]].name!r}")
+    rounded = f"; the file writes angles rounded, {turns.example}" if turn > FILE_ROUNDING and turns.example else ""
     note = (f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} rad, of "
-            f"{named})")
+            f"{named}{rounded})")
     return replace(tree, model=moved, closures=closures, notes=[*tree.notes, note])
 
 
