@@ -22,7 +22,7 @@ from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinem
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains
 from screwkit.closure.threads import for_each_block
-from screwkit.common.tolerances import NEWTON_TOLERANCE
+from screwkit.common.tolerances import LIMIT_SLACK, NEWTON_TOLERANCE
 from screwkit.common.units import spelled_pose
 from screwkit.model.mechanism import Mechanism, require_mechanism
 
@@ -187,15 +187,21 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
     return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
 
 
+def slackened(lower: NDArray, upper: NDArray) -> tuple[NDArray, NDArray]:
+    """Position limits widened by :data:`~screwkit.common.tolerances.LIMIT_SLACK` times 1 plus the larger of their
+    sizes (an infinite limit stays infinite)."""
+    slack = LIMIT_SLACK * (1.0 + np.maximum(np.abs(np.where(np.isfinite(lower), lower, 0.0)),
+                                            np.abs(np.where(np.isfinite(upper), upper, 0.0))))
+    return lower - slack, upper + slack
+
+
 def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray) -> NDArray[np.int64]:
     """Index of the first joint outside its limits for each row of ``values`` (N, m); -1 if none.
 
-    A revolute value counts as within its limits if it, or it plus or minus a full turn, is.
+    A revolute value counts as within its limits if it, or it plus or minus a full turn, is, to
+    :data:`~screwkit.common.tolerances.LIMIT_SLACK`.
     """
-    lower, upper = limits[:, 0], limits[:, 1]
-    slack = 1e-12 * (1.0 + np.maximum(np.abs(np.where(np.isfinite(lower), lower, 0.0)),
-                                      np.abs(np.where(np.isfinite(upper), upper, 0.0))))
-    lowest, highest = lower - slack, upper + slack
+    lowest, highest = slackened(limits[:, 0], limits[:, 1])
     # NaN compares false: a chain that did not close is reported as such, not as a limit
     outside = values < lowest
     outside |= values > highest

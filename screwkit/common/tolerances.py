@@ -157,6 +157,12 @@ NEWTON_TOLERANCE = 1e-11
 """Radians and length scales: a chain solved by damped Newton is closed when its loop error norm
 (rotation in rad, translation divided by the mechanism's length scale) is below this."""
 
+LIMIT_SLACK = 1e-9
+"""Radians and metres: how far beyond a position limit (relative to 1 plus the limit's size) a joint may be and still
+be at it. Joint values come from closures solved to :data:`NEWTON_TOLERANCE` and from poses asked in rounded
+numbers: a crank drawn at its stop, asked at the home pose as printed (7.7e-13 m from it), was put 3.8e-11 rad past
+the stop and the pose refused. The serial and the graph readings take the same slack."""
+
 BRANCH_MATCH_TOLERANCE = 1e-4
 """Radians, and metres relative to the mechanism's length scale: the closed-form branch closest
 to the reference assembly is its working mode when every joint value matches it to this. Working

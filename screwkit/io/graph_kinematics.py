@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.closure.solve import slackened
 from screwkit.common.rotations import cross
 from screwkit.io.closed_tree import ASSEMBLY_TOLERANCE, ClosedTree, Closure, ImportError_, joint_kind, path_to
 
@@ -441,12 +442,14 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
 
 def beyond_limits(kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> NDArray[np.bool_]:
     """(n, nv): which 1-DoF joints (by velocity coordinate; only those of the mask ``limited`` when given) of
-    configurations ``q`` (n, nq) are beyond their position limits (by more than 1e-9)."""
+    configurations ``q`` (n, nq) are beyond their position limits (by more than
+    :func:`screwkit.closure.solve.slackened`, as the serial reading counts it)."""
     values = np.zeros((q.shape[0], kinematics.nv))
     for joint, kind in enumerate(kinematics.kinds):
         if kind in ("revolute", "prismatic"):
             values[:, kinematics.idx_v[joint]] = q[:, kinematics.idx_q[joint]]
-    beyond = (values < kinematics.lower - 1e-9) | (values > kinematics.upper + 1e-9)
+    lowest, highest = slackened(kinematics.lower, kinematics.upper)
+    beyond = (values < lowest) | (values > highest)
     return beyond if limited is None else beyond & np.asarray(limited, dtype=bool)
 
 
