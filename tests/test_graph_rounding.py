@@ -44,8 +44,8 @@ def _written(path, text: str):
     return path
 
 
-def _indices(path, unit=None):
-    result = graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit)).indices()
+def _indices(path, unit=None, output="coupler", initial=()):
+    result = graph_mechanism(read_closed_tree(path, output=output, length_unit=unit, initial=initial)).indices()
     return float(result.iti), float(result.lmti), float(result.cti)
 
 
@@ -202,3 +202,79 @@ def test_a_hinge_off_by_an_angle_written_rounded_is_made_parallel_as_the_serial_
     path.write_text(_rocker_turned_by("3.1"))  # (0.042 rad: not a rounding of pi to its written decimals)
     with pytest.raises(ImportError_, match="cannot move"):
         graph_mechanism(read_closed_tree(path, output="coupler"))
+
+
+def _rsur(tilt: float = ROUNDED, swap: bool = False) -> str:
+    """An R-S-U-R loop that moves as written whatever ``tilt`` (its crank's axis ``0 1 tilt``): the rocker closed to
+    the world by a hinge written as two connects, the second with its bodies in the order ``swap`` says."""
+    a, b, c, d, lift = (np.array(p, dtype=float) for p in ((0, 0, 0), (0.1, 0.05, 0.2), (0.35, 0.02, 0.25),
+                                                           (0.4, 0, 0), (0, 0.04, 0)))
+
+    def at(v) -> str:
+        return " ".join(repr(float(x)) for x in v)
+
+    second = (f'<connect name="h1" body1="rocker" body2="world" anchor="{at(d + lift - c)}"/>' if swap else
+              f'<connect name="h1" body1="world" body2="rocker" anchor="{at(d + lift)}"/>')
+    ball = '<geom type="sphere" size="0.01"/>'
+    return ('<mujoco model="rsur"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="crank" pos="{at(a)}"><joint name="crank" type="hinge" axis="0 1 {tilt!r}"/>{ball}'
+            f'<body name="coupler" pos="{at(b - a)}"><joint name="b" type="ball"/>{ball}'
+            f'<body name="rocker" pos="{at(c - b)}"><joint name="cx" type="hinge" axis="1 0 0"/>'
+            f'<joint name="cz" type="hinge" axis="0 0 1"/>{ball}</body></body></body></worldbody><equality>'
+            f'<connect name="h0" body1="world" body2="rocker" anchor="{at(d)}"/>{second}</equality>'
+            '<actuator><motor name="m" joint="crank"/></actuator></mujoco>')
+
+
+def test_a_hinge_whose_connects_name_their_bodies_in_either_order_reads_the_same(tmp_path):
+    """Its second point is turned on each body in that body's own frame (turned in the other's, the loop no longer
+    closed and the file, which moved as written, was refused)."""
+    readings = []
+    for swap in (False, True):
+        path = _written(tmp_path / f"rsur_{swap}.xml", _rsur(swap=swap))
+        model, data, _ = mujoco_closed(path)
+        assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # it moves as written
+        readings.append(_indices(path, output="rocker"))
+    assert readings[0] == pytest.approx(readings[1], abs=1e-9)
+    assert readings[0] == pytest.approx(_indices(_written(tmp_path / "exact.xml", _rsur(0.0)), output="rocker"),
+                                        abs=1e-5)
+
+
+@pytest.mark.parametrize("crank", [0.0, 20.0, -40.0])
+def test_the_listing_and_the_joints_values_leave_the_rounded_reading_as_the_exact_one(tmp_path, crank):
+    """Assembled with the crank away from zero (each turned joint's frame kept where the assembly puts it at its own
+    value), listed either way round: the same indices to 1e-9, the exact linkage's to the rounding."""
+    start = (("crank", crank),)
+    readings = [_indices(_written(tmp_path / f"r_{reverse}.xml", rounded(reverse=reverse)), initial=start)
+                for reverse in (False, True)]
+    assert readings[0] == pytest.approx(readings[1], abs=1e-9)
+    exact = _indices(_written(tmp_path / "exact.xml", linkage(dyad="rocker")), initial=start)
+    assert readings[0] == pytest.approx(exact, abs=1e-6)
+
+
+def test_unbounded_hinges_closed_by_gazebo_joints_are_turned(tmp_path):
+    """The dyad linkage as a URDF of continuous joints (Pinocchio's unbounded hinges) written ``0 1 3e-06``, its loops
+    Gazebo revolute joints along y: the CTI is the exact linkage's |sin(BC, DC)|."""
+    f, g, e = D + (C - D) / 2, np.array([0.48, 0.0, 0.33]), np.array([0.25, 0.0, 0.35])
+
+    def at(v) -> str:
+        return " ".join(repr(float(x)) for x in v)
+
+    inertial = '<inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/>' \
+        '</inertial>'
+    links = "".join(f'<link name="{n}">{inertial}</link>' for n in ("base", "crank", "coupler", "rocker", "l1", "l2"))
+    joints = "".join(f'<joint name="{n}" type="continuous"><parent link="{p}"/><child link="{c}"/>'
+                     f'<origin xyz="{at(x)}"/><axis xyz="0 1 {ROUNDED!r}"/></joint>'
+                     for n, p, c, x in (("crank", "base", "crank", np.zeros(3)), ("bpin", "crank", "coupler", B),
+                                        ("rocker", "base", "rocker", D), ("fpin", "rocker", "l1", f - D),
+                                        ("gpin", "l1", "l2", g - f)))
+    loops = "".join(f'<joint name="{n}" type="revolute"><parent>{p}</parent><child>coupler</child>'
+                    f'<pose>{at(x - B)} 0 0 0</pose><axis><xyz>0 1 0</xyz></axis></joint>'
+                    for n, p, x in (("cpin", "rocker", C), ("epin", "l2", e)))
+    path = _written(tmp_path / "continuous.urdf", f'<robot name="para">{links}{joints}<gazebo>{loops}</gazebo>'
+                    '<transmission name="t"><type>transmission_interface/SimpleTransmission</type><joint name="crank">'
+                    '<hardwareInterface>EffortJointInterface</hardwareInterface></joint><actuator name="m">'
+                    '<mechanicalReduction>1</mechanicalReduction></actuator></transmission></robot>')
+    tree = read_closed_tree(path, output="coupler")
+    assert {tree.model.joints[j].shortname() for j in range(1, tree.model.njoints)} == {
+        "JointModelRevoluteUnboundedUnaligned"}
+    assert _indices(path) == pytest.approx((1.0, 1.0, sine(C - B, C - D)), abs=1e-5)

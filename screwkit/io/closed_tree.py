@@ -231,7 +231,12 @@ def joint_kind(model, joint: int) -> tuple[str, NDArray | None]:
     for prefix, kind in (("JointModelRevoluteUnbounded", "revolute"), ("JointModelRevolute", "revolute"),
                          ("JointModelPrismatic", "prismatic")):
         if name.startswith(prefix):
-            axis = np.asarray(joint_model.extract().axis, dtype=float)
+            if name == "JointModelRevoluteUnboundedUnaligned":  # (Pinocchio 4.1's bindings give it no axis: its
+                joint_data = joint_model.createData()  # motion subspace's rotation is the axis)
+                joint_model.calc(joint_data, np.array([1.0, 0.0]))
+                axis = np.asarray(joint_data.S, dtype=float).reshape(6, -1)[3:, 0]
+            else:
+                axis = np.asarray(joint_model.extract().axis, dtype=float)
             if not np.linalg.norm(axis) > 0.0:  # refused where the source is known (assemble); a net here
                 raise ImportError_(f"<joint name='{model.names[joint]}'>: the axis is the zero vector.")
             return kind, axis / np.linalg.norm(axis)

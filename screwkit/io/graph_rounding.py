@@ -9,8 +9,13 @@ file writes rounded angles between them: :mod:`screwkit.io.written_angles`) one 
 does, among the tree's 1-DoF joints and the hinges the file closes by two points on an axis (two
 ``3d`` closures between the same two joints: SDFormat's and Gazebo's revolute loop joints, two MJCF connects). A
 tree joint is turned with :func:`screwkit.io.rounding.turned_joint` (its frame, and every frame after it, stays where
-the assembly put it); a closed hinge's second point is turned about its first, on both bodies. A file whose axes
+the assembly put it); a closed hinge's two points are turned, on both bodies, about the point where the file draws
+the joint (SDFormat, Gazebo) or about their middle (two connects, whichever is listed first). A file whose axes
 are parallel, or apart by more than the rounding, is returned as it is.
+
+Unlike the serial reading, lines meant to meet at one point are left as written (:func:`screwkit.io.rounding.
+meeting_lines` moves a joint's line, which in a graph moves every frame its body carries), and so are hinges closed
+by three or more connects.
 """
 
 from __future__ import annotations
@@ -53,12 +58,13 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
         if axis is not None:
             owners.append(joint)
             directions.append(world[joint][:3, :3] @ axis)
-    hinges = closed_hinges(tree)
-    for first, second in hinges:
-        a, b = tree.closures[first], tree.closures[second]
-        owners.append((first, second))
-        directions.append((world[b.joint_a] @ b.placement_a - world[a.joint_a] @ a.placement_a)[:3, 3])
-    if len(directions) < 2 or not all(np.linalg.norm(d) > 0.0 for d in directions):
+    for pair in closed_hinges(tree):
+        first, second = (tree.closures[k] for k in pair)
+        ends = _points(world, first, second, first.joint_a)
+        if np.linalg.norm(ends[1] - ends[0]) > 0.0:  # (two connects at one point make no hinge: left as written)
+            owners.append(pair)
+            directions.append(ends[1] - ends[0])
+    if len(directions) < 2:
         return tree
     units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
     turns = written_turns(tree.source)  # (axes written rounded, 1.57 for pi/2: as the serial reading allows them)
@@ -76,17 +82,8 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
         if not amount:
             continue
         if isinstance(owner, tuple):
-            first, second = tree.closures[owner[0]], tree.closures[owner[1]]
-            sides = []
-            for joint, start, end in ((first.joint_a, first.placement_a, second.placement_a),
-                                      (first.joint_b, first.placement_b, second.placement_b)):
-                from_point = world[joint] @ start
-                length = np.linalg.norm((world[joint] @ end - from_point)[:3, 3])
-                placed = np.array(end, dtype=float)
-                target = np.append(from_point[:3, 3] + length * direction, 1.0)
-                placed[:3, 3] = np.linalg.solve(world[joint], target)[:3]
-                sides.append(placed)
-            closures[owner[1]] = replace(second, placement_a=sides[0], placement_b=sides[1])
+            closures[owner[0]], closures[owner[1]] = _turned_hinge(world, *(tree.closures[k] for k in owner),
+                                                                   direction)
             continue
         kind, axis = joint_kind(model, owner)
         local = world[owner][:3, :3].T @ direction
@@ -101,6 +98,35 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
     note = (f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} rad, of "
             f"{named}{rounded})")
     return replace(tree, model=moved, closures=closures, notes=[*tree.notes, note])
+
+
+def _points(world: list, first, second, joint: int) -> tuple[NDArray, NDArray]:
+    """The world points (at the assembly) of a closed hinge's closures ``first`` and ``second`` on the body of
+    ``joint`` (either end of either closure: a file may write the two with their bodies in either order)."""
+    return tuple((world[joint] @ (c.placement_a if c.joint_a == joint else c.placement_b))[:3, 3]
+                 for c in (first, second))
+
+
+def _turned_hinge(world: list, first, second, direction: NDArray) -> tuple:
+    """The closures of a closed hinge with the line through their points along ``direction``, on both bodies: turned
+    about the point the file draws the joint at (SDFormat's and Gazebo's first point; the other is marked
+    :attr:`~screwkit.io.closed_tree.Closure.axis_point`), else about the middle of the two (two connects: whichever
+    the file lists first, the same hinge)."""
+    about = 0.0 if second.axis_point and not first.axis_point else 1.0 if first.axis_point else 0.5
+    placed = {id(first): {}, id(second): {}}
+    for joint in (first.joint_a, first.joint_b):
+        start, end = _points(world, first, second, joint)
+        span = np.linalg.norm(end - start) * np.copysign(1.0, float(np.dot(end - start, direction))) * direction
+        centre = start + about * (end - start)
+        inverse = np.linalg.inv(world[joint])
+        for closure, point in ((first, centre - about * span), (second, centre + (1.0 - about) * span)):
+            placed[id(closure)][joint] = inverse[:3, :3] @ point + inverse[:3, 3]
+    turned = []
+    for closure in (first, second):
+        a, b = np.array(closure.placement_a, dtype=float), np.array(closure.placement_b, dtype=float)
+        a[:3, 3], b[:3, 3] = placed[id(closure)][closure.joint_a], placed[id(closure)][closure.joint_b]
+        turned.append(replace(closure, placement_a=a, placement_b=b))
+    return tuple(turned)
 
 
 def _joint_model(joint_model, kind: str, axis: NDArray):
