@@ -21,6 +21,7 @@ from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
+from screwkit.io.leg_ways import through_closures
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.reference import actuation_wrench, working_frame
 
@@ -39,7 +40,6 @@ class GraphLeg:
     closures: tuple[Closure, ...]
     spine: bool
     actuators: tuple[int, ...]
-
 
 
 def _columns(kinematics: TreeKinematics, joints) -> NDArray[np.int64]:
@@ -102,6 +102,7 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
     beyond = [path_to(model, end) for end in ends + ([state.platform] if leg.spine else [])]  # (a spine: its own)
     path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
+    path |= set() if any(actuator in way for way in beyond) else through_closures(model, leg, actuator, state.platform)
     free = [j for j in leg.joints if j == actuator or j not in path]
     columns = _columns(state.kinematics, free)
     right, null = _null_rows(_closure_matrix(state, free, leg))
@@ -117,8 +118,7 @@ which it moves (:func:`drives_rigidly`; joint rates in working coordinates: the 
 def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:
     """The rows (n, r, len(columns) + 6) of :func:`_twist_spaces`: the closures' relative velocities over the rates
     of ``joints`` and the platform twist. ``cuts``: connections left out, ``("closures", (k, ...))`` the leg's
-    closures k, ..., ``("joint", j)`` joint j made free in all six directions (six more columns before the platform
-    twist's)."""
+    closures k, ..., ``("joint", j)`` joint j made free in all six directions (six columns before the platform's)."""
     model, kinematics = state.model, state.kinematics
     columns = _columns(kinematics, joints)
     count = state.working.shape[0]

@@ -367,10 +367,10 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                 idle_motors.append(name)  # a motor of another limb (a humanoid's other leg): no leg, no platform
                 continue
             if through:
-                raise ImportError_(f"{tree.source}: {tree.motor_label(name)} drives through closure {through[0]!r}, "
+                raise LegWithLoops(f"{tree.source}: {tree.motor_label(name)} drives through closure {through[0]!r}, "
                                    "which ends on another leg's link, not on the platform (a closed-loop "
                                    "transmission): screwkit writes compound legs whose actuators lie on a path from "
-                                   "the base to the platform.")
+                                   f"the base to the platform{GRAPH_HINT}.")
             raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is on no leg (a leg is a tree path from the "
                                "base to the platform or to a closure).")
         motor_ids[joint] = name
