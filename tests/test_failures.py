@@ -218,13 +218,13 @@ def slider_leg(text: str) -> dict:
 
 
 def test_a_joint_just_past_its_limit_is_shown_with_the_digits_that_tell_it_from_the_limit():
-    """The hexapod raised until leg 1's slider is 1e-9 m past its upper limit: the message used to show both to 6
-    digits, the value equal to the limit it is said to be outside of; it now shows as many digits as tell them
-    apart, and the number shown is past the limit."""
+    """The hexapod raised until leg 1's slider is 1e-8 m past its upper limit (beyond LIMIT_SLACK, within which it
+    would be at the limit): the message used to show both to 6 digits, the value equal to the limit it is said to be
+    outside of; it now shows as many digits as tell them apart, and the number shown is past the limit."""
     leg = slider_leg(bundled_text("ups_hexapod_8"))
     upper = leg["limits"][1]
     d = leg["platform"] - leg["base"]
-    z = math.sqrt((upper + leg["offset"] + 1e-9) ** 2 - d[0] ** 2 - d[1] ** 2) - d[2]
+    z = math.sqrt((upper + leg["offset"] + 1e-8) ** 2 - d[0] ** 2 - d[1] ** 2) - d[2]
     with pytest.raises(UnreachablePose) as caught:
         solve_one(load("ups_hexapod_8"), [0, 0, z, 0, 0, 0])
     shown = re.search(r"joint 'leg_1_joint_slider' at (\S+) m is outside its limits \[(\S+), (\S+)\]",

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.io.closed_tree import ClosedTree, ImportError_, path_to
+from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
 from screwkit.io.graph_screws import GraphLeg, LegScrews, common_motions, couples_of_forces, model_name
 from screwkit.screw.chain_screws import ChainScrews
 
@@ -55,6 +55,14 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
                                "on its own twist is not the leg's input); analysable when the actuated joint joins the "
                                "base to the rest of its leg: the link it drives taken as the output (--output) reads "
                                "its own transmission.")
+        floating = [j for j in path_to(model, actuator)[:1] if j in leg.joints and j != platform
+                    and joint_kind(model, j)[0] == "JointModelFreeFlyer"]
+        if outside and floating:  # (not a loop: the leg's own base floats, as an export's <freejoint> on its root)
+            free = model.names[floating[0]]
+            raise ImportError_(f"{tree.source}: actuated joint {name!r} rides on the free joint {free!r} (a floating "
+                               "base, as an export writes <freejoint> on its root): --lock "
+                               f"{' --lock '.join(below)} holds the base where the file puts it, and the legs are "
+                               "analysed on it.")
         if outside:
             one = len(below) == 1
             hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "

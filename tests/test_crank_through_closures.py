@@ -1,0 +1,95 @@
+"""A crank that reaches the platform only through closures is held along that way.
+
+A walking robot's ankle (a published Kangaroo leg) drives its foot by a crank, a bar to a rocker pivoted on the
+shin, and a rod from the rocker to the foot. Read as a graph, the leg's path to the platform was its spanning tree's
+(base, rocker, rod), on which the crank is not: the rocker's hinge, which carries the crank's whole load, was left
+free as a loop beside the path, the crank passed as driving its leg, and its ITI was the rod's line against the
+crank's rotation (0.982-0.989 where the crank's own transmission falls to 0.90). The crank moves inside the
+four-bar crank-bar-rocker-base: refused, as the same linkage written with the crank on the tree path is
+(``screwkit.io.leg_ways``). Driven at the rocker, the linkage reads the textbook values.
+
+The linkage, in the plane y = 0, every pin along y: crank A-B, bar B-C, rocker D-C-E (C closed onto it), rod E-F,
+the platform hinged to the base at G and F closed onto it; each closing hinge two connects on its axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, mujoco_rows, one_line_error, screwkit, sine
+from screwkit.io import ImportError_, read_closed_tree
+from screwkit.io.graph import graph_mechanism
+
+A, B, C, D = (np.array(p, dtype=float) for p in ((0, 0, 0), (0.05, 0, 0.08), (0.32, 0, 0.12), (0.3, 0, 0)))
+E, F, G = (np.array(p, dtype=float) for p in ((0.36, 0, 0.05), (0.62, 0, 0.15), (0.7, 0, 0)))
+
+
+def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool = False,
+            motor: str = "crank") -> str:
+    """The MJCF text, every length times ``scale``, its base placed by ``world``; ``crank_on_tree``: the rocker
+    nested under the bar (the crank then on the tree path to the platform, the rocker closed onto the base);
+    ``motor``: the driven joint."""
+    def at(point) -> str:
+        return " ".join(repr(float(v) * scale) for v in point)
+
+    lift = np.array([0.0, 0.04, 0.0])
+
+    def hinge(name, body1, body2, point, origin) -> str:
+        return "".join(f'<connect name="{name}{k}" body1="{body1}" body2="{body2}" '
+                       f'anchor="{at(point + k * lift - origin)}"/>' for k in (0, 1))
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+
+    def joint(name) -> str:
+        return f'<joint name="{name}" type="hinge" axis="0 1 0"/>{ball}'
+
+    rod = f'<body name="rod" pos="{at(E - (C if crank_on_tree else D))}">{joint("epin")}</body>'
+    if crank_on_tree:
+        rocker = f'<body name="rocker" pos="{at(C - B)}">{joint("cpin")}{rod}</body>'
+        branches = (f'<body name="crank" pos="{at(A)}">{joint("crank")}<body name="bar" pos="{at(B - A)}">'
+                    f'{joint("bpin")}{rocker}</body></body>')
+        closures = hinge("dpin", "rocker", "base", D, C)
+    else:
+        branches = (f'<body name="crank" pos="{at(A)}">{joint("crank")}<body name="bar" pos="{at(B - A)}">'
+                    f'{joint("bpin")}</body></body><body name="rocker" pos="{at(D)}">{joint("rocker")}{rod}</body>')
+        closures = hinge("cpin", "bar", "rocker", C, B)
+    platform = f'<body name="platform" pos="{at(G)}">{joint("gpin")}</body>'
+    return ('<mujoco model="six_bar"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">{branches}{platform}</body></worldbody>'
+            f'<equality>{closures}{hinge("fpin", "rod", "platform", F, E)}</equality>'
+            f'<actuator><motor name="m" joint="{motor}"/></actuator></mujoco>')
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+@pytest.mark.parametrize("crank_on_tree", [False, True])
+def test_a_crank_driving_a_four_bar_grounded_on_the_base_is_refused_however_the_file_nests_it(
+        tmp_path, variant, crank_on_tree):
+    path, unit = mjcf_variant(tmp_path, f"six_bar_{crank_on_tree}", variant,
+                              lambda s, w: six_bar(s, w, crank_on_tree=crank_on_tree))
+    model, data, _ = mujoco_closed(path)
+    assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # one motion, as drawn
+    with pytest.raises(ImportError_, match=r"actuated joint 'crank' moves inside a loop of leg '\w+' \(with the other "
+                                           r"joints of its path to the platform held it cannot move"):
+        graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit))
+
+
+def test_the_command_says_why_in_one_line(tmp_path):
+    path = tmp_path / "six_bar.xml"
+    path.write_text(six_bar())
+    one_line_error(screwkit("analyze", path, "--output", "platform"), "actuated joint 'crank' moves inside a loop",
+                   "--output")
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_driven_at_the_rocker_the_linkage_reads_its_pressure_angles(tmp_path, variant):
+    """The rocker on the tree path to the platform: ITI |sin(DE, EF)| (the rod's force on the rocker's pin), OTI
+    |sin(EF, GF)| (on the platform's); the crank and the bar hang on the rocker, load-free."""
+    path, unit = mjcf_variant(tmp_path, "rocker_driven", variant, lambda s, w: six_bar(s, w, motor="rocker"))
+    model, data, anchor = mujoco_closed(path)
+    rod = model.body("rod").id
+    f = data.xpos[rod] + data.xmat[rod].reshape(3, 3) @ model.eq_data[model.equality("fpin0").id][:3]
+    expected = sine(anchor["epin"] - anchor["rocker"], f - anchor["epin"]), sine(f - anchor["epin"], f - anchor["gpin"])
+    assert expected == pytest.approx((sine(E - D, F - E), sine(F - E, F - G)), abs=1e-12)
+    result = graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit)).indices()
+    assert (float(result.iti), float(result.lmti)) == pytest.approx(expected, abs=1e-9)
