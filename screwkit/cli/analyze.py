@@ -206,7 +206,7 @@ def analyze(mechanism: str, pose, actuator_values, analysis, reading, as_json: b
 def _analyze(loaded, pose, actuator_values, analysis, as_json: bool) -> None:
     """The body of :func:`analyze` on a loaded mechanism."""
     if not isinstance(loaded, Mechanism):  # a GraphMechanism: legs with loops inside them
-        return _analyze_graph(loaded, pose, actuator_values is not None, analysis, as_json)
+        return _analyze_graph(loaded, pose, actuator_values, analysis, as_json)
     target = parse_pose(loaded, pose)
     if actuator_values is not None:
         target = pose_from_actuators(loaded, actuator_values, target)
@@ -242,14 +242,11 @@ def _slide(value: float) -> str:
     return f"{value:.6f}" if abs(value) >= 1e-3 else f"{value:.6g}"
 
 
-def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_json: bool) -> None:
+def _analyze_graph(graph, pose: str | None, actuator_values: str | None, analysis, as_json: bool) -> None:
     """``analyze`` of a mechanism whose legs have loops inside them: at the file's configuration, at ``--pose`` given
     as its task coordinates (m, deg; the dependent ones wherever the closures put them, as in a map), or with the
-    output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default)."""
-    if by_actuators:
-        raise fail(f"{graph.tree.source}: its legs have loops inside them, posed by their platform only: leave out "
-                   "--actuators (give --pose with its task coordinates, or the output frame's x y z [roll pitch yaw]; "
-                   "--initial JOINT VALUE on each actuator assembles the file with its actuators there).")
+    output frame at ``--pose x y z [roll pitch yaw]`` (m, deg; the world frame, the file's orientation by default);
+    then, with ``--actuators``, where the actuators take the values given, reached from there by continuation."""
     try:
         graph.check_study(fault_type=analysis.fault_type)
     except ValueError as error:
@@ -277,6 +274,10 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
             except ValueError as error:
                 raise fail(str(error)) from None
             shown = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), values))
+    if actuator_values is not None:
+        graph = _graph_at_actuators(graph, actuator_values, analysis.limits)
+        shown = {name: shown_number(name, value, graph.length_scale)
+                 for name, value in zip(graph.task_coordinates, graph.task_pose())}
     try:
         result = graph.indices(threshold=analysis.threshold, fault_type=analysis.fault_type)
     except ValueError as error:
@@ -295,6 +296,29 @@ def _analyze_graph(graph, pose: str | None, by_actuators: bool, analysis, as_jso
         print_report({**report, "at_file": at_file and (f"the configuration assembled from {started}" if started
                                                         else "the file's configuration")})
         click.echo(f"(analysed as a graph from {graph.report.lines()[0]})", err=True)
+
+
+def _graph_at_actuators(graph, text: str, limits: bool):
+    """The graph with its actuators at the values of ``--actuators`` (deg for a hinge, m for a slide, in the order
+    ``info`` lists them), by continuation from its configuration (:meth:`GraphMechanism.at_actuators`)."""
+    from screwkit.io.closed_tree import joint_kind  # the graph reader: when a graph is analysed
+
+    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
+    try:
+        values = [float(word) for word in text.split()]
+    except ValueError:
+        raise fail(f"Expected numbers after --actuators, got {text!r}.") from None
+    if len(values) != len(ids) or not np.all(np.isfinite(values)):
+        raise fail(f"Expected --actuators with {len(ids)} finite values (one per actuator: "
+                   f"{', '.join(graph.actuators)}), got {text!r}.")
+    slides = [joint_kind(graph.tree.model, joint)[0] == "prismatic" for joint in ids]
+    for name, value, slide in zip(graph.actuators, values, slides):
+        if not slide and abs(value) > angle_limit(degrees=True):
+            raise fail(str(angle_beyond_limit(f"--actuators ({name})", value, degrees=True)))
+    try:
+        return graph.at_actuators([v if slide else np.radians(v) for v, slide in zip(values, slides)], limits=limits)
+    except ValueError as error:
+        raise fail(str(error)) from None
 
 
 def _graph_at_task_pose(graph, values: list[float], limits: bool):

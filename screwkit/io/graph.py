@@ -68,6 +68,7 @@ from screwkit.io.graph_actuators import check_actuators
 from screwkit.io.graph_checks import IN_LOOP_TOLERANCE, check_legs, check_output, refuse_couples_of_forces
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
+    STAGE_LENGTH,
     TreeKinematics,
     beyond_reach,
     joints_beyond_limits,
@@ -288,6 +289,39 @@ class GraphMechanism:
                              + ("" if rpy is None else f", rpy {np.round(np.degrees(rpy), 9).tolist()} deg")
                              + f" ({why}).")
         return graph_mechanism(self.tree, q=q[0], scale=self.scale)
+
+    def at_actuators(self, values, *, limits: bool = True) -> GraphMechanism:
+        """The mechanism with its actuated joints at ``values`` (rad or m, :attr:`actuators` order), reached from this
+        configuration by continuation: the actuators moved in steps of at most :data:`STAGE_LENGTH` (rad, or length
+        scales), the closures assembled at each with them held, so the working mode is followed. A ValueError names
+        the step whose loops cannot close (values out of reach, past a singular configuration, or redundant ones that
+        disagree) or the joints a configuration puts beyond their limits."""
+        ids = [leg.actuators[0] for leg in self.legs if leg.actuators]
+        values = np.asarray(values, dtype=float).reshape(-1)
+        if values.shape != (len(ids),) or not np.all(np.isfinite(values)):
+            raise ValueError(f"Expected {len(ids)} finite actuator values ({', '.join(self.actuators)}), got "
+                             f"{values.tolist()}.")
+        model, q = self.tree.model, np.array(self.q, dtype=float)
+        start = np.array([joint_value(model, joint, q) for joint in ids])
+        per = np.array([self.scale if joint_kind(model, joint)[0] == "prismatic" else 1.0 for joint in ids])
+        count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
+        for step in range(1, count + 1):
+            for joint, value in zip(ids, start + step / count * (values - start)):
+                at = model.joints[joint].idx_q
+                q[at:at + model.joints[joint].nq] = [np.cos(value), np.sin(value)] if model.joints[joint].nq == 2 \
+                    else [value]
+            try:
+                q, _ = assemble(replace(self.tree, q_reference=q, notes=[]), held=ids)
+            except ImportError_:
+                raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
+                                 f"actuators at the values given: the loops cannot close {step} step(s) of {count} "
+                                 "on the way (out of reach, past a singular configuration, or redundant actuators "
+                                 "whose values disagree).") from None
+        beyond = joints_beyond_limits(model, self.kinematics, q, self.limited)
+        if beyond and limits:
+            raise ValueError(f"{self.tree.source}: the actuator values put joints of its legs beyond their limits: "
+                             f"{'; '.join(beyond)} (--ignore-limits reads it all the same).")
+        return graph_mechanism(self.tree, q=q, scale=self.scale)
 
     def check_study(self, *, closed_forms: bool = False, fault_type: str = "free-swinging") -> None:
         """A ValueError when a study asks these legs for what they do not have: closed forms, link faults."""
