@@ -26,9 +26,11 @@ E, F, G = (np.array(p, dtype=float) for p in ((0.36, 0, 0.05), (0.62, 0, 0.15), 
 
 
 def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool = False,
-            motor: str = "crank") -> str:
+            motor: str = "crank", from_platform: bool = False) -> str:
     """The MJCF text, every length times ``scale``, its base placed by ``world``; ``crank_on_tree``: the rocker
     nested under the bar (the crank then on the tree path to the platform, the rocker closed onto the base);
+    ``from_platform``: the rod, the rocker and the bar hung from the platform, the bar closed onto the crank and the
+    rocker onto the base (the crank's closure then ends on a body whose path runs through the platform);
     ``motor``: the driven joint."""
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
@@ -45,6 +47,16 @@ def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool 
         return f'<joint name="{name}" type="hinge" axis="0 1 0"/>{ball}'
 
     rod = f'<body name="rod" pos="{at(E - (C if crank_on_tree else D))}">{joint("epin")}</body>'
+    if from_platform:
+        bar = f'<body name="bar" pos="{at(C - E)}">{joint("cpin")}</body>'
+        chain = (f'<body name="rod" pos="{at(F - G)}">{joint("fpin")}<body name="rocker" pos="{at(E - F)}">'
+                 f'{joint("epin")}{bar}</body></body>')
+        return ('<mujoco model="six_bar"><option><flag contact="disable"/></option><worldbody>'
+                f'<body name="base" pos="{world[0]}" quat="{world[1]}"><body name="crank" pos="{at(A)}">'
+                f'{joint("crank")}</body><body name="platform" pos="{at(G)}">{joint("gpin")}{chain}</body></body>'
+                f'</worldbody><equality>{hinge("bpin", "crank", "bar", B, A)}'
+                f'{hinge("dpin", "base", "rocker", D, 0 * D)}</equality>'
+                f'<actuator><motor name="m" joint="{motor}"/></actuator></mujoco>')
     if crank_on_tree:
         rocker = f'<body name="rocker" pos="{at(C - B)}">{joint("cpin")}{rod}</body>'
         branches = (f'<body name="crank" pos="{at(A)}">{joint("crank")}<body name="bar" pos="{at(B - A)}">'
@@ -62,11 +74,12 @@ def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool 
 
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
-@pytest.mark.parametrize("crank_on_tree", [False, True])
+@pytest.mark.parametrize("nesting", ["rocker on the base", "crank on the tree path", "from the platform"])
 def test_a_crank_driving_a_four_bar_grounded_on_the_base_is_refused_however_the_file_nests_it(
-        tmp_path, variant, crank_on_tree):
-    path, unit = mjcf_variant(tmp_path, f"six_bar_{crank_on_tree}", variant,
-                              lambda s, w: six_bar(s, w, crank_on_tree=crank_on_tree))
+        tmp_path, variant, nesting):
+    path, unit = mjcf_variant(tmp_path, f"six_bar_{nesting.split()[0]}", variant,
+                              lambda s, w: six_bar(s, w, crank_on_tree=nesting == "crank on the tree path",
+                                                   from_platform=nesting == "from the platform"))
     model, data, _ = mujoco_closed(path)
     assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # one motion, as drawn
     with pytest.raises(ImportError_, match=r"actuated joint 'crank' moves inside a loop of leg '\w+' \(with the other "

@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from helpers import one_line_error, screwkit
+from helpers import one_line_error, screwkit, screwkit_json
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 
@@ -135,17 +135,18 @@ def test_the_command_names_the_pose_asked_at_the_boundary():
     assert "file's" not in line
 
 
-def test_actuator_values_are_given_by_initial_not_actuators():
-    """A graph is posed by its platform: ``--actuators`` is refused in one line naming ``--initial``, which assembles
-    the file with its motors there: every arm turned by 40 deg puts the platform at z = 2 - 2 cos 40 - sqrt(9 - (2 sin
-    40)^2) (the arm 2 and rod 3 of MuJoCo's placement, the platform's joints on the motors' circle), and the indices
-    are the closed form's there."""
+def test_actuator_values_are_given_by_actuators_or_by_initial():
+    """A graph posed by its motors: ``--actuators`` moves them there from the assembly, ``--initial`` assembles the
+    file with them there; every arm turned by 40 deg puts the platform at z = 2 - 2 cos 40 - sqrt(9 - (2 sin 40)^2)
+    (the arm 2 and rod 3 of MuJoCo's placement, the platform's joints on the motors' circle), and the indices are the
+    closed form's there, both ways."""
     started = [word for name, value in START for word in ("--initial", name, str(value))]
-    refused = screwkit("analyze", DELTA, *started, "--actuators", "40", "40", "40")
-    one_line_error(refused, "posed by their platform only", "--initial JOINT VALUE on each actuator")
     radius, height, arm, rod = _plane()
     turn = np.radians(40.0)
     z = height - arm * np.cos(turn) - np.sqrt(rod ** 2 - (arm * np.sin(turn)) ** 2)
+    driven = screwkit_json("analyze", DELTA, *started, "--actuators", "40", "40", "40")
+    assert driven["pose"]["z"] == pytest.approx(z, abs=1e-9)
+    assert (driven["iti"], driven["lmti"]) == pytest.approx(_closed_form(z), abs=1e-9)
     initial = [word for name, _ in START for word in ("--initial", name, "40")]
     read = screwkit("analyze", DELTA, *initial, "--json")
     assert read.returncode == 0, read.stderr

@@ -26,9 +26,11 @@ from helpers import (
     one_line_error,
     random_rotation,
     screwkit,
+    screwkit_json,
     translational_pressure_angles,
 )
 from screwkit.indices.analysis import analyze
+from screwkit.io.closed_tree import joint_value
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import bundled_names, load
 from screwkit.io.mjcf import read_mjcf
@@ -266,8 +268,8 @@ def test_another_pose_gives_the_same_indices_in_millimetres_in_another_frame_and
 
 def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_poses(tmp_path):
     """``screwkit analyze FILE`` opens the file as written (the graph at the file's configuration) and prints the
-    textbook indices; ``--pose x y z`` moves the output frame there; --actuators and unreachable poses are refused
-    in one line."""
+    textbook indices; ``--pose x y z`` moves the output frame there, ``--actuators`` at the file's motor values
+    keeps it; unreachable poses and a wrong count of actuator values are refused in one line."""
     path, graph = open_delta(tmp_path)
     expected = textbook(POSES[0])
     completed = screwkit("analyze", path)
@@ -284,8 +286,12 @@ def test_the_command_line_analyses_a_rod_level_delta_as_written_and_at_other_pos
     report = json.loads(posed.stdout)
     assert report["lmti"] == pytest.approx(textbook(POSES[1])["lmti"], abs=TOLERANCE)
     assert report["pose"] == pytest.approx(dict(zip("xyz", target)), abs=1e-12)
-    one_line_error(screwkit("analyze", path, "--actuators", "0", "0", "0", "0"), "loops inside them",
-                   "leave out --actuators")
+    one_line_error(screwkit("analyze", path, "--actuators", "0", "0"), "Expected --actuators with 4 finite values")
+    motors = [np.degrees(joint_value(graph.tree.model, leg.actuators[0], graph.q)) for leg in graph.legs
+              if leg.actuators]  # the file's own actuator values: the file's pose and indices
+    driven = screwkit_json("analyze", path, "--actuators", *[repr(float(v)) for v in motors])
+    assert driven["lmti"] == pytest.approx(expected["lmti"], abs=TOLERANCE)
+    assert driven["pose"] == pytest.approx(dict(zip("xyz", frame_position(graph))), abs=1e-9)
     one_line_error(screwkit("analyze", path, "--pose", "0", "0", "-5"), "no closed configuration puts the output "
                    "frame at (x=0, y=0, z=-5): it is never farther than")  # as a map or a sweep says it
     one_line_error(screwkit("analyze", path, "--pose", "0", "0"), "--pose takes its task coordinates x y z (m, deg), "

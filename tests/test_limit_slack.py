@@ -74,14 +74,16 @@ def test_the_command_reads_the_pose_at_the_stop_and_refuses_one_past_it(tmp_path
 
 def test_the_serial_and_the_graph_readings_take_the_same_slack():
     """``outside_limits`` (serial chains) and ``beyond_limits`` (closed-loop graphs) on values about limits of
-    several sizes: within the slack, at it; past it, beyond."""
+    several sizes, each end's slack by its own size: within it, at the limit; past it, beyond."""
     from screwkit.io.graph_kinematics import TreeKinematics, beyond_limits
 
     limits = np.array([[0.0, 1.7], [-3.0, 2.5], [-np.inf, 40.0]])
     lowest, highest = slackened(limits[:, 0], limits[:, 1])
-    assert np.allclose(highest - limits[:, 1], LIMIT_SLACK * np.array([2.7, 4.0, 41.0]), rtol=1e-6, atol=0.0)
-    assert np.allclose(limits[:2, 0] - lowest[:2], LIMIT_SLACK * np.array([2.7, 4.0]), rtol=1e-6, atol=0.0)
+    assert np.allclose(highest - limits[:, 1], LIMIT_SLACK * np.array([2.7, 3.5, 41.0]), rtol=1e-6, atol=0.0)
+    assert np.allclose(limits[:2, 0] - lowest[:2], LIMIT_SLACK * np.array([1.0, 4.0]), rtol=1e-6, atol=0.0)
     assert lowest[2] == -np.inf
+    far = np.array([[0.0, 1e8]])  # each end by its own size: a stop at 0 keeps 1e-9 whatever the other end
+    assert outside_limits(far, (True,), np.array([[-0.5 * LIMIT_SLACK], [-1e-3]])).tolist() == [-1, 0]
     values = np.array([[-0.5 * LIMIT_SLACK, 2.5, 40.0 + 20.0 * LIMIT_SLACK],  # each within its slack
                        [-3.0 * LIMIT_SLACK, 0.0, 0.0],  # the first past it
                        [0.0, 2.5 + 5.0 * LIMIT_SLACK, 0.0],

@@ -188,11 +188,11 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
 
 
 def slackened(lower: NDArray, upper: NDArray) -> tuple[NDArray, NDArray]:
-    """Position limits widened by :data:`~screwkit.common.tolerances.LIMIT_SLACK` times 1 plus the larger of their
-    sizes (an infinite limit stays infinite)."""
-    slack = LIMIT_SLACK * (1.0 + np.maximum(np.abs(np.where(np.isfinite(lower), lower, 0.0)),
-                                            np.abs(np.where(np.isfinite(upper), upper, 0.0))))
-    return lower - slack, upper + slack
+    """Position limits each widened by :data:`~screwkit.common.tolerances.LIMIT_SLACK` times 1 plus its own size (a
+    stop at 0 keeps 1e-9 whatever the other end: a slide of range 0 to 1e8 m was let 1 mm past it); an infinite limit
+    stays infinite."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    return lower - LIMIT_SLACK * (1.0 + np.abs(lower)), upper + LIMIT_SLACK * (1.0 + np.abs(upper))
 
 
 def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray) -> NDArray[np.int64]:

@@ -102,7 +102,7 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
     beyond = [path_to(model, end) for end in ends + ([state.platform] if leg.spine else [])]  # (a spine: its own)
     path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
-    path |= set() if any(actuator in way for way in beyond) else through_closures(model, leg, actuator, state.platform)
+    path |= through_closures(model, leg, actuator, state.platform)  # (whichever way the file's tree runs)
     free = [j for j in leg.joints if j == actuator or j not in path]
     columns = _columns(state.kinematics, free)
     right, null = _null_rows(_closure_matrix(state, free, leg))
