@@ -23,7 +23,7 @@ from screwkit.closure.chain_kinematics import (
     wrap_revolute_values,
 )
 from screwkit.closure.modes import describe_modes, meeting_modes, small_steps, values_at
-from screwkit.closure.newton import determinant_sign, newton_solve_chain, task_rows
+from screwkit.closure.newton import newton_solve_chain, task_rows, with_point_signs, working_sign
 from screwkit.closure.point_turns import check_turns
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
@@ -288,9 +288,7 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
         if mechanism.is_planar:
             _check_planar(mechanism, chain, values)
         frames = chain_forward_kinematics(chain.geometry, values)
-        chains.append(replace(chain, reference_values=values,
-                              reference_sign=determinant_sign(chain.geometry, mechanism.is_planar, frames.axes,
-                                                              frames.points)))
+        chains.append(replace(chain, reference_values=values, reference_sign=working_sign(mechanism, index, frames)))
     mechanism = replace(mechanism, chains=tuple(chains), assembly_notes=tuple(notes))
     solved = []
     for index, chain in enumerate(mechanism.chains):
@@ -497,11 +495,13 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
             raise mechanism.description.fail(
                 "<task_coordinates>", f"{' '.join(declared)} cannot drive a platform of mobility {mobility}: "
                 f"they are not {mobility} independent coordinates of its motion.")
-        return replace(mechanism, task_axes=axes, task_source="declared", held_axes=_held(mechanism, modes, axes))
+        return with_point_signs(replace(mechanism, task_axes=axes, task_source="declared",
+                                        held_axes=_held(mechanism, modes, axes)))
     if mobility == mechanism.n_pose:
         return mechanism
-    axes = infer_task_axes(mechanism, at_pose, at_values, mobility, candidates)
-    return replace(mechanism, task_axes=axes, task_source="inferred", held_axes=_held(mechanism, modes, axes))
+    axes = infer_task_axes(mechanism, at_pose, at_values, mobility, candidates)  # (then the signs task axes decide)
+    return with_point_signs(replace(mechanism, task_axes=axes, task_source="inferred", held_axes=_held(mechanism, modes,
+                                                                                                        axes)))
 
 
 def _held(mechanism: Mechanism, modes, axes) -> tuple[int, ...]:
@@ -527,8 +527,10 @@ def working_modes(mechanism: Mechanism) -> dict[str, str]:
         if chain.closed_form is not None:
             modes[chain.name] = f"{chain.closed_form.describe_branch(chain.branch)} ({chain.solver})"
         elif chain.branch is not None:
-            modes[chain.name] = (f"the reference assembly's sign of the chain's joint-twist determinant "
-                                 f"({int(chain.branch):+d}), kept from it (damped Newton)")
+            sign = "joint-twist determinant" if chain.geometry.n_dofs == len(task_rows(mechanism.is_planar)) else \
+                "map to the output point (its elbow)"
+            modes[chain.name] = (f"the reference assembly's sign of the chain's {sign} ({int(chain.branch):+d}), kept "
+                                 "from it (damped Newton)")
         else:
             modes[chain.name] = "the reference assembly's, followed from it (damped Newton)"
     return modes

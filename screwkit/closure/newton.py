@@ -26,7 +26,8 @@ from screwkit.common.rotations import (
 )
 from screwkit.model.chain import ChainGeometry
 
-__all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "task_rows"]
+__all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "working_sign",
+           "with_point_signs", "task_rows"]
 
 
 def pose_error(
@@ -149,12 +150,46 @@ def determinant_sign(geometry: ChainGeometry, is_planar: bool, axes: NDArray, po
     return sign
 
 
+def working_sign(mechanism, index: int, frames: ChainFrames):
+    """The sign that names the working mode of chain ``index`` at ``frames`` (batched, as :func:`determinant_sign`):
+    its twist matrix's determinant in task space; for a planar chain of two joints on a platform whose task
+    coordinates are a point's x and y (a five-bar leg that is the output body's own path, its loop fixed), which has
+    no such determinant, the sign of its map from joint rates to that point's velocity (its elbow: the two joints
+    and the point on one line where it changes). None for any other chain."""
+    geometry = mechanism.chains[index].geometry
+    if geometry.n_dofs == len(task_rows(mechanism.is_planar)):
+        return determinant_sign(geometry, mechanism.is_planar, frames.axes, frames.points)
+    if not (mechanism.is_planar and geometry.n_dofs == 2 and mechanism.task_coordinates == ("x", "y")):
+        return None
+    platform = frames.end_rotation @ np.swapaxes(geometry.platform_loop_rotation, -1, -2)
+    point = frames.end_translation - np.einsum("...ij,j->...i", platform, geometry.platform_loop_translation)
+    twists = twists_from_axes_and_points(frames.axes, frames.points, geometry.dof_prismatic)
+    velocity = twists[..., 3:] + np.cross(twists[..., :3], point[..., None, :])  # (..., 2 joints, 3) at the point
+    sign = np.sign(np.linalg.det(velocity[..., :2]))
+    if np.ndim(sign) == 0:
+        return None if sign == 0 else int(sign)
+    return sign
+
+
+def with_point_signs(mechanism):
+    """``mechanism`` with the working mode of each Newton chain that has a :func:`working_sign` only once its task
+    coordinates are known (a planar two-joint chain to a point output) kept: its sign at the reference assembly."""
+    from dataclasses import replace  # (a mechanism's chains replaced: only where one gains a sign)
+
+    chains, changed = list(mechanism.chains), False
+    for index, chain in enumerate(chains):
+        if chain.closed_form is None and chain.branch is None and chain.reference_values is not None:
+            sign = working_sign(mechanism, index, chain_forward_kinematics(chain.geometry, chain.reference_values))
+            if sign is not None:
+                chains[index], changed = replace(chain, branch=sign, reference_sign=sign), True
+    return replace(mechanism, chains=tuple(chains)) if changed else mechanism
+
+
 def _branch_kept(mechanism, index: int, values: NDArray, branch) -> NDArray[np.bool_]:
     if branch is None:
         return np.ones(values.shape[0], dtype=bool)
-    geometry = mechanism.chains[index].geometry
-    frames = chain_forward_kinematics(geometry, np.nan_to_num(values))
-    return determinant_sign(geometry, mechanism.is_planar, frames.axes, frames.points) == branch
+    frames = chain_forward_kinematics(mechanism.chains[index].geometry, np.nan_to_num(values))
+    return working_sign(mechanism, index, frames) == branch
 
 
 def _track(mechanism, index, source, values, goal, tolerance, max_iterations):

@@ -1,0 +1,125 @@
+"""A five-bar leg that is the output body's own path keeps its working mode.
+
+A diamond five-bar (a Minitaur-style leg: two thighs on one hip axis, two calves meeting at the knee, the knee point
+of the first calf the output) is read as two chains: the first thigh and calf (two hinges, the calf the platform's
+own body: no loop joint) and the second (closed onto the first calf at the knee). The first has two joints for the
+plane's three task-space rows, so no joint-twist determinant names its working mode, and poses past a fold of the
+straight way from the reference were solved with its elbow flipped: a published Minitaur leg read LMTI 0 (the two
+calves on one line) where its working mode gives 0.79. The sign of the chain's map to the output point (its elbow)
+now names the mode (``closure.newton.working_sign``): each pose reads the reference mode's textbook values, or is
+refused saying that the chain closes there only in another assembly.
+
+Textbook, from the knee positions of the reference mode (each thigh's elbow on the side it has in the file): ITI of
+leg i = |sin(OB_i, B_iP)|, and with two actuators for two coordinates the LMTI = |sin(B_1P, B_2P)| (each calf's
+force against the knee's motion with the other thigh locked).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers import mjcf_variant, one_line_error, screwkit, sine
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+THIGH, CALF, HIP = 0.1, 0.2, 0.35
+"""The thighs' and calves' lengths and the hip's height (m)."""
+
+
+def diamond(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """The leg's MJCF text (angles in degrees, MuJoCo's default), every length times ``scale``."""
+    def length(value: float) -> str:
+        return repr(value * scale)
+
+    return ('<mujoco model="diamond"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}"><body name="hip" pos="0 0 {length(HIP)}">'
+            '<body name="thigh1"><joint name="thigh1_j" type="hinge" axis="0 1 0"/>'
+            f'<body name="calf_long" pos="{length(THIGH)} {length(0.01)} 0" euler="0 120 0">'
+            '<joint name="knee1" type="hinge" axis="0 1 0"/></body></body>'
+            f'<body name="thigh2" euler="0 180 0" pos="0 {length(0.03)} 0"><joint name="thigh2_j" type="hinge" '
+            f'axis="0 1 0"/><body name="calf_short" euler="0 -120 0" pos="{length(THIGH)} {length(-0.01)} 0">'
+            '<joint name="knee2" type="hinge" axis="0 1 0"/></body></body></body></body></worldbody>'
+            f'<equality><connect name="knee" body1="calf_short" body2="calf_long" anchor="{length(CALF)} 0 0"/>'
+            '</equality><actuator><motor name="m1" joint="thigh1_j"/><motor name="m2" joint="thigh2_j"/></actuator>'
+            '</mujoco>')
+
+
+def _knees(point: np.ndarray) -> list[np.ndarray]:
+    """The two knees (in the leg's plane, hip at the origin, x forward and y up) for the knee point ``point`` in the
+    reference mode: thigh 1's elbow on the left of the way from the hip to the point, thigh 2's on the right (as
+    drawn: the thighs along +x and -x, the point below the hip)."""
+    distance = float(np.linalg.norm(point))
+    along = (THIGH ** 2 - CALF ** 2 + distance ** 2) / (2 * distance)
+    across = np.sqrt(THIGH ** 2 - along ** 2)
+    unit = point / distance
+    normal = np.array([-unit[1], unit[0]])
+    return [along * unit + across * normal, along * unit - across * normal]
+
+
+def textbook(point) -> tuple[float, float, float]:
+    point = np.asarray(point, dtype=float)
+    first, second = _knees(point)
+    flat = [np.append(v, 0.0) for v in (first, second, point)]
+    return (sine(flat[0], flat[2] - flat[0]), sine(flat[1], flat[2] - flat[1]),
+            sine(flat[2] - flat[0], flat[2] - flat[1]))
+
+
+def test_the_reference_mode_is_the_drawing():
+    first, second = _knees(np.array([0.0, -CALF * np.sin(np.radians(60.0))]))
+    assert first == pytest.approx([THIGH, 0.0], abs=1e-12) and second == pytest.approx([-THIGH, 0.0], abs=1e-12)
+
+
+@pytest.mark.parametrize("variant", ["m", "mm"])  # (a turned world takes other in-plane axes: the next test)
+def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_path, variant):
+    path, unit = mjcf_variant(tmp_path, "diamond", variant, diamond)
+    mechanism = load(path, length_unit=unit)
+    assert mechanism.task_coordinates == ("x", "y")
+    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])  # (the task y points down)
+    read, refused = 0, []
+    for x in np.linspace(-0.25, 0.25, 11):
+        for up in (0.11, -0.2):
+            offset = np.array([x, up])  # the knee point from the hip, x forward and up
+            if not CALF - THIGH < np.linalg.norm(offset) < CALF + THIGH:
+                continue
+            try:
+                result = indices_at_pose(mechanism, hip + np.array([x, -up]))
+            except ValueError as error:
+                refused.append(str(error))
+                continue
+            read += 1
+            iti_1, iti_2, lmti = textbook(offset)
+            found = dict(zip(result.actuators, result.iti_actuators))
+            assert (found["thigh1_j:thigh1_j"], found["thigh2_j:thigh2_j"], float(result.lmti)) == pytest.approx(
+                (iti_1, iti_2, lmti), abs=1e-9), (x, up)
+    assert read >= 8
+    assert all("closes there only in another assembly than its working mode" in line for line in refused), refused
+
+
+def test_a_turned_world_reads_the_drawing_and_keeps_both_elbows(tmp_path):
+    """In a turned world the task frame's in-plane axes are others (so the sweep above, posed in them, is not run
+    there): the file's own pose reads the textbook, and each chain keeps the working-mode sign it has in metres in
+    the world as drawn."""
+    path, unit = mjcf_variant(tmp_path, "diamond", "turned", diamond)
+    mechanism = load(path, length_unit=unit)
+    home = float(indices_at_pose(mechanism, mechanism.home_pose).lmti)
+    assert home == pytest.approx(textbook(np.array([0.0, -CALF * np.sin(np.radians(60.0))]))[2], abs=1e-9)
+    drawn = load(mjcf_variant(tmp_path, "diamond", "m", diamond)[0])
+    assert [chain.branch for chain in mechanism.chains] == [chain.branch for chain in drawn.chains]
+    assert None not in [chain.branch for chain in drawn.chains]
+
+
+def test_the_command_says_why_a_pose_past_the_fold_is_refused(tmp_path):
+    path = tmp_path / "diamond.xml"
+    path.write_text(diamond())
+    mechanism = load(path)
+    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])
+    for x in (0.05, 0.1, 0.15):
+        pose = hip + np.array([x, -0.11])
+        try:
+            result = indices_at_pose(mechanism, pose)
+        except ValueError:
+            one_line_error(screwkit("analyze", path, "--pose", *(repr(float(v)) for v in pose)),
+                           "closes there only in another assembly than its working mode")
+            return
+        assert float(result.lmti) == pytest.approx(textbook(np.array([x, 0.11]))[2], abs=1e-9)
