@@ -528,7 +528,7 @@ def working_modes(mechanism: Mechanism) -> dict[str, str]:
             modes[chain.name] = f"{chain.closed_form.describe_branch(chain.branch)} ({chain.solver})"
         elif chain.branch is not None:
             sign = "joint-twist determinant" if chain.geometry.n_dofs == len(task_rows(mechanism.is_planar)) else \
-                "map to the output point (its elbow)"
+                "map to the output point"
             modes[chain.name] = (f"the reference assembly's sign of the chain's {sign} ({int(chain.branch):+d}), kept "
                                  "from it (damped Newton)")
         else:
