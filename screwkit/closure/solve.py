@@ -369,7 +369,8 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
         if chain.closed_form is not None and residuals[c] < 1e-12 * mechanism.length_scale:
             parts.append(f"chain {chain.name!r} closes only to rounding (the pose is on the boundary of its reach, "
                          "or its end on the axis of its base joint, where its joint values are not determined)")
-        elif chain.branch is not None and residuals[c] < 1e3 * NEWTON_TOLERANCE * max(1.0, mechanism.length_scale):
+        elif chain.closed_form is None and chain.branch is not None and \
+                residuals[c] < 1e3 * NEWTON_TOLERANCE * max(1.0, mechanism.length_scale):  # (closed, but in another)
             parts.append(f"chain {chain.name!r} closes there only in another assembly than its working mode (the "
                          "sign that names it changed on the way from the reference assembly: the way passes where "
                          "the chain's joints are singular, or leaves its reach)")
