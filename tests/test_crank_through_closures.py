@@ -25,13 +25,18 @@ A, B, C, D = (np.array(p, dtype=float) for p in ((0, 0, 0), (0.05, 0, 0.08), (0.
 E, F, G = (np.array(p, dtype=float) for p in ((0.36, 0, 0.05), (0.62, 0, 0.15), (0.7, 0, 0)))
 
 
+H1, H2, H3 = (np.array(p, dtype=float) for p in ((0.02, 0, 0.04), (0.4, 0, 0.3), (0.68, 0, 0.12)))
+"""A load-free dyad's pins: on the crank, between its two links, on the platform."""
+
+
 def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool = False,
-            motor: str = "crank", from_platform: bool = False) -> str:
+            motor: str = "crank", from_platform: bool = False, dyad: bool = False) -> str:
     """The MJCF text, every length times ``scale``, its base placed by ``world``; ``crank_on_tree``: the rocker
     nested under the bar (the crank then on the tree path to the platform, the rocker closed onto the base);
     ``from_platform``: the rod, the rocker and the bar hung from the platform, the bar closed onto the crank and the
     rocker onto the base (the crank's closure then ends on a body whose path runs through the platform);
-    ``motor``: the driven joint."""
+    ``motor``: the driven joint; ``dyad``: two links from the crank to the platform, which carry nothing (three pins
+    in the plane) but make the shortest way from the crank to the platform."""
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
 
@@ -63,9 +68,12 @@ def six_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), crank_on_tree: bool 
                     f'{joint("bpin")}{rocker}</body></body>')
         closures = hinge("dpin", "rocker", "base", D, C)
     else:
+        links = (f'<body name="link1" pos="{at(H1 - A)}">{joint("h1pin")}<body name="link2" pos="{at(H2 - H1)}">'
+                 f'{joint("h2pin")}</body></body>') if dyad else ""
         branches = (f'<body name="crank" pos="{at(A)}">{joint("crank")}<body name="bar" pos="{at(B - A)}">'
-                    f'{joint("bpin")}</body></body><body name="rocker" pos="{at(D)}">{joint("rocker")}{rod}</body>')
-        closures = hinge("cpin", "bar", "rocker", C, B)
+                    f'{joint("bpin")}</body>{links}</body><body name="rocker" pos="{at(D)}">{joint("rocker")}{rod}'
+                    '</body>')
+        closures = hinge("cpin", "bar", "rocker", C, B) + (hinge("h3pin", "link2", "platform", H3, H2) if dyad else "")
     platform = f'<body name="platform" pos="{at(G)}">{joint("gpin")}</body>'
     return ('<mujoco model="six_bar"><option><flag contact="disable"/></option><worldbody>'
             f'<body name="base" pos="{world[0]}" quat="{world[1]}">{branches}{platform}</body></worldbody>'
@@ -84,6 +92,19 @@ def test_a_crank_driving_a_four_bar_grounded_on_the_base_is_refused_however_the_
     assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1  # one motion, as drawn
     with pytest.raises(ImportError_, match=r"actuated joint 'crank' moves inside a loop of leg '\w+' \(with the other "
                                            r"joints of its path to the platform held it cannot move"):
+        graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit))
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_load_free_dyad_from_the_crank_to_the_platform_does_not_make_the_crank_s_way(tmp_path, variant):
+    """The dyad is the shortest way from the crank to the platform; held, it would leave the rocker free and the crank
+    read as driving (ITI 0.7385, neither stage's transmission). It carries nothing (its removal leaves the leg's twist
+    systems as they are): the way held is the one through the bar, the rocker and the rod, and the crank is refused as
+    without the dyad."""
+    path, unit = mjcf_variant(tmp_path, "six_bar_dyad", variant, lambda s, w: six_bar(s, w, dyad=True))
+    model, data, _ = mujoco_closed(path)
+    assert model.nv - np.linalg.matrix_rank(mujoco_rows(model, data), tol=1e-9) == 1
+    with pytest.raises(ImportError_, match=r"actuated joint 'crank' moves inside a loop of leg"):
         graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit))
 
 

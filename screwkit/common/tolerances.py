@@ -157,6 +157,11 @@ NEWTON_TOLERANCE = 1e-11
 """Radians and length scales: a chain solved by damped Newton is closed when its loop error norm
 (rotation in rad, translation divided by the mechanism's length scale) is below this."""
 
+IN_LOOP_RATE = 1e-6
+"""The actuated joint's rate in the unit null vectors of its leg's closure rows, its path's other joints held, above
+which it moves (:func:`screwkit.io.graph_screws.drives_rigidly`; joint rates in working coordinates: the verdict does
+not turn on the unit)."""
+
 LIMIT_SLACK = 1e-9
 """Radians and metres: how far beyond a position limit (relative to 1 plus the limit's size) a joint may be and still
 be at it. Joint values come from closures solved to :data:`NEWTON_TOLERANCE` and from poses asked in rounded

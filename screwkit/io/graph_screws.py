@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from screwkit.closure.canonical import foot_on_line
 from screwkit.common.rotations import cross
-from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
+from screwkit.common.tolerances import FILE_ROUNDING, IN_LOOP_RATE, MEETING, PARALLEL_FOOT
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
@@ -102,17 +102,16 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
     beyond = [path_to(model, end) for end in ends + ([state.platform] if leg.spine else [])]  # (a spine: its own)
     path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
-    path |= through_closures(model, leg, actuator, state.platform)  # (whichever way the file's tree runs)
+    groups = [tuple(k for k, c in enumerate(leg.closures) if {c.joint_a, c.joint_b} == pair) for pair in
+              dict.fromkeys(frozenset((c.joint_a, c.joint_b)) for c in leg.closures)]  # (a hinge's two points: one)
+    loaded = _loaded(state, leg, [("closures", g) for g in groups], actuator) if len(groups) > 1 else None
+    idle = {k for g, on in zip(groups, [] if loaded is None else loaded.T) if not on.any() for k in g}
+    path |= through_closures(model, leg, actuator, state.platform, idle)  # (whichever way the file's tree runs)
     free = [j for j in leg.joints if j == actuator or j not in path]
     columns = _columns(state.kinematics, free)
     right, null = _null_rows(_closure_matrix(state, free, leg))
     own = np.isin(columns, _columns(state.kinematics, [actuator]))
     return np.linalg.norm(right[:, :, :len(columns)][:, :, own] * null[:, :, None], axis=(1, 2)) > IN_LOOP_RATE
-
-
-IN_LOOP_RATE = 1e-6
-"""The actuated joint's rate in the unit null vectors of its leg's closure rows, its path's other joints held, above
-which it moves (:func:`drives_rigidly`; joint rates in working coordinates: the verdict does not turn on the unit)."""
 
 
 def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:

@@ -15,17 +15,21 @@ from collections import deque
 __all__ = ["through_closures"]
 
 
-def through_closures(model, leg, actuator: int, platform: int) -> set[int]:
+def through_closures(model, leg, actuator: int, platform: int, idle=frozenset()) -> set[int]:
     """The joints of ``leg`` (a :class:`~screwkit.io.graph_screws.GraphLeg`) on the shortest ways from the body of
     joint ``actuator`` to the body of joint ``platform`` (Pinocchio ids: a joint's id is its body's), each step a
-    joint of the leg or one of its closures, never through the base (0) nor the actuated joint itself. Every
-    shortest way counts, so that no order of the file picks one; empty when none reaches the platform."""
+    joint of the leg or one of its closures, never through the base (0) nor the actuated joint itself, nor the
+    closures ``idle`` (by index: load-free ones, as a dyad of two links between the crank and the platform, which
+    would be the shortest way and carries nothing). Every shortest way counts, so that no order of the file picks one;
+    empty when none reaches the platform."""
     steps: dict[int, list[tuple[int, int | None]]] = {}  # body: (next body, the joint between them, None: a closure)
     for joint in leg.joints:
         if joint != actuator:
             steps.setdefault(joint, []).append((model.parents[joint], joint))
             steps.setdefault(model.parents[joint], []).append((joint, joint))
-    for closure in leg.closures:
+    for index, closure in enumerate(leg.closures):
+        if index in idle:
+            continue
         steps.setdefault(closure.joint_a, []).append((closure.joint_b, None))
         steps.setdefault(closure.joint_b, []).append((closure.joint_a, None))
     ahead, back = _distances(steps, actuator), _distances(steps, platform)
