@@ -9,6 +9,7 @@ the working-mode check (:func:`determinant_sign`).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -174,8 +175,6 @@ def working_sign(mechanism, index: int, frames: ChainFrames):
 def with_point_signs(mechanism):
     """``mechanism`` with the working mode of each Newton chain that has a :func:`working_sign` only once its task
     coordinates are known (a planar two-joint chain to a point output) kept: its sign at the reference assembly."""
-    from dataclasses import replace  # (a mechanism's chains replaced: only where one gains a sign)
-
     chains, changed = list(mechanism.chains), False
     for index, chain in enumerate(chains):
         if chain.closed_form is None and chain.branch is None and chain.reference_values is not None:

@@ -87,6 +87,7 @@ from screwkit.io.graph_screws import (
     leg_screws,
     locking_legs,
 )
+from screwkit.io.locking import put_joint_value
 from screwkit.io.output import output_frame, platform_body
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
@@ -307,9 +308,7 @@ class GraphMechanism:
         count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
         for step in range(1, count + 1):
             for joint, value in zip(ids, start + step / count * (values - start)):
-                at = model.joints[joint].idx_q
-                q[at:at + model.joints[joint].nq] = [np.cos(value), np.sin(value)] if model.joints[joint].nq == 2 \
-                    else [value]
+                put_joint_value(model, joint, q, value)
             try:
                 q, _ = assemble(replace(self.tree, q_reference=q, notes=[]), held=ids)
             except ImportError_:

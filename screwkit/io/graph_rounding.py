@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, joint_kind, joint_value
+from screwkit.io.leg_ways import pin_groups
 from screwkit.io.rounding import parallel_axes, turned_joint
 from screwkit.io.written_angles import written_turns
 
@@ -36,11 +37,7 @@ __all__ = ["drawn_tree", "closed_hinges"]
 def closed_hinges(tree: ClosedTree) -> list[tuple[int, int]]:
     """The pairs of closures (indices, in file order) that close a hinge: the only two ``3d`` closures between the
     same two joints."""
-    between: dict[frozenset, list[int]] = {}
-    for index, closure in enumerate(tree.closures):
-        if closure.kind == "3d":
-            between.setdefault(frozenset((closure.joint_a, closure.joint_b)), []).append(index)
-    return [(pair[0], pair[1]) for pair in between.values() if len(pair) == 2]
+    return [(pair[0], pair[1]) for pair in pin_groups(tree.closures, "3d") if len(pair) == 2]
 
 
 def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:

@@ -21,7 +21,7 @@ from screwkit.common.tolerances import FILE_ROUNDING, IN_LOOP_RATE, MEETING, PAR
 from screwkit.io.closed_tree import ClosedTree, Closure, ImportError_, path_to
 from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
-from screwkit.io.leg_ways import through_closures
+from screwkit.io.leg_ways import pin_groups, through_closures
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.reference import actuation_wrench, working_frame
 
@@ -102,8 +102,7 @@ def drives_rigidly(state: _State, leg: GraphLeg, actuator: int) -> NDArray[np.bo
     ends = [end for end, other in onto if state.platform in path_to(model, other)]  # the leg's ends on the platform
     beyond = [path_to(model, end) for end in ends + ([state.platform] if leg.spine else [])]  # (a spine: its own)
     path = set(path_to(model, actuator)) | {j for way in beyond if actuator in way for j in way[way.index(actuator):]}
-    groups = [tuple(k for k, c in enumerate(leg.closures) if {c.joint_a, c.joint_b} == pair) for pair in
-              dict.fromkeys(frozenset((c.joint_a, c.joint_b)) for c in leg.closures)]  # (a hinge's two points: one)
+    groups = pin_groups(leg.closures)
     loaded = _loaded(state, leg, [("closures", g) for g in groups], actuator) if len(groups) > 1 else None
     idle = {k for g, on in zip(groups, [] if loaded is None else loaded.T) if not on.any() for k in g}
     path |= through_closures(model, leg, actuator, state.platform, idle)  # (whichever way the file's tree runs)
@@ -229,14 +228,14 @@ def _attachments(state: _State, leg: GraphLeg, body: int, actuator: int | None =
         points.append(own)
         cuts.append(("joint", body))
     pins: dict[tuple, list[NDArray]] = {}  # the points of the closures between one pair of bodies
-    for closure in leg.closures:
+    group = {k: ("closures", g) for g in pin_groups(leg.closures) for k in g}  # (a hinge's both points: one cut)
+    for index, closure in enumerate(leg.closures):
         if closure.axis_point:
             continue
         for joint, placement, other in ((closure.joint_a, closure.placement_a, closure.joint_b),
                                         (closure.joint_b, closure.placement_b, closure.joint_a)):
             if joint == body:
-                cut = ("closures", tuple(k for k, c in enumerate(leg.closures)  # (a hinge's both points)
-                                         if {c.joint_a, c.joint_b} == {closure.joint_a, closure.joint_b}))
+                cut = group[index]
                 point = (_joint_point(state, other) if closure.kind == "6d" and other != 0 else
                          (state.transforms[:, joint] @ placement)[:, :3, 3])
                 pins.setdefault(cut, []).append(point)

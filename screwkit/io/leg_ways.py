@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import deque
 
-__all__ = ["through_closures"]
+__all__ = ["through_closures", "pin_groups"]
 
 
 def through_closures(model, leg, actuator: int, platform: int, idle=frozenset()) -> set[int]:
@@ -51,3 +51,13 @@ def _distances(steps: dict, start: int) -> dict[int, int]:
                 found[other] = found[body] + 1
                 queue.append(other)
     return found
+
+
+def pin_groups(closures, kind: str | None = None) -> list[tuple[int, ...]]:
+    """The indices of ``closures`` (of that ``kind`` only, when given) grouped by the two bodies they join, in file
+    order: one connection each (a hinge written as two points on its axis is one group of two)."""
+    groups: dict[frozenset, list[int]] = {}
+    for index, closure in enumerate(closures):
+        if kind is None or closure.kind == kind:
+            groups.setdefault(frozenset((closure.joint_a, closure.joint_b)), []).append(index)
+    return [tuple(group) for group in groups.values()]

@@ -25,8 +25,8 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.onshape import guessed_motors
 
-__all__ = ["lock_joints", "actuate_joints", "set_initial", "joint_names", "drivable_joints", "platform_motions",
-           "GUESSED"]
+__all__ = ["lock_joints", "actuate_joints", "set_initial", "put_joint_value", "joint_names", "drivable_joints",
+           "platform_motions", "GUESSED"]
 
 
 def lock_joints(tree: ClosedTree, names) -> ClosedTree:
@@ -223,6 +223,13 @@ def drivable_joints(tree: ClosedTree) -> str:
                      if model.joints[model.getJointId(n)].nv == 1 and str(n) not in tree.split)
 
 
+def put_joint_value(model, joint: int, q: NDArray, value: float) -> None:
+    """``value`` (rad or m) written as 1-DoF ``joint``'s coordinates in ``q``, in place (cos and sin for an unbounded
+    hinge): :func:`~screwkit.io.closed_tree.joint_value`'s inverse."""
+    start, count = model.joints[joint].idx_q, model.joints[joint].nq
+    q[start:start + count] = [np.cos(value), np.sin(value)] if count == 2 else [value]
+
+
 def set_initial(tree: ClosedTree, values) -> ClosedTree:
     """The tree with the joints of ``values`` (pairs of a joint name and a value: degrees for a revolute joint, metres
     for a prismatic one, as ``--actuators`` takes them) at those values instead of the file's (``--initial``). The
@@ -246,15 +253,12 @@ def set_initial(tree: ClosedTree, values) -> ClosedTree:
         if what is not None:
             raise ImportError_(f"{tree.source}: --initial {name} {value:g}: {what}; the joints that can be given one "
                                f"(revolute or prismatic) are {startable}.")
-        start = model.joints[joint].idx_q
         if kind == "revolute":
-            angle = np.radians(value)
-            q[start:start + model.joints[joint].nq] = ([np.cos(angle), np.sin(angle)] if model.joints[joint].nq == 2
-                                                       else [angle])
+            put_joint_value(model, joint, q, np.radians(value))
             said.append(f"{name} {value:g} deg")
         else:
-            q[start] = value / LENGTH_UNITS[tree.unit]  # the tree keeps the file's numbers when read as written
-            said.append(f"{name} {value:g} m")
+            put_joint_value(model, joint, q, value / LENGTH_UNITS[tree.unit])  # (the tree keeps the file's numbers
+            said.append(f"{name} {value:g} m")  # when read as written)
     note = (f"joint values given (--initial): {', '.join(said)}, instead of the file's; the loops closed with them "
             "held there")
     return replace(tree, q_reference=q, initial=pairs, notes=[*tree.notes, note])
