@@ -127,3 +127,18 @@ def test_driven_at_the_rocker_the_linkage_reads_its_pressure_angles(tmp_path, va
     assert expected == pytest.approx((sine(E - D, F - E), sine(F - E, F - G)), abs=1e-12)
     result = graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit)).indices()
     assert (float(result.iti), float(result.lmti)) == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+@pytest.mark.parametrize("dyad", [False, True])
+def test_the_verdicts_do_not_turn_on_the_linkage_s_size(tmp_path, scale, dyad):
+    """Every length times 1e-3 or 1e3, read in metres: the crank still refused, with or without the dyad; driven at
+    the rocker, the same pressure angles."""
+    path = tmp_path / f"six_bar_{scale}.xml"
+    path.write_text(six_bar(scale, dyad=dyad))
+    with pytest.raises(ImportError_, match=r"actuated joint 'crank' moves inside a loop of leg"):
+        graph_mechanism(read_closed_tree(path, output="platform"))
+    path.write_text(six_bar(scale, motor="rocker", dyad=dyad))
+    result = graph_mechanism(read_closed_tree(path, output="platform")).indices()
+    assert (float(result.iti), float(result.lmti)) == pytest.approx((sine(E - D, F - E), sine(F - E, F - G)),
+                                                                    abs=1e-9)

@@ -66,3 +66,12 @@ def test_bad_actuator_values_and_a_joint_past_its_limits_are_refused_in_one_line
                    "beyond their limits", "'crank'", "--ignore-limits")
     found = screwkit_json("analyze", path, "--output", "coupler", "--actuators", "70", "--ignore-limits")
     assert found["cti"] == pytest.approx(textbook(70.0), abs=1e-9)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_actuator_values_drive_the_linkage_alike_at_any_size(tmp_path, scale):
+    """Every length times 1e-3 or 1e3, read in metres: the steps are in radians, the indices the same."""
+    path = tmp_path / "dyad.xml"
+    path.write_text(linkage(scale, dyad="rocker"))
+    result = graph_mechanism(read_closed_tree(path, output="coupler")).at_actuators([np.radians(-35.0)]).indices()
+    assert (float(result.iti), float(result.cti)) == pytest.approx((1.0, textbook(-35.0)), abs=1e-9)

@@ -278,3 +278,11 @@ def test_unbounded_hinges_closed_by_gazebo_joints_are_turned(tmp_path):
     assert {tree.model.joints[j].shortname() for j in range(1, tree.model.njoints)} == {
         "JointModelRevoluteUnboundedUnaligned"}
     assert _indices(path) == pytest.approx((1.0, 1.0, sine(C - B, C - D)), abs=1e-5)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_rounded_linkage_reads_as_the_exact_one_at_any_size(tmp_path, scale):
+    """Every length times 1e-3 or 1e3, read in metres: the axes' rounding is an angle, the same at any size."""
+    exact = _indices(_written(tmp_path / "exact.xml", linkage(scale, dyad="rocker")))
+    assert exact == pytest.approx((1.0, 1.0, sine(C - B, C - D)), abs=1e-9)
+    assert _indices(_written(tmp_path / "rounded.xml", rounded(scale))) == pytest.approx(exact, abs=1e-5)

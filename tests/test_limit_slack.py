@@ -101,3 +101,23 @@ def test_the_serial_and_the_graph_readings_take_the_same_slack():
         TreeKinematics.__dataclass_fields__)
     graph = beyond_limits(Kinematics, values)
     assert [int(np.argmax(row)) if row.any() else -1 for row in graph] == serial.tolist()
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_stop_reads_alike_at_any_size(tmp_path, scale):
+    """Every length times 1e-3 or 1e3, read in metres, the poses asked scaled with it: the crank's stop (an angle)
+    is met and passed at the same poses."""
+    path = tmp_path / "slider_crank.xml"
+    path.write_text(slider_crank(scale))
+    mechanism = load(path, output="slider")
+    home = mechanism.home_pose
+    for step in (1e-12, -1e-12):
+        assert float(indices_at_pose(mechanism, home + step * scale).iti) == pytest.approx(sine(B - O, C - B),
+                                                                                            abs=1e-9)
+    refused = []
+    for step in (1e-6, -1e-6):
+        try:
+            indices_at_pose(mechanism, home + step * scale)
+        except ValueError as error:
+            refused.append(str(error))
+    assert len(refused) == 1 and "joint 'crank'" in refused[0], refused

@@ -27,22 +27,31 @@ THIGH, CALF, HIP = 0.1, 0.2, 0.35
 """The thighs' and calves' lengths and the hip's height (m)."""
 
 
-def diamond(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
-    """The leg's MJCF text (angles in degrees, MuJoCo's default), every length times ``scale``."""
+def diamond(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), names=("thigh1_j", "thigh2_j"), reverse=False) -> str:
+    """The leg's MJCF text (angles in degrees, MuJoCo's default), every length times ``scale``; ``names``: the two
+    motors' joints; ``reverse``: the second thigh's branch listed first."""
     def length(value: float) -> str:
         return repr(value * scale)
 
+    first = (f'<body name="thigh1"><joint name="{names[0]}" type="hinge" axis="0 1 0"/>'
+             f'<body name="calf_long" pos="{length(THIGH)} {length(0.01)} 0" euler="0 120 0">'
+             '<joint name="knee1" type="hinge" axis="0 1 0"/></body></body>')
+    second = (f'<body name="thigh2" euler="0 180 0" pos="0 {length(0.03)} 0"><joint name="{names[1]}" type="hinge" '
+              f'axis="0 1 0"/><body name="calf_short" euler="0 -120 0" pos="{length(THIGH)} {length(-0.01)} 0">'
+              '<joint name="knee2" type="hinge" axis="0 1 0"/></body></body>')
     return ('<mujoco model="diamond"><option><flag contact="disable"/></option><worldbody>'
             f'<body name="base" pos="{world[0]}" quat="{world[1]}"><body name="hip" pos="0 0 {length(HIP)}">'
-            '<body name="thigh1"><joint name="thigh1_j" type="hinge" axis="0 1 0"/>'
-            f'<body name="calf_long" pos="{length(THIGH)} {length(0.01)} 0" euler="0 120 0">'
-            '<joint name="knee1" type="hinge" axis="0 1 0"/></body></body>'
-            f'<body name="thigh2" euler="0 180 0" pos="0 {length(0.03)} 0"><joint name="thigh2_j" type="hinge" '
-            f'axis="0 1 0"/><body name="calf_short" euler="0 -120 0" pos="{length(THIGH)} {length(-0.01)} 0">'
-            '<joint name="knee2" type="hinge" axis="0 1 0"/></body></body></body></body></worldbody>'
+            + (second + first if reverse else first + second) + '</body></body></worldbody>'
             f'<equality><connect name="knee" body1="calf_short" body2="calf_long" anchor="{length(CALF)} 0 0"/>'
-            '</equality><actuator><motor name="m1" joint="thigh1_j"/><motor name="m2" joint="thigh2_j"/></actuator>'
-            '</mujoco>')
+            f'</equality><actuator><motor name="m1" joint="{names[0]}"/><motor name="m2" joint="{names[1]}"/>'
+            '</actuator></mujoco>')
+
+
+WRITINGS = {"m": (1.0, None, {}), "mm": (1000.0, "mm", {}), "x1e-3": (1e-3, None, {}), "x1e3": (1e3, None, {}),
+            "relabelled": (1.0, None, {"names": ("rear_j", "front_j"), "reverse": True})}
+"""The leg written five ways: ``(every length times, --length-unit, diamond's other options)``: in metres, in
+millimetres read as such, scaled by 1e-3 and 1e3 (read in metres: poses scale with it), and with its branches listed
+the other way round and its motors renamed."""
 
 
 def _knees(point: np.ndarray) -> list[np.ndarray]:
@@ -70,12 +79,16 @@ def test_the_reference_mode_is_the_drawing():
     assert first == pytest.approx([THIGH, 0.0], abs=1e-12) and second == pytest.approx([-THIGH, 0.0], abs=1e-12)
 
 
-@pytest.mark.parametrize("variant", ["m", "mm"])  # (a turned world takes other in-plane axes: the next test)
-def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_path, variant):
-    path, unit = mjcf_variant(tmp_path, "diamond", variant, diamond)
+@pytest.mark.parametrize("writing", sorted(WRITINGS))  # (a turned world takes other in-plane axes: the next test)
+def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_path, writing):
+    scale, unit, options = WRITINGS[writing]
+    path = tmp_path / f"diamond_{writing}.xml"
+    path.write_text(diamond(scale, **options))
     mechanism = load(path, length_unit=unit)
+    factor = 1.0 if unit else scale  # (poses in metres: the file's lengths unless read in millimetres)
+    motors = [f"{name}:{name}" for name in options.get("names", ("thigh1_j", "thigh2_j"))]
     assert mechanism.task_coordinates == ("x", "y")
-    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])  # (the task y points down)
+    hip = mechanism.home_pose - factor * np.array([0.0, CALF * np.sin(np.radians(60.0))])  # (the task y points down)
     read, refused = 0, []
     for x in np.linspace(-0.25, 0.25, 11):
         for up in (0.11, -0.2):
@@ -83,14 +96,14 @@ def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_
             if not CALF - THIGH < np.linalg.norm(offset) < CALF + THIGH:
                 continue
             try:
-                result = indices_at_pose(mechanism, hip + np.array([x, -up]))
+                result = indices_at_pose(mechanism, hip + factor * np.array([x, -up]))
             except ValueError as error:
                 refused.append(str(error))
                 continue
             read += 1
             iti_1, iti_2, lmti = textbook(offset)
             found = dict(zip(result.actuators, result.iti_actuators))
-            assert (found["thigh1_j:thigh1_j"], found["thigh2_j:thigh2_j"], float(result.lmti)) == pytest.approx(
+            assert (found[motors[0]], found[motors[1]], float(result.lmti)) == pytest.approx(
                 (iti_1, iti_2, lmti), abs=1e-9), (x, up)
     assert read >= 8
     assert all("closes there only in another assembly than its working mode" in line for line in refused), refused
