@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers import mjcf_variant, one_line_error, screwkit, sine
+from helpers import mjcf_variant, screwkit, sine
+from screwkit.closure.forward_kinematics import forward
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -79,8 +80,21 @@ def test_the_reference_mode_is_the_drawing():
     assert first == pytest.approx([THIGH, 0.0], abs=1e-12) and second == pytest.approx([-THIGH, 0.0], abs=1e-12)
 
 
-@pytest.mark.parametrize("writing", sorted(WRITINGS))  # (a turned world takes other in-plane axes: the next test)
-def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_path, writing):
+def _around_the_hip(mechanism, factor: float):
+    """Knee points on four circles about the hip inside the leg's reach, every 30 deg (the offset from the hip,
+    x forward and up) with the task pose of each (``factor``: the file's lengths in metres)."""
+    hip = mechanism.home_pose - factor * np.array([0.0, CALF * np.sin(np.radians(60.0))])  # (the task y points down)
+    for radius in (0.12, 0.17, 0.22, 0.27):
+        for angle in np.radians(np.arange(-180, 180, 30)):
+            offset = radius * np.array([np.sin(angle), -np.cos(angle)])
+            yield offset, hip + factor * np.array([offset[0], -offset[1]])
+
+
+@pytest.mark.parametrize("writing", sorted(WRITINGS))  # (a turned world takes other in-plane axes: the next tests)
+def test_every_pose_in_reach_reads_the_reference_mode(tmp_path, writing):
+    """All the way round the hip: the straight way from the reference to a knee point beyond the hip leaves the
+    leg's reach (or folds a chain), and the pose is solved from many starts (``closure.around``). Poses past the hip
+    were refused before (12 of the 48 of this grid on a published Minitaur leg)."""
     scale, unit, options = WRITINGS[writing]
     path = tmp_path / f"diamond_{writing}.xml"
     path.write_text(diamond(scale, **options))
@@ -88,25 +102,49 @@ def test_every_pose_reads_the_reference_mode_or_is_refused_for_its_assembly(tmp_
     factor = 1.0 if unit else scale  # (poses in metres: the file's lengths unless read in millimetres)
     motors = [f"{name}:{name}" for name in options.get("names", ("thigh1_j", "thigh2_j"))]
     assert mechanism.task_coordinates == ("x", "y")
-    hip = mechanism.home_pose - factor * np.array([0.0, CALF * np.sin(np.radians(60.0))])  # (the task y points down)
-    read, refused = 0, []
-    for x in np.linspace(-0.25, 0.25, 11):
-        for up in (0.11, -0.2):
-            offset = np.array([x, up])  # the knee point from the hip, x forward and up
-            if not CALF - THIGH < np.linalg.norm(offset) < CALF + THIGH:
-                continue
-            try:
-                result = indices_at_pose(mechanism, hip + factor * np.array([x, -up]))
-            except ValueError as error:
-                refused.append(str(error))
-                continue
-            read += 1
-            iti_1, iti_2, lmti = textbook(offset)
-            found = dict(zip(result.actuators, result.iti_actuators))
-            assert (found[motors[0]], found[motors[1]], float(result.lmti)) == pytest.approx(
-                (iti_1, iti_2, lmti), abs=1e-9), (x, up)
-    assert read >= 8
-    assert all("closes there only in another assembly than its working mode" in line for line in refused), refused
+    for offset, pose in _around_the_hip(mechanism, factor):
+        result = indices_at_pose(mechanism, pose)
+        iti_1, iti_2, lmti = textbook(offset)
+        found = dict(zip(result.actuators, result.iti_actuators))
+        assert (found[motors[0]], found[motors[1]], float(result.lmti)) == pytest.approx(
+            (iti_1, iti_2, lmti), abs=1e-9), offset
+
+
+HOME = (0.0, -CALF * np.sin(np.radians(60.0)))
+"""The reference knee point from the hip (x forward, y up)."""
+
+
+@pytest.mark.parametrize("writing", sorted(WRITINGS) + ["turned"])
+def test_motors_turned_together_turn_the_reference_assembly(tmp_path, writing):
+    """Both motors turned by one angle turn the whole leg about the hip (the thighs' frames turn alike): the
+    reference assembly turned, whose indices are the reference's whatever the world frame. At 135 and 180 deg the
+    way from the reference pose to the turned one passes the hip, out of the leg's reach, and was refused."""
+    if writing == "turned":
+        path, unit = mjcf_variant(tmp_path, "diamond", "turned", diamond)
+        scale, names = 1.0, ("thigh1_j", "thigh2_j")
+    else:
+        scale, unit, options = WRITINGS[writing]
+        path = tmp_path / f"diamond_{writing}.xml"
+        path.write_text(diamond(scale, **options))
+        names = options.get("names", ("thigh1_j", "thigh2_j"))
+    mechanism = load(path, length_unit=unit)
+    order = [mechanism.actuator_names.index(f"{name}:{name}") for name in names]
+    expected = textbook(np.array(HOME))
+    reached = []
+    for angle in (-180.0, -135.0, -90.0, 45.0, 135.0):
+        values = np.full(2, np.radians(angle))[order]
+        solution = forward(mechanism, values, mechanism.home_pose)
+        assert bool(np.asarray(solution.reachable).reshape(-1)[0]), angle
+        pose = np.asarray(solution.poses).reshape(-1)
+        result = indices_at_pose(mechanism, pose)
+        found = dict(zip(result.actuators, result.iti_actuators))
+        assert (found[f"{names[0]}:{names[0]}"], found[f"{names[1]}:{names[1]}"], float(result.lmti)) == \
+            pytest.approx(expected, abs=1e-9), angle
+        reached.append(pose)
+    # the knee turned about the hip: half a turn puts it as far beyond the hip as it was before it
+    factor = 1.0 if unit else scale
+    assert np.linalg.norm(reached[0] - mechanism.home_pose) == pytest.approx(2 * factor * CALF * np.sin(np.radians(
+        60.0)), rel=1e-9)
 
 
 def test_a_turned_world_reads_the_drawing_and_keeps_both_elbows(tmp_path):
@@ -122,17 +160,21 @@ def test_a_turned_world_reads_the_drawing_and_keeps_both_elbows(tmp_path):
     assert None not in [chain.branch for chain in drawn.chains]
 
 
-def test_the_command_says_why_a_pose_past_the_fold_is_refused(tmp_path):
+def test_a_sweep_past_the_hip_reads_the_reference_mode_on_the_command_line(tmp_path):
+    """The knee point swept from below the hip to above it, beside it (a published Minitaur leg's sweep was refused
+    at 6 of 11 poses, after reading LMTI 0 at 5): every row the textbook's."""
     path = tmp_path / "diamond.xml"
     path.write_text(diamond())
     mechanism = load(path)
-    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])
-    for x in (0.05, 0.1, 0.15):
-        pose = hip + np.array([x, -0.11])
-        try:
-            result = indices_at_pose(mechanism, pose)
-        except ValueError:
-            one_line_error(screwkit("analyze", path, "--pose", *(repr(float(v)) for v in pose)),
-                           "closes there only in another assembly than its working mode")
-            return
-        assert float(result.lmti) == pytest.approx(textbook(np.array([x, 0.11]))[2], abs=1e-9)
+    hip = float(mechanism.home_pose[1] - CALF * np.sin(np.radians(60.0)))  # (the task y points down)
+    process = screwkit("sweep", path, "--sweep", f"y:{hip - 0.25!r}:{hip + 0.26!r}:0.05", "--at", "0.12", "0",
+                       "--quiet")
+    assert process.returncode == 0, process.stderr
+    lines = process.stdout.strip().splitlines()
+    header = lines[0].split(",")
+    rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+    assert len(rows) == 11
+    for row in rows:
+        up = hip - float(row["y"])
+        assert row["reachable"] == "True", row
+        assert float(row["lmti"]) == pytest.approx(textbook(np.array([0.12, up]))[2], abs=1e-9), up

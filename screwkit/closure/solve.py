@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure.analytic import KernelKind
+from screwkit.closure.around import complete_around, eligible, newton_chain_around
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains
@@ -218,6 +219,14 @@ def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray
     return first
 
 
+def _newton_chain(mechanism, index, flat, platform, start, sign, tolerance, max_iterations):
+    """Chain ``index`` closed by continuation (:func:`~screwkit.closure.newton.solve_newton_chain`), the poses it
+    leaves unclosed solved from many starts where that finds the working mode's one assembly
+    (:func:`~screwkit.closure.around.newton_chain_around`)."""
+    solved = solve_newton_chain(mechanism, index, flat, platform, start, sign, tolerance, max_iterations)
+    return newton_chain_around(mechanism, index, platform, start, sign, tolerance, max_iterations, solved)
+
+
 def solve(
     mechanism: Mechanism,
     poses: ArrayLike,
@@ -275,7 +284,8 @@ def solve(
     initial_values = _check_initial(mechanism, initial, batch)
     completed, complete_residual = np.ones(count, dtype=bool), np.zeros(count)
     if mechanism.dependent_indices:  # lower mobility: the dependent coordinates close the constraining chains
-        flat, dependent_values, completed, complete_residual = complete_poses(mechanism, task_flat)
+        flat, dependent_values, completed, complete_residual = complete_around(
+            mechanism, task_flat, complete_poses(mechanism, task_flat), branches)
         initial_values = list(initial_values) if initial_values is not None else [None] * len(mechanism.chains)
         for index, chain_values in zip(constraining_chains(mechanism), dependent_values):
             if initial_values[index] is None:
@@ -300,14 +310,14 @@ def solve(
                 np.asarray(initial_values[index]).reshape(count, geometry.n_dofs)
             sign = branches[index] if chain.closed_form is None else chain.reference_sign
             if np.all(completed):
-                chain_values, chain_reachable, chain_residual = solve_newton_chain(
+                chain_values, chain_reachable, chain_residual = _newton_chain(
                     mechanism, index, flat, cache.platform, start, sign, tolerance, max_iterations)
             else:  # where the dependent coordinates do not close, the pose is unreachable whatever this chain does
                 todo = np.flatnonzero(completed)
                 chain_values = np.full((count, geometry.n_dofs), np.nan)
                 chain_reachable, chain_residual = np.zeros(count, dtype=bool), np.zeros(count)
                 if todo.size:
-                    chain_values[todo], chain_reachable[todo], chain_residual[todo] = solve_newton_chain(
+                    chain_values[todo], chain_reachable[todo], chain_residual[todo] = _newton_chain(
                         mechanism, index, flat[todo], tuple(part[todo] for part in cache.platform),
                         None if start is None else start[todo], sign, tolerance, max_iterations)
             frames = chain_forward_kinematics(geometry, np.nan_to_num(chain_values))
@@ -371,9 +381,11 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
                          "or its end on the axis of its base joint, where its joint values are not determined)")
         elif chain.closed_form is None and chain.branch is not None and \
                 residuals[c] < 1e3 * NEWTON_TOLERANCE * max(1.0, mechanism.length_scale):  # (closed, but in another)
+            searched = ", and no one assembly with it was found from starts over a turn of each of its joints" \
+                if eligible(mechanism, (c,), {c: chain.branch}) else ""
             parts.append(f"chain {chain.name!r} closes there only in another assembly than its working mode (the "
                          "sign that names it changed on the way from the reference assembly: the way passes where "
-                         "the chain's joints are singular, or leaves its reach)")
+                         f"the chain's joints are singular, or leaves its reach{searched})")
         else:
             parts.append(f"chain {chain.name!r} misses closure by {residuals[c]:.6g} {unit}")
     for c in np.flatnonzero(status == OUTSIDE_LIMITS):

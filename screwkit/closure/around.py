@@ -1,0 +1,184 @@
+"""Poses the straight way from the reference assembly does not reach in the working mode: solved from many starts.
+
+The continuation (:func:`screwkit.closure.newton.solve_newton_chain`, and :func:`screwkit.closure.task_space
+.complete_poses` for the chains that tie a lower-mobility platform's dependent coordinates) follows the straight way
+from the reference pose. Where that way leaves a chain's reach or passes one of its folds, it ends in another
+assembly of the chain, or in none, though the pose is reachable in the working mode: a five-bar leg's knee point
+on the far side of its hip (published Minitaur and wheel-leg files), which every way around the hip reaches.
+
+A pose left so is solved again from starts spread over a turn of each revolute joint (:data:`TURNS` each, the
+slides at their reference values), every start closed by Levenberg-Marquardt at the pose itself, and taken when
+the assemblies found that keep every working-mode sign are one (to :data:`SAME_ASSEMBLY`). That is done for planar
+chains of at most three joints only (:func:`eligible`): the sign that names such a chain's working mode
+(:func:`screwkit.closure.newton.working_sign`: the determinant of its three joint twists, or for two joints to an
+output point the elbow) tells its assemblies at a pose apart, which are two at most (a two-joint subproblem's two
+solutions on either side of the fold where the sign changes), so the one found is the working mode's. A spatial
+chain can have several assemblies with one sign (a six-joint arm's eight, four of each), which no number of starts
+proves complete: its poses stay refused, as the continuation leaves them.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.closure.chain_kinematics import chain_forward_kinematics, wrap_revolute_values
+from screwkit.closure.newton import newton_solve_chain, working_sign
+from screwkit.closure.task_space import complete_poses, constraining_chains
+from screwkit.common.rotations import wrap_angle
+
+__all__ = ["TURNS", "SAME_ASSEMBLY", "MOST_STARTS", "eligible", "starts", "one_assembly", "chain_around",
+           "completion_around", "newton_chain_around", "complete_around"]
+
+TURNS = (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)
+"""Where each revolute joint starts, from its reference value (rad): a quarter turn apart."""
+
+SAME_ASSEMBLY = 1e-6
+"""Two closed assemblies are one when no joint value (or dependent pose coordinate) differs by more than this (rad,
+and length scales)."""
+
+MOST_STARTS = 256
+"""Starts a pose may take (chains tied together multiply theirs); beyond it the pose stays as the continuation left
+it."""
+
+
+def eligible(mechanism, indices, branches) -> bool:
+    """Whether the chains ``indices`` of a planar mechanism, each of at most three joints, all have a working-mode
+    sign (``branches[index]``, +1 or -1), and their starts are at most :data:`MOST_STARTS`."""
+    if not mechanism.is_planar or not indices:
+        return False
+    revolute = 0
+    for index in indices:
+        geometry = mechanism.chains[index].geometry
+        if branches[index] is None or isinstance(branches[index], tuple) or geometry.n_dofs > 3:
+            return False
+        revolute += sum(not prismatic for prismatic in geometry.dof_prismatic)
+    return len(TURNS) ** revolute <= MOST_STARTS
+
+
+def starts(mechanism, indices) -> list[NDArray[np.float64]]:
+    """Per chain of ``indices``, its start values (S, m_i): every combination of :data:`TURNS` on the revolute
+    joints of all of them (S = 4 ** revolute joints), from their reference values."""
+    geometries = [mechanism.chains[index].geometry for index in indices]
+    revolute = [[not prismatic for prismatic in geometry.dof_prismatic] for geometry in geometries]
+    turns = np.array(list(itertools.product(TURNS, repeat=sum(map(sum, revolute)))), dtype=float).reshape(
+        -1, sum(map(sum, revolute)))
+    result, column = [], 0
+    for index, mask in zip(indices, revolute):
+        values = np.tile(mechanism.chains[index].reference_values, (turns.shape[0], 1))
+        values[:, mask] += turns[:, column:column + sum(mask)]
+        column += sum(mask)
+        result.append(values)
+    return result
+
+
+def _signs_kept(mechanism, index: int, values: NDArray, branch) -> NDArray[np.bool_]:
+    frames = chain_forward_kinematics(mechanism.chains[index].geometry, np.nan_to_num(values))
+    return np.asarray(working_sign(mechanism, index, frames) == branch)
+
+
+def one_assembly(values: NDArray, kept: NDArray, angular: NDArray, length: float):
+    """Of each pose's closed starts ``values`` (N, S, k) that keep the working mode (``kept``, (N, S)), the one
+    assembly: ``(which start (N,), found (N,))``, found where every kept start closed to the same values (angles
+    ``angular`` (k,) compared modulo a turn, lengths in units of ``length``) and at least one did."""
+    first = np.argmax(kept, axis=1)
+    chosen = values[np.arange(values.shape[0]), first]
+    difference = values - chosen[:, None, :]
+    difference[..., angular] = wrap_angle(difference[..., angular])
+    difference[..., ~angular] /= length
+    apart = np.max(np.abs(difference), axis=-1, initial=0.0) > SAME_ASSEMBLY
+    return first, np.any(kept, axis=1) & ~np.any(kept & apart, axis=1)
+
+
+def chain_around(mechanism, index: int, targets, branch, tolerance: float, max_iterations: int):
+    """Chain ``index`` closed onto loop ``targets`` (rotations (N, 3, 3), translations (N, 3)) from every start of
+    :func:`starts`: ``(values (N, m), found (N,), residual (N,))``, found where one assembly keeps the sign
+    ``branch``."""
+    geometry = mechanism.chains[index].geometry
+    (seeds,) = starts(mechanism, (index,))
+    count, many = targets[0].shape[0], seeds.shape[0]
+    values, converged, residual = newton_solve_chain(
+        geometry, np.repeat(targets[0], many, axis=0), np.repeat(targets[1], many, axis=0),
+        np.tile(seeds, (count, 1)), tolerance, max_iterations, length=mechanism.length_scale)
+    values = wrap_revolute_values(geometry, values)
+    kept = (converged & _signs_kept(mechanism, index, values, branch)).reshape(count, many)
+    values, residual = values.reshape(count, many, -1), residual.reshape(count, many)
+    angular = ~np.asarray(geometry.dof_prismatic, dtype=bool)
+    first, found = one_assembly(values, kept, angular, mechanism.length_scale)
+    rows = np.arange(count)
+    return values[rows, first], found, residual[rows, first]
+
+
+def completion_around(mechanism, chains, task_poses: NDArray, branches):
+    """The dependent coordinates and the joint values of the constraining ``chains`` at ``task_poses`` (N, n_task)
+    closed together (:func:`screwkit.closure.task_space.complete_poses`) from every start of :func:`starts`, the
+    dependent coordinates at the reference's: ``(full poses (N, n_pose), values per chain (N, m_i), found (N,),
+    residual (N,))``, found where one assembly keeps every chain's sign in ``branches``."""
+    seeds = starts(mechanism, chains)
+    count, many = task_poses.shape[0], seeds[0].shape[0]
+    repeated = np.repeat(task_poses, many, axis=0)
+    start_poses = mechanism.full_poses(repeated, mechanism.home_full_pose[list(mechanism.dependent_indices)])
+    poses, values, converged, residual = complete_poses(mechanism, repeated, start_poses=start_poses,
+                                                        start_values=[np.tile(seed, (count, 1)) for seed in seeds])
+    kept = converged.copy()
+    for index, chain_values in zip(chains, values):
+        kept &= _signs_kept(mechanism, index, chain_values, branches[index])
+    dependent = poses[:, list(mechanism.dependent_indices)]
+    stacked = np.concatenate([dependent] + list(values), axis=-1).reshape(count, many, -1)
+    angular = np.concatenate([np.asarray(mechanism.pose_angular)[list(mechanism.dependent_indices)]]
+                             + [~np.asarray(mechanism.chains[i].geometry.dof_prismatic, dtype=bool) for i in chains])
+    first, found = one_assembly(stacked, kept.reshape(count, many), angular, mechanism.length_scale)
+    pick = np.arange(count) * many + first
+    return poses[pick], [chain_values[pick] for chain_values in values], found, residual[pick]
+
+
+def _sign(mechanism, index: int, branches):
+    """The working-mode sign solve keeps for chain ``index`` (a closed-form chain solved by Newton: its reference
+    determinant's)."""
+    chain = mechanism.chains[index]
+    return branches[index] if chain.closed_form is None else chain.reference_sign
+
+
+def newton_chain_around(mechanism, index, platform, start, sign, tolerance, max_iterations, solved):
+    """``solved`` (values (N, m), reached (N,), residual (N,): chain ``index`` closed by continuation at platform
+    poses ``platform``) with the poses it left unclosed and had no ``start`` (N, m) for taken from
+    :func:`chain_around` where that finds the working mode's one assembly (a planar chain of at most three
+    joints)."""
+    values, reached, residual = solved
+    given = np.zeros(reached.shape, dtype=bool) if start is None else np.all(np.isfinite(start), axis=-1)
+    rows = np.flatnonzero(~reached & ~given)
+    if rows.size == 0 or not eligible(mechanism, (index,), {index: sign}):
+        return solved
+    targets = mechanism.loop_targets(index, platform[0][rows], platform[1][rows])
+    around, found, around_residual = chain_around(mechanism, index, targets, sign, tolerance, max_iterations)
+    values, reached, residual = values.copy(), reached.copy(), residual.copy()
+    values[rows[found]], reached[rows[found]], residual[rows[found]] = around[found], True, around_residual[found]
+    return values, reached, residual
+
+
+def complete_around(mechanism, task_poses: NDArray, completion, branches):
+    """``completion`` (:func:`screwkit.closure.task_space.complete_poses` at ``task_poses`` from the reference
+    assembly) with the poses where it did not close, or closed a constraining chain out of its working mode (a
+    planar chain of at most three joints with a sign), taken from :func:`completion_around` where that finds the
+    working mode's one assembly."""
+    poses, values, completed, residual = completion
+    chains = constraining_chains(mechanism)
+    signs = {index: _sign(mechanism, index, branches) for index in chains}
+    if not eligible(mechanism, chains, signs):
+        return completion
+    kept = completed.copy()
+    for index, chain_values in zip(chains, values):
+        kept &= _signs_kept(mechanism, index, chain_values, signs[index])
+    rows = np.flatnonzero(~kept)
+    if rows.size == 0:
+        return completion
+    around, around_values, found, around_residual = completion_around(mechanism, chains, task_poses[rows], signs)
+    poses, values = poses.copy(), [chain_values.copy() for chain_values in values]
+    completed, residual = completed.copy(), residual.copy()
+    poses[rows[found]], completed[rows[found]], residual[rows[found]] = around[found], True, around_residual[found]
+    for chain_values, found_values in zip(values, around_values):
+        chain_values[rows[found]] = found_values[found]
+    return poses, values, completed, residual
