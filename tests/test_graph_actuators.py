@@ -59,7 +59,9 @@ def test_bad_actuator_values_and_a_joint_past_its_limits_are_refused_in_one_line
                                                    'name="crank" type="hinge" axis="0 1 0" range="-60 60" '
                                                    'limited="true"'))
     one_line_error(screwkit("analyze", path, "--output", "coupler", "--actuators", "10", "20"),
-                   "Expected --actuators with 1 finite values", "crank")
+                   "Expected --actuators with 1 value (one per actuator: ", "crank", "got 2")
+    one_line_error(screwkit("analyze", path, "--output", "coupler", "--actuators", "nan"),
+                   "Expected finite values after --actuators, got nan for ", "crank")
     one_line_error(screwkit("analyze", path, "--output", "coupler", "--actuators", "ten"),
                    "Expected numbers after --actuators")
     one_line_error(screwkit("analyze", path, "--output", "coupler", "--actuators", "70"),

@@ -151,24 +151,29 @@ def print_report(report: dict) -> None:
         click.echo("All actuators are mutual-interference actuators.")
 
 
-def pose_from_actuators(mechanism, text: str, start):
-    """The task pose where every actuator has the value given (deg or m), found from ``start``."""
-    names = mechanism.actuator_names
+def actuator_numbers(text: str, names, slides) -> list[float]:
+    """The values ``--actuators`` gives (deg for a hinge, m for a slide; one per actuator of ``names``, ``slides``
+    saying which slide) in rad and m, each checked: numbers, as many as actuators, finite, angles within 100 turns."""
     try:
         values = [float(word) for word in text.split()]
     except ValueError:
         raise fail(f"Expected numbers after --actuators, got {text!r}.") from None
     if len(values) != len(names):
-        raise fail(f"Expected --actuators with {len(names)} values (one per actuator: {', '.join(names)}), "
-                   f"got {len(values)}.")
-    positions = mechanism.actuator_positions()
-    for name, value, (c, k) in zip(names, values, positions):  # as --pose: finite, angles within 100 turns
+        raise fail(f"Expected --actuators with {len(names)} value{'s' * (len(names) != 1)} (one per actuator: "
+                   f"{', '.join(names)}), got {len(values)}.")
+    for name, value, slide in zip(names, values, slides):  # as --pose: finite, angles within 100 turns
         if not np.isfinite(value):
             raise fail(f"Expected finite values after --actuators, got {value} for {name}.")
-        if not mechanism.chains[c].prismatic[k] and abs(value) > angle_limit(degrees=True):
+        if not slide and abs(value) > angle_limit(degrees=True):
             raise fail(str(angle_beyond_limit(f"--actuators ({name})", value, degrees=True)))
-    values = [value if mechanism.chains[c].prismatic[k] else float(np.deg2rad(value))
-              for value, (c, k) in zip(values, positions)]
+    return [value if slide else float(np.deg2rad(value)) for value, slide in zip(values, slides)]
+
+
+def pose_from_actuators(mechanism, text: str, start):
+    """The task pose where every actuator has the value given (deg or m), found from ``start``."""
+    names = mechanism.actuator_names
+    values = actuator_numbers(text, names, [mechanism.chains[c].prismatic[k] for c, k in
+                                            mechanism.actuator_positions()])
     solution = forward(mechanism, values, start)
     if not bool(np.asarray(solution.reachable).reshape(-1)[0]):
         agree = "redundant actuators must agree with one another, and " if len(names) > mechanism.dof else ""
@@ -304,19 +309,10 @@ def _graph_at_actuators(graph, text: str, limits: bool):
     from screwkit.io.closed_tree import joint_kind  # the graph reader: when a graph is analysed
 
     ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
+    values = actuator_numbers(text, graph.actuators, [joint_kind(graph.tree.model, joint)[0] == "prismatic"
+                                                      for joint in ids])
     try:
-        values = [float(word) for word in text.split()]
-    except ValueError:
-        raise fail(f"Expected numbers after --actuators, got {text!r}.") from None
-    if len(values) != len(ids) or not np.all(np.isfinite(values)):
-        raise fail(f"Expected --actuators with {len(ids)} finite values (one per actuator: "
-                   f"{', '.join(graph.actuators)}), got {text!r}.")
-    slides = [joint_kind(graph.tree.model, joint)[0] == "prismatic" for joint in ids]
-    for name, value, slide in zip(graph.actuators, values, slides):
-        if not slide and abs(value) > angle_limit(degrees=True):
-            raise fail(str(angle_beyond_limit(f"--actuators ({name})", value, degrees=True)))
-    try:
-        return graph.at_actuators([v if slide else np.radians(v) for v, slide in zip(values, slides)], limits=limits)
+        return graph.at_actuators(values, limits=limits)
     except ValueError as error:
         raise fail(str(error)) from None
 
