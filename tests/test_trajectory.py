@@ -773,3 +773,24 @@ def test_the_command_takes_a_path_through_poses_or_in_actuator_values(tmp_path):
                    "Expected --through with at least 2 poses")
     one_line_error(screwkit("trajectory", "planar_5rrr", "--through", "0", "0", "0", "0.1", "0"),
                    "Expected --through with at least 2 poses (named poses, or 3 numbers each", "got 0 0 0 0.1 0.")
+
+
+def test_a_failure_that_leaves_fewer_actuators_than_dof_is_said_once_not_sample_by_sample(tmp_path):
+    """A non-redundant five-bar (2 actuators, 2 DOF): after either failure the one actuator left holds nothing at
+    any pose (F_O1 = 0 by definition, as analyze says). The summary says so in one line per failure instead of
+    listing every sample as a singular point (a 100,000-sample path printed 100,000 numbers a failure); the JSON
+    keeps the samples and says how many actuators are left."""
+    five = bundled("five_bar")
+    result = trajectory(five, circle_path(five, five.home_pose, 0.05, 9))
+    summary = result.summary()
+    assert summary["dof"] == 2 and [case["actuators_left"] for case in summary["faults"]] == [1, 1]
+    assert all(len(case["singular_at_m"]) == 9 and case["minimum"] == 0.0 for case in summary["faults"])
+    done = screwkit("trajectory", "five_bar", "--circle", "home", "0.05", "--samples", "9",
+                    "--out", tmp_path / "t.csv")
+    assert done.returncode == 0, done.stderr
+    failures = [line for line in done.stderr.splitlines() if line.startswith("  fail ")]
+    assert len(failures) == 2 and all(
+        "uncontrolled all along (the 1 actuator left cannot hold the 2 DOF, so F_O1 = 0)" in line for line in failures)
+    assert "singular at" not in done.stderr
+    redundant = trajectory(bundled("planar_5rrr"), line_path(bundled("planar_5rrr"), START, STOP, 5)).summary()
+    assert redundant["dof"] == 3 and {case["actuators_left"] for case in redundant["faults"]} == {4, 3}  # j = 1, 2

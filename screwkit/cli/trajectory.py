@@ -127,6 +127,11 @@ def print_summary(summary: dict) -> None:
         where = f"sample {margin['sample']}" if margin["sample"] is not None else "refined between samples"
         echo_error(f"  min {name:<11s} {margin['value']:.4f} at {margin['arc_length_m']:.6g} m ({where})")
     for case in summary["faults"]:
+        if case["actuators_left"] < summary["dof"]:  # F_Oj = 0 at every pose by definition: no sample list
+            left = case["actuators_left"]
+            echo_error(f"  fail {'+'.join(case['failed'])}: uncontrolled all along (the {left} actuator"
+                       f"{'s' * (left != 1)} left cannot hold the {summary['dof']} DOF, so F_O{case['j']} = 0)")
+            continue
         lost = ", ".join(f"[{a:.6g}, {b:.6g}]" for a, b in case["lost_m"]) or "never"
         first = "" if case["first_loss_m"] is None else f", first at {case['first_loss_m']:.6g} m"
         singular = "" if not case["singular_at_m"] else \

@@ -204,10 +204,11 @@ class TrajectoryResult:
             "length_scale_m": path.length_scale, "level": self.level, "tolerance_m": self.tolerance,
             "aggregate": self.aggregate,
             "duration_s": None if path.times is None else float(path.times[-1] - path.times[0]),
-            "reachable_samples": int(np.count_nonzero(self.indices.reachable)),
+            "reachable_samples": int(np.count_nonzero(self.indices.reachable)), "dof": int(self.indices.dof),
             "margins": {name: {"value": number(m.value), "arc_length_m": number(m.arc_length), "sample": m.sample}
                         for name, m in self.margins.items()},
-            "faults": [{"j": c.faults, "failed": list(c.failed), "minimum": number(c.minimum),
+            "faults": [{"j": c.faults, "failed": list(c.failed),
+                        "actuators_left": len(self.indices.actuators) - c.faults, "minimum": number(c.minimum),
                         "at_m": number(c.at), "first_loss_m": number(c.first_loss),
                         "singular_at_m": list(c.singular_at),
                         "lost_m": c.lost.tolist(), "controllable_m": c.controllable.tolist()} for c in self.cases],
