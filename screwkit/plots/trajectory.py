@@ -195,8 +195,9 @@ def trajectory_figure(result):
             bars = [(start, stop - start) for start, stop in case.lost]
             ax.broken_barh(bars, (y - 0.38, 0.76), color=LOST_COLOR if case.failed in worst else "#E69F00",
                            alpha=0.9 if case.failed in worst else 0.55)
-            for z in case.singular_at:
-                ax.plot([z], [y], marker="x", color="black", markersize=4)
+            if case.singular_at:  # one line of markers (a non-redundant mechanism's case has one at every sample)
+                ax.plot(case.singular_at, [y] * len(case.singular_at), linestyle="none", marker="x", color="black",
+                        markersize=4)
         labels = [f"{'+'.join(_short(n) for n in c.failed)}  (min {c.minimum:.2f})" for c in cases]
         ax.set_yticks(range(len(cases)), labels, fontsize=LEGEND_SIZE)
         for tick, case in zip(ax.get_yticklabels(), cases):
