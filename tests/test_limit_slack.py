@@ -27,17 +27,20 @@ O, B = np.zeros(3), np.array([0.03, 0.0, 0.0])
 C = np.array([0.03 + np.sqrt(0.04**2 - 0.01**2), 0.01, 0.0])
 
 
-def slider_crank(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+def slider_crank(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), slide_stop: bool = False) -> str:
+    """``slide_stop``: the slide drawn at its lower stop (range 0 to 0.05), the crank's range wide."""
     def at(point) -> str:
         return " ".join(repr(float(v) * scale) for v in point)
 
     ball = f'<geom type="sphere" size="{0.003 * scale!r}"/>'
     return ('<mujoco model="slider_crank"><compiler angle="radian"/><option><flag contact="disable"/></option>'
             f'<worldbody><body name="base" pos="{world[0]}" quat="{world[1]}">'
-            f'<body name="crank"><joint name="crank" type="hinge" axis="0 0 1" range="0 1.7" limited="true"/>{ball}'
+            f'<body name="crank"><joint name="crank" type="hinge" axis="0 0 1" '
+            f'range="{"-3 3" if slide_stop else "0 1.7"}" limited="true"/>{ball}'
             f'<body name="link" pos="{at(B)}"><joint name="bpin" type="hinge" axis="0 0 1"/>{ball}</body></body>'
             f'<body name="slider" pos="{at(C)}"><joint name="slide" type="slide" axis="1 0 0" '
-            f'range="{-0.05 * scale!r} {0.05 * scale!r}" limited="true"/>{ball}</body></body></worldbody>'
+            f'range="{0.0 if slide_stop else -0.05 * scale!r} {0.05 * scale!r}" limited="true"/>{ball}</body></body>'
+            '</worldbody>'
             f'<equality><connect name="c0" body1="link" body2="slider" anchor="{at(C - B)}"/>'
             f'<connect name="c1" body1="link" body2="slider" anchor="{at(C - B + [0.0, 0.0, 0.05])}"/></equality>'
             '<actuator><motor name="m" joint="crank"/></actuator></mujoco>')
@@ -101,6 +104,14 @@ def test_the_serial_and_the_graph_readings_take_the_same_slack():
         TreeKinematics.__dataclass_fields__)
     graph = beyond_limits(Kinematics, values)
     assert [int(np.argmax(row)) if row.any() else -1 for row in graph] == serial.tolist()
+    for size in (1e-3, 1e3):  # slides in a mechanism of that length scale, every length times it: the same verdicts
+
+        class Scaled(Kinematics):
+            lower, upper = limits[:, 0] * size, limits[:, 1] * size
+
+        assert outside_limits(limits * size, (True, True, True), values * size, size).tolist() == serial.tolist()
+        graph = beyond_limits(Scaled, values * size, None, size)
+        assert [int(np.argmax(row)) if row.any() else -1 for row in graph] == serial.tolist()
 
 
 @pytest.mark.parametrize("scale", [1e-3, 1e3])
@@ -121,3 +132,20 @@ def test_the_stop_reads_alike_at_any_size(tmp_path, scale):
         except ValueError as error:
             refused.append(str(error))
     assert len(refused) == 1 and "joint 'crank'" in refused[0], refused
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_a_slides_stop_is_met_in_length_scales_at_any_size(tmp_path, scale):
+    """A slide's slack is LIMIT_SLACK times the mechanism's length scale (plus the limit's size), as a hinge's is
+    LIMIT_SLACK rad: the same mechanism at a thousandth or a thousand times the size (read in metres) meets and
+    passes its slide's stop at the same poses in length scales. (It was 1e-9 m whatever the size: a millimetre-sized
+    mechanism's slide let 1e-5 of its size past the stop, a hundred-metre one's refused 1e-10 of it.)"""
+    path = tmp_path / "slider_crank.xml"
+    path.write_text(slider_crank(scale, slide_stop=True))
+    mechanism = load(path, output="slider")
+    home, length = mechanism.home_pose, mechanism.length_scale
+    for step in (0.5, -0.5):  # inside the range; past the stop by half the slack: at it
+        assert float(indices_at_pose(mechanism, home + step * LIMIT_SLACK * length).iti) == pytest.approx(
+            sine(B - O, C - B), abs=1e-6)
+    with pytest.raises(ValueError, match=r"joint 'slide' at -\S+ m is outside its limits \[0, "):
+        indices_at_pose(mechanism, home - 3.0 * LIMIT_SLACK * length)

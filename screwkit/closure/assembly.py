@@ -144,7 +144,7 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
                 f"file's joint values: closed by moving the joints of chain {chain.name!r} (most: "
                 f"{chain.joint_names[most]!r} by {_tidy(change)} {unit})")
     values = wrap_revolute_values(geometry, values)
-    outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None])[0])
+    outside = int(outside_limits(chain.joint_limits, chain.prismatic, values[None], length_scale)[0])
     if outside >= 0:
         lower, upper = chain.joint_limits[outside]
         where = (f"the reference assembly puts the joint at {_tidy(values[outside])}, outside its "

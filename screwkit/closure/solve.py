@@ -188,21 +188,24 @@ def run_closed_form(mechanism: Mechanism, index: int, flat_poses: NDArray, branc
     return solver.solve(*mechanism.loop_targets(index, *cache.platform), branch)
 
 
-def slackened(lower: NDArray, upper: NDArray) -> tuple[NDArray, NDArray]:
-    """Position limits each widened by :data:`~screwkit.common.tolerances.LIMIT_SLACK` times 1 plus its own size (a
-    stop at 0 keeps 1e-9 whatever the other end: a slide of range 0 to 1e8 m was let 1 mm past it); an infinite limit
-    stays infinite."""
+def slackened(lower: NDArray, upper: NDArray, unit: ArrayLike = 1.0) -> tuple[NDArray, NDArray]:
+    """Position limits each widened by :data:`~screwkit.common.tolerances.LIMIT_SLACK` times ``unit`` plus its own
+    size (``unit``: 1 rad for a hinge, the mechanism's length scale for a slide, so that a copy of the mechanism at
+    another scale, or read in another unit, counts the same values within its limits; a stop at 0 keeps that
+    whatever the other end: a slide of range 0 to 1e8 m was let 1 mm past it); an infinite limit stays infinite."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    return lower - LIMIT_SLACK * (1.0 + np.abs(lower)), upper + LIMIT_SLACK * (1.0 + np.abs(upper))
+    return lower - LIMIT_SLACK * (unit + np.abs(lower)), upper + LIMIT_SLACK * (unit + np.abs(upper))
 
 
-def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray) -> NDArray[np.int64]:
+def outside_limits(limits: NDArray, prismatic: tuple[bool, ...], values: NDArray, length: float = 1.0
+                   ) -> NDArray[np.int64]:
     """Index of the first joint outside its limits for each row of ``values`` (N, m); -1 if none.
 
     A revolute value counts as within its limits if it, or it plus or minus a full turn, is, to
-    :data:`~screwkit.common.tolerances.LIMIT_SLACK`.
+    :data:`~screwkit.common.tolerances.LIMIT_SLACK` (:func:`slackened`; ``length``: the mechanism's length scale,
+    a slide's unit there).
     """
-    lowest, highest = slackened(limits[:, 0], limits[:, 1])
+    lowest, highest = slackened(limits[:, 0], limits[:, 1], np.where(np.asarray(prismatic, dtype=bool), length, 1.0))
     # NaN compares false: a chain that did not close is reported as such, not as a limit
     outside = values < lowest
     outside |= values > highest
@@ -329,7 +332,8 @@ def solve(
         if limits and np.any(np.isfinite(chain.joint_limits)):
             flat_values = chain_values() if callable(chain_values) else chain_values
             chain_values = flat_values
-            outside = outside_limits(chain.joint_limits, chain.prismatic, flat_values.reshape(count, geometry.n_dofs))
+            outside = outside_limits(chain.joint_limits, chain.prismatic, flat_values.reshape(count, geometry.n_dofs),
+                                     mechanism.length_scale)
             limit_joints[index] = np.where(chain_reachable, outside, -1)
             status[index] = np.where(chain_reachable & (outside >= 0), OUTSIDE_LIMITS, status[index])
         values.append(chain_values if callable(chain_values) else chain_values.reshape(batch + (geometry.n_dofs,)))

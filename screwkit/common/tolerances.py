@@ -163,8 +163,9 @@ which it moves (:func:`screwkit.io.graph_screws.drives_rigidly`; joint rates in 
 not turn on the unit)."""
 
 LIMIT_SLACK = 1e-9
-"""Radians and metres: how far beyond a position limit (relative to 1 plus the limit's size) a joint may be and still
-be at it. Joint values come from closures solved to :data:`NEWTON_TOLERANCE` and from poses asked in rounded
+"""Radians, and length scales: how far beyond a position limit (relative to 1 rad or length scale plus the limit's
+size) a joint may be and still be at it (:func:`screwkit.closure.solve.slackened`: the same for a mechanism and any
+scaled copy). Joint values come from closures solved to :data:`NEWTON_TOLERANCE` and from poses asked in rounded
 numbers: a crank drawn at its stop, asked at the home pose as printed (7.7e-13 m from it), was put 3.8e-11 rad past
 the stop and the pose refused. The serial and the graph readings take the same slack."""
 

@@ -212,7 +212,7 @@ class GraphMechanism:
         """What a command says of this reading, as of a serial mechanism's: a DOF found at the file's rounding, and
         the legs' joints the configuration puts beyond their limits (a file drawn with a joint outside its range, as
         MuJoCo's qpos0 often is): refused (a ValueError), or said with ``limits`` False (``--ignore-limits``)."""
-        beyond = joints_beyond_limits(self.tree.model, self.kinematics, self.q, self.limited)
+        beyond = joints_beyond_limits(self.tree.model, self.kinematics, self.q, self.limited, self.scale)
         plural = len(beyond) > 1
         if beyond and limits:
             raise ValueError(f"{self.tree.source}: the configuration puts {'joints' if plural else 'a joint'} of "
@@ -257,7 +257,7 @@ class GraphMechanism:
                                "pitch at +-90 deg, where roll and yaw are one angle and any value of either reads as "
                                "met): not a pose this frame's angles tell")
         if limits and free_reached[0]:
-            beyond = joints_beyond_limits(self.tree.model, self.kinematics, free_q[0], self.limited)
+            beyond = joints_beyond_limits(self.tree.model, self.kinematics, free_q[0], self.limited, self.scale)
             plural = len(beyond) > 1
             return "joint limit", (f"{self.tree.source}: at ({names}) the configuration reached from the file's by "
                                    f"continuation puts {'joints' if plural else 'a joint'} beyond "
@@ -316,7 +316,7 @@ class GraphMechanism:
                                  f"actuators at the values given: the loops cannot close {step} step(s) of {count} "
                                  "on the way (out of reach, past a singular configuration, or redundant actuators "
                                  "whose values disagree).") from None
-        beyond = joints_beyond_limits(model, self.kinematics, q, self.limited)
+        beyond = joints_beyond_limits(model, self.kinematics, q, self.limited, self.scale)
         if beyond and limits:
             raise ValueError(f"{self.tree.source}: the actuator values put joints of its legs beyond their limits: "
                              f"{'; '.join(beyond)} (--ignore-limits reads it all the same).")

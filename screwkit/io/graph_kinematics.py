@@ -436,28 +436,33 @@ def solve_poses(tree: ClosedTree, q_start: NDArray, scale: float, frame_id: int,
         pitch = rpy_of(residual.frame(kinematics.transforms(q))[:, :3, :3])[:, 1]
         reached &= np.abs(np.cos(pitch)) > GIMBAL_LOCK
     if limits:
-        reached &= ~np.any(beyond_limits(kinematics, q, limited), axis=1)
+        reached &= ~np.any(beyond_limits(kinematics, q, limited, scale), axis=1)
     return q, reached
 
 
-def beyond_limits(kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> NDArray[np.bool_]:
+def beyond_limits(kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None, length: float = 1.0
+                  ) -> NDArray[np.bool_]:
     """(n, nv): which 1-DoF joints (by velocity coordinate; only those of the mask ``limited`` when given) of
     configurations ``q`` (n, nq) are beyond their position limits (by more than
-    :func:`screwkit.closure.solve.slackened`, as the serial reading counts it)."""
-    values = np.zeros((q.shape[0], kinematics.nv))
+    :func:`screwkit.closure.solve.slackened`, as the serial reading counts it; ``length``: the length scale, a
+    slide's unit there)."""
+    values, unit = np.zeros((q.shape[0], kinematics.nv)), np.ones(kinematics.nv)
     for joint, kind in enumerate(kinematics.kinds):
         if kind in ("revolute", "prismatic"):
             values[:, kinematics.idx_v[joint]] = q[:, kinematics.idx_q[joint]]
-    lowest, highest = slackened(kinematics.lower, kinematics.upper)
+            unit[kinematics.idx_v[joint]] = length if kind == "prismatic" else 1.0
+    lowest, highest = slackened(kinematics.lower, kinematics.upper, unit)
     beyond = (values < lowest) | (values > highest)
     return beyond if limited is None else beyond & np.asarray(limited, dtype=bool)
 
 
-def joints_beyond_limits(model, kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None) -> list[str]:
-    """The joints of one configuration ``q`` (nq,) beyond their limits (those of ``limited``), each said with its
-    value and limits (deg for a revolute joint, m for a prismatic one), for a message."""
+def joints_beyond_limits(model, kinematics: TreeKinematics, q: NDArray, limited: NDArray | None = None,
+                         length: float = 1.0) -> list[str]:
+    """The joints of one configuration ``q`` (nq,) beyond their limits (those of ``limited``; :func:`beyond_limits`
+    with the length scale ``length``), each said with its value and limits (deg for a revolute joint, m for a
+    prismatic one), for a message."""
     said = []
-    for column in np.flatnonzero(beyond_limits(kinematics, q[None], limited)[0]):
+    for column in np.flatnonzero(beyond_limits(kinematics, q[None], limited, length)[0]):
         joint = int(kinematics.column_joint[column])
         value, low, high = float(q[kinematics.idx_q[joint]]), kinematics.lower[column], kinematics.upper[column]
         if kinematics.kinds[joint] == "revolute":
