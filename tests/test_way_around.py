@@ -3,7 +3,10 @@
 The textbook checks of the poses it reaches are in ``test_point_leg_mode.py`` (a diamond five-bar all the way round
 its hip, its motors turned together, a sweep on the command line). Here: the rule that takes an assembly (one, to
 ``SAME_ASSEMBLY``, among the starts that keep the working-mode sign), which chains it applies to, and that poses out
-of the leg's reach are still refused, saying which chain misses.
+of the leg's reach are still refused, saying which chain misses; and the same for actuator values
+(``forward_from_starts``, ``analyze --actuators``) on a five-bar whose hips are apart (a PhoneBot leg's layout), where
+the way from the start pose passes the fold between the hips: checked against the textbook's forward kinematics in
+the drawing's working mode (each elbow) and assembly mode (the foot on the drawing's side of the line of the knees).
 """
 
 from __future__ import annotations
@@ -14,8 +17,9 @@ import numpy as np
 import pytest
 from test_point_leg_mode import CALF, THIGH, diamond
 
-from helpers import one_line_error, screwkit
+from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit, screwkit_json
 from screwkit.closure.around import MOST_STARTS, SAME_ASSEMBLY, TURNS, eligible, one_assembly, starts
+from screwkit.closure.forward_kinematics import forward, forward_from_starts
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -85,3 +89,114 @@ def test_the_folded_leg_is_refused_saying_the_starts_found_no_assembly_with_its_
     pose = hip + (CALF - THIGH) * np.array([np.sin(1.0), np.cos(1.0)])
     with pytest.raises(ValueError, match="no one assembly with it was found from starts over a turn of each"):
         indices_at_pose(mechanism, pose)
+
+
+HIP, LEG, SHIN, FOOT = 0.05, 0.15, 0.3, np.array([0.0, -0.35])
+"""The spread five-bar: hips at x = -+HIP, thighs LEG, calves SHIN long, the foot drawn at FOOT below the hips (x, z
+in the leg's plane)."""
+
+
+def _cross(a, b) -> float:
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def _drawn_knee(hip: np.ndarray, side: float) -> np.ndarray:
+    """The knee of the thigh from ``hip`` to the calf ending at the foot, on the outer ``side`` (-1 left, +1 right)."""
+    way = FOOT - hip
+    distance = float(np.linalg.norm(way))
+    along = (LEG ** 2 - SHIN ** 2 + distance ** 2) / (2 * distance)
+    unit, across = way / distance, np.sqrt(LEG ** 2 - along ** 2)
+    normal = np.array([-unit[1], unit[0]])
+    return max((hip + along * unit + across * normal, hip + along * unit - across * normal), key=lambda k: side * k[0])
+
+
+HIPS = (np.array([-HIP, 0.0]), np.array([HIP, 0.0]))
+KNEES = (_drawn_knee(HIPS[0], -1.0), _drawn_knee(HIPS[1], 1.0))
+
+
+def spread_five_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
+    """The MJCF text (degrees, MuJoCo's default), every length times ``scale``, the base at ``world``."""
+    def turn(way) -> float:  # about y, taking x to ``way`` (x, z)
+        return float(np.degrees(np.arctan2(-way[1], way[0])))
+
+    legs = ""
+    for i, (hip, knee) in enumerate(zip(HIPS, KNEES), start=1):
+        thigh = turn(knee - hip)
+        legs += (f'<body name="thigh{i}" pos="{float(hip[0]) * scale!r} 0 {float(hip[1]) * scale!r}" '
+                 f'euler="0 {thigh!r} 0">'
+                 f'<joint name="motor{i}" type="hinge" axis="0 1 0"/><body name="calf{i}" pos="{LEG * scale!r} 0 0" '
+                 f'euler="0 {turn(FOOT - knee) - thigh!r} 0"><joint name="knee{i}" type="hinge" axis="0 1 0"/>'
+                 '</body></body>')
+    return ('<mujoco model="spread"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">{legs}</body></worldbody>'
+            f'<equality><connect name="foot" body1="calf2" body2="calf1" anchor="{SHIN * scale!r} 0 0"/></equality>'
+            '<actuator><motor name="m1" joint="motor1"/><motor name="m2" joint="motor2"/></actuator></mujoco>')
+
+
+def spread_textbook(first: float, second: float):
+    """The foot (x, z), each thigh's ITI |sin(HK, KP)| and the LMTI |sin(K1P, K2P)| at motor angles (deg) in the
+    drawing's working and assembly modes; None where those modes have no assembly."""
+    knees = []
+    for hip, knee, angle in zip(HIPS, KNEES, (first, second)):
+        way = np.arctan2(-(knee - hip)[1], (knee - hip)[0]) + np.radians(angle)
+        knees.append(hip + LEG * np.array([np.cos(way), -np.sin(way)]))
+    between = knees[1] - knees[0]
+    distance = float(np.linalg.norm(between))
+    if not 0.0 < distance < 2 * SHIN:
+        return None
+    unit, height = between / distance, np.sqrt(SHIN ** 2 - (distance / 2) ** 2)
+    middle, normal = knees[0] + distance / 2 * unit, np.array([-unit[1], unit[0]])
+    drawn = np.sign(_cross(KNEES[1] - KNEES[0], FOOT - KNEES[0]))
+    foot = next(p for p in (middle + height * normal, middle - height * normal)
+                if np.sign(_cross(between, p - knees[0])) == drawn)
+    if any(np.sign(_cross(k - h, foot - k)) != np.sign(_cross(k0 - h, FOOT - k0))
+           for h, k0, k in zip(HIPS, KNEES, knees)):
+        return None
+    flat = [np.append(v, 0.0) for v in (knees[0] - HIPS[0], foot - knees[0], knees[1] - HIPS[1], foot - knees[1])]
+    from helpers import sine
+
+    return foot, (sine(flat[0], flat[1]), sine(flat[2], flat[3])), sine(flat[1], flat[3])
+
+
+MOTORS = [(180, 180), (-165, 165), (-135, 135), (-90, 90), (165, 165), (-150, 150),  # the way from the start folds
+          (-90, -90), (45, -45), (120, 120), (0, 0),  # the way from the start reaches them
+          (120, -120), (-60, 60)]  # no assembly in the drawing's modes
+"""Motor angles (deg): where the way from the drawing's pose passes the fold between the hips (refused before),
+where it does not, and where the drawing's modes have no assembly."""
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_actuator_values_past_the_fold_between_the_hips_read_the_drawings_modes(tmp_path, variant):
+    path, unit = mjcf_variant(tmp_path, "spread", variant, spread_five_bar)
+    mechanism = load(path, length_unit=unit)
+    order = [mechanism.actuator_names.index(name) for name in ("motor1:motor1", "motor2:motor2")]
+    folded = 0
+    for first, second in MOTORS:
+        values = np.radians(np.array([first, second], dtype=float))[order]
+        solution, found = forward_from_starts(mechanism, values, mechanism.home_pose)
+        expected = spread_textbook(first, second)
+        if expected is None:
+            assert not bool(solution.reachable) and found == "", (first, second)
+            continue
+        assert bool(solution.reachable), (first, second)
+        folded += not bool(forward(mechanism, values, mechanism.home_pose).reachable)
+        result = indices_at_pose(mechanism, np.asarray(solution.poses).reshape(-1))
+        got = dict(zip(result.actuators, result.iti_actuators))
+        assert (got["motor1:motor1"], got["motor2:motor2"], float(result.lmti)) == pytest.approx(
+            (*expected[1], expected[2]), abs=1e-9), (first, second)
+        if variant == "m":  # the task frame is the file's: x along x, y down
+            assert np.asarray(solution.poses).reshape(-1) == pytest.approx([expected[0][0], -expected[0][1]],
+                                                                           abs=1e-9)
+    assert folded == 6  # (the way from the start pose reaches none of the first six)
+
+
+def test_the_command_reads_actuator_values_past_the_fold_and_refuses_those_no_assembly_reaches(tmp_path):
+    path = tmp_path / "spread.xml"
+    path.write_text(spread_five_bar())
+    report = screwkit_json("analyze", path, "--actuators", "-135", "135")
+    expected = spread_textbook(-135, 135)
+    assert (report["iti_actuators"]["motor1:motor1"], report["iti_actuators"]["motor2:motor2"], report["lmti"]) == \
+        pytest.approx((*expected[1], expected[2]), abs=1e-9)
+    assert [report["pose"]["x"], report["pose"]["y"]] == pytest.approx([expected[0][0], -expected[0][1]], abs=1e-5)
+    one_line_error(screwkit("analyze", path, "--actuators", "120", "-120"), "No closed pose of 'spread' has these "
+                   "actuator values")

@@ -19,7 +19,7 @@ from screwkit.cli.options import (
     parse_pose,
     reading_options,
 )
-from screwkit.closure import forward
+from screwkit.closure.forward_kinematics import forward_from_starts
 from screwkit.closure.on_the_way import OTHER_ASSEMBLY, singular_on_the_way
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.indices.registry import INDICES
@@ -174,8 +174,11 @@ def pose_from_actuators(mechanism, text: str, start):
     names = mechanism.actuator_names
     values = actuator_numbers(text, names, [mechanism.chains[c].prismatic[k] for c, k in
                                             mechanism.actuator_positions()])
-    solution = forward(mechanism, values, start)
+    solution, found = forward_from_starts(mechanism, values, start)
     if not bool(np.asarray(solution.reachable).reshape(-1)[0]):
+        if found:  # (several with the reference's modes)
+            raise fail(f"The actuator values of {mechanism.name!r} are not reached from the start pose, and {found}: "
+                       "give a start near the one meant with --pose.")
         agree = "redundant actuators must agree with one another, and " if len(names) > mechanism.dof else ""
         raise fail(f"No closed pose of {mechanism.name!r} has these actuator values near the start pose "
                    f"({agree}the pose may lie on another assembly, past a singular configuration from the start, or "

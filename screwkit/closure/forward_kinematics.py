@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from itertools import product
 from typing import Sequence
 
 import numpy as np
@@ -13,7 +14,7 @@ from screwkit.closure.task_space import motion_space_at, pose_rates
 from screwkit.common.rotations import wrap_angle
 from screwkit.model.mechanism import Mechanism, require_mechanism
 
-__all__ = ["forward"]
+__all__ = ["forward", "forward_from_starts"]
 
 _SHORTENED_STEPS = 12
 """Newton steps on the pose that end where the loops do not close are halved, at most this many times each."""
@@ -31,6 +32,25 @@ def _task_to_pose_rates(mechanism: Mechanism, full_poses: NDArray, joint_values)
     space = space * scale[:, None]  # back to metres
     task = space[:, list(mechanism.task_indices)]  # (N, n_task, dof)
     return space @ np.linalg.pinv(task)
+
+
+def _actuator_rates(mechanism: Mechanism, selected, full_poses: NDArray, joint_values) -> NDArray[np.float64]:
+    """d(actuators ``selected``)/d(task coordinates) (N, k, n_task) at closed configurations (full poses (N, n_pose)
+    and each chain's joint values (N, m_i)), from each chain's analytic Jacobian."""
+    rates = pose_rates(mechanism, full_poses) @ _task_to_pose_rates(mechanism, full_poses, joint_values)
+    rotation, translation = mechanism.transforms_from_poses(full_poses)
+    jacobian = np.empty((full_poses.shape[0], len(selected), mechanism.n_task))
+    for row, (chain_index, joint) in enumerate(selected):
+        chain = mechanism.chains[chain_index]
+        frames = chain_forward_kinematics(chain.geometry, joint_values[chain_index])
+        _, end = mechanism.loop_targets(chain_index, rotation, translation)
+        # velocity of the loop frame's origin: v_end = v_origin + omega x (end - origin)
+        arm = end - translation
+        loop_rates = rates.copy()
+        loop_rates[:, 3:] += np.swapaxes(np.cross(np.swapaxes(rates[:, :3], 1, 2), arm[:, None, :]), 1, 2)
+        joint_rates = np.linalg.pinv(chain_jacobian(chain.geometry, frames)) @ loop_rates
+        jacobian[:, row] = joint_rates[:, joint]
+    return jacobian
 
 
 def forward(
@@ -135,19 +155,7 @@ def forward(
             continue
         full = solution.full_poses[stepping]
         previous = [chain_values[stepping] for chain_values in solution.joint_values]
-        rates = pose_rates(mechanism, full) @ _task_to_pose_rates(mechanism, full, previous)  # (N, 6, n_task)
-        rotation, translation = mechanism.transforms_from_poses(full)
-        jacobian = np.empty((rows.size, len(selected), mechanism.n_task))
-        for row, (chain_index, joint) in enumerate(selected):
-            chain = mechanism.chains[chain_index]
-            frames = chain_forward_kinematics(chain.geometry, previous[chain_index])
-            _, end = mechanism.loop_targets(chain_index, rotation, translation)
-            # velocity of the loop frame's origin: v_end = v_origin + omega x (end - origin)
-            arm = end - translation
-            loop_rates = rates.copy()
-            loop_rates[:, 3:] += np.swapaxes(np.cross(np.swapaxes(rates[:, :3], 1, 2), arm[:, None, :]), 1, 2)
-            joint_rates = np.linalg.pinv(chain_jacobian(chain.geometry, frames)) @ loop_rates
-            jacobian[:, row] = joint_rates[:, joint]
+        jacobian = _actuator_rates(mechanism, selected, full, previous)
         update = -(np.linalg.pinv(jacobian) @ error[..., None])[..., 0]
         # steps of at most 0.2 rad and 0.2 length scales (task coordinates mix angles and lengths)
         largest = np.max(np.abs(update) / np.where(mechanism.angular, 1.0, mechanism.length_scale), axis=-1)
@@ -171,3 +179,67 @@ def forward(
         value_sources=solution.joint_values,
     )
 
+
+
+SPREAD = (-2.0, -1.0, 0.0, 1.0, 2.0)
+"""Where :func:`forward_from_starts` starts, about the reference pose: these many length scales along each length
+coordinate, and :data:`TURNS` along each angle."""
+
+TURNS = (0.0, 0.5 * np.pi, np.pi, -0.5 * np.pi)
+
+MOST_TASK_COORDINATES = 3
+"""Task spaces of more coordinates are not searched (their starts would be thousands)."""
+
+SAME_POSE = 1e-6
+"""Two poses found are one when no task coordinate differs by more than this (rad, length scales)."""
+
+
+def forward_from_starts(mechanism: Mechanism, actuator_values: ArrayLike, start: ArrayLike, *,
+                        limits: bool = False) -> tuple[Solution, str]:
+    """:func:`forward` at one set of actuator values (k,) from ``start`` (n_task,); where that finds no pose (the way
+    from the start passes a fold, or where the working mode cannot follow), from starts spread about the reference
+    pose (:data:`SPREAD`, :data:`TURNS`; those in the working mode), for a mechanism of at most
+    :data:`MOST_TASK_COORDINATES` task coordinates. A pose so found is taken when it is the only one (to
+    :data:`SAME_POSE`) with the reference assembly's assembly mode: the sign of the determinant of the actuators'
+    rates in the task coordinates, when there are as many actuators as task coordinates (a redundantly actuated
+    mechanism's values, which over-determine the pose, must give one pose). Returns the solution (batch ()) and, when
+    it is not the plain :func:`forward`'s, why: what was found from the starts (the solution then still unreachable
+    where none, or several, were)."""
+    values = np.asarray(actuator_values, dtype=float).reshape(-1)
+    first = forward(mechanism, values, start, limits=limits)
+    if bool(first.reachable) or mechanism.n_task > MOST_TASK_COORDINATES:
+        return first, ""
+    spread = [TURNS if angle else tuple(mechanism.length_scale * np.array(SPREAD)) for angle in mechanism.angular]
+    grid = mechanism.home_pose + np.array(list(product(*spread)), dtype=float).reshape(-1, mechanism.n_task)
+    starts = grid[np.asarray(solve(mechanism, grid, limits=False).reachable)]
+    if starts.shape[0] == 0:
+        return first, ""
+    found = forward(mechanism, values, starts, limits=False)
+    poses = np.asarray(found.poses)[found.reachable]
+    joint_values = [np.asarray(chain_values)[found.reachable] for chain_values in found.joint_values]
+    if len(mechanism.actuator_names) == mechanism.n_task and poses.shape[0]:
+        selected = mechanism.actuator_positions()
+        home = solve(mechanism, mechanism.home_pose[None], limits=False)
+        reference = np.sign(np.linalg.det(_actuator_rates(mechanism, selected, np.asarray(home.full_poses),
+                                                          list(home.joint_values))))
+        signs = np.sign(np.linalg.det(_actuator_rates(mechanism, selected, np.asarray(found.full_poses)[
+            found.reachable], joint_values)))
+        poses = poses[signs == reference[0]]
+    distinct = _distinct_poses(mechanism, poses)
+    if len(distinct) != 1:
+        said = ("several poses with these actuator values keep the reference assembly's working and assembly modes"
+                if len(distinct) > 1 else "")
+        return first, said
+    return forward(mechanism, values, distinct[0], limits=limits), "found from starts spread about the reference pose"
+
+
+def _distinct_poses(mechanism: Mechanism, poses: NDArray) -> list[NDArray]:
+    """The poses (K, n_task) that differ by more than :data:`SAME_POSE` (angles modulo a turn, lengths in length
+    scales), the first of each group."""
+    kept: list[NDArray] = []
+    scale = np.where(mechanism.angular, 1.0, mechanism.length_scale)
+    for pose in poses:
+        if not any(np.max(np.abs(np.where(mechanism.angular, wrap_angle(pose - other), pose - other)) / scale)
+                   <= SAME_POSE for other in kept):
+            kept.append(pose)
+    return kept
