@@ -57,11 +57,57 @@ def test_starts_cover_a_turn_of_each_hinge_from_the_reference(tmp_path):
     assert not eligible(mechanism, (0,), [None, None])  # no sign: nothing tells its assemblies apart
 
 
-def test_spatial_and_longer_chains_are_left_to_the_continuation():
-    """A six-joint arm has several assemblies with one sign: no start proves the one found is the working mode's."""
+def test_a_slide_counts_and_a_spatial_chain_is_left_to_the_continuation():
+    """A planar R-P-R leg (a slide between its hinges) is searched, its slide at its reference value in every start;
+    a six-joint arm has several assemblies with one sign: no start proves the one found is the working mode's."""
+    rpr = load("planar_4rpr")
+    signs = [chain.reference_sign for chain in rpr.chains]
+    assert rpr.chains[0].prismatic == (False, True, False) and eligible(rpr, (0,), signs)
+    (values,) = starts(rpr, (0,))
+    assert values.shape == (16, 3) and np.all(values[:, 1] == rpr.chains[0].reference_values[1])
     arms = load("coop_arms")
     assert all(chain.branch is not None for chain in arms.chains)
     assert not eligible(arms, (0,), [chain.branch for chain in arms.chains])
+
+
+@pytest.mark.parametrize("turn", [120.0, 150.0, 180.0])
+def test_every_working_mode_asked_is_reached_beyond_the_hip_and_start_values_do_not_hide_it(tmp_path, turn):
+    """``solve(branches=...)``: each of the four elbow combinations at knee points beyond the hip, where the
+    continuation from the reference ends in the reference's signs, against the textbook's knees on the sides asked;
+    and start values (``initial``) that end out of the working mode no longer refuse a pose the search reaches."""
+    from test_point_leg_mode import _knees
+
+    from screwkit.closure.chain_kinematics import chain_forward_kinematics
+    from screwkit.closure.newton import working_sign
+    from screwkit.closure.solve import solve
+
+    path = tmp_path / "diamond.xml"
+    path.write_text(diamond())
+    mechanism = load(path)
+    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])
+    offset = 0.2 * np.array([np.sin(np.radians(turn)), -np.cos(np.radians(turn))])  # x forward, y up
+    pose = hip + np.array([offset[0], -offset[1]])
+    reference = [chain.branch for chain in mechanism.chains]
+    for flips in ((1, 1), (-1, 1), (1, -1), (-1, -1)):
+        asked = tuple(b * f for b, f in zip(reference, flips))
+        solution = solve(mechanism, pose[None], branches=asked)
+        assert bool(solution.reachable[0]), (turn, flips)
+        for k, chain in enumerate(mechanism.chains):
+            frames = chain_forward_kinematics(chain.geometry, np.asarray(solution.joint_values[k])[0])
+            assert working_sign(mechanism, k, frames) == asked[k]
+        first, second = _knees(offset)
+        if flips[0] < 0:
+            first = 2 * (first @ offset) / (offset @ offset) * offset - first  # mirrored across the hip-to-foot line
+        if flips[1] < 0:
+            second = 2 * (second @ offset) / (offset @ offset) * offset - second
+        knees = [np.asarray(solution.joint_points[k])[0][1, :2] for k in range(2)]  # each knee in the base frame's
+        assert np.linalg.norm(knees[0] - knees[1]) == pytest.approx(np.linalg.norm(first - second), abs=1e-9)  # plane
+    home = solve(mechanism, mechanism.home_pose[None])
+    alone = solve(mechanism, pose[None])
+    started = solve(mechanism, pose[None], initial=home)
+    assert bool(started.reachable[0]) and bool(alone.reachable[0])
+    for with_start, without in zip(started.joint_values, alone.joint_values):
+        assert np.asarray(with_start) == pytest.approx(np.asarray(without), abs=1e-9)
 
 
 @pytest.mark.parametrize("distance", [0.05, 0.35])
@@ -200,3 +246,22 @@ def test_the_command_reads_actuator_values_past_the_fold_and_refuses_those_no_as
     assert [report["pose"]["x"], report["pose"]["y"]] == pytest.approx([expected[0][0], -expected[0][1]], abs=1e-5)
     one_line_error(screwkit("analyze", path, "--actuators", "120", "-120"), "No closed pose of 'spread' has these "
                    "actuator values")
+
+
+def test_no_singular_configuration_is_said_of_a_way_that_leaves_the_reach(tmp_path):
+    """The knee point swept beside the hip (x = 0.12, y from 0.25 below the hip to 0.26 above): every straight way
+    from the reference to these poses crosses the hole about the hip, where the legs cannot close, so the pose's
+    assembly is the working-mode sign's, found from starts, and no configuration on the way tells anything of it
+    (one way, grazing the hole, was said to pass a singular configuration, with advice to assemble "the other");
+    a way that stays in reach still says it (the file's own square four-bar check is tests/test_singular_on_the_way)."""
+    from screwkit.closure.on_the_way import singular_on_the_ways
+
+    path = tmp_path / "diamond.xml"
+    path.write_text(diamond())
+    mechanism = load(path)
+    hip = mechanism.home_pose - np.array([0.0, CALF * np.sin(np.radians(60.0))])
+    poses = np.array([hip + np.array([0.12, -up]) for up in np.arange(-0.25, 0.26, 0.05)])  # (each way sampled)
+    assert not any(passed.any() for _, passed, _ in singular_on_the_ways(mechanism, poses))
+    assert not any(passed.any() for _, passed, _ in singular_on_the_ways(mechanism, poses[[5]]))  # (grazing)
+    through = np.array([hip + np.array([0.0, -up]) for up in (0.12, 0.2, 0.27)])  # straight up through the hip
+    assert not any(passed.any() for _, passed, _ in singular_on_the_ways(mechanism, through))  # (one line, once)

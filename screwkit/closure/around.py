@@ -31,7 +31,7 @@ from screwkit.closure.task_space import complete_poses, constraining_chains
 from screwkit.common.rotations import wrap_angle
 
 __all__ = ["TURNS", "SAME_ASSEMBLY", "MOST_STARTS", "eligible", "starts", "one_assembly", "chain_around",
-           "completion_around", "newton_chain_around", "complete_around"]
+           "completion_around", "newton_chain_around", "complete_around", "searched"]
 
 TURNS = (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)
 """Where each revolute joint starts, from its reference value (rad): a quarter turn apart."""
@@ -43,6 +43,14 @@ and length scales)."""
 MOST_STARTS = 256
 """Starts a pose may take (chains tied together multiply theirs); beyond it the pose stays as the continuation left
 it."""
+
+BLOCK_ROWS = 8192
+"""Starts solved at a time (poses times their starts): the search's memory is that of this many configurations,
+whatever the batch."""
+
+REACH_SLACK = 1e-6
+"""Length scales by which a pose may be beyond a chain of hinges' reach (:func:`_reach_kept`) and still be searched
+(the boundary is where the chain is stretched or folded, singular)."""
 
 
 def eligible(mechanism, indices, branches) -> bool:
@@ -93,12 +101,62 @@ def one_assembly(values: NDArray, kept: NDArray, angular: NDArray, length: float
     return first, np.any(kept, axis=1) & ~np.any(kept & apart, axis=1)
 
 
+def _hinges_reach(mechanism, index: int, end: bool):
+    """Of chain ``index`` when its joints are all hinges (None otherwise): its first joint's point in the plane, the
+    lengths (in the plane) between its joints' points in turn and from the last to the point reached (the last
+    joint's own point when ``end``, else the platform frame's origin), and that point's offset in the chain's loop
+    frame (``end``) -- all constant as the hinges turn."""
+    chain = mechanism.chains[index]
+    if any(chain.geometry.dof_prismatic):
+        return None
+    frames = chain_forward_kinematics(chain.geometry, chain.reference_values)
+    points = frames.points[:, :2]
+    if end:
+        offset = frames.end_rotation.T @ (frames.points[-1] - frames.end_translation)
+    else:
+        offset = None
+        points = np.vstack([points, mechanism.home_translation[:2]])
+    return points[0], np.linalg.norm(np.diff(points, axis=0), axis=1), offset
+
+
+def _reach_kept(mechanism, lengths: NDArray, distance: NDArray) -> NDArray[np.bool_]:
+    """Whether a chain of links ``lengths`` in a plane reaches as far as ``distance`` (N,) from its first point: no
+    farther than their sum, no nearer than the longest less the others (to :data:`REACH_SLACK` length scales)."""
+    if lengths.size == 0:
+        return np.ones(distance.shape, dtype=bool)
+    slack = REACH_SLACK * mechanism.length_scale
+    total = float(np.sum(lengths))
+    return (distance <= total + slack) & (distance >= 2.0 * float(np.max(lengths)) - total - slack)
+
+
 def chain_around(mechanism, index: int, targets, branch, tolerance: float, max_iterations: int):
     """Chain ``index`` closed onto loop ``targets`` (rotations (N, 3, 3), translations (N, 3)) from every start of
     :func:`starts`: ``(values (N, m), found (N,), residual (N,))``, found where one assembly keeps the sign
-    ``branch``."""
+    ``branch``. A chain of hinges is not solved where the target puts its last joint out of its reach; the starts
+    are solved :data:`BLOCK_ROWS` at a time."""
     geometry = mechanism.chains[index].geometry
+    count = targets[0].shape[0]
+    values = np.full((count, geometry.n_dofs), np.nan)
+    found, residual = np.zeros(count, dtype=bool), np.full(count, np.inf)
+    hinges = _hinges_reach(mechanism, index, end=True)
+    rows = np.arange(count)
+    if hinges is not None:
+        first, lengths, offset = hinges
+        last = targets[1] + targets[0] @ offset
+        rows = rows[_reach_kept(mechanism, lengths, np.linalg.norm(last[:, :2] - first, axis=1))]
     (seeds,) = starts(mechanism, (index,))
+    block = max(1, BLOCK_ROWS // seeds.shape[0])
+    for at in range(0, rows.size, block):
+        some = rows[at:at + block]
+        values[some], found[some], residual[some] = _chain_from_starts(
+            mechanism, index, (targets[0][some], targets[1][some]), seeds, branch, tolerance, max_iterations)
+    return values, found, residual
+
+
+def _chain_from_starts(mechanism, index: int, targets, seeds: NDArray, branch, tolerance: float,
+                       max_iterations: int):
+    """:func:`chain_around` on one block of poses, every start at once."""
+    geometry = mechanism.chains[index].geometry
     count, many = targets[0].shape[0], seeds.shape[0]
     values, converged, residual = newton_solve_chain(
         geometry, np.repeat(targets[0], many, axis=0), np.repeat(targets[1], many, axis=0),
@@ -116,8 +174,33 @@ def completion_around(mechanism, chains, task_poses: NDArray, branches):
     """The dependent coordinates and the joint values of the constraining ``chains`` at ``task_poses`` (N, n_task)
     closed together (:func:`screwkit.closure.task_space.complete_poses`) from every start of :func:`starts`, the
     dependent coordinates at the reference's: ``(full poses (N, n_pose), values per chain (N, m_i), found (N,),
-    residual (N,))``, found where one assembly keeps every chain's sign in ``branches``."""
+    residual (N,))``, found where one assembly keeps every chain's sign in ``branches``. Poses where the platform's
+    origin is out of a chain of hinges' reach are not solved; the starts are solved :data:`BLOCK_ROWS` at a time."""
+    count = task_poses.shape[0]
+    poses = mechanism.full_poses(task_poses, mechanism.home_full_pose[list(mechanism.dependent_indices)])
+    values = [np.full((count, mechanism.chains[i].n_joints), np.nan) for i in chains]
+    found, residual = np.zeros(count, dtype=bool), np.full(count, np.inf)
+    rows = np.arange(count)
+    origins = mechanism.transforms_from_poses(poses)[1][:, :2]
+    for index in chains:
+        hinges = _hinges_reach(mechanism, index, end=False)
+        if hinges is not None:
+            first, lengths, _ = hinges
+            rows = rows[_reach_kept(mechanism, lengths, np.linalg.norm(origins[rows] - first, axis=1))]
     seeds = starts(mechanism, chains)
+    block = max(1, BLOCK_ROWS // seeds[0].shape[0])
+    for at in range(0, rows.size, block):
+        some = rows[at:at + block]
+        block_poses, block_values, found[some], residual[some] = _completion_from_starts(
+            mechanism, chains, task_poses[some], branches, seeds)
+        poses[some] = block_poses
+        for chain_values, found_values in zip(values, block_values):
+            chain_values[some] = found_values
+    return poses, values, found, residual
+
+
+def _completion_from_starts(mechanism, chains, task_poses: NDArray, branches, seeds):
+    """:func:`completion_around` on one block of poses, every start at once."""
     count, many = task_poses.shape[0], seeds[0].shape[0]
     repeated = np.repeat(task_poses, many, axis=0)
     start_poses = mechanism.full_poses(repeated, mechanism.home_full_pose[list(mechanism.dependent_indices)])
@@ -142,14 +225,13 @@ def _sign(mechanism, index: int, branches):
     return branches[index] if chain.closed_form is None else chain.reference_sign
 
 
-def newton_chain_around(mechanism, index, platform, start, sign, tolerance, max_iterations, solved):
-    """``solved`` (values (N, m), reached (N,), residual (N,): chain ``index`` closed by continuation at platform
-    poses ``platform``) with the poses it left unclosed and had no ``start`` (N, m) for taken from
-    :func:`chain_around` where that finds the working mode's one assembly (a planar chain of at most three
+def newton_chain_around(mechanism, index, platform, sign, tolerance, max_iterations, solved):
+    """``solved`` (values (N, m), reached (N,), residual (N,): chain ``index`` closed at platform poses ``platform``,
+    by continuation or from start values given) with the poses it left unclosed, or closed out of the sign ``sign``,
+    taken from :func:`chain_around` where that finds the working mode's one assembly (a planar chain of at most three
     joints)."""
     values, reached, residual = solved
-    given = np.zeros(reached.shape, dtype=bool) if start is None else np.all(np.isfinite(start), axis=-1)
-    rows = np.flatnonzero(~reached & ~given)
+    rows = np.flatnonzero(~reached)
     if rows.size == 0 or not eligible(mechanism, (index,), {index: sign}):
         return solved
     targets = mechanism.loop_targets(index, platform[0][rows], platform[1][rows])
@@ -157,6 +239,17 @@ def newton_chain_around(mechanism, index, platform, start, sign, tolerance, max_
     values, reached, residual = values.copy(), reached.copy(), residual.copy()
     values[rows[found]], reached[rows[found]], residual[rows[found]] = around[found], True, around_residual[found]
     return values, reached, residual
+
+
+def searched(mechanism, index: int) -> bool:
+    """Whether :func:`solve <screwkit.closure.solve.solve>` solves chain ``index`` from starts where its closure
+    fails, with the mechanism's own working modes: alone (:func:`newton_chain_around`), or with the other chains
+    that tie the dependent coordinates (:func:`complete_around`)."""
+    chains = constraining_chains(mechanism) if mechanism.dependent_indices else ()
+    if index in chains:
+        return eligible(mechanism, chains, {i: _sign(mechanism, i, [c.branch for c in mechanism.chains])
+                                            for i in chains})
+    return eligible(mechanism, (index,), {index: _sign(mechanism, index, [c.branch for c in mechanism.chains])})
 
 
 def complete_around(mechanism, task_poses: NDArray, completion, branches):

@@ -59,8 +59,9 @@ def sign_kept_chains(mechanism: Mechanism) -> list[int]:
 def singular_on_the_way(mechanism: Mechanism, pose: NDArray) -> list[tuple[str, NDArray[np.float64]]]:
     """Per chain closed by damped Newton with a working-mode sign, the first singular configuration of its joints
     on the straight way in task coordinates from the reference pose to ``pose`` (m and rad), as ``(chain name, the
-    pose there)``; none for a chain whose way has none. Dips between samples where the chain does not close are
-    looked at as well."""
+    pose there)``; none for a chain whose way has none, or whose way leaves its reach (a sample where it does not
+    close: the pose's assembly is then the one its working-mode sign names, solved from starts,
+    :mod:`~screwkit.closure.around`, which no configuration on the way tells)."""
     found = singular_on_the_ways(mechanism, np.asarray(pose, dtype=float)[None])
     return [(name, where[0]) for name, passed, where in found if passed[0]]
 
@@ -79,12 +80,15 @@ def singular_on_the_ways(mechanism: Mechanism, poses: NDArray) -> list[tuple[str
     if direction is not None:  # every way a stretch of one line (a sweep from the reference pose): sampled once
         along = (poses - start) @ direction
         line = np.linspace(min(along.min(), 0.0), max(along.max(), 0.0), SAMPLES)
-        found = singular_along(mechanism, start + line[:, None] * direction, line,
-                               lambda t: start + np.asarray(t)[..., None] * direction)
+        samples = start + line[:, None] * direction
+        values = solve(mechanism, samples, limits=False).joint_values
+        found = singular_along(mechanism, samples, line, lambda t: start + np.asarray(t)[..., None] * direction,
+                               values=values)
         names = [mechanism.chains[k].name for k in chains]
         for name, t, _ in sorted(found, key=lambda item: abs(item[1]), reverse=True):  # the nearest written last
             k = chains[names.index(name)]
             beyond = (np.sign(along) == np.sign(t)) & (np.abs(along) >= abs(t)) & (t != 0.0)
+            beyond &= ~_leaves_reach(line, np.all(np.isfinite(values[k]), axis=-1), along)
             passed[k] |= beyond
             where[k][beyond] = start + t * direction
         return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
@@ -105,10 +109,22 @@ def singular_on_the_ways(mechanism: Mechanism, poses: NDArray) -> list[tuple[str
             lows = np.array([way[max(i - 1, 0)] for _, i in candidates])
             highs = np.array([way[min(i + 1, SAMPLES - 1)] for _, i in candidates])
             at, values = _refined(mechanism, k, lambda t, r=owner: start + t[:, None] * (poses[r] - start), lows, highs)
+            left = rows[~np.all(np.isfinite(determinants), axis=1)]  # ways that leave the chain's reach: not noted
             for row, t in sorted(zip(owner[values < SINGULAR], at[values < SINGULAR]), key=lambda pair: pair[1],
                                  reverse=True):  # the first on each way written last
-                passed[k][row], where[k][row] = True, start + t * (poses[row] - start)
+                if row not in left:
+                    passed[k][row], where[k][row] = True, start + t * (poses[row] - start)
     return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
+
+
+def _leaves_reach(line: NDArray, closed: NDArray, along: NDArray) -> NDArray[np.bool_]:
+    """Of the poses at ``along`` on a line sampled at ``line`` (the chain ``closed`` at each sample), those whose way
+    from the reference (``along`` 0) passes a sample where the chain does not close: their assembly is not the one
+    the way continues into but the one the working-mode sign names (solved from starts,
+    :mod:`~screwkit.closure.around`), so no configuration on the way says anything of it."""
+    open_at = line[~closed][None, :]
+    along = np.asarray(along, dtype=float)[:, None]
+    return np.any((open_at * np.sign(along) > 0) & (np.abs(open_at) <= np.abs(along)), axis=1)
 
 
 def singular_along(mechanism: Mechanism, poses: NDArray, at: NDArray, pose_at, *,

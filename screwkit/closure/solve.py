@@ -18,7 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure.analytic import KernelKind
-from screwkit.closure.around import complete_around, eligible, newton_chain_around
+from screwkit.closure.around import complete_around, newton_chain_around
+from screwkit.closure.around import searched as around_searched
 from screwkit.closure.chain_kinematics import COMPILED_FROM, chain_forward_kinematics
 from screwkit.closure.newton import pose_error, solve_newton_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains
@@ -227,7 +228,7 @@ def _newton_chain(mechanism, index, flat, platform, start, sign, tolerance, max_
     leaves unclosed solved from many starts where that finds the working mode's one assembly
     (:func:`~screwkit.closure.around.newton_chain_around`)."""
     solved = solve_newton_chain(mechanism, index, flat, platform, start, sign, tolerance, max_iterations)
-    return newton_chain_around(mechanism, index, platform, start, sign, tolerance, max_iterations, solved)
+    return newton_chain_around(mechanism, index, platform, sign, tolerance, max_iterations, solved)
 
 
 def solve(
@@ -252,9 +253,11 @@ def solve(
         Per chain working mode; default each chain's :attr:`~screwkit.model.chain.Chain.branch`
         (the reference assembly). For a closed-form chain a tuple of +-1 signs; for a Newton
         chain the required sign of its twist-matrix determinant (None: no check). Newton
-        continuation starts from the reference assembly, so another sign also needs
-        ``initial``. With ``method="newton"`` closed-form chains keep the reference
-        determinant sign.
+        continuation starts from the reference assembly; where it (or ``initial``) ends out of
+        the sign asked, a planar chain of at most three joints is solved from starts over a turn
+        of each hinge (:mod:`~screwkit.closure.around`), which reaches any sign's one assembly;
+        another chain needs ``initial`` for another sign. With ``method="newton"`` closed-form
+        chains keep the reference determinant sign.
     initial : Solution or sequence of array_like, optional
         Start values for Newton chains (per chain, broadcastable to (..., m_i)), e.g. a
         solution at nearby poses. Default: continuation from the reference assembly.
@@ -385,8 +388,8 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
                          "or its end on the axis of its base joint, where its joint values are not determined)")
         elif chain.closed_form is None and chain.branch is not None and \
                 residuals[c] < 1e3 * NEWTON_TOLERANCE * max(1.0, mechanism.length_scale):  # (closed, but in another)
-            searched = ", and no one assembly with it was found from starts over a turn of each of its joints" \
-                if eligible(mechanism, (c,), {c: chain.branch}) else ""
+            searched = ", and no one assembly with it was found from starts over a turn of each of its hinges" \
+                if around_searched(mechanism, c) else ""
             parts.append(f"chain {chain.name!r} closes there only in another assembly than its working mode (the "
                          "sign that names it changed on the way from the reference assembly: the way passes where "
                          f"the chain's joints are singular, or leaves its reach{searched})")
