@@ -210,6 +210,8 @@ def test_classes_unnamed_bodies_and_a_free_joint_s_pos_are_read_as_mujoco_reads_
     path = written(tmp_path, CLASSES_AND_BODIES)
     assert assert_placed_as_mujoco(path) == 2 * (4 + 6)  # the named bodies and every site
     mj_model, tree = mujoco.MjModel.from_xml_path(str(path)), read_mjcf(path)
+    # the unnamed body named after its first joint, a name a reader finds in the file (messages name bodies)
+    assert "u1_body" in [frame.name for frame in tree.model.frames]
     for name in ("h", "early", "slide", "u1", "u2", "end"):
         joint = mujoco.mj_name2id(mj_model, mujoco.mjtObj.mjOBJ_JOINT, name)
         position = tree.model.joints[tree.model.getJointId(name)].idx_q

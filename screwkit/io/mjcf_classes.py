@@ -93,13 +93,16 @@ def defaults_merged(root: ElementTree.Element, path: Path) -> None:
 
 
 def bodies_named(root: ElementTree.Element) -> int:
-    """Every unnamed body given a name of its own (``body_1``, ...); returns how many."""
+    """Every unnamed body given a name of its own, one a reader finds in the file: after its first named joint
+    (``fl_ja_body`` for the body of joint ``fl_ja``), else ``body_1``, ...; returns how many."""
     taken = {body.get("name") for body in root.iter("body")}
     count = 0
     for body in root.iter("body"):
         if body.get("name") is None:
             count += 1
-            body.set("name", unused_name(f"body_{count}", taken))
+            joint = next((child.get("name") for child in body if child.tag in ("joint", "freejoint")
+                          and child.get("name")), None)
+            body.set("name", unused_name(f"{joint}_body" if joint else f"body_{count}", taken))
     return count
 
 
