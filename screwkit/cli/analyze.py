@@ -197,7 +197,8 @@ def pose_from_actuators(mechanism, text: str, start):
 @click.option("--actuators", "actuator_values", cls=GreedyOption, metavar="VALUES",
               help="Pose given by every actuator's value instead (deg for revolute, m for prismatic, in the order "
                    "screwkit info lists them): forward kinematics from --pose (default home), whose working mode "
-                   "it keeps.")
+                   "it keeps; where that finds no pose, from starts about the reference pose, the one pose in "
+                   "the reference's working and assembly modes (up to three task coordinates).")
 @analysis_options(closed_forms=False, average=True)
 @reading_options
 @json_option
