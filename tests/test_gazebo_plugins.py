@@ -391,6 +391,23 @@ def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_ele
                    "component [0zzz] to a double")
 
 
+def test_a_negative_effort_or_velocity_reads_as_no_limit(tmp_path):
+    """Gazebo's and SDFormat's -1 (no limit), which a published PhoneBot URDF writes on its joints: Pinocchio refused
+    the file ("Some components of min_effort are greater than max_effort", naming no joint); the indices use neither,
+    and the file reads as it does with its own efforts and velocities."""
+    import re
+
+    text = FIVE_BAR.read_text()
+    assert 'effort="' in text
+    path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(re.sub(r'(effort|velocity)="[^"]*"', r'\1="-1"', text))
+    expected = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    found = indices(path, output="Chain1_dummy", output_type="point")
+    assert found.keys() == expected.keys()
+    for key in expected:
+        assert found[key] == pytest.approx(expected[key], abs=1e-12), key
+
+
 def test_a_xacro_file_given_as_a_urdf_is_refused_naming_xacro(tmp_path):
     """A ROS Delta's package ships its xacro source as ``delta_robot.urdf``: it was refused with Pinocchio's complaint
     about a mass that is an expression (``${mass_base}``), leaving the user to guess; a xacro whose expressions

@@ -52,10 +52,46 @@ def urdf_model(urdf: Path):
         if text:  # urdfdom's warnings on a file it reads, as they were
             os.write(2, text)
         return model
+    if "effort" in str(error) or "velocity" in str(error):
+        unlimited = _unlimited_copy(urdf)  # a negative effort or velocity: "no limit", as SDFormat writes it
+        if unlimited is not None:
+            try:
+                with unlimited:
+                    return urdf_model(Path(unlimited.name))
+            except ImportError_ as again:
+                raise ImportError_(str(again).replace(unlimited.name, str(urdf))) from None
     complaints = [line.strip().removeprefix("Error:").strip() for line in text.decode(errors="replace").splitlines()
                   if line.strip().startswith("Error:")]
     raise ImportError_(f"{urdf}: Pinocchio cannot read the tree: "
                        + (f"{complaints[0]}." if complaints else f"{error}.").replace("..", "."))
+
+
+def _unlimited_copy(urdf: Path):
+    """A temporary copy of ``urdf`` whose joint limits' negative ``effort`` and ``velocity`` (Gazebo's and
+    SDFormat's -1: no limit; Pinocchio refuses them, "min_effort greater than max_effort") are written as 1e30, none
+    of which the indices use; None if it has none."""
+    from xml.etree import ElementTree
+
+    try:
+        tree = ElementTree.parse(urdf)
+    except (OSError, ElementTree.ParseError):
+        return None
+    changed = False
+    for limit in tree.getroot().iter("limit"):
+        for name in ("effort", "velocity"):
+            try:
+                negative = float(limit.get(name, "0")) < 0.0
+            except ValueError:
+                continue
+            if negative:
+                limit.set(name, "1e30")
+                changed = True
+    if not changed:
+        return None
+    copy = tempfile.NamedTemporaryFile("wb", suffix=".urdf", delete=True)
+    tree.write(copy, encoding="utf-8", xml_declaration=True)
+    copy.flush()
+    return copy
 
 
 def _refuse_xacro(urdf: Path) -> None:
