@@ -180,12 +180,12 @@ def forward(
     )
 
 
-
 SPREAD = (-2.0, -1.0, 0.0, 1.0, 2.0)
 """Where :func:`forward_from_starts` starts, about the reference pose: these many length scales along each length
 coordinate, and :data:`TURNS` along each angle."""
 
 TURNS = (0.0, 0.5 * np.pi, np.pi, -0.5 * np.pi)
+"""Where each angle coordinate starts, from the reference pose's (rad)."""
 
 MOST_TASK_COORDINATES = 3
 """Task spaces of more coordinates are not searched (their starts would be thousands)."""
