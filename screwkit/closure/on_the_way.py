@@ -102,18 +102,17 @@ def singular_on_the_ways(mechanism: Mechanism, poses: NDArray) -> list[tuple[str
         solved = solve(mechanism, sampled.reshape(-1, mechanism.n_task), limits=False).joint_values
         for k in chains:
             determinants = _normalised(mechanism, k, np.asarray(solved[k], dtype=float)).reshape(len(rows), SAMPLES)
-            candidates = [(row, i) for row, line in zip(rows, determinants) for i in _dips(line)]
+            inside = np.all(np.isfinite(determinants), axis=1)  # ways that leave the chain's reach are not noted
+            candidates = [(row, i) for row, line in zip(rows[inside], determinants[inside]) for i in _dips(line)]
             if not candidates:
                 continue
             owner = np.array([row for row, _ in candidates])
             lows = np.array([way[max(i - 1, 0)] for _, i in candidates])
             highs = np.array([way[min(i + 1, SAMPLES - 1)] for _, i in candidates])
             at, values = _refined(mechanism, k, lambda t, r=owner: start + t[:, None] * (poses[r] - start), lows, highs)
-            left = rows[~np.all(np.isfinite(determinants), axis=1)]  # ways that leave the chain's reach: not noted
             for row, t in sorted(zip(owner[values < SINGULAR], at[values < SINGULAR]), key=lambda pair: pair[1],
                                  reverse=True):  # the first on each way written last
-                if row not in left:
-                    passed[k][row], where[k][row] = True, start + t * (poses[row] - start)
+                passed[k][row], where[k][row] = True, start + t * (poses[row] - start)
     return [(mechanism.chains[k].name, passed[k], where[k]) for k in chains]
 
 
