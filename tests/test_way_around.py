@@ -11,6 +11,7 @@ the drawing's working mode (each elbow) and assembly mode (the foot on the drawi
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -278,3 +279,30 @@ def test_poses_found_from_several_starts_are_told_apart_to_a_micro_length_scale(
                       [0.1 + 2.0 * SAME_POSE * length, 0.2, np.pi]])  # beyond: another
     kept = _distinct_poses(five, poses)
     assert len(kept) == 2 and np.array_equal(kept[0], poses[0]) and np.array_equal(kept[1], poses[3])
+
+
+def test_a_path_in_motor_values_that_starts_past_the_fold_reads_the_drawings_modes(tmp_path):
+    """``trajectory --actuators``: a path whose first values the way from the reference pose does not reach (the
+    foot above the hips) starts at the pose the starts find (it was refused at sample 0), and every sample reads the
+    textbook's forward kinematics in the drawing's modes."""
+    from screwkit.studies import indices_at_poses
+    from screwkit.studies.actuator_paths import path_from_actuators
+
+    path = tmp_path / "spread.xml"
+    path.write_text(spread_five_bar())
+    mechanism = load(path)
+    order = [mechanism.actuator_names.index(name) for name in ("motor1:motor1", "motor2:motor2")]
+    angles = np.linspace(135.0, 105.0, 11)
+    motors = np.column_stack([-angles, angles])
+    assert not bool(forward(mechanism, np.radians(motors[0])[order], mechanism.home_pose).reachable)
+    driven = path_from_actuators(mechanism, np.radians(motors)[:, order])
+    result = indices_at_poses(mechanism, driven.poses)
+    for k, (first, second) in enumerate(motors):
+        expected = spread_textbook(first, second)
+        assert np.asarray(driven.poses)[k] == pytest.approx([expected[0][0], -expected[0][1]], abs=1e-9)
+        assert float(np.asarray(result.lmti)[k]) == pytest.approx(expected[2], abs=1e-9)
+    table = tmp_path / "motors.csv"
+    np.savetxt(table, motors, delimiter=",", header="motor1:motor1,motor2:motor2", comments="")
+    done = screwkit("trajectory", path, table, "--actuators", "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["reachable_samples"] == 11

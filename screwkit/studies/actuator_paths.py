@@ -6,6 +6,8 @@ pose, every actuator held at its value: for a redundantly actuated mechanism the
 other, as those of one pose do). The forward kinematics has several solutions (assembly modes); the one followed
 is the one reached from ``start`` (default: the reference assembly's pose), by continuation along the path:
 
+0. the first sample from ``start``, or where that finds no pose, from starts about the reference pose, the one pose
+   in the reference's working and assembly modes (:func:`~screwkit.closure.forward_kinematics.forward_from_starts`);
 1. a coarse pass, sample after sample: at most :data:`COARSE_SEGMENTS` + 1 samples evenly spread along the path,
    each solved from the pose of the one before;
 2. then, round after round, the sample halfway between two solved samples, from the pose of the first of them:
@@ -24,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.closure import forward
+from screwkit.closure.forward_kinematics import forward_from_starts
 from screwkit.common.units import angle_beyond_limit, angle_limit
 from screwkit.model import Mechanism
 from screwkit.studies.netcdf import netcdf_file
@@ -70,8 +73,13 @@ def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLik
     poses = np.full((n, mechanism.n_task), np.nan)
     start = mechanism.home_pose if start is None else mechanism.check_poses(start)
     coarse = np.unique(np.linspace(0, n - 1, min(n, COARSE_SEGMENTS + 1)).round().astype(np.int64))
-    previous = start
-    for i in coarse:  # one after the other
+    first, found = forward_from_starts(mechanism, values[0], start)  # the path's first pose, from starts if need be
+    if not bool(first.reachable):
+        if found:
+            raise ValueError(f"sample 0: {found}; give a start near the one meant.")
+        _reached(mechanism, values[:1], start[None], np.array([0]))  # (refused as any sample)
+    previous = poses[0] = np.asarray(first.poses).reshape(-1)
+    for i in coarse[1:]:  # one after the other
         poses[i] = _reached(mechanism, values[i:i + 1], previous[None], np.array([i]))[0]
         previous = poses[i]
     solved = coarse
