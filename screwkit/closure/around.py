@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure.chain_kinematics import chain_forward_kinematics, wrap_revolute_values
-from screwkit.closure.newton import newton_solve_chain, working_sign
+from screwkit.closure.newton import branch_kept, newton_solve_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains
 from screwkit.common.rotations import wrap_angle
 
@@ -81,11 +81,6 @@ def starts(mechanism, indices) -> list[NDArray[np.float64]]:
         column += sum(mask)
         result.append(values)
     return result
-
-
-def _signs_kept(mechanism, index: int, values: NDArray, branch) -> NDArray[np.bool_]:
-    frames = chain_forward_kinematics(mechanism.chains[index].geometry, np.nan_to_num(values))
-    return np.asarray(working_sign(mechanism, index, frames) == branch)
 
 
 def one_assembly(values: NDArray, kept: NDArray, angular: NDArray, length: float):
@@ -162,7 +157,7 @@ def _chain_from_starts(mechanism, index: int, targets, seeds: NDArray, branch, t
         geometry, np.repeat(targets[0], many, axis=0), np.repeat(targets[1], many, axis=0),
         np.tile(seeds, (count, 1)), tolerance, max_iterations, length=mechanism.length_scale)
     values = wrap_revolute_values(geometry, values)
-    kept = (converged & _signs_kept(mechanism, index, values, branch)).reshape(count, many)
+    kept = (converged & branch_kept(mechanism, index, values, branch)).reshape(count, many)
     values, residual = values.reshape(count, many, -1), residual.reshape(count, many)
     angular = ~np.asarray(geometry.dof_prismatic, dtype=bool)
     first, found = one_assembly(values, kept, angular, mechanism.length_scale)
@@ -208,7 +203,7 @@ def _completion_from_starts(mechanism, chains, task_poses: NDArray, branches, se
                                                         start_values=[np.tile(seed, (count, 1)) for seed in seeds])
     kept = converged.copy()
     for index, chain_values in zip(chains, values):
-        kept &= _signs_kept(mechanism, index, chain_values, branches[index])
+        kept &= branch_kept(mechanism, index, chain_values, branches[index])
     dependent = poses[:, list(mechanism.dependent_indices)]
     stacked = np.concatenate([dependent] + list(values), axis=-1).reshape(count, many, -1)
     angular = np.concatenate([np.asarray(mechanism.pose_angular)[list(mechanism.dependent_indices)]]
@@ -264,7 +259,7 @@ def complete_around(mechanism, task_poses: NDArray, completion, branches):
         return completion
     kept = completed.copy()
     for index, chain_values in zip(chains, values):
-        kept &= _signs_kept(mechanism, index, chain_values, signs[index])
+        kept &= branch_kept(mechanism, index, chain_values, signs[index])
     rows = np.flatnonzero(~kept)
     if rows.size == 0:
         return completion

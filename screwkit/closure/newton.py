@@ -28,7 +28,7 @@ from screwkit.common.rotations import (
 from screwkit.model.chain import ChainGeometry
 
 __all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "working_sign",
-           "with_point_signs", "task_rows"]
+           "with_point_signs", "branch_kept", "task_rows"]
 
 
 def pose_error(
@@ -184,7 +184,9 @@ def with_point_signs(mechanism):
     return replace(mechanism, chains=tuple(chains)) if changed else mechanism
 
 
-def _branch_kept(mechanism, index: int, values: NDArray, branch) -> NDArray[np.bool_]:
+def branch_kept(mechanism, index: int, values: NDArray, branch) -> NDArray[np.bool_]:
+    """Whether chain ``index`` at joint ``values`` (N, m; NaN read as 0) keeps the working-mode sign ``branch``
+    (:func:`working_sign`; every row where ``branch`` is None)."""
     if branch is None:
         return np.ones(values.shape[0], dtype=bool)
     frames = chain_forward_kinematics(mechanism.chains[index].geometry, np.nan_to_num(values))
@@ -264,7 +266,7 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
         values[rows], converged[rows], residual[rows] = _track(
             mechanism, index, home, reference, goal, tolerance, max_iterations
         )
-    converged &= _branch_kept(mechanism, index, values, branch)
+    converged &= branch_kept(mechanism, index, values, branch)
     scaled = _scaled_poses(mechanism, flat_poses)
     for _ in range(2):  # continuation from solved neighbours
         failed = np.flatnonzero(~converged)
@@ -282,7 +284,7 @@ def solve_newton_chain(mechanism, index, flat_poses, platform, start, branch, to
         retried, retried_converged, retried_residual = _track(
             mechanism, index, source, values[neighbours], goal, tolerance, max_iterations
         )
-        retried_converged &= _branch_kept(mechanism, index, retried, branch)
+        retried_converged &= branch_kept(mechanism, index, retried, branch)
         better = retried_converged | (retried_residual < residual[failed])
         values[failed[better]] = retried[better]
         residual[failed[better]] = retried_residual[better]
