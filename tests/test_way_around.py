@@ -270,13 +270,14 @@ def test_no_singular_configuration_is_said_of_a_way_that_leaves_the_reach(tmp_pa
 
 
 def test_poses_found_from_several_starts_are_told_apart_to_a_micro_length_scale():
-    from screwkit.closure.forward_kinematics import SAME_POSE, _distinct_poses
+    from screwkit.closure.around import SAME_ASSEMBLY
+    from screwkit.closure.forward_kinematics import _distinct_poses
 
     five = load("planar_5rrr")  # (x, y in m, phi in rad)
     length = five.length_scale
     poses = np.array([[0.1, 0.2, np.pi - 1e-9], [0.1, 0.2, -np.pi + 1e-9],  # a turn apart: one pose
-                      [0.1 + 0.5 * SAME_POSE * length, 0.2, np.pi],  # within SAME_POSE length scales: the same
-                      [0.1 + 2.0 * SAME_POSE * length, 0.2, np.pi]])  # beyond: another
+                      [0.1 + 0.5 * SAME_ASSEMBLY * length, 0.2, np.pi],  # within SAME_ASSEMBLY length scales: the same
+                      [0.1 + 2.0 * SAME_ASSEMBLY * length, 0.2, np.pi]])  # beyond: another
     kept = _distinct_poses(five, poses)
     assert len(kept) == 2 and np.array_equal(kept[0], poses[0]) and np.array_equal(kept[1], poses[3])
 

@@ -30,11 +30,12 @@ from screwkit.closure.newton import branch_kept, newton_solve_chain
 from screwkit.closure.task_space import complete_poses, constraining_chains
 from screwkit.common.rotations import wrap_angle
 
-__all__ = ["TURNS", "SAME_ASSEMBLY", "MOST_STARTS", "eligible", "starts", "one_assembly", "chain_around",
+__all__ = ["TURNS", "SAME_ASSEMBLY", "MOST_STARTS", "eligible", "starts", "apart", "one_assembly", "chain_around",
            "completion_around", "newton_chain_around", "complete_around", "searched"]
 
 TURNS = (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)
-"""Where each revolute joint starts, from its reference value (rad): a quarter turn apart."""
+"""Where each revolute joint starts, from its reference value (rad): a quarter turn apart (and each angle task
+coordinate, :func:`screwkit.closure.forward_kinematics.forward_from_starts`)."""
 
 SAME_ASSEMBLY = 1e-6
 """Two closed assemblies are one when no joint value (or dependent pose coordinate) differs by more than this (rad,
@@ -83,17 +84,23 @@ def starts(mechanism, indices) -> list[NDArray[np.float64]]:
     return result
 
 
-def one_assembly(values: NDArray, kept: NDArray, angular: NDArray, length: float):
-    """Of each pose's closed starts ``values`` (N, S, k) that keep the working mode (``kept``, (N, S)), the one
-    assembly: ``(which start (N,), found (N,))``, found where every kept start closed to the same values (angles
-    ``angular`` (k,) compared modulo a turn, lengths in units of ``length``) and at least one did."""
-    first = np.argmax(kept, axis=1)
-    chosen = values[np.arange(values.shape[0]), first]
-    difference = values - chosen[:, None, :]
+def apart(difference: NDArray, angular: NDArray, length: float) -> NDArray[np.bool_]:
+    """Whether differences (..., k) of joint values or pose coordinates make two assemblies (or poses): one of them
+    more than :data:`SAME_ASSEMBLY`, angles (``angular`` (k,)) modulo a turn, lengths in units of ``length``."""
+    difference = np.array(difference, dtype=float)
     difference[..., angular] = wrap_angle(difference[..., angular])
     difference[..., ~angular] /= length
-    apart = np.max(np.abs(difference), axis=-1, initial=0.0) > SAME_ASSEMBLY
-    return first, np.any(kept, axis=1) & ~np.any(kept & apart, axis=1)
+    return np.max(np.abs(difference), axis=-1, initial=0.0) > SAME_ASSEMBLY
+
+
+def one_assembly(values: NDArray, kept: NDArray, angular: NDArray, length: float):
+    """Of each pose's closed starts ``values`` (N, S, k) that keep the working mode (``kept``, (N, S)), the one
+    assembly: ``(which start (N,), found (N,))``, found where every kept start closed to the same values (:func:`apart`
+    from the first kept) and at least one did."""
+    first = np.argmax(kept, axis=1)
+    chosen = values[np.arange(values.shape[0]), first]
+    far = apart(values - chosen[:, None, :], angular, length)
+    return first, np.any(kept, axis=1) & ~np.any(kept & far, axis=1)
 
 
 def _hinges_reach(mechanism, index: int, end: bool):

@@ -8,6 +8,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.closure.around import TURNS, apart
 from screwkit.closure.chain_kinematics import chain_forward_kinematics, chain_jacobian
 from screwkit.closure.solve import MISSES_CLOSURE, Solution, solve
 from screwkit.closure.task_space import motion_space_at, pose_rates
@@ -182,16 +183,10 @@ def forward(
 
 SPREAD = (-2.0, -1.0, 0.0, 1.0, 2.0)
 """Where :func:`forward_from_starts` starts, about the reference pose: these many length scales along each length
-coordinate, and :data:`TURNS` along each angle."""
-
-TURNS = (0.0, 0.5 * np.pi, np.pi, -0.5 * np.pi)
-"""Where each angle coordinate starts, from the reference pose's (rad)."""
+coordinate, and :data:`screwkit.closure.around.TURNS` along each angle."""
 
 MOST_TASK_COORDINATES = 3
 """Task spaces of more coordinates are not searched (their starts would be thousands)."""
-
-SAME_POSE = 1e-6
-"""Two poses found are one when no task coordinate differs by more than this (rad, length scales)."""
 
 
 def forward_from_starts(mechanism: Mechanism, actuator_values: ArrayLike, start: ArrayLike, *,
@@ -199,12 +194,12 @@ def forward_from_starts(mechanism: Mechanism, actuator_values: ArrayLike, start:
     """:func:`forward` at one set of actuator values (k,) from ``start`` (n_task,); where that finds no pose (the way
     from the start passes a fold, or where the working mode cannot follow), from starts spread about the reference
     pose (:data:`SPREAD`, :data:`TURNS`; those in the working mode), for a mechanism of at most
-    :data:`MOST_TASK_COORDINATES` task coordinates. A pose so found is taken when it is the only one (to
-    :data:`SAME_POSE`) with the reference assembly's assembly mode: the sign of the determinant of the actuators'
-    rates in the task coordinates, when there are as many actuators as task coordinates (a redundantly actuated
-    mechanism's values, which over-determine the pose, must give one pose). Returns the solution (batch ()) and, when
-    it is not the plain :func:`forward`'s, why: what was found from the starts (the solution then still unreachable
-    where none, or several, were)."""
+    :data:`MOST_TASK_COORDINATES` task coordinates. A pose so found is taken when it is the only one
+    (:func:`screwkit.closure.around.apart`) with the reference assembly's assembly mode: the sign of the determinant
+    of the actuators' rates in the task coordinates, when there are as many actuators as task coordinates (a
+    redundantly actuated mechanism's values, which over-determine the pose, must give one pose). Returns the solution
+    (batch ()) and, when it is not the plain :func:`forward`'s, why: what was found from the starts (the solution then
+    still unreachable where none, or several, were)."""
     values = np.asarray(actuator_values, dtype=float).reshape(-1)
     first = forward(mechanism, values, start, limits=limits)
     if bool(first.reachable) or mechanism.n_task > MOST_TASK_COORDINATES:
@@ -234,12 +229,9 @@ def forward_from_starts(mechanism: Mechanism, actuator_values: ArrayLike, start:
 
 
 def _distinct_poses(mechanism: Mechanism, poses: NDArray) -> list[NDArray]:
-    """The poses (K, n_task) that differ by more than :data:`SAME_POSE` (angles modulo a turn, lengths in length
-    scales), the first of each group."""
+    """The poses (K, n_task) that are :func:`~screwkit.closure.around.apart`, the first of each group."""
     kept: list[NDArray] = []
-    scale = np.where(mechanism.angular, 1.0, mechanism.length_scale)
     for pose in poses:
-        if not any(np.max(np.abs(np.where(mechanism.angular, wrap_angle(pose - other), pose - other)) / scale)
-                   <= SAME_POSE for other in kept):
+        if not kept or np.all(apart(pose - np.array(kept), mechanism.angular, mechanism.length_scale)):
             kept.append(pose)
     return kept
