@@ -77,7 +77,7 @@ def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLik
     if not bool(first.reachable):
         if found:
             raise ValueError(f"sample 0: {found}; give a start near the one meant.")
-        _reached(mechanism, values[:1], start[None], np.array([0]))  # (refused as any sample)
+        raise _not_reached(mechanism, values[0], 0)
     previous = poses[0] = np.asarray(first.poses).reshape(-1)
     for i in coarse[1:]:  # one after the other
         poses[i] = _reached(mechanism, values[i:i + 1], previous[None], np.array([i]))[0]
@@ -97,12 +97,15 @@ def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: N
     solution = forward(mechanism, values, initial)
     missed = np.flatnonzero(~np.asarray(solution.reachable))
     if missed.size:
-        first = int(samples[missed[0]])
-        shown = ", ".join(f"{v:.6g}" for v in np.where(_angular(mechanism), np.rad2deg(values[missed[0]]),
-                                                       values[missed[0]]))
-        raise ValueError(f"sample {first}: no pose near the previous sample's gives the actuator values ({shown}; "
-                         "deg, m): they disagree with each other, or leave the workspace of the assembly followed.")
+        raise _not_reached(mechanism, values[missed[0]], int(samples[missed[0]]))
     return solution.poses
+
+
+def _not_reached(mechanism: Mechanism, values: NDArray, sample: int) -> ValueError:
+    """The refusal of ``sample``, whose actuator ``values`` (a,) no pose near the previous sample's gives."""
+    shown = ", ".join(f"{v:.6g}" for v in np.where(_angular(mechanism), np.rad2deg(values), values))
+    return ValueError(f"sample {sample}: no pose near the previous sample's gives the actuator values ({shown}; deg, "
+                      "m): they disagree with each other, or leave the workspace of the assembly followed.")
 
 
 def _angular(mechanism: Mechanism) -> NDArray[np.bool_]:
