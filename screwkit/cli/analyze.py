@@ -310,11 +310,7 @@ def _analyze_graph(graph, pose: str | None, actuator_values: str | None, analysi
 def _graph_at_actuators(graph, text: str, limits: bool):
     """The graph with its actuators at the values of ``--actuators`` (deg for a hinge, m for a slide, in the order
     ``info`` lists them), by continuation from its configuration (:meth:`GraphMechanism.at_actuators`)."""
-    from screwkit.io.closed_tree import joint_kind  # the graph reader: when a graph is analysed
-
-    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
-    values = actuator_numbers(text, graph.actuators, [joint_kind(graph.tree.model, joint)[0] == "prismatic"
-                                                      for joint in ids])
+    values = actuator_numbers(text, graph.actuators, graph.actuator_slides)
     try:
         return graph.at_actuators(values, limits=limits)
     except ValueError as error:

@@ -152,6 +152,12 @@ class GraphMechanism:
         return self.actuators
 
     @property
+    def actuator_slides(self) -> tuple[bool, ...]:
+        """Which actuated joints (:attr:`actuators` order) slide (their values in m; the others turn, in rad)."""
+        return tuple(joint_kind(self.tree.model, leg.actuators[0])[0] == "prismatic" for leg in self.legs
+                     if leg.actuators)
+
+    @property
     def actuator_legs(self) -> tuple[int, ...]:
         """The leg (index into :attr:`legs`) of each actuator: passive legs have none."""
         return tuple(index for index, leg in enumerate(self.legs) if leg.actuators)
@@ -304,7 +310,7 @@ class GraphMechanism:
                              f"{values.tolist()}.")
         model, q = self.tree.model, np.array(self.q, dtype=float)
         start = np.array([joint_value(model, joint, q) for joint in ids])
-        per = np.array([self.scale if joint_kind(model, joint)[0] == "prismatic" else 1.0 for joint in ids])
+        per = np.where(self.actuator_slides, self.scale, 1.0)
         count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
         for step in range(1, count + 1):
             for joint, value in zip(ids, start + step / count * (values - start)):
