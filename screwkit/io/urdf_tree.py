@@ -23,10 +23,26 @@ __all__ = ["urdf_model"]
 
 def urdf_model(urdf: Path):
     """Pinocchio's model of the URDF ``urdf``'s tree; an :class:`~screwkit.io.closed_tree.ImportError_` in one line
-    naming the file and urdfdom's complaint if it cannot read it."""
+    naming the file and urdfdom's complaint if it cannot read it. A joint limit's negative effort or velocity (no
+    limit, :func:`_unlimited_copy`) is read as no limit."""
+    _refuse_xacro(urdf)
+    try:
+        return _pinocchio_model(urdf)
+    except ImportError_ as error:
+        unlimited = _unlimited_copy(urdf) if "effort" in str(error) or "velocity" in str(error) else None
+        if unlimited is None:
+            raise
+    with unlimited:  # (its name said as the file's)
+        try:
+            return _pinocchio_model(Path(unlimited.name))
+        except ImportError_ as again:
+            raise ImportError_(str(again).replace(unlimited.name, str(urdf))) from None
+
+
+def _pinocchio_model(urdf: Path):
+    """:func:`urdf_model` but for a negative effort or velocity."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
-    _refuse_xacro(urdf)
     sys.stderr.flush()
     try:
         kept = os.dup(2)
@@ -52,14 +68,6 @@ def urdf_model(urdf: Path):
         if text:  # urdfdom's warnings on a file it reads, as they were
             os.write(2, text)
         return model
-    if "effort" in str(error) or "velocity" in str(error):
-        unlimited = _unlimited_copy(urdf)  # a negative effort or velocity: "no limit", as SDFormat writes it
-        if unlimited is not None:
-            try:
-                with unlimited:
-                    return urdf_model(Path(unlimited.name))
-            except ImportError_ as again:
-                raise ImportError_(str(again).replace(unlimited.name, str(urdf))) from None
     complaints = [line.strip().removeprefix("Error:").strip() for line in text.decode(errors="replace").splitlines()
                   if line.strip().startswith("Error:")]
     raise ImportError_(f"{urdf}: Pinocchio cannot read the tree: "
