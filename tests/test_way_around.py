@@ -161,23 +161,27 @@ HIPS = (np.array([-HIP, 0.0]), np.array([HIP, 0.0]))
 KNEES = (_drawn_knee(HIPS[0], -1.0), _drawn_knee(HIPS[1], 1.0))
 
 
-def spread_five_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0")) -> str:
-    """The MJCF text (degrees, MuJoCo's default), every length times ``scale``, the base at ``world``."""
+def spread_five_bar(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), names=("motor1", "motor2"),
+                    reverse: bool = False) -> str:
+    """The MJCF text (degrees, MuJoCo's default), every length times ``scale``, the base at ``world``; ``names``:
+    the two motors' joints; ``reverse``: the legs, the connect's bodies and the motors listed the other way round."""
     def turn(way) -> float:  # about y, taking x to ``way`` (x, z)
         return float(np.degrees(np.arctan2(-way[1], way[0])))
 
-    legs = ""
-    for i, (hip, knee) in enumerate(zip(HIPS, KNEES), start=1):
+    legs, motors = [], []
+    for i, (hip, knee, name) in enumerate(zip(HIPS, KNEES, names), start=1):
         thigh = turn(knee - hip)
-        legs += (f'<body name="thigh{i}" pos="{float(hip[0]) * scale!r} 0 {float(hip[1]) * scale!r}" '
-                 f'euler="0 {thigh!r} 0">'
-                 f'<joint name="motor{i}" type="hinge" axis="0 1 0"/><body name="calf{i}" pos="{LEG * scale!r} 0 0" '
-                 f'euler="0 {turn(FOOT - knee) - thigh!r} 0"><joint name="knee{i}" type="hinge" axis="0 1 0"/>'
-                 '</body></body>')
+        legs.append(f'<body name="thigh{i}" pos="{float(hip[0]) * scale!r} 0 {float(hip[1]) * scale!r}" '
+                    f'euler="0 {thigh!r} 0"><joint name="{name}" type="hinge" axis="0 1 0"/>'
+                    f'<body name="calf{i}" pos="{LEG * scale!r} 0 0" euler="0 {turn(FOOT - knee) - thigh!r} 0">'
+                    f'<joint name="knee{i}" type="hinge" axis="0 1 0"/></body></body>')
+        motors.append(f'<motor name="m{i}" joint="{name}"/>')
+    ends = ("calf1", "calf2") if reverse else ("calf2", "calf1")
+    order = slice(None, None, -1 if reverse else 1)
     return ('<mujoco model="spread"><option><flag contact="disable"/></option><worldbody>'
-            f'<body name="base" pos="{world[0]}" quat="{world[1]}">{legs}</body></worldbody>'
-            f'<equality><connect name="foot" body1="calf2" body2="calf1" anchor="{SHIN * scale!r} 0 0"/></equality>'
-            '<actuator><motor name="m1" joint="motor1"/><motor name="m2" joint="motor2"/></actuator></mujoco>')
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">{"".join(legs[order])}</body></worldbody>'
+            f'<equality><connect name="foot" body1="{ends[0]}" body2="{ends[1]}" anchor="{SHIN * scale!r} 0 0"/>'
+            f'</equality><actuator>{"".join(motors[order])}</actuator></mujoco>')
 
 
 def spread_textbook(first: float, second: float):
@@ -212,11 +216,25 @@ MOTORS = [(180, 180), (-165, 165), (-135, 135), (-90, 90), (165, 165), (-150, 15
 where it does not, and where the drawing's modes have no assembly."""
 
 
-@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+SPREAD_WRITINGS = {"x1e-3": (1e-3, {}), "x1e3": (1e3, {}),
+                   "relabelled": (1.0, {"names": ("right_motor", "left_motor"), "reverse": True})}
+"""The spread five-bar written beyond :data:`~helpers.MJCF_WORLDS`: every length times 1e-3 and 1e3 read in metres,
+and its legs, connect and motors listed the other way round with the motors renamed."""
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS) + sorted(SPREAD_WRITINGS))
 def test_actuator_values_past_the_fold_between_the_hips_read_the_drawings_modes(tmp_path, variant):
-    path, unit = mjcf_variant(tmp_path, "spread", variant, spread_five_bar)
+    names = ("motor1", "motor2")
+    if variant in SPREAD_WRITINGS:
+        scale, options = SPREAD_WRITINGS[variant]
+        path, unit = tmp_path / f"spread_{variant}.xml", None
+        path.write_text(spread_five_bar(scale, **options))
+        names = options.get("names", names)
+    else:
+        path, unit = mjcf_variant(tmp_path, "spread", variant, spread_five_bar)
     mechanism = load(path, length_unit=unit)
-    order = [mechanism.actuator_names.index(name) for name in ("motor1:motor1", "motor2:motor2")]
+    motors_named = [f"{name}:{name}" for name in names]
+    order = [mechanism.actuator_names.index(name) for name in motors_named]
     folded = 0
     motors = MOTORS if variant == "m" else [MOTORS[i] for i in (0, 2, 6, 10)]  # (two past the fold, as written)
     for first, second in motors:
@@ -230,11 +248,12 @@ def test_actuator_values_past_the_fold_between_the_hips_read_the_drawings_modes(
         folded += not bool(forward(mechanism, values, mechanism.home_pose).reachable)
         result = indices_at_pose(mechanism, np.asarray(solution.poses).reshape(-1))
         got = dict(zip(result.actuators, result.iti_actuators))
-        assert (got["motor1:motor1"], got["motor2:motor2"], float(result.lmti)) == pytest.approx(
+        assert (got[motors_named[0]], got[motors_named[1]], float(result.lmti)) == pytest.approx(
             (*expected[1], expected[2]), abs=1e-9), (first, second)
-        if variant == "m":  # the task frame is the file's: x along x, y down
-            assert np.asarray(solution.poses).reshape(-1) == pytest.approx([expected[0][0], -expected[0][1]],
-                                                                           abs=1e-9)
+        if variant not in ("mm", "turned"):  # the task frame is the file's (x along x, y down), lengths as written
+            factor = SPREAD_WRITINGS.get(variant, (1.0,))[0]
+            assert np.asarray(solution.poses).reshape(-1) == pytest.approx(
+                [factor * expected[0][0], -factor * expected[0][1]], abs=1e-9 * factor)
     assert folded == (6 if variant == "m" else 2)  # (the way from the start pose reaches none of the first six)
 
 
