@@ -8,11 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
-from screwkit.io.graph_screws import GraphLeg, LegScrews, common_motions, couples_of_forces, model_name
+from screwkit.io.graph_screws import HINGES, GraphLeg, LegScrews, axis_line, common_motions, model_name
 from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.reference import actuation_wrench, working_frame
 
-__all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "IN_LOOP_TOLERANCE"]
+__all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "couples_of_forces", "IN_LOOP_TOLERANCE",
+           "COUPLE_LIKE"]
 
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
@@ -108,3 +111,40 @@ def refuse_couples_of_forces(tree: ClosedTree, legs, chains: list[ChainScrews], 
                            "line up, so screwkit does not analyse this leg as a graph; read with one force path (the "
                            "other rods' closures left out, in MJCF <weld ... active='false'/>), the leg's ITI and OTI "
                            "are that rod's pressure angles.")
+
+
+COUPLE_LIKE = 1e3
+"""An actuation wrench whose line passes farther than this many working lengths from the mechanism's centroid acts
+as a couple: its power coefficient on any rotation is 1 to within a millionth (:func:`couples_of_forces`)."""
+
+
+def couples_of_forces(legs, chains: list[ChainScrews], state) -> list[tuple[GraphLeg, tuple[int, ...]]]:
+    """The actuated legs whose actuation wrench (its representative, as the index layer takes it) is a couple that
+    the leg carries onto its actuated link only as forces at two or more points, and those joints: balls, hinges
+    along the couple, ball closures (two rods pulling against each other, a parallelogram doubled on the far side of
+    its crank). The power coefficient of a couple is 1 whatever those forces' pressure angles, even beside the dead
+    centre where they line up and the leg locks; such a leg is refused (``docs/theory.md``)."""
+    kinds, model = state.kinematics.kinds, state.model
+    work, at, _, _ = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
+    found = []
+    for leg, twists, points in zip(legs, work, at):
+        if not leg.actuators:
+            continue
+        wrench = actuation_wrench(twists, points, 0)
+        force, moment = np.linalg.norm(wrench[:3]), np.linalg.norm(wrench[3:])
+        if not moment or moment < COUPLE_LIKE * force:
+            continue
+        axis = wrench[3:] / moment  # (moments about the centroid: of a near couple, its direction)
+        actuator = leg.actuators[0]
+        carriers = [j for j in leg.joints if model.parents[j] == actuator]
+        carriers += [other for closure in leg.closures
+                     for end, other in ((closure.joint_a, closure.joint_b), (closure.joint_b, closure.joint_a))
+                     if end == actuator and closure.kind == "3d"]
+        welded = [closure for closure in leg.closures if actuator in (closure.joint_a, closure.joint_b)
+                  and closure.kind != "3d"]
+        forces_only = all(kinds[j] == "ball" or (kinds[j] in HINGES and float(np.linalg.norm(np.cross(
+            axis_line(state, j)[1][0], axis))) <= 10 * FILE_ROUNDING) for j in carriers if j in leg.joints)
+        if len(carriers) >= 2 and forces_only and not welded:
+            found.append((leg, tuple(carriers)))
+    return found
+

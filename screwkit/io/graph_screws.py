@@ -23,10 +23,9 @@ from screwkit.io.compound import TWIST_RANK_TOLERANCE
 from screwkit.io.graph_kinematics import TreeKinematics
 from screwkit.io.leg_ways import pin_groups, through_closures
 from screwkit.screw.chain_screws import ChainScrews
-from screwkit.screw.reference import actuation_wrench, working_frame
 
 __all__ = ["GraphLeg", "LegScrews", "leg_screws", "equivalent_chains", "dimension_groups", "common_motions",
-           "locking_legs", "couples_of_forces", "COUPLE_LIKE"]
+           "locking_legs", "axis_line", "HINGES"]
 
 
 @dataclass(frozen=True)
@@ -150,7 +149,7 @@ def _closure_matrix(state: _State, joints, leg: GraphLeg, cuts=()) -> NDArray:
 HINGES = ("revolute", "unbounded")
 
 
-def _axis_line(state: _State, joint: int) -> tuple[NDArray, NDArray]:
+def axis_line(state: _State, joint: int) -> tuple[NDArray, NDArray]:
     """A revolute joint's drawn origin and unit axis (n, 3 each), in the world."""
     transforms = state.transforms[:, joint]
     return transforms[:, :3, 3], transforms[:, :3, :3] @ state.kinematics.axes[joint]
@@ -185,10 +184,10 @@ def _meetings(state: _State, joint: int, among=None, feet: bool = True) -> tuple
     neighbours = [j for j in (model.parents[joint], *range(joint + 1, model.njoints))
                   if j != 0 and kinds[j] in (*HINGES, "ball")
                   and (j == model.parents[joint] or model.parents[j] == joint) and (among is None or j in among)]
-    point, axis = _axis_line(state, joint)
+    point, axis = axis_line(state, joint)
     meetings, lines = [], {}
     for neighbour in (j for j in neighbours if kinds[j] in HINGES):
-        other_point, other_axis = _axis_line(state, neighbour)
+        other_point, other_axis = axis_line(state, neighbour)
         cosine = np.sum(axis * other_axis, axis=1)
         sine_squared = 1.0 - cosine * cosine
         if not np.all(sine_squared > PARALLEL_FOOT):
@@ -287,18 +286,41 @@ _SCREENED = 4
 
 
 def _sampled(state: _State, rows: NDArray) -> _State:  # (the configurations ``rows`` of a batch)
-    return replace(state, transforms=state.transforms[rows], working=state.working[rows], centre=state.centre[rows])
+    return replace(state, transforms=state.transforms[rows], working=state.working[rows], centre=state.centre[rows],
+                   outside=None if state.outside is None else state.outside[rows])
+
+
+def _spanned_dims(state: _State, rows: NDArray, dims: NDArray) -> NDArray[np.int64]:
+    """The dimension (n,) of the part of a twist system (rows (n, 6, 6), the first ``dims[n]`` of configuration n)
+    that lies among the twists some leg allows (:attr:`_State.outside`; all of it where that is not set): what it
+    frees beyond them only the constraint wrenches every leg holds resist, which no connection carries alone."""
+    if state.outside is None:
+        return dims
+    valid = rows * (np.arange(6)[None, :] < dims[:, None])[:, :, None]
+    values = np.linalg.svd(valid @ state.outside, compute_uv=False)
+    return dims - np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
+
+
+def _outside(screws_allowed: list[tuple[NDArray, NDArray]]) -> NDArray:
+    """The projector (n, 6, 6) off the twists some leg allows (every leg's twist system together, working
+    coordinates): what it keeps of a twist, only the constraint wrenches common to every leg resist."""
+    stacked = np.concatenate([rows * (np.arange(6)[None, :] < dims[:, None])[:, :, None]
+                              for rows, dims in screws_allowed], axis=1)
+    _, values, right = np.linalg.svd(stacked, full_matrices=True)
+    spans = (np.arange(6)[None, :] < np.sum(values > TWIST_RANK_TOLERANCE, axis=1)[:, None])[:, :, None]
+    basis = right * spans
+    return np.eye(6)[None] - np.swapaxes(basis, 1, 2) @ basis
 
 
 def _loaded_at_each(state: _State, leg: GraphLeg, cuts: list, systems: list) -> NDArray[np.bool_]:
     """:func:`_loaded` at every configuration of the batch."""
-    whole = [_twist_spaces(state, joints, leg)[1] for joints in systems]
+    whole = [_spanned_dims(state, *_twist_spaces(state, joints, leg)) for joints in systems]
 
     def same(cut) -> NDArray[np.bool_]:  # (n,): the leg's twist systems as they are with ``cut`` left out
         kept = np.ones(whole[0].shape, dtype=bool)
         for joints, dims in zip(systems, whole):  # (the locked one only where the free one is the same)
             if kept.any():
-                kept &= _twist_spaces(state, joints, leg, cut)[1] == dims
+                kept &= _spanned_dims(state, *_twist_spaces(state, joints, leg, cut)) == dims
         return kept
 
     idle = np.stack([same((cut,)) for cut in cuts], axis=1)  # (n, k)
@@ -329,7 +351,7 @@ def _actuator_point(state: _State, actuator: int, iti_point: NDArray) -> NDArray
         return np.mean(meetings, axis=0)
     if kinds[actuator] not in HINGES + ("prismatic",):
         return state.transforms[:, actuator, :3, 3]
-    return _foot_from(*_axis_line(state, actuator), iti_point)
+    return _foot_from(*axis_line(state, actuator), iti_point)
 
 
 def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
@@ -339,7 +361,7 @@ def _pin_point(state: _State, platform: int, others: list[NDArray]) -> NDArray:
     origin = state.transforms[:, platform, :3, 3]
     if state.kinematics.kinds[platform] not in HINGES or not others:
         return origin
-    return _foot_from(*_axis_line(state, platform), np.nanmean(others, axis=0))
+    return _foot_from(*axis_line(state, platform), np.nanmean(others, axis=0))
 
 
 def _foot_from(point: NDArray, axis: NDArray, other: NDArray) -> NDArray:
@@ -359,6 +381,7 @@ class _State:
     working: NDArray[np.float64]
     centre: NDArray[np.float64]
     scale: float
+    outside: NDArray[np.float64] | None = None  # (n, 6, 6): :func:`_outside` of every leg (None: not yet known)
 
     @classmethod
     def at(cls, tree: ClosedTree, kinematics: TreeKinematics, platform: int, q: NDArray, scale: float) -> _State:
@@ -397,6 +420,8 @@ def model_name(tree: ClosedTree, joint: int) -> str:
 def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs, q: NDArray, scale: float):
     """Every leg's :class:`LegScrews` at closed configurations q (n, nq), and the batch's :class:`_State`."""
     state = _State.at(tree, kinematics, platform, np.asarray(q, dtype=float).reshape(-1, kinematics.nq), scale)
+    systems = [_twist_spaces(state, leg.joints, leg) for leg in legs]
+    state = replace(state, outside=_outside(systems))  # (a connection carrying only common wrenches: out of points)
     out = []
     pinned = [leg.spine and leg.joints == (platform,) for leg in legs]  # the platform's own joint on the base
     on_platform = [_attachments(state, leg, platform, leg.actuators[0] if leg.actuators else None,  # (the own joint:
@@ -404,8 +429,7 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
                                 if not leg.actuators else state.transforms[:, platform, :3, 3])  # or as drawn)
                    for leg, pin in zip(legs, pinned)]
     others = [point for points, pin in zip(on_platform, pinned) if not pin for point in points]
-    for leg, pin, platform_points in zip(legs, pinned, on_platform):
-        allowed, allowed_dims = _twist_spaces(state, leg.joints, leg)
+    for leg, pin, platform_points, (allowed, allowed_dims) in zip(legs, pinned, on_platform, systems):
         if not leg.actuators:  # a passive leg: its twist system only (the constraint wrenches it exerts)
             oti = platform_points + ([_pin_point(state, platform, others)] if pin else [])
             if not oti:
@@ -498,41 +522,3 @@ def locking_legs(legs, screws: list[LegScrews]) -> str:
         return f": with any one of legs {', '.join(freeing)} left out, the others would let it move"
     return ": the legs allow twist systems of dimension " + ", ".join(
         f"{int(screw.allowed_dims[0])} ({leg.name})" for leg, screw in zip(legs, screws))
-
-
-
-COUPLE_LIKE = 1e3
-"""An actuation wrench whose line passes farther than this many working lengths from the mechanism's centroid acts
-as a couple: its power coefficient on any rotation is 1 to within a millionth (:func:`couples_of_forces`)."""
-
-
-def couples_of_forces(legs, chains: list[ChainScrews], state: _State) -> list[tuple[GraphLeg, tuple[int, ...]]]:
-    """The actuated legs whose actuation wrench (its representative, as the index layer takes it) is a couple that
-    the leg carries onto its actuated link only as forces at two or more points, and those joints: balls, hinges
-    along the couple, ball closures (two rods pulling against each other, a parallelogram doubled on the far side of
-    its crank). The power coefficient of a couple is 1 whatever those forces' pressure angles, even beside the dead
-    centre where they line up and the leg locks; such a leg is refused (``docs/theory.md``)."""
-    kinds, model = state.kinematics.kinds, state.model
-    work, at, _, _ = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
-    found = []
-    for leg, twists, points in zip(legs, work, at):
-        if not leg.actuators:
-            continue
-        wrench = actuation_wrench(twists, points, 0)
-        force, moment = np.linalg.norm(wrench[:3]), np.linalg.norm(wrench[3:])
-        if not moment or moment < COUPLE_LIKE * force:
-            continue
-        axis = wrench[3:] / moment  # (moments about the centroid: of a near couple, its direction)
-        actuator = leg.actuators[0]
-        carriers = [j for j in leg.joints if model.parents[j] == actuator]
-        carriers += [other for closure in leg.closures
-                     for end, other in ((closure.joint_a, closure.joint_b), (closure.joint_b, closure.joint_a))
-                     if end == actuator and closure.kind == "3d"]
-        welded = [closure for closure in leg.closures if actuator in (closure.joint_a, closure.joint_b)
-                  and closure.kind != "3d"]
-        forces_only = all(kinds[j] == "ball" or (kinds[j] in HINGES and float(np.linalg.norm(np.cross(
-            _axis_line(state, j)[1][0], axis))) <= 10 * FILE_ROUNDING) for j in carriers if j in leg.joints)
-        if len(carriers) >= 2 and forces_only and not welded:
-            found.append((leg, tuple(carriers)))
-    return found
-
