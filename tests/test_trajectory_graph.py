@@ -139,8 +139,8 @@ def test_leaving_the_workspace_is_located_to_the_tolerance(delta):
 
 def test_the_command_follows_a_path_of_the_rod_level_delta_as_written(tmp_path):
     """``screwkit trajectory delta_rods_4 --line ...`` (the bundled MJCF file, its legs closed by rods on ball
-    joints): exit 0, the summary as JSON and the netCDF with every sample; --actuators and --closed-forms refused
-    in one line."""
+    joints): exit 0, the summary as JSON and the netCDF with every sample; --closed-forms refused in one line
+    (--actuators: test_graph_actuator_path)."""
     import xarray as xr
 
     out = tmp_path / "path.nc"
@@ -153,9 +153,6 @@ def test_the_command_follows_a_path_of_the_rod_level_delta_as_written(tmp_path):
     assert len(summary["faults"]) == 4 and summary["worst"]["1"]
     with xr.open_dataset(out) as dataset:
         assert dataset.sizes["sample"] == 9 and np.all(np.isfinite(dataset["f_o1"].values))
-    path = tmp_path / "actuators.csv"
-    path.write_text("arm_1,arm_2,arm_3,arm_4\n0,0,0,0\n1,1,1,1\n")
-    one_line_error(screwkit("trajectory", "delta_rods_4", path, "--actuators"), "loops inside them", "--actuators")
     one_line_error(screwkit("trajectory", "delta_rods_4", "--line", "0", "0", "-0.75", "0", "0", "-0.7",
                             "--closed-forms"), "no closed forms")
 

@@ -25,7 +25,6 @@ from screwkit.cli.options import (
     quiet_option,
     reading_options,
 )
-from screwkit.model import Mechanism
 from screwkit.studies.actuator_paths import read_actuator_path
 from screwkit.studies.files import write_dataset
 from screwkit.studies.path_mechanisms import check_path_size, path_mechanism
@@ -173,9 +172,6 @@ class PathSource:
             return generated_path(mechanism, self)
         try:
             if self.actuators:
-                if not isinstance(mechanism, Mechanism):  # a GraphMechanism: legs with loops inside them
-                    raise fail(f"{mechanism.tree.source}: its legs have loops inside them, posed by the output frame "
-                               "only: give PATH in its task coordinates (m, deg), without --actuators.")
                 return read_actuator_path(mechanism, self.path_file)
             return read_path(mechanism, self.path_file)
         except PathFileError as error:
@@ -247,7 +243,7 @@ def trajectory(mechanism, source: PathSource, faults: FaultOptions, outputs: Out
     Crossings of --level and singular points between samples are refined to --tolerance. The indices go to
     --out (.nc or .csv; with neither --out, --figure nor --json, to stdout as CSV), the summary to stderr
     (or stdout with --json). A mechanism whose legs have loops inside them is closed at each sample by
-    continuation from its file's configuration (its path in task coordinates only).
+    continuation from its file's configuration, or, with --actuators, from the sample before.
     """
     source.check()
     outputs.check(quiet or as_json)

@@ -64,11 +64,10 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.compound import closed_samples
 from screwkit.io.couplings import check_couplings
-from screwkit.io.graph_actuators import check_actuators
+from screwkit.io.graph_actuators import check_actuators, follow_actuators
 from screwkit.io.graph_checks import IN_LOOP_TOLERANCE, check_legs, check_output, refuse_couples_of_forces
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
-    STAGE_LENGTH,
     TreeKinematics,
     beyond_reach,
     joints_beyond_limits,
@@ -87,7 +86,6 @@ from screwkit.io.graph_screws import (
     leg_screws,
     locking_legs,
 )
-from screwkit.io.locking import put_joint_value
 from screwkit.io.output import output_frame, platform_body
 from screwkit.model.mechanism import SPATIAL_TASK_COORDINATES, checked_task_poses
 from screwkit.screw.chain_screws import ChainScrews
@@ -299,8 +297,8 @@ class GraphMechanism:
 
     def at_actuators(self, values, *, limits: bool = True) -> GraphMechanism:
         """The mechanism with its actuated joints at ``values`` (rad or m, :attr:`actuators` order), reached from this
-        configuration by continuation: the actuators moved in steps of at most :data:`STAGE_LENGTH` (rad, or length
-        scales), the closures assembled at each with them held, so the working mode is followed. A ValueError names
+        configuration by continuation (:func:`~screwkit.io.graph_actuators.follow_actuators`: small steps of the
+        actuators, the closures assembled at each with them held, so the working mode is followed). A ValueError names
         the step whose loops cannot close (values out of reach, past a singular configuration, or redundant ones that
         disagree) or the joints a configuration puts beyond their limits."""
         ids = [leg.actuators[0] for leg in self.legs if leg.actuators]
@@ -308,20 +306,12 @@ class GraphMechanism:
         if values.shape != (len(ids),) or not np.all(np.isfinite(values)):
             raise ValueError(f"Expected {len(ids)} finite actuator values ({', '.join(self.actuators)}), got "
                              f"{values.tolist()}.")
-        model, q = self.tree.model, np.array(self.q, dtype=float)
-        start = np.array([joint_value(model, joint, q) for joint in ids])
-        per = np.where(self.actuator_slides, self.scale, 1.0)
-        count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
-        for step in range(1, count + 1):
-            for joint, value in zip(ids, start + step / count * (values - start)):
-                put_joint_value(model, joint, q, value)
-            try:
-                q, _ = assemble(replace(self.tree, q_reference=q, notes=[]), held=ids)
-            except ImportError_:
-                raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
-                                 f"actuators at the values given: the loops cannot close {step} step(s) of {count} "
-                                 "on the way (out of reach, past a singular configuration, or redundant actuators "
-                                 "whose values disagree).") from None
+        try:
+            q = follow_actuators(self, self.q, values)
+        except ValueError as error:
+            raise ValueError(f"{self.tree.source}: no closed configuration reached from the current one puts the "
+                             f"actuators at the values given: {error}.") from None
+        model = self.tree.model
         beyond = joints_beyond_limits(model, self.kinematics, q, self.limited, self.scale)
         if beyond and limits:
             raise ValueError(f"{self.tree.source}: the actuator values put joints of its legs beyond their limits: "

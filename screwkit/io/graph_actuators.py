@@ -4,9 +4,87 @@ turns."""
 
 from __future__ import annotations
 
-from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
+from dataclasses import replace
+from itertools import combinations
 
-__all__ = ["check_actuators", "serial_stage"]
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.io.closed_tree import ClosedTree, ImportError_, assemble, joint_kind, joint_value, path_to
+from screwkit.io.graph_kinematics import STAGE_LENGTH
+from screwkit.io.locking import put_joint_value
+
+__all__ = ["check_actuators", "serial_stage", "follow_actuators", "AGREEMENT"]
+
+
+def follow_actuators(graph, q: NDArray, values: NDArray, *, exact: bool = True) -> NDArray[np.float64]:
+    """The closed configuration of ``graph`` (a :class:`~screwkit.io.graph.GraphMechanism`) with its actuated joints
+    at ``values`` (rad or m, its actuators' order), reached from the closed configuration ``q`` by continuation: the
+    actuators moved together in steps of at most :data:`STAGE_LENGTH` (rad, or length scales), the closures assembled
+    at each with them held, so the working and assembly modes are followed. A ValueError says at which step the
+    loops cannot close (values out of reach, past a singular configuration, or redundant ones that disagree).
+
+    Redundant actuators (more than the DOF) take values that agree only on the mechanism's motions, and values
+    interpolated between two that agree do not quite: the steps hold a non-redundant set of them (the first, in the
+    order of their names, whose steps close), the others following; then, if ``exact``, the closed configuration
+    nearest to all of them at ``values`` (values rounded as a file or a logger writes them close the loops, held,
+    only to that rounding), refused if an actuator is then farther than :data:`AGREEMENT` from its value. Not
+    ``exact``: a position between two samples of a path, the set held only, the others where it puts them."""
+    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
+    if len(ids) <= graph.dof:
+        return _steps(graph, q, values, ids, ids)
+    names = graph.tree.model.names
+    failure = None
+    for held in combinations(sorted(ids, key=lambda joint: names[joint]), graph.dof):
+        try:
+            found = _steps(graph, q, values, ids, list(held))
+        except ValueError as error:
+            failure = failure or error
+            continue
+        return _agreeing(graph, found, values, ids) if exact else found
+    raise failure
+
+
+AGREEMENT = 1e-5
+"""The largest mismatch (rad, or length scales) between redundant actuators' values and the closed configuration
+nearest to them that :func:`follow_actuators` accepts, as the serial forward kinematics does
+(:func:`screwkit.closure.forward`)."""
+
+
+def _steps(graph, q: NDArray, values: NDArray, ids: list[int], held: list[int]) -> NDArray[np.float64]:
+    """:func:`follow_actuators` holding the actuated joints ``held`` at each step."""
+    model, q = graph.tree.model, np.array(q, dtype=float)
+    start = np.array([joint_value(model, joint, q) for joint in ids])
+    per = np.where(graph.actuator_slides, graph.scale, 1.0)
+    count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
+    for step in range(1, count + 1):
+        for joint, value in zip(ids, start + step / count * (values - start)):
+            put_joint_value(model, joint, q, value)
+        try:
+            q, _ = assemble(replace(graph.tree, q_reference=q, notes=[]), held=held)
+        except ImportError_:
+            raise ValueError(f"the loops cannot close {step} step(s) of {count} on the way (out of reach, past a "
+                             "singular configuration, or redundant actuators whose values disagree)") from None
+    return q
+
+
+def _agreeing(graph, q: NDArray, values: NDArray, ids: list[int]) -> NDArray[np.float64]:
+    """The closed configuration nearest to ``q`` (some redundant actuators at ``values``) with them all put there,
+    refused if an actuator is then farther than :data:`AGREEMENT` from its value."""
+    model, q = graph.tree.model, np.array(q, dtype=float)
+    for joint, value in zip(ids, values):
+        put_joint_value(model, joint, q, value)
+    try:  # (not held: values rounded as written close the loops only to that rounding, off the motions' rank)
+        q, _ = assemble(replace(graph.tree, q_reference=q, notes=[]))
+    except ImportError_:
+        raise ValueError("the loops cannot close at the values given (redundant actuators whose values "
+                         "disagree)") from None
+    per = np.where(graph.actuator_slides, graph.scale, 1.0)
+    mismatch = np.abs(np.array([joint_value(model, joint, q) for joint in ids]) - values) / per
+    if not np.max(mismatch) <= AGREEMENT:
+        raise ValueError(f"redundant actuators whose values disagree: the closed configuration nearest to them "
+                         f"misses one by {np.max(mismatch):.3g} (rad, or length scales)")
+    return q
 
 
 def check_actuators(tree: ClosedTree, legs, platform: int) -> None:

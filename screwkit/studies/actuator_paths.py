@@ -13,6 +13,12 @@ is the one reached from ``start`` (default: the reference assembly's pose), by c
 2. then, round after round, the sample halfway between two solved samples, from the pose of the first of them:
    every round one batched call, about log2(n / :data:`COARSE_SEGMENTS`) rounds in all.
 
+A mechanism whose legs have loops inside them (:class:`~screwkit.io.GraphMechanism`) is followed in joint space
+from its configuration, sample after sample (:func:`~screwkit.io.graph_actuators.follow_actuators`: the actuators
+in small steps, the closures assembled at each with them held), one assembly of its closures per step; the path
+keeps the configurations reached, which the trajectory analyses (its task coordinates may fold where the actuators do
+not: a crank past the top of its circle moves its coupler's x back).
+
 :func:`read_actuator_path` reads the values from a CSV or netCDF file (a column per actuator, named as
 :attr:`~screwkit.model.Mechanism.actuator_names` names them or by its chain's name when the chain has one actuator;
 deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in one line what is wrong.
@@ -21,6 +27,7 @@ deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,6 +35,8 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.closure import forward
 from screwkit.closure.forward_kinematics import forward_from_starts
 from screwkit.common.units import angle_beyond_limit, angle_limit
+from screwkit.io.graph import GraphMechanism
+from screwkit.io.graph_actuators import follow_actuators
 from screwkit.model import Mechanism
 from screwkit.studies.netcdf import netcdf_file
 from screwkit.studies.paths import Path, PathFileError, path_from_poses, read_columns
@@ -38,7 +47,8 @@ COARSE_SEGMENTS = 64
 """Segments of the coarse pass of the continuation, solved one after the other."""
 
 
-def actuator_columns(mechanism: Mechanism) -> tuple[tuple[str, ...], tuple[str, ...]]:
+
+def actuator_columns(mechanism: Mechanism | GraphMechanism) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """The column of each actuator in a path file (``chain:joint``) and its short alias (the chain's name, when
     the chain has one actuator; else the full name again)."""
     names = mechanism.actuator_names
@@ -47,9 +57,12 @@ def actuator_columns(mechanism: Mechanism) -> tuple[tuple[str, ...], tuple[str, 
     return names, aliases
 
 
-def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLike | None = None, *,
-                        start: ArrayLike | None = None) -> Path:
+def path_from_actuators(mechanism: Mechanism | GraphMechanism, values: ArrayLike, times: ArrayLike | None = None,
+                        *, start: ArrayLike | None = None) -> Path:
     """The path of the platform driven by actuator ``values`` (n, a) (rad, m; :attr:`Mechanism.actuators` order).
+
+    A mechanism whose legs have loops inside them (:class:`~screwkit.io.GraphMechanism`) is followed from its file's
+    configuration, sample after sample (``start`` is for the others).
 
     Raises
     ------
@@ -57,18 +70,12 @@ def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLik
         A sample whose values no pose near its neighbour's gives (values that disagree with each other, or
         outside the workspace of the assembly mode followed): the first such sample, by number.
     """
-    values = np.asarray(values, dtype=float)
-    count = len(mechanism.actuators)
-    if values.ndim != 2 or values.shape[1] != count or values.shape[0] < 2:
-        raise ValueError(f"Expected actuator values with shape (n >= 2, {count}), got {values.shape}.")
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"Expected finite actuator values, got {values[~np.isfinite(values)][0]} at sample "
-                         f"{int(np.flatnonzero(~np.all(np.isfinite(values), axis=1))[0])}.")
-    beyond = np.argwhere(_angular(mechanism) & (np.abs(values) > angle_limit(degrees=False)))
-    if beyond.size:  # 1e20 rad cannot tell one turn from the next
-        sample, k = (int(i) for i in beyond[0])
-        raise angle_beyond_limit(f"actuator values ({mechanism.actuator_names[k]}, sample {sample})",
-                                 float(values[sample, k]), degrees=False)
+    values = _checked(mechanism, values)
+    if isinstance(mechanism, GraphMechanism):
+        if start is not None:
+            raise ValueError("Expected no `start` for a mechanism whose legs have loops inside them: its path is "
+                             "followed from its configuration (GraphMechanism.at_pose moves it first).")
+        return _graph_path(mechanism, values, times)
     n = values.shape[0]
     poses = np.full((n, mechanism.n_task), np.nan)
     start = mechanism.home_pose if start is None else mechanism.check_poses(start)
@@ -91,6 +98,38 @@ def path_from_actuators(mechanism: Mechanism, values: ArrayLike, times: ArrayLik
     return path_from_poses(mechanism, poses, times)
 
 
+def _checked(mechanism: Mechanism | GraphMechanism, values: ArrayLike) -> NDArray[np.float64]:
+    """``values`` (n >= 2, a), finite, each angle within what a double tells one turn from the next."""
+    values = np.asarray(values, dtype=float)
+    count = len(mechanism.actuators)
+    if values.ndim != 2 or values.shape[1] != count or values.shape[0] < 2:
+        raise ValueError(f"Expected actuator values with shape (n >= 2, {count}), got {values.shape}.")
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"Expected finite actuator values, got {values[~np.isfinite(values)][0]} at sample "
+                         f"{int(np.flatnonzero(~np.all(np.isfinite(values), axis=1))[0])}.")
+    beyond = np.argwhere(_angular(mechanism) & (np.abs(values) > angle_limit(degrees=False)))
+    if beyond.size:  # 1e20 rad cannot tell one turn from the next
+        sample, k = (int(i) for i in beyond[0])
+        raise angle_beyond_limit(f"actuator values ({mechanism.actuator_names[k]}, sample {sample})",
+                                 float(values[sample, k]), degrees=False)
+    return values
+
+
+def _graph_path(graph: GraphMechanism, values: NDArray, times: ArrayLike | None) -> Path:
+    """The path of a graph's output frame driven by actuator ``values`` (n, a): each sample's closed configuration
+    from the one before (the first from the file's) by :func:`~screwkit.io.graph_actuators.follow_actuators`, one
+    sample after the other (each step one assembly of the closures), kept with the path."""
+    q, closed = graph.q, np.empty((values.shape[0], graph.kinematics.nq))
+    for sample, row in enumerate(values):
+        try:
+            q = closed[sample] = follow_actuators(graph, q, row)
+        except ValueError as error:
+            raise _not_reached(graph, row, sample, f"from the {'previous sample' if sample else 'file'}'s "
+                                                   f"configuration {error}") from None
+    path = path_from_poses(graph, graph.frame_pose(closed)[:, list(graph.task_axes)], times)
+    return replace(path, actuators=values, configurations=closed)
+
+
 def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: NDArray) -> NDArray[np.float64]:
     """The poses where the actuators take ``values`` (k, a), from ``initial`` poses; ValueError naming the first
     sample not reached."""
@@ -101,18 +140,24 @@ def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: N
     return solution.poses
 
 
-def _not_reached(mechanism: Mechanism, values: NDArray, sample: int) -> ValueError:
+def _not_reached(mechanism: Mechanism | GraphMechanism, values: NDArray, sample: int, why: str | None = None
+                 ) -> ValueError:
     """The refusal of ``sample``, whose actuator ``values`` (a,) no pose near the previous sample's gives."""
     shown = ", ".join(f"{v:.6g}" for v in np.where(_angular(mechanism), np.rad2deg(values), values))
+    if why is not None:
+        return ValueError(f"sample {sample}: no closed configuration puts the actuators at ({shown}; deg, m): {why}.")
     return ValueError(f"sample {sample}: no pose near the previous sample's gives the actuator values ({shown}; deg, "
                       "m): they disagree with each other, or leave the workspace of the assembly followed.")
 
 
-def _angular(mechanism: Mechanism) -> NDArray[np.bool_]:
+def _angular(mechanism: Mechanism | GraphMechanism) -> NDArray[np.bool_]:
+    if isinstance(mechanism, GraphMechanism):
+        return ~np.asarray(mechanism.actuator_slides, dtype=bool)
     return np.array([not mechanism.chains[c].prismatic[j] for c, j in mechanism.actuator_positions(None)])
 
 
-def read_actuator_path(mechanism: Mechanism, path: str | os.PathLike, *, start: ArrayLike | None = None) -> Path:
+def read_actuator_path(mechanism: Mechanism | GraphMechanism, path: str | os.PathLike, *,
+                       start: ArrayLike | None = None) -> Path:
     """The platform path driven by the actuator values of a CSV or netCDF file (:func:`path_from_actuators`).
 
     Raises

@@ -6,7 +6,9 @@ refinement), those joint values alone (the branch search), why a pose is unreach
 closures keep. :class:`SerialPath` answers for a :class:`~screwkit.model.Mechanism` (closures chain by chain:
 closed forms, damped Newton), :class:`GraphPath` for a :class:`~screwkit.io.GraphMechanism` (every closure of the
 graph solved at once, each pose by continuation from the file's configuration,
-:meth:`~screwkit.io.GraphMechanism.solve`).
+:meth:`~screwkit.io.GraphMechanism.solve`), and :class:`ActuatedGraphPath` for one along a path its actuators drive
+(each configuration followed from the sample before in joint space). The trajectory asks at arc lengths of the path
+(``indices_along``, ``joint_values_along``, ``unreachable_along``): the first two at the poses there.
 """
 
 from __future__ import annotations
@@ -20,11 +22,15 @@ from numpy.typing import NDArray
 from screwkit.closure import UnreachablePose, solve, solve_one, working_modes
 from screwkit.closure.on_the_way import singular_along
 from screwkit.closure.solve import ChainStatus
+from screwkit.common.units import spelled_pose
 from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism
+from screwkit.io.graph_actuators import follow_actuators
+from screwkit.io.graph_kinematics import beyond_limits, joints_beyond_limits
 from screwkit.model import Mechanism
 from screwkit.studies.branches import ChainJoints, chain_joints
 from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.paths import Path
 from screwkit.studies.poses import (
     check_graph_analysis,
     graph_indices_at_poses,
@@ -33,11 +39,24 @@ from screwkit.studies.poses import (
 )
 from screwkit.studies.sizes import check_fits, pose_bytes
 
-__all__ = ["SerialPath", "GraphPath", "path_mechanism", "check_path_size"]
+__all__ = ["SerialPath", "GraphPath", "ActuatedGraphPath", "path_mechanism", "check_path_size"]
+
+
+class _Along:
+    """What the trajectory asks at arc lengths of a path: by default at the poses there."""
+
+    def indices_along(self, path: Path, positions: NDArray) -> Indices:
+        return self.indices(path.at(positions))
+
+    def joint_values_along(self, path: Path, positions: NDArray) -> list[NDArray[np.float64]]:
+        return self.joint_values(path.at(positions))
+
+    def unreachable_along(self, path: Path, position: float, status: NDArray) -> tuple[str, str]:
+        return self.unreachable(path.at(np.array([position]))[0], status)
 
 
 @dataclass(frozen=True)
-class SerialPath:
+class SerialPath(_Along):
     """A mechanism of serial legs along a path: its closures keep each chain's working mode pose by pose."""
 
     mechanism: Mechanism
@@ -85,7 +104,7 @@ class SerialPath:
 
 
 @dataclass(frozen=True)
-class GraphPath:
+class GraphPath(_Along):
     """A mechanism whose legs have loops inside them along a path: every pose closed by continuation from the
     file's configuration, so the working mode is the one that continuation reaches; a branch change between two
     samples is seen on the legs' revolute and prismatic joints (their ball joints turn with them)."""
@@ -148,13 +167,84 @@ class GraphPath:
         return {leg.name: mode for leg in self.graph.legs}
 
 
-def path_mechanism(mechanism: Any, analysis: AnalysisOptions, keywords: dict) -> SerialPath | GraphPath:
+@dataclass(frozen=True)
+class ActuatedGraphPath(GraphPath):
+    """A mechanism whose legs have loops inside them along a path its actuators drive (a :class:`Path` with
+    ``configurations``, :func:`~screwkit.studies.actuator_paths.path_from_actuators`): the samples at the closed
+    configurations the actuators reached; between two samples the actuators move linearly along the segment, each
+    position closed from the sample before it (:func:`~screwkit.io.graph_actuators.follow_actuators`, one position
+    after the other: a continuation in joint space, as the path's own), so the task coordinates may fold where the
+    actuators do not."""
+
+    path: Path | None = None
+
+    def samples(self, poses: NDArray) -> tuple[Indices, list[NDArray[np.float64]]]:
+        indices, q = graph_indices_at_poses(self.graph, poses, configurations=True, closed=self.path.configurations,
+                                            **self.keywords)
+        return indices, self._values(q)
+
+    def _closed(self, positions: NDArray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The task poses (k, n_task) and closed configurations (k, nq; NaN where the closures cannot follow the
+        actuators) at arc lengths ``positions`` (k,)."""
+        path, graph = self.path, self.graph
+        wanted = np.clip(np.asarray(positions, dtype=float).reshape(-1), 0.0, path.length)
+        segment = np.clip(np.searchsorted(path.arc_length, wanted, side="right") - 1, 0, path.samples - 2)
+        span = path.arc_length[segment + 1] - path.arc_length[segment]
+        fraction = np.where(span > 0, (wanted - path.arc_length[segment]) / np.where(span > 0, span, 1.0), 0.0)
+        values = path.actuators[segment] + fraction[:, None] * (path.actuators[segment + 1] - path.actuators[segment])
+        q = np.full((wanted.size, graph.kinematics.nq), np.nan)
+        for row, (start, value) in enumerate(zip(segment, values)):  # (each a continuation from its sample)
+            try:
+                q[row] = follow_actuators(graph, path.configurations[start], value, exact=False)
+            except ValueError:
+                continue
+        poses = path.at(wanted)
+        closed = np.isfinite(q).all(axis=1)
+        poses[closed] = graph.frame_pose(q[closed])[:, list(graph.task_axes)]
+        return poses, q
+
+    def indices_along(self, path: Path, positions: NDArray) -> Indices:
+        poses, q = self._closed(positions)
+        return graph_indices_at_poses(self.graph, poses, closed=q, **self.keywords)
+
+    def joint_values_along(self, path: Path, positions: NDArray) -> list[NDArray[np.float64]]:
+        _, q = self._closed(positions)
+        if self.analysis.limits:
+            closed = np.isfinite(q).all(axis=1)
+            q[closed] = np.where(beyond_limits(self.graph.kinematics, q[closed], self.graph.limited,
+                                               self.graph.scale).any(axis=1)[:, None], np.nan, q[closed])
+        return self._values(q)
+
+    def unreachable_along(self, path: Path, position: float, status: NDArray) -> tuple[str, str]:
+        """``"joint limit"`` where the actuators' configuration puts joints beyond their limits, else
+        ``"closure"`` (the closures cannot follow the actuators there from the sample before)."""
+        pose, q = self._closed(np.array([position]))
+        graph = self.graph
+        names = spelled_pose(graph.task_coordinates, pose[0])
+        if np.isfinite(q[0]).all():
+            beyond = joints_beyond_limits(graph.tree.model, graph.kinematics, q[0], graph.limited, graph.scale)
+            return "joint limit", (f"{graph.tree.source}: at ({names}) the configuration the actuators reach puts "
+                                   f"joints beyond their limits: {'; '.join(beyond)}")
+        return "closure", (f"{graph.tree.source}: the closures cannot follow the actuators from the sample before "
+                           f"to arc length {position:.6g} m (out of reach, or past a singular configuration)")
+
+    def working_modes(self) -> dict[str, str]:
+        mode = ("the one the actuators reach from the file's configuration, sample after sample (continuation in "
+                "joint space)")
+        return {leg.name: mode for leg in self.graph.legs}
+
+
+def path_mechanism(mechanism: Any, analysis: AnalysisOptions, keywords: dict, path: Path | None = None
+                   ) -> SerialPath | GraphPath:
     """The :class:`SerialPath` or :class:`GraphPath` of ``mechanism``, with the index keywords of ``analysis``
-    (``keywords``: detail, threads, ...); a ValueError when a graph is asked for what it does not have (closed
-    forms, link faults)."""
+    (``keywords``: detail, threads, ...); for a graph along a ``path`` its actuators drive, an
+    :class:`ActuatedGraphPath`; a ValueError when a graph is asked for what it does not have (closed forms, link
+    faults)."""
     if isinstance(mechanism, GraphMechanism):
         check_graph_analysis(mechanism, analysis.closed_forms, analysis.fault_type)
         graph_keywords = {k: v for k, v in keywords.items() if k not in ("closed_forms", "fault_type")}
+        if path is not None and path.configurations is not None:
+            return ActuatedGraphPath(mechanism, analysis, graph_keywords, path)
         return GraphPath(mechanism, analysis, graph_keywords)
     return SerialPath(mechanism, analysis, keywords)
 

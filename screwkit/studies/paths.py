@@ -74,12 +74,19 @@ class Path:
         The weight of angles in the arc length (m per rad): the mechanism's length scale.
     times : ndarray (n,) or None
         The time of each sample (s), increasing, when the path has them.
+    actuators, configurations : ndarray (n, a) and (n, nq), or None
+        Of a mechanism whose legs have loops inside them driven along the path by its actuators
+        (:func:`~screwkit.studies.actuator_paths.path_from_actuators`): the actuators' values (rad, m) and the closed
+        configuration they reach at each sample, from which the path is analysed (between samples, the actuators
+        move linearly along each segment).
     """
 
     poses: NDArray[np.float64]
     arc_length: NDArray[np.float64]
     length_scale: float
     times: NDArray[np.float64] | None = None
+    actuators: NDArray[np.float64] | None = None
+    configurations: NDArray[np.float64] | None = None
 
     @property
     def length(self) -> float:

@@ -469,8 +469,8 @@ def check_graph_analysis(graph: GraphMechanism, closed_forms: bool = False, faul
 
 def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,
                            threshold: float = SINGULARITY_THRESHOLD, faults=None, limits: bool = True,
-                           threads: int | None = None, chunk_size: int = GRAPH_CHUNK,
-                           progress: Callable[[int], None] | None = None, configurations: bool = False):
+                           threads: int | None = None, chunk_size: int = GRAPH_CHUNK, configurations: bool = False,
+                           closed: NDArray | None = None):
     """Every index of a closed-loop graph (:mod:`screwkit.io.graph`) at a batch of task-coordinate poses.
 
     ``poses`` (..., len(graph.task_axes)) are the output frame's task coordinates (``graph.task_coordinates``; m
@@ -479,13 +479,16 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
     NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw. With
     ``configurations``, ``(indices, q)``: also the closed configurations (..., nq) solved (NaN where unreachable),
-    which a path needs to see its working mode without solving twice.
+    which a path needs to see its working mode without solving twice. ``closed``: those configurations (..., nq)
+    already known (a path its actuators drive), not solved again; a row of NaN, or with ``limits`` beyond a joint's
+    limits, unreachable.
     """
     from screwkit.io.graph import dimension_groups, equivalent_chains, leg_screws  # graphs only: off other paths
+    from screwkit.io.graph_kinematics import beyond_limits  # (the same reason)
 
     poses = graph.check_poses(poses)
     n_task = graph.n_task
-    _check_settings(faults, threshold, progress, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
+    _check_settings(faults, threshold, None, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]
@@ -497,7 +500,13 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     kept = np.full((count, graph.kinematics.nq), np.nan) if configurations else None
     for start in range(0, count, chunk_size):
         part = slice(start, min(start + chunk_size, count))
-        q, reached = graph.solve(flat[part], limits=limits)
+        if closed is None:
+            q, reached = graph.solve(flat[part], limits=limits)
+        else:
+            q = np.asarray(closed, dtype=float).reshape(-1, graph.kinematics.nq)[part]
+            reached = np.isfinite(q).all(axis=1)
+            if limits and reached.any():
+                reached[reached] = ~beyond_limits(graph.kinematics, q[reached], graph.limited, graph.scale).any(axis=1)
         index = np.flatnonzero(reached)
         reachable[index + start] = True
         if kept is not None:
@@ -512,8 +521,6 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
                                  faults=faults, threads=threads, dof=n_task)
                 meta = result
                 scatter(arrays, count, index[rows] + start, result)
-        if progress is not None:
-            progress(part.stop - part.start)
     chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
     names = graph.actuators
     fill_unreachable(arrays)

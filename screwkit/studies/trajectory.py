@@ -292,7 +292,7 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
         tolerance = RELATIVE_TOLERANCE * min(mechanism.length_scale, 1e3 * path.length)
     tolerance = checked_tolerance(path, tolerance)  # from a few ulps of the arc length to below the path's length
 
-    along = path_mechanism(mechanism, analysis, dict(analysis.keywords(), detail=True, threads=threads))
+    along = path_mechanism(mechanism, analysis, dict(analysis.keywords(), detail=True, threads=threads), path)
     check_path_size(along, path.samples)  # before anything is computed
     samples, joint_values = along.samples(path.poses)
     faults = samples.faults
@@ -315,7 +315,7 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
 
     def evaluate(positions: NDArray, series: NDArray) -> NDArray[np.float64]:
         evaluations[0] += positions.size
-        found = table(along.indices(path.at(positions)))
+        found = table(along.indices_along(path, positions))
         probed.append((positions, found))
         return found[np.arange(positions.size), series]
 
@@ -378,7 +378,7 @@ def trajectory(mechanism: Mechanism | GraphMechanism, path: Path | ArrayLike, *,
                                                                  if kk == reach_series})
     chains = along.chains
     changes = branch_changes(chains, mechanism.length_scale, s, joint_values,
-                             lambda at: along.joint_values(path.at(at)), tolerance)
+                             lambda at: along.joint_values_along(path, at), tolerance)
     events = _events(along, path, samples, unreachable) + tuple(
         PathEvent(c.kind, c.start, c.stop, c.samples, describe(chains, c)) for c in changes) + tuple(
         PathEvent("singular", at, at, (i, min(i + 1, len(s) - 1)), SINGULAR_REASON.format(chain=name))
@@ -527,10 +527,11 @@ def _events(along: SerialPath | GraphPath, path: Path, samples: Indices, unreach
         inside = np.flatnonzero((s >= start) & (s <= stop) & ~np.asarray(samples.reachable))
         if inside.size:
             first, last = int(inside[0]), int(inside[-1])
-            kind, reason = along.unreachable(path.poses[first], status[first])
+            kind, reason = along.unreachable_along(path, float(s[first]), status[first])
         else:  # between two samples (found by the searches): the samples either side, why at its middle
-            last = int(np.searchsorted(s, (start + stop) / 2))
-            first, middle = last - 1, path.at(np.array([(start + stop) / 2]))
-            kind, reason = along.unreachable(middle[0], np.asarray(along.indices(middle).chain_status)[0])
+            last, middle = int(np.searchsorted(s, (start + stop) / 2)), np.array([(start + stop) / 2])
+            first = last - 1
+            status_there = np.asarray(along.indices_along(path, middle).chain_status)[0]
+            kind, reason = along.unreachable_along(path, float(middle[0]), status_there)
         events.append(PathEvent(kind, float(start), float(stop), (first, last), reason))
     return tuple(events)

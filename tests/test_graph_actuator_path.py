@@ -1,0 +1,148 @@
+"""A path given in actuator values (``trajectory --actuators``) of a mechanism whose legs have loops inside them.
+
+Such a path was refused ("posed by the output frame only"). It is now followed in joint space: each sample's
+configuration from the one before, the actuators moved in small steps and the closures assembled with them held
+(``screwkit.io.graph_actuators.follow_actuators``); the trajectory analyses those configurations, and between two
+samples moves the actuators linearly along the segment. Posing it by its task coordinates instead would go wrong
+past a fold of them: the parallelogram of ``test_idle_dyad`` (a dyad on its rocker, read as a graph) has the
+coupler's x as its coordinate, which peaks near 68 deg of crank and comes back, so a pose past the peak closes
+from the file's configuration on the near side of it (another crank angle).
+
+Checked against the linkage's geometry (``test_graph_actuators.textbook``: ITI = LMTI = 1 and the CTI
+|sin(B'C', C'D)| at crank angle theta), in m, mm and a turned world, listed the other way round; a crank's stop
+located where the crank reaches it; the redundant rod-level Delta driven by the arm angles of a pose path back onto
+that path, with the textbook pressure angles there; the command as users run it.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from test_graph_actuators import textbook
+from test_graph_batch import open_delta
+from test_graph_legs import POSES
+from test_graph_legs import textbook as delta_textbook
+from test_idle_dyad import A, B, linkage
+
+from helpers import MJCF_WORLDS, mjcf_variant, one_line_error, screwkit
+from screwkit.io import read_closed_tree
+from screwkit.io.closed_tree import joint_value
+from screwkit.io.graph import graph_mechanism
+from screwkit.studies.actuator_paths import path_from_actuators
+from screwkit.studies.trajectory import trajectory
+
+CRANK = np.linspace(-40.0, 150.0, 20)
+"""Crank angles (deg) from below the file's to well past the peak of the coupler's x."""
+
+
+def coupler_x(degrees) -> np.ndarray:
+    """The x of the coupler's origin B' = A + R(theta)(B - A) (the crank turned about y)."""
+    angle = np.radians(degrees)
+    return A[0] + np.cos(angle) * (B - A)[0] + np.sin(angle) * (B - A)[2]
+
+
+def _parallelogram(tmp_path, variant="m", reverse=False, limited=False):
+    def text(scale, world):
+        written = linkage(scale, world, dyad="rocker", reverse=reverse)
+        return written.replace('name="crank" type="hinge" axis="0 1 0"', 'name="crank" type="hinge" axis="0 1 0" '
+                               'range="-60 60" limited="true"') if limited else written
+    path, unit = mjcf_variant(tmp_path, f"para_{reverse}_{limited}", variant, text)
+    return path, graph_mechanism(read_closed_tree(path, output="coupler", length_unit=unit))
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_crank_path_past_the_fold_of_its_coordinate_reads_the_parallelogram_at_every_sample(tmp_path, variant):
+    _, graph = _parallelogram(tmp_path, variant)
+    path = path_from_actuators(graph, np.radians(CRANK)[:, None])
+    if variant == "m":  # (the coordinate folds: x rises to its peak and comes back)
+        np.testing.assert_allclose(path.poses[:, 0], coupler_x(CRANK), atol=1e-12)
+        assert np.argmax(path.poses[:, 0]) not in (0, len(CRANK) - 1)
+    result = trajectory(graph, path)
+    assert result.summary()["reachable_samples"] == len(CRANK) and not result.events
+    np.testing.assert_allclose(np.asarray(result.indices.iti), 1.0, atol=1e-9)
+    np.testing.assert_allclose(np.asarray(result.indices.lmti), 1.0, atol=1e-9)
+    np.testing.assert_allclose(np.asarray(result.indices.cti), [textbook(d) for d in CRANK], atol=1e-9)
+
+
+def test_the_same_with_the_linkage_listed_the_other_way_round(tmp_path):
+    _, graph = _parallelogram(tmp_path, reverse=True)
+    result = trajectory(graph, path_from_actuators(graph, np.radians(CRANK)[:, None]))
+    np.testing.assert_allclose(np.asarray(result.indices.cti), [textbook(d) for d in CRANK], atol=1e-9)
+
+
+def test_a_crank_stop_on_the_path_is_located_where_the_crank_reaches_it(tmp_path):
+    """Range +-60 deg, the crank driven from 0 to 90 deg: reachable up to 60 deg, a joint limit after it, located
+    to the trajectory's tolerance at the arc length x(60) - x(0) (x rises all the way to 60 deg)."""
+    _, graph = _parallelogram(tmp_path, limited=True)
+    degrees = np.linspace(0.0, 90.0, 10)
+    result = trajectory(graph, path_from_actuators(graph, np.radians(degrees)[:, None]))
+    [event] = result.events
+    assert event.kind == "joint limit" and "'crank' at 70 deg, limits [-60, 60] deg" in event.reason
+    assert event.start == pytest.approx(coupler_x(60.0) - coupler_x(0.0), abs=result.tolerance)
+    assert event.stop == pytest.approx(result.path.length, abs=1e-12)
+    assert result.summary()["reachable_samples"] == int(np.sum(degrees <= 60.0))
+
+
+def test_the_redundant_rod_level_delta_driven_by_its_arms_follows_the_pose_path(tmp_path):
+    """Four arms, three DOF: the arm angles of a straight pose path (each pose closed by the pose solver), given
+    as the actuators' path, drive the platform back onto those poses (an independent solve: the actuators held,
+    not the pose), with the textbook pressure angles there."""
+    graph = open_delta(tmp_path)
+    steps = np.linspace(-1.0, 1.0, 7)[:, None] * np.array([0.08, 0.05, 0.04])
+    poses = graph.task_pose() + steps
+    closed, reached = graph.solve(poses)
+    assert reached.all()
+    motors = [leg.actuators[0] for leg in graph.legs]
+    values = np.array([[joint_value(graph.tree.model, joint, q) for joint in motors] for q in closed])
+    path = path_from_actuators(graph, values)
+    np.testing.assert_allclose(path.poses, poses, atol=1e-9)
+    result = trajectory(graph, path)
+    for k, step in enumerate(steps):
+        expected = delta_textbook(np.add(POSES[0], step))
+        np.testing.assert_allclose(result.indices.iti_actuators[k], expected["iti"], atol=1e-9)
+        np.testing.assert_allclose(result.indices.lmti[k], expected["lmti"], atol=1e-9)
+
+
+def test_the_command_follows_a_crank_path_past_the_fold_and_refuses_disagreeing_arms(tmp_path):
+    """``trajectory FILE PATH --actuators``: the crank's column in deg, the summary as JSON and the netCDF with the
+    textbook CTI at every sample; a Delta's four arms whose values no configuration takes refused in one line
+    naming the sample."""
+    import xarray as xr
+
+    model, _ = _parallelogram(tmp_path)
+    path, out = tmp_path / "crank.csv", tmp_path / "crank.nc"
+    path.write_text("crank\n" + "\n".join(f"{d!r}" for d in CRANK) + "\n")
+    completed = screwkit("trajectory", model, path, "--actuators", "--output", "coupler", "--json", "--out", out)
+    assert completed.returncode == 0, completed.stderr
+    summary = json.loads(completed.stdout)
+    assert summary["samples"] == summary["reachable_samples"] == len(CRANK) and summary["events"] == []
+    with xr.open_dataset(out) as dataset:
+        np.testing.assert_allclose(dataset["cti"].values, [textbook(d) for d in CRANK], atol=1e-9)
+    arms = tmp_path / "arms.csv"
+    arms.write_text("arm_1,arm_2,arm_3,arm_4\n0,0,0,0\n10,0,0,0\n")
+    one_line_error(screwkit("trajectory", "delta_rods_4", arms, "--actuators"), "sample 1", "(10, 0, 0, 0",
+                   "disagree")
+
+
+def test_the_redundant_delta_posed_by_its_arms_rounded_as_written_reads_that_pose(tmp_path):
+    """``at_actuators`` (``analyze --actuators``) on the four-arm Delta, away from the file's pose: the arm angles
+    of a pose, written to 1e-4 deg, agree only to that rounding. Held all four at once at every step, they closed
+    no step (a false refusal), and held at those values the loops close only to 1e-7 m, where the graph read 2 DOF.
+    The steps now hold three arms, and the configuration is the closed one nearest to all four: 3 DOF, the pose to
+    the rounding, the textbook indices there; an arm 1 deg off is refused, saying by how much it misses."""
+    graph = open_delta(tmp_path)
+    step = np.array([0.08, 0.05, 0.04])
+    closed, reached = graph.solve(graph.task_pose() + step[None])
+    motors = [leg.actuators[0] for leg in graph.legs]
+    values = np.radians(np.round(np.degrees([joint_value(graph.tree.model, j, closed[0]) for j in motors]), 4))
+    moved = graph.at_actuators(values)
+    assert moved.dof == 3 and moved.task_coordinates == ("x", "y", "z")
+    np.testing.assert_allclose(moved.task_pose(), graph.task_pose() + step, atol=1e-5)
+    result, expected = moved.indices(), delta_textbook(np.add(POSES[0], moved.task_pose() - graph.task_pose()))
+    np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=1e-9)
+    np.testing.assert_allclose(result.lmti, expected["lmti"], atol=1e-9)
+    with pytest.raises(ValueError, match="redundant actuators whose values disagree: the closed configuration "
+                                         "nearest to them misses one by"):
+        graph.at_actuators(values + np.radians([1.0, 0.0, 0.0, 0.0]))
