@@ -113,7 +113,7 @@ def test_the_command_follows_a_crank_path_past_the_fold_and_refuses_disagreeing_
 
     model, _ = _parallelogram(tmp_path)
     path, out = tmp_path / "crank.csv", tmp_path / "crank.nc"
-    path.write_text("crank\n" + "\n".join(f"{d!r}" for d in CRANK) + "\n")
+    path.write_text("crank\n" + "\n".join(repr(float(d)) for d in CRANK) + "\n")
     completed = screwkit("trajectory", model, path, "--actuators", "--output", "coupler", "--json", "--out", out)
     assert completed.returncode == 0, completed.stderr
     summary = json.loads(completed.stdout)

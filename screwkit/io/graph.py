@@ -65,7 +65,14 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import closed_samples
 from screwkit.io.couplings import check_couplings
 from screwkit.io.graph_actuators import check_actuators, follow_actuators
-from screwkit.io.graph_checks import IN_LOOP_TOLERANCE, check_legs, check_output, refuse_couples_of_forces
+from screwkit.io.graph_checks import (
+    IN_LOOP_TOLERANCE,
+    LENGTH_DEPENDENT,
+    check_legs,
+    check_output,
+    length_dependent_legs,
+    refuse_couples_of_forces,
+)
 from screwkit.io.graph_kinematics import (
     GIMBAL_LOCK,
     TreeKinematics,
@@ -223,7 +230,7 @@ class GraphMechanism:
                              f"its legs beyond {'their' if plural else 'its'} limits: {'; '.join(beyond)} "
                              "(--ignore-limits reads it all the same; --initial JOINT VALUE on such a joint, or on "
                              "the one driving it, starts the assembly inside them).")
-        return ([note for note in self.report.notes if note.startswith(DOF_AT_ROUNDING)]
+        return ([note for note in self.report.notes if note.startswith((DOF_AT_ROUNDING, LENGTH_DEPENDENT))]
                 + ([f"{LIMITS_IGNORED}{'; '.join(beyond)}"] if beyond else []))
 
     @cached_property
@@ -504,6 +511,12 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                            "point that miss it: the graph makes parallel only axes within the rounding).")
     if at_file:
         refuse_couples_of_forces(tree, legs, chains, state)
+        varying = length_dependent_legs(legs, chains)
+        if varying:
+            report.notes.append(f"{LENGTH_DEPENDENT}leg(s) {', '.join(varying)}: a constraint wrench of the leg "
+                                "neither passes through its point on the platform nor is a couple (rods not parallel), "
+                                "so the representative of its actuation wrench, and its ITI and OTI, change with the "
+                                "working length (docs/theory.md, The representative and the points)")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.turns_before = closure_turns(tree, tree.q_reference)

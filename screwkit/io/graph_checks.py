@@ -7,6 +7,7 @@ inside*)."""
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
@@ -15,7 +16,7 @@ from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.reference import actuation_wrench, working_frame
 
 __all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "couples_of_forces", "IN_LOOP_TOLERANCE",
-           "COUPLE_LIKE"]
+           "COUPLE_LIKE", "length_dependent_legs", "LENGTH_DEPENDENT", "LENGTH_CHANGE"]
 
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
@@ -148,3 +149,44 @@ def couples_of_forces(legs, chains: list[ChainScrews], state) -> list[tuple[Grap
             found.append((leg, tuple(carriers)))
     return found
 
+
+
+LENGTH_DEPENDENT = "working length in the ITI: "
+"""The start of the note naming legs whose actuation wrench's representative changes with the working length."""
+
+
+def length_dependent_legs(legs, chains: list[ChainScrews]) -> list[str]:
+    """The actuated legs whose actuation wrench (defined up to the leg's constraint wrenches) has a representative,
+    the least-norm one in working coordinates with moments about the leg's point on the platform
+    (:func:`screwkit.screw.reference.actuation_wrench`), that changes with the working length ``L``: where a
+    constraint wrench of the leg neither passes through that point nor is a couple (two rods that are not
+    parallel: their lines meet, and so does the constraint force). Its ITI and OTI then do too. The wrench of least
+    norm in |f|^2 + |m_d|^2 / L^2 is compared at the working length and at a thousandth of it."""
+    _, _, _, length = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
+    found = []
+    for leg, chain in zip(legs, chains):
+        if not leg.actuators or len(chain.twists) < 2:
+            continue
+        omega, d = chain.twists[:, :3], chain.points[-1]
+        at_d = chain.twists[:, 3:] + np.cross(omega, d)  # each twist's velocity at d
+        at_length, near_zero = (_representative(omega, at_d, scale, length) for scale in (length, 1e-3 * length))
+        if at_length is not None and near_zero is not None and \
+                min(np.linalg.norm(at_length - near_zero), np.linalg.norm(at_length + near_zero)) > LENGTH_CHANGE:
+            found.append(leg.name)
+    return found
+
+
+def _representative(omega: NDArray, at_d: NDArray, scale: float, length: float) -> NDArray | None:
+    """The unit wrench (f, m_d / ``length``) of least norm in |f|^2 + |m_d|^2 / ``scale``^2 doing unit work on the
+    first of the twists (``omega``, velocities ``at_d`` at d) and none on the others; None at an input singularity."""
+    rows = np.concatenate([scale * omega, at_d], axis=1)
+    solution = np.linalg.pinv(rows)[:, 0]
+    if np.max(np.abs(rows @ solution - np.eye(len(rows))[0])) > 1e-9 * max(1.0, np.max(np.abs(solution))):
+        return None  # (no wrench does work on the actuator alone)
+    wrench = np.concatenate([solution[3:], solution[:3] * scale / length])
+    return wrench / np.linalg.norm(wrench)
+
+
+LENGTH_CHANGE = 1e-6
+"""How far (unit wrenches, working coordinates) the representative may move between the working length and a
+thousandth of it before :func:`length_dependent_legs` names the leg."""

@@ -1,0 +1,54 @@
+"""A leg whose constraint wrench misses its platform point: the ITI depends on the working length, and it is said.
+
+The actuation wrench is defined up to the leg's constraint wrenches; screwkit's representative is the least-norm one
+in working coordinates with moments about the leg's point on the platform, and its power coefficients (the ITI, the
+OTI) depend on the representative. A Delta leg of two parallel rods holds a couple, and the representative, the
+force along the rods through the midline, is the same at any working length. Rods that converge (a published
+onshape export's, 1.4 deg from parallel) hold a force through the point where their lines meet, and the
+representative turns with the working length (``docs/theory.md``, *The representative and the working length*):
+the reading says so on every command, naming the legs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from delta_rods import SPACING, delta_rods_mjcf
+from test_graph_legs import POSES
+
+from helpers import random_rotation, screwkit
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.graph_checks import LENGTH_DEPENDENT
+from screwkit.io.mjcf import read_mjcf
+
+AZIMUTHS = np.radians([90.0, 210.0, 330.0])
+TRANSFORMS = {"m": None, "mm": (1000.0, np.eye(3), np.zeros(3)),
+              "turned": (1.0, random_rotation(np.random.default_rng(4)), np.array([0.3, -1.2, 2.0]))}
+
+
+def _notes(tmp_path, spacing, transform):
+    path = tmp_path / "delta.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], AZIMUTHS, transform=transform, platform_spacing=spacing))
+    graph = graph_mechanism(read_mjcf(path))
+    return [note for note in graph.reading_notes() if note.startswith(LENGTH_DEPENDENT)], graph
+
+
+@pytest.mark.parametrize("variant", sorted(TRANSFORMS))
+def test_converging_rods_are_said_to_make_the_iti_depend_on_the_working_length(tmp_path, variant):
+    said, graph = _notes(tmp_path, 0.05, TRANSFORMS[variant])
+    assert len(said) == 1 and all(f"{leg.name}" in said[0] for leg in graph.legs), said
+    assert "rods not parallel" in said[0]
+
+
+@pytest.mark.parametrize("variant", sorted(TRANSFORMS))
+def test_parallel_rods_say_nothing_of_it(tmp_path, variant):
+    said, _ = _notes(tmp_path, SPACING, TRANSFORMS[variant])
+    assert said == []
+
+
+def test_the_command_says_it_on_stderr(tmp_path):
+    path = tmp_path / "trapezoids.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], AZIMUTHS, platform_spacing=0.05))
+    completed = screwkit("analyze", path, "--json")
+    assert completed.returncode == 0, completed.stderr
+    assert f"{LENGTH_DEPENDENT}leg(s)" in completed.stderr
