@@ -358,6 +358,11 @@ def solve(
     )
 
 
+BOUNDARY_MISS = 1e-9
+"""A closure missed by less than this many length scales is said to miss at the boundary of the reach, to rounding
+(a chain stretched or folded exactly: a pose typed on the boundary misses by about 1e-12 of them), not outside it."""
+
+
 def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = ()) -> str:
     """Why the pose at ``index`` of a solution is unreachable, worst chain first (one line)."""
     check_solution(mechanism, solution, "unreachable_reason")
@@ -376,14 +381,17 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
     if len(missing) > 1 and mechanism.dependent_indices and np.allclose(shared, shared[0], rtol=1e-9, atol=0.0):
         # the dependent coordinates were solved with every chain together: one residual for all of them
         dependent = ", ".join(mechanism.pose_coordinates[i] for i in mechanism.dependent_indices)
+        where = ("on the boundary of the workspace to rounding, where chains stretch or fold: a singular "
+                 "configuration, whose indices a pose beside it reads" if shared[0] < BOUNDARY_MISS * max(
+                     1.0, mechanism.length_scale) else "outside the workspace")
         parts.append(f"no {dependent} closes chains {', '.join(repr(mechanism.chains[c].name) for c in missing)} "
                      f"together (the closure of the dependent coordinates misses by {shared[0]:.6g}, Newton error "
-                     "norm in m and rad: the pose is outside the workspace)")
+                     f"norm in m and rad: the pose is {where})")
         missing = []
     for c in missing:
         chain = mechanism.chains[c]
         unit = "m" if chain.closed_form is not None else "(Newton error norm, m and rad)"
-        if chain.closed_form is not None and residuals[c] < 1e-12 * mechanism.length_scale:
+        if chain.closed_form is not None and residuals[c] < BOUNDARY_MISS * mechanism.length_scale:
             parts.append(f"chain {chain.name!r} closes only to rounding (the pose is on the boundary of its reach, "
                          "or its end on the axis of its base joint, where its joint values are not determined)")
         elif chain.closed_form is None and chain.branch is not None and \
