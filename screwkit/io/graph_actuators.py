@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from screwkit.io.closed_tree import ClosedTree, ImportError_, assemble, joint_kind, joint_value, path_to
 from screwkit.io.graph_kinematics import STAGE_LENGTH
 from screwkit.io.locking import put_joint_value
+from screwkit.io.output import platform_body
 
 __all__ = ["check_actuators", "serial_stage", "follow_actuators", "AGREEMENT"]
 
@@ -128,6 +129,18 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
                 "platform (a wheel or a tool it carries, through which the leg's closure reaches it): --lock "
                 f"{' --lock '.join(riding)} holds {'it' if one else 'them'}, or --output names the body "
                 f"{'it turns' if one else 'they turn'}"), riding
+    ends = {end for closure in leg.closures for end in (closure.joint_a, closure.joint_b)}
+    tail = [a for a in leg.actuators if a in path_to(model, platform) and not any(a in path_to(model, end)
+                                                                                 for end in ends)]
+    if tail and len(tail) < len(leg.actuators):  # (a wrist the platform carries, the output on it)
+        names = [tree.written_joint(model.names[a]) for a in tail]
+        meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
+                        if int(frame.parentJoint) == model.parents[min(tail)]), None)
+        return (f"; actuated joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))} turn"
+                f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
+                + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
+                + " --lock ".join(names) + " holds it" + (f", or --output {meeting} takes that body" if meeting
+                                                            else "")), names
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
         names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
