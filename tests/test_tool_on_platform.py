@@ -5,7 +5,9 @@ onshape-to-robot Delta carries its gripper. With the tool as the output, the wri
 the platform hangs on, and a leg with loops inside it and several actuators is refused: the refusal now says the
 wrist turns the output after the body where the legs' loops end, and that ``--lock wrist`` holds it or
 ``--output platform`` takes that body. Held, the tool reads the platform's indices (it moves with it); in m, mm
-and a turned world.
+and a turned world. With it, three more refusals a tester met on published files: a driven joint on the tool alone
+(said to be on no leg), a Delta's motor no longer offered as a serial stage to hold, and the closed forms' refusal
+naming the mechanism and its driven joints.
 """
 
 from __future__ import annotations
@@ -47,3 +49,42 @@ def test_a_tool_as_the_output_is_refused_naming_the_wrist_and_the_platform(tmp_p
     platform = graph_mechanism(read_closed_tree(path, output="platform")).indices()
     np.testing.assert_allclose(held.iti_actuators, platform.iti_actuators, atol=1e-9)
     np.testing.assert_allclose([held.lmti, held.f_o[1]], [platform.lmti, platform.f_o[1]], atol=1e-9)
+
+
+def test_a_driven_joint_on_the_tool_alone_is_said_to_be_on_no_leg(tmp_path):
+    """``--actuate wrist`` alone: no leg has an actuator, and the refusal now says the joint named is on none."""
+    path = _with_wrist(tmp_path, None)
+    with pytest.raises(ImportError_, match="no leg has an actuator .*--actuate names the driven joints; 'wrist' is "
+                                           "on no leg \\(a tool the platform carries"):
+        graph_mechanism(read_closed_tree(path, output="platform", actuate=("wrist",)))
+
+
+def test_a_delta_motor_shared_by_two_rods_is_not_offered_as_a_serial_stage(tmp_path):
+    """The serial reading's refusal of a rod Delta (two rods on each arm share its motor) went on "'motor_1' is
+    actuated: if it is a serial stage before the parallel part, --lock motor_1 ...": a Delta's motor carries no other
+    motor, and holding it leaves the platform one motion short. It names the graph reading only now."""
+    from sdformat_models import delta_sdf
+
+    from screwkit.io import LegWithLoops, read_mechanism_file
+
+    path = tmp_path / "delta.sdf"
+    path.write_text(delta_sdf())
+    with pytest.raises(LegWithLoops) as refused:
+        read_mechanism_file(path)
+    assert "share joint 'motor_1'" in str(refused.value) and "--lock" not in str(refused.value)
+
+
+def test_the_closed_forms_refusal_names_the_mechanism_and_the_driven_joints(tmp_path):
+    """``verify`` (the planar closed forms) on the parallelogram read as serial legs: the refusal printed a Python
+    tuple, ``actuated (0,)``, and no mechanism; it names both and the way round."""
+    from test_idle_dyad import linkage
+
+    from screwkit.io.loader import load
+    from screwkit.studies.poses import indices_at_poses
+
+    path = tmp_path / "parallelogram.xml"
+    path.write_text(linkage(dyad=None))
+    mechanism = load(path, output="coupler", output_type="frame")
+    with pytest.raises(ValueError, match="chain 'crank' of 'parallelogram' has 2 joint\\(s\\), actuated: 'crank' "
+                                         "\\(the generic path reads it: `analyze`, without the closed forms\\)"):
+        indices_at_poses(mechanism, mechanism.home_pose[None], closed_forms=True)

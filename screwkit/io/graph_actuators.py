@@ -94,8 +94,12 @@ def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
     them all); ``platform``: the platform body's joint."""
     model = tree.model
     if not any(leg.actuators for leg in legs):
+        on_legs = {model.names[joint] for leg in legs for joint in leg.joints}
+        off = [name for name in dict.fromkeys(tree.motors) if name not in on_legs]
         raise ImportError_(f"{tree.source}: no leg has an actuator (legs {', '.join(leg.name for leg in legs)}): "
-                           "--actuate names the driven joints.")
+                           "--actuate names the driven joints" + (
+                               f"; {', '.join(map(repr, off))} {'is' if len(off) == 1 else 'are'} on no leg (a tool "
+                               "the platform carries, or a branch off the legs: left out)" if off else "") + ".")
     several = [leg for leg in legs if len(leg.actuators) > 1]
     if several:
         leg = several[0]

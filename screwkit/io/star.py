@@ -347,7 +347,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
                     joint in path_to(model, model.getJointId(motor)) for motor in tree.motors
                     if model.existJointName(motor))
                 stage = (f"; {name!r} is actuated: if it is a serial stage before the parallel part, --lock {name} "
-                         "analyses the legs on the body it turns" if name in tree.motors else
+                         "analyses the legs on the body it turns" if name in tree.motors and carries_all else
+                         "" if name in tree.motors else
                          f"; every actuator rides on {name!r}: if it is a serial stage before the parallel part, "
                          f"--lock {name} analyses the legs on the body it turns" if carries_all else "")
                 raise LegWithLoops(f"{tree.source}: closure {leg.closure!r} and {first} share joint {name!r}: a "

@@ -80,8 +80,10 @@ def planar_points(mechanism: Mechanism, solution):
     for chain in mechanism.chains:
         prismatic = tuple(chain.prismatic)
         if chain.n_joints != 3 or chain.actuated not in ((0,), (1,)):
-            raise ValueError(f"The closed forms need RRR or RPR chains with one actuator; chain {chain.name!r} "
-                             f"has {chain.n_joints} joints, actuated {chain.actuated}.")
+            driven = ", ".join(repr(chain.joint_names[i]) for i in chain.actuated) or "none"
+            raise ValueError(f"The closed forms need RRR or RPR chains with one actuator; chain {chain.name!r} of "
+                             f"{mechanism.name!r} has {chain.n_joints} joint(s), actuated: {driven} (the generic "
+                             "path reads it: `analyze`, without the closed forms).")
         if prismatic == (False, False, False) and chain.actuated == (0,):
             kinds.add("rrr")
         elif prismatic == (False, True, False) and chain.actuated == (1,):
