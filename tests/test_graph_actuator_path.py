@@ -31,6 +31,8 @@ from screwkit.io import read_closed_tree
 from screwkit.io.closed_tree import joint_value
 from screwkit.io.graph import graph_mechanism
 from screwkit.studies.actuator_paths import path_from_actuators
+from screwkit.studies.options import AnalysisOptions
+from screwkit.studies.path_mechanisms import path_mechanism
 from screwkit.studies.trajectory import trajectory
 
 CRANK = np.linspace(-40.0, 150.0, 20)
@@ -74,13 +76,14 @@ def test_the_same_with_the_linkage_listed_the_other_way_round(tmp_path):
 
 def test_a_crank_stop_on_the_path_is_located_where_the_crank_reaches_it(tmp_path):
     """Range +-60 deg, the crank driven from 0 to 90 deg: reachable up to 60 deg, a joint limit after it, located
-    to the trajectory's tolerance at the arc length x(60) - x(0) (x rises all the way to 60 deg)."""
+    to the trajectory's tolerance at 60 deg along the path (its arc length is along the actuator: the crank's
+    angle times the length scale)."""
     _, graph = _parallelogram(tmp_path, limited=True)
     degrees = np.linspace(0.0, 90.0, 10)
     result = trajectory(graph, path_from_actuators(graph, np.radians(degrees)[:, None]))
     [event] = result.events
     assert event.kind == "joint limit" and "'crank' at 70 deg, limits [-60, 60] deg" in event.reason
-    assert event.start == pytest.approx(coupler_x(60.0) - coupler_x(0.0), abs=result.tolerance)
+    assert event.start == pytest.approx(np.radians(60.0) * graph.length_scale, abs=result.tolerance)
     assert event.stop == pytest.approx(result.path.length, abs=1e-12)
     assert result.summary()["reachable_samples"] == int(np.sum(degrees <= 60.0))
 
@@ -143,6 +146,65 @@ def test_the_redundant_delta_posed_by_its_arms_rounded_as_written_reads_that_pos
     result, expected = moved.indices(), delta_textbook(np.add(POSES[0], moved.task_pose() - graph.task_pose()))
     np.testing.assert_allclose(result.iti_actuators, expected["iti"], atol=1e-9)
     np.testing.assert_allclose(result.lmti, expected["lmti"], atol=1e-9)
-    with pytest.raises(ValueError, match="redundant actuators whose values disagree: the closed configuration "
-                                         "nearest to them misses one by"):
+    with pytest.raises(ValueError, match="redundant actuators whose values disagree \\(or the ones held passed a "
+                                         "singular configuration on the way\\): the closed configuration nearest to "
+                                         "them misses one by"):
         graph.at_actuators(values + np.radians([1.0, 0.0, 0.0, 0.0]))
+
+
+def test_a_segment_whose_two_samples_share_a_pose_is_followed_through(tmp_path):
+    """Crank samples symmetric about the peak of the coupler's x (68.2 deg): 58.2 and 78.2 deg put the coupler at one
+    x. Between samples placed by the pose's arc length, that segment had no length, nothing inside it was seen, and
+    two working-mode changes were reported there; along the crank it has 20 deg, and the parallelogram stays on its
+    branch (no event), the CTI the linkage's at every sample."""
+    _, graph = _parallelogram(tmp_path)
+    degrees = np.array([0.0, 30.0, 58.2, 78.2, 100.0])
+    path = path_from_actuators(graph, np.radians(degrees)[:, None])
+    assert path.poses[2, 0] == pytest.approx(path.poses[3, 0], abs=1e-5)  # (0.4 um of 20 deg of crank)
+    result = trajectory(graph, path)
+    assert not result.events, result.events
+    np.testing.assert_allclose(np.asarray(result.indices.cti), [textbook(d) for d in degrees], atol=1e-9)
+    np.testing.assert_allclose(np.diff(path.arc_length), np.radians(np.diff(degrees)) * graph.length_scale,
+                               rtol=1e-12)
+
+
+def test_a_redundant_path_locates_each_failures_loss_where_the_textbook_crosses_the_level_whatever_the_names(tmp_path):
+    """The four-arm Delta driven by the arm angles of a closed loop of poses (12 samples): between samples the
+    configuration is assembled from the two samples' configurations interpolated, the same whatever the motors are
+    called (holding the first three by name moved a lost stretch by 0.7 mm, 1500 times the tolerance). With
+    ``motor_1`` renamed ``motor_9``, every failure's lost stretches are the same to the tolerance; and at each end
+    found inside the path, the textbook LMTI left after that failure (pressure angles of the geometry, at the pose
+    the configuration there has) is the level to 1e-6."""
+    graph = open_delta(tmp_path)
+    home, turn = graph.task_pose(), np.linspace(0.0, 2 * np.pi, 12)
+    poses = home + np.stack([0.08 * np.cos(turn) - 0.08, 0.08 * np.sin(turn), 0.03 * np.sin(2 * turn)], axis=1)
+    closed, reached = graph.solve(poses)
+    assert reached.all()
+    motors = [leg.actuators[0] for leg in graph.legs]
+    values = np.array([[joint_value(graph.tree.model, joint, q) for joint in motors] for q in closed])
+
+    def left(pose, failed: int) -> float:
+        oti = delta_textbook(np.add(POSES[0], pose - home))["oti"]
+        return max(value for members, value in oti.items() if failed not in members)
+
+    level = float(np.mean([left(pose, 0) for pose in poses]))
+    found = []
+    for name in ("motor_1", "motor_9"):
+        path = tmp_path / f"{name}.xml"
+        path.write_text((tmp_path / "delta.xml").read_text().replace('"motor_1"', f'"{name}"'))
+        renamed = graph_mechanism(read_closed_tree(path))
+        result = trajectory(renamed, path_from_actuators(renamed, values), level=level)
+        assert not result.events
+        found.append([case.lost for case in result.cases])
+    for first, second in zip(*found):
+        assert len(first) == len(second)
+        np.testing.assert_allclose(np.array(first, dtype=float).reshape(-1, 2),
+                                   np.array(second, dtype=float).reshape(-1, 2), atol=2 * result.tolerance)
+    along = path_mechanism(renamed, AnalysisOptions(), {}, result.path)
+    ends = [(k, at) for k, case in enumerate(result.cases) for stretch in case.lost for at in stretch
+            if 0.0 < at < result.path.length]
+    assert ends
+    for k, at in ends:
+        failed = graph.actuators.index(result.cases[k].failed[0].replace("motor_9", "motor_1"))
+        pose = np.asarray(along.indices_along(result.path, np.array([at])).full_poses)[0, :3]
+        assert left(pose, failed) == pytest.approx(level, abs=1e-6)

@@ -381,9 +381,9 @@ def unreachable_reason(mechanism: Mechanism, solution: Solution, index: tuple = 
     if len(missing) > 1 and mechanism.dependent_indices and np.allclose(shared, shared[0], rtol=1e-9, atol=0.0):
         # the dependent coordinates were solved with every chain together: one residual for all of them
         dependent = ", ".join(mechanism.pose_coordinates[i] for i in mechanism.dependent_indices)
+        on_it = shared[0] < BOUNDARY_MISS * mechanism.length_scale
         where = ("on the boundary of the workspace to rounding, where chains stretch or fold: a singular "
-                 "configuration, whose indices a pose beside it reads" if shared[0] < BOUNDARY_MISS * max(
-                     1.0, mechanism.length_scale) else "outside the workspace")
+                 "configuration, whose indices a pose beside it reads" if on_it else "outside the workspace")
         parts.append(f"no {dependent} closes chains {', '.join(repr(mechanism.chains[c].name) for c in missing)} "
                      f"together (the closure of the dependent coordinates misses by {shared[0]:.6g}, Newton error "
                      f"norm in m and rad: the pose is {where})")

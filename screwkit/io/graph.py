@@ -513,10 +513,11 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
         refuse_couples_of_forces(tree, legs, chains, state)
         varying = length_dependent_legs(legs, chains)
         if varying:
-            report.notes.append(f"{LENGTH_DEPENDENT}leg(s) {', '.join(varying)}: a constraint wrench of the leg "
+            turns = ", ".join(f"{name} ({turn:.2g} deg)" for name, turn in varying)
+            report.notes.append(f"{LENGTH_DEPENDENT}leg(s) {turns}: a constraint wrench of the leg "
                                 "neither passes through its point on the platform nor is a couple (rods not parallel), "
                                 "so the representative of its actuation wrench, and its ITI and OTI, change with the "
-                                "working length (docs/theory.md, The representative and the points)")
+                                "working length (docs/theory.md, The representative and the working length)")
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.turns_before = closure_turns(tree, tree.q_reference)

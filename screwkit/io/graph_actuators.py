@@ -15,10 +15,10 @@ from screwkit.io.graph_kinematics import STAGE_LENGTH
 from screwkit.io.locking import put_joint_value
 from screwkit.io.output import platform_body
 
-__all__ = ["check_actuators", "serial_stage", "follow_actuators", "AGREEMENT"]
+__all__ = ["check_actuators", "serial_stage", "follow_actuators", "between_samples", "AGREEMENT"]
 
 
-def follow_actuators(graph, q: NDArray, values: NDArray, *, exact: bool = True) -> NDArray[np.float64]:
+def follow_actuators(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
     """The closed configuration of ``graph`` (a :class:`~screwkit.io.graph.GraphMechanism`) with its actuated joints
     at ``values`` (rad or m, its actuators' order), reached from the closed configuration ``q`` by continuation: the
     actuators moved together in steps of at most :data:`STAGE_LENGTH` (rad, or length scales), the closures assembled
@@ -26,24 +26,47 @@ def follow_actuators(graph, q: NDArray, values: NDArray, *, exact: bool = True) 
     loops cannot close (values out of reach, past a singular configuration, or redundant ones that disagree).
 
     Redundant actuators (more than the DOF) take values that agree only on the mechanism's motions, and values
-    interpolated between two that agree do not quite: the steps hold a non-redundant set of them (the first, in the
-    order of their names, whose steps close), the others following; then, if ``exact``, the closed configuration
-    nearest to all of them at ``values`` (values rounded as a file or a logger writes them close the loops, held,
-    only to that rounding), refused if an actuator is then farther than :data:`AGREEMENT` from its value. Not
-    ``exact``: a position between two samples of a path, the set held only, the others where it puts them."""
+    interpolated between two that agree do not quite: held all at each step (the assembly takes them to the file's
+    rounding), or where those steps do not close, a non-redundant set of them held (each in turn, in the order of
+    their names), the others following; then the closed configuration nearest to all of them at ``values`` (values
+    rounded as a file or a logger writes them close the loops, held, only to that rounding), refused if an actuator
+    is then farther than :data:`AGREEMENT` from its value."""
     ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
     if len(ids) <= graph.dof:
         return _steps(graph, q, values, ids, ids)
     names = graph.tree.model.names
-    failure = None
-    for held in combinations(sorted(ids, key=lambda joint: names[joint]), graph.dof):
+    failures = []
+    for held in [ids] + [list(c) for c in combinations(sorted(ids, key=lambda joint: names[joint]), graph.dof)]:
         try:
-            found = _steps(graph, q, values, ids, list(held))
+            found = _steps(graph, q, values, ids, held)
         except ValueError as error:
-            failure = failure or error
+            failures.append(error)
             continue
-        return _agreeing(graph, found, values, ids) if exact else found
-    raise failure
+        try:
+            return _agreeing(graph, found, values, ids)
+        except ValueError as error:  # (said first: the steps closed, the values did not meet)
+            failures.insert(0, error)
+    raise failures[0]
+
+
+def between_samples(graph, first: NDArray, second: NDArray, fraction: float, values: NDArray) -> NDArray[np.float64]:
+    """The closed configuration of ``graph`` between two closed configurations of a path (``first``, ``second``) at
+    ``fraction`` of the way, its actuators at ``values``: assembled from the configuration interpolated between the
+    two (Pinocchio's ``interpolate``) with the actuators put at ``values``, held there, or, redundant (values
+    interpolated between two that agree do not quite), the closed configuration nearest to it. One assembly, the
+    same whatever the actuators' names or order; a ValueError where the loops do not close there."""
+    import pinocchio as pin  # (a file of another tool is read with it)
+
+    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
+    model = graph.tree.model
+    q = np.array(pin.interpolate(model, first, second, float(fraction)), dtype=float)
+    for joint, value in zip(ids, values):
+        put_joint_value(model, joint, q, value)
+    try:
+        return assemble(replace(graph.tree, q_reference=q, notes=[]), held=ids if len(ids) <= graph.dof else (),
+                        nearest=False)[0]
+    except ImportError_:
+        raise ValueError("the loops do not close there") from None
 
 
 AGREEMENT = 1e-5
@@ -83,8 +106,9 @@ def _agreeing(graph, q: NDArray, values: NDArray, ids: list[int]) -> NDArray[np.
     per = np.where(graph.actuator_slides, graph.scale, 1.0)
     mismatch = np.abs(np.array([joint_value(model, joint, q) for joint in ids]) - values) / per
     if not np.max(mismatch) <= AGREEMENT:
-        raise ValueError(f"redundant actuators whose values disagree: the closed configuration nearest to them "
-                         f"misses one by {np.max(mismatch):.3g} (rad, or length scales)")
+        raise ValueError(f"redundant actuators whose values disagree (or the ones held passed a singular "
+                         f"configuration on the way): the closed configuration nearest to them misses one by "
+                         f"{np.max(mismatch):.3g} (rad, or length scales)")
     return q
 
 
@@ -143,7 +167,8 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
         return (f"; actuated joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))} turn"
                 f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
                 + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
-                + " --lock ".join(names) + " holds it" + (f", or --output {meeting} takes that body" if meeting
+                + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
+                + (f", or --output {meeting} takes that body" if meeting
                                                             else "")), names
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":

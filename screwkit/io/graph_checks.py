@@ -155,13 +155,14 @@ LENGTH_DEPENDENT = "working length in the ITI: "
 """The start of the note naming legs whose actuation wrench's representative changes with the working length."""
 
 
-def length_dependent_legs(legs, chains: list[ChainScrews]) -> list[str]:
+def length_dependent_legs(legs, chains: list[ChainScrews]) -> list[tuple[str, float]]:
     """The actuated legs whose actuation wrench (defined up to the leg's constraint wrenches) has a representative,
     the least-norm one in working coordinates with moments about the leg's point on the platform
     (:func:`screwkit.screw.reference.actuation_wrench`), that changes with the working length ``L``: where a
     constraint wrench of the leg neither passes through that point nor is a couple (two rods that are not
     parallel: their lines meet, and so does the constraint force). Its ITI and OTI then do too. The wrench of least
-    norm in |f|^2 + |m_d|^2 / L^2 is compared at the working length and at a thousandth of it."""
+    norm in |f|^2 + |m_d|^2 / L^2 is compared at the working length and at a thousandth of it: each such leg's
+    name, and the angle (deg, in working coordinates) between the two."""
     _, _, _, length = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
     found = []
     for leg, chain in zip(legs, chains):
@@ -170,9 +171,10 @@ def length_dependent_legs(legs, chains: list[ChainScrews]) -> list[str]:
         omega, d = chain.twists[:, :3], chain.points[-1]
         at_d = chain.twists[:, 3:] + np.cross(omega, d)  # each twist's velocity at d
         at_length, near_zero = (_representative(omega, at_d, scale, length) for scale in (length, 1e-3 * length))
-        if at_length is not None and near_zero is not None and \
-                min(np.linalg.norm(at_length - near_zero), np.linalg.norm(at_length + near_zero)) > LENGTH_CHANGE:
-            found.append(leg.name)
+        if at_length is not None and near_zero is not None:
+            turn = float(np.degrees(np.arccos(np.clip(abs(at_length @ near_zero), 0.0, 1.0))))
+            if turn > LENGTH_CHANGE:
+                found.append((leg.name, turn))
     return found
 
 
@@ -187,6 +189,8 @@ def _representative(omega: NDArray, at_d: NDArray, scale: float, length: float) 
     return wrench / np.linalg.norm(wrench)
 
 
-LENGTH_CHANGE = 1e-6
-"""How far (unit wrenches, working coordinates) the representative may move between the working length and a
-thousandth of it before :func:`length_dependent_legs` names the leg."""
+LENGTH_CHANGE = 0.05
+"""How far (deg, between unit wrenches in working coordinates) the representative may turn between the working
+length and a thousandth of it before :func:`length_dependent_legs` names the leg: rods a file's rounding
+(:data:`~screwkit.common.tolerances.FILE_ROUNDING`, 1e-5 rad) from parallel turn it by about 2e-4 deg, and their ITI
+by a few millionths; a published Delta's rods 1.4 deg from parallel, by 0.3 to 1.3 deg, and their ITI by up to 0.05."""

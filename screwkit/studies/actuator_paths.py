@@ -27,7 +27,6 @@ deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in
 from __future__ import annotations
 
 import os
-from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,7 +38,7 @@ from screwkit.io.graph import GraphMechanism
 from screwkit.io.graph_actuators import follow_actuators
 from screwkit.model import Mechanism
 from screwkit.studies.netcdf import netcdf_file
-from screwkit.studies.paths import Path, PathFileError, path_from_poses, read_columns
+from screwkit.studies.paths import Path, PathFileError, checked_times, path_from_poses, read_columns
 
 __all__ = ["path_from_actuators", "read_actuator_path", "actuator_columns", "COARSE_SEGMENTS"]
 
@@ -118,16 +117,21 @@ def _checked(mechanism: Mechanism | GraphMechanism, values: ArrayLike) -> NDArra
 def _graph_path(graph: GraphMechanism, values: NDArray, times: ArrayLike | None) -> Path:
     """The path of a graph's output frame driven by actuator ``values`` (n, a): each sample's closed configuration
     from the one before (the first from the file's) by :func:`~screwkit.io.graph_actuators.follow_actuators`, one
-    sample after the other (each step one assembly of the closures), kept with the path."""
+    sample after the other (each step one assembly of the closures), kept with the path; its arc length is along the
+    actuators (angles times the length scale), as the task coordinates may fold or stand still where they move."""
     q, closed = graph.q, np.empty((values.shape[0], graph.kinematics.nq))
     for sample, row in enumerate(values):
         try:
             q = closed[sample] = follow_actuators(graph, q, row)
         except ValueError as error:
             raise _not_reached(graph, row, sample, f"from the {'previous sample' if sample else 'file'}'s "
-                                                   f"configuration {error}") from None
-    path = path_from_poses(graph, graph.frame_pose(closed)[:, list(graph.task_axes)], times)
-    return replace(path, actuators=values, configurations=closed)
+                                                   f"configuration, {error}") from None
+    steps = np.linalg.norm(np.diff(values, axis=0) * np.where(_angular(graph), graph.length_scale, 1.0), axis=1)
+    arc_length = np.concatenate([[0.0], np.cumsum(steps)])  # (along the actuators: the pose may fold or stand still)
+    if not arc_length[-1] > 0:
+        raise ValueError("Expected a path that moves: every sample's actuator values are the same.")
+    return Path(graph.frame_pose(closed)[:, list(graph.task_axes)], arc_length, float(graph.length_scale),
+                checked_times(times, values.shape[0]), values, closed)
 
 
 def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: NDArray) -> NDArray[np.float64]:

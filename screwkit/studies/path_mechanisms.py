@@ -13,7 +13,7 @@ graph solved at once, each pose by continuation from the file's configuration,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,7 @@ from screwkit.closure.solve import ChainStatus
 from screwkit.common.units import spelled_pose
 from screwkit.indices.results import Indices
 from screwkit.io.graph import GraphMechanism
-from screwkit.io.graph_actuators import follow_actuators
+from screwkit.io.graph_actuators import between_samples
 from screwkit.io.graph_kinematics import beyond_limits, joints_beyond_limits
 from screwkit.model import Mechanism
 from screwkit.studies.branches import ChainJoints, chain_joints
@@ -170,22 +170,23 @@ class GraphPath(_Along):
 @dataclass(frozen=True)
 class ActuatedGraphPath(GraphPath):
     """A mechanism whose legs have loops inside them along a path its actuators drive (a :class:`Path` with
-    ``configurations``, :func:`~screwkit.studies.actuator_paths.path_from_actuators`): the samples at the closed
-    configurations the actuators reached; between two samples the actuators move linearly along the segment, each
-    position closed from the sample before it (:func:`~screwkit.io.graph_actuators.follow_actuators`, one position
-    after the other: a continuation in joint space, as the path's own), so the task coordinates may fold where the
-    actuators do not."""
+    ``configurations``, :func:`~screwkit.studies.actuator_paths.path_from_actuators`, its arc length along the
+    actuators): the samples at the closed configurations the actuators reached; between two samples the actuators
+    move linearly along the segment, the configuration there the one assembled from the two samples' configurations
+    interpolated (:func:`~screwkit.io.graph_actuators.between_samples`), so the task coordinates may fold or stand
+    still where the actuators do not."""
 
     path: Path | None = None
+    found: dict = field(default_factory=dict, compare=False, repr=False)  # (configurations at arc lengths asked)
 
     def samples(self, poses: NDArray) -> tuple[Indices, list[NDArray[np.float64]]]:
-        indices, q = graph_indices_at_poses(self.graph, poses, configurations=True, closed=self.path.configurations,
+        indices, q = graph_indices_at_poses(self.graph, poses, configurations=self.path.configurations,
                                             **self.keywords)
         return indices, self._values(q)
 
     def _closed(self, positions: NDArray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The task poses (k, n_task) and closed configurations (k, nq; NaN where the closures cannot follow the
-        actuators) at arc lengths ``positions`` (k,)."""
+        actuators) at arc lengths ``positions`` (k,), each found once."""
         path, graph = self.path, self.graph
         wanted = np.clip(np.asarray(positions, dtype=float).reshape(-1), 0.0, path.length)
         segment = np.clip(np.searchsorted(path.arc_length, wanted, side="right") - 1, 0, path.samples - 2)
@@ -193,11 +194,14 @@ class ActuatedGraphPath(GraphPath):
         fraction = np.where(span > 0, (wanted - path.arc_length[segment]) / np.where(span > 0, span, 1.0), 0.0)
         values = path.actuators[segment] + fraction[:, None] * (path.actuators[segment + 1] - path.actuators[segment])
         q = np.full((wanted.size, graph.kinematics.nq), np.nan)
-        for row, (start, value) in enumerate(zip(segment, values)):  # (each a continuation from its sample)
-            try:
-                q[row] = follow_actuators(graph, path.configurations[start], value, exact=False)
-            except ValueError:
-                continue
+        for row, (at, start, part, value) in enumerate(zip(wanted, segment, fraction, values)):
+            if float(at) not in self.found:
+                try:
+                    self.found[float(at)] = between_samples(graph, path.configurations[start],
+                                                            path.configurations[start + 1], part, value)
+                except ValueError:
+                    self.found[float(at)] = q[row].copy()
+            q[row] = self.found[float(at)]
         poses = path.at(wanted)
         closed = np.isfinite(q).all(axis=1)
         poses[closed] = graph.frame_pose(q[closed])[:, list(graph.task_axes)]
@@ -205,7 +209,7 @@ class ActuatedGraphPath(GraphPath):
 
     def indices_along(self, path: Path, positions: NDArray) -> Indices:
         poses, q = self._closed(positions)
-        return graph_indices_at_poses(self.graph, poses, closed=q, **self.keywords)
+        return graph_indices_at_poses(self.graph, poses, configurations=q, **self.keywords)[0]
 
     def joint_values_along(self, path: Path, positions: NDArray) -> list[NDArray[np.float64]]:
         _, q = self._closed(positions)
@@ -225,8 +229,9 @@ class ActuatedGraphPath(GraphPath):
             beyond = joints_beyond_limits(graph.tree.model, graph.kinematics, q[0], graph.limited, graph.scale)
             return "joint limit", (f"{graph.tree.source}: at ({names}) the configuration the actuators reach puts "
                                    f"joints beyond their limits: {'; '.join(beyond)}")
-        return "closure", (f"{graph.tree.source}: the closures cannot follow the actuators from the sample before "
-                           f"to arc length {position:.6g} m (out of reach, or past a singular configuration)")
+        return "closure", (f"{graph.tree.source}: the closures do not close with the actuators between the samples "
+                           f"either side, at arc length {position:.6g} m (out of reach, or past a singular "
+                           "configuration)")
 
     def working_modes(self) -> dict[str, str]:
         mode = ("the one the actuators reach from the file's configuration, sample after sample (continuation in "

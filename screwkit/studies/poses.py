@@ -471,8 +471,8 @@ def check_graph_analysis(graph: GraphMechanism, closed_forms: bool = False, faul
 
 def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: bool = False,
                            threshold: float = SINGULARITY_THRESHOLD, faults=None, limits: bool = True,
-                           threads: int | None = None, chunk_size: int = GRAPH_CHUNK, configurations: bool = False,
-                           closed: NDArray | None = None):
+                           threads: int | None = None, chunk_size: int = GRAPH_CHUNK,
+                           progress: Callable[[int], None] | None = None, configurations: bool | NDArray = False):
     """Every index of a closed-loop graph (:mod:`screwkit.io.graph`) at a batch of task-coordinate poses.
 
     ``poses`` (..., len(graph.task_axes)) are the output frame's task coordinates (``graph.task_coordinates``; m
@@ -481,16 +481,17 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     (:func:`screwkit.io.graph.leg_screws`) and analysed as :meth:`~screwkit.io.GraphMechanism.indices` analyses one;
     NaN where a pose is unreachable. ``full_poses`` are the frame's x, y, z, roll, pitch, yaw. With
     ``configurations``, ``(indices, q)``: also the closed configurations (..., nq) solved (NaN where unreachable),
-    which a path needs to see its working mode without solving twice. ``closed``: those configurations (..., nq)
-    already known (a path its actuators drive), not solved again; a row of NaN, or with ``limits`` beyond a joint's
-    limits, unreachable.
+    which a path needs to see its working mode without solving twice; given as an array (..., nq), those
+    configurations already known (a path its actuators drive), not solved again (a row of NaN, or with ``limits``
+    beyond a joint's limits, unreachable), and returned with the indices.
     """
     from screwkit.io.graph import dimension_groups, equivalent_chains, leg_screws  # graphs only: off other paths
     from screwkit.io.graph_kinematics import beyond_limits  # (the same reason)
 
     poses = graph.check_poses(poses)
     n_task = graph.n_task
-    _check_settings(faults, threshold, None, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
+    _check_settings(faults, threshold, progress, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
+    closed = None if isinstance(configurations, bool) else np.asarray(configurations, dtype=float)
     batch = poses.shape[:-1]
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]
@@ -499,7 +500,7 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     arrays: dict = {}
     meta: Indices | None = None
     model = graph.tree.model
-    kept = np.full((count, graph.kinematics.nq), np.nan) if configurations else None
+    kept = np.full((count, graph.kinematics.nq), np.nan) if configurations is not False else None
     for start in range(0, count, chunk_size):
         part = slice(start, min(start + chunk_size, count))
         if closed is None:
@@ -523,11 +524,13 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
                                  faults=faults, threads=threads, dof=n_task)
                 meta = result
                 scatter(arrays, count, index[rows] + start, result)
+        if progress is not None:
+            progress(part.stop - part.start)
     chain_status = np.where(reachable, 0, 1).astype(np.int8)[:, None].repeat(len(graph.legs), axis=1)
     names = graph.actuators
     fill_unreachable(arrays)
     described = _Described(names, n_task, graph.task_coordinates, graph.name, ("x", "y", "z", "roll", "pitch", "yaw"))
     result = _batch_indices(arrays, meta, _Gathered(batch, poses, reachable, chain_status, full_poses), described,
                             faults=faults, detail=detail, threshold=threshold)
-    return (result, kept.reshape(batch + kept.shape[-1:])) if configurations else result
+    return (result, kept.reshape(batch + kept.shape[-1:])) if kept is not None else result
 
