@@ -208,3 +208,20 @@ def test_a_redundant_path_locates_each_failures_loss_where_the_textbook_crosses_
         failed = graph.actuators.index(result.cases[k].failed[0].replace("motor_9", "motor_1"))
         pose = np.asarray(along.indices_along(result.path, np.array([at])).full_poses)[0, :3]
         assert left(pose, failed) == pytest.approx(level, abs=1e-6)
+
+
+def test_four_arms_turned_together_past_where_three_of_them_fold_reach_the_symmetric_pose():
+    """``delta_rods_4`` (symmetric about z, arms at 0 in the file), all four arms to 80 deg: the values agree by
+    symmetry, but with three arms held the platform passes where they are at their input singularity (near 79 deg)
+    and the fourth came back on its other branch; refused as "disagree". The steps hold all four first now: every
+    arm at 80 deg, every rod closed, the platform on the axis (below the lowest point the arms' fold gives, where a
+    pose solve from the file's configuration stops at 77.9 deg: a pose there has two arm angles)."""
+    from screwkit.io.closed_tree import closure_gaps
+    from screwkit.io.loader import bundled_path
+
+    graph = graph_mechanism(read_closed_tree(bundled_path("delta_rods_4")))
+    moved = graph.at_actuators(np.radians([80.0] * 4))
+    arms = [np.degrees(joint_value(graph.tree.model, leg.actuators[0], moved.q)) for leg in graph.legs]
+    np.testing.assert_allclose(arms, 80.0, atol=1e-9)
+    assert max(closure_gaps(graph.tree, moved.q).values()) < 1e-12
+    np.testing.assert_allclose(moved.task_pose()[:2], 0.0, atol=1e-9)
