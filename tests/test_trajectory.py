@@ -714,7 +714,8 @@ def test_a_path_in_actuator_values_is_the_path_of_the_poses_they_drive(tmp_path)
     back = path_from_actuators(five, np.deg2rad(values))
     np.testing.assert_allclose(back.poses, path.poses, rtol=0, atol=1e-9)
     values[7, 2] += 1.0  # chain 3 one degree off at sample 7: no pose gives all five
-    with pytest.raises(ValueError, match="^sample 7: no pose near the previous sample's gives the actuator values"):
+    with pytest.raises(ValueError, match="^sample 7: no pose near the previous sample's gives the actuator values "
+                                         ".*: they disagree with each other"):
         path_from_actuators(five, np.deg2rad(values))
     untimed = "\n".join(line.split(",", 1)[1] for line in file.read_text().splitlines())  # chain_1 first
     (tmp_path / "bom.csv").write_text("\ufeff" + untimed, encoding="utf-8")  # Excel's byte-order mark, skipped
@@ -794,3 +795,17 @@ def test_a_failure_that_leaves_fewer_actuators_than_dof_is_said_once_not_sample_
     assert "singular at" not in done.stderr
     redundant = trajectory(bundled("planar_5rrr"), line_path(bundled("planar_5rrr"), START, STOP, 5)).summary()
     assert redundant["dof"] == 3 and {case["actuators_left"] for case in redundant["faults"]} == {4, 3}  # j = 1, 2
+
+
+def test_a_path_of_a_non_redundant_mechanism_is_not_said_to_disagree():
+    """Two motors of a five-bar turned apart until no pose of the mode followed gives their values: the refusal said
+    they "disagree with each other", which two values for two DOF cannot; it names the mode left instead."""
+    from screwkit.closure import solve
+
+    five = bundled("five_bar")
+    solution = solve(five, five.home_pose[None])
+    start = np.array([solution.joint_values[c][0][j] for c, j in five.actuator_positions(None)])
+    values = start + np.linspace(0.0, 1.0, 11)[:, None] * np.radians([120.0, -120.0])
+    with pytest.raises(ValueError, match="they leave the working and assembly modes followed there") as refused:
+        path_from_actuators(five, values)
+    assert "disagree" not in str(refused.value)

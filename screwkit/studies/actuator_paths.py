@@ -150,8 +150,12 @@ def _not_reached(mechanism: Mechanism | GraphMechanism, values: NDArray, sample:
     shown = ", ".join(f"{v:.6g}" for v in np.where(_angular(mechanism), np.rad2deg(values), values))
     if why is not None:
         return ValueError(f"sample {sample}: no closed configuration puts the actuators at ({shown}; deg, m): {why}.")
+    why = ("they disagree with each other, or leave the workspace of the assembly followed" if
+           len(mechanism.actuators) > mechanism.dof else "they leave the working and assembly modes followed there "
+           "(a chain stretched or folded on the way, past which only another mode meets them, or out of reach): a "
+           "path in poses, or `analyze --actuators` with --initial, reads the other mode")
     return ValueError(f"sample {sample}: no pose near the previous sample's gives the actuator values ({shown}; deg, "
-                      "m): they disagree with each other, or leave the workspace of the assembly followed.")
+                      f"m): {why}.")
 
 
 def _angular(mechanism: Mechanism | GraphMechanism) -> NDArray[np.bool_]:
