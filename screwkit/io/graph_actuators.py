@@ -1,6 +1,6 @@
 """The actuators of a closed-loop graph's legs (:mod:`screwkit.io.graph`): one revolute or prismatic actuator per leg,
 and, for a leg with several, the serial stage a user can hold with ``--lock`` to analyse the legs on the body it
-turns."""
+turns; and the graph moved by its actuators (:func:`follow_actuators`, :func:`between_samples`)."""
 
 from __future__ import annotations
 
@@ -53,8 +53,9 @@ def between_samples(graph, first: NDArray, second: NDArray, fraction: float, val
     """The closed configuration of ``graph`` between two closed configurations of a path (``first``, ``second``) at
     ``fraction`` of the way, its actuators at ``values``: assembled from the configuration interpolated between the
     two (Pinocchio's ``interpolate``) with the actuators put at ``values``, held there, or, redundant (values
-    interpolated between two that agree do not quite), the closed configuration nearest to it. One assembly, the
-    same whatever the actuators' names or order; a ValueError where the loops do not close there."""
+    interpolated between two that agree do not quite), none held: the closed configuration the damped steps reach
+    from it (without the slide to the nearest one, which cost four times as much). One assembly, the same whatever
+    the actuators' names or order; a ValueError where the loops do not close there."""
     import pinocchio as pin  # (a file of another tool is read with it)
 
     ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
