@@ -40,7 +40,7 @@ def test_converging_rods_are_said_to_make_the_iti_depend_on_the_working_length(t
     said, graph = _notes(tmp_path, 0.05, TRANSFORMS[variant])
     assert len(said) == 1 and all(f"{leg.name}" in said[0] for leg in graph.legs), said
     assert "rods not parallel" in said[0]
-    turns = [float(turn) for turn in re.findall(r"\((\d[^ ]*) deg\)", said[0])]
+    turns = [float(turn) for turn in re.findall(r"representative turns (\d[^ ]*) deg", said[0])]
     assert len(turns) == 3 and all(turn > 0.05 for turn in turns), said
 
 

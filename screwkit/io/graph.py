@@ -513,7 +513,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
         refuse_couples_of_forces(tree, legs, chains, state)
         varying = length_dependent_legs(legs, chains)
         if varying:
-            turns = ", ".join(f"{name} ({turn:.2g} deg)" for name, turn in varying)
+            turns = ", ".join(f"{name} (its representative turns {turn:.2g} deg)" for name, turn in varying)
             report.notes.append(f"{LENGTH_DEPENDENT}leg(s) {turns}: a constraint wrench of the leg "
                                 "neither passes through its point on the platform nor is a couple (rods not parallel), "
                                 "so the representative of its actuation wrench, and its ITI and OTI, change with the "

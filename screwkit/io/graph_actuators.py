@@ -52,10 +52,11 @@ def follow_actuators(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
 def between_samples(graph, first: NDArray, second: NDArray, fraction: float, values: NDArray) -> NDArray[np.float64]:
     """The closed configuration of ``graph`` between two closed configurations of a path (``first``, ``second``) at
     ``fraction`` of the way, its actuators at ``values``: assembled from the configuration interpolated between the
-    two (Pinocchio's ``interpolate``) with the actuators put at ``values``, held there, or, redundant (values
-    interpolated between two that agree do not quite), none held: the closed configuration the damped steps reach
-    from it (without the slide to the nearest one, which cost four times as much). One assembly, the same whatever
-    the actuators' names or order; a ValueError where the loops do not close there."""
+    two (Pinocchio's ``interpolate``) with the actuators put at ``values``, held there. Redundant actuators
+    interpolated between two values that agree need not quite agree, and no configuration then holds them all: each
+    non-redundant set of them is held in turn, and the configuration is the one the closures assemble from those
+    sets' configurations' mean (where the values agree, every set gives the same one). The same whatever the
+    actuators' names or order; a ValueError where the loops do not close there."""
     import pinocchio as pin  # (a file of another tool is read with it)
 
     ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
@@ -63,12 +64,32 @@ def between_samples(graph, first: NDArray, second: NDArray, fraction: float, val
     q = np.array(pin.interpolate(model, first, second, float(fraction)), dtype=float)
     for joint, value in zip(ids, values):
         put_joint_value(model, joint, q, value)
+    sets = [ids] if len(ids) <= graph.dof else [list(held) for held in combinations(ids, graph.dof)]
+    found, per = [], np.where(graph.actuator_slides, graph.scale, 1.0)
+    for held in sets:
+        try:
+            found.append(assemble(replace(graph.tree, q_reference=q, notes=[]), held=held, nearest=False)[0])
+        except ImportError_:
+            continue
+        met = np.abs(np.array([joint_value(model, joint, found[-1]) for joint in ids]) - values) / per
+        if np.max(met) <= MET:  # (values that agree: every set gives this one)
+            return found[-1]
+    if not found:
+        raise ValueError("the loops do not close there")
+    if len(sets) == 1:
+        return found[0]
+    mean = found[0]
+    for count, other in enumerate(found[1:], start=2):
+        mean = np.array(pin.interpolate(model, mean, other, 1.0 / count), dtype=float)
     try:
-        return assemble(replace(graph.tree, q_reference=q, notes=[]), held=ids if len(ids) <= graph.dof else (),
-                        nearest=False)[0]
+        return assemble(replace(graph.tree, q_reference=mean, notes=[]), nearest=False)[0]
     except ImportError_:
         raise ValueError("the loops do not close there") from None
 
+
+MET = 1e-12
+"""How near (rad, or length scales) every redundant actuator must be to its value, one set held, for
+:func:`between_samples` to take that configuration: the values agree."""
 
 AGREEMENT = 1e-5
 """The largest mismatch (rad, or length scales) between redundant actuators' values and the closed configuration

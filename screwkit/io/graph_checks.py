@@ -192,5 +192,5 @@ def _representative(omega: NDArray, at_d: NDArray, scale: float, length: float) 
 LENGTH_CHANGE = 0.05
 """How far (deg, between unit wrenches in working coordinates) the representative may turn between the working
 length and a thousandth of it before :func:`length_dependent_legs` names the leg: rods a file's rounding
-(:data:`~screwkit.common.tolerances.FILE_ROUNDING`, 1e-5 rad) from parallel turn it by about 2e-4 deg, and their ITI
+(:data:`~screwkit.common.tolerances.FILE_ROUNDING`, 1e-5 rad) from parallel turn it by 1e-4 to 3e-4 deg, and their ITI
 by a few millionths; a published Delta's rods 1.4 deg from parallel, by 0.3 to 1.3 deg, and their ITI by up to 0.05."""

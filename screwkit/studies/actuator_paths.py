@@ -38,7 +38,14 @@ from screwkit.io.graph import GraphMechanism
 from screwkit.io.graph_actuators import follow_actuators
 from screwkit.model import Mechanism
 from screwkit.studies.netcdf import netcdf_file
-from screwkit.studies.paths import Path, PathFileError, checked_times, path_from_poses, read_columns
+from screwkit.studies.paths import (
+    ROUNDING_ULPS,
+    Path,
+    PathFileError,
+    checked_times,
+    path_from_poses,
+    read_columns,
+)
 
 __all__ = ["path_from_actuators", "read_actuator_path", "actuator_columns", "COARSE_SEGMENTS"]
 
@@ -128,8 +135,11 @@ def _graph_path(graph: GraphMechanism, values: NDArray, times: ArrayLike | None)
                                                    f"configuration, {error}") from None
     steps = np.linalg.norm(np.diff(values, axis=0) * np.where(_angular(graph), graph.length_scale, 1.0), axis=1)
     arc_length = np.concatenate([[0.0], np.cumsum(steps)])  # (along the actuators: the pose may fold or stand still)
-    if not arc_length[-1] > 0:
-        raise ValueError("Expected a path that moves: every sample's actuator values are the same.")
+    size = max(float(np.max(np.abs(values * np.where(_angular(graph), graph.length_scale, 1.0)))),
+               float(graph.length_scale))
+    if not arc_length[-1] > ROUNDING_ULPS * np.spacing(size):
+        raise ValueError(f"Expected a path that moves: its actuators move by {arc_length[-1]:.3g} (angles times the "
+                         f"length scale) in all, their values' rounding at a size of {size:.3g}.")
     return Path(graph.frame_pose(closed)[:, list(graph.task_axes)], arc_length, float(graph.length_scale),
                 checked_times(times, values.shape[0]), values, closed)
 
@@ -153,7 +163,8 @@ def _not_reached(mechanism: Mechanism | GraphMechanism, values: NDArray, sample:
     why = ("they disagree with each other, or leave the workspace of the assembly followed" if
            len(mechanism.actuators) > mechanism.dof else "they leave the working and assembly modes followed there "
            "(a chain stretched or folded on the way, past which only another mode meets them, or out of reach): a "
-           "path in poses, or `analyze --actuators` with --initial, reads the other mode")
+           "path in poses, or `analyze --actuators` from a start in the other mode (--pose; --initial for a file of "
+           "another tool), reads it")
     return ValueError(f"sample {sample}: no pose near the previous sample's gives the actuator values ({shown}; deg, "
                       f"m): {why}.")
 
