@@ -243,3 +243,11 @@ def test_four_arms_turned_together_past_where_three_of_them_fold_reach_the_symme
     np.testing.assert_allclose(arms, 80.0, atol=1e-9)
     assert max(closure_gaps(graph.tree, moved.q).values()) < 1e-12
     np.testing.assert_allclose(moved.task_pose()[:2], 0.0, atol=1e-9)
+
+
+def test_a_crank_path_moving_by_rounding_only_is_refused(tmp_path):
+    """A crank moved by 2e-15 rad: as poses, such a path is refused as one that moves only by rounding; given in
+    actuator values it was analysed. Refused the same way now."""
+    _, graph = _parallelogram(tmp_path)
+    with pytest.raises(ValueError, match="Expected a path that moves: its actuators move by"):
+        path_from_actuators(graph, np.array([[0.0], [2e-15]]))
