@@ -251,3 +251,13 @@ def test_a_crank_path_moving_by_rounding_only_is_refused(tmp_path):
     _, graph = _parallelogram(tmp_path)
     with pytest.raises(ValueError, match="Expected a path that moves: its actuators move by"):
         path_from_actuators(graph, np.array([[0.0], [2e-15]]))
+
+
+def test_configurations_given_of_the_wrong_shape_are_refused_naming_both(tmp_path):
+    from screwkit.studies.poses import graph_indices_at_poses
+
+    _, graph = _parallelogram(tmp_path)
+    poses = graph.task_pose()[None].repeat(2, axis=0)
+    with pytest.raises(ValueError, match=f"Expected `configurations` of shape \\(2, {graph.kinematics.nq}\\), got "
+                                         "\\(2, 3\\)"):
+        graph_indices_at_poses(graph, poses, configurations=np.zeros((2, 3)))

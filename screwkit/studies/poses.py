@@ -493,6 +493,8 @@ def graph_indices_at_poses(graph: GraphMechanism, poses: ArrayLike, *, detail: b
     _check_settings(faults, threshold, progress, chunk_size, len(graph.actuators), n_task)  # (passive legs: none)
     closed = None if isinstance(configurations, bool) else np.asarray(configurations, dtype=float)
     batch = poses.shape[:-1]
+    if closed is not None and closed.shape != batch + (graph.kinematics.nq,):
+        raise ValueError(f"Expected `configurations` of shape {batch + (graph.kinematics.nq,)}, got {closed.shape}.")
     flat = poses.reshape(-1, n_task)
     count = flat.shape[0]
     reachable = np.zeros(count, dtype=bool)
