@@ -7,7 +7,6 @@ inside*)."""
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
@@ -160,33 +159,24 @@ def length_dependent_legs(legs, chains: list[ChainScrews]) -> list[tuple[str, fl
     the least-norm one in working coordinates with moments about the leg's point on the platform
     (:func:`screwkit.screw.reference.actuation_wrench`), that changes with the working length ``L``: where a
     constraint wrench of the leg neither passes through that point nor is a couple (two rods that are not
-    parallel: their lines meet, and so does the constraint force). Its ITI and OTI then do too. The wrench of least
-    norm in |f|^2 + |m_d|^2 / L^2 is compared at the working length and at a thousandth of it: each such leg's
+    parallel: their lines meet, and so does the constraint force). Its ITI and OTI then do too. The representative
+    is compared at the working length and at a thousandth of it (the chain in units of ``L``/1000): each such leg's
     name, and the angle (deg, in working coordinates) between the two."""
-    _, _, _, length = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
+    work, at, _, _ = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
     found = []
-    for leg, chain in zip(legs, chains):
-        if not leg.actuators or len(chain.twists) < 2:
+    for leg, twists, points in zip(legs, work, at):
+        if not leg.actuators or len(twists) < 2:
             continue
-        omega, d = chain.twists[:, :3], chain.points[-1]
-        at_d = chain.twists[:, 3:] + np.cross(omega, d)  # each twist's velocity at d
-        at_length, near_zero = (_representative(omega, at_d, scale, length) for scale in (length, 1e-3 * length))
-        if at_length is not None and near_zero is not None:
-            turn = float(np.degrees(np.arccos(np.clip(abs(at_length @ near_zero), 0.0, 1.0))))
-            if turn > LENGTH_CHANGE:
-                found.append((leg.name, turn))
+        at_length = actuation_wrench(twists, points, 0)
+        shorter = actuation_wrench(np.concatenate([twists[:, :3], twists[:, 3:] * 1e3], axis=1), points * 1e3, 0)
+        near_zero = np.concatenate([shorter[:3], shorter[3:] * 1e-3])  # (moments back in units of L)
+        if not np.any(at_length) or not np.any(near_zero):  # (an input singularity: none does work on it alone)
+            continue
+        cosine = abs(at_length @ near_zero) / (np.linalg.norm(at_length) * np.linalg.norm(near_zero))
+        turn = float(np.degrees(np.arccos(min(cosine, 1.0))))
+        if turn > LENGTH_CHANGE:
+            found.append((leg.name, turn))
     return found
-
-
-def _representative(omega: NDArray, at_d: NDArray, scale: float, length: float) -> NDArray | None:
-    """The unit wrench (f, m_d / ``length``) of least norm in |f|^2 + |m_d|^2 / ``scale``^2 doing unit work on the
-    first of the twists (``omega``, velocities ``at_d`` at d) and none on the others; None at an input singularity."""
-    rows = np.concatenate([scale * omega, at_d], axis=1)
-    solution = np.linalg.pinv(rows)[:, 0]
-    if np.max(np.abs(rows @ solution - np.eye(len(rows))[0])) > 1e-9 * max(1.0, np.max(np.abs(solution))):
-        return None  # (no wrench does work on the actuator alone)
-    wrench = np.concatenate([solution[3:], solution[:3] * scale / length])
-    return wrench / np.linalg.norm(wrench)
 
 
 LENGTH_CHANGE = 0.05
