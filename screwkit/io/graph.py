@@ -308,11 +308,10 @@ class GraphMechanism:
         actuators, the closures assembled at each with them held, so the working mode is followed). A ValueError names
         the step whose loops cannot close (values out of reach, past a singular configuration, or redundant ones that
         disagree) or the joints a configuration puts beyond their limits."""
-        ids = [leg.actuators[0] for leg in self.legs if leg.actuators]
         values = np.asarray(values, dtype=float).reshape(-1)
-        if values.shape != (len(ids),) or not np.all(np.isfinite(values)):
-            raise ValueError(f"Expected {len(ids)} finite actuator values ({', '.join(self.actuators)}), got "
-                             f"{values.tolist()}.")
+        if values.shape != (len(self.actuators),) or not np.all(np.isfinite(values)):
+            raise ValueError(f"Expected {len(self.actuators)} finite actuator values ({', '.join(self.actuators)}), "
+                             f"got {values.tolist()}.")
         try:
             q = follow_actuators(self, self.q, values)
         except ValueError as error:

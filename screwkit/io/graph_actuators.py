@@ -31,19 +31,19 @@ def follow_actuators(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
     their names), the others following; then the closed configuration nearest to all of them at ``values`` (values
     rounded as a file or a logger writes them close the loops, held, only to that rounding), refused if an actuator
     is then farther than :data:`AGREEMENT` from its value."""
-    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
+    ids = _joints(graph)
     if len(ids) <= graph.dof:
-        return _steps(graph, q, values, ids, ids)
+        return _steps(graph, q, values, ids)
     names = graph.tree.model.names
     failures = []
     for held in [ids] + [list(c) for c in combinations(sorted(ids, key=lambda joint: names[joint]), graph.dof)]:
         try:
-            found = _steps(graph, q, values, ids, held)
+            found = _steps(graph, q, values, held)
         except ValueError as error:
             failures.append(error)
             continue
         try:
-            return _agreeing(graph, found, values, ids)
+            return _agreeing(graph, found, values)
         except ValueError as error:  # (said first: the steps closed, the values did not meet)
             failures.insert(0, error)
     raise failures[0]
@@ -59,25 +59,19 @@ def between_samples(graph, first: NDArray, second: NDArray, fraction: float, val
     actuators' names or order; a ValueError where the loops do not close there."""
     import pinocchio as pin  # (a file of another tool is read with it)
 
-    ids = [leg.actuators[0] for leg in graph.legs if leg.actuators]
-    model = graph.tree.model
-    q = np.array(pin.interpolate(model, first, second, float(fraction)), dtype=float)
-    for joint, value in zip(ids, values):
-        put_joint_value(model, joint, q, value)
+    ids, model = _joints(graph), graph.tree.model
+    q = _put(graph, pin.interpolate(model, first, second, float(fraction)), values)
     sets = [ids] if len(ids) <= graph.dof else [list(held) for held in combinations(ids, graph.dof)]
-    found, per = [], np.where(graph.actuator_slides, graph.scale, 1.0)
-    for held in sets:
+    found = []
+    for held in sets:  # (all held, or each non-redundant set)
         try:
             found.append(assemble(replace(graph.tree, q_reference=q, notes=[]), held=held, nearest=False)[0])
         except ImportError_:
             continue
-        met = np.abs(np.array([joint_value(model, joint, found[-1]) for joint in ids]) - values) / per
-        if np.max(met) <= MET:  # (values that agree: every set gives this one)
+        if np.max(np.abs(_values_at(graph, found[-1]) - values) / _units(graph)) <= MET:  # (every set gives it)
             return found[-1]
     if not found:
         raise ValueError("the loops do not close there")
-    if len(sets) == 1:
-        return found[0]
     mean = found[0]
     for count, other in enumerate(found[1:], start=2):
         mean = np.array(pin.interpolate(model, mean, other, 1.0 / count), dtype=float)
@@ -85,6 +79,29 @@ def between_samples(graph, first: NDArray, second: NDArray, fraction: float, val
         return assemble(replace(graph.tree, q_reference=mean, notes=[]), nearest=False)[0]
     except ImportError_:
         raise ValueError("the loops do not close there") from None
+
+
+def _joints(graph) -> list[int]:
+    """The actuated joints of ``graph`` (its actuators' order)."""
+    return [leg.actuators[0] for leg in graph.legs if leg.actuators]
+
+
+def _values_at(graph, q: NDArray) -> NDArray[np.float64]:
+    """The actuators' values (rad, m) in configuration ``q``."""
+    return np.array([joint_value(graph.tree.model, joint, q) for joint in _joints(graph)])
+
+
+def _put(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
+    """A copy of configuration ``q`` with the actuators at ``values``."""
+    q = np.array(q, dtype=float)
+    for joint, value in zip(_joints(graph), values):
+        put_joint_value(graph.tree.model, joint, q, value)
+    return q
+
+
+def _units(graph) -> NDArray[np.float64]:
+    """Each actuator's unit of motion: the length scale for a slide, 1 (rad) for a hinge."""
+    return np.where(graph.actuator_slides, graph.scale, 1.0)
 
 
 MET = 1e-12
@@ -97,36 +114,29 @@ nearest to them that :func:`follow_actuators` accepts, as the serial forward kin
 (:func:`screwkit.closure.forward`)."""
 
 
-def _steps(graph, q: NDArray, values: NDArray, ids: list[int], held: list[int]) -> NDArray[np.float64]:
+def _steps(graph, q: NDArray, values: NDArray, held: list[int]) -> NDArray[np.float64]:
     """:func:`follow_actuators` holding the actuated joints ``held`` at each step."""
-    model, q = graph.tree.model, np.array(q, dtype=float)
-    start = np.array([joint_value(model, joint, q) for joint in ids])
-    per = np.where(graph.actuator_slides, graph.scale, 1.0)
-    count = max(1, int(np.ceil(np.max(np.abs(values - start) / per) / STAGE_LENGTH)))
+    start = _values_at(graph, q)
+    count = max(1, int(np.ceil(np.max(np.abs(values - start) / _units(graph)) / STAGE_LENGTH)))
     for step in range(1, count + 1):
-        for joint, value in zip(ids, start + step / count * (values - start)):
-            put_joint_value(model, joint, q, value)
         try:
-            q, _ = assemble(replace(graph.tree, q_reference=q, notes=[]), held=held)
+            q, _ = assemble(replace(graph.tree, q_reference=_put(graph, q, start + step / count * (values - start)),
+                                    notes=[]), held=held)
         except ImportError_:
             raise ValueError(f"the loops cannot close {step} step(s) of {count} on the way (out of reach, past a "
                              "singular configuration, or redundant actuators whose values disagree)") from None
     return q
 
 
-def _agreeing(graph, q: NDArray, values: NDArray, ids: list[int]) -> NDArray[np.float64]:
+def _agreeing(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
     """The closed configuration nearest to ``q`` (some redundant actuators at ``values``) with them all put there,
     refused if an actuator is then farther than :data:`AGREEMENT` from its value."""
-    model, q = graph.tree.model, np.array(q, dtype=float)
-    for joint, value in zip(ids, values):
-        put_joint_value(model, joint, q, value)
     try:  # (not held: values rounded as written close the loops only to that rounding, off the motions' rank)
-        q, _ = assemble(replace(graph.tree, q_reference=q, notes=[]))
+        q, _ = assemble(replace(graph.tree, q_reference=_put(graph, q, values), notes=[]))
     except ImportError_:
         raise ValueError("the loops cannot close at the values given (redundant actuators whose values "
                          "disagree)") from None
-    per = np.where(graph.actuator_slides, graph.scale, 1.0)
-    mismatch = np.abs(np.array([joint_value(model, joint, q) for joint in ids]) - values) / per
+    mismatch = np.abs(_values_at(graph, q) - values) / _units(graph)
     if not np.max(mismatch) <= AGREEMENT:
         raise ValueError(f"redundant actuators whose values disagree (or the ones held passed a singular "
                          f"configuration on the way): the closed configuration nearest to them misses one by "
@@ -190,8 +200,7 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
                 f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
                 + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
                 + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
-                + (f", or --output {meeting} takes that body" if meeting
-                                                            else "")), names
+                + (f", or --output {meeting} takes that body" if meeting else "")), names
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
         names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
