@@ -45,6 +45,7 @@ from screwkit.studies.paths import (
     checked_times,
     path_from_poses,
     read_columns,
+    weighted_arc_length,
 )
 
 __all__ = ["path_from_actuators", "read_actuator_path", "actuator_columns", "COARSE_SEGMENTS"]
@@ -133,10 +134,8 @@ def _graph_path(graph: GraphMechanism, values: NDArray, times: ArrayLike | None)
         except ValueError as error:
             raise _not_reached(graph, row, sample, f"from the {'previous sample' if sample else 'file'}'s "
                                                    f"configuration, {error}") from None
-    steps = np.linalg.norm(np.diff(values, axis=0) * np.where(_angular(graph), graph.length_scale, 1.0), axis=1)
-    arc_length = np.concatenate([[0.0], np.cumsum(steps)])  # (along the actuators: the pose may fold or stand still)
-    size = max(float(np.max(np.abs(values * np.where(_angular(graph), graph.length_scale, 1.0)))),
-               float(graph.length_scale))
+    # (along the actuators: the pose may fold or stand still)
+    arc_length, size = weighted_arc_length(values, _angular(graph), graph.length_scale)
     if not arc_length[-1] > ROUNDING_ULPS * np.spacing(size):
         raise ValueError(f"Expected a path that moves: its actuators move by {arc_length[-1]:.3g} (angles times the "
                          f"length scale) in all, their values' rounding at a size of {size:.3g}.")

@@ -189,9 +189,7 @@ class ActuatedGraphPath(GraphPath):
         actuators) at arc lengths ``positions`` (k,), each found once."""
         path, graph = self.path, self.graph
         wanted = np.clip(np.asarray(positions, dtype=float).reshape(-1), 0.0, path.length)
-        segment = np.clip(np.searchsorted(path.arc_length, wanted, side="right") - 1, 0, path.samples - 2)
-        span = path.arc_length[segment + 1] - path.arc_length[segment]
-        fraction = np.where(span > 0, (wanted - path.arc_length[segment]) / np.where(span > 0, span, 1.0), 0.0)
+        segment, fraction = path.located(wanted)
         values = path.actuators[segment] + fraction[:, None] * (path.actuators[segment + 1] - path.actuators[segment])
         q = np.full((wanted.size, graph.kinematics.nq), np.nan)
         for row, (at, start, part, value) in enumerate(zip(wanted, segment, fraction, values)):

@@ -38,7 +38,8 @@ from screwkit.model import Mechanism
 from screwkit.studies.files import open_netcdf
 
 __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
-           "PathFileError", "TIME_COLUMN", "checked_times", "checked_tolerance", "ANGLE_UNITS", "TIME_UNITS"]
+           "PathFileError", "TIME_COLUMN", "checked_times", "checked_tolerance", "ANGLE_UNITS", "TIME_UNITS",
+           "weighted_arc_length"]
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
@@ -100,13 +101,18 @@ class Path:
 
     def at(self, arc_length: ArrayLike) -> NDArray[np.float64]:
         """The poses (..., n_task) at arc lengths (...) on the piecewise-linear path (clipped to its ends)."""
+        segment, fraction = self.located(arc_length)
+        first, second = self.poses[segment], self.poses[segment + 1]
+        return first + fraction[..., None] * (second - first)
+
+    def located(self, arc_length: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """The segment (the sample it starts at) and the fraction of it (0 on a segment of no length) of each arc
+        length (...), clipped to the path's ends."""
         wanted = np.clip(np.asarray(arc_length, dtype=float), 0.0, self.length)
         segment = np.clip(np.searchsorted(self.arc_length, wanted, side="right") - 1, 0, self.samples - 2)
         start, stop = self.arc_length[segment], self.arc_length[segment + 1]
         span = stop - start
-        fraction = np.where(span > 0, (wanted - start) / np.where(span > 0, span, 1.0), 0.0)
-        first, second = self.poses[segment], self.poses[segment + 1]
-        return first + fraction[..., None] * (second - first)
+        return segment, np.where(span > 0, (wanted - start) / np.where(span > 0, span, 1.0), 0.0)
 
     def time_at(self, arc_length: ArrayLike) -> NDArray[np.float64] | None:
         """The times at arc lengths, linear along each segment; None for a path without times."""
@@ -125,10 +131,7 @@ def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | N
     if poses.ndim != 2 or poses.shape[0] < 2:
         raise ValueError(f"Expected a path of at least 2 poses with shape (n, {mechanism.n_task}), got "
                          f"{poses.shape}.")
-    weights = np.where(mechanism.angular, mechanism.length_scale, 1.0)
-    steps = np.linalg.norm(np.diff(poses, axis=0) * weights, axis=1)  # finite: the poses are within reach
-    arc_length = np.concatenate([[0.0], np.cumsum(steps)])
-    size = max(float(np.max(np.abs(poses * weights))), float(mechanism.length_scale))
+    arc_length, size = weighted_arc_length(poses, mechanism.angular, mechanism.length_scale)  # (finite: in reach)
     if not arc_length[-1] > 0:
         raise ValueError("Expected a path that moves: every pose of the path is the same.")
     if arc_length[-1] <= ROUNDING_ULPS * np.spacing(size):
@@ -136,6 +139,15 @@ def path_from_poses(mechanism: Mechanism, poses: ArrayLike, times: ArrayLike | N
                          f"{arc_length[-1]:.3g} m, at a size of {size:.3g} m: its poses' or the mechanism's length "
                          "scale).")
     return Path(poses, arc_length, float(mechanism.length_scale), checked_times(times, poses.shape[0]))
+
+
+def weighted_arc_length(samples: NDArray, angular: NDArray, length_scale: float) -> tuple[NDArray, float]:
+    """The arc length (n,) through ``samples`` (n, k), angles (``angular``) weighted by ``length_scale``, and the
+    size its rounding is taken at (the largest weighted sample, at least the length scale)."""
+    weights = np.where(angular, length_scale, 1.0)
+    steps = np.linalg.norm(np.diff(samples, axis=0) * weights, axis=1)
+    return (np.concatenate([[0.0], np.cumsum(steps)]),
+            max(float(np.max(np.abs(samples * weights))), float(length_scale)))
 
 
 def checked_tolerance(path: Path, tolerance: float, name: str = "`tolerance`") -> float:
