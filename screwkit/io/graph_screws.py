@@ -296,19 +296,21 @@ def _spanned_dims(state: _State, rows: NDArray, dims: NDArray) -> NDArray[np.int
     frees beyond them only the constraint wrenches every leg holds resist, which no connection carries alone."""
     if state.outside is None:
         return dims
-    valid = rows * (np.arange(6)[None, :] < dims[:, None])[:, :, None]
-    values = np.linalg.svd(valid @ state.outside, compute_uv=False)
+    values = np.linalg.svd(_first(rows, dims) @ state.outside, compute_uv=False)
     return dims - np.sum(values > TWIST_RANK_TOLERANCE, axis=1)
+
+
+def _first(rows: NDArray, dims: NDArray) -> NDArray:
+    """``rows`` (n, r, 6) with all but the first ``dims[n]`` of configuration n zero."""
+    return rows * (np.arange(rows.shape[1])[None, :] < np.asarray(dims)[:, None])[:, :, None]
 
 
 def _outside(screws_allowed: list[tuple[NDArray, NDArray]]) -> NDArray:
     """The projector (n, 6, 6) off the twists some leg allows (every leg's twist system together, working
     coordinates): what it keeps of a twist, only the constraint wrenches common to every leg resist."""
-    stacked = np.concatenate([rows * (np.arange(6)[None, :] < dims[:, None])[:, :, None]
-                              for rows, dims in screws_allowed], axis=1)
+    stacked = np.concatenate([_first(rows, dims) for rows, dims in screws_allowed], axis=1)
     _, values, right = np.linalg.svd(stacked, full_matrices=True)
-    spans = (np.arange(6)[None, :] < np.sum(values > TWIST_RANK_TOLERANCE, axis=1)[:, None])[:, :, None]
-    basis = right * spans
+    basis = _first(right, np.sum(values > TWIST_RANK_TOLERANCE, axis=1))
     return np.eye(6)[None] - np.swapaxes(basis, 1, 2) @ basis
 
 
@@ -442,8 +444,8 @@ def leg_screws(tree: ClosedTree, kinematics: TreeKinematics, platform: int, legs
         locked, locked_dims = _twist_spaces(state, [j for j in leg.joints if j != actuator], leg)
         own = state.working[:, kinematics.idx_v[actuator]]
         own = own / np.linalg.norm(own, axis=1, keepdims=True)
-        valid = (np.arange(6)[None, :] < allowed_dims[:, None])[:, :, None]
-        projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, allowed * valid), allowed * valid)
+        spanning = _first(allowed, allowed_dims)
+        projection = np.einsum("nk,nkj->nj", np.einsum("nj,nkj->nk", own, spanning), spanning)
         iti, oti = _attachments(state, leg, actuator, actuator), list(platform_points)
         if not iti:  # (a slide too: the actuation wrench taken about the platform's joint, drawn anywhere on the
             # slide's line, would turn with where the file draws it)
