@@ -59,3 +59,19 @@ def test_the_command_says_it_on_stderr(tmp_path):
     completed = screwkit("analyze", path, "--json")
     assert completed.returncode == 0, completed.stderr
     assert f"{LENGTH_DEPENDENT}leg(s)" in completed.stderr
+
+
+def test_each_leg_keeps_its_turn_with_the_legs_listed_in_another_order(tmp_path):
+    """The trapezoid Delta written with its legs in reverse order (arm_1 is then the leg at the last azimuth): each
+    leg, found by its azimuth, is named with the same turn of its representative (1e-9 deg)."""
+    from screwkit.io.graph_checks import length_dependent_legs
+
+    turns = []
+    for azimuths in (AZIMUTHS, AZIMUTHS[::-1]):
+        path = tmp_path / "delta.xml"
+        path.write_text(delta_rods_mjcf(POSES[0], azimuths, platform_spacing=0.05))
+        graph = graph_mechanism(read_mjcf(path))
+        found = dict(length_dependent_legs(graph.legs, graph.chains))
+        assert set(found) == {leg.name for leg in graph.legs}
+        turns.append([found[f"arm_{k + 1}"] for k in range(len(azimuths))])
+    np.testing.assert_allclose(turns[0], turns[1][::-1], atol=1e-9)
