@@ -144,8 +144,9 @@ def info(mechanism: str, reading, ignore_limits: bool, as_json: bool) -> None:
     click.echo("  chains:")
     for chain in report["chains"]:
         actuated = f"actuated: {', '.join(chain['actuated'])}" if chain["actuated"] else "passive"
+        loop = chain["loop"] or "none, the platform body's own path"  # (a graph leg that ends on the platform)
         click.echo(f"    {chain['name']}: {' - '.join(chain['joints']) or 'no joint but its loop'} ({actuated}); "
-                   f"loop {chain['loop']} ({chain['loop_type']})")
+                   f"loop {loop} ({chain['loop_type']})")
         click.echo(f"      solver {chain['solver']}: {chain['why']}")
         click.echo(f"      working mode: {chain['working_mode']}")
     for note in (note for note in report["assembly_notes"] if note not in modes):

@@ -284,24 +284,23 @@ def nearest_to_lines(projections: NDArray, points: NDArray) -> tuple[NDArray, ND
     return centre, np.einsum("kij,kj->ki", projections, points - centre)
 
 
-def _lines_scale(model, data, closures=()) -> float:
+def _lines_scale(model, data, closures=(), kinds=None) -> float:
     """The length that weighs a slide against an angle in the nearest closed configuration, at the configuration in
     ``data``: the root-mean-square distance of the revolute axis lines and ball centres (spherical joints, ``3d``
     closures) from the point nearest to them all (least squares), which neither where the file draws a joint along
     its axis, nor its link frames, nor the world frame change; the joints' spread (:func:`_length_scale`) when that
-    is zero (every line through one point) or there are none."""
-    projections, points = [], []  # each line's (or point's) projection off itself, and a point of it
-    for joint in range(1, model.njoints):
-        kind, axis = joint_kind(model, joint)
-        frame = homogeneous(data.oMi[joint])
-        if kind in ("revolute", "spherical"):
-            direction = frame[:3, :3] @ axis if kind == "revolute" else np.zeros(3)
-            projections.append(np.eye(3) - np.outer(direction, direction))
-            points.append(frame[:3, 3])
+    is zero (every line through one point) or there are none. ``kinds``: each joint's :func:`joint_kind`, if known."""
+    kinds = kinds or {joint: joint_kind(model, joint) for joint in range(1, model.njoints)}
+    lines = [(joint, axis if kind == "revolute" else np.zeros(3)) for joint, (kind, axis) in kinds.items()
+             if kind in ("revolute", "spherical")]
+    directions = np.array([np.asarray(data.oMi[joint].rotation) @ axis for joint, axis in lines]).reshape(-1, 3)
+    projections = list(np.eye(3) - directions[:, :, None] * directions[:, None, :])  # each line's projection off
+    points = [np.array(data.oMi[joint].translation, dtype=float) for joint, _ in lines]  # itself, a point of it
     for closure in closures:
         if closure.kind == "3d":  # the ball's centre: midway between its two frames (apart where the file is open)
             projections.append(np.eye(3))
-            points.append(np.mean([frame[:3, 3] for frame in _frames(model, data, closure)], axis=0))
+            first, second = _frames(model, data, closure)
+            points.append((first[:3, 3] + second[:3, 3]) / 2)
     if points:
         projections, points = np.array(projections), np.array(points)
         centre, distances = nearest_to_lines(projections, points)
@@ -382,8 +381,9 @@ def closure_motions(model, data, closure: Closure) -> list[tuple[NDArray, NDArra
     motions = []
     for joint, frame in zip((closure.joint_a, closure.joint_b), _frames(model, data, closure)):
         jacobian = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
-        offset = frame[:3, 3] - data.oMi[joint].translation
-        motions.append((jacobian[:3] - np.cross(offset[:, None], jacobian[3:], axis=0), jacobian[3:], frame))
+        (o0, o1, o2), (w0, w1, w2) = frame[:3, 3] - data.oMi[joint].translation, jacobian[3:]
+        moved = np.array([o1 * w2 - o2 * w1, o2 * w0 - o0 * w2, o0 * w1 - o1 * w0])  # (np.cross's, by components)
+        motions.append((jacobian[:3] - moved, jacobian[3:], frame))
     return motions
 
 
@@ -445,17 +445,17 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
     model = tree.model
     data = model.createData()
     pin.forwardKinematics(model, data, tree.q_reference)
-    lengths = np.zeros(model.nv, dtype=bool)  # the velocity coordinates that are lengths (slides, translations)
+    lengths, kinds = np.zeros(model.nv, dtype=bool), {}  # the velocity coordinates that are lengths (slides, ...)
     for joint in range(1, model.njoints):
         try:
-            kind = joint_kind(model, joint)[0]
+            kinds[joint] = joint_kind(model, joint)
         except ImportError_ as error:  # a zero axis (a Gepetto URDF read by Pinocchio): the file named
             raise ImportError_(f"{tree.source}: {error}") from None
         start = model.joints[joint].idx_v
-        lengths[start:start + (1 if kind == "prismatic" else
+        lengths[start:start + (1 if kinds[joint][0] == "prismatic" else
                                LENGTH_COORDINATES.get(model.joints[joint].shortname(), 0))] = True
     scale = _length_scale(model, data)
-    unit = np.where(lengths, _lines_scale(model, data, tree.closures), 1.0)  # slides weighed against angles
+    unit = np.where(lengths, _lines_scale(model, data, tree.closures, kinds), 1.0)  # slides weighed against angles
 
     def configuration(v):
         return pin.integrate(model, tree.q_reference, v * unit)

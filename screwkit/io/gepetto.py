@@ -46,19 +46,17 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
         raise ImportError_(f"{yaml_path}: not valid YAML ({str(error).splitlines()[0]}).") from None
     if not isinstance(spec, dict):
         raise ImportError_(f"{yaml_path}: expected a mapping with closed_loop, type and name_mot.")
-    unknown = sorted(set(spec) - {"closed_loop", "type", "name_mot", "joint_name", "joint_type"})
-    if unknown:
-        raise ImportError_(f"{yaml_path}: unknown key(s) {', '.join(unknown)} (expected closed_loop, type, name_mot).")
     pairs, kinds, motors = spec.get("closed_loop") or [], spec.get("type") or [], spec.get("name_mot")
-    unactuated = "" if isinstance(motors, list) and motors else f"{yaml_path}: name_mot must list the actuated joints"
-    motors = motors if not unactuated else []  # refused unless --actuate names them (screwkit.io.read_closed_tree)
     if len(kinds) != len(pairs):
         raise ImportError_(f"{yaml_path}: {len(pairs)} closed_loop pair(s) but {len(kinds)} type(s).")
     model = urdf_model(urdf)
+    spec, notes = _earlier_dialect(spec, model)
+    motors = spec.get("name_mot")
+    unactuated = "" if isinstance(motors, list) and motors else f"{yaml_path}: name_mot must list the actuated joints"
+    motors = motors if not unactuated else []  # refused unless --actuate names them (screwkit.io.read_closed_tree)
     if spec.get("joint_name") is not None or spec.get("joint_type") is not None:
-        model, notes = replaced_joints(model, spec.get("joint_name"), spec.get("joint_type"), f"{yaml_path}")
-    else:
-        notes = []
+        model, replaced = replaced_joints(model, spec.get("joint_name"), spec.get("joint_type"), f"{yaml_path}")
+        notes += replaced
     names = [frame.name for frame in model.frames]
     closures = []
     for index, (pair, kind) in enumerate(zip(pairs, kinds)):
@@ -77,6 +75,36 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
     return ClosedTree(source, model, closures, [str(m) for m in motors], pin.neutral(model), output, output_type,
                       "URDF + Gepetto robot.yaml", task_coordinates=declared_task_coordinates(urdf.read_bytes()),
                       unactuated=unactuated, notes=notes)
+
+
+KEYS = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
+"""The keys of a robot.yaml that example-parallel-robots' loader reads (by key: it passes over any other)."""
+
+
+def _earlier_dialect(spec: dict, model) -> tuple[dict, list[str]]:
+    """``spec`` with the keys of example-parallel-robots' earlier robot.yaml (2023) read as its tools read them:
+    ``name_mot`` a pattern of the motors' names (``re.search``, ``getMotId_q``), ``rotule_name`` one of the joints
+    made ball joints (``jointTypeUpdate``), when ``joint_name`` does not list them; the other keys passed over
+    (``Lidmot``/``Lidvmot``, the motors' coordinates, follow from the names), each said in a note."""
+    spec, notes, names = dict(spec), [], list(model.names)[1:]
+    if isinstance(spec.get("name_mot"), str):
+        pattern = spec["name_mot"]
+        spec["name_mot"] = [name for name in names if re.search(pattern, name)]
+        notes.append(f"robot.yaml's name_mot {pattern!r} read as a pattern of the motors' names, as the earlier "
+                     f"dialect of example-parallel-robots did: {', '.join(spec['name_mot']) or 'none'}")
+    balls = spec.pop("rotule_name", None)
+    if isinstance(balls, str) and spec.get("joint_name") is None and spec.get("joint_type") is None:
+        spec["joint_name"] = [name for name in names if re.search(balls, name)]
+        spec["joint_type"] = ["SPHERICAL"] * len(spec["joint_name"])
+        notes.append(f"robot.yaml's rotule_name {balls!r} read as a pattern of the ball joints' names, as the earlier "
+                     f"dialect of example-parallel-robots did: {', '.join(spec['joint_name']) or 'none'}")
+    elif balls is not None:
+        notes.append(f"robot.yaml's rotule_name {balls!r} passed over (joint_name and joint_type say the joints)")
+    other = sorted(set(spec) - set(KEYS))
+    if other:
+        notes.append(f"robot.yaml's key(s) {', '.join(map(str, other))} passed over: example-parallel-robots' loader "
+                     f"reads {', '.join(KEYS)}")
+    return spec, notes
 
 
 def replaced_joints(model, names, kinds, source: str):
