@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 from helpers import screwkit
 from screwkit.closure import solve
 from screwkit.io.loader import load
-from screwkit.io.rounding import meeting_lines, turned_joint
+from screwkit.io.rounding import left_as_written, meeting_lines, turned_joint
 from screwkit.studies import indices_at_pose, indices_at_poses
 
 CENTRE = np.array([0.0, 0.0, 0.3])
@@ -427,3 +427,29 @@ def test_the_rounded_manipulator_relabelled_has_the_same_indices_actuator_by_act
     np.testing.assert_allclose(two.iti_actuators[:, order], one.iti_actuators, atol=1e-9)
     for name in ("lmti", "cti"):
         np.testing.assert_allclose(getattr(two, name), getattr(one, name), atol=1e-9)
+
+
+def test_many_groups_left_as_written_are_counted_not_each_named():
+    """Four groups of three lines through a point (to 1e-7), each with a line that another line meets exactly
+    elsewhere (a universal joint on it): all four are left as written, and the report names two and counts the
+    others (a CAD Stewart platform's base, its hinges all in one plane, made twelve such notes)."""
+    rng = np.random.default_rng(3)
+    points, units, names = [], [], []
+    for group in range(4):
+        centre = np.array([1.0 * group, 0.0, 0.0])
+        for line in range(3):
+            unit = _unit(rng.normal(size=3))
+            offset = rng.normal(size=3) * 1e-7
+            points.append(centre + offset - (offset @ unit) * unit)
+            units.append(unit)
+            names.append(f"g{group}_{line}")
+        elsewhere = points[-3] + 0.3 * units[-3]  # on the group's first line, away from its centre
+        points.append(elsewhere)
+        units.append(_unit(np.cross(units[-3], rng.normal(size=3))))
+        names.append(f"u{group}")
+    _, _, left = meeting_lines(np.array(points), np.array(units), 1.0)
+    assert len(left) == 4
+    notes = left_as_written(left, names)
+    assert len(notes) == 3 and notes[-1].startswith("and 2 more group(s)")
+    assert all("left as written" in note and "also meets" in note for note in notes[:2])
+    assert left_as_written(left[:2], names) == notes[:2]

@@ -406,7 +406,7 @@ def compiled_constraint_stage(constraint_plan: ConstraintPlan, submechanisms: ND
         constraint_kernel(np.ascontiguousarray(constraints), wrench_start, own_counts, constraint_plan.common,
                           np.ascontiguousarray(points), np.ascontiguousarray(wrenches), sets, members,
                           np.ascontiguousarray(threshold, dtype=np.float64), tolerances.MOTION_SPACE_TOLERANCE,
-                          tolerances.RANK_TOLERANCE, tolerances.PURE_COUPLE, tolerances.REPEATED_PAIRING,
+                          tolerances.RANK_TOLERANCE, tolerances.ROUNDED_COUPLE, tolerances.REPEATED_PAIRING,
                           instantaneous, per_set)
         return instantaneous, per_set
 

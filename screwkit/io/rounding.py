@@ -42,7 +42,8 @@ from screwkit.common.rotations import rotation_about_axis
 from screwkit.common.tolerances import FILE_ROUNDING, PARALLEL_FOOT
 from screwkit.io.closed_tree import joint_kind, nearest_to_lines
 
-__all__ = ["parallel_axes", "plane_normal", "meeting_lines", "drawn_lines", "turned_joint", "held_limits", "EXACT"]
+__all__ = ["parallel_axes", "plane_normal", "meeting_lines", "left_as_written", "drawn_lines", "turned_joint",
+           "held_limits", "EXACT"]
 
 EXACT = 1e-12
 """Directions whose cross product is at most this already agree, lines that pass within this of the length scale
@@ -243,6 +244,19 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
     return local, equivalents
 
 
+def left_as_written(left: list, names: list[str], shown: int = 2) -> list[str]:
+    """The import report's notes on the groups of lines :func:`meeting_lines` leaves as written (its ``left``; the
+    lines' ``names``): the first ``shown`` named, the others counted (a Stewart base's hinges, all in one plane, meet
+    by threes: a CAD export's made twelve such notes)."""
+    notes = [f"joint axes {', '.join(names[k] for k in lines)} pass within the file's rounding of one point and are "
+             f"left as written: {names[line]} also meets {names[other]} elsewhere"
+             for lines, line, other in left[:shown]]
+    if len(left) > shown:
+        notes.append(f"and {len(left) - shown} more group(s) of joint axes within the file's rounding of one point "
+                     "left as written, each with an axis that also meets another elsewhere")
+    return notes
+
+
 def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, report) -> None:
     """:func:`meeting_lines` on the legs' revolute joints (axes ``local``, in their own frames) and revolute loops:
     a joint's move is added to its leg's offsets, a loop's moves its two frames."""
@@ -260,9 +274,7 @@ def _meet(model, data, legs: list, local: dict[int, NDArray], scale: float, repo
             units.append(leg.loop_dofs[0][1] / np.linalg.norm(leg.loop_dofs[0][1]))
     moves, largest, left = meeting_lines(np.array(points).reshape(-1, 3), np.array(units).reshape(-1, 3), scale)
     names = [model.names[joint] if joint is not None else f"{leg.closure} (loop)" for leg, joint in owners]
-    for lines, line, other in left:
-        report.notes.append(f"joint axes {', '.join(names[k] for k in lines)} pass within the file's rounding of one "
-                            f"point and are left as written: {names[line]} also meets {names[other]} elsewhere")
+    report.notes.extend(left_as_written(left, names))
     if not largest:
         return
     report.notes.append(f"joint axes that meet to the file's rounding written through one point (the largest move "

@@ -85,10 +85,10 @@ def power_coefficients(wrench: NDArray, twist: NDArray, point: NDArray, threshol
     characteristic point ``point`` on each wrench's axis."""
     force, moment = wrench[..., :3], wrench[..., 3:]
     omega, velocity = twist[..., :3], twist[..., 3:]
-    numerator = np.abs(np.sum(force * velocity, -1) + np.sum(moment * omega, -1))
     force_norm = np.linalg.norm(force, axis=-1)
     moment_norm = np.linalg.norm(moment, axis=-1)
-    forceful = force_norm > tolerances.PURE_COUPLE * moment_norm
+    forceful = force_norm > tolerances.ROUNDED_COUPLE * moment_norm  # (else a couple: its force, if any, left out)
+    numerator = np.abs(np.where(forceful, np.sum(force * velocity, -1), 0.0) + np.sum(moment * omega, -1))
     safe = np.where(forceful, force_norm, 1.0)
     pitch = np.where(forceful, np.sum(force * moment, -1) / safe**2, 0.0)
     arm_vector = velocity + np.cross(omega, point) + pitch[..., None] * omega

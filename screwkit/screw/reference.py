@@ -31,6 +31,7 @@ from screwkit.common.tolerances import (
     PSEUDO_INVERSE_CONSISTENCY,
     PURE_COUPLE,
     RANK_TOLERANCE,
+    ROUNDED_COUPLE,
     SINGULAR_SPAN,
 )
 from screwkit.screw.algebra import (
@@ -213,6 +214,8 @@ def constraint_transmission(twists: list[NDArray], points: list[NDArray], wrench
                 left, singular, right = np.linalg.svd(reciprocal_product(own[i][:, None], freed[None]),
                                                       full_matrices=False)
                 for wrench, twist in zip(left.T @ own[i], right @ freed):
+                    if np.linalg.norm(wrench[:3]) <= ROUNDED_COUPLE * np.linalg.norm(wrench[3:]):
+                        wrench = np.concatenate([np.zeros(3), wrench[3:]])  # the couple a file's rounding made a force
                     centre = nearest_on_axis(wrench, points[i][-1], joint_lines(twists[i], points[i], -1))
                     kappas.append(float(power_coefficient(wrench, twist, centre, threshold)))
             best = max(best, min(kappas))

@@ -308,17 +308,16 @@ def released_pairs(own, chain, size, freed, rank_tolerance, repeated_pairing, pa
 
 
 @njit(cache=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_couple):
+def coefficient(wrenches, twists, pair, points, index, chain, threshold, rounded_couple):
     """Power coefficient of the unit constraint wrench ``wrenches[pair]`` on the twist ``twists[pair]`` (as
     :func:`screwkit.screw.principal_pairs.power_coefficients`), its characteristic point the point of the wrench's axis
     nearest to the chain's platform joint ``points[index, chain, :3]`` or, for a force and when the joint has one, its
-    axis ``points[index, chain, 3:]`` (:func:`screwkit.screw.algebra.nearest_on_axis`; a couple: |m . omega| /
-    |m||omega|)."""
+    axis ``points[index, chain, 3:]`` (:func:`screwkit.screw.algebra.nearest_on_axis`; a couple, or a force at most
+    ``rounded_couple`` times its moment: |m . omega| / |m||omega|)."""
     f0, f1, f2 = wrenches[pair, 0], wrenches[pair, 1], wrenches[pair, 2]
     m0, m1, m2 = wrenches[pair, 3], wrenches[pair, 4], wrenches[pair, 5]
     w0, w1, w2 = twists[pair, 0], twists[pair, 1], twists[pair, 2]
     v0, v1, v2 = twists[pair, 3], twists[pair, 4], twists[pair, 5]
-    numerator = abs(f0 * v0 + f1 * v1 + f2 * v2 + m0 * w0 + m1 * w1 + m2 * w2)
     norm_sq = f0 * f0 + f1 * f1 + f2 * f2
     p0, p1, p2 = points[index, chain, 0], points[index, chain, 1], points[index, chain, 2]
     if norm_sq > 0.0:  # the point of the axis nearest the chain's platform joint (its axis, when it has one)
@@ -332,13 +331,15 @@ def coefficient(wrenches, twists, pair, points, index, chain, threshold, pure_co
     force_norm = np.sqrt(norm_sq)
     moment_norm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
     omega_norm = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-    if force_norm > pure_couple * moment_norm:
+    if force_norm > rounded_couple * moment_norm:
+        numerator = abs(f0 * v0 + f1 * v1 + f2 * v2 + m0 * w0 + m1 * w1 + m2 * w2)
         pitch = (f0 * m0 + f1 * m1 + f2 * m2) / (force_norm * force_norm)
         a0 = v0 + (w1 * p2 - w2 * p1) + pitch * w0
         a1 = v1 + (w2 * p0 - w0 * p2) + pitch * w1
         a2 = v2 + (w0 * p1 - w1 * p0) + pitch * w2
         arm, scale, reference = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2), force_norm, omega_norm
-    else:
+    else:  # a couple, or the couple a file's rounding made a force far away (ROUNDED_COUPLE): its force left out
+        numerator = abs(m0 * w0 + m1 * w1 + m2 * w2)
         arm, scale, reference = omega_norm, moment_norm, 0.0
     if arm <= threshold * reference or arm * scale <= 0.0:
         return 0.0
@@ -352,7 +353,7 @@ def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
     released constraint wrench on the twist it frees (as ``_subsystem_cti``). ``held``: the product of the held
     rows' norms and their sqrt(det(rows rows^T)) (:func:`complement`), the size of the complement, the
     tolerances. -1 where a chain's pairs have a repeated singular value (:func:`released_pairs`)."""
-    volume, held_volume, size, rank_tolerance, pure_couple, repeated_pairing = held
+    volume, held_volume, size, rank_tolerance, rounded_couple, repeated_pairing = held
     permutation, basis, reduced, block, freed, column, pairing, wrenches, twists, exists, scratch = work
     row, chain_row = 0, 0
     for c in range(own_counts.shape[0]):  # the square block: the subsystem's own wrenches in the complement
@@ -380,14 +381,14 @@ def subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
             return -1.0
         for i in range(count):
             if exists[i]:
-                value = min(value, coefficient(wrenches, twists, i, points, index, c, threshold[index], pure_couple))
+                value = min(value, coefficient(wrenches, twists, i, points, index, c, threshold[index], rounded_couple))
         start += count
     return value if value < np.inf else 0.0
 
 
 @njit(_SIGNATURE, nogil=True, cache=True, error_model="numpy", fastmath=FASTMATH)
 def constraint_kernel(constraints, wrench_start, own_counts, common, points, wrenches, submechanisms, members,
-                      threshold, motion_tolerance, rank_tolerance, pure_couple, repeated_pairing, instantaneous,
+                      threshold, motion_tolerance, rank_tolerance, rounded_couple, repeated_pairing, instantaneous,
                       per_set):
     """Instantaneous DOF and :math:`CTI_N` of every non-redundant actuator set of N configurations.
 
@@ -402,8 +403,8 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
     wrenches (N, a, 6) : unit actuation wrenches in working coordinates.
     submechanisms (S, n) : the actuator sets; members (L, C) : 1 for the chains of each subsystem.
     threshold (N,) : the singularity threshold in working coordinates (p / L).
-    motion_tolerance, rank_tolerance, pure_couple, repeated_pairing : MOTION_SPACE_TOLERANCE, RANK_TOLERANCE,
-        PURE_COUPLE, REPEATED_PAIRING.
+    motion_tolerance, rank_tolerance, rounded_couple, repeated_pairing : MOTION_SPACE_TOLERANCE, RANK_TOLERANCE,
+        ROUNDED_COUPLE, REPEATED_PAIRING.
     instantaneous (N,), per_set (N, S) : out, six minus the rank of all constraint wrenches, and the best
         :math:`CTI_{N,L}` over the subsystems (before constraint singularities are zeroed); NaN where a chain's
         pairs have a repeated singular value, whose worst rotation the numpy code finds.
@@ -428,7 +429,7 @@ def constraint_kernel(constraints, wrench_start, own_counts, common, points, wre
             if held_volume > 0.0:
                 for subsystem in range(members.shape[0]):
                     value = subsystem_cti(index, own_counts, members, subsystem, own, points, threshold,
-                                          (volume, held_volume, 6 - held, rank_tolerance, pure_couple,
+                                          (volume, held_volume, 6 - held, rank_tolerance, rounded_couple,
                                            repeated_pairing), work)
                     best = np.nan if value < 0.0 or np.isnan(best) else max(best, value)
             per_set[index, s] = best
