@@ -18,6 +18,7 @@ from test_universal_input import CUSTOM, HIPS
 
 from helpers import screwkit, screwkit_json
 from screwkit.io import graph_mechanism, read_closed_tree
+from screwkit.io.closed_tree import ImportError_
 
 EARLIER = {"closed_loop": [["fermeture1_B", "fermeture1_A"], ["fermeture2_B", "fermeture2_A"]], "type": ["6d", "6d"],
            "name_mot": "mot", "rotule_name": "to_rotule", "Lidmot": [0, 1, 2, 3, 4, 5], "Lidvmot": [0, 1, 2, 3, 4, 5],
@@ -55,10 +56,36 @@ def test_rotule_name_beside_joint_name_is_passed_over_and_said(tmp_path):
     tree, ours = _indices(_written(tmp_path / "both", {**later, "rotule_name": "libre"}))
     _, theirs = _indices(_written(tmp_path / "later", later))
     np.testing.assert_allclose(ours.lmti, theirs.lmti, rtol=0, atol=1e-12)
-    assert any("rotule_name 'libre' passed over (joint_name and joint_type say the joints)" in note
+    assert any("rotule_name 'libre' passed over: joint_name and joint_type say the joints" in note
                for note in tree.notes)
 
 
+@pytest.mark.parametrize("change, needle", [
+    ({"name_mot": "("}, "name_mot '(' is not a pattern of joint names (missing )"),
+    ({"rotule_name": "(["}, "rotule_name '([' is not a pattern of joint names"),
+    ({"name_mot": ""}, "name_mot '' would take every joint"),
+    ({"rotule_name": ""}, "rotule_name '' would take every joint"),
+    ({"name_mot": "zzz"}, "name_mot 'zzz', read as a pattern of the motors' names, matches no joint; --actuate"),
+])
+def test_a_pattern_that_cannot_be_read_is_refused_naming_it(tmp_path, change, needle):
+    """One line naming the key and the pattern (an invalid one raised Python's ``re.error`` from deep inside)."""
+    with pytest.raises(ImportError_) as error:
+        read_closed_tree(_written(tmp_path, {**EARLIER, **change}), lock=HIPS)
+    assert needle in str(error.value) and "\n" not in str(error.value)
+
+
+def test_keys_of_any_type_beside_the_earlier_ones_are_passed_over_and_said(tmp_path):
+    """Keys that are numbers or null beside string keys (a sorted() of mixed types raised TypeError), and a
+    ``rotule_name`` that is no string."""
+    later = yaml.safe_load((CUSTOM / "robot.yaml").read_text())
+    tree = read_closed_tree(_written(tmp_path, {**later, 1: "x", None: "y", "comment": "z", "rotule_name": [1, 2]}),
+                            lock=HIPS)
+    said = "\n".join(tree.notes)
+    assert "key(s) 1, None, comment passed over" in said
+    assert "rotule_name [1, 2] passed over: not a pattern of joint names" in said
+
+
+@pytest.mark.cli
 def test_the_command_opens_the_earlier_dialect_and_says_how_it_read_it(tmp_path):
     path = _written(tmp_path, EARLIER)
     completed = screwkit("info", path, *[item for hip in HIPS for item in ("--lock", hip)])
@@ -77,6 +104,7 @@ def _sine(u, v, normal) -> float:
     return float(abs(np.cross(u, v) @ normal) / (np.linalg.norm(u) * np.linalg.norm(v)))
 
 
+@pytest.mark.cli
 def test_a_published_five_bar_in_the_earlier_dialect_opens_as_written_with_its_pressure_angles():
     """``robot_simple`` (removed from the repository in 2024; its robot.yaml ``name_mot: mot``, ``rotule_name:
     to_rotule``, ``Lidmot``, ``Lidvmot``): the command reads it as written, and at the configuration it reports,
@@ -104,6 +132,7 @@ def test_a_published_five_bar_in_the_earlier_dialect_opens_as_written_with_its_p
     assert read["lmti"] == pytest.approx(_sine(point - at["libre1"], point - at["libre2"], normal), abs=1e-12)
 
 
+@pytest.mark.cli
 def test_a_graph_leg_on_the_platforms_own_path_says_so_where_its_loop_is_named():
     """``robot_marcheur_6`` (a 6-SPS leg read as a graph): the leg the foot hangs on has no closure of its own; ``info``
     printed an empty name there (``loop  (graph)``)."""

@@ -153,14 +153,14 @@ rounding makes rigid (a parallelogram of hinges whose axes are parallel to 6 dec
 singular value of its closure Jacobian that locks it is at most this (:mod:`screwkit.io.compound`). It is used where
 a file is read, once, never on the configurations of a study."""
 
-ROUNDED_COUPLE = 1e-4
+ROUNDED_COUPLE = 1e-3
 """Relative (working coordinates): a constraint wrench whose force is at most this times its moment about the
-centroid (its line passes farther than ``L`` / 1e-4 from the mechanism) is scored in the CTI as the couple it
-nearly is: two rods a file writes rounded off parallel (6 decimals: 1e-6 to 3e-5 of this, on links of centimetres to
-metres) hold a force through where their lines meet, 1e5 to 1e6 working lengths away, and scored as a force there its
-power coefficient did not tend to the couple's (a published CAD Delta's CTI read 0.99704 for its parallelograms'
-0.99588, and moved by 3.7e-4 with one ball drawn 1e-9 m elsewhere). Rods that converge by design (a degree) hold a
-force a few working lengths away. ``docs/theory.md``, *Not settled*."""
+centroid (its line passes farther than 1000 working lengths from the mechanism, where an actuation wrench already acts
+as a couple: ``screwkit.io.graph_checks.COUPLE_LIKE``) is scored in the CTI as the couple it nearly is. Two rods a file
+writes rounded off parallel hold a force through where their lines meet, far away, and scored as a force there its
+power coefficient did not tend to the couple's (a CAD Delta's CTI read 0.99704 for its parallelograms' 0.99588).
+Written to 6 decimals in metres, a rod Delta's rods of 55 cm give 1.4e-5 of force per moment, of 5.5 cm 7.8e-5, of
+1.1 cm 5.5e-4; to 4 decimals, rods of 55 cm up to 1.25e-3. ``docs/theory.md``, *Not settled either*."""
 
 NEWTON_TOLERANCE = 1e-11
 """Radians and length scales: a chain solved by damped Newton is closed when its loop error norm

@@ -50,9 +50,12 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
     if len(kinds) != len(pairs):
         raise ImportError_(f"{yaml_path}: {len(pairs)} closed_loop pair(s) but {len(kinds)} type(s).")
     model = urdf_model(urdf)
-    spec, notes = _earlier_dialect(spec, model)
+    written = spec.get("name_mot")
+    spec, notes = _earlier_dialect(spec, model, f"{yaml_path}")
     motors = spec.get("name_mot")
-    unactuated = "" if isinstance(motors, list) and motors else f"{yaml_path}: name_mot must list the actuated joints"
+    unactuated = "" if isinstance(motors, list) and motors else f"{yaml_path}: " + (
+        f"name_mot {written!r}, read as a pattern of the motors' names, matches no joint" if isinstance(written, str)
+        else "name_mot must list the actuated joints")
     motors = motors if not unactuated else []  # refused unless --actuate names them (screwkit.io.read_closed_tree)
     if spec.get("joint_name") is not None or spec.get("joint_type") is not None:
         model, replaced = replaced_joints(model, spec.get("joint_name"), spec.get("joint_type"), f"{yaml_path}")
@@ -81,29 +84,42 @@ KEYS = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
 """The keys of a robot.yaml that example-parallel-robots' loader reads (by key: it passes over any other)."""
 
 
-def _earlier_dialect(spec: dict, model) -> tuple[dict, list[str]]:
+def _earlier_dialect(spec: dict, model, source: str) -> tuple[dict, list[str]]:
     """``spec`` with the keys of example-parallel-robots' earlier robot.yaml (2023) read as its tools read them:
     ``name_mot`` a pattern of the motors' names (``re.search``, ``getMotId_q``), ``rotule_name`` one of the joints
     made ball joints (``jointTypeUpdate``), when ``joint_name`` does not list them; the other keys passed over
-    (``Lidmot``/``Lidvmot``, the motors' coordinates, follow from the names), each said in a note."""
+    (``Lidmot``/``Lidvmot``, the motors' coordinates, follow from the names), each said in a note. A pattern that is
+    no regular expression, or is empty (it would take every joint), is refused naming it (``source``: the file)."""
     spec, notes, names = dict(spec), [], list(model.names)[1:]
+
+    def matching(key: str) -> list[str]:
+        pattern = spec[key]
+        try:
+            found = [name for name in names if pattern and re.search(pattern, name)]
+        except re.error as error:
+            raise ImportError_(f"{source}: {key} {pattern!r} is not a pattern of joint names ({error}).") from None
+        if not pattern:
+            raise ImportError_(f"{source}: {key} '' would take every joint: write the joints' names, or a pattern.")
+        return found
+
     if isinstance(spec.get("name_mot"), str):
-        pattern = spec["name_mot"]
-        spec["name_mot"] = [name for name in names if re.search(pattern, name)]
+        pattern, spec["name_mot"] = spec["name_mot"], matching("name_mot")
         notes.append(f"robot.yaml's name_mot {pattern!r} read as a pattern of the motors' names, as the earlier "
                      f"dialect of example-parallel-robots did: {', '.join(spec['name_mot']) or 'none'}")
-    balls = spec.pop("rotule_name", None)
+    balls = spec.get("rotule_name")
     if isinstance(balls, str) and spec.get("joint_name") is None and spec.get("joint_type") is None:
-        spec["joint_name"] = [name for name in names if re.search(balls, name)]
+        spec["joint_name"] = matching("rotule_name")
         spec["joint_type"] = ["SPHERICAL"] * len(spec["joint_name"])
         notes.append(f"robot.yaml's rotule_name {balls!r} read as a pattern of the ball joints' names, as the earlier "
                      f"dialect of example-parallel-robots did: {', '.join(spec['joint_name']) or 'none'}")
     elif balls is not None:
-        notes.append(f"robot.yaml's rotule_name {balls!r} passed over (joint_name and joint_type say the joints)")
-    other = sorted(set(spec) - set(KEYS))
+        notes.append(f"robot.yaml's rotule_name {balls!r} passed over: " + (
+            "joint_name and joint_type say the joints" if isinstance(balls, str) else "not a pattern of joint names"))
+    spec.pop("rotule_name", None)
+    other = sorted(map(str, set(spec) - set(KEYS)))
     if other:
-        notes.append(f"robot.yaml's key(s) {', '.join(map(str, other))} passed over: example-parallel-robots' loader "
-                     f"reads {', '.join(KEYS)}")
+        notes.append(f"robot.yaml's key(s) {', '.join(other)} passed over: example-parallel-robots' loader reads "
+                     f"{', '.join(KEYS)}")
     return spec, notes
 
 
