@@ -6,7 +6,7 @@ a force there (the point of its axis nearest to the leg's platform joint, a mill
 coefficient did not tend to the couple's: the rod-level Delta's CTI read 0.99757 for its parallelograms' 0.93132 with
 its platform's rods drawn 1e-10 m closer together, and a published CAD Delta (RemcoKuijpers' Codian, 6 decimals) read
 0.99704 for 0.99588 and changed by 3.4e-5 with its legs listed the other way round. A constraint wrench whose force
-is at most ``ROUNDED_COUPLE`` (1e-4) times its moment about the centroid is scored as its couple, in the compiled
+is at most ``ROUNDED_COUPLE`` (1e-3) times its moment about the centroid is scored as its couple, in the compiled
 kernel, its numpy counterpart and the reference. Checked against the CTI of the couples a_i x u_i computed here from
 the drawing (``helpers.couple_cti``).
 """
