@@ -13,6 +13,8 @@ the drawing (``helpers.couple_cti``).
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from delta_rods import ROD, SPACING, delta_rods_mjcf
@@ -20,8 +22,10 @@ from test_compiled_chunks import kernel_calls  # noqa: F401 (a fixture)
 from test_graph_legs import POSES, textbook
 
 from helpers import couple_cti, random_rotation
+from screwkit.common.tolerances import ROUNDED_COUPLE
 from screwkit.indices.stages import compiled_chunks
 from screwkit.io.graph import graph_mechanism
+from screwkit.io.graph_checks import FAR_FORCE, FAR_FORCE_NOTE
 from screwkit.io.mjcf import read_mjcf
 
 AZIMUTHS = np.radians([90.0, 210.0, 330.0])
@@ -57,3 +61,24 @@ def test_the_same_in_millimetres_in_a_turned_world_and_listed_back(tmp_path, var
     azimuths = AZIMUTHS[::-1] if variant == "reversed" else AZIMUTHS
     other = _cti(tmp_path, 3e-6, azimuths, transforms.get(variant))
     assert other == pytest.approx(_cti(tmp_path, 3e-6), abs=1e-9)
+
+
+def _far_note(tmp_path, off: float, azimuths=AZIMUTHS, transform=None) -> list[str]:
+    path = tmp_path / "delta.xml"
+    path.write_text(delta_rods_mjcf(POSES[0], azimuths, transform=transform, platform_spacing=SPACING - off))
+    return [note for note in graph_mechanism(read_mjcf(path)).reading_notes() if note.startswith(FAR_FORCE_NOTE)]
+
+
+@pytest.mark.parametrize("variant", ["m", "mm", "turned", "reversed"])
+def test_rods_nearly_parallel_beyond_the_rounding_are_said_to_make_the_cti_unsettled(tmp_path, variant):
+    """Rods 1 mm closer at the platform (of 60 mm): each leg's constraint force passes 30 to 300 working lengths away,
+    scored as a force there (the step of theory.md's *Not settled either*): every command names the three legs, in
+    any unit, world frame and order; rods parallel, or a file's rounding off it, are not named."""
+    transforms = {"mm": (1000.0, np.eye(3), np.zeros(3)),
+                  "turned": (1.0, random_rotation(np.random.default_rng(7)), np.array([0.4, -1.1, 2.3]))}
+    azimuths = AZIMUTHS[::-1] if variant == "reversed" else AZIMUTHS
+    (said,) = _far_note(tmp_path, 1e-3, azimuths, transforms.get(variant))
+    distances = [float(value) for value in re.findall(r"arm_\d \(([\d.e+]+) working lengths away\)", said)]
+    assert len(distances) == 3 and all(1.0 / FAR_FORCE < d < 1.0 / ROUNDED_COUPLE for d in distances), said
+    assert _far_note(tmp_path, 0.0, azimuths, transforms.get(variant)) == []
+    assert _far_note(tmp_path, 3e-6, azimuths, transforms.get(variant)) == []

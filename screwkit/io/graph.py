@@ -66,11 +66,11 @@ from screwkit.io.compound import closed_samples
 from screwkit.io.couplings import check_couplings
 from screwkit.io.graph_actuators import check_actuators, follow_actuators
 from screwkit.io.graph_checks import (
+    CAUTIONS,
     IN_LOOP_TOLERANCE,
-    LENGTH_DEPENDENT,
     check_legs,
     check_output,
-    length_dependent_legs,
+    reading_cautions,
     refuse_couples_of_forces,
 )
 from screwkit.io.graph_kinematics import (
@@ -230,7 +230,7 @@ class GraphMechanism:
                              f"its legs beyond {'their' if plural else 'its'} limits: {'; '.join(beyond)} "
                              "(--ignore-limits reads it all the same; --initial JOINT VALUE on such a joint, or on "
                              "the one driving it, starts the assembly inside them).")
-        return ([note for note in self.report.notes if note.startswith((DOF_AT_ROUNDING, LENGTH_DEPENDENT))]
+        return ([note for note in self.report.notes if note.startswith((DOF_AT_ROUNDING, *CAUTIONS))]
                 + ([f"{LIMITS_IGNORED}{'; '.join(beyond)}"] if beyond else []))
 
     @cached_property
@@ -510,13 +510,7 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
                            "point that miss it: the graph makes parallel only axes within the rounding).")
     if at_file:
         refuse_couples_of_forces(tree, legs, chains, state)
-        varying = length_dependent_legs(legs, chains)
-        if varying:
-            turns = ", ".join(f"{name} (its representative turns {turn:.2g} deg)" for name, turn in varying)
-            report.notes.append(f"{LENGTH_DEPENDENT}leg(s) {turns}: a constraint wrench of the leg "
-                                "neither passes through its point on the platform nor is a couple (rods not parallel), "
-                                "so the representative of its actuation wrench, and its ITI and OTI, change with the "
-                                "working length (docs/theory.md, The representative and the working length)")
+        report.notes += reading_cautions(legs, chains)
     gaps = closure_gaps(tree, tree.q_reference)
     report.gaps_before, report.gaps_after = gaps, closure_gaps(tree, q)
     report.turns_before = closure_turns(tree, tree.q_reference)

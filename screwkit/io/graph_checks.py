@@ -8,14 +8,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.common.tolerances import FILE_ROUNDING
+from screwkit.common.tolerances import FILE_ROUNDING, RANK_TOLERANCE, ROUNDED_COUPLE
 from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
 from screwkit.io.graph_screws import HINGES, GraphLeg, LegScrews, axis_line, common_motions, model_name
 from screwkit.screw.chain_screws import ChainScrews
 from screwkit.screw.reference import actuation_wrench, working_frame
 
 __all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "couples_of_forces", "IN_LOOP_TOLERANCE",
-           "COUPLE_LIKE", "length_dependent_legs", "LENGTH_DEPENDENT", "LENGTH_CHANGE"]
+           "COUPLE_LIKE", "length_dependent_legs", "LENGTH_DEPENDENT", "LENGTH_CHANGE", "far_force_legs", "FAR_FORCE",
+           "FAR_FORCE_NOTE", "reading_cautions", "CAUTIONS"]
 
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
@@ -184,3 +185,58 @@ LENGTH_CHANGE = 0.05
 length and a thousandth of it before :func:`length_dependent_legs` names the leg: rods a file's rounding
 (:data:`~screwkit.common.tolerances.FILE_ROUNDING`, 1e-5 rad) from parallel turn it by 1e-4 to 3e-4 deg, and their ITI
 by a few millionths; a published Delta's rods 1.4 deg from parallel, by 0.3 to 1.3 deg, and their ITI by up to 0.05."""
+
+
+FAR_FORCE = 0.1
+"""A leg's one constraint wrench whose force is at most this times its moment about the centroid, and more than
+:data:`~screwkit.common.tolerances.ROUNDED_COUPLE` times (its line 10 to 1000 working lengths from the mechanism), is
+named by :func:`far_force_legs`: the CTI of such a force is not settled (``docs/theory.md``, *Not settled either*)."""
+
+FAR_FORCE_NOTE = "CTI of a far constraint force: "
+"""The start of the note naming the legs :func:`far_force_legs` finds."""
+
+
+def far_force_legs(legs, chains: list[ChainScrews]) -> list[tuple[str, float]]:
+    """The legs holding one constraint wrench that is a force far from the mechanism (two rods nearly parallel, or
+    written so to a rounding beyond the file's usual one), each with how far its line passes (working lengths): the
+    CTI scores it as a force there, where the paper's rule does not tend to the couple's (a desktop rod Delta written
+    to 4 decimals read 3e-2 to 6.5e-2 above its parallelograms' CTI). Legs holding several constraint wrenches are
+    not examined."""
+    work, _, _, _ = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
+    found = []
+    for leg, twists in zip(legs, work):
+        unit = twists / np.linalg.norm(twists, axis=1, keepdims=True)
+        values, vectors = np.linalg.svd(unit, full_matrices=True)[1:]
+        rank = int(np.sum(values > RANK_TOLERANCE * values[0]))
+        if rank != 5:
+            continue
+        moment, force = vectors[5, :3], vectors[5, 3:]  # (the wrench reciprocal to every twist, halves swapped)
+        ratio = float(np.linalg.norm(force) / max(np.linalg.norm(moment), 1e-300))
+        if ROUNDED_COUPLE < ratio <= FAR_FORCE:
+            found.append((leg.name, 1.0 / ratio))
+    return found
+
+
+CAUTIONS = (LENGTH_DEPENDENT, FAR_FORCE_NOTE)
+"""The starts of the notes :func:`reading_cautions` makes, which every command says."""
+
+
+def reading_cautions(legs, chains: list[ChainScrews]) -> list[str]:
+    """The notes on what the indices of these legs depend on beyond the mechanism (:func:`length_dependent_legs`,
+    :func:`far_force_legs`), for every command to say."""
+    notes = []
+    varying = length_dependent_legs(legs, chains)
+    if varying:
+        turns = ", ".join(f"{name} (its representative turns {turn:.2g} deg)" for name, turn in varying)
+        notes.append(f"{LENGTH_DEPENDENT}leg(s) {turns}: a constraint wrench of the leg neither passes through its "
+                     "point on the platform nor is a couple (rods not parallel), so the representative of its "
+                     "actuation wrench, and its ITI and OTI, change with the working length (docs/theory.md, The "
+                     "representative and the working length)")
+    far = far_force_legs(legs, chains)
+    if far:
+        lines = ", ".join(f"{name} ({distance:.3g} working lengths away)" for name, distance in far)
+        notes.append(f"{FAR_FORCE_NOTE}leg(s) {lines}: the leg's constraint wrench is a force whose line passes far "
+                     "from the mechanism (rods nearly parallel, or a parallelogram written rounded beyond 1e-5 of its "
+                     "size), and the CTI scored at that far point does not tend to a parallelogram's couple "
+                     "(docs/theory.md, Not settled either)")
+    return notes
