@@ -12,6 +12,8 @@ from screwkit.common.tolerances import FILE_ROUNDING, RANK_TOLERANCE, ROUNDED_CO
 from screwkit.io.closed_tree import ClosedTree, ImportError_, joint_kind, path_to
 from screwkit.io.graph_screws import HINGES, GraphLeg, LegScrews, axis_line, common_motions, model_name
 from screwkit.screw.chain_screws import ChainScrews
+from screwkit.screw.constraints import chain_constraint_wrenches
+from screwkit.screw.motion import chain_decompositions
 from screwkit.screw.reference import actuation_wrench, working_frame
 
 __all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "couples_of_forces", "IN_LOOP_TOLERANCE",
@@ -204,14 +206,12 @@ def far_force_legs(legs, chains: list[ChainScrews]) -> list[tuple[str, float]]:
     not examined."""
     work, _, _, _ = working_frame([chain.twists for chain in chains], [chain.points for chain in chains])
     found = []
-    for leg, twists in zip(legs, work):
-        unit = twists / np.linalg.norm(twists, axis=1, keepdims=True)
-        values, vectors = np.linalg.svd(unit, full_matrices=True)[1:]
-        rank = int(np.sum(values > RANK_TOLERANCE * values[0]))
-        if rank != 5:
+    for leg, twists, decomposition in zip(legs, work, chain_decompositions(work)):
+        values = decomposition[0]
+        if int(np.sum(values > RANK_TOLERANCE * values[0])) != 5:
             continue
-        moment, force = vectors[5, :3], vectors[5, 3:]  # (the wrench reciprocal to every twist, halves swapped)
-        ratio = float(np.linalg.norm(force) / max(np.linalg.norm(moment), 1e-300))
+        wrench = chain_constraint_wrenches(twists, 1, decomposition)[0]
+        ratio = float(np.linalg.norm(wrench[:3]) / max(np.linalg.norm(wrench[3:]), 1e-300))
         if ROUNDED_COUPLE < ratio <= FAR_FORCE:
             found.append((leg.name, 1.0 / ratio))
     return found
