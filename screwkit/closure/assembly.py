@@ -47,8 +47,8 @@ from screwkit.model.chain import Chain
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.urdf_description import initial_remedy
 
-__all__ = ["assemble", "mobility", "mobility_notes", "rounded_dof_note", "working_modes", "LIMITS_IGNORED",
-           "DOF_AT_ROUNDING", "DOF_MARGIN", "MODES_MEET", "NOT_OPEN_LOOPS"]
+__all__ = ["assemble", "mobility", "mobility_notes", "rounded_dof_note", "working_modes", "mechanism_size",
+           "LIMITS_IGNORED", "DOF_AT_ROUNDING", "DRAWN_AT_ROUNDING", "DOF_MARGIN", "MODES_MEET", "NOT_OPEN_LOOPS"]
 
 
 LIMITS_IGNORED = "limits ignored: "
@@ -57,6 +57,8 @@ reference assembly outside a joint's limits, read with ``limits=False``."""
 DOF_AT_ROUNDING = "DOF decided at the file's rounding: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that says the DOF count turns on
 a singular value of the order of a file's rounding (:func:`mobility_notes`)."""
+DRAWN_AT_ROUNDING = "drawn to the file's rounding: "
+"""How a note starts that says what :func:`screwkit.io.drawn_loops.drawn_loops` idealised (axes, loop frames)."""
 MODES_MEET = "operation modes: "
 """How a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` starts that names the operation modes
 meeting at a constraint-singular reference assembly and the one followed
@@ -67,7 +69,9 @@ does not close, or the reference assembly is a constraint singularity, :func:`_m
 MODE_SAMPLES = 12
 """Samples added near a constraint-singular reference assembly to find the operation modes that meet there, of each
 kind (:func:`_mode_samples`)."""
-NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, MODES_MEET)
+BEYOND_ROUNDING = (": more than the file's rounding read as drawn (1e-05 of its size and rad; its numbers written to 6 "
+                   "decimals or more, as a CAD export writes them, are)")
+NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, DRAWN_AT_ROUNDING, MODES_MEET)
 """The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
 DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
 """Relative: a singular value counted by :func:`mobility` (above :data:`MOTION_SPACE_TOLERANCE`) but at most this is
@@ -81,7 +85,7 @@ def _tidy(value: float) -> str:
     return "0" if abs(value) < 1e-12 else f"{value:.6g}"
 
 
-def _length_scale(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
+def mechanism_size(mechanism: Mechanism, chains: tuple[Chain, ...]) -> float:
     """The largest distance of a joint of the reference assembly, or the platform, from the centroid of the chains'
     base joints: the mechanism's own size, the same in any world frame and in any order of its chains (the base
     frame's origin, which files put anywhere, is not one of its points)."""
@@ -134,7 +138,7 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
                 f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
                 f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
                 f"platform at its joint origin), and moving the chain's joints leaves them {_tidy(residual[0])} "
-                "(m and rad) apart.",
+                "(rad and length scales) apart" + (BEYOND_ROUNDING if residual[0] <= DOF_MARGIN else "") + ".",
             )
         most = int(np.argmax(np.abs(solved[0] - values) / scale))
         change = float(solved[0][most] - values[most])
@@ -279,7 +283,7 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
     the result is the complete, immutable model. ``limits`` False: a reference assembly outside a joint's
     limits is a note of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes`, not an error.
     """
-    length_scale = _length_scale(mechanism, mechanism.chains)
+    length_scale = mechanism_size(mechanism, mechanism.chains)
     mechanism = replace(mechanism, length_scale=length_scale)
     chains, notes = [], []
     for index, chain in enumerate(mechanism.chains):
@@ -289,7 +293,7 @@ def assemble(mechanism: Mechanism, limits: bool = True) -> Mechanism:
             _check_planar(mechanism, chain, values)
         frames = chain_forward_kinematics(chain.geometry, values)
         chains.append(replace(chain, reference_values=values, reference_sign=working_sign(mechanism, index, frames)))
-    mechanism = replace(mechanism, chains=tuple(chains), assembly_notes=tuple(notes))
+    mechanism = replace(mechanism, chains=tuple(chains), assembly_notes=mechanism.assembly_notes + tuple(notes))
     solved = []
     for index, chain in enumerate(mechanism.chains):
         solver, reason = closed_form_for(chain.geometry, mechanism.is_planar, length_scale)

@@ -22,6 +22,7 @@ from screwkit.closure.assembly import assemble, task_space
 from screwkit.closure.canonical import canonical_geometry
 from screwkit.closure.point_turns import DrivenIdleTurns
 from screwkit.io import is_foreign, read_mechanism_file
+from screwkit.io.drawn_loops import drawn_loops
 from screwkit.io.model_cache import load_cached
 from screwkit.model.builder import read_chains, read_platform
 from screwkit.model.mechanism import Mechanism
@@ -79,9 +80,6 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
     if model is None:
         model = build_model(description.text, lambda problem: description.fail(f"<robot name='{name}'>", problem))
     platform = read_platform(description, model, name)
-    # every revolute drawn where the chain's geometry puts it, not where the file does (screwkit.closure.canonical)
-    chains = tuple(replace(chain, geometry=canonical_geometry(chain.geometry))
-                   for chain in read_chains(description, model, platform))
     draft = Mechanism(
         name=name, path=description.source, description=description, pinocchio_model=model,
         is_planar=platform.is_planar, pose_coordinates=platform.pose_coordinates, base_link=platform.base_link,
@@ -89,9 +87,12 @@ def mechanism_from_description(description: UrdfDescription, *, limits: bool = T
         platform_joint_id=platform.platform_joint_id, platform_frame_placement=platform.platform_frame_placement,
         rotation_world_base=platform.rotation_world_base, translation_world_base=platform.translation_world_base,
         home_rotation=platform.home_rotation, home_translation=platform.home_translation,
-        chains=chains, dof=0, length_scale=1.0, named_poses={}, length_unit=description.length_unit,
-        output_point=np.zeros(3) if description.output == "point" else None)
-    draft = replace(draft, named_poses={"home": draft.home_full_pose})  # the reference assembly, for assembling
+        chains=read_chains(description, model, platform), dof=0, length_scale=1.0, named_poses={},
+        length_unit=description.length_unit, output_point=np.zeros(3) if description.output == "point" else None)
+    draft = drawn_loops(draft)  # axes and loop frames written rounded read as drawn (screwkit.io.drawn_loops)
+    # every revolute drawn where the chain's geometry puts it, not where the file does (screwkit.closure.canonical)
+    draft = replace(draft, named_poses={"home": draft.home_full_pose},  # the reference assembly, for assembling
+                    chains=tuple(replace(chain, geometry=canonical_geometry(chain.geometry)) for chain in draft.chains))
     mechanism = task_space(assemble(draft, limits), getattr(description, "task_coordinates", None))
     return replace(mechanism, named_poses=_named_poses(description, mechanism))
 

@@ -1,0 +1,198 @@
+"""A file in screwkit's own convention written rounded, read as what its author drew.
+
+A file written by hand or by a tool that rounds (``rpy="1.570796 ..."``, ``1.5708``, an angle of 0.3238066 written
+0.323807) draws axes meant to be parallel up to 1e-6 rad apart. Read exactly, it is another mechanism: the bundled
+Delta (``delta_4.urdf``, Tsai's R-U-U legs) written to 6 decimals read 2 DOF instead of 3 and refused its own home
+pose; written to 5 decimals, its first loop did not close (4e-7 rad, which its legs' five joints cannot take up). The
+files of other tools are read as drawn where they are converted (:mod:`screwkit.io.rounding`); this is the same
+reading of the chains of a file in screwkit's convention, before their canonical points (:mod:`screwkit.closure.
+canonical`) and the reference assembly:
+
+1. **Parallel axes.** Every joint axis of every chain, and every axis of a revolute, prismatic or universal loop
+   joint, at the file's reference configuration (the loop joints' values fitted to the file's frames), grouped by
+   :func:`~screwkit.io.rounding.parallel_axes` (within :data:`~screwkit.common.tolerances.FILE_ROUNDING`, widened by
+   the angles the file writes rounded, ``1.5708`` for pi/2: :mod:`screwkit.io.written_angles`). A turned joint's
+   placement turns with it, so that at the reference configuration every frame stays where it was (as
+   :func:`~screwkit.io.rounding.turned_joint` does in a converted file).
+2. **Loops closed within the rounding.** A chain whose loop its own joints cannot close onto the platform's loop
+   frame (damped Newton from the file's values) but leave within ``FILE_ROUNDING`` of it (rad, and lengths in the
+   mechanism's length scale) has the platform's loop frame written where the chain closes: the two frames of a loop
+   are one frame, drawn twice.
+
+Nothing changes in an exact file: axes that agree to 1e-12 are left as they are, and a loop the chain closes is not
+touched (every bundled mechanism reads as before, bit for bit). What is changed is said, in one note starting
+:data:`~screwkit.closure.assembly.DRAWN_AT_ROUNDING`. A loop beyond the rounding is left to the assembly, which
+refuses it naming the loop, as before.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.closure.assembly import DRAWN_AT_ROUNDING, mechanism_size
+from screwkit.closure.chain_kinematics import chain_forward_kinematics, loop_values_from_relative_transform
+from screwkit.closure.newton import newton_solve_chain
+from screwkit.common.rotations import rotation_about_axis, rotation_vector_from_rotation
+from screwkit.common.tolerances import FILE_ROUNDING, NEWTON_TOLERANCE
+from screwkit.io.rounding import EXACT, parallel_axes
+from screwkit.io.written_angles import WIDENING_LIMIT, written_turns
+from screwkit.model.chain import ChainGeometry
+from screwkit.model.mechanism import Mechanism
+
+__all__ = ["drawn_loops"]
+
+_AXIS_LOOPS = {"revolute": 1, "continuous": 1, "prismatic": 1, "universal": 2}
+"""The loop joint types with axes, and how many."""
+
+
+def drawn_loops(mechanism: Mechanism) -> Mechanism:
+    """``mechanism`` (chains as read from a file in screwkit's convention, not assembled) with its axes made
+    parallel and its loops closed within the file's rounding (module docstring); its ``assembly_notes`` say what
+    changed. A converted file (read as drawn where it was converted) is returned as it is."""
+    description = mechanism.description
+    if description.converted_from:
+        return mechanism
+    scale = mechanism_size(mechanism, mechanism.chains)
+    values = [_file_values(mechanism, index) for index in range(len(mechanism.chains))]
+    geometries, turn, most = _parallel(mechanism, values)
+    notes = []
+    if turn:
+        notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} "
+                     f"rad, of joint {most!r})")
+    moved = []
+    for index, chain in enumerate(mechanism.chains):
+        geometry, gap = _closed(mechanism, index, geometries[index], values[index], scale)
+        geometries[index] = geometry
+        if gap is not None:
+            moved.append((chain.loop_name, *gap))
+    if moved:
+        loop, metres, radians = max(moved, key=lambda item: item[1] / scale + item[2])
+        change = " and ".join([f"moved {metres:.2g} m"] * (metres > EXACT * scale) + [f"turned {radians:.2g} rad"] *
+                              (radians > EXACT))
+        names = ", ".join(repr(name) for name, _, _ in moved)
+        notes.append(f"loop frames that meet to the file's rounding written as one (loop{'s' * (len(moved) > 1)} "
+                     f"{names}; the most, {loop!r}, its platform frame {change})")
+    if not notes:
+        return mechanism
+    chains = tuple(replace(chain, geometry=geometry) for chain, geometry in zip(mechanism.chains, geometries))
+    return replace(mechanism, chains=chains,
+                   assembly_notes=mechanism.assembly_notes + (DRAWN_AT_ROUNDING + "; ".join(notes),))
+
+
+def _file_values(mechanism: Mechanism, index: int) -> NDArray[np.float64]:
+    """Chain ``index``'s joint values at the file's reference configuration, its loop joint's fitted to its frames."""
+    chain = mechanism.chains[index]
+    geometry = chain.geometry
+    tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
+                     for name in chain.joint_names[: geometry.n_tree_joints]])
+    frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
+    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
+                                                                 mechanism.home_translation)
+    loop, _, _ = loop_values_from_relative_transform(
+        geometry, frames.leg_rotation.T @ target_rotation,
+        frames.leg_rotation.T @ (target_translation - frames.leg_translation))
+    return np.concatenate([tree, loop])
+
+
+def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArray], NDArray]:
+    """The rotation (base frame) of each tree joint's frame after its motion at ``values``, and of the leg-side loop
+    frame."""
+    rotation, after = np.eye(3), []
+    for index in range(geometry.n_tree_joints):
+        rotation = rotation @ geometry.joint_rotations[index]
+        if not geometry.joint_prismatic[index]:
+            rotation = rotation @ rotation_about_axis(geometry.joint_axes[index], values[index])
+        after.append(rotation)
+    return after, rotation @ geometry.leg_loop_rotation
+
+
+def _parallel(mechanism: Mechanism, values: list[NDArray]) -> tuple[list[ChainGeometry], float, str]:
+    """Every chain's geometry with the axes :func:`parallel_axes` groups made parallel (step 1 of the module
+    docstring), the largest turn (0: none) and the joint turned most."""
+    owners, directions = [], []
+    for index, (chain, at) in enumerate(zip(mechanism.chains, values)):
+        frames = chain_forward_kinematics(chain.geometry, at)
+        loop_axes = _AXIS_LOOPS.get(chain.geometry.loop_type, 0)
+        for dof in range(chain.geometry.n_tree_joints + loop_axes):
+            owners.append((index, dof))
+            directions.append(frames.axes[dof])
+    geometries = [chain.geometry for chain in mechanism.chains]
+    if len(directions) < 2:
+        return geometries, 0.0, ""
+    units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
+    crosses = np.linalg.norm(np.cross(units[:, None], units[None]), axis=-1)
+    if not np.any((crosses > EXACT) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
+        return geometries, 0.0, ""  # (an exact file: its file is not read again)
+    names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
+    turned, turn = parallel_axes(units, written_turns(mechanism.description.source).allowances(names))
+    if not turn:
+        return geometries, 0.0, ""
+    moved = np.linalg.norm(np.cross(turned, units), axis=1)
+    for index, chain in enumerate(mechanism.chains):
+        rows = [k for k, (owner, _) in enumerate(owners) if owner == index]
+        if np.any(moved[rows] > 0.0):
+            geometries[index] = _turned(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
+    return geometries, turn, names[int(np.argmax(moved))]
+
+
+def _turned(geometry: ChainGeometry, values: NDArray, directions: NDArray, which: NDArray) -> ChainGeometry:
+    """``geometry`` with the axes ``which`` (tree joints, then the loop joint's) along ``directions`` (base frame),
+    every frame after a turned joint's motion at ``values`` where it was: a revolute's placement turned by
+    ``R(a, q) R(a', -q)``, a slide's moved by ``(a - a') q``; a universal loop's second axis, turned, moves the
+    chain's end frame by its turn times its value, which :func:`_closed` takes up."""
+    rotations, translations = geometry.joint_rotations.copy(), geometry.joint_translations.copy()
+    axes, loop_axes = geometry.joint_axes.copy(), geometry.loop_axes.copy()
+    leg_rotation, leg_translation = geometry.leg_loop_rotation.copy(), geometry.leg_loop_translation.copy()
+    after, leg = _turned_frames(geometry, values)
+    count = geometry.n_tree_joints
+    for index in np.flatnonzero(which[:count]):
+        value, written = values[index], axes[index]
+        axes[index] = after[index].T @ directions[index]
+        if geometry.joint_prismatic[index]:
+            translations[index] = translations[index] + rotations[index] @ ((written - axes[index]) * value)
+        else:
+            rotations[index] = (rotations[index] @ rotation_about_axis(written, value)
+                                @ rotation_about_axis(axes[index], -value))
+    if which[count:].any():
+        value, written = values[count], loop_axes[0]
+        if geometry.loop_type == "prismatic":
+            loop_axes[0] = leg.T @ directions[count]
+            leg_translation = leg_translation + leg_rotation @ ((written - loop_axes[0]) * value)
+        else:
+            middle = leg @ rotation_about_axis(written, value)  # after the loop's first rotation: kept
+            loop_axes[0] = middle.T @ directions[count]
+            leg_rotation = leg_rotation @ rotation_about_axis(written, value) @ rotation_about_axis(loop_axes[0],
+                                                                                                   -value)
+            if geometry.loop_type == "universal":
+                loop_axes[1] = middle.T @ directions[count + 1]
+    return replace(geometry, joint_rotations=rotations, joint_translations=translations, joint_axes=axes,
+                   loop_axes=loop_axes, leg_loop_rotation=leg_rotation, leg_loop_translation=leg_translation)
+
+
+def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: NDArray, scale: float
+            ) -> tuple[ChainGeometry, tuple[float, float] | None]:
+    """``geometry`` with the platform's loop frame written where the chain closes, when its joints leave the loop
+    within the file's rounding but no closer (step 2 of the module docstring), and how far it moved (length, rad);
+    else ``geometry`` and None."""
+    target_rotation, target_translation = (
+        mechanism.home_rotation @ geometry.platform_loop_rotation,
+        mechanism.home_translation + mechanism.home_rotation @ geometry.platform_loop_translation)
+    frames = chain_forward_kinematics(geometry, values)
+    if (np.linalg.norm(frames.end_translation - target_translation) <= NEWTON_TOLERANCE * scale
+            and np.linalg.norm(rotation_vector_from_rotation(frames.end_rotation.T @ target_rotation))
+            <= NEWTON_TOLERANCE):
+        return geometry, None
+    solved, converged, residual = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
+                                                     values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
+                                                     length=scale)
+    if converged[0] or residual[0] > FILE_ROUNDING:
+        return geometry, None
+    end = chain_forward_kinematics(geometry, solved[0])
+    rotation = mechanism.home_rotation.T @ end.end_rotation
+    translation = mechanism.home_rotation.T @ (end.end_translation - mechanism.home_translation)
+    turn = float(np.linalg.norm(rotation_vector_from_rotation(geometry.platform_loop_rotation.T @ rotation)))
+    metres = float(np.linalg.norm(translation - geometry.platform_loop_translation))
+    return replace(geometry, platform_loop_rotation=rotation, platform_loop_translation=translation), (metres, turn)
