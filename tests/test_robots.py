@@ -260,7 +260,7 @@ def _replace(text: str, pattern: str, replacement: str, count: int = 1) -> str:
             "planar_5rrr",
             lambda text: _replace(text, r'(<successor link="platform">\s*<origin xyz=")0\.1 ', r"\g<1>5.1 "),
             r"<loop name='chain_1_joint_d'>: does not close at the reference configuration: the loop frames are 5 m "
-            r"and 0 rad apart .*, and moving the chain's joints leaves them 2\.1 \(rad and length scales\) apart",
+            r"and 0 rad apart .*, and moving the chain's joints leaves them 2\.1 \(m and rad\) apart",
         ),
         ("planar_5rrr", lambda text: re.sub(r"<transmission.*?</transmission>", "", text, flags=re.S), "no actuators"),
         (

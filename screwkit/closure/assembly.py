@@ -69,8 +69,6 @@ does not close, or the reference assembly is a constraint singularity, :func:`_m
 MODE_SAMPLES = 12
 """Samples added near a constraint-singular reference assembly to find the operation modes that meet there, of each
 kind (:func:`_mode_samples`)."""
-BEYOND_ROUNDING = (": more than the file's rounding read as drawn (1e-05 of its size and rad; its numbers written to 6 "
-                   "decimals or more, as a CAD export writes them, are)")
 NOT_OPEN_LOOPS = (LIMITS_IGNORED, DOF_AT_ROUNDING, DRAWN_AT_ROUNDING, MODES_MEET)
 """The starts of the notes of :attr:`~screwkit.model.mechanism.Mechanism.assembly_notes` that are not open loops."""
 DOF_MARGIN = float(np.sqrt(FILE_ROUNDING))
@@ -138,7 +136,7 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
                 f"does not close at the reference configuration: the loop frames are {_tidy(position_gap)} m and "
                 f"{_tidy(rotation_gap)} rad apart (tree joints at their <reference_configuration> values or 0, "
                 f"platform at its joint origin), and moving the chain's joints leaves them {_tidy(residual[0])} "
-                "(rad and length scales) apart" + (BEYOND_ROUNDING if residual[0] <= DOF_MARGIN else "") + ".",
+                "(m and rad) apart.",
             )
         most = int(np.argmax(np.abs(solved[0] - values) / scale))
         change = float(solved[0][most] - values[most])

@@ -1,28 +1,33 @@
 """A file in screwkit's own convention written rounded, read as what its author drew.
 
-A file written by hand or by a tool that rounds (``rpy="1.570796 ..."``, ``1.5708``, an angle of 0.3238066 written
-0.323807) draws axes meant to be parallel up to 1e-6 rad apart. Read exactly, it is another mechanism: the bundled
-Delta (``delta_4.urdf``, Tsai's R-U-U legs) written to 6 decimals read 2 DOF instead of 3 and refused its own home
-pose; written to 5 decimals, its first loop did not close (4e-7 rad, which its legs' five joints cannot take up). The
+A file written by hand or by a tool that rounds (``rpy="1.570796 ..."``, an angle of 0.3238066 written 0.323807)
+draws axes meant to be parallel up to 1e-6 rad apart. Read exactly, it is another mechanism: the bundled Delta
+(``delta_4.urdf``, Tsai's R-U-U legs) written to 6 decimals read 2 DOF instead of 3 and refused its own home pose;
+written to 5 decimals, its first loop did not close (4e-7 rad, which its legs' five joints cannot take up). The
 files of other tools are read as drawn where they are converted (:mod:`screwkit.io.rounding`); this is the same
 reading of the chains of a file in screwkit's convention, before their canonical points (:mod:`screwkit.closure.
 canonical`) and the reference assembly:
 
 1. **Parallel axes.** Every joint axis of every chain, and every axis of a revolute, prismatic or universal loop
    joint, at the file's reference configuration (the loop joints' values fitted to the file's frames), grouped by
-   :func:`~screwkit.io.rounding.parallel_axes` (within :data:`~screwkit.common.tolerances.FILE_ROUNDING`, widened by
-   the angles the file writes rounded, ``1.5708`` for pi/2: :mod:`screwkit.io.written_angles`). A turned joint's
-   placement turns with it, so that at the reference configuration every frame stays where it was (as
-   :func:`~screwkit.io.rounding.turned_joint` does in a converted file).
+   :func:`~screwkit.io.rounding.parallel_axes` within :data:`~screwkit.common.tolerances.FILE_ROUNDING`; two axes of
+   one chain within more where the file writes angles rounded between them (``1.5708`` for pi/2:
+   :mod:`screwkit.io.written_angles`). Not two axes of different chains: they are parallel at the reference
+   configuration only (two arms' shoulder hinges, each arm's pan at 0), and a base turn written ``3.14`` would have
+   turned each arm's hinges by 8e-4 rad, moving its ITI by 1.9e-2. A turned joint's placement turns with it, so
+   that at the reference configuration every frame after its motion stays where it was (as
+   :func:`~screwkit.io.rounding.turned_joint` does in a converted file): :func:`turned_geometry`.
 2. **Loops closed within the rounding.** A chain whose loop its own joints cannot close onto the platform's loop
-   frame (damped Newton from the file's values) but leave within ``FILE_ROUNDING`` of it (rad, and lengths in the
-   mechanism's length scale) has the platform's loop frame written where the chain closes: the two frames of a loop
-   are one frame, drawn twice.
+   frame (damped Newton from the file's values) but leave within ``FILE_ROUNDING`` of it (rad, and lengths over
+   the mechanism's size) has the platform's loop frame written where the chain closes: the two frames of a loop
+   are one frame, drawn twice. One left further apart, but within ten times that, is refused here, in one line
+   naming the loop and saying that it is of the order of a file's rounding (the Delta written to 4 decimals, 1.3e-5
+   rad); one further still is left to the assembly, which refuses it as before.
 
-Nothing changes in an exact file: axes that agree to 1e-12 are left as they are, and a loop the chain closes is not
-touched (every bundled mechanism reads as before, bit for bit). What is changed is said, in one note starting
-:data:`~screwkit.closure.assembly.DRAWN_AT_ROUNDING`. A loop beyond the rounding is left to the assembly, which
-refuses it naming the loop, as before.
+Nothing changes in an exact file: turns of at most :data:`UNSEEN` are not made (the bundled ``coop_arms.urdf``
+writes pi/2 as ``1.5707963267900003``, 4.9e-12 off), and a loop its chain closes is not touched: every bundled
+mechanism reads as before, bit for bit. What is changed is said, in one note starting
+:data:`~screwkit.closure.assembly.DRAWN_AT_ROUNDING`.
 """
 
 from __future__ import annotations
@@ -36,13 +41,20 @@ from screwkit.closure.assembly import DRAWN_AT_ROUNDING, mechanism_size
 from screwkit.closure.chain_kinematics import chain_forward_kinematics, loop_values_from_relative_transform
 from screwkit.closure.newton import newton_solve_chain
 from screwkit.common.rotations import rotation_about_axis, rotation_vector_from_rotation
-from screwkit.common.tolerances import FILE_ROUNDING, NEWTON_TOLERANCE
+from screwkit.common.tolerances import FILE_ROUNDING, MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 from screwkit.io.rounding import EXACT, parallel_axes
 from screwkit.io.written_angles import WIDENING_LIMIT, written_turns
 from screwkit.model.chain import ChainGeometry
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["drawn_loops"]
+__all__ = ["drawn_loops", "turned_geometry", "UNSEEN", "NEAR_ROUNDING"]
+
+UNSEEN = MOTION_SPACE_TOLERANCE
+"""Rad: axes a file draws at most this far from parallel are left as written (their twists are already dependent to
+:data:`~screwkit.common.tolerances.MOTION_SPACE_TOLERANCE`, and a turn this small moves no index beyond it)."""
+NEAR_ROUNDING = 10.0 * FILE_ROUNDING
+"""A loop its chain leaves open by more than ``FILE_ROUNDING`` (rad, lengths over the mechanism's size) and at most
+this is refused as of the order of a file's rounding (module docstring)."""
 
 _AXIS_LOOPS = {"revolute": 1, "continuous": 1, "prismatic": 1, "universal": 2}
 """The loop joint types with axes, and how many."""
@@ -69,7 +81,7 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
         if gap is not None:
             moved.append((chain.loop_name, *gap))
     if moved:
-        loop, metres, radians = max(moved, key=lambda item: item[1] / scale + item[2])
+        loop, metres, radians = moved[_first_most([item[1] / scale + item[2] for item in moved])]
         change = " and ".join([f"moved {metres:.2g} m"] * (metres > EXACT * scale) + [f"turned {radians:.2g} rad"] *
                               (radians > EXACT))
         names = ", ".join(repr(name) for name, _, _ in moved)
@@ -124,32 +136,42 @@ def _parallel(mechanism: Mechanism, values: list[NDArray]) -> tuple[list[ChainGe
         return geometries, 0.0, ""
     units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
     crosses = np.linalg.norm(np.cross(units[:, None], units[None]), axis=-1)
-    if not np.any((crosses > EXACT) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
+    if not np.any((crosses > UNSEEN) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
         return geometries, 0.0, ""  # (an exact file: its file is not read again)
     names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
-    turned, turn = parallel_axes(units, written_turns(mechanism.description.source).allowances(names))
-    if not turn:
+    chain_of = np.array([index for index, _ in owners])  # (widened within a chain only: module docstring)
+    allowed = np.where(chain_of[:, None] == chain_of[None], written_turns(mechanism.description.source).allowances(
+        names), FILE_ROUNDING)
+    turned, turn = parallel_axes(units, allowed)
+    if turn <= UNSEEN:
         return geometries, 0.0, ""
     moved = np.linalg.norm(np.cross(turned, units), axis=1)
     for index, chain in enumerate(mechanism.chains):
         rows = [k for k, (owner, _) in enumerate(owners) if owner == index]
         if np.any(moved[rows] > 0.0):
-            geometries[index] = _turned(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
-    return geometries, turn, names[int(np.argmax(moved))]
+            geometries[index] = turned_geometry(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
+    return geometries, turn, names[_first_most(moved)]
 
 
-def _turned(geometry: ChainGeometry, values: NDArray, directions: NDArray, which: NDArray) -> ChainGeometry:
+def _first_most(values) -> int:
+    """The first of ``values`` within 1 % of the largest: the one a note names, the same whatever round-off tells
+    values that are equal by the mechanism's symmetry apart (in a turned world, listed in another order)."""
+    values = np.asarray(values, dtype=float)
+    return int(np.flatnonzero(values >= 0.99 * values.max())[0])
+
+
+def turned_geometry(geometry: ChainGeometry, values: NDArray, directions: NDArray, which: NDArray) -> ChainGeometry:
     """``geometry`` with the axes ``which`` (tree joints, then the loop joint's) along ``directions`` (base frame),
     every frame after a turned joint's motion at ``values`` where it was: a revolute's placement turned by
     ``R(a, q) R(a', -q)``, a slide's moved by ``(a - a') q``; a universal loop's second axis, turned, moves the
-    chain's end frame by its turn times its value, which :func:`_closed` takes up."""
+    chain's end frame by its turn times its value, which step 2 of the module docstring takes up."""
     rotations, translations = geometry.joint_rotations.copy(), geometry.joint_translations.copy()
     axes, loop_axes = geometry.joint_axes.copy(), geometry.loop_axes.copy()
     leg_rotation, leg_translation = geometry.leg_loop_rotation.copy(), geometry.leg_loop_translation.copy()
     after, leg = _turned_frames(geometry, values)
     count = geometry.n_tree_joints
     for index in np.flatnonzero(which[:count]):
-        value, written = values[index], axes[index]
+        value, written = values[index], axes[index].copy()
         axes[index] = after[index].T @ directions[index]
         if geometry.joint_prismatic[index]:
             translations[index] = translations[index] + rotations[index] @ ((written - axes[index]) * value)
@@ -157,7 +179,7 @@ def _turned(geometry: ChainGeometry, values: NDArray, directions: NDArray, which
             rotations[index] = (rotations[index] @ rotation_about_axis(written, value)
                                 @ rotation_about_axis(axes[index], -value))
     if which[count:].any():
-        value, written = values[count], loop_axes[0]
+        value, written = values[count], loop_axes[0].copy()
         if geometry.loop_type == "prismatic":
             loop_axes[0] = leg.T @ directions[count]
             leg_translation = leg_translation + leg_rotation @ ((written - loop_axes[0]) * value)
@@ -176,23 +198,35 @@ def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: N
             ) -> tuple[ChainGeometry, tuple[float, float] | None]:
     """``geometry`` with the platform's loop frame written where the chain closes, when its joints leave the loop
     within the file's rounding but no closer (step 2 of the module docstring), and how far it moved (length, rad);
-    else ``geometry`` and None."""
+    else ``geometry`` and None. A ValueError names a loop left open by more, up to :data:`NEAR_ROUNDING`."""
     target_rotation, target_translation = (
         mechanism.home_rotation @ geometry.platform_loop_rotation,
         mechanism.home_translation + mechanism.home_rotation @ geometry.platform_loop_translation)
-    frames = chain_forward_kinematics(geometry, values)
-    if (np.linalg.norm(frames.end_translation - target_translation) <= NEWTON_TOLERANCE * scale
-            and np.linalg.norm(rotation_vector_from_rotation(frames.end_rotation.T @ target_rotation))
-            <= NEWTON_TOLERANCE):
+    if max(_apart(chain_forward_kinematics(geometry, values), target_rotation, target_translation, scale)) \
+            <= NEWTON_TOLERANCE:
         return geometry, None
-    solved, converged, residual = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
-                                                     values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
-                                                     length=scale)
-    if converged[0] or residual[0] > FILE_ROUNDING:
-        return geometry, None
+    solved, converged, _ = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
+                                              values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
+                                              length=scale)
     end = chain_forward_kinematics(geometry, solved[0])
+    radians, lengths = _apart(end, target_rotation, target_translation, scale)
+    if converged[0] or max(radians, lengths) > NEAR_ROUNDING:
+        return geometry, None
+    if max(radians, lengths) > FILE_ROUNDING:
+        raise mechanism.description.fail(
+            f"<loop name='{mechanism.chains[index].loop_name}'>",
+            f"does not close at the reference configuration: its chain's joints leave its frames {radians:.3g} rad "
+            f"and {lengths * scale:.3g} m apart at the closest, of the order of a file's rounding but beyond what is "
+            f"read as drawn ({FILE_ROUNDING:g} rad and {FILE_ROUNDING:g} of the mechanism's size, {scale:.3g} m): "
+            "written with 6 decimals or more, as CAD exports write them, such a loop is closed as drawn.")
     rotation = mechanism.home_rotation.T @ end.end_rotation
     translation = mechanism.home_rotation.T @ (end.end_translation - mechanism.home_translation)
     turn = float(np.linalg.norm(rotation_vector_from_rotation(geometry.platform_loop_rotation.T @ rotation)))
     metres = float(np.linalg.norm(translation - geometry.platform_loop_translation))
     return replace(geometry, platform_loop_rotation=rotation, platform_loop_translation=translation), (metres, turn)
+
+
+def _apart(frames, rotation: NDArray, translation: NDArray, scale: float) -> tuple[float, float]:
+    """How far a chain's end ``frames`` are from a loop frame: the angle (rad) and the distance over ``scale``."""
+    return (float(np.linalg.norm(rotation_vector_from_rotation(frames.end_rotation.T @ rotation))),
+            float(np.linalg.norm(frames.end_translation - translation)) / scale)
