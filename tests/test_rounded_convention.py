@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
@@ -68,8 +69,9 @@ def test_the_delta_written_rounded_has_the_pressure_angle_closed_forms(tmp_path,
 
 WITHIN_AT_5 = [name for name in bundled_names() if name not in ("prs_3_ups", "coop_arms")]
 """The bundled files whose rounding to 5 decimals stays within what is read as drawn: the 3-PRS + UPS (0.29 m) is left
-1.5e-5 of its size open (refused, below); the two-arm cell's three parallel hinges of each arm come out further apart
-than ``FILE_ROUNDING``, and 80 submechanisms singular as generated read as not singular at its home (OTI up to 0.92)."""
+1.5e-5 of its size open (refused, below); the two arms' last wrist hinges of the two-arm cell, parallel at its home,
+come out 1.5e-5 rad apart, beyond ``FILE_ROUNDING``, and read as written, 80 submechanisms singular at its home as
+generated are not singular there (OTIs up to 0.92, F_O1 6.8e-4 off)."""
 
 
 @pytest.mark.parametrize(("name", "decimals"), [(name, 6) for name in bundled_names()]
@@ -108,20 +110,37 @@ def test_a_loop_left_open_beyond_the_rounding_is_refused_at_any_size(tmp_path, f
         load(path)
 
 
-def test_a_base_turn_written_rounded_does_not_make_another_chain_s_hinges_parallel(tmp_path):
-    """The two-arm cell with its right arm's base turn written 3.14 for pi: its hinges are parallel to the left
-    arm's at the reference configuration only (each shoulder pan at 0), 1.6e-3 rad apart as written. They are not
-    made parallel (that turned each arm's hinges by 8e-4 rad and moved an ITI by 1.9e-2): the file is read as
-    written, and its pan takes the turn up, so its indices are the cell's as generated, to 1e-12."""
-    text = bundled_path("coop_arms").read_text()
-    assert text.count('rpy="0 0 3.141592653589793"') == 1
-    cell = load(written(tmp_path, "cell", text.replace('rpy="0 0 3.141592653589793"', 'rpy="0 0 3.14"')))
-    assert not [note for note in cell.assembly_notes if note.startswith(DRAWN_AT_ROUNDING)]
-    exact = load("coop_arms")
+def one_arm(text: str) -> str:
+    """The two-arm cell with its right arm left out: the left arm alone holds the object (one chain)."""
+    root = ElementTree.fromstring(text)
+    for element in list(root):
+        if element.get("name", "").startswith("right"):
+            root.remove(element)
+        if element.tag == "reference_configuration":
+            for joint in [joint for joint in element if joint.get("name", "").startswith("right")]:
+                element.remove(joint)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize(("arms", "generated", "as_rounded"),
+                         [(2, 'rpy="0 0 3.141592653589793"', 'rpy="0 0 3.14"'),
+                          (1, 'xyz="0 0.13585 0" rpy="0 1.57079632679 0"', 'xyz="0 0.13585 0" rpy="0 1.57 0"')])
+def test_axes_parallel_at_the_reference_configuration_only_are_read_as_written(tmp_path, arms, generated, as_rounded):
+    """The two-arm cell with its right arm's base turn written 3.14 for pi, and its left arm alone with its shoulder's
+    right angle written 1.57: the hinges the rounding tilts are parallel to others at the reference configuration
+    only, the other arm's (each pan at 0) or the same arm's pan (its three middle hinges' values summing to zero),
+    1.6e-3 and 8e-4 rad apart as written. They are not made parallel (that turned hinges by 8e-4 and 4e-4 rad and
+    moved an ITI by 1.9e-2 and 1.1e-5): the file is read as written, the pan or the shoulder takes the turn up, and
+    its indices are those of the file as generated, to 1e-10."""
+    text = bundled_path("coop_arms").read_text() if arms == 2 else one_arm(bundled_path("coop_arms").read_text())
+    assert generated in text  # (the first: the base's turn of the right arm, the shoulder of the left)
+    exact = load(written(tmp_path, "exact", text))
+    cell = load(written(tmp_path, "cell", text.replace(generated, as_rounded, 1)))
+    assert not [note for note in cell.assembly_notes if note.startswith(DRAWN_AT_ROUNDING)], cell.assembly_notes
     poses = random_reachable_poses(exact, np.random.default_rng(6), 5)
     first, second = indices_at_poses(exact, poses, detail=True), indices_at_poses(cell, poses, detail=True)
-    np.testing.assert_allclose(second.iti_actuators, first.iti_actuators, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(second.lmti, first.lmti, rtol=0, atol=1e-12)
+    for key in ("iti_actuators", "oti_submechanisms", "lmti"):
+        np.testing.assert_allclose(getattr(second, key), getattr(first, key), rtol=0, atol=1e-10, err_msg=key)
 
 
 def frames_after_motion(geometry: ChainGeometry, values) -> list:
@@ -205,6 +224,16 @@ def test_the_rounded_delta_reads_alike_in_millimetres_in_a_turned_world_and_with
                                    err_msg=label)
         np.testing.assert_allclose(result.f_o[1], reference.f_o[1], rtol=0, atol=1e-9, err_msg=label)
         np.testing.assert_allclose(result.lmti, reference.lmti, rtol=0, atol=1e-9, err_msg=label)
+
+
+def test_the_note_names_the_same_joint_in_millimetres_and_in_another_world(tmp_path):
+    """The 8-RSS hexapod to 6 decimals: its eight cranks turn alike (by its symmetry, to round-off), and the note names
+    the first of them whatever round-off a world or a unit leaves (it named another crank in a moved world)."""
+    text = rounded(bundled_path("rss_hexapod_8").read_text(), 6)
+    sources = {"m": text, "mm": in_unit(text, "mm", 1000.0, declare=True),
+               "world": moved_in_the_world(text, (0.4, -1.3, 2.1), (0.7, -1.1, 2.3))}
+    notes = {label: drawn_note(load(written(tmp_path, label, source))) for label, source in sources.items()}
+    assert notes["mm"] == notes["world"] == notes["m"], notes
 
 
 def test_the_commands_say_what_the_rounding_changed_and_refuse_a_loop_beyond_it_in_one_line(tmp_path):

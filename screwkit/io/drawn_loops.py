@@ -10,12 +10,14 @@ canonical`) and the reference assembly:
 
 1. **Parallel axes.** Every joint axis of every chain, and every axis of a revolute, prismatic or universal loop
    joint, at the file's reference configuration (the loop joints' values fitted to the file's frames), grouped by
-   :func:`~screwkit.io.rounding.parallel_axes` within :data:`~screwkit.common.tolerances.FILE_ROUNDING`; two axes of
-   one chain within more where the file writes angles rounded between them (``1.5708`` for pi/2:
-   :mod:`screwkit.io.written_angles`). Not two axes of different chains: they are parallel at the reference
-   configuration only (two arms' shoulder hinges, each arm's pan at 0), and a base turn written ``3.14`` would have
-   turned each arm's hinges by 8e-4 rad, moving its ITI by 1.9e-2. A turned joint's placement turns with it, so
-   that at the reference configuration every frame after its motion stays where it was (as
+   :func:`~screwkit.io.rounding.parallel_axes` within :data:`~screwkit.common.tolerances.FILE_ROUNDING`. Two axes
+   of one chain are grouped within more where the file writes angles rounded between them (``1.5708`` for pi/2:
+   :mod:`screwkit.io.written_angles`) only if every hinge between them is parallel to them, so that they are
+   parallel whatever its values (:func:`_structural`); two axes parallel at the reference configuration only are
+   not given that much: two arms' shoulder hinges, each arm's pan at 0 (a base turn written ``3.14`` turned each
+   arm's hinges by 8e-4 rad and moved its ITI by 1.9e-2), or an arm's pan and its second wrist hinge, its middle
+   hinges' values summing to zero (1.1e-5 on its ITI). A turned joint's placement turns with it, so that at the
+   reference configuration every frame after its motion stays where it was (as
    :func:`~screwkit.io.rounding.turned_joint` does in a converted file): :func:`turned_geometry`.
 2. **Loops closed within the rounding.** A chain whose loop its own joints cannot close onto the platform's loop
    frame (damped Newton from the file's values) but leave within ``FILE_ROUNDING`` of it (rad, and lengths over
@@ -139,9 +141,14 @@ def _parallel(mechanism: Mechanism, values: list[NDArray]) -> tuple[list[ChainGe
     if not np.any((crosses > UNSEEN) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
         return geometries, 0.0, ""  # (an exact file: its file is not read again)
     names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
-    chain_of = np.array([index for index, _ in owners])  # (widened within a chain only: module docstring)
-    allowed = np.where(chain_of[:, None] == chain_of[None], written_turns(mechanism.description.source).allowances(
-        names), FILE_ROUNDING)
+    widened, allowed = written_turns(mechanism.description.source).allowances(names), np.full(crosses.shape,
+                                                                                            FILE_ROUNDING)
+    for index, chain in enumerate(mechanism.chains):  # (widened within a chain only: module docstring)
+        rows = np.array([k for k, (owner, _) in enumerate(owners) if owner == index])
+        if rows.size:
+            slides = chain.geometry.dof_prismatic[:rows.size]
+            allowed[np.ix_(rows, rows)] = _structural(crosses[np.ix_(rows, rows)], slides,
+                                                      widened[np.ix_(rows, rows)])
     turned, turn = parallel_axes(units, allowed)
     if turn <= UNSEEN:
         return geometries, 0.0, ""
@@ -151,6 +158,22 @@ def _parallel(mechanism: Mechanism, values: list[NDArray]) -> tuple[list[ChainGe
         if np.any(moved[rows] > 0.0):
             geometries[index] = turned_geometry(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
     return geometries, turn, names[_first_most(moved)]
+
+
+def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.float64]:
+    """One chain's allowances: ``widened`` between two of its axes (``crosses`` of every two, in the chain's order;
+    ``slides`` the prismatic ones) that stay parallel whatever the values of the joints between them (every hinge
+    between them within its allowance of parallel to the first), else :data:`FILE_ROUNDING`: a UR arm's base pan and
+    its second wrist hinge are parallel when its three middle hinges' values sum to zero, and are not grouped for a
+    right angle written 1.57 between them."""
+    count = crosses.shape[0]
+    allowed = np.full((count, count), FILE_ROUNDING)
+    for first in range(count):
+        for second in range(first, count):
+            hinges = [k for k in range(first + 1, second) if not slides[k]]
+            if all(crosses[k, first] <= widened[k, first] for k in hinges):
+                allowed[first, second] = allowed[second, first] = widened[first, second]
+    return allowed
 
 
 def _first_most(values) -> int:
@@ -218,7 +241,8 @@ def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: N
             f"does not close at the reference configuration: its chain's joints leave its frames {radians:.3g} rad "
             f"and {lengths * scale:.3g} m apart at the closest, of the order of a file's rounding but beyond what is "
             f"read as drawn ({FILE_ROUNDING:g} rad and {FILE_ROUNDING:g} of the mechanism's size, {scale:.3g} m): "
-            "written with 6 decimals or more, as CAD exports write them, such a loop is closed as drawn.")
+            "written to that or finer (a CAD export's 6 decimals in metres, for a mechanism of 10 cm or more), such a "
+            "loop is closed as drawn.")
     rotation = mechanism.home_rotation.T @ end.end_rotation
     translation = mechanism.home_rotation.T @ (end.end_translation - mechanism.home_translation)
     turn = float(np.linalg.norm(rotation_vector_from_rotation(geometry.platform_loop_rotation.T @ rotation)))
