@@ -70,14 +70,16 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
     if description.converted_from:
         return mechanism
     scale = mechanism_size(mechanism, mechanism.chains)
-    values = [_file_values(mechanism, index) for index in range(len(mechanism.chains))]
-    geometries, turn, most = _parallel(mechanism, values)
+    values, axes, closes = zip(*(_file_values(mechanism, index, scale) for index in range(len(mechanism.chains))))
+    geometries, turn, most = _parallel(mechanism, values, axes)
     notes = []
     if turn:
         notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} "
                      f"rad, of joint {most!r})")
     moved = []
     for index, chain in enumerate(mechanism.chains):
+        if closes[index] and geometries[index] is chain.geometry:  # (as written, closed: nothing to do)
+            continue
         geometry, gap = _closed(mechanism, index, geometries[index], values[index], scale)
         geometries[index] = geometry
         if gap is not None:
@@ -96,8 +98,10 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
                    assembly_notes=mechanism.assembly_notes + (DRAWN_AT_ROUNDING + "; ".join(notes),))
 
 
-def _file_values(mechanism: Mechanism, index: int) -> NDArray[np.float64]:
-    """Chain ``index``'s joint values at the file's reference configuration, its loop joint's fitted to its frames."""
+def _file_values(mechanism: Mechanism, index: int, scale: float) -> tuple[NDArray[np.float64], NDArray, bool]:
+    """Chain ``index``'s joint values at the file's reference configuration, its loop joint's fitted to its frames;
+    the axes (base frame) of its tree joints and of its loop joint there; whether the loop closes there (the fit's
+    gap at most :data:`~screwkit.common.tolerances.NEWTON_TOLERANCE`, in rad and the mechanism's ``scale``)."""
     chain = mechanism.chains[index]
     geometry = chain.geometry
     tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
@@ -105,10 +109,16 @@ def _file_values(mechanism: Mechanism, index: int) -> NDArray[np.float64]:
     frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
     target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
                                                                  mechanism.home_translation)
-    loop, _, _ = loop_values_from_relative_transform(
+    loop, position_gap, rotation_gap = loop_values_from_relative_transform(
         geometry, frames.leg_rotation.T @ target_rotation,
         frames.leg_rotation.T @ (target_translation - frames.leg_translation))
-    return np.concatenate([tree, loop])
+    loop_axes = frames.leg_rotation @ geometry.loop_axes[:_AXIS_LOOPS.get(geometry.loop_type, 0)].T
+    if geometry.loop_type == "universal":  # (its second axis turns with its first)
+        loop_axes[:, 1] = frames.leg_rotation @ rotation_about_axis(geometry.loop_axes[0], loop[0]) @ \
+            geometry.loop_axes[1]
+    axes = np.concatenate([frames.axes[: geometry.n_tree_joints], loop_axes.T])
+    closes = max(float(position_gap) / scale, float(rotation_gap)) <= NEWTON_TOLERANCE
+    return np.concatenate([tree, loop]), axes, closes
 
 
 def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArray], NDArray]:
@@ -123,16 +133,11 @@ def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArr
     return after, rotation @ geometry.leg_loop_rotation
 
 
-def _parallel(mechanism: Mechanism, values: list[NDArray]) -> tuple[list[ChainGeometry], float, str]:
+def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], float, str]:
     """Every chain's geometry with the axes :func:`parallel_axes` groups made parallel (step 1 of the module
     docstring), the largest turn (0: none) and the joint turned most."""
-    owners, directions = [], []
-    for index, (chain, at) in enumerate(zip(mechanism.chains, values)):
-        frames = chain_forward_kinematics(chain.geometry, at)
-        loop_axes = _AXIS_LOOPS.get(chain.geometry.loop_type, 0)
-        for dof in range(chain.geometry.n_tree_joints + loop_axes):
-            owners.append((index, dof))
-            directions.append(frames.axes[dof])
+    owners = [(index, dof) for index, chain_axes in enumerate(axes) for dof in range(len(chain_axes))]
+    directions = [direction for chain_axes in axes for direction in chain_axes]
     geometries = [chain.geometry for chain in mechanism.chains]
     if len(directions) < 2:
         return geometries, 0.0, ""
