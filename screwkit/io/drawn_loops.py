@@ -9,7 +9,8 @@ reading of the chains of a file in screwkit's convention, before their canonical
 canonical`) and the reference assembly:
 
 1. **Parallel axes.** Every joint axis of every chain, and every axis of a revolute, prismatic or universal loop
-   joint, at the file's reference configuration (the loop joints' values fitted to the file's frames), grouped by
+   joint, at the file's reference configuration (the loop joints' values fitted to the file's frames; a chain that
+   does not close there, where its joints close it, as ``screwkit convert`` writes it back), grouped by
    :func:`~screwkit.io.rounding.parallel_axes` within :data:`~screwkit.common.tolerances.FILE_ROUNDING`. Two axes
    of one chain are grouped within more where the file writes angles rounded between them (``1.5708`` for pi/2:
    :mod:`screwkit.io.written_angles`) only if every hinge between them is parallel to them, so that they are
@@ -26,9 +27,9 @@ canonical`) and the reference assembly:
    naming the loop and saying that it is of the order of a file's rounding (the Delta written to 4 decimals, 1.3e-5
    rad); one further still is left to the assembly, which refuses it as before.
 
-Nothing changes in an exact file: turns of at most :data:`UNSEEN` are not made (the bundled ``coop_arms.urdf``
-writes pi/2 as ``1.5707963267900003``, 4.9e-12 off), and a loop its chain closes is not touched: every bundled
-mechanism reads as before, bit for bit. What is changed is said, in one note starting
+Nothing changes in an exact file: where no axis would turn by more than :data:`UNSEEN`, none is turned (the
+bundled ``coop_arms.urdf`` writes pi/2 as ``1.5707963267900003``, 4.9e-12 off), and a loop its chain closes is not
+touched: every bundled mechanism reads as before, bit for bit. What is changed is said, in one note starting
 :data:`~screwkit.closure.assembly.DRAWN_AT_ROUNDING`.
 """
 
@@ -70,7 +71,10 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
     if description.converted_from:
         return mechanism
     scale = mechanism_size(mechanism, mechanism.chains)
-    values, axes, closes = zip(*(_file_values(mechanism, index, scale) for index in range(len(mechanism.chains))))
+    values, axes, closes = (list(found) for found in zip(*(_file_values(mechanism, index, scale)
+                                                          for index in range(len(mechanism.chains)))))
+    for index in (index for index, closed in enumerate(closes) if not closed):  # (read where the loops close)
+        values[index], axes[index] = _closing(mechanism, index, values[index], axes[index], scale)
     geometries, turn, most = _parallel(mechanism, values, axes)
     notes = []
     if turn:
@@ -121,6 +125,22 @@ def _file_values(mechanism: Mechanism, index: int, scale: float) -> tuple[NDArra
     return np.concatenate([tree, loop]), axes, closes
 
 
+def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, scale: float
+             ) -> tuple[NDArray, NDArray]:
+    """Chain ``index``'s joint values and axes where its joints close its loop (damped Newton from the file's
+    ``values``), so that its axes are read where the mechanism is assembled, as ``screwkit convert`` writes it back;
+    ``values`` and ``axes`` as they are where they do not close it."""
+    geometry = mechanism.chains[index].geometry
+    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
+                                                                 mechanism.home_translation)
+    solved, converged, _ = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
+                                              values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
+                                              length=scale)
+    if not converged[0]:
+        return values, axes
+    return solved[0], chain_forward_kinematics(geometry, solved[0]).axes[: len(axes)]
+
+
 def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArray], NDArray]:
     """The rotation (base frame) of each tree joint's frame after its motion at ``values``, and of the leg-side loop
     frame."""
@@ -146,8 +166,9 @@ def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], 
     if not np.any((crosses > UNSEEN) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
         return geometries, 0.0, ""  # (an exact file: its file is not read again)
     names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
-    widened, allowed = written_turns(mechanism.description.source).allowances(names), np.full(crosses.shape,
-                                                                                            FILE_ROUNDING)
+    description = mechanism.description  # (the text being read: load_text's is not its source's file)
+    widened = written_turns(description.source, description.text).allowances(names)
+    allowed = np.full(crosses.shape, FILE_ROUNDING)
     for index, chain in enumerate(mechanism.chains):  # (widened within a chain only: module docstring)
         rows = np.array([k for k, (owner, _) in enumerate(owners) if owner == index])
         if rows.size:

@@ -99,13 +99,15 @@ class WrittenTurns:
         return np.array([[self.allowance(a, b) for b in names] for a in names]).reshape(len(names), len(names))
 
 
-def written_turns(source: str) -> WrittenTurns:
+def written_turns(source: str, text: str | None = None) -> WrittenTurns:
     """The :class:`WrittenTurns` of the file ``source`` (an MJCF or URDF file; none for any other, or one that
-    cannot be read again), parsed as the readers of other tools parse it (:func:`~screwkit.common.xml_text.
-    tolerant_xml`)."""
+    cannot be read again), or of its ``text`` when given (the text being read, not the file again), parsed as the
+    readers of other tools parse it (:func:`~screwkit.common.xml_text.tolerant_xml`)."""
     try:
-        with open(source, "rb") as handle:
-            root = ElementTree.fromstring(tolerant_xml(handle.read()))
+        if text is None:
+            with open(source, "rb") as handle:
+                text = handle.read()
+        root = ElementTree.fromstring(tolerant_xml(text))
     except (OSError, ElementTree.ParseError, ValueError):
         return WrittenTurns()
     found: list[tuple[float, str]] = []  # every rounded angle on a joint's path, in the file's order
