@@ -18,6 +18,7 @@ from screwkit.cli.options import (
 from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
 from screwkit.closure.assembly import DRAWN_AT_ROUNDING, NOT_OPEN_LOOPS
 from screwkit.io import ImportError_, ImportReport, is_foreign, with_reference_configuration
+from screwkit.io.drawn_loops import FRAMES_WRITTEN
 from screwkit.io.loader import converted_mechanism, load, load_text
 from screwkit.studies.files import atomic_text, check_output
 
@@ -61,7 +62,7 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
             text = with_reference_configuration(own.description.text, own)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))
-            drawn = any(note.startswith(DRAWN_AT_ROUNDING) and "loop frames" in note for note in own.assembly_notes)
+            drawn = any(note.startswith(DRAWN_AT_ROUNDING) and FRAMES_WRITTEN in note for note in own.assembly_notes)
             report.notes = [f"assembled: {note}" for note in own.assembly_notes if not note.startswith(NOT_OPEN_LOOPS)
                             ] or ["every loop closes as written" + (" to the file's rounding (below)" if drawn else "")]
             # (the others: below, from the file written)

@@ -18,12 +18,11 @@ from numpy.typing import NDArray
 from screwkit.closure.analytic import closed_form_for
 from screwkit.closure.chain_kinematics import (
     chain_forward_kinematics,
-    loop_values_from_relative_transform,
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
 from screwkit.closure.modes import describe_modes, meeting_modes, small_steps, values_at
-from screwkit.closure.newton import newton_solve_chain, task_rows, with_point_signs, working_sign
+from screwkit.closure.newton import file_fit, newton_solve_chain, task_rows, with_point_signs, working_sign
 from screwkit.closure.point_turns import check_turns
 from screwkit.closure.solve import outside_limits, run_closed_form, solve
 from screwkit.closure.task_space import (
@@ -113,18 +112,10 @@ def _reference_values(mechanism: Mechanism, index: int, chain: Chain, length_sca
     False that is a note instead).
     """
     description, geometry = mechanism.description, chain.geometry
-    tree_values = np.array([description.reference_configuration.get(name, 0.0)
-                            for name in chain.joint_names[: geometry.n_tree_joints]])
-    frames = chain_forward_kinematics(geometry,
-                                      np.concatenate([tree_values, np.zeros(geometry.n_dofs - tree_values.size)]))
+    values, _, position_gap, rotation_gap = file_fit(mechanism, index)
     target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
                                                                  mechanism.home_translation)
-    loop_values, position_gap, rotation_gap = loop_values_from_relative_transform(
-        geometry,
-        frames.leg_rotation.T @ target_rotation,
-        frames.leg_rotation.T @ (target_translation - frames.leg_translation),
-    )
-    values, note = np.concatenate([tree_values, loop_values]), None
+    note = None
     if position_gap > CLOSURE_TOLERANCE * length_scale or rotation_gap > CLOSURE_TOLERANCE:
         scale = np.where(np.asarray(geometry.dof_prismatic), length_scale, 1.0)
         solved, converged, residual = newton_solve_chain(geometry, target_rotation[None], target_translation[None],

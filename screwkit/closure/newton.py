@@ -1,5 +1,6 @@
 """Closing one chain by damped Newton steps (Levenberg-Marquardt), batched over configurations.
 
+:func:`file_fit` gives a chain's joint values as its file writes them, where the reference assembly starts;
 :func:`newton_solve_chain` closes a chain onto target loop frames from start values;
 :func:`solve_newton_chain` adds what a mechanism needs around it: continuation from the
 reference assembly along straight platform paths, then from solved neighbouring poses, and
@@ -18,6 +19,7 @@ from screwkit.closure.chain_kinematics import (
     ChainFrames,
     chain_forward_kinematics,
     chain_jacobian,
+    loop_values_from_relative_transform,
     twists_from_axes_and_points,
     wrap_revolute_values,
 )
@@ -28,7 +30,7 @@ from screwkit.common.rotations import (
 from screwkit.model.chain import ChainGeometry
 
 __all__ = ["pose_error", "apply_step", "newton_solve_chain", "solve_newton_chain", "determinant_sign", "working_sign",
-           "with_point_signs", "branch_kept", "task_rows"]
+           "with_point_signs", "branch_kept", "task_rows", "file_fit"]
 
 
 def pose_error(
@@ -149,6 +151,21 @@ def determinant_sign(geometry: ChainGeometry, is_planar: bool, axes: NDArray, po
     if np.ndim(sign) == 0:
         return None if sign == 0 else int(sign)
     return sign
+
+
+def file_fit(mechanism, index: int) -> tuple[NDArray[np.float64], ChainFrames, float, float]:
+    """Chain ``index``'s joint values as the file writes them (tree joints at ``<reference_configuration>`` or 0, the
+    loop joint's fitted to the platform's loop frame at home), its frames there with the loop joint at 0, and what the
+    fit leaves open (m, rad)."""
+    chain = mechanism.chains[index]
+    geometry = chain.geometry
+    tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
+                     for name in chain.joint_names[: geometry.n_tree_joints]])
+    frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
+    rotation, translation = mechanism.loop_targets(index, mechanism.home_rotation, mechanism.home_translation)
+    loop, position_gap, rotation_gap = loop_values_from_relative_transform(
+        geometry, frames.leg_rotation.T @ rotation, frames.leg_rotation.T @ (translation - frames.leg_translation))
+    return np.concatenate([tree, loop]), frames, float(position_gap), float(rotation_gap)
 
 
 def working_sign(mechanism, index: int, frames: ChainFrames):

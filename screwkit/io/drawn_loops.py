@@ -41,8 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.closure.assembly import DRAWN_AT_ROUNDING, mechanism_size
-from screwkit.closure.chain_kinematics import chain_forward_kinematics, loop_values_from_relative_transform
-from screwkit.closure.newton import newton_solve_chain
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
+from screwkit.closure.newton import file_fit, newton_solve_chain
 from screwkit.common.rotations import rotation_about_axis, rotation_vector_from_rotation
 from screwkit.common.tolerances import FILE_ROUNDING, MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 from screwkit.io.rounding import EXACT, parallel_axes
@@ -50,7 +50,11 @@ from screwkit.io.written_angles import WIDENING_LIMIT, written_turns
 from screwkit.model.chain import ChainGeometry
 from screwkit.model.mechanism import Mechanism
 
-__all__ = ["drawn_loops", "turned_geometry", "UNSEEN", "NEAR_ROUNDING"]
+__all__ = ["drawn_loops", "turned_geometry", "UNSEEN", "NEAR_ROUNDING", "FRAMES_WRITTEN"]
+
+FRAMES_WRITTEN = "loop frames that meet to the file's rounding written as one"
+"""The part of the :data:`~screwkit.closure.assembly.DRAWN_AT_ROUNDING` note that says loop frames were written where
+their chains close (``screwkit convert`` then does not say that every loop closes as written)."""
 
 UNSEEN = MOTION_SPACE_TOLERANCE
 """Rad: axes a file draws at most this far from parallel are left as written (their twists are already dependent to
@@ -93,7 +97,7 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
         change = " and ".join([f"moved {metres:.2g} m"] * (metres > EXACT * scale) + [f"turned {radians:.2g} rad"] *
                               (radians > EXACT))
         names = ", ".join(repr(name) for name, _, _ in moved)
-        notes.append(f"loop frames that meet to the file's rounding written as one (loop{'s' * (len(moved) > 1)} "
+        notes.append(f"{FRAMES_WRITTEN} (loop{'s' * (len(moved) > 1)} "
                      f"{names}; the most, {loop!r}, its platform frame {change})")
     if not notes:
         return mechanism
@@ -103,26 +107,17 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
 
 
 def _file_values(mechanism: Mechanism, index: int, scale: float) -> tuple[NDArray[np.float64], NDArray, bool]:
-    """Chain ``index``'s joint values at the file's reference configuration, its loop joint's fitted to its frames;
-    the axes (base frame) of its tree joints and of its loop joint there; whether the loop closes there (the fit's
-    gap at most :data:`~screwkit.common.tolerances.NEWTON_TOLERANCE`, in rad and the mechanism's ``scale``)."""
-    chain = mechanism.chains[index]
-    geometry = chain.geometry
-    tree = np.array([mechanism.description.reference_configuration.get(name, 0.0)
-                     for name in chain.joint_names[: geometry.n_tree_joints]])
-    frames = chain_forward_kinematics(geometry, np.concatenate([tree, np.zeros(geometry.n_dofs - tree.size)]))
-    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
-                                                                 mechanism.home_translation)
-    loop, position_gap, rotation_gap = loop_values_from_relative_transform(
-        geometry, frames.leg_rotation.T @ target_rotation,
-        frames.leg_rotation.T @ (target_translation - frames.leg_translation))
+    """Chain ``index``'s joint values as the file writes them (:func:`~screwkit.closure.newton.file_fit`); the
+    axes (base frame) of its tree joints and of its loop joint there; whether the loop closes there (the fit's gap
+    at most :data:`~screwkit.common.tolerances.NEWTON_TOLERANCE`, in rad and the mechanism's ``scale``)."""
+    geometry = mechanism.chains[index].geometry
+    values, frames, position_gap, rotation_gap = file_fit(mechanism, index)
     loop_axes = frames.leg_rotation @ geometry.loop_axes[:_AXIS_LOOPS.get(geometry.loop_type, 0)].T
     if geometry.loop_type == "universal":  # (its second axis turns with its first)
-        loop_axes[:, 1] = frames.leg_rotation @ rotation_about_axis(geometry.loop_axes[0], loop[0]) @ \
-            geometry.loop_axes[1]
+        first = rotation_about_axis(geometry.loop_axes[0], values[geometry.n_tree_joints])
+        loop_axes[:, 1] = frames.leg_rotation @ first @ geometry.loop_axes[1]
     axes = np.concatenate([frames.axes[: geometry.n_tree_joints], loop_axes.T])
-    closes = max(float(position_gap) / scale, float(rotation_gap)) <= NEWTON_TOLERANCE
-    return np.concatenate([tree, loop]), axes, closes
+    return values, axes, max(position_gap / scale, rotation_gap) <= NEWTON_TOLERANCE
 
 
 def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, scale: float
@@ -131,14 +126,20 @@ def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, s
     ``values``), so that its axes are read where the mechanism is assembled, as ``screwkit convert`` writes it back;
     ``values`` and ``axes`` as they are where they do not close it."""
     geometry = mechanism.chains[index].geometry
+    solved, converged = _solved(mechanism, index, geometry, values, scale)
+    return (solved, chain_forward_kinematics(geometry, solved).axes[: len(axes)]) if converged else (values, axes)
+
+
+def _solved(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: NDArray, scale: float
+            ) -> tuple[NDArray, bool]:
+    """Chain ``index`` (its ``geometry``) closed onto the platform's loop frame at home by damped Newton from
+    ``values``, and whether it closed to :data:`~screwkit.common.tolerances.NEWTON_TOLERANCE`."""
     target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
                                                                  mechanism.home_translation)
     solved, converged, _ = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
                                               values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
                                               length=scale)
-    if not converged[0]:
-        return values, axes
-    return solved[0], chain_forward_kinematics(geometry, solved[0]).axes[: len(axes)]
+    return solved[0], bool(converged[0])
 
 
 def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArray], NDArray]:
@@ -169,18 +170,16 @@ def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], 
     description = mechanism.description  # (the text being read: load_text's is not its source's file)
     widened = written_turns(description.source, description.text).allowances(names)
     allowed = np.full(crosses.shape, FILE_ROUNDING)
-    for index, chain in enumerate(mechanism.chains):  # (widened within a chain only: module docstring)
-        rows = np.array([k for k, (owner, _) in enumerate(owners) if owner == index])
-        if rows.size:
-            slides = chain.geometry.dof_prismatic[:rows.size]
-            allowed[np.ix_(rows, rows)] = _structural(crosses[np.ix_(rows, rows)], slides,
-                                                      widened[np.ix_(rows, rows)])
+    chain_rows = [np.array([k for k, (owner, _) in enumerate(owners) if owner == index], dtype=int)
+                  for index in range(len(mechanism.chains))]
+    for chain, rows in zip(mechanism.chains, chain_rows):  # (widened within a chain only: module docstring)
+        block = np.ix_(rows, rows)
+        allowed[block] = _structural(crosses[block], chain.geometry.dof_prismatic[:rows.size], widened[block])
     turned, turn = parallel_axes(units, allowed)
     if turn <= UNSEEN:
         return geometries, 0.0, ""
     moved = np.linalg.norm(np.cross(turned, units), axis=1)
-    for index, chain in enumerate(mechanism.chains):
-        rows = [k for k, (owner, _) in enumerate(owners) if owner == index]
+    for index, (chain, rows) in enumerate(zip(mechanism.chains, chain_rows)):
         if np.any(moved[rows] > 0.0):
             geometries[index] = turned_geometry(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
     return geometries, turn, names[_first_most(moved)]
@@ -248,18 +247,16 @@ def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: N
     """``geometry`` with the platform's loop frame written where the chain closes, when its joints leave the loop
     within the file's rounding but no closer (step 2 of the module docstring), and how far it moved (length, rad);
     else ``geometry`` and None. A ValueError names a loop left open by more, up to :data:`NEAR_ROUNDING`."""
-    target_rotation, target_translation = (
-        mechanism.home_rotation @ geometry.platform_loop_rotation,
-        mechanism.home_translation + mechanism.home_rotation @ geometry.platform_loop_translation)
+    # (the platform's loop frame is the file's until written here: the targets are the mechanism's)
+    target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
+                                                                 mechanism.home_translation)
     if max(_apart(chain_forward_kinematics(geometry, values), target_rotation, target_translation, scale)) \
             <= NEWTON_TOLERANCE:
         return geometry, None
-    solved, converged, _ = newton_solve_chain(geometry, target_rotation[None], target_translation[None],
-                                              values[None], tolerance=NEWTON_TOLERANCE, max_iterations=200,
-                                              length=scale)
-    end = chain_forward_kinematics(geometry, solved[0])
+    solved, converged = _solved(mechanism, index, geometry, values, scale)
+    end = chain_forward_kinematics(geometry, solved)
     radians, lengths = _apart(end, target_rotation, target_translation, scale)
-    if converged[0] or max(radians, lengths) > NEAR_ROUNDING:
+    if converged or max(radians, lengths) > NEAR_ROUNDING:
         return geometry, None
     if max(radians, lengths) > FILE_ROUNDING:
         raise mechanism.description.fail(
