@@ -203,22 +203,26 @@ def renamed_legs(text: str) -> str:
 
 
 def test_the_rounded_delta_reads_alike_in_millimetres_in_a_turned_world_and_with_its_legs_renamed(tmp_path):
-    """The Delta to 6 decimals in metres; the same file in millimetres; hung in a world turned and
-    moved (a fixed joint above its base); its legs named the other way round: the same note, word for word (the
-    renamed one names its loops in the other order), and at five poses the same indices per leg to 1e-9."""
+    """The Delta to 6 decimals in metres; the same file in millimetres; the same drawing at a thousandth and a
+    thousand times its size; hung in a world turned and moved (a fixed joint above its base); its legs named the other
+    way round: the same note, word for word (the renamed one names its loops in the other order), and at five poses
+    (scaled with it) the same indices per leg to 1e-9."""
     text = rounded(bundled_path("delta_4").read_text(), 6)
-    files = {"m": text, "mm": in_unit(text, "mm", 1000.0, declare=True),
-             "world": moved_in_the_world(text, (0.4, -1.3, 2.1), (0.7, -1.1, 2.3)), "renamed": renamed_legs(text)}
-    mechanisms = {label: load(written(tmp_path, label, source)) for label, source in files.items()}
+    files = {"m": (text, 1.0), "mm": (in_unit(text, "mm", 1000.0, declare=True), 1.0),
+             "x 1e-3": (in_unit(text, "m", 1e-3), 1e-3), "x 1e3": (in_unit(text, "m", 1e3), 1e3),
+             "world": (moved_in_the_world(text, (0.4, -1.3, 2.1), (0.7, -1.1, 2.3)), 1.0),
+             "renamed": (renamed_legs(text), 1.0)}
+    mechanisms = {label: load(written(tmp_path, label.replace(" ", "_"), source))
+                  for label, (source, _) in files.items()}
     notes = {label: drawn_note(mechanism) for label, mechanism in mechanisms.items()}
-    assert notes["mm"] == notes["world"] == notes["m"]
+    assert notes["mm"] == notes["world"] == notes["x 1e-3"] == notes["x 1e3"] == notes["m"], notes
     turn = re.search(r"largest turn ([0-9.e-]+) rad", notes["m"]).group(1)
     assert f"largest turn {turn} rad" in notes["renamed"]
     poses = delta_poses(4, seed=9)
     reference = indices_at_poses(mechanisms["m"], poses, detail=True)
     order = {"renamed": [3, 2, 1, 0]}
     for label, mechanism in mechanisms.items():
-        result = indices_at_poses(mechanism, poses, detail=True)
+        result = indices_at_poses(mechanism, poses * files[label][1], detail=True)
         legs = order.get(label, [0, 1, 2, 3])
         np.testing.assert_allclose(result.iti_actuators[:, legs], reference.iti_actuators, rtol=0, atol=1e-9,
                                    err_msg=label)
