@@ -22,7 +22,7 @@ from test_io import mjcf_of_tree
 from helpers import random_rotation, screwkit
 from screwkit.closure import actuator_values, solve
 from screwkit.io import ImportError_, read_gepetto, read_mechanism_file
-from screwkit.io.closed_tree import assemble
+from screwkit.io.closed_tree import assemble, joint_kind
 from screwkit.io.loader import load
 from screwkit.studies.poses import indices_at_poses
 
@@ -140,15 +140,19 @@ def closed_tree_at(tree, q, motors: dict[str, float]) -> np.ndarray:
 
 
 def tree_pressure_angles(tree, q) -> tuple[np.ndarray, float]:
-    """(ITI of both motors, OTI) from the tree's joint positions at q."""
+    """(ITI of both motors, OTI) from the tree's joint positions at q, in the plane across the first motor's axis
+    (a file may draw its links at several depths along the pins, as Gepetto's ``robot_delta`` does)."""
     import pinocchio as pin
 
     model = tree.model
     data = model.createData()
     pin.forwardKinematics(model, data, q)
+    motor = model.getJointId("mot1_rod1")
+    normal = np.asarray(data.oMi[motor].rotation) @ joint_kind(model, motor)[1]
+    across = np.eye(3) - np.outer(normal, normal) / (normal @ normal)
 
     def at(name):
-        return np.asarray(data.oMi[model.getJointId(name)].translation)
+        return across @ np.asarray(data.oMi[model.getJointId(name)].translation)
 
     def sine(u, v):
         return float(np.linalg.norm(np.cross(u, v)) / (np.linalg.norm(u) * np.linalg.norm(v)))
@@ -162,18 +166,26 @@ def poses_near_home(mechanism, count=8, spread=0.03, seed=5):
     return mechanism.home_pose + np.random.default_rng(seed).uniform(-spread, spread, (count, 2))
 
 
-def assert_tree_pressure_angles(mechanism, path, poses):
-    """The indices at ``poses`` equal the pressure angles of the tree of ``path`` (URDF + yaml) closed at the same
-    actuator values."""
+def tree_pressure_angles_at(mechanism, path, poses) -> tuple:
+    """The indices of ``mechanism`` at ``poses`` (every one reached), and per pose the pressure angles (ITI of each
+    motor, OTI) of the tree of ``path`` (URDF + yaml) closed by Pinocchio at the same actuator values."""
     solution = solve(mechanism, poses)
     assert solution.reachable.all()
     result = indices_at_poses(mechanism, poses, detail=True)
     motors = actuator_values(mechanism, solution.joint_values)
+    names = [name.split(":")[-1] for name in mechanism.actuator_names]
     tree = read_gepetto(path, path.parent / "robot.yaml")
     q, _ = assemble(tree)
-    for k in range(poses.shape[0]):
-        iti, oti = tree_pressure_angles(tree, closed_tree_at(tree, q, {"mot1_rod1": motors[k, 0],
-                                                                       "mot1_rod2": motors[k, 1]}))
+    angles = [tree_pressure_angles(tree, closed_tree_at(tree, q, dict(zip(names, motors[k]))))
+              for k in range(poses.shape[0])]
+    return result, angles
+
+
+def assert_tree_pressure_angles(mechanism, path, poses):
+    """The indices at ``poses`` equal the pressure angles of the tree of ``path`` (URDF + yaml) closed at the same
+    actuator values."""
+    result, angles = tree_pressure_angles_at(mechanism, path, poses)
+    for k, (iti, oti) in enumerate(angles):
         np.testing.assert_allclose(result.iti_actuators[k], iti, atol=TOLERANCE)
         np.testing.assert_allclose([result.lmti[k], *result.oti_submechanisms[k]], [oti, oti], atol=TOLERANCE)
     return result

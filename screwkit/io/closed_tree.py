@@ -22,7 +22,8 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
-from screwkit.io.pin_gaps import along_pins
+from screwkit.io.pin_gaps import along_pins, loop_kinds, on_one_plane
+from screwkit.io.tree_joints import ImportError_, homogeneous, inverse, joint_kind, joint_value, path_to
 
 GUESSED = "actuators guessed"
 """How a reader's note on guessed actuators begins."""
@@ -47,10 +48,6 @@ exporter) disagree by that much. The assembly then closes them as well as they c
 TURN_SAID = 1e-3
 """A weld's angle (rad) at the start that the report says beside its gap: 0.06 deg, above the rounding of a
 file's angles (``1.5708`` for pi / 2 is 4e-6 rad off)."""
-
-
-class ImportError_(ValueError):
-    """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
 
 
 class LegWithLoops(ImportError_):
@@ -209,59 +206,6 @@ class ImportReport:
 
 
 # -- the tree ------------------------------------------------------------------------------------
-
-
-def homogeneous(placement) -> NDArray[np.float64]:
-    """A Pinocchio placement (SE3) as a 4x4 matrix (a new array)."""
-    return np.array(placement.homogeneous, dtype=float)
-
-
-def inverse(matrix: NDArray) -> NDArray:
-    """The inverse of a 4x4 rigid transform."""
-    out = np.eye(4)
-    out[:3, :3] = matrix[:3, :3].T
-    out[:3, 3] = -matrix[:3, :3].T @ matrix[:3, 3]
-    return out
-
-
-def joint_kind(model, joint: int) -> tuple[str, NDArray | None]:
-    """("revolute" | "prismatic" | "spherical" | other shortname, unit axis in the joint frame or None)."""
-    joint_model = model.joints[joint]
-    name = joint_model.shortname()
-    for prefix, kind in (("JointModelRevoluteUnbounded", "revolute"), ("JointModelRevolute", "revolute"),
-                         ("JointModelPrismatic", "prismatic")):
-        if name.startswith(prefix):
-            if name == "JointModelRevoluteUnboundedUnaligned":  # (Pinocchio 4.1's bindings give it no axis: its
-                joint_data = joint_model.createData()  # motion subspace's rotation is the axis)
-                joint_model.calc(joint_data, np.array([1.0, 0.0]))
-                axis = np.asarray(joint_data.S, dtype=float).reshape(6, -1)[3:, 0]
-            else:
-                axis = np.asarray(joint_model.extract().axis, dtype=float)
-            if not np.linalg.norm(axis) > 0.0:  # refused where the source is known (assemble); a net here
-                raise ImportError_(f"<joint name='{model.names[joint]}'>: the axis is the zero vector.")
-            return kind, axis / np.linalg.norm(axis)
-    for prefix, kind in (("JointModelRUB", "revolute"), ("JointModelR", "revolute"), ("JointModelP", "prismatic")):
-        if name.startswith(prefix) and name[-1] in "XYZ" and len(name) == len(prefix) + 1:
-            return kind, np.eye(3)["XYZ".index(name[-1])]
-    if name == "JointModelSpherical":
-        return "spherical", None
-    return name, None
-
-
-def joint_value(model, joint: int, q: NDArray) -> float:
-    """The value (rad or m) of a 1-DoF joint in configuration q (an unbounded revolute's angle from cos, sin)."""
-    joint_model = model.joints[joint]
-    values = q[joint_model.idx_q:joint_model.idx_q + joint_model.nq]
-    return float(np.arctan2(values[1], values[0])) if joint_model.nq == 2 else float(values[0])
-
-
-def path_to(model, joint: int) -> list[int]:
-    """Joints from the root to ``joint`` (included), root side first."""
-    path = []
-    while joint != 0:
-        path.append(joint)
-        joint = model.parents[joint]
-    return path[::-1]
 
 
 def _length_scale(model, data) -> float:
@@ -523,11 +467,12 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             tree.notes.append(f"the closures close to {gaps[worst]:.3g} {tree.unit} at best (closure {worst!r}): the "
                               "file's numbers disagree by that much (redundant closures written rounded)")
             return q, scale
+        if on_one_plane(tree, q, scale):  # anchors drawn at depths the rounding sets apart on their pins: again
+            return assemble(tree, held, nearest)
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
         closure, first, second = next(item for item in closure_frames(tree, q) if item[0].name == worst)
-        loop = sorted(set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b)))
-        advice = along_pins(model, q, first, second, [(j, *joint_kind(model, j)) for j in loop]) or (
+        advice = along_pins(model, q, first, second, loop_kinds(model, closure)) or (
             "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "
             "joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "

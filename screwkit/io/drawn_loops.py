@@ -27,6 +27,11 @@ canonical`) and the reference assembly:
    naming the loop and saying that it is of the order of a file's rounding (the Delta written to 4 decimals, 1.3e-5
    rad); one further still is left to the assembly, which refuses it as before.
 
+A file of another tool, converted (:mod:`screwkit.io.star`), has step 2 only: its axes were read as drawn where it
+was converted, but a redundant closure written rounded is closed there only as well as it closes, and the chain
+written from it is left that far open (Gepetto's parallelogram Delta turned in the world and written to 6 decimals,
+6e-7 m: refused as not closing). A planar one's loop frame is not turned out of its plane (:func:`_tilts_the_plane`).
+
 Nothing changes in an exact file: where no axis would turn by more than :data:`UNSEEN`, none is turned (the
 bundled ``coop_arms.urdf`` writes pi/2 as ``1.5707963267900003``, 4.9e-12 off), and a loop its chain closes is not
 touched: every bundled mechanism reads as before, bit for bit. What is changed is said, in one note starting
@@ -70,16 +75,17 @@ _AXIS_LOOPS = {"revolute": 1, "continuous": 1, "prismatic": 1, "universal": 2}
 def drawn_loops(mechanism: Mechanism) -> Mechanism:
     """``mechanism`` (chains as read from a file in screwkit's convention, not assembled) with its axes made
     parallel and its loops closed within the file's rounding (module docstring); its ``assembly_notes`` say what
-    changed. A converted file (read as drawn where it was converted) is returned as it is."""
-    description = mechanism.description
-    if description.converted_from:
-        return mechanism
+    changed. A converted file (its axes read as drawn where it was converted) has step 2 only: its chains are left
+    open by the rounding of redundant closures, which the conversion closed as well as they close."""
     scale = mechanism_size(mechanism, mechanism.chains)
     values, axes, closes = (list(found) for found in zip(*(_file_values(mechanism, index, scale)
                                                           for index in range(len(mechanism.chains)))))
+    if mechanism.description.converted_from and all(closes):
+        return mechanism
     for index in (index for index, closed in enumerate(closes) if not closed):  # (read where the loops close)
         values[index], axes[index] = _closing(mechanism, index, values[index], axes[index], scale)
-    geometries, turn, most = _parallel(mechanism, values, axes)
+    geometries, turn, most = ([chain.geometry for chain in mechanism.chains], 0.0, "") \
+        if mechanism.description.converted_from else _parallel(mechanism, values, axes)
     notes = []
     if turn:
         notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} "
@@ -268,9 +274,24 @@ def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: N
             "loop is closed as drawn.")
     rotation = mechanism.home_rotation.T @ end.end_rotation
     translation = mechanism.home_rotation.T @ (end.end_translation - mechanism.home_translation)
-    turn = float(np.linalg.norm(rotation_vector_from_rotation(geometry.platform_loop_rotation.T @ rotation)))
+    change = rotation_vector_from_rotation(geometry.platform_loop_rotation.T @ rotation)
+    if _tilts_the_plane(mechanism, geometry, change):
+        return geometry, None
+    turn = float(np.linalg.norm(change))
     metres = float(np.linalg.norm(translation - geometry.platform_loop_translation))
     return replace(geometry, platform_loop_rotation=rotation, platform_loop_translation=translation), (metres, turn)
+
+
+def _tilts_the_plane(mechanism: Mechanism, geometry: ChainGeometry, change: NDArray) -> bool:
+    """Whether turning a converted planar mechanism's platform loop frame by ``change`` (a rotation vector in that
+    frame) would turn it out of the plane: its chain then meets the platform only at the reference pose (the
+    conversion wrote every axis along the plane's normal; a loop frame turned 3.6e-6 rad off it left Gepetto's
+    five-bar, written to 5 decimals, missing every other pose by more than Newton's tolerance). Such a loop is left
+    to the assembly, which refuses it as not closing."""
+    if not (mechanism.description.converted_from and mechanism.is_planar):
+        return False
+    normal = geometry.platform_loop_rotation.T @ np.array([0.0, 0.0, 1.0])  # (the plane's normal: the base's z)
+    return float(np.linalg.norm(np.cross(change, normal))) > UNSEEN
 
 
 def _apart(frames, rotation: NDArray, translation: NDArray, scale: float) -> tuple[float, float]:

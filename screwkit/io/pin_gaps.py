@@ -1,12 +1,32 @@
 """A closure left open along its loop's pins: the two anchors of a closure drawn at different depths on parallel
-hinges (a CAD export's), which no joint values close (:func:`screwkit.io.closed_tree.assemble` says so)."""
+hinges (a CAD export's), which no joint values close (:func:`screwkit.io.closed_tree.assemble` says so).
+
+Where the depths differ by no more than a file's rounding can make them differ (:func:`depths_drawn_apart`: at most
+:data:`DEPTH_ROUNDING` of the mechanism's length scale), the anchors are read on one plane (:func:`on_one_plane`):
+a hinge is a line, and moving an anchor along the pins moves no hinge's line. Each hinge of a loop drawn with its
+numbers rounded to 6 decimals is up to half a micrometre off its plane, and a loop adds its hinges' offsets: 1.3e-6 m
+on a five-bar of 10 cm links, beyond the :data:`~screwkit.common.tolerances.FILE_ROUNDING` (1e-5 of the length
+scale) by which a closure may stay open in any direction and be read as drawn.
+"""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["along_pins"]
+from screwkit.io.tree_joints import homogeneous, joint_kind, path_to
+
+__all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "DEPTH_ROUNDING", "ONE_PLANE"]
+
+DEPTH_ROUNDING = 1e-4
+"""Relative to the mechanism's length scale: the largest gap along a loop's parallel pins read as the file's rounding
+(ten times :data:`~screwkit.common.tolerances.FILE_ROUNDING`: a loop of up to ten hinges, each drawn to it)."""
+CLOSED = 1e-10
+"""Relative: a closure whose frames are at most this apart (the assembly's own tolerance) is left where it is."""
+ONE_PLANE = "closure frames drawn at depths on their pins that the file's rounding sets apart read on one plane"
+"""How the note of :func:`on_one_plane` begins."""
 
 PARALLEL = 1e-3
 """Sine (about 0.06 deg) below which the loop's hinge axes, and its gap, count as along one direction."""
@@ -16,19 +36,83 @@ def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) 
     """What to say of a closure left open at q (its two frames ``first``, ``second``, 4x4 in the world) where its
     gap lies along its loop's hinges, all parallel: ``kinds``, (joint, kind, local axis) of the loop's joints; else
     ''."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    data = model.createData()
-    pin.forwardKinematics(model, data, q)
-    axes = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "revolute"]
-    gap = first[:3, 3] - second[:3, 3]
-    if len(axes) < 2 or len(axes) < len(kinds) or not np.linalg.norm(gap) > 0:
-        return ""
-    across = [np.linalg.norm(np.cross(axes[0], axis)) for axis in axes] + [
-        np.linalg.norm(np.cross(axes[0], gap)) / np.linalg.norm(gap)]
-    if max(across) > PARALLEL:
+    if pin_axis(model, q, first, second, kinds) is None:
         return ""
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
     return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
             "different depths on one pin, which no joint values close: moved along the pin onto one plane (the "
             "connect's anchor or site), the loop closes")
+
+
+def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) -> NDArray | None:
+    """The world axis (unit) of the loop's hinges at q when they are all parallel, its slides (if any) across them and
+    the closure's gap along them (:data:`PARALLEL`), else None (as :func:`along_pins`)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    axes = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "revolute"]
+    slides = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "prismatic"]
+    gap = first[:3, 3] - second[:3, 3]
+    if len(axes) < 2 or len(axes) + len(slides) < len(kinds) or not np.linalg.norm(gap) > 0:
+        return None
+    across = [np.linalg.norm(np.cross(axes[0], axis)) for axis in axes] + [
+        np.linalg.norm(np.cross(axes[0], gap)) / np.linalg.norm(gap)] + [
+        abs(float(axes[0] @ slide)) / np.linalg.norm(slide) for slide in slides]  # (slides across the pins)
+    return None if max(across) > PARALLEL else axes[0] / np.linalg.norm(axes[0])
+
+
+def depths_drawn_apart(model, q: NDArray, frames: list, loops: list[list], scale: float) -> list[NDArray] | None:
+    """The world offsets along the pins that put each closure's second frame on its first's plane at q, where
+    every closure left open at q is open along its loop's pins only (:func:`along_pins`) by at most
+    :data:`DEPTH_ROUNDING` times ``scale`` (a zero offset for a closure that closes); else None. ``frames``: each
+    closure's two world frames at q; ``loops``: each closure's loop, as the ``kinds`` of :func:`along_pins`."""
+    offsets = []
+    for (first, second), kinds in zip(frames, loops):
+        gap = first[:3, 3] - second[:3, 3]
+        if not np.linalg.norm(gap) > CLOSED * scale:
+            offsets.append(np.zeros(3))
+            continue
+        axis = pin_axis(model, q, first, second, kinds)
+        if np.linalg.norm(gap) > DEPTH_ROUNDING * scale or axis is None:
+            return None
+        offsets.append(axis * float(axis @ gap))  # (the joints close what lies across the pins)
+    return offsets
+
+
+def loop_kinds(model, closure) -> list[tuple]:
+    """The joints of ``closure``'s loop (those on one of its two frames' paths from the root only), as the ``kinds``
+    of :func:`along_pins`: (joint, kind, local axis)."""
+    return [(j, *joint_kind(model, j)) for j in sorted(set(path_to(model, closure.joint_a))
+                                                      ^ set(path_to(model, closure.joint_b)))]
+
+
+def on_one_plane(tree, q: NDArray, scale: float) -> bool:
+    """Whether the closures of ``tree`` (a :class:`~screwkit.io.closed_tree.ClosedTree`) left open at q were open
+    along their loops' pins only, by a file's rounding (:func:`depths_drawn_apart`): each one's second frame is then
+    moved onto its first's plane, in ``tree`` (once: a tree whose note says so is not moved again; its closures and
+    notes are new lists), and a note says by how much."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    if any(note.startswith(ONE_PLANE) for note in tree.notes):
+        return False
+    data = tree.model.createData()
+    pin.forwardKinematics(tree.model, data, q)
+    found = [(closure, homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a,
+              homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b) for closure in tree.closures]
+    offsets = depths_drawn_apart(tree.model, q, [(first, second) for _, first, second in found],
+                                 [loop_kinds(tree.model, closure) for closure in tree.closures], scale)
+    if offsets is None:
+        return False
+    closures = []
+    for (closure, _, second), offset in zip(found, offsets):
+        placement = np.array(closure.placement_b, dtype=float)
+        placement[:3, 3] += placement[:3, :3] @ second[:3, :3].T @ offset  # (the joint's frame, in which it is drawn)
+        closures.append(replace(closure, placement_b=placement))
+    most = int(np.argmax([np.linalg.norm(offset) for offset in offsets]))
+    # new lists, not the old ones changed: a tree copied to be assembled from elsewhere shares them with its original
+    tree.closures = closures
+    tree.notes = [*tree.notes, f"{ONE_PLANE} (closure {closures[most].name!r} the most, "
+                               f"{np.linalg.norm(offsets[most]):.2g} {tree.unit}; up to {DEPTH_ROUNDING:g} of the "
+                               "length scale)"]
+    return True

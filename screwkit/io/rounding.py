@@ -49,6 +49,11 @@ EXACT = 1e-12
 """Directions whose cross product is at most this already agree, lines that pass within this of the length scale
 of their meeting point already meet: a group of them is left as written."""
 
+PLANE_AXIS = 1e-3
+"""Sine: in a planar mechanism (every revolute parallel to its normal to the file's rounding, or to that of the angles
+it writes), a hinge at most this far from the normal is written along it, and a slide at most this far from its plane
+in it (:func:`drawn_lines`)."""
+
 
 def parallel_axes(axes: NDArray, tolerance: float | NDArray = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
     """Unit directions (n, 3) with each group of nearly parallel ones made parallel, and the largest turn (rad).
@@ -190,7 +195,7 @@ def meeting_lines(points: NDArray, units: NDArray, scale: float, tolerance: floa
     return moves, largest, left
 
 
-def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report, turns=None
+def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report, turns=None, normal=None
                 ) -> tuple[dict[int, NDArray], list]:
     """The legs' joint axes, loop axes and equivalent chains' rotations with :func:`parallel_axes` applied, and the
     legs' revolute lines (joints and revolute loops) with :func:`meeting_lines` applied.
@@ -200,26 +205,45 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
     1-DoF joint's axis in its own frame (by joint id) and the equivalent chains with their rotations turned; the
     import ``report`` notes the largest turn and move. ``scale``: the mechanism's length scale; ``turns``: the
     file's rounded angles (:class:`screwkit.io.written_angles.WrittenTurns`: how far apart two joints' axes drawn
-    parallel may be written), none for :data:`FILE_ROUNDING` between every two axes.
+    parallel may be written), none for :data:`FILE_ROUNDING` between every two axes; ``normal``: a planar mechanism's
+    plane normal (:func:`plane_normal`), along which every hinge parallel to it is then written, not along the mean of
+    its group (the legs that are written, whose mean it need not be: a leg whose hinges leaned 3e-9 rad off the plane
+    reached no pose of it but its reference, by more than Newton's tolerance), and in whose plane every slide nearly
+    in it is written (two slides 4e-7 rad off it did the same).
     """
-    owners, directions = [], []
+    owners, directions, slides = [], [], []
     for leg in legs:
         for joint in leg.joints:
             if joint not in leg.locked:
                 owners.append(("joint", joint))
-                directions.append(np.asarray(data.oMi[joint].rotation) @ joint_kind(model, joint)[1])
+                kind, axis = joint_kind(model, joint)
+                directions.append(np.asarray(data.oMi[joint].rotation) @ axis)
+                slides.append(kind == "prismatic")
         if leg.loop in ("revolute", "prismatic"):
             owners.append(("loop", leg))
             directions.append(leg.loop_dofs[0][1])
+            slides.append(leg.loop == "prismatic")
     for index, (_, reduction, _) in enumerate(equivalents):
         owners += [("turn", (index, row)) for row in range(len(reduction.rotations))]
         directions += list(reduction.rotations)
+        slides += [False] * len(reduction.rotations)
     if not directions:
         return {}, equivalents
     names = [model.names[owner] if kind == "joint" else owner.loop_names[0] if kind == "loop" and owner.loop_names
              else None for kind, owner in owners]
     allowed = turns.allowances(names) if turns is not None else FILE_ROUNDING
     turned, turn = parallel_axes(np.array(directions), allowed)
+    if normal is not None:  # hinges along the normal, slides in the plane (an exact file's as written)
+        units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
+        off = np.linalg.norm(np.cross(turned, normal), axis=1)
+        along = (off <= PLANE_AXIS) & (off > EXACT) & ~np.array(slides)
+        turned[along] = np.sign(turned[along] @ normal)[:, None] * normal
+        out = turned @ normal
+        across = (np.abs(out) <= PLANE_AXIS) & (np.abs(out) > EXACT) & np.array(slides)
+        turned[across] -= out[across, None] * normal
+        turned[across] /= np.linalg.norm(turned[across], axis=1, keepdims=True)
+        turn = float(np.max(np.linalg.norm(np.cross(turned, units), axis=1), initial=0.0))
+        turn = turn if turn > EXACT else 0.0
     if turn:
         turns_each = np.linalg.norm(np.cross(turned, np.array(directions) / np.linalg.norm(directions, axis=1,
                                                                                             keepdims=True)), axis=1)

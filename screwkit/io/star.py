@@ -73,6 +73,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.compound import compound_groups, compound_legs
 from screwkit.io.couplings import check_couplings
+from screwkit.io.drawn_parallelograms import drawn_parallelograms
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.locking import platform_motions
 from screwkit.io.output import output_frame, platform_body
@@ -298,6 +299,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.turns_before = closure_turns(tree, tree.q_reference)
     q, scale = assemble(tree, held=tree.initial_joints())
     report.gaps_after = closure_gaps(tree, q)
+    tree = drawn_parallelograms(tree, q, scale)  # (four-bars drawn as parallelograms and written rounded: exact)
+    model = tree.model
     changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
     report.notes.append(f"working mode: the closed configuration nearest to {tree.start_phrase()} (the largest "
                         f"joint change {changes})")
@@ -396,7 +399,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     for leg in legs:  # (a coupling that reaches the leg's joints makes a loop inside it, which may hold it)
         lock_idle(tree, data, leg, scale, set(motor_ids), q, [c.name for c in couplings if c.name in joined and set(
             leg.joints).intersection(path_to(model, c.joint_a) + path_to(model, c.joint_b))])
-    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, turns)
+    axes, equivalents = drawn_lines(model, data, legs, equivalents, scale, report, turns, normal)
     absorbed = set()
     for closure in tree.closures:
         for joint in (closure.joint_a, closure.joint_b):
