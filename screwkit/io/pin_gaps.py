@@ -41,7 +41,8 @@ def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) 
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
     return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
             "different depths on one pin, which no joint values close: moved along the pin onto one plane (the "
-            "connect's anchor or site), the loop closes")
+            "closure's frame: an MJCF connect's anchor or site, a robot.yaml or SDFormat closing frame), the loop "
+            "closes")
 
 
 def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) -> NDArray | None:
