@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from test_compound_legs import delta_gepetto, poses_near_home, tree_pressure_angles_at, write
+from test_rounded_convention import rounded
 
 from helpers import random_rotation, screwkit
 from screwkit.closure import solve
@@ -33,14 +34,8 @@ from screwkit.io.pin_gaps import ONE_PLANE
 from screwkit.studies.poses import indices_at_poses
 
 METRES = {"m": 1.0, "mm": 1e-3}
-NUMBER = re.compile(r"-?\d+\.\d+(?:e-?\d+)?")
 PUBLISHED = (Path(__file__).resolve().parent / "data" / "gallery" / "published" / "example_parallel_robots"
              / "robot_delta")
-
-
-def rounded(text: str, decimals: int) -> str:
-    """``text`` with every decimal number written to ``decimals`` decimals."""
-    return NUMBER.sub(lambda m: repr(round(float(m.group(0)), decimals)), text)
 
 
 def against_the_exact_tree(mechanism, exact_path: Path, poses: np.ndarray) -> float:

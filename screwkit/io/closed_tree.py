@@ -467,11 +467,12 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
             tree.notes.append(f"the closures close to {gaps[worst]:.3g} {tree.unit} at best (closure {worst!r}): the "
                               "file's numbers disagree by that much (redundant closures written rounded)")
             return q, scale
-        if on_one_plane(tree, q, scale):  # anchors drawn at depths the rounding sets apart on their pins: again
+        found = closure_frames(tree, q)
+        if on_one_plane(tree, q, scale, found):  # anchors drawn at depths the rounding sets apart on their pins: again
             return assemble(tree, held, nearest)
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
-        closure, first, second = next(item for item in closure_frames(tree, q) if item[0].name == worst)
+        closure, first, second = next(item for item in found if item[0].name == worst)
         advice = along_pins(model, q, first, second, loop_kinds(model, closure)) or (
             "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "
             "joints values nearer one")

@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.io.tree_joints import homogeneous, joint_kind, path_to
+from screwkit.io.tree_joints import joint_kind, path_to
 
 __all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "DEPTH_ROUNDING", "ONE_PLANE"]
 
@@ -88,19 +88,14 @@ def loop_kinds(model, closure) -> list[tuple]:
                                                       ^ set(path_to(model, closure.joint_b)))]
 
 
-def on_one_plane(tree, q: NDArray, scale: float) -> bool:
+def on_one_plane(tree, q: NDArray, scale: float, found: list) -> bool:
     """Whether the closures of ``tree`` (a :class:`~screwkit.io.closed_tree.ClosedTree`) left open at q were open
     along their loops' pins only, by a file's rounding (:func:`depths_drawn_apart`): each one's second frame is then
     moved onto its first's plane, in ``tree`` (once: a tree whose note says so is not moved again; its closures and
-    notes are new lists), and a note says by how much."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
+    notes are new lists), and a note says by how much. ``found``: each closure with its two world frames at q
+    (:func:`~screwkit.io.closed_tree.closure_frames`)."""
     if any(note.startswith(ONE_PLANE) for note in tree.notes):
         return False
-    data = tree.model.createData()
-    pin.forwardKinematics(tree.model, data, q)
-    found = [(closure, homogeneous(data.oMi[closure.joint_a]) @ closure.placement_a,
-              homogeneous(data.oMi[closure.joint_b]) @ closure.placement_b) for closure in tree.closures]
     offsets = depths_drawn_apart(tree.model, q, [(first, second) for _, first, second in found],
                                  [loop_kinds(tree.model, closure) for closure in tree.closures], scale)
     if offsets is None:

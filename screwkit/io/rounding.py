@@ -233,8 +233,8 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
              else None for kind, owner in owners]
     allowed = turns.allowances(names) if turns is not None else FILE_ROUNDING
     turned, turn = parallel_axes(np.array(directions), allowed)
+    units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
     if normal is not None:  # hinges along the normal, slides in the plane (an exact file's as written)
-        units = np.array(directions) / np.linalg.norm(directions, axis=1, keepdims=True)
         off = np.linalg.norm(np.cross(turned, normal), axis=1)
         along = (off <= PLANE_AXIS) & (off > EXACT) & ~np.array(slides)
         turned[along] = np.sign(turned[along] @ normal)[:, None] * normal
@@ -245,9 +245,7 @@ def drawn_lines(model, data, legs: list, equivalents: list, scale: float, report
         turn = float(np.max(np.linalg.norm(np.cross(turned, units), axis=1), initial=0.0))
         turn = turn if turn > EXACT else 0.0
     if turn:
-        turns_each = np.linalg.norm(np.cross(turned, np.array(directions) / np.linalg.norm(directions, axis=1,
-                                                                                            keepdims=True)), axis=1)
-        most = names[int(np.argmax(turns_each))]
+        most = names[int(np.argmax(np.linalg.norm(np.cross(turned, units), axis=1)))]
         report.notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn "
                             f"{turn:.2g} rad{f', of joint {most!r}' if most else ''}"
                             + (f"; the file writes angles rounded, {turns.example}" if turn > FILE_ROUNDING and
