@@ -65,39 +65,42 @@ def test_a_turned_parallelogram_delta_to_six_decimals_has_the_exact_tree_s_press
     assert against_the_exact_tree(mechanism, exact, poses) < 2e-5 / size  # (twice 5e-7 m over sides of 0.05 size)
 
 
-def test_the_rounded_delta_reads_alike_in_millimetres_and_with_its_loops_listed_the_other_way(tmp_path):
-    """The same rounded drawing with every length written in millimetres (read with the unit given), and with its
-    closures and motors listed in the other order: the same note on its parallelograms (the same lines named, the
-    same move) and the same indices per actuator, to 1e-9."""
+def scaled(text: str, factor: float) -> str:
+    """A URDF text with every joint origin's lengths times ``factor`` (its axes as they are)."""
+    return re.sub(r'<origin xyz="([^"]*)"', lambda m: '<origin xyz="' + " ".join(
+        repr(round(float(v) * factor, 12)) for v in m.group(1).split()) + '"', text)
+
+
+def test_the_rounded_delta_reads_alike_in_any_unit_and_size_and_with_its_loops_listed_the_other_way(tmp_path):
+    """The same rounded drawing with every length written in millimetres (read with the unit given), at a thousandth
+    and a thousand times its size (poses scaled with it), and with its closures and motors listed in the other order:
+    the same note on its parallelograms (the same lines named, the same move, in metres of the drawing) and the same
+    indices per actuator, to 1e-9."""
     urdf, yaml = delta_gepetto(random_rotation(np.random.default_rng(2)), 0.3)
     text = rounded(urdf, 6)
-    in_mm = re.sub(r'xyz="([^"]*)"', lambda m: 'xyz="' + " ".join(repr(round(float(v) * 1000.0, 9))
-                                                                     for v in m.group(1).split()) + '"',
-                   text.replace("<axis xyz=", "<axis_keep xyz="))
-    in_mm = in_mm.replace("<axis_keep xyz=", "<axis xyz=")
     lines = yaml.splitlines()
     reordered = "\n".join([re.sub(r"\[(\[.*\])\]", lambda m: "[" + ", ".join(reversed(re.findall(r"\[[^\[\]]*\]",
                                                                                                 m.group(1)))) + "]",
                                   lines[0]), lines[1],
                            re.sub(r"\[(.*)\]", lambda m: "[" + ", ".join(reversed(m.group(1).split(", "))) + "]",
                                   lines[2])]) + "\n"
-    assert reordered != yaml and in_mm != text
-    for name in ("m", "mm", "r"):
-        (tmp_path / name).mkdir()
-    files = {"m": (write(tmp_path / "m", text, yaml), None), "mm": (write(tmp_path / "mm", in_mm, yaml), "mm"),
-             "reordered": (write(tmp_path / "r", text, reordered), None)}
+    assert reordered != yaml and scaled(text, 1000.0) != text
+    variants = {"m": (text, yaml, None, 1.0), "mm": (scaled(text, 1000.0), yaml, "mm", 1.0),
+                "small": (scaled(text, 1e-3), yaml, None, 1e-3), "large": (scaled(text, 1e3), yaml, None, 1e3),
+                "reordered": (text, reordered, None, 1.0)}
     read, said = {}, {}
-    for name, (path, unit) in files.items():
-        _, report, mechanism = converted_mechanism(path, length_unit=unit)
-        poses = poses_near_home(mechanism, spread=0.009)
+    for name, (urdf_text, yaml_text, unit, factor) in variants.items():
+        (tmp_path / name).mkdir()
+        _, report, mechanism = converted_mechanism(write(tmp_path / name, urdf_text, yaml_text), length_unit=unit)
+        poses = poses_near_home(mechanism, spread=0.009 * factor)
         result = indices_at_poses(mechanism, poses, detail=True)
         order = np.argsort(mechanism.actuator_names)
-        read[name] = (mechanism.home_pose, result.iti_actuators[:, order], result.lmti)
+        read[name] = (mechanism.home_pose / factor, result.iti_actuators[:, order], result.lmti)
         [note] = [note for note in report.notes if note.startswith(PARALLELOGRAMS_DRAWN)]
-        said[name] = re.sub(r"move (\S+) (m|mm) ", lambda m: f"move {float(m.group(1)) * METRES[m.group(2)]:.2g} m ",
-                            note)  # (the mm file's note in its own unit)
-    assert said["mm"] == said["m"] == said["reordered"], said
-    for name in ("mm", "reordered"):
+        said[name] = re.sub(r"move (\S+) (m|mm) ", lambda m, f=factor: "move {:.2g} m ".format(
+            float(m.group(1)) * METRES[m.group(2)] / f), note)  # (in metres of the drawing, whatever the file's unit)
+    assert len(set(said.values())) == 1, said
+    for name in ("mm", "small", "large", "reordered"):
         for mine, theirs in zip(read[name], read["m"]):
             np.testing.assert_allclose(mine, theirs, atol=1e-9, rtol=0)
 

@@ -54,30 +54,42 @@ _SIDE = 1e-2
 its lines nearly one)."""
 
 DEFECT_STEPS = 20
-"""How many of the file's last written decimals (each coordinate rounded by half of one, lengths and angles times the
-length scale) a four-bar's defect may add up to and still be the file's rounding: the numbers on its four hinges'
-paths."""
+"""How many of the file's last written decimals (each coordinate rounded by half of one: lengths in the file's unit,
+angles and axis components times the length scale) a four-bar's defect may add up to and still be the file's rounding:
+the numbers on its four hinges' paths."""
 
-_WRITTEN = re.compile(r'(?:xyz|rpy|pos|quat|euler|axis|fromto|axisangle)\s*=\s*"([^"]*)"|<pose[^>]*>([^<]*)</pose>')
+_LENGTHS = re.compile(r'(?:<origin[^>]*?\sxyz|\spos|\sfromto)\s*=\s*"([^"]*)"|<pose[^>]*>([^<]*)</pose>')
+_ANGLES = re.compile(r'(?:\srpy|\squat|\seuler|\saxisangle|\saxis|<axis[^>]*?\sxyz)\s*=\s*"([^"]*)"'
+                     r'|<xyz[^>]*>([^<]*)</xyz>|<pose[^>]*>([^<]*)</pose>')
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?(\d*)|\.(\d+))(?:[eE]([-+]?\d+))?")
+
+
+def _most_decimals(pattern: re.Pattern, text: str, pose: slice) -> int | None:
+    """The most decimals a number of the attributes ``pattern`` finds is written with (its last group a ``<pose>``,
+    x y z roll pitch yaw, of whose numbers ``pose`` only count: its lengths or its angles), None if there is none."""
+    found = []
+    for *attributes, written_pose in pattern.findall(text):
+        numbers = written_pose.split()[pose] if written_pose else " ".join(attributes).split()
+        found += [len(match[0] or match[1]) - int(match[2] or 0) for match in _NUMBER.findall(" ".join(numbers))]
+    return max(found) if found else None
 
 
 def written_rounding(tree: ClosedTree, scale: float) -> float:
     """The largest defect (m) that the rounding of the numbers the file writes its geometry with can give a four-bar:
-    :data:`DEFECT_STEPS` times the step of its last decimal (the most decimals any length or angle is written with),
-    as a length (times the file's length unit) and as an angle (times ``scale``). A file written with all the digits
-    of its numbers (a generated one) leaves no defect to its rounding: a four-bar it draws a little off a
-    parallelogram is one. Infinite where the file cannot be read again (its numbers unknown)."""
+    :data:`DEFECT_STEPS` times half the step of the last decimal its lengths are written with (times its length unit)
+    plus half that of its angles and axes (times ``scale``). A file written with all the digits of its numbers (a
+    generated one) leaves no defect to its rounding: a four-bar it draws a little off a parallelogram is one. Infinite
+    where the file cannot be read again (its numbers unknown)."""
     try:
         text = Path(tree.source.split(" + ")[0]).read_text(errors="replace")  # (a Gepetto source names its yaml)
     except OSError:
         return np.inf
-    decimals = [len(match[0] or match[1]) - int(match[2] or 0) for values in _WRITTEN.findall(text)
-                for match in _NUMBER.findall(" ".join(values))]
-    if not decimals:
+    lengths, angles = _most_decimals(_LENGTHS, text, slice(0, 3)), _most_decimals(_ANGLES, text, slice(3, 6))
+    if lengths is None and angles is None:
         return np.inf
     unit = metres_per(tree.length_unit) if tree.length_unit not in (None, "m") else 1.0
-    return DEFECT_STEPS * 0.5 * 10.0 ** -max(decimals) * (unit + scale)
+    return DEFECT_STEPS * 0.5 * ((10.0 ** -lengths * unit if lengths is not None else 0.0)
+                                 + (10.0 ** -angles * scale if angles is not None else 0.0))
 
 
 def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTree:
