@@ -22,18 +22,17 @@ stays where it is at the configuration, so the configuration stays closed; a not
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 from itertools import permutations
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.common.units import metres_per
 from screwkit.io.closed_tree import ClosedTree, closure_gaps, homogeneous, joint_kind
 from screwkit.io.graph_rounding import closed_hinges
+from screwkit.io.tree_joints import joint_frames
+from screwkit.io.written_decimals import written_steps
 
 __all__ = ["drawn_parallelograms", "written_rounding", "SIDES_ROUNDING", "UNSEEN", "PARALLELOGRAMS_DRAWN",
            "DEFECT_STEPS"]
@@ -58,44 +57,24 @@ DEFECT_STEPS = 20
 angles and axis components times the length scale) a four-bar's defect may add up to and still be the file's rounding:
 the numbers on its four hinges' paths."""
 
-_LENGTHS = re.compile(r'(?:<origin[^>]*?\sxyz|\spos|\sfromto)\s*=\s*"([^"]*)"|<pose[^>]*>([^<]*)</pose>')
-_ANGLES = re.compile(r'(?:\srpy|\squat|\seuler|\saxisangle|\saxis|<axis[^>]*?\sxyz)\s*=\s*"([^"]*)"'
-                     r'|<xyz[^>]*>([^<]*)</xyz>|<pose[^>]*>([^<]*)</pose>')
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?(\d*)|\.(\d+))(?:[eE]([-+]?\d+))?")
-
-
-def _most_decimals(pattern: re.Pattern, text: str, pose: slice) -> int | None:
-    """The most decimals a number of the attributes ``pattern`` finds is written with (its last group a ``<pose>``,
-    x y z roll pitch yaw, of whose numbers ``pose`` only count: its lengths or its angles), None if there is none."""
-    found = []
-    for *attributes, written_pose in pattern.findall(text):
-        numbers = written_pose.split()[pose] if written_pose else " ".join(attributes).split()
-        found += [len(match[0] or match[1]) - int(match[2] or 0) for match in _NUMBER.findall(" ".join(numbers))]
-    return max(found) if found else None
-
 
 def written_rounding(tree: ClosedTree, scale: float) -> float:
     """The largest defect (m) that the rounding of the numbers the file writes its geometry with can give a four-bar:
     :data:`DEFECT_STEPS` times half the step of the last decimal its lengths are written with (times its length unit)
-    plus half that of its angles and axes (times ``scale``). A file written with all the digits of its numbers (a
-    generated one) leaves no defect to its rounding: a four-bar it draws a little off a parallelogram is one. Infinite
-    where the file cannot be read again (its numbers unknown)."""
-    try:
-        text = Path(tree.source.split(" + ")[0]).read_text(errors="replace")  # (a Gepetto source names its yaml)
-    except OSError:
-        return np.inf
-    lengths, angles = _most_decimals(_LENGTHS, text, slice(0, 3)), _most_decimals(_ANGLES, text, slice(3, 6))
+    plus half that of its angles and axes (times ``scale``): :func:`screwkit.io.written_decimals.written_steps`. A
+    file written with all the digits of its numbers (a generated one) leaves no defect to its rounding: a four-bar it
+    draws a little off a parallelogram is one. Infinite where the file cannot be read again (its numbers unknown)."""
+    lengths, angles = written_steps(tree.source, tree.length_unit)
     if lengths is None and angles is None:
         return np.inf
-    unit = metres_per(tree.length_unit) if tree.length_unit not in (None, "m") else 1.0
-    return DEFECT_STEPS * 0.5 * ((10.0 ** -lengths * unit if lengths is not None else 0.0)
-                                 + (10.0 ** -angles * scale if angles is not None else 0.0))
+    return DEFECT_STEPS * 0.5 * ((lengths if lengths is not None else 0.0) + (angles * scale if angles is not None
+                                                                               else 0.0))
 
 
 def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTree:
     """``tree`` with its four-bars of hinges drawn as parallelograms made exact at the closed configuration ``q``
     (the module's docstring), its notes saying so; ``tree`` itself when none is moved."""
-    world = _frames(tree, q)
+    world = joint_frames(tree.model, q)
     lines, members = _lines(tree, world, scale)
     found = _four_bars(lines, members, min(SIDES_ROUNDING * scale, written_rounding(tree, scale)))
     if not any(np.linalg.norm(defect) > UNSEEN * scale for _, _, defect in found):
@@ -104,7 +83,7 @@ def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTr
     moved_model, closures = _moved(tree, world, lines, moves)
     moved = replace(tree, model=moved_model, closures=closures)
     gaps, before = closure_gaps(moved, q), closure_gaps(tree, q)
-    after_lines, after_members = _lines(moved, _frames(moved, q), scale)
+    after_lines, after_members = _lines(moved, joint_frames(moved.model, q), scale)
     left = [np.linalg.norm(defect) for _, _, defect in _four_bars(after_lines, after_members, SIDES_ROUNDING * scale)]
     if any(gaps[name] > before[name] + UNSEEN * scale for name in gaps) or max(left, default=0.0) > UNSEEN * scale:
         return tree  # (not made exact as drawn: read as written)
@@ -114,15 +93,6 @@ def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTr
             f"{sizes.max():.2g} {tree.unit} across the axes, of {named}, up to {SIDES_ROUNDING:g} of "
             "the length scale)")
     return replace(moved, notes=[*tree.notes, note])
-
-
-def _frames(tree: ClosedTree, q: NDArray) -> list[NDArray]:
-    """Every joint's frame (4x4, world) at q."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    data = tree.model.createData()
-    pin.forwardKinematics(tree.model, data, q)
-    return [homogeneous(data.oMi[j]) for j in range(tree.model.njoints)]
 
 
 def _bodies(tree: ClosedTree) -> list[int]:

@@ -28,10 +28,16 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, joint_kind, joint_value
 from screwkit.io.leg_ways import pin_groups
-from screwkit.io.rounding import parallel_axes, turned_joint
+from screwkit.io.rounding import EXACT, parallel_axes, turned_joint
+from screwkit.io.tree_joints import joint_frames
 from screwkit.io.written_angles import written_turns
+from screwkit.io.written_decimals import written_steps
 
-__all__ = ["drawn_tree", "closed_hinges"]
+__all__ = ["drawn_tree", "drawn_pairs", "closed_hinges", "PAIR_TURN"]
+
+PAIR_TURN = 1e-3
+"""Radians: the largest turn :func:`drawn_pairs` gives a hinge closed by two ball closures (beyond, the file's
+rounding over their spacing says too little of its axis to write it along another: it is read as written)."""
 
 
 def closed_hinges(tree: ClosedTree) -> list[tuple[int, int]]:
@@ -45,10 +51,9 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
     docstring), its notes saying the largest turn; ``tree`` itself when no axis turns."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
+    tree = drawn_pairs(tree, q)
     model = tree.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, np.asarray(q, dtype=float))
-    world = [np.asarray(data.oMi[j].homogeneous) for j in range(model.njoints)]
+    world = joint_frames(model, q)
     owners, directions = [], []
     for joint in range(1, model.njoints):
         kind, axis = joint_kind(model, joint)
@@ -95,6 +100,66 @@ def drawn_tree(tree: ClosedTree, q: NDArray) -> ClosedTree:
     note = (f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} rad, of "
             f"{named}{rounded})")
     return replace(tree, model=moved, closures=closures, notes=[*tree.notes, note])
+
+
+def drawn_pairs(tree: ClosedTree, q: NDArray) -> ClosedTree:
+    """``tree`` with each hinge it closes by two ball closures (no point of it marked as where the file draws the
+    joint) whose axis the file's rounding knows less well than :data:`~screwkit.common.tolerances.FILE_ROUNDING`
+    written along the revolute joints (and better-known closed hinges) parallel to it within what it knows, at the
+    closed configuration ``q``; ``tree`` itself when none turns.
+
+    The two points are written in one body's frame, each coordinate to half the step of the file's last length
+    decimal (:func:`screwkit.io.written_decimals.written_steps`): the line through them is known to sqrt(3) steps over
+    their spacing (1.2e-4 rad for two MJCF connects 6 mm apart written to 6 decimals, where a joint's axis written as
+    a direction is held to 1e-5). Read as written, such a hinge in a parallelogram made the four-bar a spatial 4R loop,
+    which does not move: a rounded Delta read 1 DOF instead of 2. A hinge is turned (about the middle of its points,
+    on both bodies, so that the configuration stays closed) when the directions within its allowance (that bound plus
+    the file's rounding, at most :data:`PAIR_TURN`) agree with each other to the file's rounding: onto their mean
+    (signed; whichever the file lists first). Where none is that near, or they disagree, it is read as written."""
+    step, _ = written_steps(tree.source, tree.length_unit)
+    if step is None or not tree.closures:
+        return tree
+    model = tree.model
+    world = joint_frames(model, q)
+    known, unsure = [], []  # directions known to the file's rounding; (pair, unit, allowance) of the others
+    for joint in range(1, model.njoints):
+        kind, axis = joint_kind(model, joint)
+        if kind == "revolute":
+            known.append(world[joint][:3, :3] @ axis)
+    for pair in closed_hinges(tree):
+        first, second = (tree.closures[k] for k in pair)
+        ends = _points(world, first, second, first.joint_a)
+        spacing = float(np.linalg.norm(ends[1] - ends[0]))
+        if spacing == 0.0:
+            continue
+        bound = np.sqrt(3.0) * step / spacing
+        if bound <= FILE_ROUNDING or first.axis_point or second.axis_point:
+            known.append((ends[1] - ends[0]) / spacing)
+        elif bound + FILE_ROUNDING <= PAIR_TURN:
+            unsure.append((pair, (ends[1] - ends[0]) / spacing, bound + FILE_ROUNDING))
+    if not known or not unsure:
+        return tree
+    known = np.array(known) / np.linalg.norm(known, axis=1, keepdims=True)
+    closures, turns = list(tree.closures), {}
+    for pair, unit, allowance in unsure:
+        near = known[np.linalg.norm(np.cross(known, unit), axis=1) <= allowance]
+        if not len(near) or np.max(np.linalg.norm(np.cross(near[:, None], near[None]), axis=-1)) > FILE_ROUNDING:
+            continue
+        direction = np.sum(near * np.sign(near @ near[0])[:, None], axis=0)
+        direction /= np.linalg.norm(direction)
+        turn = float(np.linalg.norm(np.cross(direction, unit)))
+        if turn > EXACT:
+            closures[pair[0]], closures[pair[1]] = _turned_hinge(world, *(tree.closures[k] for k in pair), direction)
+            turns[pair] = (turn, allowance - FILE_ROUNDING)
+    if not turns:
+        return tree
+    most = max(turns, key=lambda pair: (turns[pair][0], sorted(tree.closures[k].name for k in pair)))
+    names = sorted(repr(tree.closures[k].name) for k in most)
+    note = (f"hinges closed by two ball closures whose axis the file's rounding knows only over their points' "
+            f"spacing written along the hinges parallel to them ({len(turns)} hinge{'s' * (len(turns) > 1)}; the "
+            f"largest turn {turns[most][0]:.2g} rad, of the hinge closed by {names[0]} and {names[1]}, whose axis "
+            f"is known to {turns[most][1]:.2g} rad)")
+    return replace(tree, closures=closures, notes=[*tree.notes, note])
 
 
 def _points(world: list, first, second, joint: int) -> tuple[NDArray, NDArray]:

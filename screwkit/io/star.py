@@ -74,6 +74,7 @@ from screwkit.io.closed_tree import (
 from screwkit.io.compound import compound_groups, compound_legs
 from screwkit.io.couplings import check_couplings
 from screwkit.io.drawn_parallelograms import drawn_parallelograms
+from screwkit.io.graph_rounding import drawn_pairs
 from screwkit.io.idle_joints import INDEPENDENCE_TOLERANCE, lock_idle
 from screwkit.io.locking import platform_motions
 from screwkit.io.output import output_frame, platform_body
@@ -299,6 +300,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.turns_before = closure_turns(tree, tree.q_reference)
     q, scale = assemble(tree, held=tree.initial_joints())
     report.gaps_after = closure_gaps(tree, q)
+    tree = drawn_pairs(tree, q)  # (hinges closed by two points a few millimetres apart: along their joints)
     tree = drawn_parallelograms(tree, q, scale)  # (four-bars drawn as parallelograms and written rounded: exact)
     model = tree.model
     changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)

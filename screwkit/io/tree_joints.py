@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ImportError_", "homogeneous", "inverse", "joint_kind", "joint_value", "path_to"]
+__all__ = ["ImportError_", "homogeneous", "inverse", "joint_frames", "joint_kind", "joint_value", "path_to"]
 
 
 class ImportError_(ValueError):
@@ -18,6 +18,15 @@ class ImportError_(ValueError):
 def homogeneous(placement) -> NDArray[np.float64]:
     """A Pinocchio placement (SE3) as a 4x4 matrix (a new array)."""
     return np.array(placement.homogeneous, dtype=float)
+
+
+def joint_frames(model, q: NDArray) -> list[NDArray]:
+    """Every joint's frame (4x4, world) of the Pinocchio ``model`` at its configuration ``q``."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    data = model.createData()
+    pin.forwardKinematics(model, data, np.asarray(q, dtype=float))
+    return [homogeneous(data.oMi[joint]) for joint in range(model.njoints)]
 
 
 def inverse(matrix: NDArray) -> NDArray:
