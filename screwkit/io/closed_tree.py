@@ -473,7 +473,7 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
         closure, first, second = next(item for item in found if item[0].name == worst)
-        advice = along_pins(model, q, first, second, loop_kinds(model, closure)) or (
+        advice = along_pins(model, q, first, second, loop_kinds(model, closure), scale) or (
             "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "
             "joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "

@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.tree_joints import joint_kind, path_to
 
 __all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "DEPTH_ROUNDING", "ONE_PLANE"]
@@ -32,11 +33,11 @@ PARALLEL = 1e-3
 """Sine (about 0.06 deg) below which the loop's hinge axes, and its gap, count as along one direction."""
 
 
-def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) -> str:
+def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float) -> str:
     """What to say of a closure left open at q (its two frames ``first``, ``second``, 4x4 in the world) where its
-    gap lies along its loop's hinges, all parallel: ``kinds``, (joint, kind, local axis) of the loop's joints; else
-    ''."""
-    if pin_axis(model, q, first, second, kinds) is None:
+    gap lies along its loop's hinges, all parallel: ``kinds``, (joint, kind, local axis) of the loop's joints;
+    ``scale``, the mechanism's length scale (:func:`pin_axis`); else ''."""
+    if pin_axis(model, q, first, second, kinds, scale) is None:
         return ""
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
     return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
@@ -45,9 +46,12 @@ def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) 
             "closes")
 
 
-def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) -> NDArray | None:
+def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float) -> NDArray | None:
     """The world axis (unit) of the loop's hinges at q when they are all parallel, its slides (if any) across them and
-    the closure's gap along them (:data:`PARALLEL`), else None (as :func:`along_pins`)."""
+    the closure's gap along them (:data:`PARALLEL`; or across them by at most
+    :data:`~screwkit.common.tolerances.FILE_ROUNDING` of the length ``scale``, what the assembly leaves open in any
+    direction: an R-P-R/R-P-R written to 6 decimals was left 2.9e-9 m across its pins, 5e-3 of its gap of 5.9e-7 m
+    along them), else None (as :func:`along_pins`)."""
     import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
 
     data = model.createData()
@@ -57,8 +61,9 @@ def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list) ->
     gap = first[:3, 3] - second[:3, 3]
     if len(axes) < 2 or len(axes) + len(slides) < len(kinds) or not np.linalg.norm(gap) > 0:
         return None
+    off = np.linalg.norm(np.cross(axes[0], gap))
     across = [np.linalg.norm(np.cross(axes[0], axis)) for axis in axes] + [
-        np.linalg.norm(np.cross(axes[0], gap)) / np.linalg.norm(gap)] + [
+        off / np.linalg.norm(gap) if off > FILE_ROUNDING * scale else 0.0] + [
         abs(float(axes[0] @ slide)) / np.linalg.norm(slide) for slide in slides]  # (slides across the pins)
     return None if max(across) > PARALLEL else axes[0] / np.linalg.norm(axes[0])
 
@@ -74,7 +79,7 @@ def depths_drawn_apart(model, q: NDArray, frames: list, loops: list[list], scale
         if not np.linalg.norm(gap) > CLOSED * scale:
             offsets.append(np.zeros(3))
             continue
-        axis = pin_axis(model, q, first, second, kinds)
+        axis = pin_axis(model, q, first, second, kinds, scale)
         if np.linalg.norm(gap) > DEPTH_ROUNDING * scale or axis is None:
             return None
         offsets.append(axis * float(axis @ gap))  # (the joints close what lies across the pins)
