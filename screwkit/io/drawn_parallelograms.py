@@ -76,7 +76,8 @@ def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTr
     (the module's docstring), its notes saying so; ``tree`` itself when none is moved."""
     world = joint_frames(tree.model, q)
     lines, members = _lines(tree, world, scale)
-    found = _four_bars(lines, members, min(SIDES_ROUNDING * scale, written_rounding(tree, scale)))
+    limit = min(SIDES_ROUNDING * scale, written_rounding(tree, scale))
+    found = _four_bars(lines, members, limit)
     if not any(np.linalg.norm(defect) > UNSEEN * scale for _, _, defect in found):
         return tree
     moves = _least_moves(found, len(lines))
@@ -90,8 +91,8 @@ def drawn_parallelograms(tree: ClosedTree, q: NDArray, scale: float) -> ClosedTr
     sizes = np.array([np.linalg.norm(move) for move in moves])
     named = min(line["name"] for line, size in zip(lines, sizes) if size >= sizes.max() * (1 - 1e-9))  # (ties by name)
     note = (f"{PARALLELOGRAMS_DRAWN} ({len(found)} four-bar{'s' * (len(found) > 1)}; the largest move "
-            f"{sizes.max():.2g} {tree.unit} across the axes, of {named}, up to {SIDES_ROUNDING:g} of "
-            "the length scale)")
+            f"{sizes.max():.2g} {tree.unit} across the axes, of {named}; four-bars whose opposite sides "
+            f"differ by at most {limit / scale:.2g} of the length scale, the file's rounding, taken as parallelograms)")
     return replace(moved, notes=[*tree.notes, note])
 
 
