@@ -94,6 +94,36 @@ def test_a_rounded_delta_closed_by_connect_pairs_has_the_exact_tree_s_dof_and_pr
     assert against_the_exact_tree(mechanism, exact, poses) < 2e-5 / size
 
 
+def only_anchors_rounded(text: str) -> str:
+    """The MJCF text with its connects' anchors written to 6 decimals and every other number with all its digits."""
+    return re.sub(r'anchor="([^"]*)"', lambda m: 'anchor="' + rounded(m.group(1), 6) + '"', text)
+
+
+def with_extra_digits(text: str) -> str:
+    """The rounded MJCF text with a comment, a visual geom and an inertial written with ten decimals."""
+    extra = '<geom type="sphere" size="0.005" pos="0.0123456789 0 0"/><inertial pos="0.0000123456 0 0" mass="1" ' \
+        'diaginertia="1 1 1"/>'
+    return text.replace('<geom type="sphere" size="0.005"/>', extra, 1).replace(
+        "<worldbody>", '<worldbody><!-- drawn at pos="0.123456789 0 0" -->', 1)
+
+
+@pytest.mark.parametrize("variant", [only_anchors_rounded, with_extra_digits])
+def test_a_pair_is_known_to_the_numbers_that_place_it(tmp_path, variant):
+    """The step of a pair's rounding is its anchors' (bodies written with all their digits, the anchors to 6
+    decimals), and numbers that place no joint (a comment, a geom's and an inertial's positions written with ten
+    decimals) do not make the file finer: read 1 DOF before, now 2 DOF within 2e-5 / size of the exact tree."""
+    rotation = random_rotation(np.random.default_rng(2))
+    (tmp_path / "exact").mkdir()
+    exact = write(tmp_path / "exact", *delta_gepetto(rotation, 0.3))
+    text = delta_connects(rotation, 0.3, 0.02)
+    path = tmp_path / "delta.xml"
+    path.write_text(variant(text if variant is only_anchors_rounded else rounded(text, 6)))
+    assert variant(text) != text
+    _, report, mechanism = converted_mechanism(path, output="effector")
+    assert mechanism.dof == 2 and any(note.startswith(FOLLOWED) for note in report.notes), report.notes
+    assert against_the_exact_tree(mechanism, exact, poses_near_home(load(exact), spread=0.009)) < 2e-5 / 0.3
+
+
 def shifted(text: str, digits: int) -> str:
     """The MJCF text with every length (positions, anchors) times 10 ** ``digits``, written with as many decimals
     fewer (in decimal: the same numbers, not binary products)."""

@@ -31,7 +31,7 @@ from screwkit.io.leg_ways import pin_groups
 from screwkit.io.rounding import EXACT, parallel_axes, turned_joint
 from screwkit.io.tree_joints import joint_frames
 from screwkit.io.written_angles import written_turns
-from screwkit.io.written_decimals import written_steps
+from screwkit.io.written_decimals import closure_step, written_steps, written_text
 
 __all__ = ["drawn_tree", "drawn_pairs", "closed_hinges", "PAIR_TURN"]
 
@@ -108,20 +108,22 @@ def drawn_pairs(tree: ClosedTree, q: NDArray) -> ClosedTree:
     written along the revolute joints (and better-known closed hinges) parallel to it within what it knows, at the
     closed configuration ``q``; ``tree`` itself when none turns.
 
-    The two points are written in one body's frame, each coordinate to half the step of the file's last length
-    decimal (:func:`screwkit.io.written_decimals.written_steps`): the line through them is known to sqrt(3) steps over
-    their spacing (1.2e-4 rad for two MJCF connects 6 mm apart written to 6 decimals, where a joint's axis written as
-    a direction is held to 1e-5). Read as written, such a hinge in a parallelogram made the four-bar a spatial 4R loop,
-    which does not move: a rounded Delta read 1 DOF instead of 2. A hinge is turned (about the middle of its points,
-    on both bodies, so that the configuration stays closed) when the directions within its allowance (that bound plus
-    the file's rounding, at most :data:`PAIR_TURN`) agree with each other to the file's rounding: onto their mean
-    (signed; whichever the file lists first). Where none is that near, or they disagree, it is read as written."""
-    step, _ = written_steps(tree.source, tree.length_unit)
-    if step is None or not tree.closures:
+    The two points are written in one body's frame, each coordinate to half the step of the last length decimal of
+    the file, or of the numbers that place them where that is coarser (:mod:`screwkit.io.written_decimals`): the line
+    through them is known to sqrt(3) steps over their spacing (2.9e-4 rad for two MJCF connects 6 mm apart written to
+    6 decimals, where a joint's axis written as a direction is held to 1e-5). Read as written, such a hinge in a
+    parallelogram made the four-bar a spatial 4R loop, which does not move: a rounded Delta read 1 DOF instead of 2.
+    A hinge is turned (about the middle of its points, on both bodies, so that the configuration stays closed) when
+    the directions within its allowance (that bound plus the file's rounding, at most :data:`PAIR_TURN`) agree with
+    each other to the file's rounding: onto their mean (signed; whichever the file lists first). Where none is that
+    near, or they disagree, it is left as written."""
+    text = written_text(tree.source)
+    file_step = written_steps(tree.source, tree.length_unit, text)[0] if text is not None else None
+    if file_step is None or not tree.closures:
         return tree
     model = tree.model
     world = joint_frames(model, q)
-    known, unsure = [], []  # directions known to the file's rounding; (pair, unit, allowance) of the others
+    known, unsure = [], []  # directions known to the file's rounding; (pair, unit, bound) of the others
     for joint in range(1, model.njoints):
         kind, axis = joint_kind(model, joint)
         if kind == "revolute":
@@ -132,17 +134,18 @@ def drawn_pairs(tree: ClosedTree, q: NDArray) -> ClosedTree:
         spacing = float(np.linalg.norm(ends[1] - ends[0]))
         if spacing == 0.0:
             continue
-        bound = np.sqrt(3.0) * step / spacing
+        own = closure_step(text, (first.name, second.name), tree.length_unit)
+        bound = np.sqrt(3.0) * max(file_step, own or 0.0) / spacing
         if bound <= FILE_ROUNDING or first.axis_point or second.axis_point:
             known.append((ends[1] - ends[0]) / spacing)
         elif bound + FILE_ROUNDING <= PAIR_TURN:
-            unsure.append((pair, (ends[1] - ends[0]) / spacing, bound + FILE_ROUNDING))
+            unsure.append((pair, (ends[1] - ends[0]) / spacing, bound))
     if not known or not unsure:
         return tree
     known = np.array(known) / np.linalg.norm(known, axis=1, keepdims=True)
     closures, turns = list(tree.closures), {}
-    for pair, unit, allowance in unsure:
-        near = known[np.linalg.norm(np.cross(known, unit), axis=1) <= allowance]
+    for pair, unit, bound in unsure:
+        near = known[np.linalg.norm(np.cross(known, unit), axis=1) <= bound + FILE_ROUNDING]
         if not len(near) or np.max(np.linalg.norm(np.cross(near[:, None], near[None]), axis=-1)) > FILE_ROUNDING:
             continue
         direction = np.sum(near * np.sign(near @ near[0])[:, None], axis=0)
@@ -150,15 +153,15 @@ def drawn_pairs(tree: ClosedTree, q: NDArray) -> ClosedTree:
         turn = float(np.linalg.norm(np.cross(direction, unit)))
         if turn > EXACT:
             closures[pair[0]], closures[pair[1]] = _turned_hinge(world, *(tree.closures[k] for k in pair), direction)
-            turns[pair] = (turn, allowance - FILE_ROUNDING)
+            turns[tuple(sorted(repr(tree.closures[k].name) for k in pair))] = (turn, bound)
     if not turns:
         return tree
-    most = max(turns, key=lambda pair: (turns[pair][0], sorted(tree.closures[k].name for k in pair)))
-    names = sorted(repr(tree.closures[k].name) for k in most)
+    largest = max(turn for turn, _ in turns.values())  # (named: the first by name of those within 1 % of it, the
+    most = min(names for names, (turn, _) in turns.items() if turn >= 0.99 * largest)  # same in any unit or world)
     note = (f"hinges closed by two ball closures whose axis the file's rounding knows only over their points' "
             f"spacing written along the hinges parallel to them ({len(turns)} hinge{'s' * (len(turns) > 1)}; the "
-            f"largest turn {turns[most][0]:.2g} rad, of the hinge closed by {names[0]} and {names[1]}, whose axis "
-            f"is known to {turns[most][1]:.2g} rad)")
+            f"largest turn {largest:.2g} rad, of the hinge closed by {most[0]} and {most[1]}, whose axis is known "
+            f"to {turns[most][1]:.2g} rad)")
     return replace(tree, closures=closures, notes=[*tree.notes, note])
 
 
