@@ -17,7 +17,12 @@ canonical`) and the reference assembly:
    parallel whatever its values (:func:`_structural`); two axes parallel at the reference configuration only are
    not given that much: two arms' shoulder hinges, each arm's pan at 0 (a base turn written ``3.14`` turned each
    arm's hinges by 8e-4 rad and moved its ITI by 1.9e-2), or an arm's pan and its second wrist hinge, its middle
-   hinges' values summing to zero (1.1e-5 on its ITI). A turned joint's placement turns with it, so that at the
+   hinges' values summing to zero (1.1e-5 on its ITI). Two axes of two chains that are both fixed in the platform
+   (:func:`_fixed_in_platform`: each chain welded onto it, every hinge after the axis parallel to it) are parallel
+   whatever the configuration, and are grouped within the rounding of the angles between each and the platform
+   (:meth:`~screwkit.io.written_angles.WrittenTurns.to_platform`): the two-arm cell's last wrist hinges, one line
+   through the object both arms grasp, came out 1.6e-5 rad apart written to 5 decimals, and F_O2 read 0.454 where
+   it is 0. A turned joint's placement turns with it, so that at the
    reference configuration every frame after its motion stays where it was (as
    :func:`~screwkit.io.rounding.turned_joint` does in a converted file): :func:`turned_geometry`.
 2. **Loops closed within the rounding.** A chain whose loop its own joints cannot close onto the platform's loop
@@ -174,13 +179,21 @@ def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], 
         return geometries, 0.0, ""  # (an exact file: its file is not read again)
     names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
     description = mechanism.description  # (the text being read: load_text's is not its source's file)
-    widened = written_turns(description.source, description.text).allowances(names)
+    turns = written_turns(description.source, description.text)
+    widened = turns.allowances(names)
     allowed = np.full(crosses.shape, FILE_ROUNDING)
     chain_rows = [np.array([k for k, (owner, _) in enumerate(owners) if owner == index], dtype=int)
                   for index in range(len(mechanism.chains))]
-    for chain, rows in zip(mechanism.chains, chain_rows):  # (widened within a chain only: module docstring)
-        block = np.ix_(rows, rows)
-        allowed[block] = _structural(crosses[block], chain.geometry.dof_prismatic[:rows.size], widened[block])
+    to_platform = np.full(len(owners), np.nan)  # (the rounding between an axis fixed in the platform and it)
+    for chain, rows in zip(mechanism.chains, chain_rows):  # (widened within a chain only, and between axes fixed
+        block = np.ix_(rows, rows)                         # in the platform: _fixed_in_platform)
+        slides = chain.geometry.dof_prismatic[:rows.size]
+        allowed[block] = _structural(crosses[block], slides, widened[block])
+        for dof in _fixed_in_platform(chain, crosses[block], slides, widened[block]):
+            to_platform[rows[dof]] = turns.to_platform(chain.joint_names[dof], chain.loop_name)
+    across = np.isfinite(to_platform[:, None] + to_platform[None]) & np.not_equal.outer(
+        [owner for owner, _ in owners], [owner for owner, _ in owners])
+    allowed[across] = FILE_ROUNDING + np.minimum((to_platform[:, None] + to_platform[None])[across], WIDENING_LIMIT)
     turned, turn = parallel_axes(units, allowed)
     if turn <= UNSEEN:
         return geometries, 0.0, ""
@@ -205,6 +218,17 @@ def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.float6
             if all(crosses[k, first] <= widened[k, first] for k in hinges):
                 allowed[first, second] = allowed[second, first] = widened[first, second]
     return allowed
+
+
+def _fixed_in_platform(chain, crosses: NDArray, slides, widened: NDArray) -> list[int]:
+    """The tree joints of ``chain`` whose axis keeps its direction in the platform whatever the joint values: its loop
+    fixed (a weld onto the platform), and every hinge after it parallel to it within its allowance (``crosses`` of
+    every two of its axes, ``slides`` the prismatic ones, ``widened`` their allowances)."""
+    if chain.geometry.loop_type != "fixed":
+        return []
+    count = chain.geometry.n_tree_joints
+    return [dof for dof in range(count) if not slides[dof] and
+            all(slides[k] or crosses[k, dof] <= widened[k, dof] for k in range(dof + 1, count))]
 
 
 def _first_most(values) -> int:

@@ -70,6 +70,19 @@ class WrittenTurns:
 
     paths: dict[str, dict[int, float]] = field(default_factory=dict)
     example: str = ""
+    loops: dict[str, tuple[str | None, float]] = field(default_factory=dict)
+    """Per ``<loop>`` of a file in screwkit's convention: the joint into its predecessor link, and the rounding of the
+    rotations of its two frames' origins."""
+
+    def to_platform(self, joint: str, loop: str) -> float:
+        """The rounding of the rotations between the axis of ``joint`` and the platform along its chain, closed onto
+        it by ``loop``: the origins of the joints after it up to the loop's predecessor link, and the loop's frames.
+        An axis fixed in the platform (its loop fixed, every hinge after it parallel to it) is turned by them alone:
+        two such axes of two chains (two arms' last wrist hinges, both grasping the object on one line) are parallel
+        whatever the configuration, to these roundings."""
+        end, own = self.loops.get(loop, (None, 0.0))
+        path, before = self.paths.get(end, {}), self.paths.get(joint, {})
+        return sum(off for frame, off in path.items() if frame not in before) + own
 
     def allowance(self, first: str | None, second: str | None) -> float:
         """How far apart (rad, the norm of their cross product) the axes of joints ``first`` and ``second`` may be
@@ -113,11 +126,12 @@ def written_turns(source: str, text: str | None = None) -> WrittenTurns:
     found: list[tuple[float, str]] = []  # every rounded angle on a joint's path, in the file's order
     paths = _mjcf_paths(root, found) if root.tag == "mujoco" else _urdf_paths(root, found) if root.tag == "robot" \
         else {}
-    if not any(paths.values()):  # (a joint whose path has none is kept: its axis turns apart from a rounded one's)
-        return WrittenTurns()
+    loops = _urdf_loops(root, found) if root.tag == "robot" else {}
+    if not any(paths.values()) and not any(off for _, off in loops.values()):  # (a joint whose path has none is
+        return WrittenTurns()                                      # kept: its axis turns apart from a rounded one's)
     largest = max(off for off, _ in found)
     example = next(text for off, text in found if off == largest)
-    return WrittenTurns(paths, f"{example} for {_multiple(example)}")
+    return WrittenTurns(paths, f"{example} for {_multiple(example)}", loops)
 
 
 def _multiple(text: str) -> str:
@@ -185,3 +199,16 @@ def _urdf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, f
             current = into.get(parent)
         paths[name] = path
     return paths
+
+
+def _urdf_loops(root: ElementTree.Element, found: list) -> dict[str, tuple[str | None, float]]:
+    """Each ``<loop>``'s joint into its predecessor link and the rounding of its two frames' ``rpy``."""
+    into = {joint.find("child").get("link", ""): joint.get("name") for joint in root.findall("joint")
+            if joint.find("child") is not None and joint.get("name")}
+    loops = {}
+    for loop in root.findall("loop"):
+        predecessor = loop.find("predecessor")
+        if loop.get("name") and predecessor is not None:
+            words = [word for origin in loop.iter("origin") for word in (origin.get("rpy") or "").split()]
+            loops[loop.get("name")] = (into.get(predecessor.get("link", "")), _rounding(words, found))
+    return loops
