@@ -40,9 +40,12 @@ def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, 
     if pin_axis(model, q, first, second, kinds, scale) is None:
         return ""
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
+    depth = float(np.linalg.norm(first[:3, 3] - second[:3, 3])) / scale
+    beyond = (f" ({depth:.2g} of the length scale apart, beyond the {DEPTH_ROUNDING:g} read as the file's rounding)"
+              if depth > DEPTH_ROUNDING else "")
     return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
-            "different depths on one pin, which no joint values close: moved along the pin onto one plane (the "
-            "closure's frame: an MJCF connect's anchor or site, a robot.yaml or SDFormat closing frame), the loop "
+            f"different depths on one pin{beyond}, which no joint values close: moved along the pin onto one plane "
+            "(the closure's frame: an MJCF connect's anchor or site, a robot.yaml or SDFormat closing frame), the loop "
             "closes")
 
 

@@ -70,17 +70,21 @@ class WrittenTurns:
 
     paths: dict[str, dict[int, float]] = field(default_factory=dict)
     example: str = ""
-    loops: dict[str, tuple[str | None, float]] = field(default_factory=dict)
-    """Per ``<loop>`` of a file in screwkit's convention: the joint into its predecessor link, and the rounding of the
+    loops: dict[str, tuple[tuple[str | None, str | None], float]] = field(default_factory=dict)
+    """Per ``<loop>`` of a file in screwkit's convention: the joints into its two links, and the rounding of the
     rotations of its two frames' origins."""
+    lineage: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """Per joint of a URDF, the joints from the root to it, its own included."""
 
     def to_platform(self, joint: str, loop: str) -> float:
         """The rounding of the rotations between the axis of ``joint`` and the platform along its chain, closed onto
-        it by ``loop``: the origins of the joints after it up to the loop's predecessor link, and the loop's frames.
-        An axis fixed in the platform (its loop fixed, every hinge after it parallel to it) is turned by them alone:
-        two such axes of two chains (two arms' last wrist hinges, both grasping the object on one line) are parallel
-        whatever the configuration, to these roundings."""
-        end, own = self.loops.get(loop, (None, 0.0))
+        it by ``loop``: the origins of the joints after it up to the loop's link on its chain (whichever of its
+        predecessor and successor that is), and the loop's frames. An axis fixed in the platform (its loop fixed,
+        every hinge after it parallel to it) is turned by them alone: two such axes of two chains (two arms' last
+        wrist hinges, both grasping the object on one line) are parallel whatever the configuration, to these
+        roundings."""
+        ends, own = self.loops.get(loop, ((None, None), 0.0))
+        end = next((end for end in ends if joint in self.lineage.get(end, ())), None)
         path, before = self.paths.get(end, {}), self.paths.get(joint, {})
         return sum(off for frame, off in path.items() if frame not in before) + own
 
@@ -126,12 +130,12 @@ def written_turns(source: str, text: str | None = None) -> WrittenTurns:
     found: list[tuple[float, str]] = []  # every rounded angle on a joint's path, in the file's order
     paths = _mjcf_paths(root, found) if root.tag == "mujoco" else _urdf_paths(root, found) if root.tag == "robot" \
         else {}
-    loops = _urdf_loops(root, found) if root.tag == "robot" else {}
+    loops, lineage = _urdf_loops(root, found) if root.tag == "robot" else ({}, {})
     if not any(paths.values()) and not any(off for _, off in loops.values()):  # (a joint whose path has none is
         return WrittenTurns()                                      # kept: its axis turns apart from a rounded one's)
     largest = max(off for off, _ in found)
     example = next(text for off, text in found if off == largest)
-    return WrittenTurns(paths, f"{example} for {_multiple(example)}", loops)
+    return WrittenTurns(paths, f"{example} for {_multiple(example)}", loops, lineage)
 
 
 def _multiple(text: str) -> str:
@@ -201,14 +205,24 @@ def _urdf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, f
     return paths
 
 
-def _urdf_loops(root: ElementTree.Element, found: list) -> dict[str, tuple[str | None, float]]:
-    """Each ``<loop>``'s joint into its predecessor link and the rounding of its two frames' ``rpy``."""
-    into = {joint.find("child").get("link", ""): joint.get("name") for joint in root.findall("joint")
-            if joint.find("child") is not None and joint.get("name")}
+def _urdf_loops(root: ElementTree.Element, found: list) -> tuple[dict, dict[str, tuple[str, ...]]]:
+    """Each ``<loop>``'s joints into its two links and the rounding of its two frames' ``rpy``; and each joint's
+    lineage (the joints from the root to it)."""
+    parents = {joint.get("name"): (joint.find("parent").get("link", ""), joint.find("child").get("link", ""))
+               for joint in root.findall("joint") if joint.get("name") and joint.find("parent") is not None
+               and joint.find("child") is not None}
+    into = {child: name for name, (_, child) in parents.items()}
+    lineage = {}
+    for name in parents:
+        line, current = [], name
+        while current is not None and current not in line:  # (a file whose joints form a cycle: each joint once)
+            line.append(current)
+            current = into.get(parents[current][0])
+        lineage[name] = tuple(reversed(line))
     loops = {}
     for loop in root.findall("loop"):
-        predecessor = loop.find("predecessor")
-        if loop.get("name") and predecessor is not None:
+        ends = [loop.find(tag) for tag in ("predecessor", "successor")]
+        if loop.get("name") and None not in ends:
             words = [word for origin in loop.iter("origin") for word in (origin.get("rpy") or "").split()]
-            loops[loop.get("name")] = (into.get(predecessor.get("link", "")), _rounding(words, found))
-    return loops
+            loops[loop.get("name")] = (tuple(into.get(end.get("link", "")) for end in ends), _rounding(words, found))
+    return loops, lineage
