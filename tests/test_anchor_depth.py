@@ -87,10 +87,12 @@ def test_anchors_a_file_s_rounding_sets_apart_on_the_pins_read_with_mujoco_s_pre
 
 
 def test_anchors_set_apart_beyond_a_file_s_rounding_are_refused_by_name(tmp_path):
-    """Twice ``DEPTH_ROUNDING`` of the length scale along the pins: the refusal that names the depth, as at 4 mm."""
+    """Twice ``DEPTH_ROUNDING`` of the length scale along the pins: the refusal that names the depth, as at 4 mm, and
+    says how far apart they are beyond what is read as the file's rounding (it read as advice that the loop closes)."""
     path = tmp_path / "beyond.xml"
     path.write_text(deep(depth=2 * DEPTH_ROUNDING * SCALE))
-    with pytest.raises(ValueError, match="its two anchors drawn at different depths on one pin"):
+    with pytest.raises(ValueError, match=r"its two anchors drawn at different depths on one pin \(0\.0001[5-9] of "
+                                         r"the length scale apart, beyond the 0\.0001 read as the file's rounding\)"):
         load(path, output="coupler")
 
 
