@@ -191,9 +191,10 @@ def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], 
         allowed[block] = _structural(crosses[block], slides, widened[block])
         for dof in _fixed_in_platform(chain, crosses[block], slides, widened[block]):
             to_platform[rows[dof]] = turns.to_platform(chain.joint_names[dof], chain.loop_name)
-    across = np.isfinite(to_platform[:, None] + to_platform[None]) & np.not_equal.outer(
-        [owner for owner, _ in owners], [owner for owner, _ in owners])
-    allowed[across] = FILE_ROUNDING + np.minimum((to_platform[:, None] + to_platform[None])[across], WIDENING_LIMIT)
+    both = to_platform[:, None] + to_platform[None]  # (nan unless both axes are fixed in the platform)
+    chain_of = np.array([owner for owner, _ in owners])
+    across = np.isfinite(both) & (chain_of[:, None] != chain_of[None])
+    allowed[across] = FILE_ROUNDING + np.minimum(both[across], WIDENING_LIMIT)
     turned, turn = parallel_axes(units, allowed)
     if turn <= UNSEEN:
         return geometries, 0.0, ""

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.tolerances import FILE_ROUNDING
-from screwkit.io.tree_joints import joint_kind, path_to
+from screwkit.io.tree_joints import joint_frames, joint_kind, path_to
 
 __all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "DEPTH_ROUNDING", "ONE_PLANE"]
 
@@ -55,12 +55,9 @@ def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, sc
     :data:`~screwkit.common.tolerances.FILE_ROUNDING` of the length ``scale``, what the assembly leaves open in any
     direction: an R-P-R/R-P-R written to 6 decimals was left 2.9e-9 m across its pins, 5e-3 of its gap of 5.9e-7 m
     along them), else None (as :func:`along_pins`)."""
-    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
-
-    data = model.createData()
-    pin.forwardKinematics(model, data, q)
-    axes = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "revolute"]
-    slides = [np.asarray(data.oMi[joint].rotation) @ axis for joint, kind, axis in kinds if kind == "prismatic"]
+    world = joint_frames(model, q)
+    axes = [world[joint][:3, :3] @ axis for joint, kind, axis in kinds if kind == "revolute"]
+    slides = [world[joint][:3, :3] @ axis for joint, kind, axis in kinds if kind == "prismatic"]
     gap = first[:3, 3] - second[:3, 3]
     if len(axes) < 2 or len(axes) + len(slides) < len(kinds) or not np.linalg.norm(gap) > 0:
         return None

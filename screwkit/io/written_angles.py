@@ -128,9 +128,8 @@ def written_turns(source: str, text: str | None = None) -> WrittenTurns:
     except (OSError, ElementTree.ParseError, ValueError):
         return WrittenTurns()
     found: list[tuple[float, str]] = []  # every rounded angle on a joint's path, in the file's order
-    paths = _mjcf_paths(root, found) if root.tag == "mujoco" else _urdf_paths(root, found) if root.tag == "robot" \
-        else {}
-    loops, lineage = _urdf_loops(root, found) if root.tag == "robot" else ({}, {})
+    paths, lineage, loops = ({}, {}, {}) if root.tag not in ("mujoco", "robot") else \
+        (_mjcf_paths(root, found), {}, {}) if root.tag == "mujoco" else _urdf_paths(root, found)
     if not any(paths.values()) and not any(off for _, off in loops.values()):  # (a joint whose path has none is
         return WrittenTurns()                                      # kept: its axis turns apart from a rounded one's)
     largest = max(off for off, _ in found)
@@ -182,8 +181,10 @@ def _mjcf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, f
     return paths
 
 
-def _urdf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, float]]:
-    """Each joint's rounded ``rpy`` rotations of the joints' origins from the root link to it, its own included."""
+def _urdf_paths(root: ElementTree.Element, found: list) -> tuple[dict, dict, dict]:
+    """Each joint's rounded ``rpy`` rotations of the joints' origins from the root link to it, its own included; its
+    lineage (the joints from the root to it); and each ``<loop>``'s joints into its two links with the rounding of
+    its two frames' ``rpy``."""
     joints = {}
     for order, joint in enumerate(root.findall("joint")):
         parent, child, origin = joint.find("parent"), joint.find("child"), joint.find("origin")
@@ -193,36 +194,21 @@ def _urdf_paths(root: ElementTree.Element, found: list) -> dict[str, dict[int, f
         joints[joint.get("name")] = (parent.get("link", ""), child.get("link", ""), order, off)
     into = {child: name for name, (_, child, _, _) in joints.items()}  # each link's joint from its parent
     paths: dict[str, dict[int, float]] = {}
+    lineage: dict[str, tuple[str, ...]] = {}
     for name in joints:
-        path, current, seen = {}, name, set()
+        path, line, current, seen = {}, [], name, set()
         while current is not None and current not in seen:  # (a file whose joints form a cycle: each joint once)
             seen.add(current)
+            line.append(current)
             parent, _, order, off = joints[current]
             if off:
                 path[order] = off
             current = into.get(parent)
-        paths[name] = path
-    return paths
-
-
-def _urdf_loops(root: ElementTree.Element, found: list) -> tuple[dict, dict[str, tuple[str, ...]]]:
-    """Each ``<loop>``'s joints into its two links and the rounding of its two frames' ``rpy``; and each joint's
-    lineage (the joints from the root to it)."""
-    parents = {joint.get("name"): (joint.find("parent").get("link", ""), joint.find("child").get("link", ""))
-               for joint in root.findall("joint") if joint.get("name") and joint.find("parent") is not None
-               and joint.find("child") is not None}
-    into = {child: name for name, (_, child) in parents.items()}
-    lineage = {}
-    for name in parents:
-        line, current = [], name
-        while current is not None and current not in line:  # (a file whose joints form a cycle: each joint once)
-            line.append(current)
-            current = into.get(parents[current][0])
-        lineage[name] = tuple(reversed(line))
+        paths[name], lineage[name] = path, tuple(reversed(line))
     loops = {}
     for loop in root.findall("loop"):
         ends = [loop.find(tag) for tag in ("predecessor", "successor")]
         if loop.get("name") and None not in ends:
             words = [word for origin in loop.iter("origin") for word in (origin.get("rpy") or "").split()]
             loops[loop.get("name")] = (tuple(into.get(end.get("link", "")) for end in ends), _rounding(words, found))
-    return loops, lineage
+    return paths, lineage, loops

@@ -61,10 +61,6 @@ def _most_decimals(pattern: re.Pattern, text: str, pose: slice) -> int | None:
     return max(found) if found else None
 
 
-def _metres(length_unit: str | None) -> float:
-    return metres_per(length_unit) if length_unit not in (None, "m") else 1.0
-
-
 def written_steps(source: str, length_unit: str | None, text: str | None = None) -> tuple[float | None, float | None]:
     """The step of the last decimal the file ``source`` writes its lengths with (m: times ``length_unit``, the unit
     its lengths are written in, None for metres) and its angles and axis components with (rad, or a unit vector's
@@ -74,7 +70,7 @@ def written_steps(source: str, length_unit: str | None, text: str | None = None)
     if text is None:
         return None, None
     lengths, angles = _most_decimals(_LENGTHS, text, slice(0, 3)), _most_decimals(_ANGLES, text, slice(3, 6))
-    return (10.0 ** -lengths * _metres(length_unit) if lengths is not None else None,
+    return (10.0 ** -lengths * metres_per(length_unit or "m") if lengths is not None else None,
             10.0 ** -angles if angles is not None else None)
 
 
@@ -102,4 +98,4 @@ def closure_step(text: str, names, length_unit: str | None) -> float | None:
                  if site is not None]
         numbers = [anchor] if anchor is not None else [_attribute(site, "pos") or "" for site in sites if site]
         found += [decimals for written in numbers for decimals in _decimals(written)]
-    return 10.0 ** -max(found) * _metres(length_unit) if found else None
+    return 10.0 ** -max(found) * metres_per(length_unit or "m") if found else None
