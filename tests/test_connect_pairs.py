@@ -133,14 +133,18 @@ def shifted(text: str, digits: int) -> str:
 
 def test_the_connect_pair_delta_reads_alike_in_any_unit_size_and_order(tmp_path):
     """The same rounded drawing in millimetres (read with the unit given), at a thousandth and a thousand times its
-    size (poses scaled with it), with each pair's two connects and the pairs listed the other way: the same note and
-    the same indices per actuator, to 1e-9."""
+    size (poses scaled with it), with each pair's two connects and the pairs listed the other way, hung in a turned and
+    moved world, and with its motors renamed: the same note and the same indices per actuator, to 1e-9."""
     text = rounded(delta_connects(random_rotation(np.random.default_rng(2)), 0.3, 0.02), 6)
     connects = re.findall(r"<connect [^>]*/>", text)
     swapped = text.replace("".join(connects), "".join(reversed(connects)))  # (each pair's two, and the pairs)
     assert swapped != text and sorted(re.findall(r"<connect [^>]*/>", swapped)) == sorted(connects)
+    moved = text.replace("<worldbody>", '<worldbody><body name="held" pos="0.4 -1.3 2.1" euler="0.7 -1.1 2.3">', 1
+                         ).replace("</worldbody>", "</body></worldbody>", 1)
+    renamed = text.replace('"mot1_rod1"', '"drive_a"').replace('"mot1_rod2"', '"drive_b"')
     variants = {"m": (text, None, 1.0), "mm": (shifted(text, 3), "mm", 1.0), "small": (shifted(text, -3), None, 1e-3),
-                "large": (shifted(text, 3), None, 1e3), "swapped": (swapped, None, 1.0)}
+                "large": (shifted(text, 3), None, 1e3), "swapped": (swapped, None, 1.0), "world": (moved, None, 1.0),
+                "renamed": (renamed, None, 1.0)}
     read, said = {}, {}
     for name, (variant, unit, factor) in variants.items():
         path = tmp_path / f"{name}.xml"
@@ -148,13 +152,15 @@ def test_the_connect_pair_delta_reads_alike_in_any_unit_size_and_order(tmp_path)
         _, report, mechanism = converted_mechanism(path, output="effector", length_unit=unit)
         poses = poses_near_home(mechanism, spread=0.009 * factor)
         result = indices_at_poses(mechanism, poses, detail=True)
+        home = indices_at_poses(mechanism, mechanism.home_pose[None], detail=True)
         order = np.argsort(mechanism.actuator_names)
-        read[name] = (mechanism.home_pose / factor, result.iti_actuators[:, order], result.lmti)
+        read[name] = (home.iti_actuators[:, order], home.lmti, mechanism.home_pose / factor,
+                      result.iti_actuators[:, order], result.lmti)
         [said[name]] = [note for note in report.notes if note.startswith(FOLLOWED)]
     assert len(set(said.values())) == 1, said
-    for name in ("mm", "small", "large", "swapped"):
-        for mine, theirs in zip(read[name], read["m"]):
-            np.testing.assert_allclose(mine, theirs, atol=1e-9, rtol=0)
+    for name in ("mm", "small", "large", "swapped", "world", "renamed"):  # (in a moved world, its home only: its
+        for mine, theirs in list(zip(read[name], read["m"]))[:2 if name == "world" else None]:  # task axes turn)
+            np.testing.assert_allclose(mine, theirs, atol=1e-9, rtol=0, err_msg=name)
 
 
 def nudged_linkage(steps: int) -> str:

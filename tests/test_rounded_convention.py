@@ -158,8 +158,9 @@ def right_angles(text: str, decimals: int) -> str:
 @pytest.mark.parametrize("written_as", ["five decimals", "right angles 1.571"])
 def test_the_two_arm_cell_rounded_keeps_its_singular_submechanisms_in_any_unit_world_and_naming(tmp_path, written_as):
     """The two-arm cell written to 5 decimals, or with its right angles alone written 1.571, in metres, in
-    millimetres, hung in a turned and moved world, with its arms' names swapped (left for right) and with its loops'
-    ends listed the other way (the platform their predecessor): every one has F_O2 = F_O3 = 0 at its home and at four
+    millimetres, at a thousandth and a thousand times its size (poses scaled with it), hung in a turned and moved
+    world, with its arms' names swapped (left for right) and with its loops' ends listed the other way (the platform
+    their predecessor): every one has F_O2 = F_O3 = 0 at its home and at four
     poses away from it, as the file as generated has (the grasp line of the two last wrist hinges is the one twist
     ten actuators without them cannot drive), and the same F_O1 and sorted submechanism OTIs to 1e-9. Read before
     with those hinges 1.6e-5 rad apart, F_O2 was 0.454 at home at 5 decimals; with the loops' ends the other way and
@@ -171,16 +172,18 @@ def test_the_two_arm_cell_rounded_keeps_its_singular_submechanisms_in_any_unit_w
     other = {"predecessor": "successor", "successor": "predecessor"}
     ends = re.sub(r"<(/?)(predecessor|successor)\b", lambda m: f"<{m.group(1)}{other[m.group(2)]}", text)
     files = {"m": (text, 1.0), "mm": (in_unit(text, "mm", 1000.0, declare=True), 1.0),
+             "x 1e-3": (in_unit(text, "m", 1e-3), 1e-3), "x 1e3": (in_unit(text, "m", 1e3), 1e3),
              "world": (moved_in_the_world(text, (0.4, -1.3, 2.1), (0.7, -1.1, 2.3)), 1.0), "swapped": (swapped, 1.0),
              "ends": (ends, 1.0)}
     exact = load("coop_arms")
     poses = np.concatenate([exact.home_pose[None], random_reachable_poses(exact, np.random.default_rng(4), 4)])
     read = {}
-    for label, (source, _) in files.items():
-        result = indices_at_poses(load(written(tmp_path, label, source)), poses, detail=True)
+    for label, (source, factor) in files.items():
+        scaled = poses * np.array([factor] * 3 + [1.0] * 3)  # (x, y, z with the lengths; the angles as they are)
+        result = indices_at_poses(load(written(tmp_path, label.replace(" ", "_"), source)), scaled, detail=True)
         assert result.reachable.all() and not np.any(result.f_o[2]) and not np.any(result.f_o[3]), label
         read[label] = (result.f_o[1], np.sort(result.oti_submechanisms, axis=1))
-    for label in ("mm", "world", "swapped", "ends"):
+    for label in ("mm", "x 1e-3", "x 1e3", "world", "swapped", "ends"):
         for mine, theirs in zip(read[label], read["m"]):
             np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-9, err_msg=label)
 
