@@ -457,9 +457,12 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         raise mechanism.description.fail("<output type='point'>", "the output point cannot move: every platform "
                                                                   "motion is a rotation about it.")
     if mobility < 1:  # rigid: its closures leave the platform no motion (as a CAD export's rounding can make them)
+        drawn = next((note for note in mechanism.assembly_notes if note.startswith(DRAWN_AT_ROUNDING)), None)
         raise mechanism.description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move: its chains "
                                          "leave it no motion at the reference assembly (DOF 0)"
-                                         + _locking_chains(mechanism, at_pose, at_values) + ".")
+                                         + _locking_chains(mechanism, at_pose, at_values)
+                                         + ("" if drawn is None else f"; as read, {drawn}: written more exactly "
+                                            "(its angles to 6 decimals), it may move") + ".")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
     _check_actuator_count(mechanism, mobility)
     if modes:

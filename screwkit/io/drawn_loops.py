@@ -22,15 +22,20 @@ canonical`) and the reference assembly:
    whatever the configuration, and are grouped within the rounding of the angles between each and the platform
    (:meth:`~screwkit.io.written_angles.WrittenTurns.to_platform`): the two-arm cell's last wrist hinges, one line
    through the object both arms grasp, came out 1.6e-5 rad apart written to 5 decimals, and F_O2 read 0.454 where
-   it is 0. A turned joint's placement turns with it, so that at the
+   it is 0. So are two axes of two chains both fixed in the base (:func:`_fixed_in_base`: two legs' motors), to the
+   rounding on their ways from it, and a loop joint's axis, to its loop's rounding; these are grouped first
+   (:func:`_parallel`). A turned joint's placement turns with it, so that at the
    reference configuration every frame after its motion stays where it was (as
    :func:`~screwkit.io.rounding.turned_joint` does in a converted file): :func:`turned_geometry`.
 2. **Loops closed within the rounding.** A chain whose loop its own joints cannot close onto the platform's loop
    frame (damped Newton from the file's values) but leave within ``FILE_ROUNDING`` of it (rad, and lengths over
    the mechanism's size) has the platform's loop frame written where the chain closes: the two frames of a loop
-   are one frame, drawn twice. One left further apart, but within ten times that, is refused here, in one line
-   naming the loop and saying that it is of the order of a file's rounding (the Delta written to 4 decimals, 1.3e-5
-   rad); one further still is left to the assembly, which refuses it as before.
+   are one frame, drawn twice. In a file in screwkit's convention its gap in rad is allowed ``FILE_ROUNDING`` plus
+   the rounding of the angles around the loop (:meth:`~screwkit.io.written_angles.WrittenTurns.around`: the Delta
+   with its right angles written ``1.5708``, 1.28e-5 rad), and the frame is written where the chain ends at the
+   joint values at which step 1 made its axes parallel, its joints' nearest to closing it (:func:`_closing`). One
+   left further apart, but within ten times that, is refused here, in one line naming the loop and saying that it
+   is of the order of a file's rounding; one further still is left to the assembly, which refuses it as before.
 
 A file of another tool, converted (:mod:`screwkit.io.star`), has step 2 only: its axes were read as drawn where it
 was converted, but a redundant closure written rounded is closed there only as well as it closes, and the chain
@@ -45,6 +50,7 @@ touched: every bundled mechanism reads as before, bit for bit. What is changed i
 
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -56,7 +62,7 @@ from screwkit.closure.newton import file_fit, newton_solve_chain
 from screwkit.common.rotations import rotation_about_axis, rotation_vector_from_rotation
 from screwkit.common.tolerances import FILE_ROUNDING, MOTION_SPACE_TOLERANCE, NEWTON_TOLERANCE
 from screwkit.io.rounding import EXACT, parallel_axes
-from screwkit.io.written_angles import WIDENING_LIMIT, written_turns
+from screwkit.io.written_angles import WIDENING_LIMIT, WrittenTurns, written_turns
 from screwkit.model.chain import ChainGeometry
 from screwkit.model.mechanism import Mechanism
 
@@ -85,12 +91,18 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
     scale = mechanism_size(mechanism, mechanism.chains)
     values, axes, closes = (list(found) for found in zip(*(_file_values(mechanism, index, scale)
                                                           for index in range(len(mechanism.chains)))))
-    if mechanism.description.converted_from and all(closes):
+    converted = bool(mechanism.description.converted_from)
+    if converted and all(closes):
         return mechanism
+    turns = functools.cache(lambda: WrittenTurns() if converted else written_turns(mechanism.description.source,
+                                                                                   mechanism.description.text))
+    limits = functools.cache(lambda: [FILE_ROUNDING + min(turns().around(chain.loop_name), WIDENING_LIMIT)
+                                      for chain in mechanism.chains])  # (each loop's, read once it is needed)
     for index in (index for index, closed in enumerate(closes) if not closed):  # (read where the loops close)
-        values[index], axes[index] = _closing(mechanism, index, values[index], axes[index], scale)
+        values[index], axes[index] = _closing(mechanism, index, values[index], axes[index], scale,
+                                              None if converted else limits()[index])
     geometries, turn, most = ([chain.geometry for chain in mechanism.chains], 0.0, "") \
-        if mechanism.description.converted_from else _parallel(mechanism, values, axes)
+        if converted else _parallel(mechanism, values, axes, turns)
     notes = []
     if turn:
         notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} "
@@ -99,7 +111,8 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
     for index, chain in enumerate(mechanism.chains):
         if closes[index] and geometries[index] is chain.geometry:  # (as written, closed: nothing to do)
             continue
-        geometry, gap = _closed(mechanism, index, geometries[index], values[index], scale)
+        geometry, gap = _closed(mechanism, index, geometries[index], values[index], scale,
+                                None if converted else limits()[index])
         geometries[index] = geometry
         if gap is not None:
             moved.append((chain.loop_name, *gap))
@@ -131,13 +144,22 @@ def _file_values(mechanism: Mechanism, index: int, scale: float) -> tuple[NDArra
     return values, axes, max(position_gap / scale, rotation_gap) <= NEWTON_TOLERANCE
 
 
-def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, scale: float
+def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, scale: float, limit: float | None
              ) -> tuple[NDArray, NDArray]:
     """Chain ``index``'s joint values and axes where its joints close its loop (damped Newton from the file's
     ``values``), so that its axes are read where the mechanism is assembled, as ``screwkit convert`` writes it back;
-    ``values`` and ``axes`` as they are where they do not close it."""
+    with a ``limit`` (a file in screwkit's convention: its loop's rounding, :func:`_closed`), also where they come
+    nearest to closing it, if that is within ten times the limit: its loop frame is then written there (step 2), and
+    its axes are made parallel there (step 1), where the mechanism is assembled; ``values`` and ``axes`` as they are
+    where they do not close it."""
     geometry = mechanism.chains[index].geometry
     solved, converged = _solved(mechanism, index, geometry, values, scale)
+    if not converged and limit is not None:
+        target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
+                                                                     mechanism.home_translation)
+        radians, lengths = _apart(chain_forward_kinematics(geometry, solved), target_rotation, target_translation,
+                                  scale)
+        converged = max(radians / limit, lengths / FILE_ROUNDING) * FILE_ROUNDING <= NEAR_ROUNDING
     return (solved, chain_forward_kinematics(geometry, solved).axes[: len(axes)]) if converged else (values, axes)
 
 
@@ -165,9 +187,18 @@ def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArr
     return after, rotation @ geometry.leg_loop_rotation
 
 
-def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], float, str]:
+def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeometry], float, str]:
     """Every chain's geometry with the axes :func:`parallel_axes` groups made parallel (step 1 of the module
-    docstring), the largest turn (0: none) and the joint turned most."""
+    docstring), the largest turn (0: none) and the joint turned most; ``turns()``, the file's
+    :class:`~screwkit.io.written_angles.WrittenTurns`.
+
+    In two passes: first the axes parallel whatever the configuration (:func:`_structural` within a chain, and across
+    chains those fixed in the base, :func:`_fixed_in_base`, or in the platform, :func:`_fixed_in_platform`), each
+    within its allowance; then every axis, each pair within ``FILE_ROUNDING`` plus how far the first pass turned each
+    and, for a loop joint's axis, its loop's rounding (:meth:`~screwkit.io.written_angles.WrittenTurns.around`): the
+    closure sets its direction, to that. In one pass, an axis parallel to the others at the reference configuration
+    only, linked to them, held every axis of the group to ``FILE_ROUNDING`` of every other: the bundled Delta with its
+    right angles written ``1.5708`` kept one leg's motor 1.55e-5 rad off its elbow, and read 2 DOF."""
     owners = [(index, dof) for index, chain_axes in enumerate(axes) for dof in range(len(chain_axes))]
     directions = [direction for chain_axes in axes for direction in chain_axes]
     geometries = [chain.geometry for chain in mechanism.chains]
@@ -178,47 +209,67 @@ def _parallel(mechanism: Mechanism, values, axes) -> tuple[list[ChainGeometry], 
     if not np.any((crosses > UNSEEN) & (crosses <= FILE_ROUNDING + WIDENING_LIMIT)):
         return geometries, 0.0, ""  # (an exact file: its file is not read again)
     names = [mechanism.chains[index].joint_names[dof] for index, dof in owners]
-    description = mechanism.description  # (the text being read: load_text's is not its source's file)
-    turns = written_turns(description.source, description.text)
-    widened = turns.allowances(names)
-    allowed = np.full(crosses.shape, FILE_ROUNDING)
     chain_rows = [np.array([k for k, (owner, _) in enumerate(owners) if owner == index], dtype=int)
                   for index in range(len(mechanism.chains))]
+    loose = np.zeros(len(owners))  # (a loop joint's axis: its loop's rounding)
+    for chain, rows in zip(mechanism.chains, chain_rows):
+        loose[rows[chain.geometry.n_tree_joints:]] = min(turns().around(chain.loop_name), WIDENING_LIMIT)
+    widened = np.minimum(turns().allowances(names) + loose[:, None] + loose[None], FILE_ROUNDING + WIDENING_LIMIT)
+    linked = np.zeros(crosses.shape, dtype=bool)  # (the pairs parallel whatever the configuration)
     to_platform = np.full(len(owners), np.nan)  # (the rounding between an axis fixed in the platform and it)
-    for chain, rows in zip(mechanism.chains, chain_rows):  # (widened within a chain only, and between axes fixed
-        block = np.ix_(rows, rows)                         # in the platform: _fixed_in_platform)
+    in_base = np.zeros(len(owners), dtype=bool)
+    for chain, rows in zip(mechanism.chains, chain_rows):
+        block = np.ix_(rows, rows)
         slides = chain.geometry.dof_prismatic[:rows.size]
-        allowed[block] = _structural(crosses[block], slides, widened[block])
+        linked[block] = _structural(crosses[block], slides, widened[block])
         for dof in _fixed_in_platform(chain, crosses[block], slides, widened[block]):
-            to_platform[rows[dof]] = turns.to_platform(chain.joint_names[dof], chain.loop_name)
-    both = to_platform[:, None] + to_platform[None]  # (nan unless both axes are fixed in the platform)
+            to_platform[rows[dof]] = turns().to_platform(chain.joint_names[dof], chain.loop_name)
+        in_base[rows[_fixed_in_base(chain, crosses[block], slides, widened[block])]] = True
+    allowed = np.where(linked, widened, FILE_ROUNDING)
     chain_of = np.array([owner for owner, _ in owners])
-    across = np.isfinite(both) & (chain_of[:, None] != chain_of[None])
+    apart = chain_of[:, None] != chain_of[None]
+    both = to_platform[:, None] + to_platform[None]  # (nan unless both axes are fixed in the platform)
+    across = np.isfinite(both) & apart
     allowed[across] = FILE_ROUNDING + np.minimum(both[across], WIDENING_LIMIT)
-    turned, turn = parallel_axes(units, allowed)
+    based = in_base[:, None] & in_base[None] & apart  # (their paths from the base: the rounding between them)
+    allowed[based] = widened[based]
+    linked |= across | based
+    first, _ = parallel_axes(units, allowed + loose[:, None] + loose[None], links=linked)
+    loose += np.linalg.norm(np.cross(first, units), axis=1)
+    turned, _ = parallel_axes(first, allowed + loose[:, None] + loose[None])
+    moved = np.linalg.norm(np.cross(turned, units), axis=1)
+    turn = float(np.max(moved))
     if turn <= UNSEEN:
         return geometries, 0.0, ""
-    moved = np.linalg.norm(np.cross(turned, units), axis=1)
     for index, (chain, rows) in enumerate(zip(mechanism.chains, chain_rows)):
         if np.any(moved[rows] > 0.0):
             geometries[index] = turned_geometry(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
     return geometries, turn, names[_first_most(moved)]
 
 
-def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.float64]:
-    """One chain's allowances: ``widened`` between two of its axes (``crosses`` of every two, in the chain's order;
-    ``slides`` the prismatic ones) that stay parallel whatever the values of the joints between them (every hinge
-    between them within its allowance of parallel to the first), else :data:`FILE_ROUNDING`: a UR arm's base pan and
-    its second wrist hinge are parallel when its three middle hinges' values sum to zero, and are not grouped for a
-    right angle written 1.57 between them."""
+def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.bool_]:
+    """Which two of one chain's axes (``crosses`` of every two, in the chain's order; ``slides`` the prismatic ones;
+    ``widened`` their allowances) stay parallel whatever the values of the joints between them: every hinge between
+    them within its allowance of parallel to the first. A UR arm's base pan and its second wrist hinge are parallel
+    when its three middle hinges' values sum to zero, and are not grouped for a right angle written 1.57 between
+    them."""
     count = crosses.shape[0]
-    allowed = np.full((count, count), FILE_ROUNDING)
+    linked = np.zeros((count, count), dtype=bool)
     for first in range(count):
         for second in range(first, count):
             hinges = [k for k in range(first + 1, second) if not slides[k]]
             if all(crosses[k, first] <= widened[k, first] for k in hinges):
-                allowed[first, second] = allowed[second, first] = widened[first, second]
-    return allowed
+                linked[first, second] = linked[second, first] = True
+    return linked
+
+
+def _fixed_in_base(chain, crosses: NDArray, slides, widened: NDArray) -> list[int]:
+    """The tree joints of ``chain`` whose axis keeps its direction in the base whatever the joint values: every hinge
+    before it parallel to it within its allowance (as :func:`_fixed_in_platform`). Two such axes of two chains (two
+    legs' motors, each with its elbow's first hinge) are parallel whatever the configuration, to the rounding of
+    the angles on their ways from the base."""
+    return [dof for dof in range(chain.geometry.n_tree_joints) if not slides[dof] and
+            all(slides[k] or crosses[k, dof] <= widened[k, dof] for k in range(dof))]
 
 
 def _fixed_in_platform(chain, crosses: NDArray, slides, widened: NDArray) -> list[int]:
@@ -273,28 +324,41 @@ def turned_geometry(geometry: ChainGeometry, values: NDArray, directions: NDArra
                    loop_axes=loop_axes, leg_loop_rotation=leg_rotation, leg_loop_translation=leg_translation)
 
 
-def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: NDArray, scale: float
-            ) -> tuple[ChainGeometry, tuple[float, float] | None]:
+def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: NDArray, scale: float,
+            limit: float | None) -> tuple[ChainGeometry, tuple[float, float] | None]:
     """``geometry`` with the platform's loop frame written where the chain closes, when its joints leave the loop
     within the file's rounding but no closer (step 2 of the module docstring), and how far it moved (length, rad);
-    else ``geometry`` and None. A ValueError names a loop left open by more, up to :data:`NEAR_ROUNDING`."""
+    else ``geometry`` and None. A ValueError names a loop left open by more, up to ten times that.
+
+    The file's rounding is ``limit`` for a file in screwkit's convention: ``FILE_ROUNDING`` plus the rounding of the
+    angles around the loop (:meth:`~screwkit.io.written_angles.WrittenTurns.around`); its frame is written where the
+    chain ends at ``values``, where its axes were made parallel (:func:`_closing`, :func:`_parallel`), so that they
+    are parallel where the mechanism is assembled: written where Newton took the chain from there, a Delta's
+    platform-side hinge turned off its motor's by what the hinges across it took up. A converted file's (None:
+    ``FILE_ROUNDING``) is written where the chain comes nearest (damped Newton from ``values``)."""
     # (the platform's loop frame is the file's until written here: the targets are the mechanism's)
     target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
                                                                  mechanism.home_translation)
     if max(_apart(chain_forward_kinematics(geometry, values), target_rotation, target_translation, scale)) \
             <= NEWTON_TOLERANCE:
         return geometry, None
-    solved, converged = _solved(mechanism, index, geometry, values, scale)
-    end = chain_forward_kinematics(geometry, solved)
+    converged = False
+    if limit is None:
+        values, converged = _solved(mechanism, index, geometry, values, scale)
+    end = chain_forward_kinematics(geometry, values)
     radians, lengths = _apart(end, target_rotation, target_translation, scale)
-    if converged or max(radians, lengths) > NEAR_ROUNDING:
+    limit = FILE_ROUNDING if limit is None else limit
+    beyond = max(radians / limit, lengths / FILE_ROUNDING)  # (in units of what is read as drawn)
+    if converged or beyond * FILE_ROUNDING > NEAR_ROUNDING:
         return geometry, None
-    if max(radians, lengths) > FILE_ROUNDING:
+    if beyond > 1.0:
+        rounded = "" if limit == FILE_ROUNDING else \
+            f", {limit - FILE_ROUNDING:.2g} rad of it the rounding of the angles written around the loop"
         raise mechanism.description.fail(
             f"<loop name='{mechanism.chains[index].loop_name}'>",
             f"does not close at the reference configuration: its chain's joints leave its frames {radians:.3g} rad "
             f"and {lengths * scale:.3g} m apart at the closest, of the order of a file's rounding but beyond what is "
-            f"read as drawn ({FILE_ROUNDING:g} rad and {FILE_ROUNDING:g} of the mechanism's size, {scale:.3g} m): "
+            f"read as drawn ({limit:.2g} rad{rounded}, and {FILE_ROUNDING:g} of the mechanism's size, {scale:.3g} m): "
             "written to that or finer (a CAD export's 6 decimals in metres, for a mechanism of 10 cm or more), such a "
             "loop is closed as drawn.")
     rotation = mechanism.home_rotation.T @ end.end_rotation

@@ -55,26 +55,30 @@ it writes), a hinge at most this far from the normal is written along it, and a 
 in it (:func:`drawn_lines`)."""
 
 
-def parallel_axes(axes: NDArray, tolerance: float | NDArray = FILE_ROUNDING) -> tuple[NDArray[np.float64], float]:
+def parallel_axes(axes: NDArray, tolerance: float | NDArray = FILE_ROUNDING, links: NDArray | None = None
+                  ) -> tuple[NDArray[np.float64], float]:
     """Unit directions (n, 3) with each group of nearly parallel ones made parallel, and the largest turn (rad).
 
     Two directions are in one group when the norm of their cross product is at most ``tolerance`` (a number, or
-    one per pair, (n, n): :meth:`screwkit.io.written_angles.WrittenTurns.allowances`), linked pairwise: a chain of
-    such pairs is one group, unless two of its members are further apart than their own tolerance (directions at 0,
-    0.4 and 0.8 deg with 0.5 deg allowed): then its members are grouped at :data:`FILE_ROUNDING` only.
+    one per pair, (n, n): :meth:`screwkit.io.written_angles.WrittenTurns.allowances`), linked pairwise (only the
+    pairs ``links``, (n, n) booleans, when given): a chain of such pairs is one group, unless two of its members are
+    further apart than their own tolerance (directions at 0, 0.4 and 0.8 deg with 0.5 deg allowed): then its members
+    are grouped at :data:`FILE_ROUNDING` only.
     """
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     units = axes / np.linalg.norm(axes, axis=1, keepdims=True)
     count = units.shape[0]
     allowed = np.broadcast_to(np.asarray(tolerance, dtype=float), (count, count))
+    links = np.ones((count, count), dtype=bool) if links is None else links
     crosses = np.linalg.norm(np.cross(units[:, None, :], units[None, :, :]), axis=-1)
     groups = []
-    for members in _linked(crosses <= allowed):
+    for members in _linked((crosses <= allowed) & links):
         block = np.ix_(members, members)
         if np.all(crosses[block] <= allowed[block]):
             groups.append(members)
         else:
-            groups += [[members[k] for k in inner] for inner in _linked(crosses[block] <= FILE_ROUNDING)]
+            groups += [[members[k] for k in inner] for inner in _linked((crosses[block] <= FILE_ROUNDING)
+                                                                        & links[block])]
     result, turn = units.copy(), 0.0
     for members in groups:
         if len(members) < 2 or float(np.max(crosses[np.ix_(members, members)])) <= EXACT:

@@ -88,6 +88,16 @@ class WrittenTurns:
         path, before = self.paths.get(end, {}), self.paths.get(joint, {})
         return sum(off for frame, off in path.items() if frame not in before) + own
 
+    def around(self, loop: str) -> float:
+        """The rounding of the rotations around ``loop``'s cycle: the origins on the way from the frame its two links
+        share to each of them (those on one way and not the other) and the loop's own frames. Its chain's joints close
+        it onto the platform's frame only to this, and the directions of its axes, which the closure sets, are known
+        only to this."""
+        ends, own = self.loops.get(loop, ((None, None), 0.0))
+        one, other = (self.paths.get(end, {}) for end in ends)
+        return sum(off for frame, off in one.items() if frame not in other) + \
+            sum(off for frame, off in other.items() if frame not in one) + own
+
     def allowance(self, first: str | None, second: str | None) -> float:
         """How far apart (rad, the norm of their cross product) the axes of joints ``first`` and ``second`` may be
         and still be the parallel axes the author drew (module docstring); ``FILE_ROUNDING`` for a joint not read
