@@ -461,8 +461,8 @@ def task_space(mechanism: Mechanism, declared: tuple[str, ...] | None = None) ->
         raise mechanism.description.fail(f"<robot name='{mechanism.name}'>", "the platform cannot move: its chains "
                                          "leave it no motion at the reference assembly (DOF 0)"
                                          + _locking_chains(mechanism, at_pose, at_values)
-                                         + ("" if drawn is None else f"; as read, {drawn}: written more exactly "
-                                            "(its angles to 6 decimals), it may move") + ".")
+                                         + ("" if drawn is None else f"; as read, {drawn}: written more exactly, "
+                                            "it may move") + ".")
     mechanism = replace(mechanism, dof=mobility, instantaneous_dof=instantaneous)
     _check_actuator_count(mechanism, mobility)
     if modes:

@@ -79,6 +79,10 @@ NEAR_ROUNDING = 10.0 * FILE_ROUNDING
 """A loop its chain leaves open by more than ``FILE_ROUNDING`` (rad, lengths over the mechanism's size) and at most
 this is refused as of the order of a file's rounding (module docstring)."""
 
+_MOST = FILE_ROUNDING + WIDENING_LIMIT
+"""The most any two axes are allowed apart and made parallel (rad): a tilt of more than half a degree beyond the
+file's rounding is the author's (:data:`~screwkit.io.written_angles.WIDENING_LIMIT`)."""
+
 _AXIS_LOOPS = {"revolute": 1, "continuous": 1, "prismatic": 1, "universal": 2}
 """The loop joint types with axes, and how many."""
 
@@ -192,13 +196,18 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
     docstring), the largest turn (0: none) and the joint turned most; ``turns()``, the file's
     :class:`~screwkit.io.written_angles.WrittenTurns`.
 
-    In two passes: first the axes parallel whatever the configuration (:func:`_structural` within a chain, and across
-    chains those fixed in the base, :func:`_fixed_in_base`, or in the platform, :func:`_fixed_in_platform`), each
-    within its allowance; then every axis, each pair within ``FILE_ROUNDING`` plus how far the first pass turned each
-    and, for a loop joint's axis, its loop's rounding (:meth:`~screwkit.io.written_angles.WrittenTurns.around`): the
-    closure sets its direction, to that. In one pass, an axis parallel to the others at the reference configuration
-    only, linked to them, held every axis of the group to ``FILE_ROUNDING`` of every other: the bundled Delta with its
-    right angles written ``1.5708`` kept one leg's motor 1.55e-5 rad off its elbow, and read 2 DOF."""
+    In passes. First the axes parallel whatever the configuration, each chain's (:func:`_structural`), then across
+    chains those fixed in the base (:func:`_fixed_in_base`) or in the platform (:func:`_fixed_in_platform`): linked
+    pairwise each within its allowance, every two of a group within theirs or, not linked themselves, within the sum
+    along a way of linked pairs (:func:`_through`: the Schoenflies mechanism written to 3 decimals read 0 DOF, a leg's
+    loop hinge held to ``FILE_ROUNDING`` of another leg's motor). A group across chains that fails so leaves each
+    chain's groups as they are (one pair of two legs' motors 6e-7 rad beyond its allowance undid their legs' own
+    grouping). Then every axis, each pair within ``FILE_ROUNDING`` (and a loop joint's axis its loop's rounding,
+    :meth:`~screwkit.io.written_angles.WrittenTurns.around`: the closure sets its direction, to that) plus how far the
+    passes before turned each (:func:`_grown`). No pair is allowed more than :data:`_MOST`. In one pass, an axis
+    parallel to the others at the reference configuration only, linked to them, held every axis of the group to
+    ``FILE_ROUNDING`` of every other: the bundled Delta with its right angles written ``1.5708`` kept one leg's motor
+    1.55e-5 rad off its elbow, and read 2 DOF."""
     owners = [(index, dof) for index, chain_axes in enumerate(axes) for dof in range(len(chain_axes))]
     directions = [direction for chain_axes in axes for direction in chain_axes]
     geometries = [chain.geometry for chain in mechanism.chains]
@@ -214,7 +223,7 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
     loose = np.zeros(len(owners))  # (a loop joint's axis: its loop's rounding)
     for chain, rows in zip(mechanism.chains, chain_rows):
         loose[rows[chain.geometry.n_tree_joints:]] = min(turns().around(chain.loop_name), WIDENING_LIMIT)
-    widened = np.minimum(turns().allowances(names) + loose[:, None] + loose[None], FILE_ROUNDING + WIDENING_LIMIT)
+    widened = np.minimum(turns().allowances(names) + loose[:, None] + loose[None], _MOST)
     linked = np.zeros(crosses.shape, dtype=bool)  # (the pairs parallel whatever the configuration)
     to_platform = np.full(len(owners), np.nan)  # (the rounding between an axis fixed in the platform and it)
     in_base = np.zeros(len(owners), dtype=bool)
@@ -225,7 +234,7 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
         for dof in _fixed_in_platform(chain, crosses[block], slides, widened[block]):
             to_platform[rows[dof]] = turns().to_platform(chain.joint_names[dof], chain.loop_name)
         in_base[rows[_fixed_in_base(chain, crosses[block], slides, widened[block])]] = True
-    allowed = np.where(linked, widened, FILE_ROUNDING)
+    allowed = np.where(linked, widened, np.minimum(FILE_ROUNDING + loose[:, None] + loose[None], _MOST))
     chain_of = np.array([owner for owner, _ in owners])
     apart = chain_of[:, None] != chain_of[None]
     both = to_platform[:, None] + to_platform[None]  # (nan unless both axes are fixed in the platform)
@@ -233,10 +242,10 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
     allowed[across] = FILE_ROUNDING + np.minimum(both[across], WIDENING_LIMIT)
     based = in_base[:, None] & in_base[None] & apart  # (their paths from the base: the rounding between them)
     allowed[based] = widened[based]
-    linked |= across | based
-    first, _ = parallel_axes(units, allowed + loose[:, None] + loose[None], links=linked)
-    loose += np.linalg.norm(np.cross(first, units), axis=1)
-    turned, _ = parallel_axes(first, allowed + loose[:, None] + loose[None])
+    inside, linked = linked.copy(), linked | across | based
+    own, _ = parallel_axes(units, _through(allowed, inside), links=inside)  # (each chain's, then across chains)
+    first, _ = parallel_axes(own, _through(_grown(allowed, own, units), linked), links=linked)
+    turned, _ = parallel_axes(first, _grown(allowed, first, units))
     moved = np.linalg.norm(np.cross(turned, units), axis=1)
     turn = float(np.max(moved))
     if turn <= UNSEEN:
@@ -245,6 +254,25 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
         if np.any(moved[rows] > 0.0):
             geometries[index] = turned_geometry(chain.geometry, values[index], turned[rows], moved[rows] > 0.0)
     return geometries, turn, names[_first_most(moved)]
+
+
+def _grown(allowed: NDArray, turned: NDArray, units: NDArray) -> NDArray[np.float64]:
+    """The allowances ``allowed`` of every two axes grown by how far the passes before turned each (``turned`` from
+    ``units``), at most :data:`_MOST`: an axis near one as written is that near it as made parallel."""
+    turns = np.linalg.norm(np.cross(turned, units), axis=1)
+    return np.minimum(allowed + turns[:, None] + turns[None], _MOST)
+
+
+def _through(allowed: NDArray, linked: NDArray) -> NDArray[np.float64]:
+    """Each pair's allowance for the first pass of :func:`_parallel`: its own where it is ``linked`` (parallel
+    whatever the configuration), else the least sum of the allowances along a way of linked pairs from one to the
+    other (infinite where there is none): two axes each parallel to a third whatever the configuration are parallel
+    to each other, to the sum of the two roundings (a leg's loop hinge, parallel to its motor, and another leg's
+    motor)."""
+    through = np.where(linked, allowed, np.inf)
+    for middle in range(through.shape[0]):  # (Floyd-Warshall: a few tens of axes)
+        through = np.minimum(through, through[:, middle, None] + through[None, middle, :])
+    return np.where(linked, allowed, np.minimum(through, _MOST))
 
 
 def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.bool_]:
