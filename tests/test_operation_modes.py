@@ -16,7 +16,9 @@ from sdformat_models import rotation_z, upu_legs, upu_sdf
 
 from screwkit.closure import actuator_values, chain_screws, solve
 from screwkit.closure.assembly import MODES_MEET
-from screwkit.io.loader import load
+from screwkit.closure.chain_kinematics import chain_forward_kinematics
+from screwkit.common.rotations import rotation_vector_from_rotation
+from screwkit.io.loader import bundled_path, load
 from screwkit.screw.reference import reference_indices
 from screwkit.studies import indices_at_pose, indices_at_poses
 
@@ -267,3 +269,38 @@ def test_lifts_of_a_rounded_platform_give_each_pose_the_same_indices_in_any_batc
             result = indices_at_poses(mechanism, batch)
             assert float(result.lmti[at]) == pytest.approx(float(single.lmti), abs=1e-6)
             assert float(result.iti[at]) == pytest.approx(float(single.iti), abs=1e-6)
+
+
+def one_leg_turned_over(text: str) -> str:
+    """The bundled Delta with its first leg's platform universal joint written from the platform (``<predecessor>``
+    and ``<successor>`` swapped, the axes kept): that leg's cross turns about the other axes first, another mechanism,
+    whose reference assembly is a constraint singularity where two translational modes meet."""
+    start = text.index("<loop name=\"leg_1_joint_platform\"")
+    end = text.index("</loop>", start)
+    loop = text[start:end].replace("predecessor", "@").replace("successor", "predecessor").replace("@", "successor")
+    return text[:start] + loop + text[end:]
+
+
+def test_a_mode_with_its_turns_held_and_a_translation_dependent_closes_its_poses(tmp_path):
+    """The operation mode followed has its platform's three angles held at the reference assembly's values and one
+    translation dependent (the closure solves it): the closure passed the task coordinates where it reads the held
+    and task ones together, and numpy refused to broadcast (4, 2) to (4, 5) from inside the loading. Now the mechanism
+    opens (2 DOF, x and z), and poses of the mode close: at each reached pose the angles are the reference's and each
+    leg's end frame meets its loop frame on the platform (forward kinematics, not the closure's residual) to 1e-9."""
+    path = tmp_path / "delta.urdf"
+    path.write_text(one_leg_turned_over(bundled_path("delta_4").read_text()))
+    delta = load(path)
+    assert (delta.dof, delta.task_coordinates) == (2, ("x", "z"))
+    assert [delta.pose_coordinates[axis] for axis in delta.held_axes] == ["roll", "pitch", "yaw"]
+    poses = delta.home_pose + np.array([[0.0, 0.0], [0.01, 0.0], [-0.005, 0.01], [0.008, -0.006]])
+    solution = solve(delta, poses)
+    assert solution.reachable.all()
+    np.testing.assert_allclose(solution.full_poses[:, 3:], np.broadcast_to(delta.home_full_pose[3:], (4, 3)),
+                               rtol=0, atol=1e-12)
+    rotations, translations = delta.transforms_from_poses(solution.full_poses)
+    for index, chain in enumerate(delta.chains):
+        for k in range(len(poses)):
+            frames = chain_forward_kinematics(chain.geometry, solution.joint_values[index][k])
+            rotation, translation = delta.loop_targets(index, rotations[k], translations[k])
+            assert np.linalg.norm(frames.end_translation - translation) <= 1e-9
+            assert np.linalg.norm(rotation_vector_from_rotation(frames.end_rotation.T @ rotation)) <= 1e-9

@@ -266,7 +266,9 @@ def complete_poses(mechanism: Mechanism, task_poses: NDArray, *, start_poses: ND
     distance = np.abs(task_poses - start_task) / np.where(mechanism.angular, 1.0, mechanism.length_scale)
     largest = np.nan_to_num(np.max(distance, axis=-1, initial=0.0), nan=0.0, posinf=6.4)
     steps = np.clip(np.ceil(largest / 0.1), 1, 64).astype(np.int64)
-    poses, values, converged, residual = _run_closure(mechanism, chains, start_poses, start_values, free, task_poses,
+    targets = task_poses if not mechanism.held_axes else \
+        mechanism.full_poses(task_poses)[:, [axis for axis in range(mechanism.n_pose) if axis not in free]]
+    poses, values, converged, residual = _run_closure(mechanism, chains, start_poses, start_values, free, targets,
                                                       steps, ClosureSteps(tolerance, iterations, 1e-8, 12, 0.5))
     values = [wrap_revolute_values(mechanism.chains[i].geometry, v) for i, v in zip(chains, values)]
     return poses, values, converged, residual * mechanism.length_scale
