@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import mujoco
@@ -20,10 +21,11 @@ import pinocchio as pin
 import pytest
 from test_io import five_bar_mjcf
 
-from helpers import leg_line_otis
+from helpers import leg_line_otis, one_line_error, screwkit
 from screwkit.io.closed_tree import assemble
 from screwkit.io.loader import load
 from screwkit.io.mjcf import read_mjcf
+from screwkit.studies import indices_at_pose
 
 GALLERY = Path(__file__).resolve().parent / "data" / "gallery"
 TOLERANCE = 1e-9
@@ -190,6 +192,49 @@ def test_a_stewart_platform_written_by_a_cad_exporter_is_a_6_dof_platform_with_i
     assert names == [chain.name for chain in chains]
     np.testing.assert_allclose(result.oti_actuators[0], otis, atol=TOLERANCE)
     assert 0.1 < result.lmti < 1.0 and result.f_o == {1: 0.0}
+
+
+def in_a_body(text: str, pos: str, quat: str) -> str:
+    """The MJCF ``text`` with every body of its world held in one more body, ``pos`` and ``quat``, which has neither
+    an ``<inertial>`` nor a geom."""
+    root = ElementTree.fromstring(text)
+    world = root.find("worldbody")
+    holder = ElementTree.Element("body", name="holder", pos=pos, quat=quat)
+    for body in world.findall("body"):
+        world.remove(body)
+        holder.append(body)
+    world.append(holder)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+@pytest.mark.parametrize(("pos", "quat"), [("0 0 0", "1 0 0 0"), ("0.7 -0.4 1.1", "0.8 0.3 -0.2 0.47")])
+def test_the_cad_stewart_platform_held_in_a_body_without_mass_opens_as_mujoco_loads_it(tmp_path, pos, quat):
+    """The CAD exporter's Stewart platform writes ``<compiler inertiafromgeom="false">``: each body's inertia from its
+    ``<inertial>`` alone. Held in one more body with none (a world frame of the user's, placed or not), MuJoCo loads it
+    (the body has no joint); screwkit passed on Pinocchio's refusal ("Cannot get inertia from geom and no inertia was
+    found", over five lines of C++). It opens now, with the indices of the file as written at its home, to 1e-12.
+    Without the ``<inertial>`` of a body with a joint (nothing welded to it has one), MuJoCo refuses the file, and
+    so does screwkit, in one line naming the body."""
+    source = (GALLERY / "stewart_cad.xml").read_text()
+    assert 'inertiafromgeom="false"' in source
+    held = tmp_path / "held.xml"
+    held.write_text(in_a_body(source, pos, quat))
+    mujoco.MjModel.from_xml_path(str(held))  # (MuJoCo loads it)
+    written, moved = load(GALLERY / "stewart_cad.xml"), load(held)
+    first, second = indices_at_pose(written, written.home_pose), indices_at_pose(moved, moved.home_pose)
+    assert moved.dof == written.dof == 6
+    np.testing.assert_allclose(second.iti_actuators, first.iti_actuators, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(second.oti_actuators, first.oti_actuators, rtol=0, atol=1e-12)
+    assert abs(second.lmti - first.lmti) <= 1e-12
+    root = ElementTree.fromstring(held.read_text())
+    moving = next(body for body in root.iter("body") if body.get("name") == "cylinder1")
+    assert moving.find("joint") is not None and all(child.find("joint") is not None for child in moving.findall("body"))
+    moving.remove(moving.find("inertial"))
+    massless = tmp_path / "massless.xml"
+    massless.write_text(ElementTree.tostring(root, encoding="unicode"))
+    with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
+        mujoco.MjModel.from_xml_path(str(massless))
+    one_line_error(screwkit("analyze", massless), f"{massless}: <body name='cylinder1'>: a moving body without mass")
 
 
 def test_the_gallery_files_are_what_the_generator_writes(tmp_path):

@@ -106,6 +106,31 @@ def bodies_named(root: ElementTree.Element) -> int:
     return count
 
 
+def bodies_weighed(root: ElementTree.Element, path: Path, from_geoms: str | None) -> int:
+    """Under ``<compiler inertiafromgeom="false">`` (``from_geoms``: each body's inertia from its ``<inertial>``
+    alone), every body without one given a unit inertia, which Pinocchio asks of every body (the kinematics do not
+    depend on it); returns how many. MuJoCo loads such a body where it moves with one that has mass (it has no joint,
+    or a body welded to it, one of its children without joints, has an ``<inertial>``); a body with joints and none
+    is refused, as MuJoCo refuses it. Run once the frames are flattened and the bodies' joints read
+    (:func:`check_body_joints`)."""
+    def jointed(body) -> bool:
+        return any(child.tag in ("joint", "freejoint") for child in body)
+
+    def weighed(body) -> bool:  # (it, or a body welded to it, has an inertia)
+        return body.find("inertial") is not None or any(weighed(child) for child in body.findall("body")
+                                                        if not jointed(child))
+
+    count = 0
+    for body in (body for world in root.findall("worldbody") for body in world.iter("body")):
+        if from_geoms == "false" and body.find("inertial") is None:
+            if jointed(body) and not weighed(body):
+                raise MjcfError(f"{path}: {describe(body)}: a moving body without mass (no <inertial>, and <compiler "
+                                "inertiafromgeom='false'>): MuJoCo refuses the file.")
+            ElementTree.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+            count += 1
+    return count
+
+
 def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int, dict[str, str]]) -> None:
     """The joints of each body, refused where MuJoCo refuses them: a free joint or a mocap body inside another body
     (MuJoCo takes them on a body of ``<worldbody>`` only), a free joint with others (more than six DoFs), a ball

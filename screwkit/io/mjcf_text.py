@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.common.xml_text import tolerant_xml
-from screwkit.io.mjcf_classes import bodies_named, check_body_joints, defaults_merged, top_class_renamed
+from screwkit.io.mjcf_classes import bodies_named, bodies_weighed, check_body_joints, defaults_merged, top_class_renamed
 from screwkit.io.mjcf_pose import (
     MIN_AXIS,
     MjcfError,
@@ -434,6 +434,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
         notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
     check_body_joints(root, path, {id(joint): attributes for joint, attributes in _joints(root)})
     bodies_named(root)  # Pinocchio merges unnamed bodies inside others, and drops their joints
+    bodies_weighed(root, path, compiler.get("inertiafromgeom"))  # Pinocchio asks an inertia of every body
     split = joints_one_per_body(root)
     if split:
         notes.append(f"bodies with several joints ({', '.join(split)}) read as MuJoCo composes them: nested bodies "
