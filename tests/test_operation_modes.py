@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from sdformat_models import rotation_z, upu_legs, upu_sdf
 
+from helpers import in_unit, moved_in_the_world
 from screwkit.closure import actuator_values, chain_screws, solve
 from screwkit.closure.assembly import MODES_MEET
 from screwkit.closure.chain_kinematics import chain_forward_kinematics
@@ -304,3 +305,33 @@ def test_a_mode_with_its_turns_held_and_a_translation_dependent_closes_its_poses
             rotation, translation = delta.loop_targets(index, rotations[k], translations[k])
             assert np.linalg.norm(frames.end_translation - translation) <= 1e-9
             assert np.linalg.norm(rotation_vector_from_rotation(frames.end_rotation.T @ rotation)) <= 1e-9
+
+
+@pytest.mark.parametrize("variant", ["x 1e-3", "x 1e3", "world", "renamed"])
+def test_the_mode_with_held_turns_reads_alike_at_any_size_in_any_world_and_naming(tmp_path, variant):
+    """The same mechanism at a thousandth and a thousand times its size (poses scaled with it), hung in a turned and
+    moved world (a fixed joint above its base; poses compared in its own frame, at its home plus the same offsets),
+    and with its legs named the other way round (leg_1 is leg_4: the leg written from the platform is then the last):
+    2 DOF, and at three poses of the mode every leg's ITI, every OTI and the LMTI those of the file in metres to
+    1e-9."""
+    text = one_leg_turned_over(bundled_path("delta_4").read_text())
+    size, legs = 1.0, [0, 1, 2, 3]
+    if variant.startswith("x"):
+        size = float(variant[2:])
+        other = in_unit(text, "m", size)
+    elif variant == "world":
+        other = moved_in_the_world(text, (0.4, -1.3, 2.1), (0.7, -1.1, 2.3))
+    else:
+        other, legs = re.sub(r"leg_([1-4])", lambda m: f"leg_{5 - int(m.group(1))}", text), [3, 2, 1, 0]
+    (tmp_path / "m.urdf").write_text(text)
+    (tmp_path / "other.urdf").write_text(other)
+    first, second = load(tmp_path / "m.urdf"), load(tmp_path / "other.urdf")
+    assert first.dof == second.dof == 2
+    offsets = np.array([[0.01, 0.0], [-0.005, 0.01], [0.008, -0.006]])
+    one = indices_at_poses(first, first.home_pose + offsets, detail=True)
+    two = indices_at_poses(second, second.home_pose + offsets * size, detail=True, threshold=1e-6 * size)
+    assert one.reachable.all() and two.reachable.all()
+    np.testing.assert_allclose(two.iti_actuators[:, legs], one.iti_actuators, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(np.sort(two.oti_submechanisms, axis=1), np.sort(one.oti_submechanisms, axis=1), rtol=0,
+                               atol=1e-9)
+    np.testing.assert_allclose(two.lmti, one.lmti, rtol=0, atol=1e-9)
