@@ -10,6 +10,7 @@ CAD exporter writes it are checked against its leg lines.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
@@ -235,6 +236,61 @@ def test_the_cad_stewart_platform_held_in_a_body_without_mass_opens_as_mujoco_lo
     with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
         mujoco.MjModel.from_xml_path(str(massless))
     one_line_error(screwkit("analyze", massless), f"{massless}: <body name='cylinder1'>: a moving body without mass")
+
+
+MASS = '<inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>'
+
+
+def weighed_five_bar(compiler: str, body: str | None, child: str = "") -> str:
+    """The five-bar of ``tests/test_io.py`` with ``compiler``'s attributes and every body its :data:`MASS` but
+    ``body``'s, which holds ``child`` (a body welded to it) beside its geom."""
+    text = five_bar_mjcf().replace('<compiler angle="radian"/>', f'<compiler angle="radian" {compiler}/>')
+    text = re.sub(r'(<body name="([^"]*)"[^>]*>)', lambda m: m.group(1) + ("" if m.group(2) == body else MASS), text)
+    return text if body is None else re.sub(rf'(<body name="{body}"[^>]*>.*?<geom type="sphere" size="0.01"/>)',
+                                            lambda m: m.group(1) + child, text, count=1, flags=re.S)
+
+
+FALSE = 'inertiafromgeom="false"'
+WEIGHED = {"every body its mass": (FALSE, None, ""),
+           "no mass on a moving body": (FALSE, "distal_1", ""),
+           "its mass on a body welded to it": (FALSE, "distal_1", f'<body name="pad">{MASS}</body>'),
+           "its mass two bodies down": (FALSE, "distal_1", f'<body name="pad"><body name="pad_2">{MASS}</body></body>'),
+           "a welded body of mass 0": (FALSE, "distal_1",
+                                       '<body name="pad"><inertial pos="0 0 0" mass="0" diaginertia="1 1 1"/>'
+                                       '</body>'),
+           "a welded body of inertia 0": (FALSE, "distal_1",
+                                          '<body name="pad"><inertial pos="0 0 0" mass="1" diaginertia="0 0 0"/>'
+                                          '</body>'),
+           "its mass on a moving body below": (FALSE, "distal_1",
+                                               f'<body name="pad"><joint name="extra" type="hinge"/>{MASS}</body>'),
+           "both bounds": (FALSE + ' boundmass="0.001" boundinertia="0.001"', "distal_1", ""),
+           "a bound on the mass only": (FALSE + ' boundmass="0.001"', "distal_1", ""),
+           "inertias from geoms": ('inertiafromgeom="auto"', "distal_1", "")}
+"""Bodies with and without ``<inertial>`` under each ``inertiafromgeom``: MuJoCo loads some and refuses others."""
+
+
+@pytest.mark.parametrize("case", WEIGHED)
+def test_a_body_without_mass_is_read_where_mujoco_loads_it_and_refused_where_mujoco_refuses_it(tmp_path, case):
+    """Pinocchio asks an inertia of every body; under ``inertiafromgeom="false"`` screwkit gives a unit inertia to
+    every body without ``<inertial>`` (the kinematics do not depend on it), and refuses, in one line naming the body,
+    a body with joints whose mass or inertia, with the bodies welded to it and the compiler's bounds, is zero: as
+    MuJoCo's own loading of each file does (an earlier check read a welded body's ``<inertial>`` of mass 0 as mass,
+    and refused a file with both bounds, which MuJoCo loads)."""
+    path = tmp_path / "five_bar.xml"
+    path.write_text(weighed_five_bar(*WEIGHED[case]))
+    try:
+        mujoco.MjModel.from_xml_path(str(path))
+        loads = True
+    except ValueError as error:
+        assert "mass and inertia of moving bodies" in str(error)
+        loads = False
+    if loads:
+        assert load(path).dof == 2
+    else:
+        with pytest.raises(ValueError, match=rf"{re.escape(str(path))}: <body name='distal_1'>: a moving body without "
+                                             r"mass or inertia .*MuJoCo refuses the file\.$") as refused:
+            load(path)
+        assert "\n" not in str(refused.value)
 
 
 def test_the_gallery_files_are_what_the_generator_writes(tmp_path):

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from screwkit.io.mjcf_pose import ALTERNATIVES, BUILT_IN, MjcfError, describe, unused_name
 
-__all__ = ["defaults_merged", "bodies_named", "check_body_joints", "top_class_renamed", "TOP_CLASS"]
+__all__ = ["defaults_merged", "bodies_named", "bodies_weighed", "check_body_joints", "top_class_renamed", "TOP_CLASS",
+           "MUJOCO_MINIMUM"]
 
 TOP_CLASS = "screwkit_main"
 """The top class's name in the text Pinocchio reads."""
@@ -106,26 +107,38 @@ def bodies_named(root: ElementTree.Element) -> int:
     return count
 
 
-def bodies_weighed(root: ElementTree.Element, path: Path, from_geoms: str | None) -> int:
-    """Under ``<compiler inertiafromgeom="false">`` (``from_geoms``: each body's inertia from its ``<inertial>``
-    alone), every body without one given a unit inertia, which Pinocchio asks of every body (the kinematics do not
-    depend on it); returns how many. MuJoCo loads such a body where it moves with one that has mass (it has no joint,
-    or a body welded to it, one of its children without joints, has an ``<inertial>``); a body with joints and none
-    is refused, as MuJoCo refuses it. Run once the frames are flattened and the bodies' joints read
-    (:func:`check_body_joints`)."""
+MUJOCO_MINIMUM = 1e-15
+"""MuJoCo's ``mjMINVAL``: the least mass and inertia it takes of a moving body."""
+
+
+def bodies_weighed(root: ElementTree.Element, path: Path, compiler: ElementTree.Element) -> int:
+    """Under ``<compiler inertiafromgeom="false">`` (each body's inertia from its ``<inertial>`` alone), every body
+    without one given a unit inertia, which Pinocchio asks of every body (the kinematics do not depend on it); returns
+    how many. MuJoCo loads a file where each body with joints has, with the bodies welded to it (its children without
+    joints, theirs, ...), a mass and an inertia above :data:`MUJOCO_MINIMUM`, each body's at least the compiler's
+    ``boundmass`` and ``boundinertia``; a body with joints that has not is refused, as MuJoCo refuses it. Run once the
+    frames are flattened and the bodies' joints read (:func:`check_body_joints`)."""
+    if compiler.get("inertiafromgeom") != "false":
+        return 0
+    least = [float(compiler.get(name) or 0.0) for name in ("boundmass", "boundinertia")]
+
     def jointed(body) -> bool:
         return any(child.tag in ("joint", "freejoint") for child in body)
 
-    def weighed(body) -> bool:  # (it, or a body welded to it, has an inertia)
-        return body.find("inertial") is not None or any(weighed(child) for child in body.findall("body")
-                                                        if not jointed(child))
+    def weight(body) -> list[float]:  # (its mass and inertia, with the bodies welded to it)
+        inertial = body.find("inertial")
+        words = [] if inertial is None else (inertial.get("diaginertia") or inertial.get("fullinertia") or "").split()
+        own = [0.0 if inertial is None else float(inertial.get("mass") or 0.0), sum(float(word) for word in words[:3])]
+        welded = [weight(child) for child in body.findall("body") if not jointed(child)]
+        return [max(value, bound) + sum(part[k] for part in welded) for k, (value, bound) in enumerate(zip(own, least))]
 
     count = 0
     for body in (body for world in root.findall("worldbody") for body in world.iter("body")):
-        if from_geoms == "false" and body.find("inertial") is None:
-            if jointed(body) and not weighed(body):
-                raise MjcfError(f"{path}: {describe(body)}: a moving body without mass (no <inertial>, and <compiler "
-                                "inertiafromgeom='false'>): MuJoCo refuses the file.")
+        if jointed(body) and min(weight(body)) <= MUJOCO_MINIMUM:
+            raise MjcfError(f"{path}: {describe(body)}: a moving body without mass or inertia (with the bodies welded "
+                            "to it; <compiler inertiafromgeom='false'>: each from its <inertial>): MuJoCo refuses the "
+                            "file.")
+        if body.find("inertial") is None:
             ElementTree.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
             count += 1
     return count

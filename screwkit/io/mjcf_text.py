@@ -434,7 +434,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
         notes.append(f"{frames} <frame> element(s) read as MuJoCo reads them: their children placed in the frame")
     check_body_joints(root, path, {id(joint): attributes for joint, attributes in _joints(root)})
     bodies_named(root)  # Pinocchio merges unnamed bodies inside others, and drops their joints
-    bodies_weighed(root, path, compiler.get("inertiafromgeom"))  # Pinocchio asks an inertia of every body
+    bodies_weighed(root, path, compiler)  # Pinocchio asks an inertia of every body
     split = joints_one_per_body(root)
     if split:
         notes.append(f"bodies with several joints ({', '.join(split)}) read as MuJoCo composes them: nested bodies "
