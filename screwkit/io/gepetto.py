@@ -47,6 +47,9 @@ def read_gepetto(urdf: Path, yaml_path: Path, *, output: str | None = None,
     if not isinstance(spec, dict):
         raise ImportError_(f"{yaml_path}: expected a mapping with closed_loop, type and name_mot.")
     pairs, kinds, motors = spec.get("closed_loop") or [], spec.get("type") or [], spec.get("name_mot")
+    for key, value in (("closed_loop", pairs), ("type", kinds)):
+        if not isinstance(value, list):
+            raise ImportError_(f"{yaml_path}: {key} must be a list, got {value!r}.")
     if len(kinds) != len(pairs):
         raise ImportError_(f"{yaml_path}: {len(pairs)} closed_loop pair(s) but {len(kinds)} type(s).")
     model = urdf_model(urdf)

@@ -145,12 +145,13 @@ def bodies_weighed(root: ElementTree.Element, path: Path, compiler: ElementTree.
 
 
 def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int, dict[str, str]]) -> None:
-    """The joints of each body, refused where MuJoCo refuses them: a free joint or a mocap body inside another body
-    (MuJoCo takes them on a body of ``<worldbody>`` only), a free joint with others (more than six DoFs), a ball
-    joint followed by a hinge or a ball (a rotation after a rotation of every axis); a free joint's ``pos`` dropped
-    (MuJoCo places a free body by its coordinates alone). ``resolved``: each joint's attributes, its class's
-    included, by ``id``. Run once the frames are flattened (:func:`~screwkit.io.mjcf_pose.frames_flattened`: every
-    joint is then its body's child, every body of the world the world's)."""
+    """The joints of each body, refused where MuJoCo refuses them: a type MuJoCo does not know, a free joint or a
+    mocap body inside another body (MuJoCo takes them on a body of ``<worldbody>`` only), a free joint with others
+    (more than six DoFs), a ball joint followed by a hinge or a ball (a rotation after a rotation of every axis); a
+    free joint's ``pos`` dropped (MuJoCo places a free body by its coordinates alone). ``resolved``: each joint's
+    attributes, its class's included, by ``id``. Run once the frames are flattened
+    (:func:`~screwkit.io.mjcf_pose.frames_flattened`: every joint is then its body's child, every body of the world
+    the world's)."""
     top = {body for world in root.findall("worldbody") for body in world.findall("body")}
     for body in (body for world in root.findall("worldbody") for body in world.iter("body")):
         joints = [child for child in body if child.tag in ("joint", "freejoint")]
@@ -161,6 +162,9 @@ def check_body_joints(root: ElementTree.Element, path: Path, resolved: dict[int,
             raise MjcfError(f"{path}: {describe(body)}: {what} inside another body; MuJoCo takes it only on a body "
                             "of <worldbody> (and refuses the file).")
         for joint, kind in zip(joints, kinds):
+            if kind not in ("free", "ball", "slide", "hinge"):
+                raise MjcfError(f"{path}: {describe(joint)}: type='{kind}' is no joint type of MuJoCo's (free, ball, "
+                                "slide, hinge; MuJoCo refuses the file).")
             if kind == "free":
                 joint.attrib.pop("pos", None)
         if "free" in kinds and len(joints) > 1:

@@ -15,7 +15,9 @@ import re
 import sys
 import tempfile
 from pathlib import Path
+from xml.etree import ElementTree
 
+from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import ImportError_
 
 __all__ = ["urdf_model"]
@@ -26,6 +28,7 @@ def urdf_model(urdf: Path):
     naming the file and urdfdom's complaint if it cannot read it. A joint limit's negative effort or velocity (no
     limit, :func:`_unlimited_copy`) is read as no limit."""
     _refuse_xacro(urdf)
+    _refuse_cycles(urdf)
     try:
         return _pinocchio_model(urdf)
     except ImportError_ as error:
@@ -100,6 +103,36 @@ def _unlimited_copy(urdf: Path):
     tree.write(copy, encoding="utf-8", xml_declaration=True)
     copy.flush()
     return copy
+
+
+def _refuse_cycles(urdf: Path) -> None:
+    """A link with two parent joints, or joints that lead back to a link above them, refused in one line naming them:
+    urdfdom's parser, which Pinocchio calls, ends the process on such a file (a segmentation fault), and a closed
+    loop is written otherwise in a URDF of another tool (a robot.yaml's closing frames, a Gazebo plugin)."""
+    try:
+        root = ElementTree.fromstring(tolerant_xml(Path(urdf).read_bytes()))
+    except (OSError, ElementTree.ParseError, ValueError):
+        return  # (the reader says why)
+    parents: dict[str, tuple[str, str]] = {}  # each link's parent link and joint
+    for joint in root.findall("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is None or child is None:
+            continue  # (urdfdom says what is missing)
+        link, name = child.get("link", ""), joint.get("name", "?")
+        if link in parents:
+            raise ImportError_(f"{urdf}: <link name='{link}'> has two parent joints, {parents[link][1]!r} and "
+                               f"{name!r}: a URDF's joints form a tree (a loop is closed otherwise, e.g. by a "
+                               "robot.yaml's closing frames).")
+        parents[link] = (parent.get("link", ""), name)
+    for start in parents:
+        seen, link = [start], parents[start][0]
+        while link in parents and link not in seen:
+            seen.append(link)
+            link = parents[link][0]
+        if link == start:
+            joints = " -> ".join(parents[name][1] for name in reversed(seen))
+            raise ImportError_(f"{urdf}: joints {joints} lead from <link name='{start}'> back to itself: a URDF's "
+                               "joints form a tree.")
 
 
 def _refuse_xacro(urdf: Path) -> None:

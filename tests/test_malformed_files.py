@@ -1,0 +1,55 @@
+"""Files of other tools that are malformed get one line naming the file and the element, as each tool refuses them,
+never a traceback or a crash (found by mutating the bundled and gallery files one element at a time)."""
+
+from __future__ import annotations
+
+import re
+
+import mujoco
+import pytest
+from test_io import five_bar_gepetto, five_bar_mjcf
+
+from helpers import one_line_error, screwkit
+
+
+@pytest.mark.parametrize(("key", "value"), [("closed_loop", "5"), ("type", "6")])
+def test_a_robot_yaml_key_that_is_not_a_list_is_named(tmp_path, key, value):
+    """A robot.yaml whose ``closed_loop`` or ``type`` is a number: Python's "object of type 'int' has no len()" with
+    its traceback before; one line naming the key now."""
+    urdf, spec = five_bar_gepetto()
+    (tmp_path / "robot.urdf").write_text(urdf)
+    changed = re.sub(rf"(?m)^{key}:.*(\n[ -].*)*", f"{key}: {value}", spec)
+    assert changed != spec
+    (tmp_path / "robot.yaml").write_text(changed)
+    one_line_error(screwkit("analyze", tmp_path / "robot.urdf"), f"robot.yaml: {key} must be a list, got {value}.")
+
+
+@pytest.mark.parametrize("joins", ["a link with two parents", "a cycle"])
+def test_joints_that_do_not_form_a_tree_are_named_before_the_parser_crashes(tmp_path, joins):
+    """The Gepetto five-bar with one more joint from a rod's end to the other rod (that rod then has two parent
+    joints), or a base whose parent is the end of its own chain (every link one parent, none the root): urdfdom's
+    parser, called by Pinocchio, ended the process with a segmentation fault (exit status -11). Now one line names
+    the link and the joints."""
+    urdf, spec = five_bar_gepetto()
+    links = re.findall(r'<link name="([^"]+)"', urdf)
+    root, last = links[0], links[-1]
+    child = links[2] if joins == "a link with two parents" else root
+    extra = (f'<joint name="extra" type="revolute"><parent link="{last}"/><child link="{child}"/>'
+             '<origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/>'
+             '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    (tmp_path / "robot.urdf").write_text(urdf.replace("</robot>", extra))
+    (tmp_path / "robot.yaml").write_text(spec)
+    needle = (f"<link name='{child}'> has two parent joints" if joins == "a link with two parents" else
+              "back to itself: a URDF's joints form a tree")
+    one_line_error(screwkit("analyze", tmp_path / "robot.urdf"), f"{tmp_path / 'robot.urdf'}: ", needle)
+
+
+def test_a_joint_type_mujoco_does_not_know_is_named_as_mujoco_refuses_it(tmp_path):
+    """An MJCF hinge written ``type="banana"``: MuJoCo refuses the file ("invalid keyword"); screwkit passed on
+    Pinocchio's message over five lines of C++. Now one line names the joint."""
+    path = tmp_path / "five_bar.xml"
+    path.write_text(five_bar_mjcf().replace('<joint name="b_2" type="hinge"', '<joint name="b_2" type="banana"', 1))
+    assert 'type="banana"' in path.read_text()
+    with pytest.raises(ValueError, match="invalid keyword: 'banana'"):
+        mujoco.MjModel.from_xml_path(str(path))
+    one_line_error(screwkit("analyze", path), f"{path}: <joint name='b_2'>: type='banana' is no joint type of MuJoCo's")
