@@ -381,14 +381,18 @@ def test_a_passive_transmission_drives_nothing_in_screwkits_own_convention_too()
 
 def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_element(tmp_path):
     """urdfdom says what is wrong on standard error (four lines), then Pinocchio that the file holds no valid URDF
-    model: the one line now carries urdfdom's first complaint, and nothing else is written."""
+    model: the one line now carries urdfdom's first complaint (a limit that is no number), and nothing else is
+    written. An axis that is no three numbers is named before urdfdom reads the file (the joint and the element)."""
     text = FIVE_BAR.read_text()
-    axis = text.index("<axis", text.index('name="Chain1_2"'))
+    limit = text.index("lower=", text.index('name="Chain1_2"'))
     path = tmp_path / "fivebar_linkage.urdf"
+    path.write_text(text[:limit] + 'lower="1zz' + text[limit + len('lower="'):])
+    one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"),
+                   "Pinocchio cannot read the tree: joint [Chain1_2]: lower value (1zz-3.14) is not a valid float")
+    axis = text.index("<axis", text.index('name="Chain1_2"'))
     path.write_text(text[:axis] + '<axis xyz="1 0zzz 0"/>' + text[text.index("/>", axis) + 2:])
     one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"),
-                   "Pinocchio cannot read the tree: Malformed axis element for joint [Chain1_2]: Unable to parse "
-                   "component [0zzz] to a double")
+                   f"{path}: <joint name='Chain1_2'>: <axis xyz='1 0zzz 0'>: expected three finite numbers.")
 
 
 def test_a_negative_effort_or_velocity_reads_as_no_limit(tmp_path):

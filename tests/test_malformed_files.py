@@ -4,6 +4,7 @@ never a traceback or a crash (found by mutating the bundled and gallery files on
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import mujoco
 import pytest
@@ -53,3 +54,44 @@ def test_a_joint_type_mujoco_does_not_know_is_named_as_mujoco_refuses_it(tmp_pat
     with pytest.raises(ValueError, match="invalid keyword: 'banana'"):
         mujoco.MjModel.from_xml_path(str(path))
     one_line_error(screwkit("analyze", path), f"{path}: <joint name='b_2'>: type='banana' is no joint type of MuJoCo's")
+
+
+RODS = Path(__file__).resolve().parents[1] / "robots" / "delta_rods_4.xml"
+"""The bundled rod-level Delta (MJCF, legs with loops: read as a graph)."""
+
+
+@pytest.mark.parametrize(("case", "written", "changed", "needle"), [
+    ("a motor on no joint", '<motor name="motor_1" joint="motor_1"/>', '<motor name="motor_1" joint="no_such_joint"/>',
+     "actuated joint 'no_such_joint' is not a joint of the tree."),
+    ("a connect of bodies without its anchor", ' anchor="-0.481810888007 0.0 -0.638637822399"/>', "/>",
+     "<connect name='rod_1b_end'>: expected 3 numbers in 'anchor', got None.")])
+def test_what_mujoco_refuses_in_a_graph_s_file_is_refused_not_read_otherwise(tmp_path, case, written, changed, needle):
+    """The rod-level Delta with its first motor on a joint the file does not have, or its first rod's ``<connect>``
+    without its ``anchor``: MuJoCo refuses either file. screwkit read the first with that motor left out (three
+    actuators, no word said) and the second with the anchor at the body's origin (1 DOF instead of 3). Now each is
+    one line naming it."""
+    text = RODS.read_text()
+    assert written in text
+    path = tmp_path / "rods.xml"
+    path.write_text(text.replace(written, changed, 1))
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_path(str(path))
+    one_line_error(screwkit("analyze", path), f"{path}: ", needle)
+
+
+@pytest.mark.parametrize(("case", "edit", "needle"), [
+    ("a limit upside down", ('<limit effort="1"', '<limit lower="1" upper="-1" effort="1"'),
+     "<joint name='mot1'>: <limit lower='1' upper='-1'>: the lower bound is above the upper one."),
+    ("an origin of two numbers", ('<origin xyz="-0.1 0.0 0.0"', '<origin xyz="-0.1 0.0"'),
+     "<joint name='mot1'>: <origin xyz='-0.1 0.0'>: expected three finite numbers."),
+    ("an axis not a number", ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 nan"/>'),
+     "<axis xyz='0 0 nan'>: expected three finite numbers.")])
+def test_a_urdf_element_urdfdom_would_take_otherwise_or_not_name_is_named(tmp_path, case, edit, needle):
+    """The Gepetto five-bar with its first motor's limit upside down (read as no limit before: every pose reachable),
+    its origin of two numbers or an axis of NaN (urdfdom's "Parser found 2 elements but 3 expected", naming no
+    joint): one line naming the joint and the element."""
+    urdf, spec = five_bar_gepetto()
+    assert edit[0] in urdf
+    (tmp_path / "robot.urdf").write_text(urdf.replace(*edit, 1))
+    (tmp_path / "robot.yaml").write_text(spec)
+    one_line_error(screwkit("analyze", tmp_path / "robot.urdf"), f"{tmp_path / 'robot.urdf'}: ", needle)

@@ -497,7 +497,7 @@ def prepared_mjcf(path: Path) -> tuple[str, list[str], ElementTree.Element, list
 
 def _numbers(element: ElementTree.Element, attribute: str, count: int, default) -> list[float]:
     words = (element.get(attribute) or "").split()
-    if not words:
+    if not words and default is not None:  # (None: MuJoCo asks it)
         return list(default)
     try:
         values = [float(word) for word in words]
@@ -526,7 +526,7 @@ def closure_placements(element: ElementTree.Element, model, data, frame_of) -> t
     world_2 = data.oMi[body2.parentJoint].homogeneous @ body2.placement.homogeneous
     if element.tag == "connect":
         anchor = np.eye(4)
-        anchor[:3, 3] = _numbers(element, "anchor", 3, (0.0, 0.0, 0.0))
+        anchor[:3, 3] = _numbers(element, "anchor", 3, None)  # (MuJoCo refuses a connect of bodies without it)
         place_a = body1.placement.homogeneous @ anchor
         on_body2 = np.linalg.inv(world_2) @ world_1 @ anchor  # where the anchor is on body2 at qpos0
         return body1.parentJoint, place_a, body2.parentJoint, body2.placement.homogeneous @ on_body2

@@ -10,6 +10,7 @@ refused in one line with urdfdom's first complaint, which names the element.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import sys
@@ -28,7 +29,7 @@ def urdf_model(urdf: Path):
     naming the file and urdfdom's complaint if it cannot read it. A joint limit's negative effort or velocity (no
     limit, :func:`_unlimited_copy`) is read as no limit."""
     _refuse_xacro(urdf)
-    _refuse_cycles(urdf)
+    _refuse_malformed(urdf)
     try:
         return _pinocchio_model(urdf)
     except ImportError_ as error:
@@ -105,14 +106,27 @@ def _unlimited_copy(urdf: Path):
     return copy
 
 
-def _refuse_cycles(urdf: Path) -> None:
-    """A link with two parent joints, or joints that lead back to a link above them, refused in one line naming them:
-    urdfdom's parser, which Pinocchio calls, ends the process on such a file (a segmentation fault), and a closed
-    loop is written otherwise in a URDF of another tool (a robot.yaml's closing frames, a Gazebo plugin)."""
+def _refuse_malformed(urdf: Path) -> None:
+    """What urdfdom's parser, which Pinocchio calls, crashes on or says without naming the element, refused in one
+    line naming it: a link with two parent joints, or joints that lead back to a link above them (the parser ends the
+    process: a segmentation fault; a loop is closed otherwise in a URDF of another tool, by a robot.yaml's closing
+    frames or a Gazebo plugin); an ``<origin>`` or ``<axis>`` without three finite numbers; a joint's ``<limit>``
+    whose lower bound is above its upper one (read as no limit before)."""
     try:
         root = ElementTree.fromstring(tolerant_xml(Path(urdf).read_bytes()))
     except (OSError, ElementTree.ParseError, ValueError):
         return  # (the reader says why)
+    for element in [*root.findall("joint"), *root.findall("link")]:
+        for part in (part for part in element.iter() if part.tag in ("origin", "axis")):
+            for attribute in (name for name in ("xyz", "rpy") if part.get(name) is not None):
+                if not _three_numbers(part.get(attribute)):
+                    raise ImportError_(f"{urdf}: <{element.tag} name='{element.get('name')}'>: <{part.tag} "
+                                       f"{attribute}='{part.get(attribute)}'>: expected three finite numbers.")
+        limit = element.find("limit") if element.tag == "joint" else None
+        bounds = [_number(limit.get(name)) for name in ("lower", "upper")] if limit is not None else []
+        if len(bounds) == 2 and None not in bounds and bounds[0] > bounds[1]:
+            raise ImportError_(f"{urdf}: <joint name='{element.get('name')}'>: <limit lower='{limit.get('lower')}' "
+                               f"upper='{limit.get('upper')}'>: the lower bound is above the upper one.")
     parents: dict[str, tuple[str, str]] = {}  # each link's parent link and joint
     for joint in root.findall("joint"):
         parent, child = joint.find("parent"), joint.find("child")
@@ -133,6 +147,18 @@ def _refuse_cycles(urdf: Path) -> None:
             joints = " -> ".join(parents[name][1] for name in reversed(seen))
             raise ImportError_(f"{urdf}: joints {joints} lead from <link name='{start}'> back to itself: a URDF's "
                                "joints form a tree.")
+
+
+def _number(text: str | None) -> float | None:
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
+
+
+def _three_numbers(text: str) -> bool:
+    values = [_number(word) for word in text.split()]
+    return len(values) == 3 and all(value is not None and math.isfinite(value) for value in values)
 
 
 def _refuse_xacro(urdf: Path) -> None:
