@@ -392,7 +392,7 @@ def test_a_urdf_that_pinocchio_cannot_read_is_refused_in_one_line_naming_the_ele
     axis = text.index("<axis", text.index('name="Chain1_2"'))
     path.write_text(text[:axis] + '<axis xyz="1 0zzz 0"/>' + text[text.index("/>", axis) + 2:])
     one_line_error(screwkit("analyze", path, "--output", "Chain1_dummy"),
-                   f"{path}: <joint name='Chain1_2'>: <axis xyz='1 0zzz 0'>: expected three finite numbers.")
+                   f"{path}: <joint name='Chain1_2'>: <axis xyz='1 0zzz 0'>: expected three finite numbers, each")
 
 
 def test_a_negative_effort_or_velocity_reads_as_no_limit(tmp_path):

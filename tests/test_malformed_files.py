@@ -83,9 +83,9 @@ def test_what_mujoco_refuses_in_a_graph_s_file_is_refused_not_read_otherwise(tmp
     ("a limit upside down", ('<limit effort="1"', '<limit lower="1" upper="-1" effort="1"'),
      "<joint name='mot1'>: <limit lower='1' upper='-1'>: the lower bound is above the upper one."),
     ("an origin of two numbers", ('<origin xyz="-0.1 0.0 0.0"', '<origin xyz="-0.1 0.0"'),
-     "<joint name='mot1'>: <origin xyz='-0.1 0.0'>: expected three finite numbers."),
+     "<joint name='mot1'>: <origin xyz='-0.1 0.0'>: expected three finite numbers, each"),
     ("an axis not a number", ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 nan"/>'),
-     "<axis xyz='0 0 nan'>: expected three finite numbers.")])
+     "<axis xyz='0 0 nan'>: expected three finite numbers, each")])
 def test_a_urdf_element_urdfdom_would_take_otherwise_or_not_name_is_named(tmp_path, case, edit, needle):
     """The Gepetto five-bar with its first motor's limit upside down (read as no limit before: every pose reachable),
     its origin of two numbers or an axis of NaN (urdfdom's "Parser found 2 elements but 3 expected", naming no
@@ -95,3 +95,32 @@ def test_a_urdf_element_urdfdom_would_take_otherwise_or_not_name_is_named(tmp_pa
     (tmp_path / "robot.urdf").write_text(urdf.replace(*edit, 1))
     (tmp_path / "robot.yaml").write_text(spec)
     one_line_error(screwkit("analyze", tmp_path / "robot.urdf"), f"{tmp_path / 'robot.urdf'}: ", needle)
+
+
+def test_a_joint_mujoco_reads_along_no_axis_and_a_closure_of_a_body_to_itself_are_named(tmp_path):
+    """The five-bar with a hinge's axis ``1e308 0 0``: MuJoCo reads its axis as zero (the length overflows once
+    squared), and screwkit refused it as "the zero vector" without saying why; with a weld of a body to itself, which
+    MuJoCo refuses ("repeated in equality constraint"), screwkit read the file. Each is one line naming the element."""
+    path = tmp_path / "five_bar.xml"
+    text = five_bar_mjcf().replace('<joint name="b_2" type="hinge" axis="0.0 0.0 1.0"/>',
+                                   '<joint name="b_2" type="hinge" axis="1e308 0 0"/>', 1)
+    assert 'axis="1e308 0 0"' in text
+    path.write_text(text)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert not model.jnt_axis[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "b_2")].any()
+    one_line_error(screwkit("analyze", path), f"{path}: <joint name='b_2'>: the axis is the zero vector "
+                                              "(axis='1e308 0 0'; its length overflows once squared")
+    path.write_text(five_bar_mjcf().replace("</equality>", '<weld name="self" body1="distal_2" body2="distal_2"/>'
+                                            "</equality>"))
+    with pytest.raises(ValueError, match="is repeated in equality constraint"):
+        mujoco.MjModel.from_xml_path(str(path))
+    one_line_error(screwkit("analyze", path), f"{path}: <weld name='self'>: body1 and body2 are both 'distal_2'")
+
+
+def test_lock_naming_a_fixed_joint_says_so(tmp_path):
+    """``--lock`` naming a fixed joint of the file said "no joint of that name"; it says it is a fixed joint."""
+    delta = Path(__file__).resolve().parent / "data" / "gallery" / "published" / "ros2_closed_loop_ws"
+    delta = delta / "3dof_delta.urdf"
+    assert re.search(r'<joint\s+name="Chain1_tip_joint"\s+type="fixed"', delta.read_text())
+    one_line_error(screwkit("analyze", delta, "--lock", "Chain1_tip_joint"),
+                   "--lock Chain1_tip_joint: a fixed joint already, nothing to hold; joints are ")

@@ -47,8 +47,10 @@ def lock_joints(tree: ClosedTree, names) -> ClosedTree:
     asked, names = names, tuple(dict.fromkeys(hinge for name in names for hinge in _hinges_of(tree, name)))
     for name in names:
         if not model.existJointName(name) or model.getJointId(name) == 0:
-            raise ImportError_(f"{tree.source}: --lock {name}: no joint of that name; joints are "
-                               + ", ".join(str(n) for n in list(model.names)[1:]) + ".")
+            welded = model.existFrame(name, pin.FrameType.FIXED_JOINT)  # (a body may have its joint's name)
+            raise ImportError_(f"{tree.source}: --lock {name}: "
+                               + ("a fixed joint already, nothing to hold" if welded else "no joint of that name")
+                               + "; joints are " + ", ".join(str(n) for n in list(model.names)[1:]) + ".")
     locked = [model.getJointId(name) for name in names]
     held, moved = _values_closing_the_loops(tree, locked)
     data = model.createData()

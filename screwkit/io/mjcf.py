@@ -98,6 +98,11 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
             if element.get("active", "true") == "false":
                 notes.append(f"closure {element.get('name')!r} is inactive in the file: left out")
                 continue
+            for first, second in (("body1", "body2"), ("site1", "site2")):
+                if element.get(first) is not None and element.get(first) == element.get(second):
+                    raise ImportError_(f"{source}: <{element.tag} name='{element.get('name')}'>: {first} and {second} "
+                                       f"are both {element.get(first)!r}: a closure of a frame to itself (MuJoCo "
+                                       "refuses it).")
             try:
                 joint_a, place_a, joint_b, place_b = closure_placements(element, model, data, frame_of)
             except MjcfError as error:

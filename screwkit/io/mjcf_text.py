@@ -358,15 +358,15 @@ def _check_joints(root: ElementTree.Element, path: Path, autolimits: bool) -> li
     Returns the joints whose range was dropped."""
     dropped = []
     for joint, attributes in _joints(root):
-        name = joint.get("name")
-        tag = f"<joint name='{name}'>" if name else "<joint>"
+        tag = f"<joint name='{joint.get('name')}'>" if (name := joint.get("name")) else "<joint>"
         kind = attributes.get("type", "hinge")
         if kind not in ("hinge", "slide", "ball"):
             continue
         axis = attributes.get("axis", "0 0 1")
         length = math.hypot(*(float(word) for word in axis.split()))
-        if kind != "ball" and length <= MIN_AXIS:
-            small = "" if length == 0.0 else f"; MuJoCo refuses lengths up to {MIN_AXIS:g}"
+        if kind != "ball" and (length <= MIN_AXIS or length * length == math.inf):  # (squared: MuJoCo reads 0)
+            small = "" if length == 0.0 else f"; MuJoCo refuses lengths up to {MIN_AXIS:g}" if length <= MIN_AXIS \
+                else "; its length overflows once squared, and MuJoCo reads it as zero"
             raise MjcfError(f"{path}: {tag}: the axis is the zero vector (axis='{axis}'{small}).")
         limited, text = attributes.get("limited", "auto"), attributes.get("range", "0 0")
         low, high = (float(word) for word in text.split())

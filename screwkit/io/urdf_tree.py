@@ -10,7 +10,6 @@ refused in one line with urdfdom's first complaint, which names the element.
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import sys
@@ -20,6 +19,7 @@ from xml.etree import ElementTree
 
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import ImportError_
+from screwkit.model.urdf_element_reader import LARGEST_COORDINATE
 
 __all__ = ["urdf_model"]
 
@@ -121,7 +121,8 @@ def _refuse_malformed(urdf: Path) -> None:
             for attribute in (name for name in ("xyz", "rpy") if part.get(name) is not None):
                 if not _three_numbers(part.get(attribute)):
                     raise ImportError_(f"{urdf}: <{element.tag} name='{element.get('name')}'>: <{part.tag} "
-                                       f"{attribute}='{part.get(attribute)}'>: expected three finite numbers.")
+                                       f"{attribute}='{part.get(attribute)}'>: expected three finite numbers, each "
+                                       f"at most {LARGEST_COORDINATE:g} in magnitude.")
         limit = element.find("limit") if element.tag == "joint" else None
         bounds = [_number(limit.get(name)) for name in ("lower", "upper")] if limit is not None else []
         if len(bounds) == 2 and None not in bounds and bounds[0] > bounds[1]:
@@ -157,8 +158,10 @@ def _number(text: str | None) -> float | None:
 
 
 def _three_numbers(text: str) -> bool:
+    """Three finite numbers, each at most :data:`~screwkit.model.urdf_element_reader.LARGEST_COORDINATE` in
+    magnitude (as in screwkit's own URDF: ``1e308`` overflows once squared)."""
     values = [_number(word) for word in text.split()]
-    return len(values) == 3 and all(value is not None and math.isfinite(value) for value in values)
+    return len(values) == 3 and all(value is not None and abs(value) <= LARGEST_COORDINATE for value in values)
 
 
 def _refuse_xacro(urdf: Path) -> None:
