@@ -7,10 +7,13 @@ import re
 from pathlib import Path
 
 import mujoco
+import numpy as np
 import pytest
 from test_io import five_bar_gepetto, five_bar_mjcf
 
 from helpers import one_line_error, screwkit
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
 
 
 @pytest.mark.parametrize(("key", "value"), [("closed_loop", "5"), ("type", "6")])
@@ -64,7 +67,7 @@ RODS = Path(__file__).resolve().parents[1] / "robots" / "delta_rods_4.xml"
     ("a motor on no joint", '<motor name="motor_1" joint="motor_1"/>', '<motor name="motor_1" joint="no_such_joint"/>',
      "actuated joint 'no_such_joint' is not a joint of the tree."),
     ("a connect of bodies without its anchor", ' anchor="-0.481810888007 0.0 -0.638637822399"/>', "/>",
-     "<connect name='rod_1b_end'>: expected 3 numbers in 'anchor', got None.")])
+     "<connect name='rod_1b_end'>: expected 3 numbers in 'anchor', got none.")])
 def test_what_mujoco_refuses_in_a_graph_s_file_is_refused_not_read_otherwise(tmp_path, case, written, changed, needle):
     """The rod-level Delta with its first motor on a joint the file does not have, or its first rod's ``<connect>``
     without its ``anchor``: MuJoCo refuses either file. screwkit read the first with that motor left out (three
@@ -124,3 +127,23 @@ def test_lock_naming_a_fixed_joint_says_so(tmp_path):
     assert re.search(r'<joint\s+name="Chain1_tip_joint"\s+type="fixed"', delta.read_text())
     one_line_error(screwkit("analyze", delta, "--lock", "Chain1_tip_joint"),
                    "--lock Chain1_tip_joint: a fixed joint already, nothing to hold; joints are ")
+
+
+def test_what_urdfdom_does_not_read_is_not_refused(tmp_path):
+    """The checks read what urdfdom reads: a fixed joint's ``<limit>`` upside down (urdfdom reads the bounds of
+    revolute and prismatic joints only) and a link's ``<inertial>`` origin of 2e9 m (screwkit reads no inertia) leave
+    the Gepetto five-bar as it is: the same indices at its home."""
+    urdf, spec = five_bar_gepetto()
+    edited = urdf.replace('<axis xyz="0 0 0"/><joint_properties', '<axis xyz="0 0 0"/><limit lower="1" upper="-1" '
+                          'effort="1" velocity="1"/><joint_properties', 1)
+    edited = edited.replace("<inertial><mass", '<inertial><origin xyz="0 0 2e9"/><mass', 1)
+    assert edited.count("<limit lower=") == 1 and "2e9" in edited
+    results = []
+    for name, text in (("as_built", urdf), ("edited", edited)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "robot.urdf").write_text(text)
+        (tmp_path / name / "robot.yaml").write_text(spec)
+        mechanism = load(tmp_path / name / "robot.urdf")
+        results.append(indices_at_pose(mechanism, mechanism.home_pose))
+    np.testing.assert_array_equal(results[1].iti_actuators, results[0].iti_actuators)
+    assert results[1].lmti == results[0].lmti

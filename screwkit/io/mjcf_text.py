@@ -505,7 +505,7 @@ def _numbers(element: ElementTree.Element, attribute: str, count: int, default) 
         values = []
     if len(values) != count:
         raise MjcfError(f"<{element.tag} name='{element.get('name')}'>: expected {count} numbers in '{attribute}', "
-                        f"got {element.get(attribute)!r}.")
+                        "got " + (repr(element.get(attribute)) if attribute in element.attrib else "none") + ".")
     return values
 
 

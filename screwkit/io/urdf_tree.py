@@ -10,6 +10,7 @@ refused in one line with urdfdom's first complaint, which names the element.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import sys
@@ -110,20 +111,23 @@ def _refuse_malformed(urdf: Path) -> None:
     """What urdfdom's parser, which Pinocchio calls, crashes on or says without naming the element, refused in one
     line naming it: a link with two parent joints, or joints that lead back to a link above them (the parser ends the
     process: a segmentation fault; a loop is closed otherwise in a URDF of another tool, by a robot.yaml's closing
-    frames or a Gazebo plugin); an ``<origin>`` or ``<axis>`` without three finite numbers; a joint's ``<limit>``
-    whose lower bound is above its upper one (read as no limit before)."""
+    frames or a Gazebo plugin); an ``<origin>`` or ``<axis>`` without three finite numbers (a joint's, of magnitude
+    at most ``LARGEST_COORDINATE``); a revolute or prismatic joint's ``<limit>`` whose lower bound is above its upper
+    one (read as no limit before; urdfdom reads no bounds of other joints)."""
     try:
         root = ElementTree.fromstring(tolerant_xml(Path(urdf).read_bytes()))
     except (OSError, ElementTree.ParseError, ValueError):
         return  # (the reader says why)
     for element in [*root.findall("joint"), *root.findall("link")]:
+        largest = LARGEST_COORDINATE if element.tag == "joint" else math.inf  # (a link's visuals are not read)
         for part in (part for part in element.iter() if part.tag in ("origin", "axis")):
             for attribute in (name for name in ("xyz", "rpy") if part.get(name) is not None):
-                if not _three_numbers(part.get(attribute)):
+                if not _three_numbers(part.get(attribute), largest):
                     raise ImportError_(f"{urdf}: <{element.tag} name='{element.get('name')}'>: <{part.tag} "
-                                       f"{attribute}='{part.get(attribute)}'>: expected three finite numbers, each "
-                                       f"at most {LARGEST_COORDINATE:g} in magnitude.")
-        limit = element.find("limit") if element.tag == "joint" else None
+                                       f"{attribute}='{part.get(attribute)}'>: expected three finite numbers"
+                                       + (f", each at most {largest:g} in magnitude." if largest < math.inf else "."))
+        limited = element.tag == "joint" and element.get("type") in ("revolute", "prismatic")  # (others: not read)
+        limit = element.find("limit") if limited else None
         bounds = [_number(limit.get(name)) for name in ("lower", "upper")] if limit is not None else []
         if len(bounds) == 2 and None not in bounds and bounds[0] > bounds[1]:
             raise ImportError_(f"{urdf}: <joint name='{element.get('name')}'>: <limit lower='{limit.get('lower')}' "
@@ -157,11 +161,12 @@ def _number(text: str | None) -> float | None:
         return None
 
 
-def _three_numbers(text: str) -> bool:
-    """Three finite numbers, each at most :data:`~screwkit.model.urdf_element_reader.LARGEST_COORDINATE` in
-    magnitude (as in screwkit's own URDF: ``1e308`` overflows once squared)."""
+def _three_numbers(text: str, largest: float) -> bool:
+    """Three finite numbers, each at most ``largest`` in magnitude (a joint's, as in screwkit's own URDF:
+    :data:`~screwkit.model.urdf_element_reader.LARGEST_COORDINATE`; ``1e308`` overflows once squared)."""
     values = [_number(word) for word in text.split()]
-    return len(values) == 3 and all(value is not None and abs(value) <= LARGEST_COORDINATE for value in values)
+    return len(values) == 3 and all(value is not None and math.isfinite(value) and abs(value) <= largest
+                                    for value in values)
 
 
 def _refuse_xacro(urdf: Path) -> None:
