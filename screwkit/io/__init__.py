@@ -105,6 +105,8 @@ def read_closed_tree(path: Path, *, output: str | None = None, output_type: str 
     if tree.unactuated and not actuate:
         raise ImportError_(f"{tree.unactuated}; --actuate JOINT names the actuated joints (those that can be driven, "
                            f"revolute or prismatic: {drivable_joints(tree)}).")
+    for name in (name for name in tree.motors if not tree.model.existJointName(name)):  # (MuJoCo refuses the file)
+        raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is not a joint of the tree.")
     tree = actuate_joints(lock_joints(set_initial(tree, initial), lock), actuate)
     if not tree.motors:
         raise ImportError_(f"{tree.source}: nothing to actuate: the file names no actuated joint and no 1-DoF joint "

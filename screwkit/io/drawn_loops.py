@@ -100,13 +100,13 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
         return mechanism
     turns = functools.cache(lambda: WrittenTurns() if converted else written_turns(mechanism.description.source,
                                                                                    mechanism.description.text))
-    limits = functools.cache(lambda: [FILE_ROUNDING + min(turns().around(chain.loop_name), WIDENING_LIMIT)
-                                      for chain in mechanism.chains])  # (each loop's, read once it is needed)
+    roundings = functools.cache(lambda: [min(turns().around(chain.loop_name), WIDENING_LIMIT)
+                                         for chain in mechanism.chains])  # (each loop's, read once it is needed)
     for index in (index for index, closed in enumerate(closes) if not closed):  # (read where the loops close)
         values[index], axes[index] = _closing(mechanism, index, values[index], axes[index], scale,
-                                              None if converted else limits()[index])
+                                              None if converted else FILE_ROUNDING + roundings()[index])
     geometries, turn, most = ([chain.geometry for chain in mechanism.chains], 0.0, "") \
-        if converted else _parallel(mechanism, values, axes, turns)
+        if converted else _parallel(mechanism, values, axes, turns, roundings)
     notes = []
     if turn:
         notes.append(f"joint axes that agree to the file's rounding written parallel (the largest turn {turn:.2g} "
@@ -116,7 +116,7 @@ def drawn_loops(mechanism: Mechanism) -> Mechanism:
         if closes[index] and geometries[index] is chain.geometry:  # (as written, closed: nothing to do)
             continue
         geometry, gap = _closed(mechanism, index, geometries[index], values[index], scale,
-                                None if converted else limits()[index])
+                                None if converted else FILE_ROUNDING + roundings()[index])
         geometries[index] = geometry
         if gap is not None:
             moved.append((chain.loop_name, *gap))
@@ -158,13 +158,13 @@ def _closing(mechanism: Mechanism, index: int, values: NDArray, axes: NDArray, s
     where they do not close it."""
     geometry = mechanism.chains[index].geometry
     solved, converged = _solved(mechanism, index, geometry, values, scale)
+    frames = chain_forward_kinematics(geometry, solved)
     if not converged and limit is not None:
         target_rotation, target_translation = mechanism.loop_targets(index, mechanism.home_rotation,
                                                                      mechanism.home_translation)
-        radians, lengths = _apart(chain_forward_kinematics(geometry, solved), target_rotation, target_translation,
-                                  scale)
-        converged = max(radians / limit, lengths / FILE_ROUNDING) * FILE_ROUNDING <= NEAR_ROUNDING
-    return (solved, chain_forward_kinematics(geometry, solved).axes[: len(axes)]) if converged else (values, axes)
+        converged = _beyond(*_apart(frames, target_rotation, target_translation, scale), limit) * FILE_ROUNDING \
+            <= NEAR_ROUNDING
+    return (solved, frames.axes[: len(axes)]) if converged else (values, axes)
 
 
 def _solved(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: NDArray, scale: float
@@ -191,10 +191,11 @@ def _turned_frames(geometry: ChainGeometry, values: NDArray) -> tuple[list[NDArr
     return after, rotation @ geometry.leg_loop_rotation
 
 
-def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeometry], float, str]:
+def _parallel(mechanism: Mechanism, values, axes, turns, roundings) -> tuple[list[ChainGeometry], float, str]:
     """Every chain's geometry with the axes :func:`parallel_axes` groups made parallel (step 1 of the module
     docstring), the largest turn (0: none) and the joint turned most; ``turns()``, the file's
-    :class:`~screwkit.io.written_angles.WrittenTurns`.
+    :class:`~screwkit.io.written_angles.WrittenTurns`, ``roundings()`` each loop's rounding (at most
+    ``WIDENING_LIMIT``).
 
     In passes. First the axes parallel whatever the configuration, each chain's (:func:`_structural`), then across
     chains those fixed in the base (:func:`_fixed_in_base`) or in the platform (:func:`_fixed_in_platform`): linked
@@ -221,8 +222,8 @@ def _parallel(mechanism: Mechanism, values, axes, turns) -> tuple[list[ChainGeom
     chain_rows = [np.array([k for k, (owner, _) in enumerate(owners) if owner == index], dtype=int)
                   for index in range(len(mechanism.chains))]
     loose = np.zeros(len(owners))  # (a loop joint's axis: its loop's rounding)
-    for chain, rows in zip(mechanism.chains, chain_rows):
-        loose[rows[chain.geometry.n_tree_joints:]] = min(turns().around(chain.loop_name), WIDENING_LIMIT)
+    for chain, rows, rounding in zip(mechanism.chains, chain_rows, roundings()):
+        loose[rows[chain.geometry.n_tree_joints:]] = rounding
     widened = np.minimum(turns().allowances(names) + loose[:, None] + loose[None], _MOST)
     linked = np.zeros(crosses.shape, dtype=bool)  # (the pairs parallel whatever the configuration)
     to_platform = np.full(len(owners), np.nan)  # (the rounding between an axis fixed in the platform and it)
@@ -293,22 +294,26 @@ def _structural(crosses: NDArray, slides, widened: NDArray) -> NDArray[np.bool_]
 
 def _fixed_in_base(chain, crosses: NDArray, slides, widened: NDArray) -> list[int]:
     """The tree joints of ``chain`` whose axis keeps its direction in the base whatever the joint values: every hinge
-    before it parallel to it within its allowance (as :func:`_fixed_in_platform`). Two such axes of two chains (two
-    legs' motors, each with its elbow's first hinge) are parallel whatever the configuration, to the rounding of
-    the angles on their ways from the base."""
-    return [dof for dof in range(chain.geometry.n_tree_joints) if not slides[dof] and
-            all(slides[k] or crosses[k, dof] <= widened[k, dof] for k in range(dof))]
+    before it parallel to it within its allowance (:func:`_kept`). Two such axes of two chains (two legs' motors,
+    each with its elbow's first hinge) are parallel whatever the configuration, to the rounding of the angles on
+    their ways from the base."""
+    return _kept(chain.geometry.n_tree_joints, crosses, slides, widened, before=True)
 
 
 def _fixed_in_platform(chain, crosses: NDArray, slides, widened: NDArray) -> list[int]:
     """The tree joints of ``chain`` whose axis keeps its direction in the platform whatever the joint values: its loop
-    fixed (a weld onto the platform), and every hinge after it parallel to it within its allowance (``crosses`` of
-    every two of its axes, ``slides`` the prismatic ones, ``widened`` their allowances)."""
-    if chain.geometry.loop_type != "fixed":
-        return []
-    count = chain.geometry.n_tree_joints
+    fixed (a weld onto the platform), and every hinge after it parallel to it within its allowance (:func:`_kept`)."""
+    return [] if chain.geometry.loop_type != "fixed" else _kept(chain.geometry.n_tree_joints, crosses, slides,
+                                                                widened, before=False)
+
+
+def _kept(count: int, crosses: NDArray, slides, widened: NDArray, before: bool) -> list[int]:
+    """The hinges among a chain's ``count`` tree joints that every hinge before them (else after them) is parallel to
+    within its allowance (``crosses`` of every two of its axes, ``slides`` the prismatic ones, ``widened`` their
+    allowances): their directions do not depend on those joints' values."""
     return [dof for dof in range(count) if not slides[dof] and
-            all(slides[k] or crosses[k, dof] <= widened[k, dof] for k in range(dof + 1, count))]
+            all(slides[k] or crosses[k, dof] <= widened[k, dof] for k in (range(dof) if before else
+                                                                         range(dof + 1, count)))]
 
 
 def _first_most(values) -> int:
@@ -376,7 +381,7 @@ def _closed(mechanism: Mechanism, index: int, geometry: ChainGeometry, values: N
     end = chain_forward_kinematics(geometry, values)
     radians, lengths = _apart(end, target_rotation, target_translation, scale)
     limit = FILE_ROUNDING if limit is None else limit
-    beyond = max(radians / limit, lengths / FILE_ROUNDING)  # (in units of what is read as drawn)
+    beyond = _beyond(radians, lengths, limit)
     if converged or beyond * FILE_ROUNDING > NEAR_ROUNDING:
         return geometry, None
     if beyond > 1.0:
@@ -409,6 +414,12 @@ def _tilts_the_plane(mechanism: Mechanism, geometry: ChainGeometry, change: NDAr
         return False
     normal = geometry.platform_loop_rotation.T @ np.array([0.0, 0.0, 1.0])  # (the plane's normal: the base's z)
     return float(np.linalg.norm(np.cross(change, normal))) > UNSEEN
+
+
+def _beyond(radians: float, lengths: float, limit: float) -> float:
+    """How far a loop is left open, in units of what is read as drawn: ``limit`` in rad (:func:`_closed`),
+    ``FILE_ROUNDING`` in lengths over the mechanism's size."""
+    return max(radians / limit, lengths / FILE_ROUNDING)
 
 
 def _apart(frames, rotation: NDArray, translation: NDArray, scale: float) -> tuple[float, float]:

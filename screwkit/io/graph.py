@@ -383,9 +383,7 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     """The legs of a closed tree whose platform body is joint ``platform`` (tools and idle branches said in
     ``report``)."""
     model = tree.model
-    for name in (name for name in tree.motors if not model.existJointName(name)):  # (MuJoCo refuses such a file)
-        raise ImportError_(f"{tree.source}: {tree.motor_label(name)} is not a joint of the tree.")
-    motors = {model.getJointId(name): name for name in tree.motors}
+    motors = {model.getJointId(name): name for name in tree.motors}  # (each a joint: read_closed_tree)
     body_names = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
     legs, placed = [], set()
     for group in _groups(model, tree.closures, platform):

@@ -94,9 +94,7 @@ class WrittenTurns:
         it onto the platform's frame only to this, and the directions of its axes, which the closure sets, are known
         only to this."""
         ends, own = self.loops.get(loop, ((None, None), 0.0))
-        one, other = (self.paths.get(end, {}) for end in ends)
-        return sum(off for frame, off in one.items() if frame not in other) + \
-            sum(off for frame, off in other.items() if frame not in one) + own
+        return _apart(*(self.paths.get(end, {}) for end in ends)) + own
 
     def allowance(self, first: str | None, second: str | None) -> float:
         """How far apart (rad, the norm of their cross product) the axes of joints ``first`` and ``second`` may be
@@ -104,10 +102,7 @@ class WrittenTurns:
         (None: an axis that is no joint's)."""
         if first not in self.paths or second not in self.paths:
             return FILE_ROUNDING
-        one, other = self.paths[first], self.paths[second]
-        apart = sum(off for frame, off in one.items() if frame not in other) + \
-            sum(off for frame, off in other.items() if frame not in one)
-        return FILE_ROUNDING + min(apart, WIDENING_LIMIT)
+        return FILE_ROUNDING + min(_apart(self.paths[first], self.paths[second]), WIDENING_LIMIT)
 
     def furthest_beyond(self, axes: NDArray, names) -> tuple[int, int, float, float] | None:
         """Of the directions ``axes`` (n, 3) of joints ``names``, the two furthest out of parallel beyond their
@@ -124,6 +119,13 @@ class WrittenTurns:
         """The allowances (n, n) of every two of the axes of joints ``names`` (None: an axis that is no joint's)."""
         names = list(names)
         return np.array([[self.allowance(a, b) for b in names] for a in names]).reshape(len(names), len(names))
+
+
+def _apart(one: dict[int, float], other: dict[int, float]) -> float:
+    """The rounding of the rotations on one of two paths from the root and not the other (``{frame: rounding}``):
+    those below the frame they share, which turn the two ends apart."""
+    return sum(off for frame, off in one.items() if frame not in other) + \
+        sum(off for frame, off in other.items() if frame not in one)
 
 
 def written_turns(source: str, text: str | None = None) -> WrittenTurns:
