@@ -762,3 +762,21 @@ def test_an_underactuated_five_bar_s_refusal_names_its_passive_joints_to_hold(tm
                           "--lock JOINT", "passive joints:")
     passive = line.split("passive joints:")[1]
     assert "j1_right" in passive and "j1_left" not in passive, line
+
+
+@pytest.mark.parametrize("left", ['jointinparent="j1_left"', 'joint="j2_left" jointinparent="j1_left"'])
+def test_an_actuator_written_jointinparent_drives_the_joint_mujoco_drives(tmp_path, left):
+    """``jointinparent`` (the gear of a ball or free joint in its parent's frame; a hinge's the same) drives the
+    joint MuJoCo drives, also beside a ``joint`` it overrides: the motors MuJoCo's model names and the indices of the
+    file written ``joint``. Before, such an actuator was read as driving no joint and the file refused."""
+    source = Path(__file__).parent / "data" / "gallery" / "published" / "lab_robots_iitk" / "5bar.xml"
+    text = source.read_text().replace('name="motor_pos_left" joint="j1_left"', f'name="motor_pos_left" {left}')
+    path = tmp_path / "5bar.xml"
+    path.write_text(text)
+    mj = mujoco.MjModel.from_xml_string(re.sub(r'material="[^"]*"', "", re.sub(r"<asset>.*?</asset>", "", text,
+                                                                                 flags=re.S)))
+    driven = [mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, int(k)) for k in mj.actuator_trnid[:, 0]]
+    got, want = load(path, output="pen"), load(source, output="pen")
+    assert [name.split(":")[0] for name in got.actuator_names] == driven == ["j1_left", "j1_right"]
+    a, b = indices_at_pose(got, got.home_pose), indices_at_pose(want, want.home_pose)
+    np.testing.assert_allclose([a.iti, a.lmti, *a.iti_actuators], [b.iti, b.lmti, *b.iti_actuators], atol=1e-12)

@@ -8,8 +8,8 @@ tendon or flex coupling (``<equality><joint>``...: screwkit does not model coupl
 (a ball joint) and every ``<weld>`` a ``6d`` one, their frames placed as MuJoCo places them
 (:func:`~screwkit.io.mjcf_text.closure_placements`: a weld's ``relpose``, a connect's ``anchor``, or sites).
 The joints driven by ``<actuator>`` elements (``motor``, ``position``, ``velocity``, ``general``..., by their
-``joint`` attribute) are the actuated joints. A free body's joint is placed at the world's origin, its
-coordinates being its pose in the world (MuJoCo's reading; Pinocchio 4.1 offsets a turned free body).
+``joint`` or ``jointinparent`` attribute) are the actuated joints. A free body's joint is placed at the world's
+origin, its coordinates being its pose in the world (MuJoCo's reading; Pinocchio 4.1 offsets a turned free body).
 Reference joint values are ``qpos0`` (the joints' ``ref``), or the keyframe named ``home`` when there is one.
 """
 
@@ -39,7 +39,7 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
     motors, unactuated = [], ""
     for actuators in root.findall("actuator"):
         for element in actuators:
-            joint = element.get("joint")
+            joint = _driven_joint(element)
             if joint is None:
                 unactuated = unactuated or (f"{source}: <actuator><{element.tag} name={element.get('name')!r}> drives "
                                             "no joint (tendon and site transmissions are not supported)")
@@ -112,6 +112,15 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
     q = references.get("home", qpos0)
     return ClosedTree(source, model, closures, motors, np.asarray(q, dtype=float), output, output_type, "MJCF",
                       notes, unactuated=unactuated, couplings=tuple(couplings))
+
+
+def _driven_joint(element) -> str | None:
+    """The joint an ``<actuator>`` element drives, or None when its transmission is no joint's. MuJoCo takes the
+    last of ``joint``, ``jointinparent``, ``tendon``, ``cranksite``, ``site`` and ``body`` written (in that order);
+    ``jointinparent`` differs from ``joint`` only in the frame of a ball's or free joint's gear."""
+    if any(element.get(other) is not None for other in ("tendon", "cranksite", "site", "body")):
+        return None
+    return element.get("jointinparent", element.get("joint"))
 
 
 def sites_placed(model, root) -> None:
