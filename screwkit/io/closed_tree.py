@@ -468,10 +468,13 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
                               "file's numbers disagree by that much (redundant closures written rounded)")
             return q, scale
         found = closure_frames(tree, q)
-        if on_one_plane(tree, q, scale, found):  # anchors drawn at depths the rounding sets apart on their pins: again
+        if on_one_plane(tree, q, scale, found):  # anchors drawn at different depths on their pins: again
             return assemble(tree, held, nearest)
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
+        across = [closure.name for closure, first, second in found if gaps[closure.name] > FILE_ROUNDING * scale
+                  and not along_pins(model, q, first, second, loop_kinds(model, closure), scale)]
+        worst = max(across, key=gaps.get, default=worst)  # (one open across its pins kept the others from one plane)
         closure, first, second = next(item for item in found if item[0].name == worst)
         advice = along_pins(model, q, first, second, loop_kinds(model, closure), scale) or (
             "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "

@@ -1,12 +1,14 @@
 """A closure left open along its loop's pins: the two anchors of a closure drawn at different depths on parallel
-hinges (a CAD export's), which no joint values close (:func:`screwkit.io.closed_tree.assemble` says so).
+hinges, which no joint values close (:func:`screwkit.io.closed_tree.assemble` reads them on one plane).
 
-Where the depths differ by no more than a file's rounding can make them differ (:func:`depths_drawn_apart`: at most
-:data:`DEPTH_ROUNDING` of the mechanism's length scale), the anchors are read on one plane (:func:`on_one_plane`):
-a hinge is a line, and moving an anchor along the pins moves no hinge's line. Each hinge of a loop drawn with its
-numbers rounded to 6 decimals is up to half a micrometre off its plane, and a loop adds its hinges' offsets: 1.3e-6 m
-on a five-bar of 10 cm links, beyond the :data:`~screwkit.common.tolerances.FILE_ROUNDING` (1e-5 of the length
-scale) by which a closure may stay open in any direction and be read as drawn.
+A file's rounding sets such anchors apart (each hinge of a loop drawn with its numbers rounded to 6 decimals is up to
+half a micrometre off its plane, and a loop adds its hinges' offsets: 1.3e-6 m on a five-bar of 10 cm links, beyond
+the :data:`~screwkit.common.tolerances.FILE_ROUNDING` by which a closure may stay open in any direction), and so does
+a CAD export, which puts a pin's two mate frames on the two links it joins, millimetres apart along it (a wheel leg's
+connects). Either way the anchors are read on one plane (:func:`on_one_plane`): every joint of the loop turns about an
+axis along the gap, so no joint values change it, and moving an anchor along the pins moves no hinge's line: the
+loop moves as the pin the two frames mark. MuJoCo runs such a file with the gap held open (its ``connect`` pulls
+along the pin at every step). The report says how far the anchors were moved.
 """
 
 from __future__ import annotations
@@ -19,14 +21,11 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.tree_joints import joint_frames, joint_kind, path_to
 
-__all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "DEPTH_ROUNDING", "ONE_PLANE"]
+__all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "ONE_PLANE"]
 
-DEPTH_ROUNDING = 1e-4
-"""Relative to the mechanism's length scale: the largest gap along a loop's parallel pins read as the file's rounding
-(ten times :data:`~screwkit.common.tolerances.FILE_ROUNDING`: a loop of up to ten hinges, each drawn to it)."""
 CLOSED = 1e-10
 """Relative: a closure whose frames are at most this apart (the assembly's own tolerance) is left where it is."""
-ONE_PLANE = "closure frames drawn at depths on their pins that the file's rounding sets apart read on one plane"
+ONE_PLANE = "closure frames drawn at different depths on their loops' pins read on one plane"
 """How the note of :func:`on_one_plane` begins."""
 
 PARALLEL = 1e-3
@@ -41,12 +40,9 @@ def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, 
         return ""
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
     depth = float(np.linalg.norm(first[:3, 3] - second[:3, 3])) / scale
-    beyond = (f" ({depth:.2g} of the length scale apart, beyond the {DEPTH_ROUNDING:g} read as the file's rounding)"
-              if depth > DEPTH_ROUNDING else "")
     return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
-            f"different depths on one pin{beyond}, which no joint values close: moved along the pin onto one plane "
-            "(the closure's frame: an MJCF connect's anchor or site, a robot.yaml or SDFormat closing frame), the loop "
-            "closes")
+            f"different depths on one pin ({depth:.2g} of the length scale apart), which no joint values close, and "
+            "read on one plane the loop still did not close")
 
 
 def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float) -> NDArray | None:
@@ -70,9 +66,9 @@ def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, sc
 
 def depths_drawn_apart(model, q: NDArray, frames: list, loops: list[list], scale: float) -> list[NDArray] | None:
     """The world offsets along the pins that put each closure's second frame on its first's plane at q, where
-    every closure left open at q is open along its loop's pins only (:func:`along_pins`) by at most
-    :data:`DEPTH_ROUNDING` times ``scale`` (a zero offset for a closure that closes); else None. ``frames``: each
-    closure's two world frames at q; ``loops``: each closure's loop, as the ``kinds`` of :func:`along_pins`."""
+    every closure left open at q is open along its loop's pins only (:func:`pin_axis`; a zero offset for a closure
+    that closes); else None. ``frames``: each closure's two world frames at q; ``loops``: each closure's loop, as
+    the ``kinds`` of :func:`along_pins`; ``scale``: the mechanism's length scale."""
     offsets = []
     for (first, second), kinds in zip(frames, loops):
         gap = first[:3, 3] - second[:3, 3]
@@ -80,7 +76,7 @@ def depths_drawn_apart(model, q: NDArray, frames: list, loops: list[list], scale
             offsets.append(np.zeros(3))
             continue
         axis = pin_axis(model, q, first, second, kinds, scale)
-        if np.linalg.norm(gap) > DEPTH_ROUNDING * scale or axis is None:
+        if axis is None:
             return None
         offsets.append(axis * float(axis @ gap))  # (the joints close what lies across the pins)
     return offsets
@@ -95,9 +91,9 @@ def loop_kinds(model, closure) -> list[tuple]:
 
 def on_one_plane(tree, q: NDArray, scale: float, found: list) -> bool:
     """Whether the closures of ``tree`` (a :class:`~screwkit.io.closed_tree.ClosedTree`) left open at q were open
-    along their loops' pins only, by a file's rounding (:func:`depths_drawn_apart`): each one's second frame is then
-    moved onto its first's plane, in ``tree`` (once: a tree whose note says so is not moved again; its closures and
-    notes are new lists), and a note says by how much. ``found``: each closure with its two world frames at q
+    along their loops' pins only (:func:`depths_drawn_apart`): each one's second frame is then moved onto its first's
+    plane, in ``tree`` (once: a tree whose note says so is not moved again; its closures and notes are new lists),
+    and a note says by how much. ``found``: each closure with its two world frames at q
     (:func:`~screwkit.io.closed_tree.closure_frames`)."""
     if any(note.startswith(ONE_PLANE) for note in tree.notes):
         return False
@@ -113,7 +109,7 @@ def on_one_plane(tree, q: NDArray, scale: float, found: list) -> bool:
     most = int(np.argmax([np.linalg.norm(offset) for offset in offsets]))
     # new lists, not the old ones changed: a tree copied to be assembled from elsewhere shares them with its original
     tree.closures = closures
-    tree.notes = [*tree.notes, f"{ONE_PLANE} (closure {closures[most].name!r} the most, "
-                               f"{np.linalg.norm(offsets[most]):.2g} {tree.unit}; up to {DEPTH_ROUNDING:g} of the "
-                               "length scale)"]
+    depth = float(np.linalg.norm(offsets[most]))
+    tree.notes = [*tree.notes, f"{ONE_PLANE} (closure {closures[most].name!r} the most, {depth:.2g} {tree.unit}, "
+                               f"{depth / scale:.2g} of the length scale: no joint values close a gap along the pins)"]
     return True
