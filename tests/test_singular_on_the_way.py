@@ -97,12 +97,15 @@ def test_a_pose_past_the_change_point_names_the_chain_and_where(tmp_path, world,
     path.write_text(square_four_bar(scale, WORLDS[world]))
     mechanism = load(path, output="link_4", length_unit=unit)
     assert mechanism.task_coordinates == ("phi",)
-    for degrees in (200.0, 120.0, 91.0, 90.2, 300.0):  # (300: past 269.5 deg, where the chain does not close)
-        (passed,) = singular_on_the_way(mechanism, np.radians([degrees]))
-        assert passed[0] == "hinge_1"
-        assert np.degrees(passed[1][0]) == pytest.approx(90.0, abs=1e-3)
-    for degrees in (80.0, 89.0, 89.9, -60.0, 0.0):  # the way from 0 does not reach 90 deg
-        assert singular_on_the_way(mechanism, np.radians([degrees])) == []
+    (passed,) = singular_on_the_way(mechanism, np.radians([90.2]))  # analyze's one pose, its way sampled alone
+    assert passed[0] == "hinge_1"
+    assert np.degrees(passed[1][0]) == pytest.approx(90.0, abs=1e-3)
+    assert singular_on_the_way(mechanism, np.radians([89.9])) == []
+    beyond, before = [200.0, 120.0, 91.0, 90.2, 300.0], [80.0, 89.0, 89.9, -60.0, 0.0]  # (300: past 269.5 deg, where
+    ((name, past, where),) = singular_on_the_ways(mechanism, np.radians(beyond + before)[:, None])  # it does not close)
+    assert name == "hinge_1"
+    np.testing.assert_array_equal(past, [True] * 5 + [False] * 5)
+    np.testing.assert_allclose(np.degrees(where[:5, 0]), 90.0, atol=1e-3)
 
 
 def test_analyze_says_so_on_the_command_line_and_in_json(tmp_path):
