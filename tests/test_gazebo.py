@@ -25,21 +25,25 @@ EFFECTOR_RPY = (np.pi, 0.0, 0.3)
 
 
 def five_bar_gazebo(legs: int = 3, kind: str = "revolute", transmissions: bool = True, pose_rpy=(0.0, 0.0, 0.4),
-                    transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None):
+                    transform=(1.0, 0.0, (0.0, 0.0, 0.0)), order=None, motor=None, model_axis: str = ""):
     """The five-bar's tree and one Gazebo joint per further leg, its child the ``effector`` link (on distal_1 at the
     output point, turned upside down and about its normal): the pose is the joint frame in that link, turned by
     ``pose_rpy``, and the axis is written in the joint frame so that it is the plane's normal. Read in the parent
     link's frame instead (distal_i, whose origin is its elbow), the loops would not close where they do. Moved by
-    ``transform``, legs written in ``order``, motors named ``motor(i)``, as :func:`test_onshape.five_bar_links`."""
+    ``transform``, legs written in ``order``, motors named ``motor(i)``, as :func:`test_onshape.five_bar_links`.
+    ``model_axis``: the axis written as the normal in the model's frame instead, by ``<use_parent_model_frame>``
+    ("element") or ``expressed_in="__model__"`` ("attribute")."""
     motor = motor or (lambda i: f"mot{i + 1}")
     names = (lambda i: f"proximal_{i + 1}", motor, lambda i: f"distal_{i + 1}", lambda i: f"free{i + 1}")
     links = five_bar_links(legs, names, transform, order)
     urdf = onshape_urdf(links, [("effector", "distal_1", (transform[0] * DISTAL, 0.0, 0.0), EFFECTOR_RPY)])
     joint_in_distal = rotation_from_rpy(np.array(EFFECTOR_RPY)) @ rotation_from_rpy(np.array(pose_rpy))
     axis = joint_in_distal.T @ np.array([0.0, 0.0, 1.0])  # distal_1's z is the plane's normal
+    written = {"": f"<xyz>{text(axis)}</xyz>", "attribute": '<xyz expressed_in="__model__">0 0 1</xyz>',
+               "element": "<xyz>0 0 1</xyz><use_parent_model_frame>1</use_parent_model_frame>"}[model_axis]
     joints = "".join(
         f'<joint name="loop_{i + 1}" type="{kind}"><parent>distal_{i + 1}</parent><child>effector</child>'
-        f'<pose>0 0 0 {text(pose_rpy)}</pose><axis><xyz>{text(axis)}</xyz></axis></joint>'
+        f'<pose>0 0 0 {text(pose_rpy)}</pose><axis>{written}</axis></joint>'
         for i in range(1, legs))
     extra = f"<gazebo>{joints}</gazebo>"
     if transmissions:
@@ -112,8 +116,24 @@ def test_a_pose_or_axis_written_in_another_frame_is_refused_rather_than_misread(
     path.write_text(five_bar_gazebo().replace("<pose>", '<pose relative_to="distal_2">', 1))
     with pytest.raises(ImportError_, match=r"loop_2'>: a pose relative_to or an axis expressed_in another frame"):
         read_closed_tree(path)
-    path.write_text(five_bar_gazebo().replace("<xyz>", '<xyz expressed_in="__model__">', 1))
+    path.write_text(five_bar_gazebo().replace("<xyz>", '<xyz expressed_in="distal_2">', 1))
     with pytest.raises(ImportError_, match=r"loop_2'>: a pose relative_to or an axis expressed_in another frame"):
         read_closed_tree(path)
     path.write_text(five_bar_gazebo().replace("<pose>", '<pose relative_to="effector">', 1))
     read_closed_tree(path)  # the child link named explicitly: the default
+
+
+@pytest.mark.parametrize("written", ["element", "attribute"])
+@pytest.mark.parametrize("transform", MOVED)
+def test_an_axis_written_in_the_model_frame_is_read_there(tmp_path, transform, written):
+    """The plane's normal written as the model's z (``<use_parent_model_frame>``, SDFormat 1.5 and 1.6, or
+    ``expressed_in="__model__"``), each joint frame tilted off the plane: the textbook pressure angles, scaled and
+    turned in the world. The element was dropped without a word (the axis read in the tilted joint frame: the loops
+    rigid), the attribute refused; the report says where Gazebo's conversion to SDFormat 1.7 reads the element
+    otherwise."""
+    path = tmp_path / "robot.urdf"
+    path.write_text(five_bar_gazebo(transform=transform, pose_rpy=(0.3, -0.2, 0.4), model_axis=written))
+    assert_moved_textbook(load(path), transform, lambda name: int(name[-1]) - 1)
+    _, report = read_mechanism_file(path)
+    said = [note for note in report.notes if "as <use_parent_model_frame> asks" in note]
+    assert len(said) == (2 if written == "element" else 0), report.notes

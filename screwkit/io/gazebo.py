@@ -9,7 +9,8 @@ included) skips::
         <parent>distal_2</parent>
         <child>distal_1</child>
         <pose>0.3 0 0 0 0 0</pose>              <!-- in the child link's frame (SDFormat) -->
-        <axis><xyz>0 0 1</xyz></axis>           <!-- in the joint's frame -->
+        <axis><xyz>0 0 1</xyz></axis>           <!-- in the joint's frame (the model's with
+                                                     <use_parent_model_frame>1</use_parent_model_frame>) -->
       </joint>
     </gazebo>
 
@@ -39,7 +40,7 @@ from screwkit.io.closed_tree import (
     inverse,
 )
 from screwkit.io.onshape import transmitted_tree
-from screwkit.io.sdformat_text import controlled_joints, detachable_joints, parse_joint, plugin_note
+from screwkit.io.sdformat_text import MODEL_FRAME, controlled_joints, detachable_joints, parse_joint, plugin_note
 from screwkit.io.urdf_tree import urdf_model
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
@@ -85,7 +86,7 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
     pin.framesForwardKinematics(model, data, q)
     bodies = {frame.name: index for index, frame in enumerate(model.frames) if frame.type == pin.FrameType.BODY}
     scale = max(float(np.max(np.abs([np.asarray(frame.translation) for frame in data.oMf]))), 1e-3)
-    closures = []
+    closures, notes = [], []
     written = urdf.read_bytes()
     root = ElementTree.fromstring(tolerant_xml(written))  # (well-formed: Pinocchio has read it)
     found = _joints_of(root)
@@ -95,13 +96,13 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
         kind = element.get("type", "")
         if kind not in TYPES:
             raise ImportError_(f"{where}: type {kind!r} cannot close a loop here (expected one of {', '.join(TYPES)}).")
-        joint = parse_joint(element, where)
+        joint = parse_joint(element, where, (1, 6))  # (<use_parent_model_frame>, where written, read as 1.5-1.6 do)
         links = []
         for tag, link in (("parent", joint.parent), ("child", joint.child)):
             if link not in bodies:
                 raise ImportError_(f"{where}: <{tag}> names {link!r}, not a link of the tree.")
             links.append(bodies[link])
-        if joint.relative_to not in ("", joint.child) or joint.axes[0].expressed_in not in ("", name):
+        if joint.relative_to not in ("", joint.child) or joint.axes[0].expressed_in not in ("", name, MODEL_FRAME):
             raise ImportError_(f"{where}: a pose relative_to or an axis expressed_in another frame is not read: write "
                                "the pose in the child link's frame and the axis in the joint's (SDFormat's defaults).")
         in_child = joint.pose
@@ -110,8 +111,17 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
         parent_from_world = inverse(homogeneous(data.oMf[links[0]]))
         points = [in_child]
         if kind in HINGE_TYPES:  # a hinge: two points on its axis, made the hinge through them by the conversion
+            axis = joint.axes[0].xyz
+            if joint.axes[0].expressed_in == MODEL_FRAME:  # the model's frame: the root link's, the world's here
+                axis = (world_child @ in_child)[:3, :3].T @ axis
+                stated = (element.findtext("axis/use_parent_model_frame") or "").strip().lower() in ("1", "true")
+                if stated and 1.0 - abs(float(axis @ joint.axes[0].xyz)) > 1e-12:  # (another line in the 1.7 reading)
+                    notes.append(f"{written_as}: its axis read in the model's frame, as <use_parent_model_frame> asks "
+                                 "(SDFormat 1.5 and 1.6; Gazebo's URDF conversion to SDFormat 1.7, libsdformat 9 "
+                                 "and later, drops that element and reads the axis in the joint's frame: another "
+                                 "axis here)")
             second = in_child.copy()
-            second[:3, 3] = in_child[:3, 3] + scale * in_child[:3, :3] @ joint.axes[0].xyz
+            second[:3, 3] = in_child[:3, 3] + scale * in_child[:3, :3] @ axis
             points.append(second)
         for number, placement in enumerate(points):  # each side in its joint's frame, coinciding at q
             on_parent = homogeneous(parent.placement) @ parent_from_world @ world_child @ placement
@@ -126,5 +136,6 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
                             controlled_joints(root.findall("gazebo")))
     if plugins:
         tree.notes.append(plugin_note(plugins, "closures"))
+    tree.notes.extend(notes)
     return tree
 
