@@ -25,14 +25,15 @@ TRANSFORMS = {"m": None, "mm": (1000.0, np.eye(3), np.zeros(3)),
               "turned": (1.0, random_rotation(np.random.default_rng(8)), np.array([0.3, -1.2, 2.0]))}
 
 
-def _with_wrist(tmp_path, transform) -> str:
+def _with_wrist(tmp_path, transform, driven: bool = True) -> str:
     scale = 1.0 if transform is None else transform[0]
     text = delta_rods_mjcf(POSES[0], transform=transform)
     site = text.index("/>", text.index('<site name="centre"')) + 2
     wrist = (f'<body name="tool" pos="0 0 {-0.05 * scale!r}"><joint name="wrist" type="hinge" axis="0 0 1"/>'
              '<geom type="sphere" size="0.01"/></body>')
     text = text[:site] + wrist + text[site:]
-    text = text.replace("</actuator>", '<motor name="m_wrist" joint="wrist"/></actuator>')
+    if driven:
+        text = text.replace("</actuator>", '<motor name="m_wrist" joint="wrist"/></actuator>')
     path = tmp_path / "delta_wrist.xml"
     path.write_text(text)
     return path
@@ -44,6 +45,22 @@ def test_a_tool_as_the_output_is_refused_naming_the_wrist_and_the_platform(tmp_p
     with pytest.raises(ImportError_, match="actuated joint 'wrist' turns the output after the body where the legs' "
                                            "loops end \\('platform'\\), as a tool the platform carries: --lock wrist "
                                            "holds it, or --output platform takes that body"):
+        graph_mechanism(read_closed_tree(path, output="tool"))
+    held = graph_mechanism(read_closed_tree(path, output="tool", lock=("wrist",))).indices()
+    platform = graph_mechanism(read_closed_tree(path, output="platform")).indices()
+    np.testing.assert_allclose(held.iti_actuators, platform.iti_actuators, atol=1e-9)
+    np.testing.assert_allclose([held.lmti, held.f_o[1]], [platform.lmti, platform.f_o[1]], atol=1e-9)
+
+
+@pytest.mark.parametrize("variant", ["m", "turned"])
+def test_a_tool_on_a_free_swivel_as_the_output_is_refused_naming_the_swivel_and_the_platform(tmp_path, variant):
+    """The wrist not driven (a published Codian Delta's tool on its passive ``ee_joint``): the refusal named only the
+    leg's three actuators, with no advice; it now says the output hangs off the platform by the passive joint, and
+    both ways out read the platform's indices."""
+    path = _with_wrist(tmp_path, TRANSFORMS[variant], driven=False)
+    with pytest.raises(ImportError_, match=r"the output hangs off the body where the legs' loops end \('platform'\) "
+                                           "by passive joint 'wrist', which no actuator turns: --output platform "
+                                           "takes that body, or --lock wrist holds it"):
         graph_mechanism(read_closed_tree(path, output="tool"))
     held = graph_mechanism(read_closed_tree(path, output="tool", lock=("wrist",))).indices()
     platform = graph_mechanism(read_closed_tree(path, output="platform")).indices()

@@ -201,6 +201,16 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
                 + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
                 + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
                 + (f", or --output {meeting} takes that body" if meeting else "")), names
+    hanging = [j for j in path_to(model, platform) if j in leg.joints and j not in leg.actuators
+               and not any(j in path_to(model, end) for end in ends)]
+    if hanging and model.parents[min(hanging)] in ends:  # (a tool on a free swivel on the body the loops end on)
+        names = [tree.written_joint(model.names[j]) for j in hanging]
+        meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
+                        if int(frame.parentJoint) == model.parents[min(hanging)]), None)
+        return ("; the output hangs off the body where the legs' loops end" + (f" ({meeting!r})" if meeting else "")
+                + f" by passive joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))}, which no actuator "
+                "turns: " + (f"--output {meeting} takes that body, or " if meeting else "") + "--lock "
+                + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")), names
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
         names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
