@@ -94,3 +94,22 @@ def test_the_command_says_how_far_the_anchors_were_moved_onto_one_plane(tmp_path
     assert run.returncode == 0, run.stderr
     assert ONE_PLANE in run.stdout + run.stderr
     assert f"(closure 'D' the most, {DEPTH:.2g} m, " in run.stdout + run.stderr
+
+
+@pytest.mark.parametrize("swapped", [False, True])
+def test_the_closure_is_read_midway_between_its_anchors_whichever_end_is_named_first(tmp_path, swapped):
+    """Both frames move half the depth along the pins, so the closure's point (which a spatial leg's characteristic
+    points take) is the same with ``site1`` and ``site2`` the other way round: before, the second moved onto the
+    first, 4 mm along the pin from where the other order put it."""
+    from screwkit.io import read_closed_tree
+    from screwkit.io.closed_tree import assemble, closure_frames
+
+    text = deep()
+    if swapped:
+        text = text.replace('site1="D_link" site2="D_ground"', 'site1="D_ground" site2="D_link"')
+    path = tmp_path / "deep.xml"
+    path.write_text(text)
+    tree = read_closed_tree(path, output="coupler")
+    ((_, first, second),) = closure_frames(tree, assemble(tree)[0])
+    np.testing.assert_allclose(first[:3, 3], [0.3, DEPTH / 2, 0.02], atol=1e-12)
+    np.testing.assert_allclose(second[:3, 3], first[:3, 3], atol=1e-12)

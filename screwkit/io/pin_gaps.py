@@ -91,10 +91,10 @@ def loop_kinds(model, closure) -> list[tuple]:
 
 def on_one_plane(tree, q: NDArray, scale: float, found: list) -> bool:
     """Whether the closures of ``tree`` (a :class:`~screwkit.io.closed_tree.ClosedTree`) left open at q were open
-    along their loops' pins only (:func:`depths_drawn_apart`): each one's second frame is then moved onto its first's
-    plane, in ``tree`` (once: a tree whose note says so is not moved again; its closures and notes are new lists),
-    and a note says by how much. ``found``: each closure with its two world frames at q
-    (:func:`~screwkit.io.closed_tree.closure_frames`)."""
+    along their loops' pins only (:func:`depths_drawn_apart`): each one's two frames are then moved along the pins
+    onto the plane midway between them (the same whichever end the file names first), in ``tree`` (once: a tree
+    whose note says so is not moved again; its closures and notes are new lists), and a note says how far apart they
+    were. ``found``: each closure with its two world frames at q (:func:`~screwkit.io.closed_tree.closure_frames`)."""
     if any(note.startswith(ONE_PLANE) for note in tree.notes):
         return False
     offsets = depths_drawn_apart(tree.model, q, [(first, second) for _, first, second in found],
@@ -102,10 +102,11 @@ def on_one_plane(tree, q: NDArray, scale: float, found: list) -> bool:
     if offsets is None:
         return False
     closures = []
-    for (closure, _, second), offset in zip(found, offsets):
-        placement = np.array(closure.placement_b, dtype=float)
-        placement[:3, 3] += placement[:3, :3] @ second[:3, :3].T @ offset  # (the joint's frame, in which it is drawn)
-        closures.append(replace(closure, placement_b=placement))
+    for (closure, first, second), offset in zip(found, offsets):  # both frames onto the plane midway between them
+        placements = [np.array(placement, dtype=float) for placement in (closure.placement_a, closure.placement_b)]
+        for placement, frame, sign in zip(placements, (first, second), (-0.5, 0.5)):
+            placement[:3, 3] += placement[:3, :3] @ frame[:3, :3].T @ (sign * offset)  # (in the joint's frame)
+        closures.append(replace(closure, placement_a=placements[0], placement_b=placements[1]))
     most = int(np.argmax([np.linalg.norm(offset) for offset in offsets]))
     # new lists, not the old ones changed: a tree copied to be assembled from elsewhere shares them with its original
     tree.closures = closures
