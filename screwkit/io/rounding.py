@@ -96,9 +96,10 @@ def _common_direction(units: NDArray, crosses: NDArray) -> NDArray[np.float64]:
     file's axes written ``0 1 0`` beside one a CAD export's quaternion tilts by 5.6e-7 rad, ``1.9812e-07``: their
     mean leaned 1.1e-7 rad off them, which moved points 0.17 m along it 3.7e-8 across, and two rockers drawn one
     behind the other no longer held the same line), else their mean."""
-    agreeing = np.sum(crosses <= EXACT, axis=1)  # (each member counts itself)
-    best = int(np.argmax(agreeing))
-    direction = units[best] if 2 * agreeing[best] > len(units) else np.sum(units, axis=0)
+    agreeing = crosses <= EXACT  # (each member agrees with itself)
+    best = int(np.argmax(np.sum(agreeing, axis=1)))
+    majority = agreeing[best] if 2 * np.sum(agreeing[best]) > len(units) else np.ones(len(units), dtype=bool)
+    direction = np.sum(units[majority], axis=0)  # (their sum: the same whichever of them is listed first)
     return direction / np.linalg.norm(direction)
 
 
