@@ -113,3 +113,39 @@ def test_the_closure_is_read_midway_between_its_anchors_whichever_end_is_named_f
     ((_, first, second),) = closure_frames(tree, assemble(tree)[0])
     np.testing.assert_allclose(first[:3, 3], [0.3, DEPTH / 2, 0.02], atol=1e-12)
     np.testing.assert_allclose(second[:3, 3], first[:3, 3], atol=1e-12)
+
+
+def test_anchors_further_apart_than_one_pin_s_layers_are_refused_naming_the_depth(tmp_path):
+    """Beyond ``PIN_DEPTH`` of the length scale (here 0.31 of it) the anchors are no pin's two layers: where along the
+    pin the ball would stand moves a spatial reading's points, so the refusal names the depth and what closes it."""
+    path = tmp_path / "far.xml"
+    path.write_text(deep(depth=0.05))
+    with pytest.raises(ValueError, match=r"its two anchors drawn at different depths on one pin \(0\.31 of the length "
+                                         r"scale apart, more than the 0\.1 read as the two layers of one pin\), which "
+                                         r"no joint values close: moved along the pin onto one plane"):
+        load(path, output="coupler")
+
+
+def _with_strut(text: str, stretch: float) -> str:
+    """``text`` (a four-bar of :func:`deep`) with a ball-jointed strut on the base whose ground site is ``stretch``
+    times as far as its reach (a rounding's gap beyond 1)."""
+    strut = ('<body name="strut" pos="-0.2 0 0"><joint name="sball" type="ball"/><geom size="0.01"/>'
+             '<site name="S_link" pos="0 0.1 -0.2"/></body>')
+    text = text.replace('</body></body></body></body></worldbody>', f'</body></body></body>{strut}</body></worldbody>')
+    text = text.replace('<site name="D_ground"', f'<site name="S_ground" pos="-0.2 {0.1 * stretch!r} '
+                                                 f'{-0.2 * stretch!r}"/><site name="D_ground"')
+    return text.replace('</equality>', '<connect name="S" site1="S_link" site2="S_ground"/></equality>')
+
+
+def test_a_rounding_s_gap_elsewhere_leaves_the_anchors_read_on_one_plane(tmp_path):
+    """Beside the 4 mm pin, a ball-jointed strut whose ground site is 2e-7 m beyond its reach (a rounding, accepted
+    alone): the anchors are still read on one plane, with the four-bar's indices drawn flat (the strut's gap kept
+    the move from being made, and the refusal said the loop had been read on one plane)."""
+    path, flat = tmp_path / "strut.xml", tmp_path / "flat.xml"
+    path.write_text(_with_strut(deep(), 1 + 2e-7 / float(np.hypot(0.1, 0.2))))
+    flat.write_text(_with_strut(deep(depth=0.0), 1.0))
+    _, report, mechanism = converted_mechanism(path, output="coupler")
+    assert any(note.startswith(ONE_PLANE) for note in report.notes), report.notes
+    reference = load(flat, output="coupler")
+    got, want = (indices_at_pose(m, m.home_pose) for m in (mechanism, reference))
+    np.testing.assert_allclose([got.iti, got.lmti], [want.iti, want.lmti], atol=1e-9)

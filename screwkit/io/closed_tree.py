@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
-from screwkit.io.pin_gaps import along_pins, loop_kinds, on_one_plane
+from screwkit.io.pin_gaps import ONE_PLANE, along_pins, loop_kinds, on_one_plane
 from screwkit.io.tree_joints import ImportError_, homogeneous, inverse, joint_kind, joint_value, path_to
 
 GUESSED = "actuators guessed"
@@ -476,7 +476,8 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
                   and not along_pins(model, q, first, second, loop_kinds(model, closure), scale)]
         worst = max(across, key=gaps.get, default=worst)  # (one open across its pins kept the others from one plane)
         closure, first, second = next(item for item in found if item[0].name == worst)
-        advice = along_pins(model, q, first, second, loop_kinds(model, closure), scale) or (
+        moved = any(note.startswith(ONE_PLANE) for note in tree.notes)
+        advice = along_pins(model, q, first, second, loop_kinds(model, closure), scale, moved) or (
             "" if tree.initial else ": if the file draws the robot far from an assembly, --initial JOINT VALUE gives "
             "joints values nearer one")
         raise ImportError_(f"{tree.source}: the loops cannot be closed {where}: closure "

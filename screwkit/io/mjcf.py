@@ -115,9 +115,10 @@ def read_mjcf(path: Path, *, output: str | None = None, output_type: str | None 
 
 
 def _driven_joint(element) -> str | None:
-    """The joint an ``<actuator>`` element drives, or None when its transmission is no joint's. MuJoCo takes the
-    last of ``joint``, ``jointinparent``, ``tendon``, ``cranksite``, ``site`` and ``body`` written (in that order);
-    ``jointinparent`` differs from ``joint`` only in the frame of a ball's or free joint's gear."""
+    """The joint an ``<actuator>`` element drives, or None when its transmission is no joint's. Of the targets
+    written, MuJoCo takes the one latest in the order ``joint``, ``jointinparent``, ``tendon``, ``cranksite``,
+    ``site``, ``body`` (whatever the attributes' order in the element); ``jointinparent`` differs from ``joint``
+    only in the frame of a ball's or free joint's gear."""
     if any(element.get(other) is not None for other in ("tendon", "cranksite", "site", "body")):
         return None
     return element.get("jointinparent", element.get("joint"))

@@ -8,7 +8,8 @@ a CAD export, which puts a pin's two mate frames on the two links it joins, mill
 connects). Either way the anchors are read on one plane (:func:`on_one_plane`): every joint of the loop turns about an
 axis along the gap, so no joint values change it, and moving an anchor along the pins moves no hinge's line: the
 loop moves as the pin the two frames mark. MuJoCo runs such a file with the gap held open (its ``connect`` pulls
-along the pin at every step). The report says how far the anchors were moved.
+along the pin at every step). The report says how far apart the anchors were; beyond :data:`PIN_DEPTH` of the
+length scale the file is refused, naming the depth.
 """
 
 from __future__ import annotations
@@ -21,8 +22,13 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.tree_joints import joint_frames, joint_kind, path_to
 
-__all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "ONE_PLANE"]
+__all__ = ["along_pins", "pin_axis", "depths_drawn_apart", "on_one_plane", "loop_kinds", "ONE_PLANE", "PIN_DEPTH"]
 
+PIN_DEPTH = 0.1
+"""Relative to the mechanism's length scale: the largest gap along a loop's parallel pins read as one pin through the
+two links it joins (a CAD export's two mate frames, 0.9 to 1.8 % of the length scale on published wheel legs).
+Further apart the file is refused, naming the depth: where along a pin a ball closure stands moves the points a
+spatial reading takes (by about 1e-4 of the CTI at 4 mm on a 15 cm linkage, by a third at twice its size)."""
 CLOSED = 1e-10
 """Relative: a closure whose frames are at most this apart (the assembly's own tolerance) is left where it is."""
 ONE_PLANE = "closure frames drawn at different depths on their loops' pins read on one plane"
@@ -32,17 +38,23 @@ PARALLEL = 1e-3
 """Sine (about 0.06 deg) below which the loop's hinge axes, and its gap, count as along one direction."""
 
 
-def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float) -> str:
+def along_pins(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float, moved: bool = False
+               ) -> str:
     """What to say of a closure left open at q (its two frames ``first``, ``second``, 4x4 in the world) where its
     gap lies along its loop's hinges, all parallel: ``kinds``, (joint, kind, local axis) of the loop's joints;
-    ``scale``, the mechanism's length scale (:func:`pin_axis`); else ''."""
+    ``scale``, the mechanism's length scale (:func:`pin_axis`); ``moved``, whether the closures were read on one
+    plane already (:func:`on_one_plane`); else ''."""
     if pin_axis(model, q, first, second, kinds, scale) is None:
         return ""
     hinges = ", ".join(model.names[joint] for joint, _, _ in kinds)
     depth = float(np.linalg.norm(first[:3, 3] - second[:3, 3])) / scale
-    return (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
-            f"different depths on one pin ({depth:.2g} of the length scale apart), which no joint values close, and "
-            "read on one plane the loop still did not close")
+    said = (f": its gap lies along the parallel axes of its loop's hinges ({hinges}), its two anchors drawn at "
+            f"different depths on one pin ({depth:.2g} of the length scale apart")
+    if moved:
+        return said + "), which no joint values close, and read on one plane the loop still did not close"
+    return (said + f", more than the {PIN_DEPTH:g} read as the two layers of one pin), which no joint values close: "
+            "moved along the pin onto one plane (the closure's frame: an MJCF connect's anchor or site, a robot.yaml "
+            "or SDFormat closing frame), the loop closes")
 
 
 def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, scale: float) -> NDArray | None:
@@ -66,17 +78,19 @@ def pin_axis(model, q: NDArray, first: NDArray, second: NDArray, kinds: list, sc
 
 def depths_drawn_apart(model, q: NDArray, frames: list, loops: list[list], scale: float) -> list[NDArray] | None:
     """The world offsets along the pins that put each closure's second frame on its first's plane at q, where
-    every closure left open at q is open along its loop's pins only (:func:`pin_axis`; a zero offset for a closure
-    that closes); else None. ``frames``: each closure's two world frames at q; ``loops``: each closure's loop, as
-    the ``kinds`` of :func:`along_pins`; ``scale``: the mechanism's length scale."""
+    every closure left open at q is open along its loop's pins only (:func:`pin_axis`), by at most :data:`PIN_DEPTH`
+    times ``scale`` (a zero offset for a closure that closes, or that stays open by a file's rounding in another
+    direction: :data:`~screwkit.common.tolerances.FILE_ROUNDING` of ``scale``, which the assembly accepts); else None.
+    ``frames``: each closure's two world frames at q; ``loops``: each closure's loop, as the ``kinds`` of
+    :func:`along_pins`; ``scale``: the mechanism's length scale."""
     offsets = []
     for (first, second), kinds in zip(frames, loops):
         gap = first[:3, 3] - second[:3, 3]
-        if not np.linalg.norm(gap) > CLOSED * scale:
+        axis = pin_axis(model, q, first, second, kinds, scale) if np.linalg.norm(gap) > CLOSED * scale else None
+        if axis is None and not np.linalg.norm(gap) > FILE_ROUNDING * scale:
             offsets.append(np.zeros(3))
             continue
-        axis = pin_axis(model, q, first, second, kinds, scale)
-        if axis is None:
+        if axis is None or np.linalg.norm(gap) > PIN_DEPTH * scale:
             return None
         offsets.append(axis * float(axis @ gap))  # (the joints close what lies across the pins)
     return offsets
