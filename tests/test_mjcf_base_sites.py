@@ -85,3 +85,28 @@ def test_connects_on_sites_read_over_and_over_do_not_crash_the_process(tmp_path)
             "for _ in range(400):\n    read_closed_tree(sys.argv[1], output='coupler')\n")
     run = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, (run.returncode, run.stderr[-2000:])
+
+
+def test_convert_reads_a_file_in_millimetres_and_writes_its_unit(tmp_path):
+    """``convert --length-unit mm``: the four-bar written in millimetres is converted with its unit said in a
+    ``<units>`` element, and the file written reads the textbook pressure angles of the four-bar in metres (the
+    option was refused by convert alone, and without it the mechanism is written a thousand times too large)."""
+    import json
+
+    from helpers import screwkit
+
+    source, written = tmp_path / "fourbar_mm.xml", tmp_path / "fourbar.urdf"
+    source.write_text(four_bar(1000.0))
+    converted = screwkit("convert", source, written, "--output", "coupler", "--length-unit", "mm", "--json")
+    assert converted.returncode == 0, converted.stderr
+    assert '<units length="mm"/>' in written.read_text()
+    analysed = screwkit("analyze", written, "--json")
+    assert analysed.returncode == 0, analysed.stderr
+    result = json.loads(analysed.stdout)
+    metres, _ = mjcf_variant(tmp_path, "metres", "m", four_bar)
+    model, data, anchor = mujoco_closed(metres)
+    a, b, c, d = anchor["jA"], anchor["jB"], anchor["jC"], data.site_xpos[model.site("D_ground").id]
+    in_metres = json.loads(screwkit("analyze", metres, "--output", "coupler", "--json").stdout)
+    assert result["pose"] == pytest.approx(in_metres["pose"], rel=1e-9)  # (a pose in m, not mm)
+    assert result["iti"] == pytest.approx(sine(b - a, c - b), abs=1e-9)
+    assert result["lmti"] == pytest.approx(sine(c - b, c - d), abs=1e-9)

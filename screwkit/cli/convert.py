@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import click
@@ -11,6 +12,7 @@ from screwkit.cli.options import (
     fail,
     ignore_limits_option,
     json_option,
+    length_unit_option,
     option_group,
     overwrite_option,
     quiet_option,
@@ -28,7 +30,7 @@ __all__ = ["convert"]
 @click.command()
 @click.argument("source", type=click.Path(dir_okay=False, path_type=Path))
 @click.argument("out", type=click.Path(dir_okay=False, path_type=Path))
-@option_group("reading", reading_record, *FILE_OPTIONS)
+@option_group("reading", reading_record, length_unit_option, *FILE_OPTIONS)
 @ignore_limits_option
 @overwrite_option
 @quiet_option
@@ -36,10 +38,11 @@ __all__ = ["convert"]
 def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, overwrite: bool, quiet: bool,
             as_json: bool) -> None:
     """Write SOURCE (an MJCF or SDFormat file, or a URDF tree with a Gepetto robot.yaml beside it) to OUT in screwkit's
-    URDF convention: loops, transmissions and the assembled reference configuration (lengths in m). A file
-    already in the convention whose joint values leave loops open is written back with them closed. With
-    --ignore-limits, a reference assembly outside a joint's limits is written all the same (the limits as in
-    SOURCE: the file written then needs --ignore-limits too)."""
+    URDF convention: loops, transmissions and the assembled reference configuration (lengths in SOURCE's unit:
+    --length-unit says which, and OUT says it in a <units> element). A file already in the convention whose joint
+    values leave loops open is written back with them closed. With --ignore-limits, a reference assembly outside a
+    joint's limits is written all the same (the limits as in SOURCE: the file written then needs --ignore-limits
+    too)."""
     if not source.is_file():
         raise fail(f"{source}: no such file.")
     if source.suffix.lower() not in (".xml", ".mjcf", ".sdf", ".urdf"):
@@ -54,12 +57,14 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
             text, report, mechanism = converted_mechanism(source, output=reading.output,
                                                           output_type=reading.output_type, lock=reading.lock,
                                                           actuate=reading.actuate, initial=reading.initial,
-                                                          limits=not ignore_limits)
+                                                          length_unit=reading.length_unit, limits=not ignore_limits)
+            text = _with_units(text, reading.length_unit)
         else:  # screwkit's own convention: the loops the file leaves open, closed and written back (the options of
             # files of other tools refused by the loader, as on every command)
             own = load(source, limits=not ignore_limits, output=reading.output, output_type=reading.output_type,
-                       lock=reading.lock, actuate=reading.actuate, initial=reading.initial)
-            text = with_reference_configuration(own.description.text, own)
+                       lock=reading.lock, actuate=reading.actuate, initial=reading.initial,
+                       length_unit=reading.length_unit)
+            text = _with_units(with_reference_configuration(own.description.text, own), reading.length_unit)
             report = ImportReport(source=str(source), file_format="screwkit URDF", output="as in the file",
                                   planar=own.is_planar, motors=list(own.actuator_names))
             drawn = any(note.startswith(DRAWN_AT_ROUNDING) and FRAMES_WRITTEN in note for note in own.assembly_notes)
@@ -88,3 +93,13 @@ def convert(source: Path, out: Path, reading: Reading, ignore_limits: bool, over
             click.echo(line, err=True)
         click.echo(f"wrote {out}: {mechanism.dof} DOF ({' '.join(mechanism.task_coordinates)}), "
                    f"{len(mechanism.actuators)} actuators", err=True)
+
+
+def _with_units(text: str, unit: str | None) -> str:
+    """The URDF ``text`` saying its lengths are in ``unit`` (its ``<units>`` elements replaced by one), or as it is
+    for None: the file written reads as SOURCE read with --length-unit."""
+    if unit is None:
+        return text
+    text = re.sub(r"\s*<units\b[^>]*/>", "", text)
+    opening = re.search(r"<robot\b[^>]*>", text)
+    return f'{text[:opening.end()]}\n  <units length="{unit}"/>{text[opening.end():]}'
