@@ -39,17 +39,22 @@ def _with_wrist(tmp_path, transform, driven: bool = True) -> str:
     return path
 
 
-@pytest.mark.parametrize("variant", sorted(TRANSFORMS))
-def test_a_tool_as_the_output_is_refused_naming_the_wrist_and_the_platform(tmp_path, variant):
-    path = _with_wrist(tmp_path, TRANSFORMS[variant])
-    with pytest.raises(ImportError_, match="actuated joint 'wrist' turns the output after the body where the legs' "
-                                           "loops end \\('platform'\\), as a tool the platform carries: --lock wrist "
-                                           "holds it, or --output platform takes that body"):
+def _refused_then_read_held(path, refusal: str) -> None:
+    """The tool as the output is refused with ``refusal``; held (``--lock wrist``) it reads the platform's indices."""
+    with pytest.raises(ImportError_, match=refusal):
         graph_mechanism(read_closed_tree(path, output="tool"))
     held = graph_mechanism(read_closed_tree(path, output="tool", lock=("wrist",))).indices()
     platform = graph_mechanism(read_closed_tree(path, output="platform")).indices()
     np.testing.assert_allclose(held.iti_actuators, platform.iti_actuators, atol=1e-9)
     np.testing.assert_allclose([held.lmti, held.f_o[1]], [platform.lmti, platform.f_o[1]], atol=1e-9)
+
+
+@pytest.mark.parametrize("variant", sorted(TRANSFORMS))
+def test_a_tool_as_the_output_is_refused_naming_the_wrist_and_the_platform(tmp_path, variant):
+    _refused_then_read_held(_with_wrist(tmp_path, TRANSFORMS[variant]),
+                            r"actuated joint 'wrist' turns the output after the body where the legs' loops end "
+                            r"\('platform'\), as a tool the platform carries: --lock wrist holds it, or --output "
+                            "platform takes that body")
 
 
 @pytest.mark.parametrize("variant", ["m", "turned"])
@@ -57,15 +62,10 @@ def test_a_tool_on_a_free_swivel_as_the_output_is_refused_naming_the_swivel_and_
     """The wrist not driven (a published Codian Delta's tool on its passive ``ee_joint``): the refusal named only the
     leg's three actuators, with no advice; it now says the output hangs off the platform by the passive joint, and
     both ways out read the platform's indices."""
-    path = _with_wrist(tmp_path, TRANSFORMS[variant], driven=False)
-    with pytest.raises(ImportError_, match=r"the output hangs off the body where the legs' loops end \('platform'\) "
-                                           "by passive joint 'wrist', which no actuator turns: --output platform "
-                                           "takes that body, or --lock wrist holds it"):
-        graph_mechanism(read_closed_tree(path, output="tool"))
-    held = graph_mechanism(read_closed_tree(path, output="tool", lock=("wrist",))).indices()
-    platform = graph_mechanism(read_closed_tree(path, output="platform")).indices()
-    np.testing.assert_allclose(held.iti_actuators, platform.iti_actuators, atol=1e-9)
-    np.testing.assert_allclose([held.lmti, held.f_o[1]], [platform.lmti, platform.f_o[1]], atol=1e-9)
+    _refused_then_read_held(_with_wrist(tmp_path, TRANSFORMS[variant], driven=False),
+                            r"the output hangs off the body where the legs' loops end \('platform'\) by passive "
+                            "joint 'wrist', which no actuator turns: --output platform takes that body, or --lock "
+                            "wrist holds it")
 
 
 def test_a_driven_joint_on_the_tool_alone_is_said_to_be_on_no_leg(tmp_path):
