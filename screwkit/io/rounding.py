@@ -84,21 +84,25 @@ def parallel_axes(axes: NDArray, tolerance: float | NDArray = FILE_ROUNDING, lin
         if len(members) < 2 or float(np.max(crosses[np.ix_(members, members)])) <= EXACT:
             continue
         senses = np.sign(units[members] @ units[members[0]])  # whichever member comes first, each keeps its sense
-        direction = _common_direction(units[members] * senses[:, None], crosses[np.ix_(members, members)])
+        block = np.ix_(members, members)
+        direction = _common_direction(units[members] * senses[:, None], crosses[block],
+                                      bool(np.max(allowed[block]) <= FILE_ROUNDING))
         result[members] = senses[:, None] * direction
         turn = max(turn, float(np.max(np.linalg.norm(np.cross(units[members], direction), axis=1))))
     return result, turn
 
 
-def _common_direction(units: NDArray, crosses: NDArray) -> NDArray[np.float64]:
+def _common_direction(units: NDArray, crosses: NDArray, as_written: bool) -> NDArray[np.float64]:
     """The direction a group of nearly parallel ``units`` (m, 3, of one sense; ``crosses`` their pairs' cross
-    products' norms) is written along: that of more than half of them where those are written exactly parallel (a
-    file's axes written ``0 1 0`` beside one a CAD export's quaternion tilts by 5.6e-7 rad, ``1.9812e-07``: their
-    mean leaned 1.1e-7 rad off them, which moved points 0.17 m along it 3.7e-8 across, and two rockers drawn one
-    behind the other no longer held the same line), else their mean."""
+    products' norms) is written along: where they are held to the file's rounding alone (``as_written``: no angle
+    written rounded by hand lies between them), that of more than half of them where those are written exactly
+    parallel (a file's axes written ``0 1 0`` beside one a CAD export's quaternion tilts by 5.6e-7 rad,
+    ``1.9812e-07``: their mean leaned 1.1e-7 rad off them, which moved points 0.17 m along it 3.7e-8 across, and two
+    rockers drawn one behind the other no longer held one line); else their mean (axes turned by the same angles
+    written ``1.57`` agree exactly with each other, and are all off the drawn direction by those angles' rounding)."""
     agreeing = crosses <= EXACT  # (each member agrees with itself)
     best = int(np.argmax(np.sum(agreeing, axis=1)))
-    majority = agreeing[best] if 2 * np.sum(agreeing[best]) > len(units) else np.ones(len(units), dtype=bool)
+    majority = agreeing[best] if as_written and 2 * np.sum(agreeing[best]) > len(units) else np.ones(len(units), bool)
     direction = np.sum(units[majority], axis=0)  # (their sum: the same whichever of them is listed first)
     return direction / np.linalg.norm(direction)
 
