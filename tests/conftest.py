@@ -56,9 +56,23 @@ def _source(item) -> str:
     return "\n".join(sources)
 
 
+def _shares_fixtures(module) -> bool:
+    """Whether a test module holds a fixture wider than a test (a Dask cluster, a browser, a site built): its tests
+    then run in one worker process, which sets it up once (``--dist loadgroup``); the others go to whichever worker
+    is free, test by test."""
+    try:
+        text = inspect.getsource(module)
+    except (OSError, TypeError):
+        return False
+    return any(f'scope="{scope}"' in text or f"scope='{scope}'" in text for scope in ("module", "session", "package"))
+
+
 def pytest_collection_modifyitems(config, items):
+    grouped: dict[str, bool] = {}
     for item in items:
         module = item.module.__name__.rsplit(".", 1)[-1] if getattr(item, "module", None) else ""
+        if module and grouped.setdefault(module, _shares_fixtures(item.module)):
+            item.add_marker(pytest.mark.xdist_group(name=module))
         source = _source(item)
         if module in BY_MODULE:
             item.add_marker(getattr(pytest.mark, BY_MODULE[module]))
