@@ -100,6 +100,6 @@ def _with_units(text: str, unit: str | None) -> str:
     for None: the file written reads as SOURCE read with --length-unit."""
     if unit is None:
         return text
-    text = re.sub(r"\s*<units\b[^>]*/>", "", text)
+    text = re.sub(r"\s*<units\b[^>]*?(?:/>|>.*?</units\s*>)", "", text, flags=re.DOTALL)
     opening = re.search(r"<robot\b[^>]*>", text)
     return f'{text[:opening.end()]}\n  <units length="{unit}"/>{text[opening.end():]}'

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from screwkit.common.tolerances import FILE_ROUNDING, MEETING, PARALLEL_FOOT
 from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.nearest import independent_blocks, nearest_closed
-from screwkit.io.pin_gaps import ONE_PLANE, along_pins, loop_kinds, on_one_plane
+from screwkit.io.pin_gaps import ONE_PLANE, along_pins, loop_kinds, on_one_plane, pin_axis
 from screwkit.io.tree_joints import ImportError_, homogeneous, inverse, joint_kind, joint_value, path_to
 
 GUESSED = "actuators guessed"
@@ -473,7 +473,7 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         where = (f"with {', '.join(f'--initial {name} {value:g}' for name, value in tree.initial)} held (the file's "
                  "values for the other joints)" if tree.initial else "near the file's joint values")
         across = [closure.name for closure, first, second in found if gaps[closure.name] > FILE_ROUNDING * scale
-                  and not along_pins(model, q, first, second, loop_kinds(model, closure), scale)]
+                  and pin_axis(model, q, first, second, loop_kinds(model, closure), scale) is None]
         worst = max(across, key=gaps.get, default=worst)  # (one open across its pins kept the others from one plane)
         closure, first, second = next(item for item in found if item[0].name == worst)
         moved = any(note.startswith(ONE_PLANE) for note in tree.notes)

@@ -40,7 +40,14 @@ from screwkit.io.closed_tree import (
     inverse,
 )
 from screwkit.io.onshape import transmitted_tree
-from screwkit.io.sdformat_text import MODEL_FRAME, controlled_joints, detachable_joints, parse_joint, plugin_note
+from screwkit.io.sdformat_text import (
+    MODEL_FRAME,
+    controlled_joints,
+    detachable_joints,
+    in_parent_model_frame,
+    parse_joint,
+    plugin_note,
+)
 from screwkit.io.urdf_tree import urdf_model
 
 __all__ = ["has_gazebo_joints", "read_gazebo"]
@@ -114,8 +121,8 @@ def read_gazebo(urdf: Path, *, output: str | None = None, output_type: str | Non
             axis = joint.axes[0].xyz
             if joint.axes[0].expressed_in == MODEL_FRAME:  # the model's frame: the root link's, the world's here
                 axis = (world_child @ in_child)[:3, :3].T @ axis
-                stated = (element.findtext("axis/use_parent_model_frame") or "").strip().lower() in ("1", "true")
-                if stated and 1.0 - abs(float(axis @ joint.axes[0].xyz)) > 1e-12:  # (another line in the 1.7 reading)
+                if in_parent_model_frame(element.find("axis")) and 1.0 - abs(float(axis @ joint.axes[0].xyz)) > 1e-12:
+                    # (by the element, not expressed_in: another line in the 1.7 reading)
                     notes.append(f"{written_as}: its axis read in the model's frame, as <use_parent_model_frame> asks "
                                  "(SDFormat 1.5 and 1.6; Gazebo's URDF conversion to SDFormat 1.7, libsdformat 9 "
                                  "and later, drops that element and reads the axis in the joint's frame: another "

@@ -37,9 +37,9 @@ from screwkit.common.xml_text import tolerant_xml
 from screwkit.io.closed_tree import ImportError_
 from screwkit.io.drake import drake_elements
 
-__all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "read_model", "world_poses",
-           "attached_link", "controllers", "controlled_joints", "detachable_joints", "plugin_note", "WORLD",
-           "MODEL_FRAME", "CONTROLLER"]
+__all__ = ["SdfAxis", "SdfJoint", "SdfModel", "numbers", "parse_pose", "parse_joint", "in_parent_model_frame",
+           "read_model", "world_poses", "attached_link", "controllers", "controlled_joints", "detachable_joints",
+           "plugin_note", "WORLD", "MODEL_FRAME", "CONTROLLER"]
 
 WORLD = "world"
 MODEL_FRAME = "__model__"
@@ -131,14 +131,18 @@ def _axis(element, tag: str, where: str, version: tuple[int, ...], kind: str) ->
     if np.linalg.norm(xyz) < 1e-12:
         raise ImportError_(f"{where}: <{tag}><xyz> is zero.")
     expressed = xyz_node.get("expressed_in", "").strip() if xyz_node is not None else ""
-    stated = node is not None and node.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1")
-    if version < (1, 5) or (version < (1, 7) and stated):  # 1.4: always (libsdformat's 1_4.convert adds it)
+    if version < (1, 5) or (version < (1, 7) and in_parent_model_frame(node)):  # 1.4: always (its 1_4.convert)
         expressed = expressed or MODEL_FRAME
     for inner in node.iter() if node is not None else ():
         if "degrees" in inner.attrib:
             raise ImportError_(f"{where}: <{tag}>...<{inner.tag} degrees=...>: SDFormat has no degrees there (only "
                                "on <pose>): limits are in radians.")
     return SdfAxis(xyz / np.linalg.norm(xyz), expressed, _limits(element, tag, where, kind))
+
+
+def in_parent_model_frame(axis) -> bool:
+    """Whether an ``<axis>`` element (or None) says ``<use_parent_model_frame>true`` (SDFormat 1.5 and 1.6)."""
+    return axis is not None and axis.findtext("use_parent_model_frame", "").strip().lower() in ("true", "1")
 
 
 def _bounds(element, tag: str, where: str) -> NDArray[np.float64] | None:
