@@ -26,7 +26,7 @@ import pytest
 FULL_ONLY = ("cli", "cluster", "browser", "docs", "notebooks", "slow")
 """Markers of the tests that only ``pytest --full`` runs."""
 BY_MODULE = {"test_cluster": "cluster", "test_docs": "docs", "test_notebooks": "notebooks", "test_json_schema": "cli"}
-SUBPROCESS_CALLS = ("screwkit(", "subprocess.", "run_command(", "Popen(")
+SUBPROCESS_CALLS = ("screwkit(", "screwkit_json(", "subprocess.", "run_command(", "Popen(")
 
 
 def pytest_addoption(parser):

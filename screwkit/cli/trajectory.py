@@ -212,7 +212,8 @@ path_source_options = option_group(
     click.option("--actuators", is_flag=True,
                  help="PATH holds actuator values (a column per actuator, named by its chain or chain:joint; deg, "
                       "m; optionally t): the platform poses come from forward kinematics along the path, from the "
-                      "reference assembly."))
+                      "reference assembly; its arc length is along the actuators (angles times the length scale), "
+                      "wherever the file places the mechanism."))
 fault_options = option_group(
     "faults", FaultOptions,
     click.option("--level", type=click.FloatRange(min=0, max=1, min_open=True), default=0.4, show_default=True,

@@ -22,11 +22,17 @@ not: a crank past the top of its circle moves its coupler's x back).
 :func:`read_actuator_path` reads the values from a CSV or netCDF file (a column per actuator, named as
 :attr:`~screwkit.model.Mechanism.actuator_names` names them or by its chain's name when the chain has one actuator;
 deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in one line what is wrong.
+
+The arc length of a path so driven is along the actuators (their values' steps, angles times the length scale),
+for serial legs and loops alike: the same wherever the file places the mechanism in the world, where the task
+coordinates (taken in the world's frame, a one-DoF linkage's x or y as its plane lies) and their roll, pitch and
+yaw rates are not.
 """
 
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -102,7 +108,8 @@ def path_from_actuators(mechanism: Mechanism | GraphMechanism, values: ArrayLike
         middle = (solved[gaps] + solved[gaps + 1]) // 2
         poses[middle] = _reached(mechanism, values[middle], poses[solved[gaps]], middle)
         solved = np.sort(np.concatenate([solved, middle]))
-    return path_from_poses(mechanism, poses, times)
+    posed = path_from_poses(mechanism, poses, times)  # (checked as a path of poses is)
+    return replace(posed, arc_length=_along_actuators(mechanism, values))
 
 
 def _checked(mechanism: Mechanism | GraphMechanism, values: ArrayLike) -> NDArray[np.float64]:
@@ -134,13 +141,19 @@ def _graph_path(graph: GraphMechanism, values: NDArray, times: ArrayLike | None)
         except ValueError as error:
             raise _not_reached(graph, row, sample, f"from the {'previous sample' if sample else 'file'}'s "
                                                    f"configuration, {error}") from None
-    # (along the actuators: the pose may fold or stand still)
-    arc_length, size = weighted_arc_length(values, _angular(graph), graph.length_scale)
+    return Path(graph.frame_pose(closed)[:, list(graph.task_axes)], _along_actuators(graph, values),
+                float(graph.length_scale), checked_times(times, values.shape[0]), values, closed)
+
+
+def _along_actuators(mechanism: Mechanism | GraphMechanism, values: NDArray) -> NDArray[np.float64]:
+    """The arc length (n,) of a path driven by actuator ``values`` (n, a): along the actuators, angles times the
+    length scale, m for slides. No placement of the mechanism in the world changes it (its task coordinates and
+    their angles do), and it moves where they fold or stand still."""
+    arc_length, size = weighted_arc_length(values, _angular(mechanism), mechanism.length_scale)
     if not arc_length[-1] > ROUNDING_ULPS * np.spacing(size):
         raise ValueError(f"Expected a path that moves: its actuators move by {arc_length[-1]:.3g} (angles times the "
                          f"length scale) in all, their values' rounding at a size of {size:.3g}.")
-    return Path(graph.frame_pose(closed)[:, list(graph.task_axes)], arc_length, float(graph.length_scale),
-                checked_times(times, values.shape[0]), values, closed)
+    return arc_length
 
 
 def _reached(mechanism: Mechanism, values: NDArray, initial: NDArray, samples: NDArray) -> NDArray[np.float64]:

@@ -71,7 +71,7 @@ class Path:
         The samples, task coordinates in m and rad.
     arc_length : ndarray (n,)
         Arc length at each sample from the first (m; angles weighted by ``length_scale``), non-decreasing; of a
-        mechanism whose legs have loops inside them driven by its actuators, along the actuators' values.
+        path driven by the actuators (:mod:`~screwkit.studies.actuator_paths`), along the actuators' values.
     length_scale : float
         The weight of angles in the arc length (m per rad): the mechanism's length scale.
     times : ndarray (n,) or None
