@@ -57,7 +57,7 @@ def test_a_tool_as_the_output_is_refused_naming_the_wrist_and_the_platform(tmp_p
                             "platform takes that body")
 
 
-@pytest.mark.parametrize("variant", ["m", "turned"])
+@pytest.mark.parametrize("variant", sorted(TRANSFORMS))
 def test_a_tool_on_a_free_swivel_as_the_output_is_refused_naming_the_swivel_and_the_platform(tmp_path, variant):
     """The wrist not driven (a published Codian Delta's tool on its passive ``ee_joint``): the refusal named only the
     leg's three actuators, with no advice; it now says the output hangs off the platform by the passive joint, and
@@ -66,6 +66,29 @@ def test_a_tool_on_a_free_swivel_as_the_output_is_refused_naming_the_swivel_and_
                             r"the output hangs off the body where the legs' loops end \('platform'\) by passive "
                             "joint 'wrist', which no actuator turns: --output platform takes that body, or --lock "
                             "wrist holds it")
+
+
+def test_a_swivel_delta_on_a_driven_rail_is_refused_naming_both_joints_to_hold_in_one_run(tmp_path):
+    """The same Delta carried by a driven rail: the refusal named the swivel only, and held, the next run named the
+    rail. It now names both ways out and the rail each needs; either reads the platform's indices on a fixed
+    base."""
+    text = _with_wrist(tmp_path, None, driven=False).read_text()
+    fixed = graph_mechanism(read_closed_tree(tmp_path / "delta_wrist.xml", output="platform")).indices()
+    rail = (text.replace('<body name="base" ', '<body name="carriage"><joint name="rail" type="slide" axis="1 0 0"/>'
+                         '<geom size="0.01"/><body name="base" ', 1)
+            .replace("</body></worldbody>", "</body></body></worldbody>")
+            .replace("</actuator>", '<motor name="m_rail" joint="rail"/></actuator>'))
+    path = tmp_path / "delta_rail.xml"
+    path.write_text(rail)
+    with pytest.raises(ImportError_, match=r"by passive joint 'wrist', which no actuator turns: --output platform "
+                                           r"takes that body, or --lock wrist holds it; and either way the actuated "
+                                           r"joint 'rail' carries every other one \(a serial stage before the "
+                                           r"parallel part\): --lock rail analyses the legs on the body it turns.$"):
+        graph_mechanism(read_closed_tree(path, output="tool"))
+    for output, lock in (("tool", ("wrist", "rail")), ("platform", ("rail",))):
+        read = graph_mechanism(read_closed_tree(path, output=output, lock=lock)).indices()
+        np.testing.assert_allclose(read.iti_actuators, fixed.iti_actuators, atol=1e-9)
+        np.testing.assert_allclose([read.lmti, read.f_o[1]], [fixed.lmti, fixed.f_o[1]], atol=1e-9)
 
 
 def test_a_driven_joint_on_the_tool_alone_is_said_to_be_on_no_leg(tmp_path):

@@ -185,10 +185,11 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
               if a != platform and platform in path_to(model, a)]
     if riding and len(riding) < len(leg.actuators):  # (a wheel on a wheel leg's end link, where its closure ends)
         one = len(riding) == 1
-        return (f"; actuated joint{'' if one else 's'} {', '.join(map(repr, riding))} ride{'s' if one else ''} on the "
-                "platform (a wheel or a tool it carries, through which the leg's closure reaches it): --lock "
-                f"{' --lock '.join(riding)} holds {'it' if one else 'them'}, or --output names the body "
-                f"{'it turns' if one else 'they turn'}"), riding
+        return _and_stage(tree, leg, (
+            f"; actuated joint{'' if one else 's'} {', '.join(map(repr, riding))} ride{'s' if one else ''} on the "
+            "platform (a wheel or a tool it carries, through which the leg's closure reaches it): --lock "
+            f"{' --lock '.join(riding)} holds {'it' if one else 'them'}, or --output names the body "
+            f"{'it turns' if one else 'they turn'}", riding))
     ends = {end for closure in leg.closures for end in (closure.joint_a, closure.joint_b)}
     tail = [a for a in leg.actuators if a in path_to(model, platform) and not any(a in path_to(model, end)
                                                                                  for end in ends)]
@@ -196,21 +197,41 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
         names = [tree.written_joint(model.names[a]) for a in tail]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(tail)]), None)
-        return (f"; actuated joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))} turn"
-                f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
-                + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
-                + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
-                + (f", or --output {meeting} takes that body" if meeting else "")), names
+        return _and_stage(tree, leg, (
+            f"; actuated joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))} turn"
+            f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
+            + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
+            + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
+            + (f", or --output {meeting} takes that body" if meeting else ""), names))
     hanging = [j for j in path_to(model, platform) if j in leg.joints and j not in leg.actuators
                and not any(j in path_to(model, end) for end in ends)]
     if hanging and model.parents[min(hanging)] in ends:  # (a tool on a free swivel on the body the loops end on)
         names = [tree.written_joint(model.names[j]) for j in hanging]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(hanging)]), None)
-        return ("; the output hangs off the body where the legs' loops end" + (f" ({meeting!r})" if meeting else "")
-                + f" by passive joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))}, which no actuator "
-                "turns: " + (f"--output {meeting} takes that body, or " if meeting else "") + "--lock "
-                + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")), names
+        return _and_stage(tree, leg, (
+            "; the output hangs off the body where the legs' loops end" + (f" ({meeting!r})" if meeting else "")
+            + f" by passive joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))}, which no actuator "
+            "turns: " + (f"--output {meeting} takes that body, or " if meeting else "") + "--lock "
+            + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it"), names))
+    advice = _stage_advice(tree, leg)
+    return advice if advice[1] else _transmission_advice(tree, leg, platform)
+
+
+
+def _and_stage(tree: ClosedTree, leg, advice: tuple[str, list[str]]) -> tuple[str, list[str]]:
+    """``advice`` (text, joints held) with, where a serial stage also carries the leg's actuators (the whole robot
+    on a driven rail), the advice that holds it too: both are needed, and one run names them."""
+    text, names = advice
+    stage, held = _stage_advice(tree, leg)
+    if not held or set(held) & set(names):
+        return advice
+    return f"{text}; and either way{stage[1:]}", names + held
+
+def _stage_advice(tree: ClosedTree, leg) -> tuple[str, list[str]]:
+    """For a leg with several actuators: the serial stage that carries them (a rail, a floating base, a hip's motors
+    one after the other), the advice that holds it and its joints; none: ("", [])."""
+    model = tree.model
     stage = serial_stage(model, leg)
     if len(stage) > 1 and joint_kind(model, stage[0])[0] != "JointModelFreeFlyer":
         names = list(dict.fromkeys(tree.written_joint(model.names[j]) for j in stage))  # a ball: by its name
@@ -227,7 +248,7 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
                    else f"joint {name!r} carries every actuator of it")
         return (f"; {carrier} (a serial stage before the parallel part): --lock {name} analyses the legs on the body "
                 "it turns" + (f" (leave {name} out of --actuate)" if name in tree.actuated else "")), [name]
-    return _transmission_advice(tree, leg, platform)
+    return "", []
 
 
 def _transmission_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
