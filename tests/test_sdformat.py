@@ -219,6 +219,11 @@ BAD = [
     (lambda t: t.replace('<link name="effector"><pose rotation_format="quat_xyzw">',
                          '<link name="effector"><pose rotation_format="quat_xyzw">1 '),
      r"<link name='effector'>: <pose> must hold 7 finite numbers"),
+    (lambda t: t.replace('<link name="base"/>', '<link name="base"><pose>0 0  1.12 0 0</pose></link>')
+     .replace('<link name="effector"><pose rotation_format="quat_xyzw">',
+              '<link name="effector"><pose rotation_format="quat_xyzw">1 '),  # (both named in one run)
+     r"<link name='base'>: <pose> must hold 6 finite numbers, got '0 0  1.12 0 0'; <link name='effector'>: <pose> "
+     r"must hold 7 finite numbers, got '1 .*'\.$"),
     (lambda t: t.replace("<parent>world</parent><child>base</child>", "<parent>world</parent><child>base</child>")
      .replace("<child>proximal_1</child>", "<child>base</child>"),
      r"<joint name='mot1'>: <parent> and <child> are on the same link 'base'"),

@@ -315,6 +315,19 @@ def _the_model(path: Path, root) -> tuple[object, str]:
     return model, left_out
 
 
+def _check_poses(element, path: Path) -> None:
+    """Every ``<pose>`` of the model, its links, joints and frames readable (:func:`parse_pose`), or one line naming
+    each one that is not, so that one run lists them all."""
+    refused = []
+    for node in [element, *(child for tag in ("link", "joint", "frame") for child in element.findall(tag))]:
+        try:
+            parse_pose(node.find("pose"), f"<{node.tag} name='{node.get('name')}'>")
+        except ImportError_ as error:
+            refused.append(str(error).removesuffix("."))
+    if refused:
+        raise ImportError_(f"{path}: " + "; ".join(refused) + ".")
+
+
 def read_model(path: Path) -> SdfModel:
     """The one model of an SDFormat file (in ``<sdf>`` or in its one ``<world>``), as written."""
     path = Path(path)
@@ -326,6 +339,7 @@ def read_model(path: Path) -> SdfModel:
     version = tuple(int(part) for part in (root.get("version", "1.7").split(".") + ["0"])[:2] if part.isdigit())
     label = f"{path}: <model name='{element.get('name')}'>"
     _check_names(element, label)
+    _check_poses(element, path)
     drake = sorted({name for name, _ in drake_elements(element)} - {"ball_constraint"})
     if drake:  # Drake's own joints and ties: left out, the model would be another mechanism
         raise ImportError_(f"{label}: <drake:{drake[0]}>, Drake's own, joins links in a way screwkit does not read (it "
