@@ -130,10 +130,12 @@ def test_an_axis_written_in_the_model_frame_is_read_there(tmp_path, transform, w
     ``expressed_in="__model__"``), each joint frame tilted off the plane: the textbook pressure angles, scaled and
     turned in the world. The element was dropped without a word (the axis read in the tilted joint frame: the loops
     rigid), the attribute refused; the report says where Gazebo's conversion to SDFormat 1.7 reads the element
-    otherwise."""
+    otherwise. The legs written in reverse and the motors renamed, as above."""
     path = tmp_path / "robot.urdf"
-    path.write_text(five_bar_gazebo(transform=transform, pose_rpy=(0.3, -0.2, 0.4), model_axis=written))
-    assert_moved_textbook(load(path), transform, lambda name: int(name[-1]) - 1)
+    names = {0: "drive_c", 1: "drive_a", 2: "drive_b"}
+    path.write_text(five_bar_gazebo(transform=transform, pose_rpy=(0.3, -0.2, 0.4), model_axis=written,
+                                    order=(2, 1, 0), motor=names.get))
+    assert_moved_textbook(load(path), transform, {name: leg for leg, name in names.items()}.get)
     _, report = read_mechanism_file(path)
     said = [note for note in report.notes if "as <use_parent_model_frame> asks" in note]
     assert len(said) == (2 if written == "element" else 0), report.notes

@@ -72,13 +72,20 @@ def planar_points(mechanism: Mechanism, solution):
 
     Returns ``(base, elbows, distal, prismatic)``: arrays (N, k, 2) of the first, second and
     last joint points of each 3-joint planar chain, and whether the chains are RPR (actuated
-    prismatic middle joint) rather than RRR (actuated base joint).
+    prismatic middle joint) rather than RRR (actuated base joint). With a point output, an R-R chain whose second
+    link is the platform (a five-bar written with its output on a leg's distal link) has its last point at the
+    output point, where the other legs meet it: the actuation wrench's force runs from its elbow through the point.
     """
     if not mechanism.is_planar:
         raise ValueError(f"The closed forms are planar: mechanism {mechanism.name!r} is spatial.")
-    kinds = set()
+    kinds, on_platform = set(), []
     for chain in mechanism.chains:
         prismatic = tuple(chain.prismatic)
+        on_platform.append(mechanism.output_point is not None and chain.n_joints == 2 and chain.actuated == (0,)
+                           and prismatic == (False, False))
+        if on_platform[-1]:
+            kinds.add("rrr")
+            continue
         if chain.n_joints != 3 or chain.actuated not in ((0,), (1,)):
             driven = ", ".join(repr(chain.joint_names[i]) for i in chain.actuated) or "none"
             raise ValueError(f"The closed forms need RRR or RPR chains with one actuator; chain {chain.name!r} of "
@@ -101,6 +108,10 @@ def planar_points(mechanism: Mechanism, solution):
     # returned (N, k, 2) arrays are views of it (the closed-form kernel reads any layout).
     memory = np.empty((3, 2, len(solution.joint_points), count))
     for chain, points in enumerate(solution.joint_points):
+        if on_platform[chain]:  # (R-R to the platform: the output point last, in the base frame)
+            rotation, translation = mechanism.transforms_from_poses(solution.full_poses)
+            point = translation + rotation @ mechanism.output_point
+            points = np.concatenate([points, point[..., None, :]], axis=-2)
         flat = points.reshape(-1, 3, 3)
         for joint in range(3):
             for component in range(2):
