@@ -9,11 +9,16 @@ file: in metres, and turned in the world and written in millimetres; redundant (
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from test_io import five_bar_mjcf
 
 from helpers import random_rotation, screwkit_json
+from screwkit.closure import solve
+from screwkit.io.loader import load
+from screwkit.studies.poses import planar_points
 
 
 @pytest.mark.parametrize(("legs", "turned"), [(3, False), (2, True)])
@@ -26,3 +31,17 @@ def test_verify_reads_a_five_bar_whose_output_is_on_a_distal_link(tmp_path, legs
     assert report["poses"] == 200 and report["largest_deviation"] < 1e-9, report
     assert set(report["deviations"]) >= {"ITI per actuator", "OTI per submechanism", "LMTI", "F_O1", "F_IO1"}
     assert not any(report["differing_poses"].values()), report
+
+
+def test_the_closed_forms_refuse_an_output_point_where_the_legs_do_not_meet(tmp_path):
+    """The output point stands for the R-R leg's last joint only where the other legs meet the platform: moved off
+    it (a mechanism built in Python), the closed forms are refused naming the leg and the distance."""
+    path = tmp_path / "five_bar.xml"
+    path.write_text(five_bar_mjcf(legs=3))
+    mechanism = load(path, output="distal_1")
+    solution = solve(mechanism, mechanism.home_pose[None])
+    planar_points(mechanism, solution)  # as read: the legs meet at the output point
+    moved = replace(mechanism, output_point=mechanism.output_point + [0.01, 0.0, 0.0])
+    with pytest.raises(ValueError, match=r"The textbook pressure angles are for legs meeting at the output point; "
+                                         r"chain '.*' of '.*' meets the platform 0.01 m from it"):
+        planar_points(moved, solve(moved, moved.home_pose[None]))

@@ -67,6 +67,11 @@ def analyze_solution(mechanism: Mechanism, solution, *, unreachable: str = "rais
     return analyze(chains, **options)
 
 
+MEETING_TOLERANCE = 1e-9
+"""Relative to the length scale: how far a leg of a five-bar written with its output on a leg's distal link may meet
+the platform from the output point for :func:`planar_points` (the closures put them together to rounding)."""
+
+
 def planar_points(mechanism: Mechanism, solution):
     """Planar joint points of every chain in the base frame (reachable configurations), for the closed forms.
 
@@ -118,6 +123,13 @@ def planar_points(mechanism: Mechanism, solution):
                 column = flat[:, joint, component]
                 memory[joint, component, chain] = column if everything else column[mask]
     base, elbows, distal = (memory[joint].transpose(2, 1, 0) for joint in range(3))
+    if any(on_platform):  # (the output point stands for the R-R legs' last joint: where the other legs meet)
+        apart = np.linalg.norm(distal - distal[:, on_platform.index(True)][:, None], axis=-1).max(axis=0)
+        if not np.all(apart <= MEETING_TOLERANCE * mechanism.length_scale):
+            chain = mechanism.chains[int(np.argmax(apart))].name
+            raise ValueError(f"The textbook pressure angles are for legs meeting at the output point; chain {chain!r} "
+                             f"of {mechanism.name!r} meets the platform {apart.max():.3g} m from it (the generic "
+                             "path reads it: `analyze`, without the closed forms).")
     return base, elbows, distal, kinds == {"rpr"}
 
 
