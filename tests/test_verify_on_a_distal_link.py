@@ -18,7 +18,7 @@ from test_io import five_bar_mjcf
 from helpers import random_rotation, screwkit_json
 from screwkit.closure import solve
 from screwkit.io.loader import load
-from screwkit.studies.poses import planar_points
+from screwkit.studies.closed_form_poses import planar_points
 
 
 @pytest.mark.parametrize(("legs", "turned"), [(3, False), (2, True)])

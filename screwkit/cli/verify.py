@@ -18,8 +18,9 @@ from screwkit.cli.options import (
 from screwkit.closure import solve
 from screwkit.common.compiling import INDEX_KERNELS, compile_ahead
 from screwkit.indices.stages import SPACES_COMPILED_FROM
+from screwkit.studies.closed_form_poses import closed_form_indices, planar_points
 from screwkit.studies.kernels import mechanism_kernels
-from screwkit.studies.poses import analyze_solution, closed_form_indices, planar_points
+from screwkit.studies.poses import analyze_solution
 
 __all__ = ["verify"]
 

@@ -25,10 +25,10 @@ from screwkit.indices.average import AGGREGATES, failure_weights, mean_remaining
 from screwkit.indices.closed_forms import planar_indices
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.screw.planar import PlanarDesign, planar_joint_points, rrr_chain_screws
+from screwkit.studies.closed_form_poses import planar_points
 from screwkit.studies.coordinates import planar_position
 from screwkit.studies.design.families import permutation_rank
 from screwkit.studies.design.objectives import check_disc, check_turn_count, real_number
-from screwkit.studies.poses import planar_points
 from screwkit.studies.tasks import Execution, run_tasks
 
 __all__ = ["planar_design", "slot_design", "slots_of", "rotation_score", "permutation_search", "rotation_class",
