@@ -218,7 +218,6 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
     return advice if advice[1] else _transmission_advice(tree, leg, platform)
 
 
-
 def _and_stage(tree: ClosedTree, leg, advice: tuple[str, list[str]]) -> tuple[str, list[str]]:
     """``advice`` (text, joints held) with, where a serial stage also carries the leg's actuators (the whole robot
     on a driven rail), the advice that holds it too: both are needed, and one run names them."""
@@ -227,6 +226,7 @@ def _and_stage(tree: ClosedTree, leg, advice: tuple[str, list[str]]) -> tuple[st
     if not held or set(held) & set(names):
         return advice
     return f"{text}; and either way{stage[1:]}", names + held
+
 
 def _stage_advice(tree: ClosedTree, leg) -> tuple[str, list[str]]:
     """For a leg with several actuators: the serial stage that carries them (a rail, a floating base, a hip's motors
