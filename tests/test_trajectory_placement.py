@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.spatial.transform import Rotation
 from test_four_bar_output import four_bar_mjcf
 from test_meeting_lines import spm_mjcf
@@ -61,8 +62,10 @@ def test_a_one_dof_linkage_turned_in_the_world_has_the_same_arc_length_and_event
     turned = variants["turned"]
     np.savetxt(tmp_path / "crank.csv", np.rad2deg(CRANK), header=actuator_columns(turned)[0][0], comments="")
     summary = screwkit_json("trajectory", tmp_path / "turned.xml", tmp_path / "crank.csv", "--actuators", "--output",
-                            "coupler", "--quiet")
+                            "coupler", "--quiet", "--out", tmp_path / "crank.nc")
     assert summary["length_m"] == pytest.approx(reference[0].length, rel=1e-12)
+    with xr.open_dataset(tmp_path / "crank.nc", engine="scipy") as written:  # the file says which arc length
+        assert written["arc_length"].attrs["long_name"] == "arc length along the actuators"
 
 
 def test_a_spherical_manipulator_turned_in_the_world_has_the_same_arc_length(tmp_path):

@@ -41,7 +41,8 @@ def trajectory_from_dataset(dataset):
     import re
     from types import SimpleNamespace
 
-    from screwkit.studies.trajectory import FaultCase, Margin, PathEvent  # the studies: for a file read back only
+    from screwkit.studies.paths import ARC_LENGTH_NAMES  # the studies: for a file read back only
+    from screwkit.studies.trajectory import FaultCase, Margin, PathEvent  # (likewise)
 
     summary = json.loads(dataset.attrs["summary"])
 
@@ -57,7 +58,8 @@ def trajectory_from_dataset(dataset):
     s = np.asarray(dataset["arc_length"].values, dtype=float)
     path = SimpleNamespace(arc_length=s, times=np.asarray(dataset["t"].values, dtype=float) if "t" in dataset else None,
                            samples=int(summary["samples"]), length=float(summary["length_m"]),
-                           length_scale=float(summary["length_scale_m"]))
+                           length_scale=float(summary["length_scale_m"]),
+                           along_actuators=dataset["arc_length"].attrs.get("long_name") == ARC_LENGTH_NAMES[True])
     cases = tuple(FaultCase(int(c["j"]), tuple(c["failed"]), np.asarray(c["controllable_m"], float).reshape(-1, 2),
                             np.asarray(c["lost_m"], float).reshape(-1, 2), c["first_loss_m"], number(c["minimum"]),
                             number(c["at_m"]), tuple(c["singular_at_m"])) for c in summary["faults"])
@@ -209,8 +211,8 @@ def trajectory_figure(result):
         ax.set_title(wrap_text(f"({chr(ord('a') + row)}) {j} failure(s): shaded where the LMTI of the actuators "
                                f"left is below {result.level:g} (x: singular); worst for this path in bold: "
                                f"{named or 'none'}", 7.5, TITLE_SIZE), fontsize=TITLE_SIZE, loc="left")
-    axes[-1].set_xlabel("arc length (m; angles weighted by the length scale "
-                        f"{result.path.length_scale:.4g} m/rad)")
+    axes[-1].set_xlabel(f"arc length{' along the actuators' if result.path.along_actuators else ''} (m; angles "
+                        f"weighted by the length scale {result.path.length_scale:.4g} m/rad)")
     axes[-1].set_xlim(s[0], s[-1])
     figure.suptitle(wrap_text(f"{result.mechanism}: {result.path.samples} samples, {result.path.length:.4g} m of "
                               f"path; worst failure {'; '.join(worst_names)}", 9.0, TITLE_SIZE + 1),

@@ -109,7 +109,7 @@ def path_from_actuators(mechanism: Mechanism | GraphMechanism, values: ArrayLike
         poses[middle] = _reached(mechanism, values[middle], poses[solved[gaps]], middle)
         solved = np.sort(np.concatenate([solved, middle]))
     posed = path_from_poses(mechanism, poses, times)  # (checked as a path of poses is)
-    return replace(posed, arc_length=_along_actuators(mechanism, values))
+    return replace(posed, arc_length=_along_actuators(mechanism, values), actuators=values)
 
 
 def _checked(mechanism: Mechanism | GraphMechanism, values: ArrayLike) -> NDArray[np.float64]:

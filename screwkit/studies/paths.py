@@ -39,7 +39,11 @@ from screwkit.studies.files import open_netcdf
 
 __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path", "read_path", "read_columns",
            "PathFileError", "TIME_COLUMN", "checked_times", "checked_tolerance", "ANGLE_UNITS", "TIME_UNITS",
-           "weighted_arc_length"]
+           "weighted_arc_length", "ARC_LENGTH_NAMES"]
+
+ARC_LENGTH_NAMES = {False: "arc length", True: "arc length along the actuators"}
+"""The ``long_name`` of a path file's ``arc_length`` (by :attr:`Path.along_actuators`), which a figure drawn again
+from the file reads."""
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""
@@ -76,11 +80,13 @@ class Path:
         The weight of angles in the arc length (m per rad): the mechanism's length scale.
     times : ndarray (n,) or None
         The time of each sample (s), increasing, when the path has them.
-    actuators, configurations : ndarray (n, a) and (n, nq), or None
-        Of a mechanism whose legs have loops inside them driven along the path by its actuators
-        (:func:`~screwkit.studies.actuator_paths.path_from_actuators`): the actuators' values (rad, m) and the closed
-        configuration they reach at each sample, from which the path is analysed (between samples, the actuators
-        move linearly along each segment).
+    actuators : ndarray (n, a) or None
+        Of a path driven by the mechanism's actuators (:func:`~screwkit.studies.actuator_paths.path_from_actuators`):
+        their values (rad, m) at each sample, along which the arc length is measured.
+    configurations : ndarray (n, nq) or None
+        Of a mechanism whose legs have loops inside them so driven: the closed configuration the actuators reach at
+        each sample, from which the path is analysed (between samples, the actuators move linearly along each
+        segment).
     """
 
     poses: NDArray[np.float64]
@@ -94,6 +100,11 @@ class Path:
     def length(self) -> float:
         """The path's length (m)."""
         return float(self.arc_length[-1])
+
+    @property
+    def along_actuators(self) -> bool:
+        """Whether the arc length is along the actuators (a path driven by them), not in task coordinates."""
+        return self.actuators is not None
 
     @property
     def samples(self) -> int:

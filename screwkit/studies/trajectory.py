@@ -47,7 +47,7 @@ from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions, checked_analysis
 from screwkit.studies.path_mechanisms import GraphPath, SerialPath, check_path_size, path_mechanism
-from screwkit.studies.paths import Path, checked_tolerance, path_from_poses
+from screwkit.studies.paths import ARC_LENGTH_NAMES, Path, checked_tolerance, path_from_poses
 from screwkit.studies.refinement import (
     bisected_crossings,
     bracketed_minima,
@@ -229,7 +229,8 @@ class TrajectoryResult:
     def plain_dataset(self) -> PlainDataset:
         """What :meth:`to_dataset` holds, as plain arrays: ``--out`` writes it to netCDF without importing xarray
         (:meth:`PlainDataset.write_netcdf`), and ``xarray.open_dataset`` reads back the same dataset."""
-        coords = {"arc_length": ("sample", self.path.arc_length, {"units": "m", "long_name": "arc length"})}
+        coords = {"arc_length": ("sample", self.path.arc_length, {"units": "m", "long_name": ARC_LENGTH_NAMES[
+            self.path.along_actuators]})}
         if self.path.times is not None:
             coords["t"] = ("sample", self.path.times, {"units": "s"})
         variables, coords, attrs = indices_variables(self.indices, ("sample",), coords)
