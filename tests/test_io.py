@@ -672,6 +672,13 @@ def test_ignore_limits_reads_a_reference_assembly_outside_its_limits_on_every_co
     analysed = screwkit("analyze", path, "--ignore-limits", "--json")
     assert analysed.returncode == 0, analysed.stderr
     assert "limits ignored: joint 'a_1'" in analysed.stderr
+    both = tmp_path / "both.xml"  # two joints outside one range: said once, naming both
+    both.write_text(path.read_text().replace('<joint name="a_2" type="hinge"', '<joint name="a_2" type="hinge" '
+                                                                              'range="0.001 1"'))
+    twice = screwkit("info", both, "--ignore-limits")
+    assert twice.returncode == 0 and twice.stderr.count("limits ignored") == 1, twice.stderr
+    assert "limits ignored: joints 'a_1', 'a_2': the reference assembly puts each at 0, outside its limits [0.001, " \
+           "1]" in twice.stderr
     assert json.loads(analysed.stdout)["lmti"] == pytest.approx(five_bar_expected(HOME)["lmti"], abs=TOLERANCE)
     assert screwkit("info", path, "--ignore-limits", "--json").returncode == 0
     mapped = screwkit("map", path, "--ignore-limits", "--grid", "x:-0.02:0.02:0.01", "--grid", "y:0.33:0.37:0.01",

@@ -20,7 +20,7 @@ import click
 import numpy as np
 
 from screwkit.cli.option_checks import execution_record, finite_threshold
-from screwkit.cli.reading import FILE_OPTIONS, Reading, reading_record
+from screwkit.cli.reading import FILE_OPTIONS, Reading, grouped_notes, reading_record
 from screwkit.closure.assembly import NOT_OPEN_LOOPS
 from screwkit.common.compiling import (
     INDEX_KERNELS,
@@ -422,7 +422,7 @@ def load_mechanism(name: str, reading: Reading | str | None = None, *, indices: 
         # a file whose loops are open as written describes another mechanism than the one analysed: say so
         echo_error(f"{name}: loops open at the file's own joint values were closed at loading: " + "; ".join(opened))
     if ignored and not _quiet():
-        echo_error(f"{name}: " + "; ".join(ignored))
+        echo_error(f"{name}: " + "; ".join(grouped_notes(ignored)))
     if indices:  # the kernels of this mechanism's chains, compiled while the command goes on
         from screwkit.studies.kernels import mechanism_kernels  # the closures and indices: commands computing them
 

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Callable
 
 import click
 
+from screwkit.closure.assembly import LIMITS_IGNORED
+
 __all__ = ["Reading", "reading_record", "lock_option", "actuate_option", "initial_option", "output_frame_option",
-           "output_type_option", "LOCK_HELP", "ACTUATE_HELP", "INITIAL_HELP", "FILE_OPTIONS"]
+           "output_type_option", "grouped_notes", "LOCK_HELP", "ACTUATE_HELP", "INITIAL_HELP", "FILE_OPTIONS"]
 
 
 @dataclass(frozen=True)
@@ -77,3 +80,23 @@ def output_type_option(function: Callable) -> Callable:
 
 FILE_OPTIONS = (output_frame_option, output_type_option, lock_option, actuate_option, initial_option)
 """The options of a file of another tool, in the order every command that reads MECHANISM shows them."""
+
+
+def grouped_notes(notes) -> list[str]:
+    """``notes`` with the :data:`LIMITS_IGNORED` ones that say the same of several joints (a hexapod's six slides
+    at 0, outside one range) said once, naming the joints, where the first of them stood: the line a command prints."""
+    shared: dict[str, list[str]] = {}
+    for note in notes:
+        named = re.fullmatch(rf"{re.escape(LIMITS_IGNORED)}joint ('.*?'): (.*)", note)
+        if named:
+            shared.setdefault(named.group(2), []).append(named.group(1))
+    out = []
+    for note in notes:
+        named = re.fullmatch(rf"{re.escape(LIMITS_IGNORED)}joint ('.*?'): (.*)", note)
+        if not named:
+            out.append(note)
+        elif shared.get(named.group(2), [None])[0] == named.group(1):
+            joints = shared[named.group(2)]
+            where = named.group(2) if len(joints) == 1 else named.group(2).replace("puts the joint at", "puts each at")
+            out.append(f"{LIMITS_IGNORED}joint{'s' if len(joints) > 1 else ''} {', '.join(joints)}: {where}")
+    return out
