@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 
 from helpers import one_line_error, screwkit
-from screwkit.closure import chain_screws, solve_one
+from screwkit.closure import chain_screws, solve, solve_one
+from screwkit.closure.solve import actuator_values
 from screwkit.common.tolerances import SINGULARITY_THRESHOLD
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
@@ -695,12 +696,25 @@ def test_cli_view_animates_a_path_and_refuses_a_bad_path_file(tmp_path):
     clip = {item["path"]: item["clip"] for item in animation}[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]
     keys = {t["name"]: t for t in clip["tracks"]}[".position"]["keys"]
     np.testing.assert_allclose([key["time"] / clip["fps"] for key in keys], [0.0, 0.5, 2.0], atol=1e-12)
+    five = load("planar_5rrr")  # the line's actuator values (inverse kinematics), animated through their poses
+    poses = five.poses_from_degrees(np.linspace([-0.3, -0.2, -45], [0.3, 0.2, 45], 5))
+    values = np.rad2deg(actuator_values(five, solve(five, poses).joint_values))
+    driven = tmp_path / "driven.csv"
+    np.savetxt(driven, values, delimiter=",", header=",".join(f"chain_{i}" for i in range(1, 6)), comments="")
+    outcome = screwkit("view", "planar_5rrr", "--path", driven, "--actuators", "--html", tmp_path / "driven.html")
+    assert outcome.returncode == 0, outcome.stderr
+    animation = [c for c in scene_commands((tmp_path / "driven.html").read_text())
+                 if c["type"] == "set_animation" and c["animations"]][-1]["animations"]
+    clip = {item["path"]: item["clip"] for item in animation}[full_path(f"{ROOT_PATH}/mechanism/visuals/platform_0")]
+    keys = {t["name"]: t for t in clip["tracks"]}[".position"]["keys"]
+    np.testing.assert_allclose([key["value"][:2] for key in keys], poses[:, :2], atol=1e-9)
     bad = tmp_path / "bad.csv"
     bad.write_text("x,y\n0,0\n0.1,0\n")
     for arguments, needles in (
         (["--path", bad], ("bad.csv", "no column 'phi'")),
         (["--path", tmp_path / "missing.csv"], ("missing.csv: no such file",)),
         (["--path", table, "--sweep-phi", "0:10:5"], ("at most one of", "--sweep-phi, --path")),
+        (["--actuators"], ("--actuators says that --path holds actuator values, and there is no --path",)),
     ):
         one_line_error(screwkit("view", "planar_5rrr", *arguments, "--html", tmp_path / "never.html"), *needles)
     assert not (tmp_path / "never.html").exists()
@@ -728,6 +742,12 @@ def test_cli_view_draws_and_animates_a_graph(tmp_path):
     assert len(keys) == 13  # 12 samples evenly spaced in arc length, plus the pose in the middle
     one_line_error(screwkit("view", "delta_rods_4", "--pose", "0", "0", "5", "--html", tmp_path / "far.html"),
                    "no closed configuration", "z=5")
+    driven = tmp_path / "arms.csv"  # actuator values: poses closed again past a fold may close elsewhere
+    driven.write_text("arm_1,arm_2,arm_3,arm_4\n0,0,0,0\n5,5,5,5\n")
+    one_line_error(screwkit("view", "delta_rods_4", "--path", driven, "--actuators", "--html", tmp_path / "a.html"),
+                   "--actuators animates the poses the actuators drive", "the legs of 'delta_rods_4' have loops",
+                   "`screwkit trajectory --actuators` follows such a path in joint space")
+    assert not (tmp_path / "a.html").exists()
 
 
 SIGNAL_AFTER_THE_LINE = """

@@ -53,7 +53,7 @@ class Motion:
 
 
 def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, line: str | None, circle: str | None,
-            through: str | None, samples: int) -> Motion:
+            through: str | None, samples: int, actuators: bool = False) -> Motion:
     """The :class:`Motion`: at most one of its sources, a path file that exists (checked before anything loads)."""
     given = [name for name, value in (("--sweep-phi", sweep_phi), ("--path", path_file), ("--line", line),
                                       ("--circle", circle), ("--through", through)) if value]
@@ -70,8 +70,12 @@ def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, lin
                    "or leave --frame-rate out.")
     source = None
     if given and given[0] != "--sweep-phi":
-        source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples)
+        source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples,
+                            actuators=actuators)
         source.check()
+    elif actuators:
+        raise fail("--actuators says that --path holds actuator values, and there is no --path: give one, or leave "
+                   "--actuators out.")
     return Motion(sweep_phi, source, frame_rate)
 
 
@@ -109,6 +113,12 @@ def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool, 
         return poses, None
     if motion.path is None:
         return None
+    from screwkit.io.graph import GraphMechanism  # (loaded already: the mechanism was read)
+
+    if motion.path.actuators and isinstance(mechanism, GraphMechanism):  # (animated by poses, closed again)
+        raise fail(f"--actuators animates the poses the actuators drive, closed again frame by frame: the legs of "
+                   f"{mechanism.name!r} have loops inside them, its task coordinates may fold, and a pose past a fold "
+                   "may close elsewhere; `screwkit trajectory --actuators` follows such a path in joint space.")
     path = motion.path.read(mechanism)
     if path.times is not None and not quiet:
         echo_error(f"Animated at the path's own times: {path.times[-1] - path.times[0]:g} s.")
@@ -246,6 +256,9 @@ def _say(message: str) -> None:
                       f"trajectory` reads it, played at its time column's times if it has one (more than {MAX_FRAMES} "
                       f"samples: {MAX_FRAMES} frames evenly spaced in time, else in arc length); the chains' colours "
                       "follow their index frame by frame."),
+    click.option("--actuators", is_flag=True,
+                 help="--path holds actuator values (as `screwkit trajectory --actuators` reads them): the platform "
+                      "is animated through the poses they drive (mechanisms of serial legs)."),
     line_option, circle_option, through_option, samples_option,
     click.option("--frame-rate", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
                  help="--sweep-phi and paths: keyframes per second (1/s); a path with a time column plays at "
