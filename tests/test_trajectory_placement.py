@@ -60,10 +60,16 @@ def test_a_one_dof_linkage_turned_in_the_world_has_the_same_arc_length_and_event
             assert result.margins[name].arc_length == pytest.approx(margin.arc_length,
                                                                     abs=2 * reference[1].tolerance), (variant, name)
     turned = variants["turned"]
+    wrapped = CRANK.copy()  # a log written in [-180, 180) deg: the crank's step the short way round, as driven
+    wrapped[10:] -= 2.0 * np.pi
+    again = path_from_actuators(turned, wrapped)
+    np.testing.assert_allclose(again.poses, path_from_actuators(turned, CRANK).poses, atol=1e-12)
+    np.testing.assert_allclose(again.arc_length, reference[0].arc_length, rtol=1e-12)
     np.savetxt(tmp_path / "crank.csv", np.rad2deg(CRANK), header=actuator_columns(turned)[0][0], comments="")
     summary = screwkit_json("trajectory", tmp_path / "turned.xml", tmp_path / "crank.csv", "--actuators", "--output",
                             "coupler", "--quiet", "--out", tmp_path / "crank.nc")
     assert summary["length_m"] == pytest.approx(reference[0].length, rel=1e-12)
+    assert summary["arc_length"] == "along the actuators"
     with xr.open_dataset(tmp_path / "crank.nc", engine="scipy") as written:  # the file says which arc length
         assert written["arc_length"].attrs["long_name"] == "arc length along the actuators"
 

@@ -715,6 +715,7 @@ def test_cli_view_animates_a_path_and_refuses_a_bad_path_file(tmp_path):
         (["--path", tmp_path / "missing.csv"], ("missing.csv: no such file",)),
         (["--path", table, "--sweep-phi", "0:10:5"], ("at most one of", "--sweep-phi, --path")),
         (["--actuators"], ("--actuators says that --path holds actuator values, and there is no --path",)),
+        (["--line", "0", "0", "0", "0.1", "0", "0", "--actuators"], ("give --path a file, not --line",)),
     ):
         one_line_error(screwkit("view", "planar_5rrr", *arguments, "--html", tmp_path / "never.html"), *needles)
     assert not (tmp_path / "never.html").exists()

@@ -110,7 +110,8 @@ def _through(mechanism, words: list[str]) -> list[np.ndarray]:
 def print_summary(summary: dict) -> None:
     """The summary of a trajectory on stderr: margins, every failure's lost stretches, worst failures, events."""
     echo_error(f"{summary['mechanism']}: {summary['samples']} samples, {summary['length_m']:.6g} m of path "
-               f"(angles weighted by {summary['length_scale_m']:.6g} m/rad), {summary['reachable_samples']} "
+               f"{summary['arc_length']} (angles weighted by {summary['length_scale_m']:.6g} m/rad), "
+               f"{summary['reachable_samples']} "
                f"reachable; level {summary['level']:g}, tolerance {summary['tolerance_m']:.3g} m")
     for event in summary["events"]:
         if event["kind"] == "branch":
@@ -152,6 +153,7 @@ class PathSource:
     through: str | None = None
     samples: int = DEFAULT_SAMPLES
     actuators: bool = False
+    file_option: str = "PATH"  # (how the command names the file: `view` takes it as --path)
 
     def check(self) -> None:
         """Exactly one source, and a file that exists, before the mechanism is even loaded."""
@@ -161,7 +163,8 @@ class PathSource:
             raise fail("Expected exactly one of PATH (a .csv or .nc file), --line A B, --circle CENTRE RADIUS or "
                        f"--through POSE POSE ..., got {', '.join(given) or 'none'}.")
         if self.actuators and self.path_file is None:
-            raise fail(f"--actuators says that PATH holds actuator values: give a PATH file, not {given[0]}.")
+            raise fail(f"--actuators says that {self.file_option} holds actuator values: give {self.file_option} a "
+                       f"file, not {given[0]}.")
         if self.path_file is not None and not os.path.isfile(self.path_file):
             raise fail(f"{self.path_file}: "
                        f"{'is a folder, not a path file' if os.path.isdir(self.path_file) else 'no such file'}.")

@@ -71,7 +71,7 @@ def _motion(sweep_phi: str | None, frame_rate: float, path_file: str | None, lin
     source = None
     if given and given[0] != "--sweep-phi":
         source = PathSource(path_file=path_file, line=line, circle=circle, through=through, samples=samples,
-                            actuators=actuators)
+                            actuators=actuators, file_option="--path")
         source.check()
     elif actuators:
         raise fail("--actuators says that --path holds actuator values, and there is no --path: give one, or leave "

@@ -26,7 +26,9 @@ deg for revolute and m for prismatic actuators; optionally ``t``, s) and says in
 The arc length of a path so driven is along the actuators (their values' steps, angles times the length scale),
 for serial legs and loops alike: the same wherever the file places the mechanism in the world, where the task
 coordinates (taken in the world's frame, a one-DoF linkage's x or y as its plane lies) and their roll, pitch and
-yaw rates are not.
+yaw rates are not. For serial legs a revolute actuator's step is taken the short way round, as the forward
+kinematics takes it (a log written in [-180, 180) deg); legs with loops inside them are moved through every value
+in between, and their steps are measured so.
 """
 
 from __future__ import annotations
@@ -109,7 +111,10 @@ def path_from_actuators(mechanism: Mechanism | GraphMechanism, values: ArrayLike
         poses[middle] = _reached(mechanism, values[middle], poses[solved[gaps]], middle)
         solved = np.sort(np.concatenate([solved, middle]))
     posed = path_from_poses(mechanism, poses, times)  # (checked as a path of poses is)
-    return replace(posed, arc_length=_along_actuators(mechanism, values), actuators=values)
+    # (a revolute actuator's step the short way, as the forward kinematics takes it: a log written in [-180, 180))
+    unwrapped = values.copy()
+    unwrapped[:, _angular(mechanism)] = np.unwrap(values[:, _angular(mechanism)], axis=0)
+    return replace(posed, arc_length=_along_actuators(mechanism, unwrapped), actuators=values)
 
 
 def _checked(mechanism: Mechanism | GraphMechanism, values: ArrayLike) -> NDArray[np.float64]:

@@ -30,7 +30,7 @@ from screwkit.indices.results import Indices
 from screwkit.indices.stages import checked_chunk_size, checked_faults, checked_threshold
 from screwkit.model import Mechanism, require_mechanism
 from screwkit.studies.batch_arrays import ARRAYS, DICTS, fill_unreachable, scatter
-from screwkit.studies.closed_form_poses import closed_form_indices
+from screwkit.studies.closed_form_poses import closed_form_indices, planar_points  # noqa: F401 (importable here too)
 
 if TYPE_CHECKING:  # the graph reader is imported when a graph is analysed (it is no part of the other paths)
     from screwkit.io.graph import GraphMechanism

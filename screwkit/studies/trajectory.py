@@ -47,7 +47,7 @@ from screwkit.studies.branches import branch_changes, describe
 from screwkit.studies.netcdf import PlainDataset
 from screwkit.studies.options import AnalysisOptions, checked_analysis
 from screwkit.studies.path_mechanisms import GraphPath, SerialPath, check_path_size, path_mechanism
-from screwkit.studies.paths import ARC_LENGTH_NAMES, Path, checked_tolerance, path_from_poses
+from screwkit.studies.paths import ARC_LENGTH_NAMES, ARC_LENGTH_WAYS, Path, checked_tolerance, path_from_poses
 from screwkit.studies.refinement import (
     bisected_crossings,
     bracketed_minima,
@@ -201,7 +201,8 @@ class TrajectoryResult:
         path = self.path
         return {
             "mechanism": self.mechanism, "samples": path.samples, "length_m": path.length,
-            "length_scale_m": path.length_scale, "level": self.level, "tolerance_m": self.tolerance,
+            "length_scale_m": path.length_scale, "arc_length": ARC_LENGTH_WAYS[path.along_actuators],
+            "level": self.level, "tolerance_m": self.tolerance,
             "aggregate": self.aggregate,
             "duration_s": None if path.times is None else float(path.times[-1] - path.times[0]),
             "reachable_samples": int(np.count_nonzero(self.indices.reachable)), "dof": int(self.indices.dof),
