@@ -113,12 +113,14 @@ def _animated_poses(mechanism, motion: Motion, target: np.ndarray, quiet: bool, 
         return poses, None
     if motion.path is None:
         return None
-    from screwkit.io.graph import GraphMechanism  # (loaded already: the mechanism was read)
+    if motion.path.actuators:
+        from screwkit.io.graph import GraphMechanism  # (with --actuators only: legs with loops are refused)
 
-    if motion.path.actuators and isinstance(mechanism, GraphMechanism):  # (animated by poses, closed again)
-        raise fail(f"--actuators animates the poses the actuators drive, closed again frame by frame: the legs of "
-                   f"{mechanism.name!r} have loops inside them, its task coordinates may fold, and a pose past a fold "
-                   "may close elsewhere; `screwkit trajectory --actuators` follows such a path in joint space.")
+        if isinstance(mechanism, GraphMechanism):  # (animated by poses, each closed again)
+            raise fail(f"--actuators animates the poses the actuators drive, closed again frame by frame: the legs of "
+                       f"{mechanism.name!r} have loops inside them, its task coordinates may fold, and a pose past a "
+                       "fold may close elsewhere; `screwkit trajectory --actuators` follows such a path in joint "
+                       "space.")
     path = motion.path.read(mechanism)
     if path.times is not None and not quiet:
         echo_error(f"Animated at the path's own times: {path.times[-1] - path.times[0]:g} s.")
