@@ -85,17 +85,16 @@ FILE_OPTIONS = (output_frame_option, output_type_option, lock_option, actuate_op
 def grouped_notes(notes) -> list[str]:
     """``notes`` with the :data:`LIMITS_IGNORED` ones that say the same of several joints (a hexapod's six slides
     at 0, outside one range) said once, naming the joints, where the first of them stood: the line a command prints."""
+    read = [(note, re.fullmatch(rf"{re.escape(LIMITS_IGNORED)}joint ('.*?'): (.*)", note)) for note in notes]
     shared: dict[str, list[str]] = {}
-    for note in notes:
-        named = re.fullmatch(rf"{re.escape(LIMITS_IGNORED)}joint ('.*?'): (.*)", note)
+    for _, named in read:
         if named:
             shared.setdefault(named.group(2), []).append(named.group(1))
     out = []
-    for note in notes:
-        named = re.fullmatch(rf"{re.escape(LIMITS_IGNORED)}joint ('.*?'): (.*)", note)
+    for note, named in read:
         if not named:
             out.append(note)
-        elif shared.get(named.group(2), [None])[0] == named.group(1):
+        elif shared[named.group(2)][0] == named.group(1):
             joints = shared[named.group(2)]
             where = named.group(2) if len(joints) == 1 else named.group(2).replace("puts the joint at", "puts each at")
             out.append(f"{LIMITS_IGNORED}joint{'s' if len(joints) > 1 else ''} {', '.join(joints)}: {where}")

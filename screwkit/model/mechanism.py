@@ -289,6 +289,14 @@ class Mechanism:
             return rotation, translation
         return rotation_from_rpy(poses[..., 3:]), poses[..., :3].copy()
 
+    def output_positions(self, poses: ArrayLike) -> NDArray[np.float64] | None:
+        """Where the point output is (..., 3), in the base frame, at full poses (..., n_pose); None for a frame
+        output."""
+        if self.output_point is None:
+            return None
+        rotation, translation = self.transforms_from_poses(poses)
+        return translation + rotation @ self.output_point
+
     def poses_from_transforms(self, rotation: ArrayLike, translation: ArrayLike) -> NDArray[np.float64]:
         """Full poses (pose coordinates) of platform frames given in the base frame."""
         rotation = np.asarray(rotation, dtype=float)

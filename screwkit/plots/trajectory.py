@@ -211,8 +211,10 @@ def trajectory_figure(result):
         ax.set_title(wrap_text(f"({chr(ord('a') + row)}) {j} failure(s): shaded where the LMTI of the actuators "
                                f"left is below {result.level:g} (x: singular); worst for this path in bold: "
                                f"{named or 'none'}", 7.5, TITLE_SIZE), fontsize=TITLE_SIZE, loc="left")
-    axes[-1].set_xlabel(f"arc length{' along the actuators' if result.path.along_actuators else ''} (m; angles "
-                        f"weighted by the length scale {result.path.length_scale:.4g} m/rad)")
+    from screwkit.studies.paths import ARC_LENGTH_NAMES  # (the studies' words for the axis, as the file says them)
+
+    axes[-1].set_xlabel(f"{ARC_LENGTH_NAMES[result.path.along_actuators]} (m; angles weighted by the length scale "
+                        f"{result.path.length_scale:.4g} m/rad)")
     axes[-1].set_xlim(s[0], s[-1])
     figure.suptitle(wrap_text(f"{result.mechanism}: {result.path.samples} samples, {result.path.length:.4g} m of "
                               f"path; worst failure {'; '.join(worst_names)}", 9.0, TITLE_SIZE + 1),

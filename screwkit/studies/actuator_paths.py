@@ -112,8 +112,8 @@ def path_from_actuators(mechanism: Mechanism | GraphMechanism, values: ArrayLike
         solved = np.sort(np.concatenate([solved, middle]))
     posed = path_from_poses(mechanism, poses, times)  # (checked as a path of poses is)
     # (a revolute actuator's step the short way, as the forward kinematics takes it: a log written in [-180, 180))
-    unwrapped = values.copy()
-    unwrapped[:, _angular(mechanism)] = np.unwrap(values[:, _angular(mechanism)], axis=0)
+    unwrapped, angular = values.copy(), _angular(mechanism)
+    unwrapped[:, angular] = np.unwrap(values[:, angular], axis=0)
     return replace(posed, arc_length=_along_actuators(mechanism, unwrapped), actuators=values)
 
 

@@ -59,10 +59,9 @@ def planar_points(mechanism: Mechanism, solution):
     # (joint, component, chain, configuration) so that every copy below is contiguous; the
     # returned (N, k, 2) arrays are views of it (the closed-form kernel reads any layout).
     memory = np.empty((3, 2, len(solution.joint_points), count))
+    point = mechanism.output_positions(solution.full_poses) if any(on_platform) else None  # (in the base frame)
     for chain, points in enumerate(solution.joint_points):
-        if on_platform[chain]:  # (R-R to the platform: the output point last, in the base frame)
-            rotation, translation = mechanism.transforms_from_poses(solution.full_poses)
-            point = translation + rotation @ mechanism.output_point
+        if on_platform[chain]:  # (R-R to the platform: the output point last)
             points = np.concatenate([points, point[..., None, :]], axis=-2)
         flat = points.reshape(-1, 3, 3)
         for joint in range(3):

@@ -41,11 +41,12 @@ __all__ = ["Path", "path_from_poses", "line_path", "circle_path", "through_path"
            "PathFileError", "TIME_COLUMN", "checked_times", "checked_tolerance", "ANGLE_UNITS", "TIME_UNITS",
            "weighted_arc_length", "ARC_LENGTH_NAMES", "ARC_LENGTH_WAYS"]
 
-ARC_LENGTH_NAMES = {False: "arc length", True: "arc length along the actuators"}
-"""The ``long_name`` of a path file's ``arc_length`` (by :attr:`Path.along_actuators`), which a figure drawn again
-from the file reads."""
 ARC_LENGTH_WAYS = {False: "in task coordinates", True: "along the actuators"}
-"""How the arc length is measured, as a trajectory's summary says it (its ``arc_length``)."""
+"""How the arc length is measured (by :attr:`Path.along_actuators`), as a trajectory's summary says it (its
+``arc_length``)."""
+ARC_LENGTH_NAMES = {False: "arc length", True: f"arc length {ARC_LENGTH_WAYS[True]}"}
+"""The ``long_name`` of a path file's ``arc_length`` and its figure's axis (a figure drawn again from the file reads
+it)."""
 
 TIME_COLUMN = "t"
 """The optional column (CSV) or variable (netCDF) of a path file holding the time of each sample (s)."""

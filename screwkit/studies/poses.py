@@ -41,10 +41,9 @@ __all__ = ["indices_at_poses", "indices_at_pose", "indices_and_joint_values", "g
 
 def output_points(mechanism: Mechanism, full_poses: NDArray) -> NDArray[np.float64] | None:
     """The world position (..., 3) of a mechanism's point output at full poses; None for a frame output."""
-    if mechanism.output_point is None:
+    in_base = mechanism.output_positions(full_poses)
+    if in_base is None:
         return None
-    rotation, translation = mechanism.transforms_from_poses(full_poses)
-    in_base = translation + rotation @ mechanism.output_point
     return in_base @ mechanism.rotation_world_base.T + mechanism.translation_world_base
 
 
