@@ -254,6 +254,11 @@ def test_analyze_and_info_open_sdformat_files_on_the_command_line(tmp_path):
     info = screwkit("info", five_bar)
     assert info.returncode == 0, info.stderr
     assert "SDFormat (joints closing loops)" in info.stdout and "planar" in info.stdout
+    bad = write(tmp_path, five_bar_sdf().replace('<link name="base"/>', '<link name="base"><pose>0 0 1</pose></link>')
+                .replace('<link name="effector"><pose rotation_format="quat_xyzw">',
+                         '<link name="effector"><pose rotation_format="quat_xyzw">1 '), "bad.sdf")
+    one_line_error(screwkit("analyze", bad), "<link name='base'>: <pose> must hold 6 finite numbers, got '0 0 1'; "
+                   "<link name='effector'>: <pose> must hold 7 finite numbers")  # (every one, in one run)
     delta = write(tmp_path, delta_sdf(), "delta.sdf")
     expected = textbook(POSES[0])
     analysed = screwkit("analyze", delta)

@@ -130,3 +130,20 @@ def test_a_redundant_hexapod_loses_control_on_the_same_stretches_however_placed_
         for case in expected.cases:
             np.testing.assert_allclose(cases[frozenset(case.failed)].lost, case.lost, rtol=0,
                                        atol=2 * expected.tolerance, err_msg=f"{variant} {case.failed}")
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_arc_length_of_a_linkage_scaled_scales_with_it(tmp_path, scale):
+    """The knee a thousand times smaller or larger, read in metres: every arc length, and the ITI minimum's place
+    on it, times the scale; the indices the same."""
+    results = {}
+    for factor in (1.0, scale):
+        (tmp_path / f"knee_{factor:g}.xml").write_text(four_bar_mjcf(scale=factor))
+        mechanism = load(tmp_path / f"knee_{factor:g}.xml", output="coupler")
+        result = trajectory(mechanism, path_from_actuators(mechanism, CRANK))
+        results[factor] = result
+    small, big = results[1.0], results[scale]
+    np.testing.assert_allclose(big.path.arc_length, scale * small.path.arc_length, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(big.indices.iti, small.indices.iti, atol=1e-9)
+    assert big.margins["iti"].arc_length == pytest.approx(scale * small.margins["iti"].arc_length,
+                                                          abs=2 * big.tolerance)

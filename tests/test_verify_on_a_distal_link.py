@@ -9,6 +9,7 @@ file: in metres, and turned in the world and written in millimetres; redundant (
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -21,11 +22,30 @@ from screwkit.io.loader import load
 from screwkit.studies.closed_form_poses import planar_points
 
 
-@pytest.mark.parametrize(("legs", "turned"), [(3, False), (2, True)])
-def test_verify_reads_a_five_bar_whose_output_is_on_a_distal_link(tmp_path, legs, turned):
+def listed_last(text: str, body: str) -> str:
+    """The MJCF text with ``body`` (a leg's first body, with all it holds) listed after the other legs."""
+    start = text.index(f'<body name="{body}"')
+    depth, at = 0, start
+    for tag in re.finditer(r"<body\b[^>]*?(/?)>|</body>", text[start:]):
+        depth += 0 if tag.group(0).endswith("/>") else 1 if tag.group(0).startswith("<body") else -1
+        if depth == 0:
+            at = start + tag.end()
+            break
+    leg, rest = text[start:at], text[:start] + text[at:]
+    end = rest.index("</body></worldbody>")
+    return rest[:end] + leg + rest[end:]
+
+
+@pytest.mark.parametrize(("legs", "variant"), [(3, "m"), (2, "turned, mm"), (3, "x1e-3, listed otherwise")])
+def test_verify_reads_a_five_bar_whose_output_is_on_a_distal_link(tmp_path, legs, variant):
+    """In m; turned in the world and written in mm; a thousand times smaller, read in metres, with the leg that
+    carries the output listed last."""
+    turned = variant.startswith("turned")
     rotation = random_rotation(np.random.default_rng(legs)) if turned else None
+    scale = 1000.0 if turned else 1e-3 if variant.startswith("x1e-3") else 1.0
+    text = five_bar_mjcf(rotation=rotation, scale=scale, legs=legs)
     path = tmp_path / "five_bar.xml"
-    path.write_text(five_bar_mjcf(rotation=rotation, scale=1000.0 if turned else 1.0, legs=legs))
+    path.write_text(listed_last(text, "proximal_1") if "listed" in variant else text)
     unit = ["--length-unit", "mm"] if turned else []
     report = screwkit_json("verify", path, "--output", "distal_1", *unit, "--samples", "200")
     assert report["poses"] == 200 and report["largest_deviation"] < 1e-9, report
