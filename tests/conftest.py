@@ -18,6 +18,7 @@ Helpers shared by several modules are in ``helpers.py``; fixtures shared by seve
 
 from __future__ import annotations
 
+import functools
 import inspect
 
 import numpy as np
@@ -47,13 +48,16 @@ def _source(item) -> str:
     info = getattr(item, "_fixtureinfo", None)
     for name in getattr(item, "fixturenames", ()):
         functions += [definition.func for definition in (info.name2fixturedefs.get(name, ()) if info else ())]
-    sources = []
-    for function in functions:
-        try:
-            sources.append(inspect.getsource(function))
-        except (OSError, TypeError):
-            continue
-    return "\n".join(sources)
+    return "\n".join(_function_source(function) for function in functions)
+
+
+@functools.cache
+def _function_source(function) -> str:
+    """One function's code, looked up once (the items of a parametrised test share it); "" where it has none."""
+    try:
+        return inspect.getsource(function)
+    except (OSError, TypeError):
+        return ""
 
 
 def _shares_fixtures(module) -> bool:

@@ -227,12 +227,13 @@ def test_joints_renamed_and_motors_listed_the_other_way_name_the_renamed_chain_a
 SWEPT = np.array([-100.0, -60.0, 0.0, 45.0, 80.0, 89.0, 90.5, 91.0, 120.0, 200.0])
 
 
-@pytest.mark.parametrize("world", WORLDS)
-@pytest.mark.parametrize(("scale", "unit"), [(1.0, None), (1e3, "mm"), (1e-3, None)])
+@pytest.mark.parametrize(("scale", "unit", "world"), [(1.0, None, "as written"), (1.0, None, "moved"),
+                                                      (1e3, "mm", "moved"), (1e-3, None, "moved")])
 def test_a_sweep_marks_the_poses_past_the_change_point(tmp_path, world, scale, unit):
     """The sweep's poses all lie on one line through the reference pose (phi from 0): the line is sampled once; the
     poses past 90 deg and past -90 deg, and only those, are marked, with the chain, whatever the unit and the world
-    frame. (At -90 deg the parallelogram lies flat: C on A, every joint on one line, the joints singular too.)"""
+    frame (each scale in the moved world, as written at 1 too). (At -90 deg the parallelogram lies flat: C on A,
+    every joint on one line, the joints singular too.)"""
     path = tmp_path / "square.xml"
     path.write_text(square_four_bar(scale, WORLDS[world]))
     mechanism = load(path, output="link_4", length_unit=unit)
