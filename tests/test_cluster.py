@@ -216,8 +216,8 @@ def test_an_unreachable_scheduler_fails_with_one_line_naming_the_address_and_the
              f"Cannot reach the Dask scheduler at {address} within 3 s", "Connection refused")
     one_line(screwkit(*MAP, "--scheduler", address, "--out", out, "--connect-timeout", "0.5", timeout=120),
              "within 0.5 s")
-    one_line(screwkit(*SEARCH[:-2], "--scheduler", address, "--connect-timeout", "4", timeout=120),
-             f"Cannot reach the Dask scheduler at {address} within 4 s")
+    one_line(screwkit(*SEARCH[:-2], "--scheduler", address, "--connect-timeout", "1.5", timeout=120),
+             f"Cannot reach the Dask scheduler at {address} within 1.5 s")
     # An address that is no address, and the same with --json.
     one_line(screwkit(*MAP, "--scheduler", "nowhere", "--out", out), "Dask scheduler address 'nowhere'")
     result = screwkit(*SEARCH[:-1], "--scheduler", address, "--connect-timeout", "0.5", timeout=120)
