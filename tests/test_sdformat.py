@@ -15,7 +15,7 @@ import re
 
 import numpy as np
 import pytest
-from delta_rods import delta_rods_mjcf
+from delta_rods import SPACING, delta_geometry, delta_rods_mjcf
 from sdformat_models import delta_sdf, five_bar_sdf, five_bar_world_poses, hexapod_sdf, rss_sdf
 from test_graph_legs import POSES, assert_delta_textbook, textbook
 from test_io import HOME, assert_textbook, poses_near_home
@@ -181,6 +181,36 @@ def test_a_delta_whose_platform_balls_are_written_as_three_hinges_opens_in_any_o
         command = screwkit("analyze", path, "--json")
         assert command.returncode == 0, command.stderr
         assert json.loads(command.stdout)["lmti"] == pytest.approx(float(result.lmti), abs=1e-12)
+
+
+def test_the_length_scale_is_the_same_whatever_order_the_file_lists_its_joints_in(tmp_path):
+    """SDFormat does not say which joints close the loops: the reader's spanning tree leaves out those its order
+    meets last, and the length scale (the spread of the tree's joints) followed the order: 0.41326 m as written,
+    0.41345 m with the joints listed the other way, and with it every tolerance (a path's ``tolerance_m``). It is now
+    the spread of every joint of the file, once each: the same in either order, and a thousand times the metre
+    file's in a file written in mm, turned and moved in the world (read in metres from it)."""
+    as_written = write(tmp_path, delta_sdf(), "delta.sdf")
+    reversed_ = write(tmp_path, balls_as_three_hinges(delta_sdf(), [], reverse=True), "reversed.sdf")
+    turn = (1e3, random_rotation(np.random.default_rng(11)), np.array([300.0, -200.0, 500.0]))
+    in_mm = write(tmp_path, balls_as_three_hinges(delta_sdf(transform=turn), [], reverse=True), "mm.sdf")
+    trees = {"as written": read_closed_tree(as_written), "reversed": read_closed_tree(reversed_),
+             "mm": read_closed_tree(in_mm, length_unit="mm")}
+    assert [c.name for c in trees["as written"].closures] != [c.name for c in trees["reversed"].closures]  # cut
+    scales = {name: graph_mechanism(tree).length_scale for name, tree in trees.items()}  # (elsewhere)
+    assert scales["reversed"] == pytest.approx(scales["as written"], rel=1e-12)
+    assert scales["mm"] == pytest.approx(scales["as written"], rel=1e-12)
+    base, axes, elbows, attach = delta_geometry((0.02, -0.03, -0.45), np.radians([90.0, 180.0, 270.0, 0.0]))
+    drawn = np.array([np.zeros(3), *base] + [point + sign * SPACING / 2 * axis for points in (elbows, attach)
+                                             for point, axis in zip(points, axes) for sign in (-1.0, 1.0)])
+    # (the file's 17 joints where the generator puts them: the anchor, the motors, the rods' balls at both ends)
+    assert scales["as written"] == pytest.approx(np.sqrt(np.mean(np.sum((drawn - drawn.mean(axis=0)) ** 2, axis=1))),
+                                                 rel=1e-12)
+    line = ["--line", "0.02", "-0.03", "-0.45", "0.03", "-0.02", "-0.44", "--samples", "5", "--json"]
+    runs = [screwkit("trajectory", path, *line) for path in (as_written, reversed_)]
+    assert all(run.returncode == 0 for run in runs), [run.stderr for run in runs]
+    one, other = (json.loads(run.stdout) for run in runs)
+    assert other["length_scale_m"] == pytest.approx(one["length_scale_m"], rel=1e-12)
+    assert other["tolerance_m"] == pytest.approx(one["tolerance_m"], rel=1e-12)
 
 
 def test_motors_marked_in_the_file_and_the_marker_on_a_joint_that_cannot_drive(tmp_path):

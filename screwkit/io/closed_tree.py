@@ -148,6 +148,10 @@ class ClosedTree:
     cut_by_order: tuple[str, ...] = ()
     """Closures of loops the file could as well have closed at another joint, where the reader chose by the file's
     order (SDFormat's breadth-first tree tied): no point output is taken at them unless asked."""
+    joint_points: NDArray[np.float64] | None = None
+    """Where each joint of the file is (k, 3, world, m), once each, at the file's joint values, where the reader
+    chooses the spanning tree (SDFormat): the length scale's points (:func:`_file_length_scale`), the same whatever
+    joints the tree leaves out and in whatever order the file lists them. None: the model's joints."""
 
 
 def declared_task_coordinates(urdf_text: bytes) -> tuple[str, ...] | None:
@@ -212,7 +216,18 @@ def _length_scale(model, data) -> float:
     """The root-mean-square distance of the joints from their centroid: the mechanism's own size, the same in any
     world frame (the universe joint, at the world's origin, is not one of them); what the closures' gaps and their
     tolerances are measured in."""
-    points = np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3)
+    return _spread(np.array([np.asarray(data.oMi[j].translation) for j in range(1, model.njoints)]).reshape(-1, 3))
+
+
+def _file_length_scale(tree: ClosedTree, data) -> float:
+    """:func:`_length_scale` of the tree's model at the configuration in ``data``, or, where the reader chose the
+    spanning tree, of every joint of the file (:attr:`ClosedTree.joint_points`): the joints a tree leaves out
+    depend on the order the file lists them in, and a reading in another order must have the same size."""
+    return _length_scale(tree.model, data) if tree.joint_points is None else _spread(tree.joint_points)
+
+
+def _spread(points: NDArray) -> float:
+    """The root-mean-square distance of ``points`` (k, 3) from their centroid; 1 where it is zero."""
     spread = np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=-1)))
     return float(spread) if spread > 0.0 else 1.0
 
@@ -398,7 +413,7 @@ def assemble(tree: ClosedTree, held=(), nearest: bool = True) -> tuple[NDArray, 
         start = model.joints[joint].idx_v
         lengths[start:start + (1 if kinds[joint][0] == "prismatic" else
                                LENGTH_COORDINATES.get(model.joints[joint].shortname(), 0))] = True
-    scale = _length_scale(model, data)
+    scale = _file_length_scale(tree, data)
     unit = np.where(lengths, _lines_scale(model, data, tree.closures, kinds), 1.0)  # slides weighed against angles
 
     def configuration(v):

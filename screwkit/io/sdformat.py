@@ -427,9 +427,12 @@ def read_sdformat(path: Path, *, output: str | None = None, output_type: str | N
         plugins = "its joint controller plugin names no <joint_name>" if silent else "no joint controller plugin"
         notes.append(f"actuators guessed from the branches leaving the base (no <screwkit:actuated/>, {plugins}): "
                      f"{', '.join(motors)}; --actuate JOINT says otherwise")
+    every_joint = np.array([poses[joint.name][:3, 3] for joint in sdf.joints]).reshape(-1, 3)  # (the tree's choice
+    # of which to leave out follows the file's order; the size does not)
     return ClosedTree(str(path), model, closures, motors, pin.neutral(model), output, output_type,
                       "SDFormat (joints closing loops)", notes, cut_by_order=cut_by_order, split=builder.split,
-                      unactuated=unactuated, couplings=_mimics(sdf))
+                      unactuated=unactuated, couplings=_mimics(sdf), joint_points=every_joint if len(every_joint) else
+                      None)
 
 
 def _mimics(sdf) -> tuple[tuple[str, str, float, str], ...]:

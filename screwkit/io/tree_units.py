@@ -53,4 +53,5 @@ def in_metres(tree: ClosedTree, unit: str | None) -> ClosedTree:
     closures = [Closure(c.name, c.joint_a, scaled(c.placement_a), c.joint_b, scaled(c.placement_b), c.kind,
                         c.axis_point) for c in tree.closures]
     return replace(tree, model=model, closures=closures, q_reference=q, length_unit=unit,
+                   joint_points=None if tree.joint_points is None else tree.joint_points * factor,
                    notes=[*tree.notes, f"lengths read in {unit} (--length-unit) and used in m"])
