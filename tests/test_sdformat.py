@@ -187,18 +187,21 @@ def test_the_length_scale_is_the_same_whatever_order_the_file_lists_its_joints_i
     """SDFormat does not say which joints close the loops: the reader's spanning tree leaves out those its order
     meets last, and the length scale (the spread of the tree's joints) followed the order: 0.41326 m as written,
     0.41345 m with the joints listed the other way, and with it every tolerance (a path's ``tolerance_m``). It is now
-    the spread of every joint of the file, once each: the same in either order, and a thousand times the metre
-    file's in a file written in mm, turned and moved in the world (read in metres from it)."""
+    the spread of every joint of the file, once each: the same in either order and in the file written in mm,
+    turned and moved in the world (read in its unit); a thousandth of it for a Delta a thousand times smaller."""
     as_written = write(tmp_path, delta_sdf(), "delta.sdf")
     reversed_ = write(tmp_path, balls_as_three_hinges(delta_sdf(), [], reverse=True), "reversed.sdf")
     turn = (1e3, random_rotation(np.random.default_rng(11)), np.array([300.0, -200.0, 500.0]))
     in_mm = write(tmp_path, balls_as_three_hinges(delta_sdf(transform=turn), [], reverse=True), "mm.sdf")
+    smaller = write(tmp_path, balls_as_three_hinges(delta_sdf(transform=(1e-3, np.eye(3), np.zeros(3))), [],
+                                                    reverse=True), "smaller.sdf")
     trees = {"as written": read_closed_tree(as_written), "reversed": read_closed_tree(reversed_),
-             "mm": read_closed_tree(in_mm, length_unit="mm")}
+             "mm": read_closed_tree(in_mm, length_unit="mm"), "x1e-3": read_closed_tree(smaller)}
     assert [c.name for c in trees["as written"].closures] != [c.name for c in trees["reversed"].closures]  # cut
     scales = {name: graph_mechanism(tree).length_scale for name, tree in trees.items()}  # (elsewhere)
     assert scales["reversed"] == pytest.approx(scales["as written"], rel=1e-12)
     assert scales["mm"] == pytest.approx(scales["as written"], rel=1e-12)
+    assert scales["x1e-3"] == pytest.approx(1e-3 * scales["as written"], rel=1e-12)  # (a smaller Delta, in metres)
     base, axes, elbows, attach = delta_geometry((0.02, -0.03, -0.45), np.radians([90.0, 180.0, 270.0, 0.0]))
     drawn = np.array([np.zeros(3), *base] + [point + sign * SPACING / 2 * axis for points in (elbows, attach)
                                              for point, axis in zip(points, axes) for sign in (-1.0, 1.0)])
