@@ -71,6 +71,7 @@ def _shares_fixtures(module) -> bool:
     return any(f'scope="{scope}"' in text or f"scope='{scope}'" in text for scope in ("module", "session", "package"))
 
 
+@pytest.hookimpl(tryfirst=True)  # (before xdist's, which reads the xdist_group marks added here to group the tests)
 def pytest_collection_modifyitems(config, items):
     grouped: dict[str, bool] = {}
     for item in items:
