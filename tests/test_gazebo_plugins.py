@@ -128,9 +128,10 @@ def indices(path, **options) -> dict:
 
 
 def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_with_pinocchios_pressure_angles():
-    """Its output the point where the legs meet (the pin that the plugin's weld and Chain1_closure make), where the
-    pressure angles are measured; its default output, the frame of the body welded to the right leg's distal link,
-    has the same LMTI."""
+    """As written (no option), its output the point where the legs meet: the pin Chain1_closure, by which the link
+    that the plugin welds onto the right leg's distal link hangs from the left leg's, said in the report; the
+    pressure angles measured there. So with the body welded named (--output Chain1_dummy, a point output), whose
+    frame output has the same LMTI."""
     mechanism = load(FIVE_BAR, output="Chain1_dummy", output_type="point")
     assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1"]
     notes = " | ".join(read_mechanism_file(FIVE_BAR, output="Chain1_dummy")[1].notes)
@@ -139,34 +140,49 @@ def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_wi
         "URDF + Gazebo joints (DetachableJoint plugins)"
     assert "the joints the file's joint controller plugins drive, Chain1_1, Chain2_1" in notes
     expected = five_bar_textbook(FIVE_BAR)
-    found = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
-    assert found.keys() == expected.keys()
-    for key in expected:
-        assert found[key] == pytest.approx(expected[key], abs=1e-9), key
+    for options in ({}, {"output": "Chain1_dummy", "output_type": "point"}):
+        found = indices(FIVE_BAR, **options)
+        assert found.keys() == expected.keys()
+        for key in expected:
+            assert found[key] == pytest.approx(expected[key], abs=1e-9), (options, key)
+    report = read_mechanism_file(FIVE_BAR)[1]
+    assert "platform inferred: body 'Chain1_link_2', where closure 'Chain2_tip_to_Chain1_dummy' joins the legs " \
+           "through joint 'Chain1_closure' (the welded link hangs by it alone)" in " | ".join(report.notes), report
+    assert report.output.startswith("the point where the chains meet on body 'Chain1_link_2'"), report.output
     assert indices(FIVE_BAR, output="Chain1_dummy")["lmti"] == pytest.approx(expected["lmti"], abs=1e-9)
 
 
 @pytest.mark.parametrize("unit, factor, world, relabel", [("mm", 1e3, None, False), (None, 1.0, TURN, False),
-                                                            ("km", 1e-3, TURN, False), (None, 1.0, None, True)])
+                                                            ("km", 1e-3, TURN, False), (None, 1.0, None, True),
+                                                            (None, 1.0, None, "weld")])
 def test_the_published_five_bar_reads_the_same_in_another_unit_and_world(tmp_path, unit, factor, world, relabel):
-    """In mm and km, turned, and with its motors renamed and its joints and links written in reverse order (each
-    ITI follows its motor)."""
-    expected = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    """In mm and km, turned, with its motors renamed and its joints and links written in reverse order (each ITI
+    follows its motor), and with its plugin's weld written the other way round: as written, as with the body welded
+    named, Pinocchio's pressure angles of the file as published."""
+    expected = five_bar_textbook(FIVE_BAR)
     text = FIVE_BAR.read_text()
     if world is not None:
         text = turned(text, *world)
     if unit is not None:
         text = in_unit(text, unit, factor)
-    if relabel:
+    if relabel == "weld":
+        swapped = text.replace("<parent_link>Chain2_tip</parent_link>", "<parent_link>Chain1_dummy</parent_link>") \
+            .replace("<child_link>Chain1_dummy</child_link>", "<child_link>Chain2_tip</child_link>")
+        assert swapped.count("<parent_link>Chain1_dummy</parent_link>") == 1 and swapped != text
+        text = swapped
+    elif relabel:
         text = relabelled(text)
     path = tmp_path / "fivebar_linkage.urdf"
     path.write_text(text)
-    found = indices(path, output="Chain1_dummy", output_type="point", length_unit=unit)
     back = {new: old for old, new in RENAMED.items()}
-    found = {back.get(key, key): value for key, value in found.items()}
-    assert found.keys() == expected.keys()
-    for key in expected:
-        assert found[key] == pytest.approx(expected[key], abs=1e-9), key
+    # (named, the welded body's point is where the weld is: the plugin's child link's origin, 0.12 mm off the pin
+    # when the tip is the child; as written, the pin's centre whichever way the weld is written)
+    for options in ({}, *([{"output": "Chain1_dummy", "output_type": "point"}] if relabel != "weld" else [])):
+        found = indices(path, length_unit=unit, **options)
+        found = {back.get(key, key): value for key, value in found.items()}
+        assert found.keys() == expected.keys()
+        for key in expected:
+            assert found[key] == pytest.approx(expected[key], abs=1e-9), (options, key)
 
 
 RENAMED = {"Chain1_1": "drive_c", "Chain2_1": "drive_a", "Chain3_1": "drive_b"}
@@ -291,13 +307,77 @@ def test_a_transmission_with_a_passive_hardware_interface_drives_nothing(tmp_pat
     assert indices(path, output="Chain1_dummy") == pytest.approx(indices(FIVE_BAR, output="Chain1_dummy"), abs=1e-12)
 
 
+def sdf_five_bar_textbook(text: str, actuators_deg) -> dict:
+    """The SDFormat five-bar's pressure angles from its file's geometry (every pose unturned: each joint where its
+    child link's pose and the joint's own pose put it, in the file's lengths), with its motors joint_A0 and joint_B0
+    (both at the base point O, turning about y) at ``actuators_deg``: the elbows A and B turned about O, the pin C
+    where the distal links meet, nearer its place in the file; ITI_i = |sin(OA, AC)|, |sin(OB, BC)|, the LMTI
+    |sin(AC, BC)|."""
+    model = ET.fromstring(text).find("model")
+    links = {link.get("name"): np.array(link.findtext("pose").split(), dtype=float) for link in model.iter("link")}
+    joints = {}
+    for joint in model.iter("joint"):
+        own = joint.findtext("pose")
+        if own is not None and joint.findtext("child") in links:
+            place = links[joint.findtext("child")] + np.array(own.split(), dtype=float)
+            assert not np.any(place[3:]), joint.get("name")  # (no turn anywhere: positions add)
+            joints[joint.get("name")] = place[:3]
+    origin, (a, b, c) = joints["joint_A0"], (joints[name] for name in ("joint_A", "joint_B", "joint_C"))
+    assert np.allclose(joints["joint_B0"], origin)
+
+    def turned(point, degrees):
+        s, k = np.sin(np.radians(degrees)), np.cos(np.radians(degrees))
+        return origin + np.array([[k, 0, s], [0, 1, 0], [-s, 0, k]]) @ (point - origin)
+
+    first, second = turned(a, actuators_deg[0]), turned(b, actuators_deg[1])
+    r1, r2 = np.linalg.norm(c - a), np.linalg.norm(c - b)  # the distal links
+    span = second - first
+    along = (r1 ** 2 - r2 ** 2 + span @ span) / (2 * np.linalg.norm(span))
+    unit = span / np.linalg.norm(span)
+    across = np.cross([0.0, 1.0, 0.0], unit)
+    pins = [first + along * unit + side * np.sqrt(r1 ** 2 - along ** 2) * across for side in (1, -1)]
+    pin = min(pins, key=lambda point: np.linalg.norm(point - c))
+
+    def sine(u, v):
+        return abs(np.cross(u, v)[1]) / np.linalg.norm(u) / np.linalg.norm(v)
+
+    return {"joint_A0:joint_A0": sine(first - origin, pin - first),
+            "joint_B0:joint_B0": sine(second - origin, pin - second), "lmti": sine(pin - first, pin - second)}
+
+
 def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_many_of(tmp_path):
-    done = screwkit("analyze", FIVE_BAR, "--output", "Chain1_dummy", "--output-type", "point", "--json")
-    assert done.returncode == 0, done.stderr
-    printed = json.loads(done.stdout)
+    """Both five-bars as written: the URDF against Pinocchio's pressure angles; the SDFormat one against those of
+    its file's geometry at its motors' values (forward kinematics, ``--actuators``), also written in millimetres
+    with its elements in reverse order (its legs read in another order)."""
     expected = five_bar_textbook(FIVE_BAR)
-    assert [printed["iti"], printed["lmti"]] == pytest.approx([min(expected["Chain1_1"], expected["Chain2_1"]),
-                                                               expected["lmti"]], abs=1e-9)
+    for options in ((), ("--output", "Chain1_dummy", "--output-type", "point")):
+        done = screwkit("analyze", FIVE_BAR, *options, "--json")
+        assert done.returncode == 0, done.stderr
+        printed = json.loads(done.stdout)
+        assert [printed["iti"], printed["lmti"]] == pytest.approx([min(expected["Chain1_1"], expected["Chain2_1"]),
+                                                                   expected["lmti"]], abs=1e-9), options
+    text = SDF_FIVE_BAR.read_text()
+    root = ET.fromstring(text)
+    model = root.find("model")
+    for pose in model.iter("pose"):
+        values = pose.text.split()
+        pose.text = " ".join([*(repr(1e3 * float(v)) for v in values[:3]), *values[3:]])
+    elements = list(model)
+    for element in elements:
+        model.remove(element)
+    model.extend(reversed(elements))
+    millimetres = tmp_path / "model.sdf"
+    millimetres.write_text(ET.tostring(root, encoding="unicode"))
+    for actuators in (("0", "0"), ("10", "-15"), ("-25", "5")):
+        expected = sdf_five_bar_textbook(text, [float(v) for v in actuators])
+        for path, unit in ((SDF_FIVE_BAR, "m"), (millimetres, "mm")):
+            done = screwkit("analyze", path, "--actuators", *actuators, "--length-unit", unit, "--json")
+            assert done.returncode == 0, done.stderr
+            printed = json.loads(done.stdout)
+            assert printed["iti_actuators"] == pytest.approx({k: expected[k] for k in printed["iti_actuators"]},
+                                                             abs=1e-9), (path, actuators)
+            assert printed["lmti"] == pytest.approx(expected["lmti"], abs=1e-9), (path, actuators)
+            assert sorted(printed["iti_actuators"]) == ["joint_A0:joint_A0", "joint_B0:joint_B0"]
     model = ET.tostring(ET.fromstring(SDF_FIVE_BAR.read_text()).find("model"), encoding="unicode")
     world = tmp_path / "world.sdf"
     world.write_text(f'<sdf version="1.9"><world name="w">{GROUND}{model}{model.replace("closed_loop_demo", "b")}'

@@ -6,7 +6,8 @@ the body where the most closures meet, that body: a Delta's turning tool), else 
 (where every leg ends; failing one, where the most closures meet through balls written as three hinges each: a
 Delta's rods on the platform), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that
 the one ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is
-then its output). The notes say which was inferred.
+then its output; a weld onto a closure dummy that hangs by one pin is that pin's closure). The notes say which was
+inferred.
 """
 
 from __future__ import annotations
@@ -66,25 +67,57 @@ def output_frame(tree: ClosedTree) -> int:
             tree.notes.append(f"output frame inferred: {names[lowered.index(candidate)]!r} (name another with "
                               "--output FRAME)")
             return lowered.index(candidate)
-    closure = tree.closures[0] if len(tree.closures) == 1 else None
-    if closure is not None and closure.kind == "3d" and closure.joint_a and closure.joint_b \
-            and tree.output_type != "frame" and closure.name not in tree.cut_by_order:
+    found = _pin_between_legs(tree) if tree.output_type != "frame" else None
+    if found is not None:
         # two legs meeting at one ball or pin the file places: its point is the output, the same on either body
-        # (their frames are not, nor the point of a loop cut where the file's order puts the cut); the platform is
-        # the body more joints from the base, whichever end the file writes first (a servo's horn pinned to a thigh
-        # that a hip, a knee and an ankle carry: the thigh), the second end on a tie (a five-bar's two distal links,
-        # whose point reads the same either way)
-        ends = (closure.joint_a, closure.joint_b)
-        index = _body_frame(model, max(ends[::-1], key=lambda joint: len(path_to(model, joint))))
+        # (their frames are not, nor the point of a loop cut where the file's order puts the cut)
+        closure, joint, hinge = found
+        index = _body_frame(model, joint)
         if index is not None:
             tree.notes.append(f"platform inferred: body {names[index]!r}, where closure {closure.name!r} joins the "
-                              "legs (name another with --output FRAME)")
+                              + (f"legs through joint {model.names[hinge]!r} (the welded link hangs by it alone)"
+                                 if hinge else "legs") + " (name another with --output FRAME)")
             return index
     joined = [names[i] for i in dict.fromkeys(_body_frame(model, joint) for joint, _ in ranked) if i is not None]
     said = f" (the closures join bodies {', '.join(map(repr, joined[:6]))}{', ...' if len(joined) > 6 else ''})"
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
                        f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet"
                        + (said if joined else "") + ".")
+
+
+def _pin_between_legs(tree: ClosedTree):
+    """The one ball or pin where the two legs of a mechanism meet, if its closures make that alone: (the closure, the
+    joint of the body taken as the platform, the joint that is the pin when the closure is a weld, else 0); else None.
+
+    * One "3d" closure, a ball (with second points on its axis, a pin): the platform is the body more joints from
+      the base, whichever end the file writes first (a servo's horn pinned to a thigh that a hip, a knee and an ankle
+      carry: the thigh), the second end on a tie (a five-bar's two distal links, whose point reads the same).
+    * One weld onto a link that hangs by one revolute or ball joint alone, carrying nothing else, not driven, from a
+      body two joints or more from the base (a CAD export's closure dummy, welded by Gazebo's DetachableJoint onto
+      the other leg's last link): that link is one body with the one it is welded to, wherever the weld is, so that
+      joint is the pin between the legs, and the platform the body it hangs from, on which the pin's point is the
+      output as on a pinned closure (on the welded body the output would be that body's frame). A weld between two
+      links, neither such, is refused: which body is the platform is for the user to say (a five-bar's two distal
+      links welded make a four-bar, whose links both hang from a crank)."""
+    model = tree.model
+    main = [closure for closure in tree.closures if not closure.axis_point]
+    if len(main) != 1 or any(closure.name in tree.cut_by_order for closure in tree.closures):
+        return None
+    closure = main[0]
+    ends = {closure.joint_a, closure.joint_b}
+    if 0 in ends or any({other.joint_a, other.joint_b} != ends for other in tree.closures):
+        return None
+    if closure.kind == "3d":
+        return closure, max((closure.joint_b, closure.joint_a), key=lambda joint: len(path_to(model, joint))), 0
+    if closure.kind != "6d":
+        return None
+    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
+    hanging = [joint for joint in ends if joint not in motors and int(model.parents[joint]) not in ends
+               and len(path_to(model, joint)) >= 3 and joint_kind(model, joint)[0] in ("revolute", "spherical")
+               and not any(int(model.parents[k]) == joint for k in range(1, model.njoints))]
+    if len(hanging) != 1:
+        return None
+    return closure, int(model.parents[hanging[0]]), hanging[0]
 
 
 def _meeting(tree: ClosedTree, carriers: dict[int, int]):
