@@ -130,9 +130,10 @@ def indices(path, **options) -> dict:
 def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_with_pinocchios_pressure_angles():
     """As written (no option), its output the point where the legs meet: the pin Chain1_closure, by which the link
     that the plugin welds onto the right leg's distal link hangs from the left leg's, said in the report; the
-    pressure angles measured there. So with the body welded named (--output Chain1_dummy, a point output), whose
-    frame output has the same LMTI."""
-    mechanism = load(FIVE_BAR, output="Chain1_dummy", output_type="point")
+    pressure angles measured there; so with that body named (--output Chain1_link_2). The link welded named instead
+    (--output Chain1_dummy) has its frame as the output, with the same LMTI; a point asked of it is refused, since a
+    weld meets its body at no point (its point was the weld's frame, which moved with the way the weld is written)."""
+    mechanism = load(FIVE_BAR)
     assert sorted(name.split(":")[-1] for name in mechanism.actuator_names) == ["Chain1_1", "Chain2_1"]
     notes = " | ".join(read_mechanism_file(FIVE_BAR, output="Chain1_dummy")[1].notes)
     assert "closures Chain2_tip_to_Chain1_dummy: the fixed joints Gazebo's DetachableJoint plugins make" in notes
@@ -140,7 +141,7 @@ def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_wi
         "URDF + Gazebo joints (DetachableJoint plugins)"
     assert "the joints the file's joint controller plugins drive, Chain1_1, Chain2_1" in notes
     expected = five_bar_textbook(FIVE_BAR)
-    for options in ({}, {"output": "Chain1_dummy", "output_type": "point"}):
+    for options in ({}, {"output": "Chain1_link_2"}):
         found = indices(FIVE_BAR, **options)
         assert found.keys() == expected.keys()
         for key in expected:
@@ -149,6 +150,10 @@ def test_the_published_five_bar_closed_by_a_detachable_joint_opens_as_written_wi
     assert "platform inferred: body 'Chain1_link_2', where closure 'Chain2_tip_to_Chain1_dummy' joins the legs " \
            "through joint 'Chain1_closure' (the welded link hangs by it alone)" in " | ".join(report.notes), report
     assert report.output.startswith("the point where the chains meet on body 'Chain1_link_2'"), report.output
+    with pytest.raises(ImportError_, match=r"--output-type point needs every closure to meet the platform at one "
+                                           r"point; closure 'Chain2_tip_to_Chain1_dummy' welds a leg to it, which "
+                                           r"meets it at none \(--output names a body"):
+        load(FIVE_BAR, output="Chain1_dummy", output_type="point")
     assert indices(FIVE_BAR, output="Chain1_dummy")["lmti"] == pytest.approx(expected["lmti"], abs=1e-9)
 
 
@@ -175,9 +180,7 @@ def test_the_published_five_bar_reads_the_same_in_another_unit_and_world(tmp_pat
     path = tmp_path / "fivebar_linkage.urdf"
     path.write_text(text)
     back = {new: old for old, new in RENAMED.items()}
-    # (named, the welded body's point is where the weld is: the plugin's child link's origin, 0.12 mm off the pin
-    # when the tip is the child; as written, the pin's centre whichever way the weld is written)
-    for options in ({}, *([{"output": "Chain1_dummy", "output_type": "point"}] if relabel != "weld" else [])):
+    for options in ({}, {"output": "Chain1_link_2"}):
         found = indices(path, length_unit=unit, **options)
         found = {back.get(key, key): value for key, value in found.items()}
         assert found.keys() == expected.keys()
@@ -350,7 +353,7 @@ def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_m
     its file's geometry at its motors' values (forward kinematics, ``--actuators``), also written in millimetres
     with its elements in reverse order (its legs read in another order)."""
     expected = five_bar_textbook(FIVE_BAR)
-    for options in ((), ("--output", "Chain1_dummy", "--output-type", "point")):
+    for options in ((), ("--output", "Chain1_link_2")):
         done = screwkit("analyze", FIVE_BAR, *options, "--json")
         assert done.returncode == 0, done.stderr
         printed = json.loads(done.stdout)
@@ -485,8 +488,8 @@ def test_a_negative_effort_or_velocity_reads_as_no_limit(tmp_path):
     assert 'effort="' in text
     path = tmp_path / "fivebar_linkage.urdf"
     path.write_text(re.sub(r'(effort|velocity)="[^"]*"', r'\1="-1"', text))
-    expected = indices(FIVE_BAR, output="Chain1_dummy", output_type="point")
-    found = indices(path, output="Chain1_dummy", output_type="point")
+    expected = indices(FIVE_BAR)
+    found = indices(path)
     assert found.keys() == expected.keys()
     for key in expected:
         assert found[key] == pytest.approx(expected[key], abs=1e-12), key

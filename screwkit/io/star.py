@@ -427,9 +427,13 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         report.notes.append(f"output the platform's frame: the loop closed at {chosen[0]!r} could as well be closed at "
                             "another joint (the file does not say where its legs end), which would move the point "
                             "where the chains meet; --output-type point takes the point there")
-    if point and not meet:
+    welded = [leg.closure for leg in legs[1:] if leg.loop == "fixed"]  # (its weld's frame is no point of a leg: the
+    # file puts it anywhere on the bodies it welds, and which way round it is written moves it)
+    if point and (welded or not meet):
         raise ImportError_(f"{tree.source}: --output-type point needs every closure to meet the platform at one "
-                           "point; they do not.")
+                           + (f"point; closure {welded[0]!r} welds a leg to it, which meets it at none (--output names "
+                              "a body the welded links hang from by a pin or ball)." if welded else
+                              "point; they do not."))
     if point:
         offset = float(np.linalg.norm(in_plane(output_world[:3, 3] - centres[0], normal)))  # in the plane of motion
         where = (f"at frame {frame.name!r}" if offset <= FILE_ROUNDING * scale else  # (one point, to the rounding)
