@@ -13,10 +13,14 @@ Checked on the model Gepetto's own loader builds (``tests/gepetto_loader.py``), 
 the values screwkit assembles, as written (where the knees are square to the motors and the shanks: ITI 1) and with
 the three knees' axes tilted in their joint frames (the same points, the same assembly at the file's
 configuration; ITI below 1); and the same in millimetres, in a moved world and with the robot.yaml listed back.
+
+As written, its hips driven too, it opens with six motors (the foot hangs on the first leg's ball, that leg's loop
+joint): against the force lines of each leg through its ball, on Gepetto's own model.
 """
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -29,8 +33,10 @@ from test_axis_points import revolutes_moved
 from test_gallery_published import GEPETTO
 from test_gepetto_joint_types import variants
 
-from helpers import one_line_error, screwkit
+from helpers import leg_line_otis, screwkit
 from screwkit.io import graph_mechanism, read_closed_tree
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
 
 CUSTOM = GEPETTO / "custom_1"
 HIPS = ("mot_1", "mot_3", "mot_4")
@@ -126,15 +132,73 @@ def test_a_weld_open_in_rotation_alone_says_its_angle_as_gepetto_s_model_has_it(
         assert f" and {angle:.3g} deg at the file's joint values" in line, (angle, line)
 
 
-def test_the_refusal_names_every_leg_s_serial_stage_at_once():
-    """Each of the three legs has its hip motor before the parallel part: one refusal named one hip a run, three runs
-    to learn the set; it names all three, and with them held the foot opens."""
-    message = one_line_error(screwkit("info", CUSTOM / "robot.urdf"), "leg 'cuisse2' has loops inside it",
-                             "legs 'cuisse2_2', 'cuisse2_3' likewise, all at once: --lock mot_1 --lock mot_3 "
-                             "--lock mot_4")
-    held = message.rsplit("all at once: ", 1)[1].rstrip(".").replace("--lock ", "").split()
-    assert sorted(held) == sorted(HIPS)
-    assert screwkit("info", CUSTOM / "robot.urdf", *[f"--lock={name}" for name in held]).returncode == 0
+def transversal(point, first, second):
+    """The line through ``point`` that meets the lines ``first`` and ``second`` (origin, unit axis): its unit
+    direction, and the point where it crosses ``first``."""
+    n1, n2 = (np.cross(axis, origin - point) for origin, axis in (first, second))
+    direction = np.cross(n1, n2) / np.linalg.norm(np.cross(n1, n2))
+    (along, _), *_ = np.linalg.lstsq(np.column_stack([direction, -first[1]]), first[0] - point, rcond=None)
+    return direction, point + along * direction
+
+
+def six_motor_indices(path, values: dict[str, float]):
+    """custom_1 with its hips driven too, on Gepetto's own reading of ``path`` closed by scipy with the six motors at
+    ``values``. In each leg (hip H, motor M, knee K, ball S on the foot) every actuation wrench is a force through S
+    reciprocal to the leg's other hinges: the hip's meets M's and K's axes, the motor's H's and K's. Each ITI is
+    |u . v_c| / |v_c|, c where the force crosses the hinge after its actuator (M for the hip, K for the motor: where
+    the rest of the leg meets the link the actuator turns), v_c = a x (c - o) about the actuator's axis; the OTIs are
+    the leg-line OTIs of the six forces at their balls (numpy alone)."""
+    model = gepetto_model(path, path.parent / "robot.yaml")
+    spec = yaml.safe_load((path.parent / "robot.yaml").read_text())
+    pairs = [(model.getFrameId(a), model.getFrameId(b)) for a, b in spec["closed_loop"]]
+    data, _ = closed_by_scipy(model, pairs, values)
+    itis, starts, ends, names = {}, [], [], []
+    for hip, (motor, (knee, ball)) in zip(HIPS, LEGS.items()):
+        lines = {name: joint_line(model, data, name) for name in (hip, motor, knee)}
+        s = data.oMi[model.getJointId(ball)].translation.copy()
+        for driver, after, other in ((hip, motor, knee), (motor, knee, hip)):
+            direction, c = transversal(s, lines[after], lines[other])
+            origin, axis = lines[driver]
+            v = np.cross(axis, c - origin)
+            itis[driver] = abs(direction @ v) / np.linalg.norm(v)
+            starts.append(c)
+            ends.append(s)
+            names.append(driver)
+    return itis, dict(zip(names, leg_line_otis(starts, ends)))
+
+
+def six_motors(path, **options):
+    """screwkit's ITI and OTI of each motor (by joint name), the LMTI, and the motors' values, as written."""
+    mechanism = load(path, **options)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    names = [name.split(":")[-1] for name in mechanism.actuator_names]
+    values = {name.split(":")[-1]: value for name, value in result.joint_values.items() if name.split(":")[-1] in names}
+    return (dict(zip(names, np.ravel(result.iti_actuators))), dict(zip(names, np.ravel(result.oti_actuators[0]))),
+            float(result.lmti), values, result.dof)
+
+
+def test_the_robot_opens_as_written_with_six_motors_on_three_r_r_r_s_legs(tmp_path):
+    """As written, its hips driven: six motors on three R-R-R-S legs, the foot in six DoF. Before, the foot's hanging
+    on the first leg's ball made that leg's path "a leg with loops inside it and 2 actuators", refused with the
+    advice to hold the hips; the ball is now that leg's loop joint, as the other legs' are. Against the force lines of
+    Gepetto's own model closed at the motors' values; in millimetres, in a moved world and listed back; from the
+    command line; and with the hips held it still opens."""
+    itis, otis, lmti, values, dof = six_motors(CUSTOM / "robot.urdf")
+    assert sorted(itis) == sorted(HIPS + tuple(LEGS)) and dof == 6
+    expected_itis, expected_otis = six_motor_indices(CUSTOM / "robot.urdf", values)
+    assert itis == pytest.approx(expected_itis, abs=1e-9)
+    assert otis == pytest.approx(expected_otis, abs=1e-9)
+    assert lmti == pytest.approx(min(expected_otis.values()), abs=1e-9)
+    assert 0.05 < min(itis.values()) and max(otis.values()) < 0.99  # neither singular nor trivially 1
+    for name, other_path, options in variants(CUSTOM / "robot.urdf", tmp_path):
+        other = six_motors(other_path, **options)
+        assert other[0] == pytest.approx(itis, abs=1e-9), name
+        assert other[1] == pytest.approx(otis, abs=1e-9), name
+        assert other[3] == pytest.approx(values, abs=1e-8), name
+    printed = json.loads(screwkit("analyze", CUSTOM / "robot.urdf", "--json").stdout)
+    assert [printed["iti"], printed["lmti"]] == pytest.approx([min(expected_itis.values()), lmti], abs=1e-9)
+    held = screwkit("info", CUSTOM / "robot.urdf", *[f"--lock={name}" for name in HIPS])
+    assert held.returncode == 0, held.stderr
 
 
 @pytest.mark.parametrize("joint, distance", [("free_knee1", 0.05), ("free_knee3", -0.2), ("mot_6", 0.1),

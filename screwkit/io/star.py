@@ -190,6 +190,19 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
                    data, platform, scale)
 
 
+def _spine(model, data, platform: int) -> _Leg:
+    """The platform's own path as a leg: the platform its last link, or, where the platform hangs from a link by a
+    ball joint, the path to that link with the ball its loop joint, at the ball's centre as a ball closure's is (a
+    Gepetto foot on three R-R-R-S legs, the first of which carries it)."""
+    path = path_to(model, platform)
+    if len(path) < 2 or joint_kind(model, platform)[0] != "spherical":
+        return _Leg(path, "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
+    placement = homogeneous(model.jointPlacements[platform])  # the ball's frame on the link, as it is drawn
+    frame = homogeneous(data.oMi[int(model.parents[platform])]) @ placement
+    return _Leg(path[:-1], "spherical", placement, frame, None, [("revolute", frame[:3, k], frame[:3, 3])
+                                                                 for k in range(3)], "")
+
+
 def _refuse_beyond(tree: ClosedTree, after: list[int], what: str, data, platform: int, scale: float) -> None:
     """Refuse a closure that ends on joints ``after`` between the platform body and it (``what`` says so), with the
     options that hold them (the bodies beyond then move with the platform as one body: two platforms joined by a
@@ -316,7 +329,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     if platform == 0:
         raise ImportError_(f"{tree.source}: the output frame {frame.name!r} is on the fixed base.")
     body = report.platform_body = platform_body(model, frame_index)
-    spine = _Leg(path_to(model, platform), "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
+    spine = _spine(model, data, platform)
     closures = _without_carried_loops(tree, platform, report)
     onto_platform = [platform in path_to(model, c.joint_a) or platform in path_to(model, c.joint_b)
                      for c in closures]
