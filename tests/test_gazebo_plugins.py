@@ -18,6 +18,7 @@ perpendicular to the normal, and the file's own home was refused as unreachable 
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -277,6 +278,21 @@ def test_the_published_sdformat_five_bar_reads_as_its_plugin_written_as_a_fixed_
                                            r"without joints\); screwkit reads one model: write the mechanism's model "
                                            r"alone in a file\.$"):
         load(world, output="link_4")
+
+
+def test_a_hinge_closure_out_of_the_plane_of_motion_leaves_the_platform_to_be_named(tmp_path):
+    """The SDFormat five-bar opens as written at the point where its hinge closure joins the legs, a hinge normal to
+    its plane of motion; with one elbow's axis tilted out of that plane the hinge's drawn point is no meeting of the
+    legs, and which body is the platform is asked for, as before."""
+    assert load(SDF_FIVE_BAR).dof == 2
+    text, count = re.subn(r"(<joint name='joint_B' type='revolute'>.*?<xyz>)0 1 0(</xyz>)", r"\g<1>0 1 0.2\g<2>",
+                          SDF_FIVE_BAR.read_text(), count=1, flags=re.S)
+    assert count == 1
+    path = tmp_path / "model.sdf"
+    path.write_text(text)
+    with pytest.raises(ImportError_, match=r"which body is the platform\? Name its output frame"):
+        load(path)
+    assert load(path, output="link_2").dof == 1  # (named, it opens: the tilted loop moves in one DoF)
 
 
 def test_a_detachable_joint_to_another_models_link_closes_no_loop(tmp_path):

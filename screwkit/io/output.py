@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from screwkit.common.tolerances import FILE_ROUNDING
 from screwkit.io.closed_tree import ClosedTree, ImportError_, ball_of_revolutes, homogeneous, joint_kind, path_to
 
 __all__ = ["output_frame", "platform_body", "OUTPUT_NAMES", "OUTPUT_SUFFIXES"]
@@ -108,6 +109,8 @@ def _pin_between_legs(tree: ClosedTree):
     if 0 in ends or any({other.joint_a, other.joint_b} != ends for other in tree.closures):
         return None
     if closure.kind == "3d":
+        if len(tree.closures) > 1 and not _about_the_hinge(tree):
+            return None  # (a hinge out of the plane of motion: its drawn point is not where the legs meet)
         return closure, max((closure.joint_b, closure.joint_a), key=lambda joint: len(path_to(model, joint))), 0
     if closure.kind != "6d":
         return None
@@ -118,6 +121,30 @@ def _pin_between_legs(tree: ClosedTree):
     if len(hanging) != 1:
         return None
     return closure, int(model.parents[hanging[0]]), hanging[0]
+
+
+def _about_the_hinge(tree: ClosedTree) -> bool:
+    """Whether a mechanism whose closures are one hinge (points on its axis) moves in the plane normal to it: every
+    hinge of the file parallel to it and every slide across it (then the hinge's point in that plane is where the
+    legs meet, wherever the file draws it along the axis)."""
+    import pinocchio as pin  # Pinocchio: imported where a file of another tool is read
+
+    model = tree.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, tree.q_reference)
+    body = tree.closures[0].joint_a  # (both points on one body: the file's joint values may leave the hinge open)
+    first, second = ((homogeneous(data.oMi[body]) @ (c.placement_a if c.joint_a == body else c.placement_b))[:3, 3]
+                     for c in tree.closures[:2])
+    normal = (second - first) / max(float(np.linalg.norm(second - first)), 1e-300)
+    for joint in range(1, model.njoints):
+        kind, axis = joint_kind(model, joint)
+        if kind not in ("revolute", "prismatic"):
+            return False
+        axis = np.asarray(data.oMi[joint].rotation) @ axis / np.linalg.norm(axis)
+        if (kind == "revolute" and np.linalg.norm(np.cross(axis, normal)) > FILE_ROUNDING) or \
+                (kind == "prismatic" and abs(float(axis @ normal)) > FILE_ROUNDING):
+            return False
+    return True
 
 
 def _meeting(tree: ClosedTree, carriers: dict[int, int]):
