@@ -37,14 +37,14 @@ def _quaternion(rotation: np.ndarray) -> np.ndarray:
     return found
 
 
-def stewart_mjcf(carrier: int = 0, scale: float = 1.0, world=None) -> str:
-    """Six U-P-S legs, the platform nested in leg ``carrier`` on a ball joint; lengths times ``scale``; the base
-    placed in the world by ``world`` (rpy, xyz), if given."""
+def stewart_mjcf(carrier: int = 0, scale: float = 1.0, world=None, base=BASE, top=TOP) -> str:
+    """U-P-S legs from ``base`` to ``top`` (six by default), the platform nested in leg ``carrier`` on a ball joint;
+    lengths times ``scale``; the base placed in the world by ``world`` (rpy, xyz), if given."""
     def text(vector):
         return " ".join(repr(float(v)) for v in vector)
 
     legs, connects = [], []
-    for k, (b, p) in enumerate(zip(BASE, TOP)):
+    for k, (b, p) in enumerate(zip(base, top)):
         axis = (p - b) / np.linalg.norm(p - b)
         side = np.cross([0.0, 0.0, 1.0], axis)
         side /= np.linalg.norm(side)
@@ -63,19 +63,19 @@ def stewart_mjcf(carrier: int = 0, scale: float = 1.0, world=None) -> str:
                     f'{end}</body></body></body></body>')
     turn = None if world is None else _quaternion(rotation_from_rpy(world[0]))
     placed = "" if world is None else f' pos="{text(world[1])}" quat="{text(turn)}"'
-    actuators = "".join(f'<position joint="slide_{k}"/>' for k in range(6))
+    actuators = "".join(f'<position joint="slide_{k}"/>' for k in range(len(base)))
     return (f'<mujoco model="stewart"><worldbody><body name="base"{placed}>{"".join(legs)}</body></worldbody>'
             f'<equality>{"".join(connects)}</equality><actuator>{actuators}</actuator></mujoco>')
 
 
-def mujoco_leg_lines(text: str, scale: float):
+def mujoco_leg_lines(text: str, scale: float, legs: int = 6):
     """Each leg's universal-joint centre and ball centre as MuJoCo places them (in the file's lengths over
     ``scale``), in the order of the legs."""
     model = mujoco.MjModel.from_xml_string(text)
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    starts = [data.xanchor[model.joint(f"u1_{k}").id] / scale for k in range(6)]
-    ends = [data.xpos[model.body(f"end_{k}").id] / scale for k in range(6)]
+    starts = [data.xanchor[model.joint(f"u1_{k}").id] / scale for k in range(legs)]
+    ends = [data.xpos[model.body(f"end_{k}").id] / scale for k in range(legs)]
     return np.array(starts), np.array(ends)
 
 
@@ -113,3 +113,24 @@ def test_convert_writes_the_platform_on_a_legs_ball_in_the_convention(tmp_path):
     starts, ends = mujoco_leg_lines(source.read_text(), 1.0)
     order = [int(name.split(":")[-1].split("_")[-1]) for name in mechanism.actuator_names]
     np.testing.assert_allclose(result.oti_actuators[0], leg_line_otis(starts[order], ends[order]), atol=1e-9)
+
+
+@pytest.mark.parametrize("carrier, world", [(0, None), (2, ((0.4, -0.3, 1.1), (0.3, -0.2, 0.5)))])
+def test_three_legs_meeting_where_the_platform_hangs_on_a_ball_read_that_point(tmp_path, carrier, world):
+    """Three U-P-S legs whose balls meet at one point, the platform on one of them: the output is that point (x, y,
+    z; the platform's turns about it idle), OTI_k = |u_k . (u_i x u_j)| / |u_i x u_j| of the legs' unit lines as
+    MuJoCo places them (the graph reading refused it: the platform's frame turns with every actuator locked)."""
+    meeting = np.array([0.05, -0.03, 0.6])
+    path = tmp_path / "tripod.xml"
+    path.write_text(stewart_mjcf(carrier, world=world, base=BASE[::2], top=[meeting] * 3))
+    mechanism = load(path)
+    result = indices_at_pose(mechanism, mechanism.home_pose)
+    assert mechanism.task_coordinates == ("x", "y", "z") and result.dof == 3
+    starts, ends = mujoco_leg_lines(path.read_text(), 1.0, legs=3)
+    order = [int(name.split(":")[-1].split("_")[-1]) for name in mechanism.actuator_names]
+    lines = [(ends[k] - starts[k]) / np.linalg.norm(ends[k] - starts[k]) for k in order]
+    across = [np.cross(lines[k - 2], lines[k - 1]) for k in range(3)]  # the motion the other two forces allow
+    expected = [abs(lines[k] @ across[k]) / np.linalg.norm(across[k]) for k in range(3)]
+    np.testing.assert_allclose(np.ravel(result.iti_actuators), np.ones(3), atol=1e-9)
+    np.testing.assert_allclose(result.oti_actuators[0], expected, atol=1e-9)
+    assert any("output the point where the chains meet on body 'platform'" in line for line in mechanism.import_report)

@@ -407,7 +407,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
             raise ImportError_(f"{tree.source}: closure {leg.closure!r} (3d) joins the fixed base to a body beyond the "
                                "platform: screwkit reads that leg (the pin, then the body's joint onto the platform) "
                                f"in a planar mechanism only{nearly_planar(tree, data, legs, turns)}.")
-    centres = [leg.successor_world[:3, 3] for leg in legs[1:]]  # every closure onto the platform, compound legs' too
+    onto = legs if legs[0].loop != "fixed" else legs[1:]  # meeting the platform at a loop joint (its own path's ball)
+    centres = [leg.successor_world[:3, 3] for leg in onto]  # every closure onto the platform, compound legs' too
     # in a plane, pins about the normal drawn anywhere along their common axis meet (a coaxial wrist drawn stacked)
     meet = all(np.linalg.norm(in_plane(c - centres[0], normal)) < FILE_ROUNDING * scale for c in centres)
     equivalents = compound_legs(tree, q, scale, legs, couplings, set(motor_ids), platform, normal, report)
@@ -422,7 +423,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     report.dropped = [model.names[j] for j in range(1, model.njoints) if j not in owner and j not in absorbed]
     report.planar = normal is not None
     output_world = homogeneous(data.oMf[frame_index])
-    idle = idle_about_the_meeting_point(legs, normal)
+    idle = idle_about_the_meeting_point(onto, normal)
     chosen = [leg.closure for leg in legs[1:] if leg.closure in tree.cut_by_order]
     pinned = any(not leg.joints and not leg.base_dofs for leg in legs[1:])  # its loop joint alone, on the base
     # a loop closed on a link that one actuator turns alone from the base: the point there is that link's (a

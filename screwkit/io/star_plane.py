@@ -74,10 +74,11 @@ def planar_loops(legs: list, normal: NDArray) -> None:
 
 
 def idle_about_the_meeting_point(legs: list, normal: NDArray | None) -> bool:
-    """Whether every leg closed onto the platform joins it by every rotation about the point where they meet (a
-    ball, or in a plane a pin about the normal): the platform's rotations about that point are then idle, and
-    the output is the point. A weld or a pin in another direction makes them the actuators' to control."""
-    for leg in legs[1:]:
+    """Whether every leg of ``legs`` (those meeting the platform at a loop joint) joins it by every rotation about the
+    point where they meet (a ball, or in a plane a pin about the normal): the platform's rotations about that point
+    are then idle, and the output is the point. A weld or a pin in another direction makes them the actuators' to
+    control."""
+    for leg in legs:
         if leg.loop == "spherical" and normal is None:
             continue
         if leg.loop == "revolute" and normal is not None and \
