@@ -8,7 +8,8 @@ theirs: it was read as a joint inside a leg, so that ``screwkit.load`` and ``scr
 against the leg-line indices of MuJoCo's own placement of the joints (ITI = 1: the force along the leg and the
 slide's motion along it; OTI_k at leg k's ball, of the platform twist reciprocal to the other five leg forces), as
 written, in millimetres, in a moved world, and with the platform nested in another leg; against the graph reading
-of the same file; and through ``screwkit convert``.
+of the same file; and through ``screwkit convert``. Three such legs meeting at the ball the platform hangs on read
+that point as the output; a wrist turning on a ball on the base reads its rotations.
 """
 
 from __future__ import annotations
@@ -134,3 +135,40 @@ def test_three_legs_meeting_where_the_platform_hangs_on_a_ball_read_that_point(t
     np.testing.assert_allclose(np.ravel(result.iti_actuators), np.ones(3), atol=1e-9)
     np.testing.assert_allclose(result.oti_actuators[0], expected, atol=1e-9)
     assert any("output the point where the chains meet on body 'platform'" in line for line in mechanism.import_report)
+
+
+def test_a_wrist_on_a_central_ball_reads_the_rotations_the_legs_control(tmp_path):
+    """Three U-P-S legs onto a platform that turns on a ball on the base (a spherical wrist): the ball is a leg of its
+    loop joint alone (read as a joint inside a leg before; the graph reading gives the same numbers). Output the
+    platform's rotations (roll, pitch, yaw) about the centre C; OTI_k of the force along leg k through its ball P_k
+    and the rotation omega_k about C that the other two forces allow (omega_k . ((P_j - C) x u_j) = 0 for both):
+    |u_k . (omega_k x (P_k - C))| / |omega_k x (P_k - C)|, the legs' lines as MuJoCo places them; also in mm."""
+    centre = np.array([0.03, -0.02, 0.62])
+    top = [centre + 0.3 * np.array([np.cos(a), np.sin(a), 0.0]) for a in np.radians([10, 130, 250])]
+    for unit, scale in ((None, 1.0), ("mm", 1e3)):
+        text = stewart_mjcf(-1, scale, base=BASE[::2], top=top).replace(
+            "</body></worldbody>", f'<body name="platform" pos="{" ".join(repr(float(v)) for v in scale * centre)}">'
+            '<joint name="centre" type="ball"/><inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>'
+            "</body></worldbody>")
+        path = tmp_path / f"wrist_{unit}.xml"
+        path.write_text(text)
+        mechanism = load(path, length_unit=unit)
+        result = indices_at_pose(mechanism, mechanism.home_pose)
+        assert mechanism.task_coordinates == ("roll", "pitch", "yaw") and result.dof == 3
+        starts, ends = mujoco_leg_lines(text, scale, legs=3)
+        order = [int(name.split(":")[-1].split("_")[-1]) for name in mechanism.actuator_names]
+        lines = [(ends[k] - starts[k]) / np.linalg.norm(ends[k] - starts[k]) for k in order]
+        arms = [ends[k] - centre for k in order]
+        moments = [np.cross(arm, line) for arm, line in zip(arms, lines)]
+        expected = []
+        for k in range(3):
+            omega = np.cross(moments[k - 2], moments[k - 1])
+            velocity = np.cross(omega, arms[k])
+            expected.append(abs(lines[k] @ velocity) / np.linalg.norm(velocity))
+        np.testing.assert_allclose(np.ravel(result.iti_actuators), np.ones(3), atol=1e-9)
+        np.testing.assert_allclose(result.oti_actuators[0], expected, atol=1e-9)
+        assert 0.05 < min(expected) < max(expected) < 0.99
+        assert any("chain centre: no joint but its loop, loop spherical (the platform body's own path)" in line
+                   for line in mechanism.import_report), mechanism.import_report
+        graph = graph_mechanism(read_closed_tree(path, length_unit=unit)).indices()
+        np.testing.assert_allclose(graph.lmti, result.lmti, atol=1e-9)

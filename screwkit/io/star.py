@@ -9,7 +9,8 @@ platform by one loop joint. :func:`convert_tree` maps a closed tree
    joint values, gaps and working mode reported.
 2. **Platform.** The body carrying the output frame (:func:`~screwkit.io.output.output_frame`: named, or a
    frame called effector, eff, ee, tool, tcp, foot or platform, or where the legs meet). Its own tree path from
-   the root is one leg, welded to the platform.
+   the root is one leg, welded to the platform, or, where the platform hangs from it by a ball joint, closed onto
+   it by that ball (a leg of the ball alone where it is on the base).
 3. **Legs and loop joints.** Every closure onto the platform joins a leg (a tree path from the
    root that shares no joint with another leg) to it; the joints between the platform body and
    the closure frame become the loop joint: none (a ``6d`` weld: ``fixed``; a ``3d`` closure:
@@ -85,6 +86,7 @@ from screwkit.io.star_writing import (
     base_frame,
     in_base,
     joint_motion,
+    largest_changes,
     origin_of,
     pose_of,
     write_base_pin,
@@ -193,14 +195,15 @@ def _loop_of(tree: ClosedTree, data, closure: Closure, platform: int, scale: flo
 def _spine(model, data, platform: int) -> _Leg:
     """The platform's own path as a leg: the platform its last link, or, where the platform hangs from a link by a
     ball joint, the path to that link with the ball its loop joint, at the ball's centre as a ball closure's is (a
-    Gepetto foot on three R-R-R-S legs, the first of which carries it)."""
+    Gepetto foot on three R-R-R-S legs, the first of which carries it); a ball on the base (a wrist's centre) is a
+    leg of its loop joint alone, named after it."""
     path = path_to(model, platform)
-    if len(path) < 2 or joint_kind(model, platform)[0] != "spherical":
+    if joint_kind(model, platform)[0] != "spherical":
         return _Leg(path, "fixed", np.eye(4), homogeneous(data.oMi[platform]), None, [], "")
     placement = homogeneous(model.jointPlacements[platform])  # the ball's frame on the link, as it is drawn
-    frame = homogeneous(data.oMi[int(model.parents[platform])]) @ placement
-    return _Leg(path[:-1], "spherical", placement, frame, None, [("revolute", frame[:3, k], frame[:3, 3])
-                                                                 for k in range(3)], "")
+    frame, alone = homogeneous(data.oMi[int(model.parents[platform])]) @ placement, len(path) == 1
+    return _Leg(path[:-1], "spherical", frame if alone else placement, frame, None, [
+        ("revolute", frame[:3, k], frame[:3, 3]) for k in range(3)], model.names[platform] if alone else "")
 
 
 def _refuse_beyond(tree: ClosedTree, after: list[int], what: str, data, platform: int, scale: float) -> None:
@@ -266,21 +269,6 @@ def _platform_legs(tree: ClosedTree, data, closures: list[Closure], platform: in
     return legs
 
 
-def _largest_changes(model, change: NDArray, unit: str) -> str:
-    """The largest change of a joint angle (rad) and, when a joint slides, of a length (``unit``), between two
-    configurations (``change``: Pinocchio's difference, velocity coordinates)."""
-    angles, lengths = [0.0], []
-    for joint in range(1, model.njoints):
-        part = np.abs(change[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv])
-        kind, _ = joint_kind(model, joint)
-        slides = {"prismatic": 1, "JointModelFreeFlyer": 3, "JointModelPlanar": 2, "JointModelTranslation": 3}.get(
-            kind, 0)  # (Pinocchio's velocity coordinates: the lengths first)
-        if slides:
-            lengths.append(float(part[:slides].max()))
-        angles.append(float(part[slides:].max(initial=0.0)))
-    return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
-
-
 def _without_carried_loops(tree: ClosedTree, platform: int, report: ImportReport) -> list[Closure]:
     """The closures but the loops the platform carries (both frames beyond the platform: an excavator's arm and
     bucket linkages on its boom taken as the platform), left out and said, as the graph reading leaves out a tool
@@ -316,7 +304,7 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
     tree = drawn_pairs(tree, q)  # (hinges closed by two points a few millimetres apart: along their joints)
     tree = drawn_parallelograms(tree, q, scale)  # (four-bars drawn as parallelograms and written rounded: exact)
     model = tree.model
-    changes = _largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
+    changes = largest_changes(model, pin.difference(model, tree.q_reference, q), tree.unit)
     report.notes.append(f"working mode: the closed configuration nearest to {tree.start_phrase()} (the largest "
                         f"joint change {changes})")
     data = model.createData()
@@ -520,7 +508,8 @@ def convert_tree(tree: ClosedTree) -> tuple[str, ImportReport]:
         listed = synthetic + [model.names[j] for j in leg.joints]
         report.chains.append(f"{name}: " + (f"joints {', '.join(listed)}, " if listed else "no joint but its loop, ")
                              + f"loop {leg.loop}"
-                             + (f" (closure {leg.closure})" if leg.closure else " (the platform body's own path)")
+                             + (f" (closure {leg.closure})" if leg.closure and leg is not spine else
+                                " (the platform body's own path)")
                              + (f", actuated {', '.join(actuated)}" if actuated else ""))
     for name, reduction, attachment in equivalents:
         joints = write_equivalent(writer, name, reduction, attachment, world_base, platform_world)

@@ -1,5 +1,6 @@
 """Writing a closed tree's star (:mod:`screwkit.io.star`) as screwkit's URDF: joint origins and poses, the written
-base frame, a compound leg's equivalent constraint chain, the pin of a ball closed on the base itself."""
+base frame, a compound leg's equivalent constraint chain, the pin of a ball closed on the base itself; and how far
+the assembly moved the joints, as the report says it."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from screwkit.io.compound import Reduction
 from screwkit.model.urdf_writer import UrdfWriter
 
 __all__ = ["UNLIMITED_SLIDE", "origin_of", "pose_of", "in_base", "joint_motion", "base_frame", "write_equivalent",
-           "write_base_pin"]
+           "write_base_pin", "largest_changes"]
 
 UNLIMITED_SLIDE = 1e6
 """Limits (m) written for a prismatic joint the file gives none (URDF requires limits on sliders)."""
@@ -115,3 +116,18 @@ def write_base_pin(writer: UrdfWriter, leg, world_base: NDArray, reference: dict
                  **origin_of(origin))
     reference[leg.closure] = 0.0
     return [leg.closure]
+
+
+def largest_changes(model, change: NDArray, unit: str) -> str:
+    """The largest change of a joint angle (rad) and, when a joint slides, of a length (``unit``), between two
+    configurations (``change``: Pinocchio's difference, velocity coordinates)."""
+    angles, lengths = [0.0], []
+    for joint in range(1, model.njoints):
+        part = np.abs(change[model.joints[joint].idx_v:model.joints[joint].idx_v + model.joints[joint].nv])
+        kind, _ = joint_kind(model, joint)
+        slides = {"prismatic": 1, "JointModelFreeFlyer": 3, "JointModelPlanar": 2, "JointModelTranslation": 3}.get(
+            kind, 0)  # (Pinocchio's velocity coordinates: the lengths first)
+        if slides:
+            lengths.append(float(part[:slides].max()))
+        angles.append(float(part[slides:].max(initial=0.0)))
+    return f"{max(angles):.3g} rad" + (f", {max(lengths):.3g} {unit}" if lengths else "")
