@@ -46,13 +46,16 @@ def textbook(points: dict) -> dict:
 
 def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 32.0), azimuths=AZIMUTHS,
                      platform_leg: int = 0, digits: int | None = None, transform=None, half_width: float = HALF_WIDTH,
-                     widen: float = 0.0, elbow_shift: float = 0.0, unit: float = 1.0) -> str:
+                     widen: float = 0.0, elbow_shift: float = 0.0, unit: float = 1.0, platform_name: str = "platform",
+                     wrists_onto_platform: bool = False) -> str:
     """The SDFormat text (see the module docstring); ``transform`` (rotation, translation) moves the whole robot.
 
     The first rod of each leg is at +``half_width`` along a (a negative value mirrors the rods: the tree then runs
     through the other one); ``widen`` moves the second rod's lower hinge that much further out along a, so that
     the rods make a trapezoid, not a parallelogram; ``elbow_shift`` draws each elbow hinge that far along its own
     axis (the same mechanism); ``unit``: every length written times it (1000: the file in millimetres).
+    ``platform_name`` names the platform's link; with ``wrists_onto_platform`` every leg's wrist is written from its
+    lower cross-piece to the platform (the reader's tree takes one, the others close loops onto the platform).
     """
     points = geometry(centre, arm_angles, azimuths)
     rotation, shift = (np.eye(3), np.zeros(3)) if transform is None else transform
@@ -107,10 +110,11 @@ def hinged_delta_sdf(centre=(0.01, -0.02, -0.42), arm_angles=(35.0, 28.0, 40.0, 
         joint(f"top_{leg}b", f"cross_{leg}", f"rod_{leg}b", e - half_width * a, n, True)
         joint(f"bottom_{leg}a", f"rod_{leg}a", f"lower_{leg}", p + half_width * a, n, True)
         joint(f"bottom_{leg}b", f"rod_{leg}b", f"lower_{leg}", p - (half_width + widen) * a, n, False)
-        if k == platform_leg:
+        if k == platform_leg or wrists_onto_platform:
             joint(f"wrist_{leg}", f"lower_{leg}", "platform", p, a, True)
         else:
             joint(f"wrist_{leg}", "platform", f"lower_{leg}", p, a, False)
     fixed = "<joint name='anchor' type='fixed'><parent>world</parent><child>base</child></joint>"
-    return ("<?xml version='1.0'?>\n<sdf version='1.6'><model name='hinged_delta'>" + "".join(links) + fixed
+    text = ("<?xml version='1.0'?>\n<sdf version='1.6'><model name='hinged_delta'>" + "".join(links) + fixed
             + "".join(joints) + "</model></sdf>\n")
+    return text.replace("'platform'", f"'{platform_name}'").replace(">platform<", f">{platform_name}<")

@@ -6,8 +6,8 @@ the body where the most closures meet, that body: a Delta's turning tool), else 
 (where every leg ends; failing one, where the most closures meet through balls written as three hinges each: a
 Delta's rods on the platform), else a frame called so with a ROS ending (``ee_link``, ``tool0``), else the body that
 the one ball or pin closure of a two-legged mechanism closes onto (a five-bar's pen: the point where its legs meet is
-then its output; a weld onto a closure dummy that hangs by one pin is that pin's closure). The notes say which was
-inferred.
+then its output; a weld onto a closure dummy that hangs by one pin is that pin's closure), else, of the bodies tied
+for the most closures, the one on which every actuated leg ends. The notes say which was inferred.
 """
 
 from __future__ import annotations
@@ -79,11 +79,42 @@ def output_frame(tree: ClosedTree) -> int:
                               + (f"legs through joint {model.names[hinge]!r} (the welded link hangs by it alone)"
                                  if hinge else "legs") + " (name another with --output FRAME)")
             return index
+    every = _where_every_leg_ends(tree)
+    index = None if every is None else _body_frame(model, every)
+    if index is not None:
+        tree.notes.append(f"platform inferred: body {names[index]!r}, where every actuated leg ends (name another with "
+                          "--output FRAME)")
+        return index
     joined = [names[i] for i in dict.fromkeys(_body_frame(model, joint) for joint, _ in ranked) if i is not None]
     said = f" (the closures join bodies {', '.join(map(repr, joined[:6]))}{', ...' if len(joined) > 6 else ''})"
     raise ImportError_(f"{tree.source}: which body is the platform? Name its output frame (--output FRAME); "
                        f"no frame is called {', '.join(OUTPUT_NAMES)}, and no one body is where most closures meet"
                        + (said if joined else "") + ".")
+
+
+def _where_every_leg_ends(tree: ClosedTree) -> int | None:
+    """Of the bodies tied for the most closures, the joint of the one on which every actuated leg ends, if one: the
+    base's branches that carry the motors, each reaching the body by its own path or by a closure from one of its
+    links (a Delta whose platform hangs on one leg by a pin, the other legs' connectors pinned to it: each of those
+    has as many closures, one from its own leg's parallelogram, and two legs end on it)."""
+    model = tree.model
+    counts: dict[int, int] = {}
+    for closure in tree.closures:
+        for joint in {closure.joint_a, closure.joint_b} - {0}:
+            counts[joint] = counts.get(joint, 0) + 1
+    legs = {path_to(model, model.getJointId(name))[0] for name in tree.motors if model.existJointName(name)}
+    if not counts or len(legs) < 2:
+        return None
+    most = max(counts.values())
+
+    def reaching(joint: int) -> set[int]:
+        ends = [other for closure in tree.closures for mine, other in ((closure.joint_a, closure.joint_b),
+                                                                        (closure.joint_b, closure.joint_a))
+                if mine == joint and other]
+        return {path_to(model, end)[0] for end in [joint, *ends]}
+
+    found = [joint for joint, count in counts.items() if count == most and legs <= reaching(joint)]
+    return found[0] if len(found) == 1 else None
 
 
 def _pin_between_legs(tree: ClosedTree):
