@@ -63,7 +63,8 @@ def compare(mechanism, poses):
 @pytest.mark.parametrize("name", bundled_names())
 def test_the_compiled_pipeline_equals_the_reference_on_every_bundled_mechanism(name):
     mechanism = load(name)
-    poses = random_reachable_poses(mechanism, np.random.default_rng(len(name)), COUNT, spread=0.5)
+    count = 2 if name == "coop_arms" else COUNT  # (its 924 submechanisms: the reference takes 1.4 s a pose)
+    poses = random_reachable_poses(mechanism, np.random.default_rng(len(name)), count, spread=0.5)
     compare(mechanism, np.concatenate([mechanism.home_pose[None], poses]))
 
 

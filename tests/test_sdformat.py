@@ -498,7 +498,7 @@ def test_a_parallelogram_whose_loop_the_file_does_not_cut_has_the_same_indices_w
     coupler translates on the circle x = CRANK sin t, and the constraint keeping it from turning, a force along a
     crank, has power coefficient cos t with the twist freed by releasing that crank (the coupler turning about the
     other crank's pin, its velocity at the pin across the horizontal coupler)."""
-    angles = np.radians([0.0, 12.0, 19.47122063449069, -30.0, 40.0])
+    angles = np.radians([12.0, 19.47122063449069, -30.0])
     results = {}
     for first in ("A", "D"):
         path = write(tmp_path, parallelogram_sdf(first), f"parallelogram_{first}.sdf")
