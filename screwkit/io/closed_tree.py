@@ -136,6 +136,10 @@ class ClosedTree:
         match = re.fullmatch(r"one hinge of \w+ joint (['\"])(.*)\1", self.split.get(name, ""))
         return match.group(2) if match else name
 
+    def motor_joints(self) -> set[int]:
+        """The model's joints of the actuated joints (those of :attr:`motors` the model has)."""
+        return {self.model.getJointId(name) for name in self.motors if self.model.existJointName(name)}
+
     def motor_label(self, name: str) -> str:
         """How a message names the actuated joint ``name``: by the option that named it, as guessed (the file marks
         none), else as the file's."""

@@ -138,8 +138,7 @@ def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDAr
     cycles = set()  # the joints of every closure's loop: its two tree paths, less what they share
     for closure in tree.closures:
         cycles |= set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b))
-    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
-    inside = [joint for joint in locked if joint in cycles and joint not in motors]
+    inside = [joint for joint in locked if joint in cycles and joint not in tree.motor_joints()]
     if not inside:
         raise ImportError_(f"{refusal} (with --lock {', --lock '.join(model.names[j] for j in locked)} held at the "
                            "file's values)") from None

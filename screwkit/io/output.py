@@ -98,11 +98,8 @@ def _where_every_leg_ends(tree: ClosedTree) -> int | None:
     links (a Delta whose platform hangs on one leg by a pin, the other legs' connectors pinned to it: each of those
     has as many closures, one from its own leg's parallelogram, and two legs end on it)."""
     model = tree.model
-    counts: dict[int, int] = {}
-    for closure in tree.closures:
-        for joint in {closure.joint_a, closure.joint_b} - {0}:
-            counts[joint] = counts.get(joint, 0) + 1
-    legs = {path_to(model, model.getJointId(name))[0] for name in tree.motors if model.existJointName(name)}
+    counts, _, _ = _meeting(tree, {})
+    legs = {path_to(model, joint)[0] for joint in tree.motor_joints()}
     if not counts or len(legs) < 2:
         return None
     most = max(counts.values())
@@ -145,7 +142,7 @@ def _pin_between_legs(tree: ClosedTree):
         return closure, max((closure.joint_b, closure.joint_a), key=lambda joint: len(path_to(model, joint))), 0
     if closure.kind != "6d":
         return None
-    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
+    motors = tree.motor_joints()
     hanging = [joint for joint in ends if joint not in motors and int(model.parents[joint]) not in ends
                and len(path_to(model, joint)) >= 3 and joint_kind(model, joint)[0] in ("revolute", "spherical")
                and not any(int(model.parents[k]) == joint for k in range(1, model.njoints))]
@@ -207,7 +204,7 @@ def _ball_carriers(tree: ClosedTree) -> dict[int, int]:
     scale = max(max(float(np.linalg.norm(placement.translation)) for placement in data.oMi), 1e-9)
     ends = [end for closure in tree.closures for end in (closure.joint_a, closure.joint_b)]
     children = [[k for k in range(1, model.njoints) if model.parents[k] == joint] for joint in range(model.njoints)]
-    motors = {model.getJointId(name) for name in tree.motors if model.existJointName(name)}
+    motors = tree.motor_joints()
     carriers = {}
     for joint in set(ends) - {0}:
         path = [joint, int(model.parents[joint]), int(model.parents[int(model.parents[joint])])][::-1]
