@@ -366,8 +366,8 @@ def sdf_five_bar_textbook(text: str, actuators_deg) -> dict:
 
 def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_many_of(tmp_path):
     """Both five-bars as written: the URDF against Pinocchio's pressure angles; the SDFormat one against those of
-    its file's geometry at its motors' values (forward kinematics, ``--actuators``), also written in millimetres
-    with its elements in reverse order (its legs read in another order)."""
+    its file's geometry at its motors' values (forward kinematics, ``--actuators``), also written in millimetres and
+    in kilometres with its elements in reverse order (its legs read in another order)."""
     expected = five_bar_textbook(FIVE_BAR)
     for options in ((), ("--output", "Chain1_link_2")):
         done = screwkit("analyze", FIVE_BAR, *options, "--json")
@@ -376,20 +376,22 @@ def test_the_command_opens_the_published_files_and_says_what_a_world_holds_too_m
         assert [printed["iti"], printed["lmti"]] == pytest.approx([min(expected["Chain1_1"], expected["Chain2_1"]),
                                                                    expected["lmti"]], abs=1e-9), options
     text = SDF_FIVE_BAR.read_text()
-    root = ET.fromstring(text)
-    model = root.find("model")
-    for pose in model.iter("pose"):
-        values = pose.text.split()
-        pose.text = " ".join([*(repr(1e3 * float(v)) for v in values[:3]), *values[3:]])
-    elements = list(model)
-    for element in elements:
-        model.remove(element)
-    model.extend(reversed(elements))
-    millimetres = tmp_path / "model.sdf"
-    millimetres.write_text(ET.tostring(root, encoding="unicode"))
+    scaled = {"m": SDF_FIVE_BAR}
+    for unit, factor in (("mm", 1e3), ("km", 1e-3)):  # (written in that unit, its elements in reverse order)
+        root = ET.fromstring(text)
+        model = root.find("model")
+        for pose in model.iter("pose"):
+            values = pose.text.split()
+            pose.text = " ".join([*(repr(factor * float(v)) for v in values[:3]), *values[3:]])
+        elements = list(model)
+        for element in elements:
+            model.remove(element)
+        model.extend(reversed(elements))
+        scaled[unit] = tmp_path / f"model_{unit}.sdf"
+        scaled[unit].write_text(ET.tostring(root, encoding="unicode"))
     for actuators in (("0", "0"), ("10", "-15"), ("-25", "5")):
         expected = sdf_five_bar_textbook(text, [float(v) for v in actuators])
-        for path, unit in ((SDF_FIVE_BAR, "m"), (millimetres, "mm")):
+        for unit, path in scaled.items():
             done = screwkit("analyze", path, "--actuators", *actuators, "--length-unit", unit, "--json")
             assert done.returncode == 0, done.stderr
             printed = json.loads(done.stdout)

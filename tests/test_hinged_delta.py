@@ -77,17 +77,20 @@ def test_a_hinged_delta_has_the_textbook_pressure_angles_whichever_rod_and_leg_t
     assert not [note for note in notes if "rounding" in note], notes  # an exact file is read as written
 
 
-@pytest.mark.parametrize(("order", "unit"), [((0, 1, 2), None), ((2, 0, 1), None), ((1, 2, 0), "mm")])
-def test_three_legs_whose_wrists_all_close_onto_the_platform_open_as_written(tmp_path, order, unit):
+@pytest.mark.parametrize(("order", "unit", "transform"), [((0, 1, 2), None, None), ((2, 0, 1), None, MOVED),
+                                                         ((1, 2, 0), "mm", None), ((2, 0, 1), "km", MOVED)])
+def test_three_legs_whose_wrists_all_close_onto_the_platform_open_as_written(tmp_path, order, unit, transform):
     """A three-legged hinged Delta whose every wrist is written from its leg onto a platform named ``low_base`` (as a
     published SDFormat Delta writes it): the reader's tree takes one wrist, the others close onto the platform, and
     each of those legs' lower cross-pieces meets as many closures as the platform (one from its parallelogram). It
     asked which body is the platform; the one where every actuated leg ends is taken, said in the report, with the
-    textbook pressure angles, the legs listed in any order, also in millimetres."""
+    textbook pressure angles, the legs listed in any order, also in millimetres and kilometres and moved in the
+    world."""
     azimuths, arms = AZIMUTHS[:3][list(order)], np.array([35.0, 28.0, 40.0])[list(order)]
     path = tmp_path / "hinged_delta.sdf"
     path.write_text(hinged_delta_sdf(arm_angles=arms, azimuths=azimuths, platform_name="low_base",
-                                     wrists_onto_platform=True, unit=1000.0 if unit else 1.0))
+                                     wrists_onto_platform=True, unit={None: 1.0, "mm": 1e3, "km": 1e-3}[unit],
+                                     transform=transform))
     mechanism = load(path, length_unit=unit)
     result = indices_at_pose(mechanism, mechanism.home_pose)
     expected = textbook(geometry((0.01, -0.02, -0.42), arms, azimuths))

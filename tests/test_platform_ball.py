@@ -80,10 +80,16 @@ def mujoco_leg_lines(text: str, scale: float, legs: int = 6):
     return np.array(starts), np.array(ends)
 
 
+SCALES = {None: 1.0, "mm": 1e3, "km": 1e-3}
+"""The factor of the file's lengths for each --length-unit the tests read it in."""
+WORLD = ((0.4, -0.3, 1.1), (0.3, -0.2, 0.5))
+"""A world the mechanisms are turned (rpy, rad) and moved (xyz, m) into."""
+
+
 @pytest.mark.parametrize("carrier, unit, world", [(0, None, None), (3, None, None), (0, "mm", None),
-                                                  (2, None, ((0.4, -0.3, 1.1), (0.3, -0.2, 0.5)))])
+                                                  (2, None, WORLD), (1, "km", WORLD)])
 def test_a_platform_on_a_legs_ball_reads_the_leg_line_indices(tmp_path, carrier, unit, world):
-    scale = 1e3 if unit == "mm" else 1.0
+    scale = SCALES[unit]
     text = stewart_mjcf(carrier, scale, world)
     path = tmp_path / "stewart.xml"
     path.write_text(text)
@@ -116,18 +122,19 @@ def test_convert_writes_the_platform_on_a_legs_ball_in_the_convention(tmp_path):
     np.testing.assert_allclose(result.oti_actuators[0], leg_line_otis(starts[order], ends[order]), atol=1e-9)
 
 
-@pytest.mark.parametrize("carrier, world", [(0, None), (2, ((0.4, -0.3, 1.1), (0.3, -0.2, 0.5)))])
-def test_three_legs_meeting_where_the_platform_hangs_on_a_ball_read_that_point(tmp_path, carrier, world):
+@pytest.mark.parametrize("carrier, unit, world", [(0, None, None), (2, None, WORLD), (1, "mm", None),
+                                                  (0, "km", WORLD)])
+def test_three_legs_meeting_where_the_platform_hangs_on_a_ball_read_that_point(tmp_path, carrier, unit, world):
     """Three U-P-S legs whose balls meet at one point, the platform on one of them: the output is that point (x, y,
     z; the platform's turns about it idle), OTI_k = |u_k . (u_i x u_j)| / |u_i x u_j| of the legs' unit lines as
     MuJoCo places them (the graph reading refused it: the platform's frame turns with every actuator locked)."""
     meeting = np.array([0.05, -0.03, 0.6])
     path = tmp_path / "tripod.xml"
-    path.write_text(stewart_mjcf(carrier, world=world, base=BASE[::2], top=[meeting] * 3))
-    mechanism = load(path)
+    path.write_text(stewart_mjcf(carrier, SCALES[unit], world, base=BASE[::2], top=[meeting] * 3))
+    mechanism = load(path, length_unit=unit)
     result = indices_at_pose(mechanism, mechanism.home_pose)
     assert mechanism.task_coordinates == ("x", "y", "z") and result.dof == 3
-    starts, ends = mujoco_leg_lines(path.read_text(), 1.0, legs=3)
+    starts, ends = mujoco_leg_lines(path.read_text(), SCALES[unit], legs=3)
     order = [int(name.split(":")[-1].split("_")[-1]) for name in mechanism.actuator_names]
     lines = [(ends[k] - starts[k]) / np.linalg.norm(ends[k] - starts[k]) for k in order]
     across = [np.cross(lines[k - 2], lines[k - 1]) for k in range(3)]  # the motion the other two forces allow
@@ -142,10 +149,10 @@ def test_a_wrist_on_a_central_ball_reads_the_rotations_the_legs_control(tmp_path
     loop joint alone (read as a joint inside a leg before; the graph reading gives the same numbers). Output the
     platform's rotations (roll, pitch, yaw) about the centre C; OTI_k of the force along leg k through its ball P_k
     and the rotation omega_k about C that the other two forces allow (omega_k . ((P_j - C) x u_j) = 0 for both):
-    |u_k . (omega_k x (P_k - C))| / |omega_k x (P_k - C)|, the legs' lines as MuJoCo places them; also in mm."""
+    |u_k . (omega_k x (P_k - C))| / |omega_k x (P_k - C)|, the legs' lines as MuJoCo places them; also in mm and km."""
     centre = np.array([0.03, -0.02, 0.62])
     top = [centre + 0.3 * np.array([np.cos(a), np.sin(a), 0.0]) for a in np.radians([10, 130, 250])]
-    for unit, scale in ((None, 1.0), ("mm", 1e3)):
+    for unit, scale in SCALES.items():
         text = stewart_mjcf(-1, scale, base=BASE[::2], top=top).replace(
             "</body></worldbody>", f'<body name="platform" pos="{" ".join(repr(float(v)) for v in scale * centre)}">'
             '<joint name="centre" type="ball"/><inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>'
