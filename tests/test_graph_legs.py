@@ -209,11 +209,13 @@ def test_the_equivalent_chain_of_the_graph_derivation_gives_the_per_chain_wrench
 
 
 def test_a_leg_whose_actuator_moves_inside_its_loop_is_refused_naming_it(tmp_path):
-    """The actuated joint must join the base to the rest of its leg; a rod's ball joint driven is not that."""
+    """The actuated joint must join the base to the rest of its leg; a rod's ball joint driven is not that (a leg of
+    two actuators is read one at a time, and the ball is refused as no actuator)."""
     path = tmp_path / "driven_rod.xml"
     path.write_text(delta_rods_mjcf().replace('<motor name="m_2" joint="motor_2"/>',
                                               '<motor name="m_2" joint="motor_2"/><motor name="m_5" joint="ball_2a"/>'))
-    with pytest.raises(ValueError, match=r"leg 'arm_2' has loops inside it and 2 actuators"):
+    with pytest.raises(ValueError, match=r"actuated joint 'ball_2a' is spherical: an actuator drives one revolute "
+                                         r"or prismatic joint"):
         graph_mechanism(read_mjcf(path))
 
 

@@ -64,7 +64,7 @@ from screwkit.io.closed_tree import (
 )
 from screwkit.io.compound import closed_samples
 from screwkit.io.couplings import check_couplings
-from screwkit.io.graph_actuators import check_actuators, follow_actuators
+from screwkit.io.graph_actuators import check_actuators, follow_actuators, split_legs
 from screwkit.io.graph_checks import (
     CAUTIONS,
     IN_LOOP_TOLERANCE,
@@ -478,7 +478,15 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
     legs = graph_legs(tree, platform, report)
     if not legs:
         raise ImportError_(f"{tree.source}: no leg joins the base to the platform {report.platform_body!r}.")
-    check_actuators(tree, legs, platform)  # (first: a serial stage left free is what to hold, whatever it couples)
+    deferred = check_actuators(tree, legs, platform)  # (first: a serial stage left free is what to hold)
+    several = [leg for leg in legs if len(leg.actuators) > 1]
+    if several:  # (the copies named, not the leg: its name is its first body in the file's order)
+        legs = split_legs(tree, legs)
+        for leg in several:
+            copies = ", ".join(f"{copy.name} ({tree.written_joint(model.names[copy.actuators[0]])})"
+                               for copy in legs if copy.of == leg.name)
+            report.notes.append(f"chains {copies}: one leg with loops inside it and {len(leg.actuators)} actuators, "
+                                "analysed one actuator at a time (the others free), an equivalent chain each")
     check_couplings(tree, q, scale, {joint for leg in legs for joint in leg.joints}, platform, report.notes)
     kinematics = TreeKinematics.of(model, tree.source)
     screws, state = leg_screws(tree, kinematics, platform, legs, q, scale)
@@ -487,8 +495,8 @@ def graph_mechanism(tree: ClosedTree, q: NDArray | None = None, scale: float | N
             samples = closed_samples(tree, q, scale, count=3)
             return leg_screws(tree, kinematics, platform, legs, np.array(samples), scale)[0] if samples else []
 
-        check_legs(tree, legs, screws, nearby, platform)
-        check_output(tree, screws, report.platform_body, legs)
+        check_legs(tree, legs, screws, nearby, platform, deferred)
+        check_output(tree, screws, report.platform_body, legs, deferred)
     chains, iti_points, oti_points = equivalent_chains(legs, screws, state, np.array([0]), model)
     chains = [ChainScrews(c.twists[0], c.points[0], c.actuated, c.name, c.joint_names) for c in chains]
     counted = []

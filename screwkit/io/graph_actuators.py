@@ -1,6 +1,7 @@
-"""The actuators of a closed-loop graph's legs (:mod:`screwkit.io.graph`): one revolute or prismatic actuator per leg,
-and, for a leg with several, the serial stage a user can hold with ``--lock`` to analyse the legs on the body it
-turns; and the graph moved by its actuators (:func:`follow_actuators`, :func:`between_samples`)."""
+"""The actuators of a closed-loop graph's legs (:mod:`screwkit.io.graph`): revolute or prismatic ones, a leg of several
+analysed one actuator at a time (:func:`split_legs`), and, where one of them carries the others, the serial stage a
+user can hold with ``--lock`` to analyse the legs on the body it turns; and the graph moved by its actuators
+(:func:`follow_actuators`, :func:`between_samples`)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from screwkit.io.graph_kinematics import STAGE_LENGTH
 from screwkit.io.locking import put_joint_value
 from screwkit.io.output import platform_body
 
-__all__ = ["check_actuators", "serial_stage", "follow_actuators", "between_samples", "AGREEMENT"]
+__all__ = ["check_actuators", "split_legs", "serial_stage", "follow_actuators", "between_samples", "AGREEMENT"]
 
 
 def follow_actuators(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
@@ -144,10 +145,13 @@ def _agreeing(graph, q: NDArray, values: NDArray) -> NDArray[np.float64]:
     return q
 
 
-def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
-    """Before any screw is derived: one revolute or prismatic actuator per leg (a serial stage carrying every other
-    actuator is named, with the option that holds it, and every other leg's that needs one, so that one run names
-    them all); ``platform``: the platform body's joint."""
+def check_actuators(tree: ClosedTree, legs, platform: int) -> dict[str, str]:
+    """Before any screw is derived: revolute or prismatic actuators, a leg of several read one at a time where
+    none rides on another joint than actuators (a floating base, a passive joint the loops turn), on the platform or
+    after the body its loops end on (refused, naming the joints to hold, and every other leg's that needs one, so
+    that one run names them all); ``platform``: the platform body's joint. Returns, for the legs whose actuators are
+    in series (a hip's motors one after the other), the advice that holds them, given with the reason if reading
+    them one at a time fails (:func:`screwkit.io.graph_checks.check_legs`)."""
     model = tree.model
     if not any(leg.actuators for leg in legs):
         on_legs = {model.names[joint] for leg in legs for joint in leg.joints}
@@ -156,30 +160,59 @@ def check_actuators(tree: ClosedTree, legs, platform: int) -> None:
                            "--actuate names the driven joints" + (
                                f"; {', '.join(map(repr, off))} {'is' if len(off) == 1 else 'are'} on no leg (a tool "
                                "the platform carries, or a branch off the legs: left out)" if off else "") + ".")
-    several = [leg for leg in legs if len(leg.actuators) > 1]
-    if several:
-        leg = several[0]
-        advice, held = _leg_advice(tree, leg, platform)
-        others = [(other, _leg_advice(tree, other, platform)[1]) for other in several[1:]]
-        if advice and others and all(locks for _, locks in others):
+    several, deferred = [leg for leg in legs if len(leg.actuators) > 1], {}
+    for leg in several:
+        advice, held = _leg_advice(tree, leg, platform, alone=len(legs) == 1)
+        if not advice:  # (analysed one actuator at a time: split_legs)
+            continue
+        if all(joint in leg.actuators for joint in serial_stage(model, leg)) and advice == _stage_advice(tree, leg)[0]:
+            deferred[leg.name] = advice  # (actuators in series: read one at a time, the advice given if that fails)
+            continue
+        others = [(other, _leg_advice(tree, other, platform, alone=len(legs) == 1)[1]) for other in several
+                  if other is not leg]
+        if others and all(locks for _, locks in others):
             every = held + [name for _, locks in others for name in locks]
             advice += (f"; legs {', '.join(repr(other.name) for other, _ in others)} likewise, all at once: --lock "
                        + " --lock ".join(dict.fromkeys(every)))
-        raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and "
-                           f"{len(leg.actuators)} actuators: screwkit analyses such a leg with exactly "
-                           "one (a leg with loops and several actuators has no per-actuator twist system yet)"
-                           f"{advice}.")
+        raise ImportError_(f"{tree.source}: leg {leg.name!r} has loops inside it and {len(leg.actuators)} actuators, "
+                           f"which screwkit does not read one at a time here{advice}.")
     for leg in legs:
-        if leg.actuators:
-            kind, _ = joint_kind(model, leg.actuators[0])
+        for actuator in leg.actuators:
+            kind, _ = joint_kind(model, actuator)
             if kind not in ("revolute", "prismatic"):
-                raise ImportError_(f"{tree.source}: actuated joint {model.names[leg.actuators[0]]!r} is {kind}: an "
+                raise ImportError_(f"{tree.source}: actuated joint {model.names[actuator]!r} is {kind}: an "
                                    "actuator drives one revolute or prismatic joint.")
+    return deferred
 
 
-def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
+def split_legs(tree: ClosedTree, legs) -> list:
+    """``legs`` with each leg of several actuators (one :func:`check_actuators` lets through) replaced by one copy
+    per actuator: the same joints and closures, that actuator its own and the others in ``others``, free in the
+    copy's twist systems. Its actuation wrench is then reciprocal to the platform twists the leg allows with that
+    actuator alone locked, as the paper's is for a serial chain of several actuated joints (reciprocal to every other
+    joint of the chain), and with some of them locked (the others failed and swinging free) the platform keeps the
+    twists none of their wrenches works on, as the leg does: :func:`screwkit.io.graph_checks.check_legs` checks that
+    no motion inside the leg, the platform held, moves an actuator. A copy is named after the body its
+    actuated joint moves (what a leg of that actuator alone would be named, whatever order the file lists them in),
+    ``of`` the leg's name; the legs in order by name."""
+    model, split = tree.model, []
+    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    for leg in legs:
+        if len(leg.actuators) < 2:
+            split.append(leg)
+            continue
+        for actuator in leg.actuators:
+            split.append(replace(leg, name=bodies.get(actuator, tree.written_joint(model.names[actuator])),
+                                 actuators=(actuator,), others=tuple(o for o in leg.actuators if o != actuator),
+                                 of=leg.name))
+    return sorted(split, key=lambda leg: leg.name)
+
+
+def _leg_advice(tree: ClosedTree, leg, platform: int, alone: bool) -> tuple[str, list[str]]:
     """For a leg with several actuators: what holds the serial stage that carries them (the refusal's end) and the
-    joints it holds (none: no advice)."""
+    joints it holds (none: no advice, and the leg is analysed one actuator at a time). ``alone``: the mechanism has
+    no other leg (a tool turned, or hanging free, after the body where the leg's loops end is then no output any
+    other leg holds)."""
     model = tree.model
     riding = [tree.written_joint(model.names[a]) for a in leg.actuators
               if a != platform and platform in path_to(model, a)]
@@ -193,7 +226,7 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
     ends = {end for closure in leg.closures for end in (closure.joint_a, closure.joint_b)}
     tail = [a for a in leg.actuators if a in path_to(model, platform) and not any(a in path_to(model, end)
                                                                                  for end in ends)]
-    if tail and len(tail) < len(leg.actuators):  # (a wrist the platform carries, the output on it)
+    if tail and alone and len(tail) < len(leg.actuators):  # (a wrist the platform carries, the output on it)
         names = [tree.written_joint(model.names[a]) for a in tail]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(tail)]), None)
@@ -205,7 +238,7 @@ def _leg_advice(tree: ClosedTree, leg, platform: int) -> tuple[str, list[str]]:
             + (f", or --output {meeting} takes that body" if meeting else ""), names))
     hanging = [j for j in path_to(model, platform) if j in leg.joints and j not in leg.actuators
                and not any(j in path_to(model, end) for end in ends)]
-    if hanging and model.parents[min(hanging)] in ends:  # (a tool on a free swivel on the body the loops end on)
+    if hanging and alone and model.parents[min(hanging)] in ends:  # (a tool on a free swivel where the loops end)
         names = [tree.written_joint(model.names[j]) for j in hanging]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(hanging)]), None)

@@ -18,72 +18,133 @@ from screwkit.screw.reference import actuation_wrench, working_frame
 
 __all__ = ["check_legs", "check_output", "refuse_couples_of_forces", "couples_of_forces", "IN_LOOP_TOLERANCE",
            "COUPLE_LIKE", "length_dependent_legs", "LENGTH_DEPENDENT", "LENGTH_CHANGE", "far_force_legs", "FAR_FORCE",
-           "FAR_FORCE_NOTE", "reading_cautions", "CAUTIONS"]
+           "FAR_FORCE_NOTE", "reading_cautions", "CAUTIONS", "stage_refusal"]
 
 IN_LOOP_TOLERANCE = 1e-8
 """Distance (working coordinates, unit twist) of an actuated joint's twist from its leg's twist system above
 which the joint moves inside a loop of the leg (its twist is not a motion of the leg)."""
 
 
-def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform: int) -> None:
+def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform: int,
+               deferred: dict[str, str] | None = None) -> None:
     """At the file's configuration: each actuated joint's twist is a motion of its leg, and locking it takes one
     motion away (else the actuator moves inside a loop of the leg, or the file's joint values are a singular
-    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none)."""
-    model = tree.model
+    configuration of the leg: ``nearby()`` gives the legs' screws at closed configurations near it, or none).
+    ``deferred``: by leg name, the advice that holds a leg's actuators in series
+    (:func:`~screwkit.io.graph_actuators.check_actuators`), given with the reason where one of them fails."""
     for index, (leg, screw) in enumerate(zip(legs, screws)):  # one actuator each, or none (check_actuators)
         if not leg.actuators:
             continue
-        actuator = leg.actuators[0]
-        name = model.names[actuator]
-        carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
-        if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
-            around = nearby()
-            if around and np.any(around[index].locked_dims < around[index].allowed_dims):
-                raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
-                                   f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
-                                   "away at closed configurations near them: the file is written at a singular "
-                                   "configuration of the leg (its links on one line, stretched or folded); give "
-                                   "joint values away from it: --initial JOINT VALUE (an actuated joint away from its "
-                                   "dead centre, held there while the loops close), or a keyframe named 'home' "
-                                   "(MJCF).")
+        try:
+            _check_leg(tree, leg, index, screw, nearby, platform)
+        except ImportError_ as error:
+            if leg.of not in (deferred or {}):
+                raise
+            raise stage_refusal(tree, legs, {leg.of: deferred[leg.of]}, error, leg.name) from None
+
+
+def stage_refusal(tree: ClosedTree, legs, deferred: dict[str, str], error: ImportError_, copy: str = ""
+                  ) -> ImportError_:
+    """The refusal of a leg of actuators in series read one at a time (``deferred``: its advice by its name, the
+    first one's taken) where ``error`` (its first clause the reason; ``copy``: the copy of the leg it names) says
+    why that failed: the advice that holds the stage."""
+    name, advice = next(iter(deferred.items()))
+    count = sum(1 for leg in legs if leg.of == name)
+    reason = str(error).removeprefix(f"{tree.source}: ").replace(f" of leg {copy!r}", "")
+    reason = reason.split(" (")[0].split(": ")[0].split(";")[0].removesuffix(".")
+    return ImportError_(f"{tree.source}: leg {name!r} has loops inside it and {count} actuators, which screwkit does "
+                        f"not read one at a time here ({reason}){advice}.")
+
+
+def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, nearby, platform: int) -> None:
+    """:func:`check_legs` of one leg with an actuator."""
+    model = tree.model
+    actuator = leg.actuators[0]
+    name = model.names[actuator]
+    if leg.others:
+        _check_independent(tree, leg, index, screw, nearby)
+    carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
+    if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
+        around = nearby()
+        if around and np.any(around[index].locked_dims < around[index].allowed_dims):
             raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
-                               f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
-                               "(motors the file does not name, or a leg with no input); if it is a serial stage "
-                               f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
-        outside = screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1
-        below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
-                 if j in leg.joints and j != platform]
-        if screw.rigid_input is not None and not screw.rigid_input[0] and not (outside and below):
-            # (where joints of the leg carry it, holding them is the way out named below)
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
-                               "the other joints of its path to the platform held it cannot move: a loop through that "
-                               "path closes on the base and shares the load the leg carries, so the power coefficient "
-                               "on its own twist is not the leg's input); analysable when the actuated joint joins the "
-                               "base to the rest of its leg: the link it drives taken as the output (--output) reads "
-                               "its own transmission.")
-        floating = [j for j in path_to(model, actuator)[:1] if j in leg.joints and j != platform
-                    and joint_kind(model, j)[0] == "JointModelFreeFlyer"]
-        if outside and floating:  # (not a loop: the leg's own base floats, as an export's <freejoint> on its root)
-            free = model.names[floating[0]]
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} rides on the free joint {free!r} (a floating "
-                               "base, as an export writes <freejoint> on its root): --lock "
-                               f"{' --lock '.join(below)} holds the base where the file puts it, and the legs are "
-                               "analysed on it.")
-        if outside:
-            one = len(below) == 1
-            hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
-                    f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else
-                    f"; it turns a body on the platform (a wrist after the parallel part): --lock {name} holds it, "
-                    "and the legs are analysed on the platform" if model.parents[actuator] == platform else "")
-            raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
-                               "twist is not a motion the leg allows: the leg has no serial input); analysable when "
-                               f"the actuated joint joins the base to the rest of its leg{hint}.")
+                               f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
+                               "away at closed configurations near them: the file is written at a singular "
+                               "configuration of the leg (its links on one line, stretched or folded); give "
+                               "joint values away from it: --initial JOINT VALUE (an actuated joint away from its "
+                               "dead centre, held there while the loops close), or a keyframe named 'home' "
+                               "(MJCF).")
+        raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
+                           f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
+                           "(motors the file does not name, or a leg with no input); if it is a serial stage "
+                           f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
+    outside = screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1
+    below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
+             if j in leg.joints and j != platform]
+    if screw.rigid_input is not None and not screw.rigid_input[0] and not (outside and below):
+        # (where joints of the leg carry it, holding them is the way out named below)
+        raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (with "
+                           "the other joints of its path to the platform held it cannot move: a loop through that "
+                           "path closes on the base and shares the load the leg carries, so the power coefficient "
+                           "on its own twist is not the leg's input); analysable when the actuated joint joins the "
+                           "base to the rest of its leg: the link it drives taken as the output (--output) reads "
+                           "its own transmission.")
+    floating = [j for j in path_to(model, actuator)[:1] if j in leg.joints and j != platform
+                and joint_kind(model, j)[0] == "JointModelFreeFlyer"]
+    if outside and floating:  # (not a loop: the leg's own base floats, as an export's <freejoint> on its root)
+        free = model.names[floating[0]]
+        raise ImportError_(f"{tree.source}: actuated joint {name!r} rides on the free joint {free!r} (a floating "
+                           "base, as an export writes <freejoint> on its root): --lock "
+                           f"{' --lock '.join(below)} holds the base where the file puts it, and the legs are "
+                           "analysed on it.")
+    if outside:
+        one = len(below) == 1
+        hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
+                f"{' --lock '.join(below)} holds {'it' if one else 'them'} where the loops close" if below else
+                f"; it turns a body on the platform (a wrist after the parallel part): --lock {name} holds it, "
+                "and the legs are analysed on the platform" if model.parents[actuator] == platform else "")
+        raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
+                           "twist is not a motion the leg allows: the leg has no serial input); analysable when "
+                           f"the actuated joint joins the base to the rest of its leg{hint}.")
 
 
-def check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
+def _check_independent(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, nearby) -> None:
+    """One actuator of a leg of several (:func:`~screwkit.io.graph_actuators.split_legs`): locking it alone takes a
+    motion of the platform away. Then no motion inside the leg with the platform held moves it, its rate is one linear
+    function of the platform twist (its actuation wrench), and any set of the leg's actuators locked leaves the
+    platform the twists none of their wrenches works on, as the copies read it. Else the leg's other actuators undo
+    its motion (kinematic redundancy inside the leg), refused, or the file is written at a singular configuration of
+    the leg (``nearby()``)."""
+    if screw.locked_dims[0] < screw.allowed_dims[0]:
+        return
+    name = tree.written_joint(tree.model.names[leg.actuators[0]])
+    others = ", ".join(sorted(tree.written_joint(tree.model.names[j]) for j in leg.others))
+    around = nearby()
+    if around and np.any(around[index].locked_dims < around[index].allowed_dims):
+        raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform as free as before at "
+                           "the file's joint values, and takes a motion away at closed configurations near them: the "
+                           "file is written at a singular configuration of its leg; give joint values away from it: "
+                           "--initial JOINT VALUE, or a keyframe named 'home' (MJCF).")
+    raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform as free as before: a "
+                       "motion inside its leg moves it with the platform held (kinematic redundancy; the leg's other "
+                       f"actuated joints: {others}), so it has no actuation wrench; --lock {name} holds it.")
+
+
+def check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg],
+                 deferred: dict[str, str] | None = None) -> None:
     """The platform's frame is the output of a graph: refused when a point is asked for, or when the platform still
     moves with every actuator locked (an effector turning freely on the pin where the legs meet: its frame is no
-    output any actuator controls, and its indices would be zero everywhere)."""
+    output any actuator controls, and its indices would be zero everywhere); ``deferred``: as :func:`check_legs`'s,
+    the stage named instead."""
+    try:
+        _check_output(tree, screws, body, legs)
+    except ImportError_ as error:
+        if deferred:
+            raise stage_refusal(tree, legs, deferred, error) from None
+        raise
+
+
+def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
     if tree.output_type == "point":
         raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
                            f"frame of their platform {body!r} only.")

@@ -32,13 +32,17 @@ __all__ = ["GraphLeg", "LegScrews", "leg_screws", "equivalent_chains", "dimensio
 class GraphLeg:
     """One leg of a closed-loop graph: its joints (Pinocchio joint ids, the platform's own joint when the platform
     hangs on the leg: ``spine``), the closures with an end on it, and its actuated joint (none for a passive leg,
-    which only constrains the platform)."""
+    which only constrains the platform); ``others``: for one actuator of a leg of several
+    (:func:`~screwkit.io.graph_actuators.split_legs`), the leg's other actuated joints, free in its twist systems,
+    and ``of`` that leg's name."""
 
     name: str
     joints: tuple[int, ...]
     closures: tuple[Closure, ...]
     spine: bool
     actuators: tuple[int, ...]
+    others: tuple[int, ...] = ()
+    of: str = ""
 
 
 def _columns(kinematics: TreeKinematics, joints) -> NDArray[np.int64]:

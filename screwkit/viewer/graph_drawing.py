@@ -40,10 +40,18 @@ class Rod:
 
 
 def _owners(graph) -> dict[int, int | str]:
-    """The owner of each joint's body: its leg, the platform's joint the platform (also where a leg carries it)."""
+    """The owner of each joint's body: its leg, the platform's joint the platform (also where a leg carries it). Of a
+    leg of several actuators read one at a time (copies of it, ``of`` its name), the copy whose actuator the body
+    rides on (a five-bar leg's two sides), else the first."""
     owners: dict[int, int | str] = {0: "base"}
+    parents = graph.tree.model.parents
     for index, leg in enumerate(graph.legs):
-        owners.update({joint: index for joint in leg.joints})
+        for joint in leg.joints:
+            above, rides = (joint if leg.of else 0), False  # (a copy's actuator: one; a passive leg has none)
+            while above and not rides:
+                rides, above = above == leg.actuators[0], int(parents[above])
+            if joint not in owners or not leg.of or rides:
+                owners[joint] = index
     owners[graph.platform] = "platform"
     return owners
 

@@ -1,0 +1,253 @@
+"""A leg with a loop inside it and several actuators, analysed one actuator at a time.
+
+The mechanism: a planar platform (hinges along y, the plane y = 0) held by a five-bar leg, whose two motors m1 and
+m2 on the base drive distal links that meet at the platform's pin P, and by two R-R-R legs closed onto the platform
+at Q and R (motors m3, m4): four actuators for three motions. The five-bar's loop closes at P (the second distal
+link onto the first), so the leg has a loop inside it and two actuators. Each actuator's wrench is then reciprocal
+to the platform twists the leg allows with that actuator alone locked (the paper's definition for a chain of several
+actuated joints): the five-bar reads as its two sides would as legs of their own, each closed onto the platform at
+P. The checks:
+
+* against the same mechanism written as those two legs (the second distal link closed onto the platform, not onto
+  the first), which screwkit reads leg by leg: every index, actuation wrench and worst fault the same to 1e-12;
+* against the textbook pressure angles from MuJoCo's own placement of the pins: ITI = |sin(OE, EP)| of each side;
+* in metres, in millimetres and in a moved, turned world; with the file's bodies, closures and motors listed in
+  reverse order, and with the platform hung on another leg (a different tree of the same mechanism);
+* with the first elbow driven too (three actuators in the leg, redundant inside it): against the two legs, the first
+  a serial chain of two actuators;
+* refused, naming the actuator, where a motion inside the leg moves it with the platform held (a six-bar side);
+* through ``screwkit analyze --json`` as a subprocess.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, screwkit, sine
+from screwkit.io import ImportError_, read_closed_tree
+from screwkit.io.graph import graph_mechanism
+from screwkit.io.loader import load
+from screwkit.studies import indices_at_pose
+
+POINTS = {"O1": (-0.20, 0.0), "E1": (-0.25, -0.18), "F1": (-0.17, -0.30), "P": (-0.05, -0.35),
+          "O2": (0.05, 0.0), "E2": (0.15, -0.17),
+          "O3": (0.35, -0.05), "E3": (0.30, -0.25), "Q": (0.08, -0.36),
+          "O4": (-0.30, -0.60), "E4": (-0.10, -0.62), "R": (0.02, -0.45)}
+"""The motors O, elbows E, the platform's pins P, Q, R (x, z; the plane y = 0); F1 an extra elbow of a six-bar side."""
+
+
+def point(name: str) -> np.ndarray:
+    x, z = POINTS[name]
+    return np.array([x, 0.0, z])
+
+
+def five_bar_leg(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), *, closed_on: str = "dist1", spine: str = "dist1",
+                 reverse: bool = False, driven_elbow: bool = False, six_bar: bool = False) -> str:
+    """The MJCF file. ``closed_on``: the body the second distal link is closed onto at P (``dist1``: the five-bar
+    leg; ``platform``: its two sides as two legs); ``spine``: the body the platform hangs on (``dist1`` or
+    ``dist3``); ``reverse``: bodies, closures and motors listed the other way round; ``driven_elbow``: a motor on the
+    first elbow too; ``six_bar``: the first side with one more hinge (at F1)."""
+    def at(v) -> str:
+        return " ".join(repr(float(c) * scale) for c in v)
+
+    ball = f'<geom type="sphere" size="{0.005 * scale!r}"/>'
+    hinge = '<joint name="{}" type="hinge" axis="0 1 0"/>' + ball
+    last = {"dist1": "F1" if six_bar else "E1", "dist3": "E3"}[spine]
+    origin = {"dist1": point("P"), "dist3": point("Q")}[spine]
+    platform = (f'<body name="platform" pos="{at(origin - point(last))}">{hinge.format("pin")}'
+                + "".join(f'<site name="{p}_pin" pos="{at(point(p) - origin)}"/>' for p in "PQR") + "</body>")
+
+    def leg(k: int) -> str:
+        joints = [f"O{k}", f"E{k}"] + (["F1"] if six_bar and k == 1 else [])
+        text, before = "", np.zeros(3)
+        for depth, joint in enumerate(joints):
+            body = f"dist{k}" if depth == len(joints) - 1 else ("prox", "mid")[depth] + str(k)
+            text += (f'<body name="{body}" pos="{at(point(joint) - before)}">'
+                     + hinge.format(f"m{k}" if depth == 0 else f"{'ef'[depth - 1]}{k}"))
+            before = point(joint)
+        return text + (platform if spine == f"dist{k}" else "") + "</body>" * len(joints)
+
+    def anchor(body: str, joint: str, pin: str) -> str:
+        return f'anchor="{at(point(pin) - point(joint))}" body1="{body}"'
+
+    legs = [leg(k) for k in (1, 2, 3, 4)]
+    closures = [f'<connect name="c_P" {anchor("dist2", "E2", "P")} body2="{closed_on}"/>']
+    if spine != "dist1":
+        closures.append(f'<connect name="c_P1" {anchor("dist1", "F1" if six_bar else "E1", "P")} body2="platform"/>')
+    if spine != "dist3":
+        closures.append(f'<connect name="c_Q" {anchor("dist3", "E3", "Q")} body2="platform"/>')
+    closures.append(f'<connect name="c_R" {anchor("dist4", "E4", "R")} body2="platform"/>')
+    motors = [f'<motor joint="m{k}"/>' for k in (1, 2, 3, 4)] + (['<motor joint="e1"/>'] if driven_elbow else [])
+    if reverse:
+        legs, closures, motors = legs[::-1], closures[::-1], motors[::-1]
+    return ('<mujoco model="five_bar_leg"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">' + "".join(legs) + "</body></worldbody>"
+            "<equality>" + "".join(closures) + "</equality><actuator>" + "".join(motors) + "</actuator></mujoco>")
+
+
+def read(path, unit=None):
+    """The graph reading of a file, its platform the output, and its indices at the file's configuration."""
+    graph = graph_mechanism(read_closed_tree(path, output="platform", length_unit=unit))
+    return graph, graph.indices()
+
+
+def by_joint(graph, values) -> dict[str, float]:
+    """Per-actuator values keyed by the actuated joint (chain names differ between two readings)."""
+    return {name.split(":")[1]: float(v) for name, v in zip(graph.actuators, np.ravel(values))}
+
+
+def assert_same(first, second, tolerance: float = 1e-12, cti: bool = True) -> None:
+    """Two readings (mechanism, indices) of one mechanism, their actuators matched by joint: every index, actuation
+    wrench (up to its sign) and worst fault the same (the CTI and F_Cj unless ``cti`` is False: the serial reading
+    takes a planar mechanism's pins for hinges, where the graph keeps MJCF's balls and their couples)."""
+    (graph_a, a), (graph_b, b) = first, second
+    joints_a, joints_b = ([name.split(":")[1] for name in g.actuator_names] for g in (graph_a, graph_b))
+    assert sorted(joints_a) == sorted(joints_b)
+    order = [joints_b.index(joint) for joint in joints_a]  # b's actuators in a's order
+    np.testing.assert_allclose(a.iti_actuators, b.iti_actuators[order], atol=tolerance)
+    for index, members in enumerate(a.submechanisms):  # (each actuator's OTI in each submechanism)
+        theirs = tuple(sorted(order[k] for k in members))
+        row = b.submechanisms.index(theirs)
+        np.testing.assert_allclose(a.oti_actuators[index], b.oti_actuators[row][[theirs.index(order[k])
+                                                                                 for k in members]], atol=tolerance)
+        assert float(a.oti_submechanisms[index]) == pytest.approx(float(b.oti_submechanisms[row]), abs=tolerance)
+    for name in ("iti", "lmti") + (("cti",) if cti else ()):
+        assert float(getattr(a, name)) == pytest.approx(float(getattr(b, name)), abs=tolerance), name
+    for name in ("f_o", "f_io") + (("f_c",) if cti else ()):
+        assert getattr(a, name).keys() == getattr(b, name).keys()
+        for j in getattr(a, name):
+            assert float(getattr(a, name)[j]) == pytest.approx(float(getattr(b, name)[j]), abs=tolerance), (name, j)
+    for j in a.remaining_lmti:  # (each set of j failed, by the joints failed)
+        theirs = [b.failed_sets(j).index(tuple(sorted(order[k] for k in failed))) for failed in a.failed_sets(j)]
+        np.testing.assert_allclose(a.remaining_lmti[j], b.remaining_lmti[j][theirs], atol=tolerance)
+        worst_a = sorted(joints_a[k] for k in np.ravel(a.worst_fault_indices[j]))
+        assert worst_a == sorted(joints_b[k] for k in np.ravel(b.worst_fault_indices[j]))
+    signs = np.sign(np.sum(a.actuation_wrenches * b.actuation_wrenches[order], axis=1))[:, None]
+    np.testing.assert_allclose(a.actuation_wrenches, b.actuation_wrenches[order] * signs, atol=tolerance)
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_five_bar_leg_reads_as_its_two_sides_and_the_textbook_pressure_angles(tmp_path, variant):
+    leg, unit = mjcf_variant(tmp_path, "leg", variant, five_bar_leg)
+    sides, _ = mjcf_variant(tmp_path, "sides", variant, lambda *a: five_bar_leg(*a, closed_on="platform"))
+    graph, indices = reading = read(leg, unit)
+    assert any("one leg with loops inside it and 2 actuators" in note for note in graph.report.notes)
+    assert len({leg_.name for leg_ in graph.legs}) == 4 and graph.dof == 3
+    assert_same(reading, read(sides, unit))
+    _, _, anchor = mujoco_closed(leg)
+    pin = anchor["pin"]
+    itis = by_joint(graph, indices.iti_actuators)
+    for k in (1, 2):
+        assert itis[f"m{k}"] == pytest.approx(sine(anchor[f"e{k}"] - anchor[f"m{k}"], pin - anchor[f"e{k}"]), abs=1e-9)
+    assert abs(itis["m1"] - itis["m2"]) > 1e-3  # (the sides told apart)
+    assert 0 < float(indices.f_o[1]) < float(indices.lmti)
+
+
+def test_the_same_whatever_the_tree_and_the_order_of_the_file(tmp_path):
+    readings = []
+    for name, options in (("as_drawn", {}), ("reversed", {"reverse": True}), ("on_leg_3", {"spine": "dist3"}),
+                          ("on_leg_3_reversed", {"spine": "dist3", "reverse": True})):
+        path = tmp_path / f"{name}.xml"
+        path.write_text(five_bar_leg(**options))
+        readings.append(read(path))
+        assert readings[-1][0].actuators == readings[0][0].actuators  # (named after the bodies the motors turn)
+    for reading in readings[1:]:
+        assert_same(readings[0], reading)
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_leg_redundant_inside_reads_as_a_serial_leg_of_two_actuators_beside_the_other_side(tmp_path, variant):
+    """The first elbow driven as well: three actuators in the leg for its two motions of P. Each wrench is still the
+    one reciprocal to the leg with that actuator alone locked; the same as the first side read as a serial chain
+    with two actuated joints (m1, e1) closed onto the platform."""
+    leg, unit = mjcf_variant(tmp_path, "leg", variant, lambda *a: five_bar_leg(*a, driven_elbow=True))
+    sides, _ = mjcf_variant(tmp_path, "sides", variant,
+                            lambda *a: five_bar_leg(*a, driven_elbow=True, closed_on="platform"))
+    graph, indices = reading = read(leg, unit)
+    assert len(graph.actuators) == 5
+    assert_same(reading, read(sides, unit))
+    serial = load(sides, output="platform", length_unit=unit)  # (the serial reading: chain m1 of two actuators)
+    assert sorted(serial.actuator_names) == ["m1:e1", "m1:m1", "m2:m2", "m3:m3", "m4:m4"]
+    assert_same(reading, (serial, indices_at_pose(serial, serial.home_pose)), cti=False)
+    _, _, anchor = mujoco_closed(leg)
+    itis = by_joint(graph, indices.iti_actuators)  # e1's wrench: along O1P (m1 free), on P (the joint after e1)
+    assert itis["e1"] == pytest.approx(sine(anchor["pin"] - anchor["m1"], anchor["pin"] - anchor["e1"]), abs=1e-9)
+
+
+def test_an_actuator_that_moves_with_the_platform_held_is_refused_naming_it(tmp_path):
+    path = tmp_path / "six_bar.xml"
+    path.write_text(five_bar_leg(six_bar=True))
+    with pytest.raises(ImportError_, match=r"locking actuated joint 'm1' leaves the platform as free as before: a "
+                                           r"motion inside its leg moves it with the platform held \(kinematic "
+                                           r"redundancy; the leg's other actuated joints: m2\), so it has no actuation "
+                                           r"wrench; --lock m1 holds it\.$"):
+        read(path)
+
+
+def test_the_command_reads_the_leg_as_its_two_sides(tmp_path):
+    leg, sides = tmp_path / "leg.xml", tmp_path / "sides.xml"
+    leg.write_text(five_bar_leg(scale=1000.0))
+    sides.write_text(five_bar_leg(closed_on="platform"))
+    printed = []
+    for path, unit in ((leg, ["--length-unit", "mm"]), (sides, [])):
+        run = screwkit("analyze", path, "--output", "platform", *unit, "--json")
+        assert run.returncode == 0, run.stderr
+        printed.append(json.loads(run.stdout))
+    itis = [{name.split(":")[1]: value for name, value in text["iti_actuators"].items()} for text in printed]
+    assert itis[0] == pytest.approx(itis[1], abs=1e-12) and len(itis[0]) == 4
+    assert printed[0]["lmti"] == pytest.approx(printed[1]["lmti"], abs=1e-12)
+    assert printed[0]["f_o"] == pytest.approx(printed[1]["f_o"], abs=1e-12)
+
+
+def test_poses_in_a_batch_read_as_the_two_sides_do(tmp_path):
+    """The batched path (sweeps, maps, paths): at poses about the file's, every index as the two sides give it."""
+    from screwkit.studies.poses import graph_indices_at_poses
+
+    leg, sides = tmp_path / "leg.xml", tmp_path / "sides.xml"
+    leg.write_text(five_bar_leg())
+    sides.write_text(five_bar_leg(closed_on="platform"))
+    rng = np.random.default_rng(7)
+    poses = np.column_stack([rng.uniform(-0.07, -0.03, 12), rng.uniform(-0.37, -0.33, 12),
+                             np.radians(rng.uniform(-10.0, 10.0, 12))])
+    ours, theirs = (graph_indices_at_poses(graph_mechanism(read_closed_tree(path, output="platform")), poses,
+                                           detail=True) for path in (leg, sides))
+    assert ours.actuators == theirs.actuators and np.all(np.isfinite(ours.lmti))
+    for name in ("iti_actuators", "iti", "lmti", "cti"):
+        np.testing.assert_allclose(getattr(ours, name), getattr(theirs, name), atol=1e-12, err_msg=name)
+    for j in ours.f_o:
+        np.testing.assert_allclose(ours.f_o[j], theirs.f_o[j], atol=1e-12)
+        np.testing.assert_allclose(ours.remaining_lmti[j], theirs.remaining_lmti[j], atol=1e-12)
+
+
+def test_the_viewer_marks_the_side_of_the_failed_motor(tmp_path):
+    """Each side of the five-bar leg drawn as its motor's: with m1 failed, side 1 is drawn failed and side 2 is not."""
+    from screwkit.viewer.graph_drawing import graph_markers, solve_graph_frames
+
+    path = tmp_path / "leg.xml"
+    path.write_text(five_bar_leg())
+    graph = graph_mechanism(read_closed_tree(path, output="platform"))
+    frames = solve_graph_frames(graph, graph.home_pose[None], threshold=1e-6, strict=True)
+    failed = graph.actuators.index("prox1:m1")
+    markers = graph_markers(graph, frames, failed=(failed,))[0]
+    drawn = {marker.path.split("/")[-1]: marker.failed for marker in markers if marker.kind == "joint"}
+    assert drawn["e1"] and not drawn["e2"] and not drawn["m3"], drawn
+
+
+def test_the_command_moves_the_leg_by_its_actuators(tmp_path):
+    """``analyze --actuators`` (degrees, in the actuators' order) at the values a pose puts the four motors at: the
+    indices of that pose, the five-bar leg's two motors driven with the others."""
+    from screwkit.io.closed_tree import joint_value
+
+    path = tmp_path / "leg.xml"
+    path.write_text(five_bar_leg())
+    graph = graph_mechanism(read_closed_tree(path, output="platform"))
+    moved = graph.at_pose([-0.04, 0.0, -0.34], [0.0, np.radians(4.0), 0.0])
+    values = [np.degrees(joint_value(graph.tree.model, leg.actuators[0], moved.q)) for leg in moved.legs]
+    run = screwkit("analyze", path, "--output", "platform", "--actuators", " ".join(f"{v:.15g}" for v in values),
+                   "--json")
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["lmti"] == pytest.approx(float(moved.indices().lmti), abs=1e-9)
+    assert moved.indices().lmti != pytest.approx(float(graph.indices().lmti), abs=1e-3)  # (a pose of its own)
