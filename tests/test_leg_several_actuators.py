@@ -251,3 +251,27 @@ def test_the_command_moves_the_leg_by_its_actuators(tmp_path):
     assert run.returncode == 0, run.stderr
     assert json.loads(run.stdout)["lmti"] == pytest.approx(float(moved.indices().lmti), abs=1e-9)
     assert moved.indices().lmti != pytest.approx(float(graph.indices().lmti), abs=1e-3)  # (a pose of its own)
+
+
+def test_a_path_through_the_command_reads_as_the_two_sides_do(tmp_path):
+    """``screwkit trajectory`` on the five-bar leg, its poses quoted with negative numbers: at every sample the
+    indices of the two sides written as legs, computed in this process."""
+    import csv
+
+    from screwkit.studies.poses import graph_indices_at_poses
+
+    leg, sides = tmp_path / "leg.xml", tmp_path / "sides.xml"
+    leg.write_text(five_bar_leg())
+    sides.write_text(five_bar_leg(closed_on="platform"))
+    run = screwkit("trajectory", leg, "--output", "platform", "--line", "-0.06 -0.35 -3", "-0.04 -0.34 5",
+                   "--samples", "9", "--out", tmp_path / "path.csv")
+    assert run.returncode == 0, run.stderr
+    rows = list(csv.DictReader((tmp_path / "path.csv").open()))
+    assert len(rows) >= 9 and all(row["reachable"] == "True" for row in rows)
+    poses = np.array([[float(row["x"]), float(row["z"]), np.radians(float(row["pitch"]))] for row in rows])
+    theirs = graph_indices_at_poses(graph_mechanism(read_closed_tree(sides, output="platform")), poses, detail=True)
+    np.testing.assert_allclose([float(row["lmti"]) for row in rows], theirs.lmti, atol=1e-12)
+    np.testing.assert_allclose([float(row["f_o1"]) for row in rows], theirs.f_o[1], atol=1e-12)
+    for k, name in enumerate(theirs.actuators):
+        np.testing.assert_allclose([float(row[f"iti_actuator[{name}]"]) for row in rows],
+                                   theirs.iti_actuators[:, k], atol=1e-12)
