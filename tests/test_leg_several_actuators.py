@@ -185,6 +185,11 @@ def test_an_actuator_that_moves_with_the_platform_held_is_refused_naming_it(tmp_
                                            r"redundancy; the leg's other actuated joints: m2\), so it has no actuation "
                                            r"wrench; --lock m1 holds it\.$"):
         read(path)
+    held = graph_mechanism(read_closed_tree(path, output="platform", lock=("m1",)))  # as the message says
+    itis = by_joint(held, held.indices().iti_actuators)
+    _, _, anchor = mujoco_closed(path)
+    assert sorted(itis) == ["m2", "m3", "m4"]
+    assert itis["m2"] == pytest.approx(sine(anchor["e2"] - anchor["m2"], anchor["pin"] - anchor["e2"]), abs=1e-9)
 
 
 def test_the_command_reads_the_leg_as_its_two_sides(tmp_path):
