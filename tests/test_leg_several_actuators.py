@@ -16,7 +16,9 @@ P. The checks:
 * with the first elbow driven too (three actuators in the leg, redundant inside it): against the two legs, the first
   a serial chain of two actuators;
 * refused, naming the actuator, where a motion inside the leg moves it with the platform held (a six-bar side);
-* through ``screwkit analyze --json`` as a subprocess.
+* through ``screwkit analyze --json``, ``analyze --actuators`` and ``trajectory`` as subprocesses;
+* spatial: a 6-3 Stewart platform of R-S-S legs whose rods meet two by two at the platform's balls, each pair
+  written as one leg of two motors: every ITI and OTI from the rods' lines.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import json
 import numpy as np
 import pytest
 
-from helpers import MJCF_WORLDS, mjcf_variant, mujoco_closed, screwkit, sine
+from helpers import MJCF_WORLDS, leg_line_otis, mjcf_variant, mujoco_closed, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
 from screwkit.io.loader import load
@@ -115,11 +117,12 @@ def assert_same(first, second, tolerance: float = 1e-12, cti: bool = True) -> No
                                                                                  for k in members]], atol=tolerance)
         assert float(a.oti_submechanisms[index]) == pytest.approx(float(b.oti_submechanisms[row]), abs=tolerance)
     for name in ("iti", "lmti") + (("cti",) if cti else ()):
-        assert float(getattr(a, name)) == pytest.approx(float(getattr(b, name)), abs=tolerance), name
+        np.testing.assert_allclose(float(getattr(a, name)), float(getattr(b, name)), atol=tolerance, err_msg=name)
     for name in ("f_o", "f_io") + (("f_c",) if cti else ()):
         assert getattr(a, name).keys() == getattr(b, name).keys()
         for j in getattr(a, name):
-            assert float(getattr(a, name)[j]) == pytest.approx(float(getattr(b, name)[j]), abs=tolerance), (name, j)
+            np.testing.assert_allclose(float(getattr(a, name)[j]), float(getattr(b, name)[j]), atol=tolerance,
+                                       err_msg=f"{name}{j}")
     for j in a.remaining_lmti:  # (each set of j failed, by the joints failed)
         theirs = [b.failed_sets(j).index(tuple(sorted(order[k] for k in failed))) for failed in a.failed_sets(j)]
         np.testing.assert_allclose(a.remaining_lmti[j], b.remaining_lmti[j][theirs], atol=tolerance)
@@ -280,3 +283,78 @@ def test_a_path_through_the_command_reads_as_the_two_sides_do(tmp_path):
     for k, name in enumerate(theirs.actuators):
         np.testing.assert_allclose([float(row[f"iti_actuator[{name}]"]) for row in rows],
                                    theirs.iti_actuators[:, k], atol=1e-12)
+
+
+def paired_stewart(scale: float = 1.0, world=("0 0 0", "1 0 0 0"), *, pairs: bool = True, reverse: bool = False
+                   ) -> str:
+    """A 6-3 Stewart platform of R-S-S legs: six cranks on the base, their rods meeting two by two at three ball
+    centres P0, P1, P2 of the platform, which hangs on rod 0a by its ball at P0. ``pairs``: each second rod closed
+    onto the first at their common P (three legs with a loop inside and two actuators each); else onto the
+    platform (six legs of one actuator)."""
+    def at(v) -> str:
+        return " ".join(repr(float(c) * scale) for c in v)
+
+    points, cranks = paired_stewart_geometry()
+    ball = f'<geom type="sphere" size="{0.004 * scale!r}"/>'
+    platform = (f'<body name="platform" pos="{at(points[0] - cranks["0a"][1])}"><joint name="s_p" type="ball"/>'
+                + ball + "".join(f'<site name="P{k}" pos="{at(points[k] - points[0])}"/>' for k in range(3))
+                + "</body>")
+    legs, closures = [], []
+    for name, (motor, end, axis) in cranks.items():
+        k = int(name[0])
+        legs.append(f'<body name="crank_{name}" pos="{at(motor)}"><joint name="m_{name}" type="hinge" '
+                    f'axis="{at(axis / scale)}"/>{ball}<body name="rod_{name}" pos="{at(end - motor)}">'
+                    f'<joint name="b_{name}" type="ball"/>{ball}{platform if name == "0a" else ""}</body></body>')
+        if name != "0a":
+            onto = f"rod_{k}a" if pairs and name.endswith("b") else "platform"
+            closures.append(f'<connect name="c_{name}" body1="rod_{name}" anchor="{at(points[k] - end)}" '
+                            f'body2="{onto}"/>')
+    motors = [f'<motor joint="m_{name}"/>' for name in cranks]
+    if reverse:
+        legs, closures, motors = legs[::-1], closures[::-1], motors[::-1]
+    return ('<mujoco model="paired_stewart"><option><flag contact="disable"/></option><worldbody>'
+            f'<body name="base" pos="{world[0]}" quat="{world[1]}">' + "".join(legs) + "</body></worldbody>"
+            "<equality>" + "".join(closures) + "</equality><actuator>" + "".join(motors) + "</actuator></mujoco>")
+
+
+def paired_stewart_geometry():
+    """The platform's three ball centres and, per rod, its crank's motor point, crank end and axis (m)."""
+    points = [np.array([0.12 * np.cos(t), 0.12 * np.sin(t), 0.30]) for t in np.radians([90.0, 215.0, 330.0])]
+    cranks = {}
+    for k, (first, second) in enumerate(((55.0, 128.0), (178.0, 250.0), (295.0, 8.0))):
+        for side, angle in zip("ab", np.radians([first, second])):
+            radial = np.array([np.cos(angle), np.sin(angle), 0.0])
+            motor = 0.25 * radial
+            end = motor + 0.06 * radial + np.array([0.0, 0.0, 0.02])
+            cranks[f"{k}{side}"] = (motor, end, np.array([-np.sin(angle), np.cos(angle), 0.0]))
+    return points, cranks
+
+
+@pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
+def test_a_stewart_platform_whose_rods_meet_in_pairs_reads_the_rod_lines(tmp_path, variant):
+    """Spatial: each pair of rods meeting at one ball of the platform written as one leg with a loop inside and two
+    motors. Every ITI |u . t| and OTI from the rods' lines (MuJoCo's placement of the balls, numpy alone), the same as
+    the six legs written apart, in m, mm and a moved world, and with the file listed backwards."""
+    path, unit = mjcf_variant(tmp_path, "pairs", variant, paired_stewart)
+    graph, indices = reading = read(path, unit)
+    assert len(graph.actuators) == 6 and graph.dof == 6
+    assert any("one leg with loops inside it and 2 actuators" in note for note in graph.report.notes)
+    model, data, anchor = mujoco_closed(path)
+    joints = {model.joint(k).name: k for k in range(model.njnt)}
+    ends = {name[2:]: data.site_xpos[model.site(f"P{name[2]}").id].copy() for name in joints if name[:2] == "b_"}
+    itis, starts, tips = {}, [], []
+    for name in sorted(ends):
+        motor, start, axis = anchor[f"m_{name}"], anchor[f"b_{name}"], data.xaxis[joints[f"m_{name}"]]
+        rod = (ends[name] - start) / np.linalg.norm(ends[name] - start)
+        tangent = np.cross(axis, start - motor)
+        itis[f"m_{name}"] = abs(rod @ tangent) / np.linalg.norm(tangent)
+        starts.append(start)
+        tips.append(ends[name])
+    assert by_joint(graph, indices.iti_actuators) == pytest.approx(itis, abs=1e-9)
+    otis = dict(zip((f"m_{name}" for name in sorted(ends)), leg_line_otis(starts, tips)))
+    assert by_joint(graph, indices.oti_actuators[0]) == pytest.approx(otis, abs=1e-9)
+    assert float(indices.lmti) == pytest.approx(min(otis.values()), abs=1e-9)
+    apart, _ = mjcf_variant(tmp_path, "apart", variant, lambda *a: paired_stewart(*a, pairs=False))
+    assert_same(reading, read(apart, unit))
+    backwards, _ = mjcf_variant(tmp_path, "backwards", variant, lambda *a: paired_stewart(*a, reverse=True))
+    assert_same(reading, read(backwards, unit))
