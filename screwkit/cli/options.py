@@ -162,13 +162,11 @@ class GreedyOption(click.Option):
 
 
 def _is_number(token: str) -> bool:
-    """Whether ``token`` is a value, not an option: a number, or numbers quoted together (``--line "-0.06 -0.35 -3"
-    "-0.04 -0.34 5"``: each pose one argument)."""
+    """A value, not an option: a number, or numbers quoted together (``--line "-0.06 -0.35 -3" "-0.04 -0.34 5"``)."""
     try:
-        [float(word) for word in token.split()]
+        return bool([float(word) for word in token.split()])
     except ValueError:
         return False
-    return bool(token.split())
 
 
 def fail(message: str) -> click.ClickException:

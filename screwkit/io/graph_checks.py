@@ -136,18 +136,19 @@ def check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: lis
     moves with every actuator locked (an effector turning freely on the pin where the legs meet: its frame is no
     output any actuator controls, and its indices would be zero everywhere); ``deferred``: as :func:`check_legs`'s,
     the stage named instead."""
+    if tree.output_type == "point":
+        raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
+                           f"frame of their platform {body!r} only.")
     try:
-        _check_output(tree, screws, body, legs)
+        _check_idle(tree, screws, body, legs)
     except ImportError_ as error:
         if deferred:
             raise stage_refusal(tree, legs, deferred, error) from None
         raise
 
 
-def _check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
-    if tree.output_type == "point":
-        raise ImportError_(f"{tree.source}: --output-type point: legs with loops inside them are analysed for the "
-                           f"frame of their platform {body!r} only.")
+def _check_idle(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg]) -> None:
+    """:func:`check_output`'s refusal of a platform that moves with every actuator locked."""
     idle = common_motions(screws, locked=True)
     if len(idle):
         guessed = next((note.split(":")[0].split(" (")[0].removeprefix("actuators ") for note in tree.notes
