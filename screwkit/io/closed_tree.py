@@ -136,6 +136,10 @@ class ClosedTree:
         match = re.fullmatch(r"one hinge of \w+ joint (['\"])(.*)\1", self.split.get(name, ""))
         return match.group(2) if match else name
 
+    def body_names(self) -> dict[int, str]:
+        """Each joint's body, by the name of its first BODY frame (the body a joint moves, as a leg is named)."""
+        return {int(f.parentJoint): f.name for f in reversed(list(self.model.frames)) if str(f.type) == "BODY"}
+
     def motor_joints(self) -> set[int]:
         """The model's joints of the actuated joints (those of :attr:`motors` the model has)."""
         return {self.model.getJointId(name) for name in self.motors if self.model.existJointName(name)}

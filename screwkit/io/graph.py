@@ -384,7 +384,7 @@ def graph_legs(tree: ClosedTree, platform: int, report: ImportReport) -> list[Gr
     ``report``)."""
     model = tree.model
     motors = {model.getJointId(name): name for name in tree.motors}  # (each a joint: read_closed_tree)
-    body_names = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    body_names = tree.body_names()
     legs, placed = [], set()
     for group in _groups(model, tree.closures, platform):
         members = set(group)

@@ -162,11 +162,11 @@ def check_actuators(tree: ClosedTree, legs, platform: int) -> dict[str, str]:
                                "the platform carries, or a branch off the legs: left out)" if off else "") + ".")
     several, deferred = [leg for leg in legs if len(leg.actuators) > 1], {}
     for leg in several:
-        advice, held = _leg_advice(tree, leg, platform, alone=len(legs) == 1)
+        advice, held, series = _leg_advice(tree, leg, platform, alone=len(legs) == 1)
         if not advice:  # (analysed one actuator at a time: split_legs)
             continue
-        if all(joint in leg.actuators for joint in serial_stage(model, leg)) and advice == _stage_advice(tree, leg)[0]:
-            deferred[leg.name] = advice  # (actuators in series: read one at a time, the advice given if that fails)
+        if series:  # (actuators in series: read one at a time, the advice given if that fails)
+            deferred[leg.name] = advice
             continue
         others = [(other, _leg_advice(tree, other, platform, alone=len(legs) == 1)[1]) for other in several
                   if other is not leg]
@@ -196,7 +196,7 @@ def split_legs(tree: ClosedTree, legs) -> list:
     actuated joint moves (what a leg of that actuator alone would be named, whatever order the file lists them in),
     ``of`` the leg's name; the legs in order by name."""
     model, split = tree.model, []
-    bodies = {int(f.parentJoint): f.name for f in reversed(list(model.frames)) if str(f.type) == "BODY"}
+    bodies = tree.body_names()
     for leg in legs:
         if len(leg.actuators) < 2:
             split.append(leg)
@@ -208,21 +208,22 @@ def split_legs(tree: ClosedTree, legs) -> list:
     return sorted(split, key=lambda leg: leg.name)
 
 
-def _leg_advice(tree: ClosedTree, leg, platform: int, alone: bool) -> tuple[str, list[str]]:
-    """For a leg with several actuators: what holds the serial stage that carries them (the refusal's end) and the
-    joints it holds (none: no advice, and the leg is analysed one actuator at a time). ``alone``: the mechanism has
-    no other leg (a tool turned, or hanging free, after the body where the leg's loops end is then no output any
-    other leg holds)."""
+def _leg_advice(tree: ClosedTree, leg, platform: int, alone: bool) -> tuple[str, list[str], bool]:
+    """For a leg with several actuators: what holds the serial stage that carries them (the refusal's end), the
+    joints it holds (none: no advice, and the leg is analysed one actuator at a time) and whether that stage is of
+    actuators alone (a hip's motors in series: the leg is read one actuator at a time all the same, the advice given
+    if that fails). ``alone``: the mechanism has no other leg (a tool turned, or hanging free, after the body where
+    the leg's loops end is then no output any other leg holds)."""
     model = tree.model
     riding = [tree.written_joint(model.names[a]) for a in leg.actuators
               if a != platform and platform in path_to(model, a)]
     if riding and len(riding) < len(leg.actuators):  # (a wheel on a wheel leg's end link, where its closure ends)
         one = len(riding) == 1
-        return _and_stage(tree, leg, (
+        return *_and_stage(tree, leg, (
             f"; actuated joint{'' if one else 's'} {', '.join(map(repr, riding))} ride{'s' if one else ''} on the "
             "platform (a wheel or a tool it carries, through which the leg's closure reaches it): --lock "
             f"{' --lock '.join(riding)} holds {'it' if one else 'them'}, or --output names the body "
-            f"{'it turns' if one else 'they turn'}", riding))
+            f"{'it turns' if one else 'they turn'}", riding)), False
     ends = {end for closure in leg.closures for end in (closure.joint_a, closure.joint_b)}
     tail = [a for a in leg.actuators if a in path_to(model, platform) and not any(a in path_to(model, end)
                                                                                  for end in ends)]
@@ -230,25 +231,27 @@ def _leg_advice(tree: ClosedTree, leg, platform: int, alone: bool) -> tuple[str,
         names = [tree.written_joint(model.names[a]) for a in tail]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(tail)]), None)
-        return _and_stage(tree, leg, (
+        return *_and_stage(tree, leg, (
             f"; actuated joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))} turn"
             f"{'' if len(names) > 1 else 's'} the output after the body where the legs' loops end"
             + (f" ({meeting!r})" if meeting else "") + ", as a tool the platform carries: --lock "
             + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it")
-            + (f", or --output {meeting} takes that body" if meeting else ""), names))
+            + (f", or --output {meeting} takes that body" if meeting else ""), names)), False
     hanging = [j for j in path_to(model, platform) if j in leg.joints and j not in leg.actuators
                and not any(j in path_to(model, end) for end in ends)]
     if hanging and alone and model.parents[min(hanging)] in ends:  # (a tool on a free swivel where the loops end)
         names = [tree.written_joint(model.names[j]) for j in hanging]
         meeting = next((platform_body(model, k) for k, frame in enumerate(model.frames)
                         if int(frame.parentJoint) == model.parents[min(hanging)]), None)
-        return _and_stage(tree, leg, (
+        return *_and_stage(tree, leg, (
             "; the output hangs off the body where the legs' loops end" + (f" ({meeting!r})" if meeting else "")
             + f" by passive joint{'s' if len(names) > 1 else ''} {', '.join(map(repr, names))}, which no actuator "
             "turns: " + (f"--output {meeting} takes that body, or " if meeting else "") + "--lock "
-            + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it"), names))
+            + " --lock ".join(names) + (" hold them" if len(names) > 1 else " holds it"), names)), False
     advice = _stage_advice(tree, leg)
-    return advice if advice[1] else _transmission_advice(tree, leg, platform)
+    if advice[1]:
+        return *advice, all(joint in leg.actuators for joint in serial_stage(model, leg))
+    return *_transmission_advice(tree, leg, platform), False
 
 
 def _and_stage(tree: ClosedTree, leg, advice: tuple[str, list[str]]) -> tuple[str, list[str]]:

@@ -65,15 +65,7 @@ def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, ne
         _check_independent(tree, leg, index, screw, nearby)
     carries = all(actuator in path_to(model, j) for j in leg.joints if j != actuator)
     if screw.outside[0] <= IN_LOOP_TOLERANCE and screw.locked_dims[0] == screw.allowed_dims[0] and carries:
-        around = nearby()
-        if around and np.any(around[index].locked_dims < around[index].allowed_dims):
-            raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
-                               f"{leg.name!r} as free as before at the file's joint values, and takes a motion "
-                               "away at closed configurations near them: the file is written at a singular "
-                               "configuration of the leg (its links on one line, stretched or folded); give "
-                               "joint values away from it: --initial JOINT VALUE (an actuated joint away from its "
-                               "dead centre, held there while the loops close), or a keyframe named 'home' "
-                               "(MJCF).")
+        _refuse_a_singular_file(tree, name, leg, index, nearby)
         raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
                            f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                            "(motors the file does not name, or a leg with no input); if it is a serial stage "
@@ -117,17 +109,26 @@ def _check_independent(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegSc
     the leg (``nearby()``)."""
     if screw.locked_dims[0] < screw.allowed_dims[0]:
         return
+    _refuse_a_singular_file(tree, tree.model.names[leg.actuators[0]], leg, index, nearby)
     name = tree.written_joint(tree.model.names[leg.actuators[0]])
     others = ", ".join(sorted(tree.written_joint(tree.model.names[j]) for j in leg.others))
-    around = nearby()
-    if around and np.any(around[index].locked_dims < around[index].allowed_dims):
-        raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform as free as before at "
-                           "the file's joint values, and takes a motion away at closed configurations near them: the "
-                           "file is written at a singular configuration of its leg; give joint values away from it: "
-                           "--initial JOINT VALUE, or a keyframe named 'home' (MJCF).")
     raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform as free as before: a "
                        "motion inside its leg moves it with the platform held (kinematic redundancy; the leg's other "
                        f"actuated joints: {others}), so it has no actuation wrench; --lock {name} holds it.")
+
+
+def _refuse_a_singular_file(tree: ClosedTree, name: str, leg: GraphLeg, index: int, nearby) -> None:
+    """Where locking actuated joint ``name`` leaves leg ``index``'s platform as free as before at the file's joint
+    values: refused as a file written at a singular configuration of the leg if it takes a motion away at closed
+    configurations near them (``nearby()``); nothing otherwise (the caller says why else)."""
+    around = nearby()
+    if around and np.any(around[index].locked_dims < around[index].allowed_dims):
+        raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg {leg.name!r} "
+                           "as free as before at the file's joint values, and takes a motion away at closed "
+                           "configurations near them: the file is written at a singular configuration of the leg "
+                           "(its links on one line, stretched or folded); give joint values away from it: --initial "
+                           "JOINT VALUE (an actuated joint away from its dead centre, held there while the loops "
+                           "close), or a keyframe named 'home' (MJCF).")
 
 
 def check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg],

@@ -138,7 +138,8 @@ def _values_closing_the_loops(tree: ClosedTree, locked: list[int]) -> tuple[NDAr
     cycles = set()  # the joints of every closure's loop: its two tree paths, less what they share
     for closure in tree.closures:
         cycles |= set(path_to(model, closure.joint_a)) ^ set(path_to(model, closure.joint_b))
-    inside = [joint for joint in locked if joint in cycles and joint not in tree.motor_joints()]
+    motors = tree.motor_joints()
+    inside = [joint for joint in locked if joint in cycles and joint not in motors]
     if not inside:
         raise ImportError_(f"{refusal} (with --lock {', --lock '.join(model.names[j] for j in locked)} held at the "
                            "file's values)") from None

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.io.closed_tree import path_to
 from screwkit.viewer.markers import ROOT_PATH, Frames, Marker, node_label
 
 __all__ = ["Rod", "graph_rods", "solve_graph_frames", "graph_markers"]
@@ -44,13 +45,9 @@ def _owners(graph) -> dict[int, int | str]:
     leg of several actuators read one at a time (copies of it, ``of`` its name), the copy whose actuator the body
     rides on (a five-bar leg's two sides), else the first."""
     owners: dict[int, int | str] = {0: "base"}
-    parents = graph.tree.model.parents
     for index, leg in enumerate(graph.legs):
-        for joint in leg.joints:
-            above, rides = (joint if leg.of else 0), False  # (a copy's actuator: one; a passive leg has none)
-            while above and not rides:
-                rides, above = above == leg.actuators[0], int(parents[above])
-            if joint not in owners or not leg.of or rides:
+        for joint in leg.joints:  # (a copy has one actuator; a passive leg, never a copy, none)
+            if joint not in owners or not leg.of or leg.actuators[0] in path_to(graph.tree.model, joint):
                 owners[joint] = index
     owners[graph.platform] = "platform"
     return owners
