@@ -11,8 +11,9 @@ P. The checks:
 * against the same mechanism written as those two legs (the second distal link closed onto the platform, not onto
   the first), which screwkit reads leg by leg: every index, actuation wrench and worst fault the same to 1e-12;
 * against the textbook pressure angles from MuJoCo's own placement of the pins: ITI = |sin(OE, EP)| of each side;
-* in metres, in millimetres and in a moved, turned world; with the file's bodies, closures and motors listed in
-  reverse order, and with the platform hung on another leg (a different tree of the same mechanism);
+* in metres, in millimetres and in a moved, turned world; every length times 1e-3 and 1e3; with the file's
+  bodies, closures and motors listed in reverse order, with motors renamed each as another (the indices and worst
+  faults follow the joints), and with the platform hung on another leg (a different tree of the same mechanism);
 * with the first elbow driven too (three actuators in the leg, redundant inside it): against the two legs, the first
   a serial chain of two actuators;
 * refused, naming the actuator, where a motion inside the leg moves it with the platform held (a six-bar side);
@@ -101,10 +102,11 @@ def by_joint(graph, values) -> dict[str, float]:
     return {name.split(":")[1]: float(v) for name, v in zip(graph.actuators, np.ravel(values))}
 
 
-def assert_same(first, second, tolerance: float = 1e-12, cti: bool = True) -> None:
+def assert_same(first, second, tolerance: float = 1e-12, cti: bool = True, wrenches: bool = True) -> None:
     """Two readings (mechanism, indices) of one mechanism, their actuators matched by joint: every index, actuation
     wrench (up to its sign) and worst fault the same (the CTI and F_Cj unless ``cti`` is False: the serial reading
-    takes a planar mechanism's pins for hinges, where the graph keeps MJCF's balls and their couples)."""
+    takes a planar mechanism's pins for hinges, where the graph keeps MJCF's balls and their couples; the wrenches
+    unless ``wrenches`` is False: a moment scales with the mechanism's size)."""
     (graph_a, a), (graph_b, b) = first, second
     joints_a, joints_b = ([name.split(":")[1] for name in g.actuator_names] for g in (graph_a, graph_b))
     assert sorted(joints_a) == sorted(joints_b)
@@ -128,8 +130,9 @@ def assert_same(first, second, tolerance: float = 1e-12, cti: bool = True) -> No
         np.testing.assert_allclose(a.remaining_lmti[j], b.remaining_lmti[j][theirs], atol=tolerance)
         worst_a = sorted(joints_a[k] for k in np.ravel(a.worst_fault_indices[j]))
         assert worst_a == sorted(joints_b[k] for k in np.ravel(b.worst_fault_indices[j]))
-    signs = np.sign(np.sum(a.actuation_wrenches * b.actuation_wrenches[order], axis=1))[:, None]
-    np.testing.assert_allclose(a.actuation_wrenches, b.actuation_wrenches[order] * signs, atol=tolerance)
+    if wrenches:
+        signs = np.sign(np.sum(a.actuation_wrenches * b.actuation_wrenches[order], axis=1))[:, None]
+        np.testing.assert_allclose(a.actuation_wrenches, b.actuation_wrenches[order] * signs, atol=tolerance)
 
 
 @pytest.mark.parametrize("variant", sorted(MJCF_WORLDS))
@@ -358,3 +361,44 @@ def test_a_stewart_platform_whose_rods_meet_in_pairs_reads_the_rod_lines(tmp_pat
     assert_same(reading, read(apart, unit))
     backwards, _ = mjcf_variant(tmp_path, "backwards", variant, lambda *a: paired_stewart(*a, reverse=True))
     assert_same(reading, read(backwards, unit))
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_same_for_the_mechanisms_scaled(tmp_path, scale):
+    """Every length times 1e-3 and 1e3, read in metres: the planar five-bar leg and the paired Stewart platform give
+    the indices of their size-one selves."""
+    for name, write in (("leg", five_bar_leg), ("pairs", paired_stewart)):
+        one, scaled = tmp_path / f"{name}.xml", tmp_path / f"{name}_scaled.xml"
+        one.write_text(write())
+        scaled.write_text(write(scale))
+        assert_same(read(one), read(scaled), wrenches=False)
+
+
+def swapped(text: str, first: str, second: str) -> str:
+    """The file with joints ``first`` and ``second`` renamed each as the other (their motors follow)."""
+    for attribute in ("name", "joint"):
+        text = text.replace(f'{attribute}="{first}"', f'{attribute}="@@"')
+        text = text.replace(f'{attribute}="{second}"', f'{attribute}="{first}"')
+        text = text.replace(f'{attribute}="@@"', f'{attribute}="{second}"')
+    return text
+
+
+def test_the_indices_follow_the_motors_renamed(tmp_path):
+    """The five-bar leg's motors renamed each as the other (m1 <-> m2) and an R-R-R leg's (m3 <-> m4): each ITI, the
+    worst fault and the LMTI left after each failure follow the joint, not the name."""
+    plain, renamed = tmp_path / "leg.xml", tmp_path / "renamed.xml"
+    plain.write_text(five_bar_leg())
+    renamed.write_text(swapped(swapped(five_bar_leg(), "m1", "m2"), "m3", "m4"))
+    (graph, indices), (other, theirs) = read(plain), read(renamed)
+    names = {"m1": "m2", "m2": "m1", "m3": "m4", "m4": "m3"}
+    ours = by_joint(graph, indices.iti_actuators)
+    assert {names[joint]: value for joint, value in ours.items()} == pytest.approx(
+        by_joint(other, theirs.iti_actuators), abs=1e-12)
+    worst = {names[graph.actuators[k].split(":")[1]] for k in np.ravel(indices.worst_fault_indices[1])}
+    assert worst == {other.actuators[k].split(":")[1] for k in np.ravel(theirs.worst_fault_indices[1])}
+    left = {names[graph.actuators[failed[0]].split(":")[1]]: value
+            for failed, value in zip(indices.failed_sets(1), indices.remaining_lmti[1])}
+    assert left == pytest.approx({other.actuators[failed[0]].split(":")[1]: value
+                                  for failed, value in zip(theirs.failed_sets(1), theirs.remaining_lmti[1])}, abs=1e-12)
+    assert float(theirs.lmti) == pytest.approx(float(indices.lmti), abs=1e-12)
+    assert ours["m1"] != pytest.approx(ours["m2"], abs=1e-3)  # (the swap is seen)
