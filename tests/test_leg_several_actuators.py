@@ -25,6 +25,8 @@ P. The checks:
 from __future__ import annotations
 
 import json
+import pickle
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -32,6 +34,7 @@ import pytest
 from helpers import MJCF_WORLDS, leg_line_otis, mjcf_variant, mujoco_closed, screwkit, sine
 from screwkit.io import ImportError_, read_closed_tree
 from screwkit.io.graph import graph_mechanism
+from screwkit.io.graph_checks import stage_refusal
 from screwkit.io.loader import load
 from screwkit.studies import indices_at_pose
 
@@ -402,3 +405,22 @@ def test_the_indices_follow_the_motors_renamed(tmp_path):
                                   for failed, value in zip(theirs.failed_sets(1), theirs.remaining_lmti[1])}, abs=1e-12)
     assert float(theirs.lmti) == pytest.approx(float(indices.lmti), abs=1e-12)
     assert ours["m1"] != pytest.approx(ours["m2"], abs=1e-3)  # (the swap is seen)
+
+
+def test_a_stage_refusal_quotes_the_reason_its_refusal_carries_and_the_reason_crosses_processes():
+    """The reason a leg of actuators in series cannot be read one at a time is the one its refusal carries, quoted
+    whole whatever punctuation it holds (it was the refusal's first clause, cut out of its text), else the whole
+    refusal; the copy's name is left out. A refusal pickled (a worker's) keeps its reason."""
+    tree = SimpleNamespace(source="robot.xml")
+    legs = [SimpleNamespace(of="hip"), SimpleNamespace(of="hip"), SimpleNamespace(of="arm")]
+    advice = "; --lock h1 holds the stage"
+    carried = ImportError_("robot.xml: actuated joint 'k' of leg 'shin' rides on the free joint 'f' (a floating "
+                           "base): --lock f holds it.", reason="actuated joint 'k' of leg 'shin' rides on 'f' (free)")
+    assert str(stage_refusal(tree, legs, {"hip": advice}, carried, "shin")) == (
+        "robot.xml: leg 'hip' has loops inside it and 2 actuators, which screwkit does not read one at a time here "
+        "(actuated joint 'k' rides on 'f' (free)); --lock h1 holds the stage.")
+    bare = ImportError_("robot.xml: actuated joint 'k' of leg 'shin' is odd: see its notes.")
+    assert "here (actuated joint 'k' is odd: see its notes); --lock" in str(
+        stage_refusal(tree, legs, {"hip": advice}, bare, "shin"))
+    again = pickle.loads(pickle.dumps(carried))
+    assert (type(again), str(again), again.reason) == (ImportError_, str(carried), carried.reason)

@@ -46,12 +46,12 @@ def check_legs(tree: ClosedTree, legs, screws: list[LegScrews], nearby, platform
 def stage_refusal(tree: ClosedTree, legs, deferred: dict[str, str], error: ImportError_, copy: str = ""
                   ) -> ImportError_:
     """The refusal of a leg of actuators in series read one at a time (``deferred``: its advice by its name, the
-    first one's taken) where ``error`` (its first clause the reason; ``copy``: the copy of the leg it names) says
-    why that failed: the advice that holds the stage."""
+    first one's taken) where ``error`` (its ``reason``, else its whole message; ``copy``: the copy of the leg it
+    names, left out of the reason) says why that failed: the advice that holds the stage."""
     name, advice = next(iter(deferred.items()))
     count = sum(1 for leg in legs if leg.of == name)
-    reason = str(error).removeprefix(f"{tree.source}: ").replace(f" of leg {copy!r}", "")
-    reason = reason.split(" (")[0].split(": ")[0].split(";")[0].removesuffix(".")
+    reason = error.reason or str(error).removeprefix(f"{tree.source}: ").removesuffix(".")
+    reason = reason.replace(f" of leg {copy!r}", "")
     return ImportError_(f"{tree.source}: leg {name!r} has loops inside it and {count} actuators, which screwkit does "
                         f"not read one at a time here ({reason}){advice}.")
 
@@ -69,7 +69,8 @@ def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, ne
         raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform of leg "
                            f"{leg.name!r} as free as before: the joints it carries move the platform on their own "
                            "(motors the file does not name, or a leg with no input); if it is a serial stage "
-                           f"before the parallel part, --lock {name} analyses the legs on the body it turns.")
+                           f"before the parallel part, --lock {name} analyses the legs on the body it turns.",
+                           reason=f"locking actuated joint {name!r} leaves the platform as free as before")
     outside = screw.outside[0] > IN_LOOP_TOLERANCE or screw.locked_dims[0] != screw.allowed_dims[0] - 1
     below = [model.names[j] for j in path_to(model, actuator)[:-1]  # carrying it (not the platform's pin)
              if j in leg.joints and j != platform]
@@ -80,7 +81,7 @@ def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, ne
                            "path closes on the base and shares the load the leg carries, so the power coefficient "
                            "on its own twist is not the leg's input); analysable when the actuated joint joins the "
                            "base to the rest of its leg: the link it drives taken as the output (--output) reads "
-                           "its own transmission.")
+                           "its own transmission.", reason=f"actuated joint {name!r} moves inside a loop")
     floating = [j for j in path_to(model, actuator)[:1] if j in leg.joints and j != platform
                 and joint_kind(model, j)[0] == "JointModelFreeFlyer"]
     if outside and floating:  # (not a loop: the leg's own base floats, as an export's <freejoint> on its root)
@@ -88,7 +89,7 @@ def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, ne
         raise ImportError_(f"{tree.source}: actuated joint {name!r} rides on the free joint {free!r} (a floating "
                            "base, as an export writes <freejoint> on its root): --lock "
                            f"{' --lock '.join(below)} holds the base where the file puts it, and the legs are "
-                           "analysed on it.")
+                           "analysed on it.", reason=f"actuated joint {name!r} rides on the free joint {free!r}")
     if outside:
         one = len(below) == 1
         hint = (f"; {', '.join(below)} carr{'ies' if one else 'y'} it within the leg: --lock "
@@ -97,7 +98,8 @@ def _check_leg(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, ne
                 "and the legs are analysed on the platform" if model.parents[actuator] == platform else "")
         raise ImportError_(f"{tree.source}: actuated joint {name!r} moves inside a loop of leg {leg.name!r} (its "
                            "twist is not a motion the leg allows: the leg has no serial input); analysable when "
-                           f"the actuated joint joins the base to the rest of its leg{hint}.")
+                           f"the actuated joint joins the base to the rest of its leg{hint}.",
+                           reason=f"actuated joint {name!r} moves inside a loop")
 
 
 def _check_independent(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegScrews, nearby) -> None:
@@ -114,7 +116,8 @@ def _check_independent(tree: ClosedTree, leg: GraphLeg, index: int, screw: LegSc
     others = ", ".join(sorted(tree.written_joint(tree.model.names[j]) for j in leg.others))
     raise ImportError_(f"{tree.source}: locking actuated joint {name!r} leaves the platform as free as before: a "
                        "motion inside its leg moves it with the platform held (kinematic redundancy; the leg's other "
-                       f"actuated joints: {others}), so it has no actuation wrench; --lock {name} holds it.")
+                       f"actuated joints: {others}), so it has no actuation wrench; --lock {name} holds it.",
+                       reason=f"locking actuated joint {name!r} leaves the platform as free as before")
 
 
 def _refuse_a_singular_file(tree: ClosedTree, name: str, leg: GraphLeg, index: int, nearby) -> None:
@@ -128,7 +131,9 @@ def _refuse_a_singular_file(tree: ClosedTree, name: str, leg: GraphLeg, index: i
                            "configurations near them: the file is written at a singular configuration of the leg "
                            "(its links on one line, stretched or folded); give joint values away from it: --initial "
                            "JOINT VALUE (an actuated joint away from its dead centre, held there while the loops "
-                           "close), or a keyframe named 'home' (MJCF).")
+                           "close), or a keyframe named 'home' (MJCF).",
+                           reason=f"locking actuated joint {name!r} leaves the platform as free as before at the "
+                           "file's joint values, and takes a motion away at closed configurations near them")
 
 
 def check_output(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list[GraphLeg],
@@ -162,7 +167,8 @@ def _check_idle(tree: ClosedTree, screws: list[LegScrews], body: str, legs: list
                            f"{f', {guessed}' if guessed else ''}): its frame is no output of this mechanism; --lock "
                            "holds a passive joint that moves it"
                            + (f" (the legs' passive joints: {', '.join(passive)})" if passive else "")
-                           + ", --actuate names a joint that drives it.")
+                           + ", --actuate names a joint that drives it.",
+                           reason=f"the platform {body!r} moves with every actuator locked")
 
 
 def refuse_couples_of_forces(tree: ClosedTree, legs, chains: list[ChainScrews], state) -> None:

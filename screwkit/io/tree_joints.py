@@ -12,7 +12,13 @@ __all__ = ["ImportError_", "homogeneous", "inverse", "joint_frames", "joint_kind
 
 
 class ImportError_(ValueError):
-    """A file of another tool that cannot be written in screwkit's convention (the message says why)."""
+    """A file of another tool that cannot be written in screwkit's convention (the message says why); ``reason``:
+    its cause in one clause, for a refusal that quotes it (a leg's stage refused because one of its actuators cannot
+    be read), else empty."""
+
+    def __init__(self, message: str, reason: str = "") -> None:
+        super().__init__(message)
+        self.reason = reason
 
 
 def homogeneous(placement) -> NDArray[np.float64]:
