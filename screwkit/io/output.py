@@ -177,16 +177,23 @@ def _about_the_hinge(tree: ClosedTree) -> bool:
 
 def _meeting(tree: ClosedTree, carriers: dict[int, int]):
     """How many closures end on each joint's body (an end on a joint of ``carriers`` counted on its carrier's), the
-    joints ranked by it, and the joint of the one body where the most closures meet (where every leg ends), if one."""
+    joints ranked by it (ties by their bodies' names, so that a refusal lists them alike whatever order the file lists
+    its closures in), and the joint of the one body where the most closures meet (where every leg ends), if one."""
     counts: dict[int, int] = {}
     for closure in tree.closures:
         for joint in {carriers.get(closure.joint_a, closure.joint_a), carriers.get(closure.joint_b, closure.joint_b)} \
                 - {0}:
             counts[joint] = counts.get(joint, 0) + 1
-    ranked = sorted(counts.items(), key=lambda item: -item[1])
+    ranked = sorted(counts.items(), key=lambda item: (-item[1], _body_name(tree.model, item[0])))
     meeting = ranked[0][0] if ranked and ranked[0][1] >= 2 and (len(ranked) == 1 or ranked[1][1] < ranked[0][1]) \
         else None
     return counts, ranked, meeting
+
+
+def _body_name(model, joint: int) -> str:
+    """The name of the body ``joint`` carries (the joint's own where it has no body frame)."""
+    index = _body_frame(model, joint)
+    return model.names[joint] if index is None else model.frames[index].name
 
 
 def _ball_carriers(tree: ClosedTree) -> dict[int, int]:
