@@ -13,6 +13,7 @@ these are the files no generator of ours wrote.
 
 from __future__ import annotations
 
+import re
 import shutil
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
@@ -37,6 +38,9 @@ OPENING = {  # the file, and the locks its own refusals advise (none: it opens a
 OPENING_FILES = [GEPETTO / name / "robot.urdf" for name in OPENING] + [
     PUBLISHED / "ros2_closed_loop_ws" / "3dof_delta.urdf", PUBLISHED / "ros2_closed_loop_ws" / "fivebar_linkage.urdf"]
 REFUSED = ["battobot_6d", "digit_like_2legs", "digit_like_2legs_6D", "robot_ludo", "robot_marcheur_2"]
+MJCF_FILES = [PUBLISHED / "lab_robots_iitk" / "5bar.xml", PUBLISHED / "reachy_mini" / "reachy_mini.xml",
+              PUBLISHED / "agility_cassie" / "cassie.xml", PUBLISHED / "pinocchio_closed_chain" / "closed_chain.xml",
+              PUBLISHED / "golf_modeling_suite" / "delta_robot.xml", PUBLISHED / "kayra" / "kayraCircle.xml"]
 
 
 def _numbers(text: str | None, factor: float) -> str | None:
@@ -83,6 +87,28 @@ def rewritten(source: Path, folder: Path) -> Path:
     return target / source.name
 
 
+def mjcf_rewritten(source: Path, folder: Path) -> Path:
+    """``source`` (MJCF) with the bodies of every body, the equality constraints and the actuators listed
+    backwards (each body's joints kept in their order, which composes them), and its world's bodies hung from a new
+    body moved to (0.3, -0.2, 0.5) and turned, unless a free joint must stay at the top (MuJoCo's rule)."""
+    model = ElementTree.fromstring(source.read_text())
+    for parent in [*model.iter("worldbody"), *model.iter("body"), *model.iter("equality"), *model.iter("actuator")]:
+        kept = [child for child in parent if parent.tag in ("equality", "actuator") or child.tag == "body"]
+        places = [index for index, child in enumerate(parent) if child in kept]
+        for index, child in zip(places, reversed(kept)):
+            parent[index] = child
+    world = model.find("worldbody")
+    if not any(joint.get("type") == "free" for joint in model.iter("joint")) and model.find(".//freejoint") is None:
+        moved = ElementTree.Element("body", name="moved_world", pos="0.3 -0.2 0.5", quat="0.8 0.3 -0.4 0.2")
+        moved.extend(list(world))
+        for child in list(world):
+            world.remove(child)
+        world.append(moved)
+    target = folder / source.name
+    target.write_text(ElementTree.tostring(model, encoding="unicode"))
+    return target
+
+
 def read(path: Path, **options):
     """The mechanism as the command line opens it: serial legs, else the closed-loop graph."""
     try:
@@ -98,6 +124,11 @@ def indices(mechanism):
 def same(value, expected) -> bool:
     """Equal to :data:`TOLERANCE`, or both NaN (an index that does not apply: the CTI of a point output)."""
     return bool(np.isnan(value) and np.isnan(expected) or abs(value - expected) < TOLERANCE)
+
+
+def words(refusal: Exception) -> list[str]:
+    """A refusal's words after the file's name, in sorted order."""
+    return sorted(re.split(r"[\s,().]+", str(refusal).split(": ", 1)[1]))
 
 
 def by_actuator(result) -> dict[str, float]:
@@ -130,3 +161,25 @@ def test_a_published_file_refused_as_written_is_refused_for_the_same_reason_rewr
     with pytest.raises(ImportError_) as other:
         read(rewritten(source, tmp_path), length_unit="mm")
     assert str(other.value).split(": ", 1)[1] == str(published.value).split(": ", 1)[1]
+
+
+@pytest.mark.parametrize("source", MJCF_FILES, ids=lambda path: path.parent.name)
+def test_a_published_mjcf_file_listed_backwards_in_a_moved_world_reads_the_same(source, tmp_path):
+    """MuJoCo files are read in their order (Pinocchio numbers the joints so): listed backwards, the same indices by
+    actuator name, or the same refusal in the same words (a list of joints it names in the file's order)."""
+    try:
+        published = indices(read(source))
+    except ImportError_ as refusal:
+        with pytest.raises(ImportError_) as other:
+            read(mjcf_rewritten(source, tmp_path))
+        # (the joints it names listed in the file's order, which is the reader's: the same words, in any order)
+        assert words(other.value) == words(refusal)
+        return
+    other = indices(read(mjcf_rewritten(source, tmp_path)))
+    assert sorted(other.actuators) == sorted(published.actuators)
+    first, second = by_actuator(published), by_actuator(other)
+    assert all(same(second[name], value) for name, value in first.items()), (first, second)
+    assert same(other.lmti, published.lmti)
+    for faults in ("f_o", "f_io"):
+        mine, theirs = getattr(published, faults), getattr(other, faults)
+        assert mine.keys() == theirs.keys() and all(same(theirs[j], mine[j]) for j in mine), faults
