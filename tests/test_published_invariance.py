@@ -1,16 +1,19 @@
-"""Invariance of reading, on the files users bring: every published URDF of the gallery (Gepetto's
-example-parallel-robots, a ROS 2 closed-loop workspace) written otherwise -- every length times 1000 and read in
-millimetres, hung from a new root link moved and turned in the world, its links and joints listed backwards and,
-where a ``robot.yaml`` names its closures, those listed backwards with each pair's frames swapped -- reads the
-same mechanism: the same actuators, and at the file's configuration the same ITI of each actuator, LMTI, every F_Oj
-and F_IOj, CTI and F_Cj (to 1e-11; the rewriting itself rounds nothing: Python writes each number exactly). A file
-refused as published is refused for the same reason, in the same words after its name. Files that open only with
-the locks their own refusals advise are taken with those locks.
+"""Invariance of reading, on the files users bring.
+
+* Every published URDF of the gallery (Gepetto's example-parallel-robots, a ROS 2 closed-loop workspace) written
+  otherwise -- every length times 1000 and read in millimetres, hung from a new root link moved and turned in the
+  world, its links and joints listed backwards and, where a ``robot.yaml`` names its closures, those listed
+  backwards with each pair's frames swapped -- reads the same mechanism: the same actuators, and at the file's
+  configuration the same ITI of each actuator, LMTI, every F_Oj and F_IOj, CTI and F_Cj (to 1e-11; the times 1000
+  rounds each number in its last bit at most). A file refused as published is refused in the same words after its
+  name. Files that open only with the locks their own refusals advise are taken with those locks.
+* Every published MJCF file with its bodies, equalities and actuators listed backwards (which renumbers its joints
+  in Pinocchio, unlike a URDF's order) and, where no free joint must stay at the top, hung in a moved, turned world.
+* The published SDFormat files in millimetres, listed backwards, placed elsewhere in the world.
 
 The bundled mechanisms have their own invariance tests (``tests/test_invariance.py``, ``tests/test_relabelling.py``);
 these are the files no generator of ours wrote.
 """
-
 from __future__ import annotations
 
 import re
@@ -38,6 +41,8 @@ OPENING = {  # the file, and the locks its own refusals advise (none: it opens a
 OPENING_FILES = [GEPETTO / name / "robot.urdf" for name in OPENING] + [
     PUBLISHED / "ros2_closed_loop_ws" / "3dof_delta.urdf", PUBLISHED / "ros2_closed_loop_ws" / "fivebar_linkage.urdf"]
 REFUSED = ["battobot_6d", "digit_like_2legs", "digit_like_2legs_6D", "robot_ludo", "robot_marcheur_2"]
+SDF_FILES = [PUBLISHED / "ros2_closed_loop_demo" / "model.sdf",
+             PUBLISHED / "example_robot_data_cassie" / "cassie_v2.sdf"]
 MJCF_FILES = [PUBLISHED / "lab_robots_iitk" / "5bar.xml", PUBLISHED / "reachy_mini" / "reachy_mini.xml",
               PUBLISHED / "agility_cassie" / "cassie.xml", PUBLISHED / "pinocchio_closed_chain" / "closed_chain.xml",
               PUBLISHED / "golf_modeling_suite" / "delta_robot.xml", PUBLISHED / "kayra" / "kayraCircle.xml"]
@@ -109,6 +114,31 @@ def mjcf_rewritten(source: Path, folder: Path) -> Path:
     return target
 
 
+def sdf_rewritten(source: Path, folder: Path) -> Path:
+    """``source`` (SDFormat, one model) in millimetres (every pose's position and prismatic limit times 1000), its
+    links and joints listed backwards, the model placed at (0.3, -0.2, 0.5) m turned by rpy (0.4, -0.7, 1.1)."""
+    root = ElementTree.fromstring(source.read_text())
+    for pose in root.iter("pose"):
+        values = (pose.text or "").split()
+        if len(values) == 6:
+            pose.text = " ".join([*_numbers(" ".join(values[:3]), 1000.0).split(), *values[3:]])
+    for joint in root.iter("joint"):
+        for bound in joint.iter("lower") if joint.get("type") == "prismatic" else ():
+            bound.text = _numbers(bound.text, 1000.0)
+        for bound in joint.iter("upper") if joint.get("type") == "prismatic" else ():
+            bound.text = _numbers(bound.text, 1000.0)
+    (model,) = root.iter("model")
+    parts = [element for element in model if element.tag in ("link", "joint")]
+    for element in parts:
+        model.remove(element)
+    model.extend(reversed(parts))
+    assert model.find("pose") is None
+    ElementTree.SubElement(model, "pose").text = "300.0 -200.0 500.0 0.4 -0.7 1.1"
+    target = folder / source.name
+    target.write_text(ElementTree.tostring(root, encoding="unicode"))
+    return target
+
+
 def read(path: Path, **options):
     """The mechanism as the command line opens it: serial legs, else the closed-loop graph."""
     try:
@@ -126,7 +156,7 @@ def same(value, expected) -> bool:
     return bool(np.isnan(value) and np.isnan(expected) or abs(value - expected) < TOLERANCE)
 
 
-def words(refusal: Exception) -> list[str]:
+def words(refusal) -> list[str]:
     """A refusal's words after the file's name, in sorted order."""
     return sorted(re.split(r"[\s,().]+", str(refusal).split(": ", 1)[1]))
 
@@ -176,6 +206,29 @@ def test_a_published_mjcf_file_listed_backwards_in_a_moved_world_reads_the_same(
         assert words(other.value) == words(refusal)
         return
     other = indices(read(mjcf_rewritten(source, tmp_path)))
+    assert sorted(other.actuators) == sorted(published.actuators)
+    first, second = by_actuator(published), by_actuator(other)
+    assert all(same(second[name], value) for name, value in first.items()), (first, second)
+    assert same(other.lmti, published.lmti)
+    for faults in ("f_o", "f_io"):
+        mine, theirs = getattr(published, faults), getattr(other, faults)
+        assert mine.keys() == theirs.keys() and all(same(theirs[j], mine[j]) for j in mine), faults
+
+
+@pytest.mark.parametrize("source", SDF_FILES, ids=lambda path: path.parent.name)
+def test_a_published_sdformat_file_in_millimetres_listed_backwards_in_a_moved_world_reads_the_same(source, tmp_path):
+    """SDFormat closes its loops with joints of the model, and the reader cuts each loop at a joint the file's order
+    picks: listed backwards, the same indices by actuator name, or the same refusal up to the bodies it names as
+    joined by the cut joints (Cassie's: which body is the platform?)."""
+    try:
+        published = indices(read(source))
+    except ImportError_ as refusal:
+        with pytest.raises(ImportError_) as other:
+            read(sdf_rewritten(source, tmp_path), length_unit="mm")
+        cut = " (the closures join"
+        assert words(str(other.value).split(cut)[0]) == words(str(refusal).split(cut)[0])
+        return
+    other = indices(read(sdf_rewritten(source, tmp_path), length_unit="mm"))
     assert sorted(other.actuators) == sorted(published.actuators)
     first, second = by_actuator(published), by_actuator(other)
     assert all(same(second[name], value) for name, value in first.items()), (first, second)
