@@ -70,8 +70,8 @@ def rewritten(source: Path, folder: Path) -> Path:
     for tag, sizes in (("box", ("size",)), ("cylinder", ("radius", "length")), ("sphere", ("radius",)),
                        ("mesh", ("scale",))):
         for shape in robot.iter(tag):
-            for size in sizes:
-                shape.set(size, _numbers(shape.get(size, "1 1 1" if size == "scale" else None), 1000.0))
+            for size in (size for size in sizes if size in shape.attrib or size == "scale"):
+                shape.set(size, _numbers(shape.get(size, "1 1 1"), 1000.0))
     children = {joint.find("child").get("link") for joint in robot.iter("joint")}
     (root,) = [link.get("name") for link in robot.findall("link") if link.get("name") not in children]
     parts = [element for element in robot if element.tag in ("link", "joint")]
